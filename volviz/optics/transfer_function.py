@@ -1,0 +1,277 @@
+"""Piecewise-linear transfer functions: chromaticity κ(s) (RGB) and extinction ρ(s) per unit length.
+
+Optical model (Roettger §7.1 and §8.4, Eq. 8.1; Guthe §1.2): the emitted colour density is κ(s)·ρ(s) (Roettger's
+pre-multiplied convention), the opacity of a segment is α = 1 − exp(−∫ρ). Both κ and ρ are linear between control
+points. Scalars outside ``[scalars[0], scalars[-1]]`` and NaN scalars are transparent (κ = 0, ρ = 0).
+
+VTK convention (DESIGN.md, "Opacity conventions differ"): a VTK scalar opacity value ``a`` with the volume property's
+``ScalarOpacityUnitDistance`` ``u`` is read as the extinction ρ = a / u (per unit length), and written back as
+a = ρ · u. VTK's colour transfer function supplies κ directly.
+"""
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+__all__ = ["TransferFunction"]
+
+_DICT_FORMAT = "volviz-transfer-function"
+_DICT_VERSION = 1
+
+
+def _as_float_array(value: Any, name: str, ndim: int) -> np.ndarray:
+    try:
+        arr = np.array(value, dtype=np.float64, copy=True)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"TransferFunction {name} must be numeric, got {type(value).__name__}") from exc
+    if arr.ndim != ndim:
+        raise ValueError(f"TransferFunction {name} must be {ndim}-D, got shape {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"TransferFunction {name} must be finite (no NaN or Inf)")
+    return arr
+
+
+class TransferFunction:
+    """Piecewise-linear κ(s) (colour, RGB ≥ 0) and ρ(s) (extinction per unit length ≥ 0) over control points.
+
+    Parameters
+    ----------
+    scalars : (n,) strictly increasing, n ≥ 2.
+    colors : (n, 3) chromaticity κ ≥ 0 at the control points (not premultiplied; emission is κ·ρ).
+    extinction : (n,) ρ ≥ 0 at the control points, per unit length.
+    name : free text, kept in dicts and presets.
+
+    Arrays are copied and made read-only; a transfer function is immutable (make a new one to edit).
+    """
+
+    __slots__ = ("_scalars", "_colors", "_extinction", "name")
+
+    def __init__(self, scalars: Any, colors: Any, extinction: Any, name: str = "") -> None:
+        s = _as_float_array(scalars, "scalars", 1)
+        c = _as_float_array(colors, "colors", 2)
+        r = _as_float_array(extinction, "extinction", 1)
+        n = s.shape[0]
+        if n < 2:
+            raise ValueError(f"TransferFunction needs at least 2 control points, got {n}")
+        if c.shape != (n, 3):
+            raise ValueError(f"TransferFunction colors must have shape ({n}, 3), got {c.shape}")
+        if r.shape != (n,):
+            raise ValueError(f"TransferFunction extinction must have shape ({n},), got {r.shape}")
+        steps = np.diff(s)
+        if np.any(steps <= 0):
+            bad = int(np.argmax(steps <= 0))
+            raise ValueError(
+                f"TransferFunction scalars must be strictly increasing; scalars[{bad}]={s[bad]!r} >= "
+                f"scalars[{bad + 1}]={s[bad + 1]!r}"
+            )
+        if np.any(c < 0):
+            raise ValueError("TransferFunction colors must be >= 0")
+        if np.any(r < 0):
+            raise ValueError("TransferFunction extinction must be >= 0")
+        if not isinstance(name, str):
+            raise ValueError(f"TransferFunction name must be a string, got {type(name).__name__}")
+        for arr in (s, c, r):
+            arr.setflags(write=False)
+        self._scalars, self._colors, self._extinction, self.name = s, c, r, name
+
+    # -- data -------------------------------------------------------------------------------------------------------
+    @property
+    def scalars(self) -> np.ndarray:
+        """Control-point scalars (n,), read-only."""
+        return self._scalars
+
+    @property
+    def colors(self) -> np.ndarray:
+        """Chromaticity κ at the control points (n, 3), read-only."""
+        return self._colors
+
+    @property
+    def extinction(self) -> np.ndarray:
+        """Extinction ρ at the control points (n,), read-only."""
+        return self._extinction
+
+    @property
+    def range(self) -> tuple[float, float]:
+        """(first, last) control-point scalar; outside it the medium is transparent."""
+        return float(self._scalars[0]), float(self._scalars[-1])
+
+    def __len__(self) -> int:
+        return int(self._scalars.shape[0])
+
+    def __repr__(self) -> str:
+        lo, hi = self.range
+        return f"TransferFunction(name={self.name!r}, n={len(self)}, range=({lo:g}, {hi:g}), max_rho={self.max_extinction:g})"
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, TransferFunction):
+            return NotImplemented
+        return (
+            self.name == other.name
+            and np.array_equal(self._scalars, other._scalars)
+            and np.array_equal(self._colors, other._colors)
+            and np.array_equal(self._extinction, other._extinction)
+        )
+
+    __hash__ = None  # type: ignore[assignment]
+
+    @property
+    def max_extinction(self) -> float:
+        """max ρ over the range (the maximum is at a control point)."""
+        return float(self._extinction.max())
+
+    # -- evaluation -------------------------------------------------------------------------------------------------
+    def evaluate(self, s: Any) -> tuple[np.ndarray, np.ndarray]:
+        """κ and ρ at scalars ``s`` (any shape): returns ``(rgb (..., 3), rho (...))`` float64.
+
+        Linear interpolation between control points; outside the range and at NaN: (0, 0, 0) and 0.
+        """
+        x = np.asarray(s, dtype=np.float64)
+        lo, hi = self.range
+        inside = (x >= lo) & (x <= hi)  # False for NaN
+        xs = np.where(inside, x, lo)
+        rho = np.where(inside, np.interp(xs, self._scalars, self._extinction), 0.0)
+        rgb = np.empty(x.shape + (3,), dtype=np.float64)
+        for ch in range(3):
+            rgb[..., ch] = np.where(inside, np.interp(xs, self._scalars, self._colors[:, ch]), 0.0)
+        return rgb, rho
+
+    def emission(self, s: Any) -> np.ndarray:
+        """Emitted colour density κ(s)·ρ(s) (..., 3)."""
+        rgb, rho = self.evaluate(s)
+        return rgb * rho[..., None]
+
+    # -- edits ------------------------------------------------------------------------------------------------------
+    def rescaled(self, lo: float, hi: float) -> "TransferFunction":
+        """The same shape mapped linearly onto the scalar range [lo, hi]."""
+        lo, hi = float(lo), float(hi)
+        if not (np.isfinite(lo) and np.isfinite(hi) and hi > lo):
+            raise ValueError(f"rescaled range must be finite with hi > lo, got ({lo}, {hi})")
+        a, b = self.range
+        s = lo + (self._scalars - a) * ((hi - lo) / (b - a))
+        s[0], s[-1] = lo, hi
+        return TransferFunction(s, self._colors, self._extinction, self.name)
+
+    def scaled_extinction(self, factor: float) -> "TransferFunction":
+        """ρ multiplied by ``factor`` ≥ 0 (e.g. a density slider)."""
+        factor = float(factor)
+        if not (np.isfinite(factor) and factor >= 0):
+            raise ValueError(f"extinction factor must be finite and >= 0, got {factor}")
+        return TransferFunction(self._scalars, self._colors, self._extinction * factor, self.name)
+
+    # -- serialisation ----------------------------------------------------------------------------------------------
+    def to_dict(self) -> dict:
+        """JSON-safe dict (plain lists of floats) for session files."""
+        return {
+            "format": _DICT_FORMAT,
+            "version": _DICT_VERSION,
+            "name": self.name,
+            "scalars": [float(v) for v in self._scalars],
+            "colors": [[float(v) for v in row] for row in self._colors],
+            "extinction": [float(v) for v in self._extinction],
+        }
+
+    @classmethod
+    def from_dict(cls, d: Any) -> "TransferFunction":
+        """Inverse of :meth:`to_dict`; raises ValueError naming the offending field."""
+        if not isinstance(d, dict):
+            raise ValueError(f"transfer function must be a dict, got {type(d).__name__}")
+        fmt = d.get("format", _DICT_FORMAT)
+        if fmt != _DICT_FORMAT:
+            raise ValueError(f"transfer function 'format' must be {_DICT_FORMAT!r}, got {fmt!r}")
+        version = d.get("version", _DICT_VERSION)
+        if not isinstance(version, int) or version > _DICT_VERSION or version < 1:
+            raise ValueError(f"transfer function 'version' {version!r} is not supported (max {_DICT_VERSION})")
+        for key in ("scalars", "colors", "extinction"):
+            if key not in d:
+                raise ValueError(f"transfer function dict is missing field {key!r}")
+        name = d.get("name", "")
+        if not isinstance(name, str):
+            raise ValueError("transfer function field 'name' must be a string")
+        for key in ("scalars", "colors", "extinction"):
+            try:
+                np.asarray(d[key], dtype=np.float64)
+            except (TypeError, ValueError) as exc:
+                raise ValueError(f"transfer function field {key!r} is not a numeric array") from exc
+        return cls(d["scalars"], d["colors"], d["extinction"], name=name)
+
+    # -- VTK --------------------------------------------------------------------------------------------------------
+    @classmethod
+    def from_vtk(cls, ctf: Any, otf: Any, unit_distance: float, name: str = "", samples: int = 256) -> "TransferFunction":
+        """From a ``vtkColorTransferFunction`` (κ) and a ``vtkPiecewiseFunction`` (opacity a): ρ = a / unit_distance.
+
+        Control points are the union of both functions' nodes, which is exact when both interpolate linearly in RGB
+        (colour space RGB, every node midpoint 0.5 and sharpness 0). Otherwise (HSV/Lab/diverging colour space or
+        non-default midpoints) the functions are additionally sampled at ``samples`` evenly spaced scalars: the result
+        is then a piecewise-linear approximation of VTK's curve. VTK clamps outside its range; volviz is transparent
+        there (the range is the union of both functions' ranges).
+        """
+        unit_distance = float(unit_distance)
+        if not (np.isfinite(unit_distance) and unit_distance > 0):
+            raise ValueError(f"unit_distance must be finite and > 0, got {unit_distance}")
+        n_c = int(ctf.GetSize())
+        n_o = int(otf.GetSize())
+        if n_c < 1 or n_o < 1:
+            raise ValueError(f"VTK transfer functions must have nodes (colour: {n_c}, opacity: {n_o})")
+        cnodes = np.zeros((n_c, 6))
+        onodes = np.zeros((n_o, 4))
+        for i in range(n_c):
+            val = [0.0] * 6
+            ctf.GetNodeValue(i, val)
+            cnodes[i] = val
+        for i in range(n_o):
+            val4 = [0.0] * 4
+            otf.GetNodeValue(i, val4)
+            onodes[i] = val4
+        exact = (
+            int(ctf.GetColorSpace()) == 0  # VTK_CTF_RGB
+            and np.allclose(cnodes[:, 4], 0.5, atol=1e-12, rtol=0) and np.allclose(cnodes[:, 5], 0.0, atol=1e-12)
+            and np.allclose(onodes[:, 2], 0.5, atol=1e-12, rtol=0) and np.allclose(onodes[:, 3], 0.0, atol=1e-12)
+        )
+        s = np.unique(np.concatenate([cnodes[:, 0], onodes[:, 0]]))
+        if s.size == 1:
+            raise ValueError("VTK transfer functions span a single scalar; need a range")
+        if exact:
+            colors = np.stack([np.interp(s, cnodes[:, 0], cnodes[:, 1 + ch]) for ch in range(3)], axis=1)
+            opacity = np.interp(s, onodes[:, 0], onodes[:, 1])
+        else:
+            s = np.unique(np.concatenate([s, np.linspace(s[0], s[-1], int(samples))]))
+            c2, o2 = type(ctf)(), type(otf)()
+            c2.DeepCopy(ctf)
+            o2.DeepCopy(otf)
+            c2.ClampingOn()
+            o2.ClampingOn()
+            colors = np.array([c2.GetColor(float(x)) for x in s], dtype=np.float64)
+            opacity = np.array([o2.GetValue(float(x)) for x in s], dtype=np.float64)
+        return cls(s, np.clip(colors, 0.0, None), np.clip(opacity, 0.0, None) / unit_distance, name=name)
+
+    def to_vtk(self, unit_distance: float) -> tuple[Any, Any]:
+        """``(vtkColorTransferFunction, vtkPiecewiseFunction)`` with opacity a = ρ · unit_distance.
+
+        Set the same ``unit_distance`` as the volume property's ``ScalarOpacityUnitDistance``. Clamping is turned off
+        on both, so VTK is transparent outside the range like volviz. Opacity values above 1 are kept as they are (VTK
+        clamps them when it uses them), so round-trips are exact.
+        """
+        unit_distance = float(unit_distance)
+        if not (np.isfinite(unit_distance) and unit_distance > 0):
+            raise ValueError(f"unit_distance must be finite and > 0, got {unit_distance}")
+        from vtkmodules.vtkCommonDataModel import vtkPiecewiseFunction
+        from vtkmodules.vtkRenderingCore import vtkColorTransferFunction
+
+        ctf = vtkColorTransferFunction()
+        ctf.SetColorSpaceToRGB()
+        ctf.ClampingOff()
+        otf = vtkPiecewiseFunction()
+        otf.ClampingOff()
+        for s, (r, g, b), rho in zip(self._scalars, self._colors, self._extinction):
+            ctf.AddRGBPoint(float(s), float(r), float(g), float(b))
+            otf.AddPoint(float(s), float(rho) * unit_distance)
+        return ctf, otf
+
+    # -- common shapes ----------------------------------------------------------------------------------------------
+    @classmethod
+    def ramp(cls, lo: float = 0.0, hi: float = 1.0, rho_max: float = 1.0, color: Any = (1.0, 1.0, 1.0),
+             name: str = "ramp") -> "TransferFunction":
+        """ρ rising linearly from 0 at ``lo`` to ``rho_max`` at ``hi``, constant colour."""
+        c = np.asarray(color, dtype=np.float64)
+        return cls([lo, hi], [c, c], [0.0, rho_max], name=name)
