@@ -1,0 +1,166 @@
+"""Background work: an executor with progress callbacks, cancellation and superseding of stale requests.
+
+Long work in volviz (loading, decompression, sorting, table builds, extraction) takes an optional
+``progress(fraction, message)`` callable. Run through a ``JobRunner``, that callable reports progress and raises
+``Cancelled`` once the job's token is cancelled, so cancellation needs no extra plumbing in the numerics. A job
+submitted with a ``key`` supersedes the running job of the same key: the old one is cancelled and its result is never
+delivered (sorting for the newest camera, not every camera; DESIGN.md "Background work").
+
+This module is Qt-free; the app bridges ``on_progress`` and ``on_done`` to Qt signals.
+"""
+from __future__ import annotations
+
+import itertools
+import logging
+import threading
+import traceback
+from concurrent.futures import Future, ThreadPoolExecutor
+from dataclasses import dataclass, field
+from typing import Any, Callable, Optional
+
+log = logging.getLogger(__name__)
+
+ProgressCallback = Callable[[float, str], None]
+
+
+class Cancelled(Exception):
+    """Raised inside a job when its token was cancelled."""
+
+
+class CancelToken:
+    """A flag shared between the requester and the job."""
+
+    def __init__(self) -> None:
+        self._event = threading.Event()
+
+    def cancel(self) -> None:
+        self._event.set()
+
+    @property
+    def cancelled(self) -> bool:
+        return self._event.is_set()
+
+    def raise_if_cancelled(self) -> None:
+        if self._event.is_set():
+            raise Cancelled()
+
+
+def report(progress: Optional[ProgressCallback], fraction: float, message: str = "") -> None:
+    """Call ``progress`` if given; library code uses this so that a missing callback costs nothing."""
+    if progress is not None:
+        progress(fraction, message)
+
+
+@dataclass
+class JobOutcome:
+    """What a finished job delivers to ``on_done``: a result, an error (with traceback text), or a cancellation."""
+
+    job_id: int
+    name: str
+    result: Any = None
+    error: Optional[BaseException] = None
+    traceback: str = ""
+    cancelled: bool = False
+
+    @property
+    def ok(self) -> bool:
+        return self.error is None and not self.cancelled
+
+
+@dataclass
+class Job:
+    job_id: int
+    name: str
+    key: Optional[str]
+    token: CancelToken
+    future: Future = field(repr=False)
+
+    def cancel(self) -> None:
+        """Ask the job to stop; a job not yet started finishes at once as cancelled."""
+        self.token.cancel()
+
+    def done(self) -> bool:
+        return self.future.done()
+
+    def outcome(self, timeout: Optional[float] = None) -> JobOutcome:
+        return self.future.result(timeout)
+
+
+class JobRunner:
+    """Runs callables on worker threads. Numba kernels (nogil) and NumPy release the GIL, so the UI stays live."""
+
+    def __init__(self, max_workers: int = 2):
+        self._pool = ThreadPoolExecutor(max_workers=max_workers, thread_name_prefix="volviz-job")
+        self._ids = itertools.count(1)
+        self._lock = threading.Lock()
+        self._latest: dict[str, Job] = {}
+        self._running: dict[int, Job] = {}
+
+    def submit(self, fn: Callable[..., Any], *args: Any, name: str = "", key: Optional[str] = None,
+               on_progress: Optional[Callable[[int, float, str], None]] = None,
+               on_done: Optional[Callable[[JobOutcome], None]] = None, **kwargs: Any) -> Job:
+        """Run ``fn(*args, progress=..., **kwargs)`` in the background.
+
+        ``fn`` must accept a ``progress`` keyword. ``on_progress(job_id, fraction, message)`` and ``on_done(outcome)``
+        are called on the worker thread; ``on_done`` is not called for a job superseded by a newer one of its key.
+        """
+        token = CancelToken()
+        job_id = next(self._ids)
+        label = name or getattr(fn, "__name__", "job")
+
+        def progress(fraction: float, message: str = "") -> None:
+            token.raise_if_cancelled()
+            if on_progress is not None:
+                on_progress(job_id, min(max(float(fraction), 0.0), 1.0), message)
+
+        def run() -> JobOutcome:
+            outcome = JobOutcome(job_id, label)
+            try:
+                token.raise_if_cancelled()
+                outcome.result = fn(*args, progress=progress, **kwargs)
+                if token.cancelled:
+                    outcome.cancelled, outcome.result = True, None
+            except Cancelled:
+                outcome.cancelled = True
+            except BaseException as exc:  # delivered to the caller, never a silently dead thread
+                outcome.error = exc
+                outcome.traceback = traceback.format_exc()
+                log.error("job %s (%s) failed:\n%s", job_id, label, outcome.traceback)
+            finally:
+                with self._lock:
+                    self._running.pop(job_id, None)
+                    superseded = key is not None and self._latest.get(key) is not None \
+                        and self._latest[key].job_id != job_id
+                    if key is not None and not superseded:
+                        self._latest.pop(key, None)
+            if on_done is not None and not superseded:
+                try:
+                    on_done(outcome)
+                except Exception:  # a broken callback must not kill the worker
+                    log.exception("on_done callback of job %s (%s) failed", job_id, label)
+            return outcome
+
+        with self._lock:
+            if key is not None and key in self._latest:
+                self._latest[key].cancel()
+            future = self._pool.submit(run)
+            job = Job(job_id, label, key, token, future)
+            self._running[job_id] = job
+            if key is not None:
+                self._latest[key] = job
+        return job
+
+    def cancel_all(self) -> None:
+        with self._lock:
+            jobs = list(self._running.values())
+        for job in jobs:
+            job.cancel()
+
+    @property
+    def active(self) -> int:
+        with self._lock:
+            return len(self._running)
+
+    def shutdown(self, wait: bool = True) -> None:
+        self.cancel_all()
+        self._pool.shutdown(wait=wait, cancel_futures=True)

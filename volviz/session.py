@@ -1,0 +1,429 @@
+"""Session files: versioned, validated JSON; atomic save (DESIGN.md "Sessions").
+
+A session is ``{"format": "volviz-session", "version": N, ...}`` with datasets (paths relative to the session file),
+scene components and their settings, transfer functions, camera, camera paths and bookmarks, render settings and the
+window layout. Loading validates every field and names the offending one (``components[1].opacity: ...``); a newer
+version is refused; older versions are migrated step by step through ``MIGRATIONS``. Nothing read is executed or
+unpickled: the file is parsed with ``json`` and every value is checked against the schema below.
+"""
+from __future__ import annotations
+
+import copy
+import json
+import math
+import os
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable
+
+FORMAT = "volviz-session"
+VERSION = 1
+MAX_SESSION_BYTES = 64 * 1024 * 1024
+
+COMPONENT_TYPES = ("volume", "mesh", "isosurface", "terrain", "fog", "clouds", "sky", "demo")
+RENDER_METHODS = ("auto", "pt", "reference", "vtk")
+
+
+class SessionError(Exception):
+    """A session file that cannot be loaded or saved; names the file and, for bad content, the field path."""
+
+    def __init__(self, path: str | os.PathLike | None, problem: str, field: str | None = None):
+        self.path = None if path is None else str(path)
+        self.field = field
+        self.problem = problem
+        where = f"{self.path}: " if self.path else ""
+        what = f"{field}: " if field else ""
+        super().__init__(f"{where}{what}{problem}")
+
+
+@dataclass
+class DatasetRef:
+    id: str
+    path: str
+    options: dict[str, Any] = field(default_factory=dict)
+
+
+@dataclass
+class Component:
+    id: str
+    type: str
+    dataset: str | None = None
+    visible: bool = True
+    opacity: float = 1.0
+    transfer_function: str | None = None
+    settings: dict[str, Any] = field(default_factory=dict)
+
+
+@dataclass
+class CameraState:
+    position: tuple[float, float, float] = (1.0, 1.0, 1.0)
+    focal_point: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    view_up: tuple[float, float, float] = (0.0, 0.0, 1.0)
+    view_angle: float = 30.0
+    parallel: bool = False
+    parallel_scale: float = 1.0
+
+
+@dataclass
+class CameraKey:
+    time: float
+    camera: CameraState
+
+
+@dataclass
+class RenderSettings:
+    method: str = "auto"
+    size: tuple[int, int] = (1024, 768)
+    background: tuple[float, float, float] = (0.1, 0.1, 0.12)
+    options: dict[str, Any] = field(default_factory=dict)
+
+
+@dataclass
+class Session:
+    datasets: list[DatasetRef] = field(default_factory=list)
+    components: list[Component] = field(default_factory=list)
+    transfer_functions: dict[str, dict[str, Any]] = field(default_factory=dict)
+    camera: CameraState | None = None
+    camera_paths: dict[str, list[CameraKey]] = field(default_factory=dict)
+    bookmarks: dict[str, CameraState] = field(default_factory=dict)
+    render: RenderSettings = field(default_factory=RenderSettings)
+    layout: dict[str, Any] = field(default_factory=dict)
+
+    def dataset(self, dataset_id: str) -> DatasetRef:
+        for ref in self.datasets:
+            if ref.id == dataset_id:
+                return ref
+        raise KeyError(dataset_id)
+
+
+# --------------------------------------------------------------------------------------------------------- validation
+class _Reader:
+    """Walks a parsed JSON document, checking types and naming the field path on the first problem."""
+
+    def __init__(self, source: str | None):
+        self.source = source
+
+    def fail(self, where: str, problem: str) -> SessionError:
+        return SessionError(self.source, problem, where)
+
+    def obj(self, value: Any, where: str) -> dict[str, Any]:
+        if not isinstance(value, dict):
+            raise self.fail(where, f"expected an object, got {_kind(value)}")
+        return value
+
+    def lst(self, value: Any, where: str) -> list[Any]:
+        if not isinstance(value, list):
+            raise self.fail(where, f"expected a list, got {_kind(value)}")
+        return value
+
+    def string(self, value: Any, where: str, choices: tuple[str, ...] | None = None) -> str:
+        if not isinstance(value, str):
+            raise self.fail(where, f"expected a string, got {_kind(value)}")
+        if choices is not None and value not in choices:
+            raise self.fail(where, f"expected one of {', '.join(choices)}, got {value!r}")
+        return value
+
+    def boolean(self, value: Any, where: str) -> bool:
+        if not isinstance(value, bool):
+            raise self.fail(where, f"expected true or false, got {_kind(value)}")
+        return value
+
+    def number(self, value: Any, where: str, lo: float = -math.inf, hi: float = math.inf) -> float:
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+            raise self.fail(where, f"expected a finite number, got {_kind(value)}")
+        if not lo <= value <= hi:
+            raise self.fail(where, f"expected a number in [{lo}, {hi}], got {value}")
+        return float(value)
+
+    def vector(self, value: Any, where: str, n: int = 3) -> tuple[float, ...]:
+        items = self.lst(value, where)
+        if len(items) != n:
+            raise self.fail(where, f"expected {n} numbers, got {len(items)}")
+        return tuple(self.number(v, f"{where}[{i}]") for i, v in enumerate(items))
+
+    def json_value(self, value: Any, where: str) -> Any:
+        """Free-form settings: plain JSON only (objects, lists, strings, finite numbers, booleans, null)."""
+        if isinstance(value, dict):
+            return {self.string(k, where): self.json_value(v, f"{where}.{k}") for k, v in value.items()}
+        if isinstance(value, list):
+            return [self.json_value(v, f"{where}[{i}]") for i, v in enumerate(value)]
+        if isinstance(value, float) and not math.isfinite(value):
+            raise self.fail(where, "NaN and Infinity are not allowed")
+        if value is None or isinstance(value, (str, bool, int, float)):
+            return value
+        raise self.fail(where, f"unsupported value {_kind(value)}")
+
+    def known_keys(self, value: dict[str, Any], where: str, keys: set[str]) -> None:
+        unknown = sorted(set(value) - keys)
+        if unknown:
+            raise self.fail(f"{where}.{unknown[0]}" if where else unknown[0], "unknown field")
+
+    def camera(self, value: Any, where: str) -> CameraState:
+        d = self.obj(value, where)
+        self.known_keys(d, where, {"position", "focal_point", "view_up", "view_angle", "parallel", "parallel_scale"})
+        cam = CameraState(
+            position=self.vector(d.get("position", [1, 1, 1]), f"{where}.position"),  # type: ignore[arg-type]
+            focal_point=self.vector(d.get("focal_point", [0, 0, 0]), f"{where}.focal_point"),  # type: ignore[arg-type]
+            view_up=self.vector(d.get("view_up", [0, 0, 1]), f"{where}.view_up"),  # type: ignore[arg-type]
+            view_angle=self.number(d.get("view_angle", 30.0), f"{where}.view_angle", 1e-3, 179.0),
+            parallel=self.boolean(d.get("parallel", False), f"{where}.parallel"),
+            parallel_scale=self.number(d.get("parallel_scale", 1.0), f"{where}.parallel_scale", 1e-12),
+        )
+        if all(a == b for a, b in zip(cam.position, cam.focal_point)):
+            raise self.fail(where, "position and focal_point coincide")
+        if all(v == 0 for v in cam.view_up):
+            raise self.fail(f"{where}.view_up", "must not be the zero vector")
+        return cam
+
+
+def _kind(value: Any) -> str:
+    if value is None:
+        return "null"
+    if isinstance(value, bool):
+        return "a boolean"
+    if isinstance(value, (int, float)):
+        return repr(value)
+    if isinstance(value, str):
+        return f"the string {value[:40]!r}"
+    return {dict: "an object", list: "a list"}.get(type(value), type(value).__name__)
+
+
+def _validate_transfer_function(reader: _Reader, value: Any, where: str) -> dict[str, Any]:
+    d = reader.json_value(reader.obj(value, where), where)
+    try:
+        from volviz.optics import TransferFunction
+    except ImportError:  # the optics layer is optional for plain session handling
+        return d
+    try:
+        TransferFunction.from_dict(d)
+    except (ValueError, TypeError, KeyError) as exc:
+        raise reader.fail(where, f"invalid transfer function: {exc}") from None
+    return d
+
+
+def session_from_dict(doc: Any, source: str | os.PathLike | None = None) -> Session:
+    """Validate a parsed session document (already migrated to ``VERSION``) and build a ``Session``."""
+    r = _Reader(None if source is None else str(source))
+    d = r.obj(doc, "(document)")
+    r.known_keys(d, "", {"format", "version", "datasets", "components", "transfer_functions", "camera",
+                         "camera_paths", "bookmarks", "render", "layout"})
+    session = Session()
+
+    ids: set[str] = set()
+    for i, item in enumerate(r.lst(d.get("datasets", []), "datasets")):
+        where = f"datasets[{i}]"
+        o = r.obj(item, where)
+        r.known_keys(o, where, {"id", "path", "options"})
+        ref = DatasetRef(id=r.string(o.get("id"), f"{where}.id"), path=r.string(o.get("path"), f"{where}.path"),
+                         options=r.json_value(r.obj(o.get("options", {}), f"{where}.options"), f"{where}.options"))
+        if not ref.path:
+            raise r.fail(f"{where}.path", "must not be empty")
+        if ref.id in ids:
+            raise r.fail(f"{where}.id", f"duplicate dataset id {ref.id!r}")
+        ids.add(ref.id)
+        session.datasets.append(ref)
+
+    tfs = r.obj(d.get("transfer_functions", {}), "transfer_functions")
+    for name, value in tfs.items():
+        session.transfer_functions[name] = _validate_transfer_function(r, value, f"transfer_functions.{name}")
+
+    component_ids: set[str] = set()
+    for i, item in enumerate(r.lst(d.get("components", []), "components")):
+        where = f"components[{i}]"
+        o = r.obj(item, where)
+        r.known_keys(o, where, {"id", "type", "dataset", "visible", "opacity", "transfer_function", "settings"})
+        comp = Component(
+            id=r.string(o.get("id"), f"{where}.id"),
+            type=r.string(o.get("type"), f"{where}.type", COMPONENT_TYPES),
+            dataset=None if o.get("dataset") is None else r.string(o.get("dataset"), f"{where}.dataset"),
+            visible=r.boolean(o.get("visible", True), f"{where}.visible"),
+            opacity=r.number(o.get("opacity", 1.0), f"{where}.opacity", 0.0, 1.0),
+            transfer_function=(None if o.get("transfer_function") is None
+                               else r.string(o.get("transfer_function"), f"{where}.transfer_function")),
+            settings=r.json_value(r.obj(o.get("settings", {}), f"{where}.settings"), f"{where}.settings"),
+        )
+        if comp.id in component_ids:
+            raise r.fail(f"{where}.id", f"duplicate component id {comp.id!r}")
+        component_ids.add(comp.id)
+        if comp.dataset is not None and comp.dataset not in ids:
+            raise r.fail(f"{where}.dataset", f"no dataset with id {comp.dataset!r}")
+        if comp.transfer_function is not None and comp.transfer_function not in session.transfer_functions:
+            raise r.fail(f"{where}.transfer_function", f"no transfer function named {comp.transfer_function!r}")
+        session.components.append(comp)
+
+    if d.get("camera") is not None:
+        session.camera = r.camera(d["camera"], "camera")
+    for name, keys in r.obj(d.get("camera_paths", {}), "camera_paths").items():
+        path_keys = []
+        last = -math.inf
+        for j, key in enumerate(r.lst(keys, f"camera_paths.{name}")):
+            where = f"camera_paths.{name}[{j}]"
+            k = r.obj(key, where)
+            r.known_keys(k, where, {"time", "camera"})
+            t = r.number(k.get("time"), f"{where}.time")
+            if t <= last:
+                raise r.fail(f"{where}.time", "key times must increase")
+            last = t
+            path_keys.append(CameraKey(time=t, camera=r.camera(k.get("camera"), f"{where}.camera")))
+        session.camera_paths[name] = path_keys
+    for name, cam in r.obj(d.get("bookmarks", {}), "bookmarks").items():
+        session.bookmarks[name] = r.camera(cam, f"bookmarks.{name}")
+
+    rs = r.obj(d.get("render", {}), "render")
+    r.known_keys(rs, "render", {"method", "size", "background", "options"})
+    size = r.vector(rs.get("size", [1024, 768]), "render.size", 2)
+    if any(v < 1 or v > 16384 or v != int(v) for v in size):
+        raise r.fail("render.size", f"expected two whole numbers in 1..16384, got {list(size)}")
+    session.render = RenderSettings(
+        method=r.string(rs.get("method", "auto"), "render.method", RENDER_METHODS),
+        size=(int(size[0]), int(size[1])),
+        background=tuple(r.number(v, f"render.background[{i}]", 0.0, 1.0)  # type: ignore[arg-type]
+                         for i, v in enumerate(r.vector(rs.get("background", [0.1, 0.1, 0.12]), "render.background"))),
+        options=r.json_value(r.obj(rs.get("options", {}), "render.options"), "render.options"),
+    )
+    session.layout = r.json_value(r.obj(d.get("layout", {}), "layout"), "layout")
+    return session
+
+
+def _camera_dict(cam: CameraState) -> dict[str, Any]:
+    return {"position": list(cam.position), "focal_point": list(cam.focal_point), "view_up": list(cam.view_up),
+            "view_angle": cam.view_angle, "parallel": cam.parallel, "parallel_scale": cam.parallel_scale}
+
+
+def session_to_dict(session: Session) -> dict[str, Any]:
+    """The JSON document of a session (current ``VERSION``)."""
+    doc: dict[str, Any] = {
+        "format": FORMAT,
+        "version": VERSION,
+        "datasets": [{"id": d.id, "path": d.path, "options": copy.deepcopy(d.options)} for d in session.datasets],
+        "transfer_functions": copy.deepcopy(session.transfer_functions),
+        "components": [{"id": c.id, "type": c.type, "dataset": c.dataset, "visible": c.visible, "opacity": c.opacity,
+                        "transfer_function": c.transfer_function, "settings": copy.deepcopy(c.settings)}
+                       for c in session.components],
+        "camera": None if session.camera is None else _camera_dict(session.camera),
+        "camera_paths": {name: [{"time": k.time, "camera": _camera_dict(k.camera)} for k in keys]
+                         for name, keys in session.camera_paths.items()},
+        "bookmarks": {name: _camera_dict(cam) for name, cam in session.bookmarks.items()},
+        "render": {"method": session.render.method, "size": list(session.render.size),
+                   "background": list(session.render.background), "options": copy.deepcopy(session.render.options)},
+        "layout": copy.deepcopy(session.layout),
+    }
+    return doc
+
+
+# --------------------------------------------------------------------------------------------------------- migration
+# MIGRATIONS[v] turns a version-v document into a version-(v + 1) document. Version 1 is the first format.
+MIGRATIONS: dict[int, Callable[[dict[str, Any]], dict[str, Any]]] = {}
+
+
+def migrate(doc: dict[str, Any], source: str | None = None) -> dict[str, Any]:
+    """Check format and version; bring an older document up to ``VERSION``; refuse a newer one."""
+    if not isinstance(doc, dict) or doc.get("format") != FORMAT:
+        raise SessionError(source, f"not a volviz session (expected \"format\": \"{FORMAT}\")", "format")
+    version = doc.get("version")
+    if isinstance(version, bool) or not isinstance(version, int) or version < 1:
+        raise SessionError(source, f"expected a whole number >= 1, got {_kind(version)}", "version")
+    if version > VERSION:
+        raise SessionError(source, f"session version {version} is newer than this volviz supports ({VERSION}); "
+                                   "please update volviz", "version")
+    while version < VERSION:
+        doc = MIGRATIONS[version](copy.deepcopy(doc))
+        version += 1
+        doc["version"] = version
+    return doc
+
+
+# --------------------------------------------------------------------------------------------------------- files
+def resolve_path(session_file: str | os.PathLike, dataset_path: str) -> Path:
+    """A dataset path as stored (relative to the session file, or absolute) made absolute."""
+    p = Path(os.path.expandvars(dataset_path)).expanduser()
+    return p if p.is_absolute() else (Path(session_file).resolve().parent / p).resolve()
+
+
+def relative_path(session_file: str | os.PathLike, dataset_path: str | os.PathLike) -> str:
+    """How a dataset path is stored: relative to the session file's folder where possible, with '/' separators."""
+    target = Path(dataset_path).resolve()
+    base = Path(session_file).resolve().parent
+    try:
+        return Path(os.path.relpath(target, base)).as_posix()
+    except ValueError:  # another drive on Windows
+        return target.as_posix()
+
+
+def loads(text: str, source: str | os.PathLike | None = None) -> Session:
+    src = None if source is None else str(source)
+    try:
+        doc = json.loads(text, parse_constant=lambda name: _reject_constant(name, src))
+    except json.JSONDecodeError as exc:
+        raise SessionError(src, f"not valid JSON: {exc.msg} at line {exc.lineno} column {exc.colno}") from None
+    return session_from_dict(migrate(doc, src), src)
+
+
+def _reject_constant(name: str, source: str | None) -> None:
+    raise SessionError(source, f"{name} is not allowed in a session file")
+
+
+def load(path: str | os.PathLike) -> Session:
+    """Read and validate a session file. Raises ``SessionError`` naming the file and the offending field."""
+    p = Path(path)
+    if not p.exists():
+        raise SessionError(p, "no such file")
+    if p.is_dir():
+        raise SessionError(p, "is a folder, not a session file")
+    try:
+        size = p.stat().st_size
+        if size > MAX_SESSION_BYTES:
+            raise SessionError(p, f"is {size} bytes; a session file is at most {MAX_SESSION_BYTES} bytes")
+        data = p.read_bytes()
+    except OSError as exc:
+        raise SessionError(p, f"cannot be read: {exc.strerror or exc}") from None
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError:
+        raise SessionError(p, "is not UTF-8 text") from None
+    return loads(text, p)
+
+
+def dumps(session: Session) -> str:
+    return json.dumps(session_to_dict(session), indent=2, allow_nan=False) + "\n"
+
+
+def atomic_write_bytes(path: str | os.PathLike, data: bytes) -> None:
+    """Write a file atomically: a temporary file in the same folder, fsync, rename; the old file survives a failure."""
+    target = Path(path)
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+    try:
+        with os.fdopen(fd, "wb") as handle:
+            handle.write(data)
+            handle.flush()
+            os.fsync(handle.fileno())
+        os.replace(tmp, target)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        raise
+    try:  # make the rename itself durable
+        dir_fd = os.open(target.parent, os.O_RDONLY)
+        try:
+            os.fsync(dir_fd)
+        finally:
+            os.close(dir_fd)
+    except OSError:
+        pass
+
+
+def save(session: Session, path: str | os.PathLike) -> None:
+    """Validate and save atomically. Raises ``SessionError``; on failure the previous file is left intact."""
+    p = Path(path)
+    try:
+        text = dumps(session)
+    except (TypeError, ValueError) as exc:
+        raise SessionError(p, f"cannot be saved: {exc}") from None
+    session_from_dict(json.loads(text), p)  # never write what could not be read back
+    try:
+        atomic_write_bytes(p, text.encode("utf-8"))
+    except OSError as exc:
+        raise SessionError(p, f"cannot be written: {exc.strerror or exc}") from None
