@@ -1,0 +1,39 @@
+"""The one exception every volviz reader raises for bad input, and the warning for kept non-finite values."""
+from __future__ import annotations
+
+import os
+from typing import Union
+
+PathLike = Union[str, "os.PathLike[str]"]
+
+
+class ReadError(Exception):
+    """A file could not be read as a dataset. The message always names the file and the problem.
+
+    ``ReadError(path, "header claims 100000x100000x100000 voxels (1e15 bytes) but the file holds 18 KB")`` reads
+    ``"<path>: header claims ..."``. The parts are kept as ``.path`` and ``.problem``.
+    """
+
+    def __init__(self, path: PathLike, problem: str) -> None:
+        self.path = os.fspath(path) if not isinstance(path, str) else path
+        self.problem = str(problem)
+        super().__init__(f"{self.path}: {self.problem}")
+
+    def __reduce__(self):  # keep the two-argument form picklable (background jobs send errors across threads)
+        return (type(self), (self.path, self.problem))
+
+
+class NonFiniteWarning(UserWarning):
+    """Emitted when a reader was called with ``allow_nonfinite=True`` and the data holds NaN or Inf values."""
+
+
+def human_bytes(n: int) -> str:
+    """``18047`` -> ``'18 KB'``; exact for small sizes, one decimal otherwise."""
+    value = float(n)
+    for unit in ("bytes", "KB", "MB", "GB", "TB", "PB", "EB"):
+        if abs(value) < 1000 or unit == "EB":
+            if unit == "bytes":
+                return f"{int(n)} bytes"
+            return f"{value:.0f} {unit}" if value >= 10 else f"{value:.1f} {unit}"
+        value /= 1000.0
+    return f"{n} bytes"  # pragma: no cover
