@@ -1,0 +1,37 @@
+"""Bridge from volviz.jobs (Qt-free) to Qt signals, so results reach widgets on the GUI thread."""
+from __future__ import annotations
+
+from typing import Any, Callable, Optional
+
+from PySide6.QtCore import QObject, Signal
+
+from volviz.jobs import Job, JobOutcome, JobRunner
+
+
+class JobBridge(QObject):
+    """Runs jobs on a JobRunner; emits ``progress(job_id, fraction, message)`` and ``finished(outcome)`` queued."""
+
+    progress = Signal(int, float, str)
+    finished = Signal(object)
+
+    def __init__(self, parent: Optional[QObject] = None, max_workers: int = 2):
+        super().__init__(parent)
+        self.runner = JobRunner(max_workers=max_workers)
+        self._handlers: dict[int, Callable[[JobOutcome], None]] = {}
+        self.finished.connect(self._dispatch)
+
+    def submit(self, fn: Callable[..., Any], *args: Any, name: str, key: Optional[str] = None,
+               on_done: Optional[Callable[[JobOutcome], None]] = None, **kwargs: Any) -> Job:
+        job = self.runner.submit(fn, *args, name=name, key=key, on_progress=self.progress.emit,
+                                 on_done=self.finished.emit, **kwargs)
+        if on_done is not None:
+            self._handlers[job.job_id] = on_done
+        return job
+
+    def _dispatch(self, outcome: JobOutcome) -> None:
+        handler = self._handlers.pop(outcome.job_id, None)
+        if handler is not None:
+            handler(outcome)
+
+    def shutdown(self) -> None:
+        self.runner.shutdown(wait=False)

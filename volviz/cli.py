@@ -1,0 +1,167 @@
+"""The `volviz` command line: info, render, bench, compress. Never imports Qt.
+
+User errors (unreadable files, bad sessions, bad arguments) print one line ``volviz: error: ...`` and exit 2; an
+unexpected failure prints one line too (``--debug`` shows the traceback) and exits 1.
+"""
+from __future__ import annotations
+
+import argparse
+import importlib
+import json
+import sys
+from pathlib import Path
+from typing import Any, Optional, Sequence
+
+import volviz
+
+BENCHMARKS = ("tables", "unstructured", "compression", "nature", "iso")
+
+
+class UsageError(Exception):
+    """A bad command-line value."""
+
+
+def _size(text: str) -> tuple[int, int]:
+    try:
+        w, h = (int(v) for v in text.lower().split("x"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected WIDTHxHEIGHT, e.g. 800x600, got {text!r}") from None
+    if not (1 <= w <= 16384 and 1 <= h <= 16384):
+        raise argparse.ArgumentTypeError(f"image size must be 1..16384 on each side, got {text!r}")
+    return (w, h)
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message: str) -> None:  # one line, no usage dump
+        raise UsageError(message)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(prog="volviz", description="Accurate, fast volume rendering.")
+    parser.add_argument("--version", action="version", version=f"volviz {volviz.__version__}")
+    parser.add_argument("--debug", action="store_true", help="show tracebacks of unexpected errors")
+    sub = parser.add_subparsers(dest="command", parser_class=_Parser)
+
+    info = sub.add_parser("info", help="describe a data file or a compressed volume")
+    info.add_argument("file")
+    info.add_argument("--json", action="store_true", help="print JSON instead of text")
+
+    render = sub.add_parser("render", help="render a session or data file offscreen to PNG")
+    render.add_argument("target", help="a session (.json), a data file, or 'demo'")
+    render.add_argument("-o", "--output", required=True, help="output PNG")
+    render.add_argument("--size", type=_size, default=None, help="WIDTHxHEIGHT (default: the session's, or 1024x768)")
+
+    bench = sub.add_parser("bench", help="speed-against-error benchmarks", add_help=False)
+    bench.add_argument("name", choices=BENCHMARKS)
+    bench.add_argument("args", nargs=argparse.REMAINDER)
+
+    compress = sub.add_parser("compress", help="compress a regular volume (see `volviz compress --help`)",
+                              add_help=False)
+    compress.add_argument("args", nargs=argparse.REMAINDER)
+    return parser
+
+
+def describe(path: str) -> dict[str, Any]:
+    """Kind, dimensions, counts, ranges and time steps of a data file (or a .vvz compressed volume)."""
+    p = Path(path)
+    if p.suffix.lower() == ".vvz":
+        from volviz.regular.codec import info as vvz_info
+
+        return {"file": str(p), **vvz_info(p)}
+    from volviz.io import read
+    from volviz.model import TimeSeries
+
+    dataset = read(p)
+    desc: dict[str, Any] = {"file": str(p), "kind": dataset.kind, "dimensions": list(dataset.dimensions),
+                            "points": dataset.n_points, "cells": dataset.n_cells}
+    lo, hi = dataset.scalar_range()
+    desc["range"] = [lo, hi]
+    if isinstance(dataset, TimeSeries):
+        desc["time_steps"] = dataset.n_steps
+        desc["times"] = [float(dataset.times[0]), float(dataset.times[-1])]
+    for attr in ("spacing", "origin"):
+        if hasattr(dataset, attr):
+            desc[attr] = list(getattr(dataset, attr))
+    arrays = getattr(dataset, "point_data", None)
+    if arrays:
+        desc["arrays"] = sorted(arrays)
+    return desc
+
+
+def _print_info(desc: dict[str, Any]) -> None:
+    width = max(len(k) for k in desc)
+    for key, value in desc.items():
+        if isinstance(value, list):
+            value = " x ".join(str(v) for v in value) if key == "dimensions" else ", ".join(f"{v:g}" if isinstance(
+                v, float) else str(v) for v in value)
+        print(f"{key:<{width}}  {value}")
+
+
+def run(argv: Optional[Sequence[str]] = None) -> int:
+    args = build_parser().parse_args(argv)
+    if args.command is None:
+        raise UsageError("a command is needed: info, render, bench or compress (see volviz --help)")
+    if args.command == "info":
+        desc = describe(args.file)
+        if args.json:
+            print(json.dumps(desc, indent=2))
+        else:
+            _print_info(desc)
+        return 0
+    if args.command == "render":
+        return _render(args)
+    if args.command == "bench":
+        module = importlib.import_module(f"volviz.bench.{args.name}")
+        return int(module.main(list(args.args)) or 0)
+    if args.command == "compress":
+        from volviz.regular.cli import compress_main
+
+        return int(compress_main(list(args.args)) or 0)
+    raise UsageError(f"unknown command {args.command}")
+
+
+def _render(args: argparse.Namespace) -> int:
+    from volviz.render.export import is_session_file, render_to_png
+
+    size = args.size
+    if size is None:
+        size = (1024, 768)
+        target = Path(args.target)
+        if is_session_file(target):
+            from volviz.session import load
+
+            size = load(target).render.size
+    out = render_to_png(args.target, args.output, size)
+    print(f"wrote {out} ({size[0]}x{size[1]})")
+    return 0
+
+
+def user_errors() -> tuple[type[BaseException], ...]:
+    from volviz.io import ReadError
+    from volviz.render.scene import SceneError
+    from volviz.session import SessionError
+
+    return (UsageError, ReadError, SessionError, SceneError, FileNotFoundError, IsADirectoryError, PermissionError)
+
+
+def main(argv: Optional[Sequence[str]] = None) -> int:
+    debug = "--debug" in (sys.argv[1:] if argv is None else argv)
+    try:
+        return run(argv)
+    except SystemExit as exc:  # --version / --help
+        return int(exc.code or 0)
+    except KeyboardInterrupt:
+        print("volviz: interrupted", file=sys.stderr)
+        return 130
+    except Exception as exc:
+        if isinstance(exc, user_errors()):
+            print(f"volviz: error: {exc}", file=sys.stderr)
+            return 2
+        if debug:
+            raise
+        print(f"volviz: internal error: {type(exc).__name__}: {exc} (run with --debug for details)", file=sys.stderr)
+        return 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
