@@ -1,0 +1,77 @@
+"""The `volviz` command line: version, info, offscreen render, one-line errors, no Qt."""
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import imageio.v3 as iio
+import numpy as np
+
+from conftest import data_file
+
+import volviz
+from volviz.cli import main
+
+
+def run_cli(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "volviz.cli", *args], capture_output=True, text=True, timeout=300)
+
+
+def test_version(capsys) -> None:
+    assert main(["--version"]) == 0
+    assert capsys.readouterr().out.strip() == f"volviz {volviz.__version__}"
+
+
+def test_render_demo_offscreen_without_qt(tmp_path: Path) -> None:
+    out = tmp_path / "demo.png"
+    code = (
+        "import sys; from volviz.cli import main; rc = main(['render', 'demo', '-o', sys.argv[1], '--size', '320x200']);"
+        "assert not [m for m in sys.modules if m.startswith(('PySide6', 'PyQt', 'pyvistaqt'))], 'Qt imported';"
+        "sys.exit(rc)"
+    )
+    result = subprocess.run([sys.executable, "-c", code, str(out)], capture_output=True, text=True, timeout=300,
+                            env={k: v for k, v in __import__("os").environ.items() if k != "DISPLAY"})
+    assert result.returncode == 0, result.stderr
+    image = iio.imread(out)
+    assert image.shape[:2] == (200, 320)
+    background = image[0, 0, :3].astype(int)
+    differs = np.abs(image[..., :3].astype(int) - background).sum(axis=2) > 30
+    assert differs.mean() > 0.05, "rendered image is blank"
+
+
+def test_render_data_file_at_requested_size(tmp_path: Path) -> None:
+    source = data_file("volumes/neghip.slc")
+    out = tmp_path / "neghip.png"
+    assert main(["render", str(source), "-o", str(out), "--size", "256x192"]) == 0
+    image = iio.imread(out)
+    assert image.shape[:2] == (192, 256)
+    assert image[..., :3].std() > 5.0
+
+
+def test_info_reports_kind_dimensions_and_range(capsys) -> None:
+    source = data_file("volumes/neghip.slc")
+    assert main(["info", "--json", str(source)]) == 0
+    desc = json.loads(capsys.readouterr().out)
+    assert desc["kind"] == "regular volume"
+    assert desc["dimensions"] == [66, 66, 66]
+    assert desc["points"] == 66 ** 3
+    assert 0 <= desc["range"][0] < desc["range"][1] <= 255
+
+
+def test_user_errors_are_one_line_and_nonzero(tmp_path: Path) -> None:
+    bad = tmp_path / "broken.pvm"
+    bad.write_bytes(b"PVM\n100000 100000 100000\n1\n" + b"\0" * 100)
+    for args, words in [
+        (["info", str(bad)], "broken.pvm"),
+        (["info", str(tmp_path / "missing.slc")], "missing.slc"),
+        (["render", "demo", "-o", str(tmp_path / "x.png"), "--size", "big"], "WIDTHxHEIGHT"),
+        (["frobnicate"], "invalid choice"),
+    ]:
+        result = run_cli(*args)
+        assert result.returncode == 2, (args, result.stderr)
+        lines = result.stderr.strip().splitlines()
+        assert len(lines) == 1 and lines[0].startswith("volviz: error:"), result.stderr
+        assert words in lines[0]
+        assert "Traceback" not in result.stderr
