@@ -1,0 +1,97 @@
+"""Headerless binary volumes: one file (``read_raw``) or a stack of slice files (``read_slice_stack``).
+
+The caller gives what the file cannot: dimensions (x fastest), sample type and byte order. The file size must
+match exactly (``header_bytes`` + voxels x sample size); a mismatch means wrong dimensions or type and is reported.
+"""
+from __future__ import annotations
+
+from typing import Sequence
+
+import numpy as np
+
+from volviz.io._checks import check_dims, check_finite, describe_dims, file_size, read_at
+from volviz.io.errors import PathLike, ReadError, human_bytes
+from volviz.model import Image2D, RegularVolume
+
+_BYTEORDERS = {"little": "<", "<": "<", "big": ">", ">": ">", "native": "=", "=": "=", "msb": ">", "lsb": "<"}
+
+
+def file_dtype(dtype: object, byteorder: str) -> np.dtype:
+    """The on-disk dtype for a sample type and byte order ("little", "big", "native", "<", ">", "=")."""
+    try:
+        bo = _BYTEORDERS[str(byteorder).lower()]
+    except KeyError:
+        raise ValueError(f"byteorder must be one of {sorted(_BYTEORDERS)}, got {byteorder!r}") from None
+    dt = np.dtype(dtype)
+    if dt.kind not in "uif" or dt.itemsize > 8:
+        raise ValueError(f"raw volumes hold integer or float samples, not {dt}")
+    return dt.newbyteorder(bo) if dt.itemsize > 1 else dt
+
+
+def decode_samples(path: PathLike, raw: bytes | bytearray, disk: np.dtype, allow_nonfinite: bool) -> np.ndarray:
+    """Bytes -> native-endian samples, with the finite check for float data."""
+    values = np.frombuffer(raw, dtype=disk)
+    if not disk.isnative:
+        values = values.astype(disk.newbyteorder("="))
+    check_finite(path, values, allow_nonfinite)
+    return values
+
+
+def _size_problem(path: PathLike, dims: Sequence[int], disk: np.dtype, header_bytes: int, size: int) -> None:
+    need = header_bytes + int(np.prod([int(d) for d in dims], dtype=object)) * disk.itemsize
+    if need != size:
+        claim = f"{describe_dims(dims)} samples of {disk.itemsize} byte(s)"
+        if header_bytes:
+            claim += f" after a {header_bytes}-byte header"
+        more = "more" if size > need else "less"
+        raise ReadError(path, f"{claim} need {need} bytes ({human_bytes(need)}) but the file holds {size} bytes "
+                              f"({human_bytes(size)}, {abs(size - need)} {more}): wrong dimensions, type or header")
+
+
+def read_raw(path: PathLike, dims: Sequence[int], dtype: object, byteorder: str = "little", header_bytes: int = 0,
+             spacing: Sequence[float] = (1.0, 1.0, 1.0), origin: Sequence[float] = (0.0, 0.0, 0.0),
+             allow_nonfinite: bool = False, name: str = "scalars") -> RegularVolume | Image2D:
+    """Read a headerless volume (dims (nx, ny, nz), x fastest) or image (dims (nx, ny) -> Image2D (ny, nx))."""
+    dims = check_dims(path, dims, "raw dimensions")
+    if len(dims) not in (2, 3):
+        raise ValueError(f"dims must be (nx, ny) or (nx, ny, nz), got {dims}")
+    if header_bytes < 0:
+        raise ValueError(f"header_bytes must be >= 0, got {header_bytes}")
+    disk = file_dtype(dtype, byteorder)
+    size = file_size(path)
+    _size_problem(path, dims, disk, header_bytes, size)
+    n = int(np.prod(dims))
+    values = decode_samples(path, read_at(path, header_bytes, n * disk.itemsize), disk, allow_nonfinite)
+    if len(dims) == 2:
+        return Image2D(values.reshape(dims[1], dims[0]), spacing=tuple(spacing)[:2], origin=tuple(origin)[:2],
+                       source=str(path))
+    return RegularVolume(values.reshape(dims, order="F"), spacing=tuple(spacing), origin=tuple(origin),
+                         name=name, source=str(path))
+
+
+def read_slice_stack(pattern: str | Sequence[PathLike], dims: Sequence[int], dtype: object,
+                     byteorder: str = "little", header_bytes: int = 0,
+                     spacing: Sequence[float] = (1.0, 1.0, 1.0), origin: Sequence[float] = (0.0, 0.0, 0.0),
+                     allow_nonfinite: bool = False, name: str = "scalars") -> RegularVolume:
+    """Stack numbered slice files (e.g. ``headsq/quarter.%d`` or ``headsq/quarter.*``) into one RegularVolume.
+
+    ``dims`` is (nx, ny) of one slice, or (nx, ny, nz) to also check the number of slices. Slices are ordered by
+    their number (``quarter.2`` before ``quarter.10``) and stacked along z. Every file's size is checked before
+    anything is allocated.
+    """
+    from volviz.io.series import expand_pattern
+
+    paths = [p for _, p in expand_pattern(pattern)]
+    nx, ny, *rest = check_dims(str(pattern), dims, "slice dimensions")
+    if rest and rest[0] != len(paths):
+        raise ReadError(str(pattern), f"dims ask for {rest[0]} slices but {len(paths)} files match")
+    disk = file_dtype(dtype, byteorder)
+    for p in paths:
+        _size_problem(p, (nx, ny), disk, header_bytes, file_size(p))
+    nz = len(paths)
+    volume = np.empty((nx, ny, nz), dtype=disk.newbyteorder("="), order="F")
+    for k, p in enumerate(paths):
+        values = decode_samples(p, read_at(p, header_bytes, nx * ny * disk.itemsize), disk, allow_nonfinite)
+        volume[:, :, k] = values.reshape((nx, ny), order="F")
+    return RegularVolume(volume, spacing=tuple(spacing), origin=tuple(origin), name=name,
+                         source=str(paths[0]))

@@ -1,0 +1,99 @@
+"""Numbered file series: ``Storm.pvm-t01..t21``, ``quarter.1..93``, given as a list, a glob or a printf pattern.
+
+``read_series`` turns them into one TimeSeries whose frames are read lazily (frame 0 is read at once so that a
+bad series fails fast).
+"""
+from __future__ import annotations
+
+import glob
+import os
+import re
+from pathlib import Path
+from typing import Callable, Sequence
+
+import numpy as np
+
+from volviz.io.errors import PathLike, ReadError
+from volviz.model import TimeSeries
+
+_PRINTF = re.compile(r"%(0?)(\d*)d")
+_LAST_NUMBER = re.compile(r"(\d+)(?!.*\d)")
+
+
+def _number_of(path: str) -> int | None:
+    m = _LAST_NUMBER.search(os.path.basename(path))
+    return int(m.group(1)) if m else None
+
+
+def expand_pattern(pattern: str | PathLike | Sequence[PathLike]) -> list[tuple[int | None, Path]]:
+    """Resolve a list of paths, a glob (``Storm.pvm-t*``) or a printf pattern (``quarter.%d``) to
+    ``[(number, path), ...]`` sorted by the number in the file name (natural order). ReadError if nothing matches."""
+    if isinstance(pattern, (list, tuple)):
+        if not pattern:
+            raise ReadError("<empty list>", "no files given for the series")
+        items = [(_number_of(os.fspath(p)), Path(os.fspath(p))) for p in pattern]
+        return items
+    text = os.fspath(pattern)
+    if _PRINTF.search(text):
+        directory, base = os.path.split(text)
+        parts = _PRINTF.split(base)
+        regex = ""
+        for i in range(0, len(parts), 3):
+            regex += re.escape(parts[i])
+            if i + 2 < len(parts):
+                regex += r"(\d+)"
+        rx = re.compile(regex + r"\Z")
+        try:
+            names = os.listdir(directory or ".")
+        except OSError as exc:
+            raise ReadError(text, f"cannot list the directory of the pattern ({exc.strerror or exc})") from None
+        items = []
+        for name in names:
+            m = rx.match(name)
+            if m:
+                items.append((int(m.group(1)), Path(directory or ".") / name))
+    elif any(ch in text for ch in "*?["):
+        items = [(_number_of(p), Path(p)) for p in glob.glob(text)]
+    else:
+        items = [(_number_of(text), Path(text))]
+    if not items:
+        raise ReadError(text, "no files match this pattern")
+    items.sort(key=lambda t: (t[0] is None, t[0] if t[0] is not None else 0, str(t[1])))
+    return items
+
+
+def read_series(paths_or_pattern: str | PathLike | Sequence[PathLike],
+                reader: Callable[..., object] | None = None, times: Sequence[float] | None = None,
+                **options) -> TimeSeries:
+    """A TimeSeries of every file of a numbered series, read lazily with ``reader`` (default ``volviz.io.read``).
+
+    Times are the numbers in the file names when all files have distinct ones (``t01`` -> 1.0), else 0, 1, 2...;
+    ``times`` overrides them. Frame 0 is read now; every later frame must have frame 0's kind and dimensions.
+    """
+    items = expand_pattern(paths_or_pattern)
+    if reader is None:
+        from volviz.io import read as reader  # type: ignore[no-redef]
+    paths = [p for _, p in items]
+    numbers = [n for n, _ in items]
+    if times is None:
+        if all(n is not None for n in numbers) and len(set(numbers)) == len(numbers):
+            times = [float(n) for n in numbers]  # type: ignore[arg-type]
+        else:
+            times = [float(i) for i in range(len(paths))]
+    if len(times) != len(paths):
+        raise ValueError(f"{len(times)} times given for {len(paths)} files")
+    first = reader(paths[0], **options)
+    if isinstance(first, TimeSeries):
+        raise ReadError(paths[0], "is itself a time series; a series of series is not supported")
+
+    def load(index: int):
+        frame = reader(paths[index], **options)
+        if type(frame) is not type(first) or frame.dimensions != first.dimensions:
+            raise ReadError(paths[index], f"frame {index} is a {getattr(frame, 'kind', type(frame).__name__)} of "
+                                          f"{frame.dimensions}, but frame 0 ({paths[0]}) is a {first.kind} of "
+                                          f"{first.dimensions}")
+        return frame
+
+    frames: list = [first] + [None] * (len(paths) - 1)
+    return TimeSeries(np.asarray(times, dtype=np.float64), frames, loader=load,
+                      source=os.fspath(os.path.commonpath([str(p) for p in paths])) if len(paths) > 1 else str(paths[0]))
