@@ -44,47 +44,54 @@ def load_datasets(session: Session, session_file: Optional[str | os.PathLike],
     return loaded
 
 
+def component_dataset(comp: Component, datasets: dict[str, Any]) -> Any:
+    """The dataset a component shows: generated for the demo, else the loaded dataset it names."""
+    if comp.type == "demo":
+        from volviz.model.demo import demo_tet_mesh
+
+        key = f"demo:{int(comp.settings.get('cells_per_edge', 20))}"
+        if key not in datasets:
+            datasets[key] = demo_tet_mesh(int(comp.settings.get("cells_per_edge", 20)))
+        return datasets[key]
+    if comp.dataset is None:
+        raise SceneError(f"component {comp.id!r} ({comp.type}) names no dataset")
+    return datasets[comp.dataset]
+
+
+def ensure_transfer_functions(session: Session, datasets: dict[str, Any]) -> None:
+    """Give every volume-like component without a transfer function a default one fitted to its data."""
+    from volviz.render.vtk_scene import default_transfer_function_for
+
+    for comp in session.components:
+        if comp.transfer_function is None and comp.type in ("volume", "mesh", "demo"):
+            name = comp.id
+            while name in session.transfer_functions:
+                name += "'"
+            tf = default_transfer_function_for(component_dataset(comp, datasets), name)
+            session.transfer_functions[name] = tf.to_dict()
+            comp.transfer_function = name
+
+
+def component_transfer_function(session: Session, comp: Component) -> Any:
+    from volviz.optics import TransferFunction
+
+    if comp.transfer_function is None:
+        return None
+    return TransferFunction.from_dict(session.transfer_functions[comp.transfer_function])
+
+
 def build_scene(plotter: Any, session: Session, datasets: dict[str, Any]) -> dict[str, Any]:
     """Add every visible component to ``plotter``; returns the VTK prop of each component by id."""
     from volviz.render.vtk_scene import add_dataset, apply_camera
 
+    ensure_transfer_functions(session, datasets)
     props: dict[str, Any] = {}
     for comp in session.components:
         if not comp.visible:
             continue
-        if comp.type == "demo":
-            from volviz.model.demo import demo_tet_mesh
-
-            dataset = demo_tet_mesh(int(comp.settings.get("cells_per_edge", 20)))
-        elif comp.dataset is None:
-            raise SceneError(f"component {comp.id!r} ({comp.type}) names no dataset")
-        else:
-            dataset = datasets[comp.dataset]
-        style = None
-        if comp.transfer_function is not None:
-            style = style_from_transfer_function(session.transfer_functions[comp.transfer_function], dataset)
-        props[comp.id] = add_dataset(plotter, dataset, style=style, opacity=comp.opacity, name=comp.id)
+        dataset = component_dataset(comp, datasets)
+        tf = component_transfer_function(session, comp)
+        props[comp.id] = add_dataset(plotter, dataset, tf=tf, opacity=comp.opacity, name=comp.id)
     plotter.set_background(session.render.background)
     apply_camera(plotter, session.camera)
     return props
-
-
-def style_from_transfer_function(tf_dict: dict[str, Any], dataset: Any) -> Any:
-    """VTK colour/opacity points for a session transfer function (VTK convention: ρ = opacity / unit distance)."""
-    from volviz.optics import TransferFunction
-    from volviz.render.vtk_scene import VolumeStyle
-
-    tf = TransferFunction.from_dict(tf_dict)
-    unit = 1.0
-    ctf, otf = tf.to_vtk(unit)
-    colors = []
-    for i in range(ctf.GetSize()):
-        node = [0.0] * 6
-        ctf.GetNodeValue(i, node)
-        colors.append((node[0], node[1], node[2], node[3]))
-    opacities = []
-    for i in range(otf.GetSize()):
-        node = [0.0] * 4
-        otf.GetNodeValue(i, node)
-        opacities.append((node[0], node[1]))
-    return VolumeStyle(colors, opacities, unit)

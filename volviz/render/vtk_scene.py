@@ -7,7 +7,6 @@ the app's viewport.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any, Optional
 
 import numpy as np
@@ -15,76 +14,92 @@ import numpy as np
 from volviz.model import CurvilinearGrid, Image2D, RegularVolume, TetMesh, TimeSeries, UnstructuredMesh
 from volviz.session import CameraState
 
-DEFAULT_COLORS = ((0.23, 0.30, 0.75), (0.87, 0.87, 0.87), (0.71, 0.02, 0.15))  # cool-warm endpoints and middle
+DEFAULT_COLORS = ((0.23, 0.30, 0.75), (0.87, 0.87, 0.87), (0.71, 0.02, 0.15))  # cool-warm: low, middle, high
 
 
-@dataclass
-class VolumeStyle:
-    """How a volume looks in VTK: colour map points (scalar, r, g, b) and opacity points (scalar, opacity per unit)."""
+def default_transfer_function(scalar_range: tuple[float, float], diagonal: float, name: str = "default") -> Any:
+    """A cool-warm colour map with a ramp extinction over the data range: the first look at unknown data.
 
-    colors: list[tuple[float, float, float, float]]
-    opacities: list[tuple[float, float]]
-    unit_distance: float = 1.0
+    The extinction peaks at 4 / diagonal, so a ray through the whole bounding box at the top of the range reaches an
+    optical depth of about 4 (mostly opaque) while lower values stay translucent.
+    """
+    from volviz.optics import TransferFunction
 
-
-def default_style(scalar_range: tuple[float, float], unit_distance: float) -> VolumeStyle:
-    """A cool-warm colour map with a ramp opacity over the data range: the first look at unknown data."""
     lo, hi = scalar_range
     if not (np.isfinite(lo) and np.isfinite(hi)):
         lo, hi = 0.0, 1.0
     if hi <= lo:
         hi = lo + 1.0
-    mid = 0.5 * (lo + hi)
-    colors = [(lo, *DEFAULT_COLORS[0]), (mid, *DEFAULT_COLORS[1]), (hi, *DEFAULT_COLORS[2])]
-    opacities = [(lo, 0.0), (lo + 0.1 * (hi - lo), 0.0), (hi, 0.8)]
-    return VolumeStyle(colors, opacities, unit_distance)
+    rho_max = 4.0 / diagonal if diagonal > 0 else 1.0
+    scalars = [lo, lo + 0.1 * (hi - lo), 0.5 * (lo + hi), hi]
+    colors = [DEFAULT_COLORS[0], DEFAULT_COLORS[0], DEFAULT_COLORS[1], DEFAULT_COLORS[2]]
+    extinction = [0.0, 0.0, 0.35 * rho_max, rho_max]
+    return TransferFunction(scalars, colors, extinction, name=name)
 
 
-def vtk_volume_property(style: VolumeStyle) -> Any:
-    import vtk
+def vtk_unit_distance(tf: Any) -> float:
+    """The opacity unit distance that keeps VTK's opacity a = ρ·unit ≤ 0.9 (VTK clamps a to 1)."""
+    rho_max = float(tf.max_extinction)
+    return 0.9 / rho_max if rho_max > 0.9 else 1.0
 
-    ctf = vtk.vtkColorTransferFunction()
-    for s, r, g, b in style.colors:
-        ctf.AddRGBPoint(s, r, g, b)
-    otf = vtk.vtkPiecewiseFunction()
-    for s, a in style.opacities:
-        otf.AddPoint(s, a)
-    prop = vtk.vtkVolumeProperty()
+
+def update_volume_property(prop: Any, tf: Any, opacity: float = 1.0) -> None:
+    """Point a vtkVolumeProperty at ``tf`` (VTK convention: ρ = opacity / unit distance); ``opacity`` scales ρ."""
+    tf = tf.scaled_extinction(max(float(opacity), 0.0)) if opacity != 1.0 else tf
+    unit = vtk_unit_distance(tf)
+    ctf, otf = tf.to_vtk(unit)
     prop.SetColor(ctf)
     prop.SetScalarOpacity(otf)
-    prop.SetScalarOpacityUnitDistance(style.unit_distance)
+    prop.SetScalarOpacityUnitDistance(unit)
+
+
+def vtk_volume_property(tf: Any, opacity: float = 1.0) -> Any:
+    import vtk
+
+    prop = vtk.vtkVolumeProperty()
+    update_volume_property(prop, tf, opacity)
     prop.SetInterpolationTypeToLinear()
     prop.ShadeOff()
     return prop
 
 
-def _characteristic_length(bounds: tuple[float, ...]) -> float:
-    diag = float(np.linalg.norm(np.subtract(bounds[1::2], bounds[0::2])))
-    return diag / 50.0 if diag > 0 else 1.0
+def bounds_diagonal(bounds: tuple[float, ...]) -> float:
+    return float(np.linalg.norm(np.subtract(bounds[1::2], bounds[0::2])))
 
 
-def add_dataset(plotter: Any, dataset: Any, style: Optional[VolumeStyle] = None, opacity: float = 1.0,
-                name: Optional[str] = None) -> Any:
-    """Add a dataset to ``plotter`` as its default visual; returns the VTK prop."""
+def volume_grid(dataset: Any) -> Any:
+    """The PyVista grid a dataset is drawn from, with scalar active (vectors shown by their magnitude)."""
+    if isinstance(dataset, TimeSeries):
+        dataset = dataset.frame(0)
+    grid = dataset.to_pyvista() if isinstance(dataset, (TetMesh, UnstructuredMesh, CurvilinearGrid,
+                                                        RegularVolume)) else dataset
+    scalars = grid.active_scalars
+    if scalars is not None and np.asarray(scalars).ndim > 1:
+        grid.point_data["magnitude"] = np.linalg.norm(np.asarray(scalars), axis=1)
+        grid.set_active_scalars("magnitude")
+    return grid
+
+
+def default_transfer_function_for(dataset: Any, name: str = "default") -> Any:
+    grid = volume_grid(dataset)
+    rng = grid.get_data_range() if grid.active_scalars is not None else (0.0, 1.0)
+    return default_transfer_function(rng, bounds_diagonal(grid.bounds), name)
+
+
+def add_dataset(plotter: Any, dataset: Any, tf: Any = None, opacity: float = 1.0, name: Optional[str] = None) -> Any:
+    """Add a dataset to ``plotter`` as its default visual (a volume with ``tf``); returns the VTK prop."""
     import vtk
 
     if isinstance(dataset, TimeSeries):
-        return add_dataset(plotter, dataset.frame(0), style, opacity, name)
+        return add_dataset(plotter, dataset.frame(0), tf, opacity, name)
     if isinstance(dataset, Image2D):
         return _add_image(plotter, dataset, name)
 
-    if isinstance(dataset, (TetMesh, UnstructuredMesh, CurvilinearGrid, RegularVolume)):
-        grid = dataset.to_pyvista()
-    else:
-        grid = dataset
+    grid = volume_grid(dataset)
     if grid.active_scalars is None:
         return plotter.add_mesh(grid, opacity=opacity, name=name)
-    scalars = np.asarray(grid.active_scalars)
-    if scalars.ndim > 1:  # vectors: show their magnitude
-        grid.point_data["magnitude"] = np.linalg.norm(scalars, axis=1)
-        grid.set_active_scalars("magnitude")
-    rng = grid.get_data_range()
-    style = style or default_style(rng, _characteristic_length(grid.bounds))
+    if tf is None:
+        tf = default_transfer_function(grid.get_data_range(), bounds_diagonal(grid.bounds))
 
     if isinstance(dataset, RegularVolume):
         mapper = vtk.vtkSmartVolumeMapper()
@@ -98,10 +113,7 @@ def add_dataset(plotter: Any, dataset: Any, style: Optional[VolumeStyle] = None,
         mapper.SetInputData(tets.GetOutput())
     volume = vtk.vtkVolume()
     volume.SetMapper(mapper)
-    prop = vtk_volume_property(style)
-    if opacity < 1.0:
-        prop.SetScalarOpacityUnitDistance(style.unit_distance / max(opacity, 1e-6))
-    volume.SetProperty(prop)
+    volume.SetProperty(vtk_volume_property(tf, opacity))
     plotter.add_actor(volume, name=name, reset_camera=False)
     return volume
 
