@@ -1,0 +1,146 @@
+"""VTK data objects -> volviz model datasets (shared by the VTK legacy/XML and VTKHDF readers).
+
+vtkImageData -> RegularVolume (the active point scalars, else the first point array), vtkStructuredGrid and
+vtkRectilinearGrid -> CurvilinearGrid (every point array), vtkUnstructuredGrid / vtkPolyData -> UnstructuredMesh
+(cells grouped by VTK type and size; cell data permuted to that grouping). Composite data (multiblock,
+partitioned) is merged with vtkAppendFilter first. Float arrays are checked for NaN/Inf.
+"""
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+
+from volviz.io._checks import check_finite
+from volviz.io.errors import PathLike, ReadError
+from volviz.model import CurvilinearGrid, RegularVolume, UnstructuredMesh
+
+_VTK_POLYHEDRON = 42
+
+
+def _arrays(path: PathLike, attributes, n: int, allow_nonfinite: bool, where: str) -> dict[str, np.ndarray]:
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+
+    out: dict[str, np.ndarray] = {}
+    for i in range(attributes.GetNumberOfArrays()):
+        arr = attributes.GetArray(i)  # None for string / non-numeric arrays
+        if arr is None or arr.GetNumberOfTuples() != n:
+            continue
+        name = arr.GetName() or f"{where}{i}"
+        values = np.array(vtk_to_numpy(arr))
+        check_finite(path, values, allow_nonfinite, f"{where} array {name!r}")
+        out[name] = values
+    return out
+
+
+def _active_name(attributes) -> str | None:
+    scalars = attributes.GetScalars()
+    return scalars.GetName() if scalars is not None and scalars.GetName() else None
+
+
+def merge_composite(path: PathLike, obj):
+    """A composite data set (multiblock / partitioned) as one data set; ReadError if it holds nothing."""
+    import vtk
+
+    if not obj.IsA("vtkCompositeDataSet"):
+        return obj
+    leaves = []
+    it = obj.NewIterator()
+    it.InitTraversal()
+    while not it.IsDoneWithTraversal():
+        leaf = it.GetCurrentDataObject()
+        if leaf is not None and leaf.IsA("vtkDataSet") and leaf.GetNumberOfPoints() > 0:
+            leaves.append(leaf)
+        it.GoToNextItem()
+    if not leaves:
+        raise ReadError(path, "holds no data set with points")
+    if len(leaves) == 1:
+        return leaves[0]
+    append = vtk.vtkAppendFilter()
+    append.SetMergePoints(False)
+    for leaf in leaves:
+        append.AddInputData(leaf)
+    append.Update()
+    out = vtk.vtkUnstructuredGrid()
+    out.ShallowCopy(append.GetOutput())
+    return out
+
+
+def vtk_to_model(path: PathLike, obj, allow_nonfinite: bool = False):
+    """Convert a VTK data object to the matching volviz model dataset."""
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+
+    if obj is None:
+        raise ReadError(path, "the VTK reader produced no output")
+    obj = merge_composite(path, obj)
+    if not obj.IsA("vtkDataSet"):
+        raise ReadError(path, f"holds a {obj.GetClassName()}, which volviz cannot use")
+    n_points = obj.GetNumberOfPoints()
+    if n_points == 0:
+        raise ReadError(path, f"the {obj.GetClassName()} in the file has no points")
+    pd = obj.GetPointData()
+    if obj.IsA("vtkImageData"):
+        dims = obj.GetDimensions()
+        name = _active_name(pd)
+        arrays = _arrays(path, pd, n_points, allow_nonfinite, "point")
+        if not arrays:
+            raise ReadError(path, "image data without point data arrays (cell-only data is not supported)")
+        if name not in arrays:
+            name = next(iter(arrays))
+        values = arrays[name]
+        if values.ndim != 1:
+            raise ReadError(path, f"image array {name!r} has {values.shape[1]} components; a volume needs scalars")
+        direction = np.array([obj.GetDirectionMatrix().GetElement(i, j) for i in range(3) for j in range(3)])
+        if not np.allclose(direction, np.eye(3).ravel()):
+            warnings.warn(f"{path}: image direction matrix {direction.tolist()} is ignored (volumes are "
+                          "axis-aligned)", UserWarning, stacklevel=3)
+        return RegularVolume(values.reshape(dims, order="F"), spacing=obj.GetSpacing(), origin=obj.GetOrigin(),
+                             name=name, source=str(path))
+    if obj.IsA("vtkStructuredGrid") or obj.IsA("vtkRectilinearGrid"):
+        ext = obj.GetExtent()
+        dims = (ext[1] - ext[0] + 1, ext[3] - ext[2] + 1, ext[5] - ext[4] + 1)
+        if obj.IsA("vtkStructuredGrid"):
+            pts = vtk_to_numpy(obj.GetPoints().GetData()).astype(np.float64)
+        else:
+            axes = [vtk_to_numpy(c).astype(np.float64) for c in (obj.GetXCoordinates(), obj.GetYCoordinates(),
+                                                                  obj.GetZCoordinates())]
+            grid = np.meshgrid(*axes, indexing="ij")
+            pts = np.stack([g.ravel(order="F") for g in grid], axis=-1)
+        check_finite(path, pts, False, "point coordinates")
+        points = pts.reshape(tuple(dims) + (3,), order="F")
+        arrays = _arrays(path, pd, n_points, allow_nonfinite, "point")
+        point_data = {k: (v.reshape(dims, order="F") if v.ndim == 1 else v.reshape(tuple(dims) + v.shape[1:], order="F"))
+                      for k, v in arrays.items()}
+        active = _active_name(pd)
+        return CurvilinearGrid(points, point_data, active=active if active in point_data else None, source=str(path))
+    return _unstructured(path, obj, allow_nonfinite)
+
+
+def _unstructured(path: PathLike, obj, allow_nonfinite: bool) -> UnstructuredMesh:
+    import pyvista as pv
+
+    grid = pv.wrap(obj)
+    if not isinstance(grid, pv.UnstructuredGrid):
+        grid = grid.cast_to_unstructured_grid()
+    points = np.asarray(grid.points, dtype=np.float64)
+    check_finite(path, points, False, "point coordinates")
+    types = np.asarray(grid.celltypes)
+    if np.any(types == _VTK_POLYHEDRON):
+        raise ReadError(path, "polyhedron cells (VTK type 42) are not supported")
+    offsets = np.asarray(grid.cell_offsets if hasattr(grid, "cell_offsets") else grid.offset, dtype=np.int64)
+    conn = np.asarray(grid.cell_connectivity, dtype=np.int64)
+    sizes = np.diff(offsets)
+    cells, order = [], []
+    keys = np.stack([types.astype(np.int64), sizes], axis=1) if len(types) else np.empty((0, 2), np.int64)
+    for ctype, size in sorted({(int(t), int(s)) for t, s in keys}):
+        idx = np.flatnonzero((types == ctype) & (sizes == size))
+        block = conn[(offsets[idx][:, None] + np.arange(size)[None, :])] if size else np.empty((len(idx), 0), np.int64)
+        cells.append((ctype, block))
+        order.append(idx)
+    perm = np.concatenate(order) if order else np.empty(0, np.int64)
+    pd, cd = obj.GetPointData(), obj.GetCellData()
+    point_data = _arrays(path, pd, obj.GetNumberOfPoints(), allow_nonfinite, "point")
+    cell_data = {k: v[perm] for k, v in _arrays(path, cd, obj.GetNumberOfCells(), allow_nonfinite, "cell").items()}
+    active = _active_name(pd)
+    return UnstructuredMesh(points, cells, point_data, cell_data,
+                            active=active if active in point_data else None, source=str(path))
