@@ -1,4 +1,81 @@
-"""Dataset readers. Every reader raises ``volviz.io.ReadError`` (naming the file and the problem) on bad input."""
-from volviz.io.errors import NonFiniteWarning, ReadError
+"""Dataset readers: ``read(path)`` picks the format; every reader raises ``ReadError`` naming the file and the
+problem, quickly and before any large allocation (sizes are checked against the header first).
 
-__all__ = ["NonFiniteWarning", "ReadError"]
+Readers (each returns a ``volviz.model`` dataset, convertible with ``.to_pyvista()``):
+
+- PLOT3D whole-grid binary xyz (+ q)      -> CurvilinearGrid (Density, Momentum, StagnationEnergy, derived)
+- PVM v1/v2/v3, 8/16 bit (DDS refused)    -> RegularVolume
+- SLC (raw or run-length coded)           -> RegularVolume
+- MetaImage .mhd/.raw, .mha               -> RegularVolume (3D) or Image2D (2D)
+- raw volumes (explicit dims/type/order)  -> RegularVolume (``read_raw``), slice stacks (``read_slice_stack``)
+- VTK legacy .vtk, XML .vti .vtu .vts .vtr .vtp -> RegularVolume / CurvilinearGrid / UnstructuredMesh
+- VTKHDF (static or transient)            -> the matching dataset, or TimeSeries with lazy frames
+- PGM/PPM P2/P3/P5/P6, 8/16 bit           -> Image2D
+- USGS DEM (ASCII)                        -> Image2D of heights in metres
+- anything meshio reads                   -> UnstructuredMesh
+- a numbered series (list, glob, ``%d``)  -> TimeSeries with lazy frames (``read_series``)
+
+Float data holding NaN/Inf raises ReadError unless ``allow_nonfinite=True`` is passed, which keeps the values and
+emits a ``NonFiniteWarning`` with their count.
+"""
+from __future__ import annotations
+
+from typing import Any
+
+from volviz.io.errors import NonFiniteWarning, PathLike, ReadError
+from volviz.io.raw import read_raw, read_slice_stack
+from volviz.io.registry import FORMATS, call_reader, format_of, is_pattern
+from volviz.io.series import expand_pattern, read_series
+
+
+def read(path: PathLike, **options: Any):
+    """Read any supported file (or a series pattern: a glob, ``name%02d.ext`` or a list) into a model dataset.
+
+    The format comes from the extension, else the file's magic bytes. Options go to the format's reader
+    (e.g. ``q=`` for PLOT3D, ``dims=, dtype=, byteorder=`` for raw files, ``vtk_compatible=`` for DEM,
+    ``allow_nonfinite=``). Raises ReadError for bad or unsupported files.
+    """
+    if is_pattern(path):
+        return read_series(path, **options)
+    kind = format_of(path, options)
+    return call_reader(kind, path, options)
+
+
+def supported_formats() -> list[tuple[str, tuple[str, ...]]]:
+    """``[(description, (glob, ...)), ...]`` of the formats ``read`` recognises by name (for Open dialogs).
+
+    meshio's many formats are one extra entry.
+    """
+    from volviz.io.meshio_reader import meshio_extensions
+
+    taken = {g[1:] for _, globs in FORMATS for g in globs if g.startswith("*.")}
+    mesh = tuple(f"*{e}" for e in meshio_extensions() if e not in taken)
+    return list(FORMATS) + [("Meshes (meshio)", mesh)]
+
+
+def open_dialog_filter() -> str:
+    """A Qt-style file filter string: ``All supported (...);;PVM volume (*.pvm *.pvm-t*);;...;;All files (*)``."""
+    formats = supported_formats()
+    everything = " ".join(g for _, globs in formats for g in globs)
+    parts = [f"All supported ({everything})"] + [f"{d} ({' '.join(g)})" for d, g in formats] + ["All files (*)"]
+    return ";;".join(parts)
+
+
+def __getattr__(name: str):
+    """Lazy access to the individual readers (``volviz.io.read_pvm`` ...) without importing VTK up front."""
+    modules = {
+        "read_pvm": "pvm", "read_pnm": "pnm", "read_slc": "slc", "read_dem": "dem", "read_metaimage": "metaimage",
+        "read_plot3d": "plot3d", "read_vtk_file": "vtkfiles", "read_vtkhdf": "vtkhdf", "read_meshio": "meshio_reader",
+    }
+    if name in modules:
+        import importlib
+
+        return getattr(importlib.import_module(f"volviz.io.{modules[name]}"), name)
+    raise AttributeError(f"module 'volviz.io' has no attribute {name!r}")
+
+
+__all__ = [
+    "NonFiniteWarning", "ReadError", "expand_pattern", "open_dialog_filter", "read", "read_dem", "read_meshio",
+    "read_metaimage", "read_plot3d", "read_pnm", "read_pvm", "read_raw", "read_series", "read_slc",
+    "read_slice_stack", "read_vtk_file", "read_vtkhdf", "supported_formats",
+]
