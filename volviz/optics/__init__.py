@@ -1,7 +1,27 @@
-"""Optics: transfer functions, the exact ray-segment integral (Roettger Eq. 8.1), pre-integration tables, metrics."""
+"""Optics: transfer functions, the exact ray-segment integral (Roettger Eq. 8.1), pre-integration tables, metrics.
+
+- ``TransferFunction``: piecewise-linear κ(s), ρ(s); dict, VTK and ParaView-preset conversion.
+- ``integrate_segment``: the exact float64 reference for a linear-scalar segment (Eq. 8.1).
+- Tables, each with ``lookup(s_f, s_b, l)``, ``error(...)`` against the reference and ``rebuild(new_tf)``:
+  ``build_table3d`` (§8.4; direct or incremental), ``build_table2d`` (§8.5, Eq. 8.2), ``build_separable``
+  (Ch. 9: ρ̂ + colour polynomial), ``build_iso_table`` (§8.8–8.13), ``build_zot`` (conservative zero-opacity test).
+- ``volviz.optics.metrics``: RMSE / max abs in 8-bit units, PSNR, error heat map.
+"""
 from volviz.optics.integrate import integrate_segment
+from volviz.optics.isosurface import IsoSurface, IsoTable, build_iso_table, heaviside_alpha, iso_peaks_tf
+from volviz.optics.presets import list_presets, load_preset, read_paraview_presets, write_paraview_presets
+from volviz.optics.separable import SeparableTable, build_separable, segment_averages
+from volviz.optics.table2d import Table2D, build_table2d
 from volviz.optics.table3d import Table3D, build_table3d
 from volviz.optics.table_error import TableError
+from volviz.optics.tf_change import changed_span
 from volviz.optics.transfer_function import TransferFunction
+from volviz.optics.zot import ZOTable, build_zot
 
-__all__ = ["TransferFunction", "integrate_segment", "Table3D", "build_table3d", "TableError"]
+__all__ = [
+    "TransferFunction", "integrate_segment",
+    "Table3D", "build_table3d", "Table2D", "build_table2d", "SeparableTable", "build_separable", "segment_averages",
+    "IsoSurface", "IsoTable", "build_iso_table", "heaviside_alpha", "iso_peaks_tf", "ZOTable", "build_zot",
+    "TableError", "changed_span",
+    "list_presets", "load_preset", "read_paraview_presets", "write_paraview_presets",
+]
