@@ -26,6 +26,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         window.open_path(args.target)
     else:
         window.open_demo()
+    window.offer_recovery()
     return int(app.exec())
 
 

@@ -1,20 +1,35 @@
-"""The main window: a PyVista viewport, File menu, status bar with progress and cancel. No numerics here."""
+"""The main window: a PyVista viewport with docks (transfer function, scene tree, render settings, timeline,
+statistics), menus, status bar with progress and cancel, sessions with autosave and crash recovery. No numerics here:
+everything is a call into volviz."""
 from __future__ import annotations
 
 import logging
 import os
+import time
 from pathlib import Path
 from typing import Any, Optional
 
-from PySide6.QtCore import QByteArray, Qt
+from PySide6.QtCore import QByteArray, QSettings, QStandardPaths, Qt, QTimer
 from PySide6.QtGui import QAction, QKeySequence
-from PySide6.QtWidgets import (QFileDialog, QLabel, QMainWindow, QMessageBox, QProgressBar, QPushButton, QWidget)
+from PySide6.QtWidgets import (QDockWidget, QFileDialog, QInputDialog, QLabel, QMainWindow, QMessageBox,
+                               QProgressBar, QProgressDialog, QPushButton, QWidget)
 
 from volviz.jobs import JobOutcome
-from volviz.session import Session, SessionError, relative_path
+from volviz.session import CameraKey, Session, SessionError, relative_path
+from volviz_app.docks.render_settings import RenderSettings
+from volviz_app.docks.scene_tree import SceneTree
+from volviz_app.docks.statistics import Statistics
+from volviz_app.docks.tf_editor import TransferFunctionEditor
+from volviz_app.docks.timeline import Timeline
+from volviz_app.navigation import FlyMode
 from volviz_app.workers import JobBridge
 
 log = logging.getLogger(__name__)
+
+AUTOSAVE_MS = 60_000
+PREVIEW_MS = 40          # live transfer-function preview: at most one re-render per 40 ms while dragging
+RECORD_MS = 250          # camera-path recording samples the camera four times a second
+MAX_RECENT = 8
 
 
 def _data_filter() -> str:
@@ -24,15 +39,26 @@ def _data_filter() -> str:
     return f"Data files ({patterns});;All files (*)"
 
 
+def default_recovery_dir() -> Path:
+    env = os.environ.get("VOLVIZ_RECOVERY_DIR")
+    if env:
+        return Path(env)
+    base = QStandardPaths.writableLocation(QStandardPaths.StandardLocation.AppDataLocation)
+    return Path(base or Path.home() / ".volviz") / "recovery"
+
+
 class MainWindow(QMainWindow):
     """volviz main window. ``open_path`` is the single code path behind File > Open and the command line."""
 
-    def __init__(self, parent: Optional[QWidget] = None):
+    def __init__(self, parent: Optional[QWidget] = None, settings: Optional[QSettings] = None,
+                 recovery_dir: Optional[Path] = None):
         super().__init__(parent)
         from pyvistaqt import QtInteractor
 
         self.setWindowTitle("volviz")
-        self.resize(1200, 800)
+        self.resize(1280, 820)
+        self.settings = settings or QSettings("volviz", "volviz")
+        self.recovery_dir = Path(recovery_dir) if recovery_dir else default_recovery_dir()
         self.plotter = QtInteractor(self)
         self.setCentralWidget(self.plotter.interactor)
         self.jobs = JobBridge(self)
@@ -40,17 +66,67 @@ class MainWindow(QMainWindow):
         self.session: Session = Session()
         self.session_path: Optional[Path] = None
         self.datasets: dict[str, Any] = {}
+        self.controller: Optional[Any] = None
         self.error_dialog: Optional[QMessageBox] = None
+        self.recovery_dialog: Optional[QMessageBox] = None
+        self.dirty = False
+        self.last_stats: dict[str, Any] = {}
         self._current_job = None
+        self._pending_tf: Optional[tuple[str, Any]] = None
+        self._recording: Optional[list[CameraKey]] = None
+        self._record_start = 0.0
+
+        self._build_docks()
         self._build_menus()
         self._build_status_bar()
+        self.fly = FlyMode(self.plotter, on_camera_moved=self._camera_moved)
+
+        self.preview_timer = QTimer(self, singleShot=True, interval=PREVIEW_MS)
+        self.preview_timer.timeout.connect(self._apply_pending_tf)
+        self.autosave_timer = QTimer(self, interval=AUTOSAVE_MS)
+        self.autosave_timer.timeout.connect(self.autosave)
+        self.autosave_timer.start()
+        self.record_timer = QTimer(self, interval=RECORD_MS)
+        self.record_timer.timeout.connect(self._record_sample)
 
     # ------------------------------------------------------------------------------------------------ construction
+    def _dock(self, title: str, name: str, widget: QWidget, area: Qt.DockWidgetArea) -> QDockWidget:
+        dock = QDockWidget(title, self)
+        dock.setObjectName(name)
+        dock.setWidget(widget)
+        self.addDockWidget(area, dock)
+        return dock
+
+    def _build_docks(self) -> None:
+        self.tf_editor = TransferFunctionEditor()
+        self.scene_tree = SceneTree()
+        self.render_settings = RenderSettings()
+        self.timeline = Timeline()
+        self.statistics = Statistics()
+        right, left, bottom = (Qt.DockWidgetArea.RightDockWidgetArea, Qt.DockWidgetArea.LeftDockWidgetArea,
+                               Qt.DockWidgetArea.BottomDockWidgetArea)
+        self.tf_dock = self._dock("Transfer function", "tfDock", self.tf_editor, right)
+        self.scene_dock = self._dock("Scene", "sceneDock", self.scene_tree, left)
+        self.settings_dock = self._dock("Render settings", "settingsDock", self.render_settings, left)
+        self.timeline_dock = self._dock("Timeline", "timelineDock", self.timeline, bottom)
+        self.stats_dock = self._dock("Statistics", "statsDock", self.statistics, right)
+        self.docks = [self.tf_dock, self.scene_dock, self.settings_dock, self.timeline_dock, self.stats_dock]
+
+        self.tf_editor.changed.connect(self._tf_changed)
+        self.tf_editor.committed.connect(self._tf_committed)
+        self.scene_tree.componentSelected.connect(self._select_component)
+        self.scene_tree.visibilityChanged.connect(self._set_visibility)
+        self.scene_tree.opacityChanged.connect(self._set_opacity)
+        self.render_settings.changed.connect(self._settings_changed)
+        self.timeline.timeChanged.connect(self._time_changed)
+        self.timeline.interpolationToggled.connect(self._interpolation_toggled)
+
     def _build_menus(self) -> None:
         file_menu = self.menuBar().addMenu("&File")
         self.action_open_data = self._action(file_menu, "Open &Data…", QKeySequence.StandardKey.Open,
                                              self._ask_open_data)
         self.action_open_session = self._action(file_menu, "Open &Session…", "Ctrl+Shift+O", self._ask_open_session)
+        self.recent_menu = file_menu.addMenu("Open &Recent")
         self.action_save_session = self._action(file_menu, "&Save Session", QKeySequence.StandardKey.Save,
                                                 self._save_session)
         self.action_save_session_as = self._action(file_menu, "Save Session &As…", QKeySequence.StandardKey.SaveAs,
@@ -58,8 +134,33 @@ class MainWindow(QMainWindow):
         file_menu.addSeparator()
         self.action_export_screenshot = self._action(file_menu, "&Export Screenshot…", "Ctrl+E",
                                                      self._ask_export_screenshot)
+        self.action_export_movie = self._action(file_menu, "Export &Movie…", "Ctrl+Shift+E", self._ask_export_movie)
         file_menu.addSeparator()
         self._action(file_menu, "&Quit", QKeySequence.StandardKey.Quit, self.close)
+
+        edit_menu = self.menuBar().addMenu("&Edit")
+        undo = self.tf_editor.undo_stack.createUndoAction(self, "&Undo")
+        undo.setShortcut(QKeySequence.StandardKey.Undo)
+        redo = self.tf_editor.undo_stack.createRedoAction(self, "&Redo")
+        redo.setShortcut(QKeySequence.StandardKey.Redo)
+        edit_menu.addAction(undo)
+        edit_menu.addAction(redo)
+
+        view_menu = self.menuBar().addMenu("&View")
+        for dock in self.docks:
+            view_menu.addAction(dock.toggleViewAction())
+        view_menu.addSeparator()
+        self.action_fly = self._action(view_menu, "&Fly Mode", "F", self.set_fly_mode)
+        self.action_fly.setCheckable(True)
+        self._action(view_menu, "&Reset Camera", "R", self.reset_camera)
+
+        camera_menu = self.menuBar().addMenu("&Camera")
+        self._action(camera_menu, "Add &Bookmark…", "Ctrl+B", self._ask_bookmark)
+        self.bookmark_menu = camera_menu.addMenu("Go to Bookmark")
+        camera_menu.addSeparator()
+        self.action_record = self._action(camera_menu, "&Record Camera Path", "Ctrl+R", self.set_recording)
+        self.action_record.setCheckable(True)
+        self._refresh_recent_menu()
 
     def _action(self, menu: Any, text: str, shortcut: Any, slot: Any) -> QAction:
         action = QAction(text, self)
@@ -106,8 +207,10 @@ class MainWindow(QMainWindow):
             self._show_session(session, p, p.name)
         else:
             self._show_session(data_session(p), None, p.name)
+        self._add_recent(p)
 
-    def _show_session(self, session: Session, session_path: Optional[Path], title: str) -> None:
+    def _show_session(self, session: Session, session_path: Optional[Path], title: str,
+                      dirty: bool = False) -> None:
         from volviz.render.scene import load_datasets
 
         self.status_label.setText(f"Loading {title}…")
@@ -122,33 +225,194 @@ class MainWindow(QMainWindow):
                 self.status_label.setText(f"Could not load {title}")
                 self.show_error(f"Cannot open {title}", str(outcome.error))
                 return
-            self._install_session(session, session_path, outcome.result, title)
+            self._install_session(session, session_path, outcome.result, title, dirty)
 
         self._current_job = self.jobs.submit(load_datasets, session, session_path, name=f"load {title}", key="load",
                                              on_done=done)
 
     def _install_session(self, session: Session, session_path: Optional[Path], datasets: dict[str, Any],
-                         title: str) -> None:
-        from volviz.render.scene import build_scene
+                         title: str, dirty: bool) -> None:
+        from volviz.render.controller import SceneController
 
         self.plotter.clear()
+        controller = SceneController(self.plotter, session, datasets)
         try:
-            build_scene(self.plotter, session, datasets)
+            controller.build()
         except Exception as exc:  # a scene that cannot be shown must not take the window down
             log.exception("building the scene for %s failed", title)
+            self.plotter.clear()
             self.show_error(f"Cannot show {title}", str(exc))
             return
-        self.session, self.session_path, self.datasets = session, session_path, datasets
+        self.session, self.session_path, self.datasets, self.controller = session, session_path, datasets, controller
         if "window_state" in session.layout:
             self.restoreState(QByteArray.fromBase64(session.layout["window_state"].encode("ascii")))
-        self.plotter.render()
-        self.setWindowTitle(f"volviz — {title}")
+        self.scene_tree.populate(session.components)
+        self.render_settings.load(session.render)
+        self.timeline.set_steps(controller.time_steps())
+        self._refresh_bookmark_menu()
+        self.title = title
+        self.set_dirty(dirty)
+        self.render()
         self.status_label.setText(f"Showing {title}")
+
+    # ------------------------------------------------------------------------------------------------ rendering
+    def render(self) -> None:
+        start = time.perf_counter()
+        self.plotter.render()
+        elapsed = time.perf_counter() - start
+        self.last_stats = {"frame_seconds": elapsed, "method": self.session.render.method,
+                           "cells": sum(getattr(d, "n_cells", 0) for d in self.datasets.values())}
+        self.statistics.show_stats(self.last_stats)
+
+    def set_dirty(self, dirty: bool = True) -> None:
+        self.dirty = dirty
+        name = self.session_path.name if self.session_path else getattr(self, "title", "untitled")
+        self.setWindowTitle(f"volviz — {name}{' *' if dirty else ''}")
+
+    # ------------------------------------------------------------------------------------------------ docks
+    def _select_component(self, comp_id: str) -> None:
+        if self.controller is None:
+            return
+        from volviz.model.stats import histogram
+
+        tf = self.controller.transfer_function(comp_id)
+        if tf is None:
+            return
+        dataset = self.controller.dataset_of(comp_id)
+        counts, edges = histogram(dataset)
+        self.tf_editor.set_transfer_function(tf, data_range=(float(edges[0]), float(edges[-1])),
+                                             histogram=(counts, edges))
+
+    def _tf_changed(self, tf: Any) -> None:
+        comp_id = self.scene_tree.current_component()
+        if comp_id is None or self.controller is None:
+            return
+        self._pending_tf = (comp_id, tf)
+        if not self.preview_timer.isActive():
+            self.preview_timer.start()
+
+    def _apply_pending_tf(self) -> None:
+        if self._pending_tf is None or self.controller is None:
+            return
+        comp_id, tf = self._pending_tf
+        self._pending_tf = None
+        self.controller.set_transfer_function(comp_id, tf)
+        self.render()
+
+    def _tf_committed(self, tf: Any) -> None:
+        self._tf_changed(tf)
+        self.set_dirty()
+
+    def _set_visibility(self, comp_id: str, visible: bool) -> None:
+        if self.controller is not None:
+            self.controller.set_visible(comp_id, visible)
+            self.set_dirty()
+            self.render()
+
+    def _set_opacity(self, comp_id: str, opacity: float) -> None:
+        if self.controller is not None:
+            self.controller.set_opacity(comp_id, opacity)
+            self.set_dirty()
+            self.render()
+
+    def _settings_changed(self, values: dict[str, Any]) -> None:
+        self.session.render.method = values["method"]
+        self.session.render.size = values["size"]
+        self.session.render.options.update(values["options"])
+        self.set_dirty()
+
+    def _time_changed(self, t: float) -> None:
+        if self.controller is not None and self.controller.time_series():
+            self.controller.set_time(t)
+            self.render()
+
+    def _interpolation_toggled(self, on: bool) -> None:
+        if self.controller is not None:
+            self.controller.set_time(self.timeline.time, interpolate=on)
+            self.render()
+
+    # ------------------------------------------------------------------------------------------------ navigation
+    def set_fly_mode(self, enabled: bool) -> None:
+        bounds = self.plotter.bounds
+        size = max(bounds[1] - bounds[0], bounds[3] - bounds[2], bounds[5] - bounds[4], 1e-9)
+        self.fly.set_enabled(enabled, size)
+        self.action_fly.setChecked(enabled)
+        self.status_label.setText("Fly mode: W/A/S/D or arrows move, Q/E sink/rise, drag to look, +/- speed"
+                                  if enabled else "Orbit mode")
+        if enabled:
+            self.plotter.interactor.setFocus()
+
+    def reset_camera(self) -> None:
+        if self.controller is not None:
+            self.controller.set_camera(None)
+            self.render()
+
+    def _camera_moved(self) -> None:
+        self.render()
+
+    def add_bookmark(self, name: str) -> None:
+        if self.controller is None:
+            return
+        self.session.bookmarks[name] = self.controller.camera()
+        self._refresh_bookmark_menu()
+        self.set_dirty()
+
+    def go_to_bookmark(self, name: str) -> None:
+        if self.controller is not None and name in self.session.bookmarks:
+            self.controller.set_camera(self.session.bookmarks[name])
+            self.render()
+
+    def _ask_bookmark(self) -> None:
+        name, ok = QInputDialog.getText(self, "Add bookmark", "Name:", text=f"view {len(self.session.bookmarks) + 1}")
+        if ok and name:
+            self.add_bookmark(name)
+
+    def _refresh_bookmark_menu(self) -> None:
+        self.bookmark_menu.clear()
+        for name in self.session.bookmarks:
+            action = self.bookmark_menu.addAction(name)
+            action.triggered.connect(lambda checked=False, n=name: self.go_to_bookmark(n))
+        self.bookmark_menu.setEnabled(bool(self.session.bookmarks))
+
+    def set_recording(self, recording: bool) -> Optional[str]:
+        """Start or stop recording a camera path; stopping stores it in the session and returns its name."""
+        self.action_record.setChecked(recording)
+        if recording and self.controller is not None:
+            self._recording = []
+            self._record_start = time.perf_counter()
+            self._record_sample()
+            self.record_timer.start()
+            self.status_label.setText("Recording camera path…")
+            return None
+        self.record_timer.stop()
+        keys, self._recording = self._recording, None
+        if not keys:
+            return None
+        self._record_sample_into(keys)
+        if len(keys) < 2:
+            return None
+        name = f"path {len(self.session.camera_paths) + 1}"
+        self.session.camera_paths[name] = keys
+        self.set_dirty()
+        self.status_label.setText(f"Recorded camera path {name!r} ({len(keys)} keys, {keys[-1].time:.1f} s)")
+        return name
+
+    def _record_sample(self) -> None:
+        if self._recording is not None:
+            self._record_sample_into(self._recording)
+
+    def _record_sample_into(self, keys: list[CameraKey]) -> None:
+        if self.controller is None:
+            return
+        t = time.perf_counter() - self._record_start
+        cam = self.controller.camera()
+        if keys and (t <= keys[-1].time or cam == keys[-1].camera):
+            return
+        keys.append(CameraKey(t, cam))
 
     # ------------------------------------------------------------------------------------------------ saving
     def capture_session(self, target: Path) -> Session:
         """The current state as a session to be saved at ``target`` (paths made relative to it)."""
-        from volviz.render.vtk_scene import camera_state
         from volviz.session import DatasetRef, resolve_path
 
         session = self.session
@@ -158,9 +422,10 @@ class MainWindow(QMainWindow):
             refs.append(DatasetRef(ref.id, relative_path(target, absolute), dict(ref.options)))
         layout = dict(session.layout)
         layout["window_state"] = bytes(self.saveState().toBase64()).decode("ascii")
+        camera = self.controller.camera() if self.controller is not None else session.camera
         return Session(datasets=refs, components=session.components, transfer_functions=session.transfer_functions,
-                       camera=camera_state(self.plotter), camera_paths=session.camera_paths,
-                       bookmarks=session.bookmarks, render=session.render, layout=layout)
+                       camera=camera, camera_paths=session.camera_paths, bookmarks=session.bookmarks,
+                       render=session.render, layout=layout)
 
     def save_session(self, path: str | os.PathLike) -> bool:
         from volviz.session import save
@@ -173,22 +438,110 @@ class MainWindow(QMainWindow):
             self.show_error("Cannot save session", str(exc))
             return False
         self.session, self.session_path = session, target
+        if self.controller is not None:
+            self.controller.session = session
+        self._add_recent(target)
+        self.set_dirty(False)
+        self.clear_recovery()
         self.status_label.setText(f"Saved {target.name}")
         return True
 
+    # -- autosave and recovery ------------------------------------------------------------------------------------
+    @property
+    def recovery_file(self) -> Path:
+        return self.recovery_dir / "recovery.json"
+
+    def autosave(self) -> bool:
+        """Write the current state to the recovery file (only when there are unsaved changes)."""
+        if not self.dirty or self.controller is None:
+            return False
+        from volviz.session import save
+
+        self.recovery_dir.mkdir(parents=True, exist_ok=True)
+        session = self.capture_session(self.recovery_file)
+        session.layout["recovered_from"] = str(self.session_path) if self.session_path else ""
+        try:
+            save(session, self.recovery_file)
+        except SessionError as exc:
+            log.error("autosave failed: %s", exc)
+            return False
+        self.status_label.setText("Autosaved")
+        return True
+
+    def clear_recovery(self) -> None:
+        self.recovery_file.unlink(missing_ok=True)
+
+    def offer_recovery(self) -> bool:
+        """If a previous run left a recovery file, ask (without blocking) whether to restore it."""
+        if not self.recovery_file.exists():
+            return False
+        box = QMessageBox(QMessageBox.Icon.Question, "Recover unsaved work",
+                          "volviz did not shut down cleanly last time. Restore the unsaved work it kept?",
+                          QMessageBox.StandardButton.Yes | QMessageBox.StandardButton.No, self)
+        box.finished.connect(lambda result: self._recovery_answer(box.result()))
+        box.open()
+        self.recovery_dialog = box
+        return True
+
+    def _recovery_answer(self, result: int) -> None:
+        if result == QMessageBox.StandardButton.Yes:
+            self.recover()
+        else:
+            self.clear_recovery()
+
+    def recover(self) -> None:
+        from volviz.session import load
+
+        try:
+            session = load(self.recovery_file)
+        except SessionError as exc:
+            self.show_error("Cannot recover", str(exc))
+            return
+        origin = session.layout.pop("recovered_from", "")
+        if origin:  # keep paths valid relative to the original session file when saved there again
+            from volviz.session import resolve_path
+
+            for ref in session.datasets:
+                ref.path = relative_path(origin, resolve_path(self.recovery_file, ref.path))
+        self._show_session(session, Path(origin) if origin else None, "recovered session", dirty=True)
+
+    # -- recent files ------------------------------------------------------------------------------------------------
+    def recent_files(self) -> list[str]:
+        value = self.settings.value("recent_files", [])
+        if isinstance(value, str):
+            value = [value]
+        return [str(v) for v in (value or [])]
+
+    def _add_recent(self, path: Path) -> None:
+        entry = str(Path(path).resolve())
+        files = [entry] + [f for f in self.recent_files() if f != entry]
+        self.settings.setValue("recent_files", files[:MAX_RECENT])
+        self._refresh_recent_menu()
+
+    def _refresh_recent_menu(self) -> None:
+        self.recent_menu.clear()
+        for f in self.recent_files():
+            action = self.recent_menu.addAction(f)
+            action.triggered.connect(lambda checked=False, p=f: self.open_path(p))
+        self.recent_menu.setEnabled(bool(self.recent_files()))
+
+    # ------------------------------------------------------------------------------------------------ export
     def export_screenshot(self, path: str | os.PathLike, size: Optional[tuple[int, int]] = None) -> bool:
         """Re-render the current view offscreen at ``size`` (default: the viewport's) and write a PNG."""
+        from volviz.render.controller import SceneController
         from volviz.render.export import offscreen_plotter, write_png
-        from volviz.render.scene import build_scene
-        from volviz.render.vtk_scene import camera_state
 
         width, height = size or (self.plotter.interactor.width(), self.plotter.interactor.height())
         plotter = offscreen_plotter((width, height))
         try:
             session = Session(datasets=self.session.datasets, components=self.session.components,
-                              transfer_functions=self.session.transfer_functions, camera=camera_state(self.plotter),
+                              transfer_functions=self.session.transfer_functions,
+                              camera=self.controller.camera() if self.controller else None,
                               render=self.session.render)
-            build_scene(plotter, session, self.datasets)
+            controller = SceneController(plotter, session, self.datasets)
+            controller.build()
+            if self.controller is not None and self.controller.time_series():
+                controller.set_time(self.controller.time, self.controller.interpolate_time)
             image = plotter.screenshot(None, return_img=True, window_size=[width, height])
             write_png(image, path)
         except Exception as exc:
@@ -198,6 +551,45 @@ class MainWindow(QMainWindow):
         finally:
             plotter.close()
         self.status_label.setText(f"Exported {Path(path).name} ({width}x{height})")
+        return True
+
+    def export_movie(self, path: str | os.PathLike, path_name: Optional[str], through_time: bool,
+                     fps: float = 24.0, size: Optional[tuple[int, int]] = None) -> bool:
+        """Render a movie offscreen along a camera path and/or through time, with a cancellable progress dialog."""
+        from volviz.jobs import Cancelled
+        from volviz.render.export import render_movie
+
+        if self.session_path is None and self.session.datasets:
+            self.show_error("Cannot export movie", "save the session first: the movie is rendered from it")
+            return False
+        size = size or self.session.render.size
+        dialog = QProgressDialog("Rendering movie…", "Cancel", 0, 1000, self)
+        dialog.setWindowModality(Qt.WindowModality.WindowModal)
+        dialog.setMinimumDuration(0)
+
+        def progress(fraction: float, message: str) -> None:
+            dialog.setValue(int(fraction * 1000))
+            dialog.setLabelText(message)
+            from PySide6.QtWidgets import QApplication
+
+            QApplication.processEvents()
+            if dialog.wasCanceled():
+                raise Cancelled()
+
+        session = self.capture_session(self.session_path or Path(path))
+        try:
+            render_movie(session, self.session_path, path, size, path_name=path_name, fps=fps,
+                         through_time=through_time, progress=progress)
+        except Cancelled:
+            self.status_label.setText("Movie export cancelled")
+            return False
+        except Exception as exc:
+            log.exception("movie export failed")
+            self.show_error("Cannot export movie", f"{path}: {exc}")
+            return False
+        finally:
+            dialog.close()
+        self.status_label.setText(f"Exported movie {Path(path).name}")
         return True
 
     # ------------------------------------------------------------------------------------------------ dialogs
@@ -211,21 +603,33 @@ class MainWindow(QMainWindow):
         if path:
             self.open_path(path)
 
-    def _save_session(self) -> None:
+    def _save_session(self) -> bool:
         if self.session_path is None:
-            self._ask_save_session_as()
-        else:
-            self.save_session(self.session_path)
+            return self._ask_save_session_as()
+        return self.save_session(self.session_path)
 
-    def _ask_save_session_as(self) -> None:
+    def _ask_save_session_as(self) -> bool:
         path, _ = QFileDialog.getSaveFileName(self, "Save session", "session.json", "volviz sessions (*.json)")
-        if path:
-            self.save_session(path)
+        return bool(path) and self.save_session(path)
 
     def _ask_export_screenshot(self) -> None:
         path, _ = QFileDialog.getSaveFileName(self, "Export screenshot", "volviz.png", "PNG images (*.png)")
         if path:
-            self.export_screenshot(path)
+            self.export_screenshot(path, self.session.render.size)
+
+    def _ask_export_movie(self) -> None:
+        paths = list(self.session.camera_paths)
+        through_time = bool(self.controller and self.controller.time_series())
+        if not paths and not through_time:
+            self.show_error("Cannot export movie", "record a camera path (Camera menu) or open a time series first")
+            return
+        choices = paths + (["(through time)"] if through_time else [])
+        choice, ok = QInputDialog.getItem(self, "Export movie", "Camera path:", choices, 0, False)
+        if not ok:
+            return
+        path, _ = QFileDialog.getSaveFileName(self, "Export movie", "volviz.mp4", "MP4 video (*.mp4)")
+        if path:
+            self.export_movie(path, None if choice == "(through time)" else choice, choice == "(through time)")
 
     def show_error(self, title: str, text: str) -> None:
         """A non-blocking error dialog (the app keeps running); also logged."""
@@ -251,7 +655,24 @@ class MainWindow(QMainWindow):
         if self._current_job is not None:
             self._current_job.cancel()
 
+    # ------------------------------------------------------------------------------------------------ closing
+    def ask_unsaved_changes(self) -> QMessageBox.StandardButton:
+        box = QMessageBox(QMessageBox.Icon.Warning, "Unsaved changes", "Save the changes to this session?",
+                          QMessageBox.StandardButton.Save | QMessageBox.StandardButton.Discard
+                          | QMessageBox.StandardButton.Cancel, self)
+        self.unsaved_dialog = box
+        return QMessageBox.StandardButton(box.exec())
+
     def closeEvent(self, event: Any) -> None:
+        if self.dirty:
+            answer = self.ask_unsaved_changes()
+            if answer == QMessageBox.StandardButton.Cancel or (
+                    answer == QMessageBox.StandardButton.Save and not self._save_session()):
+                event.ignore()
+                return
+        self.clear_recovery()
+        self.autosave_timer.stop()
+        self.timeline.set_playing(False)
         self.jobs.shutdown()
         self.plotter.close()
         super().closeEvent(event)

@@ -50,6 +50,10 @@ def build_parser() -> argparse.ArgumentParser:
     render.add_argument("target", help="a session (.json), a data file, or 'demo'")
     render.add_argument("-o", "--output", required=True, help="output PNG")
     render.add_argument("--size", type=_size, default=None, help="WIDTHxHEIGHT (default: the session's, or 1024x768)")
+    render.add_argument("--path", default=None, help="render a movie along this recorded camera path")
+    render.add_argument("--time", action="store_true", help="render a movie through the time series")
+    render.add_argument("--fps", type=float, default=24.0, help="movie frames per second (default 24)")
+    render.add_argument("--duration", type=float, default=None, help="movie length in seconds (default: the path's)")
 
     bench = sub.add_parser("bench", help="speed-against-error benchmarks", add_help=False)
     bench.add_argument("name", choices=BENCHMARKS)
@@ -121,17 +125,28 @@ def run(argv: Optional[Sequence[str]] = None) -> int:
 
 
 def _render(args: argparse.Namespace) -> int:
-    from volviz.render.export import is_session_file, render_to_png
+    from volviz.render.export import is_session_file, render_movie, render_to_png
+    from volviz.session import load
 
-    size = args.size
-    if size is None:
-        size = (1024, 768)
-        target = Path(args.target)
-        if is_session_file(target):
-            from volviz.session import load
+    target = Path(args.target)
+    session = load(target) if is_session_file(target) else None
+    size = args.size or (session.render.size if session is not None else (1024, 768))
+    movie = args.path is not None or args.time or Path(args.output).suffix.lower() in (".mp4", ".m4v", ".mov")
+    if not movie:
+        out = render_to_png(args.target, args.output, size)
+        print(f"wrote {out} ({size[0]}x{size[1]})")
+        return 0
+    if session is None:
+        raise UsageError("movies are rendered from a session file (camera paths and time live there)")
+    if args.fps <= 0:
+        raise UsageError(f"--fps must be positive, got {args.fps}")
 
-            size = load(target).render.size
-    out = render_to_png(args.target, args.output, size)
+    def progress(fraction: float, message: str) -> None:
+        print(f"\r{message} ({fraction:4.0%})", end="", file=sys.stderr, flush=True)
+
+    out = render_movie(session, target, args.output, size, path_name=args.path, fps=args.fps,
+                       through_time=args.time, duration=args.duration, progress=progress)
+    print(file=sys.stderr)
     print(f"wrote {out} ({size[0]}x{size[1]})")
     return 0
 

@@ -30,13 +30,14 @@ def write_png(image: np.ndarray, path: str | os.PathLike) -> None:
 def render_session(session: Session, session_file: Optional[str | os.PathLike], size: tuple[int, int],
                    progress: Optional[ProgressCallback] = None) -> np.ndarray:
     """Render a session offscreen; returns the (H, W, 3) uint8 image."""
-    from volviz.render.scene import build_scene, load_datasets
+    from volviz.render.controller import SceneController
+    from volviz.render.scene import load_datasets
 
     datasets = load_datasets(session, session_file, progress)
     report(progress, 0.8, "rendering")
     plotter = offscreen_plotter(size)
     try:
-        build_scene(plotter, session, datasets)
+        SceneController(plotter, session, datasets).build()
         image = plotter.screenshot(None, return_img=True, window_size=[int(size[0]), int(size[1])])
     finally:
         plotter.close()
@@ -69,3 +70,99 @@ def is_session_file(path: Path) -> bool:
     with open(path, "rb") as handle:
         head = handle.read(4096)
     return b"volviz-session" in head
+
+
+def movie_frames(controller: Any, path_name: Optional[str], fps: float, through_time: bool,
+                 duration: Optional[float] = None) -> list[tuple[Optional[Any], Optional[float]]]:
+    """(camera, display time) for every frame: along a recorded camera path, through the time series, or both."""
+    from volviz.render.camera_path import frame_times, interpolate_path
+
+    session = controller.session
+    cameras: list[Optional[Any]] = [None]
+    if path_name is not None:
+        if path_name not in session.camera_paths:
+            from volviz.render.scene import SceneError
+
+            known = ", ".join(sorted(session.camera_paths)) or "none"
+            raise SceneError(f"the session has no camera path named {path_name!r} (it has: {known})")
+        keys = session.camera_paths[path_name]
+        cameras = [interpolate_path(keys, t) for t in frame_times(keys, fps, duration)]
+    times: list[Optional[float]] = [None]
+    span = controller.time_span()
+    if through_time and span is not None:
+        n = len(cameras) if len(cameras) > 1 else max(int(round((duration or (span[1] - span[0])) * fps)) + 1, 2)
+        times = [span[0] + (span[1] - span[0]) * i / (n - 1) for i in range(n)]
+    n = max(len(cameras), len(times))
+    return [(cameras[min(i, len(cameras) - 1)], times[min(i, len(times) - 1)]) for i in range(n)]
+
+
+def render_movie(session: Session, session_file: Optional[str | os.PathLike], out: str | os.PathLike,
+                 size: tuple[int, int], path_name: Optional[str] = None, fps: float = 24.0,
+                 through_time: bool = False, duration: Optional[float] = None,
+                 progress: Optional[ProgressCallback] = None) -> Path:
+    """Render a movie offscreen: MP4 (H.264 through imageio-ffmpeg) for ``.mp4``, else a PNG sequence in the folder
+    ``out`` (frame_00000.png, ...). The MP4 is written to a temporary file and renamed when complete."""
+    from volviz.render.controller import SceneController
+    from volviz.render.scene import load_datasets
+
+    datasets = load_datasets(session, session_file)
+    plotter = offscreen_plotter(size)
+    target = Path(out)
+    try:
+        controller = SceneController(plotter, session, datasets)
+        controller.build()
+        frames = movie_frames(controller, path_name, fps, through_time, duration)
+        writer = _MovieWriter(target, fps)
+        try:
+            for i, (camera, t) in enumerate(frames):
+                if camera is not None:
+                    controller.set_camera(camera)
+                if t is not None:
+                    controller.set_time(t)
+                image = plotter.screenshot(None, return_img=True, window_size=[int(size[0]), int(size[1])])
+                writer.append(np.asarray(image))
+                report(progress, (i + 1) / len(frames), f"frame {i + 1} of {len(frames)}")
+        except BaseException:
+            writer.abort()
+            raise
+        writer.close()
+    finally:
+        plotter.close()
+    return target
+
+
+class _MovieWriter:
+    """MP4 through imageio-ffmpeg (to a temporary name, renamed at the end) or a PNG sequence in a folder."""
+
+    def __init__(self, target: Path, fps: float):
+        self.target = target
+        self.count = 0
+        self.mp4 = target.suffix.lower() in (".mp4", ".m4v", ".mov")
+        if self.mp4:
+            import imageio.v2 as iio2
+
+            self.tmp = target.with_name(f".{target.name}.partial{target.suffix}")
+            self.writer = iio2.get_writer(self.tmp, format="FFMPEG", mode="I", fps=fps, codec="libx264",
+                                          quality=8, pixelformat="yuv420p", macro_block_size=2)
+        else:
+            target.mkdir(parents=True, exist_ok=True)
+
+    def append(self, image: np.ndarray) -> None:
+        if self.mp4:
+            h, w = image.shape[:2]
+            self.writer.append_data(image[: h - h % 2, : w - w % 2, :3])
+        else:
+            write_png(image, self.target / f"frame_{self.count:05d}.png")
+        self.count += 1
+
+    def close(self) -> None:
+        if self.mp4:
+            self.writer.close()
+            os.replace(self.tmp, self.target)
+
+    def abort(self) -> None:
+        if self.mp4:
+            try:
+                self.writer.close()
+            finally:
+                self.tmp.unlink(missing_ok=True)

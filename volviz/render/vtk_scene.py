@@ -86,6 +86,22 @@ def default_transfer_function_for(dataset: Any, name: str = "default") -> Any:
     return default_transfer_function(rng, bounds_diagonal(grid.bounds), name)
 
 
+def volume_input(dataset: Any) -> Any:
+    """The VTK data object a volume mapper draws for ``dataset`` (tetrahedralised for non-image grids)."""
+    import vtk
+
+    grid = volume_grid(dataset)
+    if isinstance(dataset, RegularVolume):
+        return grid
+    if isinstance(dataset, TetMesh):
+        return grid
+    ugrid = grid if grid.GetDataObjectType() == vtk.VTK_UNSTRUCTURED_GRID else grid.cast_to_unstructured_grid()
+    tets = vtk.vtkDataSetTriangleFilter()
+    tets.SetInputData(ugrid)
+    tets.Update()
+    return tets.GetOutput()
+
+
 def add_dataset(plotter: Any, dataset: Any, tf: Any = None, opacity: float = 1.0, name: Optional[str] = None) -> Any:
     """Add a dataset to ``plotter`` as its default visual (a volume with ``tf``); returns the VTK prop."""
     import vtk
@@ -100,17 +116,8 @@ def add_dataset(plotter: Any, dataset: Any, tf: Any = None, opacity: float = 1.0
         return plotter.add_mesh(grid, opacity=opacity, name=name)
     if tf is None:
         tf = default_transfer_function(grid.get_data_range(), bounds_diagonal(grid.bounds))
-
-    if isinstance(dataset, RegularVolume):
-        mapper = vtk.vtkSmartVolumeMapper()
-        mapper.SetInputData(grid)
-    else:
-        ugrid = grid if grid.GetDataObjectType() == vtk.VTK_UNSTRUCTURED_GRID else grid.cast_to_unstructured_grid()
-        tets = vtk.vtkDataSetTriangleFilter()
-        tets.SetInputData(ugrid)
-        tets.Update()
-        mapper = vtk.vtkProjectedTetrahedraMapper()
-        mapper.SetInputData(tets.GetOutput())
+    mapper = vtk.vtkSmartVolumeMapper() if isinstance(dataset, RegularVolume) else vtk.vtkProjectedTetrahedraMapper()
+    mapper.SetInputData(volume_input(dataset))
     volume = vtk.vtkVolume()
     volume.SetMapper(mapper)
     volume.SetProperty(vtk_volume_property(tf, opacity))

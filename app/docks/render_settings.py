@@ -1,0 +1,76 @@
+"""Render settings dock: renderer method, table kind and resolution, sort mode, error budget, export image size."""
+from __future__ import annotations
+
+from typing import Any, Optional
+
+from PySide6.QtCore import Signal
+from PySide6.QtWidgets import QComboBox, QDoubleSpinBox, QFormLayout, QSpinBox, QWidget
+
+METHODS = ("auto", "pt", "reference", "vtk")
+TABLE_KINDS = ("3d", "2d", "separable-1", "separable-2", "separable-4")
+SORTS = ("centroid", "mpvo", "exact")
+
+
+class RenderSettings(QWidget):
+    """Edits ``session.render``; emits ``changed(dict)`` with the new settings."""
+
+    changed = Signal(dict)
+
+    def __init__(self, parent: Optional[QWidget] = None):
+        super().__init__(parent)
+        self.method = QComboBox()
+        self.method.addItems(METHODS)
+        self.table_kind = QComboBox()
+        self.table_kind.addItems(TABLE_KINDS)
+        self.table_resolution = QComboBox()
+        self.table_resolution.addItems(["64", "128", "256", "512"])
+        self.table_resolution.setCurrentText("128")
+        self.sort = QComboBox()
+        self.sort.addItems(SORTS)
+        self.sort.setCurrentText("mpvo")
+        self.error_budget = QDoubleSpinBox()
+        self.error_budget.setRange(0.0, 64.0)
+        self.error_budget.setSingleStep(0.5)
+        self.error_budget.setValue(1.0)
+        self.error_budget.setSuffix(" /255 RMSE")
+        self.width_box = QSpinBox()
+        self.height_box = QSpinBox()
+        for box in (self.width_box, self.height_box):
+            box.setRange(16, 16384)
+        self.width_box.setValue(1024)
+        self.height_box.setValue(768)
+        form = QFormLayout(self)
+        form.addRow("Renderer", self.method)
+        form.addRow("Table", self.table_kind)
+        form.addRow("Table resolution", self.table_resolution)
+        form.addRow("Sort", self.sort)
+        form.addRow("Error budget", self.error_budget)
+        form.addRow("Export width", self.width_box)
+        form.addRow("Export height", self.height_box)
+        for combo in (self.method, self.table_kind, self.table_resolution, self.sort):
+            combo.currentTextChanged.connect(self._emit)
+        for box in (self.error_budget, self.width_box, self.height_box):
+            box.valueChanged.connect(self._emit)
+        self._loading = False
+
+    def settings(self) -> dict[str, Any]:
+        return {"method": self.method.currentText(), "size": (self.width_box.value(), self.height_box.value()),
+                "options": {"table": self.table_kind.currentText(),
+                            "table_resolution": int(self.table_resolution.currentText()),
+                            "sort": self.sort.currentText(), "error_budget": self.error_budget.value()}}
+
+    def load(self, render: Any) -> None:
+        self._loading = True
+        self.method.setCurrentText(render.method)
+        self.width_box.setValue(render.size[0])
+        self.height_box.setValue(render.size[1])
+        opts = render.options
+        self.table_kind.setCurrentText(str(opts.get("table", "3d")))
+        self.table_resolution.setCurrentText(str(opts.get("table_resolution", 128)))
+        self.sort.setCurrentText(str(opts.get("sort", "mpvo")))
+        self.error_budget.setValue(float(opts.get("error_budget", 1.0)))
+        self._loading = False
+
+    def _emit(self, *args: Any) -> None:
+        if not self._loading:
+            self.changed.emit(self.settings())

@@ -1,0 +1,82 @@
+"""Scene tree dock: the session's components with visibility check boxes and an opacity slider."""
+from __future__ import annotations
+
+from typing import Any, Optional
+
+from PySide6.QtCore import Qt, Signal
+from PySide6.QtWidgets import QHBoxLayout, QLabel, QSlider, QTreeWidget, QTreeWidgetItem, QVBoxLayout, QWidget
+
+KIND_LABELS = {"volume": "Volume", "mesh": "Mesh", "isosurface": "Isosurface", "terrain": "Terrain", "fog": "Ground fog",
+               "clouds": "Clouds", "sky": "Sky", "demo": "Demo volume"}
+
+
+class SceneTree(QWidget):
+    visibilityChanged = Signal(str, bool)
+    opacityChanged = Signal(str, float)
+    componentSelected = Signal(str)
+
+    def __init__(self, parent: Optional[QWidget] = None):
+        super().__init__(parent)
+        self.tree = QTreeWidget()
+        self.tree.setHeaderLabels(["Component", "Kind"])
+        self.tree.setRootIsDecorated(False)
+        self.opacity = QSlider(Qt.Orientation.Horizontal)
+        self.opacity.setRange(0, 100)
+        self.opacity.setEnabled(False)
+        self.opacity_label = QLabel("Opacity")
+        row = QHBoxLayout()
+        row.addWidget(self.opacity_label)
+        row.addWidget(self.opacity, 1)
+        layout = QVBoxLayout(self)
+        layout.addWidget(self.tree, 1)
+        layout.addLayout(row)
+        self.tree.itemChanged.connect(self._item_changed)
+        self.tree.currentItemChanged.connect(self._current_changed)
+        self.opacity.valueChanged.connect(self._opacity_moved)
+        self._filling = False
+
+    def populate(self, components: list[Any]) -> None:
+        self._filling = True
+        self.tree.clear()
+        for comp in components:
+            item = QTreeWidgetItem([comp.id, KIND_LABELS.get(comp.type, comp.type)])
+            item.setData(0, Qt.ItemDataRole.UserRole, comp.id)
+            item.setData(0, Qt.ItemDataRole.UserRole + 1, comp.opacity)
+            item.setFlags(item.flags() | Qt.ItemFlag.ItemIsUserCheckable)
+            item.setCheckState(0, Qt.CheckState.Checked if comp.visible else Qt.CheckState.Unchecked)
+            self.tree.addTopLevelItem(item)
+        self._filling = False
+        if self.tree.topLevelItemCount():
+            self.tree.setCurrentItem(self.tree.topLevelItem(0))
+
+    def item(self, comp_id: str) -> QTreeWidgetItem:
+        for i in range(self.tree.topLevelItemCount()):
+            item = self.tree.topLevelItem(i)
+            if item.data(0, Qt.ItemDataRole.UserRole) == comp_id:
+                return item
+        raise KeyError(comp_id)
+
+    def current_component(self) -> Optional[str]:
+        item = self.tree.currentItem()
+        return None if item is None else item.data(0, Qt.ItemDataRole.UserRole)
+
+    def _item_changed(self, item: QTreeWidgetItem, column: int) -> None:
+        if not self._filling and column == 0:
+            self.visibilityChanged.emit(item.data(0, Qt.ItemDataRole.UserRole),
+                                        item.checkState(0) == Qt.CheckState.Checked)
+
+    def _current_changed(self, current: Optional[QTreeWidgetItem], previous: Any) -> None:
+        self.opacity.setEnabled(current is not None)
+        if current is None:
+            return
+        self._filling = True
+        self.opacity.setValue(int(round(float(current.data(0, Qt.ItemDataRole.UserRole + 1)) * 100)))
+        self._filling = False
+        self.componentSelected.emit(current.data(0, Qt.ItemDataRole.UserRole))
+
+    def _opacity_moved(self, value: int) -> None:
+        item = self.tree.currentItem()
+        if self._filling or item is None:
+            return
+        item.setData(0, Qt.ItemDataRole.UserRole + 1, value / 100.0)
+        self.opacityChanged.emit(item.data(0, Qt.ItemDataRole.UserRole), value / 100.0)

@@ -1,0 +1,33 @@
+"""Statistics dock: frame time split, cells drawn, and the current method's measured error estimate."""
+from __future__ import annotations
+
+from typing import Any, Optional
+
+from PySide6.QtWidgets import QFormLayout, QLabel, QWidget
+
+
+class Statistics(QWidget):
+    FIELDS = (("frame", "Frame time"), ("split", "Sort / project / raster"), ("cells", "Cells drawn"),
+              ("method", "Method"), ("error", "Error estimate"))
+
+    def __init__(self, parent: Optional[QWidget] = None):
+        super().__init__(parent)
+        form = QFormLayout(self)
+        self.labels: dict[str, QLabel] = {}
+        for key, title in self.FIELDS:
+            self.labels[key] = QLabel("–")
+            form.addRow(title, self.labels[key])
+
+    def show_stats(self, stats: dict[str, Any]) -> None:
+        frame = stats.get("frame_seconds")
+        self.labels["frame"].setText("–" if frame is None else f"{frame * 1000:.1f} ms ({1.0 / max(frame, 1e-9):.1f} fps)")
+        split = [stats.get(k) for k in ("sort_seconds", "project_seconds", "raster_seconds")]
+        self.labels["split"].setText(" / ".join("–" if v is None else f"{v * 1000:.1f} ms" for v in split))
+        cells = stats.get("cells")
+        self.labels["cells"].setText("–" if cells is None else f"{cells:,}")
+        self.labels["method"].setText(str(stats.get("method", "–")))
+        error = stats.get("error")
+        self.labels["error"].setText("–" if error is None else str(error))
+
+    def text(self, key: str) -> str:
+        return self.labels[key].text()

@@ -1,0 +1,89 @@
+"""Fly-through mode for the viewport: WASD/arrow keys move, Q/E (or PgDn/PgUp) sink and rise, mouse drag looks
+around, +/- change speed. The motion itself is volviz.render.camera_path.FlyNavigator (Qt-free)."""
+from __future__ import annotations
+
+from typing import Any, Callable, Optional
+
+from PySide6.QtCore import QEvent, QObject, Qt
+
+from volviz.render.camera_path import FlyNavigator
+
+MOVES = {
+    Qt.Key.Key_W: (1, 0, 0), Qt.Key.Key_Up: (1, 0, 0),
+    Qt.Key.Key_S: (-1, 0, 0), Qt.Key.Key_Down: (-1, 0, 0),
+    Qt.Key.Key_D: (0, 1, 0), Qt.Key.Key_Right: (0, 1, 0),
+    Qt.Key.Key_A: (0, -1, 0), Qt.Key.Key_Left: (0, -1, 0),
+    Qt.Key.Key_E: (0, 0, 1), Qt.Key.Key_PageUp: (0, 0, 1),
+    Qt.Key.Key_Q: (0, 0, -1), Qt.Key.Key_PageDown: (0, 0, -1),
+}
+STEP_SECONDS = 0.05   # one key press (or auto-repeat) moves this much flight time
+LOOK_DEGREES_PER_PIXEL = 0.2
+
+
+class FlyMode(QObject):
+    """Event filter on the viewport widget. While enabled it consumes navigation keys and mouse drags, so VTK's own
+    key bindings (w = wireframe, q = quit, ...) never fire in fly mode."""
+
+    def __init__(self, plotter: Any, on_camera_moved: Optional[Callable[[], None]] = None):
+        super().__init__(plotter.interactor)
+        self.plotter = plotter
+        self.navigator = FlyNavigator()
+        self.enabled = False
+        self.on_camera_moved = on_camera_moved
+        self._last_mouse: Optional[Any] = None
+        plotter.interactor.installEventFilter(self)
+
+    def set_enabled(self, enabled: bool, scene_size: float = 1.0) -> None:
+        self.enabled = bool(enabled)
+        if enabled:
+            self.navigator.speed = max(scene_size, 1e-9) * 0.25  # cross a quarter of the scene per second
+
+    def set_ground(self, ground: Optional[Callable[[float, float], float]], clearance: float = 0.0) -> None:
+        self.navigator.ground = ground
+        self.navigator.clearance = clearance
+
+    def _camera(self) -> Any:
+        from volviz.render.vtk_scene import camera_state
+
+        return camera_state(self.plotter)
+
+    def _apply(self, cam: Any) -> None:
+        from volviz.render.vtk_scene import apply_camera
+
+        apply_camera(self.plotter, cam)
+        self.plotter.render()
+        if self.on_camera_moved is not None:
+            self.on_camera_moved()
+
+    def eventFilter(self, watched: QObject, event: QEvent) -> bool:
+        if not self.enabled:
+            return False
+        kind = event.type()
+        if kind == QEvent.Type.KeyPress:
+            key = event.key()
+            if key in MOVES:
+                f, r, u = MOVES[key]
+                self._apply(self.navigator.move(self._camera(), f, r, u, STEP_SECONDS))
+                return True
+            if key in (Qt.Key.Key_Plus, Qt.Key.Key_Equal):
+                self.navigator.speed *= 1.5
+                return True
+            if key == Qt.Key.Key_Minus:
+                self.navigator.speed /= 1.5
+                return True
+            return True  # no VTK key bindings while flying
+        if kind == QEvent.Type.KeyRelease:
+            return True
+        if kind == QEvent.Type.MouseButtonPress:
+            self._last_mouse = event.position()
+            return True
+        if kind == QEvent.Type.MouseMove and self._last_mouse is not None:
+            pos = event.position()
+            dx, dy = pos.x() - self._last_mouse.x(), pos.y() - self._last_mouse.y()
+            self._last_mouse = pos
+            self._apply(self.navigator.look(self._camera(), dx * LOOK_DEGREES_PER_PIXEL, -dy * LOOK_DEGREES_PER_PIXEL))
+            return True
+        if kind == QEvent.Type.MouseButtonRelease:
+            self._last_mouse = None
+            return True
+        return False

@@ -1,0 +1,41 @@
+"""Summary statistics of a dataset's active scalar: the values and their histogram (for the transfer-function editor)."""
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from volviz.model.datasets import CurvilinearGrid, Image2D, RegularVolume, TetMesh, TimeSeries, UnstructuredMesh
+
+
+def scalar_values(dataset: Any) -> np.ndarray:
+    """The active scalar of a dataset as a flat array (vector arrays by their magnitude)."""
+    if isinstance(dataset, TimeSeries):
+        dataset = dataset.frame(0)
+    if isinstance(dataset, (RegularVolume, Image2D)):
+        values = dataset.data
+    elif isinstance(dataset, TetMesh):
+        values = dataset.scalars
+    elif isinstance(dataset, (CurvilinearGrid, UnstructuredMesh)):
+        if not dataset.active:
+            return np.zeros(0)
+        values = dataset.point_data[dataset.active]
+        if isinstance(dataset, CurvilinearGrid) and values.ndim == 4 or isinstance(dataset, UnstructuredMesh) \
+                and values.ndim == 2:
+            values = np.linalg.norm(values, axis=-1)
+    else:
+        raise TypeError(f"no scalar values for {type(dataset).__name__}")
+    return np.asarray(values).reshape(-1)
+
+
+def histogram(dataset: Any, bins: int = 128) -> tuple[np.ndarray, np.ndarray]:
+    """Counts and bin edges of the finite active-scalar values (NaN/Inf are left out)."""
+    values = scalar_values(dataset)
+    if values.dtype.kind == "f":
+        values = values[np.isfinite(values)]
+    if values.size == 0:
+        return np.zeros(bins, dtype=np.int64), np.linspace(0.0, 1.0, bins + 1)
+    lo, hi = float(values.min()), float(values.max())
+    if hi <= lo:
+        hi = lo + 1.0
+    return np.histogram(values, bins=bins, range=(lo, hi))

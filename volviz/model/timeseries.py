@@ -1,0 +1,45 @@
+"""Continuous display time over a time series (the libMini note's 4D interpolation): the data between two steps is
+the linear blend of their point values, so playback is smooth at any display rate."""
+from __future__ import annotations
+
+from dataclasses import replace
+from typing import Any
+
+import numpy as np
+
+from volviz.model.datasets import CurvilinearGrid, RegularVolume, TetMesh, TimeSeries, UnstructuredMesh
+
+
+def bracket(series: TimeSeries, t: float) -> tuple[int, int, float]:
+    """Indices ``(i, j)`` of the steps around time ``t`` and the weight ``w`` of step ``j`` (t clamped to the span)."""
+    times = series.times
+    if t <= times[0]:
+        return 0, 0, 0.0
+    if t >= times[-1]:
+        last = len(times) - 1
+        return last, last, 0.0
+    j = int(np.searchsorted(times, t, side="right"))
+    i = j - 1
+    return i, j, float((t - times[i]) / (times[j] - times[i]))
+
+
+def _blend(a: np.ndarray, b: np.ndarray, w: float) -> np.ndarray:
+    if a.shape != b.shape:
+        raise ValueError(f"time steps differ in shape ({a.shape} and {b.shape}); cannot interpolate")
+    return ((1.0 - w) * a.astype(np.float32) + w * b.astype(np.float32)).astype(np.float32)
+
+
+def frame_at(series: TimeSeries, t: float, interpolate: bool = True) -> Any:
+    """The dataset shown at display time ``t``: the nearest earlier step, or the blend of its two neighbours."""
+    i, j, w = bracket(series, t)
+    if not interpolate or w == 0.0 or i == j:
+        return series.frame(i)
+    a, b = series.frame(i), series.frame(j)
+    if isinstance(a, RegularVolume):
+        return replace(a, data=_blend(a.data, b.data, w))
+    if isinstance(a, TetMesh):
+        return TetMesh(a.points, a.tets, _blend(a.scalars, b.scalars, w), a.name, a.source)
+    if isinstance(a, (CurvilinearGrid, UnstructuredMesh)):
+        data = {name: _blend(arr, b.point_data[name], w) for name, arr in a.point_data.items() if name in b.point_data}
+        return replace(a, point_data=data)
+    raise ValueError(f"cannot interpolate a time series of {a.kind}")

@@ -1,0 +1,127 @@
+"""A live scene in one plotter: what the app's docks change and what export renders, through one code path.
+
+``SceneController`` owns the mapping from session components to VTK props. Transfer-function edits, visibility,
+opacity and display time update the props in place (no rebuild), so live previews stay cheap.
+"""
+from __future__ import annotations
+
+from typing import Any, Optional
+
+from volviz.model import TimeSeries
+from volviz.session import CameraState, Component, Session
+
+
+class SceneController:
+    def __init__(self, plotter: Any, session: Session, datasets: dict[str, Any]):
+        self.plotter = plotter
+        self.session = session
+        self.datasets = datasets
+        self.props: dict[str, Any] = {}
+        self.time = 0.0
+        self.interpolate_time = True
+
+    # -- building ---------------------------------------------------------------------------------------------------
+    def build(self) -> None:
+        from volviz.render.scene import build_scene
+
+        self.props = build_scene(self.plotter, self.session, self.datasets)
+        span = self.time_span()
+        self.time = span[0] if span else 0.0
+
+    def component(self, comp_id: str) -> Component:
+        for comp in self.session.components:
+            if comp.id == comp_id:
+                return comp
+        raise KeyError(comp_id)
+
+    def dataset_of(self, comp_id: str) -> Any:
+        from volviz.render.scene import component_dataset
+
+        return component_dataset(self.component(comp_id), self.datasets)
+
+    # -- transfer functions, visibility, opacity --------------------------------------------------------------------
+    def transfer_function(self, comp_id: str) -> Any:
+        from volviz.render.scene import component_transfer_function
+
+        return component_transfer_function(self.session, self.component(comp_id))
+
+    def set_transfer_function(self, comp_id: str, tf: Any) -> None:
+        from volviz.render.vtk_scene import update_volume_property
+
+        comp = self.component(comp_id)
+        name = comp.transfer_function or comp.id
+        self.session.transfer_functions[name] = tf.to_dict()
+        comp.transfer_function = name
+        prop = self.props.get(comp_id)
+        if prop is not None and prop.IsA("vtkVolume"):
+            update_volume_property(prop.GetProperty(), tf, comp.opacity)
+
+    def set_visible(self, comp_id: str, visible: bool) -> None:
+        comp = self.component(comp_id)
+        comp.visible = bool(visible)
+        prop = self.props.get(comp_id)
+        if prop is None and visible:  # hidden at build time: add it now
+            from volviz.render.vtk_scene import add_dataset
+
+            self.props[comp_id] = add_dataset(self.plotter, self.dataset_of(comp_id),
+                                              tf=self.transfer_function(comp_id), opacity=comp.opacity, name=comp_id)
+        elif prop is not None:
+            prop.SetVisibility(bool(visible))
+
+    def set_opacity(self, comp_id: str, opacity: float) -> None:
+        comp = self.component(comp_id)
+        comp.opacity = float(min(max(opacity, 0.0), 1.0))
+        prop = self.props.get(comp_id)
+        if prop is None:
+            return
+        if prop.IsA("vtkVolume"):
+            from volviz.render.vtk_scene import update_volume_property
+
+            update_volume_property(prop.GetProperty(), self.transfer_function(comp_id), comp.opacity)
+        else:
+            prop.GetProperty().SetOpacity(comp.opacity)
+
+    # -- time -------------------------------------------------------------------------------------------------------
+    def time_series(self) -> dict[str, TimeSeries]:
+        out = {}
+        for comp in self.session.components:
+            if comp.dataset is not None and isinstance(self.datasets.get(comp.dataset), TimeSeries):
+                out[comp.id] = self.datasets[comp.dataset]
+        return out
+
+    def time_span(self) -> Optional[tuple[float, float]]:
+        series = self.time_series()
+        if not series:
+            return None
+        return (min(float(s.times[0]) for s in series.values()), max(float(s.times[-1]) for s in series.values()))
+
+    def time_steps(self) -> list[float]:
+        steps: set[float] = set()
+        for s in self.time_series().values():
+            steps.update(float(t) for t in s.times)
+        return sorted(steps)
+
+    def set_time(self, t: float, interpolate: Optional[bool] = None) -> None:
+        """Show display time ``t`` (blending neighbouring steps when interpolating)."""
+        from volviz.model.timeseries import frame_at
+        from volviz.render.vtk_scene import volume_input
+
+        if interpolate is not None:
+            self.interpolate_time = bool(interpolate)
+        self.time = float(t)
+        for comp_id, series in self.time_series().items():
+            prop = self.props.get(comp_id)
+            if prop is None or not prop.IsA("vtkVolume"):
+                continue
+            prop.GetMapper().SetInputData(volume_input(frame_at(series, self.time, self.interpolate_time)))
+
+    # -- camera -----------------------------------------------------------------------------------------------------
+    def camera(self) -> CameraState:
+        from volviz.render.vtk_scene import camera_state
+
+        return camera_state(self.plotter)
+
+    def set_camera(self, camera: Optional[CameraState]) -> None:
+        from volviz.render.vtk_scene import apply_camera
+
+        apply_camera(self.plotter, camera)
