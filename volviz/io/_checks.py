@@ -16,8 +16,8 @@ from volviz.io.errors import NonFiniteWarning, PathLike, ReadError, human_bytes
 
 def check_file(path: PathLike) -> Path:
     """Return ``path`` as a Path after checking it names an existing, regular, readable file."""
-    p = Path(os.fspath(path))
     try:
+        p = Path(os.fspath(path))
         st = p.stat()
     except FileNotFoundError:
         raise ReadError(p, "no such file") from None
@@ -25,6 +25,8 @@ def check_file(path: PathLike) -> Path:
         raise ReadError(p, "permission denied (cannot look up the file)") from None
     except OSError as exc:
         raise ReadError(p, f"cannot access the file ({exc.strerror or exc})") from None
+    except (ValueError, TypeError) as exc:  # embedded NUL byte, not a path at all
+        raise ReadError(str(path)[:200], f"is not a valid file name ({exc})") from None
     if stat.S_ISDIR(st.st_mode):
         raise ReadError(p, "is a directory, not a file")
     if not stat.S_ISREG(st.st_mode):

@@ -36,7 +36,7 @@ def _field(path: PathLike, rec: bytes, start: int, width: int, what: str, kind=f
     text = rec[start:start + width].decode("ascii", "replace").strip().replace("D", "E").replace("d", "e")
     try:
         value = kind(float(text)) if kind is int and "." in text else kind(text)
-    except ValueError:
+    except (ValueError, OverflowError):
         raise ReadError(path, f"DEM header field {what} at column {start + 1} is {text[:30]!r}, not a number") from None
     if kind is float and not np.isfinite(value):
         raise ReadError(path, f"DEM header field {what} is {value}")
@@ -66,12 +66,22 @@ def parse_dem_header(path: PathLike, rec: bytes) -> dict:
     return h
 
 
-def _vtk_grid(h: dict) -> tuple[int, int]:
-    """vtkDEMReader::ComputeExtentOriginAndSpacing: (columns, rows)."""
+def _vtk_grid(h: dict) -> tuple[float, float]:
+    """vtkDEMReader::ComputeExtentOriginAndSpacing: (columns, rows), as floats until checked to be sane."""
     c = h["corners"]  # SW, NW, NE, SE
     east, west = max(c[2, 0], c[3, 0]), min(c[1, 0], c[0, 0])
     north, south = max(c[2, 1], c[1, 1]), min(c[0, 1], c[3, 1])
-    return int((east - west) / h["resolution"][0] + 1.0), int((north - south) / h["resolution"][1] + 1.0)
+    with np.errstate(all="ignore"):
+        return (np.floor((east - west) / h["resolution"][0] + 1.0), np.floor((north - south) / h["resolution"][1] + 1.0))
+
+
+def _grid_fits(path: PathLike, cols: float, rows: float, size: int, what: str) -> tuple[int, int]:
+    """Columns and rows as ints once they are finite, positive and not more cells than the file has bytes."""
+    ok = np.isfinite(cols) and np.isfinite(rows) and cols >= 1 and rows >= 1 and cols * rows <= max(size, 1)
+    if not ok:
+        raise ReadError(path, f"{what} a {cols:g} x {rows:g} grid, which does not fit the file's {size} bytes "
+                              f"({human_bytes(size)}): corrupt coordinates or resolution")
+    return int(cols), int(rows)
 
 
 def _read_profiles(path: PathLike, buf: bytes, h: dict):
@@ -121,10 +131,7 @@ def read_dem(path: PathLike, vtk_compatible: bool = False) -> Image2D:
     dx, dy, dz = h["resolution"]
     plane, elev = _unit(h["plane_unit"]), _unit(h["elevation_unit"])
     low = h["elevation_bounds"][0] * elev
-    cols, rows = _vtk_grid(h)
-    if cols <= 0 or rows <= 0 or cols * rows > max(size, 1):
-        raise ReadError(path, f"DEM header describes a {describe_dims((cols, rows))} grid, which does not fit the "
-                              f"file's {size} bytes ({human_bytes(size)}): corrupt corner coordinates or resolution")
+    cols, rows = _grid_fits(path, *_vtk_grid(h), size, "DEM header corners describe")
     profiles = _read_profiles(path, buf, h)
     if not profiles:
         raise ReadError(path, "DEM holds no elevation profiles")
@@ -141,13 +148,12 @@ def read_dem(path: PathLike, vtk_compatible: bool = False) -> Image2D:
         xs = np.array([p[2] for p in profiles])
         ys = np.array([p[3] for p in profiles])
         x0, y0 = xs.min(), ys.min()
-        col_idx = np.rint((xs - x0) / dx).astype(np.int64)
-        row_idx = np.rint((ys - y0) / dy).astype(np.int64)
-        n_cols = int(col_idx.max()) + 1
-        n_rows = int(max(r + len(p[4]) for r, p in zip(row_idx, profiles)))
-        if n_cols * n_rows > max(size, 1):
-            raise ReadError(path, f"DEM profiles span a {describe_dims((n_cols, n_rows))} grid, which does not fit "
-                                  f"the file's {size} bytes")
+        with np.errstate(all="ignore"):
+            col_f = np.rint((xs - x0) / dx)
+            row_f = np.rint((ys - y0) / dy)
+            span_rows = max(float(r) + len(p[4]) for r, p in zip(row_f, profiles))
+        n_cols, n_rows = _grid_fits(path, float(col_f.max()) + 1.0, span_rows, size, "DEM profiles span")
+        col_idx, row_idx = col_f.astype(np.int64), row_f.astype(np.int64)
         grid = np.full((n_rows, n_cols), low, dtype=np.float64)
         for r, c, (_, _, _, _, values) in zip(row_idx, col_idx, profiles):
             grid[r:r + len(values), c] = values * (dz * elev)

@@ -243,6 +243,11 @@ def derived_functions(q: np.ndarray, cond: FlowConditions, r_gas: float = 1.0) -
     T = p / (rho R); h = gamma p / ((gamma - 1) rho); c = sqrt(gamma p / rho); Mach = |v| / c;
     Cp = (p - p_inf) / (rho_inf V_inf^2 / 2); s = R/(gamma-1) ln((p / p_inf) / (rho / rho_inf)^gamma).
     """
+    with np.errstate(all="ignore"):  # non-finite results are reported by the caller's finite check
+        return _derived(q, cond, r_gas)
+
+
+def _derived(q: np.ndarray, cond: FlowConditions, r_gas: float) -> dict[str, np.ndarray]:
     g = cond.gamma
     q64 = q.astype(np.float64)
     rho = q64[..., 0].copy()
@@ -252,23 +257,22 @@ def derived_functions(q: np.ndarray, cond: FlowConditions, r_gas: float = 1.0) -
     vel = mom / rho[..., None]
     v2 = np.einsum("...i,...i->...", vel, vel)
     p = (g - 1.0) * (e - 0.5 * rho * v2)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        c = np.sqrt(g * p / rho)
-        rho_inf, c_inf = 1.0, 1.0
-        p_inf = rho_inf * c_inf * c_inf / g
-        v_inf = cond.fsmach * c_inf
-        out = {
-            "Velocity": vel,
-            "VelocityMagnitude": np.sqrt(v2),
-            "KineticEnergy": 0.5 * v2,
-            "Pressure": p,
-            "Temperature": p / (rho * r_gas),
-            "Enthalpy": g * p / ((g - 1.0) * rho),
-            "SoundSpeed": c,
-            "MachNumber": np.sqrt(v2) / c,
-            "PressureCoefficient": (p - p_inf) / (0.5 * rho_inf * v_inf * v_inf) if v_inf != 0 else None,
-            "Entropy": r_gas / (g - 1.0) * np.log((p / p_inf) / (rho / rho_inf) ** g),
-        }
+    c = np.sqrt(g * p / rho)
+    rho_inf, c_inf = 1.0, 1.0
+    p_inf = rho_inf * c_inf * c_inf / g
+    v_inf = cond.fsmach * c_inf
+    out = {
+        "Velocity": vel,
+        "VelocityMagnitude": np.sqrt(v2),
+        "KineticEnergy": 0.5 * v2,
+        "Pressure": p,
+        "Temperature": p / (rho * r_gas),
+        "Enthalpy": g * p / ((g - 1.0) * rho),
+        "SoundSpeed": c,
+        "MachNumber": np.sqrt(v2) / c,
+        "PressureCoefficient": (p - p_inf) / (0.5 * rho_inf * v_inf * v_inf) if v_inf != 0 else None,
+        "Entropy": r_gas / (g - 1.0) * np.log((p / p_inf) / (rho / rho_inf) ** g),
+    }
     return {k: v for k, v in out.items() if v is not None}
 
 

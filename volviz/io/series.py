@@ -67,8 +67,9 @@ def read_series(paths_or_pattern: str | PathLike | Sequence[PathLike],
                 **options) -> TimeSeries:
     """A TimeSeries of every file of a numbered series, read lazily with ``reader`` (default ``volviz.io.read``).
 
-    Times are the numbers in the file names when all files have distinct ones (``t01`` -> 1.0), else 0, 1, 2...;
-    ``times`` overrides them. Frame 0 is read now; every later frame must have frame 0's kind and dimensions.
+    Globs and printf patterns are sorted by the number in the file name; an explicit list keeps its order. Times
+    are those numbers when they increase strictly along the series (``t01`` -> 1.0), else 0, 1, 2...; ``times``
+    overrides them. Frame 0 is read now; every later frame must have frame 0's kind and dimensions.
     """
     items = expand_pattern(paths_or_pattern)
     if reader is None:
@@ -76,7 +77,7 @@ def read_series(paths_or_pattern: str | PathLike | Sequence[PathLike],
     paths = [p for _, p in items]
     numbers = [n for n, _ in items]
     if times is None:
-        if all(n is not None for n in numbers) and len(set(numbers)) == len(numbers):
+        if all(n is not None for n in numbers) and all(a < b for a, b in zip(numbers, numbers[1:])):
             times = [float(n) for n in numbers]  # type: ignore[arg-type]
         else:
             times = [float(i) for i in range(len(paths))]
