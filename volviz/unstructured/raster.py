@@ -28,24 +28,31 @@ TILE = 32
 N_COEF = 30
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _det3(a0, a1, a2, b0, b1, b2, c0, c1, c2):
+    return a0 * (b1 * c2 - b2 * c1) - a1 * (b0 * c2 - b2 * c0) + a2 * (b0 * c1 - b1 * c0)
+
+
 @njit(cache=True, nogil=True, parallel=True)
 def project_cells(pts: np.ndarray, tets: np.ndarray, scal: np.ndarray, cells: np.ndarray, face_n: np.ndarray,
                   face_d: np.ndarray, rb: np.ndarray, frame: np.ndarray, scales: np.ndarray, parallel: bool,
-                  near: float, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
-    """Pixel boxes (k, 4) [c0, c1, r0, r1] and coefficients (k, 30) of the listed cells (positions relative)."""
+                  near: float, width: int, height: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Pixel boxes (k, 4) [c0, c1, r0, r1], coefficients (k, 30) and projected vertices (k, 8) [px0, py0, ...] of
+    the listed cells (positions relative); a NaN in the projected vertices marks a cell crossing the near plane."""
     k = len(cells)
     box = np.empty((k, 4), np.int64)
     coef = np.empty((k, N_COEF))
+    vxy = np.empty((k, 8))
     for q in prange(k):
         c = cells[q]
         # --- pixel box from the projected vertices (whole screen if a vertex is at/behind the near plane)
         xmin, xmax, ymin, ymax = 1e300, -1e300, 1e300, -1e300
         full = False
         for v in range(4):
-            p = pts[tets[c, v]]
-            rel0 = p[0] - frame[3, 0]
-            rel1 = p[1] - frame[3, 1]
-            rel2 = p[2] - frame[3, 2]
+            iv = tets[c, v]
+            rel0 = pts[iv, 0] - frame[3, 0]
+            rel1 = pts[iv, 1] - frame[3, 1]
+            rel2 = pts[iv, 2] - frame[3, 2]
             x = rel0 * frame[0, 0] + rel1 * frame[0, 1] + rel2 * frame[0, 2]
             y = rel0 * frame[1, 0] + rel1 * frame[1, 1] + rel2 * frame[1, 2]
             z = rel0 * frame[2, 0] + rel1 * frame[2, 1] + rel2 * frame[2, 2]
@@ -57,15 +64,18 @@ def project_cells(pts: np.ndarray, tets: np.ndarray, scal: np.ndarray, cells: np
                 y /= z
             px = (x / scales[0] + 1.0) * width * 0.5 - 0.5
             py = (1.0 - y / scales[1]) * height * 0.5 - 0.5
+            vxy[q, 2 * v] = px
+            vxy[q, 2 * v + 1] = py
             xmin, xmax = min(xmin, px), max(xmax, px)
             ymin, ymax = min(ymin, py), max(ymax, py)
         if full:
             box[q, 0], box[q, 1], box[q, 2], box[q, 3] = 0, width - 1, 0, height - 1
+            vxy[q, 0] = np.nan
         else:
-            box[q, 0] = max(int(math.floor(xmin)) - 1, 0)
-            box[q, 1] = min(int(math.ceil(xmax)) + 1, width - 1)
-            box[q, 2] = max(int(math.floor(ymin)) - 1, 0)
-            box[q, 3] = min(int(math.ceil(ymax)) + 1, height - 1)
+            box[q, 0] = max(int(math.floor(xmin)), 0)
+            box[q, 1] = min(int(math.ceil(xmax)), width - 1)
+            box[q, 2] = max(int(math.floor(ymin)), 0)
+            box[q, 3] = min(int(math.ceil(ymax)), height - 1)
         # --- face half-spaces as affine forms of (px, py)
         for f in range(4):
             n0, n1, n2 = face_n[c, f, 0], face_n[c, f, 1], face_n[c, f, 2]
@@ -76,34 +86,48 @@ def project_cells(pts: np.ndarray, tets: np.ndarray, scal: np.ndarray, cells: np
             coef[q, b + 3] = n0 * rb[3, 0] + n1 * rb[3, 1] + n2 * rb[3, 2]
             coef[q, b + 4] = n0 * rb[4, 0] + n1 * rb[4, 1] + n2 * rb[4, 2]
             coef[q, b + 5] = n0 * rb[5, 0] + n1 * rb[5, 1] + n2 * rb[5, 2]
-        # --- scalar gradient g (E g = ds, Cramer) and s(x) = s0 + g.(x - p0)
-        p0 = pts[tets[c, 0]]
-        e = np.empty((3, 3))
-        ds = np.empty(3)
-        for r in range(3):
-            pr = pts[tets[c, r + 1]]
-            for a in range(3):
-                e[r, a] = pr[a] - p0[a]
-            ds[r] = scal[tets[c, r + 1]] - scal[tets[c, 0]]
-        det = (e[0, 0] * (e[1, 1] * e[2, 2] - e[1, 2] * e[2, 1]) - e[0, 1] * (e[1, 0] * e[2, 2] - e[1, 2] * e[2, 0])
-               + e[0, 2] * (e[1, 0] * e[2, 1] - e[1, 1] * e[2, 0]))
-        g = np.zeros(3)
+        # --- scalar gradient g (E g = ds, Cramer's rule) and s(x) = s0 + g.x
+        i0, i1, i2, i3 = tets[c, 0], tets[c, 1], tets[c, 2], tets[c, 3]
+        a0, a1, a2 = pts[i1, 0] - pts[i0, 0], pts[i1, 1] - pts[i0, 1], pts[i1, 2] - pts[i0, 2]
+        b0, b1, b2 = pts[i2, 0] - pts[i0, 0], pts[i2, 1] - pts[i0, 1], pts[i2, 2] - pts[i0, 2]
+        c0, c1, c2 = pts[i3, 0] - pts[i0, 0], pts[i3, 1] - pts[i0, 1], pts[i3, 2] - pts[i0, 2]
+        d0, d1, d2 = scal[i1] - scal[i0], scal[i2] - scal[i0], scal[i3] - scal[i0]
+        det = _det3(a0, a1, a2, b0, b1, b2, c0, c1, c2)
+        g0 = g1 = g2 = 0.0
         if det != 0.0:
-            for a in range(3):
-                m = e.copy()
-                for r in range(3):
-                    m[r, a] = ds[r]
-                g[a] = (m[0, 0] * (m[1, 1] * m[2, 2] - m[1, 2] * m[2, 1])
-                        - m[0, 1] * (m[1, 0] * m[2, 2] - m[1, 2] * m[2, 0])
-                        + m[0, 2] * (m[1, 0] * m[2, 1] - m[1, 1] * m[2, 0])) / det
-        s0 = scal[tets[c, 0]] - (g[0] * p0[0] + g[1] * p0[1] + g[2] * p0[2])
-        coef[q, 24] = s0 + g[0] * rb[0, 0] + g[1] * rb[0, 1] + g[2] * rb[0, 2]
-        coef[q, 25] = g[0] * rb[1, 0] + g[1] * rb[1, 1] + g[2] * rb[1, 2]
-        coef[q, 26] = g[0] * rb[2, 0] + g[1] * rb[2, 1] + g[2] * rb[2, 2]
-        coef[q, 27] = g[0] * rb[3, 0] + g[1] * rb[3, 1] + g[2] * rb[3, 2]
-        coef[q, 28] = g[0] * rb[4, 0] + g[1] * rb[4, 1] + g[2] * rb[4, 2]
-        coef[q, 29] = g[0] * rb[5, 0] + g[1] * rb[5, 1] + g[2] * rb[5, 2]
-    return box, coef
+            g0 = _det3(d0, a1, a2, d1, b1, b2, d2, c1, c2) / det
+            g1 = _det3(a0, d0, a2, b0, d1, b2, c0, d2, c2) / det
+            g2 = _det3(a0, a1, d0, b0, b1, d1, c0, c1, d2) / det
+        s0 = scal[i0] - (g0 * pts[i0, 0] + g1 * pts[i0, 1] + g2 * pts[i0, 2])
+        coef[q, 24] = s0 + g0 * rb[0, 0] + g1 * rb[0, 1] + g2 * rb[0, 2]
+        coef[q, 25] = g0 * rb[1, 0] + g1 * rb[1, 1] + g2 * rb[1, 2]
+        coef[q, 26] = g0 * rb[2, 0] + g1 * rb[2, 1] + g2 * rb[2, 2]
+        coef[q, 27] = g0 * rb[3, 0] + g1 * rb[3, 1] + g2 * rb[3, 2]
+        coef[q, 28] = g0 * rb[4, 0] + g1 * rb[4, 1] + g2 * rb[4, 2]
+        coef[q, 29] = g0 * rb[5, 0] + g1 * rb[5, 1] + g2 * rb[5, 2]
+    return box, coef, vxy
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _row_span(v: np.ndarray, py: float) -> tuple[float, float]:
+    """x-extent at row py of the convex hull of the 4 projected vertices (span of its 6 edges' crossings)."""
+    lo = 1e300
+    hi = -1e300
+    for a in range(3):
+        for b in range(a + 1, 4):
+            xa, ya, xb, yb = v[2 * a], v[2 * a + 1], v[2 * b], v[2 * b + 1]
+            if ya > yb:
+                xa, ya, xb, yb = xb, yb, xa, ya
+            if py < ya or py > yb:
+                continue
+            if yb > ya:
+                x = xa + (py - ya) * (xb - xa) / (yb - ya)
+                lo = min(lo, x)
+                hi = max(hi, x)
+            else:
+                lo = min(lo, min(xa, xb))
+                hi = max(hi, max(xa, xb))
+    return lo, hi
 
 
 @njit(cache=True, nogil=True)
@@ -134,32 +158,49 @@ def bin_tiles(box: np.ndarray, width: int, height: int, tile: int) -> tuple[np.n
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _lookup(table: np.ndarray, s_lo: float, inv_ds: float, inv_dl: float, sf: float, sb: float, ln: float,
-            out: np.ndarray) -> None:
-    n = table.shape[0]
-    nl = table.shape[2]
-    fi = (sf - s_lo) * inv_ds
-    fj = (sb - s_lo) * inv_ds
-    fk = ln * inv_dl
-    fi = min(max(fi, 0.0), n - 1.0)
-    fj = min(max(fj, 0.0), n - 1.0)
-    fk = min(max(fk, 0.0), nl - 1.0)
+def _lookup(flat: np.ndarray, n: int, nl: int, s_lo: float, inv_ds: float, inv_dl: float, sf: float, sb: float,
+            ln: float) -> tuple[float, float, float, float]:
+    """Trilinear lookup in the flattened (n, n, nl, 4) table; scalars clamp to the table, l clamps to l_max."""
+    fi = min(max((sf - s_lo) * inv_ds, 0.0), n - 1.0)
+    fj = min(max((sb - s_lo) * inv_ds, 0.0), n - 1.0)
+    fk = min(max(ln * inv_dl, 0.0), nl - 1.0)
     i = min(int(fi), n - 2)
     j = min(int(fj), n - 2)
     k = min(int(fk), nl - 2)
     wi = fi - i
     wj = fj - j
     wk = fk - k
-    for ch in range(4):
-        a = (1 - wk) * table[i, j, k, ch] + wk * table[i, j, k + 1, ch]
-        b = (1 - wk) * table[i, j + 1, k, ch] + wk * table[i, j + 1, k + 1, ch]
-        c = (1 - wk) * table[i + 1, j, k, ch] + wk * table[i + 1, j, k + 1, ch]
-        d = (1 - wk) * table[i + 1, j + 1, k, ch] + wk * table[i + 1, j + 1, k + 1, ch]
-        out[ch] = (1 - wi) * ((1 - wj) * a + wj * b) + wi * ((1 - wj) * c + wj * d)
+    w00 = (1.0 - wi) * (1.0 - wj)
+    w01 = (1.0 - wi) * wj
+    w10 = wi * (1.0 - wj)
+    w11 = wi * wj
+    sj = nl * 4
+    si = n * sj
+    b = i * si + j * sj + k * 4
+    r0 = 0.0
+    r1 = 0.0
+    r2 = 0.0
+    r3 = 0.0
+    for corner in range(4):
+        if corner == 0:
+            o, w = b, w00
+        elif corner == 1:
+            o, w = b + sj, w01
+        elif corner == 2:
+            o, w = b + si, w10
+        else:
+            o, w = b + si + sj, w11
+        wa = w * (1.0 - wk)
+        wb = w * wk
+        r0 += wa * flat[o] + wb * flat[o + 4]
+        r1 += wa * flat[o + 1] + wb * flat[o + 5]
+        r2 += wa * flat[o + 2] + wb * flat[o + 6]
+        r3 += wa * flat[o + 3] + wb * flat[o + 7]
+    return r0, r1, r2, r3
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def raster_tiles(box: np.ndarray, coef: np.ndarray, ptr: np.ndarray, items: np.ndarray, tile_order: np.ndarray,
+def raster_tiles(box: np.ndarray, coef: np.ndarray, vxy: np.ndarray, ptr: np.ndarray, items: np.ndarray, tile_order: np.ndarray,
                  rb: np.ndarray, near: float, far: float, table: np.ndarray, s_lo: float, ds: float, dl: float,
                  width: int, height: int, tile: int, t_min: float, image: np.ndarray) -> np.ndarray:
     """Composite every tile's cells front to back into ``image`` (H, W, 4); returns fragments drawn per tile."""
@@ -167,6 +208,9 @@ def raster_tiles(box: np.ndarray, coef: np.ndarray, ptr: np.ndarray, items: np.n
     frags = np.zeros(len(tile_order), np.int64)
     inv_ds = 1.0 / ds
     inv_dl = 1.0 / dl
+    n_s = table.shape[0]
+    n_l = table.shape[2]
+    flat = table.ravel()
     for ti in prange(len(tile_order)):
         t = tile_order[ti]
         x0 = (t % tx) * tile
@@ -176,7 +220,6 @@ def raster_tiles(box: np.ndarray, coef: np.ndarray, ptr: np.ndarray, items: np.n
         npx = (x1 - x0 + 1) * (y1 - y0 + 1)
         col = np.zeros((tile, tile, 3))
         trans = np.ones((tile, tile))
-        rgba = np.empty(4)
         opaque = 0
         nf = 0
         for it in range(ptr[t + 1] - 1, ptr[t] - 1, -1):
@@ -184,8 +227,18 @@ def raster_tiles(box: np.ndarray, coef: np.ndarray, ptr: np.ndarray, items: np.n
                 break
             q = items[it]
             cq = coef[q]
+            vq = vxy[q]
+            full = vq[0] != vq[0]
             for py in range(max(box[q, 2], y0), min(box[q, 3], y1) + 1):
-                for px in range(max(box[q, 0], x0), min(box[q, 1], x1) + 1):
+                xa = max(box[q, 0], x0)
+                xb = min(box[q, 1], x1)
+                if not full:
+                    lo, hi = _row_span(vq, float(py))
+                    if lo > hi:
+                        continue
+                    xa = max(xa, int(math.ceil(lo - 1e-7)))
+                    xb = min(xb, int(math.floor(hi + 1e-7)))
+                for px in range(xa, xb + 1):
                     ly = py - y0
                     lx = px - x0
                     tr = trans[ly, lx]
@@ -216,11 +269,11 @@ def raster_tiles(box: np.ndarray, coef: np.ndarray, ptr: np.ndarray, items: np.n
                     d1 = rb[3, 1] + px * rb[4, 1] + py * rb[5, 1]
                     d2 = rb[3, 2] + px * rb[4, 2] + py * rb[5, 2]
                     ln = (t1 - t0) * math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
-                    _lookup(table, s_lo, inv_ds, inv_dl, sa + t0 * sb, sa + t1 * sb, ln, rgba)
-                    col[ly, lx, 0] += tr * rgba[0]
-                    col[ly, lx, 1] += tr * rgba[1]
-                    col[ly, lx, 2] += tr * rgba[2]
-                    tr *= 1.0 - rgba[3]
+                    c0, c1, c2, c3 = _lookup(flat, n_s, n_l, s_lo, inv_ds, inv_dl, sa + t0 * sb, sa + t1 * sb, ln)
+                    col[ly, lx, 0] += tr * c0
+                    col[ly, lx, 1] += tr * c1
+                    col[ly, lx, 2] += tr * c2
+                    tr *= 1.0 - c3
                     trans[ly, lx] = tr
                     nf += 1
                     if tr < t_min:

@@ -113,7 +113,7 @@ def render(mesh: TetMesh, tf: Any, camera: Camera, size: tuple[int, int] = (512,
     frame = np.stack([r, u, f, camera.position - topo.origin])
     hx, hy = camera._scales((w, h))
     near, far = camera.clipping_range
-    box, coef = project_cells(topo.points, topo.tets, mesh.scalars, cells, topo.face_n, topo.face_d,
+    box, coef, vxy = project_cells(topo.points, topo.tets, mesh.scalars, cells, topo.face_n, topo.face_d,
                               rb.as_array(), frame, np.array([hx, hy]), bool(camera.parallel), near, w, h)
     stats.project_s = time.perf_counter() - t0
     t0 = time.perf_counter()
@@ -122,7 +122,7 @@ def render(mesh: TetMesh, tf: Any, camera: Camera, size: tuple[int, int] = (512,
     # interleave heavy and light tiles across threads: Numba's prange hands out contiguous chunks
     tile_order = np.random.default_rng(12345).permutation(n_tiles).astype(np.int64)
     img = np.zeros((h, w, 4))
-    frags = raster_tiles(box, coef, ptr, items, tile_order, rb.as_array(), near, far, table.rgba, table.s_lo,
+    frags = raster_tiles(box, coef, vxy, ptr, items, tile_order, rb.as_array(), near, far, table.rgba, table.s_lo,
                          table.ds, table.dl, w, h, TILE, float(t_min), img)
     stats.fragments = int(frags.sum())
     stats.raster_s = time.perf_counter() - t0

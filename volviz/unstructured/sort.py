@@ -119,6 +119,8 @@ def _mpvo(neighbor: np.ndarray, face_n: np.ndarray, face_d: np.ndarray, eye: np.
     fb = 0
     while n_out < m:
         if top == 0:
+            if len(fallback) == 0:
+                return order[:n_out], -1          # stalled: the caller retries with a fallback order
             while done[fallback[fb]]:
                 fb += 1
             t = fallback[fb]
@@ -164,59 +166,62 @@ def _mpvo(neighbor: np.ndarray, face_n: np.ndarray, face_d: np.ndarray, eye: np.
 
 # --------------------------------------------------------------------------------------------------------------------
 # image-space boundary relations (SXMPVO-style)
-@njit(cache=True, nogil=True)
-def _boundary_fragments(pts: np.ndarray, tets: np.ndarray, bfaces: np.ndarray, entry: np.ndarray,
-                        bbox: np.ndarray, rb: np.ndarray, near: float, far: float, width: int,
-                        count_only: bool, pix: np.ndarray, depth: np.ndarray, fid: np.ndarray) -> int:
-    """Ray-cast every boundary triangle at the pixel centres of its box (Moller-Trumbore, edges inclusive)."""
-    k = 0
-    o = np.empty(3)
-    d = np.empty(3)
-    for b in range(len(bfaces)):
+@njit(cache=True, nogil=True, parallel=True)
+def _boundary_fragments(pts: np.ndarray, tets: np.ndarray, bfaces: np.ndarray, bbox: np.ndarray, off: np.ndarray,
+                        rb: np.ndarray, near: float, far: float, width: int,
+                        pix: np.ndarray, depth: np.ndarray) -> np.ndarray:
+    """Ray-cast every boundary triangle at the pixel centres of its box (Moller-Trumbore, edges inclusive).
+
+    Triangle b writes its fragments to slots off[b]...; returns the number written per triangle."""
+    nb = len(bfaces)
+    cnt = np.zeros(nb, np.int64)
+    for b in prange(nb):
         if bbox[b, 0] > bbox[b, 1] or bbox[b, 2] > bbox[b, 3]:
             continue
         t_id = bfaces[b, 0]
         f = bfaces[b, 1]
-        v0 = pts[tets[t_id, FACES[f, 0]]]
-        v1 = pts[tets[t_id, FACES[f, 1]]]
-        v2 = pts[tets[t_id, FACES[f, 2]]]
-        e1 = v1 - v0
-        e2 = v2 - v0
+        i0 = tets[t_id, FACES[f, 0]]
+        i1 = tets[t_id, FACES[f, 1]]
+        i2 = tets[t_id, FACES[f, 2]]
+        v00, v01, v02 = pts[i0, 0], pts[i0, 1], pts[i0, 2]
+        e10, e11, e12 = pts[i1, 0] - v00, pts[i1, 1] - v01, pts[i1, 2] - v02
+        e20, e21, e22 = pts[i2, 0] - v00, pts[i2, 1] - v01, pts[i2, 2] - v02
+        k = off[b]
         for row in range(bbox[b, 2], bbox[b, 3] + 1):
             for col in range(bbox[b, 0], bbox[b, 1] + 1):
-                for a in range(3):
-                    o[a] = rb[0, a] + col * rb[1, a] + row * rb[2, a]
-                    d[a] = rb[3, a] + col * rb[4, a] + row * rb[5, a]
-                px = d[1] * e2[2] - d[2] * e2[1]
-                py = d[2] * e2[0] - d[0] * e2[2]
-                pz = d[0] * e2[1] - d[1] * e2[0]
-                det = e1[0] * px + e1[1] * py + e1[2] * pz
+                o0 = rb[0, 0] + col * rb[1, 0] + row * rb[2, 0]
+                o1 = rb[0, 1] + col * rb[1, 1] + row * rb[2, 1]
+                o2 = rb[0, 2] + col * rb[1, 2] + row * rb[2, 2]
+                d0 = rb[3, 0] + col * rb[4, 0] + row * rb[5, 0]
+                d1 = rb[3, 1] + col * rb[4, 1] + row * rb[5, 1]
+                d2 = rb[3, 2] + col * rb[4, 2] + row * rb[5, 2]
+                px = d1 * e22 - d2 * e21
+                py = d2 * e20 - d0 * e22
+                pz = d0 * e21 - d1 * e20
+                det = e10 * px + e11 * py + e12 * pz
                 if det == 0.0:
                     continue
                 inv = 1.0 / det
-                sx = o[0] - v0[0]
-                sy = o[1] - v0[1]
-                sz = o[2] - v0[2]
+                sx = o0 - v00
+                sy = o1 - v01
+                sz = o2 - v02
                 u = (sx * px + sy * py + sz * pz) * inv
                 if u < -1e-12 or u > 1.0 + 1e-12:
                     continue
-                qx = sy * e1[2] - sz * e1[1]
-                qy = sz * e1[0] - sx * e1[2]
-                qz = sx * e1[1] - sy * e1[0]
-                v = (d[0] * qx + d[1] * qy + d[2] * qz) * inv
+                qx = sy * e12 - sz * e11
+                qy = sz * e10 - sx * e12
+                qz = sx * e11 - sy * e10
+                v = (d0 * qx + d1 * qy + d2 * qz) * inv
                 if v < -1e-12 or u + v > 1.0 + 1e-12:
                     continue
-                t = (e2[0] * qx + e2[1] * qy + e2[2] * qz) * inv
+                t = (e20 * qx + e21 * qy + e22 * qz) * inv
                 if t < near or t > far:
                     continue
-                if not count_only:
-                    pix[k] = row * width + col
-                    depth[k] = t
-                    fid[k] = b
+                pix[k] = row * width + col
+                depth[k] = t
                 k += 1
-    return k
-
-
+        cnt[b] = k - off[b]
+    return cnt
 
 
 @njit(cache=True, nogil=True)
@@ -297,11 +302,20 @@ def boundary_relations(topo: Topology, cam: Camera, size: tuple[int, int]) -> tu
     box = _boundary_box(cam, topo, size)
     rb = cam.rays(size, origin=topo.origin).as_array()
     near, far = cam.clipping_range
-    e64 = np.empty(0, np.int64)
-    ef = np.empty(0)
-    cnt = _boundary_fragments(topo.points, topo.tets, bf, entry, box, rb, near, far, w, True, e64, ef, e64)
-    pix, depth, fid = np.empty(cnt, np.int64), np.empty(cnt), np.empty(cnt, np.int64)
-    _boundary_fragments(topo.points, topo.tets, bf, entry, box, rb, near, far, w, False, pix, depth, fid)
+    area = np.maximum(box[:, 1] - box[:, 0] + 1, 0) * np.maximum(box[:, 3] - box[:, 2] + 1, 0)
+    parts: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
+    start = 0
+    while start < len(bf):               # chunks of at most ~8M candidate pixels (whole-screen boxes near the eye)
+        stop = start + max(1, int(np.searchsorted(np.cumsum(area[start:]), 8_000_000)))
+        off = np.zeros(stop - start + 1, np.int64)
+        np.cumsum(area[start:stop], out=off[1:])
+        pix, depth = np.empty(off[-1], np.int64), np.empty(off[-1])
+        cnt = _boundary_fragments(topo.points, topo.tets, bf[start:stop], box[start:stop], off, rb, near, far, w,
+                                  pix, depth)
+        idx = np.repeat(off[:-1] - np.concatenate([[0], np.cumsum(cnt)[:-1]]), cnt) + np.arange(cnt.sum())
+        parts.append((pix[idx], depth[idx], np.repeat(np.arange(start, stop), cnt)))
+        start = stop
+    pix, depth, fid = (np.concatenate([p[i] for p in parts]) for i in range(3))
     m = topo.n_tets
     keys = np.unique(_gap_relations(pix, depth, fid, w * h, bf, entry, m))
     return keys // m, keys % m
@@ -370,6 +384,9 @@ def visibility_order(mesh: TetMesh | Topology, camera: Camera, size: tuple[int, 
     else:
         src, dst = np.empty(0, np.int64), np.empty(0, np.int64)
     ptr, dsts = _csr(src, dst, m)
-    fallback = np.argsort(_centroid_keys(topo.centroid, eye, fwd, camera.parallel), kind="stable")
-    order, cycles = _mpvo(topo.neighbor, topo.face_n, topo.face_d, eye, fwd, camera.parallel, ptr, dsts, fallback)
+    args = (topo.neighbor, topo.face_n, topo.face_d, eye, fwd, camera.parallel, ptr, dsts)
+    order, cycles = _mpvo(*args, np.empty(0, np.int64))
+    if cycles < 0:                      # a cycle: redo with the farthest-first fallback for breaking it
+        fallback = np.argsort(_centroid_keys(topo.centroid, eye, fwd, camera.parallel), kind="stable")
+        order, cycles = _mpvo(*args, fallback)
     return SortResult(order, method, int(cycles), int(len(src)), time.perf_counter() - t0)
