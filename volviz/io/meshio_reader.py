@@ -6,6 +6,9 @@ kept; float data is checked for NaN/Inf.
 """
 from __future__ import annotations
 
+import contextlib
+import io
+
 import numpy as np
 
 from volviz.io._checks import check_file, check_finite, open_file
@@ -26,12 +29,17 @@ def read_meshio(path: PathLike, file_format: str | None = None, allow_nonfinite:
 
     check_file(path)
     open_file(path).close()  # permission problems as ReadError before meshio sees the file
+    chatter = io.StringIO()
     try:
-        mesh = meshio.read(path, file_format=file_format)
+        with contextlib.redirect_stdout(chatter), contextlib.redirect_stderr(chatter):
+            mesh = meshio.read(path, file_format=file_format)
     except ReadError:
         raise
     except MemoryError:
         raise ReadError(path, "meshio ran out of memory: the file's header claims an impossible size") from None
+    except SystemExit:  # meshio calls sys.exit(1) when several candidate formats all fail
+        detail = " ".join(chatter.getvalue().split())[:200]
+        raise ReadError(path, f"meshio could not read it ({detail or 'no reader accepted the file'})") from None
     except Exception as exc:  # meshio's readers raise many exception types for bad input
         raise ReadError(path, f"meshio could not read it ({type(exc).__name__}: {str(exc)[:200]})") from None
     points = np.asarray(mesh.points, dtype=np.float64)

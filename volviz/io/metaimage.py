@@ -66,7 +66,18 @@ def _floats(path: PathLike, fields: dict[str, str], keys: tuple[str, ...], n: in
 
 
 def read_metaimage(path: PathLike, allow_nonfinite: bool = False) -> RegularVolume | Image2D:
-    """Read .mhd (+ data file) or .mha into RegularVolume (3D) or Image2D (2D, any number of channels)."""
+    """Read .mhd (+ data file) or .mha into RegularVolume (3D) or Image2D (2D, any number of channels).
+
+    Problems with a separate data file are reported against the header, naming the data file too."""
+    try:
+        return _read_metaimage(path, allow_nonfinite)
+    except ReadError as exc:
+        if exc.path != str(path):
+            raise ReadError(path, f"data file {exc.path}: {exc.problem}") from None
+        raise
+
+
+def _read_metaimage(path: PathLike, allow_nonfinite: bool) -> RegularVolume | Image2D:
     size = file_size(path)
     head = read_bytes(path, _HEADER_LIMIT)
     fields, header_end = parse_mhd_header(path, head)
