@@ -1,0 +1,156 @@
+"""Terrain C-LOD (Roettger §3.5.3): crack-freeness, full refinement, geomorph continuity, d2 propagation."""
+from __future__ import annotations
+
+import matplotlib.tri as mtri
+import numpy as np
+import pytest
+
+from conftest import data_file
+from volviz.nature.heightfield import HeightField, pow2_plus_one, resample_bilinear
+from volviz.nature.terrain import TerrainLOD, frustum_planes, propagation_factor
+
+
+def rough_field(n: int = 65, seed: int = 0) -> HeightField:
+    rng = np.random.default_rng(seed)
+    g = np.cumsum(np.cumsum(rng.normal(size=(n, n)), 0), 1) * 0.05
+    return HeightField(g, (1.0, 1.0))
+
+
+def non_conforming_edges(mesh, n: int) -> int:
+    """Edges used by one triangle that are not on the grid border (T-junctions / cracks) or by more than two."""
+    t = mesh.triangles
+    e = np.sort(np.concatenate([t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]]), axis=1)
+    edges, counts = np.unique(e, axis=0, return_counts=True)
+    gi = mesh.grid_index
+    a, b = gi[edges[:, 0]], gi[edges[:, 1]]
+    border = ((a[:, 0] == b[:, 0]) & np.isin(a[:, 0], (0, n - 1))) | ((a[:, 1] == b[:, 1]) & np.isin(a[:, 1], (0, n - 1)))
+    return int(np.sum(counts > 2) + np.sum((counts == 1) & ~border) + np.sum((counts == 2) & border))
+
+
+@pytest.mark.parametrize("big_c", [2.5, 4.0, 9.0])
+def test_no_t_junctions_for_many_eyes(big_c: float) -> None:
+    hf = rough_field()
+    lod = TerrainLOD(hf, big_c=big_c, small_c=5.0)
+    rng = np.random.default_rng(1)
+    for eye in rng.uniform([-30, -30, 0], [95, 95, 40], size=(25, 3)):
+        mesh = lod.update(eye)
+        assert non_conforming_edges(mesh, hf.size) == 0
+        # the triangles tile the square exactly (no overlaps, no holes)
+        p = mesh.points[:, :2]
+        t = mesh.triangles
+        u, v = p[t[:, 1]] - p[t[:, 0]], p[t[:, 2]] - p[t[:, 0]]
+        area = 0.5 * (u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0])
+        assert np.all(area > 0)  # counter-clockwise from above
+        assert area.sum() == pytest.approx(64.0 * 64.0)
+
+
+def test_full_refinement_is_the_full_grid() -> None:
+    hf = rough_field(33)
+    mesh = TerrainLOD(hf).full_mesh()
+    assert mesh.n_triangles == 2 * 32 * 32
+    assert len(mesh.points) == 33 * 33
+    np.testing.assert_array_equal(mesh.points[:, 2], hf.heights[mesh.grid_index[:, 0], mesh.grid_index[:, 1]])
+    assert non_conforming_edges(mesh, 33) == 0
+
+
+def test_coarse_far_away_and_fine_nearby() -> None:
+    hf = rough_field()
+    lod = TerrainLOD(hf, big_c=4.0, small_c=2.0)
+    far = lod.update((32.0, 32.0, 5000.0))
+    near = lod.update((32.0, 32.0, 3.0))
+    assert far.n_triangles <= 8
+    assert near.n_triangles > 20 * far.n_triangles
+
+
+def test_d2_propagation_property() -> None:
+    hf = rough_field()
+    big_c = 6.0
+    lod = TerrainLOD(hf, big_c=big_c)
+    k = propagation_factor(big_c)
+    assert k == pytest.approx(6.0 / 10.0)
+    n, d2 = hf.size, lod.d2
+    d = 4
+    while d <= n - 1:
+        h, q = d // 2, d // 4
+        for ci in range(h, n - 1, d):
+            for cj in range(h, n - 1, d):
+                children = [d2[ci + si * q, cj + sj * q] for si in (-1, 1) for sj in (-1, 1)]
+                assert d2[ci, cj] >= k * max(children) - 1e-15
+                assert d2[ci, cj] == pytest.approx(max(lod.d2_local[ci, cj], k * max(children)))
+        d *= 2
+    # local d2 of a size-2 node by hand: six differences over the edge length
+    g, ci, cj = hf.heights, 5, 7
+    diffs = [g[ci, cj - 1] - (g[ci - 1, cj - 1] + g[ci + 1, cj - 1]) / 2, g[ci + 1, cj] - (g[ci + 1, cj - 1] + g[ci + 1, cj + 1]) / 2,
+             g[ci, cj + 1] - (g[ci - 1, cj + 1] + g[ci + 1, cj + 1]) / 2, g[ci - 1, cj] - (g[ci - 1, cj - 1] + g[ci - 1, cj + 1]) / 2,
+             g[ci, cj] - (g[ci - 1, cj - 1] + g[ci + 1, cj + 1]) / 2, g[ci, cj] - (g[ci + 1, cj - 1] + g[ci - 1, cj + 1]) / 2]
+    assert lod.d2_local[ci, cj] == pytest.approx(max(abs(x) for x in diffs) / 2.0)
+    with pytest.raises(ValueError, match="C must be > 2"):
+        propagation_factor(2.0)
+
+
+def _surface(mesh, x, y):
+    tri = mtri.Triangulation(mesh.points[:, 0], mesh.points[:, 1], mesh.triangles)
+    return mtri.LinearTriInterpolator(tri, mesh.points[:, 2])(x, y).filled(np.nan)
+
+
+def test_geomorph_is_continuous() -> None:
+    hf = rough_field()
+    xs = np.linspace(0.25, 63.75, 90)
+    x, y = np.meshgrid(xs, xs)
+
+    def max_step_change(geomorph: bool, step: float) -> float:
+        lod = TerrainLOD(hf, big_c=4.0, small_c=3.0, geomorph=geomorph)
+        prev, worst = None, 0.0
+        for s in np.arange(0.0, 30.0, step):
+            surf = _surface(lod.update((s, 10 + 0.5 * s, 8.0)), x, y)
+            if prev is not None:
+                worst = max(worst, float(np.nanmax(np.abs(surf - prev))))
+            prev = surf
+        return worst
+
+    coarse_step = max_step_change(True, 0.2)
+    fine_step = max_step_change(True, 0.05)
+    popping = max_step_change(False, 0.2)
+    assert popping > 0.5              # without geomorphing a refinement pops by a visible height
+    assert coarse_step < popping / 20  # with geomorphing the change per step is small ...
+    assert fine_step < 0.5 * coarse_step  # ... and shrinks with the step (continuity, no jump hidden in it)
+
+
+def test_layers_morph_with_the_terrain_and_culling() -> None:
+    hf = rough_field()
+    top = hf.heights + 2.0 + np.linspace(0, 1, hf.size)[:, None]
+    lod = TerrainLOD(hf, layers={"fog_top": top}, curvature=[(top - hf.heights, 4.0)], big_c=4.0, small_c=3.0)
+    mesh = lod.update((10.0, 20.0, 6.0))
+    # the morphed top minus the morphed terrain is the linearly morphed thickness (>= 2 everywhere)
+    assert np.all(mesh.layers["fog_top"] - mesh.points[:, 2] >= 2.0 - 1e-12)
+    from volviz.unstructured.camera import Camera
+
+    cam = Camera((-10, 32, 20), (30, 32, 0), (0, 0, 1), 40.0, clipping_range=(0.5, 500))
+    culled = lod.update(cam.position, frustum_planes(cam, (64, 48)))
+    full = lod.update(cam.position)
+    assert 0 < culled.n_triangles < full.n_triangles
+    px = cam.project(full.points, (64, 48))
+    # every triangle with a vertex well inside the image survives culling
+    inside = (px[:, 0] > 2) & (px[:, 0] < 61) & (px[:, 1] > 2) & (px[:, 1] < 45) & (px[:, 2] > 1)
+    kept = {tuple(sorted(tuple(full.grid_index[v]) for v in tri)) for tri in full.triangles[inside[full.triangles].any(1)]}
+    have = {tuple(sorted(tuple(culled.grid_index[v]) for v in tri)) for tri in culled.triangles}
+    assert kept <= have
+
+
+def test_resampling_and_yukon_map() -> None:
+    assert pow2_plus_one(689) == 1025 and pow2_plus_one(513) == 513 and pow2_plus_one(3) == 3
+    a = np.arange(12.0).reshape(3, 4)
+    r = resample_bilinear(a, (5, 7))
+    assert r[0, 0] == 0 and r[-1, -1] == 11 and r[2, 3] == pytest.approx(a.mean())
+    from volviz.io import read
+
+    img = read(data_file("yukon/Yukon.map.pgm"))
+    hf = HeightField.from_image(img, extent=(1000.0, 1000.0), height_scale=0.33)
+    assert hf.size == 1025 and hf.spacing == pytest.approx((1000 / 1024, 1000 / 1024))
+    # north-west corner of the image is grid (0, N-1)
+    assert hf.heights[0, -1] == pytest.approx(0.33 * float(img.data[0, 0]))
+    lod = TerrainLOD(hf, big_c=9.0, small_c=2.0)
+    mesh = lod.update((500.0, -200.0, 250.0))
+    assert non_conforming_edges(mesh, hf.size) == 0
+    assert 1000 < mesh.n_triangles < 2 * 1024 * 1024 / 10
+    assert mesh.tcoords.min() >= 0 and mesh.tcoords.max() <= 1

@@ -1,0 +1,303 @@
+"""Numba kernels of the terrain C-LOD (Roettger §3.5.3 / [89], digest §2.4). See ``volviz.nature.terrain``.
+
+Quadtree matrix convention: a node of edge length ``d`` (grid units, a power of two) has its centre at a grid point
+whose indices are odd multiples of ``d / 2``; every grid point is the centre of at most one node, so per-node values
+live in (N, N) matrices at the node centres (Roettger's "quadtree matrix").
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True, nogil=True)
+def local_d2(g: np.ndarray, n: int, unit: float, out: np.ndarray, weight: float) -> None:
+    """out[centre] = max(out, weight * d2) with d2 = max_i |dh_i| / d over the 4 edge midpoints and 2 diagonals."""
+    d = n - 1
+    while d >= 2:
+        h = d // 2
+        for ci in range(h, n - 1, d):
+            for cj in range(h, n - 1, d):
+                a = g[ci - h, cj - h]
+                b = g[ci + h, cj - h]
+                c = g[ci + h, cj + h]
+                e = g[ci - h, cj + h]
+                m = abs(g[ci, cj - h] - 0.5 * (a + b))
+                m = max(m, abs(g[ci + h, cj] - 0.5 * (b + c)))
+                m = max(m, abs(g[ci, cj + h] - 0.5 * (c + e)))
+                m = max(m, abs(g[ci - h, cj] - 0.5 * (e + a)))
+                m = max(m, abs(g[ci, cj] - 0.5 * (a + c)))
+                m = max(m, abs(g[ci, cj] - 0.5 * (b + e)))
+                v = weight * m / (d * unit)
+                if v > out[ci, cj]:
+                    out[ci, cj] = v
+        d //= 2
+
+
+@njit(cache=True, nogil=True)
+def propagate_d2(d2: np.ndarray, n: int, k: float) -> None:
+    """Bottom-up: d2(node) := max(d2_local(node), K * d2(child)) for the 4 children (digest §2.4)."""
+    d = 4
+    while d <= n - 1:
+        h = d // 2
+        q = h // 2
+        for ci in range(h, n - 1, d):
+            for cj in range(h, n - 1, d):
+                m = d2[ci, cj]
+                for si in (-1, 1):
+                    for sj in (-1, 1):
+                        v = k * d2[ci + si * q, cj + sj * q]
+                        if v > m:
+                            m = v
+                d2[ci, cj] = m
+        d *= 2
+
+
+@njit(cache=True, nogil=True)
+def node_zrange(zlo: np.ndarray, zhi: np.ndarray, n: int, out_lo: np.ndarray, out_hi: np.ndarray) -> None:
+    """Per node centre: min of ``zlo`` and max of ``zhi`` over the node's (d + 1)^2 samples (bottom-up)."""
+    d = 2
+    while d <= n - 1:
+        h = d // 2
+        for ci in range(h, n - 1, d):
+            for cj in range(h, n - 1, d):
+                if d == 2:
+                    lo = zlo[ci, cj]
+                    hi = zhi[ci, cj]
+                    for a in range(ci - 1, ci + 2):
+                        for b in range(cj - 1, cj + 2):
+                            lo = min(lo, zlo[a, b])
+                            hi = max(hi, zhi[a, b])
+                else:
+                    q = h // 2
+                    lo = np.inf
+                    hi = -np.inf
+                    for si in (-1, 1):
+                        for sj in (-1, 1):
+                            lo = min(lo, out_lo[ci + si * q, cj + sj * q])
+                            hi = max(hi, out_hi[ci + si * q, cj + sj * q])
+                out_lo[ci, cj] = lo
+                out_hi[ci, cj] = hi
+        d *= 2
+
+
+@njit(cache=True, nogil=True)
+def refine(d2: np.ndarray, height: np.ndarray, n: int, sx: float, sy: float, x0: float, y0: float,
+           eye: np.ndarray, big_c: float, small_c: float, geomorph: bool,
+           state: np.ndarray, weight: np.ndarray, nodes: np.ndarray, sizes: np.ndarray) -> tuple[int, int]:
+    """Top-down, level by level: f = l / (d C max(c d2, 1)), refine if f < 1 (Eq. 3.2), l the L1 eye distance.
+
+    ``state`` gets 1 for every visited node and 2 for refined ones; ``weight`` the effective morph factor
+    w = min(clamp(1/f - 1, 0, 1), w(parent), w(constraining neighbours)). A node refines only if the two nodes of
+    its parent's size across its outer edges are refined (or outside the grid): the conformity guard that keeps
+    neighbouring leaves within one level (it rarely binds thanks to the K propagation; the count is returned).
+    Returns (number of visited nodes, number of refinements blocked by the guard).
+    """
+    m = (n - 1) // 2
+    nodes[0, 0] = m
+    nodes[0, 1] = m
+    sizes[0] = n - 1
+    state[m, m] = 1
+    start = 0
+    end = 1
+    d = n - 1
+    unit = max(sx, sy)
+    blocked = 0
+    while True:
+        h = d // 2
+        nxt = end
+        for k in range(start, end):
+            ci = nodes[k, 0]
+            cj = nodes[k, 1]
+            l = abs(eye[0] - (x0 + ci * sx)) + abs(eye[1] - (y0 + cj * sy)) + abs(eye[2] - height[ci, cj])
+            denom = d * unit * big_c * max(small_c * d2[ci, cj], 1.0)
+            f = l / denom
+            if d <= 2 or f >= 1.0:
+                continue
+            if not geomorph or f <= 0.5:
+                w = 1.0
+            else:
+                w = 1.0 / f - 1.0
+            ok = True
+            if d < n - 1:
+                pi = ci - h if (ci - h) % (2 * d) == d else ci + h
+                pj = cj - h if (cj - h) % (2 * d) == d else cj + h
+                w = min(w, weight[pi, pj])
+                ax = pi + (2 * d if ci > pi else -2 * d)
+                if 0 <= ax <= n - 1:
+                    if state[ax, pj] != 2:
+                        ok = False
+                    else:
+                        w = min(w, weight[ax, pj])
+                ay = pj + (2 * d if cj > pj else -2 * d)
+                if 0 <= ay <= n - 1:
+                    if state[pi, ay] != 2:
+                        ok = False
+                    else:
+                        w = min(w, weight[pi, ay])
+            if not ok:
+                blocked += 1
+                continue
+            state[ci, cj] = 2
+            weight[ci, cj] = w
+            q = h // 2
+            for si in (-1, 1):
+                for sj in (-1, 1):
+                    nodes[nxt, 0] = ci + si * q
+                    nodes[nxt, 1] = cj + sj * q
+                    sizes[nxt] = h
+                    state[ci + si * q, cj + sj * q] = 1
+                    nxt += 1
+        if nxt == end:
+            break
+        start = end
+        end = nxt
+        d = h
+    return end, blocked
+
+
+@njit(cache=True, nogil=True)
+def _blend(fields: np.ndarray, out: np.ndarray, vi: int, vj: int, ai: int, aj: int, bi: int, bj: int, w: float) -> None:
+    for f in range(fields.shape[0]):
+        out[f, vi, vj] = (1.0 - w) * 0.5 * (out[f, ai, aj] + out[f, bi, bj]) + w * fields[f, vi, vj]
+
+
+@njit(cache=True, nogil=True)
+def morph(fields: np.ndarray, n: int, state: np.ndarray, weight: np.ndarray, nodes: np.ndarray, sizes: np.ndarray,
+          count: int, out: np.ndarray) -> None:
+    """Geomorphing: every vertex a refinement introduces is the midpoint of an edge (a, b) of the coarser fan and
+    gets ``(1 - w) (out[a] + out[b]) / 2 + w * true`` with w the refining node's factor (edge points shared with the
+    neighbour use the minimum of both factors). Coarse to fine, so ``out[a]``, ``out[b]`` are already morphed."""
+    m = (n - 1) // 2
+    last = n - 1
+    for f in range(fields.shape[0]):
+        for (i, j) in ((0, 0), (last, 0), (0, last), (last, last), (m, m), (m, 0), (last, m), (m, last), (0, m)):
+            out[f, i, j] = fields[f, i, j]
+    for k in range(count):
+        ci = nodes[k, 0]
+        cj = nodes[k, 1]
+        if state[ci, cj] != 2:
+            continue
+        d = sizes[k]
+        h = d // 2
+        q = h // 2
+        w = weight[ci, cj]
+        for si in (-1, 1):
+            for sj in (-1, 1):  # children centres on the centre-corner diagonals
+                _blend(fields, out, ci + si * q, cj + sj * q, ci, cj, ci + si * h, cj + sj * h, w)
+        for s in (-1, 1):  # inner child-edge midpoints on the centre-to-edge-midpoint spokes
+            _blend(fields, out, ci + s * q, cj, ci, cj, ci + s * h, cj, w)
+            _blend(fields, out, ci, cj + s * q, ci, cj, ci, cj + s * h, w)
+        for s in (-1, 1):  # outer child-edge midpoints on this node's border, shared with the neighbour
+            ni = ci + s * d
+            wn = w if (ni < 0 or ni > last) else min(w, weight[ni, cj])
+            for t in (-1, 1):
+                _blend(fields, out, ci + s * h, cj + t * q, ci + s * h, cj, ci + s * h, cj + t * h, wn)
+            nj = cj + s * d
+            wn = w if (nj < 0 or nj > last) else min(w, weight[ci, nj])
+            for t in (-1, 1):
+                _blend(fields, out, ci + t * q, cj + s * h, ci, cj + s * h, ci + t * h, cj + s * h, wn)
+
+
+@njit(cache=True, nogil=True)
+def _outside(planes: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> bool:
+    for p in range(planes.shape[0]):
+        # the box corner furthest along the plane normal
+        x = hi[0] if planes[p, 0] >= 0 else lo[0]
+        y = hi[1] if planes[p, 1] >= 0 else lo[1]
+        z = hi[2] if planes[p, 2] >= 0 else lo[2]
+        if planes[p, 0] * x + planes[p, 1] * y + planes[p, 2] * z + planes[p, 3] < 0.0:
+            return True
+    return False
+
+
+@njit(cache=True, nogil=True)
+def emit_fans(n: int, sx: float, sy: float, x0: float, y0: float, state: np.ndarray, nodes: np.ndarray,
+              sizes: np.ndarray, count: int, zlo: np.ndarray, zhi: np.ndarray, planes: np.ndarray,
+              vmap: np.ndarray, stamp: int, vstamp: np.ndarray, verts: np.ndarray, tris: np.ndarray) -> tuple[int, int]:
+    """Triangle fans around the centre of every leaf, skipping the edge midpoints whose same-size neighbour does not
+    exist (the T-vertex rule of §3.5.3). Leaves whose box misses the frustum ``planes`` are skipped (emission only).
+    Vertices are numbered on first use (``verts`` gets their grid indices). Returns (n_vertices, n_triangles)."""
+    nv = 0
+    nt = 0
+    ring_i = np.empty(8, dtype=np.int64)
+    ring_j = np.empty(8, dtype=np.int64)
+    lo = np.empty(3)
+    hi = np.empty(3)
+    last = n - 1
+    for k in range(count):
+        ci = nodes[k, 0]
+        cj = nodes[k, 1]
+        if state[ci, cj] != 1:
+            continue
+        d = sizes[k]
+        h = d // 2
+        if planes.shape[0] > 0:
+            lo[0] = x0 + (ci - h) * sx
+            hi[0] = x0 + (ci + h) * sx
+            lo[1] = y0 + (cj - h) * sy
+            hi[1] = y0 + (cj + h) * sy
+            lo[2] = zlo[ci, cj]
+            hi[2] = zhi[ci, cj]
+            if _outside(planes, lo, hi):
+                continue
+        r = 0
+        # counter-clockwise seen from above (x east, y north)
+        ring_i[r] = ci - h
+        ring_j[r] = cj - h
+        r += 1
+        if cj - d < 0 or state[ci, cj - d] != 0:
+            ring_i[r] = ci
+            ring_j[r] = cj - h
+            r += 1
+        ring_i[r] = ci + h
+        ring_j[r] = cj - h
+        r += 1
+        if ci + d > last or state[ci + d, cj] != 0:
+            ring_i[r] = ci + h
+            ring_j[r] = cj
+            r += 1
+        ring_i[r] = ci + h
+        ring_j[r] = cj + h
+        r += 1
+        if cj + d > last or state[ci, cj + d] != 0:
+            ring_i[r] = ci
+            ring_j[r] = cj + h
+            r += 1
+        ring_i[r] = ci - h
+        ring_j[r] = cj + h
+        r += 1
+        if ci - d < 0 or state[ci - d, cj] != 0:
+            ring_i[r] = ci - h
+            ring_j[r] = cj
+            r += 1
+        if vstamp[ci, cj] != stamp:
+            vstamp[ci, cj] = stamp
+            vmap[ci, cj] = nv
+            verts[nv, 0] = ci
+            verts[nv, 1] = cj
+            nv += 1
+        c_id = vmap[ci, cj]
+        for a in range(r):
+            i = ring_i[a]
+            j = ring_j[a]
+            if vstamp[i, j] != stamp:
+                vstamp[i, j] = stamp
+                vmap[i, j] = nv
+                verts[nv, 0] = i
+                verts[nv, 1] = j
+                nv += 1
+        for a in range(r):
+            b = (a + 1) % r
+            tris[nt, 0] = c_id
+            tris[nt, 1] = vmap[ring_i[a], ring_j[a]]
+            tris[nt, 2] = vmap[ring_i[b], ring_j[b]]
+            nt += 1
+    return nv, nt
+
+
+@njit(cache=True, nogil=True)
+def gather(out: np.ndarray, verts: np.ndarray, nv: int, dest: np.ndarray) -> None:
+    for v in range(nv):
+        for f in range(out.shape[0]):
+            dest[v, f] = out[f, verts[v, 0], verts[v, 1]]
