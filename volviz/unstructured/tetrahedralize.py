@@ -9,8 +9,9 @@ Conformity rules used here:
   mesh vertices along hexahedron edges. For a curvilinear grid the colour is ``(i + j + k) % 2`` (the classic
   alternating parity). Every face diagonal then joins the two colour-0 corners of that face, so both neighbours pick the
   same diagonal. Unstructured hexahedral meshes whose vertex graph is not bipartite are refused with a clear error.
-- prisms and pyramids: every quadrilateral face is split along the diagonal through its smallest global vertex id
-  (Dompierre et al. 1999), which is consistent between neighbours by construction.
+- prisms and pyramids: every quadrilateral face is split along the diagonal through its smallest vertex in the global
+  order (colour, id) (Dompierre et al. 1999: any global order is consistent between neighbours); on a face shared with
+  a hexahedron this is the hexahedron's colour-0 diagonal, so mixed meshes conform.
 
 Degenerate cells (|6V| <= 1e-12 * (longest edge)^3) are dropped and counted.
 """
@@ -82,25 +83,29 @@ def hexahedra_to_tets(hexes: np.ndarray, even_corner0: np.ndarray) -> np.ndarray
     return out.reshape(-1, 4)
 
 
-def wedges_to_tets(wedges: np.ndarray) -> np.ndarray:
-    """Split prisms (k, 6) into 3 tetrahedra each, quad diagonals through the smallest vertex id (Dompierre 1999)."""
+def wedges_to_tets(wedges: np.ndarray, rank: np.ndarray | None = None) -> np.ndarray:
+    """Split prisms (k, 6) into 3 tetrahedra each, quad diagonals through the vertex of smallest ``rank`` (default:
+    the vertex id; Dompierre 1999: any global total order gives conforming splits)."""
     w = np.asarray(wedges, dtype=np.int64)
     if len(w) == 0:
         return np.empty((0, 4), dtype=np.int64)
-    rot = _WEDGE_ROT[np.argmin(w, axis=1)]
+    r = w if rank is None else rank[w]
+    rot = _WEDGE_ROT[np.argmin(r, axis=1)]
     v = np.take_along_axis(w, rot, axis=1)
-    first = np.minimum(v[:, 1], v[:, 5]) < np.minimum(v[:, 2], v[:, 4])
+    rv = np.take_along_axis(r, rot, axis=1)
+    first = np.minimum(rv[:, 1], rv[:, 5]) < np.minimum(rv[:, 2], rv[:, 4])
     a = np.stack([v[:, [0, 1, 2, 5]], v[:, [0, 1, 5, 4]], v[:, [0, 4, 5, 3]]], axis=1)
     b = np.stack([v[:, [0, 1, 2, 4]], v[:, [0, 4, 2, 5]], v[:, [0, 4, 5, 3]]], axis=1)
     return np.where(first[:, None, None], a, b).reshape(-1, 4)
 
 
-def pyramids_to_tets(pyramids: np.ndarray) -> np.ndarray:
-    """Split pyramids (k, 5) into 2 tetrahedra each along the base diagonal through the smallest vertex id."""
+def pyramids_to_tets(pyramids: np.ndarray, rank: np.ndarray | None = None) -> np.ndarray:
+    """Split pyramids (k, 5) into 2 tetrahedra each along the base diagonal through the vertex of smallest rank."""
     p = np.asarray(pyramids, dtype=np.int64)
     if len(p) == 0:
         return np.empty((0, 4), dtype=np.int64)
-    d02 = np.minimum(p[:, 0], p[:, 2]) < np.minimum(p[:, 1], p[:, 3])
+    r = p if rank is None else rank[p]
+    d02 = np.minimum(r[:, 0], r[:, 2]) < np.minimum(r[:, 1], r[:, 3])
     a = np.stack([p[:, [0, 1, 2, 4]], p[:, [0, 2, 3, 4]]], axis=1)
     b = np.stack([p[:, [1, 2, 3, 4]], p[:, [1, 3, 0, 4]]], axis=1)
     return np.where(d02[:, None, None], a, b).reshape(-1, 4)
@@ -197,20 +202,25 @@ def _unstructured_tets(points: np.ndarray, cells: list[tuple[int, np.ndarray]]
                        ) -> tuple[np.ndarray, dict[str, int]]:
     parts: list[np.ndarray] = []
     counts: dict[str, int] = {}
+    n = len(points)
+    hexes = [np.asarray(c, dtype=np.int64) for t, c in cells if t == VTK_HEXAHEDRON and len(c)]
+    colour = _hex_vertex_colours(np.concatenate(hexes), n) if hexes else np.zeros(n, dtype=np.int64)
+    # quad diagonals of prisms/pyramids through the smallest (colour, id): on faces shared with a hexahedron that is
+    # the colour-0 diagonal the 5-split uses, so mixed meshes conform too
+    rank = np.maximum(colour, 0) * n + np.arange(n)
     for cell_type, conn in cells:
         conn = np.asarray(conn, dtype=np.int64)
         if cell_type == VTK_TETRA:
             parts.append(conn)
             counts["tetra"] = counts.get("tetra", 0) + len(conn)
         elif cell_type == VTK_HEXAHEDRON:
-            colour = _hex_vertex_colours(conn, len(points))
             parts.append(hexahedra_to_tets(conn, colour[conn[:, 0]] == 0))
             counts["hexahedron"] = counts.get("hexahedron", 0) + len(conn)
         elif cell_type == VTK_WEDGE:
-            parts.append(wedges_to_tets(conn))
+            parts.append(wedges_to_tets(conn, rank))
             counts["wedge"] = counts.get("wedge", 0) + len(conn)
         elif cell_type == VTK_PYRAMID:
-            parts.append(pyramids_to_tets(conn))
+            parts.append(pyramids_to_tets(conn, rank))
             counts["pyramid"] = counts.get("pyramid", 0) + len(conn)
         else:
             counts[f"ignored type {cell_type}"] = counts.get(f"ignored type {cell_type}", 0) + len(conn)
