@@ -20,7 +20,7 @@ range is then transparent in the table as in the reference.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Callable
 
 import numba
 import numpy as np
@@ -31,7 +31,9 @@ from volviz.optics.table_error import TableError, measure_error, sample_points
 from volviz.optics.tf_change import changed_span, touching_pairs
 from volviz.optics.transfer_function import TransferFunction
 
-__all__ = ["Table3D", "build_table3d"]
+__all__ = ["Table3D", "build_table3d", "build_table3d_job"]
+
+Progress = Callable[[float, str], None]
 
 _METHODS = ("direct", "incremental")
 _ROUNDING = ("linear", "nearest")
@@ -59,11 +61,12 @@ def resolve_range(tf: TransferFunction, s_range: Any) -> tuple[float, float]:
 
 
 @numba.njit(cache=True, nogil=True, parallel=True)
-def _incremental_fill(t, mask, nearest):
-    """Fill slices k ≥ 2 of t (L, n, n, 4) float64 from slice 1 and slice k − 1, only where mask[i, j]."""
-    nl = t.shape[0]
+def _incremental_fill(t, mask, nearest, k_start, k_stop):
+    """Fill slices k_start ≤ k < k_stop (k ≥ 2) of t (L, n, n, 4) from slice 1 and slice k − 1 where mask[i, j].
+
+    Arithmetic in float64 whatever t's dtype."""
     n = t.shape[1]
-    for k in range(2, nl):
+    for k in range(max(k_start, 2), k_stop):
         for i in numba.prange(n):
             for j in range(n):
                 if not mask[i, j]:
@@ -76,25 +79,46 @@ def _incremental_fill(t, mask, nearest):
                     m0 = int(np.floor(m))
                     w = m - m0
                 m1 = min(m0 + 1, n - 1)
-                fa = (1.0 - w) * t[1, i, m0, 3] + w * t[1, i, m1, 3]
+                fa = (1.0 - w) * np.float64(t[1, i, m0, 3]) + w * np.float64(t[1, i, m1, 3])
                 for ch in range(4):
-                    front = (1.0 - w) * t[1, i, m0, ch] + w * t[1, i, m1, ch]
-                    back = (1.0 - w) * t[k - 1, m0, j, ch] + w * t[k - 1, m1, j, ch]
+                    front = (1.0 - w) * np.float64(t[1, i, m0, ch]) + w * np.float64(t[1, i, m1, ch])
+                    back = (1.0 - w) * np.float64(t[k - 1, m0, j, ch]) + w * np.float64(t[k - 1, m1, j, ch])
                     t[k, i, j, ch] = front + (1.0 - fa) * back
 
 
-def _fill(tf: TransferFunction, t: np.ndarray, s: np.ndarray, ls: np.ndarray, mask: np.ndarray, method: str,
-          m_rounding: str) -> None:
-    """(Re)compute the entries t[:, i, j, :] with mask[i, j] (float64 work array, layout (L, n, n, 4))."""
+_CHUNK_SEGMENTS = 1 << 20  # segments integrated per progress step (≈ 32 MiB of float64 RGBA)
+
+
+def _fill(tf: TransferFunction, out: np.ndarray, s: np.ndarray, ls: np.ndarray, mask: np.ndarray, method: str,
+          m_rounding: str, progress: Progress | None = None) -> None:
+    """(Re)compute the entries out[i, j, :, :] with mask[i, j] in the float32 table ``out`` (n, n, L, 4).
+
+    ``progress(fraction, message)`` is called between chunks (it may raise to cancel the build)."""
+    n, nl = out.shape[0], out.shape[2]
+    if method == "direct":
+        rows = max(1, _CHUNK_SEGMENTS // max(1, n * (nl - 1)))
+        for i0 in range(0, n, rows):
+            ii, jj = np.nonzero(mask[i0:i0 + rows])
+            ii += i0
+            if ii.size:
+                out[ii, jj, 0, :] = 0.0
+                out[ii, jj, 1:, :] = integrate_segment(tf, s[ii][:, None], s[jj][:, None], ls[None, 1:])
+            if progress is not None:
+                progress(min(i0 + rows, n) / n, "pre-integration table (direct)")
+        return
     ii, jj = np.nonzero(mask)
     if ii.size == 0:
         return
-    t[0, ii, jj, :] = 0.0
-    if method == "direct":
-        t[1:, ii, jj, :] = integrate_segment(tf, s[ii][None, :], s[jj][None, :], ls[1:, None])
-        return
-    t[1, ii, jj, :] = integrate_segment(tf, s[ii], s[jj], ls[1])
-    _incremental_fill(t, mask, m_rounding == "nearest")
+    full = ii.size == n * n  # every pair is recomputed: no need to copy the old entries in
+    work = np.zeros((nl, n, n, 4), np.float32) if full else np.ascontiguousarray(out.transpose(2, 0, 1, 3))
+    work[0, ii, jj, :] = 0.0
+    work[1, ii, jj, :] = integrate_segment(tf, s[ii], s[jj], ls[1])
+    slices = max(1, _CHUNK_SEGMENTS // (n * n))
+    for k0 in range(2, nl, slices):
+        _incremental_fill(work, mask, m_rounding == "nearest", k0, min(k0 + slices, nl))
+        if progress is not None:
+            progress(min(k0 + slices, nl) / nl, "pre-integration table (incremental)")
+    out[...] = work.transpose(1, 2, 0, 3)
 
 
 @dataclass
@@ -155,9 +179,7 @@ class Table3D:
         mask = touching_pairs(self.scalars, span)
         count = int(mask.sum())
         if count:
-            work = np.ascontiguousarray(self.rgba.transpose(2, 0, 1, 3), dtype=np.float64)
-            _fill(tf, work, self.scalars, self.lengths, mask, self.method, self.m_rounding)
-            self.rgba[...] = work.transpose(1, 2, 0, 3)
+            _fill(tf, self.rgba, self.scalars, self.lengths, mask, self.method, self.m_rounding)
         self.tf = tf
         return count
 
@@ -171,11 +193,13 @@ class Table3D:
 
 
 def build_table3d(tf: TransferFunction, n_s: int = 128, n_l: int = 64, l_max: float = 1.0, method: str = "direct",
-                  *, s_range: Any = None, m_rounding: str = "linear") -> Table3D:
+                  *, s_range: Any = None, m_rounding: str = "linear", progress: Progress | None = None
+                  ) -> Table3D:
     """Build the 3D pre-integration table (Roettger §8.4) by direct integration or incrementally (digest §15.4).
 
     ``l_max`` should be the longest segment the renderer produces (VTK uses the largest cell bounding-box diagonal);
-    longer segments are clamped by ``lookup``.
+    longer segments are clamped by ``lookup``. ``progress(fraction, message)`` is called between chunks of work
+    (``volviz.jobs`` passes a callable that raises to cancel).
     """
     if method not in _METHODS:
         raise ValueError(f"method must be one of {_METHODS}, got {method!r}")
@@ -184,9 +208,12 @@ def build_table3d(tf: TransferFunction, n_s: int = 128, n_l: int = 64, l_max: fl
     l_max = float(l_max)
     _check_sizes(n_s, n_l, l_max)
     lo, hi = resolve_range(tf, s_range)
-    table = Table3D(np.empty((0, 0, 0, 4), np.float32), lo, hi, l_max, method, tf, m_rounding)
-    work = np.zeros((n_l, n_s, n_s, 4), dtype=np.float64)
-    s = np.linspace(lo, hi, n_s)
-    _fill(tf, work, s, np.linspace(0.0, l_max, n_l), np.ones((n_s, n_s), dtype=bool), method, m_rounding)
-    table.rgba = np.ascontiguousarray(work.transpose(1, 2, 0, 3), dtype=np.float32)
-    return table
+    rgba = np.zeros((n_s, n_s, n_l, 4), dtype=np.float32)
+    _fill(tf, rgba, np.linspace(lo, hi, n_s), np.linspace(0.0, l_max, n_l), np.ones((n_s, n_s), dtype=bool), method,
+          m_rounding, progress)
+    return Table3D(rgba, lo, hi, l_max, method, tf, m_rounding)
+
+
+def build_table3d_job(tf: TransferFunction, *, progress: Progress, **kw: Any) -> Table3D:
+    """``build_table3d`` for ``volviz.jobs.JobRunner.submit`` (progress is required there; it cancels by raising)."""
+    return build_table3d(tf, progress=progress, **kw)
