@@ -61,14 +61,16 @@ def resolve_range(tf: TransferFunction, s_range: Any) -> tuple[float, float]:
 
 
 @numba.njit(cache=True, nogil=True, parallel=True)
-def _incremental_fill(t, mask, nearest, k_start, k_stop):
-    """Fill slices k_start ≤ k < k_stop (k ≥ 2) of t (L, n, n, 4) from slice 1 and slice k − 1 where mask[i, j].
+def _incremental_fill(front, work, mask, nearest, k_start, k_stop):
+    """Fill slices k_start ≤ k < k_stop (k ≥ 2) of ``work`` (n_j, L, n_i, 4) where mask[i, j]:
 
-    Arithmetic in float64 whatever t's dtype."""
-    n = t.shape[1]
-    for k in range(max(k_start, 2), k_stop):
-        for i in numba.prange(n):
-            for j in range(n):
+    entry(i, j, k) = front(i → m) over entry(m, j, k − 1), m = ((k − 1) i + j)/k, with ``front`` (n, n, 4) the
+    slice of length Δl. Entries of one back scalar j depend only on entries of the same j, so the outer loop over j
+    is parallel and each j's data is contiguous. Arithmetic in float64 whatever work's dtype."""
+    n = work.shape[0]
+    for j in numba.prange(n):
+        for k in range(max(k_start, 2), k_stop):
+            for i in range(n):
                 if not mask[i, j]:
                     continue
                 m = ((k - 1) * i + j) / k
@@ -79,11 +81,11 @@ def _incremental_fill(t, mask, nearest, k_start, k_stop):
                     m0 = int(np.floor(m))
                     w = m - m0
                 m1 = min(m0 + 1, n - 1)
-                fa = (1.0 - w) * np.float64(t[1, i, m0, 3]) + w * np.float64(t[1, i, m1, 3])
+                fa = (1.0 - w) * front[i, m0, 3] + w * front[i, m1, 3]
                 for ch in range(4):
-                    front = (1.0 - w) * np.float64(t[1, i, m0, ch]) + w * np.float64(t[1, i, m1, ch])
-                    back = (1.0 - w) * np.float64(t[k - 1, m0, j, ch]) + w * np.float64(t[k - 1, m1, j, ch])
-                    t[k, i, j, ch] = front + (1.0 - fa) * back
+                    f = (1.0 - w) * front[i, m0, ch] + w * front[i, m1, ch]
+                    back = (1.0 - w) * np.float64(work[j, k - 1, m0, ch]) + w * np.float64(work[j, k - 1, m1, ch])
+                    work[j, k, i, ch] = f + (1.0 - fa) * back
 
 
 _CHUNK_SEGMENTS = 1 << 20  # segments integrated per progress step (≈ 32 MiB of float64 RGBA)
@@ -110,15 +112,18 @@ def _fill(tf: TransferFunction, out: np.ndarray, s: np.ndarray, ls: np.ndarray, 
     if ii.size == 0:
         return
     full = ii.size == n * n  # every pair is recomputed: no need to copy the old entries in
-    work = np.zeros((nl, n, n, 4), np.float32) if full else np.ascontiguousarray(out.transpose(2, 0, 1, 3))
-    work[0, ii, jj, :] = 0.0
-    work[1, ii, jj, :] = integrate_segment(tf, s[ii], s[jj], ls[1])
+    # work[j, k, i] = out[i, j, k]: one back scalar's entries are contiguous
+    work = np.zeros((n, nl, n, 4), np.float32) if full else np.ascontiguousarray(out.transpose(1, 2, 0, 3))
+    front = out[:, :, 1, :].astype(np.float64)
+    front[ii, jj] = integrate_segment(tf, s[ii], s[jj], ls[1])
+    work[jj, 0, ii, :] = 0.0
+    work[jj, 1, ii, :] = front[ii, jj]
     slices = max(1, _CHUNK_SEGMENTS // (n * n))
     for k0 in range(2, nl, slices):
-        _incremental_fill(work, mask, m_rounding == "nearest", k0, min(k0 + slices, nl))
+        _incremental_fill(front, work, mask, m_rounding == "nearest", k0, min(k0 + slices, nl))
         if progress is not None:
             progress(min(k0 + slices, nl) / nl, "pre-integration table (incremental)")
-    out[...] = work.transpose(1, 2, 0, 3)
+    out[...] = work.transpose(2, 0, 1, 3)
 
 
 @dataclass
