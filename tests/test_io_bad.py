@@ -119,6 +119,7 @@ def test_headsq_slice_of_wrong_size(tmp_path):
     ("a.xyz", b"\xff" * 7, "not a PLOT3D xyz file"),
     ("a.msh", b"$NotGmsh\n", "meshio could not read it"),
     ("a.unknownext", b"\x00\x01\x02\x03", "unknown data format"),
+    ("a.jpg", b"\xff\xd8\xff\xe0 not really a jpeg", "not a readable image"),
 ])
 def test_wrong_magic(tmp_path, name, content, match):
     path = tmp_path / name

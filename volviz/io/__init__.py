@@ -12,6 +12,7 @@ Readers (each returns a ``volviz.model`` dataset, convertible with ``.to_pyvista
 - VTKHDF (static or transient)            -> the matching dataset, or TimeSeries with lazy frames
 - PGM/PPM P2/P3/P5/P6, 8/16 bit           -> Image2D
 - USGS DEM (ASCII)                        -> Image2D of heights in metres
+- PNG/JPEG/TIFF/BMP (Pillow)              -> Image2D
 - anything meshio reads                   -> UnstructuredMesh
 - a numbered series (list, glob, ``%d``)  -> TimeSeries with lazy frames (``read_series``)
 
@@ -66,6 +67,7 @@ def __getattr__(name: str):
     modules = {
         "read_pvm": "pvm", "read_pnm": "pnm", "read_slc": "slc", "read_dem": "dem", "read_metaimage": "metaimage",
         "read_plot3d": "plot3d", "read_vtk_file": "vtkfiles", "read_vtkhdf": "vtkhdf", "read_meshio": "meshio_reader",
+        "read_image": "image",
     }
     if name in modules:
         import importlib
@@ -75,7 +77,7 @@ def __getattr__(name: str):
 
 
 __all__ = [
-    "NonFiniteWarning", "ReadError", "expand_pattern", "open_dialog_filter", "read", "read_dem", "read_meshio",
+    "NonFiniteWarning", "ReadError", "expand_pattern", "open_dialog_filter", "read", "read_dem", "read_image", "read_meshio",
     "read_metaimage", "read_plot3d", "read_pnm", "read_pvm", "read_raw", "read_series", "read_slc",
     "read_slice_stack", "read_vtk_file", "read_vtkhdf", "supported_formats",
 ]

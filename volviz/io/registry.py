@@ -21,6 +21,7 @@ FORMATS: list[tuple[str, tuple[str, ...]]] = [
     ("VTKHDF", ("*.vtkhdf", "*.hdf")),
     ("PGM/PPM image", ("*.pgm", "*.ppm", "*.pnm")),
     ("USGS DEM", ("*.dem",)),
+    ("Raster image", ("*.png", "*.jpg", "*.jpeg", "*.tif", "*.tiff", "*.bmp")),
 ]
 _PVM_NAME = re.compile(r"\.pvm(-t\d+)?$", re.I)
 _PLOT3D_EXT = {".xyz", ".x", ".p3d", ".g", ".grd"}
@@ -48,6 +49,8 @@ def _loader(kind: str) -> Callable[..., Any]:
         from volviz.io.raw import read_raw as f
     elif kind == "meshio":
         from volviz.io.meshio_reader import read_meshio as f
+    elif kind == "image":
+        from volviz.io.image import read_image as f
     else:  # pragma: no cover
         raise KeyError(kind)
     return f
@@ -88,7 +91,8 @@ def format_of(path: PathLike, options: dict) -> str:
         return "pvm"
     by_ext = {".pgm": "pnm", ".ppm": "pnm", ".pnm": "pnm", ".slc": "slc", ".dem": "dem", ".mhd": "metaimage",
               ".mha": "metaimage", ".vtk": "vtk", ".vti": "vtk", ".vtu": "vtk", ".vts": "vtk", ".vtr": "vtk",
-              ".vtp": "vtk", ".vtkhdf": "vtkhdf", ".hdf": "vtkhdf"}
+              ".vtp": "vtk", ".vtkhdf": "vtkhdf", ".hdf": "vtkhdf", ".png": "image", ".jpg": "image",
+              ".jpeg": "image", ".tif": "image", ".tiff": "image", ".bmp": "image"}
     if "dims" in options:
         return "raw"
     if ext in by_ext:

@@ -1,0 +1,39 @@
+"""Ordinary raster images (PNG, JPEG, TIFF, BMP) through Pillow -> Image2D (e.g. the sky/clouds.jpeg photo).
+
+The header is read first; images of more than ``MAX_PIXELS`` pixels are refused before decoding (a small
+compressed file can describe a gigantic image).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from volviz.io._checks import check_file, open_file
+from volviz.io.errors import PathLike, ReadError
+from volviz.model import Image2D
+
+EXTENSIONS = (".png", ".jpg", ".jpeg", ".tif", ".tiff", ".bmp")
+MAX_PIXELS = 1 << 28
+
+
+def read_image(path: PathLike) -> Image2D:
+    """Read a PNG/JPEG/TIFF/BMP into Image2D: (rows, cols) grey or (rows, cols, 3|4) colour, row 0 at the top."""
+    from PIL import Image, UnidentifiedImageError
+
+    check_file(path)
+    with open_file(path) as fh:
+        try:
+            with Image.open(fh) as im:
+                width, height = im.size
+                if width <= 0 or height <= 0:
+                    raise ReadError(path, f"image size {width}x{height} must be positive")
+                if width * height > MAX_PIXELS:
+                    raise ReadError(path, f"image claims {width}x{height} pixels, more than the limit of {MAX_PIXELS}")
+                if im.mode not in ("L", "I;16", "I;16B", "RGB", "RGBA"):
+                    im = im.convert("RGBA" if "A" in im.getbands() else "RGB")
+                data = np.array(im)
+        except ReadError:
+            raise
+        except (UnidentifiedImageError, OSError, ValueError, SyntaxError, Image.DecompressionBombError) as exc:
+            raise ReadError(path, f"not a readable image ({type(exc).__name__}: {str(exc)[:200]})") from None
+    maxval = 65535 if data.dtype == np.uint16 else 255
+    return Image2D(data, maxval=maxval, source=str(path))
