@@ -342,3 +342,21 @@ def test_no_warnings_escape_for_good_files():
         warnings.simplefilter("error")
         vio.read(data_file("storm/Storm.pvm-t01"))
         vio.read(data_file("bluntfin/bluntfinxyz.bin"))
+
+
+def test_vtkhdf_dataset_claiming_too_much(tmp_path):
+    import h5py
+
+    path = tmp_path / "big.vtkhdf"
+    with h5py.File(path, "w") as f:
+        root = f.create_group("VTKHDF")
+        root.attrs["Type"] = np.bytes_(b"ImageData")
+        root.create_dataset("PointData/a", shape=(10**6, 10**6), dtype="f8")  # never written: no storage
+    with allocation_budget():
+        read_error(path, "dataset /VTKHDF/PointData/a claims 8000000000000 bytes")
+
+
+def test_file_named_like_a_pattern_is_read_as_a_file(tmp_path):
+    path = tmp_path / "scan[1].pvm"
+    path.write_bytes(b"PVM\n1 1 1\n1\n\x05")
+    assert vio.read(path).data.ravel().tolist() == [5]

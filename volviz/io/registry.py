@@ -137,6 +137,12 @@ def call_reader(kind: str, path: PathLike, options: dict):
 
 
 def is_pattern(path: Any) -> bool:
-    return isinstance(path, (list, tuple)) or (isinstance(path, (str, os.PathLike)) and
-                                               (any(c in os.fspath(path) for c in "*?[") or
-                                                re.search(r"%0?\d*d", os.fspath(path)) is not None))
+    """A list of paths, or a glob / printf pattern that is not itself the name of an existing file."""
+    if isinstance(path, (list, tuple)):
+        return True
+    if not isinstance(path, (str, os.PathLike)):
+        return False
+    text = os.fspath(path)
+    if isinstance(text, bytes) or os.path.lexists(text):
+        return False
+    return any(c in text for c in "*?[") or re.search(r"%0?\d*d", text) is not None

@@ -33,6 +33,7 @@ def _inspect(path: PathLike) -> tuple[str, np.ndarray | None]:
             if kind is None:
                 raise ReadError(path, "/VTKHDF has no Type attribute")
             kind = kind.decode() if isinstance(kind, bytes) else str(kind)
+            _check_dataset_sizes(path, root, size)
             times = None
             if "Steps" in root:
                 steps = root["Steps"]
@@ -50,6 +51,25 @@ def _inspect(path: PathLike) -> tuple[str, np.ndarray | None]:
     except (OSError, KeyError, ValueError, TypeError) as exc:
         raise ReadError(path, f"HDF5 library could not read the file ({exc})") from None
     return kind, times
+
+
+def _check_dataset_sizes(path: PathLike, root, size: int) -> None:
+    """No dataset may claim more bytes than the file could hold after decompression (deflate stays under
+    ~1032:1), so a corrupt shape cannot make VTK allocate a huge array."""
+    import h5py
+
+    budget = 1100 * size + (1 << 20)
+    found: list[tuple[str, int]] = []
+
+    def visit(name: str, obj) -> None:
+        if isinstance(obj, h5py.Dataset):
+            found.append((name, int(np.prod(obj.shape, dtype=object)) * obj.dtype.itemsize))
+
+    root.visititems(visit)
+    for name, nbytes in found:
+        if nbytes > budget:
+            raise ReadError(path, f"dataset /VTKHDF/{name} claims {nbytes} bytes, more than the file's {size} bytes "
+                                  "can hold even compressed")
 
 
 def _read_step(path: PathLike, step: int | None, allow_nonfinite: bool):
