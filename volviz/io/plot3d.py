@@ -287,6 +287,9 @@ def read_plot3d(xyz_path: PathLike, q_path: PathLike | None = None, *, block: in
     auto-detection. Derived values that come out NaN/Inf (negative pressure, ...) raise ReadError unless
     ``allow_nonfinite``.
     """
+    unknown = set(functions or ()) - set(DERIVED)
+    if unknown:
+        raise ValueError(f"unknown PLOT3D functions {sorted(unknown)}; available: {', '.join(DERIVED)}")
     points, iblank, layout = read_plot3d_xyz(xyz_path, block, **layout_options)
     point_data: dict[str, np.ndarray] = {}
     if q_path is not None:
@@ -300,9 +303,6 @@ def read_plot3d(xyz_path: PathLike, q_path: PathLike | None = None, *, block: in
         point_data["Momentum"] = np.ascontiguousarray(q[..., 1:4])
         point_data["StagnationEnergy"] = np.ascontiguousarray(q[..., 4])
         derived = derived_functions(q, cond, r_gas)
-        unknown = set(functions or ()) - set(DERIVED)
-        if unknown:
-            raise ValueError(f"unknown PLOT3D functions {sorted(unknown)}; available: {', '.join(DERIVED)}")
         for name in functions or ():
             if name in derived:
                 check_finite(q_path, derived[name], allow_nonfinite, f"derived function {name}")

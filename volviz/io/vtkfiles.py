@@ -7,7 +7,6 @@ array. VTK's error events are turned into ReadError.
 from __future__ import annotations
 
 import re
-import zlib  # noqa: F401  (zlib's ~1032:1 bound is why compressed XML gets a larger budget)
 
 from volviz.io._checks import file_size, read_bytes
 from volviz.io.errors import PathLike, ReadError, human_bytes
