@@ -1,0 +1,669 @@
+"""Entropy coding of wavelet bricks (Guthe §2.2.2): sign mapping, significance map, zero-subtree stripping and two
+coders.
+
+Scan order (shared by both coders). A tile's seven detail subbands ``b = 1..7`` (bit ``a`` of ``b`` set = axis
+``a`` highpass) are visited in order; each subband is cut into 4^3 sub-blocks. A one-bit significance flag per
+subband and per sub-block (the significance map) says whether it holds any non-zero coefficient; only significant
+sub-blocks carry coefficients. An all-zero tile codes to zero bytes (a stripped node, see ``codec``). Context class
+of a subband = number of highpass axes - 1 (0, 1, 2); class 3 is the root's lowpass residual.
+
+``CODER_RANS`` (the fast coder; a measured replacement of the thesis's fixed gamma-Huffman): coefficients are sign
+mapped (c -> 2c for c >= 0, -2c-1 for c < 0, the thesis's mapping) to v. Tokens are v for v < 16 and
+``11 + bitlength(v)`` otherwise, followed by the bits of v below its leading one as raw bits (the thesis's
+gamma-code structure). Tokens are coded with a static rANS coder (32-bit state, 16-bit renormalisation, 12-bit
+probabilities) whose per-class frequency tables are stored in the brick. Node layout::
+
+    u32 nbytes of the bit section | bit section (LSB first: significance map, tables, raw bits) | rANS u16 words
+
+``CODER_ARITH`` (the high-ratio option; Guthe's adaptive arithmetic coder of [GS04] in spirit): an LZMA-style
+adaptive binary range coder (11-bit probabilities) codes the significance map with the previous flag as context and
+each coefficient as zero flag, sign, unary bit length and mantissa bits, where the contexts are the class and the
+magnitude sum of the three causal neighbours (previous sample along each axis in the same subband).
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+CODER_RANS = 0
+CODER_ARITH = 1
+CODERS = {"rans": CODER_RANS, "arith": CODER_ARITH}
+
+SB = 4  # sub-block edge of the significance map
+N_TOK = 48
+PROB_BITS = 12
+PROB_SCALE = 1 << PROB_BITS
+RANS_L = 1 << 16
+N_CLASS = 4
+
+
+@njit(cache=True, nogil=True)
+def sign_map(c):
+    """Guthe §2.2.2 sign mapping: c -> 2c (c >= 0), -2c - 1 (c < 0)."""
+    return 2 * c if c >= 0 else -2 * c - 1
+
+
+@njit(cache=True, nogil=True)
+def sign_unmap(v):
+    return v >> 1 if (v & 1) == 0 else -((v + 1) >> 1)
+
+
+@njit(cache=True, nogil=True)
+def _bitlen(v):
+    n = 0
+    while v > 0:
+        v >>= 1
+        n += 1
+    return n
+
+
+@njit(cache=True, nogil=True)
+def regions(n0, n1, n2, root):
+    """Coded regions of a tile: rows (lo0, hi0, lo1, hi1, lo2, hi2, class). ``root``: the whole box, class 3."""
+    out = np.zeros((7, 7), np.int64)
+    if root:
+        out[0, 1] = n0
+        out[0, 3] = n1
+        out[0, 5] = n2
+        out[0, 6] = 3
+        return out[:1]
+    l0 = (n0 + 1) // 2
+    l1 = (n1 + 1) // 2
+    l2 = (n2 + 1) // 2
+    m = 0
+    for b in range(1, 8):
+        h0 = b & 1
+        h1 = (b >> 1) & 1
+        h2 = (b >> 2) & 1
+        out[m, 0] = l0 if h0 else 0
+        out[m, 1] = n0 if h0 else l0
+        out[m, 2] = l1 if h1 else 0
+        out[m, 3] = n1 if h1 else l1
+        out[m, 4] = l2 if h2 else 0
+        out[m, 5] = n2 if h2 else l2
+        out[m, 6] = h0 + h1 + h2 - 1
+        if out[m, 1] > out[m, 0] and out[m, 3] > out[m, 2] and out[m, 5] > out[m, 4]:
+            m += 1
+    return out[:m]
+
+
+@njit(cache=True, nogil=True)
+def _put_bits(buf, base, bitpos, value, n):
+    """Write the n low bits of value at bit position bitpos (LSB first); buf must be zeroed there."""
+    for i in range(n):
+        if (value >> i) & 1:
+            p = bitpos + i
+            buf[base + (p >> 3)] |= np.uint8(1 << (p & 7))
+    return bitpos + n
+
+
+@njit(cache=True, nogil=True)
+def _get_bits(buf, base, limit, bitpos, n):
+    """Read n <= 32 bits at bitpos (LSB first); bytes at or beyond ``limit`` read as zero."""
+    value = np.int64(0)
+    got = 0
+    p = bitpos
+    while got < n:
+        byte = base + (p >> 3)
+        sh = p & 7
+        take = min(8 - sh, n - got)
+        b = np.int64(buf[byte]) if byte < limit else np.int64(0)
+        value |= ((b >> sh) & ((1 << take) - 1)) << got
+        got += take
+        p += take
+    return value
+
+
+@njit(cache=True, nogil=True)
+def _sig_map(w, reg, sig, anyflag):
+    """Fill the significance map of all regions; returns number of significant sub-blocks."""
+    total = 0
+    for r in range(reg.shape[0]):
+        lo0, hi0, lo1, hi1, lo2, hi2 = reg[r, 0], reg[r, 1], reg[r, 2], reg[r, 3], reg[r, 4], reg[r, 5]
+        q = 0
+        anyflag[r] = 0
+        for b0 in range(lo0, hi0, SB):
+            for b1 in range(lo1, hi1, SB):
+                for b2 in range(lo2, hi2, SB):
+                    s = 0
+                    for i in range(b0, min(b0 + SB, hi0)):
+                        for j in range(b1, min(b1 + SB, hi1)):
+                            for k in range(b2, min(b2 + SB, hi2)):
+                                if w[i, j, k] != 0:
+                                    s = 1
+                                    break
+                            if s:
+                                break
+                        if s:
+                            break
+                    sig[r, q] = s
+                    if s:
+                        anyflag[r] = 1
+                        total += 1
+                    q += 1
+    return total
+
+
+@njit(cache=True, nogil=True)
+def zero_regions(w, reg):
+    """Set every coded coefficient to zero (a stripped node or a damaged brick)."""
+    for r in range(reg.shape[0]):
+        for i in range(reg[r, 0], reg[r, 1]):
+            for j in range(reg[r, 2], reg[r, 3]):
+                for k in range(reg[r, 4], reg[r, 5]):
+                    w[i, j, k] = 0
+
+
+# ----------------------------------------------------------------------------------------------------------- rANS
+@njit(cache=True, nogil=True)
+def _normalise(counts, freq):
+    total = counts.sum()
+    if total == 0:
+        return
+    acc = 0
+    big = 0
+    for s in range(N_TOK):
+        if counts[s] > 0:
+            f = max(1, (counts[s] * PROB_SCALE) // total)
+            freq[s] = f
+            acc += f
+            if f > freq[big] or counts[big] == 0:
+                big = s
+    while acc != PROB_SCALE:
+        if acc > PROB_SCALE:
+            # take from the largest symbols that can spare it
+            best = -1
+            for s in range(N_TOK):
+                if freq[s] > 1 and (best < 0 or freq[s] > freq[best]):
+                    best = s
+            take = min(acc - PROB_SCALE, freq[best] - 1)
+            freq[best] -= take
+            acc -= take
+        else:
+            freq[big] += PROB_SCALE - acc
+            acc = PROB_SCALE
+
+
+@njit(cache=True, nogil=True)
+def encode_rans(w, n0, n1, n2, root, out, base):
+    """Encode a tile (details, or the whole box if ``root``) into ``out[base:]``; returns the byte count (0 = all
+    zero). ``out`` must be zeroed from ``base`` on and large enough (:func:`capacity`)."""
+    reg = regions(n0, n1, n2, root)
+    nreg = reg.shape[0]
+    sig = np.zeros((7, 512), np.uint8)
+    anyflag = np.zeros(7, np.uint8)
+    if _sig_map(w, reg, sig, anyflag) == 0:
+        return 0
+    ncoef = 0
+    for r in range(nreg):
+        ncoef += (reg[r, 1] - reg[r, 0]) * (reg[r, 3] - reg[r, 2]) * (reg[r, 5] - reg[r, 4])
+    tok = np.empty(ncoef, np.uint8)
+    tcls = np.empty(ncoef, np.uint8)
+    counts = np.zeros((N_CLASS, N_TOK), np.int64)
+    hdr = base + 4
+    bp = 0
+    # significance map
+    for r in range(nreg):
+        bp = _put_bits(out, hdr, bp, anyflag[r], 1)
+    for r in range(nreg):
+        if anyflag[r]:
+            q = 0
+            for b0 in range(reg[r, 0], reg[r, 1], SB):
+                for b1 in range(reg[r, 2], reg[r, 3], SB):
+                    for b2 in range(reg[r, 4], reg[r, 5], SB):
+                        bp = _put_bits(out, hdr, bp, sig[r, q], 1)
+                        q += 1
+    # tokens
+    nt = 0
+    for r in range(nreg):
+        if not anyflag[r]:
+            continue
+        c = reg[r, 6]
+        q = 0
+        for b0 in range(reg[r, 0], reg[r, 1], SB):
+            for b1 in range(reg[r, 2], reg[r, 3], SB):
+                for b2 in range(reg[r, 4], reg[r, 5], SB):
+                    if sig[r, q]:
+                        for i in range(b0, min(b0 + SB, reg[r, 1])):
+                            for j in range(b1, min(b1 + SB, reg[r, 3])):
+                                for k in range(b2, min(b2 + SB, reg[r, 5])):
+                                    v = sign_map(np.int64(w[i, j, k]))
+                                    t = v if v < 16 else 11 + _bitlen(v)
+                                    tok[nt] = t
+                                    tcls[nt] = c
+                                    counts[c, t] += 1
+                                    nt += 1
+                    q += 1
+    # tables: per class, 6-bit (max token + 1), presence bits, 12-bit freq - 1
+    freq = np.zeros((N_CLASS, N_TOK), np.int64)
+    start = np.zeros((N_CLASS, N_TOK), np.int64)
+    for c in range(N_CLASS):
+        _normalise(counts[c], freq[c])
+        top = 0
+        for s in range(N_TOK):
+            if freq[c, s] > 0:
+                top = s + 1
+        bp = _put_bits(out, hdr, bp, top, 6)
+        for s in range(top):
+            bp = _put_bits(out, hdr, bp, 1 if freq[c, s] > 0 else 0, 1)
+        acc = 0
+        for s in range(top):
+            if freq[c, s] > 0:
+                bp = _put_bits(out, hdr, bp, freq[c, s] - 1, PROB_BITS)
+                start[c, s] = acc
+                acc += freq[c, s]
+    # raw mantissa bits in token order
+    nt2 = 0
+    for r in range(nreg):
+        if not anyflag[r]:
+            continue
+        q = 0
+        for b0 in range(reg[r, 0], reg[r, 1], SB):
+            for b1 in range(reg[r, 2], reg[r, 3], SB):
+                for b2 in range(reg[r, 4], reg[r, 5], SB):
+                    if sig[r, q]:
+                        for i in range(b0, min(b0 + SB, reg[r, 1])):
+                            for j in range(b1, min(b1 + SB, reg[r, 3])):
+                                for k in range(b2, min(b2 + SB, reg[r, 5])):
+                                    t = tok[nt2]
+                                    if t >= 16:
+                                        v = sign_map(np.int64(w[i, j, k]))
+                                        nb = t - 11
+                                        bp = _put_bits(out, hdr, bp, v & ((1 << (nb - 1)) - 1), nb - 1)
+                                    nt2 += 1
+                    q += 1
+    nbytes_bits = (bp + 15) // 16 * 2
+    out[base] = nbytes_bits & 0xFF
+    out[base + 1] = (nbytes_bits >> 8) & 0xFF
+    out[base + 2] = (nbytes_bits >> 16) & 0xFF
+    out[base + 3] = (nbytes_bits >> 24) & 0xFF
+    # rANS, tokens in reverse, words written backwards into a scratch buffer
+    words = np.empty(nt + 4, np.uint16)
+    pos = nt + 4
+    x = np.uint64(RANS_L)
+    for n in range(nt - 1, -1, -1):
+        c = tcls[n]
+        t = tok[n]
+        f = np.uint64(freq[c, t])
+        x_max = np.uint64(((RANS_L >> PROB_BITS) << 16)) * f
+        if x >= x_max:
+            pos -= 1
+            words[pos] = np.uint16(x & np.uint64(0xFFFF))
+            x >>= np.uint64(16)
+        x = ((x // f) << np.uint64(PROB_BITS)) + (x % f) + np.uint64(start[c, t])
+    pos -= 1
+    words[pos] = np.uint16(x & np.uint64(0xFFFF))
+    pos -= 1
+    words[pos] = np.uint16(x >> np.uint64(16))
+    o = hdr + nbytes_bits
+    for n in range(pos, nt + 4):
+        out[o] = words[n] & 0xFF
+        out[o + 1] = words[n] >> 8
+        o += 2
+    return o - base
+
+
+@njit(cache=True, nogil=True)
+def decode_rans(buf, base, length, w, n0, n1, n2, root):
+    """Decode a node written by :func:`encode_rans` into the tile buffer ``w`` (coded regions only). Returns 0 on
+    success, -1 if the stream is inconsistent (a damaged brick that passed its checksum is still caught)."""
+    reg = regions(n0, n1, n2, root)
+    nreg = reg.shape[0]
+    if length == 0:
+        zero_regions(w, reg)
+        return 0
+    if length < 4:
+        return -1
+    nbb = np.int64(buf[base]) | (np.int64(buf[base + 1]) << 8) | (np.int64(buf[base + 2]) << 16) | (
+        np.int64(buf[base + 3]) << 24)
+    if nbb > length - 4:
+        return -1
+    hdr = base + 4
+    limit = hdr + nbb
+    bp = 0
+    anyflag = np.zeros(7, np.uint8)
+    sig = np.zeros((7, 512), np.uint8)
+    for r in range(nreg):
+        anyflag[r] = _get_bits(buf, hdr, limit, bp, 1)
+        bp += 1
+    for r in range(nreg):
+        q = 0
+        for b0 in range(reg[r, 0], reg[r, 1], SB):
+            for b1 in range(reg[r, 2], reg[r, 3], SB):
+                for b2 in range(reg[r, 4], reg[r, 5], SB):
+                    if anyflag[r]:
+                        sig[r, q] = _get_bits(buf, hdr, limit, bp, 1)
+                        bp += 1
+                    q += 1
+    freq = np.zeros((N_CLASS, N_TOK), np.int64)
+    start = np.zeros((N_CLASS, N_TOK), np.int64)
+    lut = np.zeros((N_CLASS, PROB_SCALE), np.uint8)
+    for c in range(N_CLASS):
+        top = _get_bits(buf, hdr, limit, bp, 6)
+        bp += 6
+        if top > N_TOK:
+            return -1
+        pres = np.zeros(N_TOK, np.uint8)
+        for s in range(top):
+            pres[s] = _get_bits(buf, hdr, limit, bp, 1)
+            bp += 1
+        acc = 0
+        for s in range(top):
+            if pres[s]:
+                f = _get_bits(buf, hdr, limit, bp, PROB_BITS) + 1
+                bp += PROB_BITS
+                if acc + f > PROB_SCALE:
+                    return -1
+                freq[c, s] = f
+                start[c, s] = acc
+                for u in range(acc, acc + f):
+                    lut[c, u] = s
+                acc += f
+        if top > 0 and acc != PROB_SCALE:
+            return -1
+    if bp > nbb * 8:
+        return -1
+    o = limit
+    end = base + length
+    if o + 4 > end:
+        return -1
+    x = (np.uint64(buf[o]) | (np.uint64(buf[o + 1]) << np.uint64(8))) << np.uint64(16)
+    x |= np.uint64(buf[o + 2]) | (np.uint64(buf[o + 3]) << np.uint64(8))
+    o += 4
+    mask = np.uint64(PROB_SCALE - 1)
+    for r in range(nreg):
+        c = reg[r, 6]
+        q = 0
+        for b0 in range(reg[r, 0], reg[r, 1], SB):
+            for b1 in range(reg[r, 2], reg[r, 3], SB):
+                for b2 in range(reg[r, 4], reg[r, 5], SB):
+                    e0 = min(b0 + SB, reg[r, 1])
+                    e1 = min(b1 + SB, reg[r, 3])
+                    e2 = min(b2 + SB, reg[r, 5])
+                    if sig[r, q]:
+                        if freq[c].sum() == 0:
+                            return -1
+                        for i in range(b0, e0):
+                            for j in range(b1, e1):
+                                for k in range(b2, e2):
+                                    slot = x & mask
+                                    t = lut[c, slot]
+                                    x = np.uint64(freq[c, t]) * (x >> np.uint64(PROB_BITS)) + slot - np.uint64(
+                                        start[c, t])
+                                    if x < np.uint64(RANS_L):
+                                        if o + 2 <= end:
+                                            x = (x << np.uint64(16)) | np.uint64(buf[o]) | (
+                                                np.uint64(buf[o + 1]) << np.uint64(8))
+                                        else:
+                                            x = x << np.uint64(16)
+                                        o += 2
+                                    if t < 16:
+                                        v = np.int64(t)
+                                    else:
+                                        nb = np.int64(t) - 11
+                                        v = (np.int64(1) << (nb - 1)) | _get_bits(buf, hdr, limit, bp, nb - 1)
+                                        bp += nb - 1
+                                    w[i, j, k] = sign_unmap(v)
+                    else:
+                        for i in range(b0, e0):
+                            for j in range(b1, e1):
+                                for k in range(b2, e2):
+                                    w[i, j, k] = 0
+                    q += 1
+    if o > end + 2 or bp > nbb * 8:
+        return -1
+    return 0
+
+
+# ------------------------------------------------------------------------------------------- adaptive arithmetic
+_PB = 11
+_PTOT = 1 << _PB
+_SHIFT = 4
+_TOP = 1 << 24
+N_NB = 8  # neighbourhood magnitude buckets
+_P_ANY = 0
+_P_SIG = _P_ANY + N_CLASS
+_P_ZERO = _P_SIG + N_CLASS * 2
+_P_SIGN = _P_ZERO + N_CLASS * N_NB
+_P_EXP = _P_SIGN + N_CLASS
+_P_MAN = _P_EXP + N_CLASS * N_NB * 24
+N_PROBS = _P_MAN + N_CLASS * 32
+
+
+@njit(cache=True, nogil=True)
+def _nb_bucket(s):
+    if s < 3:
+        return s
+    if s < 5:
+        return 3
+    if s < 9:
+        return 4
+    if s < 17:
+        return 5
+    if s < 33:
+        return 6
+    return 7
+
+
+@njit(cache=True, nogil=True)
+def _shift_low(st, out):
+    # st: [low, range, cache, cache_size, pos]
+    low = st[0]
+    if low < 0xFF000000 or low >= (1 << 32):
+        carry = low >> 32
+        temp = st[2]
+        while True:
+            out[st[4]] = (temp + carry) & 0xFF
+            st[4] += 1
+            temp = 0xFF
+            st[3] -= 1
+            if st[3] == 0:
+                break
+        st[2] = (low >> 24) & 0xFF
+    st[3] += 1
+    st[0] = (low & 0x00FFFFFF) << 8
+
+
+@njit(cache=True, nogil=True)
+def _enc_bit(st, out, probs, idx, bit):
+    p = probs[idx]
+    bound = (st[1] >> _PB) * p
+    if bit == 0:
+        st[1] = bound
+        probs[idx] = p + ((_PTOT - p) >> _SHIFT)
+    else:
+        st[0] += bound
+        st[1] -= bound
+        probs[idx] = p - (p >> _SHIFT)
+    while st[1] < _TOP:
+        st[1] <<= 8
+        _shift_low(st, out)
+
+
+@njit(cache=True, nogil=True)
+def _enc_direct(st, out, value, n):
+    for i in range(n - 1, -1, -1):
+        st[1] >>= 1
+        if (value >> i) & 1:
+            st[0] += st[1]
+        while st[1] < _TOP:
+            st[1] <<= 8
+            _shift_low(st, out)
+
+
+@njit(cache=True, nogil=True)
+def _dec_bit(st, buf, probs, idx):
+    # st: [code, range, pos, end]
+    p = probs[idx]
+    bound = (st[1] >> _PB) * p
+    if st[0] < bound:
+        st[1] = bound
+        probs[idx] = p + ((_PTOT - p) >> _SHIFT)
+        bit = 0
+    else:
+        st[0] -= bound
+        st[1] -= bound
+        probs[idx] = p - (p >> _SHIFT)
+        bit = 1
+    while st[1] < _TOP:
+        st[1] <<= 8
+        b = buf[st[2]] if st[2] < st[3] else 0
+        st[0] = ((st[0] << 8) | b) & 0xFFFFFFFF
+        st[2] += 1
+    return bit
+
+
+@njit(cache=True, nogil=True)
+def _dec_direct(st, buf, n):
+    v = 0
+    for _ in range(n):
+        st[1] >>= 1
+        bit = 0
+        if st[0] >= st[1]:
+            st[0] -= st[1]
+            bit = 1
+        v = (v << 1) | bit
+        while st[1] < _TOP:
+            st[1] <<= 8
+            b = buf[st[2]] if st[2] < st[3] else 0
+            st[0] = ((st[0] << 8) | b) & 0xFFFFFFFF
+            st[2] += 1
+    return v
+
+
+@njit(cache=True, nogil=True)
+def _nb_sum(w, i, j, k, lo0, lo1, lo2):
+    s = 0
+    if i > lo0:
+        s += abs(w[i - 1, j, k])
+    if j > lo1:
+        s += abs(w[i, j - 1, k])
+    if k > lo2:
+        s += abs(w[i, j, k - 1])
+    return s
+
+
+@njit(cache=True, nogil=True)
+def encode_arith(w, n0, n1, n2, root, out, base):
+    """Adaptive binary arithmetic coding of a tile into ``out[base:]``; returns the byte count (0 = all zero)."""
+    reg = regions(n0, n1, n2, root)
+    nreg = reg.shape[0]
+    sig = np.zeros((7, 512), np.uint8)
+    anyflag = np.zeros(7, np.uint8)
+    if _sig_map(w, reg, sig, anyflag) == 0:
+        return 0
+    probs = np.full(N_PROBS, _PTOT // 2, np.int64)
+    st = np.zeros(5, np.int64)
+    st[1] = 0xFFFFFFFF
+    st[3] = 1
+    st[4] = base
+    for r in range(nreg):
+        c = reg[r, 6]
+        _enc_bit(st, out, probs, _P_ANY + c, anyflag[r])
+        if not anyflag[r]:
+            continue
+        lo0, hi0, lo1, hi1, lo2, hi2 = reg[r, 0], reg[r, 1], reg[r, 2], reg[r, 3], reg[r, 4], reg[r, 5]
+        q = 0
+        prev = 1
+        for b0 in range(lo0, hi0, SB):
+            for b1 in range(lo1, hi1, SB):
+                for b2 in range(lo2, hi2, SB):
+                    s = sig[r, q]
+                    _enc_bit(st, out, probs, _P_SIG + 2 * c + prev, s)
+                    prev = s
+                    q += 1
+                    if not s:
+                        continue
+                    for i in range(b0, min(b0 + SB, hi0)):
+                        for j in range(b1, min(b1 + SB, hi1)):
+                            for k in range(b2, min(b2 + SB, hi2)):
+                                ctx = c * N_NB + _nb_bucket(_nb_sum(w, i, j, k, lo0, lo1, lo2))
+                                v = np.int64(w[i, j, k])
+                                if v == 0:
+                                    _enc_bit(st, out, probs, _P_ZERO + ctx, 0)
+                                    continue
+                                _enc_bit(st, out, probs, _P_ZERO + ctx, 1)
+                                _enc_bit(st, out, probs, _P_SIGN + c, 1 if v < 0 else 0)
+                                m = abs(v)
+                                e = _bitlen(m)
+                                for u in range(1, e):
+                                    _enc_bit(st, out, probs, _P_EXP + ctx * 24 + min(u, 23), 1)
+                                _enc_bit(st, out, probs, _P_EXP + ctx * 24 + min(e, 23), 0)
+                                if e >= 2:
+                                    top = (m >> (e - 2)) & 1
+                                    _enc_bit(st, out, probs, _P_MAN + c * 32 + min(e, 31), top)
+                                    if e >= 3:
+                                        _enc_direct(st, out, m & ((1 << (e - 2)) - 1), e - 2)
+    for _ in range(5):
+        _shift_low(st, out)
+    return st[4] - base
+
+
+@njit(cache=True, nogil=True)
+def decode_arith(buf, base, length, w, n0, n1, n2, root):
+    """Decode a node written by :func:`encode_arith` into ``w``; returns 0 (or -1 on an inconsistent stream)."""
+    reg = regions(n0, n1, n2, root)
+    nreg = reg.shape[0]
+    if length == 0:
+        zero_regions(w, reg)
+        return 0
+    if length < 5:
+        return -1
+    probs = np.full(N_PROBS, _PTOT // 2, np.int64)
+    st = np.zeros(4, np.int64)
+    st[1] = 0xFFFFFFFF
+    st[2] = base + 1
+    st[3] = base + length
+    for _ in range(4):
+        st[0] = (st[0] << 8) | buf[st[2]]
+        st[2] += 1
+    for r in range(nreg):
+        c = reg[r, 6]
+        lo0, hi0, lo1, hi1, lo2, hi2 = reg[r, 0], reg[r, 1], reg[r, 2], reg[r, 3], reg[r, 4], reg[r, 5]
+        anyf = _dec_bit(st, buf, probs, _P_ANY + c)
+        q = 0
+        prev = 1
+        for b0 in range(lo0, hi0, SB):
+            for b1 in range(lo1, hi1, SB):
+                for b2 in range(lo2, hi2, SB):
+                    e0 = min(b0 + SB, hi0)
+                    e1 = min(b1 + SB, hi1)
+                    e2 = min(b2 + SB, hi2)
+                    s = 0
+                    if anyf:
+                        s = _dec_bit(st, buf, probs, _P_SIG + 2 * c + prev)
+                        prev = s
+                    q += 1
+                    if not s:
+                        for i in range(b0, e0):
+                            for j in range(b1, e1):
+                                for k in range(b2, e2):
+                                    w[i, j, k] = 0
+                        continue
+                    for i in range(b0, e0):
+                        for j in range(b1, e1):
+                            for k in range(b2, e2):
+                                ctx = c * N_NB + _nb_bucket(_nb_sum(w, i, j, k, lo0, lo1, lo2))
+                                if _dec_bit(st, buf, probs, _P_ZERO + ctx) == 0:
+                                    w[i, j, k] = 0
+                                    continue
+                                neg = _dec_bit(st, buf, probs, _P_SIGN + c)
+                                e = 1
+                                while _dec_bit(st, buf, probs, _P_EXP + ctx * 24 + min(e, 23)) == 1:
+                                    e += 1
+                                    if e > 40:
+                                        return -1
+                                m = np.int64(1)
+                                if e >= 2:
+                                    m = (m << 1) | _dec_bit(st, buf, probs, _P_MAN + c * 32 + min(e, 31))
+                                    if e >= 3:
+                                        m = (m << (e - 2)) | _dec_direct(st, buf, e - 2)
+                                w[i, j, k] = -m if neg else m
+    if st[2] > st[3] + 4:
+        return -1
+    return 0
+
+
+def capacity(n_coef: int) -> int:
+    """Worst-case byte count of a coded tile of ``n_coef`` coefficients (both coders)."""
+    return 6 * n_coef + 4096
