@@ -281,17 +281,17 @@ def _check_meta(meta: dict[str, Any], name: str) -> tuple[tuple[int, int, int], 
         float(meta["delta"]), np.dtype(str(meta["dtype"]))
         int(meta["tile"])
     except (KeyError, TypeError, ValueError) as exc:
-        raise VVZError(f"{name}: metadata field missing or invalid ({exc})") from exc
+        raise VVZError(name, f"metadata field missing or invalid ({exc})") from exc
     if len(dims) != 3 or min(dims) < 1 or max(dims) > 1 << 20:
-        raise VVZError(f"{name}: bad dims {dims}")
+        raise VVZError(name, f"bad dims {dims}")
     if int(meta["tile"]) != TILE:
-        raise VVZError(f"{name}: tile size {meta['tile']} not supported (this build uses {TILE})")
+        raise VVZError(name, f"tile size {meta['tile']} not supported (this build uses {TILE})")
     if coder not in CODERS:
-        raise VVZError(f"{name}: unknown coder {coder!r}")
+        raise VVZError(name, f"unknown coder {coder!r}")
     if kind not in _INT_TYPES and kind not in ("float", "int-quantised"):
-        raise VVZError(f"{name}: unknown sample kind {kind!r}")
+        raise VVZError(name, f"unknown sample kind {kind!r}")
     if levels != len(level_shapes(dims)) - 1:
-        raise VVZError(f"{name}: {levels} levels do not match dims {dims}")
+        raise VVZError(name, f"{levels} levels do not match dims {dims}")
     return dims, levels, coder  # type: ignore[return-value]
 
 
@@ -322,7 +322,7 @@ def decompress(path: str | Path, strict: bool = False, report: list[dict[str, An
             index[(int(rec["kind"]), int(rec["level"]), int(rec["tile"]))] = i
         expected = 1 + sum(n_tiles(s[0]) * n_tiles(s[1]) * n_tiles(s[2]) for s in shapes[:-1])
         if len(index) != expected or len(table) != expected:
-            raise VVZError(f"{name}: brick table has {len(table)} records, dims {dims} need {expected}")
+            raise VVZError(name, f"brick table has {len(table)} records, dims {dims} need {expected}")
         damaged: list[dict[str, Any]] = []
         payload = rd.payload
         ci = CODERS[coder]
@@ -337,7 +337,7 @@ def decompress(path: str | Path, strict: bool = False, report: list[dict[str, An
 
         ri = index.get((KIND_ROOT, levels, 0))
         if ri is None:
-            raise VVZError(f"{name}: root brick missing")
+            raise VVZError(name, f"root brick missing")
         root = np.zeros(shapes[-1], np.int32)
         rec = table[ri]
         if rd.brick_ok(ri):
@@ -354,7 +354,7 @@ def decompress(path: str | Path, strict: bool = False, report: list[dict[str, An
             nt = n_tiles(shp[0]) * n_tiles(shp[1]) * n_tiles(shp[2])
             idx = np.array([index.get((KIND_NODE, lev, t), -1) for t in range(nt)], np.int64)
             if (idx < 0).any():
-                raise VVZError(f"{name}: level {lev} tile {int(np.argmin(idx))} missing from the brick table")
+                raise VVZError(name, f"level {lev} tile {int(np.argmin(idx))} missing from the brick table")
             offs = table["offset"][idx].astype(np.int64)
             sizes = table["size"][idx].astype(np.int64)
             valid = np.ones(nt, np.uint8)
@@ -374,7 +374,7 @@ def decompress(path: str | Path, strict: bool = False, report: list[dict[str, An
             msg = "; ".join(f"brick {d['index']} ({d['kind']}, level {d['level']}, tile {d['tile']}, voxels "
                             f"{d['region']}): {d['reason']}" for d in damaged)
             if strict:
-                raise CorruptBrickError(f"{name}: corrupt bricks: {msg}")
+                raise CorruptBrickError(name, f"corrupt bricks: {msg}")
             warnings.warn(f"{name}: {len(damaged)} corrupt brick(s) filled from the coarser level: {msg}",
                           CorruptBrickWarning, stacklevel=2)
             if report is not None:

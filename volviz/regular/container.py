@@ -38,10 +38,7 @@ from typing import Any, BinaryIO
 
 import numpy as np
 
-try:  # the io layer's error type when it exists (io sits left of regular in the layering)
-    from volviz.io import ReadError as _ReadBase  # type: ignore[attr-defined]
-except ImportError:  # pragma: no cover - depends on the io package's progress
-    _ReadBase = ValueError
+from volviz.io.errors import ReadError
 
 MAGIC = b"VVZ\x00\r\n\x1a\n"
 VERSION = 1
@@ -55,7 +52,7 @@ KIND_NODE = 1
 assert _HDR.size == 60 and BRICK_DTYPE.itemsize == 32
 
 
-class VVZError(_ReadBase):
+class VVZError(ReadError):
     """A ``.vvz`` file that cannot be read; the message names the file and the problem."""
 
 
@@ -145,23 +142,23 @@ class Writer:
 def parse_header(head: bytes, file_size: int, name: str = "<vvz>") -> dict[str, int]:
     """Validate the fixed 64-byte header against the file size; return its fields. Raises :class:`VVZError`."""
     if len(head) < HEADER_SIZE or file_size < HEADER_SIZE:
-        raise VVZError(f"{name}: truncated file ({file_size} bytes, a .vvz header alone is {HEADER_SIZE})")
+        raise VVZError(name, f"truncated file ({file_size} bytes, a .vvz header alone is {HEADER_SIZE})")
     if head[:8] != MAGIC:
-        raise VVZError(f"{name}: not a .vvz file (wrong magic {head[:8]!r})")
+        raise VVZError(name, f"not a .vvz file (wrong magic {head[:8]!r})")
     (_, version, hdr_size, flags, meta_off, meta_len, table_off, table_count, meta_crc, table_crc,
      _) = _HDR.unpack(head[:60])
     if crc32(head[:60]) != struct.unpack("<I", head[60:64])[0]:
-        raise VVZError(f"{name}: header checksum mismatch (damaged header)")
+        raise VVZError(name, f"header checksum mismatch (damaged header)")
     if version != VERSION:
-        raise VVZError(f"{name}: .vvz version {version} is not supported (this reader knows version {VERSION})")
+        raise VVZError(name, f".vvz version {version} is not supported (this reader knows version {VERSION})")
     if hdr_size != HEADER_SIZE:
-        raise VVZError(f"{name}: bad header size {hdr_size}")
+        raise VVZError(name, f"bad header size {hdr_size}")
     if meta_len > MAX_META or meta_off < HEADER_SIZE or meta_off + meta_len > file_size:
-        raise VVZError(f"{name}: metadata block ({meta_len} bytes at {meta_off}) lies outside the file "
+        raise VVZError(name, f"metadata block ({meta_len} bytes at {meta_off}) lies outside the file "
                        f"({file_size} bytes): truncated or damaged")
     if table_count > file_size // BRICK_DTYPE.itemsize or table_off < HEADER_SIZE or \
             table_off + table_count * BRICK_DTYPE.itemsize > file_size:
-        raise VVZError(f"{name}: brick table ({table_count} records at {table_off}) lies outside the file "
+        raise VVZError(name, f"brick table ({table_count} records at {table_off}) lies outside the file "
                        f"({file_size} bytes): truncated or damaged")
     return dict(version=version, flags=flags, meta_off=meta_off, meta_len=meta_len, table_off=table_off,
                 table_count=table_count, meta_crc=meta_crc, table_crc=table_crc)
@@ -183,17 +180,17 @@ class Reader:
                 f.seek(h["table_off"])
                 table_bytes = f.read(h["table_count"] * BRICK_DTYPE.itemsize)
         except OSError as exc:
-            raise VVZError(f"{name}: cannot read ({exc})") from exc
+            raise VVZError(name, f"cannot read ({exc})") from exc
         if crc32(meta_bytes) != h["meta_crc"]:
-            raise VVZError(f"{name}: metadata checksum mismatch (damaged metadata)")
+            raise VVZError(name, f"metadata checksum mismatch (damaged metadata)")
         if crc32(table_bytes) != h["table_crc"]:
-            raise VVZError(f"{name}: brick table checksum mismatch (damaged table)")
+            raise VVZError(name, f"brick table checksum mismatch (damaged table)")
         try:
             meta = json.loads(meta_bytes.decode("utf-8"))
         except (UnicodeDecodeError, json.JSONDecodeError) as exc:
-            raise VVZError(f"{name}: metadata is not valid JSON ({exc})") from exc
+            raise VVZError(name, f"metadata is not valid JSON ({exc})") from exc
         if not isinstance(meta, dict) or meta.get("format") != "volviz-vvz":
-            raise VVZError(f"{name}: metadata is not a volviz-vvz object")
+            raise VVZError(name, f"metadata is not a volviz-vvz object")
         self.header = h
         self.meta: dict[str, Any] = meta
         self.table = np.frombuffer(table_bytes, BRICK_DTYPE)
@@ -202,7 +199,7 @@ class Reader:
                                                       (end > np.uint64(h["meta_off"]))))[0]
         if bad.size:
             b = self.table[bad[0]]
-            raise VVZError(f"{name}: brick {int(bad[0])} (level {int(b['level'])}, tile {int(b['tile'])}) points "
+            raise VVZError(name, f"brick {int(bad[0])} (level {int(b['level'])}, tile {int(b['tile'])}) points "
                            f"outside the payload area: truncated or damaged")
         self._map: np.ndarray | None = None
 
