@@ -41,13 +41,18 @@ def _tfs() -> dict[str, TransferFunction]:
     return {"smooth": smooth, "hard": hard}
 
 
-def _median_time(fn: Callable[[], Any], repeats: int) -> tuple[float, Any]:
+def _median_time(fn: Callable[[], Any], repeats: int, cpu: list | None = None) -> tuple[float, Any]:
+    """Median wall time of ``repeats`` calls after a warm-up; appends the median CPU time (all threads) to ``cpu``."""
     result = fn()  # warm-up (and Numba compilation on a cold cache)
-    times = []
+    times, cpus = [], []
     for _ in range(repeats):
+        c0 = time.process_time()
         t0 = time.perf_counter()
         result = fn()
         times.append(time.perf_counter() - t0)
+        cpus.append(time.process_time() - c0)
+    if cpu is not None:
+        cpu.append(statistics.median(cpus))
     return statistics.median(times), result
 
 
@@ -89,10 +94,11 @@ def run(quick: bool = False, repeats: int = 5, n_points: int = 200_000, l_max: f
         extras[f"reference_{tf_key}"] = {"segments": n_points, "seconds": t_ref,
                                          "ns_per_segment": 1e9 * t_ref / n_points}
         for method, size, build in _cases(quick):
-            seconds, table = _median_time(lambda: build(tf, l_max), repeats)
+            cpu: list[float] = []
+            seconds, table = _median_time(lambda: build(tf, l_max), repeats, cpu)
             mx, rms = _error(table.lookup, ref, pts)
-            row = {"tf": tf_key, "method": method, "size": size, "seconds": seconds, "max_error": mx,
-                   "rms_error": rms}
+            row = {"tf": tf_key, "method": method, "size": size, "seconds": seconds, "cpu_seconds": cpu[0],
+                   "max_error": mx, "rms_error": rms}
             if method.startswith("3D"):
                 node = table.error(where="nodes", max_points=300_000)
                 row["node_max_error"] = node.max_abs
@@ -130,16 +136,20 @@ def _find(rows: list[dict], tf: str, method: str, size: str) -> dict | None:
 def _targets(result: dict) -> list[str]:
     rows = result["rows"]
     lines = []
-    t2 = [r["seconds"] for r in rows if r["method"].startswith("table2d") and r["size"] == "512^2"]
-    if t2:
-        ok = max(t2) <= TARGETS["table2d 512"]
-        lines.append(f"- 512 x 512 2D table (Eq. 8.2) in <= 0.2 s: {max(t2):.3f} s (slowest TF) -> "
-                     f"{'met' if ok else 'NOT met'}")
-    inc = [r["seconds"] for r in rows if r["method"] == "3D incremental-linear" and r["size"] == "128x128x128"]
-    if inc:
-        ok = max(inc) <= TARGETS["incremental 128x128x128"]
-        lines.append(f"- 128 x 128 x 128 3D table, incremental, in <= 1 s: {max(inc):.3f} s (slowest TF) -> "
-                     f"{'met' if ok else 'NOT met'}")
+    for label, key, pick in (
+        ("512 x 512 2D table (Eq. 8.2) in <= 0.2 s", "table2d 512",
+         lambda r: r["method"].startswith("table2d") and r["size"] == "512^2"),
+        ("128 x 128 x 128 3D table, incremental, in <= 1 s", "incremental 128x128x128",
+         lambda r: r["method"] == "3D incremental-linear" and r["size"] == "128x128x128"),
+    ):
+        sel = [r for r in rows if pick(r)]
+        if sel:
+            wall = max(r["seconds"] for r in sel)
+            cpu = max(r["cpu_seconds"] for r in sel)
+            verdict = "met" if wall <= TARGETS[key] else ("NOT met in wall time" + (
+                f" (but the CPU time summed over threads, {cpu:.3f} s, is within it: the machine was shared)"
+                if cpu <= TARGETS[key] else ""))
+            lines.append(f"- {label}: wall {wall:.3f} s, CPU {cpu:.3f} s (slowest TF) -> {verdict}")
     node = [r["node_max_error"] for r in rows if r["method"] == "3D direct"]
     if node:
         ok = max(node) <= TARGETS["direct node max error"]
@@ -167,7 +177,8 @@ def write_report(result: dict, out_dir: Path, command: str) -> Path:
         "",
         f"Machine: {platform.machine()}, {os.cpu_count()} cores shared with other work (load average at the end "
         f"{load[0]:.1f} / {load[1]:.1f} / {load[2]:.1f}), Python {platform.python_version()}, numpy {np.__version__}.",
-        f"Times are the median of {result['repeats']} builds after a warm-up. Errors are absolute premultiplied "
+        f"Times are the median of {result['repeats']} builds after a warm-up (wall clock, and CPU time summed over "
+        "all threads, which is less sensitive to other load). Errors are absolute premultiplied "
         f"RGBA (0..1; x255 for 8-bit units) against the exact reference `integrate_segment` at the same "
         f"{result['n_points']:,} random segments (s_f, s_b uniform over the TF range, l uniform in "
         f"[0, l_max = {result['l_max']}]). 3D tables: 'node' errors are at the table's own sample points.",
@@ -180,13 +191,13 @@ def write_report(result: dict, out_dir: Path, command: str) -> Path:
         "",
         "## All methods",
         "",
-        "| TF | method | size | build time | max error | RMS error | node max error |",
-        "|---|---|---|---|---|---|---|",
+        "| TF | method | size | build time (wall) | CPU time | max error | RMS error | node max error |",
+        "|---|---|---|---|---|---|---|---|",
     ]
     for r in result["rows"]:
         node = f"{r['node_max_error']:.1e}" if "node_max_error" in r else ""
-        md.append(f"| {r['tf']} | {r['method']} | {r['size']} | {r['seconds'] * 1e3:.1f} ms | {r['max_error']:.2e} | "
-                  f"{r['rms_error']:.2e} | {node} |")
+        md.append(f"| {r['tf']} | {r['method']} | {r['size']} | {r['seconds'] * 1e3:.1f} ms | "
+                  f"{r['cpu_seconds'] * 1e3:.1f} ms | {r['max_error']:.2e} | {r['rms_error']:.2e} | {node} |")
     md += ["", "## Reference, incremental rebuild, ZOT", ""]
     for key, val in result["extras"].items():
         md.append(f"- `{key}`: " + ", ".join(f"{k} = {_fmt(v)}" for k, v in val.items()))

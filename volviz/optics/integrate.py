@@ -15,7 +15,8 @@ Method (analytic, no quadrature error beyond the special functions):
        C = κ_a (1 − M) + κ_b (M − e^{−T}),      M(p, q) = ∫_0^1 e^{−p x − q x²} dx  (mean transmittance)
    Both weights lie in [0, 1] and add up to 1 − e^{−T}; no division by the scalar difference occurs, so s_f = s_b and
    ∫ρ = 0 need no special case (the weights are simply 0).
-3. M(p, q): for T ≤ 1, 12-point Gauss–Legendre (there p ≤ 2 and |q| ≤ 1, the integrand is entire and smooth); for T > 1
+3. M(p, q): for T ≤ 1, Gauss–Legendre with 3 to 10 nodes chosen by the larger end density (there p ≤ 2 and
+   |q| ≤ 1, the integrand is entire; the node counts and their measured errors ≤ 1.2e-15 are listed at the rules); for T > 1
    the closed forms  q > 0: M = √π/(2√q) [erfcx(z₀) − e^{−T} erfcx(z₁)], z₀ = p/(2√q), z₁ = z₀ + √q;
    q < 0: M = [F(w₁) − e^{−T} F(w₀)]/√|q|, F = Dawson's function, w₀ = (p + 2q)/(2√|q|), w₁ = w₀ + √|q|;
    q = 0: M = (1 − e^{−p})/p. Both closed forms are free of overflow and, for T > 1, of cancellation.
@@ -39,9 +40,21 @@ from volviz.optics.transfer_function import TransferFunction
 
 __all__ = ["integrate_segment", "mean_transmittance", "riemann_segment", "erfcx", "dawson"]
 
-_GL_NODES, _GL_WEIGHTS = np.polynomial.legendre.leggauss(12)
-_GL_X = 0.5 * (_GL_NODES + 1.0)  # nodes on [0, 1]
-_GL_W = 0.5 * _GL_WEIGHTS
+
+def _gauss_legendre_01(n: int) -> tuple[np.ndarray, np.ndarray]:
+    x, w = np.polynomial.legendre.leggauss(n)
+    return 0.5 * (x + 1.0), 0.5 * w
+
+
+# Gauss–Legendre rules on [0, 1] for M(p, q) when T = p + q ≤ 1, picked by a = max(p, p + 2q) (the larger end
+# density × L, ≤ 2 there). Measured max abs error over a 41×41 grid of end densities in [0, a_max] against a 60-point
+# rule: 3 nodes ≤ 7.5e-18 (a ≤ 1e-3, scaled from 7.5e-12 at a = 0.01), 4 nodes 6.7e-16 (a ≤ 0.01),
+# 6 nodes 3.3e-16 (a ≤ 0.1), 8 nodes 6.7e-16 (a ≤ 1), 10 nodes 1.2e-15 (a ≤ 2).
+_GL3_X, _GL3_W = _gauss_legendre_01(3)
+_GL4_X, _GL4_W = _gauss_legendre_01(4)
+_GL6_X, _GL6_W = _gauss_legendre_01(6)
+_GL8_X, _GL8_W = _gauss_legendre_01(8)
+_GL10_X, _GL10_W = _gauss_legendre_01(10)
 _GL_MAX_DEPTH = 1.0  # Gauss–Legendre below this optical depth, closed forms above
 _SKIP_DEPTH = 750.0  # e^{-750} underflows: nothing behind contributes
 _INV_SQRT_PI = 1.0 / math.sqrt(math.pi)
@@ -92,21 +105,36 @@ def _dawson(x: float) -> float:
     return _INV_SQRT_PI * math.exp(-xp * xp) * total
 
 
+@numba.njit(cache=True, nogil=True, inline="always")
+def _gl_sum(xs, ws, p, q):
+    acc = 0.0
+    for i in range(xs.shape[0]):
+        x = xs[i]
+        acc += ws[i] * math.exp(-(p + q * x) * x)
+    return acc
+
+
 @numba.njit(cache=True, nogil=True)
 def _mean_transmittance(p: float, q: float) -> float:
     """M(p, q) = ∫_0^1 exp(−p x − q x²) dx for p ≥ 0, p + 2q ≥ 0 (a piece's mean transmittance)."""
     t = p + q
-    if t <= _GL_MAX_DEPTH:
-        acc = 0.0
-        for i in range(_GL_X.shape[0]):
-            x = _GL_X[i]
-            acc += _GL_W[i] * math.exp(-(p + q * x) * x)
-        return acc
     et = math.exp(-t)
-    if abs(q) <= 1e-13 * p:
+    if t <= _GL_MAX_DEPTH:
+        a = max(p, p + 2.0 * q)
+        if a <= 1e-3:
+            m = _gl_sum(_GL3_X, _GL3_W, p, q)
+        elif a <= 0.01:
+            m = _gl_sum(_GL4_X, _GL4_W, p, q)
+        elif a <= 0.1:
+            m = _gl_sum(_GL6_X, _GL6_W, p, q)
+        elif a <= 1.0:
+            m = _gl_sum(_GL8_X, _GL8_W, p, q)
+        else:
+            m = _gl_sum(_GL10_X, _GL10_W, p, q)
+    elif abs(q) <= 1e-13 * p:
         # |∂M/∂q| ≤ 2/p³, so dropping q costs < 2e-13 here (p ≈ T > 1)
-        return -math.expm1(-p) / p
-    if q > 0.0:
+        m = -math.expm1(-p) / p
+    elif q > 0.0:
         rq = math.sqrt(q)
         z0 = 0.5 * p / rq
         m = 0.5 * math.sqrt(math.pi) / rq * (_erfcx(z0) - et * _erfcx(z0 + rq))
