@@ -16,7 +16,7 @@ Method (analytic, no quadrature error beyond the special functions):
    Both weights lie in [0, 1] and add up to 1 − e^{−T}; no division by the scalar difference occurs, so s_f = s_b and
    ∫ρ = 0 need no special case (the weights are simply 0).
 3. M(p, q): for T ≤ 1, Gauss–Legendre with 3 to 10 nodes chosen by the larger end density (there p ≤ 2 and
-   |q| ≤ 1, the integrand is entire; the node counts and their measured errors ≤ 1.2e-15 are listed at the rules); for T > 1
+   |q| ≤ 1, the integrand is entire; node counts and measured errors ≤ 1.2e-15 are listed at the rules); for T > 1
    the closed forms  q > 0: M = √π/(2√q) [erfcx(z₀) − e^{−T} erfcx(z₁)], z₀ = p/(2√q), z₁ = z₀ + √q;
    q < 0: M = [F(w₁) − e^{−T} F(w₀)]/√|q|, F = Dawson's function, w₀ = (p + 2q)/(2√|q|), w₁ = w₀ + √|q|;
    q = 0: M = (1 − e^{−p})/p. Both closed forms are free of overflow and, for T > 1, of cancellation.
@@ -24,9 +24,12 @@ Method (analytic, no quadrature error beyond the special functions):
    (their weight e^{−750} underflows to 0).
 
 Measured accuracy (``tests/test_optics_integrate.py``): M against adaptive quadrature over p, q spanning 0 … 1e6 has
-absolute error < 1e-13; ``erfcx``/``dawson`` agree with SciPy to < 2e-15 relative; whole segments agree with 10^6-step
-Riemann sums to the sums' own O(h²) error and with closed forms to < 1e-13. The stated tolerance is ≤ 1e-9 absolute
-per RGBA channel (colours with κ ≤ 1).
+absolute error < 1e-13 (measured 3e-16 on a 41×41 grid of end densities 0, 1e-6 … 1e6); ``erfcx``/``dawson`` agree
+with SciPy to < 2e-14 relative; whole segments agree with 10^6-step Riemann sums to the sums' own O(h²) error
+(≤ 4e-12 measured) and with closed forms to < 1e-12. Error propagation: an error δ in M changes a piece's colour by
+|κ_b − κ_a|·δ and its opacity not at all (α uses e^{−T} directly); compositing multiplies by transmittances ≤ 1, so a
+segment crossing P pieces has colour error ≤ P·κ_max·δ plus rounding. With δ ≤ 1e-13 the stated tolerance, ≤ 1e-9
+absolute per RGBA channel for κ ≤ 1, holds for up to 10^4 crossed control points.
 """
 from __future__ import annotations
 
@@ -115,8 +118,8 @@ def _gl_sum(xs, ws, p, q):
 
 
 @numba.njit(cache=True, nogil=True)
-def _mean_transmittance(p: float, q: float) -> float:
-    """M(p, q) = ∫_0^1 exp(−p x − q x²) dx for p ≥ 0, p + 2q ≥ 0 (a piece's mean transmittance)."""
+def _mean_transmittance(p: float, q: float) -> tuple[float, float]:
+    """(M, e^{−T}): M(p, q) = ∫_0^1 exp(−p x − q x²) dx for p ≥ 0, p + 2q ≥ 0 (a piece's mean transmittance)."""
     t = p + q
     et = math.exp(-t)
     if t <= _GL_MAX_DEPTH:
@@ -143,7 +146,7 @@ def _mean_transmittance(p: float, q: float) -> float:
         pb = max(p + 2.0 * q, 0.0)  # back density × L
         w0 = 0.5 * pb / rq
         m = (_dawson(w0 + rq) - et * _dawson(w0)) / rq
-    return min(max(m, et), 1.0)
+    return min(max(m, et), 1.0), et
 
 
 @numba.njit(cache=True, nogil=True)
@@ -190,8 +193,7 @@ def _segment(sc, col, ext, s_f, s_b, length, out):
             q = 0.5 * (rb - ra)
             t = p + q
             if t > 0.0:
-                m = _mean_transmittance(p, q)
-                et = math.exp(-t)
+                m, et = _mean_transmittance(p, q)
                 ca = 1.0 - m
                 cb = max(m - et, 0.0)
                 for ch in range(3):
@@ -269,7 +271,7 @@ def mean_transmittance(p: Any, q: Any) -> np.ndarray:
 def _vec_mean_transmittance(p, q):
     out = np.empty_like(p)
     for i in range(p.shape[0]):
-        out[i] = _mean_transmittance(p[i], q[i])
+        out[i] = _mean_transmittance(p[i], q[i])[0]
     return out
 
 

@@ -13,7 +13,8 @@ from volviz.optics.table2d import Table2D, build_table2d
 from volviz.optics.table3d import Table3D, build_table3d, build_table3d_job
 from volviz.optics.zot import ZOTable, build_zot
 
-__all__ = ["Table3D", "build_table3d", "build_table3d_job", "Table2D", "build_table2d", "SeparableTable", "build_separable",
+__all__ = ["Table3D", "build_table3d", "build_table3d_job", "Table2D", "build_table2d", "SeparableTable",
+           "build_separable",
            "IsoSurface", "IsoTable", "build_iso_table", "ZOTable", "build_zot", "error_report"]
 
 

@@ -101,7 +101,8 @@ class TransferFunction:
 
     def __repr__(self) -> str:
         lo, hi = self.range
-        return f"TransferFunction(name={self.name!r}, n={len(self)}, range=({lo:g}, {hi:g}), max_rho={self.max_extinction:g})"
+        return (f"TransferFunction(name={self.name!r}, n={len(self)}, range=({lo:g}, {hi:g}), "
+                f"max_rho={self.max_extinction:g})")
 
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, TransferFunction):
@@ -197,7 +198,8 @@ class TransferFunction:
 
     # -- VTK --------------------------------------------------------------------------------------------------------
     @classmethod
-    def from_vtk(cls, ctf: Any, otf: Any, unit_distance: float, name: str = "", samples: int = 256) -> "TransferFunction":
+    def from_vtk(cls, ctf: Any, otf: Any, unit_distance: float, name: str = "",
+                 samples: int = 256) -> "TransferFunction":
         """From a ``vtkColorTransferFunction`` (κ) and a ``vtkPiecewiseFunction`` (opacity a): ρ = a / unit_distance.
 
         Control points are the union of both functions' nodes, which is exact when both interpolate linearly in RGB
