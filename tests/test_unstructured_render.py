@@ -126,3 +126,23 @@ def test_bluntfin_small():
                           [0.0, 0.05, 0.3, 0.8, 0.0])
     cam = Camera.orbit(mesh.points, 40, 25, 1.6, up=(0, 0, 1))
     _check(mesh, cam, tf=tf, size=(48, 48))
+
+
+def test_shirley_tuchman_classes_and_classic_pt():
+    """Classic PT (3/4 triangles, thick-vertex values interpolated linearly) equals the per-pixel path for parallel
+    projection (Roettger §8.4) and is only approximate under perspective."""
+    m = syn.box_tets(5, jitter=0.3)
+    par = Camera.orbit(m.points, 10, 5, 3.0, parallel=True)
+    img, st = render(m, TF, par, SIZE, "pt-st", return_stats=True)
+    cls = st.extra["classes"]
+    assert cls[0] == 0 and cls[1] + cls[2] == m.n_cells and cls[1] > 0 and cls[2] > 0
+    assert st.extra["triangles"] == 3 * cls[1] + 4 * cls[2]
+    exact = render(m, TF, par, SIZE, "pt")
+    assert _err(img, exact)[1] < 1e-6
+    # degenerate projections: a regular grid seen exactly along z has edge-on faces and vertices on edges
+    along = Camera((0.5, 0.5, 4.0), (0.5, 0.5, 0.0), (0, 1, 0), parallel=True, parallel_scale=0.6,
+                   clipping_range=(0.1, 10))
+    grid = syn.box_tets(4)
+    img, st = render(grid, TF, along, (33, 33), "pt-st", return_stats=True)
+    assert st.extra["classes"][0] > 0                            # vertices on edges / on one point
+    assert _err(img, render(grid, TF, along, (33, 33), "reference"))[1] <= 4.0

@@ -5,6 +5,9 @@ Methods:
 - ``"pt"``: visibility sort (``sort``: "mpvo" with image-space boundary relations by default, or "centroid"/"power"),
   zero-opacity culling of cells by their scalar range (Roettger §9.1, "ZOT"), per-cell projection and the tiled Numba
   rasteriser with exact per-pixel (s_f, s_b, l) and the 3D pre-integration table (``raster``).
+- ``"pt-st"``: the classic Shirley-Tuchman split into 3 or 4 triangles with (s_f, s_b, l) at the thick vertex,
+  interpolated linearly in screen space (``project``): exact for parallel projection, approximate under perspective;
+  cells crossing the near plane are skipped (use "pt" with the camera inside the mesh).
 - ``"reference"``: the exact float64 ray caster (``reference``).
 
 The image is premultiplied float RGBA (H, W, 4), row 0 at the top; ``size`` is (W, H). With ``return_stats=True`` the
@@ -20,12 +23,13 @@ import numpy as np
 
 from volviz.model.datasets import TetMesh
 from volviz.unstructured.camera import Camera
+from volviz.unstructured.project import raster_triangles, shirley_tuchman
 from volviz.unstructured.raster import TILE, bin_tiles, project_cells, raster_tiles
 from volviz.unstructured.reference import render_reference
 from volviz.unstructured.sort import visibility_order
 from volviz.unstructured.topology import cell_ranges, topology, visible_cells
 
-METHODS = ("pt", "reference")
+METHODS = ("pt", "pt-st", "reference")
 
 
 @dataclass
@@ -131,6 +135,18 @@ def render(mesh: TetMesh, tf: Any, camera: Camera, size: tuple[int, int] = (512,
                               rb.as_array(), frame, np.array([hx, hy]), bool(camera.parallel), near, w, h)
     stats.project_s = time.perf_counter() - t0
     t0 = time.perf_counter()
+    if method == "pt-st":
+        cls, ntri, txy, tval = shirley_tuchman(vxy, coef, mesh.scalars[topo.tets[cells]], rb.as_array(), near, far)
+        stats.extra["classes"] = {int(c): int((cls == c).sum()) for c in (0, 1, 2)}
+        stats.extra["triangles"] = int(ntri.sum())
+        stats.project_s += time.perf_counter() - t0
+        t0 = time.perf_counter()
+        img = np.zeros((h, w, 4))
+        stats.fragments = int(raster_triangles(ntri, txy, tval, table.rgba, table.s_lo, table.ds, table.dl, w, h,
+                                               img))
+        stats.raster_s = time.perf_counter() - t0
+        stats.total_s = time.perf_counter() - t_start
+        return (img, stats) if return_stats else img
     ptr, items = bin_tiles(box, w, h, TILE)
     n_tiles = len(ptr) - 1
     # interleave heavy and light tiles across threads: Numba's prange hands out contiguous chunks
