@@ -137,28 +137,40 @@ def _root_undpcm(d: np.ndarray) -> np.ndarray:
     return r.astype(np.int32)
 
 
+def forward_pyramid(vol: np.ndarray) -> tuple[list[tuple[tuple[int, int, int], np.ndarray]], np.ndarray]:
+    """Whole-volume forward wavelet octree in memory: per level (shape, tile buffers (ntiles, 32, 32, 32)) and
+    the root lowpass. Used by the PSNR search and the wavelet + zstd baseline."""
+    shapes = level_shapes(vol.shape)
+    cur = np.ascontiguousarray(vol, dtype=np.int32)
+    pyr = []
+    for lev in range(1, len(shapes)):
+        low = np.zeros(shapes[lev], np.int32)
+        nt = n_tiles(cur.shape[0]) * n_tiles(cur.shape[1]) * n_tiles(cur.shape[2])
+        det = np.zeros((nt, TILE, TILE, TILE), np.int32)
+        K.run_tiles(K.transform_level, cur, low, det)
+        pyr.append((cur.shape, det))
+        cur = low
+    return pyr, cur
+
+
+def inverse_pyramid(pyr: list[tuple[tuple[int, int, int], np.ndarray]], root: np.ndarray, steps: np.ndarray,
+                    quantise: bool) -> np.ndarray:
+    """Inverse of :func:`forward_pyramid` with (quantisation and) dequantisation by ``steps[level]``."""
+    cur = root
+    for lev in range(len(pyr), 0, -1):
+        shape, det = pyr[lev - 1]
+        a = np.empty(shape, np.int32)
+        K.run_tiles(K.reconstruct_level, cur, det, steps[lev], a, quantise)
+        cur = a
+    return cur
+
+
 def _reconstruct_psnr(vol: np.ndarray, delta: float, peak: float, cache: dict[str, Any],
                       clip: tuple[float, float] = (0.0, 65535.0)) -> float:
     """PSNR of quantise + inverse wavelet at step ``delta`` (no entropy coding; same arithmetic as the decoder)."""
     if "pyr" not in cache:
-        shapes = level_shapes(vol.shape)
-        cur = np.ascontiguousarray(vol, dtype=np.int32)
-        pyr = []
-        for lev in range(1, len(shapes)):
-            low = np.zeros(shapes[lev], np.int32)
-            nt = n_tiles(cur.shape[0]) * n_tiles(cur.shape[1]) * n_tiles(cur.shape[2])
-            det = np.zeros((nt, TILE, TILE, TILE), np.int32)
-            K.run_tiles(K.transform_level, cur, low, det)
-            pyr.append((cur.shape, det))
-            cur = low
-        cache["pyr"], cache["root"], cache["levels"] = pyr, cur, len(shapes) - 1
-    steps = level_steps(delta, cache["levels"])
-    cur = cache["root"]
-    for lev in range(len(cache["pyr"]), 0, -1):
-        shape, det = cache["pyr"][lev - 1]
-        a = np.empty(shape, np.int32)
-        K.run_tiles(K.reconstruct_level, cur, det, steps[lev], a)
-        cur = a
+        cache["pyr"], cache["root"] = forward_pyramid(vol)
+    cur = inverse_pyramid(cache["pyr"], cache["root"], level_steps(delta, len(cache["pyr"])), True)
     mse = float(np.mean((np.clip(cur, clip[0], clip[1]).astype(np.float64) - vol) ** 2))
     return math.inf if mse == 0 else 10.0 * math.log10(peak * peak / mse)
 

@@ -66,6 +66,17 @@ def _quantise(w, n0, n1, n2, steps):
 
 
 @njit(cache=True, nogil=True)
+def quantise_level(details, shape, steps, first, stride):
+    """Quantise the detail buffers of a level in place (the wavelet + zstd baseline)."""
+    c0 = (shape[0] + TILE - 1) // TILE
+    c1 = (shape[1] + TILE - 1) // TILE
+    c2 = (shape[2] + TILE - 1) // TILE
+    for t in range(first, c0 * c1 * c2, stride):
+        _, _, _, _, _, _, n0, n1, n2 = _tile_box(t, c0, c1, shape)
+        _quantise(details[t], n0, n1, n2, steps)
+
+
+@njit(cache=True, nogil=True)
 def _dequantise(w, n0, n1, n2, steps):
     _requant(w, n0, n1, n2, steps, True)
 
@@ -181,8 +192,9 @@ def transform_level(a, low, details, first, stride):
 
 
 @njit(cache=True, nogil=True)
-def reconstruct_level(low, details, steps, a, first, stride):
-    """Quantise + dequantise the stored details with ``steps`` and inverse-transform into ``a`` (PSNR search)."""
+def reconstruct_level(low, details, steps, a, quantise, first, stride):
+    """(Quantise if ``quantise``, then) dequantise the stored details with ``steps`` and inverse-transform into
+    ``a`` (PSNR search; the wavelet + zstd baseline)."""
     shape = a.shape
     c0 = (shape[0] + TILE - 1) // TILE
     c1 = (shape[1] + TILE - 1) // TILE
@@ -190,7 +202,8 @@ def reconstruct_level(low, details, steps, a, first, stride):
     for t in range(first, c0 * c1 * c2, stride):
         t0, t1, t2, s0, s1, s2, n0, n1, n2 = _tile_box(t, c0, c1, shape)
         w = details[t].copy()
-        _quantise(w, n0, n1, n2, steps)
+        if quantise:
+            _quantise(w, n0, n1, n2, steps)
         _dequantise(w, n0, n1, n2, steps)
         for i in range((n0 + 1) // 2):
             for j in range((n1 + 1) // 2):
