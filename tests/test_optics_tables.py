@@ -294,3 +294,23 @@ def test_all_tables_with_zero_opacity_and_with_rho_1e6():
                 assert np.all(out == 0)
         z = build_zot(tf, 16)
         assert np.all(z.is_transparent(s, s)) == (tf is zero)
+
+
+def test_table3d_job_reports_progress_and_cancels(hard):
+    from volviz.optics.tables import build_table3d_job
+
+    for method in ("direct", "incremental"):
+        seen: list[float] = []
+        table = build_table3d_job(hard, n_s=200, n_l=40, l_max=1.0, method=method,
+                                  progress=lambda f, msg: seen.append(f))
+        assert len(seen) >= 2 and seen == sorted(seen) and seen[-1] == 1.0
+        np.testing.assert_allclose(table.rgba, build_table3d(hard, 200, 40, 1.0, method).rgba, atol=0)
+
+    class Stop(Exception):
+        pass
+
+    def stop(fraction: float, message: str) -> None:
+        raise Stop(message)
+
+    with pytest.raises(Stop, match="pre-integration"):
+        build_table3d_job(hard, n_s=200, n_l=40, progress=stop)
