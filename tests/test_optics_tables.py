@@ -314,3 +314,13 @@ def test_table3d_job_reports_progress_and_cancels(hard):
 
     with pytest.raises(Stop, match="pre-integration"):
         build_table3d_job(hard, n_s=200, n_l=40, progress=stop)
+
+
+def test_nan_and_negative_inputs_to_every_lookup_are_transparent(hard):
+    tables = [build_table3d(hard, 9, 4, 1.0), build_table2d(hard, 9, 0.5), build_separable(hard, 9, 1.0, 2),
+              build_iso_table([0.5], 9)]
+    for t in tables:
+        out = t.lookup([np.nan, 0.2, 0.2, 0.2], [0.8, np.nan, 0.8, 0.8], [0.5, 0.5, np.nan, -1.0])
+        assert np.all(np.isfinite(out))
+        if not hasattr(t, "isosurfaces"):  # iso textures ignore l
+            assert np.all(out == 0)

@@ -147,7 +147,7 @@ class SeparableTable:
         vals = np.empty((sf.size, self.data.shape[2]), dtype=np.float64)
         if sf.size:
             _interp.bilinear(self.data, self.s_lo, self.ds, sf, sb, vals)
-        ll = np.clip(ll, 0.0, None)
+        ll = np.where(np.isnan(ll), 0.0, np.clip(ll, 0.0, None))  # NaN lengths are transparent
         alpha = -np.expm1(-ll * vals[:, 0])
         u = np.clip(ll / self.l_max, 0.0, 1.0)
         coef = vals[:, 1:].reshape(-1, self.degree + 1, 3)

@@ -59,7 +59,8 @@ class Table2D:
 
     def vertex_factor(self, l: Any) -> np.ndarray:
         """The clamped vertex colour v = min(l·α_max/l̄, 1) (what a GPU would put in the vertex RGBA)."""
-        return np.clip(np.asarray(l, dtype=np.float64) * self.vertex_scale, 0.0, 1.0)
+        v = np.clip(np.asarray(l, dtype=np.float64) * self.vertex_scale, 0.0, 1.0)
+        return np.where(np.isnan(v), 0.0, v)  # NaN lengths are transparent
 
     def lookup(self, s_f: Any, s_b: Any, l: Any) -> np.ndarray:
         """Approximate RGBA (..., 4) float64 of segments: vertex factor × bilinear texture sample."""
