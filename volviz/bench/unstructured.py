@@ -107,6 +107,7 @@ def main(argv: list[str] | None = None) -> int:
     from volviz.unstructured.render import render
     from volviz.unstructured.tetrahedralize import tetrahedralize
 
+    load_start = os.getloadavg()[0]
     ds = Path(args.dataset)
     grid = read_plot3d(ds / "bluntfinxyz.bin", ds / "bluntfinq.bin")
     mesh, rep = tetrahedralize(grid, "Density", report=True)
@@ -143,6 +144,7 @@ def main(argv: list[str] | None = None) -> int:
         "command": "volviz bench unstructured " + " ".join(shlex.quote(a) for a in (argv if argv is not None
                                                                                     else sys.argv[1:])),
         "n_tets": rep.n_tets, "n_degenerate": rep.n_degenerate, "size": args.size, "frames": len(cams),
+        "load_average_start": load_start,
         "methods": {},
     }
     e_rgb = _rgb_err(pt_imgs[0], ref)
@@ -171,6 +173,7 @@ def main(argv: list[str] | None = None) -> int:
         images[name] = img0
         print(f"{name}: {results['methods'][name]}", flush=True)
 
+    results["load_average_end"] = os.getloadavg()[0]
     vtk_best = min((v["frame_s"] for k, v in results["methods"].items() if k.startswith("vtk")), default=None)
     if vtk_best:
         results["speedup_vs_fastest_vtk"] = vtk_best / pt["total_s"]
@@ -231,7 +234,9 @@ def _markdown(results: dict[str, Any], path: Path) -> None:
         f"Command: `{results['command']}`", "",
         f"Blunt Fin, Density, {results['n_tets']} tetrahedra ({results['n_degenerate']} zero-volume tetrahedra of the "
         f"5-split dropped), {results['size']}² pixels, perspective, {results['frames']} frames along a fixed orbit. "
-        "Times are medians after a warm-up; the machine has 2 cores shared with other jobs, so absolute times vary.",
+        "Times are medians after a warm-up; the machine has 2 cores shared with other jobs, so absolute times vary "
+        f"(1-minute load average {results.get('load_average_start', float('nan')):.1f} at the start, "
+        f"{results.get('load_average_end', float('nan')):.1f} at the end of this run).",
         "Errors are against the exact float64 reference ray caster on frame 0, in 8-bit units of premultiplied "
         "colour (VTK images are read back over black, i.e. premultiplied RGB).",
         "VTK gets the same κ and opacity a = ρ·unit_distance with ScalarOpacityUnitDistance = unit_distance = 1.", "",
