@@ -40,6 +40,8 @@ def _tile_box(t, c0, c1, shape):
 @njit(cache=True, nogil=True)
 def _requant(w, n0, n1, n2, steps, inverse):
     """Quantise (``inverse`` False) or reconstruct (True) the detail subbands of a tile in place."""
+    if steps[1:].max() <= 1.0:  # lossless: nothing to do
+        return
     l0 = (n0 + 1) // 2
     l1 = (n1 + 1) // 2
     l2 = (n2 + 1) // 2
@@ -123,6 +125,13 @@ def decode_level(low, payload, offsets, sizes, valid, steps, coder, a, status, f
     for t in range(first, c0 * c1 * c2, stride):
         t0, t1, t2, s0, s1, s2, n0, n1, n2 = _tile_box(t, c0, c1, shape)
         w = np.empty((TILE, TILE, TILE), np.int32)
+        l0 = (n0 + 1) // 2
+        l1 = (n1 + 1) // 2
+        l2 = (n2 + 1) // 2
+        for i in range(l0):  # the lowpass first: the arithmetic coder's contexts read it
+            for j in range(l1):
+                for k in range(l2):
+                    w[i, j, k] = low[t0 * HALF + i, t1 * HALF + j, t2 * HALF + k]
         n = sizes[t] if valid[t] else 0
         if coder == CODER_RANS:
             rc = decode_rans(payload, offsets[t], n, w, n0, n1, n2, False)
@@ -131,13 +140,6 @@ def decode_level(low, payload, offsets, sizes, valid, steps, coder, a, status, f
         status[t] = rc
         if rc != 0:
             decode_rans(payload, 0, 0, w, n0, n1, n2, False)  # zero the details
-        l0 = (n0 + 1) // 2
-        l1 = (n1 + 1) // 2
-        l2 = (n2 + 1) // 2
-        for i in range(l0):
-            for j in range(l1):
-                for k in range(l2):
-                    w[i, j, k] = low[t0 * HALF + i, t1 * HALF + j, t2 * HALF + k]
         _dequantise(w, n0, n1, n2, steps)
         inverse_tile(w, n0, n1, n2)
         for i in range(n0):
