@@ -1,0 +1,585 @@
+"""Numba kernels of the volumetric C-LOD (Roettger Ch. 11, digest §9). See ``volviz.nature.clouds``.
+
+Node addressing: level ``lv`` (0 = root, size R; size = R >> lv grid cells), integer node coordinates (a, b, c) in
+units of the node size, per-level dense arrays flattened at ``off[lv] + (a * nb + b) * nc + c`` with
+``(na, nb, nc) = roots << lv``. Levels 0 .. L-1 (sizes R .. 2) are stored; size-1 cells never refine.
+
+5-tetrahedra split with global parity: a node's central tetrahedron uses the corners whose local index sum has the
+parity ``p = (a + b + c) % 2`` (the corners of global-even parity at the node's level), so neighbouring nodes of the
+same level agree on every shared face diagonal, and a finer level's face triangulation refines the coarser one.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _corner(i: int, j: int, k: int) -> int:
+    return (i << 2) | (j << 1) | k
+
+
+@njit(cache=True, nogil=True)
+def coarse_value(cv: np.ndarray, ii: int, jj: int, kk: int, p: int) -> float:
+    """Value at lattice point (ii, jj, kk) in {0, 1, 2}^3 of the node's own linear 5-tet interpolation of its
+    corner values cv[8] (index i<<2 | j<<1 | k): edge midpoint = mean of the edge's ends, face centre = mean of the
+    face diagonal of parity p, centroid = mean of the central tetrahedron (the 4 corners of parity p)."""
+    odd = (ii & 1) + (jj & 1) + (kk & 1)
+    if odd == 0:
+        return cv[_corner(ii >> 1, jj >> 1, kk >> 1)]
+    if odd == 1:
+        if ii == 1:
+            return 0.5 * (cv[_corner(0, jj >> 1, kk >> 1)] + cv[_corner(1, jj >> 1, kk >> 1)])
+        if jj == 1:
+            return 0.5 * (cv[_corner(ii >> 1, 0, kk >> 1)] + cv[_corner(ii >> 1, 1, kk >> 1)])
+        return 0.5 * (cv[_corner(ii >> 1, jj >> 1, 0)] + cv[_corner(ii >> 1, jj >> 1, 1)])
+    acc = 0.0
+    cnt = 0
+    for c in range(8):
+        i, j, k = c >> 2, (c >> 1) & 1, c & 1
+        if (i + j + k) % 2 != p:
+            continue
+        if odd == 2:  # face centre: the two corners of parity p on that face
+            if ii != 1 and i != (ii >> 1):
+                continue
+            if jj != 1 and j != (jj >> 1):
+                continue
+            if kk != 1 and k != (kk >> 1):
+                continue
+        acc += cv[c]
+        cnt += 1
+    return acc / cnt
+
+
+@njit(cache=True, nogil=True)
+def node_stats(f, g, g_weight, root, levels, roots, off, delta_local, fmax):
+    """Per stored node: local deviation Δ = max over the 19 non-corner lattice points of max(|f − coarse|,
+    g_weight |g − coarse|) (the maximum variant of §11.4), and fmax over the node's closed box."""
+    cf = np.empty(8)
+    cg = np.empty(8)
+    for lv in range(levels - 1, -1, -1):
+        s = root >> lv
+        h = s // 2
+        na, nb, nc = roots[0] << lv, roots[1] << lv, roots[2] << lv
+        for a in range(na):
+            for b in range(nb):
+                for c in range(nc):
+                    x0, y0, z0 = a * s, b * s, c * s
+                    p = (a + b + c) % 2
+                    for q in range(8):
+                        i, j, k = q >> 2, (q >> 1) & 1, q & 1
+                        cf[q] = f[x0 + i * s, y0 + j * s, z0 + k * s]
+                        cg[q] = g[x0 + i * s, y0 + j * s, z0 + k * s]
+                    dev = 0.0
+                    m = -np.inf
+                    for ii in range(3):
+                        for jj in range(3):
+                            for kk in range(3):
+                                v = f[x0 + ii * h, y0 + jj * h, z0 + kk * h]
+                                if h == 1:
+                                    m = max(m, v)
+                                if (ii & 1) + (jj & 1) + (kk & 1) == 0:
+                                    continue
+                                w = g[x0 + ii * h, y0 + jj * h, z0 + kk * h]
+                                dev = max(dev, abs(v - coarse_value(cf, ii, jj, kk, p)))
+                                dev = max(dev, g_weight * abs(w - coarse_value(cg, ii, jj, kk, p)))
+                    idx = off[lv] + (a * nb + b) * nc + c
+                    delta_local[idx] = dev
+                    if h > 1:
+                        cb, cc = nb << 1, nc << 1
+                        for q in range(8):
+                            ch = off[lv + 1] + ((2 * a + (q >> 2)) * cb + 2 * b + ((q >> 1) & 1)) * cc + 2 * c + (q & 1)
+                            m = max(m, fmax[ch])
+                    fmax[idx] = m
+
+
+@njit(cache=True, nogil=True)
+def propagate(delta, levels, roots, off, kmax):
+    """Eq. (11.5), bottom-up one level at a time: Δ := max(Δ, K_max Δ_child) over the 8 children."""
+    for lv in range(levels - 2, -1, -1):
+        na, nb, nc = roots[0] << lv, roots[1] << lv, roots[2] << lv
+        cb, cc = nb << 1, nc << 1
+        for a in range(na):
+            for b in range(nb):
+                for c in range(nc):
+                    idx = off[lv] + (a * nb + b) * nc + c
+                    m = delta[idx]
+                    for q in range(8):
+                        ch = off[lv + 1] + ((2 * a + (q >> 2)) * cb + 2 * b + ((q >> 1) & 1)) * cc + 2 * c + (q & 1)
+                        m = max(m, kmax * delta[ch])
+                    delta[idx] = m
+
+
+@njit(cache=True, nogil=True)
+def decide(delta, fmax, cutoff, root, levels, roots, off, origin, spacing, eye, big_c, small_c, geomorph,
+           state, eprime, nodes):
+    """Top-down, level by level: e = s C max(c Δ, 1) / d (Eq. 11.1), refine if e > 1; e' = clamp(e − 1, 0, 1)
+    (Eq. 11.6) capped by the parent's. Nodes with fmax <= cutoff are transparent (ZOT) and never refined.
+    Returns the number of nodes written to ``nodes`` (lv, a, b, c), or -1 if the buffer is too small."""
+    n = 0
+    for a in range(roots[0]):
+        for b in range(roots[1]):
+            for c in range(roots[2]):
+                nodes[n, 0], nodes[n, 1], nodes[n, 2], nodes[n, 3] = 0, a, b, c
+                n += 1
+    start = 0
+    cap = nodes.shape[0]
+    for lv in range(levels):
+        end = n
+        s = root >> lv
+        na, nb, nc = roots[0] << lv, roots[1] << lv, roots[2] << lv
+        ex, ey, ez = spacing[0] * s, spacing[1] * s, spacing[2] * s
+        edge = max(ex, max(ey, ez))
+        for t in range(start, end):
+            a, b, c = nodes[t, 1], nodes[t, 2], nodes[t, 3]
+            idx = off[lv] + (a * nb + b) * nc + c
+            state[idx] = 1
+            if fmax[idx] <= cutoff:
+                continue
+            dx = origin[0] + (a + 0.5) * ex - eye[0]
+            dy = origin[1] + (b + 0.5) * ey - eye[1]
+            dz = origin[2] + (c + 0.5) * ez - eye[2]
+            d = math.sqrt(dx * dx + dy * dy + dz * dz)
+            num = edge * big_c * max(small_c * delta[idx], 1.0)
+            if d >= num:  # e <= 1
+                continue
+            e = num / d if d > 0 else 1e30
+            w = 1.0 if not geomorph else min(max(e - 1.0, 0.0), 1.0)
+            if lv > 0:
+                pidx = off[lv - 1] + ((a >> 1) * (nb >> 1) + (b >> 1)) * (nc >> 1) + (c >> 1)
+                w = min(w, eprime[pidx])
+            state[idx] = 2
+            eprime[idx] = w
+            if n + 8 > cap:
+                return -1
+            for q in range(8):
+                nodes[n, 0] = lv + 1
+                nodes[n, 1] = 2 * a + (q >> 2)
+                nodes[n, 2] = 2 * b + ((q >> 1) & 1)
+                nodes[n, 3] = 2 * c + (q & 1)
+                n += 1
+        start = end
+        if start == n:
+            break
+    return n
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _ep(state, eprime, off, lv, na, nb, nc, a, b, c, inside_default):
+    """e' of node (lv, a, b, c): 0 if not refined; ``inside_default`` outside the volume."""
+    if a < 0 or b < 0 or c < 0 or a >= na or b >= nb or c >= nc:
+        return inside_default
+    idx = off[lv] + (a * nb + b) * nc + c
+    return eprime[idx] if state[idx] == 2 else 0.0
+
+
+@njit(cache=True, nogil=True)
+def morph(f, g, root, roots, off, state, eprime, nodes, count, vf, vg):
+    """Volumetric morphing (§11.4) with the corrected Eq. (11.8): S' = (1 − w) coarse + w S, w = the minimum e' of
+    all same-level nodes sharing the vertex (unrefined = 0). Coarse values come from the refining node's own 5-tet
+    interpolation of its (already morphed) corners; coarse to fine."""
+    nx, ny, nz = f.shape
+    for a in range(0, nx, root):
+        for b in range(0, ny, root):
+            for c in range(0, nz, root):
+                vf[a, b, c] = f[a, b, c]
+                vg[a, b, c] = g[a, b, c]
+    cf = np.empty(8)
+    cg = np.empty(8)
+    for t in range(count):
+        lv, a, b, c = nodes[t, 0], nodes[t, 1], nodes[t, 2], nodes[t, 3]
+        if lv >= off.shape[0] - 1:
+            continue
+        na, nb, nc = roots[0] << lv, roots[1] << lv, roots[2] << lv
+        idx = off[lv] + (a * nb + b) * nc + c
+        if state[idx] != 2:
+            continue
+        w0 = eprime[idx]
+        s = root >> lv
+        h = s // 2
+        x0, y0, z0 = a * s, b * s, c * s
+        p = (a + b + c) % 2
+        for q in range(8):
+            i, j, k = q >> 2, (q >> 1) & 1, q & 1
+            cf[q] = vf[x0 + i * s, y0 + j * s, z0 + k * s]
+            cg[q] = vg[x0 + i * s, y0 + j * s, z0 + k * s]
+        for ii in range(3):
+            for jj in range(3):
+                for kk in range(3):
+                    odd = (ii & 1) + (jj & 1) + (kk & 1)
+                    if odd == 0:
+                        continue
+                    w = w0
+                    # the other same-level nodes sharing this point (face: 1, edge: 3)
+                    da = 0 if ii == 1 else (1 if ii == 2 else -1)
+                    db = 0 if jj == 1 else (1 if jj == 2 else -1)
+                    dc = 0 if kk == 1 else (1 if kk == 2 else -1)
+                    for sa in range(2):
+                        if sa == 1 and da == 0:
+                            continue
+                        for sb in range(2):
+                            if sb == 1 and db == 0:
+                                continue
+                            for sc in range(2):
+                                if sc == 1 and dc == 0:
+                                    continue
+                                if sa + sb + sc == 0:
+                                    continue
+                                w = min(w, _ep(state, eprime, off, lv, na, nb, nc, a + sa * da, b + sb * db,
+                                               c + sc * dc, w0))
+                    xi, yi, zi = x0 + ii * h, y0 + jj * h, z0 + kk * h
+                    vf[xi, yi, zi] = (1.0 - w) * coarse_value(cf, ii, jj, kk, p) + w * f[xi, yi, zi]
+                    vg[xi, yi, zi] = (1.0 - w) * coarse_value(cg, ii, jj, kk, p) + w * g[xi, yi, zi]
+
+
+@njit(cache=True, nogil=True)
+def _box_outside(planes, x0, y0, z0, x1, y1, z1):
+    for q in range(planes.shape[0]):
+        x = x1 if planes[q, 0] >= 0 else x0
+        y = y1 if planes[q, 1] >= 0 else y0
+        z = z1 if planes[q, 2] >= 0 else z0
+        if planes[q, 0] * x + planes[q, 1] * y + planes[q, 2] * z + planes[q, 3] < 0.0:
+            return True
+    return False
+
+
+@njit(cache=True, nogil=True)
+def emit(fmax, cutoff, root, levels, roots, off, origin, spacing, eye, planes, state, root_order, vf, full,
+         out, stack):
+    """Back-to-front octree traversal (§11.5): roots in a BSP order of the root grid, children far-to-near at every
+    level; per node frustum culling and the zero-opacity test (fmax <= cutoff; for leaves the max of the morphed
+    corner densities). Leaves go to ``out`` (lv, a, b, c) in visibility order. ``full`` refines every node (the
+    full-resolution reference). Returns the number of leaves, or -1 if ``out`` is too small."""
+    n = 0
+    cap = out.shape[0]
+    for r in range(root_order.shape[0]):
+        top = 0
+        stack[0, 0], stack[0, 1], stack[0, 2], stack[0, 3] = 0, root_order[r, 0], root_order[r, 1], root_order[r, 2]
+        top = 1
+        while top > 0:
+            top -= 1
+            lv, a, b, c = stack[top, 0], stack[top, 1], stack[top, 2], stack[top, 3]
+            s = root >> lv
+            ex, ey, ez = spacing[0] * s, spacing[1] * s, spacing[2] * s
+            bx0, by0, bz0 = origin[0] + a * ex, origin[1] + b * ey, origin[2] + c * ez
+            if planes.shape[0] > 0 and _box_outside(planes, bx0, by0, bz0, bx0 + ex, by0 + ey, bz0 + ez):
+                continue
+            refined = False
+            if lv < levels:
+                nb, nc = roots[1] << lv, roots[2] << lv
+                idx = off[lv] + (a * nb + b) * nc + c
+                if fmax[idx] <= cutoff:
+                    continue
+                refined = full or state[idx] == 2
+            if refined:
+                # far-to-near order: bit set = the child half away from the eye on that axis
+                fx = 1 if eye[0] < bx0 + 0.5 * ex else 0
+                fy = 1 if eye[1] < by0 + 0.5 * ey else 0
+                fz = 1 if eye[2] < bz0 + 0.5 * ez else 0
+                far = (fx << 2) | (fy << 1) | fz
+                for i in range(7, -1, -1):  # push nearest first so that the farthest pops first
+                    q = far ^ i
+                    stack[top, 0] = lv + 1
+                    stack[top, 1] = 2 * a + (q >> 2)
+                    stack[top, 2] = 2 * b + ((q >> 1) & 1)
+                    stack[top, 3] = 2 * c + (q & 1)
+                    top += 1
+                continue
+            m = -np.inf
+            x0, y0, z0 = a * s, b * s, c * s
+            for q in range(8):
+                m = max(m, vf[x0 + (q >> 2) * s, y0 + ((q >> 1) & 1) * s, z0 + (q & 1) * s])
+            if m <= cutoff:
+                continue
+            if n >= cap:
+                return -1
+            out[n, 0], out[n, 1], out[n, 2], out[n, 3] = lv, a, b, c
+            n += 1
+    return n
+
+
+# ----------------------------------------------------------------------------------------------- rendering
+@njit(cache=True, nogil=True, inline="always")
+def _coord(x, lo, step, n):
+    f = (x - lo) / step
+    if f <= 0.0:
+        return 0, 0.0
+    if f >= n - 1:
+        return n - 2, 1.0
+    i0 = int(f)
+    return i0, f - i0
+
+
+@njit(cache=True, nogil=True)
+def _lookup(table, s_lo, ds, dl, sf, sb, l, out):
+    """Trilinear sample of the 3D pre-integration table (n, n, L, 4) at (sf, sb, l) (l clamps to the last slice)."""
+    n = table.shape[0]
+    nl = table.shape[2]
+    i, wi = _coord(sf, s_lo, ds, n)
+    j, wj = _coord(sb, s_lo, ds, n)
+    k, wk = _coord(l, 0.0, dl, nl)
+    for ch in range(4):
+        a = (1 - wk) * table[i, j, k, ch] + wk * table[i, j, k + 1, ch]
+        b = (1 - wk) * table[i, j + 1, k, ch] + wk * table[i, j + 1, k + 1, ch]
+        c = (1 - wk) * table[i + 1, j, k, ch] + wk * table[i + 1, j, k + 1, ch]
+        d = (1 - wk) * table[i + 1, j + 1, k, ch] + wk * table[i + 1, j + 1, k + 1, ch]
+        out[ch] = (1 - wi) * ((1 - wj) * a + wj * b) + wi * ((1 - wj) * c + wj * d)
+
+
+@njit(cache=True, nogil=True)
+def _eval(cv, region, u0, u1, u2):
+    """The 5-tet piecewise-linear interpolant (even parity: central tet on corners 000, 110, 101, 011) in region
+    ``region`` (0..3: corner tet of the odd corner 100, 010, 001, 111; 4: central) at local point (u0, u1, u2)."""
+    if region == 4:
+        s0, s110, s101, s011 = cv[0], cv[6], cv[5], cv[3]
+        be = 0.5 * (s110 + s101 - s011 - s0)
+        ga = 0.5 * (s110 + s011 - s101 - s0)
+        de = 0.5 * (s101 + s011 - s110 - s0)
+        return s0 + be * u0 + ga * u1 + de * u2
+    if region == 0:
+        qi, qj, qk = 1, 0, 0
+    elif region == 1:
+        qi, qj, qk = 0, 1, 0
+    elif region == 2:
+        qi, qj, qk = 0, 0, 1
+    else:
+        qi, qj, qk = 1, 1, 1
+    vq = cv[_corner(qi, qj, qk)]
+    return (vq + (cv[_corner(1 - qi, qj, qk)] - vq) * abs(u0 - qi) + (cv[_corner(qi, 1 - qj, qk)] - vq) * abs(u1 - qj)
+            + (cv[_corner(qi, qj, 1 - qk)] - vq) * abs(u2 - qk))
+
+
+@njit(cache=True, nogil=True)
+def _l1(region, u0, u1, u2):
+    """L1 distance of a local point from the odd corner of corner tet ``region`` (inside the tet if <= 1)."""
+    if region == 0:
+        return (1 - u0) + u1 + u2
+    if region == 1:
+        return u0 + (1 - u1) + u2
+    if region == 2:
+        return u0 + u1 + (1 - u2)
+    return (1 - u0) + (1 - u1) + (1 - u2)
+
+
+@njit(cache=True, nogil=True)
+def _pieces(uo, ud, t0, t1, ca, cm, ts, sa, sm, cuts):
+    """Split [t0, t1] (inside the unit cube in local coordinates uo + t ud, even parity) at the 4 corner-tet planes
+    L1 = 1 (linear in t inside the cube); per piece the scalar/modulation at both ends. Returns the piece count."""
+    nc = 0
+    cuts[nc] = t0
+    nc += 1
+    for r in range(4):
+        g0 = _l1(r, uo[0] + t0 * ud[0], uo[1] + t0 * ud[1], uo[2] + t0 * ud[2])
+        g1 = _l1(r, uo[0] + t1 * ud[0], uo[1] + t1 * ud[1], uo[2] + t1 * ud[2])
+        if (g0 - 1.0) * (g1 - 1.0) < 0.0:
+            cuts[nc] = t0 + (1.0 - g0) / (g1 - g0) * (t1 - t0)
+            nc += 1
+    cuts[nc] = t1
+    nc += 1
+    for i in range(1, nc):
+        v = cuts[i]
+        j = i - 1
+        while j >= 0 and cuts[j] > v:
+            cuts[j + 1] = cuts[j]
+            j -= 1
+        cuts[j + 1] = v
+    n = 0
+    for i in range(nc - 1):
+        ta, tb = cuts[i], cuts[i + 1]
+        if tb - ta <= 0.0:
+            continue
+        tm = 0.5 * (ta + tb)
+        m0, m1, m2 = uo[0] + tm * ud[0], uo[1] + tm * ud[1], uo[2] + tm * ud[2]
+        region = 4
+        for r in range(4):
+            if _l1(r, m0, m1, m2) < 1.0:
+                region = r
+                break
+        a0, a1, a2 = uo[0] + ta * ud[0], uo[1] + ta * ud[1], uo[2] + ta * ud[2]
+        b0, b1, b2 = uo[0] + tb * ud[0], uo[1] + tb * ud[1], uo[2] + tb * ud[2]
+        ts[n] = ta
+        ts[n + 1] = tb
+        sa[n, 0] = _eval(ca, region, a0, a1, a2)
+        sa[n, 1] = _eval(ca, region, b0, b1, b2)
+        sm[n, 0] = _eval(cm, region, a0, a1, a2)
+        sm[n, 1] = _eval(cm, region, b0, b1, b2)
+        n += 1
+        if n == 3:
+            break
+    return n
+
+
+@njit(cache=True, nogil=True)
+def cube_segments(o, d, p0, e, flip, t_lo, t_hi, ca, cm, ts, sa, sm, uo, ud, cuts):
+    """The ray o + t d inside the box (min corner p0, edges e) and [t_lo, t_hi], split into its 5-tet pieces (front
+    to back). ca/cm: corner values, already mirrored in x if ``flip`` (odd parity). uo, ud (3,), cuts (6,) scratch."""
+    t0, t1 = t_lo, t_hi
+    for ax in range(3):
+        uo[ax] = (o[ax] - p0[ax]) / e[ax]
+        ud[ax] = d[ax] / e[ax]
+    if flip:
+        uo[0] = 1.0 - uo[0]
+        ud[0] = -ud[0]
+    for ax in range(3):
+        if ud[ax] != 0.0:
+            ta = -uo[ax] / ud[ax]
+            tb = (1.0 - uo[ax]) / ud[ax]
+            if ta > tb:
+                ta, tb = tb, ta
+            t0 = max(t0, ta)
+            t1 = min(t1, tb)
+        elif uo[ax] < 0.0 or uo[ax] > 1.0:
+            return 0
+    if t1 <= t0:
+        return 0
+    return _pieces(uo, ud, t0, t1, ca, cm, ts, sa, sm, cuts)
+
+
+@njit(cache=True, nogil=True)
+def _leaf_setup(leaves, nleaf, root, vp, w, h, origin, spacing, boxes):
+    """Screen box of every leaf cube, clipped to the near plane (corners in front + edge/near-plane crossings)."""
+    near = vp[14]
+    cam = np.empty((8, 3))
+    for t in range(nleaf):
+        lv, a, b, c = leaves[t, 0], leaves[t, 1], leaves[t, 2], leaves[t, 3]
+        s = root >> lv
+        for q in range(8):
+            px = origin[0] + (a + (q >> 2)) * s * spacing[0] - vp[0]
+            py = origin[1] + (b + ((q >> 1) & 1)) * s * spacing[1] - vp[1]
+            pz = origin[2] + (c + (q & 1)) * s * spacing[2] - vp[2]
+            cam[q, 0] = px * vp[3] + py * vp[4] + pz * vp[5]
+            cam[q, 1] = px * vp[6] + py * vp[7] + pz * vp[8]
+            cam[q, 2] = px * vp[9] + py * vp[10] + pz * vp[11]
+        x0, x1, y0, y1 = 1e300, -1e300, 1e300, -1e300
+        for q in range(8):
+            if cam[q, 2] >= near:
+                sx = (cam[q, 0] / cam[q, 2] / vp[12] + 1.0) * w * 0.5 - 0.5
+                sy = (1.0 - cam[q, 1] / cam[q, 2] / vp[13]) * h * 0.5 - 0.5
+                x0, x1, y0, y1 = min(x0, sx), max(x1, sx), min(y0, sy), max(y1, sy)
+            for bit in (4, 2, 1):
+                r = q | bit
+                if r == q:
+                    continue
+                za, zb = cam[q, 2], cam[r, 2]
+                if (za >= near) != (zb >= near):
+                    f = (near - za) / (zb - za)
+                    cx = cam[q, 0] + f * (cam[r, 0] - cam[q, 0])
+                    cy = cam[q, 1] + f * (cam[r, 1] - cam[q, 1])
+                    sx = (cx / near / vp[12] + 1.0) * w * 0.5 - 0.5
+                    sy = (1.0 - cy / near / vp[13]) * h * 0.5 - 0.5
+                    x0, x1, y0, y1 = min(x0, sx), max(x1, sx), min(y0, sy), max(y1, sy)
+        boxes[t, 0] = max(int(math.floor(x0)), 0)
+        boxes[t, 1] = min(int(math.ceil(x1)), w - 1)
+        boxes[t, 2] = max(int(math.floor(y0)), 0)
+        boxes[t, 3] = min(int(math.ceil(y1)), h - 1)
+
+
+@njit(cache=True, nogil=True)
+def _render_band(leaves, nleaf, boxes, root, origin, spacing, va, vm, m_scale, a_cut, table, s_lo, ds, dl, eye,
+                 dirs, invd, dnorm, depth, near, row0, row1, img, trans):
+    """Leaves front to back (the reverse of the back-to-front list) composited *under* the pixel with early ray
+    termination (transmittance < 1/1024); equivalent to back-to-front "over" up to that cut-off."""
+    p0 = np.empty(3)
+    e = np.empty(3)
+    ca = np.empty(8)
+    cm = np.empty(8)
+    ts = np.empty(4)
+    sa = np.empty((3, 2))
+    sm = np.empty((3, 2))
+    seg = np.empty(4)
+    uo = np.empty(3)
+    ud = np.empty(3)
+    cuts = np.empty(6)
+    lo = np.empty(3)
+    hi = np.empty(3)
+    for t in range(nleaf - 1, -1, -1):
+        y_lo = max(boxes[t, 2], row0)
+        y_hi = min(boxes[t, 3], row1 - 1)
+        if y_lo > y_hi or boxes[t, 0] > boxes[t, 1]:
+            continue
+        lv, a, b, c = leaves[t, 0], leaves[t, 1], leaves[t, 2], leaves[t, 3]
+        s = root >> lv
+        flip = (a + b + c) % 2 == 1
+        for q in range(8):
+            i, j, k = q >> 2, (q >> 1) & 1, q & 1
+            src = ((1 - i) if flip else i)
+            gx, gy, gz = (a + src) * s, (b + j) * s, (c + k) * s
+            ca[q] = va[gx, gy, gz]
+            cm[q] = vm[gx, gy, gz] * m_scale
+        for ax in range(3):
+            e[ax] = s * spacing[ax]
+        p0[0] = origin[0] + a * e[0]
+        p0[1] = origin[1] + b * e[1]
+        p0[2] = origin[2] + c * e[2]
+        for ax in range(3):
+            lo[ax] = p0[ax] - eye[ax]
+            hi[ax] = p0[ax] + e[ax] - eye[ax]
+            uo[ax] = (eye[ax] - p0[ax]) / e[ax]
+        if flip:
+            uo[0] = 1.0 - uo[0]
+        for row in range(y_lo, y_hi + 1):
+            for col in range(boxes[t, 0], boxes[t, 1] + 1):
+                if trans[row, col] < 1.0 / 1024.0:
+                    continue
+                t0 = near
+                t1 = depth[row, col]
+                for ax in range(3):
+                    ta = lo[ax] * invd[row, col, ax]
+                    tb = hi[ax] * invd[row, col, ax]
+                    if ta > tb:
+                        ta, tb = tb, ta
+                    if ta > t0:
+                        t0 = ta
+                    if tb < t1:
+                        t1 = tb
+                if t1 <= t0:
+                    continue
+                for ax in range(3):
+                    ud[ax] = dirs[row, col, ax] / e[ax]
+                if flip:
+                    ud[0] = -ud[0]
+                npc = _pieces(uo, ud, t0, t1, ca, cm, ts, sa, sm, cuts)
+                dn = dnorm[row, col]
+                for k in range(npc):
+                    if sa[k, 0] <= a_cut and sa[k, 1] <= a_cut:
+                        continue
+                    length = (ts[k + 1] - ts[k]) * dn * 0.5 * (sm[k, 0] + sm[k, 1])
+                    if length <= 0.0:
+                        continue
+                    _lookup(table, s_lo, ds, dl, sa[k, 0], sa[k, 1], length, seg)
+                    tr = trans[row, col]
+                    for ch in range(4):
+                        img[row, col, ch] += tr * seg[ch]
+                    trans[row, col] = tr * (1.0 - seg[3])
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def _directions(rb, w, h, dirs, invd, dnorm):
+    for row in prange(h):
+        for col in range(w):
+            n2 = 0.0
+            for ax in range(3):
+                v = rb[3, ax] + col * rb[4, ax] + row * rb[5, ax]
+                dirs[row, col, ax] = v
+                invd[row, col, ax] = 1.0 / v if v != 0.0 else (1e300 if not math.copysign(1.0, v) < 0 else -1e300)
+                n2 += v * v
+            dnorm[row, col] = math.sqrt(n2)
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def render(leaves, nleaf, root, origin, spacing, va, vm, m_scale, a_cut, table, s_lo, ds, dl, rb, vp, depth, bands,
+           w, h, img):
+    """Perspective only (all rays start at the eye ``vp[0:3]``)."""
+    boxes = np.empty((nleaf, 4), dtype=np.int64)
+    _leaf_setup(leaves, nleaf, root, vp, w, h, origin, spacing, boxes)
+    dirs = np.empty((h, w, 3))
+    invd = np.empty((h, w, 3))
+    dnorm = np.empty((h, w))
+    _directions(rb, w, h, dirs, invd, dnorm)
+    trans = np.ones((h, w))
+    eye = vp[0:3].copy()
+    for bi in prange(bands.shape[0] - 1):
+        _render_band(leaves, nleaf, boxes, root, origin, spacing, va, vm, m_scale, a_cut, table, s_lo, ds, dl, eye,
+                     dirs, invd, dnorm, depth, vp[14], bands[bi], bands[bi + 1], img, trans)
