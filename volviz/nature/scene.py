@@ -1,0 +1,453 @@
+"""Natural scenes: terrain + ground fog / cloud layers + volumetric clouds + sky, on the CPU and in a PyVista plotter.
+
+``NatureScene`` holds the pieces (terrain C-LOD with its morphed layers, PCP prism layers, cloud C-LOD, sky) and
+renders a frame on the CPU (``render``): the terrain z-buffer and colour (``raster``), the sky behind it, and the
+volumes as one premultiplied RGBA overlay clipped at the terrain depth. Volumes are composited as layers, farthest
+(from the eye's height) first — exact for layers that do not interleave along a ray (each prism layer is itself order
+independent, see ``fog``; the clouds are sorted by the octree).
+
+``NatureView`` puts a scene into a PyVista plotter: the terrain as a textured mesh (the baked colour map, lighting
+off, so it matches the CPU image), the sky dome, and the volume overlay as a screen-space RGBA image in front (the
+terrain occlusion is already in it). ``update(camera)`` recomputes the terrain LOD mesh and the overlay for a camera.
+
+Session components (``build_nature_components``): "terrain", "fog" (ground fog or, with ``base_dataset``, a cloud
+layer between two height fields), "clouds" (generated Perlin clouds or a volume dataset), "sky".
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Any, Sequence
+
+import numpy as np
+
+from volviz.nature.clouds import CloudLOD, CloudShading, CloudVolume, build_cloud_table, render_cloud_image
+from volviz.nature.fog import FogLayer, render_layer
+from volviz.nature.heightfield import HeightField, grid_from_image, resample_bilinear
+from volviz.nature.raster import bake_colour_map, mip_pyramid, render_sky, render_terrain
+from volviz.nature.terrain import TerrainLOD, TerrainMesh, frustum_planes
+
+
+def over(front: np.ndarray, back: np.ndarray) -> np.ndarray:
+    """Premultiplied "over": front + (1 − α_front) back."""
+    return front + (1.0 - front[..., 3:4]) * back
+
+
+@dataclass
+class NatureFrame:
+    """One CPU frame: final RGB (H, W, 3), the volume overlay (premultiplied RGBA), terrain depth and statistics."""
+
+    rgb: np.ndarray
+    overlay: np.ndarray
+    depth: np.ndarray
+    stats: dict[str, float] = field(default_factory=dict)
+    mesh: TerrainMesh | None = None
+
+
+@dataclass
+class _Fog:
+    name: str
+    layer: FogLayer
+    bottom: str
+    top: str
+    mid_height: float
+
+
+class NatureScene:
+    """Terrain, prism layers, clouds and sky; call ``finalize()`` after adding layers (or let ``render`` do it)."""
+
+    def __init__(self, terrain: HeightField | None = None, texture: np.ndarray | None = None,
+                 sky: np.ndarray | None = None, big_c: float = 12.0, small_c: float = 60.0,
+                 light: Sequence[float] = (0.4, 0.3, 0.85)) -> None:
+        self.terrain = terrain
+        self.texture = texture
+        self.sky = sky
+        self.big_c = float(big_c)
+        self.small_c = float(small_c)
+        self.light = tuple(float(v) for v in light)
+        self._layers: dict[str, np.ndarray] = {}
+        self._curvature: list[tuple[np.ndarray, float]] = []
+        self.fogs: list[_Fog] = []
+        self.cloud_lod: CloudLOD | None = None
+        self.cloud_shading: CloudShading | None = None
+        self.cloud_table: Any = None
+        self.lod: TerrainLOD | None = None
+        self.colour_map: np.ndarray | None = None
+        self._pyramid: Any = None
+
+    # ----------------------------------------------------------------------------------------------- building
+    def _grid(self, values: np.ndarray) -> np.ndarray:
+        if self.terrain is None:
+            raise ValueError("prism layers need a terrain")
+        return resample_bilinear(np.asarray(values, dtype=np.float64), (self.terrain.size, self.terrain.size))
+
+    def add_fog(self, name: str, thickness: np.ndarray, layer: FogLayer | None = None, base: np.ndarray | None = None,
+                weight: float = 4.0) -> None:
+        """A prism layer: ``thickness`` (x-major grid, any size, world units) above ``base`` (absolute heights; None:
+        the terrain, i.e. ground fog). ``weight`` scales the thickness map's d2 in the C-LOD criterion (§10.4)."""
+        if name in self._layers or f"{name}_base" in self._layers:
+            raise ValueError(f"duplicate layer name {name!r}")
+        thick = np.maximum(self._grid(thickness), 0.0)
+        assert self.terrain is not None
+        if base is None:
+            bottom_name, bottom = "terrain", self.terrain.heights
+        else:
+            bottom_name, bottom = f"{name}_base", self._grid(base)
+            self._layers[bottom_name] = bottom
+        self._layers[name] = bottom + thick
+        if weight > 0:
+            self._curvature.append((thick, float(weight)))
+        present = thick > 0
+        mid = float(np.mean((bottom + 0.5 * thick)[present])) if present.any() else float(np.mean(bottom))
+        self.fogs.append(_Fog(name, layer or FogLayer(), bottom_name, name, mid))
+        self.lod = None
+
+    def add_clouds(self, volume: CloudVolume, shading: CloudShading | None = None, big_c: float = 3.0,
+                   small_c: float = 4.0, table_size: tuple[int, int] = (64, 128)) -> None:
+        """Volumetric clouds (Ch. 11) with their C-LOD and pre-integration table."""
+        self.cloud_shading = shading or CloudShading.npr()
+        self.cloud_lod = CloudLOD(volume, big_c=big_c, small_c=small_c, cutoff=self.cloud_shading.cutoff)
+        l_max = volume.root * float(np.linalg.norm(volume.spacing))
+        self.cloud_table = build_cloud_table(self.cloud_shading, l_max, n_s=table_size[0], n_l=table_size[1])
+
+    def finalize(self) -> None:
+        if self.terrain is not None and self.lod is None:
+            self.lod = TerrainLOD(self.terrain, layers=self._layers, curvature=self._curvature, big_c=self.big_c,
+                                  small_c=self.small_c)
+            if self.colour_map is None:
+                self.colour_map = bake_colour_map(self.terrain.normals(), self.texture, self.light)
+                self._pyramid = mip_pyramid(self.colour_map)
+
+    # ----------------------------------------------------------------------------------------------- rendering
+    def terrain_mesh(self, camera: Any, size: tuple[int, int], full: bool = False) -> TerrainMesh | None:
+        self.finalize()
+        if self.lod is None:
+            return None
+        if full:
+            return self.lod.full_mesh()
+        return self.lod.update(camera.position, frustum_planes(camera, size, margin=0.05))
+
+    def render_volumes(self, camera: Any, size: tuple[int, int], mesh: TerrainMesh | None, depth: np.ndarray,
+                       full: bool = False, stats: dict[str, float] | None = None) -> np.ndarray:
+        """The premultiplied RGBA overlay of every prism layer and the clouds, clipped at ``depth``."""
+        w, h = size
+        stats = {} if stats is None else stats
+        eye_z = float(camera.position[2])
+        items: list[tuple[float, str, Any]] = []
+        for fog in self.fogs:
+            items.append((abs(eye_z - fog.mid_height), "fog", fog))
+        if self.cloud_lod is not None:
+            b = self.cloud_lod.volume.bounds()
+            items.append((abs(eye_z - 0.5 * (b[4] + b[5])), "clouds", None))
+        items.sort(key=lambda it: -it[0])  # farthest layer first
+        overlay = np.zeros((h, w, 4))
+        stats.setdefault("fog_prisms", 0.0)
+        stats.setdefault("fog_s", 0.0)
+        for _, kind, fog in items:
+            t0 = time.perf_counter()
+            if kind == "fog" and mesh is not None:
+                bottom = mesh.points[:, 2] if fog.bottom == "terrain" else mesh.layers[fog.bottom]
+                rgba, drawn = render_layer(mesh.points, bottom, mesh.layers[fog.top], mesh.triangles, fog.layer, camera,
+                                           size, depth)
+                stats["fog_prisms"] += drawn
+                stats["fog_s"] += time.perf_counter() - t0
+            else:
+                assert self.cloud_lod is not None
+                frame = self.cloud_lod.update(camera, size, full=full)
+                rgba = render_cloud_image(frame, self.cloud_shading, self.cloud_table, camera, size, depth)
+                stats["cloud_tets"] = float(frame.n_tets)
+                stats["clouds_s"] = time.perf_counter() - t0
+            overlay = over(rgba, overlay)
+        return overlay
+
+    def render(self, camera: Any, size: tuple[int, int], full: bool = False) -> NatureFrame:
+        """A CPU frame; ``full`` uses the full-resolution terrain, prisms and cloud cells (the reference)."""
+        w, h = (int(v) for v in size)
+        stats: dict[str, float] = {}
+        t0 = time.perf_counter()
+        mesh = self.terrain_mesh(camera, (w, h), full)
+        if mesh is not None:
+            depth, rgb = render_terrain(mesh.points, mesh.triangles, mesh.tcoords, camera, (w, h), self._pyramid)
+            stats["terrain_triangles"] = float(mesh.n_triangles)
+        else:
+            depth, rgb = np.full((h, w), np.inf), np.zeros((h, w, 3), np.float32)
+        base = np.where(np.isfinite(depth)[..., None], rgb, render_sky(camera, (w, h), self.sky)).astype(np.float64)
+        stats["terrain_s"] = time.perf_counter() - t0
+        overlay = self.render_volumes(camera, (w, h), mesh, depth, full, stats)
+        final = overlay[..., :3] + (1.0 - overlay[..., 3:4]) * base
+        stats["total_s"] = time.perf_counter() - t0
+        return NatureFrame(np.clip(final, 0.0, 1.0), overlay, depth, stats, mesh)
+
+
+# --------------------------------------------------------------------------------------------------- scenes
+def demo_scene(seed: int = 0, terrain_size: int = 257, cloud_shape: tuple[int, int, int] = (129, 129, 17)
+               ) -> NatureScene:
+    """The built-in procedural scene: fractal terrain, Perlin ground fog, Perlin clouds, sky gradient (§10.4, §11.6).
+
+    1000 x 1000 units, relief 160; fog up to 25 units deep in the valleys; a cumulus layer from height 190 to 315.
+    """
+    from volviz.nature import noise
+
+    extent = 1000.0
+    h = noise.fractal_terrain(terrain_size, seed=seed + 1, relief=160.0)
+    hf = HeightField(h, (extent / (terrain_size - 1),) * 2)
+    scene = NatureScene(hf, None, None, big_c=9.0, small_c=40.0)
+    fog = noise.fog_map(h, level=55.0, thickness=25.0, seed=seed + 2)
+    scene.add_fog("ground_fog", fog, FogLayer(colour=(0.85, 0.87, 0.95), density=0.04, mode="attenuated"))
+    nx, ny, nz = cloud_shape
+    spacing = extent / (nx - 1)
+    f = noise.cloud_density(cloud_shape, seed=seed + 3, coverage=0.25)
+    g = noise.cloud_light(f, (spacing,) * 3)
+    scene.add_clouds(CloudVolume(f, g, (spacing, extent / (ny - 1), spacing), (0.0, 0.0, 190.0)),
+                     CloudShading.npr(rho_max=0.06))
+    return scene
+
+
+def demo_camera(scene: NatureScene | None = None) -> Any:
+    from volviz.unstructured.camera import Camera
+
+    return Camera((500.0, -350.0, 330.0), (500.0, 450.0, 80.0), (0.0, 0.0, 1.0), 60.0,
+                  clipping_range=(5.0, 10000.0))
+
+
+# ------------------------------------------------------------------------------------------- session components
+def _image_grid(image: Any) -> np.ndarray:
+    data = np.asarray(getattr(image, "data", image), dtype=np.float64)
+    return grid_from_image(data)
+
+
+def _setting_dataset(comp: Any, key: str, datasets: dict[str, Any]) -> Any:
+    ref = comp.settings.get(key)
+    if ref is None:
+        return None
+    if ref not in datasets:
+        raise ValueError(f"component {comp.id!r}: settings.{key} names dataset {ref!r}, which is not loaded")
+    return datasets[ref]
+
+
+def nature_dataset_ids(components: Sequence[Any]) -> set[str]:
+    """Every dataset id a list of nature components needs: their ``dataset`` and any ``settings.*_dataset``."""
+    ids: set[str] = set()
+    for comp in components:
+        if comp.dataset:
+            ids.add(comp.dataset)
+        for key, value in comp.settings.items():
+            if key.endswith("_dataset") and isinstance(value, str):
+                ids.add(value)
+    return ids
+
+
+def scene_from_components(components: Sequence[Any], datasets: dict[str, Any]) -> NatureScene:
+    """A ``NatureScene`` from session components of types terrain / fog / clouds / sky (in any order).
+
+    terrain: ``dataset`` = height map (PGM or DEM); settings ``extent`` [ex, ey] (default: the image's spacing),
+      ``height_scale`` (1), ``texture_dataset``, ``size`` (2^n + 1), ``C`` (12), ``c`` (60).
+    fog: ``dataset`` = thickness map; ``thickness_scale`` (1), ``base_dataset`` + ``base_scale`` + ``base_offset``
+      for a cloud layer between two height fields, ``mode`` (attenuated | emissive | mip), ``density``, ``colour``,
+      ``weight`` (curvature weight, 4).
+    clouds: ``dataset`` = a RegularVolume of densities, or generated: ``shape`` [nx, ny, nz], ``seed``,
+      ``coverage``; ``base_height``, ``thickness``, ``extent``; ``shading`` (npr | physical), ``rho_max``, ``C``, ``c``.
+    sky: ``dataset`` = the polar sky image (optional; default a gradient).
+    """
+    from volviz.nature import noise
+    from volviz.nature.sky import sky_texture
+
+    by_type: dict[str, list[Any]] = {}
+    for comp in components:
+        if getattr(comp, "visible", True):
+            by_type.setdefault(comp.type, []).append(comp)
+    terrain = None
+    texture = None
+    settings: dict[str, Any] = {}
+    if "terrain" in by_type:
+        comp = by_type["terrain"][0]
+        settings = comp.settings
+        if comp.dataset is None:
+            h = noise.fractal_terrain(int(settings.get("size", 257)), seed=int(settings.get("seed", 1)),
+                                      relief=float(settings.get("relief", 160.0)))
+            ext = settings.get("extent", [1000.0, 1000.0])
+            terrain = HeightField(h, (ext[0] / (h.shape[0] - 1), ext[1] / (h.shape[1] - 1)))
+        else:
+            image = datasets[comp.dataset]
+            extent = settings.get("extent")
+            terrain = HeightField.from_image(image, tuple(extent) if extent else None,
+                                             float(settings.get("height_scale", 1.0)), settings.get("size"))
+        tex = _setting_dataset(comp, "texture_dataset", datasets)
+        if tex is not None:
+            texture = np.asarray(tex.data, dtype=np.float32) / float(getattr(tex, "maxval", None) or 255)
+    sky = None
+    if "sky" in by_type and by_type["sky"][0].dataset:
+        sky = sky_texture(datasets[by_type["sky"][0].dataset])
+    scene = NatureScene(terrain, texture, sky, big_c=float(settings.get("C", 12.0)),
+                        small_c=float(settings.get("c", 60.0)))
+    for comp in by_type.get("fog", []):
+        st = comp.settings
+        if terrain is None:
+            raise ValueError(f"component {comp.id!r}: a fog layer needs a terrain component")
+        if comp.dataset is None:
+            thick = noise.fog_map(terrain.heights, float(st.get("level", 50.0)), float(st.get("thickness", 25.0)),
+                                  seed=int(st.get("seed", 2)))
+        else:
+            thick = _image_grid(datasets[comp.dataset]) * float(st.get("thickness_scale", 1.0))
+        base_img = _setting_dataset(comp, "base_dataset", datasets)
+        base = None
+        if base_img is not None:
+            base = _image_grid(base_img) * float(st.get("base_scale", 1.0)) + float(st.get("base_offset", 0.0))
+        layer = FogLayer(colour=tuple(st.get("colour", (0.75, 0.75, 1.0))), density=float(st.get("density", 0.05)),
+                         mode=str(st.get("mode", "attenuated")), mip_gain=float(st.get("mip_gain", 0.05)))
+        scene.add_fog(comp.id, thick, layer, base, float(st.get("weight", 4.0)))
+    for comp in by_type.get("clouds", [])[:1]:
+        st = comp.settings
+        if comp.dataset is not None:
+            vol = datasets[comp.dataset]
+            dens = np.asarray(vol.data, dtype=np.float64)
+            dens = (dens - dens.min()) / max(float(np.ptp(dens)), 1e-12)
+        else:
+            shape = tuple(int(v) for v in st.get("shape", (129, 129, 17)))
+            dens = noise.cloud_density(shape, seed=int(st.get("seed", 3)), coverage=float(st.get("coverage", 0.25)))
+        if terrain is not None:
+            ext_default = list(terrain.extent)
+        else:
+            ext_default = [1000.0, 1000.0]
+        ext = st.get("extent", ext_default)
+        thickness = float(st.get("thickness", ext[0] * (dens.shape[2] - 1) / (dens.shape[0] - 1)))
+        origin = (terrain.origin[0] if terrain else 0.0, terrain.origin[1] if terrain else 0.0,
+                  float(st.get("base_height", 190.0)))
+        spacing = (ext[0] / (dens.shape[0] - 1), ext[1] / (dens.shape[1] - 1), thickness / (dens.shape[2] - 1))
+        light = noise.cloud_light(np.ascontiguousarray(dens, dtype=np.float32), spacing)
+        try:
+            volume = CloudVolume(dens, light, spacing, origin)
+        except ValueError:  # sizes without a common power-of-two cell count: resample (§11.3.1)
+            volume = CloudVolume.fit(dens, light, (ext[0], ext[1], thickness), origin)
+        shading_name = st.get("shading", "npr")
+        rho = float(st.get("rho_max", 0.06))
+        shading = CloudShading.physical(rho) if shading_name == "physical" else CloudShading.npr(rho)
+        scene.add_clouds(volume, shading, float(st.get("C", 3.0)), float(st.get("c", 4.0)))
+    scene.finalize()
+    return scene
+
+
+# --------------------------------------------------------------------------------------------------- PyVista
+class NatureView:
+    """A ``NatureScene`` inside a PyVista plotter: terrain mesh, sky dome and the volume overlay (see module doc)."""
+
+    def __init__(self, plotter: Any, scene: NatureScene, size: tuple[int, int] | None = None) -> None:
+        import pyvista as pv
+
+        from volviz.nature.sky import sky_dome_mesh
+
+        self.plotter = plotter
+        self.scene = scene
+        scene.finalize()
+        self.size = size
+        self.terrain_actor = None
+        self.sky_actor = None
+        self._overlay_actor = None
+        self._overlay_image = None
+        self._mesh = None
+        self.last_stats: dict[str, float] = {}
+        if scene.terrain is not None and scene.colour_map is not None:
+            img = np.clip(scene.colour_map.transpose(1, 0, 2)[::-1] * 255.0, 0, 255).astype(np.uint8)
+            self._texture = pv.Texture(np.ascontiguousarray(img))
+            b = scene.terrain.bounds()
+            centre = (0.5 * (b[0] + b[1]), 0.5 * (b[2] + b[3]), b[4])
+            radius = 3.0 * max(b[1] - b[0], b[3] - b[2])
+        else:
+            self._texture = None
+            centre, radius = (0.0, 0.0, 0.0), 3000.0
+        dome = sky_dome_mesh(radius, centre)
+        if scene.sky is not None:
+            sky_img = np.clip(scene.sky * 255.0, 0, 255).astype(np.uint8)
+            self.sky_actor = plotter.add_mesh(dome, texture=pv.Texture(sky_img), lighting=False, name="nature-sky")
+        else:
+            zen, hor = np.array([0.32, 0.5, 0.85]), np.array([0.78, 0.85, 0.95])
+            t = np.sqrt(np.asarray(dome.active_texture_coordinates)[:, 1])[:, None]
+            dome.point_data["sky"] = ((hor + (zen - hor) * t) * 255).astype(np.uint8)
+            self.sky_actor = plotter.add_mesh(dome, scalars="sky", rgb=True, lighting=False, name="nature-sky")
+
+    def _camera(self) -> Any:
+        from volviz.unstructured.camera import Camera
+
+        return Camera.from_pyvista(self.plotter.camera)
+
+    def update(self, camera: Any = None) -> dict[str, float]:
+        """Re-triangulate the terrain and re-render the overlay for ``camera`` (default: the plotter's camera)."""
+        import pyvista as pv
+
+        cam = camera or self._camera()
+        if camera is not None:
+            camera.apply_to(self.plotter.camera)
+        size = self.size or tuple(int(v) for v in self.plotter.window_size)
+        w, h = size
+        mesh = self.scene.terrain_mesh(cam, size)
+        stats: dict[str, float] = {}
+        depth = np.full((h, w), np.inf)
+        if mesh is not None:
+            poly = mesh.to_pyvista()
+            if self.terrain_actor is None:
+                self.terrain_actor = self.plotter.add_mesh(poly, texture=self._texture, lighting=False,
+                                                           name="nature-terrain")
+            else:
+                self.terrain_actor.mapper.SetInputData(poly)
+            self._mesh = poly
+            depth, _ = render_terrain(mesh.points, mesh.triangles, mesh.tcoords, cam, size, self.scene._pyramid)
+            stats["terrain_triangles"] = float(mesh.n_triangles)
+        overlay = self.scene.render_volumes(cam, size, mesh, depth, stats=stats)
+        self._set_overlay(overlay)
+        self.last_stats = stats
+        return stats
+
+    def _set_overlay(self, overlay: np.ndarray) -> None:
+        """Show a premultiplied RGBA image in front of the scene with straight-alpha blending. Pure emission (α = 0,
+        colour > 0) is shown with α' = max(α, max colour): C + (1 − α') B instead of C + B (error ≤ α' B)."""
+        import vtk
+        from vtk.util.numpy_support import numpy_to_vtk
+
+        h, w = overlay.shape[:2]
+        alpha = np.maximum(overlay[..., 3], overlay[..., :3].max(axis=-1))
+        alpha = np.clip(alpha, 0.0, 1.0)
+        safe = np.where(alpha > 1e-6, alpha, 1.0)
+        straight = np.clip(overlay[..., :3] / safe[..., None], 0.0, 1.0)
+        rgba = np.concatenate([straight, alpha[..., None]], axis=-1)[::-1]  # VTK rows start at the bottom
+        data = np.ascontiguousarray((rgba * 255.0 + 0.5).astype(np.uint8).reshape(-1, 4))
+        if self._overlay_image is None:
+            self._overlay_image = vtk.vtkImageData()
+            mapper = vtk.vtkImageMapper()
+            mapper.SetInputData(self._overlay_image)
+            mapper.SetColorWindow(255.0)
+            mapper.SetColorLevel(127.5)
+            actor = vtk.vtkActor2D()
+            actor.SetMapper(mapper)
+            self.plotter.renderer.AddActor2D(actor)
+            self._overlay_actor = actor
+        img = self._overlay_image
+        img.SetDimensions(w, h, 1)
+        arr = numpy_to_vtk(data, deep=True)
+        arr.SetNumberOfComponents(4)
+        img.GetPointData().SetScalars(arr)
+        img.Modified()
+
+
+def build_nature_components(plotter: Any, components: Sequence[Any], datasets: dict[str, Any], camera: Any = None,
+                            size: tuple[int, int] | None = None) -> NatureView:
+    """Add the session's terrain / fog / clouds / sky components to ``plotter`` and render the first overlay for
+    ``camera`` (a ``volviz.unstructured.camera.Camera``, a ``volviz.session.CameraState`` or None for the
+    plotter's). Call ``view.update()`` again after the camera moves."""
+    scene = scene_from_components(components, datasets)
+    view = NatureView(plotter, scene, size)
+    cam = _as_camera(camera, scene) if camera is not None else None
+    view.update(cam)
+    return view
+
+
+def _as_camera(camera: Any, scene: NatureScene) -> Any:
+    from volviz.unstructured.camera import Camera
+
+    if isinstance(camera, Camera):
+        return camera
+    near, far = 5.0, 20000.0
+    if scene.terrain is not None:
+        ex = max(scene.terrain.extent)
+        near, far = max(ex * 1e-3, 0.1), ex * 20.0
+    return Camera(camera.position, camera.focal_point, camera.view_up, camera.view_angle,
+                  clipping_range=(near, far))
