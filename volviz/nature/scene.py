@@ -206,7 +206,7 @@ def demo_scene(seed: int = 0, terrain_size: int = 257, cloud_shape: tuple[int, i
 def demo_camera(scene: NatureScene | None = None) -> Any:
     from volviz.unstructured.camera import Camera
 
-    return Camera((500.0, -350.0, 330.0), (500.0, 450.0, 80.0), (0.0, 0.0, 1.0), 60.0,
+    return Camera((500.0, -150.0, 330.0), (500.0, 600.0, 80.0), (0.0, 0.0, 1.0), 60.0,
                   clipping_range=(5.0, 10000.0))
 
 
@@ -241,6 +241,7 @@ def scene_from_components(components: Sequence[Any], datasets: dict[str, Any]) -
     """A ``NatureScene`` from session components of types terrain / fog / clouds / sky (in any order).
 
     terrain: ``dataset`` = height map (PGM or DEM); settings ``extent`` [ex, ey] (default: the image's spacing),
+      ``origin`` [x0, y0] (default: the image's),
       ``height_scale`` (1), ``texture_dataset``, ``size`` (2^n + 1), ``C`` (12), ``c`` (60).
     fog: ``dataset`` = thickness map; ``thickness_scale`` (1), ``base_dataset`` + ``base_scale`` + ``base_offset``
       for a cloud layer between two height fields, ``mode`` (attenuated | emissive | mip), ``density``, ``colour``,
@@ -272,6 +273,8 @@ def scene_from_components(components: Sequence[Any], datasets: dict[str, Any]) -
             extent = settings.get("extent")
             terrain = HeightField.from_image(image, tuple(extent) if extent else None,
                                              float(settings.get("height_scale", 1.0)), settings.get("size"))
+            if "origin" in settings:  # e.g. UTM coordinates of a DEM moved to the origin
+                terrain = HeightField(terrain.heights, terrain.spacing, tuple(settings["origin"]), terrain.source)
         tex = _setting_dataset(comp, "texture_dataset", datasets)
         if tex is not None:
             texture = np.asarray(tex.data, dtype=np.float32) / float(getattr(tex, "maxval", None) or 255)
@@ -350,20 +353,20 @@ class NatureView:
             img = np.clip(scene.colour_map.transpose(1, 0, 2)[::-1] * 255.0, 0, 255).astype(np.uint8)
             self._texture = pv.Texture(np.ascontiguousarray(img))
             b = scene.terrain.bounds()
-            centre = (0.5 * (b[0] + b[1]), 0.5 * (b[2] + b[3]), b[4])
             radius = 3.0 * max(b[1] - b[0], b[3] - b[2])
         else:
             self._texture = None
-            centre, radius = (0.0, 0.0, 0.0), 3000.0
-        dome = sky_dome_mesh(radius, centre)
+            radius = 3000.0
+        dome = sky_dome_mesh(radius, (0.0, 0.0, 0.0))  # moved to the eye by ``update``: the sky is at infinity
         if scene.sky is not None:
             sky_img = np.clip(scene.sky * 255.0, 0, 255).astype(np.uint8)
             self.sky_actor = plotter.add_mesh(dome, texture=pv.Texture(sky_img), lighting=False, name="nature-sky")
-        else:
+        else:  # the CPU gradient of ``render_sky`` as a polar texture (rows: zenith at the top, horizon at the bottom)
             zen, hor = np.array([0.32, 0.5, 0.85]), np.array([0.78, 0.85, 0.95])
-            t = np.sqrt(np.asarray(dome.active_texture_coordinates)[:, 1])[:, None]
-            dome.point_data["sky"] = ((hor + (zen - hor) * t) * 255).astype(np.uint8)
-            self.sky_actor = plotter.add_mesh(dome, scalars="sky", rgb=True, lighting=False, name="nature-sky")
+            t = np.sqrt(np.linspace(1.0, 0.0, 256))[:, None, None]
+            grad = np.broadcast_to(hor + (zen - hor) * t, (256, 4, 3))
+            sky_img = np.ascontiguousarray(np.clip(grad * 255.0 + 0.5, 0, 255).astype(np.uint8))
+            self.sky_actor = plotter.add_mesh(dome, texture=pv.Texture(sky_img), lighting=False, name="nature-sky")
 
     def _camera(self) -> Any:
         from volviz.unstructured.camera import Camera
@@ -379,6 +382,8 @@ class NatureView:
             camera.apply_to(self.plotter.camera)
         size = self.size or tuple(int(v) for v in self.plotter.window_size)
         w, h = size
+        if self.sky_actor is not None:
+            self.sky_actor.SetPosition(*np.asarray(cam.position, dtype=np.float64))
         mesh = self.scene.terrain_mesh(cam, size)
         stats: dict[str, float] = {}
         depth = np.full((h, w), np.inf)
@@ -418,7 +423,7 @@ class NatureView:
             mapper.SetColorLevel(127.5)
             actor = vtk.vtkActor2D()
             actor.SetMapper(mapper)
-            self.plotter.renderer.AddActor2D(actor)
+            self.plotter.add_actor(actor, name="nature-overlay", reset_camera=False)
             self._overlay_actor = actor
         img = self._overlay_image
         img.SetDimensions(w, h, 1)

@@ -1,0 +1,99 @@
+"""Natural scenes: the demo scene, session files for Yukon and St. Helens, the sky dome, and the PyVista view."""
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from conftest import REPO, data_file, data_root
+from volviz.nature.scene import NatureView, demo_camera, demo_scene, nature_dataset_ids, scene_from_components
+from volviz.nature.sky import sky_dome_mesh
+from volviz.unstructured.camera import Camera
+
+SESSIONS = REPO / "resources" / "sessions"
+
+
+@pytest.fixture(scope="module")
+def demo():
+    return demo_scene(terrain_size=129, cloud_shape=(65, 65, 9))
+
+
+def test_demo_scene_frame(demo) -> None:
+    cam = demo_camera()
+    frame = demo.render(cam, (96, 72))
+    s = frame.stats
+    assert s["terrain_triangles"] > 100 and s["fog_prisms"] > 0 and s["cloud_tets"] > 0
+    assert np.all(np.isfinite(frame.rgb)) and frame.rgb.min() >= 0 and frame.rgb.max() <= 1
+    assert np.all(np.isinf(frame.depth[:5]))       # sky at the top of the image
+    assert np.all(np.isfinite(frame.depth[-5:]))   # terrain at the bottom
+    assert frame.overlay[..., 3].max() > 0.3       # fog and clouds are visible
+    full = demo.render(cam, (96, 72), full=True)
+    assert full.stats["terrain_triangles"] == 2 * 128 * 128
+    assert full.stats["cloud_tets"] > s["cloud_tets"]
+
+
+def test_sky_dome_mesh() -> None:
+    dome = sky_dome_mesh(100.0, (1.0, 2.0, 3.0), n_azimuth=16, n_elevation=4)
+    tc = np.asarray(dome.active_texture_coordinates)
+    pts = np.asarray(dome.points)
+    zenith = np.argmax(pts[:, 2])
+    assert tc[zenith, 1] == pytest.approx(1.0) and pts[zenith, 2] == pytest.approx(103.0)
+    assert tc[:, 0].min() == 0.0 and tc[:, 0].max() == 1.0
+    assert np.allclose(np.linalg.norm(pts - (1, 2, 3), axis=1), 100.0)
+    with pytest.raises(ValueError, match="radius"):
+        sky_dome_mesh(0.0)
+
+
+def test_pyvista_view_matches_the_cpu_frame(demo) -> None:
+    """The VTK side (textured terrain mesh, sky dome, RGBA overlay) shows what the CPU frame shows."""
+    import pyvista as pv
+
+    size = (128, 96)
+    cam = demo_camera()
+    plotter = pv.Plotter(off_screen=True, window_size=size)
+    try:
+        view = NatureView(plotter, demo, size=size)
+        stats = view.update(cam)
+        assert stats["terrain_triangles"] > 100
+        shot = plotter.screenshot(return_img=True)[..., :3] / 255.0
+    finally:
+        plotter.close()
+    cpu = demo.render(cam, size).rgb
+    assert shot.shape == cpu.shape
+    rmse = float(np.sqrt(np.mean((shot - cpu) ** 2)) * 255)
+    assert rmse < 14.0
+    # the sky texture mapping: top rows (sky) agree closely
+    assert float(np.abs(shot[:8] - cpu[:8]).mean()) * 255 < 6.0
+
+
+@pytest.mark.parametrize("name", ["yukon", "sainthelens"])
+def test_session_files(name: str, monkeypatch) -> None:
+    from volviz import session
+    from volviz.io import read
+
+    path = SESSIONS / f"{name}.json"
+    sess = session.load(path)
+    types = {c.type for c in sess.components}
+    assert {"terrain", "fog", "sky"} <= types
+    assert name != "sainthelens" or "clouds" in types
+    assert all(ref.path.startswith("$VOLVIZ_DATA/") for ref in sess.datasets)
+    assert len(sess.camera_paths["flythrough"]) >= 3
+    data_file("yukon/Yukon.map.pgm" if name == "yukon" else "terrain/SainteHelens.dem")
+    monkeypatch.setenv("VOLVIZ_DATA", str(data_root()))
+    ids = nature_dataset_ids(sess.components)
+    datasets = {r.id: read(session.resolve_path(path, r.path)) for r in sess.datasets if r.id in ids}
+    scene = scene_from_components(sess.components, datasets)
+    assert scene.terrain is not None and len(scene.fogs) >= 1
+    cam_state = sess.camera_paths["flythrough"][0].camera
+    ext = max(scene.terrain.extent)
+    cam = Camera(cam_state.position, cam_state.focal_point, cam_state.view_up, cam_state.view_angle,
+                 clipping_range=(ext * 1e-3, ext * 20))
+    frame = scene.render(cam, (64, 48))
+    assert np.all(np.isfinite(frame.rgb))
+    assert np.isfinite(frame.depth).mean() > 0.2     # the terrain is in view
+    assert frame.overlay[..., 3].max() > 0.2          # and so are its fog / cloud layers
+    if name == "yukon":
+        assert scene.texture is not None and scene.sky is not None
+        assert len(scene.fogs) == 2  # ground fog + the cloud layer between two height fields
