@@ -113,6 +113,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--terrain-lod", default="9,30", help="terrain C,c (default 9,30)")
     ap.add_argument("--cloud-lod", default="3,4", help="cloud C,c (default 3,4)")
     ap.add_argument("--popping-frames", type=int, default=6, help="frames of the dense popping sub-path (0: skip)")
+    ap.add_argument("--popping-step", type=float, default=0.25, help="camera step of that sub-path in world units")
+    ap.add_argument("--sweep", default="2,2;3,4;4,8;6,16;6,64",
+                    help="cloud C,c settings for the tetrahedra-vs-error sweep on frames 0 and 3 ('' to skip)")
     ap.add_argument("--data", type=Path, default=DEFAULT_DATA)
     ap.add_argument("--json", type=Path, default=None, help="write the results as JSON")
     ap.add_argument("--out", type=Path, default=REPO / "docs" / "bench" / "nature.md")
@@ -152,7 +155,9 @@ def main(argv: list[str] | None = None) -> int:
               f"{row['clouds_s']:.3f}), RMSE {row['rmse']:.2f}, reference {ref_s:.1f} s", flush=True)
     popping = {}
     if args.popping_frames > 1:
-        dense = path_cameras(args.popping_frames, 0.55, 0.58)
+        length = sum(float(np.linalg.norm(np.subtract(KEYS[i + 1][0], KEYS[i][0]))) for i in range(len(KEYS) - 1))
+        span = args.popping_step * (args.popping_frames - 1) / length
+        dense = path_cameras(args.popping_frames, 0.55, 0.55 + span)
         refs = [scene.render(c, size, full=True).rgb for c in dense]
         for morph in (True, False):
             scene.lod.geomorph = morph
@@ -165,6 +170,26 @@ def main(argv: list[str] | None = None) -> int:
         scene.cloud_lod.geomorph = True
         step_len = float(np.linalg.norm(dense[1].position - dense[0].position))
         popping["step_units"] = step_len
+    sweep = []
+    if args.sweep:
+        from volviz.nature.clouds import render_cloud_image
+
+        lod = scene.cloud_lod
+        saved = (lod.big_c, lod.small_c)
+        for fi in sorted({0, min(3, len(cams) - 1)}):
+            cam = cams[fi]
+            full = render_cloud_image(lod.update(cam, size, full=True), scene.cloud_shading, scene.cloud_table, cam,
+                                      size)
+            for item in args.sweep.split(";"):
+                lod.big_c, lod.small_c = (float(v) for v in item.split(","))
+                t0 = time.perf_counter()
+                frame = lod.update(cam, size)
+                img = render_cloud_image(frame, scene.cloud_shading, scene.cloud_table, cam, size)
+                sweep.append({"frame": fi, "C": lod.big_c, "c": lod.small_c, "tets": frame.n_tets,
+                              "clouds_s": time.perf_counter() - t0, "cloud_rmse": rmse(img, full)})
+                print(f"sweep frame {fi} C={lod.big_c} c={lod.small_c}: {frame.n_tets} tets, "
+                      f"RMSE {sweep[-1]['cloud_rmse']:.2f}", flush=True)
+        lod.big_c, lod.small_c = saved
     summary = {
         "mean_cloud_tets": float(np.mean([r["cloud_tets"] for r in rows])),
         "full_resolution_tets": int(vol.n_tets_full),
@@ -177,7 +202,8 @@ def main(argv: list[str] | None = None) -> int:
     }
     command = "volviz bench nature " + " ".join(shlex.quote(a) for a in (argv if argv is not None else sys.argv[1:]))
     result = {"command": command, "source": source, "size": list(size), "cloud_shape": list(cloud_shape),
-              "terrain_lod": list(tc), "cloud_lod": list(cc), "frames": rows, "summary": summary, "popping": popping}
+              "terrain_lod": list(tc), "cloud_lod": list(cc), "frames": rows, "summary": summary, "popping": popping,
+              "sweep": sweep}
     if args.json:
         args.json.write_text(json.dumps(result, indent=2))
     _write_report(args.out, result, images)
@@ -247,6 +273,18 @@ def _write_report(out: Path, result: dict[str, Any], images: list[tuple[np.ndarr
             f"{pop['geomorph']['max_step_rmse']:.2f} / {pop['geomorph']['max_step_abs']:.0f}, off "
             f"{pop['no_geomorph']['max_step_rmse']:.2f} / {pop['no_geomorph']['max_step_abs']:.0f}.",
         ]
+    if result.get("sweep"):
+        lines += [
+            "",
+            "Cloud tetrahedra against cloud error (the overlay alone, premultiplied RGBA, against the full-resolution "
+            "cloud overlay of the same frame; time = LOD update + rendering):",
+            "",
+            "| frame | C | c | cloud tets | clouds s | cloud RMSE |",
+            "|---|---|---|---|---|---|",
+        ]
+        for r in result["sweep"]:
+            lines.append(f"| {r['frame']} | {r['C']:g} | {r['c']:g} | {r['tets']:,} | {r['clouds_s']:.3f} | "
+                         f"{r['cloud_rmse']:.2f} |")
     lines += ["", f"![frames]({png.name})", ""]
     out.write_text("\n".join(lines))
 

@@ -476,24 +476,65 @@ def _leaf_setup(leaves, nleaf, root, vp, w, h, origin, spacing, boxes):
         boxes[t, 3] = min(int(math.ceil(y1)), h - 1)
 
 
+# odd corners of the even-parity corner tetrahedra (regions 0..3) and their plane normals n (g = c + n . u)
+_QC = np.array([[1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 1, 1]], dtype=np.int64)
+
+
+@njit(cache=True, nogil=True)
+def _leaf_linear(cv, alpha, beta):
+    """Per region (0..3 corner tets, 4 central) the linear interpolant S = alpha + beta . u of corner values cv."""
+    for r in range(4):
+        qi, qj, qk = _QC[r, 0], _QC[r, 1], _QC[r, 2]
+        vq = cv[_corner(qi, qj, qk)]
+        alpha[r] = vq
+        for ax in range(3):
+            if ax == 0:
+                dv = cv[_corner(1 - qi, qj, qk)] - vq
+                q = qi
+            elif ax == 1:
+                dv = cv[_corner(qi, 1 - qj, qk)] - vq
+                q = qj
+            else:
+                dv = cv[_corner(qi, qj, 1 - qk)] - vq
+                q = qk
+            if q == 0:
+                beta[r, ax] = dv
+            else:
+                alpha[r] += dv
+                beta[r, ax] = -dv
+    s0, s110, s101, s011 = cv[0], cv[6], cv[5], cv[3]
+    alpha[4] = s0
+    beta[4, 0] = 0.5 * (s110 + s101 - s011 - s0)
+    beta[4, 1] = 0.5 * (s110 + s011 - s101 - s0)
+    beta[4, 2] = 0.5 * (s101 + s011 - s110 - s0)
+
+
 @njit(cache=True, nogil=True)
 def _render_band(leaves, nleaf, boxes, root, origin, spacing, va, vm, m_scale, a_cut, table, s_lo, ds, dl, eye,
                  dirs, invd, dnorm, depth, near, row0, row1, img, trans):
     """Leaves front to back (the reverse of the back-to-front list) composited *under* the pixel with early ray
-    termination (transmittance < 1/1024); equivalent to back-to-front "over" up to that cut-off."""
+    termination (transmittance < 1/1024); equivalent to back-to-front "over" up to that cut-off.
+
+    Per leaf the 5 linear pieces are precomputed as functions of the ray parameter's offset (alpha + beta . uo), so
+    per pixel only dot products with the local direction remain (the arithmetic of ``cube_segments``)."""
     p0 = np.empty(3)
     e = np.empty(3)
     ca = np.empty(8)
     cm = np.empty(8)
-    ts = np.empty(4)
-    sa = np.empty((3, 2))
-    sm = np.empty((3, 2))
     seg = np.empty(4)
     uo = np.empty(3)
     ud = np.empty(3)
     cuts = np.empty(6)
     lo = np.empty(3)
     hi = np.empty(3)
+    al_a = np.empty(5)
+    be_a = np.empty((5, 3))
+    al_m = np.empty(5)
+    be_m = np.empty((5, 3))
+    a0 = np.empty(5)
+    m0 = np.empty(5)
+    g0 = np.empty(4)
+    g1 = np.empty(4)
     for t in range(nleaf - 1, -1, -1):
         y_lo = max(boxes[t, 2], row0)
         y_hi = min(boxes[t, 3], row1 - 1)
@@ -508,6 +549,8 @@ def _render_band(leaves, nleaf, boxes, root, origin, spacing, va, vm, m_scale, a
             gx, gy, gz = (a + src) * s, (b + j) * s, (c + k) * s
             ca[q] = va[gx, gy, gz]
             cm[q] = vm[gx, gy, gz] * m_scale
+        _leaf_linear(ca, al_a, be_a)
+        _leaf_linear(cm, al_m, be_m)
         for ax in range(3):
             e[ax] = s * spacing[ax]
         p0[0] = origin[0] + a * e[0]
@@ -519,6 +562,15 @@ def _render_band(leaves, nleaf, boxes, root, origin, spacing, va, vm, m_scale, a
             uo[ax] = (eye[ax] - p0[ax]) / e[ax]
         if flip:
             uo[0] = 1.0 - uo[0]
+        for r in range(5):
+            a0[r] = al_a[r] + be_a[r, 0] * uo[0] + be_a[r, 1] * uo[1] + be_a[r, 2] * uo[2]
+            m0[r] = al_m[r] + be_m[r, 0] * uo[0] + be_m[r, 1] * uo[1] + be_m[r, 2] * uo[2]
+        for r in range(4):
+            g = 0.0
+            for ax in range(3):
+                g += (1.0 - uo[ax]) if _QC[r, ax] == 1 else uo[ax]
+            g0[r] = g
+        inv_e0, inv_e1, inv_e2 = 1.0 / e[0], 1.0 / e[1], 1.0 / e[2]
         for row in range(y_lo, y_hi + 1):
             for col in range(boxes[t, 0], boxes[t, 1] + 1):
                 if trans[row, col] < 1.0 / 1024.0:
@@ -536,19 +588,54 @@ def _render_band(leaves, nleaf, boxes, root, origin, spacing, va, vm, m_scale, a
                         t1 = tb
                 if t1 <= t0:
                     continue
-                for ax in range(3):
-                    ud[ax] = dirs[row, col, ax] / e[ax]
+                ud[0] = dirs[row, col, 0] * inv_e0
+                ud[1] = dirs[row, col, 1] * inv_e1
+                ud[2] = dirs[row, col, 2] * inv_e2
                 if flip:
                     ud[0] = -ud[0]
-                npc = _pieces(uo, ud, t0, t1, ca, cm, ts, sa, sm, cuts)
+                nc = 0
+                cuts[nc] = t0
+                nc += 1
+                for r in range(4):
+                    gg = 0.0
+                    for ax in range(3):
+                        gg += -ud[ax] if _QC[r, ax] == 1 else ud[ax]
+                    g1[r] = gg
+                    if gg != 0.0:
+                        tc = (1.0 - g0[r]) / gg
+                        if t0 < tc < t1:
+                            cuts[nc] = tc
+                            nc += 1
+                cuts[nc] = t1
+                nc += 1
+                for i in range(1, nc):
+                    v = cuts[i]
+                    j = i - 1
+                    while j >= 0 and cuts[j] > v:
+                        cuts[j + 1] = cuts[j]
+                        j -= 1
+                    cuts[j + 1] = v
                 dn = dnorm[row, col]
-                for k in range(npc):
-                    if sa[k, 0] <= a_cut and sa[k, 1] <= a_cut:
+                for i in range(nc - 1):
+                    ta, tb = cuts[i], cuts[i + 1]
+                    if tb <= ta:
                         continue
-                    length = (ts[k + 1] - ts[k]) * dn * 0.5 * (sm[k, 0] + sm[k, 1])
+                    tm = 0.5 * (ta + tb)
+                    region = 4
+                    for r in range(4):
+                        if g0[r] + g1[r] * tm < 1.0:
+                            region = r
+                            break
+                    ba = be_a[region, 0] * ud[0] + be_a[region, 1] * ud[1] + be_a[region, 2] * ud[2]
+                    sf = a0[region] + ba * ta
+                    sb = a0[region] + ba * tb
+                    if sf <= a_cut and sb <= a_cut:
+                        continue
+                    bm = be_m[region, 0] * ud[0] + be_m[region, 1] * ud[1] + be_m[region, 2] * ud[2]
+                    length = (tb - ta) * dn * (m0[region] + bm * tm)
                     if length <= 0.0:
                         continue
-                    _lookup(table, s_lo, ds, dl, sa[k, 0], sa[k, 1], length, seg)
+                    _lookup(table, s_lo, ds, dl, sf, sb, length, seg)
                     tr = trans[row, col]
                     for ch in range(4):
                         img[row, col, ch] += tr * seg[ch]

@@ -90,7 +90,7 @@ def _raster_poly(px, py, iz, au, av, nvert, w, h, row0, row1, depth, uvbuf):
 
 
 @njit(cache=True, nogil=True)
-def _raster_band(vp, cam, tris, tc, w, h, row0, row1, depth, uvbuf):
+def _raster_band(vp, cam, sy, tris, tc, w, h, row0, row1, depth, uvbuf):
     near = vp[14]
     cx = np.empty(8)
     cy = np.empty(8)
@@ -103,6 +103,11 @@ def _raster_band(vp, cam, tris, tc, w, h, row0, row1, depth, uvbuf):
     au = np.empty(8)
     av = np.empty(8)
     for t in range(tris.shape[0]):
+        i0, i1, i2 = tris[t, 0], tris[t, 1], tris[t, 2]
+        if cam[i0, 2] >= near and cam[i1, 2] >= near and cam[i2, 2] >= near:
+            # fast reject by the precomputed screen rows when no clipping is needed
+            if max(sy[i0], sy[i1], sy[i2]) < row0 - 1 or min(sy[i0], sy[i1], sy[i2]) > row1:
+                continue
         # near-plane clipping of the triangle (camera space)
         nv = 0
         for e in range(3):
@@ -140,8 +145,11 @@ def _raster_band(vp, cam, tris, tc, w, h, row0, row1, depth, uvbuf):
 @njit(cache=True, nogil=True, parallel=True)
 def _raster(vp, cam, tris, tc, w, h, bands, depth, uvbuf):
     nb = bands.shape[0] - 1
+    sy = np.empty(cam.shape[0])
+    for i in prange(cam.shape[0]):
+        sy[i] = (1.0 - cam[i, 1] / cam[i, 2] / vp[13]) * h * 0.5 - 0.5 if cam[i, 2] > 0 else 0.0
     for b in prange(nb):
-        _raster_band(vp, cam, tris, tc, w, h, bands[b], bands[b + 1], depth, uvbuf)
+        _raster_band(vp, cam, sy, tris, tc, w, h, bands[b], bands[b + 1], depth, uvbuf)
 
 
 def mip_pyramid(image: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
