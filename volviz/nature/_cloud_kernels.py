@@ -15,6 +15,8 @@ import math
 import numpy as np
 from numba import njit, prange
 
+from volviz.nature.raster import CUBE_EDGES, clipped_screen_box
+
 
 @njit(cache=True, nogil=True, inline="always")
 def _corner(i: int, j: int, k: int) -> int:
@@ -363,6 +365,18 @@ def _l1(region, u0, u1, u2):
     return (1 - u0) + (1 - u1) + (1 - u2)
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _sort_small(v, n):
+    """Insertion sort of v[0:n] (n <= 6)."""
+    for i in range(1, n):
+        x = v[i]
+        j = i - 1
+        while j >= 0 and v[j] > x:
+            v[j + 1] = v[j]
+            j -= 1
+        v[j + 1] = x
+
+
 @njit(cache=True, nogil=True)
 def _pieces(uo, ud, t0, t1, ca, cm, ts, sa, sm, cuts):
     """Split [t0, t1] (inside the unit cube in local coordinates uo + t ud, even parity) at the 4 corner-tet planes
@@ -378,13 +392,7 @@ def _pieces(uo, ud, t0, t1, ca, cm, ts, sa, sm, cuts):
             nc += 1
     cuts[nc] = t1
     nc += 1
-    for i in range(1, nc):
-        v = cuts[i]
-        j = i - 1
-        while j >= 0 and cuts[j] > v:
-            cuts[j + 1] = cuts[j]
-            j -= 1
-        cuts[j + 1] = v
+    _sort_small(cuts, nc)
     n = 0
     for i in range(nc - 1):
         ta, tb = cuts[i], cuts[i + 1]
@@ -440,8 +448,8 @@ def cube_segments(o, d, p0, e, flip, t_lo, t_hi, ca, cm, ts, sa, sm, uo, ud, cut
 @njit(cache=True, nogil=True)
 def _leaf_setup(leaves, nleaf, root, vp, w, h, origin, spacing, boxes):
     """Screen box of every leaf cube, clipped to the near plane (corners in front + edge/near-plane crossings)."""
-    near = vp[14]
     cam = np.empty((8, 3))
+    box = np.empty(4, dtype=np.int64)
     for t in range(nleaf):
         lv, a, b, c = leaves[t, 0], leaves[t, 1], leaves[t, 2], leaves[t, 3]
         s = root >> lv
@@ -452,28 +460,11 @@ def _leaf_setup(leaves, nleaf, root, vp, w, h, origin, spacing, boxes):
             cam[q, 0] = px * vp[3] + py * vp[4] + pz * vp[5]
             cam[q, 1] = px * vp[6] + py * vp[7] + pz * vp[8]
             cam[q, 2] = px * vp[9] + py * vp[10] + pz * vp[11]
-        x0, x1, y0, y1 = 1e300, -1e300, 1e300, -1e300
-        for q in range(8):
-            if cam[q, 2] >= near:
-                sx = (cam[q, 0] / cam[q, 2] / vp[12] + 1.0) * w * 0.5 - 0.5
-                sy = (1.0 - cam[q, 1] / cam[q, 2] / vp[13]) * h * 0.5 - 0.5
-                x0, x1, y0, y1 = min(x0, sx), max(x1, sx), min(y0, sy), max(y1, sy)
-            for bit in (4, 2, 1):
-                r = q | bit
-                if r == q:
-                    continue
-                za, zb = cam[q, 2], cam[r, 2]
-                if (za >= near) != (zb >= near):
-                    f = (near - za) / (zb - za)
-                    cx = cam[q, 0] + f * (cam[r, 0] - cam[q, 0])
-                    cy = cam[q, 1] + f * (cam[r, 1] - cam[q, 1])
-                    sx = (cx / near / vp[12] + 1.0) * w * 0.5 - 0.5
-                    sy = (1.0 - cy / near / vp[13]) * h * 0.5 - 0.5
-                    x0, x1, y0, y1 = min(x0, sx), max(x1, sx), min(y0, sy), max(y1, sy)
-        boxes[t, 0] = max(int(math.floor(x0)), 0)
-        boxes[t, 1] = min(int(math.ceil(x1)), w - 1)
-        boxes[t, 2] = max(int(math.floor(y0)), 0)
-        boxes[t, 3] = min(int(math.ceil(y1)), h - 1)
+        if not clipped_screen_box(cam, CUBE_EDGES, vp, w, h, box):
+            boxes[t, 0], boxes[t, 1], boxes[t, 2], boxes[t, 3] = 1, 0, 1, 0  # empty
+            continue
+        for k in range(4):
+            boxes[t, k] = box[k]
 
 
 # odd corners of the even-parity corner tetrahedra (regions 0..3) and their plane normals n (g = c + n . u)
@@ -608,13 +599,7 @@ def _render_band(leaves, nleaf, boxes, root, origin, spacing, va, vm, m_scale, a
                             nc += 1
                 cuts[nc] = t1
                 nc += 1
-                for i in range(1, nc):
-                    v = cuts[i]
-                    j = i - 1
-                    while j >= 0 and cuts[j] > v:
-                        cuts[j + 1] = cuts[j]
-                        j -= 1
-                    cuts[j + 1] = v
+                _sort_small(cuts, nc)
                 dn = dnorm[row, col]
                 for i in range(nc - 1):
                     ta, tb = cuts[i], cuts[i + 1]

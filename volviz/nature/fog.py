@@ -37,7 +37,7 @@ from typing import Any
 import numpy as np
 from numba import njit, prange
 
-from volviz.nature.raster import row_bands, view_params
+from volviz.nature.raster import PRISM_EDGES, clipped_screen_box, row_bands, view_params
 
 
 @dataclass
@@ -59,8 +59,8 @@ class FogLayer:
 @njit(cache=True, nogil=True)
 def _prism_setup(pts, bot, top, eb, et, tris, vp, w, h, planes, boxes, keep):
     """Per prism: 5 inward planes (a, b, c, d) and the clipped screen box [x0, x1, y0, y1]; keep[p] = 0 to skip."""
-    near = vp[14]
     cam = np.empty((6, 3))
+    box = np.empty(4, dtype=np.int64)
     for p in range(tris.shape[0]):
         i0, i1, i2 = tris[p, 0], tris[p, 1], tris[p, 2]
         keep[p] = 0
@@ -103,39 +103,10 @@ def _prism_setup(pts, bot, top, eb, et, tris, vp, w, h, planes, boxes, keep):
             cam[v, 0] = dx * vp[3] + dy * vp[4] + dz * vp[5]
             cam[v, 1] = dx * vp[6] + dy * vp[7] + dz * vp[8]
             cam[v, 2] = dx * vp[9] + dy * vp[10] + dz * vp[11]
-        x0, x1, y0, y1 = 1e300, -1e300, 1e300, -1e300
-        anyv = False
-        for v in range(6):
-            if cam[v, 2] >= near:
-                sx = (cam[v, 0] / cam[v, 2] / vp[12] + 1.0) * w * 0.5 - 0.5
-                sy = (1.0 - cam[v, 1] / cam[v, 2] / vp[13]) * h * 0.5 - 0.5
-                x0, x1, y0, y1 = min(x0, sx), max(x1, sx), min(y0, sy), max(y1, sy)
-                anyv = True
-        for e in range(9):
-            if e < 3:
-                a, b = e, (e + 1) % 3
-            elif e < 6:
-                a, b = 3 + (e - 3), 3 + (e - 2) % 3
-            else:
-                a, b = e - 6, e - 3
-            za, zb = cam[a, 2], cam[b, 2]
-            if (za >= near) != (zb >= near):
-                s = (near - za) / (zb - za)
-                cx = cam[a, 0] + s * (cam[b, 0] - cam[a, 0])
-                cy = cam[a, 1] + s * (cam[b, 1] - cam[a, 1])
-                sx = (cx / near / vp[12] + 1.0) * w * 0.5 - 0.5
-                sy = (1.0 - cy / near / vp[13]) * h * 0.5 - 0.5
-                x0, x1, y0, y1 = min(x0, sx), max(x1, sx), min(y0, sy), max(y1, sy)
-                anyv = True
-        if not anyv:
+        if not clipped_screen_box(cam, PRISM_EDGES, vp, w, h, box):
             continue
-        bx0 = max(int(math.floor(x0)), 0)
-        bx1 = min(int(math.ceil(x1)), w - 1)
-        by0 = max(int(math.floor(y0)), 0)
-        by1 = min(int(math.ceil(y1)), h - 1)
-        if bx0 > bx1 or by0 > by1:
-            continue
-        boxes[p, 0], boxes[p, 1], boxes[p, 2], boxes[p, 3] = bx0, bx1, by0, by1
+        for k in range(4):
+            boxes[p, k] = box[k]
         keep[p] = 1
 
 

@@ -40,6 +40,44 @@ def to_camera(vp: np.ndarray, p: np.ndarray, out: np.ndarray) -> None:
         out[i, 2] = dx * vp[9] + dy * vp[10] + dz * vp[11]
 
 
+PRISM_EDGES = np.array([[0, 1], [1, 2], [2, 0], [3, 4], [4, 5], [5, 3], [0, 3], [1, 4], [2, 5]], dtype=np.int64)
+CUBE_EDGES = np.array([[q, q | b] for q in range(8) for b in (4, 2, 1) if not q & b], dtype=np.int64)
+
+
+@njit(cache=True, nogil=True)
+def clipped_screen_box(cam: np.ndarray, edges: np.ndarray, vp: np.ndarray, w: int, h: int, out: np.ndarray) -> bool:
+    """Pixel box out = [x0, x1, y0, y1] (clamped to the image) of a convex cell from its vertices in camera space and
+    its edges, clipped at the near plane: the vertices in front plus the edges' near-plane crossings. False if no part
+    of the cell is in front of the near plane or the box misses the image."""
+    near = vp[14]
+    x0, x1, y0, y1 = 1e300, -1e300, 1e300, -1e300
+    anyv = False
+    for v in range(cam.shape[0]):
+        if cam[v, 2] >= near:
+            sx = (cam[v, 0] / cam[v, 2] / vp[12] + 1.0) * w * 0.5 - 0.5
+            sy = (1.0 - cam[v, 1] / cam[v, 2] / vp[13]) * h * 0.5 - 0.5
+            x0, x1, y0, y1 = min(x0, sx), max(x1, sx), min(y0, sy), max(y1, sy)
+            anyv = True
+    for e in range(edges.shape[0]):
+        a, b = edges[e, 0], edges[e, 1]
+        za, zb = cam[a, 2], cam[b, 2]
+        if (za >= near) != (zb >= near):
+            f = (near - za) / (zb - za)
+            cx = cam[a, 0] + f * (cam[b, 0] - cam[a, 0])
+            cy = cam[a, 1] + f * (cam[b, 1] - cam[a, 1])
+            sx = (cx / near / vp[12] + 1.0) * w * 0.5 - 0.5
+            sy = (1.0 - cy / near / vp[13]) * h * 0.5 - 0.5
+            x0, x1, y0, y1 = min(x0, sx), max(x1, sx), min(y0, sy), max(y1, sy)
+            anyv = True
+    if not anyv:
+        return False
+    out[0] = max(int(math.floor(x0)), 0)
+    out[1] = min(int(math.ceil(x1)), w - 1)
+    out[2] = max(int(math.floor(y0)), 0)
+    out[3] = min(int(math.ceil(y1)), h - 1)
+    return out[0] <= out[1] and out[2] <= out[3]
+
+
 @njit(cache=True, nogil=True, inline="always")
 def _screen(vp, w, h, x, y, z):
     return (x / z / vp[12] + 1.0) * w * 0.5 - 0.5, (1.0 - y / z / vp[13]) * h * 0.5 - 0.5
