@@ -97,3 +97,14 @@ def test_session_files(name: str, monkeypatch) -> None:
     if name == "yukon":
         assert scene.texture is not None and scene.sky is not None
         assert len(scene.fogs) == 2  # ground fog + the cloud layer between two height fields
+
+
+def test_demo_components_build_without_data() -> None:
+    from volviz.nature.scene import demo_components
+
+    comps = demo_components()
+    assert {c.type for c in comps} == {"terrain", "fog", "clouds", "sky"}
+    scene = scene_from_components(comps, {})
+    assert scene.terrain.size == 257 and scene.cloud_lod is not None and len(scene.fogs) == 1 and scene.sky is None
+    frame = scene.render(demo_camera(), (48, 36))
+    assert frame.stats["cloud_tets"] > 0 and np.all(np.isfinite(frame.rgb))

@@ -203,6 +203,23 @@ def demo_scene(seed: int = 0, terrain_size: int = 257, cloud_shape: tuple[int, i
     return scene
 
 
+def demo_components() -> list[Any]:
+    """Session components of the procedural natural scene (no datasets): fractal terrain, Perlin ground fog, Perlin
+    clouds, sky gradient — what ``demo_scene`` builds, for a session or the app's default scene."""
+    from volviz.session import Component
+
+    return [
+        Component(id="terrain", type="terrain", settings={"size": 257, "seed": 1, "relief": 160.0,
+                                                          "extent": [1000.0, 1000.0], "C": 9.0, "c": 40.0}),
+        Component(id="ground_fog", type="fog", settings={"level": 55.0, "thickness": 25.0, "seed": 2,
+                                                         "mode": "attenuated", "density": 0.04,
+                                                         "colour": [0.85, 0.87, 0.95]}),
+        Component(id="clouds", type="clouds", settings={"shape": [129, 129, 17], "seed": 3, "coverage": 0.25,
+                                                        "base_height": 190.0, "rho_max": 0.06}),
+        Component(id="sky", type="sky"),
+    ]
+
+
 def demo_camera(scene: NatureScene | None = None) -> Any:
     from volviz.unstructured.camera import Camera
 
