@@ -108,3 +108,14 @@ def test_demo_components_build_without_data() -> None:
     assert scene.terrain.size == 257 and scene.cloud_lod is not None and len(scene.fogs) == 1 and scene.sky is None
     frame = scene.render(demo_camera(), (48, 36))
     assert frame.stats["cloud_tets"] > 0 and np.all(np.isfinite(frame.rgb))
+
+
+def test_components_with_missing_datasets_are_refused() -> None:
+    from volviz.session import Component
+
+    with pytest.raises(ValueError, match="'t'.*not loaded"):
+        scene_from_components([Component(id="t", type="terrain", dataset="nope")], {})
+    with pytest.raises(ValueError, match="texture_dataset"):
+        scene_from_components([Component(id="t", type="terrain", settings={"size": 33, "texture_dataset": "x"})], {})
+    with pytest.raises(ValueError, match="needs a terrain"):
+        scene_from_components([Component(id="f", type="fog")], {})

@@ -233,6 +233,12 @@ def _image_grid(image: Any) -> np.ndarray:
     return grid_from_image(data)
 
 
+def _dataset(comp: Any, datasets: dict[str, Any]) -> Any:
+    if comp.dataset not in datasets:
+        raise ValueError(f"component {comp.id!r}: dataset {comp.dataset!r} is not loaded")
+    return datasets[comp.dataset]
+
+
 def _setting_dataset(comp: Any, key: str, datasets: dict[str, Any]) -> Any:
     ref = comp.settings.get(key)
     if ref is None:
@@ -286,7 +292,7 @@ def scene_from_components(components: Sequence[Any], datasets: dict[str, Any]) -
             ext = settings.get("extent", [1000.0, 1000.0])
             terrain = HeightField(h, (ext[0] / (h.shape[0] - 1), ext[1] / (h.shape[1] - 1)))
         else:
-            image = datasets[comp.dataset]
+            image = _dataset(comp, datasets)
             extent = settings.get("extent")
             terrain = HeightField.from_image(image, tuple(extent) if extent else None,
                                              float(settings.get("height_scale", 1.0)), settings.get("size"))
@@ -297,7 +303,7 @@ def scene_from_components(components: Sequence[Any], datasets: dict[str, Any]) -
             texture = np.asarray(tex.data, dtype=np.float32) / float(getattr(tex, "maxval", None) or 255)
     sky = None
     if "sky" in by_type and by_type["sky"][0].dataset:
-        sky = sky_texture(datasets[by_type["sky"][0].dataset])
+        sky = sky_texture(_dataset(by_type["sky"][0], datasets))
     scene = NatureScene(terrain, texture, sky, big_c=float(settings.get("C", 12.0)),
                         small_c=float(settings.get("c", 60.0)))
     for comp in by_type.get("fog", []):
@@ -308,7 +314,7 @@ def scene_from_components(components: Sequence[Any], datasets: dict[str, Any]) -
             thick = noise.fog_map(terrain.heights, float(st.get("level", 50.0)), float(st.get("thickness", 25.0)),
                                   seed=int(st.get("seed", 2)))
         else:
-            thick = _image_grid(datasets[comp.dataset]) * float(st.get("thickness_scale", 1.0))
+            thick = _image_grid(_dataset(comp, datasets)) * float(st.get("thickness_scale", 1.0))
         base_img = _setting_dataset(comp, "base_dataset", datasets)
         base = None
         if base_img is not None:
@@ -319,7 +325,7 @@ def scene_from_components(components: Sequence[Any], datasets: dict[str, Any]) -
     for comp in by_type.get("clouds", [])[:1]:
         st = comp.settings
         if comp.dataset is not None:
-            vol = datasets[comp.dataset]
+            vol = _dataset(comp, datasets)
             dens = np.asarray(vol.data, dtype=np.float64)
             dens = (dens - dens.min()) / max(float(np.ptp(dens)), 1e-12)
         else:
