@@ -68,11 +68,7 @@ def perlin2_at(perm: np.ndarray, grad: np.ndarray, x: float, y: float) -> float:
 
 @njit(cache=True, nogil=True, parallel=True)
 def _fbm3_grid(perm, grad, nx, ny, nz, fx, fy, fz, ox, oy, oz, octaves, lacunarity, persistence, out):
-    norm = 0.0
-    a = 1.0
-    for _ in range(octaves):
-        norm += a
-        a *= persistence
+    norm = (1.0 - persistence ** octaves) / (1.0 - persistence) if persistence != 1.0 else float(octaves)
     for i in prange(nx):
         for j in range(ny):
             for k in range(nz):
@@ -87,11 +83,7 @@ def _fbm3_grid(perm, grad, nx, ny, nz, fx, fy, fz, ox, oy, oz, octaves, lacunari
 
 @njit(cache=True, nogil=True, parallel=True)
 def _fbm2_grid(perm, grad, nx, ny, fx, fy, ox, oy, octaves, lacunarity, persistence, out):
-    norm = 0.0
-    a = 1.0
-    for _ in range(octaves):
-        norm += a
-        a *= persistence
+    norm = (1.0 - persistence ** octaves) / (1.0 - persistence) if persistence != 1.0 else float(octaves)
     for i in prange(nx):
         for j in range(ny):
             x, y = ox + i * fx, oy + j * fy
