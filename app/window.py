@@ -33,10 +33,9 @@ MAX_RECENT = 8
 
 
 def _data_filter() -> str:
-    from volviz.io import supported_formats
+    from volviz.io import open_dialog_filter
 
-    patterns = " ".join(f"*{ext}" for ext in supported_formats())
-    return f"Data files ({patterns});;All files (*)"
+    return open_dialog_filter()
 
 
 def default_recovery_dir() -> Path:

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from conftest import data_file
+from PySide6.QtCore import QSettings
 
 pytest.importorskip("PySide6")
 
@@ -26,13 +27,14 @@ def not_blank(image: np.ndarray) -> float:
 
 
 @pytest.fixture
-def window(qtbot):
-    win = MainWindow()
-    qtbot.addWidget(win)
+def window(qtbot, tmp_path):
+    win = MainWindow(settings=QSettings(str(tmp_path / "settings.ini"), QSettings.Format.IniFormat),
+                     recovery_dir=tmp_path / "recovery")
     win.resize(640, 480)
     win.show()
     qtbot.waitExposed(win)
     yield win
+    win.dirty = False
     win.close()
 
 

@@ -347,13 +347,16 @@ class TransferFunctionEditor(QWidget):
             self.import_paraview(path)
 
     def import_paraview(self, path: str) -> None:
-        from volviz.optics.presets import read_paraview_json
+        from volviz.optics.presets import read_paraview_presets
 
-        self.edit(self._recolor(read_paraview_json(path)[0]), "Import colour map")
+        self.edit(self._recolor(read_paraview_presets(path)[0]), "Import colour map")
 
     def _ask_export(self) -> None:
         path, _ = QFileDialog.getSaveFileName(self, "Export ParaView colour map", "colormap.json", "JSON (*.json)")
         if path:
-            from volviz.optics.presets import write_paraview_json
+            self.export_paraview(path)
 
-            write_paraview_json(self._tf, path)
+    def export_paraview(self, path: str) -> None:
+        from volviz.optics.presets import write_paraview_presets
+
+        write_paraview_presets(path, self._tf)

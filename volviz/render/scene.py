@@ -6,6 +6,7 @@ by several components are read once.
 from __future__ import annotations
 
 import os
+import re
 from pathlib import Path
 from typing import Any, Optional
 
@@ -17,9 +18,33 @@ class SceneError(Exception):
     """A session that cannot be shown: names the component and the problem."""
 
 
+MIN_SERIES_FILES = 3
+
+
+def series_pattern(path: str | os.PathLike) -> Optional[str]:
+    """``Storm.pvm-t%02d`` for ``Storm.pvm-t01`` when at least three numbered siblings exist (opened as one time
+    series, as ParaView groups numbered files); None otherwise."""
+    p = Path(path)
+    match = re.search(r"(\d+)(?!.*\d)", p.name)
+    if match is None:
+        return None
+    head, digits, tail = p.name[:match.start()], match.group(1), p.name[match.end():]
+    rx = re.compile(re.escape(head) + r"(\d+)" + re.escape(tail) + r"\Z")
+    try:
+        siblings = [name for name in os.listdir(p.parent) if rx.match(name)]
+    except OSError:
+        return None
+    if len(siblings) < MIN_SERIES_FILES:
+        return None
+    widths = {len(rx.match(name).group(1)) for name in siblings}  # type: ignore[union-attr]
+    number = f"%0{len(digits)}d" if len(widths) == 1 and digits.startswith("0") else "%d"
+    return str(p.parent.resolve() / f"{head}{number}{tail}")
+
+
 def data_session(path: str | os.PathLike) -> Session:
-    """A one-dataset session that shows ``path`` with its default visual (what opening a data file does)."""
-    ref = DatasetRef(id="data", path=str(Path(path).resolve()))
+    """A one-dataset session that shows ``path`` with its default visual (what opening a data file does); a file of a
+    numbered series opens the whole series."""
+    ref = DatasetRef(id="data", path=series_pattern(path) or str(Path(path).resolve()))
     return Session(datasets=[ref], components=[Component(id="data", type="volume", dataset="data")])
 
 

@@ -1,0 +1,287 @@
+"""What a user does in the app, under Xvfb with real widgets and real VTK rendering (issue: the desktop application)."""
+from __future__ import annotations
+
+import json
+import time
+from pathlib import Path
+
+import imageio.v3 as iio
+import numpy as np
+import pytest
+from PySide6.QtCore import QEvent, QPoint, QPointF, QSettings, Qt, QTimer
+from PySide6.QtGui import QMouseEvent
+from PySide6.QtWidgets import QApplication, QFileDialog, QMessageBox
+
+from conftest import data_file
+from volviz_app.window import MainWindow
+
+
+@pytest.fixture
+def make_window(qtbot, tmp_path: Path):
+    created = []
+
+    def make() -> MainWindow:
+        settings = QSettings(str(tmp_path / "settings.ini"), QSettings.Format.IniFormat)
+        win = MainWindow(settings=settings, recovery_dir=tmp_path / "recovery")  # closed below, not by qtbot:
+        win.resize(1400, 900)
+        win.show()
+        qtbot.waitExposed(win)
+        created.append(win)
+        return win
+
+    yield make
+    for win in created:
+        win.dirty = False  # no "save changes?" prompt at teardown
+        win.close()
+
+
+def wait_loaded(qtbot, window: MainWindow) -> None:
+    qtbot.waitUntil(lambda: not window.progress_bar.isVisible() and window.controller is not None, timeout=60000)
+
+
+def viewport(window: MainWindow) -> np.ndarray:
+    window.plotter.render()
+    return np.asarray(window.plotter.screenshot(None, return_img=True)).astype(np.float64)
+
+
+def answer_file_dialog(path: Path) -> None:
+    """Fill in and accept the Qt file dialog that the menu action is about to open."""
+    def fill() -> None:
+        dialog = QApplication.activeModalWidget()
+        if isinstance(dialog, QFileDialog):
+            dialog.selectFile(str(path))
+            dialog.accept()
+        else:
+            QTimer.singleShot(50, fill)
+
+    QTimer.singleShot(50, fill)
+
+
+def test_open_data_through_the_menu_action(qtbot, make_window) -> None:
+    window = make_window()
+    path = data_file("volumes/neghip.slc")
+    answer_file_dialog(path)
+    window.action_open_data.trigger()
+    wait_loaded(qtbot, window)
+    assert window.error_dialog is None
+    assert "neghip.slc" in window.windowTitle()
+    assert window.scene_tree.tree.topLevelItemCount() == 1
+    assert window.recent_files()[0] == str(path.resolve())
+    assert viewport(window).std() > 5.0
+
+
+def _mouse(widget, kind: QEvent.Type, pos: QPoint, buttons: Qt.MouseButton) -> None:
+    local = QPointF(pos)
+    event = QMouseEvent(kind, local, widget.mapToGlobal(local), Qt.MouseButton.LeftButton, buttons,
+                        Qt.KeyboardModifier.NoModifier)
+    QApplication.sendEvent(widget, event)
+
+
+def _drag(qtbot, canvas, start: QPoint, end: QPoint) -> None:
+    """A real press-move-release sequence delivered through Qt's event system."""
+    held = Qt.MouseButton.LeftButton
+    _mouse(canvas, QEvent.Type.MouseButtonPress, start, held)
+    for k in range(1, 6):
+        _mouse(canvas, QEvent.Type.MouseMove, start + (end - start) * (k / 5), held)
+        qtbot.wait(20)
+    _mouse(canvas, QEvent.Type.MouseButtonRelease, end, Qt.MouseButton.NoButton)
+
+
+def test_drag_transfer_function_point_changes_image_and_undo_restores_it(qtbot, make_window) -> None:
+    window = make_window()
+    window.open_path(data_file("volumes/neghip.slc"))
+    wait_loaded(qtbot, window)
+    before = viewport(window)
+    tf_before = window.tf_editor.transfer_function
+    canvas = window.tf_editor.canvas
+    index = len(tf_before) - 1  # the top end point: drag it down to make the volume far more transparent
+    p = canvas.to_screen(tf_before.scalars[index], tf_before.extinction[index])
+    start = QPoint(int(p.x()), int(p.y()))
+    _drag(qtbot, canvas, start, QPoint(start.x(), canvas._plot_rect().bottom() - 2))
+    qtbot.wait(300)  # let the throttled preview render
+    after = viewport(window)
+    tf_after = window.tf_editor.transfer_function
+    assert tf_after.extinction[index] < 0.1 * tf_before.extinction[index]
+    changed = (np.abs(after - before).sum(axis=2) > 10).mean()
+    assert changed > 0.01, f"image did not change ({changed:.2%} of the pixels changed)"
+    assert window.dirty
+    assert window.tf_editor.undo_stack.count() == 1
+
+    window.tf_editor.undo_stack.undo()
+    qtbot.wait(300)
+    restored = viewport(window)
+    assert window.tf_editor.transfer_function == tf_before
+    assert np.abs(restored - before).max() <= 2.0
+    window.tf_editor.undo_stack.redo()
+    assert window.tf_editor.transfer_function == tf_after
+
+
+def test_save_and_reopen_session_gives_the_same_image(qtbot, make_window, tmp_path: Path) -> None:
+    window = make_window()
+    window.open_path(data_file("volumes/neghip.slc"))
+    wait_loaded(qtbot, window)
+    window.plotter.camera.azimuth = 40.0
+    window.plotter.camera.elevation = 20.0
+    window.tf_editor.apply_preset(window.tf_editor._preset_names()[0])
+    qtbot.wait(200)
+    image = viewport(window)
+    session_file = tmp_path / "neghip-session.json"
+    assert window.save_session(session_file)
+    assert not window.dirty
+
+    other = make_window()
+    other.open_path(session_file)
+    wait_loaded(qtbot, other)
+    assert other.session.transfer_functions == window.session.transfer_functions
+    reopened = viewport(other)
+    assert reopened.shape == image.shape
+    assert np.abs(reopened - image).mean() < 0.5
+
+
+def test_timeline_plays_the_storm_series(qtbot, make_window, tmp_path: Path) -> None:
+    window = make_window()
+    window.open_path(data_file("storm/Storm.pvm-t01"))
+    wait_loaded(qtbot, window)
+    assert window.timeline.steps == [float(i) for i in range(1, 22)]
+    first = viewport(window)
+    window.timeline.speed.setValue(20.0)
+    window.timeline.set_playing(True)
+    qtbot.waitUntil(lambda: window.timeline.time > 5.0, timeout=10000)
+    window.timeline.set_playing(False)
+    assert window.controller.time == pytest.approx(window.timeline.time)
+    assert np.abs(viewport(window) - first).mean() > 0.2, "the volume did not change over time"
+    window.timeline.set_time(1.5)  # between two steps: interpolated data
+    a = window.controller.datasets["data"].frame(0).data.astype(np.float32)
+    b = window.controller.datasets["data"].frame(1).data.astype(np.float32)
+    from volviz.model.timeseries import frame_at
+
+    assert np.allclose(frame_at(window.controller.datasets["data"], 1.5).data, 0.5 * (a + b))
+
+
+def test_fly_forward_with_keys_moves_the_camera(qtbot, make_window) -> None:
+    window = make_window()
+    window.open_demo()
+    wait_loaded(qtbot, window)
+    window.set_fly_mode(True)
+    cam = window.plotter.camera
+    start = np.array(cam.position)
+    direction = np.array(cam.focal_point) - start
+    direction /= np.linalg.norm(direction)
+    for _ in range(5):
+        qtbot.keyClick(window.plotter.interactor, Qt.Key.Key_W)
+    moved = np.array(window.plotter.camera.position) - start
+    assert np.linalg.norm(moved) > 0
+    assert np.dot(moved, direction) == pytest.approx(np.linalg.norm(moved), rel=1e-6)  # straight ahead
+    qtbot.keyClick(window.plotter.interactor, Qt.Key.Key_D)
+    sideways = np.array(window.plotter.camera.position) - start - moved
+    assert abs(np.dot(sideways, direction)) < 1e-9 * max(np.linalg.norm(sideways), 1)
+    window.set_fly_mode(False)
+    position = np.array(window.plotter.camera.position)
+    qtbot.keyClick(window.plotter.interactor, Qt.Key.Key_Up)  # orbit mode: keys are VTK's again
+    assert np.allclose(window.plotter.camera.position, position)
+
+
+def test_bookmarks_and_recorded_path_are_saved_and_render_a_movie(qtbot, make_window, tmp_path: Path) -> None:
+    window = make_window()
+    window.open_path(data_file("volumes/neghip.slc"))
+    wait_loaded(qtbot, window)
+    window.add_bookmark("start")
+    window.set_recording(True)
+    for azimuth in (10, 20, 30):
+        window.plotter.camera.azimuth = azimuth
+        qtbot.wait(300)
+    name = window.set_recording(False)
+    assert name in window.session.camera_paths and len(window.session.camera_paths[name]) >= 3
+    session_file = tmp_path / "paths.json"
+    assert window.save_session(session_file)
+    doc = json.loads(session_file.read_text())
+    assert "start" in doc["bookmarks"] and name in doc["camera_paths"]
+    frames = tmp_path / "frames"
+    assert window.export_movie(frames, name, through_time=False, fps=4, size=(96, 64))
+    pngs = sorted(frames.glob("frame_*.png"))
+    assert len(pngs) >= 3
+    assert iio.imread(pngs[0]).shape[:2] == (64, 96)
+    assert np.abs(iio.imread(pngs[0]).astype(int) - iio.imread(pngs[-1]).astype(int)).mean() > 0.5
+
+
+def test_export_screenshot_any_size(qtbot, make_window, tmp_path: Path) -> None:
+    window = make_window()
+    window.open_demo()
+    wait_loaded(qtbot, window)
+    out = tmp_path / "shot.png"
+    assert window.export_screenshot(out, size=(1000, 333))
+    image = iio.imread(out)
+    assert image.shape[:2] == (333, 1000)
+    assert image[..., :3].std() > 3.0
+
+
+def test_cancel_a_long_job_and_ui_stays_responsive(qtbot, make_window) -> None:
+    window = make_window()
+    from volviz.optics import TransferFunction
+    from volviz.optics.tables import build_table3d_job
+
+    tf = TransferFunction([0.0, 0.5, 1.0], [[1, 0, 0], [0, 1, 0], [0, 0, 1]], [0.0, 30.0, 2.0])
+    outcomes = []
+    window._set_busy(True)
+    job = window.jobs.submit(build_table3d_job, tf, n_s=512, n_l=256, l_max=1.0, name="table",
+                             on_done=outcomes.append)
+    window._current_job = job
+    gaps, last = [], [time.perf_counter()]
+
+    def tick() -> None:
+        now = time.perf_counter()
+        gaps.append(now - last[0])
+        last[0] = now
+
+    timer = QTimer()
+    timer.setInterval(10)
+    timer.timeout.connect(tick)
+    timer.start()
+    qtbot.waitUntil(lambda: window.progress_bar.value() > 0, timeout=30000)
+    qtbot.wait(1000)
+    qtbot.mouseClick(window.cancel_button, Qt.MouseButton.LeftButton)
+    qtbot.waitUntil(lambda: bool(outcomes), timeout=30000)
+    timer.stop()
+    assert outcomes[0].cancelled and outcomes[0].result is None
+    assert len(gaps) > 50
+    assert max(gaps[5:]) < 0.1, f"event loop stalled for {max(gaps[5:]) * 1000:.0f} ms"
+
+
+def test_autosave_and_recovery_after_a_crash(qtbot, make_window, tmp_path: Path) -> None:
+    window = make_window()
+    window.open_path(data_file("volumes/neghip.slc"))
+    wait_loaded(qtbot, window)
+    window.scene_tree.opacity.setValue(40)  # an unsaved change
+    assert window.dirty
+    assert window.autosave()  # what the 60 s timer runs
+    assert window.recovery_file.exists()
+    # "crash": the window goes away without a clean close, so the recovery file stays
+    window.dirty = False
+    window.autosave_timer.stop()
+
+    restarted = make_window()
+    assert restarted.offer_recovery()
+    qtbot.waitUntil(lambda: restarted.recovery_dialog is not None and restarted.recovery_dialog.isVisible())
+    restarted.recovery_dialog.button(QMessageBox.StandardButton.Yes).click()
+    wait_loaded(qtbot, restarted)
+    assert restarted.session.components[0].opacity == pytest.approx(0.4)
+    assert restarted.dirty
+
+
+def test_unsaved_changes_prompt_can_cancel_closing(qtbot, make_window) -> None:
+    window = make_window()
+    window.open_demo()
+    wait_loaded(qtbot, window)
+    window.scene_tree.opacity.setValue(50)
+    assert window.dirty
+
+    def press_cancel() -> None:
+        box = getattr(window, "unsaved_dialog", None)
+        if box is not None and box.isVisible():
+            box.button(QMessageBox.StandardButton.Cancel).click()
+        else:
+            QTimer.singleShot(50, press_cancel)
+
+    QTimer.singleShot(50, press_cancel)
+    window.close()
+    assert window.isVisible()  # still open: the user cancelled
