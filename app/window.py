@@ -245,6 +245,7 @@ class MainWindow(QMainWindow):
         self.session, self.session_path, self.datasets, self.controller = session, session_path, datasets, controller
         if "window_state" in session.layout:
             self.restoreState(QByteArray.fromBase64(session.layout["window_state"].encode("ascii")))
+        self.plotter.iren.add_observer("EndInteractionEvent", lambda *args: QTimer.singleShot(0, self._camera_moved))
         self.scene_tree.populate(session.components)
         self.render_settings.load(session.render)
         self.timeline.set_steps(controller.time_steps())
@@ -275,6 +276,7 @@ class MainWindow(QMainWindow):
         from volviz.model.stats import histogram
 
         tf = self.controller.transfer_function(comp_id)
+        self.tf_editor.setEnabled(tf is not None)
         if tf is None:
             return
         dataset = self.controller.dataset_of(comp_id)
@@ -347,6 +349,9 @@ class MainWindow(QMainWindow):
             self.render()
 
     def _camera_moved(self) -> None:
+        """After the camera moved: refresh what depends on it (terrain LOD, fog and cloud images), then draw."""
+        if self.controller is not None and self.controller.nature is not None:
+            self.last_view_stats = self.controller.update_views()
         self.render()
 
     def add_bookmark(self, name: str) -> None:

@@ -57,8 +57,13 @@ class SceneController:
             update_volume_property(prop.GetProperty(), tf, comp.opacity)
 
     def set_visible(self, comp_id: str, visible: bool) -> None:
+        from volviz.render.scene import NATURE_TYPES
+
         comp = self.component(comp_id)
         comp.visible = bool(visible)
+        if comp.type in NATURE_TYPES:
+            self.rebuild_nature()
+            return
         prop = self.props.get(comp_id)
         if prop is None and visible:  # hidden at build time: add it now
             from volviz.render.vtk_scene import add_dataset
@@ -125,3 +130,25 @@ class SceneController:
         from volviz.render.vtk_scene import apply_camera
 
         apply_camera(self.plotter, camera)
+        self.update_views()
+
+    # -- view-dependent parts (terrain LOD, fog and cloud images) ---------------------------------------------------
+    @property
+    def nature(self) -> Any:
+        return self.props.get("nature")
+
+    def update_views(self) -> dict[str, float]:
+        """Re-run what depends on the camera (C-LOD terrain, fog and clouds); returns their statistics."""
+        if self.nature is None:
+            return {}
+        return self.nature.update()
+
+    def rebuild_nature(self) -> None:
+        from volviz.render.scene import build_nature
+
+        for name in ("nature-sky", "nature-terrain", "nature-overlay"):
+            self.plotter.remove_actor(name, render=False)
+        self.props.pop("nature", None)
+        view = build_nature(self.plotter, self.session, self.datasets)
+        if view is not None:
+            self.props["nature"] = view

@@ -51,9 +51,11 @@ def render_to_png(target: str | os.PathLike, out: str | os.PathLike, size: tuple
     from volviz.render.scene import data_session, demo_session
     from volviz.session import load
 
-    target_path = Path(target) if str(target) != "demo" else None
+    from volviz.render.scene import demo_volume_session
+
+    target_path = Path(target) if str(target) not in ("demo", "demo-volume") else None
     if target_path is None:
-        session, session_file = demo_session(), None
+        session, session_file = (demo_session() if str(target) == "demo" else demo_volume_session()), None
     elif is_session_file(target_path):
         session, session_file = load(target_path), target_path
     else:

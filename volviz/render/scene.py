@@ -49,14 +49,31 @@ def data_session(path: str | os.PathLike) -> Session:
 
 
 def demo_session() -> Session:
-    """The built-in procedural demo (generated at start-up, no files)."""
+    """The built-in procedural natural scene (fractal terrain, Perlin ground fog and clouds, sky), generated at
+    start-up from no files."""
+    from volviz.nature.scene import demo_components
+    from volviz.session import CameraState
+
+    camera = CameraState(position=(500.0, -150.0, 330.0), focal_point=(500.0, 600.0, 80.0), view_up=(0.0, 0.0, 1.0),
+                         view_angle=60.0)
+    from volviz.session import RenderSettings
+
+    return Session(components=demo_components(), camera=camera,
+                   render=RenderSettings(size=(1024, 768), background=(0.78, 0.85, 0.95)))
+
+
+def demo_volume_session() -> Session:
+    """A tetrahedralised cube carrying an analytic field (``volviz render demo-volume``)."""
     return Session(components=[Component(id="demo", type="demo", settings={"cells_per_edge": 20})])
 
 
 def load_datasets(session: Session, session_file: Optional[str | os.PathLike],
                   progress: Optional[ProgressCallback] = None) -> dict[str, Any]:
     """Read every dataset that a visible component uses, once each, with progress."""
+    from volviz.nature.scene import nature_dataset_ids
+
     used = {c.dataset for c in session.components if c.visible and c.dataset is not None}
+    used |= nature_dataset_ids([c for c in session.components if c.visible and c.type in NATURE_TYPES])
     refs = [ref for ref in session.datasets if ref.id in used]
     loaded: dict[str, Any] = {}
     for i, ref in enumerate(refs):
@@ -105,18 +122,38 @@ def component_transfer_function(session: Session, comp: Component) -> Any:
     return TransferFunction.from_dict(session.transfer_functions[comp.transfer_function])
 
 
+NATURE_TYPES = ("terrain", "fog", "clouds", "sky")
+
+
 def build_scene(plotter: Any, session: Session, datasets: dict[str, Any]) -> dict[str, Any]:
-    """Add every visible component to ``plotter``; returns the VTK prop of each component by id."""
+    """Add every visible component to ``plotter``; returns the VTK prop of each component by id, and under
+    ``"nature"`` the NatureView that draws the terrain, fog, clouds and sky components together."""
     from volviz.render.vtk_scene import add_dataset, apply_camera
 
     ensure_transfer_functions(session, datasets)
     props: dict[str, Any] = {}
     for comp in session.components:
-        if not comp.visible:
+        if not comp.visible or comp.type in NATURE_TYPES:
             continue
         dataset = component_dataset(comp, datasets)
         tf = component_transfer_function(session, comp)
         props[comp.id] = add_dataset(plotter, dataset, tf=tf, opacity=comp.opacity, name=comp.id)
     plotter.set_background(session.render.background)
     apply_camera(plotter, session.camera)
+    nature = build_nature(plotter, session, datasets)
+    if nature is not None:
+        props["nature"] = nature
     return props
+
+
+def build_nature(plotter: Any, session: Session, datasets: dict[str, Any]) -> Any:
+    """The NatureView of the session's visible terrain / fog / clouds / sky components (None when it has none)."""
+    components = [c for c in session.components if c.visible and c.type in NATURE_TYPES]
+    if not components:
+        return None
+    from volviz.nature.scene import build_nature_components
+
+    try:
+        return build_nature_components(plotter, components, datasets)
+    except (ValueError, KeyError) as exc:
+        raise SceneError(f"natural scene: {exc}") from None
