@@ -4,8 +4,9 @@ Conventions (used everywhere in volviz):
 
 - Regular volumes store their samples as ``data[i, j, k]`` with ``i`` along x, ``j`` along y and ``k`` along z, i.e.
   shape ``(nx, ny, nz)``. Flattening in Fortran order gives VTK's point order (x fastest).
-- 2D images (height fields, fog maps, textures) store ``data[row, col]`` with row 0 at the top of the file as read, and
-  an optional trailing channel axis. ``Image2D.to_grid()`` returns the x-major view used by terrain code.
+- 2D images (height fields, fog maps, textures) store ``data[row, col]`` with row 0 at the top of the file as read
+  (north for maps and DEMs), and an optional trailing channel axis. ``origin`` is the position of the bottom-left
+  (south-west) sample, as in VTK, so row ``r`` lies at ``y = origin_y + (rows - 1 - r) * spacing_y``.
 - Every coordinate is float64; scalar arrays keep their file's dtype until a renderer converts them.
 """
 from __future__ import annotations
@@ -286,13 +287,14 @@ class Image2D:
         return _range(self.data)
 
     def to_pyvista(self) -> Any:
-        """Image data on the z = 0 plane, x along columns, y along rows (row 0 at the top, so y grows downwards)."""
+        """Image data on the z = 0 plane, x along columns, y northwards (row 0, the top row, at the largest y)."""
         import pyvista as pv
 
         rows, cols = self.data.shape[:2]
         grid = pv.ImageData(dimensions=(cols, rows, 1), spacing=(self.spacing[0], self.spacing[1], 1.0),
                             origin=(self.origin[0], self.origin[1], 0.0))
-        values = self.data.reshape(rows * cols, -1) if self.data.ndim == 3 else self.data.reshape(-1)
+        flipped = self.data[::-1]  # VTK's first row is the bottom (southern) one
+        values = flipped.reshape(rows * cols, -1) if self.data.ndim == 3 else flipped.reshape(-1)
         grid.point_data["values"] = values
         return grid
 

@@ -1,0 +1,42 @@
+"""Dataset model conventions: VTK point order, image orientation, time-series interpolation."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from volviz.model import Image2D, RegularVolume, TimeSeries
+from volviz.model.timeseries import bracket, frame_at
+
+
+def test_regular_volume_to_pyvista_keeps_x_fastest() -> None:
+    data = np.arange(2 * 3 * 4, dtype=np.float32).reshape(2, 3, 4)
+    grid = RegularVolume(data, spacing=(1, 2, 3), origin=(5, 0, 0)).to_pyvista()
+    assert grid.dimensions == (2, 3, 4)
+    assert grid.point_data["scalars"][grid.find_closest_point((6, 4, 9))] == data[1, 2, 3]
+
+
+def test_image_row_zero_is_north() -> None:
+    data = np.array([[10, 11, 12], [20, 21, 22]], dtype=np.uint8)  # row 0 = top of the file = north
+    grid = Image2D(data, spacing=(1.0, 5.0), origin=(100.0, 200.0)).to_pyvista()
+    assert grid.point_data["values"][grid.find_closest_point((100, 205, 0))] == 10  # north-west corner
+    assert grid.point_data["values"][grid.find_closest_point((102, 200, 0))] == 22  # south-east corner
+
+
+def test_bad_shapes_are_refused() -> None:
+    with pytest.raises(ValueError, match="3D"):
+        RegularVolume(np.zeros((2, 2)))
+    with pytest.raises(ValueError, match="spacing"):
+        RegularVolume(np.zeros((2, 2, 2)), spacing=(1, 0, 1))
+    with pytest.raises(ValueError, match="increase"):
+        TimeSeries([1.0, 1.0], [None, None])
+
+
+def test_time_series_interpolation() -> None:
+    frames = [RegularVolume(np.full((2, 2, 2), v, dtype=np.uint8)) for v in (0, 100, 200)]
+    series = TimeSeries([1.0, 2.0, 4.0], frames)
+    assert bracket(series, 3.0) == (1, 2, 0.5)
+    assert bracket(series, 0.0) == (0, 0, 0.0) and bracket(series, 9.0) == (2, 2, 0.0)
+    assert np.all(frame_at(series, 3.0).data == 150.0)
+    assert np.all(frame_at(series, 1.25).data == 25.0)
+    assert np.all(frame_at(series, 3.0, interpolate=False).data == 100)
+    assert frame_at(series, 2.0).data.dtype == np.uint8  # exactly on a step: the step itself
