@@ -337,6 +337,10 @@ class MainWindow(QMainWindow):
         bounds = self.plotter.bounds
         size = max(bounds[1] - bounds[0], bounds[3] - bounds[2], bounds[5] - bounds[4], 1e-9)
         self.fly.set_enabled(enabled, size)
+        nature = self.controller.nature if self.controller is not None else None
+        terrain = getattr(getattr(nature, "scene", None), "terrain", None)
+        # over terrain the flight is collision-free: the camera stays 1 % of the scene size above the ground
+        self.fly.set_ground(terrain.height_at if terrain is not None else None, clearance=0.01 * size)
         self.action_fly.setChecked(enabled)
         self.status_label.setText("Fly mode: W/A/S/D or arrows move, Q/E sink/rise, drag to look, +/- speed"
                                   if enabled else "Orbit mode")

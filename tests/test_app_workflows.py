@@ -285,3 +285,17 @@ def test_unsaved_changes_prompt_can_cancel_closing(qtbot, make_window) -> None:
     QTimer.singleShot(50, press_cancel)
     window.close()
     assert window.isVisible()  # still open: the user cancelled
+
+
+def test_fly_over_terrain_never_goes_below_the_ground(qtbot, make_window) -> None:
+    window = make_window()
+    window.open_demo()
+    wait_loaded(qtbot, window)
+    terrain = window.controller.nature.scene.terrain
+    window.set_fly_mode(True)
+    window.fly.navigator.speed *= 20
+    for _ in range(3):
+        qtbot.keyClick(window.plotter.interactor, Qt.Key.Key_Q)  # sink
+    x, y, z = window.plotter.camera.position
+    assert z >= terrain.height_at(x, y)
+    assert z == pytest.approx(terrain.height_at(x, y) + window.fly.navigator.clearance)

@@ -40,3 +40,14 @@ def test_time_series_interpolation() -> None:
     assert np.all(frame_at(series, 1.25).data == 25.0)
     assert np.all(frame_at(series, 3.0, interpolate=False).data == 100)
     assert frame_at(series, 2.0).data.dtype == np.uint8  # exactly on a step: the step itself
+
+
+def test_height_field_bilinear_height() -> None:
+    from volviz.nature.heightfield import HeightField
+
+    h = np.zeros((3, 3))
+    h[1, 1] = 4.0
+    field = HeightField(h, spacing=(2.0, 2.0), origin=(10.0, 20.0))
+    assert field.height_at(12.0, 22.0) == 4.0
+    assert field.height_at(11.0, 22.0) == 2.0
+    assert field.height_at(-100.0, 22.0) == 0.0  # clamped to the grid

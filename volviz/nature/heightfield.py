@@ -103,6 +103,16 @@ class HeightField:
         n = self.size
         return (self.origin[0] + np.arange(n) * self.spacing[0], self.origin[1] + np.arange(n) * self.spacing[1])
 
+    def height_at(self, x: float, y: float) -> float:
+        """Bilinearly interpolated terrain height at world (x, y), clamped to the grid (fly-through collision)."""
+        n = self.size
+        u = min(max((x - self.origin[0]) / self.spacing[0], 0.0), n - 1.0)
+        v = min(max((y - self.origin[1]) / self.spacing[1], 0.0), n - 1.0)
+        i, j = min(int(u), n - 2), min(int(v), n - 2)
+        fu, fv = u - i, v - j
+        h = self.heights
+        return float((1 - fu) * ((1 - fv) * h[i, j] + fv * h[i, j + 1]) + fu * ((1 - fv) * h[i + 1, j] + fv * h[i + 1, j + 1]))
+
     def sample(self, grid: np.ndarray) -> np.ndarray:
         """Resample another x-major grid (e.g. a fog map) to this height field's (N, N) samples."""
         return resample_bilinear(grid, (self.size, self.size))
