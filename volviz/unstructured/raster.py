@@ -10,7 +10,10 @@ This is the projected-tetrahedron footprint (the union of the 3 or 4 Shirley-Tuc
 homogeneous divide: it is exact under perspective, where interpolating (s_f, s_b, l) linearly from the thick vertex is
 not (Roettger §8.4, digest §15.2 item 7). Segments clipped by the near plane start at t = near (volumetric clipping of
 cells around the camera). Rays through shared faces or edges produce zero-length segments in the neighbours, which
-contribute nothing, so no fill-convention is needed: no pixel is drawn twice or missed.
+contribute nothing, so no fill-convention is needed: no pixel is drawn twice or missed. A ray lying in a face plane
+(|n.D| <= 1e-12 |D|, e.g. a grid seen exactly along its planes) is inside when its distance to the plane exceeds
+``tol`` and otherwise by the same simulation-of-simplicity tie-break as the reference (displacement by a fixed generic
+vector), so the two cells sharing the face do not both draw it (before: 79/255 errors on a grid seen along z).
 
 Compositing is front to back over the reversed visibility order (equivalent to back-to-front "over",
 C = C_seg + (1 - a_seg) C_behind), in screen tiles processed in parallel; a tile stops when every pixel's transmittance
@@ -24,8 +27,12 @@ import numpy as np
 from numba import njit, prange
 
 TILE = 32
-#: per-cell coefficients: 4 faces x (num0, numx, numy, den0, denx, deny), then scalar (a0, ax, ay, b0, bx, by)
-N_COEF = 30
+#: per-cell coefficients: 4 faces x (num0, numx, numy, den0, denx, deny), then scalar (a0, ax, ay, b0, bx, by), then
+#: per face +1 / -1: whether a ray lying in the face plane counts as inside (simulation-of-simplicity tie-break)
+N_COEF = 34
+#: the generic displacement of the tie-break (the same as the reference's)
+SOS = np.array([0.5773502691896258, 0.6180339887498949, 0.5335536495417815])
+SOS /= np.linalg.norm(SOS)
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -36,7 +43,7 @@ def _det3(a0, a1, a2, b0, b1, b2, c0, c1, c2):
 @njit(cache=True, nogil=True, parallel=True)
 def project_cells(pts: np.ndarray, tets: np.ndarray, scal: np.ndarray, cells: np.ndarray, face_n: np.ndarray,
                   face_d: np.ndarray, rb: np.ndarray, frame: np.ndarray, scales: np.ndarray, parallel: bool,
-                  near: float, width: int, height: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                  near: float, width: int, height: int, sos: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Pixel boxes (k, 4) [c0, c1, r0, r1], coefficients (k, 30) and projected vertices (k, 8) [px0, py0, ...] of
     the listed cells (positions relative); a NaN in the projected vertices marks a cell crossing the near plane."""
     k = len(cells)
@@ -86,6 +93,7 @@ def project_cells(pts: np.ndarray, tets: np.ndarray, scal: np.ndarray, cells: np
             coef[q, b + 3] = n0 * rb[3, 0] + n1 * rb[3, 1] + n2 * rb[3, 2]
             coef[q, b + 4] = n0 * rb[4, 0] + n1 * rb[4, 1] + n2 * rb[4, 2]
             coef[q, b + 5] = n0 * rb[5, 0] + n1 * rb[5, 1] + n2 * rb[5, 2]
+            coef[q, 30 + f] = 1.0 if n0 * sos[0] + n1 * sos[1] + n2 * sos[2] < 0.0 else -1.0
         # --- scalar gradient g (E g = ds, Cramer's rule) and s(x) = s0 + g.x
         i0, i1, i2, i3 = tets[c, 0], tets[c, 1], tets[c, 2], tets[c, 3]
         a0, a1, a2 = pts[i1, 0] - pts[i0, 0], pts[i1, 1] - pts[i0, 1], pts[i1, 2] - pts[i0, 2]
@@ -202,7 +210,7 @@ def _lookup(flat: np.ndarray, n: int, nl: int, s_lo: float, inv_ds: float, inv_d
 @njit(cache=True, nogil=True, parallel=True)
 def raster_tiles(box: np.ndarray, coef: np.ndarray, vxy: np.ndarray, ptr: np.ndarray, items: np.ndarray, tile_order: np.ndarray,
                  rb: np.ndarray, near: float, far: float, table: np.ndarray, s_lo: float, ds: float, dl: float,
-                 width: int, height: int, tile: int, t_min: float, image: np.ndarray) -> np.ndarray:
+                 width: int, height: int, tile: int, t_min: float, tol: float, image: np.ndarray) -> np.ndarray:
     """Composite every tile's cells front to back into ``image`` (H, W, 4); returns fragments drawn per tile."""
     tx = (width + tile - 1) // tile
     frags = np.zeros(len(tile_order), np.int64)
@@ -247,28 +255,30 @@ def raster_tiles(box: np.ndarray, coef: np.ndarray, vxy: np.ndarray, ptr: np.nda
                     t0 = near
                     t1 = far
                     ok = True
+                    d0 = rb[3, 0] + px * rb[4, 0] + py * rb[5, 0]
+                    d1 = rb[3, 1] + px * rb[4, 1] + py * rb[5, 1]
+                    d2 = rb[3, 2] + px * rb[4, 2] + py * rb[5, 2]
+                    dn = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+                    eps = 1e-12 * dn
                     for f in range(4):
                         b = 6 * f
                         num = cq[b] + px * cq[b + 1] + py * cq[b + 2]
                         den = cq[b + 3] + px * cq[b + 4] + py * cq[b + 5]
-                        if den > 0.0:
+                        if den > eps:
                             v = num / den
                             if v < t1:
                                 t1 = v
-                        elif den < 0.0:
+                        elif den < -eps:
                             v = num / den
                             if v > t0:
                                 t0 = v
-                        elif num < 0.0:
+                        elif num < -tol or (num <= tol and cq[30 + f] < 0.0):
                             ok = False
                     if not ok or t0 >= t1:
                         continue
                     sa = cq[24] + px * cq[25] + py * cq[26]
                     sb = cq[27] + px * cq[28] + py * cq[29]
-                    d0 = rb[3, 0] + px * rb[4, 0] + py * rb[5, 0]
-                    d1 = rb[3, 1] + px * rb[4, 1] + py * rb[5, 1]
-                    d2 = rb[3, 2] + px * rb[4, 2] + py * rb[5, 2]
-                    ln = (t1 - t0) * math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+                    ln = (t1 - t0) * dn
                     c0, c1, c2, c3 = _lookup(flat, n_s, n_l, s_lo, inv_ds, inv_dl, sa + t0 * sb, sa + t1 * sb, ln)
                     col[ly, lx, 0] += tr * c0
                     col[ly, lx, 1] += tr * c1

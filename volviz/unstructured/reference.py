@@ -29,12 +29,11 @@ from numba import njit
 
 from volviz.model.datasets import TetMesh
 from volviz.unstructured.camera import Camera
+from volviz.unstructured.raster import SOS
 from volviz.unstructured.topology import cell_ranges, topology
 
 
-#: the generic displacement direction of the simulation-of-simplicity tie-break (unit length, no rational ratios)
-_SOS = np.array([0.5773502691896258, 0.6180339887498949, 0.5335536495417815])
-_SOS = _SOS / np.linalg.norm(_SOS)
+_SOS = SOS                  # the generic displacement of the simulation-of-simplicity tie-break (shared with "pt")
 
 
 @njit(cache=True, nogil=True)

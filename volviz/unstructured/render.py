@@ -24,7 +24,7 @@ import numpy as np
 from volviz.model.datasets import TetMesh
 from volviz.unstructured.camera import Camera
 from volviz.unstructured.project import raster_triangles, shirley_tuchman
-from volviz.unstructured.raster import TILE, bin_tiles, project_cells, raster_tiles
+from volviz.unstructured.raster import SOS, TILE, bin_tiles, project_cells, raster_tiles
 from volviz.unstructured.reference import render_reference
 from volviz.unstructured.sort import visibility_order
 from volviz.unstructured.topology import cell_ranges, topology, visible_cells
@@ -132,7 +132,8 @@ def render(mesh: TetMesh, tf: Any, camera: Camera, size: tuple[int, int] = (512,
     hx, hy = camera._scales((w, h))
     near, far = camera.clipping_range
     box, coef, vxy = project_cells(topo.points, topo.tets, mesh.scalars, cells, topo.face_n, topo.face_d,
-                              rb.as_array(), frame, np.array([hx, hy]), bool(camera.parallel), near, w, h)
+                                   rb.as_array(), frame, np.array([hx, hy]), bool(camera.parallel), near, w, h, SOS)
+    tol = 1e-10 * max(float(np.abs(topo.points).max()) + float(np.abs(rb.o0).max()), 1e-300)
     stats.project_s = time.perf_counter() - t0
     t0 = time.perf_counter()
     if method == "pt-st":
@@ -153,7 +154,7 @@ def render(mesh: TetMesh, tf: Any, camera: Camera, size: tuple[int, int] = (512,
     tile_order = np.random.default_rng(12345).permutation(n_tiles).astype(np.int64)
     img = np.zeros((h, w, 4))
     frags = raster_tiles(box, coef, vxy, ptr, items, tile_order, rb.as_array(), near, far, table.rgba, table.s_lo,
-                         table.ds, table.dl, w, h, TILE, float(t_min), img)
+                         table.ds, table.dl, w, h, TILE, float(t_min), tol, img)
     stats.fragments = int(frags.sum())
     stats.raster_s = time.perf_counter() - t0
     stats.total_s = time.perf_counter() - t_start
