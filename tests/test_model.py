@@ -51,3 +51,12 @@ def test_height_field_bilinear_height() -> None:
     assert field.height_at(12.0, 22.0) == 4.0
     assert field.height_at(11.0, 22.0) == 2.0
     assert field.height_at(-100.0, 22.0) == 0.0  # clamped to the grid
+
+
+def test_histogram_of_a_series_covers_every_step() -> None:
+    from volviz.model.stats import histogram
+
+    frames = [RegularVolume(np.full((2, 2, 2), v, dtype=np.uint8)) for v in (0, 0, 200)]
+    counts, edges = histogram(TimeSeries([0.0, 1.0, 2.0], frames), bins=4)
+    assert edges[0] == 0 and edges[-1] == 200
+    assert counts.tolist() == [16, 0, 0, 8]

@@ -8,10 +8,16 @@ import numpy as np
 from volviz.model.datasets import CurvilinearGrid, Image2D, RegularVolume, TetMesh, TimeSeries, UnstructuredMesh
 
 
+MAX_SERIES_VALUES = 50_000_000
+
+
 def scalar_values(dataset: Any) -> np.ndarray:
-    """The active scalar of a dataset as a flat array (vector arrays by their magnitude)."""
+    """The active scalar of a dataset as a flat array (vector arrays by their magnitude); for a time series, the
+    values of all its steps (of evenly spaced steps when that would exceed ``MAX_SERIES_VALUES``)."""
     if isinstance(dataset, TimeSeries):
-        dataset = dataset.frame(0)
+        n = len(dataset)
+        step = max(1, (n * dataset.n_points) // MAX_SERIES_VALUES)  # every step while small, else every k-th
+        return np.concatenate([scalar_values(dataset.frame(i)) for i in range(0, n, step)])
     if isinstance(dataset, (RegularVolume, Image2D)):
         values = dataset.data
     elif isinstance(dataset, TetMesh):

@@ -20,8 +20,8 @@ DEFAULT_COLORS = ((0.23, 0.30, 0.75), (0.87, 0.87, 0.87), (0.71, 0.02, 0.15))  #
 def default_transfer_function(scalar_range: tuple[float, float], diagonal: float, name: str = "default") -> Any:
     """A cool-warm colour map with a ramp extinction over the data range: the first look at unknown data.
 
-    The extinction peaks at 4 / diagonal, so a ray through the whole bounding box at the top of the range reaches an
-    optical depth of about 4 (mostly opaque) while lower values stay translucent.
+    The extinction peaks at 8 / diagonal, so a ray through the whole bounding box at the top of the range reaches an
+    optical depth of about 8 (opaque) while lower values stay translucent.
     """
     from volviz.optics import TransferFunction
 
@@ -30,7 +30,7 @@ def default_transfer_function(scalar_range: tuple[float, float], diagonal: float
         lo, hi = 0.0, 1.0
     if hi <= lo:
         hi = lo + 1.0
-    rho_max = 4.0 / diagonal if diagonal > 0 else 1.0
+    rho_max = 8.0 / diagonal if diagonal > 0 else 1.0
     scalars = [lo, lo + 0.1 * (hi - lo), 0.5 * (lo + hi), hi]
     colors = [DEFAULT_COLORS[0], DEFAULT_COLORS[0], DEFAULT_COLORS[1], DEFAULT_COLORS[2]]
     extinction = [0.0, 0.0, 0.35 * rho_max, rho_max]
@@ -81,8 +81,12 @@ def volume_grid(dataset: Any) -> Any:
 
 
 def default_transfer_function_for(dataset: Any, name: str = "default") -> Any:
+    """The default transfer function over the data range (of every step, for a time series)."""
     grid = volume_grid(dataset)
-    rng = grid.get_data_range() if grid.active_scalars is not None else (0.0, 1.0)
+    if isinstance(dataset, TimeSeries):
+        rng = dataset.scalar_range()
+    else:
+        rng = grid.get_data_range() if grid.active_scalars is not None else (0.0, 1.0)
     return default_transfer_function(rng, bounds_diagonal(grid.bounds), name)
 
 
