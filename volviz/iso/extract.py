@@ -93,9 +93,14 @@ def _vtk_input(volume: Any, scalars: str | None) -> tuple[Any, bool]:
 
 def _poly_to_arrays(poly: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     import pyvista as pv
-    from vtkmodules.vtkFiltersCore import vtkTriangleFilter
+    from vtkmodules.vtkFiltersCore import vtkCleanPolyData, vtkTriangleFilter
+    clean = vtkCleanPolyData()  # merge coincident points (degenerate grid cells), degenerate triangles -> lines
+    clean.SetInputData(poly)
+    clean.ToleranceIsAbsoluteOn()
+    clean.SetAbsoluteTolerance(0.0)
+    clean.Update()
     tri = vtkTriangleFilter()
-    tri.SetInputData(poly)
+    tri.SetInputData(clean.GetOutput())
     tri.PassLinesOff()
     tri.PassVertsOff()
     tri.Update()
@@ -103,6 +108,8 @@ def _poly_to_arrays(poly: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     pts = np.asarray(out.points, dtype=np.float64).reshape(-1, 3)
     faces = np.asarray(out.faces, dtype=np.int64)
     tris = faces.reshape(-1, 4)[:, 1:].copy() if faces.size else np.zeros((0, 3), np.int64)
+    ok = (tris[:, 0] != tris[:, 1]) & (tris[:, 1] != tris[:, 2]) & (tris[:, 0] != tris[:, 2])
+    tris = tris[ok]
     nrm = out.point_data.get("Normals")
     nrm = np.zeros_like(pts) if nrm is None else np.asarray(nrm, dtype=np.float64).reshape(-1, 3)
     return pts, tris, nrm
