@@ -210,8 +210,13 @@ def _lookup(flat: np.ndarray, n: int, nl: int, s_lo: float, inv_ds: float, inv_d
 @njit(cache=True, nogil=True, parallel=True)
 def raster_tiles(box: np.ndarray, coef: np.ndarray, vxy: np.ndarray, ptr: np.ndarray, items: np.ndarray, tile_order: np.ndarray,
                  rb: np.ndarray, near: float, far: float, table: np.ndarray, s_lo: float, ds: float, dl: float,
-                 width: int, height: int, tile: int, t_min: float, tol: float, image: np.ndarray) -> np.ndarray:
-    """Composite every tile's cells front to back into ``image`` (H, W, 4); returns fragments drawn per tile."""
+                 width: int, height: int, tile: int, t_min: float, tol: float, far_px: np.ndarray,
+                 image: np.ndarray) -> np.ndarray:
+    """Composite every tile's cells front to back into ``image`` (H, W, 4); returns fragments drawn per tile.
+
+    ``far_px`` (H, W) is a per-pixel far limit on the ray depth t (opaque geometry from a depth buffer), or an empty
+    (0, 0) array for none."""
+    use_far = far_px.shape[0] == height and far_px.shape[1] == width
     tx = (width + tile - 1) // tile
     frags = np.zeros(len(tile_order), np.int64)
     inv_ds = 1.0 / ds
@@ -253,7 +258,7 @@ def raster_tiles(box: np.ndarray, coef: np.ndarray, vxy: np.ndarray, ptr: np.nda
                     if tr < t_min:
                         continue
                     t0 = near
-                    t1 = far
+                    t1 = min(far, far_px[py, px]) if use_far else far
                     ok = True
                     d0 = rb[3, 0] + px * rb[4, 0] + py * rb[5, 0]
                     d1 = rb[3, 1] + px * rb[4, 1] + py * rb[5, 1]

@@ -66,8 +66,10 @@ def _ray_interval(minv: np.ndarray, o: np.ndarray, d: np.ndarray, near: float, f
 @njit(cache=True, nogil=True)
 def _band_segments(minv: np.ndarray, svals: np.ndarray, cells: np.ndarray, bbox: np.ndarray, rb: np.ndarray,
                    near: float, far: float, tol: float, width: int, row0: int, row1: int, count_only: bool,
-                   pix: np.ndarray, seg: np.ndarray) -> int:
-    """Intersect every pixel ray of rows [row0, row1) with the candidate cells; returns the number of segments."""
+                   pix: np.ndarray, seg: np.ndarray, far_px: np.ndarray) -> int:
+    """Intersect every pixel ray of rows [row0, row1) with the candidate cells; returns the number of segments.
+    ``far_px`` (H, W): per-pixel far limits, or (0, 0) for none."""
+    use_far = far_px.shape[0] > 0
     o = np.empty(3)
     d = np.empty(3)
     k = 0
@@ -80,7 +82,7 @@ def _band_segments(minv: np.ndarray, svals: np.ndarray, cells: np.ndarray, bbox:
                 for a in range(3):
                     o[a] = rb[0, a] + col * rb[1, a] + row * rb[2, a]
                     d[a] = rb[3, a] + col * rb[4, a] + row * rb[5, a]
-                ok, t0, t1 = _ray_interval(minv[c], o, d, near, far, tol)
+                ok, t0, t1 = _ray_interval(minv[c], o, d, near, min(far, far_px[row, col]) if use_far else far, tol)
                 if not ok:
                     continue
                 if not count_only:
@@ -149,11 +151,24 @@ def screen_bboxes(cam: Camera, pts_world: np.ndarray, tets: np.ndarray, size: tu
     return box.astype(np.int64)
 
 
+def depth_limits(depth: np.ndarray | None, w: int, h: int) -> np.ndarray:
+    """A contiguous (H, W) float64 per-pixel far limit, or an empty (0, 0) array for none."""
+    if depth is None:
+        return np.empty((0, 0))
+    far = np.ascontiguousarray(depth, dtype=np.float64)
+    if far.shape != (h, w):
+        raise ValueError(f"depth limit must have shape (H, W) = {(h, w)}, got {far.shape}")
+    return np.nan_to_num(far, nan=np.inf)
+
+
 def iter_ray_segments(mesh: TetMesh, camera: Camera, size: tuple[int, int], band_rows: int = 32,
-                      max_segments: int = 4_000_000) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+                      max_segments: int = 4_000_000, depth: np.ndarray | None = None
+                      ) -> Iterator[tuple[np.ndarray, np.ndarray]]:
     """Exact ray segments of every pixel, band by band: ``(pix, seg)`` sorted by (pixel, entry depth) where
-    ``pix = row * W + col`` and ``seg`` columns are (t_entry, s_f, s_b, length, cell id)."""
+    ``pix = row * W + col`` and ``seg`` columns are (t_entry, s_f, s_b, length, cell id). ``depth`` (H, W) limits
+    each ray to t <= depth (opaque geometry)."""
     w, h = (int(v) for v in size)
+    far_px = depth_limits(depth, w, h)
     topo = topology(mesh)
     ranges = cell_ranges(mesh)
     live = np.nonzero(~ranges.nan)[0]
@@ -173,12 +188,12 @@ def iter_ray_segments(mesh: TetMesh, camera: Camera, size: tuple[int, int], band
         sel = np.nonzero(on & (box[:, 2] < row + rows) & (box[:, 3] >= row))[0]
         dummy_p, dummy_s = np.empty(0, np.int64), np.empty((0, 5))
         n = _band_segments(minv, svals, sel, box[sel], rb, near, far, tol, w, row, row + rows, True, dummy_p,
-                           dummy_s)
+                           dummy_s, far_px)
         if n > max_segments and rows > 1:
             band_rows = max(1, rows // 2)
             continue
         pix, seg = np.empty(n, np.int64), np.empty((n, 5))
-        _band_segments(minv, svals, sel, box[sel], rb, near, far, tol, w, row, row + rows, False, pix, seg)
+        _band_segments(minv, svals, sel, box[sel], rb, near, far, tol, w, row, row + rows, False, pix, seg, far_px)
         order = np.lexsort((seg[:, 0], pix))
         pix, seg = pix[order], seg[order]
         seg[:, 4] = live[seg[:, 4].astype(np.int64)]
@@ -187,13 +202,13 @@ def iter_ray_segments(mesh: TetMesh, camera: Camera, size: tuple[int, int], band
 
 
 def render_reference(mesh: TetMesh, tf: Any, camera: Camera, size: tuple[int, int], band_rows: int = 32,
-                     max_segments: int = 4_000_000) -> np.ndarray:
-    """Exact float64 image (H, W, 4), premultiplied RGBA, row 0 at the top."""
+                     max_segments: int = 4_000_000, depth: np.ndarray | None = None) -> np.ndarray:
+    """Exact float64 image (H, W, 4), premultiplied RGBA, row 0 at the top (``depth``: per-pixel far limits)."""
     from volviz.optics import integrate_segment
 
     w, h = (int(v) for v in size)
     out = np.zeros((h * w, 4))
-    for pix, seg in iter_ray_segments(mesh, camera, (w, h), band_rows, max_segments):
+    for pix, seg in iter_ray_segments(mesh, camera, (w, h), band_rows, max_segments, depth):
         rgba = np.asarray(integrate_segment(tf, seg[:, 1], seg[:, 2], seg[:, 3]), dtype=np.float64)
         _composite_front_to_back(pix, np.ascontiguousarray(rgba), out)
     return np.nan_to_num(out.reshape(h, w, 4), nan=0.0, posinf=0.0, neginf=0.0)

@@ -25,7 +25,7 @@ from volviz.model.datasets import TetMesh
 from volviz.unstructured.camera import Camera
 from volviz.unstructured.project import raster_triangles, shirley_tuchman
 from volviz.unstructured.raster import SOS, TILE, bin_tiles, project_cells, raster_tiles
-from volviz.unstructured.reference import render_reference
+from volviz.unstructured.reference import depth_limits, render_reference
 from volviz.unstructured.sort import visibility_order
 from volviz.unstructured.topology import cell_ranges, topology, visible_cells
 
@@ -88,12 +88,15 @@ def _table_for(mesh: TetMesh, tf: Any, n_s: int, n_l: int, l_max: float) -> Any:
 
 def render(mesh: TetMesh, tf: Any, camera: Camera, size: tuple[int, int] = (512, 512), method: str = "pt", *,
            sort: str = "mpvo", nonconvex: str = "auto", order: np.ndarray | None = None, n_s: int = 128,
-           n_l: int = 64, table: Any = None, t_min: float = 1e-3, return_stats: bool = False
-           ) -> np.ndarray | tuple[np.ndarray, RenderStats]:
+           n_l: int = 64, table: Any = None, t_min: float = 1e-3, depth: np.ndarray | None = None,
+           return_stats: bool = False) -> np.ndarray | tuple[np.ndarray, RenderStats]:
     """Render ``mesh`` with transfer function ``tf`` seen by ``camera`` into a (H, W, 4) premultiplied RGBA image.
 
     ``order`` (a back-to-front cell order, e.g. from a background sort) skips the sort. ``table`` overrides the 3D
     pre-integration table (default: n_s x n_s x n_l over the data and TF range, l_max = the longest edge).
+    ``depth`` (H, W): a per-pixel far limit on the depth along the direction of projection (the ray parameter t of
+    ``Camera.rays``), e.g. opaque geometry from a z-buffer; every ray segment is clipped at it ("pt" and
+    "reference"; "pt-st" refuses it).
     """
     if method not in METHODS:
         raise ValueError(f"unknown render method {method!r}; choose one of {METHODS}")
@@ -105,7 +108,7 @@ def render(mesh: TetMesh, tf: Any, camera: Camera, size: tuple[int, int] = (512,
     stats = RenderStats(method, (w, h), n_tets=mesh.n_cells)
     t_start = time.perf_counter()
     if method == "reference":
-        img = render_reference(mesh, tf, camera, (w, h))
+        img = render_reference(mesh, tf, camera, (w, h), depth=depth)
         stats.total_s = stats.raster_s = time.perf_counter() - t_start
         return (img, stats) if return_stats else img
     topo = topology(mesh)
@@ -137,6 +140,8 @@ def render(mesh: TetMesh, tf: Any, camera: Camera, size: tuple[int, int] = (512,
     stats.project_s = time.perf_counter() - t0
     t0 = time.perf_counter()
     if method == "pt-st":
+        if depth is not None:
+            raise ValueError('method "pt-st" does not support a depth limit; use "pt"')
         cls, ntri, txy, tval = shirley_tuchman(vxy, coef, mesh.scalars[topo.tets[cells]], rb.as_array(), near, far)
         stats.extra["classes"] = {int(c): int((cls == c).sum()) for c in (0, 1, 2)}
         stats.extra["triangles"] = int(ntri.sum())
@@ -154,7 +159,8 @@ def render(mesh: TetMesh, tf: Any, camera: Camera, size: tuple[int, int] = (512,
     tile_order = np.random.default_rng(12345).permutation(n_tiles).astype(np.int64)
     img = np.zeros((h, w, 4))
     frags = raster_tiles(box, coef, vxy, ptr, items, tile_order, rb.as_array(), near, far, table.rgba, table.s_lo,
-                         table.ds, table.dl, w, h, TILE, float(t_min), tol, img)
+                         table.ds, table.dl, w, h, TILE, float(t_min), tol,
+                         depth_limits(depth, w, h), img)
     stats.fragments = int(frags.sum())
     stats.raster_s = time.perf_counter() - t0
     stats.total_s = time.perf_counter() - t_start
