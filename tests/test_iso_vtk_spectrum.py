@@ -39,3 +39,22 @@ def test_shader_alpha_follows_the_fitted_spectrum():
     assert expect.max() - expect.min() > 0.2  # the test sees the angular variation, not a constant
     flat, _ = _sphere_row(False)
     assert np.max(np.abs(flat[inside] - 0.3)) < 3.0 / 255.0  # without the shader: constant opacity
+
+
+def test_iso_actor_renders_translucent_and_opaque_surfaces():
+    from volviz.iso.extract import IsoMesh, IsoStyle
+    s = pv.Sphere(radius=1.0).compute_normals()
+    tris = np.asarray(s.faces).reshape(-1, 4)[:, 1:]
+    pl = pv.Plotter(off_screen=True, window_size=(64, 64))
+    pl.set_background((0.0, 0.0, 0.0))
+    for style in (IsoStyle(0.0, (0.0, 0.0, 1.0), 0.4), IsoStyle(0.0, (1.0, 0.0, 0.0), 1.0)):
+        pts = np.asarray(s.points) * (0.5 if style.opacity == 1.0 else 1.0)
+        mesh = IsoMesh(pts, tris, np.asarray(s.point_data["Normals"]), style)
+        from volviz.iso.vtk_spectrum import iso_actor
+        pl.renderer.AddActor(iso_actor(mesh))
+    pl.reset_camera()
+    img = pl.screenshot(return_img=True).astype(np.float64)
+    pl.close()
+    centre, rim = img[32, 32], img[32, 18]
+    assert centre[0] > 60 and centre[2] > 20  # red opaque core seen through the blue translucent shell
+    assert rim[2] > 20 and rim[0] < 5  # only the shell at the rim

@@ -16,7 +16,7 @@ from typing import Any
 
 from volviz.iso.spectrum import SpectrumFit, fit_spectrum
 
-__all__ = ["apply_spectrum_shader", "SPECTRUM_GLSL"]
+__all__ = ["apply_spectrum_shader", "iso_actor", "SPECTRUM_GLSL"]
 
 SPECTRUM_GLSL = """//VTK::Light::Impl
   {
@@ -43,3 +43,26 @@ def apply_spectrum_shader(actor: Any, opacity: float, parallel: bool = False) ->
     uni.SetUniformf("isoParallel", 1.0 if parallel else 0.0)
     actor.GetProperty().SetOpacity(float(opacity))
     return fit
+
+
+def iso_actor(mesh: Any, parallel: bool = False, spectrum: bool = True) -> Any:
+    """A vtkActor for an ``IsoMesh`` (vtkOpenGLPolyDataMapper, the surface colour, Phong-interpolated normals).
+
+    Translucent surfaces get the iso-spectrum shader when ``spectrum`` is true, else constant opacity; VTK then
+    blends them unsorted (the note's 2-pass mode). The accurate modes are the CPU compositor's
+    (``volviz.iso.composite``); opaque surfaces are plain opaque actors.
+    """
+    from vtkmodules.vtkRenderingCore import vtkActor
+    from vtkmodules.vtkRenderingOpenGL2 import vtkOpenGLPolyDataMapper
+    mapper = vtkOpenGLPolyDataMapper()
+    mapper.SetInputData(mesh.to_pyvista())
+    mapper.ScalarVisibilityOff()
+    actor = vtkActor()
+    actor.SetMapper(mapper)
+    prop = actor.GetProperty()
+    prop.SetColor(*(float(c) for c in mesh.style.color))
+    prop.SetInterpolationToPhong()
+    prop.SetOpacity(float(mesh.style.opacity))
+    if spectrum and 0.0 < float(mesh.style.opacity) < 1.0:
+        apply_spectrum_shader(actor, float(mesh.style.opacity), parallel=parallel)
+    return actor
