@@ -131,3 +131,17 @@ def test_lru_cache_budget_evicts_only_decoded_leaves(noisy):
     n_dec = tree.decoder.decoded_bricks
     tree.node((0, (3, 3, 3)))  # most recent: a cache hit, no decode
     assert tree.decoder.decoded_bricks == n_dec and c.hits > 0
+
+
+def test_prefetch_in_a_worker_thread_fills_the_cache(noisy):
+    from concurrent.futures import ThreadPoolExecutor
+
+    data, path = noisy
+    tree = LodTree(path, volume=RegularVolume(data))
+    cam = Camera(eye=(32.0, 32.0, 200.0), target=(32.0, 32.0, 0.0), fov_y=90, height=4096)
+    sel = tree.select(cam, 64)
+    with ThreadPoolExecutor(1) as ex:
+        assert ex.submit(tree.prefetch, sel).result() == 1 + 8  # root's and the 8 level-1 nodes' bricks
+    n = tree.decoder.decoded_bricks
+    assert np.array_equal(tree.reconstruct(sel), data.astype(np.int32))
+    assert tree.decoder.decoded_bricks == n  # everything came from the cache

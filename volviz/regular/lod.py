@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import heapq
 import math
+import threading
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Iterator
@@ -137,6 +138,7 @@ class LodTree:
         self.spacing = np.asarray(meta.get("spacing", (1, 1, 1)), float)
         self.origin = np.asarray(meta.get("origin", (0, 0, 0)), float)
         self.cache = NodeCache(cache_bytes, self.levels)
+        self._lock = threading.RLock()  # node decoding and the cache may be driven from a background worker
         if volume is None:
             from .codec import decompress  # statistics of the decoded (possibly lossy) volume
             volume = decompress(path)
@@ -148,6 +150,8 @@ class LodTree:
             self._scale = (0.0, 1.0)
         self.stats, self.bin_lo, self.bin_w = node_statistics(src.slab(0, volume.data.shape[2]))
         self._tf_err: dict[int, np.ndarray] = {}
+        self._tf_clear: dict[int, np.ndarray] = {}
+        self._tf_obj: Any = None
         self._tf_key: Any = None
 
     # -- geometry -------------------------------------------------------------------------------------------------
@@ -176,18 +180,28 @@ class LodTree:
     def _to_data(self, v: np.ndarray) -> np.ndarray:
         return self._scale[0] + np.asarray(v, float) * self._scale[1]
 
+    def _tf_cache(self, tf: Any) -> None:
+        """Drop the per-TF caches when the TF changes (by value; the same object is checked once)."""
+        if tf is self._tf_obj:
+            return
+        tk = tf.to_dict() if hasattr(tf, "to_dict") else id(tf)
+        if tk != self._tf_key:
+            self._tf_err, self._tf_clear, self._tf_key = {}, {}, tk
+        self._tf_obj = tf
+
     def transparent(self, key: Key, tf: Any) -> bool:
-        """True when ρ = 0 over the node's value range (footprint plus one-voxel apron)."""
-        st = self.stats[key[0]]
-        lo, hi = self._to_data(st.vmin[key[1]]), self._to_data(st.vmax[key[1]])
-        _, dmax, _, _ = _tf_minmax(tf, np.atleast_1d(lo), np.atleast_1d(hi))
-        return bool(dmax[0] <= 0.0)
+        """True when ρ = 0 over the node's value range (footprint plus one-voxel apron). Cached per TF."""
+        self._tf_cache(tf)
+        level = key[0]
+        if level not in self._tf_clear:
+            st = self.stats[level]
+            _, dmax, _, _ = _tf_minmax(tf, self._to_data(st.vmin), self._to_data(st.vmax))
+            self._tf_clear[level] = dmax <= 0.0
+        return bool(self._tf_clear[level][key[1]])
 
     def tf_error(self, key: Key, tf: Any) -> float:
         """Eq. 2.7 bound for the node under ``tf`` (per ray through the block; 0 for leaves). Cached per TF."""
-        tk = tf.to_dict() if hasattr(tf, "to_dict") else id(tf)
-        if tk != self._tf_key:
-            self._tf_err, self._tf_key = {}, tk
+        self._tf_cache(tf)
         level = key[0]
         if level not in self._tf_err:
             st = self.stats[level]
@@ -217,18 +231,18 @@ class LodTree:
         q = camera.q
         th = math.atan(math.tan(math.radians(camera.fov_y) / 2))
         tw = math.atan(math.tan(math.radians(camera.fov_y) / 2) * camera.width / camera.height)
-        planes = [(f * math.sin(th) + u * math.cos(th)), (f * math.sin(th) - u * math.cos(th)),
-                  (f * math.sin(tw) + r * math.cos(tw)), (f * math.sin(tw) - r * math.cos(tw))]
+        planes = np.array([f * math.sin(th) + u * math.cos(th), f * math.sin(th) - u * math.cos(th),
+                           f * math.sin(tw) + r * math.cos(tw), f * math.sin(tw) - r * math.cos(tw), f]).T
         sel = Selection(nodes=[])
         corner_idx = np.array([[a, b, c] for a in (0, 1) for b in (0, 1) for c in (0, 1)])
 
         def classify(key: Key) -> tuple[bool, float, float]:
             """(visible, priority, pixel size of a voxel)"""
             lo, hi = self.node_box(key)
-            corners = np.where(corner_idx == 0, lo, hi) - e
-            if any(np.all(corners @ n < 0) for n in planes) or np.all(corners @ f < 0):
+            dist = (np.where(corner_idx == 0, lo, hi) - e) @ planes  # (8 corners, 4 side planes + view axis)
+            if (dist < 0).all(axis=0).any():
                 return False, 0.0, 0.0
-            z = max(0.0, float((corners @ f).min()))
+            z = max(0.0, float(dist[:, 4].min()))
             vox = float(np.max(self.spacing)) * (1 << key[0])
             if z <= 0:
                 return True, math.inf, math.inf
@@ -280,22 +294,38 @@ class LodTree:
 
     # -- decoding ---------------------------------------------------------------------------------------------------
     def node(self, key: Key) -> np.ndarray:
-        """The node's samples (int32, up to 16^3), decoded one level at a time through the LRU cache."""
-        level, p = key
-        if level == self.levels:
-            return self.cache.get_or_make(key, self.decoder.root)
-        a = self.cache.get(key)
-        if a is not None:
-            return a
-        parent: Key = (level + 1, (p[0] // 2, p[1] // 2, p[2] // 2))
-        kids = self.decoder.children(parent, self.node(parent))
-        for k, v in kids.items():
-            self.cache.put(k, v)
-        return kids[key]
+        """The node's samples (int32, up to 16^3), decoded one level at a time through the LRU cache. Thread-safe
+        (one lock; the Numba decode kernel releases the GIL, so a worker thread decodes while the UI renders)."""
+        with self._lock:
+            level, p = key
+            if level == self.levels:
+                return self.cache.get_or_make(key, self.decoder.root)
+            a = self.cache.get(key)
+            if a is not None:
+                return a
+            parent: Key = (level + 1, (p[0] // 2, p[1] // 2, p[2] // 2))
+            kids = self.decoder.children(parent, self.node(parent))
+            for k, v in kids.items():
+                self.cache.put(k, v)
+            return kids[key]
+
+    def prefetch(self, selection: Selection, cancelled: Any = None) -> int:
+        """Decode every node of ``selection`` into the cache (for a background worker: the next frame's blocks
+        while the current one renders); ``cancelled()`` -> True stops early. Returns the bricks decoded."""
+        before = self.decoder.decoded_bricks
+        for key in selection.nodes:
+            if cancelled is not None and cancelled():
+                break
+            self.node(key)
+        return self.decoder.decoded_bricks - before
 
     def block(self, key: Key) -> Block:
         """The node's samples as float32 in data units, extended by one voxel from its +x/+y/+z neighbours at the
         same level (decoded on demand, their neighbours never), so adjacent blocks share their border samples."""
+        with self._lock:
+            return self._block(key)
+
+    def _block(self, key: Key) -> Block:
         level, p = key
         c = self.decoder.n_nodes(level)
         a = self.node(key)
