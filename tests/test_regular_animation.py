@@ -111,3 +111,13 @@ def test_storm_series_lossless(tmp_path):
     (tmp_path / "storm.vvs" / "series.json").write_text("{}")
     with pytest.raises(A.SeriesError, match="storm.vvs"):
         A.SeriesDecoder(tmp_path / "storm.vvs")
+
+
+def test_cli_compress_series(tmp_path, capsys):
+    from volviz.regular.cli import compress_main
+
+    pattern = str(data_file("storm/Storm.pvm-t01")).replace("t01", "t%02d")
+    assert compress_main([pattern, "-o", str(tmp_path / "s.vvs"), "--series", "--pattern", "IPP", "--quiet"]) == 0
+    assert "21 volumes (28, 28, 23)  pattern IPP  lossless" in capsys.readouterr().out
+    back = A.decompress_series(tmp_path / "s.vvs")
+    assert np.array_equal(back[20], np.asarray(read(pattern).frame(20).data))

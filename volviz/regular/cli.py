@@ -1,5 +1,8 @@
 """``volviz compress`` and ``volviz vvzinfo``: command-line front ends of the wavelet codec (Guthe §2.2, §2.3).
 
+``volviz compress IN -o OUT --series [--pattern IBBPBBPPB] [--quality Q | --lossless]`` reads IN as a time series
+(e.g. ``Storm.pvm-t%02d``) and writes a motion-compensated I/P/B store directory (:mod:`.animation`).
+
 ``volviz compress IN -o OUT [--quality Q | --psnr DB | --lossless] [--coder rans|arith]`` reads IN with
 ``volviz.io.read`` (any supported volume), or -- for volumes larger than memory -- a headerless raw file given with
 ``--raw NX NY NZ --dtype uint8``, which is memory-mapped and compressed out of core. A text progress bar goes to
@@ -64,13 +67,40 @@ def compress_main(argv: Sequence[str] | None = None) -> int:
     p.add_argument("--raw", type=int, nargs=3, metavar=("NX", "NY", "NZ"),
                    help="INPUT is a headerless raw volume (x fastest), memory-mapped and compressed out of core")
     p.add_argument("--dtype", default="uint8", help="sample type of --raw input (uint8, uint16, int16, float32)")
+    p.add_argument("--series", action="store_true",
+                   help="INPUT is a time series of 8-bit volumes (e.g. Storm.pvm-t%%02d); OUTPUT a .vvs store directory")
+    p.add_argument("--pattern", default="IBBPBBPPB", help="GOP pattern of --series (I, IPP, IBB, IBBPBBPPB, ...)")
     p.add_argument("--quiet", action="store_true")
     p.add_argument("--json", help="write the resulting info as JSON to this file")
     args = p.parse_args(list(argv) if argv is not None else None)
+    if args.series:
+        return _series_main(args)
     vol = _load(args)
     result = compress(vol, args.output, quality=args.quality, psnr=args.psnr, coder=args.coder,
                       progress=None if args.quiet else _progress_bar())
     _print_info(result)
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump(result, f, indent=1)
+    return 0
+
+
+def _series_main(args: argparse.Namespace) -> int:
+    from volviz.io import read
+    from volviz.model.datasets import TimeSeries
+
+    from .animation import compress_series
+
+    if args.psnr is not None or args.raw:
+        raise SystemExit("--series supports --lossless or --quality (not --psnr or --raw)")
+    series = read(args.input)
+    if not isinstance(series, TimeSeries):
+        raise SystemExit(f"{args.input}: not a time series (use a numbered pattern such as Storm.pvm-t%02d)")
+    result = compress_series(series, args.output, pattern=args.pattern,
+                             mode="lossless" if args.quality is None else "quality", quality=args.quality,
+                             progress=None if args.quiet else _progress_bar())
+    print(f"{result['n']} volumes {tuple(result['dims'])}  pattern {result['pattern']}  {result['mode']}  "
+          f"{result['bytes']} bytes  ratio {result['ratio']:.2f}:1  {result['bits_per_voxel']:.3f} bits/voxel")
     if args.json:
         with open(args.json, "w") as f:
             json.dump(result, f, indent=1)
