@@ -1,4 +1,5 @@
-"""4D isosurfaces of the Storm (libMini note, "4D Visualization"): smooth in display time, extracted in the background."""
+"""4D isosurfaces of the Storm (libMini note, "4D Visualization"): smooth in display time, extracted in the
+background."""
 from __future__ import annotations
 
 import threading

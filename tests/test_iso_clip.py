@@ -26,7 +26,8 @@ def _sphere() -> RegularVolume:
 
 
 def test_settings_json_round_trip_and_validation():
-    cs = ClipSettings((ClipPlane((0, 0, 0.5), (0, 0, 2)), ClipPlane((1, 2, 3), (1, 1, 0))), BoxCrop((0, 0, 0), (1, 2, 3)))
+    cs = ClipSettings((ClipPlane((0, 0, 0.5), (0, 0, 2)), ClipPlane((1, 2, 3), (1, 1, 0))),
+                      BoxCrop((0, 0, 0), (1, 2, 3)))
     text = json.dumps(cs.to_dict())
     back = ClipSettings.from_dict(json.loads(text))
     assert back == cs and back.planes[0].normal == (0.0, 0.0, 1.0)

@@ -202,7 +202,6 @@ def clip_isosurfaces(meshes: Sequence[IsoMesh], clip: ClipSettings | Sequence[Cl
 def clip_tetmesh(mesh: TetMesh, clip: ClipSettings | Sequence[ClipPlane] | BoxCrop) -> TetMesh:
     """The tetrahedral mesh cut by the planes and box, re-tetrahedralised; scalars exact for the linear field."""
     import pyvista as pv
-    from vtkmodules.vtkFiltersCore import vtkCleanPolyData  # noqa: F401 (ensures the core filters are loaded)
     from vtkmodules.vtkFiltersGeneral import vtkDataSetTriangleFilter
     cs = _as_settings(clip)
     planes = cs.all_planes()

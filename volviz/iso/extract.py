@@ -157,7 +157,6 @@ def extract(volume: Any, styles: Sequence[IsoStyle | float], scalars: str | None
     Plain numbers are accepted as styles (white, opacity 0.5). Empty surfaces (value outside the data range) are
     returned as meshes with no triangles, so the list always matches ``styles``.
     """
-    from vtkmodules.vtkCommonExecutionModel import vtkStreamingDemandDrivenPipeline  # noqa: F401 (loads VTK)
     from vtkmodules.vtkFiltersCore import vtkContourFilter, vtkFlyingEdges3D, vtkPolyDataNormals
     sty = [s if isinstance(s, IsoStyle) else IsoStyle(float(s)) for s in styles]
     grid, is_image = _vtk_input(volume, scalars)
