@@ -109,7 +109,7 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     out.mkdir(parents=True, exist_ok=True)
     load_start = os.getloadavg()[0]
-    results: dict[str, Any] = {"command": "volviz bench iso " + shlex.join(argv or sys.argv[1:]), "size": args.size,
+    results: dict[str, Any] = {"command": ("volviz bench iso " + shlex.join(argv if argv is not None else sys.argv[1:])).strip(), "size": args.size,
                                "reps": args.reps, "machine": f"{platform.machine()}, {os.cpu_count()} cores",
                                "scenes": {}, "load_average_start": load_start}
     images: dict[str, dict[str, np.ndarray]] = {}
