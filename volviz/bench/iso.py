@@ -109,7 +109,8 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     out.mkdir(parents=True, exist_ok=True)
     load_start = os.getloadavg()[0]
-    results: dict[str, Any] = {"command": ("volviz bench iso " + shlex.join(argv if argv is not None else sys.argv[1:])).strip(), "size": args.size,
+    command = ("volviz bench iso " + shlex.join(argv if argv is not None else sys.argv[1:])).strip()
+    results: dict[str, Any] = {"command": command, "size": args.size,
                                "reps": args.reps, "machine": f"{platform.machine()}, {os.cpu_count()} cores",
                                "scenes": {}, "load_average_start": load_start}
     images: dict[str, dict[str, np.ndarray]] = {}
