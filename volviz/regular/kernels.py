@@ -39,27 +39,31 @@ def _tile_box(t, c0, c1, shape):
 
 @njit(cache=True, nogil=True)
 def _requant(w, n0, n1, n2, steps, inverse):
-    """Quantise (``inverse`` False) or reconstruct (True) the detail subbands of a tile in place."""
+    """Quantise (``inverse`` False) or reconstruct (True) the detail subbands of a tile in place, one subband box
+    at a time (no per-sample subband test; zeros skipped)."""
     if steps[1:].max() <= 1.0:  # lossless: nothing to do
         return
     l0 = (n0 + 1) // 2
     l1 = (n1 + 1) // 2
     l2 = (n2 + 1) // 2
-    for i in range(n0):
-        h0 = 1 if i >= l0 else 0
-        for j in range(n1):
-            h1 = 2 if j >= l1 else 0
-            for k in range(n2):
-                b = h0 | h1 | (4 if k >= l2 else 0)
-                st = steps[b]
-                if b == 0 or st <= 1.0:
-                    continue
-                c = w[i, j, k]
-                if inverse:
-                    m = np.int32((abs(c) + BIAS) * st + 0.5) if c != 0 else np.int32(0)
-                else:
-                    m = np.int32(abs(c) / st + ROUND)
-                w[i, j, k] = -m if c < 0 else m
+    for b in range(1, 8):
+        st = steps[b]
+        if st <= 1.0:
+            continue
+        i0, i1 = (l0, n0) if b & 1 else (0, l0)
+        j0, j1 = (l1, n1) if b & 2 else (0, l1)
+        k0, k1 = (l2, n2) if b & 4 else (0, l2)
+        for i in range(i0, i1):
+            for j in range(j0, j1):
+                for k in range(k0, k1):
+                    c = w[i, j, k]
+                    if c == 0:
+                        continue
+                    if inverse:
+                        m = np.int32((abs(c) + BIAS) * st + 0.5)
+                    else:
+                        m = np.int32(abs(c) / st + ROUND)
+                    w[i, j, k] = -m if c < 0 else m
 
 
 @njit(cache=True, nogil=True)
