@@ -601,29 +601,43 @@ class MainWindow(QMainWindow):
         return True
 
     # ------------------------------------------------------------------------------------------------ dialogs
+    def ask_file(self, title: str, name_filter: str, on_chosen: Any, save: bool = False,
+                 default_name: str = "") -> QFileDialog:
+        """A non-blocking file dialog (kept as ``self.file_dialog``); ``on_chosen(path)`` runs when accepted."""
+        dialog = QFileDialog(self, title, "", name_filter)
+        dialog.setOption(QFileDialog.Option.DontUseNativeDialog, True)
+        if save:
+            dialog.setAcceptMode(QFileDialog.AcceptMode.AcceptSave)
+            dialog.setFileMode(QFileDialog.FileMode.AnyFile)
+            if default_name:
+                dialog.selectFile(default_name)
+        else:
+            dialog.setFileMode(QFileDialog.FileMode.ExistingFile)
+        dialog.fileSelected.connect(lambda path: path and on_chosen(path))
+        dialog.open()
+        self.file_dialog = dialog
+        return dialog
+
     def _ask_open_data(self) -> None:
-        path, _ = QFileDialog.getOpenFileName(self, "Open data", "", _data_filter())
-        if path:
-            self.open_path(path)
+        self.ask_file("Open data", _data_filter(), self.open_path)
 
     def _ask_open_session(self) -> None:
-        path, _ = QFileDialog.getOpenFileName(self, "Open session", "", "volviz sessions (*.json);;All files (*)")
-        if path:
-            self.open_path(path)
+        self.ask_file("Open session", "volviz sessions (*.json);;All files (*)", self.open_path)
 
     def _save_session(self) -> bool:
         if self.session_path is None:
-            return self._ask_save_session_as()
+            self._ask_save_session_as()
+            return False
         return self.save_session(self.session_path)
 
-    def _ask_save_session_as(self) -> bool:
-        path, _ = QFileDialog.getSaveFileName(self, "Save session", "session.json", "volviz sessions (*.json)")
-        return bool(path) and self.save_session(path)
+    def _ask_save_session_as(self) -> None:
+        self.ask_file("Save session", "volviz sessions (*.json)", self.save_session, save=True,
+                      default_name="session.json")
 
     def _ask_export_screenshot(self) -> None:
-        path, _ = QFileDialog.getSaveFileName(self, "Export screenshot", "volviz.png", "PNG images (*.png)")
-        if path:
-            self.export_screenshot(path, self.session.render.size)
+        self.ask_file("Export screenshot", "PNG images (*.png)",
+                      lambda path: self.export_screenshot(path, self.session.render.size), save=True,
+                      default_name="volviz.png")
 
     def _ask_export_movie(self) -> None:
         paths = list(self.session.camera_paths)
@@ -635,9 +649,9 @@ class MainWindow(QMainWindow):
         choice, ok = QInputDialog.getItem(self, "Export movie", "Camera path:", choices, 0, False)
         if not ok:
             return
-        path, _ = QFileDialog.getSaveFileName(self, "Export movie", "volviz.mp4", "MP4 video (*.mp4)")
-        if path:
-            self.export_movie(path, None if choice == "(through time)" else choice, choice == "(through time)")
+        self.ask_file("Export movie", "MP4 video (*.mp4)", lambda path: self.export_movie(
+            path, None if choice == "(through time)" else choice, choice == "(through time)"), save=True,
+            default_name="volviz.mp4")
 
     def show_error(self, title: str, text: str) -> None:
         """A non-blocking error dialog (the app keeps running); also logged."""

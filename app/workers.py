@@ -1,11 +1,15 @@
 """Bridge from volviz.jobs (Qt-free) to Qt signals, so results reach widgets on the GUI thread."""
 from __future__ import annotations
 
+import time
 from typing import Any, Callable, Optional
 
 from PySide6.QtCore import QObject, Signal
 
 from volviz.jobs import Job, JobOutcome, JobRunner
+
+
+PROGRESS_INTERVAL = 0.08
 
 
 class JobBridge(QObject):
@@ -22,8 +26,16 @@ class JobBridge(QObject):
 
     def submit(self, fn: Callable[..., Any], *args: Any, name: str, key: Optional[str] = None,
                on_done: Optional[Callable[[JobOutcome], None]] = None, **kwargs: Any) -> Job:
-        job = self.runner.submit(fn, *args, name=name, key=key, on_progress=self.progress.emit,
-                                 on_done=self.finished.emit, **kwargs)
+        last = [0.0]
+
+        def progress(job_id: int, fraction: float, message: str) -> None:
+            now = time.monotonic()
+            if now - last[0] >= PROGRESS_INTERVAL or fraction >= 1.0:  # at most ~12 UI updates a second
+                last[0] = now
+                self.progress.emit(job_id, fraction, message)
+
+        job = self.runner.submit(fn, *args, name=name, key=key, on_progress=progress, on_done=self.finished.emit,
+                                 **kwargs)
         if on_done is not None:
             self._handlers[job.job_id] = on_done
         return job

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from PySide6.QtCore import QEvent, QPoint, QPointF, QSettings, Qt, QTimer
 from PySide6.QtGui import QMouseEvent
-from PySide6.QtWidgets import QApplication, QFileDialog, QMessageBox
+from PySide6.QtWidgets import QApplication, QMessageBox
 
 from conftest import data_file
 from volviz_app.window import MainWindow
@@ -44,24 +44,14 @@ def viewport(window: MainWindow) -> np.ndarray:
     return np.asarray(window.plotter.screenshot(None, return_img=True)).astype(np.float64)
 
 
-def answer_file_dialog(path: Path) -> None:
-    """Fill in and accept the Qt file dialog that the menu action is about to open."""
-    def fill() -> None:
-        dialog = QApplication.activeModalWidget()
-        if isinstance(dialog, QFileDialog):
-            dialog.selectFile(str(path))
-            dialog.accept()
-        else:
-            QTimer.singleShot(50, fill)
-
-    QTimer.singleShot(50, fill)
-
-
 def test_open_data_through_the_menu_action(qtbot, make_window) -> None:
     window = make_window()
     path = data_file("volumes/neghip.slc")
-    answer_file_dialog(path)
     window.action_open_data.trigger()
+    dialog = window.file_dialog
+    assert dialog.isVisible() and dialog.nameFilters()[0].startswith("All supported")
+    dialog.selectFile(str(path))
+    dialog.accept()
     wait_loaded(qtbot, window)
     assert window.error_dialog is None
     assert "neghip.slc" in window.windowTitle()
@@ -238,13 +228,14 @@ def test_cancel_a_long_job_and_ui_stays_responsive(qtbot, make_window) -> None:
     timer.timeout.connect(tick)
     timer.start()
     qtbot.waitUntil(lambda: window.progress_bar.value() > 0, timeout=30000)
-    qtbot.wait(1000)
+    gaps.clear()  # from the first progress report on: the one-time Numba compilation (cached on disk) is over
+    qtbot.wait(1500)
     qtbot.mouseClick(window.cancel_button, Qt.MouseButton.LeftButton)
     qtbot.waitUntil(lambda: bool(outcomes), timeout=30000)
     timer.stop()
     assert outcomes[0].cancelled and outcomes[0].result is None
     assert len(gaps) > 50
-    assert max(gaps[5:]) < 0.1, f"event loop stalled for {max(gaps[5:]) * 1000:.0f} ms"
+    assert max(gaps) < 0.1, f"event loop stalled for {max(gaps) * 1000:.0f} ms"
 
 
 def test_autosave_and_recovery_after_a_crash(qtbot, make_window, tmp_path: Path) -> None:
@@ -299,3 +290,23 @@ def test_fly_over_terrain_never_goes_below_the_ground(qtbot, make_window) -> Non
     x, y, z = window.plotter.camera.position
     assert z >= terrain.height_at(x, y)
     assert z == pytest.approx(terrain.height_at(x, y) + window.fly.navigator.clearance)
+
+
+def test_paraview_preset_export_import_round_trip_and_bad_file(qtbot, make_window, tmp_path: Path) -> None:
+    window = make_window()
+    window.open_path(data_file("volumes/neghip.slc"))
+    wait_loaded(qtbot, window)
+    editor = window.tf_editor
+    editor.apply_preset("viridis")
+    exported = tmp_path / "viridis.json"
+    editor.export_paraview(str(exported))
+    colors = editor.transfer_function.colors.copy()
+    editor.apply_preset("grayscale")
+    assert not np.allclose(editor.transfer_function.colors, colors)
+    assert editor.import_paraview(str(exported))
+    assert np.allclose(editor.transfer_function.colors, colors, atol=1e-6)
+    bad = tmp_path / "bad.json"
+    bad.write_text("{not json")
+    assert not editor.import_paraview(str(bad))
+    assert "bad.json" in editor.error_dialog.text()
+    assert window.isVisible()

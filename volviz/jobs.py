@@ -86,6 +86,16 @@ class Job:
         return self.future.result(timeout)
 
 
+def _leave_a_core_free() -> None:
+    """Parallel Numba kernels started from this worker thread use all cores but one (a per-thread setting), so the
+    UI thread and the display server are never starved while background work runs."""
+    try:
+        import numba
+    except ImportError:  # pragma: no cover - numba is a dependency
+        return
+    numba.set_num_threads(max(1, numba.config.NUMBA_NUM_THREADS - 1))
+
+
 class JobRunner:
     """Runs callables on worker threads. Numba kernels (nogil) and NumPy release the GIL, so the UI stays live."""
 
@@ -114,6 +124,7 @@ class JobRunner:
                 on_progress(job_id, min(max(float(fraction), 0.0), 1.0), message)
 
         def run() -> JobOutcome:
+            _leave_a_core_free()
             outcome = JobOutcome(job_id, label)
             try:
                 token.raise_if_cancelled()

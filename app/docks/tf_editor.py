@@ -12,8 +12,8 @@ from typing import Any, Optional
 import numpy as np
 from PySide6.QtCore import QPointF, QRectF, Qt, Signal
 from PySide6.QtGui import QBrush, QColor, QLinearGradient, QPainter, QPainterPath, QPen, QUndoCommand, QUndoStack
-from PySide6.QtWidgets import (QCheckBox, QColorDialog, QComboBox, QFileDialog, QHBoxLayout, QLabel, QPushButton,
-                               QSizePolicy, QVBoxLayout, QWidget)
+from PySide6.QtWidgets import (QCheckBox, QColorDialog, QComboBox, QFileDialog, QHBoxLayout, QLabel, QMessageBox,
+                               QPushButton, QSizePolicy, QVBoxLayout, QWidget)
 
 from volviz.optics import TransferFunction
 
@@ -346,10 +346,20 @@ class TransferFunctionEditor(QWidget):
         if path:
             self.import_paraview(path)
 
-    def import_paraview(self, path: str) -> None:
+    def import_paraview(self, path: str) -> bool:
+        """Colours from the first preset of a ParaView JSON file; a bad file gives a message, not a crash."""
         from volviz.optics.presets import read_paraview_presets
 
-        self.edit(self._recolor(read_paraview_presets(path)[0]), "Import colour map")
+        try:
+            preset = read_paraview_presets(path)[0]
+        except ValueError as exc:
+            box = QMessageBox(QMessageBox.Icon.Warning, "Cannot import colour map", str(exc),
+                              QMessageBox.StandardButton.Ok, self)
+            box.open()
+            self.error_dialog = box
+            return False
+        self.edit(self._recolor(preset), "Import colour map")
+        return True
 
     def _ask_export(self) -> None:
         path, _ = QFileDialog.getSaveFileName(self, "Export ParaView colour map", "colormap.json", "JSON (*.json)")

@@ -88,7 +88,7 @@ def _incremental_fill(front, work, mask, nearest, k_start, k_stop):
                     work[j, k, i, ch] = f + (1.0 - fa) * back
 
 
-_CHUNK_SEGMENTS = 1 << 20  # segments integrated per progress step (≈ 32 MiB of float64 RGBA)
+_CHUNK_SEGMENTS = 1 << 16  # segments per progress step (2 MiB of float64 RGBA): short GIL holds, prompt cancel
 
 
 def _fill(tf: TransferFunction, out: np.ndarray, s: np.ndarray, ls: np.ndarray, mask: np.ndarray, method: str,
