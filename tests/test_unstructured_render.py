@@ -137,7 +137,7 @@ def test_shirley_tuchman_classes_and_classic_pt():
     cls = st.extra["classes"]
     assert cls[0] == 0 and cls[1] + cls[2] == m.n_cells and cls[1] > 0 and cls[2] > 0
     assert st.extra["triangles"] == 3 * cls[1] + 4 * cls[2]
-    exact = render(m, TF, par, SIZE, "pt")
+    exact = render(m, TF, par, SIZE, "pt", lookup="3d")                 # the same (3D) table as "pt-st"
     assert _err(img, exact)[1] < 1e-6
     # degenerate projections: a regular grid seen exactly along z has edge-on faces and vertices on edges
     along = Camera((0.5, 0.5, 4.0), (0.5, 0.5, 0.0), (0, 1, 0), parallel=True, parallel_scale=0.6,
@@ -146,3 +146,17 @@ def test_shirley_tuchman_classes_and_classic_pt():
     img, st = render(grid, TF, along, (33, 33), "pt-st", return_stats=True)
     assert st.extra["classes"][0] > 0                            # vertices on edges / on one point
     assert _err(img, render(grid, TF, along, (33, 33), "reference"))[1] <= 4.0
+
+
+@pytest.mark.parametrize("lookup,degree,scale", [("separable", 2, 1.0), ("separable", 4, 4.0), ("3d", None, 4.0),
+                                                 ("auto", None, 8.0)])
+def test_every_lookup_matches_reference(lookup, degree, scale):
+    """Separable (Roettger §9.1: exact opacity, colour polynomial in l) and 3D tables, and the automatic choice by
+    optical depth per cell (2 ... 20 here)."""
+    m = syn.box_tets(5, jitter=0.3)
+    tf = TF.scaled_extinction(scale)
+    cam = Camera.orbit(m.points, 25, 30, 2.0)
+    ref = render(m, tf, cam, SIZE, "reference")
+    img = render(m, tf, cam, SIZE, "pt", lookup=lookup, degree=degree)
+    e = _err(img, ref)
+    assert e[0] <= 0.5 and e[1] <= 2.0, e

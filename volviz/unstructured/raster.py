@@ -17,11 +17,16 @@ vector), so the two cells sharing the face do not both draw it (before: 79/255 e
 
 Compositing is front to back over the reversed visibility order (equivalent to back-to-front "over",
 C = C_seg + (1 - a_seg) C_behind), in screen tiles processed in parallel; a tile stops when every pixel's transmittance
-is below ``t_min`` (early ray termination; error <= t_min per channel). The table lookup is trilinear.
+is below ``t_min`` (early ray termination; error <= t_min per channel). The segment colour comes from the separable
+tables (Roettger §9.1: exact opacity 1 - exp(-l rho_hat), colour polynomial of degree 2 in l; default, 256^2) or the
+3D table (trilinear). Measured on the Blunt Fin at 512^2 against the reference: separable 256^2 degree 2 RMSE 0.04,
+max 0.23 (8-bit); 3D 128^2 x 64 RMSE 0.43, max 1.9; the separable lookup's table (2.6 MB) stays in cache where the
+3D one (16 MB) does not, and it took about 2/3 of the raster time of the trilinear lookup.
 """
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 from numba import njit, prange
@@ -207,9 +212,72 @@ def _lookup(flat: np.ndarray, n: int, nl: int, s_lo: float, inv_ds: float, inv_d
     return r0, r1, r2, r3
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _lookup_separable(flat: np.ndarray, n: int, nc: int, deg: int, s_lo: float, inv_ds: float, inv_lmax: float,
+                      k0: float, k1: float, k2: float, sf: float, sb: float, ln: float
+                      ) -> tuple[float, float, float, float]:
+    """Separable pre-integration (Roettger §9.1): bilinear rho_hat and colour coefficients in (s_f, s_b),
+    a = 1 - exp(-l rho_hat) (exact in l), colour = a clamp(sum_i C_i u^i), u = l / l_max clamped to [0, 1]."""
+    fi = min(max((sf - s_lo) * inv_ds, 0.0), n - 1.0)
+    fj = min(max((sb - s_lo) * inv_ds, 0.0), n - 1.0)
+    i = min(int(fi), n - 2)
+    j = min(int(fj), n - 2)
+    wi = fi - i
+    wj = fj - j
+    w00 = (1.0 - wi) * (1.0 - wj)
+    w01 = (1.0 - wi) * wj
+    w10 = wi * (1.0 - wj)
+    w11 = wi * wj
+    b00 = (i * n + j) * nc
+    b01 = b00 + nc
+    b10 = b00 + n * nc
+    b11 = b10 + nc
+    rho = w00 * flat[b00] + w01 * flat[b01] + w10 * flat[b10] + w11 * flat[b11]
+    a = -math.expm1(-ln * rho)
+    u = min(max(ln * inv_lmax, 0.0), 1.0)
+    c0 = 0.0
+    c1 = 0.0
+    c2 = 0.0
+    for d in range(deg, -1, -1):
+        o = 1 + 3 * d
+        c0 = c0 * u + (w00 * flat[b00 + o] + w01 * flat[b01 + o] + w10 * flat[b10 + o] + w11 * flat[b11 + o])
+        o += 1
+        c1 = c1 * u + (w00 * flat[b00 + o] + w01 * flat[b01 + o] + w10 * flat[b10 + o] + w11 * flat[b11 + o])
+        o += 1
+        c2 = c2 * u + (w00 * flat[b00 + o] + w01 * flat[b01 + o] + w10 * flat[b10 + o] + w11 * flat[b11 + o])
+    c0 = min(max(c0, 0.0), k0)
+    c1 = min(max(c1, 0.0), k1)
+    c2 = min(max(c2, 0.0), k2)
+    return c0 * a, c1 * a, c2 * a, a
+
+
+def lut_args(table: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(flat float32 data, int64 [kind, n_s, n_l or channels, degree], float64 [s_lo, 1/ds, 1/dl or 1/l_max,
+    kappa_max (3)]) of a ``Table3D`` (kind 0) or a ``SeparableTable`` (kind 1) for the raster kernels."""
+    if hasattr(table, "rgba"):
+        flat = np.ascontiguousarray(table.rgba, dtype=np.float32).ravel()
+        ip = np.array([0, table.rgba.shape[0], table.rgba.shape[2], 0], np.int64)
+        fp = np.array([table.s_lo, 1.0 / table.ds, 1.0 / table.dl, 0.0, 0.0, 0.0])
+    else:
+        flat = np.ascontiguousarray(table.data, dtype=np.float32).ravel()
+        ip = np.array([1, table.data.shape[0], table.data.shape[2], table.degree], np.int64)
+        k = np.asarray(table.kappa_max, dtype=np.float64)
+        fp = np.array([table.s_lo, 1.0 / table.ds, 1.0 / table.l_max, k[0], k[1], k[2]])
+    return flat, ip, fp
+
+
+@njit(cache=True, nogil=True, inline="always")
+def lookup_any(flat: np.ndarray, ip: np.ndarray, fp: np.ndarray, sf: float, sb: float, ln: float
+               ) -> tuple[float, float, float, float]:
+    """Premultiplied RGBA of the segment (s_f, s_b, l) from the table described by ``lut_args``."""
+    if ip[0] == 0:
+        return _lookup(flat, ip[1], ip[2], fp[0], fp[1], fp[2], sf, sb, ln)
+    return _lookup_separable(flat, ip[1], ip[2], ip[3], fp[0], fp[1], fp[2], fp[3], fp[4], fp[5], sf, sb, ln)
+
+
 @njit(cache=True, nogil=True, parallel=True)
 def raster_tiles(box: np.ndarray, coef: np.ndarray, vxy: np.ndarray, ptr: np.ndarray, items: np.ndarray, tile_order: np.ndarray,
-                 rb: np.ndarray, near: float, far: float, table: np.ndarray, s_lo: float, ds: float, dl: float,
+                 rb: np.ndarray, near: float, far: float, lut: np.ndarray, lut_i: np.ndarray, lut_f: np.ndarray,
                  width: int, height: int, tile: int, t_min: float, tol: float, far_px: np.ndarray,
                  image: np.ndarray) -> np.ndarray:
     """Composite every tile's cells front to back into ``image`` (H, W, 4); returns fragments drawn per tile.
@@ -219,11 +287,6 @@ def raster_tiles(box: np.ndarray, coef: np.ndarray, vxy: np.ndarray, ptr: np.nda
     use_far = far_px.shape[0] == height and far_px.shape[1] == width
     tx = (width + tile - 1) // tile
     frags = np.zeros(len(tile_order), np.int64)
-    inv_ds = 1.0 / ds
-    inv_dl = 1.0 / dl
-    n_s = table.shape[0]
-    n_l = table.shape[2]
-    flat = table.ravel()
     for ti in prange(len(tile_order)):
         t = tile_order[ti]
         x0 = (t % tx) * tile
@@ -284,7 +347,7 @@ def raster_tiles(box: np.ndarray, coef: np.ndarray, vxy: np.ndarray, ptr: np.nda
                     sa = cq[24] + px * cq[25] + py * cq[26]
                     sb = cq[27] + px * cq[28] + py * cq[29]
                     ln = (t1 - t0) * dn
-                    c0, c1, c2, c3 = _lookup(flat, n_s, n_l, s_lo, inv_ds, inv_dl, sa + t0 * sb, sa + t1 * sb, ln)
+                    c0, c1, c2, c3 = lookup_any(lut, lut_i, lut_f, sa + t0 * sb, sa + t1 * sb, ln)
                     col[ly, lx, 0] += tr * c0
                     col[ly, lx, 1] += tr * c1
                     col[ly, lx, 2] += tr * c2
