@@ -27,6 +27,9 @@ class SceneController:
         self.props = build_scene(self.plotter, self.session, self.datasets)
         span = self.time_span()
         self.time = span[0] if span else 0.0
+        start = self.session.render.options.get("time")
+        if span and isinstance(start, (int, float)) and start != self.time:
+            self.set_time(float(start))  # the session's display time
 
     def component(self, comp_id: str) -> Component:
         for comp in self.session.components:
@@ -116,9 +119,17 @@ class SceneController:
         self.time = float(t)
         for comp_id, series in self.time_series().items():
             prop = self.props.get(comp_id)
-            if prop is None or not prop.IsA("vtkVolume"):
+            if prop is None:
                 continue
-            prop.GetMapper().SetInputData(volume_input(frame_at(series, self.time, self.interpolate_time)))
+            comp = self.component(comp_id)
+            if comp.type == "isosurface":  # re-extract at the new time (the 4D blend happens in prepare)
+                from volviz.render.scene import add_isosurfaces
+
+                self.plotter.remove_actor(prop, render=False)
+                comp.settings = {**comp.settings, "interpolate": self.interpolate_time}
+                self.props[comp_id] = add_isosurfaces(self.plotter, comp, series, self.time)
+            elif prop.IsA("vtkVolume"):
+                prop.GetMapper().SetInputData(volume_input(frame_at(series, self.time, self.interpolate_time)))
 
     # -- camera -----------------------------------------------------------------------------------------------------
     def camera(self) -> CameraState:

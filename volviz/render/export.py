@@ -15,6 +15,11 @@ from volviz.session import Session, atomic_write_bytes
 def offscreen_plotter(size: tuple[int, int]) -> Any:
     import pyvista as pv
 
+    if not os.environ.get("DISPLAY"):  # VTK tries X first and warns before it falls back to EGL: not the user's concern
+        from vtkmodules.vtkCommonCore import vtkLogger
+
+        vtkLogger.SetStderrVerbosity(vtkLogger.VERBOSITY_ERROR)
+
     return pv.Plotter(off_screen=True, window_size=[int(size[0]), int(size[1])])
 
 

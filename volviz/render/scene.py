@@ -136,6 +136,9 @@ def build_scene(plotter: Any, session: Session, datasets: dict[str, Any]) -> dic
         if not comp.visible or comp.type in NATURE_TYPES:
             continue
         dataset = component_dataset(comp, datasets)
+        if comp.type == "isosurface":
+            props[comp.id] = add_isosurfaces(plotter, comp, dataset)
+            continue
         tf = component_transfer_function(session, comp)
         props[comp.id] = add_dataset(plotter, dataset, tf=tf, opacity=comp.opacity, name=comp.id)
     plotter.set_background(session.render.background)
@@ -144,6 +147,28 @@ def build_scene(plotter: Any, session: Session, datasets: dict[str, Any]) -> dic
     if nature is not None:
         props["nature"] = nature
     return props
+
+
+def add_isosurfaces(plotter: Any, comp: Component, dataset: Any, t: Optional[float] = None) -> Any:
+    """The isosurfaces of an ``isosurface`` component (settings: ``volviz.iso.IsoSettings``) as one prop assembly of
+    VTK actors with the iso-spectrum shader (drawn by VTK as the note's 2-pass blend)."""
+    import vtk
+
+    from volviz.iso import IsoSettings, iso_actor, prepare
+
+    try:
+        settings = IsoSettings.from_dict(comp.settings)
+    except ValueError as exc:
+        raise SceneError(f"component {comp.id!r}: {exc}") from None
+    if not settings.styles:
+        raise SceneError(f"component {comp.id!r}: settings.styles lists no iso-values")
+    prepared = prepare(dataset, settings, t)
+    assembly = vtk.vtkPropAssembly()
+    for mesh in prepared.meshes:
+        if len(mesh.triangles):
+            assembly.AddPart(iso_actor(mesh, parallel=bool(plotter.camera.parallel_projection)))
+    plotter.add_actor(assembly, name=comp.id, reset_camera=False)
+    return assembly
 
 
 def build_nature(plotter: Any, session: Session, datasets: dict[str, Any]) -> Any:

@@ -1,0 +1,73 @@
+"""Sessions rendered offscreen: isosurface components over a time series, display time, movies, file modes."""
+from __future__ import annotations
+
+import json
+import os
+import stat
+from pathlib import Path
+
+import imageio.v3 as iio
+import numpy as np
+
+from conftest import data_file
+from volviz.cli import main
+
+
+def storm_iso_session(tmp_path: Path, time: float) -> Path:
+    storm = data_file("storm/Storm.pvm-t01").parent
+    doc = {
+        "format": "volviz-session", "version": 1,
+        "datasets": [{"id": "storm", "path": os.path.relpath(storm / "Storm.pvm-t%02d", tmp_path)}],
+        "components": [{"id": "iso", "type": "isosurface", "dataset": "storm", "settings": {
+            "styles": [{"value": 40, "color": [0.2, 0.5, 1.0], "opacity": 0.3},
+                       {"value": 120, "color": [1.0, 0.8, 0.2], "opacity": 0.6}]}}],
+        "camera": {"position": [80, -40, 60], "focal_point": [14, 14, 11], "view_up": [0, 0, 1], "view_angle": 30},
+        "render": {"options": {"time": time}, "background": [0, 0, 0]},
+    }
+    path = tmp_path / f"storm-iso-{time}.json"
+    path.write_text(json.dumps(doc))
+    return path
+
+
+def lit_fraction(image: np.ndarray) -> float:
+    return float((image[..., :3].astype(int).sum(axis=2) > 30).mean())
+
+
+def test_isosurface_session_follows_the_display_time(tmp_path: Path) -> None:
+    empty, stormy = tmp_path / "t1.png", tmp_path / "t12.png"
+    assert main(["render", str(storm_iso_session(tmp_path, 1.0)), "-o", str(empty), "--size", "160x120"]) == 0
+    assert main(["render", str(storm_iso_session(tmp_path, 12.5)), "-o", str(stormy), "--size", "160x120"]) == 0
+    assert lit_fraction(iio.imread(empty)) == 0.0  # the storm has not formed at t = 1: no isosurface
+    assert lit_fraction(iio.imread(stormy)) > 0.02
+    mode = stat.S_IMODE(stormy.stat().st_mode)
+    assert mode & 0o044, f"exported file is not readable by others (mode {mode:o})"
+
+
+def test_movie_through_time_as_png_sequence(tmp_path: Path) -> None:
+    frames = tmp_path / "frames"
+    session = storm_iso_session(tmp_path, 1.0)
+    assert main(["render", str(session), "--time", "--fps", "2", "--duration", "2", "-o", str(frames),
+                 "--size", "96x64"]) == 0
+    images = [iio.imread(p) for p in sorted(frames.glob("frame_*.png"))]
+    assert len(images) == 5
+    lit = [lit_fraction(im) for im in images]
+    assert lit[0] == 0.0 and lit[-1] > 0.02  # from the empty first step to the grown storm
+
+
+def test_movie_mp4(tmp_path: Path) -> None:
+    out = tmp_path / "storm.mp4"
+    assert main(["render", str(storm_iso_session(tmp_path, 1.0)), "--time", "--fps", "4", "--duration", "1",
+                 "-o", str(out), "--size", "96x64"]) == 0
+    import imageio.v2 as iio2
+
+    reader = iio2.get_reader(out, format="FFMPEG")
+    count = sum(1 for _ in reader)
+    reader.close()
+    assert count == 5
+    assert not list(tmp_path.glob(".*partial*"))
+
+
+def test_missing_camera_path_is_a_clear_error(tmp_path: Path, capsys) -> None:
+    assert main(["render", str(storm_iso_session(tmp_path, 1.0)), "--path", "nope", "-o",
+                 str(tmp_path / "x.mp4")]) == 2
+    assert "no camera path named 'nope'" in capsys.readouterr().err
