@@ -310,3 +310,22 @@ def test_paraview_preset_export_import_round_trip_and_bad_file(qtbot, make_windo
     assert not editor.import_paraview(str(bad))
     assert "bad.json" in editor.error_dialog.text()
     assert window.isVisible()
+
+
+def test_dock_layout_is_restored_from_the_session(qtbot, make_window, tmp_path: Path) -> None:
+    window = make_window()
+    window.open_path(data_file("volumes/neghip.slc"))
+    wait_loaded(qtbot, window)
+    window.timeline_dock.hide()
+    window.removeDockWidget(window.stats_dock)
+    window.addDockWidget(Qt.DockWidgetArea.LeftDockWidgetArea, window.stats_dock)
+    window.stats_dock.show()
+    session_file = tmp_path / "layout.json"
+    assert window.save_session(session_file)
+
+    other = make_window()
+    assert other.timeline_dock.isVisible()
+    other.open_path(session_file)
+    wait_loaded(qtbot, other)
+    assert not other.timeline_dock.isVisible()
+    assert other.dockWidgetArea(other.stats_dock) == Qt.DockWidgetArea.LeftDockWidgetArea

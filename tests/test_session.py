@@ -125,3 +125,20 @@ def test_relative_paths(tmp_path: Path) -> None:
     stored = S.relative_path(session_file, data)
     assert stored == "../data/v.slc"
     assert S.resolve_path(session_file, stored) == data.resolve()
+
+
+def test_older_versions_are_migrated_step_by_step(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Version 1 is the first format; this exercises the migration chain the way a version 2 will use it."""
+    def v1_to_v2(doc: dict) -> dict:
+        doc["render"]["options"]["migrated"] = True
+        return doc
+
+    doc = S.session_to_dict(sample_session())
+    path = tmp_path / "old.json"
+    path.write_text(json.dumps(doc))
+    monkeypatch.setattr(S, "VERSION", 2)
+    monkeypatch.setitem(S.MIGRATIONS, 1, v1_to_v2)
+    loaded = S.load(path)
+    assert loaded.render.options["migrated"] is True
+    S.save(loaded, tmp_path / "new.json")
+    assert json.loads((tmp_path / "new.json").read_text())["version"] == 2
