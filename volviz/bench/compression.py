@@ -385,6 +385,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return main_animation(args, argv)
     results: dict[str, list[dict[str, Any]]] = {}
     peaks: dict[str, float] = {}
+    env0 = _load_avg()
     with tempfile.TemporaryDirectory(prefix="vvzbench") as td:
         for name in args.volumes:
             vol, peak = _load(name)
@@ -402,7 +403,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     cmd = "volviz bench compression " + " ".join(argv if argv is not None else sys.argv[1:])
-    env = f"Machine: {platform.machine()}, {os.cpu_count()} cores (shared with other jobs), Python {platform.python_version()}."
+    env = (f"Machine: {platform.machine()}, {os.cpu_count()} cores shared with other engineers' jobs; {env0} at the "
+           f"start, {_load_avg()} at the end. Python {platform.python_version()}.")
     md = _markdown(results, peaks, cmd.strip(), "compression.png", env)
     md += "\n## Summary (PSNR interpolated in log bits/voxel between measured points)\n\n```\n" + json.dumps(
         summary, indent=1) + "\n```\n"
