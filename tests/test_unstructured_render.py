@@ -160,3 +160,16 @@ def test_every_lookup_matches_reference(lookup, degree, scale):
     img = render(m, tf, cam, SIZE, "pt", lookup=lookup, degree=degree)
     e = _err(img, ref)
     assert e[0] <= 0.5 and e[1] <= 2.0, e
+
+
+def test_million_tetrahedra_small_image():
+    """A conforming grid of 1,026,895 tetrahedra (59^3 hexahedra x 5) at 24 x 20 pixels: the MPVO order, the
+    projection and the raster scale to 10^6 cells and still match the reference."""
+    m = syn.box_tets(60)
+    assert m.n_cells == 5 * 59 ** 3 > 10 ** 6
+    cam = Camera.orbit(m.points, 30, 20, 2.5)
+    img, st = render(m, TF, cam, (24, 20), "pt", return_stats=True)
+    ref = render(m, TF, cam, (24, 20), "reference")
+    assert st.n_visible > 10 ** 5 and st.cycles == 0 and ref[..., 3].max() > 0.5
+    e = _err(img, ref)
+    assert e[0] <= 1.0 and e[1] <= 4.0, e

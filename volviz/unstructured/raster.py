@@ -171,22 +171,26 @@ def bin_tiles(box: np.ndarray, width: int, height: int, tile: int) -> tuple[np.n
 
 
 @njit(cache=True, nogil=True, inline="always")
+def _bin(x: float, inv_step: float, n: int) -> tuple[int, float]:
+    """Table cell and weight of x (in table units after * inv_step), clamped to [0, n - 1]."""
+    f = min(max(x * inv_step, 0.0), n - 1.0)
+    i = min(int(f), n - 2)
+    return i, f - i
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _bilinear_weights(wi: float, wj: float) -> tuple[float, float, float, float]:
+    return (1.0 - wi) * (1.0 - wj), (1.0 - wi) * wj, wi * (1.0 - wj), wi * wj
+
+
+@njit(cache=True, nogil=True, inline="always")
 def _lookup(flat: np.ndarray, n: int, nl: int, s_lo: float, inv_ds: float, inv_dl: float, sf: float, sb: float,
             ln: float) -> tuple[float, float, float, float]:
     """Trilinear lookup in the flattened (n, n, nl, 4) table; scalars clamp to the table, l clamps to l_max."""
-    fi = min(max((sf - s_lo) * inv_ds, 0.0), n - 1.0)
-    fj = min(max((sb - s_lo) * inv_ds, 0.0), n - 1.0)
-    fk = min(max(ln * inv_dl, 0.0), nl - 1.0)
-    i = min(int(fi), n - 2)
-    j = min(int(fj), n - 2)
-    k = min(int(fk), nl - 2)
-    wi = fi - i
-    wj = fj - j
-    wk = fk - k
-    w00 = (1.0 - wi) * (1.0 - wj)
-    w01 = (1.0 - wi) * wj
-    w10 = wi * (1.0 - wj)
-    w11 = wi * wj
+    i, wi = _bin(sf - s_lo, inv_ds, n)
+    j, wj = _bin(sb - s_lo, inv_ds, n)
+    k, wk = _bin(ln, inv_dl, nl)
+    w00, w01, w10, w11 = _bilinear_weights(wi, wj)
     sj = nl * 4
     si = n * sj
     b = i * si + j * sj + k * 4
@@ -218,16 +222,9 @@ def _lookup_separable(flat: np.ndarray, n: int, nc: int, deg: int, s_lo: float, 
                       ) -> tuple[float, float, float, float]:
     """Separable pre-integration (Roettger §9.1): bilinear rho_hat and colour coefficients in (s_f, s_b),
     a = 1 - exp(-l rho_hat) (exact in l), colour = a clamp(sum_i C_i u^i), u = l / l_max clamped to [0, 1]."""
-    fi = min(max((sf - s_lo) * inv_ds, 0.0), n - 1.0)
-    fj = min(max((sb - s_lo) * inv_ds, 0.0), n - 1.0)
-    i = min(int(fi), n - 2)
-    j = min(int(fj), n - 2)
-    wi = fi - i
-    wj = fj - j
-    w00 = (1.0 - wi) * (1.0 - wj)
-    w01 = (1.0 - wi) * wj
-    w10 = wi * (1.0 - wj)
-    w11 = wi * wj
+    i, wi = _bin(sf - s_lo, inv_ds, n)
+    j, wj = _bin(sb - s_lo, inv_ds, n)
+    w00, w01, w10, w11 = _bilinear_weights(wi, wj)
     b00 = (i * n + j) * nc
     b01 = b00 + nc
     b10 = b00 + n * nc
@@ -253,8 +250,15 @@ def _lookup_separable(flat: np.ndarray, n: int, nc: int, deg: int, s_lo: float, 
 
 def lut_args(table: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(flat float32 data, int64 [kind, n_s, n_l or channels, degree], float64 [s_lo, 1/ds, 1/dl or 1/l_max,
-    kappa_max (3)]) of a ``Table3D`` (kind 0) or a ``SeparableTable`` (kind 1) for the raster kernels."""
-    if hasattr(table, "rgba"):
+    kappa_max (3)]) of a ``Table3D`` (kind 0), a ``SeparableTable`` (kind 1) or an ``IsoTable`` (kind 2: its
+    isosurfaces evaluated exactly, not its texture) for the raster kernels."""
+    if hasattr(table, "isosurfaces"):                       # exact flat isosurfaces (kind 2)
+        isos = sorted(table.isosurfaces, key=lambda i: i.value)
+        flat = np.array([[i.value, i.opacity, *i.color, *(i.color if i.back_color is None else i.back_color)]
+                         for i in isos], dtype=np.float32).ravel()
+        ip = np.array([2, len(isos), 8, 0], np.int64)
+        fp = np.array([table.thicken, 0.0, 0.0, 0.0, 0.0, 0.0])
+    elif hasattr(table, "rgba"):
         flat = np.ascontiguousarray(table.rgba, dtype=np.float32).ravel()
         ip = np.array([0, table.rgba.shape[0], table.rgba.shape[2], 0], np.int64)
         fp = np.array([table.s_lo, 1.0 / table.ds, 1.0 / table.dl, 0.0, 0.0, 0.0])
@@ -266,12 +270,44 @@ def lut_args(table: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return flat, ip, fp
 
 
+@njit(cache=True, nogil=True)
+def _iso_exact(flat: np.ndarray, n: int, thicken: float, sf: float, sb: float) -> tuple[float, float, float, float]:
+    """Exact flat isosurfaces crossed by the segment (Roettger §8.13 Heaviside limit, H(0) = 1/2), front to back;
+    ``flat`` holds per surface (ascending values) value, opacity, colour (3), back colour (3)."""
+    lo = min(sf, sb)
+    hi = max(sf, sb)
+    asc = sb >= sf
+    tr = 1.0
+    c0 = 0.0
+    c1 = 0.0
+    c2 = 0.0
+    for idx in range(n):
+        k = 8 * (idx if asc else n - 1 - idx)
+        v = flat[k]
+        h = 0.0
+        if thicken > 0.0:
+            if lo - thicken <= v <= hi + thicken:
+                h = 1.0
+        elif lo < hi:
+            h = (1.0 if lo < v else (0.5 if lo == v else 0.0)) * (1.0 if hi > v else (0.5 if hi == v else 0.0))
+        a = h * flat[k + 1]
+        if a > 0.0:
+            o = k + 2 if asc else k + 5
+            c0 += tr * a * flat[o]
+            c1 += tr * a * flat[o + 1]
+            c2 += tr * a * flat[o + 2]
+            tr *= 1.0 - a
+    return c0, c1, c2, 1.0 - tr
+
+
 @njit(cache=True, nogil=True, inline="always")
 def lookup_any(flat: np.ndarray, ip: np.ndarray, fp: np.ndarray, sf: float, sb: float, ln: float
                ) -> tuple[float, float, float, float]:
     """Premultiplied RGBA of the segment (s_f, s_b, l) from the table described by ``lut_args``."""
     if ip[0] == 0:
         return _lookup(flat, ip[1], ip[2], fp[0], fp[1], fp[2], sf, sb, ln)
+    if ip[0] == 2:
+        return _iso_exact(flat, ip[1], fp[0], sf, sb)
     return _lookup_separable(flat, ip[1], ip[2], ip[3], fp[0], fp[1], fp[2], fp[3], fp[4], fp[5], sf, sb, ln)
 
 

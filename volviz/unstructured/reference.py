@@ -22,7 +22,7 @@ Robustness (the ground truth must not depend on round-off):
 """
 from __future__ import annotations
 
-from typing import Any, Iterator
+from typing import Any, Callable, Iterator
 
 import numpy as np
 from numba import njit
@@ -202,14 +202,21 @@ def iter_ray_segments(mesh: TetMesh, camera: Camera, size: tuple[int, int], band
 
 
 def render_reference(mesh: TetMesh, tf: Any, camera: Camera, size: tuple[int, int], band_rows: int = 32,
-                     max_segments: int = 4_000_000, depth: np.ndarray | None = None) -> np.ndarray:
-    """Exact float64 image (H, W, 4), premultiplied RGBA, row 0 at the top (``depth``: per-pixel far limits)."""
+                     max_segments: int = 4_000_000, depth: np.ndarray | None = None,
+                     segment_rgba: Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray] | None = None
+                     ) -> np.ndarray:
+    """Exact float64 image (H, W, 4), premultiplied RGBA, row 0 at the top (``depth``: per-pixel far limits).
+    ``segment_rgba(s_f, s_b, l)`` replaces the exact TF integral (e.g. exact flat isosurfaces)."""
     from volviz.optics import integrate_segment
+
+    if segment_rgba is None:
+        def segment_rgba(sf: np.ndarray, sb: np.ndarray, ln: np.ndarray) -> np.ndarray:
+            return integrate_segment(tf, sf, sb, ln)
 
     w, h = (int(v) for v in size)
     out = np.zeros((h * w, 4))
     for pix, seg in iter_ray_segments(mesh, camera, (w, h), band_rows, max_segments, depth):
-        rgba = np.asarray(integrate_segment(tf, seg[:, 1], seg[:, 2], seg[:, 3]), dtype=np.float64)
+        rgba = np.asarray(segment_rgba(seg[:, 1], seg[:, 2], seg[:, 3]), dtype=np.float64)
         _composite_front_to_back(pix, np.ascontiguousarray(rgba), out)
     return np.nan_to_num(out.reshape(h, w, 4), nan=0.0, posinf=0.0, neginf=0.0)
 

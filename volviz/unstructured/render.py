@@ -23,6 +23,7 @@ import numpy as np
 
 from volviz.model.datasets import TetMesh
 from volviz.unstructured.camera import Camera
+from volviz.unstructured.iso import iso_lut, iso_segment_rgba, iso_visible
 from volviz.unstructured.project import raster_triangles, shirley_tuchman
 from volviz.unstructured.raster import SOS, TILE, bin_tiles, lut_args, project_cells, raster_tiles
 from volviz.unstructured.reference import depth_limits, render_reference
@@ -108,7 +109,8 @@ def _table_for(mesh: TetMesh, tf: Any, kind: str, sizes: tuple[int, int], l_max:
 def render(mesh: TetMesh, tf: Any, camera: Camera, size: tuple[int, int] = (512, 512), method: str = "pt", *,
            sort: str = "mpvo", nonconvex: str = "auto", order: np.ndarray | None = None, lookup: str = "auto",
            n_s: int | None = None, n_l: int = 64, degree: int | None = None, table: Any = None, t_min: float = 1e-3,
-           depth: np.ndarray | None = None, return_stats: bool = False) -> np.ndarray | tuple[np.ndarray, RenderStats]:
+           depth: np.ndarray | None = None, iso: Any = None, iso_mode: str = "exact", return_stats: bool = False
+           ) -> np.ndarray | tuple[np.ndarray, RenderStats]:
     """Render ``mesh`` with transfer function ``tf`` seen by ``camera`` into a (H, W, 4) premultiplied RGBA image.
 
     ``order`` (a back-to-front cell order, e.g. from a background sort) skips the sort. ``lookup`` picks the
@@ -119,6 +121,12 @@ def render(mesh: TetMesh, tf: Any, camera: Camera, size: tuple[int, int] = (512,
     ``depth`` (H, W): a per-pixel far limit on the depth along the direction of projection (the ray parameter t of
     ``Camera.rays``), e.g. opaque geometry from a z-buffer; every ray segment is clipped at it ("pt" and
     "reference"; "pt-st" refuses it).
+    ``iso`` (an ``IsoTable`` of ``volviz.optics.isosurface``) renders its flat isosurfaces instead of the volume
+    (Roettger §8.8-8.10; ``tf`` is then ignored). "pt" with ``iso_mode="exact"`` evaluates the §8.13 Heaviside
+    limit per pixel segment (equal to the reference up to float32 isovalues); ``iso_mode="texture"`` looks up the
+    bilinear (s_f, s_b) texture like the GPU method (segments ending within a texel of an isovalue are partly
+    covered: measured RMSE 5, 5% of pixels off by > 4/255 on a 7^3 jittered grid at 48 x 40). "reference" evaluates
+    the Heaviside limit per exact segment.
     """
     if method not in METHODS:
         raise ValueError(f"unknown render method {method!r}; choose one of {METHODS}")
@@ -131,13 +139,20 @@ def render(mesh: TetMesh, tf: Any, camera: Camera, size: tuple[int, int] = (512,
     w, h = (int(v) for v in size)
     stats = RenderStats(method, (w, h), n_tets=mesh.n_cells)
     t_start = time.perf_counter()
+    if iso is not None and method == "pt-st":
+        raise ValueError('isosurfaces need method "pt" or "reference"')
     if method == "reference":
-        img = render_reference(mesh, tf, camera, (w, h), depth=depth)
+        seg_fn = None if iso is None else (lambda sf, sb, ln: iso_segment_rgba(iso, sf, sb))
+        img = render_reference(mesh, tf, camera, (w, h), depth=depth, segment_rgba=seg_fn)
         stats.total_s = stats.raster_s = time.perf_counter() - t_start
         return (img, stats) if return_stats else img
     topo = topology(mesh)
     t0 = time.perf_counter()
-    if table is None:
+    if iso is not None:
+        if iso_mode not in ("exact", "texture"):
+            raise ValueError(f"iso_mode must be 'exact' or 'texture', got {iso_mode!r}")
+        table = iso if iso_mode == "exact" else iso_lut(iso)
+    elif table is None:
         l_max = max(topo.max_edge, 1e-12)
         if lookup == "auto":
             lookup, auto_degree = auto_lookup(tf.max_extinction * l_max)
@@ -155,7 +170,7 @@ def render(mesh: TetMesh, tf: Any, camera: Camera, size: tuple[int, int] = (512,
         order = res.order
         stats.cycles, stats.boundary_relations = res.cycles, res.boundary_relations
     stats.sort_method = sort
-    vis = visible_cells(mesh, tf.scalars, tf.extinction)
+    vis = visible_cells(mesh, tf.scalars, tf.extinction) if iso is None else iso_visible(mesh, iso)
     cells = np.ascontiguousarray(order[vis[order]], dtype=np.int64)
     stats.n_visible = int(len(cells))
     stats.sort_s = time.perf_counter() - t0
