@@ -145,3 +145,12 @@ def test_prefetch_in_a_worker_thread_fills_the_cache(noisy):
     n = tree.decoder.decoded_bricks
     assert np.array_equal(tree.reconstruct(sel), data.astype(np.int32))
     assert tree.decoder.decoded_bricks == n  # everything came from the cache
+
+
+def test_back_to_front_order(noisy):
+    data, path = noisy
+    tree = LodTree(path, volume=RegularVolume(data))
+    cam = Camera(eye=(300.0, 20.0, 40.0), target=(32.0, 32.0, 32.0), fov_y=40, height=512)
+    order = tree.back_to_front(tree.select(cam, 8), cam)
+    assert sorted(order) == sorted(tree.select(cam, 8).nodes)
+    assert order[0][1][0] == 0 and order[-1][1][0] == 1  # the -x blocks first, the +x (near) ones last

@@ -271,26 +271,39 @@ class LodTree:
         push(root, pr, pix)
         while heap:
             negp, key, _ = heapq.heappop(heap)
-            kids = []
+            kids, clear, culled = [], 0, 0
             for c in self.children_keys(key):
                 if tf is not None and self.transparent(c, tf):
-                    sel.skipped_transparent += 1
+                    clear += 1
                     continue
                 vis, pr, pix = classify(c)
                 if not vis:
-                    sel.culled += 1
+                    culled += 1
                     continue
                 kids.append((c, pr, pix))
             if len(chosen) - 1 + len(kids) > budget:
                 continue
             del chosen[key]
             sel.refinements += 1
+            sel.skipped_transparent += clear
+            sel.culled += culled
             for c, pr, pix in kids:
                 chosen[c] = pr
                 push(c, pr, pix)
         sel.nodes = sorted(chosen, key=lambda k: (-k[0], k[1]))
         sel.priority = chosen
         return sel
+
+    def back_to_front(self, selection: Selection, camera: Camera) -> list[Key]:
+        """The selected nodes sorted by decreasing distance of their box centres from the eye (the drawing order
+        for "over" compositing of non-overlapping blocks, §2.3.6)."""
+        e = np.asarray(camera.eye, float)
+
+        def dist(k: Key) -> float:
+            lo, hi = self.node_box(k)
+            return float(np.linalg.norm((lo + hi) / 2 - e))
+
+        return sorted(selection.nodes, key=dist, reverse=True)
 
     # -- decoding ---------------------------------------------------------------------------------------------------
     def node(self, key: Key) -> np.ndarray:
