@@ -37,14 +37,14 @@ _SOS = SOS                  # the generic displacement of the simulation-of-simp
 
 
 @njit(cache=True, nogil=True)
-def _ray_interval(minv: np.ndarray, o: np.ndarray, d: np.ndarray, near: float, far: float, tol: float
-                  ) -> tuple[bool, float, float]:
-    """Parameter interval [t0, t1] of the ray O + tD inside the cell with barycentric map ``minv`` (4, 4)."""
+def _ray_interval(minv: np.ndarray, gnorm: np.ndarray, o: np.ndarray, d: np.ndarray, dn: float, near: float,
+                  far: float, tol: float) -> tuple[bool, float, float]:
+    """Parameter interval [t0, t1] of the ray O + tD (|D| = dn) inside the cell with barycentric map ``minv``
+    (4, 4) whose gradient rows have norms ``gnorm`` (4,)."""
     t0, t1 = near, far
-    dn = np.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
     for i in range(4):
         g0, g1, g2 = minv[i, 0], minv[i, 1], minv[i, 2]
-        gn = np.sqrt(g0 * g0 + g1 * g1 + g2 * g2)
+        gn = gnorm[i]
         a = g0 * o[0] + g1 * o[1] + g2 * o[2] + minv[i, 3]
         b = g0 * d[0] + g1 * d[1] + g2 * d[2]
         if abs(b) <= 1e-12 * gn * dn:
@@ -64,7 +64,7 @@ def _ray_interval(minv: np.ndarray, o: np.ndarray, d: np.ndarray, near: float, f
 
 
 @njit(cache=True, nogil=True)
-def _band_segments(minv: np.ndarray, svals: np.ndarray, cells: np.ndarray, bbox: np.ndarray, rb: np.ndarray,
+def _band_segments(minv: np.ndarray, gnorm: np.ndarray, svals: np.ndarray, cells: np.ndarray, bbox: np.ndarray, rb: np.ndarray,
                    near: float, far: float, tol: float, width: int, row0: int, row1: int, count_only: bool,
                    pix: np.ndarray, seg: np.ndarray, far_px: np.ndarray) -> int:
     """Intersect every pixel ray of rows [row0, row1) with the candidate cells; returns the number of segments.
@@ -82,7 +82,9 @@ def _band_segments(minv: np.ndarray, svals: np.ndarray, cells: np.ndarray, bbox:
                 for a in range(3):
                     o[a] = rb[0, a] + col * rb[1, a] + row * rb[2, a]
                     d[a] = rb[3, a] + col * rb[4, a] + row * rb[5, a]
-                ok, t0, t1 = _ray_interval(minv[c], o, d, near, min(far, far_px[row, col]) if use_far else far, tol)
+                dn = np.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
+                ok, t0, t1 = _ray_interval(minv[c], gnorm[c], o, d, dn, near,
+                                           min(far, far_px[row, col]) if use_far else far, tol)
                 if not ok:
                     continue
                 if not count_only:
@@ -99,7 +101,6 @@ def _band_segments(minv: np.ndarray, svals: np.ndarray, cells: np.ndarray, bbox:
                         hi = max(hi, svals[c, i])
                     sf = min(max(sf, lo), hi)                # a convex combination: clamp the round-off
                     sb = min(max(sb, lo), hi)
-                    dn = np.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
                     pix[k] = row * width + col
                     seg[k, 0] = t0
                     seg[k, 1] = sf
@@ -175,6 +176,7 @@ def iter_ray_segments(mesh: TetMesh, camera: Camera, size: tuple[int, int], band
     p = topo.points[topo.tets[live]]                            # (k, 4, 3) relative to origin
     mat = np.concatenate([np.transpose(p, (0, 2, 1)), np.ones((len(live), 1, 4))], axis=1)
     minv = np.ascontiguousarray(np.linalg.inv(mat))
+    gnorm = np.ascontiguousarray(np.sqrt((minv[:, :, :3] ** 2).sum(axis=2)))
     svals = np.ascontiguousarray(mesh.scalars[topo.tets[live]])
     box = screen_bboxes(camera, mesh.points, topo.tets[live], (w, h))
     on = (box[:, 0] <= box[:, 1]) & (box[:, 2] <= box[:, 3])
@@ -187,13 +189,13 @@ def iter_ray_segments(mesh: TetMesh, camera: Camera, size: tuple[int, int], band
         rows = min(band_rows, h - row)
         sel = np.nonzero(on & (box[:, 2] < row + rows) & (box[:, 3] >= row))[0]
         dummy_p, dummy_s = np.empty(0, np.int64), np.empty((0, 5))
-        n = _band_segments(minv, svals, sel, box[sel], rb, near, far, tol, w, row, row + rows, True, dummy_p,
+        n = _band_segments(minv, gnorm, svals, sel, box[sel], rb, near, far, tol, w, row, row + rows, True, dummy_p,
                            dummy_s, far_px)
         if n > max_segments and rows > 1:
             band_rows = max(1, rows // 2)
             continue
         pix, seg = np.empty(n, np.int64), np.empty((n, 5))
-        _band_segments(minv, svals, sel, box[sel], rb, near, far, tol, w, row, row + rows, False, pix, seg, far_px)
+        _band_segments(minv, gnorm, svals, sel, box[sel], rb, near, far, tol, w, row, row + rows, False, pix, seg, far_px)
         order = np.lexsort((seg[:, 0], pix))
         pix, seg = pix[order], seg[order]
         seg[:, 4] = live[seg[:, 4].astype(np.int64)]

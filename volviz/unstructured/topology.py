@@ -10,6 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit, prange
 
 from volviz.model.datasets import TetMesh
 
@@ -62,6 +63,67 @@ def _face_adjacency(tets: np.ndarray) -> np.ndarray:
     return neighbor.reshape(m, 4)
 
 
+@njit(cache=True, nogil=True, parallel=True)
+def _geometry(pts: np.ndarray, tets: np.ndarray, faces: np.ndarray, n: np.ndarray, d: np.ndarray,
+              centroid: np.ndarray, circ_center: np.ndarray, circ_r2: np.ndarray) -> float:
+    """Per tetrahedron (in place): positive orientation (swap vertices 2 and 3 when the signed volume is negative),
+    unit outward face normals and plane offsets, centroid, circumsphere (Cramer's rule on 2 (p_i - p_0) . c =
+    |p_i - p_0|^2; a degenerate cell gets its centroid and radius 0); returns the longest edge."""
+    m = len(tets)
+    longest = np.zeros(m)
+    for c in prange(m):
+        p = np.empty((4, 3))
+        for v in range(4):
+            for a in range(3):
+                p[v, a] = pts[tets[c, v], a]
+        e = np.empty((3, 3))
+        for i in range(3):
+            for a in range(3):
+                e[i, a] = p[i + 1, a] - p[0, a]
+        vol = (e[0, 0] * (e[1, 1] * e[2, 2] - e[1, 2] * e[2, 1]) - e[0, 1] * (e[1, 0] * e[2, 2] - e[1, 2] * e[2, 0])
+               + e[0, 2] * (e[1, 0] * e[2, 1] - e[1, 1] * e[2, 0]))
+        if vol < 0:
+            tets[c, 2], tets[c, 3] = tets[c, 3], tets[c, 2]
+            for a in range(3):
+                p[2, a], p[3, a] = p[3, a], p[2, a]
+                e[1, a], e[2, a] = e[2, a], e[1, a]
+            vol = -vol
+        for f in range(4):
+            i0, i1, i2 = faces[f, 0], faces[f, 1], faces[f, 2]
+            ux, uy, uz = p[i1, 0] - p[i0, 0], p[i1, 1] - p[i0, 1], p[i1, 2] - p[i0, 2]
+            wx, wy, wz = p[i2, 0] - p[i0, 0], p[i2, 1] - p[i0, 1], p[i2, 2] - p[i0, 2]
+            nx, ny, nz = uy * wz - uz * wy, uz * wx - ux * wz, ux * wy - uy * wx
+            nn = np.sqrt(nx * nx + ny * ny + nz * nz)
+            if nn > 0:
+                nx, ny, nz = nx / nn, ny / nn, nz / nn
+            n[c, f, 0], n[c, f, 1], n[c, f, 2] = nx, ny, nz
+            d[c, f] = nx * p[i0, 0] + ny * p[i0, 1] + nz * p[i0, 2]
+        for a in range(3):
+            centroid[c, a] = 0.25 * (p[0, a] + p[1, a] + p[2, a] + p[3, a])
+        r0 = 0.5 * (e[0, 0] ** 2 + e[0, 1] ** 2 + e[0, 2] ** 2)
+        r1 = 0.5 * (e[1, 0] ** 2 + e[1, 1] ** 2 + e[1, 2] ** 2)
+        r2 = 0.5 * (e[2, 0] ** 2 + e[2, 1] ** 2 + e[2, 2] ** 2)
+        if vol > 0:
+            cx = (r0 * (e[1, 1] * e[2, 2] - e[1, 2] * e[2, 1]) - e[0, 1] * (r1 * e[2, 2] - e[1, 2] * r2)
+                  + e[0, 2] * (r1 * e[2, 1] - e[1, 1] * r2)) / vol
+            cy = (e[0, 0] * (r1 * e[2, 2] - e[1, 2] * r2) - r0 * (e[1, 0] * e[2, 2] - e[1, 2] * e[2, 0])
+                  + e[0, 2] * (e[1, 0] * r2 - r1 * e[2, 0])) / vol
+            cz = (e[0, 0] * (e[1, 1] * r2 - r1 * e[2, 1]) - e[0, 1] * (e[1, 0] * r2 - r1 * e[2, 0])
+                  + r0 * (e[1, 0] * e[2, 1] - e[1, 1] * e[2, 0])) / vol
+            circ_center[c, 0], circ_center[c, 1], circ_center[c, 2] = p[0, 0] + cx, p[0, 1] + cy, p[0, 2] + cz
+            circ_r2[c] = cx * cx + cy * cy + cz * cz
+        else:
+            for a in range(3):
+                circ_center[c, a] = centroid[c, a]
+            circ_r2[c] = 0.0
+        best = 0.0
+        for i in range(3):
+            for j in range(i + 1, 4):
+                best = max(best, (p[j, 0] - p[i, 0]) ** 2 + (p[j, 1] - p[i, 1]) ** 2 + (p[j, 2] - p[i, 2]) ** 2)
+        longest[c] = best
+    return np.sqrt(longest.max())
+
+
 def build_topology(mesh: TetMesh) -> Topology:
     """Compute the adjacency and geometry of ``mesh`` (see :func:`topology` for the cached version)."""
     if mesh.n_cells == 0:
@@ -70,37 +132,19 @@ def build_topology(mesh: TetMesh) -> Topology:
     if not np.all(np.isfinite(used)):
         raise ValueError("TetMesh has non-finite point coordinates")
     origin = 0.5 * (used.min(axis=0) + used.max(axis=0))
-    pts = mesh.points - origin
-    tets = mesh.tets
-    p = pts[tets]
-    vol6 = np.einsum("ij,ij->i", np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), p[:, 3] - p[:, 0])
-    tets = tets.copy()
-    neg = vol6 < 0
-    tets[neg, 2], tets[neg, 3] = mesh.tets[neg, 3], mesh.tets[neg, 2]
-    p = pts[tets]
+    pts = np.ascontiguousarray(mesh.points - origin)
+    tets = np.ascontiguousarray(mesh.tets, dtype=np.int64).copy()
+    m = len(tets)
+    n = np.empty((m, 4, 3))
+    d = np.empty((m, 4))
+    centroid = np.empty((m, 3))
+    circ_center = np.empty((m, 3))
+    circ_r2 = np.empty(m)
+    max_edge = _geometry(pts, tets, FACES, n, d, centroid, circ_center, circ_r2)
     neighbor = _face_adjacency(tets)
-    fv = p[:, FACES]                                              # (m, 4, 3, 3)
-    n = np.cross(fv[:, :, 1] - fv[:, :, 0], fv[:, :, 2] - fv[:, :, 0])
-    norm = np.linalg.norm(n, axis=2, keepdims=True)
-    n = n / np.where(norm > 0, norm, 1.0)
-    d = np.einsum("ijk,ijk->ij", n, fv[:, :, 0])
     bt, bf = np.nonzero(neighbor < 0)
-    centroid = p.mean(axis=1)
-    # circumsphere: solve 2 (p_i - p_0) . c = |p_i|^2 - |p_0|^2 in coordinates relative to p_0
-    e = p[:, 1:] - p[:, :1]
-    rhs = 0.5 * (e ** 2).sum(axis=2)
-    det = np.linalg.det(e)
-    ok = np.abs(det) > 0
-    c = np.zeros((len(tets), 3))
-    c[ok] = np.linalg.solve(e[ok], rhs[ok][..., None])[..., 0]
-    circ_center = p[:, 0] + c
-    circ_r2 = (c ** 2).sum(axis=1)
-    circ_center[~ok], circ_r2[~ok] = centroid[~ok], 0.0
-    edges = p[:, [1, 2, 3, 2, 3, 3]] - p[:, [0, 0, 0, 1, 1, 2]]
-    max_edge = float(np.sqrt((edges ** 2).sum(axis=2).max()))
-    return Topology(origin, np.ascontiguousarray(pts), np.ascontiguousarray(tets), neighbor,
-                    np.stack([bt, bf], axis=1).astype(np.int64), np.ascontiguousarray(n), np.ascontiguousarray(d),
-                    centroid, circ_center, circ_r2, max_edge)
+    return Topology(origin, pts, tets, neighbor, np.stack([bt, bf], axis=1).astype(np.int64), n, d, centroid,
+                    circ_center, circ_r2, float(max_edge))
 
 
 def topology(mesh: TetMesh) -> Topology:
