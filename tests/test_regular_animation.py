@@ -121,3 +121,20 @@ def test_cli_compress_series(tmp_path, capsys):
     assert "21 volumes (28, 28, 23)  pattern IPP  lossless" in capsys.readouterr().out
     back = A.decompress_series(tmp_path / "s.vvs")
     assert np.array_equal(back[20], np.asarray(read(pattern).frame(20).data))
+
+
+def test_damaged_store_and_bad_input_name_the_problem(tmp_path):
+    vols = _moving_series(4)
+    store = tmp_path / "d.vvs"
+    A.compress_series(vols, store, pattern="IPP")
+    mv = sorted(store.glob("m*.bin"))[0]
+    mv.write_bytes(b"\x00" + mv.read_bytes()[1:])
+    with pytest.raises(A.SeriesError, match=mv.name):
+        A.decompress_series(store)
+    A.compress_series(vols, store, pattern="IPP")
+    vvz = sorted(store.glob("v*.vvz"))[1]
+    vvz.unlink()
+    with pytest.raises(A.SeriesError, match=vvz.name):
+        A.decompress_series(store)
+    with pytest.raises(ValueError, match="8-bit"):
+        A.compress_series([v.astype(np.uint16) for v in vols], tmp_path / "e.vvs")

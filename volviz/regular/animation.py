@@ -386,7 +386,10 @@ class SeriesDecoder:
         if rec["type"] != "I":
             mvs = []
             for m in rec["mv"]:
-                blob = (self.path / m["file"]).read_bytes()
+                try:
+                    blob = (self.path / m["file"]).read_bytes()
+                except OSError as exc:
+                    raise SeriesError(str(self.path / m["file"]), f"cannot read motion vectors ({exc})") from exc
                 if zlib.crc32(blob) != int(m["crc"]):
                     raise SeriesError(str(self.path / m["file"]), "motion-vector checksum mismatch")
                 mvs.append(np.frombuffer(zlib.decompress(blob), np.int8).reshape(n_blocks(self.dims) + (3,)))
@@ -395,6 +398,8 @@ class SeriesDecoder:
                 raise ValueError(f"frame {display} needs reference frames {missing} decoded first")
             pred = _predict(FrameInfo(display, rec["type"], tuple(rec["refs"])), mvs, refs)
         if rec["file"] is not None:
+            if not (self.path / rec["file"]).is_file():
+                raise SeriesError(str(self.path / rec["file"]), f"volume file of frame {display} is missing")
             res = decompress(self.path / rec["file"], strict=True).data.astype(np.int32)
             pred = res if pred is None else pred + res
         self.decodes += 1
