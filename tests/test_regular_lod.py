@@ -154,3 +154,19 @@ def test_back_to_front_order(noisy):
     order = tree.back_to_front(tree.select(cam, 8), cam)
     assert sorted(order) == sorted(tree.select(cam, 8).nodes)
     assert order[0][1][0] == 0 and order[-1][1][0] == 1  # the -x blocks first, the +x (near) ones last
+
+
+def test_statistics_sidecar_is_reused_only_for_its_file(tmp_path):
+    rng = np.random.default_rng(5)
+    data = rng.integers(0, 200, (40, 33, 20)).astype(np.uint8)
+    path = tmp_path / "s.vvz"
+    compress(RegularVolume(data), path)
+    a = LodTree(path)  # full decode, writes s.vvz.lod.npz
+    assert a.sidecar.is_file()
+    b = LodTree(path)  # from the sidecar
+    for sa, sb in zip(a.stats, b.stats):
+        assert np.array_equal(sa.l2, sb.l2) and np.array_equal(sa.hist_pos, sb.hist_pos)
+        assert np.array_equal(sa.vmin, sb.vmin) and np.array_equal(sa.hist_n, sb.hist_n)
+    compress(RegularVolume(data // 2), path)  # a different file at the same path: the sidecar is stale
+    c = LodTree(path)
+    assert c.stats[1].l2.max() != a.stats[1].l2.max()

@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import heapq
 import math
+import os
 import threading
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -38,7 +39,6 @@ import numpy as np
 from volviz.model.datasets import RegularVolume
 
 from .cache import NodeCache
-from .codec import _Source
 from .nodes import HALF, Key, LevelStats, NodeDecoder, node_statistics
 
 
@@ -127,10 +127,44 @@ def eq27_error(dmin: np.ndarray, dmax: np.ndarray, cmin: np.ndarray, cmax: np.nd
     return np.maximum(err_o + err_c, err_o2 + err_c2)
 
 
+_STAT_FIELDS = ("l2", "hist_pos", "hist_neg", "hist_n", "vmin", "vmax")
+
+
+def _save_stats(path: Path, dec: NodeDecoder, stats: list[LevelStats], lo: float, w: float) -> None:
+    arrays = {f"{f}_{lev}": getattr(st, f) for lev, st in enumerate(stats) for f in _STAT_FIELDS}
+    arrays["key"] = np.array([dec.reader.header["table_crc"], len(stats), lo, w], np.float64)
+    tmp = path.with_name(path.name + ".tmp.npz")
+    try:
+        np.savez(tmp, **arrays)
+        os.replace(tmp, path)
+    except OSError:
+        tmp.unlink(missing_ok=True)
+
+
+def _load_stats(path: Path, dec: NodeDecoder) -> tuple[list[LevelStats], float, float] | None:
+    """Statistics from a sidecar written for this very file (same brick-table CRC), else None. Never unpickles."""
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            key = z["key"]
+            if int(key[0]) != dec.reader.header["table_crc"] or int(key[1]) != dec.levels + 1:
+                return None
+            stats = [LevelStats(*(z[f"{f}_{lev}"] for f in _STAT_FIELDS)) for lev in range(dec.levels + 1)]
+    except (OSError, KeyError, ValueError):
+        return None
+    for lev, st in enumerate(stats):
+        if st.l2.shape != dec.n_nodes(lev):
+            return None
+    return stats, float(key[2]), float(key[3])
+
+
 class LodTree:
     """A ``.vvz`` wavelet octree with per-node statistics, an LRU node cache and view-dependent selection."""
 
-    def __init__(self, path: str | Path, cache_bytes: int = 256 << 20, volume: RegularVolume | None = None) -> None:
+    def __init__(self, path: str | Path, cache_bytes: int = 256 << 20, volume: RegularVolume | None = None,
+                 sidecar: bool = True) -> None:
+        """Open ``path``. Node statistics come from the sidecar ``PATH.lod.npz`` when it matches the file (same
+        brick-table checksum), else from ``volume`` (the original, in memory) or one full decode of the file; in the latter case
+        (with ``sidecar``) they are saved next to the file (atomic write; silently skipped when not writable)."""
         self.decoder = NodeDecoder(path)
         meta = self.decoder.meta
         self.levels = self.decoder.levels
@@ -139,16 +173,27 @@ class LodTree:
         self.origin = np.asarray(meta.get("origin", (0, 0, 0)), float)
         self.cache = NodeCache(cache_bytes, self.levels)
         self._lock = threading.RLock()  # node decoding and the cache may be driven from a background worker
-        if volume is None:
-            from .codec import decompress  # statistics of the decoded (possibly lossy) volume
-            volume = decompress(path)
-        src = _Source(volume.data)
-        if src.kind == "float" or src.kind == "int-quantised":
+        kind = str(meta["kind"])
+        if kind in ("float", "int-quantised"):
             lo, hi = float(meta["float_lo"]), float(meta["float_hi"])
             self._scale = (lo, (hi - lo) / 65535.0)
         else:
             self._scale = (0.0, 1.0)
-        self.stats, self.bin_lo, self.bin_w = node_statistics(src.slab(0, volume.data.shape[2]))
+        self.sidecar = Path(str(path) + ".lod.npz")
+        loaded = _load_stats(self.sidecar, self.decoder) if volume is None and sidecar else None
+        if loaded is None:
+            save = sidecar and volume is None  # a sidecar always describes the decoded file
+            if volume is None:
+                from .codec import decompress  # statistics of the decoded (possibly lossy) volume
+                volume = decompress(path)
+            data = np.asarray(volume.data)
+            if kind in ("float", "int-quantised"):
+                data = np.clip(np.rint((data.astype(np.float64) - self._scale[0]) / max(self._scale[1], 1e-300)),
+                               0, 65535)
+            loaded = node_statistics(data)
+            if save:
+                _save_stats(self.sidecar, self.decoder, *loaded)
+        self.stats, self.bin_lo, self.bin_w = loaded
         self._tf_err: dict[int, np.ndarray] = {}
         self._tf_clear: dict[int, np.ndarray] = {}
         self._tf_obj: Any = None
