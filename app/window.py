@@ -233,6 +233,8 @@ class MainWindow(QMainWindow):
                          title: str, dirty: bool) -> None:
         from volviz.render.controller import SceneController
 
+        if self.controller is not None:
+            self.controller.clear()
         self.plotter.clear()
         controller = SceneController(self.plotter, session, datasets)
         try:
@@ -260,9 +262,18 @@ class MainWindow(QMainWindow):
         start = time.perf_counter()
         self.plotter.render()
         elapsed = time.perf_counter() - start
-        self.last_stats = {"frame_seconds": elapsed, "method": self.session.render.method,
-                           "cells": sum(getattr(d, "n_cells", 0) for d in self.datasets.values())}
-        self.statistics.show_stats(self.last_stats)
+        stats: dict[str, Any] = {"frame_seconds": elapsed, "method": self.session.render.method,
+                                 "cells": sum(getattr(d, "n_cells", 0) for d in self.datasets.values())}
+        pt = self.controller.pt_stats() if self.controller is not None else {}
+        if pt:  # volviz's own renderer: the split of its last frame
+            last = list(pt.values())
+            stats.update(frame_seconds=sum(s.get("total_s", 0.0) for s in last) + elapsed,
+                         sort_seconds=sum(s.get("sort_s", 0.0) for s in last),
+                         project_seconds=sum(s.get("project_s", 0.0) for s in last),
+                         raster_seconds=sum(s.get("raster_s", 0.0) for s in last),
+                         method=", ".join(sorted({str(s.get("method")) for s in last})))
+        self.last_stats = stats
+        self.statistics.show_stats(stats)
 
     def set_dirty(self, dirty: bool = True) -> None:
         self.dirty = dirty
@@ -317,10 +328,16 @@ class MainWindow(QMainWindow):
             self.render()
 
     def _settings_changed(self, values: dict[str, Any]) -> None:
+        rebuild = (values["method"] != self.session.render.method
+                   or values["options"].get("sort") != self.session.render.options.get("sort"))
         self.session.render.method = values["method"]
         self.session.render.size = values["size"]
         self.session.render.options.update(values["options"])
         self.set_dirty()
+        if rebuild and self.controller is not None:  # another renderer: rebuild the scene with the same camera
+            camera = self.controller.camera()
+            self.session.camera = camera
+            self._install_session(self.session, self.session_path, self.datasets, getattr(self, "title", ""), True)
 
     def _time_changed(self, t: float) -> None:
         if self.controller is not None and self.controller.time_series():
@@ -694,7 +711,10 @@ class MainWindow(QMainWindow):
                 return
         self.clear_recovery()
         self.autosave_timer.stop()
+        self.preview_timer.stop()
+        self.record_timer.stop()
         self.timeline.set_playing(False)
+        self.controller = None  # late timer callbacks find no scene to update
         self.jobs.shutdown()
         self.plotter.close()
         super().closeEvent(event)

@@ -329,3 +329,19 @@ def test_dock_layout_is_restored_from_the_session(qtbot, make_window, tmp_path: 
     wait_loaded(qtbot, other)
     assert not other.timeline_dock.isVisible()
     assert other.dockWidgetArea(other.stats_dock) == Qt.DockWidgetArea.LeftDockWidgetArea
+
+
+def test_unstructured_data_renders_with_volviz_pt_and_shows_the_frame_split(qtbot, make_window) -> None:
+    window = make_window()
+    window.open_path(data_file("bluntfin/bluntfinxyz.bin"))
+    wait_loaded(qtbot, window)
+    assert window.controller.pt_stats(), "the Blunt Fin is not drawn by volviz's PT renderer"
+    pt_image = viewport(window)
+    for key in ("split", "frame"):
+        assert "ms" in window.statistics.text(key)
+    assert window.statistics.text("method") == "pt"
+    window.render_settings.method.setCurrentText("vtk")  # VTK's own projected-tetrahedra mapper instead
+    qtbot.waitUntil(lambda: not window.controller.pt_stats(), timeout=30000)
+    vtk_image = viewport(window)
+    assert pt_image.std() > 3.0 and vtk_image.std() > 3.0  # neither is blank
+    assert np.abs(vtk_image - pt_image).mean() > 0.2  # and they are different renderers

@@ -8,7 +8,7 @@ from PySide6.QtWidgets import QComboBox, QDoubleSpinBox, QFormLayout, QSpinBox, 
 
 METHODS = ("auto", "pt", "reference", "vtk")
 TABLE_KINDS = ("3d", "2d", "separable-1", "separable-2", "separable-4")
-SORTS = ("centroid", "mpvo", "exact")
+SORTS = ("mpvo", "centroid", "power")
 
 
 class RenderSettings(QWidget):

@@ -11,6 +11,12 @@ from volviz.model import TimeSeries
 from volviz.session import CameraState, Component, Session
 
 
+def _is_pt(prop: Any) -> bool:
+    from volviz.render.pt_prop import PTVolume
+
+    return isinstance(prop, PTVolume)
+
+
 class SceneController:
     def __init__(self, plotter: Any, session: Session, datasets: dict[str, Any]):
         self.plotter = plotter
@@ -30,6 +36,14 @@ class SceneController:
         start = self.session.render.options.get("time")
         if span and isinstance(start, (int, float)) and start != self.time:
             self.set_time(float(start))  # the session's display time
+
+    def clear(self) -> None:
+        """Remove everything this controller added, including PT overlay renderers, which ``plotter.clear()`` keeps."""
+        for prop in self.props.values():
+            if _is_pt(prop):
+                prop.remove()
+        self.props = {}
+        self.plotter.clear()
 
     def component(self, comp_id: str) -> Component:
         for comp in self.session.components:
@@ -56,7 +70,10 @@ class SceneController:
         self.session.transfer_functions[name] = tf.to_dict()
         comp.transfer_function = name
         prop = self.props.get(comp_id)
-        if prop is not None and prop.IsA("vtkVolume"):
+        if _is_pt(prop):
+            prop.tf = tf.scaled_extinction(comp.opacity) if comp.opacity != 1.0 else tf
+            prop.update()
+        elif prop is not None and prop.IsA("vtkVolume"):
             update_volume_property(prop.GetProperty(), tf, comp.opacity)
 
     def set_visible(self, comp_id: str, visible: bool) -> None:
@@ -73,6 +90,8 @@ class SceneController:
 
             self.props[comp_id] = add_dataset(self.plotter, self.dataset_of(comp_id),
                                               tf=self.transfer_function(comp_id), opacity=comp.opacity, name=comp_id)
+        elif _is_pt(prop):
+            prop.visible = bool(visible)
         elif prop is not None:
             prop.SetVisibility(bool(visible))
 
@@ -82,7 +101,11 @@ class SceneController:
         prop = self.props.get(comp_id)
         if prop is None:
             return
-        if prop.IsA("vtkVolume"):
+        if _is_pt(prop):
+            tf = self.transfer_function(comp_id)
+            prop.tf = tf.scaled_extinction(comp.opacity) if comp.opacity != 1.0 else tf
+            prop.update()
+        elif prop.IsA("vtkVolume"):
             from volviz.render.vtk_scene import update_volume_property
 
             update_volume_property(prop.GetProperty(), self.transfer_function(comp_id), comp.opacity)
@@ -148,11 +171,20 @@ class SceneController:
     def nature(self) -> Any:
         return self.props.get("nature")
 
-    def update_views(self) -> dict[str, float]:
-        """Re-run what depends on the camera (C-LOD terrain, fog and clouds); returns their statistics."""
-        if self.nature is None:
-            return {}
-        return self.nature.update()
+    def update_views(self) -> dict[str, Any]:
+        """Re-run what depends on the camera (C-LOD terrain, fog and clouds, PT volumes); returns their statistics."""
+        stats: dict[str, Any] = {}
+        if self.nature is not None:
+            stats.update(self.nature.update())
+        for comp_id, prop in self.props.items():
+            if _is_pt(prop) and prop.visible:
+                prop.update()
+                stats[comp_id] = dict(prop.stats)
+        return stats
+
+    def pt_stats(self) -> dict[str, Any]:
+        """The last frame statistics of every PT volume (sort / project / raster seconds, fragments, method)."""
+        return {comp_id: dict(prop.stats) for comp_id, prop in self.props.items() if _is_pt(prop)}
 
     def rebuild_nature(self) -> None:
         from volviz.render.scene import build_nature

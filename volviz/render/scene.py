@@ -10,6 +10,8 @@ import re
 from pathlib import Path
 from typing import Any, Optional
 
+import numpy as np
+
 from volviz.jobs import ProgressCallback, report
 from volviz.session import Component, DatasetRef, Session, resolve_path
 
@@ -132,21 +134,62 @@ def build_scene(plotter: Any, session: Session, datasets: dict[str, Any]) -> dic
 
     ensure_transfer_functions(session, datasets)
     props: dict[str, Any] = {}
+    pt_components = []
     for comp in session.components:
         if not comp.visible or comp.type in NATURE_TYPES:
             continue
         dataset = component_dataset(comp, datasets)
         if comp.type == "isosurface":
             props[comp.id] = add_isosurfaces(plotter, comp, dataset)
-            continue
-        tf = component_transfer_function(session, comp)
-        props[comp.id] = add_dataset(plotter, dataset, tf=tf, opacity=comp.opacity, name=comp.id)
+        elif uses_pt(session, dataset):
+            pt_components.append((comp, dataset))  # drawn last: they composite over the opaque scene's depth
+        else:
+            tf = component_transfer_function(session, comp)
+            props[comp.id] = add_dataset(plotter, dataset, tf=tf, opacity=comp.opacity, name=comp.id)
     plotter.set_background(session.render.background)
-    apply_camera(plotter, session.camera)
+    if session.camera is None and pt_components:
+        from volviz.render.vtk_scene import volume_grid
+
+        plotter.view_isometric()
+        bounds = np.array([volume_grid(d).bounds for _, d in pt_components])
+        lo, hi = bounds[:, 0::2].min(axis=0), bounds[:, 1::2].max(axis=0)
+        plotter.renderer.ResetCamera(lo[0], hi[0], lo[1], hi[1], lo[2], hi[2])
+        plotter.camera_set = True  # else PyVista re-frames its (empty) VTK props at the next render
+    else:
+        apply_camera(plotter, session.camera)
     nature = build_nature(plotter, session, datasets)
     if nature is not None:
         props["nature"] = nature
+    for comp, dataset in pt_components:
+        props[comp.id] = add_pt_component(plotter, session, comp, dataset)
     return props
+
+
+PT_DATASETS = ("TetMesh", "UnstructuredMesh", "CurvilinearGrid")
+
+
+def uses_pt(session: Session, dataset: Any) -> bool:
+    """Unstructured and curvilinear data are drawn by volviz's pre-integrated projected tetrahedra unless the
+    session asks for VTK's own mappers (render method "vtk"); regular volumes go to VTK's ray casters."""
+    from volviz.model import TimeSeries
+
+    if isinstance(dataset, TimeSeries):
+        return False  # time-varying meshes stay on VTK's mapper for now
+    return session.render.method != "vtk" and type(dataset).__name__ in PT_DATASETS
+
+
+def add_pt_component(plotter: Any, session: Session, comp: Component, dataset: Any) -> Any:
+    """A volviz PT volume (``volviz.render.pt_prop``) for a component, with its TF scaled by its opacity."""
+    from volviz.render.pt_prop import add_pt_volume
+
+    tf = component_transfer_function(session, comp)
+    if comp.opacity != 1.0:
+        tf = tf.scaled_extinction(comp.opacity)
+    method = "reference" if session.render.method == "reference" else "pt"
+    sort = str(session.render.options.get("sort", "mpvo"))
+    scalars = getattr(dataset, "active", None)
+    return add_pt_volume(plotter, dataset, tf, method=method, scalars=scalars,
+                         **({"sort": sort} if method == "pt" and sort in ("mpvo", "centroid", "power") else {}))
 
 
 def add_isosurfaces(plotter: Any, comp: Component, dataset: Any, t: Optional[float] = None) -> Any:
