@@ -110,3 +110,25 @@ def test_zbuffer_to_depth_inverts_vtk_projection():
         eye_depth = (pts - np.array(cam.GetPosition())) @ fwd
         assert np.allclose(zbuffer_to_depth(z_window, cam.GetClippingRange(), parallel), eye_depth, rtol=1e-9)
     assert np.isinf(zbuffer_to_depth(np.array([1.0]), (0.1, 10.0), False)[0])
+
+
+def test_two_volumes_both_see_the_opaque_depth():
+    """Each volume's depth read happens with every PT overlay off, so a second volume is clipped by the geometry
+    too (not by the first volume's overlay)."""
+    pl = pv.Plotter(off_screen=True, window_size=list(SIZE))
+    try:
+        pl.ren_win.SetMultiSamples(0)
+        pl.add_mesh(pv.Plane(center=(0.5, 0.5, 0.5), direction=(0, 1, 0), i_size=0.6, j_size=0.6), color="white",
+                    lighting=False)
+        pl.camera_position = [(0.6, -2.5, 0.9), (0.5, 0.5, 0.5), (0, 0, 1)]
+        a = add_pt_volume(pl, syn.box_tets(4), TF)
+        b = add_pt_volume(pl, syn.box_tets(4), TF)
+        a.update()
+        assert np.isfinite(a.depth).sum() > 100
+        assert np.array_equal(np.isfinite(a.depth), np.isfinite(b.depth))
+        assert np.allclose(a.image, b.image)
+        b.remove()
+        a.update()
+        assert np.isfinite(a.depth).sum() == np.isfinite(b.depth).sum()
+    finally:
+        pl.close()

@@ -22,7 +22,10 @@ How a frame is made (``update``):
    the tests).
 
 Later renders of the plotter (screenshots, interaction) keep showing the last volume image over the live scene; call
-``update()`` after the camera or the opaque geometry changed.
+``update()`` after the camera or the opaque geometry changed. Several PT volumes in one plotter are each clipped by
+the opaque depth and blended in the order they were added (their own depths are not interleaved: overlapping
+volumes should be merged into one mesh). With multisampling (PyVista's default) a silhouette pixel of opaque geometry
+has a blended colour but one depth, so the volume is cut there by that sample's depth (the tests turn MSAA off).
 """
 from __future__ import annotations
 
@@ -113,6 +116,8 @@ class PTVolume:
         self._overlay.GetActiveCamera().ParallelProjectionOn()
         ren_win.AddRenderer(self._overlay)
         self._overlay.DrawOff()
+        self._siblings = plotter.__dict__.setdefault("_volviz_pt_overlays", [])
+        self._siblings.append(self._overlay)
 
     def _mesh_far(self, cam: Camera) -> float:
         p = self.mesh.points
@@ -128,9 +133,13 @@ class PTVolume:
         t_start = time.perf_counter()
         ren_win = self.plotter.ren_win
         w, h = (int(v) for v in ren_win.GetSize())
-        self._overlay.DrawOff()
+        shown = [o.GetDraw() for o in self._siblings]            # every PT overlay off: opaque depth only
+        for o in self._siblings:
+            o.DrawOff()
         ren_win.Render()
         z, rgb = _read_buffers(ren_win, w, h)
+        for o, on in zip(self._siblings, shown):
+            o.SetDraw(on)
         vcam = self.plotter.renderer.GetActiveCamera()
         cam = Camera.from_pyvista(vcam)
         depth = zbuffer_to_depth(z, cam.clipping_range, cam.parallel)
@@ -176,6 +185,8 @@ class PTVolume:
     def remove(self) -> None:
         """Detach the overlay from the plotter's render window."""
         self.plotter.ren_win.RemoveRenderer(self._overlay)
+        if self._overlay in self._siblings:
+            self._siblings.remove(self._overlay)
 
 
 def add_pt_volume(plotter: Any, mesh: Any, tf: Any, **opts: Any) -> PTVolume:
