@@ -58,7 +58,7 @@ class MainWindow(QMainWindow):
         self.resize(1280, 820)
         self.settings = settings or QSettings("volviz", "volviz")
         self.recovery_dir = Path(recovery_dir) if recovery_dir else default_recovery_dir()
-        self.plotter = QtInteractor(self)
+        self.plotter = QtInteractor(self, auto_update=False)  # we render when something changed, never on a timer
         self.setCentralWidget(self.plotter.interactor)
         self.jobs = JobBridge(self)
         self.jobs.progress.connect(self._on_progress)
