@@ -75,3 +75,14 @@ def test_user_errors_are_one_line_and_nonzero(tmp_path: Path) -> None:
         assert len(lines) == 1 and lines[0].startswith("volviz: error:"), result.stderr
         assert words in lines[0]
         assert "Traceback" not in result.stderr
+
+
+def test_info_on_a_compressed_series(tmp_path: Path, capsys) -> None:
+    storm = data_file("storm/Storm.pvm-t01").parent
+    out = tmp_path / "storm.vvs"
+    assert main(["compress", str(storm / "Storm.pvm-t%02d"), "-o", str(out), "--series", "--lossless"]) == 0
+    capsys.readouterr()
+    assert main(["info", "--json", str(out)]) == 0
+    desc = json.loads(capsys.readouterr().out)
+    assert desc["n"] == 21 and desc["dims"] == [28, 28, 23] and desc["mode"] == "lossless"
+    assert desc["ratio"] > 1.0

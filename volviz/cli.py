@@ -72,6 +72,10 @@ def describe(path: str) -> dict[str, Any]:
         from volviz.regular.codec import info as vvz_info
 
         return {"file": str(p), **vvz_info(p)}
+    if p.suffix.lower() == ".vvs":
+        from volviz.regular.animation import series_info
+
+        return {"file": str(p), **series_info(p)}
     from volviz.io import read
     from volviz.model import TimeSeries
 
