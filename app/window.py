@@ -33,9 +33,11 @@ MAX_RECENT = 8
 
 
 def _data_filter() -> str:
+    """The readers' filter plus volviz's own compressed volumes."""
     from volviz.io import open_dialog_filter
 
-    return open_dialog_filter()
+    everything, rest = open_dialog_filter().split(";;", 1)
+    return everything.replace("(", "(*.vvz ", 1) + ";;volviz compressed volume (*.vvz);;" + rest
 
 
 def default_recovery_dir() -> Path:

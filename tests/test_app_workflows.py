@@ -345,3 +345,19 @@ def test_unstructured_data_renders_with_volviz_pt_and_shows_the_frame_split(qtbo
     vtk_image = viewport(window)
     assert pt_image.std() > 3.0 and vtk_image.std() > 3.0  # neither is blank
     assert np.abs(vtk_image - pt_image).mean() > 0.2  # and they are different renderers
+
+
+def test_compressed_volume_decodes_in_the_background_and_shows(qtbot, make_window, tmp_path: Path) -> None:
+    from volviz.cli import main as cli
+
+    compressed = tmp_path / "neghip.vvz"
+    assert cli(["compress", str(data_file("volumes/neghip.slc")), "-o", str(compressed), "--lossless"]) == 0
+    window = make_window()
+    window.open_path(compressed)
+    wait_loaded(qtbot, window)
+    assert window.error_dialog is None
+    from volviz.io import read
+
+    original = read(data_file("volumes/neghip.slc"))
+    assert np.array_equal(window.datasets["data"].data, original.data)  # lossless through the app's loader
+    assert viewport(window).std() > 3.0

@@ -81,9 +81,7 @@ def load_datasets(session: Session, session_file: Optional[str | os.PathLike],
     for i, ref in enumerate(refs):
         report(progress, i / max(len(refs), 1), f"reading {Path(ref.path).name}")
         path = resolve_path(session_file, ref.path) if session_file else Path(ref.path)
-        from volviz.io import read
-
-        loaded[ref.id] = read(path, **ref.options)
+        loaded[ref.id] = read_any(path, ref.options, progress)
     report(progress, 1.0, "datasets read")
     return loaded
 
@@ -125,6 +123,18 @@ def component_transfer_function(session: Session, comp: Component) -> Any:
 
 
 NATURE_TYPES = ("terrain", "fog", "clouds", "sky")
+
+
+def read_any(path: Path, options: dict[str, Any], progress: Optional[ProgressCallback] = None) -> Any:
+    """A data file through ``volviz.io.read``, or a volviz-compressed volume (``.vvz``) through the wavelet decoder
+    (damaged bricks are filled from the coarser level and reported as warnings, never silently)."""
+    if path.suffix.lower() == ".vvz":
+        from volviz.regular.codec import decompress
+
+        return decompress(path, progress=progress)
+    from volviz.io import read
+
+    return read(path, **options)
 
 
 def build_scene(plotter: Any, session: Session, datasets: dict[str, Any]) -> dict[str, Any]:
