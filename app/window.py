@@ -189,6 +189,12 @@ class MainWindow(QMainWindow):
 
         self._show_session(demo_session(), None, "demo scene")
 
+    def open_demo_volume(self) -> None:
+        """The tetrahedral demo volume (an analytic field on a tetrahedralised cube), drawn by volviz's PT."""
+        from volviz.render.scene import demo_volume_session
+
+        self._show_session(demo_volume_session(), None, "demo volume")
+
     def open_path(self, path: str | os.PathLike) -> None:
         """Open a session file or a data file (the path behind every Open action and the command line)."""
         from volviz.render.export import is_session_file
@@ -310,8 +316,24 @@ class MainWindow(QMainWindow):
             return
         comp_id, tf = self._pending_tf
         self._pending_tf = None
-        self.controller.set_transfer_function(comp_id, tf)
-        self.render()
+        volume = self.controller.pt_volume(comp_id)
+        if volume is None:  # VTK mapper: the new colour/opacity functions draw at once
+            self.controller.set_transfer_function(comp_id, tf)
+            self.render()
+            return
+        # volviz PT volume: table build and rasterisation run in the background; a newer edit supersedes this one
+        self.controller.set_transfer_function(comp_id, tf, update=False)
+        request = volume.begin()
+        controller = self.controller
+
+        def done(outcome: JobOutcome) -> None:
+            if outcome.ok and self.controller is controller and controller.pt_volume(comp_id) is volume:
+                volume.finish(request, *outcome.result)
+                self.render()
+            elif outcome.error is not None:
+                self.show_error("Cannot render the volume", str(outcome.error))
+
+        self.jobs.submit(volume.compute, request, name="volume preview", key=f"pt:{comp_id}", on_done=done)
 
     def _tf_committed(self, tf: Any) -> None:
         self._tf_changed(tf)

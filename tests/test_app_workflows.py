@@ -361,3 +361,19 @@ def test_compressed_volume_decodes_in_the_background_and_shows(qtbot, make_windo
     original = read(data_file("volumes/neghip.slc"))
     assert np.array_equal(window.datasets["data"].data, original.data)  # lossless through the app's loader
     assert viewport(window).std() > 3.0
+
+
+def test_pt_volume_transfer_function_edits_render_in_the_background(qtbot, make_window) -> None:
+    window = make_window()
+    window.open_demo_volume()
+    wait_loaded(qtbot, window)
+    assert window.controller.pt_volume("demo") is not None
+    before = viewport(window)
+    tf = window.tf_editor.transfer_function
+    window.tf_editor.edit(tf.scaled_extinction(0.05), "Thin out")  # as a finished drag would
+    qtbot.waitUntil(lambda: window.jobs.runner.active == 0 and window._pending_tf is None, timeout=30000)
+    qtbot.wait(200)
+    after = viewport(window)
+    h, w = min(before.shape[0], after.shape[0]), min(before.shape[1], after.shape[1])  # docks may shift by a few px
+    assert np.abs(after[:h, :w] - before[:h, :w]).mean() > 0.5
+    assert window.controller.pt_volume("demo").tf == tf.scaled_extinction(0.05)

@@ -62,7 +62,9 @@ class SceneController:
 
         return component_transfer_function(self.session, self.component(comp_id))
 
-    def set_transfer_function(self, comp_id: str, tf: Any) -> None:
+    def set_transfer_function(self, comp_id: str, tf: Any, update: bool = True) -> None:
+        """Store ``tf`` in the session and apply it; a PT volume re-renders only when ``update`` (the app instead
+        renders it in the background: ``pt_volume(comp_id)``, then ``begin`` / ``compute`` / ``finish``)."""
         from volviz.render.vtk_scene import update_volume_property
 
         comp = self.component(comp_id)
@@ -72,7 +74,8 @@ class SceneController:
         prop = self.props.get(comp_id)
         if _is_pt(prop):
             prop.tf = tf.scaled_extinction(comp.opacity) if comp.opacity != 1.0 else tf
-            prop.update()
+            if update:
+                prop.update()
         elif prop is not None and prop.IsA("vtkVolume"):
             update_volume_property(prop.GetProperty(), tf, comp.opacity)
 
@@ -181,6 +184,11 @@ class SceneController:
                 prop.update()
                 stats[comp_id] = dict(prop.stats)
         return stats
+
+    def pt_volume(self, comp_id: str) -> Any:
+        """The PT volume handle of a component, or None when it is drawn by VTK."""
+        prop = self.props.get(comp_id)
+        return prop if _is_pt(prop) else None
 
     def pt_stats(self) -> dict[str, Any]:
         """The last frame statistics of every PT volume (sort / project / raster seconds, fragments, method)."""

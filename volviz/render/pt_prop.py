@@ -128,8 +128,11 @@ class PTVolume:
 
     def update(self) -> np.ndarray:
         """Re-render the volume for the plotter's current camera and opaque scene; returns the premultiplied image."""
-        from vtk.util.numpy_support import numpy_to_vtk
+        request = self.begin()
+        return self.finish(request, *self.compute(request))
 
+    def begin(self) -> dict[str, Any]:
+        """GUI-thread part 1: render the opaque scene, read its depth, fix the camera (see the module docstring)."""
         t_start = time.perf_counter()
         ren_win = self.plotter.ren_win
         w, h = (int(v) for v in ren_win.GetSize())
@@ -147,10 +150,24 @@ class PTVolume:
         far = max(far, 1.01 * self._mesh_far(cam))                  # VTK's range only covers its own props
         cam = Camera(cam.position, cam.focal_point, cam.view_up, cam.view_angle, cam.parallel, cam.parallel_scale,
                      (near, far))
-        t_read = time.perf_counter()
-        img, st = render(self.mesh, self.tf, cam, (w, h), self.method, depth=depth, return_stats=True,
-                         **self.render_opts)
+        return {"camera": cam, "depth": depth, "rgb": rgb, "size": (w, h), "tf": self.tf, "t_start": t_start,
+                "t_read": time.perf_counter()}
+
+    def compute(self, request: dict[str, Any], progress: Any = None) -> tuple[np.ndarray, Any]:
+        """Any-thread part: the volume image for a request of ``begin`` (pure NumPy/Numba, no VTK)."""
+        if progress is not None:
+            progress(0.0, "rendering volume")
+        img, st = render(self.mesh, request["tf"], request["camera"], request["size"], self.method,
+                         depth=request["depth"], return_stats=True, **self.render_opts)
+        return img, st
+
+    def finish(self, request: dict[str, Any], img: np.ndarray, st: Any) -> np.ndarray:
+        """GUI-thread part 2: show a computed image as the overlay and record the statistics."""
+        from vtk.util.numpy_support import numpy_to_vtk
+
         t_vol = time.perf_counter()
+        w, h = request["size"]
+        ren_win = self.plotter.ren_win
         rgba8 = unpremultiply_rgba8(img)[::-1]                        # VTK images start at the bottom row
         self._data.SetDimensions(w, h, 1)
         arr = numpy_to_vtk(np.ascontiguousarray(rgba8.reshape(-1, 4)), deep=True)
@@ -166,10 +183,12 @@ class PTVolume:
         self._overlay.DrawOn()
         ren_win.Render()
         t_end = time.perf_counter()
-        self.image, self.depth, self.scene_rgb, self.camera = img, depth, rgb, cam
-        self.stats = {"readback_s": t_read - t_start, "sort_s": st.sort_s, "project_s": st.project_s,
-                      "raster_s": st.raster_s, "volume_s": t_vol - t_read, "upload_s": t_end - t_vol,
-                      "total_s": t_end - t_start, "fragments": st.fragments, "n_visible": st.n_visible,
+        depth = request["depth"]
+        self.image, self.depth, self.scene_rgb, self.camera = img, depth, request["rgb"], request["camera"]
+        self.stats = {"readback_s": request["t_read"] - request["t_start"], "sort_s": st.sort_s,
+                      "project_s": st.project_s, "raster_s": st.raster_s, "volume_s": st.total_s,
+                      "upload_s": t_end - t_vol, "total_s": request["t_read"] - request["t_start"] + st.total_s
+                      + (t_end - t_vol), "fragments": st.fragments, "n_visible": st.n_visible,
                       "occluded_px": int(np.isfinite(depth).sum()), "size": (w, h), "method": self.method}
         return img
 
