@@ -261,11 +261,34 @@ class MainWindow(QMainWindow):
         self.timeline.set_steps(controller.time_steps())
         self._refresh_bookmark_menu()
         self.title = title
+        self.error_estimate = None
         self.set_dirty(dirty)
         self.render()
+        for comp in session.components:
+            if controller.pt_volume(comp.id) is not None:
+                self.estimate_error(comp.id)
         self.status_label.setText(f"Showing {title}")
 
     # ------------------------------------------------------------------------------------------------ rendering
+    def estimate_error(self, comp_id: str, request: Optional[dict[str, Any]] = None) -> None:
+        """Measure the PT volume's error against the exact reference for the current view, in the background; the
+        statistics dock shows it when done (a newer request supersedes an older one)."""
+        volume = self.controller.pt_volume(comp_id) if self.controller is not None else None
+        if volume is None:
+            return
+        request = request or volume.begin()
+        controller = self.controller
+
+        def done(outcome: JobOutcome) -> None:
+            if outcome.ok and self.controller is controller:
+                e = outcome.result
+                self.error_estimate = (f"RMSE {e['rmse']:.2f}, max {e['max']:.1f} of 255 vs exact "
+                                       f"({e['size'][0]}x{e['size'][1]})")
+                self.render()
+
+        self.jobs.submit(volume.error_estimate, request, name="error estimate", key=f"error:{comp_id}",
+                         on_done=done)
+
     def render(self) -> None:
         start = time.perf_counter()
         self.plotter.render()
@@ -279,7 +302,8 @@ class MainWindow(QMainWindow):
                          sort_seconds=sum(s.get("sort_s", 0.0) for s in last),
                          project_seconds=sum(s.get("project_s", 0.0) for s in last),
                          raster_seconds=sum(s.get("raster_s", 0.0) for s in last),
-                         method=", ".join(sorted({str(s.get("method")) for s in last})))
+                         method=", ".join(sorted({str(s.get("method")) for s in last})),
+                         error=getattr(self, "error_estimate", None))
         self.last_stats = stats
         self.statistics.show_stats(stats)
 
@@ -330,6 +354,7 @@ class MainWindow(QMainWindow):
             if outcome.ok and self.controller is controller and controller.pt_volume(comp_id) is volume:
                 volume.finish(request, *outcome.result)
                 self.render()
+                self.estimate_error(comp_id, request)
             elif outcome.error is not None:
                 self.show_error("Cannot render the volume", str(outcome.error))
 
@@ -394,10 +419,14 @@ class MainWindow(QMainWindow):
             self.render()
 
     def _camera_moved(self) -> None:
-        """After the camera moved: refresh what depends on it (terrain LOD, fog and cloud images), then draw."""
-        if self.controller is not None and self.controller.nature is not None:
-            self.last_view_stats = self.controller.update_views()
+        """After the camera moved: refresh what depends on it (terrain LOD, fog and cloud images, PT volumes), then
+        draw and re-measure the error estimate for the new view."""
+        if self.controller is None:
+            return
+        self.last_view_stats = self.controller.update_views()
         self.render()
+        for comp_id in self.controller.pt_stats():
+            self.estimate_error(comp_id)
 
     def add_bookmark(self, name: str) -> None:
         if self.controller is None:

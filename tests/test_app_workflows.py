@@ -340,6 +340,9 @@ def test_unstructured_data_renders_with_volviz_pt_and_shows_the_frame_split(qtbo
     for key in ("split", "frame"):
         assert "ms" in window.statistics.text(key)
     assert window.statistics.text("method") == "pt"
+    qtbot.waitUntil(lambda: "vs exact" in window.statistics.text("error"), timeout=60000)
+    rmse = float(window.statistics.text("error").split()[1].rstrip(","))
+    assert 0.0 <= rmse <= 1.0  # the fast path's measured error for this very view is within the product's budget
     window.render_settings.method.setCurrentText("vtk")  # VTK's own projected-tetrahedra mapper instead
     qtbot.waitUntil(lambda: not window.controller.pt_stats(), timeout=30000)
     vtk_image = viewport(window)

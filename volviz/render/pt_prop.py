@@ -161,6 +161,22 @@ class PTVolume:
                          depth=request["depth"], return_stats=True, **self.render_opts)
         return img, st
 
+    def error_estimate(self, request: dict[str, Any], size: tuple[int, int] = (96, 72),
+                       progress: Any = None) -> dict[str, Any]:
+        """Any-thread: the current method's error against the exact float64 reference for this view and TF, measured
+        on a small image (``size``, same camera and aspect): RMSE and max abs in 8-bit units. This is what the app's
+        statistics show as the error estimate."""
+        from volviz.optics.metrics import max_abs, rmse
+
+        w, h = request["size"]
+        sw, sh = size
+        sh = max(8, int(round(sw * h / max(w, 1))))
+        fast = render(self.mesh, request["tf"], request["camera"], (sw, sh), self.method, **self.render_opts)
+        if progress is not None:
+            progress(0.5, "error estimate: exact reference")
+        exact = render(self.mesh, request["tf"], request["camera"], (sw, sh), "reference")
+        return {"rmse": float(rmse(fast, exact)), "max": float(max_abs(fast, exact)), "size": (sw, sh)}
+
     def finish(self, request: dict[str, Any], img: np.ndarray, st: Any) -> np.ndarray:
         """GUI-thread part 2: show a computed image as the overlay and record the statistics."""
         from vtk.util.numpy_support import numpy_to_vtk
