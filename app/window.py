@@ -347,8 +347,17 @@ class MainWindow(QMainWindow):
             return
         # volviz PT volume: table build and rasterisation run in the background; a newer edit supersedes this one
         self.controller.set_transfer_function(comp_id, tf, update=False)
-        request = volume.begin()
+        self.refresh_pt(comp_id)
+
+    def refresh_pt(self, comp_id: str) -> None:
+        """Re-render a PT volume for the current camera and TF: the depth read-back on this thread, the sort, table
+        and rasterisation in the background (a newer request for the same volume supersedes a stale one), then the
+        image and a fresh error estimate."""
         controller = self.controller
+        volume = controller.pt_volume(comp_id) if controller is not None else None
+        if volume is None:
+            return
+        request = volume.begin()
 
         def done(outcome: JobOutcome) -> None:
             if outcome.ok and self.controller is controller and controller.pt_volume(comp_id) is volume:
@@ -358,7 +367,7 @@ class MainWindow(QMainWindow):
             elif outcome.error is not None:
                 self.show_error("Cannot render the volume", str(outcome.error))
 
-        self.jobs.submit(volume.compute, request, name="volume preview", key=f"pt:{comp_id}", on_done=done)
+        self.jobs.submit(volume.compute, request, name="volume", key=f"pt:{comp_id}", on_done=done)
 
     def _tf_committed(self, tf: Any) -> None:
         self._tf_changed(tf)
@@ -423,10 +432,10 @@ class MainWindow(QMainWindow):
         draw and re-measure the error estimate for the new view."""
         if self.controller is None:
             return
-        self.last_view_stats = self.controller.update_views()
+        self.last_view_stats = self.controller.update_views(pt=False)
         self.render()
         for comp_id in self.controller.pt_stats():
-            self.estimate_error(comp_id)
+            self.refresh_pt(comp_id)
 
     def add_bookmark(self, name: str) -> None:
         if self.controller is None:

@@ -380,3 +380,17 @@ def test_pt_volume_transfer_function_edits_render_in_the_background(qtbot, make_
     h, w = min(before.shape[0], after.shape[0]), min(before.shape[1], after.shape[1])  # docks may shift by a few px
     assert np.abs(after[:h, :w] - before[:h, :w]).mean() > 0.5
     assert window.controller.pt_volume("demo").tf == tf.scaled_extinction(0.05)
+
+
+def test_pt_volume_follows_the_camera_with_background_rendering(qtbot, make_window) -> None:
+    window = make_window()
+    window.open_demo_volume()
+    wait_loaded(qtbot, window)
+    volume = window.controller.pt_volume("demo")
+    first = volume.image.copy()
+    window.plotter.camera.azimuth = 35.0
+    window.plotter.camera.elevation = 25.0
+    window._camera_moved()  # what the end of a mouse interaction triggers
+    assert volume.image is not None and np.array_equal(volume.image, first)  # not yet: it renders in the background
+    qtbot.waitUntil(lambda: not np.array_equal(volume.image, first), timeout=30000)
+    assert volume.camera.position == pytest.approx(tuple(window.plotter.camera.position))

@@ -174,13 +174,14 @@ class SceneController:
     def nature(self) -> Any:
         return self.props.get("nature")
 
-    def update_views(self) -> dict[str, Any]:
-        """Re-run what depends on the camera (C-LOD terrain, fog and clouds, PT volumes); returns their statistics."""
+    def update_views(self, pt: bool = True) -> dict[str, Any]:
+        """Re-run what depends on the camera (C-LOD terrain, fog and clouds, and PT volumes unless ``pt`` is false,
+        for callers that render those in the background); returns their statistics."""
         stats: dict[str, Any] = {}
         if self.nature is not None:
             stats.update(self.nature.update())
         for comp_id, prop in self.props.items():
-            if _is_pt(prop) and prop.visible:
+            if pt and _is_pt(prop) and prop.visible:
                 prop.update()
                 stats[comp_id] = dict(prop.stats)
         return stats
