@@ -81,6 +81,7 @@ class MainWindow(QMainWindow):
         self._build_menus()
         self._build_status_bar()
         self.fly = FlyMode(self.plotter, on_camera_moved=self._camera_moved)
+        self.plotter.iren.add_observer("EndInteractionEvent", lambda *args: QTimer.singleShot(0, self._camera_moved))
 
         self.preview_timer = QTimer(self, singleShot=True, interval=PREVIEW_MS)
         self.preview_timer.timeout.connect(self._apply_pending_tf)
@@ -118,6 +119,7 @@ class MainWindow(QMainWindow):
         self.scene_tree.componentSelected.connect(self._select_component)
         self.scene_tree.visibilityChanged.connect(self._set_visibility)
         self.scene_tree.opacityChanged.connect(self._set_opacity)
+        self.scene_tree.settingsEdited.connect(self.apply_component_settings)
         self.render_settings.changed.connect(self._settings_changed)
         self.timeline.timeChanged.connect(self._time_changed)
         self.timeline.interpolationToggled.connect(self._interpolation_toggled)
@@ -244,21 +246,24 @@ class MainWindow(QMainWindow):
         if self.controller is not None:
             self.controller.clear()
         self.plotter.clear()
-        controller = SceneController(self.plotter, session, datasets)
+        controller = SceneController(self.plotter, session, datasets, on_screen=True)
         try:
             controller.build()
         except Exception as exc:  # a scene that cannot be shown must not take the window down
             log.exception("building the scene for %s failed", title)
-            self.plotter.clear()
+            controller.clear()
+            self.controller = None
             self.show_error(f"Cannot show {title}", str(exc))
             return
         self.session, self.session_path, self.datasets, self.controller = session, session_path, datasets, controller
         if "window_state" in session.layout:
             self.restoreState(QByteArray.fromBase64(session.layout["window_state"].encode("ascii")))
-        self.plotter.iren.add_observer("EndInteractionEvent", lambda *args: QTimer.singleShot(0, self._camera_moved))
         self.scene_tree.populate(session.components)
         self.render_settings.load(session.render)
+        display_time = controller.time  # the session's display time, which set_steps would reset to the first step
         self.timeline.set_steps(controller.time_steps())
+        if controller.time_series():
+            self.timeline.set_time(display_time)
         self._refresh_bookmark_menu()
         self.title = title
         self.error_estimate = None
@@ -385,9 +390,38 @@ class MainWindow(QMainWindow):
             self.set_dirty()
             self.render()
 
+    def apply_component_settings(self, comp_id: str, text: str) -> bool:
+        """New settings for a component (JSON from the scene tree): validated through the session schema, then the
+        scene is rebuilt with the same camera; a bad value gives a message naming the field and changes nothing."""
+        import copy
+        import json
+
+        from volviz.session import session_from_dict, session_to_dict
+
+        if self.controller is None:
+            return False
+        try:
+            settings = json.loads(text)
+            doc = session_to_dict(self.session)
+            for comp in doc["components"]:
+                if comp["id"] == comp_id:
+                    comp["settings"] = settings
+            candidate = session_from_dict(doc, "scene tree")
+        except (ValueError, SessionError) as exc:
+            self.show_error("Invalid settings", f"{comp_id}: {exc}")
+            return False
+        candidate.camera = self.controller.camera()
+        previous = copy.deepcopy(self.session)
+        self._install_session(candidate, self.session_path, self.datasets, getattr(self, "title", ""), True)
+        if self.controller is None or self.controller.session is not candidate:  # could not be shown: keep the old
+            self._install_session(previous, self.session_path, self.datasets, getattr(self, "title", ""), True)
+            return False
+        return True
+
     def _settings_changed(self, values: dict[str, Any]) -> None:
+        renderer_keys = ("sort", "table", "table_resolution")
         rebuild = (values["method"] != self.session.render.method
-                   or values["options"].get("sort") != self.session.render.options.get("sort"))
+                   or any(values["options"].get(k) != self.session.render.options.get(k) for k in renderer_keys))
         self.session.render.method = values["method"]
         self.session.render.size = values["size"]
         self.session.render.options.update(values["options"])

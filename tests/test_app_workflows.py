@@ -394,3 +394,31 @@ def test_pt_volume_follows_the_camera_with_background_rendering(qtbot, make_wind
     assert volume.image is not None and np.array_equal(volume.image, first)  # not yet: it renders in the background
     qtbot.waitUntil(lambda: not np.array_equal(volume.image, first), timeout=30000)
     assert volume.camera.position == pytest.approx(tuple(window.plotter.camera.position))
+
+
+def test_component_settings_edited_in_the_scene_tree(qtbot, make_window, tmp_path: Path) -> None:
+    storm = data_file("storm/Storm.pvm-t01").parent
+    session_file = tmp_path / "iso.json"
+    session_file.write_text(json.dumps({
+        "format": "volviz-session", "version": 1,
+        "datasets": [{"id": "storm", "path": str(storm / "Storm.pvm-t%02d")}],
+        "components": [{"id": "iso", "type": "isosurface", "dataset": "storm",
+                        "settings": {"styles": [{"value": 200, "color": [1, 0.8, 0.2], "opacity": 0.8}]}}],
+        "camera": {"position": [80, -40, 60], "focal_point": [14, 14, 11], "view_up": [0, 0, 1]},
+        "render": {"options": {"time": 12.5}}}))
+    window = make_window()
+    window.open_path(session_file)
+    wait_loaded(qtbot, window)
+    tree = window.scene_tree
+    assert json.loads(tree.settings_edit.toPlainText())["styles"][0]["value"] == 200
+    before = viewport(window)
+    settings = json.loads(tree.settings_edit.toPlainText())
+    settings["styles"][0]["value"] = 40  # a lower iso-value: a much larger surface
+    tree.settings_edit.setPlainText(json.dumps(settings))
+    tree.apply_button.click()
+    assert window.session.components[0].settings["styles"][0]["value"] == 40 and window.dirty
+    assert (np.abs(viewport(window) - before).sum(axis=2) > 30).mean() > 0.01
+    tree.settings_edit.setPlainText('{"styles": "many"}')  # invalid: refused with a message, nothing changes
+    tree.apply_button.click()
+    assert "iso" in window.error_dialog.text()
+    assert window.session.components[0].settings["styles"][0]["value"] == 40

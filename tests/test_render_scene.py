@@ -71,3 +71,14 @@ def test_missing_camera_path_is_a_clear_error(tmp_path: Path, capsys) -> None:
     assert main(["render", str(storm_iso_session(tmp_path, 1.0)), "--path", "nope", "-o",
                  str(tmp_path / "x.mp4")]) == 2
     assert "no camera path named 'nope'" in capsys.readouterr().err
+
+
+def test_render_settings_map_to_the_pt_renderer() -> None:
+    from volviz.render.scene import pt_options
+
+    assert pt_options({}) == {}
+    assert pt_options({"table": "3d", "table_resolution": 64, "sort": "centroid"}) == \
+        {"lookup": "3d", "n_s": 64, "sort": "centroid"}
+    assert pt_options({"table": "separable-4", "table_resolution": 256}) == \
+        {"lookup": "separable", "degree": 4, "n_s": 256}
+    assert pt_options({"table": "auto", "table_resolution": 256, "sort": "bogus"}) == {}

@@ -1,13 +1,14 @@
-"""Render settings dock: renderer method, table kind and resolution, sort mode, error budget, export image size."""
+"""Render settings dock: renderer method, pre-integration table kind and resolution, sort mode, export image size.
+The table and sort settings apply to volviz's PT renderer ("auto" picks the table by each cell's optical depth)."""
 from __future__ import annotations
 
 from typing import Any, Optional
 
 from PySide6.QtCore import Signal
-from PySide6.QtWidgets import QComboBox, QDoubleSpinBox, QFormLayout, QSpinBox, QWidget
+from PySide6.QtWidgets import QComboBox, QFormLayout, QSpinBox, QWidget
 
 METHODS = ("auto", "pt", "reference", "vtk")
-TABLE_KINDS = ("3d", "2d", "separable-1", "separable-2", "separable-4")
+TABLE_KINDS = ("auto", "3d", "separable-1", "separable-2", "separable-4")
 SORTS = ("mpvo", "centroid", "power")
 
 
@@ -28,11 +29,6 @@ class RenderSettings(QWidget):
         self.sort = QComboBox()
         self.sort.addItems(SORTS)
         self.sort.setCurrentText("mpvo")
-        self.error_budget = QDoubleSpinBox()
-        self.error_budget.setRange(0.0, 64.0)
-        self.error_budget.setSingleStep(0.5)
-        self.error_budget.setValue(1.0)
-        self.error_budget.setSuffix(" /255 RMSE")
         self.width_box = QSpinBox()
         self.height_box = QSpinBox()
         for box in (self.width_box, self.height_box):
@@ -44,12 +40,11 @@ class RenderSettings(QWidget):
         form.addRow("Table", self.table_kind)
         form.addRow("Table resolution", self.table_resolution)
         form.addRow("Sort", self.sort)
-        form.addRow("Error budget", self.error_budget)
         form.addRow("Export width", self.width_box)
         form.addRow("Export height", self.height_box)
         for combo in (self.method, self.table_kind, self.table_resolution, self.sort):
             combo.currentTextChanged.connect(self._emit)
-        for box in (self.error_budget, self.width_box, self.height_box):
+        for box in (self.width_box, self.height_box):
             box.valueChanged.connect(self._emit)
         self._loading = False
 
@@ -57,7 +52,7 @@ class RenderSettings(QWidget):
         return {"method": self.method.currentText(), "size": (self.width_box.value(), self.height_box.value()),
                 "options": {"table": self.table_kind.currentText(),
                             "table_resolution": int(self.table_resolution.currentText()),
-                            "sort": self.sort.currentText(), "error_budget": self.error_budget.value()}}
+                            "sort": self.sort.currentText()}}
 
     def load(self, render: Any) -> None:
         self._loading = True
@@ -65,10 +60,9 @@ class RenderSettings(QWidget):
         self.width_box.setValue(render.size[0])
         self.height_box.setValue(render.size[1])
         opts = render.options
-        self.table_kind.setCurrentText(str(opts.get("table", "3d")))
+        self.table_kind.setCurrentText(str(opts.get("table", "auto")))
         self.table_resolution.setCurrentText(str(opts.get("table_resolution", 128)))
         self.sort.setCurrentText(str(opts.get("sort", "mpvo")))
-        self.error_budget.setValue(float(opts.get("error_budget", 1.0)))
         self._loading = False
 
     def _emit(self, *args: Any) -> None:

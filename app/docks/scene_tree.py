@@ -1,19 +1,25 @@
 """Scene tree dock: the session's components with visibility check boxes and an opacity slider."""
 from __future__ import annotations
 
+import json
 from typing import Any, Optional
 
 from PySide6.QtCore import Qt, Signal
-from PySide6.QtWidgets import QHBoxLayout, QLabel, QSlider, QTreeWidget, QTreeWidgetItem, QVBoxLayout, QWidget
+from PySide6.QtWidgets import (QHBoxLayout, QLabel, QPlainTextEdit, QPushButton, QSlider, QTreeWidget, QTreeWidgetItem,
+                               QVBoxLayout, QWidget)
 
 KIND_LABELS = {"volume": "Volume", "mesh": "Mesh", "isosurface": "Isosurface", "terrain": "Terrain", "fog": "Ground fog",
                "clouds": "Clouds", "sky": "Sky", "demo": "Demo volume"}
 
 
 class SceneTree(QWidget):
+    """Components with visibility check boxes, an opacity slider and their settings as editable JSON (validated by
+    the window through the session schema before anything changes)."""
+
     visibilityChanged = Signal(str, bool)
     opacityChanged = Signal(str, float)
     componentSelected = Signal(str)
+    settingsEdited = Signal(str, str)  # component id, JSON text
 
     def __init__(self, parent: Optional[QWidget] = None):
         super().__init__(parent)
@@ -27,9 +33,16 @@ class SceneTree(QWidget):
         row = QHBoxLayout()
         row.addWidget(self.opacity_label)
         row.addWidget(self.opacity, 1)
+        self.settings_edit = QPlainTextEdit()
+        self.settings_edit.setPlaceholderText("component settings (JSON)")
+        self.settings_edit.setMaximumHeight(140)
+        self.apply_button = QPushButton("Apply settings")
+        self.apply_button.clicked.connect(self._apply_settings)
         layout = QVBoxLayout(self)
         layout.addWidget(self.tree, 1)
         layout.addLayout(row)
+        layout.addWidget(self.settings_edit)
+        layout.addWidget(self.apply_button)
         self.tree.itemChanged.connect(self._item_changed)
         self.tree.currentItemChanged.connect(self._current_changed)
         self.opacity.valueChanged.connect(self._opacity_moved)
@@ -42,6 +55,7 @@ class SceneTree(QWidget):
             item = QTreeWidgetItem([comp.id, KIND_LABELS.get(comp.type, comp.type)])
             item.setData(0, Qt.ItemDataRole.UserRole, comp.id)
             item.setData(0, Qt.ItemDataRole.UserRole + 1, comp.opacity)
+            item.setData(0, Qt.ItemDataRole.UserRole + 2, json.dumps(comp.settings, indent=1))
             item.setFlags(item.flags() | Qt.ItemFlag.ItemIsUserCheckable)
             item.setCheckState(0, Qt.CheckState.Checked if comp.visible else Qt.CheckState.Unchecked)
             self.tree.addTopLevelItem(item)
@@ -71,8 +85,14 @@ class SceneTree(QWidget):
             return
         self._filling = True
         self.opacity.setValue(int(round(float(current.data(0, Qt.ItemDataRole.UserRole + 1)) * 100)))
+        self.settings_edit.setPlainText(current.data(0, Qt.ItemDataRole.UserRole + 2) or "{}")
         self._filling = False
         self.componentSelected.emit(current.data(0, Qt.ItemDataRole.UserRole))
+
+    def _apply_settings(self) -> None:
+        comp_id = self.current_component()
+        if comp_id is not None:
+            self.settingsEdited.emit(comp_id, self.settings_edit.toPlainText())
 
     def _opacity_moved(self, value: int) -> None:
         item = self.tree.currentItem()

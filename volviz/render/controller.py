@@ -18,8 +18,9 @@ def _is_pt(prop: Any) -> bool:
 
 
 class SceneController:
-    def __init__(self, plotter: Any, session: Session, datasets: dict[str, Any]):
+    def __init__(self, plotter: Any, session: Session, datasets: dict[str, Any], on_screen: bool = False):
         self.plotter = plotter
+        self.on_screen = on_screen  # the Qt viewport: no iso-spectrum shader (see scene.add_isosurfaces)
         self.session = session
         self.datasets = datasets
         self.props: dict[str, Any] = {}
@@ -30,7 +31,7 @@ class SceneController:
     def build(self) -> None:
         from volviz.render.scene import build_scene
 
-        self.props = build_scene(self.plotter, self.session, self.datasets)
+        self.props = build_scene(self.plotter, self.session, self.datasets, spectrum=not self.on_screen)
         span = self.time_span()
         self.time = span[0] if span else 0.0
         start = self.session.render.options.get("time")
@@ -153,7 +154,8 @@ class SceneController:
 
                 self.plotter.remove_actor(prop, render=False)
                 comp.settings = {**comp.settings, "interpolate": self.interpolate_time}
-                self.props[comp_id] = add_isosurfaces(self.plotter, comp, series, self.time)
+                self.props[comp_id] = add_isosurfaces(self.plotter, comp, series, self.time,
+                                                      spectrum=not self.on_screen)
             elif prop.IsA("vtkVolume"):
                 prop.GetMapper().SetInputData(volume_input(frame_at(series, self.time, self.interpolate_time)))
 

@@ -137,7 +137,7 @@ def read_any(path: Path, options: dict[str, Any], progress: Optional[ProgressCal
     return read(path, **options)
 
 
-def build_scene(plotter: Any, session: Session, datasets: dict[str, Any]) -> dict[str, Any]:
+def build_scene(plotter: Any, session: Session, datasets: dict[str, Any], spectrum: bool = True) -> dict[str, Any]:
     """Add every visible component to ``plotter``; returns the VTK prop of each component by id, and under
     ``"nature"`` the NatureView that draws the terrain, fog, clouds and sky components together."""
     from volviz.render.vtk_scene import add_dataset, apply_camera
@@ -150,7 +150,7 @@ def build_scene(plotter: Any, session: Session, datasets: dict[str, Any]) -> dic
             continue
         dataset = component_dataset(comp, datasets)
         if comp.type == "isosurface":
-            props[comp.id] = add_isosurfaces(plotter, comp, dataset)
+            props[comp.id] = add_isosurfaces(plotter, comp, dataset, spectrum=spectrum)
         elif uses_pt(session, dataset):
             pt_components.append((comp, dataset))  # drawn last: they composite over the opaque scene's depth
         else:
@@ -196,15 +196,36 @@ def add_pt_component(plotter: Any, session: Session, comp: Component, dataset: A
     if comp.opacity != 1.0:
         tf = tf.scaled_extinction(comp.opacity)
     method = "reference" if session.render.method == "reference" else "pt"
-    sort = str(session.render.options.get("sort", "mpvo"))
     scalars = getattr(dataset, "active", None)
     return add_pt_volume(plotter, dataset, tf, method=method, scalars=scalars,
-                         **({"sort": sort} if method == "pt" and sort in ("mpvo", "centroid", "power") else {}))
+                         **(pt_options(session.render.options) if method == "pt" else {}))
 
 
-def add_isosurfaces(plotter: Any, comp: Component, dataset: Any, t: Optional[float] = None) -> Any:
+def pt_options(options: dict[str, Any]) -> dict[str, Any]:
+    """Render settings -> keywords of ``volviz.unstructured.render``: sort ("mpvo", "centroid", "power"), table
+    ("auto" by optical depth, "3d", or "separable-N" with a colour polynomial of degree N) and its resolution."""
+    out: dict[str, Any] = {}
+    sort = options.get("sort")
+    if sort in ("mpvo", "centroid", "power"):
+        out["sort"] = sort
+    table = str(options.get("table", "auto"))
+    resolution = options.get("table_resolution")
+    if table == "3d":
+        out["lookup"] = "3d"
+    elif table.startswith("separable-") and table[len("separable-"):] in ("1", "2", "4"):
+        out.update(lookup="separable", degree=int(table[len("separable-"):]))
+    if table != "auto" and isinstance(resolution, int) and 16 <= resolution <= 1024:
+        out["n_s"] = resolution
+    return out
+
+
+def add_isosurfaces(plotter: Any, comp: Component, dataset: Any, t: Optional[float] = None,
+                    spectrum: bool = True) -> Any:
     """The isosurfaces of an ``isosurface`` component (settings: ``volviz.iso.IsoSettings``) as one prop assembly of
-    VTK actors with the iso-spectrum shader (drawn by VTK as the note's 2-pass blend)."""
+    VTK actors, with the iso-spectrum shader when ``spectrum`` (drawn by VTK as the note's 2-pass blend).
+
+    The shader compiles in offscreen render windows but not in the Qt viewport's (VTK 9.7 reports
+    ``normalVCVSOutput`` undeclared there), so the app passes ``spectrum=False`` and draws constant opacity."""
     import vtk
 
     from volviz.iso import IsoSettings, iso_actor, prepare
@@ -219,7 +240,8 @@ def add_isosurfaces(plotter: Any, comp: Component, dataset: Any, t: Optional[flo
     assembly = vtk.vtkPropAssembly()
     for mesh in prepared.meshes:
         if len(mesh.triangles):
-            assembly.AddPart(iso_actor(mesh, parallel=bool(plotter.camera.parallel_projection)))
+            assembly.AddPart(iso_actor(mesh, parallel=bool(plotter.camera.parallel_projection),
+                                       spectrum=spectrum and settings.shading == "spectrum"))
     plotter.add_actor(assembly, name=comp.id, reset_camera=False)
     return assembly
 
