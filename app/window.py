@@ -267,6 +267,7 @@ class MainWindow(QMainWindow):
         self._refresh_bookmark_menu()
         self.title = title
         self.error_estimate = None
+        self.last_error_rmse = None
         self.set_dirty(dirty)
         self.render()
         for comp in session.components:
@@ -289,10 +290,31 @@ class MainWindow(QMainWindow):
                 e = outcome.result
                 self.error_estimate = (f"RMSE {e['rmse']:.2f}, max {e['max']:.1f} of 255 vs exact "
                                        f"({e['size'][0]}x{e['size'][1]})")
+                self.last_error_rmse = e["rmse"]
                 self.render()
+                self._enforce_error_budget(e["rmse"])
 
         self.jobs.submit(volume.error_estimate, request, name="error estimate", key=f"error:{comp_id}",
                          on_done=done)
+
+    MOST_ACCURATE_TABLE = {"table": "separable-4", "table_resolution": 512}
+
+    def _enforce_error_budget(self, rmse: float) -> None:
+        """Measured error above the budget: switch to the most accurate table once, or say that it cannot be met."""
+        options = self.session.render.options
+        budget = float(options.get("error_budget", 1.0))
+        if rmse <= budget:
+            return
+        if all(options.get(k) == v for k, v in self.MOST_ACCURATE_TABLE.items()):
+            self.status_label.setText(f"Measured error {rmse:.2f} exceeds the budget {budget:.2f} even with the "
+                                      "finest table; the exact 'reference' renderer meets any budget")
+            return
+        self.status_label.setText(f"Measured error {rmse:.2f} exceeds the budget {budget:.2f}: switching to the "
+                                  "degree-4 separable table at 512²")
+        values = self.render_settings.settings()
+        values["options"].update(self.MOST_ACCURATE_TABLE)
+        self.render_settings.load_values(values)
+        self._settings_changed(values)
 
     def render(self) -> None:
         start = time.perf_counter()
@@ -422,10 +444,14 @@ class MainWindow(QMainWindow):
         renderer_keys = ("sort", "table", "table_resolution")
         rebuild = (values["method"] != self.session.render.method
                    or any(values["options"].get(k) != self.session.render.options.get(k) for k in renderer_keys))
+        budget_changed = values["options"].get("error_budget") != self.session.render.options.get("error_budget")
         self.session.render.method = values["method"]
         self.session.render.size = values["size"]
         self.session.render.options.update(values["options"])
         self.set_dirty()
+        if budget_changed and not rebuild and getattr(self, "last_error_rmse", None) is not None:
+            self._enforce_error_budget(self.last_error_rmse)
+            return
         if rebuild and self.controller is not None:  # another renderer: rebuild the scene with the same camera
             camera = self.controller.camera()
             self.session.camera = camera

@@ -422,3 +422,26 @@ def test_component_settings_edited_in_the_scene_tree(qtbot, make_window, tmp_pat
     tree.apply_button.click()
     assert "iso" in window.error_dialog.text()
     assert window.session.components[0].settings["styles"][0]["value"] == 40
+
+
+def test_error_budget_switches_to_the_most_accurate_table(qtbot, make_window) -> None:
+    window = make_window()
+    window.open_demo_volume()
+    wait_loaded(qtbot, window)
+    window.render_settings.error_budget.setValue(0.0)  # any measured error is above it
+    qtbot.waitUntil(lambda: window.session.render.options.get("table") == "separable-4", timeout=60000)
+    assert window.session.render.options["table_resolution"] == 512
+    assert window.render_settings.table_kind.currentText() == "separable-4"
+    qtbot.waitUntil(lambda: "vs exact" in window.statistics.text("error"), timeout=60000)
+
+
+def test_fit_to_data_range(qtbot, make_window) -> None:
+    window = make_window()
+    window.open_path(data_file("volumes/neghip.slc"))
+    wait_loaded(qtbot, window)
+    editor = window.tf_editor
+    editor.edit(editor.transfer_function.rescaled(50.0, 60.0), "narrow")
+    editor.fit_to_data()
+    assert editor.transfer_function.range == pytest.approx((0.0, 255.0))
+    editor.undo_stack.undo()
+    assert editor.transfer_function.range == pytest.approx((50.0, 60.0))

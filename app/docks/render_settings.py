@@ -1,11 +1,12 @@
-"""Render settings dock: renderer method, pre-integration table kind and resolution, sort mode, export image size.
-The table and sort settings apply to volviz's PT renderer ("auto" picks the table by each cell's optical depth)."""
+"""Render settings dock: renderer method, pre-integration table kind and resolution, sort mode, error budget, export
+image size. The table and sort settings apply to volviz's PT renderer ("auto" picks the table by each cell's optical
+depth); the error budget is checked against the measured error of the current view (see MainWindow.estimate_error)."""
 from __future__ import annotations
 
 from typing import Any, Optional
 
 from PySide6.QtCore import Signal
-from PySide6.QtWidgets import QComboBox, QFormLayout, QSpinBox, QWidget
+from PySide6.QtWidgets import QComboBox, QDoubleSpinBox, QFormLayout, QSpinBox, QWidget
 
 METHODS = ("auto", "pt", "reference", "vtk")
 TABLE_KINDS = ("auto", "3d", "separable-1", "separable-2", "separable-4")
@@ -29,6 +30,13 @@ class RenderSettings(QWidget):
         self.sort = QComboBox()
         self.sort.addItems(SORTS)
         self.sort.setCurrentText("mpvo")
+        self.error_budget = QDoubleSpinBox()
+        self.error_budget.setRange(0.0, 64.0)
+        self.error_budget.setSingleStep(0.25)
+        self.error_budget.setValue(1.0)
+        self.error_budget.setSuffix(" /255 RMSE")
+        self.error_budget.setToolTip("When the measured error of volviz's renderer exceeds this, the app switches to "
+                                     "the most accurate pre-integration table")
         self.width_box = QSpinBox()
         self.height_box = QSpinBox()
         for box in (self.width_box, self.height_box):
@@ -40,11 +48,12 @@ class RenderSettings(QWidget):
         form.addRow("Table", self.table_kind)
         form.addRow("Table resolution", self.table_resolution)
         form.addRow("Sort", self.sort)
+        form.addRow("Error budget", self.error_budget)
         form.addRow("Export width", self.width_box)
         form.addRow("Export height", self.height_box)
         for combo in (self.method, self.table_kind, self.table_resolution, self.sort):
             combo.currentTextChanged.connect(self._emit)
-        for box in (self.width_box, self.height_box):
+        for box in (self.error_budget, self.width_box, self.height_box):
             box.valueChanged.connect(self._emit)
         self._loading = False
 
@@ -52,7 +61,7 @@ class RenderSettings(QWidget):
         return {"method": self.method.currentText(), "size": (self.width_box.value(), self.height_box.value()),
                 "options": {"table": self.table_kind.currentText(),
                             "table_resolution": int(self.table_resolution.currentText()),
-                            "sort": self.sort.currentText()}}
+                            "sort": self.sort.currentText(), "error_budget": self.error_budget.value()}}
 
     def load(self, render: Any) -> None:
         self._loading = True
@@ -63,7 +72,14 @@ class RenderSettings(QWidget):
         self.table_kind.setCurrentText(str(opts.get("table", "auto")))
         self.table_resolution.setCurrentText(str(opts.get("table_resolution", 128)))
         self.sort.setCurrentText(str(opts.get("sort", "mpvo")))
+        self.error_budget.setValue(float(opts.get("error_budget", 1.0)))
         self._loading = False
+
+    def load_values(self, values: dict[str, Any]) -> None:
+        """Show ``values`` (the shape ``settings`` returns) without emitting ``changed``."""
+        from types import SimpleNamespace
+
+        self.load(SimpleNamespace(method=values["method"], size=values["size"], options=values["options"]))
 
     def _emit(self, *args: Any) -> None:
         if not self._loading:
