@@ -6,7 +6,7 @@ cd "$(dirname "$0")/.."
 
 DEBS=(xvfb xauth libgl1 libegl1 libxrender1 libxcb-icccm4 libxcb-keysyms1 libxcb-xinerama0 libxcb-randr0
       libxcb-xfixes0 libxcb-shape0 libxcb-xkb1 libxcb-cursor0 libxcb-image0 libxcb-render-util0 libxkbcommon-x11-0
-      libfontconfig1 libdbus-1-3)
+      libfontconfig1 libdbus-1-3 libgomp1)
 if command -v dpkg-query >/dev/null 2>&1; then
   missing=()
   for pkg in "${DEBS[@]}"; do
