@@ -17,6 +17,7 @@ from PySide6.QtWidgets import (QDockWidget, QFileDialog, QInputDialog, QLabel, Q
 from volviz.jobs import JobOutcome
 from volviz.session import CameraKey, Session, SessionError, relative_path
 from volviz_app.docks.render_settings import RenderSettings
+from volviz_app.gc_guard import GuiThreadCollector
 from volviz_app.docks.scene_tree import SceneTree
 from volviz_app.docks.statistics import Statistics
 from volviz_app.docks.tf_editor import TransferFunctionEditor
@@ -58,6 +59,7 @@ class MainWindow(QMainWindow):
 
         self.setWindowTitle("volviz")
         self.resize(1280, 820)
+        self.collector = GuiThreadCollector(self)  # cycles are freed on this thread, never in a worker
         self.settings = settings or QSettings("volviz", "volviz")
         self.recovery_dir = Path(recovery_dir) if recovery_dir else default_recovery_dir()
         self.plotter = QtInteractor(self, auto_update=False)  # we render when something changed, never on a timer

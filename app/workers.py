@@ -18,7 +18,9 @@ class JobBridge(QObject):
     progress = Signal(int, float, str)
     finished = Signal(object)
 
-    def __init__(self, parent: Optional[QObject] = None, max_workers: int = 2):
+    def __init__(self, parent: Optional[QObject] = None, max_workers: int = 1):
+        # One worker: background jobs run Numba kernels one at a time. Two at once (a volume render beside an error
+        # estimate that was still compiling) aborted the process once in CI even with the OpenMP threading layer.
         super().__init__(parent)
         self.runner = JobRunner(max_workers=max_workers)
         self._handlers: dict[int, Callable[[JobOutcome], None]] = {}

@@ -1,6 +1,8 @@
 """The application skeleton under Xvfb: real window, real VTK viewport, the menu's code paths."""
 from __future__ import annotations
 
+import gc
+
 from pathlib import Path
 
 import imageio.v3 as iio
@@ -36,6 +38,7 @@ def window(qtbot, tmp_path):
     yield win
     win.dirty = False
     win.close()
+    gc.collect()  # free the closed window here, on the GUI thread
 
 
 def wait_loaded(qtbot, window: MainWindow, timeout: int = 60000) -> None:

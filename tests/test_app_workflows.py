@@ -1,6 +1,8 @@
 """What a user does in the app, under Xvfb with real widgets and real VTK rendering (issue: the desktop application)."""
 from __future__ import annotations
 
+import gc
+
 import json
 import time
 from pathlib import Path
@@ -33,6 +35,7 @@ def make_window(qtbot, tmp_path: Path):
     for win in created:
         win.dirty = False  # no "save changes?" prompt at teardown
         win.close()
+    gc.collect()  # free the closed windows here, on the GUI thread
 
 
 def wait_loaded(qtbot, window: MainWindow) -> None:

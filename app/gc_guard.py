@@ -1,0 +1,33 @@
+"""Run Python's cyclic garbage collector on the GUI thread only.
+
+Automatic collection runs in whichever thread happens to allocate. When a background job triggers it, Qt widgets and
+VTK render windows that sit in reference cycles are destroyed on that worker thread, and Qt or the OpenGL driver
+aborts the process (seen in our GUI tests). The usual remedy in Qt applications: turn automatic collection off and
+collect from a timer on the GUI thread, generation by generation when the counts call for it.
+"""
+from __future__ import annotations
+
+import gc
+from typing import Optional
+
+from PySide6.QtCore import QObject, QTimer
+
+
+class GuiThreadCollector(QObject):
+    def __init__(self, parent: Optional[QObject] = None, interval_ms: int = 500):
+        super().__init__(parent)
+        self.thresholds = gc.get_threshold()
+        gc.disable()
+        self.timer = QTimer(self)
+        self.timer.timeout.connect(self.check)
+        self.timer.start(interval_ms)
+
+    def check(self) -> None:
+        counts = gc.get_count()
+        if counts[0] > self.thresholds[0]:
+            generation = 0
+            if counts[1] > self.thresholds[1]:
+                generation = 1
+                if counts[2] > self.thresholds[2]:
+                    generation = 2
+            gc.collect(generation)
