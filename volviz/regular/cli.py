@@ -1,4 +1,4 @@
-"""``volviz compress`` and ``volviz vvzinfo``: command-line front ends of the wavelet codec (Guthe §2.2, §2.3).
+"""``volviz compress``: the command-line front end of the wavelet codec (Guthe §2.2, §2.3).
 
 ``volviz compress IN -o OUT --series [--pattern IBBPBBPPB] [--quality Q | --lossless]`` reads IN as a time series
 (e.g. ``Storm.pvm-t%02d``) and writes a motion-compensated I/P/B store directory (:mod:`.animation`).
@@ -6,7 +6,8 @@
 ``volviz compress IN -o OUT [--quality Q | --psnr DB | --lossless] [--coder rans|arith]`` reads IN with
 ``volviz.io.read`` (any supported volume), or -- for volumes larger than memory -- a headerless raw file given with
 ``--raw NX NY NZ --dtype uint8``, which is memory-mapped and compressed out of core. A text progress bar goes to
-stderr. ``info_main`` prints :func:`volviz.regular.codec.info` of a ``.vvz`` file.
+stderr.
+``volviz info OUT.vvz`` (in :mod:`volviz.cli`) describes the result.
 """
 from __future__ import annotations
 
@@ -23,7 +24,9 @@ from volviz.model.datasets import RegularVolume
 from .codec import compress, info
 
 
-def _progress_bar(stream: Any = sys.stderr) -> Any:
+def _progress_bar(stream: Any = None) -> Any:
+    """A text progress bar on ``stream`` (default: the ``sys.stderr`` of the moment it is made, not of import time)."""
+    stream = sys.stderr if stream is None else stream
     start = time.perf_counter()
 
     def report(fraction: float, message: str) -> None:
@@ -113,20 +116,6 @@ def _print_info(meta: dict[str, Any]) -> None:
           f"({meta['stripped_bricks']} stripped)  coder {meta['coder']}")
     print(f"{meta['original_bytes']} -> {meta['file_bytes']} bytes  ratio {meta['ratio']:.2f}:1  "
           f"{meta['bits_per_voxel']:.3f} bits/voxel  PSNR {psnr}")
-
-
-def info_main(argv: Sequence[str] | None = None) -> int:
-    """``volviz info FILE.vvz``: ratio, levels, bricks, PSNR (``--json`` for the full dictionary)."""
-    p = argparse.ArgumentParser(prog="volviz info", description="Describe a .vvz file")
-    p.add_argument("path")
-    p.add_argument("--json", action="store_true")
-    args = p.parse_args(list(argv) if argv is not None else None)
-    meta = info(args.path)
-    if args.json:
-        print(json.dumps(meta, indent=1))
-    else:
-        _print_info(meta)
-    return 0
 
 
 if __name__ == "__main__":  # pragma: no cover
