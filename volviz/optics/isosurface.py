@@ -27,6 +27,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from volviz.optics import _interp
+from volviz.optics._axis import ScalarAxis
 from volviz.optics.table_error import TableError, measure_error, sample_points
 from volviz.optics.transfer_function import TransferFunction
 
@@ -68,7 +69,7 @@ def heaviside_alpha(s_f: Any, s_b: Any, s_iso: float, thicken: float = 0.0) -> n
 
 
 @dataclass
-class IsoTable:
+class IsoTable(ScalarAxis):
     """``rgba (n, n, 4)`` premultiplied flat texture and ``front_weight (n, n)`` for smooth shading (float32)."""
 
     rgba: np.ndarray
@@ -77,14 +78,6 @@ class IsoTable:
     s_hi: float
     isosurfaces: tuple[IsoSurface, ...]
     thicken: float = 0.0
-
-    @property
-    def n_s(self) -> int:
-        return int(self.rgba.shape[0])
-
-    @property
-    def ds(self) -> float:
-        return (self.s_hi - self.s_lo) / (self.n_s - 1)
 
     def smooth_front_rgba(self) -> np.ndarray:
         """The §8.9 front-face texture: the flat texture modulated by the front-face weight."""

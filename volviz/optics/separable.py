@@ -25,6 +25,7 @@ import numba
 import numpy as np
 
 from volviz.optics import _interp
+from volviz.optics._axis import ScalarAxis
 from volviz.optics.integrate import integrate_segment
 from volviz.optics.table3d import resolve_range
 from volviz.optics.table_error import TableError, measure_error, sample_points
@@ -108,8 +109,10 @@ def _vandermonde_inverse(degree: int) -> np.ndarray:
 
 
 @dataclass
-class SeparableTable:
+class SeparableTable(ScalarAxis):
     """``data (n, n, 1 + 3(deg + 1))`` float32: channel 0 is ρ̂, then the coefficients C̃_0…C̃_deg (RGB each)."""
+
+    _axis_field = "data"
 
     data: np.ndarray
     s_lo: float
@@ -118,18 +121,6 @@ class SeparableTable:
     degree: int
     kappa_max: np.ndarray
     tf: TransferFunction | None = None
-
-    @property
-    def n_s(self) -> int:
-        return int(self.data.shape[0])
-
-    @property
-    def ds(self) -> float:
-        return (self.s_hi - self.s_lo) / (self.n_s - 1)
-
-    @property
-    def scalars(self) -> np.ndarray:
-        return np.linspace(self.s_lo, self.s_hi, self.n_s)
 
     @property
     def rho_hat(self) -> np.ndarray:

@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from volviz.optics import _interp
+from volviz.optics._axis import ScalarAxis
 from volviz.optics.integrate import integrate_segment
 from volviz.optics.table3d import resolve_range
 from volviz.optics.table_error import TableError, measure_error, sample_points
@@ -30,7 +31,7 @@ __all__ = ["Table2D", "build_table2d"]
 
 
 @dataclass
-class Table2D:
+class Table2D(ScalarAxis):
     """Eq. 8.2 texture ``rgba (n, n, 4)`` float32 (already divided by ``alpha_max``) and its scaling constants."""
 
     rgba: np.ndarray
@@ -39,18 +40,6 @@ class Table2D:
     l_bar: float
     alpha_max: float
     tf: TransferFunction | None = None
-
-    @property
-    def n_s(self) -> int:
-        return int(self.rgba.shape[0])
-
-    @property
-    def ds(self) -> float:
-        return (self.s_hi - self.s_lo) / (self.n_s - 1)
-
-    @property
-    def scalars(self) -> np.ndarray:
-        return np.linspace(self.s_lo, self.s_hi, self.n_s)
 
     @property
     def vertex_scale(self) -> float:

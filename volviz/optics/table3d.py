@@ -26,6 +26,7 @@ import numba
 import numpy as np
 
 from volviz.optics import _interp
+from volviz.optics._axis import ScalarAxis
 from volviz.optics.integrate import integrate_segment
 from volviz.optics.table_error import TableError, measure_error, sample_points
 from volviz.optics.tf_change import changed_span, touching_pairs
@@ -127,7 +128,7 @@ def _fill(tf: TransferFunction, out: np.ndarray, s: np.ndarray, ls: np.ndarray, 
 
 
 @dataclass
-class Table3D:
+class Table3D(ScalarAxis):
     """A 3D pre-integration table; see the module docstring for the layout."""
 
     rgba: np.ndarray
@@ -139,25 +140,12 @@ class Table3D:
     m_rounding: str = "linear"
 
     @property
-    def n_s(self) -> int:
-        return int(self.rgba.shape[0])
-
-    @property
     def n_l(self) -> int:
         return int(self.rgba.shape[2])
 
     @property
-    def ds(self) -> float:
-        return (self.s_hi - self.s_lo) / (self.n_s - 1)
-
-    @property
     def dl(self) -> float:
         return self.l_max / (self.n_l - 1)
-
-    @property
-    def scalars(self) -> np.ndarray:
-        """The table's scalar sample positions s_lo + i·ds."""
-        return np.linspace(self.s_lo, self.s_hi, self.n_s)
 
     @property
     def lengths(self) -> np.ndarray:
