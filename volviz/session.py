@@ -89,6 +89,7 @@ class Session:
     bookmarks: dict[str, CameraState] = field(default_factory=dict)
     render: RenderSettings = field(default_factory=RenderSettings)
     layout: dict[str, Any] = field(default_factory=dict)
+    clip: dict[str, Any] = field(default_factory=lambda: {"planes": [], "box": None})
 
     def dataset(self, dataset_id: str) -> DatasetRef:
         for ref in self.datasets:
@@ -207,7 +208,7 @@ def session_from_dict(doc: Any, source: str | os.PathLike | None = None) -> Sess
     r = _Reader(None if source is None else str(source))
     d = r.obj(doc, "(document)")
     r.known_keys(d, "", {"format", "version", "datasets", "components", "transfer_functions", "camera",
-                         "camera_paths", "bookmarks", "render", "layout"})
+                         "camera_paths", "bookmarks", "render", "layout", "clip"})
     session = Session()
 
     ids: set[str] = set()
@@ -283,7 +284,34 @@ def session_from_dict(doc: Any, source: str | os.PathLike | None = None) -> Sess
         options=r.json_value(r.obj(rs.get("options", {}), "render.options"), "render.options"),
     )
     session.layout = r.json_value(r.obj(d.get("layout", {}), "layout"), "layout")
+    session.clip = _read_clip(r, d.get("clip", {"planes": [], "box": None}))
     return session
+
+
+def _read_clip(r: _Reader, value: Any) -> dict[str, Any]:
+    """Scene-wide clipping (``volviz.iso.clip.ClipSettings`` as JSON): any number of planes ``{"point", "normal"}``
+    keeping ``(x - point)·normal >= 0``, and an optional box ``{"lo", "hi"}``. Sessions written before clipping
+    existed have no ``clip`` field and load with no clipping."""
+    d = r.obj(value, "clip")
+    r.known_keys(d, "clip", {"planes", "box"})
+    planes = []
+    for i, item in enumerate(r.lst(d.get("planes", []), "clip.planes")):
+        where = f"clip.planes[{i}]"
+        o = r.obj(item, where)
+        r.known_keys(o, where, {"point", "normal"})
+        normal = r.vector(o.get("normal"), f"{where}.normal")
+        if math.sqrt(sum(v * v for v in normal)) < 1e-12:
+            raise r.fail(f"{where}.normal", "must not be the zero vector")
+        planes.append({"point": list(r.vector(o.get("point"), f"{where}.point")), "normal": list(normal)})
+    box = None
+    if d.get("box") is not None:
+        o = r.obj(d["box"], "clip.box")
+        r.known_keys(o, "clip.box", {"lo", "hi"})
+        lo, hi = r.vector(o.get("lo"), "clip.box.lo"), r.vector(o.get("hi"), "clip.box.hi")
+        if any(a > b for a, b in zip(lo, hi)):
+            raise r.fail("clip.box", f"needs lo <= hi on every axis, got lo={list(lo)} hi={list(hi)}")
+        box = {"lo": list(lo), "hi": list(hi)}
+    return {"planes": planes, "box": box}
 
 
 def _camera_dict(cam: CameraState) -> dict[str, Any]:
@@ -308,6 +336,7 @@ def session_to_dict(session: Session) -> dict[str, Any]:
         "render": {"method": session.render.method, "size": list(session.render.size),
                    "background": list(session.render.background), "options": copy.deepcopy(session.render.options)},
         "layout": copy.deepcopy(session.layout),
+        "clip": copy.deepcopy(session.clip),
     }
     return doc
 

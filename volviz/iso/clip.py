@@ -21,7 +21,7 @@ from volviz.iso.extract import IsoMesh
 from volviz.model.datasets import RegularVolume, TetMesh
 
 __all__ = ["ClipPlane", "BoxCrop", "ClipSettings", "clip_volume", "clip_isosurface", "clip_isosurfaces",
-           "clip_tetmesh"]
+           "clip_tetmesh", "clip_grid"]
 
 
 def _vec3(v: Any, what: str) -> tuple[float, float, float]:
@@ -199,22 +199,27 @@ def clip_isosurfaces(meshes: Sequence[IsoMesh], clip: ClipSettings | Sequence[Cl
     return [clip_isosurface(m, clip) for m in meshes]
 
 
-def clip_tetmesh(mesh: TetMesh, clip: ClipSettings | Sequence[ClipPlane] | BoxCrop) -> TetMesh:
-    """The tetrahedral mesh cut by the planes and box, re-tetrahedralised; scalars exact for the linear field."""
-    import pyvista as pv
+def clip_grid(grid: Any, clip: ClipSettings | Sequence[ClipPlane] | BoxCrop) -> Any:
+    """A VTK/PyVista volumetric grid cut by the planes and box and re-tetrahedralised (a vtkUnstructuredGrid of
+    tetrahedra; point data interpolated linearly along the cut edges, exact for a linear field on tetrahedra)."""
     from vtkmodules.vtkFiltersGeneral import vtkDataSetTriangleFilter
-    cs = _as_settings(clip)
-    planes = cs.all_planes()
-    if not planes:
-        return mesh
-    grid = mesh.to_pyvista()
-    grid.set_active_scalars(grid.point_data.keys()[0])
-    out = _clip_vtk(grid, planes, poly=False)
+    out = _clip_vtk(grid, _as_settings(clip).all_planes(), poly=False)
     tf = vtkDataSetTriangleFilter()
     tf.SetInputData(out)
     tf.TetrahedraOnlyOn()
     tf.Update()
-    res = pv.wrap(tf.GetOutput())
+    return tf.GetOutput()
+
+
+def clip_tetmesh(mesh: TetMesh, clip: ClipSettings | Sequence[ClipPlane] | BoxCrop) -> TetMesh:
+    """The tetrahedral mesh cut by the planes and box, re-tetrahedralised; scalars exact for the linear field."""
+    import pyvista as pv
+    cs = _as_settings(clip)
+    if not cs.all_planes():
+        return mesh
+    grid = mesh.to_pyvista()
+    grid.set_active_scalars(grid.point_data.keys()[0])
+    res = pv.wrap(clip_grid(grid, cs))
     if res.n_cells == 0:
         raise ValueError("the clipping removes the whole tetrahedral mesh")
     tets = np.asarray(res.cells, dtype=np.int64).reshape(-1, 5)[:, 1:]

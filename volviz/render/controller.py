@@ -1,7 +1,10 @@
 """A live scene in one plotter: what the app's docks change and what export renders, through one code path.
 
 ``SceneController`` owns the mapping from session components to VTK props. Transfer-function edits, visibility,
-opacity and display time update the props in place (no rebuild), so live previews stay cheap.
+opacity and display time update the props in place (no rebuild), so live previews stay cheap. The scene-wide clipping
+(``session.clip``, ``set_clip``) cuts every prop alike (``volviz.render.clipping``); the isosurfaces' transparency
+mode (``session.render.options["iso_mode"]``: "vtk" = VTK's own 2-pass blend, or one of the CPU modes "2pass",
+"3pass", "4pass", "exact" drawn as a depth-composited overlay, ``volviz.render.iso_overlay``) is chosen per scene.
 """
 from __future__ import annotations
 
@@ -11,19 +14,33 @@ from volviz.model import TimeSeries
 from volviz.session import CameraState, Component, Session
 
 
+ISO_MODES = ("vtk", "2pass", "3pass", "4pass", "exact")
+
+
 def _is_pt(prop: Any) -> bool:
+    from volviz.render.iso_overlay import IsoOverlay
     from volviz.render.pt_prop import PTVolume
 
-    return isinstance(prop, PTVolume)
+    return isinstance(prop, PTVolume) and not isinstance(prop, IsoOverlay)
+
+
+def ensure_lights(plotter: Any) -> None:
+    """Give a renderer without lights PyVista's default light kit again (``Plotter.clear`` removes all lights; unlit,
+    VTK compiles shaders without normals, and the iso-spectrum shader cannot compile)."""
+    if plotter.renderer.GetLights().GetNumberOfItems() == 0:
+        plotter.enable_lightkit()
 
 
 class SceneController:
     def __init__(self, plotter: Any, session: Session, datasets: dict[str, Any], on_screen: bool = False):
         self.plotter = plotter
-        self.on_screen = on_screen  # the Qt viewport: no iso-spectrum shader (see scene.add_isosurfaces)
+        self.on_screen = on_screen  # the Qt viewport (kept for callers; both draw the iso-spectrum shader)
         self.session = session
         self.datasets = datasets
         self.props: dict[str, Any] = {}
+        self.iso_overlay: Any = None      # IsoOverlay while a CPU transparency mode is on
+        self._pt_meshes: dict[str, Any] = {}   # uncut tetrahedral meshes of clipped PT volumes
+        self._vtk_inputs: dict[str, Any] = {}  # uncut inputs of clipped VTK tetrahedral volumes
         self.time = 0.0
         self.interpolate_time = True
 
@@ -31,18 +48,26 @@ class SceneController:
     def build(self) -> None:
         from volviz.render.scene import build_scene
 
-        self.props = build_scene(self.plotter, self.session, self.datasets, spectrum=not self.on_screen)
+        ensure_lights(self.plotter)
+        self.props = build_scene(self.plotter, self.session, self.datasets, spectrum=True)
+        self._pt_meshes, self._vtk_inputs = {}, {}
         span = self.time_span()
         self.time = span[0] if span else 0.0
         start = self.session.render.options.get("time")
         if span and isinstance(start, (int, float)) and start != self.time:
             self.set_time(float(start))  # the session's display time
+        if self.clip.all_planes():
+            self.apply_clip()
+        self.set_iso_mode(self.iso_mode, update=True)
 
     def clear(self) -> None:
         """Remove everything this controller added, including PT overlay renderers, which ``plotter.clear()`` keeps."""
         for prop in self.props.values():
             if _is_pt(prop):
                 prop.remove()
+        if self.iso_overlay is not None:
+            self.iso_overlay.remove()
+            self.iso_overlay = None
         self.props = {}
         self.plotter.clear()
 
@@ -89,6 +114,15 @@ class SceneController:
             self.rebuild_nature()
             return
         prop = self.props.get(comp_id)
+        if comp.type == "isosurface":
+            if prop is None and visible:  # hidden at build time: extract and add it now
+                from volviz.render.scene import add_isosurfaces
+
+                self.props[comp_id] = add_isosurfaces(self.plotter, comp, self.dataset_of(comp_id),
+                                                      self.time if self.time_series() else None,
+                                                      clip=self.session.clip)
+            self._sync_iso_overlay()
+            return
         if prop is None and visible:  # hidden at build time: add it now
             from volviz.render.vtk_scene import add_dataset
 
@@ -139,6 +173,7 @@ class SceneController:
     def set_time(self, t: float, interpolate: Optional[bool] = None) -> None:
         """Show display time ``t`` (blending neighbouring steps when interpolating)."""
         from volviz.model.timeseries import frame_at
+        from volviz.render.clipping import clip_vtk_prop
         from volviz.render.vtk_scene import volume_input
 
         if interpolate is not None:
@@ -154,10 +189,13 @@ class SceneController:
 
                 self.plotter.remove_actor(prop, render=False)
                 comp.settings = {**comp.settings, "interpolate": self.interpolate_time}
-                self.props[comp_id] = add_isosurfaces(self.plotter, comp, series, self.time,
-                                                      spectrum=not self.on_screen)
+                self.props[comp_id] = add_isosurfaces(self.plotter, comp, series, self.time, clip=self.session.clip)
             elif prop.IsA("vtkVolume"):
+                self._vtk_inputs.pop(comp_id, None)
                 prop.GetMapper().SetInputData(volume_input(frame_at(series, self.time, self.interpolate_time)))
+                if self.clip.all_planes():
+                    self._vtk_inputs[comp_id] = clip_vtk_prop(prop, self.clip)
+        self._sync_iso_overlay()
 
     # -- camera -----------------------------------------------------------------------------------------------------
     def camera(self) -> CameraState:
@@ -186,6 +224,9 @@ class SceneController:
             if pt and _is_pt(prop) and prop.visible:
                 prop.update()
                 stats[comp_id] = dict(prop.stats)
+        if pt and self.iso_overlay is not None:
+            self.iso_overlay.update()
+            stats["iso"] = dict(self.iso_overlay.stats)
         return stats
 
     def pt_volume(self, comp_id: str) -> Any:
@@ -206,3 +247,96 @@ class SceneController:
         view = build_nature(self.plotter, self.session, self.datasets)
         if view is not None:
             self.props["nature"] = view
+
+    # -- clipping (scene-wide) --------------------------------------------------------------------------------------
+    @property
+    def clip(self) -> Any:
+        from volviz.render.clipping import clip_settings
+
+        return clip_settings(self.session.clip)
+
+    def set_clip(self, clip: Any, update_pt: bool = True) -> list[str]:
+        """Store new clipping (``session.clip`` JSON or ClipSettings) and cut every prop; returns the ids of the PT
+        volumes that need a re-render (done here when ``update_pt``; the app renders them in the background)."""
+        from volviz.iso.clip import ClipSettings
+
+        self.session.clip = clip.to_dict() if isinstance(clip, ClipSettings) else self.clip.from_dict(clip).to_dict()
+        return self.apply_clip(update_pt)
+
+    def apply_clip(self, update_pt: bool = True) -> list[str]:
+        from volviz.iso.clip import clip_tetmesh
+        from volviz.render.clipping import clip_vtk_prop
+        from volviz.render.scene import add_isosurfaces
+
+        clip = self.clip
+        pt_ids = []
+        for comp_id, prop in list(self.props.items()):
+            if comp_id == "nature":
+                continue
+            comp = self.component(comp_id)
+            if comp.type == "isosurface":
+                self.plotter.remove_actor(prop, render=False)
+                self.props[comp_id] = add_isosurfaces(self.plotter, comp, None, clip=clip, meshes=prop.volviz_meshes)
+                self.props[comp_id].SetVisibility(comp.visible)
+            elif _is_pt(prop):
+                whole = self._pt_meshes.setdefault(comp_id, prop.mesh)
+                try:
+                    prop.mesh = clip_tetmesh(whole, clip)
+                    prop.visible = comp.visible
+                except ValueError:  # everything clipped away
+                    prop.visible = False
+                pt_ids.append(comp_id)
+                if update_pt and prop.visible:
+                    prop.update()
+            elif hasattr(prop, "GetMapper"):
+                self._vtk_inputs[comp_id] = clip_vtk_prop(prop, clip, self._vtk_inputs.get(comp_id))
+        self._sync_iso_overlay()
+        self.plotter.render()
+        return pt_ids
+
+    # -- isosurface transparency mode (per scene) -------------------------------------------------------------------
+    @property
+    def iso_mode(self) -> str:
+        mode = self.session.render.options.get("iso_mode", "vtk")
+        return mode if mode in ISO_MODES else "vtk"
+
+    def set_iso_mode(self, mode: str, update: bool = True) -> None:
+        """Draw the isosurfaces with VTK's blend ("vtk") or a CPU mode through the overlay (rendered now when
+        ``update``; the app renders it in the background: ``iso_overlay.begin`` / ``compute`` / ``finish``)."""
+        if mode not in ISO_MODES:
+            raise ValueError(f"unknown isosurface mode {mode!r}; choose from {ISO_MODES}")
+        if mode != "vtk" or "iso_mode" in self.session.render.options:
+            self.session.render.options["iso_mode"] = mode
+        isos = self._iso_props()
+        if mode == "vtk" or not isos:
+            if self.iso_overlay is not None:
+                self.iso_overlay.remove()
+                self.iso_overlay = None
+        elif self.iso_overlay is None:
+            from volviz.render.iso_overlay import IsoOverlay
+
+            self.iso_overlay = IsoOverlay(self.plotter, mode=mode)
+        if self.iso_overlay is not None:
+            self.iso_overlay.mode = mode
+        self._sync_iso_overlay()
+        if update and self.iso_overlay is not None:
+            self.iso_overlay.update()
+        else:
+            self.plotter.render()
+
+    def _iso_props(self) -> dict[str, Any]:
+        return {comp_id: prop for comp_id, prop in self.props.items()
+                if comp_id != "nature" and self.component(comp_id).type == "isosurface"}
+
+    def _sync_iso_overlay(self) -> None:
+        """VTK's isosurface actors show only in "vtk" mode; the overlay gets the visible components' cut surfaces."""
+        overlay = self.iso_overlay
+        meshes, shading = [], "spectrum"
+        for comp_id, prop in self._iso_props().items():
+            visible = self.component(comp_id).visible
+            prop.SetVisibility(visible and overlay is None)
+            if visible:
+                meshes.extend(prop.volviz_shown)
+                shading = prop.volviz_shading
+        if overlay is not None:
+            overlay.meshes, overlay.shading = meshes, shading

@@ -150,7 +150,7 @@ def build_scene(plotter: Any, session: Session, datasets: dict[str, Any], spectr
             continue
         dataset = component_dataset(comp, datasets)
         if comp.type == "isosurface":
-            props[comp.id] = add_isosurfaces(plotter, comp, dataset, spectrum=spectrum)
+            props[comp.id] = add_isosurfaces(plotter, comp, dataset, spectrum=spectrum, clip=session.clip)
         elif uses_pt(session, dataset):
             pt_components.append((comp, dataset))  # drawn last: they composite over the opaque scene's depth
         else:
@@ -220,15 +220,23 @@ def pt_options(options: dict[str, Any]) -> dict[str, Any]:
 
 
 def add_isosurfaces(plotter: Any, comp: Component, dataset: Any, t: Optional[float] = None,
-                    spectrum: bool = True) -> Any:
+                    spectrum: bool = True, clip: Any = None, meshes: Optional[list[Any]] = None) -> Any:
     """The isosurfaces of an ``isosurface`` component (settings: ``volviz.iso.IsoSettings``) as one prop assembly of
     VTK actors, with the iso-spectrum shader when ``spectrum`` (drawn by VTK as the note's 2-pass blend).
 
-    The shader compiles in offscreen render windows but not in the Qt viewport's (VTK 9.7 reports
-    ``normalVCVSOutput`` undeclared there), so the app passes ``spectrum=False`` and draws constant opacity."""
+    ``clip``: the scene's clipping (``session.clip`` or ClipSettings), cut exactly into the triangles on top of the
+    component's own. ``meshes``: the component's extracted surfaces when already known (re-clipping skips the
+    extraction). The assembly keeps the uncut surfaces as ``volviz_meshes`` and the shown ones as ``volviz_shown``
+    (the CPU transparency modes draw those, ``volviz.render.iso_overlay``).
+
+    The shader needs the renderer's lights: a renderer without lights (``pyvista.Plotter.clear`` removes them)
+    compiles VTK's unlit shader, which declares no normals (``normalVCVSOutput`` undeclared); the scene controller
+    restores the light kit before building."""
     import vtk
 
     from volviz.iso import IsoSettings, iso_actor, prepare
+    from volviz.iso.clip import clip_isosurfaces
+    from volviz.render.clipping import clip_settings
 
     try:
         settings = IsoSettings.from_dict(comp.settings)
@@ -236,12 +244,16 @@ def add_isosurfaces(plotter: Any, comp: Component, dataset: Any, t: Optional[flo
         raise SceneError(f"component {comp.id!r}: {exc}") from None
     if not settings.styles:
         raise SceneError(f"component {comp.id!r}: settings.styles lists no iso-values")
-    prepared = prepare(dataset, settings, t)
+    if meshes is None:
+        meshes = prepare(dataset, settings, t).meshes
+    scene_clip = clip_settings(clip)
+    shown = clip_isosurfaces(meshes, scene_clip) if scene_clip.all_planes() else list(meshes)
     assembly = vtk.vtkPropAssembly()
-    for mesh in prepared.meshes:
+    for mesh in shown:
         if len(mesh.triangles):
             assembly.AddPart(iso_actor(mesh, parallel=bool(plotter.camera.parallel_projection),
                                        spectrum=spectrum and settings.shading == "spectrum"))
+    assembly.volviz_meshes, assembly.volviz_shown, assembly.volviz_shading = meshes, shown, settings.shading
     plotter.add_actor(assembly, name=comp.id, reset_camera=False)
     return assembly
 

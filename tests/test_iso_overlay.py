@@ -1,0 +1,117 @@
+"""The isosurface transparency modes and the scene-wide clipping in a real (offscreen) VTK scene."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import pyvista as pv
+
+from volviz.iso.composite import render
+from volviz.model.datasets import RegularVolume
+from volviz.model.demo import demo_tet_mesh
+from volviz.render.controller import SceneController
+from volviz.session import CameraState, Component, DatasetRef, Session
+
+SIZE = (160, 120)
+BG = (0.1, 0.1, 0.12)
+STYLES = [{"value": 0.3, "color": [1.0, 0.3, 0.2], "opacity": 0.5}, {"value": 0.8, "color": [0.2, 0.4, 1.0],
+                                                                       "opacity": 0.4}]
+
+
+def ball() -> RegularVolume:
+    g = np.linspace(-1, 1, 24)
+    x, y, z = np.meshgrid(g, g, g, indexing="ij")
+    return RegularVolume((x * x + y * y + z * z).astype(np.float32))
+
+
+def scene(components: list[Component], clip: dict | None = None) -> tuple[SceneController, pv.Plotter]:
+    s = Session(datasets=[DatasetRef("b", "/unused")], components=components,
+                camera=CameraState((11.5, -40.0, 11.5), (11.5, 11.5, 11.5), (0.0, 0.0, 1.0)))
+    s.render.background = BG
+    if clip is not None:
+        s.clip = clip
+    p = pv.Plotter(off_screen=True, window_size=SIZE)
+    p.ren_win.SetMultiSamples(0)
+    c = SceneController(p, s, {"b": ball()})
+    c.build()
+    return c, p
+
+
+def shot(p: pv.Plotter) -> np.ndarray:
+    return p.screenshot(None, return_img=True).astype(np.float64) / 255.0
+
+
+def iso_component() -> Component:
+    return Component("iso", "isosurface", "b", settings={"styles": STYLES})
+
+
+def test_three_pass_overlay_equals_the_cpu_render_and_modes_differ():
+    c, p = scene([iso_component()])
+    vtk_image = shot(p)
+    c.set_iso_mode("3pass")
+    three = shot(p)
+    cam = c.iso_overlay.camera
+    cpu, _ = render(c.iso_overlay.meshes, cam, SIZE, "3pass")
+    expected = cpu[..., :3] + (1.0 - cpu[..., 3:4]) * np.asarray(BG)   # premultiplied over the background
+    err = np.abs(three - expected) * 255.0
+    assert err.max() <= 3.0, err.max()           # 8-bit straight-alpha overlay, background and screen rounding
+    assert err.mean() <= 0.6, err.mean()
+    assert cpu[..., 3].max() > 0.5               # the surfaces are in view
+    c.set_iso_mode("exact")
+    exact = shot(p)
+    assert np.abs(exact - three).mean() * 255 > 1.0   # 3-pass neglects self-attenuation: visibly brighter
+    assert np.abs(three - vtk_image).mean() * 255 > 1.0
+    c.set_iso_mode("vtk")
+    assert c.iso_overlay is None and np.abs(shot(p) - vtk_image).max() == 0.0
+    assert c.session.render.options["iso_mode"] == "vtk"
+
+
+def test_overlay_is_hidden_behind_opaque_geometry():
+    c, p = scene([iso_component()])
+    c.set_iso_mode("exact")
+    before = shot(p)
+    wall = pv.Box((10.5, 12.5, -6.0, -5.0, -20.0, 40.0))
+    p.add_mesh(wall, color="white", lighting=False)
+    c.iso_overlay.update()
+    after = shot(p)
+    col = SIZE[0] // 2
+    assert np.allclose(after[SIZE[1] // 2, col], 1.0, atol=2 / 255)       # the wall hides the surfaces
+    assert np.abs(after[:, :col - 15] - before[:, :col - 15]).max() * 255 <= 1.0  # unchanged beside it
+
+
+def test_scene_clip_cuts_isosurfaces_volumes_and_pt_meshes_alike():
+    half = {"planes": [{"point": [11.5, 0.0, 0.0], "normal": [1.0, 0.0, 0.0]}], "box": None}
+    row, left, right = SIZE[1] // 2, SIZE[0] // 2 - 15, SIZE[0] // 2 + 15
+    bg = np.asarray(BG)
+    for comp in (iso_component(), Component("vol", "volume", "b")):
+        c, p = scene([comp])
+        full = shot(p)
+        c.set_clip(half)
+        cut = shot(p)
+        assert np.abs(cut[row, left] - bg).max() < 3 / 255, comp.type        # left half removed
+        assert np.abs(cut[row, right] - full[row, right]).max() < 3 / 255     # right half as before
+        c.set_clip({"planes": [], "box": None})
+        assert np.abs(shot(p) - full).max() < 3 / 255
+    # overlay mode draws the cut surfaces too
+    c, p = scene([iso_component()], clip=half)
+    c.set_iso_mode("4pass")
+    img = shot(p)
+    assert np.abs(img[row, left] - bg).max() < 3 / 255 and np.abs(img[row, right] - bg).max() > 0.05
+
+
+def test_clip_box_on_a_pt_volume_is_exact_cut_of_the_mesh():
+    mesh = demo_tet_mesh(6)
+    lo, hi = mesh.points.min(axis=0), mesh.points.max(axis=0)
+    mid = (lo + hi) / 2
+    s = Session(components=[Component("demo", "demo", settings={"cells_per_edge": 6})])
+    p = pv.Plotter(off_screen=True, window_size=SIZE)
+    p.ren_win.SetMultiSamples(0)
+    c = SceneController(p, s, {})
+    c.build()
+    whole, full_alpha = c.pt_volume("demo").mesh, c.pt_volume("demo").image[..., 3].sum()
+    c.set_clip({"planes": [], "box": {"lo": list(lo), "hi": list(mid)}})
+    cut = c.pt_volume("demo").mesh
+    assert cut.points.max(axis=0) == pytest.approx(mid) and cut.points.min(axis=0) == pytest.approx(lo)
+    assert cut.n_cells < whole.n_cells
+    assert 0 < c.pt_volume("demo").image[..., 3].sum() < 0.8 * full_alpha  # re-rendered with an eighth of the cube
+    c.set_clip({"planes": [], "box": None})
+    assert c.pt_volume("demo").mesh is whole
