@@ -375,8 +375,14 @@ def decompress(path: str | Path, strict: bool = False, report: list[dict[str, An
                     valid[t] = 0
                     fail(int(idx[t]), lev, t, "checksum mismatch")
             status = np.zeros(nt, np.int64)
-            a = np.empty(shp, np.int32)
-            K.run_tiles(K.decode_level, cur, payload, offs, sizes, valid, steps[lev], ci, a, status)
+            if lev == 1 and meta["kind"] in _INT_TYPES:  # the finest level writes the output type directly
+                dt = np.dtype(meta["dtype"])
+                a = np.empty(shp, dt)
+                lo, hi = int(np.iinfo(dt).min), int(np.iinfo(dt).max)
+            else:
+                a = np.empty(shp, np.int32)
+                lo, hi = -(1 << 31), (1 << 31) - 1
+            K.run_tiles(K.decode_level, cur, payload, offs, sizes, valid, steps[lev], ci, a, lo, hi, status)
             for t in np.nonzero(status != 0)[0]:
                 fail(int(idx[t]), lev, int(t), "inconsistent stream")
             cur = a
@@ -403,6 +409,8 @@ def _to_dtype(a: np.ndarray, meta: dict[str, Any]) -> np.ndarray:
     kind = meta["kind"]
     dtype = np.dtype(meta["dtype"])
     if kind in _INT_TYPES:
+        if a.dtype == dtype:  # already clipped and cast by the finest level's decode
+            return a
         info_ = np.iinfo(dtype)
         out = np.empty(a.shape, dtype)
         K.run_tiles(K.clip_cast, a, info_.min, info_.max, out)

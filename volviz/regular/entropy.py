@@ -306,7 +306,11 @@ def encode_rans(w, n0, n1, n2, root, out, base):
 @njit(cache=True, nogil=True)
 def decode_rans(buf, base, length, w, n0, n1, n2, root):
     """Decode a node written by :func:`encode_rans` into the tile buffer ``w`` (coded regions only). Returns 0 on
-    success, -1 if the stream is inconsistent (a damaged brick that passed its checksum is still caught)."""
+    success, -1 if the stream is inconsistent (a damaged brick that passed its checksum is still caught).
+
+    Speed: one packed table entry per rANS slot (token | freq << 6 | start << 19), a 64-bit buffered reader for
+    the raw mantissa bits and the sign unmapping fused into the store (``(v >> 1) ^ -(v & 1)``); about 2x faster
+    than a per-bit reader."""
     reg = regions(n0, n1, n2, root)
     nreg = reg.shape[0]
     if length == 0:
@@ -327,17 +331,15 @@ def decode_rans(buf, base, length, w, n0, n1, n2, root):
         anyflag[r] = _get_bits(buf, hdr, limit, bp, 1)
         bp += 1
     for r in range(nreg):
-        q = 0
-        for b0 in range(reg[r, 0], reg[r, 1], SB):
-            for b1 in range(reg[r, 2], reg[r, 3], SB):
-                for b2 in range(reg[r, 4], reg[r, 5], SB):
-                    if anyflag[r]:
-                        sig[r, q] = _get_bits(buf, hdr, limit, bp, 1)
-                        bp += 1
-                    q += 1
-    freq = np.zeros((N_CLASS, N_TOK), np.int64)
-    start = np.zeros((N_CLASS, N_TOK), np.int64)
-    lut = np.zeros((N_CLASS, PROB_SCALE), np.uint8)
+        if not anyflag[r]:
+            continue
+        nq = (((reg[r, 1] - reg[r, 0] + SB - 1) // SB) * ((reg[r, 3] - reg[r, 2] + SB - 1) // SB)
+              * ((reg[r, 5] - reg[r, 4] + SB - 1) // SB))
+        for q in range(nq):
+            sig[r, q] = _get_bits(buf, hdr, limit, bp, 1)
+            bp += 1
+    lut = np.empty((N_CLASS, PROB_SCALE), np.int32)
+    present = np.zeros(N_CLASS, np.uint8)
     for c in range(N_CLASS):
         top = _get_bits(buf, hdr, limit, bp, 6)
         bp += 6
@@ -354,63 +356,84 @@ def decode_rans(buf, base, length, w, n0, n1, n2, root):
                 bp += PROB_BITS
                 if acc + f > PROB_SCALE:
                     return -1
-                freq[c, s] = f
-                start[c, s] = acc
+                e = s | (f << 6) | (acc << 19)
                 for u in range(acc, acc + f):
-                    lut[c, u] = s
+                    lut[c, u] = e
                 acc += f
-        if top > 0 and acc != PROB_SCALE:
-            return -1
+        if top > 0:
+            if acc != PROB_SCALE:
+                return -1
+            present[c] = 1
     if bp > nbb * 8:
         return -1
     o = limit
     end = base + length
     if o + 4 > end:
         return -1
-    x = (np.uint64(buf[o]) | (np.uint64(buf[o + 1]) << np.uint64(8))) << np.uint64(16)
-    x |= np.uint64(buf[o + 2]) | (np.uint64(buf[o + 3]) << np.uint64(8))
+    x = ((np.int64(buf[o]) | (np.int64(buf[o + 1]) << 8)) << 16) | np.int64(buf[o + 2]) | (
+        np.int64(buf[o + 3]) << 8)
     o += 4
-    mask = np.uint64(PROB_SCALE - 1)
+    # buffered raw-bit reader over [hdr, limit), positioned at bit bp
+    rp = hdr + (bp >> 3)
+    bits = np.int64(0)
+    nbits = 0
+    while nbits <= 48 and rp < limit:
+        bits |= np.int64(buf[rp]) << nbits
+        nbits += 8
+        rp += 1
+    skip = bp & 7
+    bits >>= skip
+    nbits -= skip
+    used = bp
     for r in range(nreg):
         c = reg[r, 6]
+        if anyflag[r] and not present[c]:
+            return -1
+        lut_c = lut[c]
         q = 0
         for b0 in range(reg[r, 0], reg[r, 1], SB):
+            e0 = min(b0 + SB, reg[r, 1])
             for b1 in range(reg[r, 2], reg[r, 3], SB):
+                e1 = min(b1 + SB, reg[r, 3])
                 for b2 in range(reg[r, 4], reg[r, 5], SB):
-                    e0 = min(b0 + SB, reg[r, 1])
-                    e1 = min(b1 + SB, reg[r, 3])
                     e2 = min(b2 + SB, reg[r, 5])
                     if sig[r, q]:
-                        if freq[c].sum() == 0:
-                            return -1
                         for i in range(b0, e0):
                             for j in range(b1, e1):
+                                wl = w[i, j]
                                 for k in range(b2, e2):
-                                    slot = x & mask
-                                    t = lut[c, slot]
-                                    x = np.uint64(freq[c, t]) * (x >> np.uint64(PROB_BITS)) + slot - np.uint64(
-                                        start[c, t])
-                                    if x < np.uint64(RANS_L):
+                                    slot = x & (PROB_SCALE - 1)
+                                    e = np.int64(lut_c[slot])
+                                    t = e & 63
+                                    x = ((e >> 6) & 0x1FFF) * (x >> PROB_BITS) + slot - (e >> 19)
+                                    if x < RANS_L:
                                         if o + 2 <= end:
-                                            x = (x << np.uint64(16)) | np.uint64(buf[o]) | (
-                                                np.uint64(buf[o + 1]) << np.uint64(8))
+                                            x = (x << 16) | np.int64(buf[o]) | (np.int64(buf[o + 1]) << 8)
                                         else:
-                                            x = x << np.uint64(16)
+                                            x = x << 16
                                         o += 2
                                     if t < 16:
-                                        v = np.int64(t)
+                                        v = t
                                     else:
-                                        nb = np.int64(t) - 11
-                                        v = (np.int64(1) << (nb - 1)) | _get_bits(buf, hdr, limit, bp, nb - 1)
-                                        bp += nb - 1
-                                    w[i, j, k] = sign_unmap(v)
+                                        nb = t - 12
+                                        if nbits < nb:
+                                            while nbits <= 48:
+                                                if rp < limit:
+                                                    bits |= np.int64(buf[rp]) << nbits
+                                                rp += 1
+                                                nbits += 8
+                                        v = (np.int64(1) << nb) | (bits & ((np.int64(1) << nb) - 1))
+                                        bits >>= nb
+                                        nbits -= nb
+                                        used += nb
+                                    wl[k] = (v >> 1) ^ -(v & 1)
                     else:
                         for i in range(b0, e0):
                             for j in range(b1, e1):
                                 for k in range(b2, e2):
                                     w[i, j, k] = 0
                     q += 1
-    if o > end + 2 or bp > nbb * 8:
+    if o > end + 2 or used > nbb * 8:
         return -1
     return 0
 

@@ -20,7 +20,7 @@ import numpy as np
 from numba import njit
 
 from .entropy import CODER_RANS, decode_arith, decode_rans, encode_arith, encode_rans
-from .wavelet import HALF, TILE, forward_tile, inverse_tile
+from .wavelet import HALF, TILE, forward_tile, inverse_tile, inverse_tile_with
 
 ROUND = 0.40
 BIAS = 0.10
@@ -118,24 +118,29 @@ def encode_level(a, steps, coder, out, cap, sizes, low, first, stride):
 
 
 @njit(cache=True, nogil=True)
-def decode_level(low, payload, offsets, sizes, valid, steps, coder, a, status, first, stride):
+def decode_level(low, payload, offsets, sizes, valid, steps, coder, a, lo, hi, status, first, stride):
     """Inverse of :func:`encode_level`: tile ``t``'s bytes are ``payload[offsets[t]: offsets[t] + sizes[t]]``;
     tiles with ``valid[t] == 0`` (failed checksum) get zero details, i.e. the linear interpolation of the lowpass.
-    ``status[t]`` is set to -1 where a stream turned out inconsistent (its details are then zeroed too)."""
+    ``status[t]`` is set to -1 where a stream turned out inconsistent (its details are then zeroed too).
+    Samples are clipped to ``[lo, hi]`` on the way into ``a`` (of any integer dtype), so the finest level writes
+    the caller's output type directly (no int32 volume, no separate conversion pass)."""
     shape = a.shape
     c0 = (shape[0] + TILE - 1) // TILE
     c1 = (shape[1] + TILE - 1) // TILE
     c2 = (shape[2] + TILE - 1) // TILE
+    w = np.empty((TILE, TILE, TILE), np.int32)
+    tmp = np.empty((TILE, TILE, TILE), np.int32)
     for t in range(first, c0 * c1 * c2, stride):
         t0, t1, t2, s0, s1, s2, n0, n1, n2 = _tile_box(t, c0, c1, shape)
-        w = np.empty((TILE, TILE, TILE), np.int32)
         l0 = (n0 + 1) // 2
         l1 = (n1 + 1) // 2
         l2 = (n2 + 1) // 2
         for i in range(l0):  # the lowpass first: the arithmetic coder's contexts read it
             for j in range(l1):
+                src = low[t0 * HALF + i, t1 * HALF + j, t2 * HALF:t2 * HALF + l2]
+                dst = w[i, j]
                 for k in range(l2):
-                    w[i, j, k] = low[t0 * HALF + i, t1 * HALF + j, t2 * HALF + k]
+                    dst[k] = src[k]
         n = sizes[t] if valid[t] else 0
         if coder == CODER_RANS:
             rc = decode_rans(payload, offsets[t], n, w, n0, n1, n2, False)
@@ -145,11 +150,13 @@ def decode_level(low, payload, offsets, sizes, valid, steps, coder, a, status, f
         if rc != 0:
             decode_rans(payload, 0, 0, w, n0, n1, n2, False)  # zero the details
         _dequantise(w, n0, n1, n2, steps)
-        inverse_tile(w, n0, n1, n2)
+        inverse_tile_with(w, tmp, n0, n1, n2)
         for i in range(n0):
             for j in range(n1):
+                src = w[i, j]
+                dst = a[s0 + i, s1 + j, s2:s2 + n2]
                 for k in range(n2):
-                    a[s0 + i, s1 + j, s2 + k] = w[i, j, k]
+                    dst[k] = min(max(src[k], lo), hi)
 
 
 @njit(cache=True, nogil=True)

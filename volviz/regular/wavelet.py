@@ -158,12 +158,52 @@ def forward_tile(w, n0, n1, n2):
 
 
 @njit(cache=True, nogil=True)
+def _inv_planes_to(src, dst, m0, m1, m2):
+    """Inverse lifting along axis 0 from ``src`` ([s | d] halves) into ``dst`` (interleaved signal); the same
+    arithmetic as the inverse branch of :func:`_planes` without the copy back (ping-pong buffers)."""
+    if m0 < 2:
+        for j in range(m1):
+            for k in range(m2):
+                dst[0, j, k] = src[0, j, k]
+        return
+    nl = (m0 + 1) // 2
+    nh = m0 // 2
+    for i in range(nl):
+        dl = nl + i - 1 if i > 0 else nl
+        dr = nl + i if i < nh else nl + nh - 1
+        for j in range(m1):
+            s_row = src[i, j]
+            l_row = src[dl, j]
+            r_row = src[dr, j]
+            o_row = dst[2 * i, j]
+            for k in range(m2):
+                o_row[k] = s_row[k] - ((l_row[k] + r_row[k] + 2) >> 2)
+    for i in range(nh):
+        a = 2 * i
+        b = 2 * i + 2 if 2 * i + 2 < m0 else a
+        for j in range(m1):
+            d_row = src[nl + i, j]
+            a_row = dst[a, j]
+            b_row = dst[b, j]
+            o_row = dst[2 * i + 1, j]
+            for k in range(m2):
+                o_row[k] = d_row[k] + ((a_row[k] + b_row[k]) >> 1)
+
+
+@njit(cache=True, nogil=True)
+def inverse_tile_with(w, tmp, n0, n1, n2):
+    """Inverse of :func:`forward_tile` (bit-exact) with a caller-provided scratch tile ``tmp``: x (w -> tmp),
+    y (tmp -> w, on transposed views), then z in place. Two full-tile copies fewer than :func:`_planes`."""
+    _inv_planes_to(w, tmp, n0, n1, n2)
+    _inv_planes_to(tmp.transpose(1, 0, 2), w.transpose(1, 0, 2), n1, n0, n2)
+    _inv_lines(w, n0, n1, n2)
+
+
+@njit(cache=True, nogil=True)
 def inverse_tile(w, n0, n1, n2):
     """Inverse of :func:`forward_tile` (bit-exact): x, y, z."""
     tmp = np.empty((TILE, TILE, TILE), np.int32)
-    _planes(w, n0, n1, n2, tmp, True)
-    _planes(w.transpose(1, 0, 2), n1, n0, n2, tmp, True)
-    _inv_lines(w, n0, n1, n2)
+    inverse_tile_with(w, tmp, n0, n1, n2)
 
 
 def n_tiles(n: int) -> int:
