@@ -16,6 +16,7 @@ from PySide6.QtWidgets import (QDockWidget, QFileDialog, QInputDialog, QLabel, Q
 
 from volviz.jobs import JobOutcome
 from volviz.session import CameraKey, Session, SessionError, relative_path
+from volviz_app.docks.clipping import ClippingDock
 from volviz_app.docks.render_settings import RenderSettings
 from volviz_app.gc_guard import GuiThreadCollector
 from volviz_app.docks.scene_tree import SceneTree
@@ -107,6 +108,7 @@ class MainWindow(QMainWindow):
         self.render_settings = RenderSettings()
         self.timeline = Timeline()
         self.statistics = Statistics()
+        self.clipping = ClippingDock()
         right, left, bottom = (Qt.DockWidgetArea.RightDockWidgetArea, Qt.DockWidgetArea.LeftDockWidgetArea,
                                Qt.DockWidgetArea.BottomDockWidgetArea)
         self.tf_dock = self._dock("Transfer function", "tfDock", self.tf_editor, right)
@@ -114,7 +116,10 @@ class MainWindow(QMainWindow):
         self.settings_dock = self._dock("Render settings", "settingsDock", self.render_settings, left)
         self.timeline_dock = self._dock("Timeline", "timelineDock", self.timeline, bottom)
         self.stats_dock = self._dock("Statistics", "statsDock", self.statistics, right)
-        self.docks = [self.tf_dock, self.scene_dock, self.settings_dock, self.timeline_dock, self.stats_dock]
+        self.clip_dock = self._dock("Clipping", "clipDock", self.clipping, right)
+        self.tabifyDockWidget(self.stats_dock, self.clip_dock)
+        self.docks = [self.tf_dock, self.scene_dock, self.settings_dock, self.timeline_dock, self.stats_dock,
+                      self.clip_dock]
 
         self.tf_editor.changed.connect(self._tf_changed)
         self.tf_editor.committed.connect(self._tf_committed)
@@ -125,6 +130,7 @@ class MainWindow(QMainWindow):
         self.render_settings.changed.connect(self._settings_changed)
         self.timeline.timeChanged.connect(self._time_changed)
         self.timeline.interpolationToggled.connect(self._interpolation_toggled)
+        self.clipping.changed.connect(self.set_clip)
 
     def _build_menus(self) -> None:
         file_menu = self.menuBar().addMenu("&File")
@@ -262,6 +268,7 @@ class MainWindow(QMainWindow):
             self.restoreState(QByteArray.fromBase64(session.layout["window_state"].encode("ascii")))
         self.scene_tree.populate(session.components)
         self.render_settings.load(session.render)
+        self.clipping.load(session.clip, self.plotter.bounds)
         display_time = controller.time  # the session's display time, which set_steps would reset to the first step
         self.timeline.set_steps(controller.time_steps())
         if controller.time_series():
@@ -384,19 +391,47 @@ class MainWindow(QMainWindow):
         image and a fresh error estimate."""
         controller = self.controller
         volume = controller.pt_volume(comp_id) if controller is not None else None
-        if volume is None:
-            return
-        request = volume.begin()
+        if volume is not None:
+            self._refresh_overlay(volume, f"pt:{comp_id}", "volume", lambda: controller.pt_volume(comp_id),
+                                  lambda request: self.estimate_error(comp_id, request))
+
+    def refresh_iso_overlay(self) -> None:
+        """Re-render the isosurfaces' CPU transparency mode (when one is on) in the background, like a PT volume."""
+        controller = self.controller
+        overlay = controller.iso_overlay if controller is not None else None
+        if overlay is not None:
+            self._refresh_overlay(overlay, "iso-overlay", "isosurfaces", lambda: controller.iso_overlay)
+
+    def _refresh_overlay(self, handle: Any, key: str, what: str, current: Any, after: Any = None) -> None:
+        controller = self.controller
+        request = handle.begin()
 
         def done(outcome: JobOutcome) -> None:
-            if outcome.ok and self.controller is controller and controller.pt_volume(comp_id) is volume:
-                volume.finish(request, *outcome.result)
+            if outcome.ok and self.controller is controller and current() is handle:
+                handle.finish(request, *outcome.result)
                 self.render()
-                self.estimate_error(comp_id, request)
+                if after is not None:
+                    after(request)
             elif outcome.error is not None:
-                self.show_error("Cannot render the volume", str(outcome.error))
+                self.show_error(f"Cannot render the {what}", str(outcome.error))
 
-        self.jobs.submit(volume.compute, request, name="volume", key=f"pt:{comp_id}", on_done=done)
+        self.jobs.submit(handle.compute, request, name=what, key=key, on_done=done)
+
+    def set_clip(self, clip: dict[str, Any]) -> None:
+        """New scene-wide clipping (from the clipping dock): every prop is cut; PT volumes and the isosurface
+        overlay re-render in the background."""
+        if self.controller is None:
+            return
+        try:
+            pt_ids = self.controller.set_clip(clip, update_pt=False)
+        except ValueError as exc:
+            self.show_error("Invalid clipping", str(exc))
+            return
+        self.set_dirty()
+        self.render()
+        for comp_id in pt_ids:
+            self.refresh_pt(comp_id)
+        self.refresh_iso_overlay()
 
     def _tf_committed(self, tf: Any) -> None:
         self._tf_changed(tf)
@@ -447,10 +482,16 @@ class MainWindow(QMainWindow):
         rebuild = (values["method"] != self.session.render.method
                    or any(values["options"].get(k) != self.session.render.options.get(k) for k in renderer_keys))
         budget_changed = values["options"].get("error_budget") != self.session.render.options.get("error_budget")
+        iso_mode = values["options"].get("iso_mode", "vtk")
+        iso_changed = iso_mode != self.session.render.options.get("iso_mode", "vtk")
         self.session.render.method = values["method"]
         self.session.render.size = values["size"]
         self.session.render.options.update(values["options"])
         self.set_dirty()
+        if iso_changed and not rebuild and self.controller is not None:
+            self.controller.set_iso_mode(iso_mode, update=False)
+            self.render()
+            self.refresh_iso_overlay()
         if budget_changed and not rebuild and getattr(self, "last_error_rmse", None) is not None:
             self._enforce_error_budget(self.last_error_rmse)
             return
@@ -498,6 +539,7 @@ class MainWindow(QMainWindow):
         self.render()
         for comp_id in self.controller.pt_stats():
             self.refresh_pt(comp_id)
+        self.refresh_iso_overlay()
 
     def add_bookmark(self, name: str) -> None:
         if self.controller is None:
@@ -574,7 +616,7 @@ class MainWindow(QMainWindow):
         camera = self.controller.camera() if self.controller is not None else session.camera
         return Session(datasets=refs, components=session.components, transfer_functions=session.transfer_functions,
                        camera=camera, camera_paths=session.camera_paths, bookmarks=session.bookmarks,
-                       render=session.render, layout=layout)
+                       render=session.render, layout=layout, clip=session.clip)
 
     def save_session(self, path: str | os.PathLike) -> bool:
         from volviz.session import save
@@ -686,7 +728,7 @@ class MainWindow(QMainWindow):
             session = Session(datasets=self.session.datasets, components=self.session.components,
                               transfer_functions=self.session.transfer_functions,
                               camera=self.controller.camera() if self.controller else None,
-                              render=self.session.render)
+                              render=self.session.render, clip=self.session.clip)
             controller = SceneController(plotter, session, self.datasets)
             controller.build()
             if self.controller is not None and self.controller.time_series():

@@ -11,6 +11,7 @@ from PySide6.QtWidgets import QComboBox, QDoubleSpinBox, QFormLayout, QSpinBox, 
 METHODS = ("auto", "pt", "reference", "vtk")
 TABLE_KINDS = ("auto", "3d", "separable-1", "separable-2", "separable-4")
 SORTS = ("mpvo", "centroid", "power")
+ISO_MODES = ("vtk", "2pass", "3pass", "4pass", "exact")  # volviz.render.controller.ISO_MODES
 
 
 class RenderSettings(QWidget):
@@ -37,6 +38,10 @@ class RenderSettings(QWidget):
         self.error_budget.setSuffix(" /255 RMSE")
         self.error_budget.setToolTip("When the measured error of volviz's renderer exceeds this, the app switches to "
                                      "the most accurate pre-integration table")
+        self.iso_mode = QComboBox()
+        self.iso_mode.addItems(ISO_MODES)
+        self.iso_mode.setToolTip("Transparency of isosurfaces: VTK's 2-pass blend on the GPU, or volviz's CPU modes "
+                                 "(2-pass, order-independent 3-pass and 4-pass, exact sorted fragments)")
         self.width_box = QSpinBox()
         self.height_box = QSpinBox()
         for box in (self.width_box, self.height_box):
@@ -49,9 +54,10 @@ class RenderSettings(QWidget):
         form.addRow("Table resolution", self.table_resolution)
         form.addRow("Sort", self.sort)
         form.addRow("Error budget", self.error_budget)
+        form.addRow("Isosurfaces", self.iso_mode)
         form.addRow("Export width", self.width_box)
         form.addRow("Export height", self.height_box)
-        for combo in (self.method, self.table_kind, self.table_resolution, self.sort):
+        for combo in (self.method, self.table_kind, self.table_resolution, self.sort, self.iso_mode):
             combo.currentTextChanged.connect(self._emit)
         for box in (self.error_budget, self.width_box, self.height_box):
             box.valueChanged.connect(self._emit)
@@ -61,7 +67,8 @@ class RenderSettings(QWidget):
         return {"method": self.method.currentText(), "size": (self.width_box.value(), self.height_box.value()),
                 "options": {"table": self.table_kind.currentText(),
                             "table_resolution": int(self.table_resolution.currentText()),
-                            "sort": self.sort.currentText(), "error_budget": self.error_budget.value()}}
+                            "sort": self.sort.currentText(), "error_budget": self.error_budget.value(),
+                            "iso_mode": self.iso_mode.currentText()}}
 
     def load(self, render: Any) -> None:
         self._loading = True
@@ -73,6 +80,7 @@ class RenderSettings(QWidget):
         self.table_resolution.setCurrentText(str(opts.get("table_resolution", 128)))
         self.sort.setCurrentText(str(opts.get("sort", "mpvo")))
         self.error_budget.setValue(float(opts.get("error_budget", 1.0)))
+        self.iso_mode.setCurrentText(str(opts.get("iso_mode", "vtk")))
         self._loading = False
 
     def load_values(self, values: dict[str, Any]) -> None:

@@ -1,0 +1,148 @@
+"""Clipping planes, the isosurface transparency modes and the iso-spectrum shader in the app's real Qt viewport
+(pytest-qt under Xvfb, real rendering)."""
+from __future__ import annotations
+
+import gc
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+import pyvista as pv
+from PySide6.QtCore import QSettings
+
+from volviz.iso.composite import render
+from volviz.unstructured.camera import Camera
+from volviz_app.window import MainWindow
+
+STYLES = [{"value": 0.3, "color": [1.0, 0.3, 0.2], "opacity": 0.5},
+          {"value": 0.8, "color": [0.2, 0.4, 1.0], "opacity": 0.4}]
+
+
+@pytest.fixture
+def session_file(tmp_path: Path) -> Path:
+    g = np.linspace(-1, 1, 24)
+    x, y, z = np.meshgrid(g, g, g, indexing="ij")
+    grid = pv.ImageData(dimensions=(24, 24, 24))
+    grid.point_data["s"] = (x * x + y * y + z * z).ravel(order="F")
+    grid.save(tmp_path / "ball.vti")
+    doc = {"format": "volviz-session", "version": 1, "datasets": [{"id": "b", "path": "ball.vti"}],
+           "components": [{"id": "iso", "type": "isosurface", "dataset": "b", "settings": {"styles": STYLES}}],
+           "camera": {"position": [11.5, -45.0, 11.5], "focal_point": [11.5, 11.5, 11.5], "view_up": [0, 0, 1]}}
+    path = tmp_path / "ball.json"
+    path.write_text(json.dumps(doc))
+    return path
+
+
+@pytest.fixture
+def make_window(qtbot, tmp_path: Path):
+    created = []
+
+    def make() -> MainWindow:
+        win = MainWindow(settings=QSettings(str(tmp_path / "settings.ini"), QSettings.Format.IniFormat),
+                         recovery_dir=tmp_path / "recovery")
+        win.resize(1100, 760)
+        win.show()
+        qtbot.waitExposed(win)
+        created.append(win)
+        return win
+
+    yield make
+    for win in created:
+        win.dirty = False
+        win.close()
+    gc.collect()
+
+
+def open_session(qtbot, window: MainWindow, path: Path) -> None:
+    window.open_path(path)
+    qtbot.waitUntil(lambda: not window.progress_bar.isVisible() and window.controller is not None, timeout=60000)
+    window.plotter.ren_win.SetMultiSamples(0)
+
+
+def viewport(window: MainWindow) -> np.ndarray:
+    window.plotter.render()
+    return np.asarray(window.plotter.screenshot(None, return_img=True)).astype(np.float64)
+
+
+def pixel(window: MainWindow, point: tuple[float, float, float]) -> tuple[int, int]:
+    """(row, col) of a world point in the viewport image."""
+    w, h = window.plotter.ren_win.GetSize()
+    px, py, _ = Camera.from_pyvista(window.plotter.camera).project(np.array(point), (w, h))
+    return int(round(py)), int(round(px))
+
+
+def test_clip_plane_cuts_the_view_undo_and_survives_save_and_reopen(qtbot, make_window, session_file, tmp_path):
+    window = make_window()
+    open_session(qtbot, window, session_file)
+    before = viewport(window)
+    left, right = pixel(window, (8.0, 11.5, 11.5)), pixel(window, (15.0, 11.5, 11.5))
+    background = before[5, 5]
+    assert np.abs(before[left] - background).max() > 20 and np.abs(before[right] - background).max() > 20
+
+    dock = window.clipping
+    dock.add_button.click()                              # a plane through the centre, normal +x: keeps x >= 11.5
+    assert len(window.session.clip["planes"]) == 1 and window.dirty
+    cut = viewport(window)
+    assert np.abs(cut[left] - background).max() <= 3     # the left half is gone
+    assert np.abs(cut[right] - before[right]).max() <= 3  # the right half is as it was
+    dock.offset.setValue(13.0)                           # move the plane with the spin box
+    assert window.session.clip["planes"][0]["point"] == pytest.approx([13.0, 0.0, 0.0])
+    dock.undo_button.click()
+    assert window.session.clip["planes"][0]["point"] == pytest.approx([11.5, 0.0, 0.0])
+    assert np.abs(viewport(window) - cut).max() <= 3
+    dock.undo_button.click()                             # undo the plane itself
+    assert window.session.clip["planes"] == [] and np.abs(viewport(window) - before).max() <= 3
+    dock.redo_button.click()
+    assert len(window.session.clip["planes"]) == 1
+
+    saved = tmp_path / "clipped.json"
+    assert window.save_session(saved)
+    assert json.loads(saved.read_text())["clip"]["planes"][0]["normal"] == [1.0, 0.0, 0.0]
+    other = make_window()
+    open_session(qtbot, other, saved)
+    assert other.session.clip == window.session.clip
+    assert other.clipping.plane_list.count() == 1 and other.clipping.offset.value() == pytest.approx(11.5)
+    reopened = viewport(other)
+    assert np.abs(reopened[left] - background).max() <= 3
+    assert np.abs(reopened[right] - cut[right]).max() <= 3
+
+
+def test_transparency_mode_from_render_settings_and_spectrum_shader_on_screen(qtbot, make_window, session_file,
+                                                                              tmp_path):
+    window = make_window()
+    for dock in (window.tf_dock, window.stats_dock, window.clip_dock):
+        dock.hide()                              # room for the whole scene in the viewport
+    open_session(qtbot, window, session_file)
+    vtk_image = viewport(window)
+    # the iso-spectrum shader compiles in the Qt viewport (it needs the lights that Plotter.clear removed): the
+    # viewport equals the offscreen export, which always had it
+    export = tmp_path / "export.png"
+    w, h = window.plotter.ren_win.GetSize()
+    assert window.export_screenshot(export, (w, h))
+    import imageio.v3 as iio
+    offscreen = iio.imread(export)[..., :3].astype(np.float64)
+    assert offscreen.shape == vtk_image.shape
+    assert np.abs(offscreen - vtk_image).mean() < 1.0
+    flat = [c for c in window.session.components if c.id == "iso"][0]
+    assert window.apply_component_settings("iso", json.dumps({**flat.settings, "shading": "flat"}))
+    window.plotter.ren_win.SetMultiSamples(0)
+    assert np.abs(viewport(window) - vtk_image).mean() > 0.5  # constant opacity looks different
+
+    assert window.apply_component_settings("iso", json.dumps({"styles": STYLES}))
+    window.plotter.ren_win.SetMultiSamples(0)
+    window.render_settings.iso_mode.setCurrentText("3pass")
+    overlay = window.controller.iso_overlay
+    assert overlay is not None and window.session.render.options["iso_mode"] == "3pass"
+    qtbot.waitUntil(lambda: overlay.stats.get("method") == "iso 3pass" and overlay.stats.get("size") == (w, h),
+                    timeout=30000)
+    three = viewport(window)
+    assert np.abs(three - vtk_image).mean() > 1.0
+    cpu, _ = render(overlay.meshes, overlay.camera, (w, h), "3pass")
+    bg = np.asarray(window.session.render.background) * 255.0
+    expected = (cpu[..., :3] * 255.0 + (1.0 - cpu[..., 3:4]) * bg)
+    err = np.abs(three - expected)[1:-1, 1:-1]  # (the overlay image's outermost pixels are not compared)
+    assert err.max() <= 3.0 and err.mean() < 0.6
+    window.render_settings.iso_mode.setCurrentText("vtk")
+    assert window.controller.iso_overlay is None
+    assert np.abs(viewport(window) - vtk_image).max() <= 3
