@@ -2,17 +2,16 @@
 (pytest-qt under Xvfb, real rendering)."""
 from __future__ import annotations
 
-import gc
 import json
 from pathlib import Path
 
 import numpy as np
 import pytest
 import pyvista as pv
-from PySide6.QtCore import QSettings
 
 from volviz.iso.composite import render
 from volviz.unstructured.camera import Camera
+from test_app_workflows import make_window  # noqa: F401  (the shared window fixture)
 from volviz_app.window import MainWindow
 
 STYLES = [{"value": 0.3, "color": [1.0, 0.3, 0.2], "opacity": 0.5},
@@ -32,26 +31,6 @@ def session_file(tmp_path: Path) -> Path:
     path = tmp_path / "ball.json"
     path.write_text(json.dumps(doc))
     return path
-
-
-@pytest.fixture
-def make_window(qtbot, tmp_path: Path):
-    created = []
-
-    def make() -> MainWindow:
-        win = MainWindow(settings=QSettings(str(tmp_path / "settings.ini"), QSettings.Format.IniFormat),
-                         recovery_dir=tmp_path / "recovery")
-        win.resize(1100, 760)
-        win.show()
-        qtbot.waitExposed(win)
-        created.append(win)
-        return win
-
-    yield make
-    for win in created:
-        win.dirty = False
-        win.close()
-    gc.collect()
 
 
 def open_session(qtbot, window: MainWindow, path: Path) -> None:
