@@ -31,7 +31,7 @@ import numpy as np
 from numba import njit, prange
 
 from volviz.iso.extract import IsoMesh, merge_meshes
-from volviz.iso.raster import rasterize
+from volviz.iso.raster import clip_near_plane, rasterize
 from volviz.iso.spectrum import fit_spectrum, spectrum_alpha
 from volviz.unstructured.camera import Camera
 
@@ -98,6 +98,14 @@ def fragments(meshes: Sequence[IsoMesh], camera: Camera, size: tuple[int, int] =
     t0 = time.perf_counter()
     w, h = (int(v) for v in size)
     pts, tris, nrm, sid = merge_meshes(meshes)
+    n_input = len(tris)
+    n_opaque = int(sum(m.n_triangles for m in meshes if m.style.opacity >= 1.0))
+    _, _, fwd = camera.frame()
+    n_pts = len(pts)
+    pts, tris, nrm, parent = clip_near_plane(pts, tris, nrm, camera.position, fwd, camera.clipping_range[0])
+    sid = sid[parent]  # triangles crossing the near plane are cut there, as OpenGL does
+    if len(pts) > n_pts:  # normals interpolated along cut edges: unit length again
+        nrm[n_pts:] /= np.maximum(np.linalg.norm(nrm[n_pts:], axis=1, keepdims=True), 1e-300)
     mu_v = _view_mu(pts, nrm, camera) if len(pts) else np.zeros(0)
     scr = camera.project(pts, (w, h)) if len(pts) else np.zeros((0, 3))
     pix, dep, mu, tid = rasterize(scr, mu_v, tris, (w, h), perspective=not camera.parallel)
@@ -124,7 +132,7 @@ def fragments(meshes: Sequence[IsoMesh], camera: Camera, size: tuple[int, int] =
     back = _back_facing(pts, tris, nrm, camera)[tid]
     return Fragments((w, h), ptr, np.ascontiguousarray(dep[order]), np.ascontiguousarray(rgba[order]),
                      np.ascontiguousarray(is_opaque[s][order]), np.ascontiguousarray(back[order]),
-                     int(len(tris)), int(np.sum(is_opaque[sid])), time.perf_counter() - t0)
+                     n_input, n_opaque, time.perf_counter() - t0)
 
 
 @njit(cache=True, nogil=True, parallel=True)

@@ -2,16 +2,61 @@
 
 Pixel centres sit at continuous coordinates (col, row) as ``Camera.project`` gives them; coverage uses the top-left
 rule, so a pixel on an edge shared by two triangles gets exactly one fragment (no double-counted layers). Depth and
-the per-vertex attribute μ = |cos θ| are interpolated perspective-correctly (through 1/z). Triangles with a vertex at
-or in front of the near plane are dropped (no near-plane clipping; the cameras keep surfaces beyond ``near``).
-Fragments are written in triangle (draw) order, which the 2-pass mode relies on.
+the per-vertex attribute μ = |cos θ| are interpolated perspective-correctly (through 1/z). ``rasterize`` drops
+triangles with a vertex at or behind the eye; call :func:`clip_near_plane` first to cut triangles that cross the
+near plane, as OpenGL's clipper does (``volviz.iso.composite.fragments`` does). Fragments are written in triangle
+(draw) order, which the 2-pass mode relies on.
 """
 from __future__ import annotations
 
 import numpy as np
 from numba import njit, prange
 
-__all__ = ["rasterize"]
+__all__ = ["rasterize", "clip_near_plane"]
+
+
+def clip_near_plane(points: np.ndarray, triangles: np.ndarray, attributes: np.ndarray, eye: np.ndarray,
+                    forward: np.ndarray, near: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Cut triangles at the near plane ``(x − eye)·forward = near`` and keep the parts beyond it.
+
+    A triangle with one vertex beyond the plane becomes one triangle, with two vertices beyond it a quad split in two
+    triangles; the new vertices lie on the plane, their ``attributes`` (n, k) (e.g. normals) linearly interpolated
+    along the cut edges (exact for attributes linear over the triangle). Triangles wholly in front are dropped,
+    wholly beyond kept unchanged and first, in their order. Returns (points, triangles, attributes, parent index of
+    every output triangle)."""
+    pts = np.asarray(points, dtype=np.float64)
+    tris = np.asarray(triangles, dtype=np.int64).reshape(-1, 3)
+    att = np.asarray(attributes, dtype=np.float64).reshape(len(pts), -1)
+    d = (pts - np.asarray(eye, dtype=np.float64)) @ np.asarray(forward, dtype=np.float64) - float(near)
+    inside = d[tris] >= 0.0 if len(tris) else np.zeros((0, 3), bool)
+    n_in = inside.sum(axis=1)
+    keep = np.flatnonzero(n_in == 3)
+    cut = np.flatnonzero((n_in == 1) | (n_in == 2))
+    if len(cut) == 0:
+        return pts, tris[keep], att, keep
+    t = tris[cut]
+    odd = np.where((n_in[cut] == 1)[:, None], inside[cut], ~inside[cut])  # the lone vertex (in or out)
+    first = np.argmax(odd, axis=1)                                           # rotate it to slot 0 (same winding)
+    rot = t[np.arange(len(t))[:, None], (first[:, None] + np.arange(3)) % 3]
+    v0, v1, v2 = rot[:, 0], rot[:, 1], rot[:, 2]
+
+    def edge(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        w = (d[a] / (d[a] - d[b]))[:, None]
+        return pts[a] + w * (pts[b] - pts[a]), att[a] + w * (att[b] - att[a])
+
+    p01, a01 = edge(v0, v1)
+    p02, a02 = edge(v0, v2)
+    m = len(cut)
+    base = len(pts)
+    i01, i02 = base + np.arange(m), base + m + np.arange(m)
+    one = n_in[cut] == 1   # v0 beyond the plane: triangle (v0, e01, e02)
+    new_tris = [np.stack([v0, i01, i02], axis=1)[one],
+                np.stack([i01, v1, v2], axis=1)[~one],  # v0 in front: quad (e01, v1, v2, e02)
+                np.stack([i01, v2, i02], axis=1)[~one]]
+    parents = [cut[one], cut[~one], cut[~one]]
+    out_pts = np.concatenate([pts, p01, p02])
+    out_att = np.concatenate([att, a01, a02])
+    return (out_pts, np.concatenate([tris[keep]] + new_tris), out_att, np.concatenate([keep] + parents))
 
 
 @njit(cache=True, nogil=True, inline="always")
