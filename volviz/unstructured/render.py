@@ -25,7 +25,7 @@ from volviz.model.datasets import TetMesh
 from volviz.unstructured.camera import Camera
 from volviz.unstructured.iso import iso_lut, iso_segment_rgba, iso_visible
 from volviz.unstructured.project import raster_triangles, shirley_tuchman
-from volviz.unstructured.raster import SOS, TILE, bin_tiles, lut_args, project_cells, raster_tiles
+from volviz.unstructured.raster import SOS, TILE, bin_tiles, lut_args, project_cells, raster_tiles, ray_images
 from volviz.unstructured.reference import depth_limits, render_reference
 from volviz.unstructured.sort import visibility_order
 from volviz.unstructured.topology import cell_ranges, topology, visible_cells
@@ -204,9 +204,9 @@ def render(mesh: TetMesh, tf: Any, camera: Camera, size: tuple[int, int] = (512,
     # interleave heavy and light tiles across threads: Numba's prange hands out contiguous chunks
     tile_order = np.random.default_rng(12345).permutation(n_tiles).astype(np.int64)
     img = np.zeros((h, w, 4))
-    frags = raster_tiles(box, coef, vxy, ptr, items, tile_order, rb.as_array(), near, far, *lut_args(table),
-                         w, h, TILE, float(t_min), tol,
-                         depth_limits(depth, w, h), img)
+    far_img, dn_img = ray_images(rb.as_array(), near, far, depth_limits(depth, w, h), w, h)
+    frags = raster_tiles(box, coef, vxy, ptr, items, tile_order, rb.as_array(), near, *lut_args(table),
+                         w, h, TILE, float(t_min), tol, far_img, dn_img, bool(camera.parallel), img)
     stats.fragments = int(frags.sum())
     stats.raster_s = time.perf_counter() - t0
     stats.total_s = time.perf_counter() - t_start
