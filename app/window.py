@@ -340,6 +340,11 @@ class MainWindow(QMainWindow):
                          raster_seconds=sum(s.get("raster_s", 0.0) for s in last),
                          method=", ".join(sorted({str(s.get("method")) for s in last})),
                          error=getattr(self, "error_estimate", None))
+        overlay = self.controller.iso_overlay if self.controller is not None else None
+        if overlay is not None and overlay.stats:
+            st = overlay.stats
+            stats["iso"] = (f"{st['method']}: {st['triangles']:,} triangles, {st['triangles_drawn']:,} drawn, "
+                            f"{st['volume_s'] * 1000:.0f} ms")
         self.last_stats = stats
         self.statistics.show_stats(stats)
 
@@ -442,12 +447,14 @@ class MainWindow(QMainWindow):
             self.controller.set_visible(comp_id, visible)
             self.set_dirty()
             self.render()
+            self.refresh_iso_overlay()
 
     def _set_opacity(self, comp_id: str, opacity: float) -> None:
         if self.controller is not None:
             self.controller.set_opacity(comp_id, opacity)
             self.set_dirty()
             self.render()
+            self.refresh_iso_overlay()
 
     def apply_component_settings(self, comp_id: str, text: str) -> bool:
         """New settings for a component (JSON from the scene tree): validated through the session schema, then the
@@ -504,11 +511,13 @@ class MainWindow(QMainWindow):
         if self.controller is not None and self.controller.time_series():
             self.controller.set_time(t)
             self.render()
+            self.refresh_iso_overlay()
 
     def _interpolation_toggled(self, on: bool) -> None:
         if self.controller is not None:
             self.controller.set_time(self.timeline.time, interpolate=on)
             self.render()
+            self.refresh_iso_overlay()
 
     # ------------------------------------------------------------------------------------------------ navigation
     def set_fly_mode(self, enabled: bool) -> None:

@@ -23,14 +23,30 @@ def ball() -> RegularVolume:
     return RegularVolume((x * x + y * y + z * z).astype(np.float32))
 
 
+_PLOTTERS: list[pv.Plotter] = []
+
+
+@pytest.fixture(autouse=True)
+def _close_plotters():
+    yield
+    while _PLOTTERS:  # close render windows before the X server goes away at exit
+        _PLOTTERS.pop().close()
+
+
+def plotter() -> pv.Plotter:
+    p = pv.Plotter(off_screen=True, window_size=SIZE)
+    p.ren_win.SetMultiSamples(0)
+    _PLOTTERS.append(p)
+    return p
+
+
 def scene(components: list[Component], clip: dict | None = None) -> tuple[SceneController, pv.Plotter]:
     s = Session(datasets=[DatasetRef("b", "/unused")], components=components,
                 camera=CameraState((11.5, -40.0, 11.5), (11.5, 11.5, 11.5), (0.0, 0.0, 1.0)))
     s.render.background = BG
     if clip is not None:
         s.clip = clip
-    p = pv.Plotter(off_screen=True, window_size=SIZE)
-    p.ren_win.SetMultiSamples(0)
+    p = plotter()
     c = SceneController(p, s, {"b": ball()})
     c.build()
     return c, p
@@ -103,8 +119,7 @@ def test_clip_box_on_a_pt_volume_is_exact_cut_of_the_mesh():
     lo, hi = mesh.points.min(axis=0), mesh.points.max(axis=0)
     mid = (lo + hi) / 2
     s = Session(components=[Component("demo", "demo", settings={"cells_per_edge": 6})])
-    p = pv.Plotter(off_screen=True, window_size=SIZE)
-    p.ren_win.SetMultiSamples(0)
+    p = plotter()
     c = SceneController(p, s, {})
     c.build()
     whole, full_alpha = c.pt_volume("demo").mesh, c.pt_volume("demo").image[..., 3].sum()
@@ -115,3 +130,19 @@ def test_clip_box_on_a_pt_volume_is_exact_cut_of_the_mesh():
     assert 0 < c.pt_volume("demo").image[..., 3].sum() < 0.8 * full_alpha  # re-rendered with an eighth of the cube
     c.set_clip({"planes": [], "box": None})
     assert c.pt_volume("demo").mesh is whole
+
+
+def test_component_opacity_and_visibility_reach_the_isosurfaces_in_both_paths():
+    c, p = scene([iso_component()])
+    full = shot(p)
+    c.set_opacity("iso", 0.3)
+    fainter = shot(p)
+    bg = np.asarray(BG)
+    row, col = SIZE[1] // 2, SIZE[0] // 2
+    assert 0.02 < np.abs(fainter[row, col] - bg).max() < np.abs(full[row, col] - bg).max() - 0.02
+    c.set_iso_mode("exact")
+    assert max(m.style.opacity for m in c.iso_overlay.meshes) == pytest.approx(0.5 * 0.3)
+    c.set_visible("iso", False)
+    assert c.iso_overlay.meshes == []
+    c.iso_overlay.update()
+    assert np.abs(shot(p) - bg).max() < 2 / 255

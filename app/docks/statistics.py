@@ -8,7 +8,7 @@ from PySide6.QtWidgets import QFormLayout, QLabel, QWidget
 
 class Statistics(QWidget):
     FIELDS = (("frame", "Frame time"), ("split", "Sort / project / raster"), ("cells", "Cells drawn"),
-              ("method", "Method"), ("error", "Error estimate"))
+              ("method", "Method"), ("error", "Error estimate"), ("iso", "Isosurfaces"))
 
     def __init__(self, parent: Optional[QWidget] = None):
         super().__init__(parent)
@@ -28,6 +28,7 @@ class Statistics(QWidget):
         self.labels["method"].setText(str(stats.get("method", "–")))
         error = stats.get("error")
         self.labels["error"].setText("–" if error is None else str(error))
+        self.labels["iso"].setText(str(stats.get("iso", "–")))
 
     def text(self, key: str) -> str:
         return self.labels[key].text()

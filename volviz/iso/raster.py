@@ -26,7 +26,8 @@ def clip_near_plane(points: np.ndarray, triangles: np.ndarray, attributes: np.nd
     every output triangle)."""
     pts = np.asarray(points, dtype=np.float64)
     tris = np.asarray(triangles, dtype=np.int64).reshape(-1, 3)
-    att = np.asarray(attributes, dtype=np.float64).reshape(len(pts), -1)
+    att = np.asarray(attributes, dtype=np.float64)
+    att = att.reshape(len(pts), -1) if att.ndim != 2 else att
     d = (pts - np.asarray(eye, dtype=np.float64)) @ np.asarray(forward, dtype=np.float64) - float(near)
     inside = d[tris] >= 0.0 if len(tris) else np.zeros((0, 3), bool)
     n_in = inside.sum(axis=1)

@@ -139,7 +139,9 @@ class SceneController:
         prop = self.props.get(comp_id)
         if prop is None:
             return
-        if _is_pt(prop):
+        if comp.type == "isosurface":
+            self._readd_isosurfaces(comp_id)
+        elif _is_pt(prop):
             tf = self.transfer_function(comp_id)
             prop.tf = tf.scaled_extinction(comp.opacity) if comp.opacity != 1.0 else tf
             prop.update()
@@ -266,7 +268,6 @@ class SceneController:
     def apply_clip(self, update_pt: bool = True) -> list[str]:
         from volviz.iso.clip import clip_tetmesh
         from volviz.render.clipping import clip_vtk_prop
-        from volviz.render.scene import add_isosurfaces
 
         clip = self.clip
         pt_ids = []
@@ -275,9 +276,7 @@ class SceneController:
                 continue
             comp = self.component(comp_id)
             if comp.type == "isosurface":
-                self.plotter.remove_actor(prop, render=False)
-                self.props[comp_id] = add_isosurfaces(self.plotter, comp, None, clip=clip, meshes=prop.volviz_meshes)
-                self.props[comp_id].SetVisibility(comp.visible)
+                self._readd_isosurfaces(comp_id)
             elif _is_pt(prop):
                 whole = self._pt_meshes.setdefault(comp_id, prop.mesh)
                 try:
@@ -293,6 +292,16 @@ class SceneController:
         self._sync_iso_overlay()
         self.plotter.render()
         return pt_ids
+
+    def _readd_isosurfaces(self, comp_id: str) -> None:
+        """New actors for an isosurface component's already extracted surfaces (after a clip or opacity change)."""
+        from volviz.render.scene import add_isosurfaces
+
+        prop = self.props[comp_id]
+        self.plotter.remove_actor(prop, render=False)
+        self.props[comp_id] = add_isosurfaces(self.plotter, self.component(comp_id), None, clip=self.session.clip,
+                                              meshes=prop.volviz_meshes)
+        self._sync_iso_overlay()
 
     # -- isosurface transparency mode (per scene) -------------------------------------------------------------------
     @property

@@ -248,6 +248,10 @@ def add_isosurfaces(plotter: Any, comp: Component, dataset: Any, t: Optional[flo
         meshes = prepare(dataset, settings, t).meshes
     scene_clip = clip_settings(clip)
     shown = clip_isosurfaces(meshes, scene_clip) if scene_clip.all_planes() else list(meshes)
+    if comp.opacity < 1.0:  # the component's opacity scales every surface's
+        from dataclasses import replace
+
+        shown = [replace(m, style=replace(m.style, opacity=m.style.opacity * comp.opacity)) for m in shown]
     assembly = vtk.vtkPropAssembly()
     for mesh in shown:
         if len(mesh.triangles):
