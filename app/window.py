@@ -16,6 +16,7 @@ from PySide6.QtWidgets import (QDockWidget, QFileDialog, QInputDialog, QLabel, Q
 
 from volviz.jobs import JobOutcome
 from volviz.session import CameraKey, Session, SessionError, relative_path
+from volviz_app.clip_widget import ClipPlaneWidget
 from volviz_app.docks.clipping import ClippingDock
 from volviz_app.docks.render_settings import RenderSettings
 from volviz_app.gc_guard import GuiThreadCollector
@@ -84,6 +85,7 @@ class MainWindow(QMainWindow):
         self._build_menus()
         self._build_status_bar()
         self.fly = FlyMode(self.plotter, on_camera_moved=self._camera_moved)
+        self.clip_widget = ClipPlaneWidget(self.plotter, self.clipping)
         self.plotter.iren.add_observer("EndInteractionEvent", lambda *args: QTimer.singleShot(0, self._camera_moved))
 
         self.preview_timer = QTimer(self, singleShot=True, interval=PREVIEW_MS)

@@ -86,6 +86,24 @@ def test_clip_plane_cuts_the_view_undo_and_survives_save_and_reopen(qtbot, make_
     assert np.abs(reopened[left] - background).max() <= 3
     assert np.abs(reopened[right] - cut[right]).max() <= 3
 
+    # drag the plane in the viewport: the VTK plane widget's release edits the plane through the dock (undoable)
+    other.clipping.show_widget.setChecked(True)
+    widget = other.clip_widget.widget
+    assert widget is not None and widget.GetNormal() == pytest.approx((1.0, 0.0, 0.0))
+    widget.SetNormal(0.0, -1.0, 0.0)
+    widget.SetOrigin(11.5, 11.5, 11.5)
+    widget.InvokeEvent("EndInteractionEvent")
+    assert other.session.clip["planes"][0]["normal"] == pytest.approx([0.0, -1.0, 0.0])
+    assert other.session.clip["planes"][0]["point"] == pytest.approx([0.0, 11.5, 0.0])
+    dragged = viewport(other)
+    assert np.abs(dragged[left] - reopened[left]).max() > 20      # the plane now faces the camera: both
+    assert np.abs(dragged[right] - reopened[right]).max() > 3     # halves show the cut (back) half
+    other.clipping.undo_button.click()
+    assert other.session.clip["planes"][0]["normal"] == pytest.approx([1.0, 0.0, 0.0])
+    assert widget.GetNormal() == pytest.approx((1.0, 0.0, 0.0))   # the widget follows the dock
+    other.clipping.show_widget.setChecked(False)
+    assert other.clip_widget.widget is None
+
 
 def test_transparency_mode_from_render_settings_and_spectrum_shader_on_screen(qtbot, make_window, session_file,
                                                                               tmp_path):

@@ -68,6 +68,7 @@ class ClippingDock(QWidget):
     """Edits ``session.clip``; emits ``changed(dict)``."""
 
     changed = Signal(dict)
+    refreshed = Signal()  # the shown planes or the selection changed (the viewport widget follows)
 
     def __init__(self, parent: Optional[QWidget] = None):
         super().__init__(parent)
@@ -82,6 +83,7 @@ class ClippingDock(QWidget):
         self.flip_button = QPushButton("Flip")
         self.normal = [_spin() for _ in range(3)]
         self.offset = _spin()
+        self.show_widget = QCheckBox("Drag the selected plane in the viewport")
         self.box_enabled = QCheckBox("Box crop")
         self.box_lo = [_spin() for _ in range(3)]
         self.box_hi = [_spin() for _ in range(3)]
@@ -94,6 +96,7 @@ class ClippingDock(QWidget):
         form.addRow(_row([self.add_button, self.remove_button, self.flip_button]))
         form.addRow("Normal", _row(self.normal))
         form.addRow("Offset", self.offset)
+        form.addRow(self.show_widget)
         box = QGroupBox("Box")
         box_form = QFormLayout(box)
         box_form.addRow(self.box_enabled)
@@ -109,6 +112,7 @@ class ClippingDock(QWidget):
         self.remove_button.clicked.connect(self.remove_plane)
         self.flip_button.clicked.connect(self.flip_plane)
         self.plane_list.currentRowChanged.connect(self._show_plane)
+        self.plane_list.currentRowChanged.connect(lambda row: self._loading or self.refreshed.emit())
         for b in self.normal + [self.offset]:
             b.valueChanged.connect(self._plane_edited)
         self.box_enabled.toggled.connect(self._box_edited)
@@ -196,6 +200,7 @@ class ClippingDock(QWidget):
         self.undo_button.setEnabled(self.undo_stack.canUndo())
         self.redo_button.setEnabled(self.undo_stack.canRedo())
         self._loading = False
+        self.refreshed.emit()
 
     def _show_plane(self, row: int) -> None:
         loading, self._loading = self._loading, True
