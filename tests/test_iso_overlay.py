@@ -146,3 +146,22 @@ def test_component_opacity_and_visibility_reach_the_isosurfaces_in_both_paths():
     assert c.iso_overlay.meshes == []
     c.iso_overlay.update()
     assert np.abs(shot(p) - bg).max() < 2 / 255
+
+
+def test_lod_components_draw_fewer_triangles_far_away_in_the_overlay():
+    comp = Component("iso", "isosurface", "b", settings={"styles": STYLES, "lod": True,
+                                                         "triangles_per_pixel2": 0.05})
+    c, p = scene([comp])
+    c.set_iso_mode("exact")
+    near = dict(c.iso_overlay.stats)
+    near_img = shot(p)
+    assert near["triangles"] <= near["full_triangles"]
+    p.camera.position = (11.5, -400.0, 11.5)
+    p.renderer.ResetCameraClippingRange()
+    c.iso_overlay.update()
+    far = c.iso_overlay.stats
+    assert far["triangles"] < 0.5 * near["triangles"] and far["full_triangles"] == near["full_triangles"]
+    p.camera.position = (11.5, -40.0, 11.5)
+    p.renderer.ResetCameraClippingRange()
+    c.iso_overlay.update()
+    assert np.abs(shot(p) - near_img).max() == 0.0   # the same view gives the same level

@@ -340,12 +340,13 @@ class SceneController:
     def _sync_iso_overlay(self) -> None:
         """VTK's isosurface actors show only in "vtk" mode; the overlay gets the visible components' cut surfaces."""
         overlay = self.iso_overlay
-        meshes, shading = [], "spectrum"
+        meshes, lod, shading = [], [], "spectrum"
         for comp_id, prop in self._iso_props().items():
             visible = self.component(comp_id).visible
             prop.SetVisibility(visible and overlay is None)
             if visible:
                 meshes.extend(prop.volviz_shown)
+                lod.extend(prop.volviz_lod or [None] * len(prop.volviz_shown))
                 shading = prop.volviz_shading
         if overlay is not None:
-            overlay.meshes, overlay.shading = meshes, shading
+            overlay.meshes, overlay.lod, overlay.shading = meshes, lod, shading

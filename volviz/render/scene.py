@@ -258,6 +258,12 @@ def add_isosurfaces(plotter: Any, comp: Component, dataset: Any, t: Optional[flo
             assembly.AddPart(iso_actor(mesh, parallel=bool(plotter.camera.parallel_projection),
                                        spectrum=spectrum and settings.shading == "spectrum"))
     assembly.volviz_meshes, assembly.volviz_shown, assembly.volviz_shading = meshes, shown, settings.shading
+    assembly.volviz_lod = None  # LOD chains of the shown surfaces (the CPU modes draw them view-dependently)
+    if settings.lod:
+        from volviz.iso.lod import build_lod
+
+        assembly.volviz_lod = [(build_lod(m), settings.triangles_per_pixel2) if m.n_triangles else None
+                               for m in shown]
     plotter.add_actor(assembly, name=comp.id, reset_camera=False)
     return assembly
 
