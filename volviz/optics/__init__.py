@@ -7,7 +7,7 @@
   (Ch. 9: ρ̂ + colour polynomial), ``build_iso_table`` (§8.8–8.13), ``build_zot`` (conservative zero-opacity test).
 - ``volviz.optics.metrics``: RMSE / max abs in 8-bit units, PSNR, error heat map.
 """
-from volviz.optics.integrate import integrate_segment
+from volviz.optics.integrate import integrate_preclassified, integrate_segment
 from volviz.optics.isosurface import IsoSurface, IsoTable, build_iso_table, heaviside_alpha, iso_peaks_tf
 from volviz.optics.presets import list_presets, load_preset, read_paraview_presets, write_paraview_presets
 from volviz.optics.separable import SeparableTable, build_separable, segment_averages
@@ -19,7 +19,7 @@ from volviz.optics.transfer_function import TransferFunction
 from volviz.optics.zot import ZOTable, build_zot
 
 __all__ = [
-    "TransferFunction", "integrate_segment",
+    "TransferFunction", "integrate_segment", "integrate_preclassified",
     "Table3D", "build_table3d", "Table2D", "build_table2d", "SeparableTable", "build_separable", "segment_averages",
     "IsoSurface", "IsoTable", "build_iso_table", "heaviside_alpha", "iso_peaks_tf", "ZOTable", "build_zot",
     "TableError", "changed_span",

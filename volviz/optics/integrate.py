@@ -149,6 +149,37 @@ def _mean_transmittance(p: float, q: float) -> tuple[float, float]:
     return min(max(m, et), 1.0), et
 
 
+@numba.njit(cache=True, nogil=True, inline="always")
+def _linear_piece(col_lo, col_hi, wa, wb, ra, rb, trans, out):
+    """Add the colour of a piece with κ linear from lerp(col_lo, col_hi, wa) to lerp(..., wb) and optical depth
+    density linear from ``ra`` to ``rb`` (both already times the piece length), seen through ``trans``, to ``out``;
+    returns (the piece's transmittance, its optical depth)."""
+    p = ra
+    q = 0.5 * (rb - ra)
+    t = p + q
+    if not t > 0.0:
+        return 1.0, 0.0
+    m, et = _mean_transmittance(p, q)
+    ca = 1.0 - m
+    cb = max(m - et, 0.0)
+    for ch in range(3):
+        ka = col_lo[ch] + wa * (col_hi[ch] - col_lo[ch])
+        kb = col_lo[ch] + wb * (col_hi[ch] - col_lo[ch])
+        out[ch] += trans * (ka * ca + kb * cb)
+    return et, t
+
+
+@numba.njit(cache=True, nogil=True, parallel=True)
+def _preclassified_many(ka, kb, rho_a, rho_b, length, out):
+    """Segments whose κ and ρ vary linearly between the classified end values (pre-classification)."""
+    for i in numba.prange(length.shape[0]):
+        for ch in range(4):
+            out[i, ch] = 0.0
+        if length[i] > 0.0:
+            et, t = _linear_piece(ka[i], kb[i], 0.0, 1.0, rho_a[i] * length[i], rho_b[i] * length[i], 1.0, out[i])
+            out[i, 3] = -math.expm1(-t)
+
+
 @numba.njit(cache=True, nogil=True)
 def _segment(sc, col, ext, s_f, s_b, length, out):
     """Premultiplied RGBA of one segment with s_f <= s_b (callers mirror the TF for decreasing scalars)."""
@@ -189,19 +220,9 @@ def _segment(sc, col, ext, s_f, s_b, length, out):
             pl = (x1 - x0) * length
             ra = (ext[k] + wa * (ext[k + 1] - ext[k])) * pl
             rb = (ext[k] + wb * (ext[k + 1] - ext[k])) * pl
-            p = ra
-            q = 0.5 * (rb - ra)
-            t = p + q
-            if t > 0.0:
-                m, et = _mean_transmittance(p, q)
-                ca = 1.0 - m
-                cb = max(m - et, 0.0)
-                for ch in range(3):
-                    ka = col[k, ch] + wa * (col[k + 1, ch] - col[k, ch])
-                    kb = col[k, ch] + wb * (col[k + 1, ch] - col[k, ch])
-                    out[ch] += trans * (ka * ca + kb * cb)
-                trans *= et
-                depth += t
+            et, t = _linear_piece(col[k], col[k + 1], wa, wb, ra, rb, trans, out)
+            trans *= et
+            depth += t
         if x1 >= 1.0 or depth > _SKIP_DEPTH or s1 > hi:
             break
         k += 1
@@ -256,6 +277,25 @@ def integrate_segment(tf: TransferFunction, s_f: Any, s_b: Any, length: Any) -> 
     out = np.empty((sf.shape[0], 4), dtype=np.float64)
     if sf.shape[0]:
         _integrate_many(*arrays, sf, sb, ln, out)
+    return out.reshape(shape + (4,))
+
+
+def integrate_preclassified(tf: TransferFunction, s_f: Any, s_b: Any, length: Any) -> np.ndarray:
+    """Premultiplied RGBA (..., 4) float64 of segments under pre-classification (Roettger §8.14, the original
+    Shirley-Tuchman projected tetrahedra): the TF is applied at the two ends only, and κ and ρ are interpolated
+    linearly in between, so the TF's non-linear parts inside a segment (a cut, a peak) are smoothed away. Exact for
+    that model (the closed form of one linear piece of ``integrate_segment``); equal to ``integrate_segment`` when the
+    TF is linear between s_f and s_b. Ends outside the TF range or NaN are transparent (κ = ρ = 0)."""
+    if not isinstance(tf, TransferFunction):
+        raise TypeError(f"expected a TransferFunction, got {type(tf).__name__}")
+    shape, sf, sb, ln = _segment_arrays(s_f, s_b, length)
+    ka, ra = tf.evaluate(sf)
+    kb, rb = tf.evaluate(sb)
+    out = np.empty((sf.shape[0], 4), dtype=np.float64)
+    if sf.shape[0]:
+        _preclassified_many(np.ascontiguousarray(ka, dtype=np.float64), np.ascontiguousarray(kb, dtype=np.float64),
+                            np.ascontiguousarray(ra, dtype=np.float64), np.ascontiguousarray(rb, dtype=np.float64),
+                            ln, out)
     return out.reshape(shape + (4,))
 
 

@@ -7,6 +7,8 @@ Two builders:
 
 - ``method="direct"``: every entry from ``integrate_segment`` (exact to 1e-9 in float64, stored as float32, so the
   error at the table's own sample points is the float32 rounding, ≤ 6e-8).
+- ``classification="pre"`` (Roettger §8.14): entries from ``integrate_preclassified`` (the TF applied at the segment
+  ends only, κ and ρ linear in between: the original projected tetrahedra), direct only, for A/B comparisons.
 - ``method="incremental"`` (Weiler et al., as VTK's ``vtkUnstructuredGridPreIntegration`` does; digest §15.4): slice
   k = 1 directly, then for k ≥ 2 ``entry(i, j, k) = front(i → m, 1) over back(m → j, k − 1)`` with the scalar at
   distance Δl, m = ((k − 1) i + j)/k. VTK rounds m to the nearest index (``m_rounding="nearest"``); the default
@@ -27,7 +29,7 @@ import numpy as np
 
 from volviz.optics import _interp
 from volviz.optics._axis import ScalarAxis
-from volviz.optics.integrate import integrate_segment
+from volviz.optics.integrate import integrate_preclassified, integrate_segment
 from volviz.optics.table_error import TableError, measure_error, sample_points
 from volviz.optics.tf_change import changed_span, touching_pairs
 from volviz.optics.transfer_function import TransferFunction
@@ -92,8 +94,11 @@ def _incremental_fill(front, work, mask, nearest, k_start, k_stop):
 _CHUNK_SEGMENTS = 1 << 16  # segments per progress step (2 MiB of float64 RGBA): short GIL holds, prompt cancel
 
 
+_INTEGRATORS = {"post": integrate_segment, "pre": integrate_preclassified}
+
+
 def _fill(tf: TransferFunction, out: np.ndarray, s: np.ndarray, ls: np.ndarray, mask: np.ndarray, method: str,
-          m_rounding: str, progress: Progress | None = None) -> None:
+          m_rounding: str, progress: Progress | None = None, classification: str = "post") -> None:
     """(Re)compute the entries out[i, j, :, :] with mask[i, j] in the float32 table ``out`` (n, n, L, 4).
 
     ``progress(fraction, message)`` is called between chunks (it may raise to cancel the build)."""
@@ -105,7 +110,7 @@ def _fill(tf: TransferFunction, out: np.ndarray, s: np.ndarray, ls: np.ndarray, 
             ii += i0
             if ii.size:
                 out[ii, jj, 0, :] = 0.0
-                out[ii, jj, 1:, :] = integrate_segment(tf, s[ii][:, None], s[jj][:, None], ls[None, 1:])
+                out[ii, jj, 1:, :] = _INTEGRATORS[classification](tf, s[ii][:, None], s[jj][:, None], ls[None, 1:])
             if progress is not None:
                 progress(min(i0 + rows, n) / n, "pre-integration table (direct)")
         return
@@ -138,6 +143,7 @@ class Table3D(ScalarAxis):
     method: str = "direct"
     tf: TransferFunction | None = None
     m_rounding: str = "linear"
+    classification: str = "post"
 
     @property
     def n_l(self) -> int:
@@ -172,28 +178,34 @@ class Table3D(ScalarAxis):
         mask = touching_pairs(self.scalars, span)
         count = int(mask.sum())
         if count:
-            _fill(tf, self.rgba, self.scalars, self.lengths, mask, self.method, self.m_rounding)
+            _fill(tf, self.rgba, self.scalars, self.lengths, mask, self.method, self.m_rounding,
+                  classification=self.classification)
         self.tf = tf
         return count
 
     def error(self, tf: TransferFunction | None = None, where: str = "centers", **kw: Any) -> TableError:
-        """Max and RMS RGBA error against ``integrate_segment`` (see ``volviz.optics.table_error``)."""
+        """Max and RMS RGBA error against the exact integral of its classification (see ``table_error``)."""
         tf = tf or self.tf
         if tf is None:
             raise ValueError("no transfer function to measure against")
         pts = sample_points(self.s_lo, self.s_hi, self.l_max, self.n_s, self.n_l, where, **kw)
-        return measure_error(self.lookup, tf, pts, where)
+        return measure_error(self.lookup, tf, pts, where, _INTEGRATORS[self.classification])
 
 
 def build_table3d(tf: TransferFunction, n_s: int = 128, n_l: int = 64, l_max: float = 1.0, method: str = "direct",
-                  *, s_range: Any = None, m_rounding: str = "linear", progress: Progress | None = None
-                  ) -> Table3D:
+                  *, s_range: Any = None, m_rounding: str = "linear", progress: Progress | None = None,
+                  classification: str = "post") -> Table3D:
     """Build the 3D pre-integration table (Roettger §8.4) by direct integration or incrementally (digest §15.4).
 
     ``l_max`` should be the longest segment the renderer produces (VTK uses the largest cell bounding-box diagonal);
     longer segments are clamped by ``lookup``. ``progress(fraction, message)`` is called between chunks of work
-    (``volviz.jobs`` passes a callable that raises to cancel).
+    (``volviz.jobs`` passes a callable that raises to cancel). ``classification="pre"`` tabulates pre-classified
+    segments instead (direct method only).
     """
+    if classification not in _INTEGRATORS:
+        raise ValueError(f"classification must be 'post' or 'pre', got {classification!r}")
+    if classification == "pre" and method != "direct":
+        raise ValueError("pre-classified tables are built with method='direct'")
     if method not in _METHODS:
         raise ValueError(f"method must be one of {_METHODS}, got {method!r}")
     if m_rounding not in _ROUNDING:
@@ -203,8 +215,8 @@ def build_table3d(tf: TransferFunction, n_s: int = 128, n_l: int = 64, l_max: fl
     lo, hi = resolve_range(tf, s_range)
     rgba = np.zeros((n_s, n_s, n_l, 4), dtype=np.float32)
     _fill(tf, rgba, np.linspace(lo, hi, n_s), np.linspace(0.0, l_max, n_l), np.ones((n_s, n_s), dtype=bool), method,
-          m_rounding, progress)
-    return Table3D(rgba, lo, hi, l_max, method, tf, m_rounding)
+          m_rounding, progress, classification)
+    return Table3D(rgba, lo, hi, l_max, method, tf, m_rounding, classification)
 
 
 def build_table3d_job(tf: TransferFunction, *, progress: Progress, **kw: Any) -> Table3D:

@@ -13,7 +13,7 @@ Errors are absolute, over all four premultiplied RGBA channels, in [0, 1] units 
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass
-from typing import Callable
+from typing import Any, Callable
 
 import numpy as np
 
@@ -69,10 +69,10 @@ def sample_points(s_lo: float, s_hi: float, l_max: float, n_s: int, n_l: int, wh
 
 
 def measure_error(lookup: Lookup, tf: TransferFunction, points: tuple[np.ndarray, np.ndarray, np.ndarray],
-                  where: str = "") -> TableError:
-    """Compare ``lookup(s_f, s_b, l)`` (..., 4) with ``integrate_segment`` at the given points."""
+                  where: str = "", integrator: Any = None) -> TableError:
+    """Compare ``lookup(s_f, s_b, l)`` (..., 4) with ``integrator`` (default ``integrate_segment``) at the points."""
     sf, sb, ll = points
-    ref = integrate_segment(tf, sf, sb, ll)
+    ref = (integrator or integrate_segment)(tf, sf, sb, ll)
     got = np.asarray(lookup(sf, sb, ll), dtype=np.float64)
     if got.shape != ref.shape:
         raise ValueError(f"lookup returned shape {got.shape}, expected {ref.shape}")

@@ -32,6 +32,8 @@ from typing import Any
 import numpy as np
 from numba import njit, prange, uint64
 
+from volviz.optics.integrate import _linear_piece
+
 TILE = 32
 #: per-cell coefficients: 4 faces x (num0, numx, numy, den0, denx, deny), then scalar (a0, ax, ay, b0, bx, by), then
 #: per face +1 / -1: whether a ray lying in the face plane counts as inside (simulation-of-simplicity tie-break)
@@ -253,8 +255,14 @@ def _lookup_separable(flat: np.ndarray, n: int, nc: int, deg: int, s_lo: float, 
 def lut_args(table: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(flat float64 data (float32 tables widened once: no conversion per tap), int64 [kind, n_s, n_l or channels, degree], float64 [s_lo, 1/ds, 1/dl or 1/l_max,
     kappa_max (3)]) of a ``Table3D`` (kind 0), a ``SeparableTable`` (kind 1) or an ``IsoTable`` (kind 2: its
-    isosurfaces evaluated exactly, not its texture) for the raster kernels."""
-    if hasattr(table, "isosurfaces"):                       # exact flat isosurfaces (kind 2)
+    isosurfaces evaluated exactly, not its texture) or a ``Preclassified`` TF (kind 3: each segment's ends classified
+    exactly, ``_preclassified``) for the raster kernels."""
+    if hasattr(table, "preclassified_tf"):                  # exact pre-classified segments (kind 3)
+        tf = table.preclassified_tf
+        flat = np.concatenate([tf.scalars, tf.colors.ravel(), tf.extinction]).astype(np.float64)
+        ip = np.array([3, len(tf.scalars), 0, 0], np.int64)
+        fp = np.zeros(6)
+    elif hasattr(table, "isosurfaces"):                     # exact flat isosurfaces (kind 2)
         isos = sorted(table.isosurfaces, key=lambda i: i.value)
         flat = np.array([[i.value, i.opacity, *i.color, *(i.color if i.back_color is None else i.back_color)]
                          for i in isos], dtype=np.float64).ravel()
@@ -303,6 +311,30 @@ def _iso_exact(flat: np.ndarray, n: int, thicken: float, sf: float, sb: float) -
 
 
 @njit(cache=True, nogil=True, inline="always")
+def _classify(flat: np.ndarray, n: int, s: float) -> tuple[float, float, float, float]:
+    """κ (3) and ρ of the TF packed in ``flat`` (scalars, colours, extinction) at s; outside or NaN: zero."""
+    if not (flat[0] <= s <= flat[n - 1]):
+        return 0.0, 0.0, 0.0, 0.0
+    k = min(max(np.searchsorted(flat[:n], s, side="right") - 1, 0), n - 2)
+    w = (s - flat[k]) / (flat[k + 1] - flat[k])
+    c = n + 3 * k
+    e = 4 * n + k
+    return (flat[c] + w * (flat[c + 3] - flat[c]), flat[c + 1] + w * (flat[c + 4] - flat[c + 1]),
+            flat[c + 2] + w * (flat[c + 5] - flat[c + 2]), flat[e] + w * (flat[e + 1] - flat[e]))
+
+
+@njit(cache=True, nogil=True)
+def _preclassified(flat: np.ndarray, n: int, sf: float, sb: float, ln: float) -> tuple[float, float, float, float]:
+    """Pre-classified segment (Roettger §8.14): the TF at both ends, κ and ρ linear in between, integrated in
+    closed form (``volviz.optics.integrate_preclassified``, evaluated per pixel without a table)."""
+    kf0, kf1, kf2, rf = _classify(flat, n, sf)
+    kb0, kb1, kb2, rb = _classify(flat, n, sb)
+    out = np.zeros(3)
+    et, t = _linear_piece((kf0, kf1, kf2), (kb0, kb1, kb2), 0.0, 1.0, rf * ln, rb * ln, 1.0, out)
+    return out[0], out[1], out[2], -math.expm1(-t)
+
+
+@njit(cache=True, nogil=True, inline="always")
 def lookup_any(flat: np.ndarray, ip: np.ndarray, fp: np.ndarray, sf: float, sb: float, ln: float
                ) -> tuple[float, float, float, float]:
     """Premultiplied RGBA of the segment (s_f, s_b, l) from the table described by ``lut_args``."""
@@ -310,6 +342,8 @@ def lookup_any(flat: np.ndarray, ip: np.ndarray, fp: np.ndarray, sf: float, sb: 
         return _lookup(flat, ip[1], ip[2], fp[0], fp[1], fp[2], sf, sb, ln)
     if ip[0] == 2:
         return _iso_exact(flat, ip[1], fp[0], sf, sb)
+    if ip[0] == 3:
+        return _preclassified(flat, ip[1], sf, sb, ln)
     return _lookup_separable(flat, ip[1], ip[2], ip[3], fp[0], fp[1], fp[2], fp[3], fp[4], fp[5], sf, sb, ln)
 
 

@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from volviz.model.datasets import TetMesh
+from volviz.optics.integrate import integrate_preclassified
 from volviz.unstructured.camera import Camera
 from volviz.unstructured.iso import iso_lut, iso_segment_rgba, iso_visible
 from volviz.unstructured.project import raster_triangles, shirley_tuchman
@@ -44,6 +45,13 @@ def auto_lookup(max_depth: float) -> tuple[str, int]:
     if max_depth <= 24.0:
         return "separable", 4
     return "3d", 0
+
+
+@dataclass(frozen=True)
+class Preclassified:
+    """The "table" of pre-classification for "pt": the TF itself, evaluated at each segment's ends."""
+
+    preclassified_tf: Any
 
 
 @dataclass
@@ -82,7 +90,8 @@ def table_size(max_depth: float, n_s: int = 128, n_l: int = 64, depth_per_bin: f
 
 
 def _table_for(mesh: TetMesh, tf: Any, kind: str, sizes: tuple[int, int], l_max: float) -> Any:
-    """The pre-integration table (``kind`` "3d": sizes = (n_s, n_l); "separable": sizes = (n_s, degree)) over the
+    """The pre-integration table (``kind`` "3d" or "pre" (pre-classified 3D): sizes = (n_s, n_l); "separable":
+    sizes = (n_s, degree)) over the
     union of the TF range and the data range (so out-of-range parts stay transparent), cached on the mesh for the
     last (kind, TF, sizes)."""
     from volviz.optics import build_table3d
@@ -98,8 +107,9 @@ def _table_for(mesh: TetMesh, tf: Any, kind: str, sizes: tuple[int, int], l_max:
     cached = mesh.__dict__.get(slot)
     if cached is not None and cached[0] == key:
         return cached[1]
-    if kind == "3d":
-        table = build_table3d(tf, n_s=sizes[0], n_l=sizes[1], l_max=l_max, s_range=(lo, hi))
+    if kind in ("3d", "pre"):
+        table = build_table3d(tf, n_s=sizes[0], n_l=sizes[1], l_max=l_max, s_range=(lo, hi),
+                              classification="pre" if kind == "pre" else "post")
     else:
         table = build_separable(tf, n_s=sizes[0], l_max=l_max, degree=sizes[1], s_range=(lo, hi))
     mesh.__dict__[slot] = (key, table)
@@ -109,8 +119,8 @@ def _table_for(mesh: TetMesh, tf: Any, kind: str, sizes: tuple[int, int], l_max:
 def render(mesh: TetMesh, tf: Any, camera: Camera, size: tuple[int, int] = (512, 512), method: str = "pt", *,
            sort: str = "mpvo", nonconvex: str = "auto", order: np.ndarray | None = None, lookup: str = "auto",
            n_s: int | None = None, n_l: int = 64, degree: int | None = None, table: Any = None, t_min: float = 1e-3,
-           depth: np.ndarray | None = None, iso: Any = None, iso_mode: str = "exact", return_stats: bool = False
-           ) -> np.ndarray | tuple[np.ndarray, RenderStats]:
+           depth: np.ndarray | None = None, iso: Any = None, iso_mode: str = "exact", classification: str = "post",
+           return_stats: bool = False) -> np.ndarray | tuple[np.ndarray, RenderStats]:
     """Render ``mesh`` with transfer function ``tf`` seen by ``camera`` into a (H, W, 4) premultiplied RGBA image.
 
     ``order`` (a back-to-front cell order, e.g. from a background sort) skips the sort. ``lookup`` picks the
@@ -127,7 +137,16 @@ def render(mesh: TetMesh, tf: Any, camera: Camera, size: tuple[int, int] = (512,
     bilinear (s_f, s_b) texture like the GPU method (segments ending within a texel of an isovalue are partly
     covered: measured RMSE 5, 5% of pixels off by > 4/255 on a 7^3 jittered grid at 48 x 40). "reference" evaluates
     the Heaviside limit per exact segment.
+    ``classification``: "post" (default; the TF applied to the interpolated scalar, exact inside cells) or "pre"
+    (Roettger §8.14, the original projected tetrahedra: the TF applied at each segment's ends only, κ and ρ linear in
+    between, ``volviz.optics.integrate_preclassified``), for A/B comparisons: "pt" and "reference" then integrate
+    the pre-classified segments exactly per pixel (a table in (s_f, s_b) would blur the TF's kinks, which
+    pre-classification keeps at the ends), "pt-st" uses a pre-classified 3D table.
     """
+    if classification not in ("post", "pre"):
+        raise ValueError(f"classification must be 'post' or 'pre', got {classification!r}")
+    if classification == "pre" and iso is not None:
+        raise ValueError("isosurfaces are post-classified; use classification='post'")
     if method not in METHODS:
         raise ValueError(f"unknown render method {method!r}; choose one of {METHODS}")
     if lookup not in LOOKUPS:
@@ -143,6 +162,8 @@ def render(mesh: TetMesh, tf: Any, camera: Camera, size: tuple[int, int] = (512,
         raise ValueError('isosurfaces need method "pt" or "reference"')
     if method == "reference":
         seg_fn = None if iso is None else (lambda sf, sb, ln: iso_segment_rgba(iso, sf, sb))
+        if classification == "pre":
+            seg_fn = (lambda sf, sb, ln: integrate_preclassified(tf, sf, sb, ln))
         img = render_reference(mesh, tf, camera, (w, h), depth=depth, segment_rgba=seg_fn)
         stats.total_s = stats.raster_s = time.perf_counter() - t_start
         return (img, stats) if return_stats else img
@@ -157,8 +178,11 @@ def render(mesh: TetMesh, tf: Any, camera: Camera, size: tuple[int, int] = (512,
         if lookup == "auto":
             lookup, auto_degree = auto_lookup(tf.max_extinction * l_max)
             degree = degree or auto_degree
-        if lookup == "3d" or method == "pt-st":
-            table = _table_for(mesh, tf, "3d", table_size(tf.max_extinction * l_max, n_s or 128, n_l), l_max)
+        if classification == "pre" and method == "pt":
+            table = Preclassified(tf)
+        elif lookup == "3d" or method == "pt-st" or classification == "pre":
+            kind = "pre" if classification == "pre" else "3d"
+            table = _table_for(mesh, tf, kind, table_size(tf.max_extinction * l_max, n_s or 128, n_l), l_max)
         else:
             table = _table_for(mesh, tf, "separable", (n_s or 256, int(degree or 2)), l_max)
     elif method == "pt-st" and not hasattr(table, "rgba"):
