@@ -119,3 +119,27 @@ def test_components_with_missing_datasets_are_refused() -> None:
         scene_from_components([Component(id="t", type="terrain", settings={"size": 33, "texture_dataset": "x"})], {})
     with pytest.raises(ValueError, match="needs a terrain"):
         scene_from_components([Component(id="f", type="fog")], {})
+
+
+def test_sky_shows_with_the_plotters_own_camera(demo) -> None:
+    """The app's path: the session camera is applied to an empty renderer (VTK's default clipping range 0.01 ..
+    1000.01), then the view renders with the plotter's camera. The dome (radius 3 x the extent) must not be clipped
+    away: the top rows show the sky gradient, not the background colour."""
+    import pyvista as pv
+
+    size = (128, 96)
+    cam = demo_camera()
+    plotter = pv.Plotter(off_screen=True, window_size=size)
+    try:
+        plotter.set_background((1.0, 0.0, 1.0))
+        pc = plotter.camera
+        pc.position, pc.focal_point, pc.up, pc.view_angle = cam.position, cam.focal_point, cam.view_up, cam.view_angle
+        plotter.renderer.ResetCameraClippingRange()  # no props yet: VTK's default range
+        view = NatureView(plotter, demo, size=size)
+        view.update()
+        assert plotter.camera.clipping_range[1] >= view.dome_radius
+        shot = plotter.screenshot(return_img=True)[..., :3] / 255.0
+    finally:
+        plotter.close()
+    cpu = demo.render(cam, size).rgb
+    assert float(np.abs(shot[:8] - cpu[:8]).mean()) * 255 < 6.0

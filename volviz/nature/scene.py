@@ -370,6 +370,7 @@ class NatureView:
         self.sky_actor = None
         self._overlay_actor = None
         self._overlay_image = None
+        self._near = 0.1
         self._mesh = None
         self.last_stats: dict[str, float] = {}
         if scene.terrain is not None and scene.colour_map is not None:
@@ -377,9 +378,11 @@ class NatureView:
             self._texture = pv.Texture(np.ascontiguousarray(img))
             b = scene.terrain.bounds()
             radius = 3.0 * max(b[1] - b[0], b[3] - b[2])
+            self._near = max(1e-3 * max(b[1] - b[0], b[3] - b[2]), 0.1)
         else:
             self._texture = None
             radius = 3000.0
+        self.dome_radius = radius
         dome = sky_dome_mesh(radius, (0.0, 0.0, 0.0))  # moved to the eye by ``update``: the sky is at infinity
         if scene.sky is not None:
             sky_img = np.clip(scene.sky * 255.0, 0, 255).astype(np.uint8)
@@ -394,7 +397,18 @@ class NatureView:
     def _camera(self) -> Any:
         from volviz.unstructured.camera import Camera
 
+        self._fit_clipping()
         return Camera.from_pyvista(self.plotter.camera)
+
+    def _fit_clipping(self) -> None:
+        """Make the plotter camera's clipping range hold the sky dome around the eye. A session camera applied before
+        any actor existed leaves VTK's default range (0.01, 1000.01), whose far plane cut the dome (radius 3 x the
+        terrain extent) away so the background colour showed instead of the sky."""
+        pc = self.plotter.camera
+        near, far = (float(v) for v in pc.clipping_range)
+        need = 1.05 * self.dome_radius
+        if far < need or near < 0.5 * self._near:
+            pc.clipping_range = (max(near, self._near), max(far, need))
 
     def update(self, camera: Any = None) -> dict[str, float]:
         """Re-triangulate the terrain and re-render the overlay for ``camera`` (default: the plotter's camera)."""
