@@ -136,3 +136,22 @@ def test_parse_header_fuzz_mutated(tmp_path_factory, pos, value, size):
         return
     assert h["meta_len"] <= 16 << 20
     assert h["meta_off"] + h["meta_len"] <= size and h["table_off"] + 32 * h["table_count"] <= size
+
+
+def test_older_arith_coder_version_is_refused(tmp_path):
+    # arith coder version 2 changed the contexts: a version-1 stream must not be decoded with them
+    src, old = tmp_path / "a.vvz", tmp_path / "old.vvz"
+    compress(RegularVolume(_smooth_volume((40, 20, 20))), src, coder="arith")
+    rd = Reader(src)
+    from volviz.regular.container import Writer
+    with Writer(old) as w:
+        for rec in rd.table:
+            off, size = int(rec["offset"]), int(rec["size"])
+            w.add(int(rec["level"]), int(rec["kind"]), int(rec["tile"]), np.asarray(rd.payload[off:off + size]))
+        meta = dict(rd.meta)
+        assert meta["coder_version"] == 2
+        meta.pop("coder_version")  # files written before the field existed
+        w.close(meta)
+    rd.close()
+    with pytest.raises(VVZError, match=r"old\.vvz.*arith coder version 1 is not supported"):
+        decompress(old)

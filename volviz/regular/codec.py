@@ -35,7 +35,7 @@ from volviz.model.datasets import RegularVolume
 
 from . import kernels as K
 from .container import KIND_NODE, KIND_ROOT, CorruptBrickError, CorruptBrickWarning, Reader, VVZError, Writer
-from .entropy import CODERS, capacity
+from .entropy import CODER_VERSION, CODERS, capacity
 from .wavelet import HALF, TILE, level_shapes, n_tiles, subband_weights
 
 Progress = Callable[[float, str], None]
@@ -52,11 +52,13 @@ def quality_to_delta(quality: float) -> float:
 
 
 def level_steps(delta: float, levels: int) -> np.ndarray:
-    """Quantiser steps ``steps[l, b]`` for level l = 1..levels and subband b (0 unused); all zero for lossless."""
+    """Quantiser steps ``steps[l, b]`` for level l = 1..levels and detail subband b = 1..7; all zero for lossless.
+    ``steps[:, 0]`` is 1 for lossless files (the decoder's lowpass is exact: a context of the arithmetic coder),
+    else 0."""
     steps = np.zeros((levels + 1, 8))
     if delta > 0:
         steps[1:] = delta / np.sqrt(subband_weights(levels)[1:])
-    steps[:, 0] = 0.0
+    steps[:, 0] = 0.0 if delta > 0 else 1.0
     return steps
 
 
@@ -271,7 +273,8 @@ def compress(volume: RegularVolume, path: str | Path, mode: str = "lossless", qu
         payload = writer.payload_bytes
         meta = {
             "format": "volviz-vvz", "dims": list(shape), "dtype": src.dtype.name, "kind": src.kind,
-            "levels": levels, "tile": TILE, "coder": coder, "mode": mode, "delta": delta,
+            "levels": levels, "tile": TILE, "coder": coder, "coder_version": CODER_VERSION[coder], "mode": mode,
+            "delta": delta,
             "quality": None if quality is None else float(quality), "psnr_target": psnr,
             "psnr": None if measured is None or math.isinf(measured) else round(measured, 4),
             "psnr_scope": psnr_scope, "lossless": delta == 0.0, "peak": peak,
@@ -300,6 +303,9 @@ def _check_meta(meta: dict[str, Any], name: str) -> tuple[tuple[int, int, int], 
         raise VVZError(name, f"tile size {meta['tile']} not supported (this build uses {TILE})")
     if coder not in CODERS:
         raise VVZError(name, f"unknown coder {coder!r}")
+    if int(meta.get("coder_version", 1)) != CODER_VERSION[coder]:
+        raise VVZError(name, f"{coder} coder version {meta.get('coder_version', 1)} is not supported (this build "
+                       f"reads version {CODER_VERSION[coder]}); compress the volume again")
     if kind not in _INT_TYPES and kind not in ("float", "int-quantised"):
         raise VVZError(name, f"unknown sample kind {kind!r}")
     if levels != len(level_shapes(dims)) - 1:

@@ -15,10 +15,16 @@ probabilities) whose per-class frequency tables are stored in the brick. Node la
 
     u32 nbytes of the bit section | bit section (LSB first: significance map, tables, raw bits) | rANS u16 words
 
-``CODER_ARITH`` (the high-ratio option; Guthe's adaptive arithmetic coder of [GS04] in spirit): an LZMA-style
-adaptive binary range coder (11-bit probabilities) codes the significance map with the previous flag as context and
-each coefficient as zero flag, sign, unary bit length and mantissa bits, where the contexts are the class and the
-magnitude sum of the three causal neighbours (previous sample along each axis in the same subband).
+``CODER_ARITH`` (the high-ratio option; Guthe's adaptive arithmetic coder of [GS04] in spirit, version 2): an
+LZMA-style adaptive binary range coder (15-bit probabilities; the adaptation rate starts at 1/2 and slows to 1/128 as
+a context is used, so the contexts of a small brick learn quickly) codes the significance map with the previous flag
+as context and each coefficient as zero flag, sign, unary bit length and mantissa bits. Contexts: the class, the
+bucketed magnitude sum of the three causal neighbours (previous sample along each axis in the same subband) plus the
+magnitudes at the same position in the subbands already coded (cross-subband), and -- in lossless files only, where
+the decoder's lowpass equals the encoder's -- the bucketed activity (3^3 max - min) of the lowpass at that position.
+Measured on embryo (256^3, lossless): 6.10:1 with version 1 (causal neighbours only, fixed rate 1/16), 6.34:1 with
+version 2; at quality 80: 8.49:1 -> 8.87:1 (same PSNR). A damaged coarse brick in a lossless arith file also
+perturbs the contexts of its children, whose region is then approximate too (it is the damaged region anyway).
 """
 from __future__ import annotations
 
@@ -28,8 +34,10 @@ from numba import njit
 CODER_RANS = 0
 CODER_ARITH = 1
 CODERS = {"rans": CODER_RANS, "arith": CODER_ARITH}
+CODER_VERSION = {"rans": 1, "arith": 2}  # arith 2: cross-subband and lowpass-activity contexts
 
 SB = 4  # sub-block edge of the significance map
+HALF_T = 16  # largest subband edge of a 32^3 tile (and of the root)
 N_TOK = 48
 PROB_BITS = 12
 PROB_SCALE = 1 << PROB_BITS
@@ -439,33 +447,33 @@ def decode_rans(buf, base, length, w, n0, n1, n2, root):
 
 
 # ------------------------------------------------------------------------------------------- adaptive arithmetic
-_PB = 11
+_PB = 15
 _PTOT = 1 << _PB
-_SHIFT = 4
+_SHIFT = 7
 _TOP = 1 << 24
-N_NB = 8  # neighbourhood magnitude buckets
+N_NB = 10  # buckets of the causal neighbour + cross-subband magnitude sum
+N_ACT = 6  # buckets of the lowpass activity (lossless only)
+N_EXP = 24
 _P_ANY = 0
 _P_SIG = _P_ANY + N_CLASS
 _P_ZERO = _P_SIG + N_CLASS * 2
-_P_SIGN = _P_ZERO + N_CLASS * N_NB
+_P_SIGN = _P_ZERO + N_CLASS * N_ACT * N_NB
 _P_EXP = _P_SIGN + N_CLASS
-_P_MAN = _P_EXP + N_CLASS * N_NB * 24
+_P_MAN = _P_EXP + N_CLASS * 3 * N_NB * N_EXP
 N_PROBS = _P_MAN + N_CLASS * 32
 
 
+_NB_EDGES = np.array([1, 2, 3, 5, 9, 17, 33, 65, 129], np.int64)  # N_NB buckets of magnitude sums
+_ACT_EDGES = np.array([1, 3, 9, 33, 129], np.int64)  # N_ACT buckets of lowpass activity
+
+
 @njit(cache=True, nogil=True)
-def _nb_bucket(s):
-    if s < 3:
-        return s
-    if s < 5:
-        return 3
-    if s < 9:
-        return 4
-    if s < 17:
-        return 5
-    if s < 33:
-        return 6
-    return 7
+def _bucket(s, edges):
+    """Number of ``edges`` that ``s`` reaches (0..len(edges))."""
+    b = 0
+    while b < edges.shape[0] and s >= edges[b]:
+        b += 1
+    return b
 
 
 @njit(cache=True, nogil=True)
@@ -488,16 +496,31 @@ def _shift_low(st, out):
 
 
 @njit(cache=True, nogil=True)
+def _adapt(probs, idx, bit):
+    """Update a context: ``probs[idx]`` packs the 15-bit probability of a 0 and (above bit 16) how often the
+    context was used; the adaptation rate starts at 1/2 and slows to 1/2^_SHIFT (running average at first,
+    then exponential forgetting), so the many contexts of a small brick learn quickly."""
+    e = probs[idx]
+    p = e & 0xFFFF
+    n = e >> 16
+    sh = min(_bitlen(n + 1), _SHIFT)
+    if bit == 0:
+        p += (_PTOT - p) >> sh
+    else:
+        p -= p >> sh
+    probs[idx] = p | (min(n + 1, 63) << 16)
+
+
+@njit(cache=True, nogil=True)
 def _enc_bit(st, out, probs, idx, bit):
-    p = probs[idx]
+    p = probs[idx] & 0xFFFF
     bound = (st[1] >> _PB) * p
     if bit == 0:
         st[1] = bound
-        probs[idx] = p + ((_PTOT - p) >> _SHIFT)
     else:
         st[0] += bound
         st[1] -= bound
-        probs[idx] = p - (p >> _SHIFT)
+    _adapt(probs, idx, bit)
     while st[1] < _TOP:
         st[1] <<= 8
         _shift_low(st, out)
@@ -517,17 +540,16 @@ def _enc_direct(st, out, value, n):
 @njit(cache=True, nogil=True)
 def _dec_bit(st, buf, probs, idx):
     # st: [code, range, pos, end]
-    p = probs[idx]
+    p = probs[idx] & 0xFFFF
     bound = (st[1] >> _PB) * p
     if st[0] < bound:
         st[1] = bound
-        probs[idx] = p + ((_PTOT - p) >> _SHIFT)
         bit = 0
     else:
         st[0] -= bound
         st[1] -= bound
-        probs[idx] = p - (p >> _SHIFT)
         bit = 1
+    _adapt(probs, idx, bit)
     while st[1] < _TOP:
         st[1] <<= 8
         b = buf[st[2]] if st[2] < st[3] else 0
@@ -555,26 +577,72 @@ def _dec_direct(st, buf, n):
 
 
 @njit(cache=True, nogil=True)
-def _nb_sum(w, i, j, k, lo0, lo1, lo2):
-    s = 0
-    if i > lo0:
-        s += abs(w[i - 1, j, k])
-    if j > lo1:
-        s += abs(w[i, j - 1, k])
-    if k > lo2:
-        s += abs(w[i, j, k - 1])
-    return s
+def _activity_map(w, l0, l1, l2, am):
+    """``am[p]`` = bucket of (max - min) of the lowpass ``w[:l0, :l1, :l2]`` over the 3^3 neighbourhood of p
+    (clamped at the borders; separable, one axis per pass): the local activity of the coarser level, which
+    predicts the detail magnitudes."""
+    mx = np.empty((HALF_T, HALF_T, HALF_T), np.int64)
+    mn = np.empty((HALF_T, HALF_T, HALF_T), np.int64)
+    mx2 = np.empty((HALF_T, HALF_T, HALF_T), np.int64)
+    mn2 = np.empty((HALF_T, HALF_T, HALF_T), np.int64)
+    for i in range(l0):
+        for j in range(l1):
+            for k in range(l2):
+                ka = max(k - 1, 0)
+                kb = min(k + 1, l2 - 1)
+                mx[i, j, k] = max(w[i, j, k], max(w[i, j, ka], w[i, j, kb]))
+                mn[i, j, k] = min(w[i, j, k], min(w[i, j, ka], w[i, j, kb]))
+    for i in range(l0):
+        for j in range(l1):
+            ja = max(j - 1, 0)
+            jb = min(j + 1, l1 - 1)
+            for k in range(l2):
+                mx2[i, j, k] = max(mx[i, j, k], max(mx[i, ja, k], mx[i, jb, k]))
+                mn2[i, j, k] = min(mn[i, j, k], min(mn[i, ja, k], mn[i, jb, k]))
+    for i in range(l0):
+        ia = max(i - 1, 0)
+        ib = min(i + 1, l0 - 1)
+        for j in range(l1):
+            for k in range(l2):
+                hi = max(mx2[i, j, k], max(mx2[ia, j, k], mx2[ib, j, k]))
+                lo = min(mn2[i, j, k], min(mn2[ia, j, k], mn2[ib, j, k]))
+                am[i, j, k] = _bucket(hi - lo, _ACT_EDGES)
 
 
 @njit(cache=True, nogil=True)
-def encode_arith(w, n0, n1, n2, root, out, base):
-    """Adaptive binary arithmetic coding of a tile into ``out[base:]``; returns the byte count (0 = all zero)."""
+def _contexts(w, i, j, k, lo0, lo1, lo2, cs, am, c):
+    """Zero-flag and magnitude context of coefficient (i, j, k) of a subband starting at (lo0, lo1, lo2)."""
+    p0 = i - lo0
+    p1 = j - lo1
+    p2 = k - lo2
+    s = cs[p0, p1, p2]
+    if p0 > 0:
+        s += abs(w[i - 1, j, k])
+    if p1 > 0:
+        s += abs(w[i, j - 1, k])
+    if p2 > 0:
+        s += abs(w[i, j, k - 1])
+    nbb = _bucket(s, _NB_EDGES)
+    a = am[p0, p1, p2]
+    return (c * N_ACT + a) * N_NB + nbb, ((c * 3 + min(a, 2)) * N_NB + nbb) * N_EXP
+
+
+@njit(cache=True, nogil=True)
+def encode_arith(w, n0, n1, n2, root, out, base, uselow=False):
+    """Adaptive binary arithmetic coding of a tile into ``out[base:]``; returns the byte count (0 = all zero).
+
+    ``uselow``: the lowpass ``w[:l0, :l1, :l2]`` is known exactly to the decoder (lossless files), so its local
+    activity joins the contexts."""
     reg = regions(n0, n1, n2, root)
     nreg = reg.shape[0]
     sig = np.zeros((7, 512), np.uint8)
     anyflag = np.zeros(7, np.uint8)
     if _sig_map(w, reg, sig, anyflag) == 0:
         return 0
+    cs = np.zeros((HALF_T, HALF_T, HALF_T), np.int64)
+    am = np.zeros((HALF_T, HALF_T, HALF_T), np.uint8)
+    if uselow and not root:
+        _activity_map(w, (n0 + 1) // 2, (n1 + 1) // 2, (n2 + 1) // 2, am)
     probs = np.full(N_PROBS, _PTOT // 2, np.int64)
     st = np.zeros(5, np.int64)
     st[1] = 0xFFFFFFFF
@@ -600,7 +668,7 @@ def encode_arith(w, n0, n1, n2, root, out, base):
                     for i in range(b0, min(b0 + SB, hi0)):
                         for j in range(b1, min(b1 + SB, hi1)):
                             for k in range(b2, min(b2 + SB, hi2)):
-                                ctx = c * N_NB + _nb_bucket(_nb_sum(w, i, j, k, lo0, lo1, lo2))
+                                ctx, ectx = _contexts(w, i, j, k, lo0, lo1, lo2, cs, am, c)
                                 v = np.int64(w[i, j, k])
                                 if v == 0:
                                     _enc_bit(st, out, probs, _P_ZERO + ctx, 0)
@@ -608,10 +676,11 @@ def encode_arith(w, n0, n1, n2, root, out, base):
                                 _enc_bit(st, out, probs, _P_ZERO + ctx, 1)
                                 _enc_bit(st, out, probs, _P_SIGN + c, 1 if v < 0 else 0)
                                 m = abs(v)
+                                cs[i - lo0, j - lo1, k - lo2] += m
                                 e = _bitlen(m)
                                 for u in range(1, e):
-                                    _enc_bit(st, out, probs, _P_EXP + ctx * 24 + min(u, 23), 1)
-                                _enc_bit(st, out, probs, _P_EXP + ctx * 24 + min(e, 23), 0)
+                                    _enc_bit(st, out, probs, _P_EXP + ectx + min(u, N_EXP - 1), 1)
+                                _enc_bit(st, out, probs, _P_EXP + ectx + min(e, N_EXP - 1), 0)
                                 if e >= 2:
                                     top = (m >> (e - 2)) & 1
                                     _enc_bit(st, out, probs, _P_MAN + c * 32 + min(e, 31), top)
@@ -623,8 +692,9 @@ def encode_arith(w, n0, n1, n2, root, out, base):
 
 
 @njit(cache=True, nogil=True)
-def decode_arith(buf, base, length, w, n0, n1, n2, root):
-    """Decode a node written by :func:`encode_arith` into ``w``; returns 0 (or -1 on an inconsistent stream)."""
+def decode_arith(buf, base, length, w, n0, n1, n2, root, uselow=False):
+    """Decode a node written by :func:`encode_arith` into ``w`` (with the same ``uselow``: the lowpass must be in
+    ``w`` already); returns 0 (or -1 on an inconsistent stream)."""
     reg = regions(n0, n1, n2, root)
     nreg = reg.shape[0]
     if length == 0:
@@ -632,6 +702,10 @@ def decode_arith(buf, base, length, w, n0, n1, n2, root):
         return 0
     if length < 5:
         return -1
+    cs = np.zeros((HALF_T, HALF_T, HALF_T), np.int64)
+    am = np.zeros((HALF_T, HALF_T, HALF_T), np.uint8)
+    if uselow and not root:
+        _activity_map(w, (n0 + 1) // 2, (n1 + 1) // 2, (n2 + 1) // 2, am)
     probs = np.full(N_PROBS, _PTOT // 2, np.int64)
     st = np.zeros(4, np.int64)
     st[1] = 0xFFFFFFFF
@@ -666,13 +740,13 @@ def decode_arith(buf, base, length, w, n0, n1, n2, root):
                     for i in range(b0, e0):
                         for j in range(b1, e1):
                             for k in range(b2, e2):
-                                ctx = c * N_NB + _nb_bucket(_nb_sum(w, i, j, k, lo0, lo1, lo2))
+                                ctx, ectx = _contexts(w, i, j, k, lo0, lo1, lo2, cs, am, c)
                                 if _dec_bit(st, buf, probs, _P_ZERO + ctx) == 0:
                                     w[i, j, k] = 0
                                     continue
                                 neg = _dec_bit(st, buf, probs, _P_SIGN + c)
                                 e = 1
-                                while _dec_bit(st, buf, probs, _P_EXP + ctx * 24 + min(e, 23)) == 1:
+                                while _dec_bit(st, buf, probs, _P_EXP + ectx + min(e, N_EXP - 1)) == 1:
                                     e += 1
                                     if e > 40:
                                         return -1
@@ -681,6 +755,7 @@ def decode_arith(buf, base, length, w, n0, n1, n2, root):
                                     m = (m << 1) | _dec_bit(st, buf, probs, _P_MAN + c * 32 + min(e, 31))
                                     if e >= 3:
                                         m = (m << (e - 2)) | _dec_direct(st, buf, e - 2)
+                                cs[i - lo0, j - lo1, k - lo2] += m
                                 w[i, j, k] = -m if neg else m
     if st[2] > st[3] + 4:
         return -1

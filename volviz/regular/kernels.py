@@ -4,7 +4,9 @@
 One *level* step maps an int32 array ``a`` (n0, n1, n2) to its lowpass ``low`` (ceil(n/2) per axis) plus one coded
 node per 32^3 tile. Tiles are numbered x fastest: ``t = t0 + c0 * (t1 + c1 * t2)``.
 
-Quantisation (lossy modes): detail subband ``b`` uses step ``steps[b]``; a step <= 1 means no quantisation
+``steps[0] > 0`` flags a lossless level: the decoder's lowpass equals the encoder's, so the arithmetic coder may use
+it as context. Quantisation (lossy modes): detail subband ``b`` uses step ``steps[b]``; a step <= 1 means no
+quantisation
 (lossless integers). Coefficient c -> q = sign(c) * floor(|c| / step + ROUND) (a dead-zone quantiser),
 reconstruction c' = sign(q) * round((|q| + BIAS) * step).
 The kernels are plain ``nogil`` Numba functions over a strided subset of tiles (``first``, ``first + stride``, ...);
@@ -114,7 +116,7 @@ def encode_level(a, steps, coder, out, cap, sizes, low, first, stride):
         if coder == CODER_RANS:
             sizes[t] = encode_rans(w, n0, n1, n2, False, out, t * cap)
         else:
-            sizes[t] = encode_arith(w, n0, n1, n2, False, out, t * cap)
+            sizes[t] = encode_arith(w, n0, n1, n2, False, out, t * cap, steps[0] > 0)
 
 
 @njit(cache=True, nogil=True)
@@ -145,7 +147,7 @@ def decode_level(low, payload, offsets, sizes, valid, steps, coder, a, lo, hi, s
         if coder == CODER_RANS:
             rc = decode_rans(payload, offsets[t], n, w, n0, n1, n2, False)
         else:
-            rc = decode_arith(payload, offsets[t], n, w, n0, n1, n2, False)
+            rc = decode_arith(payload, offsets[t], n, w, n0, n1, n2, False, steps[0] > 0)
         status[t] = rc
         if rc != 0:
             decode_rans(payload, 0, 0, w, n0, n1, n2, False)  # zero the details

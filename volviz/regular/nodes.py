@@ -47,7 +47,7 @@ def _decode_tile(low, payload, offset, size, steps, coder, n0, n1, n2):
     if coder == CODER_RANS:
         rc = decode_rans(payload, offset, size, w, n0, n1, n2, False)
     else:
-        rc = decode_arith(payload, offset, size, w, n0, n1, n2, False)
+        rc = decode_arith(payload, offset, size, w, n0, n1, n2, False, steps[0] > 0)
     if rc != 0:
         decode_rans(payload, 0, 0, w, n0, n1, n2, False)
     K._dequantise(w, n0, n1, n2, steps)
