@@ -82,3 +82,30 @@ def test_render_settings_map_to_the_pt_renderer() -> None:
     assert pt_options({"table": "separable-4", "table_resolution": 256}) == \
         {"lookup": "separable", "degree": 4, "n_s": 256}
     assert pt_options({"table": "auto", "table_resolution": 256, "sort": "bogus"}) == {}
+
+
+def test_movie_export_sorts_the_next_frame_in_the_background() -> None:
+    from volviz.render.controller import SceneController
+    from volviz.render.export import _prefetch_sorts, offscreen_plotter
+    from volviz.session import CameraState, Component, RenderSettings, Session
+
+    session = Session(components=[Component(id="demo", type="demo", settings={"cells_per_edge": 5})],
+                      render=RenderSettings(method="pt", size=(64, 48)))
+    plotter = offscreen_plotter((64, 48))
+    try:
+        controller = SceneController(plotter, session, {})
+        controller.build()
+        pt = controller.pt_volume("demo")
+        assert pt is not None
+        nxt = CameraState(position=(2.5, -1.5, 1.2), focal_point=(0.5, 0.5, 0.5), view_up=(0, 0, 1))
+        controller.set_camera(CameraState(position=(2.0, -2.0, 1.5), focal_point=(0.5, 0.5, 0.5)))
+        assert pt.stats["sort_prefetched"] is False
+        controller.set_camera(nxt)
+        plain = pt.image.copy()
+        controller.set_camera(CameraState(position=(2.0, -2.0, 1.5), focal_point=(0.5, 0.5, 0.5)))
+        _prefetch_sorts(controller, nxt, (64, 48))             # while this frame is shown, sort for the next
+        controller.set_camera(nxt)
+        assert pt.stats["sort_prefetched"] is True
+        assert np.array_equal(pt.image, plain)
+    finally:
+        plotter.close()

@@ -132,3 +132,21 @@ def test_two_volumes_both_see_the_opaque_depth():
         assert np.isfinite(a.depth).sum() == np.isfinite(b.depth).sum()
     finally:
         pl.close()
+
+
+def test_prefetched_sort_for_the_next_camera_is_used_and_changes_nothing(scene):
+    from volviz.unstructured.camera import Camera
+
+    pl, mesh, h = scene
+    old = pl.camera_position
+    try:
+        pl.camera_position = [(1.4, -2.2, 1.1), (0.5, 0.5, 0.5), (0, 0, 1)]
+        plain = h.update().copy()
+        assert h.stats["sort_prefetched"] is False
+        h.prefetch(Camera.from_pyvista(pl.camera))                 # what a movie export does for the next frame
+        again = h.update()
+        assert h.stats["sort_prefetched"] is True
+        assert np.array_equal(again, plain)
+    finally:
+        pl.camera_position = old
+        h.update()

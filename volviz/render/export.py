@@ -103,6 +103,19 @@ def movie_frames(controller: Any, path_name: Optional[str], fps: float, through_
     return [(cameras[min(i, len(cameras) - 1)], times[min(i, len(times) - 1)]) for i in range(n)]
 
 
+def _prefetch_sorts(controller: Any, camera: Any, size: tuple[int, int]) -> None:
+    """Start sorting every visible PT volume for the next frame's camera while this frame renders
+    (``volviz.unstructured.prefetch``)."""
+    from volviz.unstructured.camera import Camera
+
+    cam = Camera(camera.position, camera.focal_point, camera.view_up, camera.view_angle, camera.parallel,
+                 camera.parallel_scale)
+    for comp_id in list(controller.props):
+        pt = controller.pt_volume(comp_id)
+        if pt is not None and pt.visible:
+            pt.prefetch(cam, (int(size[0]), int(size[1])))
+
+
 def render_movie(session: Session, session_file: Optional[str | os.PathLike], out: str | os.PathLike,
                  size: tuple[int, int], path_name: Optional[str] = None, fps: float = 24.0,
                  through_time: bool = False, duration: Optional[float] = None,
@@ -122,6 +135,8 @@ def render_movie(session: Session, session_file: Optional[str | os.PathLike], ou
         writer = _MovieWriter(target, fps)
         try:
             for i, (camera, t) in enumerate(frames):
+                if i + 1 < len(frames) and frames[i + 1][0] is not None:
+                    _prefetch_sorts(controller, frames[i + 1][0], size)
                 if camera is not None:
                     controller.set_camera(camera)
                 if t is not None:

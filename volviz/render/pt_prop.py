@@ -100,6 +100,7 @@ class PTVolume:
         self.depth: np.ndarray | None = None          # last per-pixel depth limit (H, W)
         self.scene_rgb: np.ndarray | None = None      # last opaque scene colour (H, W, 3) uint8
         self.camera: Camera | None = None
+        self._prefetcher: Any = None                  # sorts for a known next camera in the background
         ren_win = plotter.ren_win
         self._layer = max(1, ren_win.GetNumberOfLayers())
         ren_win.SetNumberOfLayers(self._layer + 1)
@@ -157,9 +158,33 @@ class PTVolume:
         """Any-thread part: the volume image for a request of ``begin`` (pure NumPy/Numba, no VTK)."""
         if progress is not None:
             progress(0.0, "rendering volume")
+        opts = dict(self.render_opts)
+        pre = self._prefetcher
+        res = None
+        if self.method == "pt" and pre is not None and pre.mesh is self.mesh and "order" not in opts:
+            res = pre.take(request["camera"], request["size"])
+        if res is not None:
+            opts["order"] = res.order
         img, st = render(self.mesh, request["tf"], request["camera"], request["size"], self.method,
-                         depth=request["depth"], return_stats=True, **self.render_opts)
+                         depth=request["depth"], return_stats=True, **opts)
+        st.extra["sort_prefetched"] = res is not None
         return img, st
+
+    def prefetch(self, camera: Camera, size: tuple[int, int] | None = None) -> None:
+        """Sort the mesh for ``camera`` (the next frame's; ``size`` defaults to the window's) in the background, so
+        that the ``update`` for that camera skips the sort (``volviz.unstructured.prefetch``)."""
+        from volviz.unstructured.prefetch import SortPrefetcher
+
+        if self.method != "pt":
+            return
+        if self._prefetcher is None or self._prefetcher.mesh is not self.mesh:
+            if self._prefetcher is not None:
+                self._prefetcher.close()
+            self._prefetcher = SortPrefetcher(self.mesh, sort=self.render_opts.get("sort", "mpvo"),
+                                              nonconvex=self.render_opts.get("nonconvex", "auto"))
+        if size is None:
+            size = tuple(int(v) for v in self.plotter.ren_win.GetSize())
+        self._prefetcher.prefetch(camera, size)
 
     def error_estimate(self, request: dict[str, Any], size: tuple[int, int] = (96, 72),
                        progress: Any = None) -> dict[str, Any]:
@@ -205,7 +230,8 @@ class PTVolume:
                       "project_s": st.project_s, "raster_s": st.raster_s, "volume_s": st.total_s,
                       "upload_s": t_end - t_vol, "total_s": request["t_read"] - request["t_start"] + st.total_s
                       + (t_end - t_vol), "fragments": st.fragments, "n_visible": st.n_visible,
-                      "occluded_px": int(np.isfinite(depth).sum()), "size": (w, h), "method": self.method}
+                      "occluded_px": int(np.isfinite(depth).sum()), "size": (w, h), "method": self.method,
+                      "sort_prefetched": bool(st.extra.get("sort_prefetched", False))}
         return img
 
     @property
@@ -219,6 +245,9 @@ class PTVolume:
 
     def remove(self) -> None:
         """Detach the overlay from the plotter's render window."""
+        if self._prefetcher is not None:
+            self._prefetcher.close()
+            self._prefetcher = None
         self.plotter.ren_win.RemoveRenderer(self._overlay)
         if self._overlay in self._siblings:
             self._siblings.remove(self._overlay)
