@@ -270,7 +270,7 @@ class MainWindow(QMainWindow):
             self.restoreState(QByteArray.fromBase64(session.layout["window_state"].encode("ascii")))
         self.scene_tree.populate(session.components)
         self.render_settings.load(session.render)
-        self.clipping.load(session.clip, self.plotter.bounds)
+        self.clipping.load(session.clip, controller.bounds())
         display_time = controller.time  # the session's display time, which set_steps would reset to the first step
         self.timeline.set_steps(controller.time_steps())
         if controller.time_series():

@@ -165,3 +165,18 @@ def test_lod_components_draw_fewer_triangles_far_away_in_the_overlay():
     p.renderer.ResetCameraClippingRange()
     c.iso_overlay.update()
     assert np.abs(shot(p) - near_img).max() == 0.0   # the same view gives the same level
+
+
+def test_scene_bounds_include_overlay_isosurfaces_and_pt_volumes():
+    c, p = scene([iso_component()])
+    c.set_iso_mode("3pass")  # the VTK actors are hidden now
+    b = c.bounds()
+    pts = np.concatenate([m.points for m in c.props["iso"].volviz_meshes])
+    assert b == pytest.approx(tuple(v for pair in zip(pts.min(axis=0), pts.max(axis=0)) for v in pair))
+    s = Session(components=[Component("demo", "demo", settings={"cells_per_edge": 4})])
+    p2 = plotter()
+    c2 = SceneController(p2, s, {})
+    c2.build()
+    mesh = c2.pt_volume("demo").mesh
+    assert c2.bounds() == pytest.approx(tuple(v for pair in zip(mesh.points.min(axis=0), mesh.points.max(axis=0))
+                                              for v in pair))
