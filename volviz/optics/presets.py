@@ -22,6 +22,7 @@ from typing import Any
 
 import numpy as np
 
+from volviz.io.atomic import atomic_write_text
 from volviz.optics.transfer_function import TransferFunction
 
 __all__ = ["list_presets", "load_preset", "preset_path", "tf_from_paraview", "tf_to_paraview",
@@ -139,10 +140,10 @@ def read_paraview_presets(path: str | Path, unit_distance: float | None = None) 
 
 def write_paraview_presets(path: str | Path, tfs: TransferFunction | list[TransferFunction],
                            unit_distance: float = 1.0) -> None:
-    """Write one or more transfer functions as a ParaView preset list."""
+    """Write one or more transfer functions as a ParaView preset list (atomically: the old file survives a failure)."""
     items = [tfs] if isinstance(tfs, TransferFunction) else list(tfs)
     text = "[\n" + ",\n".join(_format(tf_to_paraview(t, unit_distance)) for t in items) + "\n]\n"
-    Path(path).write_text(text, encoding="utf-8")
+    atomic_write_text(path, text)
 
 
 def _format(obj: dict) -> str:

@@ -9,7 +9,8 @@ from typing import Any, Optional
 import numpy as np
 
 from volviz.jobs import ProgressCallback, report
-from volviz.session import Session, atomic_write_bytes
+from volviz.io.atomic import atomic_write_bytes
+from volviz.session import Session
 
 
 def offscreen_plotter(size: tuple[int, int]) -> Any:
