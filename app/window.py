@@ -10,7 +10,7 @@ from pathlib import Path
 from typing import Any, Optional
 
 from PySide6.QtCore import QByteArray, QSettings, QStandardPaths, Qt, QTimer
-from PySide6.QtGui import QAction, QKeySequence
+from PySide6.QtGui import QAction, QKeySequence, QUndoGroup
 from PySide6.QtWidgets import (QDockWidget, QFileDialog, QInputDialog, QLabel, QMainWindow, QMessageBox,
                                QProgressBar, QProgressDialog, QPushButton, QWidget)
 
@@ -152,12 +152,19 @@ class MainWindow(QMainWindow):
         self._action(file_menu, "&Quit", QKeySequence.StandardKey.Quit, self.close)
 
         edit_menu = self.menuBar().addMenu("&Edit")
-        undo = self.tf_editor.undo_stack.createUndoAction(self, "&Undo")
+        # Edit > Undo / Redo act on the stack edited last (transfer function or clipping)
+        self.undo_group = QUndoGroup(self)
+        for stack in (self.tf_editor.undo_stack, self.clipping.undo_stack):
+            self.undo_group.addStack(stack)
+            stack.indexChanged.connect(lambda _index, s=stack: self._activate_undo_stack(s))
+        self.undo_group.setActiveStack(self.tf_editor.undo_stack)
+        undo = self.undo_group.createUndoAction(self, "&Undo")
         undo.setShortcut(QKeySequence.StandardKey.Undo)
-        redo = self.tf_editor.undo_stack.createRedoAction(self, "&Redo")
+        redo = self.undo_group.createRedoAction(self, "&Redo")
         redo.setShortcut(QKeySequence.StandardKey.Redo)
         edit_menu.addAction(undo)
         edit_menu.addAction(redo)
+        self.action_undo, self.action_redo = undo, redo
 
         view_menu = self.menuBar().addMenu("&View")
         for dock in self.docks:
@@ -174,6 +181,12 @@ class MainWindow(QMainWindow):
         self.action_record = self._action(camera_menu, "&Record Camera Path", "Ctrl+R", self.set_recording)
         self.action_record.setCheckable(True)
         self._refresh_recent_menu()
+
+    def _activate_undo_stack(self, stack: Any) -> None:
+        import shiboken6
+
+        if shiboken6.isValid(stack) and shiboken6.isValid(self.undo_group):  # not while the window is torn down
+            self.undo_group.setActiveStack(stack)
 
     def _action(self, menu: Any, text: str, shortcut: Any, slot: Any) -> QAction:
         action = QAction(text, self)

@@ -67,7 +67,7 @@ def test_clip_plane_cuts_the_view_undo_and_survives_save_and_reopen(qtbot, make_
     assert np.abs(cut[right] - before[right]).max() <= 3  # the right half is as it was
     dock.offset.setValue(13.0)                           # move the plane with the spin box
     assert window.session.clip["planes"][0]["point"] == pytest.approx([13.0, 0.0, 0.0])
-    dock.undo_button.click()
+    window.action_undo.trigger()                         # Edit > Undo acts on the clipping edits
     assert window.session.clip["planes"][0]["point"] == pytest.approx([11.5, 0.0, 0.0])
     assert np.abs(viewport(window) - cut).max() <= 3
     dock.undo_button.click()                             # undo the plane itself

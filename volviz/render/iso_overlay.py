@@ -101,7 +101,7 @@ class IsoOverlay(PTVolume):
         t2 = time.perf_counter()
         st = SimpleNamespace(sort_s=0.0, project_s=0.0, raster_s=t1 - t0, total_s=t2 - t0, fragments=len(fr.depth),
                              n_visible=fr.n_triangles, triangles_drawn=triangles_drawn(fr, request["mode"]),
-                             full_triangles=sum(m.n_triangles for m in request["meshes"]))
+                             full_triangles=sum(m.n_triangles for m in request["meshes"]), extra={})
         return img, st
 
     def finish(self, request: dict[str, Any], img: np.ndarray, st: Any) -> np.ndarray:
