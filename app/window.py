@@ -524,13 +524,13 @@ class MainWindow(QMainWindow):
 
     def _time_changed(self, t: float) -> None:
         if self.controller is not None and self.controller.time_series():
-            self.controller.set_time(t)
+            self.controller.set_time(t, update=False)
             self.render()
             self.refresh_iso_overlay()
 
     def _interpolation_toggled(self, on: bool) -> None:
         if self.controller is not None:
-            self.controller.set_time(self.timeline.time, interpolate=on)
+            self.controller.set_time(self.timeline.time, interpolate=on, update=False)
             self.render()
             self.refresh_iso_overlay()
 

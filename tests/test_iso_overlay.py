@@ -180,3 +180,26 @@ def test_scene_bounds_include_overlay_isosurfaces_and_pt_volumes():
     mesh = c2.pt_volume("demo").mesh
     assert c2.bounds() == pytest.approx(tuple(v for pair in zip(mesh.points.min(axis=0), mesh.points.max(axis=0))
                                               for v in pair))
+
+
+def test_overlay_follows_display_time_and_clip_of_a_time_series():
+    from volviz.model.datasets import TimeSeries
+
+    small, big = ball(), ball()
+    big = RegularVolume(big.data * 0.5)  # the iso-values sit further out at t = 1
+    s = Session(datasets=[DatasetRef("b", "/unused")], components=[iso_component()],
+                camera=CameraState((11.5, -40.0, 11.5), (11.5, 11.5, 11.5), (0.0, 0.0, 1.0)))
+    s.render.background = BG
+    s.render.options["iso_mode"] = "4pass"
+    p = plotter()
+    c = SceneController(p, s, {"b": TimeSeries([0.0, 1.0], [small, big])})
+    c.build()
+    assert c.iso_overlay is not None and c.iso_overlay.mode == "4pass"
+    at0 = shot(p)
+    c.set_time(1.0)
+    at1 = shot(p)
+    assert np.abs(at1 - at0).mean() * 255 > 1.0
+    c.set_clip({"planes": [{"point": [11.5, 0.0, 0.0], "normal": [1.0, 0.0, 0.0]}], "box": None})
+    c.set_time(0.0)
+    row, left = SIZE[1] // 2, SIZE[0] // 2 - 15
+    assert np.abs(shot(p)[row, left] - np.asarray(BG)).max() < 3 / 255  # the clip holds at the new time

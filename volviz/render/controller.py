@@ -172,8 +172,9 @@ class SceneController:
             steps.update(float(t) for t in s.times)
         return sorted(steps)
 
-    def set_time(self, t: float, interpolate: Optional[bool] = None) -> None:
-        """Show display time ``t`` (blending neighbouring steps when interpolating)."""
+    def set_time(self, t: float, interpolate: Optional[bool] = None, update: bool = True) -> None:
+        """Show display time ``t`` (blending neighbouring steps when interpolating). The CPU-mode isosurface overlay
+        re-renders at once when ``update`` (the app renders it in the background instead)."""
         from volviz.model.timeseries import frame_at
         from volviz.render.clipping import clip_vtk_prop
         from volviz.render.vtk_scene import volume_input
@@ -198,6 +199,8 @@ class SceneController:
                 if self.clip.all_planes():
                     self._vtk_inputs[comp_id] = clip_vtk_prop(prop, self.clip)
         self._sync_iso_overlay()
+        if update and self.iso_overlay is not None:
+            self.iso_overlay.update()
 
     # -- camera -----------------------------------------------------------------------------------------------------
     def camera(self) -> CameraState:
