@@ -65,3 +65,30 @@ def test_pt_texture_isosurfaces_are_close():
     d = np.abs(img - ref) * 255
     assert np.sqrt((d ** 2).mean()) < 6.0 and (d.max(axis=-1) > 4).mean() < 0.08
     assert abs(img[..., 3].mean() - ref[..., 3].mean()) < 0.01 * ref[..., 3].mean()
+
+
+def test_smooth_isosurfaces_match_reference_and_darken_towards_the_silhouette():
+    """Smooth shading (Roettger §8.9): the spherical surface s = 0.3 around the centre of a fine grid, headlight.
+    pt equals the reference (the same linear interpolation of vertex intensities, evaluated where the ray crosses
+    the surface), the surface facing the camera keeps its flat colour and it darkens towards its silhouette."""
+    m = syn.box_tets(10)                                                   # s = distance from the centre
+    one = build_iso_table([IsoSurface(0.3, (1.0, 0.8, 0.4), 1.0)], n_s=256, s_range=(0.0, 0.9))
+    cam = Camera((0.5, 0.5, 3.0), (0.5, 0.5, 0.5), (0, 1, 0), parallel=True, parallel_scale=0.4,
+                 clipping_range=(0.1, 10.0))
+    ref = render(m, None, cam, SIZE, "reference", iso=one, iso_shading="smooth")
+    img = render(m, None, cam, SIZE, "pt", iso=one, iso_shading="smooth")
+    flat = render(m, None, cam, SIZE, "pt", iso=one)
+    d = (img - ref) * 255.0
+    assert float(np.sqrt((d ** 2).mean())) <= 1.0 and float(np.abs(d).max()) <= 4.0
+    hit = flat[..., 3] > 0.99
+    assert hit.sum() > 200
+    assert np.array_equal(img[..., 3], flat[..., 3])                      # shading changes colour, not coverage
+    ratio = img[hit, 0] / flat[hit, 0]
+    assert ratio.max() <= 1.0 + 1e-12 and ratio.max() > 0.95               # facing the light: nearly unshaded
+    h, w = SIZE[1], SIZE[0]
+    yy, xx = np.nonzero(hit)
+    r = np.hypot(xx - (w - 1) / 2, yy - (h - 1) / 2)
+    centre, rim = ratio[r < 0.3 * r.max()], ratio[r > 0.85 * r.max()]
+    assert rim.mean() < centre.mean() - 0.2                                # oblique normals at the silhouette
+    with pytest.raises(ValueError, match="exact"):
+        render(m, None, cam, (8, 8), "pt", iso=one, iso_mode="texture", iso_shading="smooth")

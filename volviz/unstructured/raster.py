@@ -252,11 +252,12 @@ def _lookup_separable(flat: np.ndarray, n: int, nc: int, deg: int, s_lo: float, 
     return c0 * a, c1 * a, c2 * a, a
 
 
-def lut_args(table: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def lut_args(table: Any, smooth: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(flat float64 data (float32 tables widened once: no conversion per tap), int64 [kind, n_s, n_l or channels, degree], float64 [s_lo, 1/ds, 1/dl or 1/l_max,
     kappa_max (3)]) of a ``Table3D`` (kind 0), a ``SeparableTable`` (kind 1) or an ``IsoTable`` (kind 2: its
     isosurfaces evaluated exactly, not its texture) or a ``Preclassified`` TF (kind 3: each segment's ends classified
-    exactly, ``_preclassified``) for the raster kernels."""
+    exactly, ``_preclassified``) for the raster kernels. ``smooth``: shade isosurfaces (kind 2) with the per-pixel
+    intensities the rasteriser interpolates (``volviz.unstructured.iso.vertex_shade``)."""
     if hasattr(table, "preclassified_tf"):                  # exact pre-classified segments (kind 3)
         tf = table.preclassified_tf
         flat = np.concatenate([tf.scalars, tf.colors.ravel(), tf.extinction]).astype(np.float64)
@@ -267,7 +268,7 @@ def lut_args(table: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         flat = np.array([[i.value, i.opacity, *i.color, *(i.color if i.back_color is None else i.back_color)]
                          for i in isos], dtype=np.float64).ravel()
         ip = np.array([2, len(isos), 8, 0], np.int64)
-        fp = np.array([table.thicken, 0.0, 0.0, 0.0, 0.0, 0.0])
+        fp = np.array([table.thicken, 1.0 if smooth else 0.0, 0.0, 0.0, 0.0, 0.0])
     elif hasattr(table, "rgba"):
         flat = np.ascontiguousarray(table.rgba, dtype=np.float64).ravel()
         ip = np.array([0, table.rgba.shape[0], table.rgba.shape[2], 0], np.int64)
@@ -281,9 +282,12 @@ def lut_args(table: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 
 @njit(cache=True, nogil=True)
-def _iso_exact(flat: np.ndarray, n: int, thicken: float, sf: float, sb: float) -> tuple[float, float, float, float]:
-    """Exact flat isosurfaces crossed by the segment (Roettger §8.13 Heaviside limit, H(0) = 1/2), front to back;
-    ``flat`` holds per surface (ascending values) value, opacity, colour (3), back colour (3)."""
+def _iso_exact(flat: np.ndarray, n: int, thicken: float, smooth: bool, sf: float, sb: float, hf: float, hb: float
+               ) -> tuple[float, float, float, float]:
+    """Exact isosurfaces crossed by the segment (Roettger §8.13 Heaviside limit, H(0) = 1/2), front to back;
+    ``flat`` holds per surface (ascending values) value, opacity, colour (3), back colour (3). Flat colours, or with
+    ``smooth`` scaled by the shading intensity where the surface is crossed, linear from ``hf`` (front) to ``hb``
+    (Roettger §8.9)."""
     lo = min(sf, sb)
     hi = max(sf, sb)
     asc = sb >= sf
@@ -303,9 +307,13 @@ def _iso_exact(flat: np.ndarray, n: int, thicken: float, sf: float, sb: float) -
         a = h * flat[k + 1]
         if a > 0.0:
             o = k + 2 if asc else k + 5
-            c0 += tr * a * flat[o]
-            c1 += tr * a * flat[o + 1]
-            c2 += tr * a * flat[o + 2]
+            shade = 1.0
+            if smooth:
+                w = min(max((v - sf) / (sb - sf), 0.0), 1.0) if sb != sf else 0.5
+                shade = hf + w * (hb - hf)
+            c0 += tr * a * flat[o] * shade
+            c1 += tr * a * flat[o + 1] * shade
+            c2 += tr * a * flat[o + 2] * shade
             tr *= 1.0 - a
     return c0, c1, c2, 1.0 - tr
 
@@ -335,16 +343,25 @@ def _preclassified(flat: np.ndarray, n: int, sf: float, sb: float, ln: float) ->
 
 
 @njit(cache=True, nogil=True, inline="always")
-def lookup_any(flat: np.ndarray, ip: np.ndarray, fp: np.ndarray, sf: float, sb: float, ln: float
-               ) -> tuple[float, float, float, float]:
-    """Premultiplied RGBA of the segment (s_f, s_b, l) from the table described by ``lut_args``."""
+def lookup_any(flat: np.ndarray, ip: np.ndarray, fp: np.ndarray, sf: float, sb: float, ln: float, hf: float = 1.0,
+               hb: float = 1.0) -> tuple[float, float, float, float]:
+    """Premultiplied RGBA of the segment (s_f, s_b, l) from the table described by ``lut_args`` (``hf``/``hb``:
+    shading intensities at the segment's ends, used by smooth isosurfaces)."""
     if ip[0] == 0:
         return _lookup(flat, ip[1], ip[2], fp[0], fp[1], fp[2], sf, sb, ln)
     if ip[0] == 2:
-        return _iso_exact(flat, ip[1], fp[0], sf, sb)
+        return _iso_exact(flat, ip[1], fp[0], fp[1] != 0.0, sf, sb, hf, hb)
     if ip[0] == 3:
         return _preclassified(flat, ip[1], sf, sb, ln)
     return _lookup_separable(flat, ip[1], ip[2], ip[3], fp[0], fp[1], fp[2], fp[3], fp[4], fp[5], sf, sb, ln)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _shade_ends(hq: np.ndarray, x: float, y: float, t0: float, t1: float) -> tuple[float, float]:
+    """Shading intensity at the segment's ends from a cell's affine forms ``hq`` (a0, ax, ay, b0, bx, by)."""
+    ha = hq[0] + x * hq[1] + y * hq[2]
+    hb = hq[3] + x * hq[4] + y * hq[5]
+    return ha + t0 * hb, ha + t1 * hb
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -363,7 +380,7 @@ def _composite(col: np.ndarray, trans: np.ndarray, ly: int, lx: int, tr: float,
 @njit(cache=True, nogil=True, inline="always", error_model="numpy", fastmath={"contract"})
 def _span(xa: int, xb: int, x0: int, ly: int, py: float, cq: np.ndarray, fr: np.ndarray, near: float,
           far_row: np.ndarray, dn_row: np.ndarray, lut: np.ndarray, lut_i: np.ndarray, lut_f: np.ndarray,
-          t_min: float, col: np.ndarray, trans: np.ndarray) -> tuple[int, int]:
+          t_min: float, col: np.ndarray, trans: np.ndarray, hq: np.ndarray, shaded: bool) -> tuple[int, int]:
     """Composite one row span of a cell whose faces are classified once (``fr[f]``: entry face) into the tile.
 
     Entry faces (eye outside) bound t from below; where their denominator is >= 0 the ray never enters and the pixel
@@ -395,7 +412,8 @@ def _span(xa: int, xb: int, x0: int, ly: int, py: float, cq: np.ndarray, fr: np.
             continue
         sa = sab + x * cq[25]
         sg = sgb + x * cq[28]
-        rgba = lookup_any(lut, lut_i, lut_f, sa + t0 * sg, sa + t1 * sg, (t1 - t0) * dn_row[px])
+        hf, hb = _shade_ends(hq, x, py, t0, t1) if shaded else (1.0, 1.0)
+        rgba = lookup_any(lut, lut_i, lut_f, sa + t0 * sg, sa + t1 * sg, (t1 - t0) * dn_row[px], hf, hb)
         opaque += _composite(col, trans, ly, lx, tr, rgba, t_min)
         nf += 1
     return nf, opaque
@@ -405,14 +423,17 @@ def _span(xa: int, xb: int, x0: int, ly: int, py: float, cq: np.ndarray, fr: np.
 def raster_tiles(box: np.ndarray, coef: np.ndarray, vxy: np.ndarray, ptr: np.ndarray, items: np.ndarray,
                  tile_order: np.ndarray, rb: np.ndarray, near: float, lut: np.ndarray, lut_i: np.ndarray,
                  lut_f: np.ndarray, width: int, height: int, tile: int, t_min: float, tol: float, far_img: np.ndarray,
-                 dn_img: np.ndarray, parallel: bool, image: np.ndarray) -> np.ndarray:
+                 dn_img: np.ndarray, parallel: bool, shade_coef: np.ndarray, image: np.ndarray) -> np.ndarray:
     """Composite every tile's cells front to back into ``image`` (H, W, 4); returns fragments drawn per tile.
 
     ``far_img`` (H, W) is the per-pixel far limit on the ray depth t (the far plane, or opaque geometry from a depth
     buffer), ``dn_img`` (H, W) the length |D| of each pixel's ray direction. A cell whose faces have a fixed role for
     every pixel (the eye, or the direction of a parallel projection, strictly off every face plane: all but
     degenerate views) goes through ``_span``; the others through the general per-pixel classification with the
-    in-plane tie-break."""
+    in-plane tie-break. ``shade_coef`` (k, 6): per cell the shading intensity as affine forms a + t b of the pixel
+    (the layout of the scalar's coefficients), for smooth isosurfaces; an empty (0, 6) array for none."""
+    shaded = shade_coef.shape[0] == coef.shape[0] and coef.shape[0] > 0
+    empty6 = np.ones(6)
     tx = (width + tile - 1) // tile
     frags = np.zeros(len(tile_order), np.int64)
     for ti in prange(len(tile_order)):
@@ -433,6 +454,7 @@ def raster_tiles(box: np.ndarray, coef: np.ndarray, vxy: np.ndarray, ptr: np.nda
             q = items[it]
             cq = coef[q]
             vq = vxy[q]
+            hq = shade_coef[q] if shaded else empty6
             full = vq[0] != vq[0]
             fast = True
             for f in range(4):
@@ -455,7 +477,7 @@ def raster_tiles(box: np.ndarray, coef: np.ndarray, vxy: np.ndarray, ptr: np.nda
                     xb = min(xb, int(math.floor(hi + 1e-7)))
                 if fast:
                     n_add, o_add = _span(xa, xb, x0, py - y0, float(py), cq, fr, near, far_img[py], dn_img[py],
-                                         lut, lut_i, lut_f, t_min, col, trans)
+                                         lut, lut_i, lut_f, t_min, col, trans, hq, shaded)
                     nf += n_add
                     opaque += o_add
                     continue
@@ -489,7 +511,8 @@ def raster_tiles(box: np.ndarray, coef: np.ndarray, vxy: np.ndarray, ptr: np.nda
                     sa = cq[24] + px * cq[25] + py * cq[26]
                     sb = cq[27] + px * cq[28] + py * cq[29]
                     ln = (t1 - t0) * dn
-                    rgba = lookup_any(lut, lut_i, lut_f, sa + t0 * sb, sa + t1 * sb, ln)
+                    hf, hb = _shade_ends(hq, float(px), float(py), t0, t1) if shaded else (1.0, 1.0)
+                    rgba = lookup_any(lut, lut_i, lut_f, sa + t0 * sb, sa + t1 * sb, ln, hf, hb)
                     opaque += _composite(col, trans, ly, lx, tr, rgba, t_min)
                     nf += 1
         frags[ti] = nf

@@ -163,11 +163,12 @@ def depth_limits(depth: np.ndarray | None, w: int, h: int) -> np.ndarray:
 
 
 def iter_ray_segments(mesh: TetMesh, camera: Camera, size: tuple[int, int], band_rows: int = 32,
-                      max_segments: int = 4_000_000, depth: np.ndarray | None = None
-                      ) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+                      max_segments: int = 4_000_000, depth: np.ndarray | None = None,
+                      extra: np.ndarray | None = None) -> Iterator[tuple[np.ndarray, np.ndarray]]:
     """Exact ray segments of every pixel, band by band: ``(pix, seg)`` sorted by (pixel, entry depth) where
     ``pix = row * W + col`` and ``seg`` columns are (t_entry, s_f, s_b, length, cell id). ``depth`` (H, W) limits
-    each ray to t <= depth (opaque geometry)."""
+    each ray to t <= depth (opaque geometry). ``extra`` (n,): a second point field interpolated like the scalar;
+    its values at each segment's front and back are appended as columns 5 and 6."""
     w, h = (int(v) for v in size)
     far_px = depth_limits(depth, w, h)
     topo = topology(mesh)
@@ -178,6 +179,7 @@ def iter_ray_segments(mesh: TetMesh, camera: Camera, size: tuple[int, int], band
     minv = np.ascontiguousarray(np.linalg.inv(mat))
     gnorm = np.ascontiguousarray(np.sqrt((minv[:, :, :3] ** 2).sum(axis=2)))
     svals = np.ascontiguousarray(mesh.scalars[topo.tets[live]])
+    extra_vals = None if extra is None else np.ascontiguousarray(np.asarray(extra, np.float64)[topo.tets[live]])
     box = screen_bboxes(camera, mesh.points, topo.tets[live], (w, h))
     on = (box[:, 0] <= box[:, 1]) & (box[:, 2] <= box[:, 3])
     rb = camera.rays((w, h), origin=topo.origin).as_array()
@@ -196,6 +198,11 @@ def iter_ray_segments(mesh: TetMesh, camera: Camera, size: tuple[int, int], band
             continue
         pix, seg = np.empty(n, np.int64), np.empty((n, 5))
         _band_segments(minv, gnorm, svals, sel, box[sel], rb, near, far, tol, w, row, row + rows, False, pix, seg, far_px)
+        if extra_vals is not None:              # the same rays and cells again, with the extra field's values
+            seg_x = np.empty((n, 5))
+            _band_segments(minv, gnorm, extra_vals, sel, box[sel], rb, near, far, tol, w, row, row + rows, False,
+                           np.empty(n, np.int64), seg_x, far_px)
+            seg = np.concatenate([seg, seg_x[:, 1:3]], axis=1)
         order = np.lexsort((seg[:, 0], pix))
         pix, seg = pix[order], seg[order]
         seg[:, 4] = live[seg[:, 4].astype(np.int64)]
@@ -205,10 +212,11 @@ def iter_ray_segments(mesh: TetMesh, camera: Camera, size: tuple[int, int], band
 
 def render_reference(mesh: TetMesh, tf: Any, camera: Camera, size: tuple[int, int], band_rows: int = 32,
                      max_segments: int = 4_000_000, depth: np.ndarray | None = None,
-                     segment_rgba: Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray] | None = None
+                     segment_rgba: Callable[..., np.ndarray] | None = None, extra: np.ndarray | None = None
                      ) -> np.ndarray:
     """Exact float64 image (H, W, 4), premultiplied RGBA, row 0 at the top (``depth``: per-pixel far limits).
-    ``segment_rgba(s_f, s_b, l)`` replaces the exact TF integral (e.g. exact flat isosurfaces)."""
+    ``segment_rgba(s_f, s_b, l)`` replaces the exact TF integral (e.g. exact flat isosurfaces); with an ``extra``
+    point field it is called as ``segment_rgba(s_f, s_b, l, x_f, x_b)`` with that field at the segment's ends."""
     from volviz.optics import integrate_segment
 
     if segment_rgba is None:
@@ -217,8 +225,9 @@ def render_reference(mesh: TetMesh, tf: Any, camera: Camera, size: tuple[int, in
 
     w, h = (int(v) for v in size)
     out = np.zeros((h * w, 4))
-    for pix, seg in iter_ray_segments(mesh, camera, (w, h), band_rows, max_segments, depth):
-        rgba = np.asarray(segment_rgba(seg[:, 1], seg[:, 2], seg[:, 3]), dtype=np.float64)
+    for pix, seg in iter_ray_segments(mesh, camera, (w, h), band_rows, max_segments, depth, extra):
+        args = (seg[:, 1], seg[:, 2], seg[:, 3]) + ((seg[:, 5], seg[:, 6]) if extra is not None else ())
+        rgba = np.asarray(segment_rgba(*args), dtype=np.float64)
         _composite_front_to_back(pix, np.ascontiguousarray(rgba), out)
     return np.nan_to_num(out.reshape(h, w, 4), nan=0.0, posinf=0.0, neginf=0.0)
 
