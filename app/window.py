@@ -31,6 +31,7 @@ log = logging.getLogger(__name__)
 
 AUTOSAVE_MS = 60_000
 PREVIEW_MS = 40          # live transfer-function preview: at most one re-render per 40 ms while dragging
+RESIZE_MS = 200          # overlays re-render once the viewport stopped resizing for 200 ms
 RECORD_MS = 250          # camera-path recording samples the camera four times a second
 MAX_RECENT = 8
 
@@ -93,6 +94,10 @@ class MainWindow(QMainWindow):
         self.autosave_timer = QTimer(self, interval=AUTOSAVE_MS)
         self.autosave_timer.timeout.connect(self.autosave)
         self.autosave_timer.start()
+        # a resized viewport makes the overlay images (PT volumes, CPU-mode isosurfaces) the wrong size: redo them
+        self.resize_timer = QTimer(self, singleShot=True, interval=RESIZE_MS)
+        self.resize_timer.timeout.connect(self._viewport_resized)
+        self.plotter.iren.add_observer("ConfigureEvent", lambda *args: self.resize_timer.start())
         self.record_timer = QTimer(self, interval=RECORD_MS)
         self.record_timer.timeout.connect(self._record_sample)
 
@@ -564,6 +569,17 @@ class MainWindow(QMainWindow):
         for comp_id in self.controller.pt_stats():
             self.refresh_pt(comp_id)
         self.refresh_iso_overlay()
+
+    def _viewport_resized(self) -> None:
+        if self.controller is None:
+            return
+        size = tuple(int(v) for v in self.plotter.ren_win.GetSize())
+        for comp_id, stats in self.controller.pt_stats().items():
+            if stats and tuple(stats.get("size", size)) != size:
+                self.refresh_pt(comp_id)
+        overlay = self.controller.iso_overlay
+        if overlay is not None and tuple(overlay.stats.get("size", size)) != size:
+            self.refresh_iso_overlay()
 
     def add_bookmark(self, name: str) -> None:
         if self.controller is None:

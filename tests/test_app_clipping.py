@@ -140,6 +140,11 @@ def test_transparency_mode_from_render_settings_and_spectrum_shader_on_screen(qt
     expected = (cpu[..., :3] * 255.0 + (1.0 - cpu[..., 3:4]) * bg)
     err = np.abs(three - expected)[1:-1, 1:-1]  # (the overlay image's outermost pixels are not compared)
     assert err.max() <= 3.0 and err.mean() < 0.6
+    window.resize(1000, 700)                           # a resized viewport re-renders the overlay at its new size
+    qtbot.waitUntil(lambda: overlay.stats.get("size") == tuple(window.plotter.ren_win.GetSize()) != (w, h),
+                    timeout=30000)
     window.render_settings.iso_mode.setCurrentText("vtk")
     assert window.controller.iso_overlay is None
+    window.resize(1400, 900)
+    qtbot.waitUntil(lambda: tuple(window.plotter.ren_win.GetSize()) == (w, h), timeout=10000)
     assert np.abs(viewport(window) - vtk_image).max() <= 3
