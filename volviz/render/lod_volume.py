@@ -1,0 +1,120 @@
+"""Multiresolution rendering of a compressed volume in a PyVista plotter (Guthe §2.3.6 block rendering).
+
+A ``LodVolume`` owns a ``volviz.regular.lod.LodTree`` (the wavelet octree of a ``.vvz`` file) and one ``vtkVolume``
+whose ``vtkMultiBlockVolumeMapper`` draws the blocks chosen for the current camera, each as its own image with its
+own spacing, sorted back to front by VTK:
+
+    lod = LodVolume(plotter, LodTree("head.vvz"), tf, budget=256)
+    lod.update()                      # select for the plotter's camera, decode through the LRU cache, draw
+    lod.stats                         # blocks, levels, decode and select seconds, transparent blocks skipped
+
+Blocks carry a one-voxel overlap with their +x/+y/+z neighbours of the same level (``LodTree.block``), so trilinear
+interpolation is continuous across the boundary of two blocks of one level: the image of a selection that is one
+level everywhere matches that level rendered as one volume (measured in ``tests/test_render_lod.py``: RMSE 0.52 of
+255 between 27 blocks and one volume; 7.6 without the overlap, where the gaps show as lines along the block faces).
+Where levels meet, the coarser block's samples differ from the finer one's by the node's approximation error (the
+quantity the selection bounds, Eq. 2.7). ``select`` and ``decode`` are Qt-free and thread-safe, so the app can run
+them in the job runner and call ``show`` on the GUI thread; ``update`` does all three.
+"""
+from __future__ import annotations
+
+import time
+from typing import Any, Optional
+
+import numpy as np
+
+from volviz.regular.lod import Block, Camera as LodCamera, LodTree, Selection
+from volviz.render.vtk_scene import update_volume_property, vtk_volume_property
+
+__all__ = ["LodVolume", "lod_camera"]
+
+
+def lod_camera(vtk_camera: Any, size: tuple[int, int]) -> LodCamera:
+    """The LOD selection's pinhole camera for a ``vtkCamera``/``pyvista.Camera`` and an image ``size`` (W, H)."""
+    return LodCamera(eye=tuple(map(float, vtk_camera.GetPosition())),
+                     target=tuple(map(float, vtk_camera.GetFocalPoint())),
+                     up=tuple(map(float, vtk_camera.GetViewUp())), fov_y=float(vtk_camera.GetViewAngle()),
+                     width=int(size[0]), height=int(size[1]))
+
+
+def _image(block: Block) -> Any:
+    """A vtkImageData of one block (samples at origin + spacing * index, x fastest)."""
+    import vtk
+    from vtk.util.numpy_support import numpy_to_vtk
+
+    img = vtk.vtkImageData()
+    img.SetDimensions(*block.data.shape)
+    img.SetOrigin(*block.origin)
+    img.SetSpacing(*block.spacing)
+    arr = numpy_to_vtk(np.ascontiguousarray(block.data.ravel(order="F")), deep=True)
+    arr.SetName("scalars")
+    img.GetPointData().SetScalars(arr)
+    return img
+
+
+class LodVolume:
+    """A LOD-rendered compressed volume attached to a plotter (see the module docstring)."""
+
+    def __init__(self, plotter: Any, tree: LodTree, tf: Any, budget: int = 256, mode: str = "tf",
+                 opacity: float = 1.0) -> None:
+        import vtk
+
+        self.plotter, self.tree, self.tf = plotter, tree, tf
+        self.budget, self.mode, self.opacity = int(budget), mode, float(opacity)
+        self.mapper = vtk.vtkMultiBlockVolumeMapper()
+        self.volume = vtk.vtkVolume()
+        self.volume.SetMapper(self.mapper)
+        self.volume.SetProperty(vtk_volume_property(tf, opacity))
+        self._images: dict[Any, Any] = {}               # block key -> vtkImageData (reused while selected)
+        self.selection: Optional[Selection] = None
+        self.stats: dict[str, Any] = {}
+        plotter.renderer.AddVolume(self.volume)
+
+    def set_transfer_function(self, tf: Any) -> None:
+        self.tf = tf
+        update_volume_property(self.volume.GetProperty(), tf, self.opacity)
+
+    def select(self, camera: LodCamera) -> Selection:
+        """Any thread: the blocks for ``camera`` under the block budget (Guthe §2.3.3)."""
+        return self.tree.select(camera, self.budget, tf=self.tf, mode=self.mode)
+
+    def decode(self, selection: Selection) -> list[Block]:
+        """Any thread: the selected blocks' samples (decoded on demand through the tree's LRU cache)."""
+        return [self.tree.block(key) for key in selection.nodes if key not in self._images] \
+            if selection.nodes else []
+
+    def show(self, selection: Selection, blocks: list[Block]) -> None:
+        """GUI thread: draw ``selection`` (``blocks`` holds the ones not drawn before)."""
+        import vtk
+
+        for b in blocks:
+            self._images[b.key] = _image(b)
+        keep = set(selection.nodes)
+        for key in [k for k in self._images if k not in keep]:
+            del self._images[key]
+        mb = vtk.vtkMultiBlockDataSet()
+        mb.SetNumberOfBlocks(len(selection.nodes))
+        for i, key in enumerate(selection.nodes):
+            mb.SetBlock(i, self._images[key])
+        self.mapper.SetInputDataObject(mb)
+        self.selection = selection
+
+    def update(self) -> dict[str, Any]:
+        """Select for the plotter's current camera, decode and draw; returns the statistics."""
+        w, h = (int(v) for v in self.plotter.ren_win.GetSize())
+        t0 = time.perf_counter()
+        sel = self.select(lod_camera(self.plotter.renderer.GetActiveCamera(), (w, h)))
+        t1 = time.perf_counter()
+        blocks = self.decode(sel)
+        t2 = time.perf_counter()
+        self.show(sel, blocks)
+        levels: dict[int, int] = {}
+        for level, _ in sel.nodes:
+            levels[level] = levels.get(level, 0) + 1
+        self.stats = {"blocks": len(sel.nodes), "levels": dict(sorted(levels.items())), "select_s": t1 - t0,
+                      "decode_s": t2 - t1, "new_blocks": len(blocks), "skipped_transparent": sel.skipped_transparent,
+                      "culled": sel.culled}
+        return self.stats
+
+    def remove(self) -> None:
+        self.plotter.renderer.RemoveVolume(self.volume)
