@@ -101,8 +101,23 @@ def test_clip_plane_cuts_the_view_undo_and_survives_save_and_reopen(qtbot, make_
     other.clipping.undo_button.click()
     assert other.session.clip["planes"][0]["normal"] == pytest.approx([1.0, 0.0, 0.0])
     assert widget.GetNormal() == pytest.approx((1.0, 0.0, 0.0))   # the widget follows the dock
+    other.clipping.box_enabled.setChecked(True)           # box crop: default box = the scene bounds; drag it
+    box_widget = other.clip_widget.box_widget
+    assert box_widget is not None and other.session.clip["box"] is not None
+    top = pixel(other, (15.0, 11.5, 17.0))
+    unboxed = viewport(other)
+    assert np.abs(unboxed[top] - background).max() > 20
+    box_widget.PlaceWidget([-5.0, 30.0, -5.0, 30.0, -5.0, 14.0])
+    box_widget.InvokeEvent("EndInteractionEvent")
+    assert other.session.clip["box"] == {"lo": pytest.approx([-5.0] * 3), "hi": pytest.approx([30.0, 30.0, 14.0])}
+    boxed = viewport(other)
+    assert np.abs(boxed[top] - background).max() <= 3                 # above z = 14: cropped
+    low = pixel(other, (17.0, 11.5, 8.0))                             # (clear of the widgets' handles)
+    assert np.abs(boxed[low] - unboxed[low]).max() <= 3 and np.abs(boxed[low] - background).max() > 20
+    other.clipping.undo_button.click()
+    assert np.abs(viewport(other) - unboxed).max() <= 3
     other.clipping.show_widget.setChecked(False)
-    assert other.clip_widget.widget is None
+    assert other.clip_widget.widget is None and other.clip_widget.box_widget is None
 
 
 def test_transparency_mode_from_render_settings_and_spectrum_shader_on_screen(qtbot, make_window, session_file,

@@ -83,7 +83,7 @@ class ClippingDock(QWidget):
         self.flip_button = QPushButton("Flip")
         self.normal = [_spin() for _ in range(3)]
         self.offset = _spin()
-        self.show_widget = QCheckBox("Drag the selected plane in the viewport")
+        self.show_widget = QCheckBox("Drag the selected plane and the box in the viewport")
         self.box_enabled = QCheckBox("Box crop")
         self.box_lo = [_spin() for _ in range(3)]
         self.box_hi = [_spin() for _ in range(3)]
