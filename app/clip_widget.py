@@ -27,12 +27,7 @@ class ClipPlaneWidget:
         """The box widget on the crop box while box crop is on and widgets are shown."""
         box = self.dock.clip["box"]
         if not (self.dock.show_widget.isChecked() and box is not None):
-            if self.box_widget is not None:
-                self.box_widget.Off()
-                widgets = self.plotter.widgets.box_widgets
-                if self.box_widget in widgets:
-                    widgets.remove(self.box_widget)
-                self.box_widget = None
+            self.box_widget = _drop(self.box_widget, self.plotter.widgets.box_widgets)
             return
         bounds = [v for pair in zip(box["lo"], box["hi"]) for v in pair]
         self._placing = True
@@ -78,9 +73,14 @@ class ClipPlaneWidget:
 
     def _remove(self) -> None:
         if self.widget is not None:
-            self.widget.Off()
-            widgets = self.plotter.widgets.plane_widgets
-            if self.widget in widgets:
-                widgets.remove(self.widget)
-            self.widget = None
+            self.widget = _drop(self.widget, self.plotter.widgets.plane_widgets)
             self.plotter.render()
+
+
+def _drop(widget: Any, registry: list[Any]) -> None:
+    """Switch a widget off and forget it (PyVista keeps a list of its widgets)."""
+    if widget is not None:
+        widget.Off()
+        if widget in registry:
+            registry.remove(widget)
+    return None
