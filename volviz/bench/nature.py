@@ -27,7 +27,7 @@ import numpy as np
 
 DEFAULT_DATA = Path(os.environ.get("VOLVIZ_DATA", Path(__file__).resolve().parents[2].parent / "shared" / "data"))
 REPO = Path(__file__).resolve().parents[2]
-OCT, SHARP = 3, 1.5
+OCT, SCALE, SHARP = 2, 4.0, 0.6  # band-limited clouds: every octave > 60 samples per period (see NOTES)
 
 # camera keys: above the cloud deck, under it over the fog, into the clouds, and out again looking down
 KEYS = [((500.0, -300.0, 330.0), (500.0, 500.0, 110.0)),
@@ -95,8 +95,9 @@ def build_scene(data: Path, cloud_shape: tuple[int, int, int], terrain_c: tuple[
     scene.add_fog("ground_fog", fog, FogLayer(colour=(0.75, 0.75, 1.0), density=0.05, mode="attenuated"), weight=2.0)
     nx, ny, nz = cloud_shape
     sp = 1000.0 / (nx - 1)
-    f = noise.cloud_density(cloud_shape, seed=5, coverage=0.3, octaves=OCT, sharpness=SHARP)
-    g = noise.cloud_light(f, (sp, sp, sp))
+    f = noise.cloud_density(cloud_shape, seed=5, coverage=0.3, scale=SCALE, octaves=OCT, sharpness=SHARP,
+                            edge="smooth")
+    g = noise.cloud_light(f, (sp, sp, sp), soft=1.0)
     scene.add_clouds(CloudVolume(f, g, (sp, sp, sp), (0.0, 0.0, 110.0)), CloudShading.npr(rho_max=0.08),
                      big_c=cloud_c[0], small_c=cloud_c[1])
     scene.finalize()
@@ -127,10 +128,10 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--reps", type=int, default=3, help="timed runs per frame, median reported (default 3)")
     ap.add_argument("--cloud-shape", default="513x513x65", help="cloud volume points (default 513x513x65)")
     ap.add_argument("--terrain-lod", default="9,30", help="terrain C,c (default 9,30)")
-    ap.add_argument("--cloud-lod", default="3,4", help="cloud C,c (default 3,4)")
+    ap.add_argument("--cloud-lod", default="2,20", help="cloud C,c (default 2,20)")
     ap.add_argument("--popping-frames", type=int, default=6, help="frames of the dense popping sub-path (0: skip)")
     ap.add_argument("--popping-step", type=float, default=0.25, help="camera step of that sub-path in world units")
-    ap.add_argument("--sweep", default="2,2;3,4;4,8;6,16;6,64",
+    ap.add_argument("--sweep", default="2,10;2,20;2,50;2,100;2,200",
                     help="cloud C,c settings for the tetrahedra-vs-error sweep on frames 0 and 3 ('' to skip)")
     ap.add_argument("--data", type=Path, default=DEFAULT_DATA)
     ap.add_argument("--json", type=Path, default=None, help="write the results as JSON")

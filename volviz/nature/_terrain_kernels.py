@@ -54,34 +54,6 @@ def propagate_d2(d2: np.ndarray, n: int, k: float) -> None:
 
 
 @njit(cache=True, nogil=True)
-def node_zrange(zlo: np.ndarray, zhi: np.ndarray, n: int, out_lo: np.ndarray, out_hi: np.ndarray) -> None:
-    """Per node centre: min of ``zlo`` and max of ``zhi`` over the node's (d + 1)^2 samples (bottom-up)."""
-    d = 2
-    while d <= n - 1:
-        h = d // 2
-        for ci in range(h, n - 1, d):
-            for cj in range(h, n - 1, d):
-                if d == 2:
-                    lo = zlo[ci, cj]
-                    hi = zhi[ci, cj]
-                    for a in range(ci - 1, ci + 2):
-                        for b in range(cj - 1, cj + 2):
-                            lo = min(lo, zlo[a, b])
-                            hi = max(hi, zhi[a, b])
-                else:
-                    q = h // 2
-                    lo = np.inf
-                    hi = -np.inf
-                    for si in (-1, 1):
-                        for sj in (-1, 1):
-                            lo = min(lo, out_lo[ci + si * q, cj + sj * q])
-                            hi = max(hi, out_hi[ci + si * q, cj + sj * q])
-                out_lo[ci, cj] = lo
-                out_hi[ci, cj] = hi
-        d *= 2
-
-
-@njit(cache=True, nogil=True)
 def refine(d2: np.ndarray, height: np.ndarray, n: int, sx: float, sy: float, x0: float, y0: float,
            eye: np.ndarray, big_c: float, small_c: float, geomorph: bool,
            state: np.ndarray, weight: np.ndarray, nodes: np.ndarray, sizes: np.ndarray) -> tuple[int, int]:
@@ -213,10 +185,14 @@ def _outside(planes: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> bool:
 
 @njit(cache=True, nogil=True)
 def emit_fans(n: int, sx: float, sy: float, x0: float, y0: float, state: np.ndarray, nodes: np.ndarray,
-              sizes: np.ndarray, count: int, zlo: np.ndarray, zhi: np.ndarray, planes: np.ndarray,
+              sizes: np.ndarray, count: int, morphed: np.ndarray, planes: np.ndarray,
               vmap: np.ndarray, stamp: int, vstamp: np.ndarray, verts: np.ndarray, tris: np.ndarray) -> tuple[int, int]:
     """Triangle fans around the centre of every leaf, skipping the edge midpoints whose same-size neighbour does not
-    exist (the T-vertex rule of §3.5.3). Leaves whose box misses the frustum ``planes`` are skipped (emission only).
+    exist (the T-vertex rule of §3.5.3). Leaves whose box misses the frustum ``planes`` are skipped (emission only);
+    the box's height range is that of the fan's own morphed vertices over every field (``morphed`` (F, n, n)), which
+    bounds its planar triangles exactly. (The unmorphed height range of the node does not: a morphed vertex averages
+    ancestors' vertices outside the node, so visible fans near the image border were culled — holes that appeared
+    and vanished from frame to frame.)
     Vertices are numbered on first use (``verts`` gets their grid indices). Returns (n_vertices, n_triangles)."""
     nv = 0
     nt = 0
@@ -232,15 +208,6 @@ def emit_fans(n: int, sx: float, sy: float, x0: float, y0: float, state: np.ndar
             continue
         d = sizes[k]
         h = d // 2
-        if planes.shape[0] > 0:
-            lo[0] = x0 + (ci - h) * sx
-            hi[0] = x0 + (ci + h) * sx
-            lo[1] = y0 + (cj - h) * sy
-            hi[1] = y0 + (cj + h) * sy
-            lo[2] = zlo[ci, cj]
-            hi[2] = zhi[ci, cj]
-            if _outside(planes, lo, hi):
-                continue
         r = 0
         # counter-clockwise seen from above (x east, y north)
         ring_i[r] = ci - h
@@ -271,6 +238,24 @@ def emit_fans(n: int, sx: float, sy: float, x0: float, y0: float, state: np.ndar
             ring_i[r] = ci - h
             ring_j[r] = cj
             r += 1
+        if planes.shape[0] > 0:
+            lo[0] = x0 + (ci - h) * sx
+            hi[0] = x0 + (ci + h) * sx
+            lo[1] = y0 + (cj - h) * sy
+            hi[1] = y0 + (cj + h) * sy
+            zl = np.inf
+            zh = -np.inf
+            for f in range(morphed.shape[0]):
+                zl = min(zl, morphed[f, ci, cj])
+                zh = max(zh, morphed[f, ci, cj])
+                for a in range(r):
+                    v = morphed[f, ring_i[a], ring_j[a]]
+                    zl = min(zl, v)
+                    zh = max(zh, v)
+            lo[2] = zl
+            hi[2] = zh
+            if _outside(planes, lo, hi):
+                continue
         if vstamp[ci, cj] != stamp:
             vstamp[ci, cj] = stamp
             vmap[ci, cj] = nv

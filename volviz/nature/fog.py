@@ -56,12 +56,22 @@ class FogLayer:
             raise ValueError(f"fog density must be finite and >= 0, got {self.density}")
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, parallel=True)
 def _prism_setup(pts, bot, top, eb, et, tris, vp, w, h, planes, boxes, keep):
+    """In parallel over chunks of prisms (``_prism_setup_range``)."""
+    m = tris.shape[0]
+    chunks = 16
+    for ci in prange(chunks):
+        _prism_setup_range(pts, bot, top, eb, et, tris, vp, w, h, planes, boxes, keep, ci * m // chunks,
+                           (ci + 1) * m // chunks)
+
+
+@njit(cache=True, nogil=True)
+def _prism_setup_range(pts, bot, top, eb, et, tris, vp, w, h, planes, boxes, keep, p0, p1):
     """Per prism: 5 inward planes (a, b, c, d) and the clipped screen box [x0, x1, y0, y1]; keep[p] = 0 to skip."""
     cam = np.empty((6, 3))
     box = np.empty(4, dtype=np.int64)
-    for p in range(tris.shape[0]):
+    for p in range(p0, p1):
         i0, i1, i2 = tris[p, 0], tris[p, 1], tris[p, 2]
         keep[p] = 0
         if (eb[i0] <= 0 and eb[i1] <= 0 and eb[i2] <= 0 and et[i0] <= 0 and et[i1] <= 0 and et[i2] <= 0):
@@ -133,23 +143,29 @@ def _field(pts, bot, top, eb, et, i0, i1, i2, x, y, z):
 def _pcp_band(pts, bot, top, eb, et, tris, planes, boxes, keep, rb, depth, near, row0, row1, emis, mip):
     o = np.empty(3)
     d = np.empty(3)
+    ca = np.empty((5, 3))  # plane . origin = ca0 + col ca1 + row ca2 (the ray table is linear in col and row)
+    cb = np.empty((5, 3))  # plane . direction, likewise
     for p in range(tris.shape[0]):
         if keep[p] == 0:
             continue
         y_lo = max(boxes[p, 2], row0)
         y_hi = min(boxes[p, 3], row1 - 1)
+        if y_lo > y_hi:
+            continue
         i0, i1, i2 = tris[p, 0], tris[p, 1], tris[p, 2]
+        for k in range(5):
+            for j in range(3):
+                ca[k, j] = (planes[p, k, 0] * rb[j, 0] + planes[p, k, 1] * rb[j, 1] + planes[p, k, 2] * rb[j, 2]
+                            + (planes[p, k, 3] if j == 0 else 0.0))
+                cb[k, j] = planes[p, k, 0] * rb[3 + j, 0] + planes[p, k, 1] * rb[3 + j, 1] + planes[p, k, 2] * rb[3 + j, 2]
         for row in range(y_lo, y_hi + 1):
             for col in range(boxes[p, 0], boxes[p, 1] + 1):
-                for a in range(3):
-                    o[a] = rb[0, a] + col * rb[1, a] + row * rb[2, a]
-                    d[a] = rb[3, a] + col * rb[4, a] + row * rb[5, a]
                 t0 = near
                 t1 = depth[row, col]
                 ok = True
                 for k in range(5):
-                    pa = planes[p, k, 0] * o[0] + planes[p, k, 1] * o[1] + planes[p, k, 2] * o[2] + planes[p, k, 3]
-                    pb = planes[p, k, 0] * d[0] + planes[p, k, 1] * d[1] + planes[p, k, 2] * d[2]
+                    pa = ca[k, 0] + col * ca[k, 1] + row * ca[k, 2]
+                    pb = cb[k, 0] + col * cb[k, 1] + row * cb[k, 2]
                     if pb > 0.0:
                         t0 = max(t0, -pa / pb)
                     elif pb < 0.0:
@@ -159,6 +175,9 @@ def _pcp_band(pts, bot, top, eb, et, tris, planes, boxes, keep, rb, depth, near,
                         break
                 if not ok or t1 <= t0:
                     continue
+                for a in range(3):
+                    o[a] = rb[0, a] + col * rb[1, a] + row * rb[2, a]
+                    d[a] = rb[3, a] + col * rb[4, a] + row * rb[5, a]
                 ef = _field(pts, bot, top, eb, et, i0, i1, i2, o[0] + t0 * d[0], o[1] + t0 * d[1], o[2] + t0 * d[2])
                 eback = _field(pts, bot, top, eb, et, i0, i1, i2, o[0] + t1 * d[0], o[1] + t1 * d[1],
                                o[2] + t1 * d[2])

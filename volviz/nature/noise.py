@@ -150,29 +150,42 @@ def fog_map(heights: np.ndarray, level: float, thickness: float, seed: int = 2, 
 
 
 def cloud_density(shape: tuple[int, int, int], seed: int = 3, coverage: float = 0.3, scale: float = 6.0,
-                  octaves: int = 5, sharpness: float = 3.0) -> np.ndarray:
+                  octaves: int = 5, sharpness: float = 3.0, edge: str = "hard") -> np.ndarray:
     """Cumulus-like density f in [0, 1] on a (nx, ny, nz) grid, float32 (§11.6.2: 3D Perlin noise).
 
     fBm with ``scale`` base cells across x and y (z scaled to keep cells cubic), a vertical profile that thins the
     cloud towards the layer's top and bottom and flattens the bases, then ``f = clip((noise - threshold) sharpness, 0,
     1)`` with the threshold chosen so that roughly ``coverage`` of the samples are non-zero.
+
+    ``edge="smooth"`` band-limits the result for the LOD (§11.3: a piecewise-linear octree can only represent what
+    its cells resolve): the clip becomes a smoothstep 3x^2 - 2x^3 (C1 at the cloud's edge and core instead of two
+    kinks) and the vertical profile a smoothstep ramp. Use few octaves (2 at scale 4 on a 513-point grid keeps every
+    octave above 60 samples per period).
     """
+    if edge not in ("hard", "smooth"):
+        raise ValueError(f"edge must be 'hard' or 'smooth', got {edge!r}")
     nx, ny, nz = (int(v) for v in shape)
     sz = scale * (nz - 1) / max(nx - 1, 1)
     f = fbm3((nx, ny, nz), scale=(scale, scale * (ny - 1) / max(nx - 1, 1), sz), octaves=octaves, seed=seed)
     zeta = np.linspace(0.0, 1.0, nz, dtype=np.float32)
-    profile = np.clip(np.minimum(zeta / 0.25, (1.0 - zeta) / 0.6), 0.0, 1.0) ** 0.5
+    if edge == "smooth":
+        profile = np.clip(np.minimum(zeta / 0.35, (1.0 - zeta) / 0.6), 0.0, 1.0)
+        profile = profile * profile * (3.0 - 2.0 * profile)
+    else:
+        profile = np.clip(np.minimum(zeta / 0.25, (1.0 - zeta) / 0.6), 0.0, 1.0) ** 0.5
     f = f * np.float32(0.5) + np.float32(0.5) * profile[None, None, :] - np.float32(0.25)
     sample = f[:: max(nx // 64, 1), :: max(ny // 64, 1), :]
     threshold = float(np.quantile(sample, 1.0 - coverage))
     f -= np.float32(threshold)
     f *= np.float32(sharpness / max(float(sample.max()) - threshold, 1e-6))
     np.clip(f, 0.0, 1.0, out=f)
+    if edge == "smooth":
+        f *= f * (np.float32(3.0) - np.float32(2.0) * f)
     return f
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def _light(f, sx, sy, sz, lx, ly, lz, ambient, diffuse, out):
+def _light(f, sx, sy, sz, lx, ly, lz, ambient, diffuse, g0, out):
     nx, ny, nz = f.shape
     for i in prange(nx):
         for j in range(ny):
@@ -183,7 +196,7 @@ def _light(f, sx, sy, sz, lx, ly, lz, ambient, diffuse, out):
                 gx = (f[i1, j, k] - f[i0, j, k]) / ((i1 - i0) * sx)
                 gy = (f[i, j1, k] - f[i, j0, k]) / ((j1 - j0) * sy)
                 gz = (f[i, j, k1] - f[i, j, k0]) / ((k1 - k0) * sz)
-                g = math.sqrt(gx * gx + gy * gy + gz * gz)
+                g = math.sqrt(gx * gx + gy * gy + gz * gz + g0 * g0)
                 lam = 0.0
                 if g > 1e-12:
                     lam = -(gx * lx + gy * ly + gz * lz) / g  # outward normal = -grad f
@@ -191,13 +204,26 @@ def _light(f, sx, sy, sz, lx, ly, lz, ambient, diffuse, out):
 
 
 def cloud_light(density: np.ndarray, spacing: tuple[float, float, float], light_dir=(0.4, 0.3, 0.85),
-                ambient: float = 0.35, diffuse: float = 0.65) -> np.ndarray:
+                ambient: float = 0.35, diffuse: float = 0.65, soft: float = 0.0) -> np.ndarray:
     """Isotropic light intensity gamma = ambient + diffuse max(n . L, 0), n = -grad f / |grad f| (§11.6.2; the thesis
     leaves the normal's source open, the density gradient is the natural choice). float32, in [ambient, ambient +
-    diffuse]."""
+    diffuse].
+
+    ``soft`` > 0 normalises by sqrt(|grad f|^2 + g0^2), g0 = ``soft`` x the median gradient magnitude inside the
+    cloud (f > 0.05): where the gradient vanishes (flat cores, the empty sky, saddles) the unit normal flips
+    arbitrarily and gamma jumps between neighbouring samples; the soft form fades to the ambient term there instead,
+    so gamma is as smooth as f and the LOD need not resolve spurious light edges."""
     L = np.asarray(light_dir, dtype=np.float64)
     L = L / np.linalg.norm(L)
     out = np.empty(density.shape, dtype=np.float32)
+    g0 = 0.0
+    if soft > 0:
+        f = np.asarray(density, dtype=np.float64)
+        step = max(1, int(round((f.size / 2e6) ** (1 / 3))))  # a subsample suffices for a median
+        sub = f[::step, ::step, ::step]
+        grads = np.gradient(sub, *(float(s) * step for s in spacing))
+        mag = np.sqrt(sum(gr * gr for gr in grads))[sub > 0.05]
+        g0 = float(soft) * (float(np.median(mag)) if mag.size else 0.0)
     _light(np.ascontiguousarray(density), float(spacing[0]), float(spacing[1]), float(spacing[2]),
-           L[0], L[1], L[2], float(ambient), float(diffuse), out)
+           L[0], L[1], L[2], float(ambient), float(diffuse), g0, out)
     return out

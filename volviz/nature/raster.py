@@ -319,9 +319,11 @@ def render_terrain(points: np.ndarray, triangles: np.ndarray, tcoords: np.ndarra
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def _sky(vp, w, h, tex, zenith, horizon, has_tex, out):
+def _sky(vp, w, h, tex, zenith, horizon, has_tex, mask, out):
     for y in prange(h):
         for x in range(w):
+            if not mask[y, x]:
+                continue
             sx = (2.0 * (x + 0.5) / w - 1.0) * vp[12]
             sy = (1.0 - 2.0 * (y + 0.5) / h) * vp[13]
             dx = vp[9] + sx * vp[3] + sy * vp[6]
@@ -342,13 +344,15 @@ def _sky(vp, w, h, tex, zenith, horizon, has_tex, out):
 
 
 def render_sky(camera: Any, size: tuple[int, int], texture: np.ndarray | None = None,
-               zenith=(0.32, 0.5, 0.85), horizon=(0.78, 0.85, 0.95)) -> np.ndarray:
+               zenith=(0.32, 0.5, 0.85), horizon=(0.78, 0.85, 0.95), mask: np.ndarray | None = None) -> np.ndarray:
     """Sky colour per pixel (H, W, 3) float32: the sky dome at infinity (Roettger §5.1) — a polar texture (u =
     azimuth / 2 pi, top row = zenith, bottom row = horizon) or a zenith/horizon gradient. Below the horizon the
-    horizon colour continues."""
+    horizon colour continues. ``mask`` (H, W) bool: only those pixels are computed (the others stay 0), e.g. where
+    no terrain covers the sky."""
     w, h = (int(v) for v in size)
     vp = view_params(camera, (w, h))
     out = np.zeros((h, w, 3), dtype=np.float32)
     tex = np.zeros((1, 1, 3), dtype=np.float32) if texture is None else np.ascontiguousarray(texture, dtype=np.float32)
-    _sky(vp, w, h, tex, np.asarray(zenith, float), np.asarray(horizon, float), texture is not None, out)
+    m = np.ones((h, w), dtype=np.bool_) if mask is None else np.ascontiguousarray(mask, dtype=np.bool_)
+    _sky(vp, w, h, tex, np.asarray(zenith, float), np.asarray(horizon, float), texture is not None, m, out)
     return out

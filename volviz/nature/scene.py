@@ -102,11 +102,14 @@ class NatureScene:
         self.fogs.append(_Fog(name, layer or FogLayer(), bottom_name, name, mid))
         self.lod = None
 
-    def add_clouds(self, volume: CloudVolume, shading: CloudShading | None = None, big_c: float = 3.0,
-                   small_c: float = 4.0, table_size: tuple[int, int] = (64, 128)) -> None:
-        """Volumetric clouds (Ch. 11) with their C-LOD and pre-integration table."""
+    def add_clouds(self, volume: CloudVolume, shading: CloudShading | None = None, big_c: float = 2.0,
+                   small_c: float = 8.0, table_size: tuple[int, int] = (64, 128), optical: bool = True) -> None:
+        """Volumetric clouds (Ch. 11) with their C-LOD and pre-integration table. ``optical``: the LOD's Δ is the
+        optical-depth error Δ ρ_max s of a node (``CloudLOD(extinction=...)``), not the bare field deviation."""
         self.cloud_shading = shading or CloudShading.npr()
-        self.cloud_lod = CloudLOD(volume, big_c=big_c, small_c=small_c, cutoff=self.cloud_shading.cutoff)
+        ext = self.cloud_shading.tf.max_extinction if optical else 0.0
+        self.cloud_lod = CloudLOD(volume, big_c=big_c, small_c=small_c, cutoff=self.cloud_shading.cutoff,
+                                  extinction=ext)
         l_max = volume.root * float(np.linalg.norm(volume.spacing))
         self.cloud_table = build_cloud_table(self.cloud_shading, l_max, n_s=table_size[0], n_l=table_size[1])
 
@@ -171,7 +174,9 @@ class NatureScene:
             stats["terrain_triangles"] = float(mesh.n_triangles)
         else:
             depth, rgb = np.full((h, w), np.inf), np.zeros((h, w, 3), np.float32)
-        base = np.where(np.isfinite(depth)[..., None], rgb, render_sky(camera, (w, h), self.sky)).astype(np.float64)
+        open_sky = ~np.isfinite(depth)
+        base = np.where(open_sky[..., None], render_sky(camera, (w, h), self.sky, mask=open_sky), rgb
+                        ).astype(np.float64)
         stats["terrain_s"] = time.perf_counter() - t0
         overlay = self.render_volumes(camera, (w, h), mesh, depth, full, stats)
         final = overlay[..., :3] + (1.0 - overlay[..., 3:4]) * base
@@ -197,7 +202,7 @@ def demo_scene(seed: int = 0, terrain_size: int = 257, cloud_shape: tuple[int, i
     nx, ny, nz = cloud_shape
     spacing = extent / (nx - 1)
     f = noise.cloud_density(cloud_shape, seed=seed + 3, coverage=0.25)
-    g = noise.cloud_light(f, (spacing,) * 3)
+    g = noise.cloud_light(f, (spacing,) * 3, soft=1.0)
     scene.add_clouds(CloudVolume(f, g, (spacing, extent / (ny - 1), spacing), (0.0, 0.0, 190.0)),
                      CloudShading.npr(rho_max=0.06))
     return scene
@@ -340,7 +345,7 @@ def scene_from_components(components: Sequence[Any], datasets: dict[str, Any]) -
         origin = (terrain.origin[0] if terrain else 0.0, terrain.origin[1] if terrain else 0.0,
                   float(st.get("base_height", 190.0)))
         spacing = (ext[0] / (dens.shape[0] - 1), ext[1] / (dens.shape[1] - 1), thickness / (dens.shape[2] - 1))
-        light = noise.cloud_light(np.ascontiguousarray(dens, dtype=np.float32), spacing)
+        light = noise.cloud_light(np.ascontiguousarray(dens, dtype=np.float32), spacing, soft=1.0)
         try:
             volume = CloudVolume(dens, light, spacing, origin)
         except ValueError:  # sizes without a common power-of-two cell count: resample (§11.3.1)
@@ -348,7 +353,7 @@ def scene_from_components(components: Sequence[Any], datasets: dict[str, Any]) -
         shading_name = st.get("shading", "npr")
         rho = float(st.get("rho_max", 0.06))
         shading = CloudShading.physical(rho) if shading_name == "physical" else CloudShading.npr(rho)
-        scene.add_clouds(volume, shading, float(st.get("C", 3.0)), float(st.get("c", 4.0)))
+        scene.add_clouds(volume, shading, float(st.get("C", 2.0)), float(st.get("c", 8.0)))
     scene.finalize()
     return scene
 

@@ -119,11 +119,6 @@ class TerrainLOD:
         self.d2_local = d2.copy()
         K.propagate_d2(d2, n, self.k)
         self.d2 = d2
-        zlo = self.fields.min(axis=0)
-        zhi = self.fields.max(axis=0)
-        self.zmin = np.zeros((n, n))
-        self.zmax = np.zeros((n, n))
-        K.node_zrange(zlo, zhi, n, self.zmin, self.zmax)
         self._state = np.zeros((n, n), dtype=np.int8)
         self._weight = np.zeros((n, n))
         cap = ((n - 1) ** 2) // 2 + 8
@@ -156,7 +151,7 @@ class TerrainLOD:
         verts = np.empty((n_leaves * 9 + 8, 2), dtype=np.int64)
         tris = np.empty((n_leaves * 8 + 8, 3), dtype=np.int64)
         nv, nt = K.emit_fans(n, hf.spacing[0], hf.spacing[1], hf.origin[0], hf.origin[1], self._state, self._nodes,
-                             self._sizes, count, self.zmin, self.zmax, pl, self._vmap, self._stamp, self._vstamp,
+                             self._sizes, count, self._morphed, pl, self._vmap, self._stamp, self._vstamp,
                              verts, tris)
         verts = verts[:nv]
         vals = np.empty((nv, self.fields.shape[0]))
