@@ -143,3 +143,32 @@ def test_sky_shows_with_the_plotters_own_camera(demo) -> None:
         plotter.close()
     cpu = demo.render(cam, size).rgb
     assert float(np.abs(shot[:8] - cpu[:8]).mean()) * 255 < 6.0
+
+
+def test_fly_through_does_not_pop_with_geomorphing() -> None:
+    """Scene level (terrain + fog + clouds): along a dense camera path the total per-frame change of the C-LOD image
+    stays below that of the full-resolution reference (ratio <= 1: the LOD adds no jumps of its own), while the same
+    LOD without geomorphing adds popping (measured ratio 0.89 with morphing, 3.2 without)."""
+    from volviz.optics.metrics import rmse
+
+    size = (64, 48)
+    scene = demo_scene(terrain_size=65, cloud_shape=(33, 33, 9))
+    scene.big_c, scene.small_c = 4.0, 4.0  # coarse, so that many nodes refine along the path
+    scene.finalize()
+    scene.cloud_lod.big_c, scene.cloud_lod.small_c = 2.0, 4.0
+    p0 = np.array([500.0, -100.0, 300.0])
+    d = np.array([0.0, 1.0, -0.35]) / np.linalg.norm([0.0, 1.0, -0.35])
+    cams = [Camera(p0 + i * 0.05 * d, (500.0, 600.0, 80.0), (0.0, 0.0, 1.0), 60.0, clipping_range=(5.0, 10000.0))
+            for i in range(26)]
+
+    def variation(images: list[np.ndarray]) -> float:
+        rgba = [np.concatenate([im, np.ones(im.shape[:2] + (1,))], axis=-1) for im in images]
+        return sum(rmse(a, b) for a, b in zip(rgba[1:], rgba[:-1]))
+
+    reference = variation([scene.render(c, size, full=True).rgb for c in cams])
+    ratios = {}
+    for morph in (True, False):
+        scene.lod.geomorph = scene.cloud_lod.geomorph = morph
+        ratios[morph] = variation([scene.render(c, size).rgb for c in cams]) / reference
+    assert ratios[True] <= 1.0
+    assert ratios[False] > 1.3
