@@ -6,9 +6,13 @@ per octree node in a ``.vvz`` file (:mod:`.container`).
 
 Modes
 - ``lossless``: threshold 0, bit-exact for 8/16-bit integer input (and for the quantised integers of float input).
-- ``quality=Q`` (0..100): image-domain quantiser step ``delta = 2 ** ((90 - Q) / 10)`` voxel units (Q = 90 ->
-  delta = 1, about 58 dB on 8-bit data; each -10 halves the rate roughly); subband steps ``delta / sqrt(weight)``
-  with the 5/3 synthesis energy weights (``wavelet.subband_weights``), so the error spreads evenly over subbands.
+- ``quality=Q`` (0..100): image-domain quantiser step ``delta = 2 ** ((90 - Q) / 10)`` voxel units (each -10
+  halves the rate roughly); subband steps ``delta / sqrt(weight)`` with the 5/3 synthesis energy weights
+  (``wavelet.subband_weights``), so the error spreads evenly over subbands, rounded to integers (>= 1; 1 = that
+  subband is lossless). Integer steps on the integer coefficients give bins of equal integer counts; fractional
+  steps in (1, 2) cost rate for almost no error reduction. Measured on embryo with the arithmetic coder: 57.0 dB
+  at 0.99 bit/voxel with integer steps against 56.4 dB at 1.0 with fractional ones (Q = 90: about 63 dB;
+  Q >= 95: lossless). The quality knob therefore moves in discrete steps near lossless.
 - ``psnr=DB``: bisection over log(delta) until the PSNR (peak = the dtype's maximum, 255 for 8-bit, 65535 for
   16-bit and quantised float) is at least DB; the search measures the true reconstruction (quantise + inverse
   wavelet) of the whole volume, or of a central 256^3 crop for volumes above 2^25 voxels (then stated in ``info``).
@@ -57,7 +61,7 @@ def level_steps(delta: float, levels: int) -> np.ndarray:
     else 0."""
     steps = np.zeros((levels + 1, 8))
     if delta > 0:
-        steps[1:] = delta / np.sqrt(subband_weights(levels)[1:])
+        steps[1:] = np.maximum(np.rint(delta / np.sqrt(subband_weights(levels)[1:])), 1.0)
     steps[:, 0] = 0.0 if delta > 0 else 1.0
     return steps
 

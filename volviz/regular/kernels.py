@@ -8,7 +8,9 @@ node per 32^3 tile. Tiles are numbered x fastest: ``t = t0 + c0 * (t1 + c1 * t2)
 it as context. Quantisation (lossy modes): detail subband ``b`` uses step ``steps[b]``; a step <= 1 means no
 quantisation
 (lossless integers). Coefficient c -> q = sign(c) * floor(|c| / step + ROUND) (a dead-zone quantiser),
-reconstruction c' = sign(q) * round((|q| + BIAS) * step).
+reconstruction c' = sign(q) * round((|q| + BIAS) * step). ROUND = 0.40, BIAS = 0 measured best on embryo with
+integer steps (PSNR at 1 bit/voxel: 57.0 dB; 0.30/0: 56.9, 0.25/0.05: 56.3, the former 0.40/0.10 with fractional
+steps: 56.4).
 The kernels are plain ``nogil`` Numba functions over a strided subset of tiles (``first``, ``first + stride``, ...);
 :func:`run_tiles` runs them on a small thread pool. (A ``prange`` version compiled 3-4x slower for no speed gain.)
 """
@@ -25,7 +27,7 @@ from .entropy import CODER_RANS, decode_arith, decode_rans, encode_arith, encode
 from .wavelet import HALF, TILE, forward_tile, inverse_tile, inverse_tile_with
 
 ROUND = 0.40
-BIAS = 0.10
+BIAS = 0.0
 
 
 @njit(cache=True, nogil=True)
