@@ -203,3 +203,25 @@ def test_overlay_follows_display_time_and_clip_of_a_time_series():
     c.set_time(0.0)
     row, left = SIZE[1] // 2, SIZE[0] // 2 - 15
     assert np.abs(shot(p)[row, left] - np.asarray(BG)).max() < 3 / 255  # the clip holds at the new time
+
+
+def test_vtk_projected_tetrahedra_are_cut_on_the_cpu():
+    s = Session(components=[Component("demo", "demo", settings={"cells_per_edge": 6})])
+    s.render.method = "vtk"  # VTK's projected tetrahedra, which ignore mapper clipping planes
+    s.render.background = BG
+    p = plotter()
+    c = SceneController(p, s, {})
+    c.build()
+    mapper = c.props["demo"].GetMapper()
+    assert mapper.IsA("vtkProjectedTetrahedraMapper")
+    whole = mapper.GetInput()
+    lo, hi = np.array(whole.GetBounds()[0::2]), np.array(whole.GetBounds()[1::2])
+    mid = (lo + hi) / 2
+    full = shot(p)
+    c.set_clip({"planes": [{"point": list(mid), "normal": [1.0, 0.0, 0.0]}], "box": None})
+    cut = mapper.GetInput()
+    assert cut.GetBounds()[0] == pytest.approx(mid[0]) and cut.GetBounds()[1] == pytest.approx(hi[0])
+    assert cut.GetNumberOfCells() < whole.GetNumberOfCells()
+    assert np.abs(shot(p) - full).max() > 0.05
+    c.set_clip({"planes": [], "box": None})
+    assert mapper.GetInput() is whole and np.abs(shot(p) - full).max() < 2 / 255
