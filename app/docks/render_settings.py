@@ -8,10 +8,11 @@ from typing import Any, Optional
 from PySide6.QtCore import Signal
 from PySide6.QtWidgets import QComboBox, QDoubleSpinBox, QFormLayout, QSpinBox, QWidget
 
+from volviz.render.controller import ISO_MODES
+
 METHODS = ("auto", "pt", "reference", "vtk")
 TABLE_KINDS = ("auto", "3d", "separable-1", "separable-2", "separable-4")
 SORTS = ("mpvo", "centroid", "power")
-ISO_MODES = ("vtk", "2pass", "3pass", "4pass", "exact")  # volviz.render.controller.ISO_MODES
 
 
 class RenderSettings(QWidget):
