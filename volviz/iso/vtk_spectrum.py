@@ -9,6 +9,11 @@ view axis for parallel projection). Only the alpha is replaced, right after ``//
 none at all through pyvista's ``vtkDataSetMapper``, so use a plain ``vtkOpenGLPolyDataMapper``. The actor must have
 point normals; its property opacity is set to the normal-incidence opacity so VTK draws it in the
 translucent pass (VTK blends straight alpha, SRC_ALPHA / ONE_MINUS_SRC_ALPHA, so the colour follows α).
+
+The renderer must have at least one light: without lights VTK builds its unlit shader, which declares neither
+``normalVCVSOutput`` nor ``vertexVC``, and the replacement fails to compile (this was the "does not compile in the Qt
+viewport" failure: ``pyvista.Plotter.clear`` removes all lights; ``volviz.render.controller.ensure_lights`` restores
+them).
 """
 from __future__ import annotations
 
