@@ -447,16 +447,28 @@ class MainWindow(QMainWindow):
         overlay re-render in the background."""
         if self.controller is None:
             return
+        controller = self.controller
         try:
-            pt_ids = self.controller.set_clip(clip, update_pt=False)
+            pt_ids = controller.set_clip(clip, update_pt=False, cut_pt=False)
         except ValueError as exc:
             self.show_error("Invalid clipping", str(exc))
             return
         self.set_dirty()
         self.render()
-        for comp_id in pt_ids:
-            self.refresh_pt(comp_id)
         self.refresh_iso_overlay()
+        settings = controller.clip
+        for comp_id in pt_ids:  # the exact cut of a tetrahedral mesh runs in the background, then the re-render
+
+            def done(outcome: JobOutcome, comp_id: str = comp_id) -> None:
+                if outcome.ok and self.controller is controller and controller.clip == settings:
+                    controller.set_pt_mesh(comp_id, outcome.result)
+                    self.render()
+                    self.refresh_pt(comp_id)
+                elif outcome.error is not None:
+                    self.show_error("Cannot clip the volume", str(outcome.error))
+
+            self.jobs.submit(controller.cut_pt_mesh, comp_id, settings, name="clip volume", key=f"clip:{comp_id}",
+                             on_done=done)
 
     def _tf_committed(self, tf: Any) -> None:
         self._tf_changed(tf)

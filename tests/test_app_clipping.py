@@ -163,3 +163,20 @@ def test_transparency_mode_from_render_settings_and_spectrum_shader_on_screen(qt
     window.resize(1400, 900)
     qtbot.waitUntil(lambda: tuple(window.plotter.ren_win.GetSize()) == (w, h), timeout=10000)
     assert np.abs(viewport(window) - vtk_image).max() <= 3
+
+
+def test_pt_volume_is_cut_in_the_background_and_re_rendered(qtbot, make_window):
+    window = make_window()
+    window.open_demo_volume()
+    qtbot.waitUntil(lambda: not window.progress_bar.isVisible() and window.controller is not None, timeout=60000)
+    volume = window.controller.pt_volume("demo")
+    whole = volume.mesh
+    lo, hi = whole.points.min(axis=0), whole.points.max(axis=0)
+    qtbot.waitUntil(lambda: bool(volume.stats), timeout=30000)
+    alpha = volume.image[..., 3].sum()
+    window.clipping.set_box(lo, (lo + hi) / 2)
+    qtbot.waitUntil(lambda: volume.mesh is not whole and volume.image[..., 3].sum() < 0.8 * alpha, timeout=60000)
+    assert volume.mesh.points.max(axis=0) == pytest.approx((lo + hi) / 2)
+    window.action_undo.trigger()
+    qtbot.waitUntil(lambda: volume.image[..., 3].sum() == pytest.approx(alpha, rel=1e-6), timeout=60000)
+    assert volume.mesh.n_cells == whole.n_cells

@@ -161,7 +161,8 @@ class ClippingDock(QWidget):
     def set_box(self, lo: Optional[Sequence[float]], hi: Optional[Sequence[float]] = None) -> None:
         """Crop to the box [lo, hi] (None: no box)."""
         after = copy.deepcopy(self.clip)
-        after["box"] = None if lo is None else {"lo": [float(v) for v in lo], "hi": [float(v) for v in hi or lo]}
+        after["box"] = None if lo is None else {"lo": [float(v) for v in lo],
+                                                "hi": [float(v) for v in (lo if hi is None else hi)]}
         self._push(after, "box crop")
 
     # -- internals --------------------------------------------------------------------------------------------------

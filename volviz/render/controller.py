@@ -281,16 +281,16 @@ class SceneController:
 
         return clip_settings(self.session.clip)
 
-    def set_clip(self, clip: Any, update_pt: bool = True) -> list[str]:
+    def set_clip(self, clip: Any, update_pt: bool = True, cut_pt: bool = True) -> list[str]:
         """Store new clipping (``session.clip`` JSON or ClipSettings) and cut every prop; returns the ids of the PT
-        volumes that need a re-render (done here when ``update_pt``; the app renders them in the background)."""
+        volumes affected. Their meshes are cut here when ``cut_pt`` and re-rendered when ``update_pt``; the app
+        instead cuts them in the background (``cut_pt_mesh`` on a worker, then ``set_pt_mesh``) and re-renders."""
         from volviz.iso.clip import ClipSettings
 
         self.session.clip = clip.to_dict() if isinstance(clip, ClipSettings) else self.clip.from_dict(clip).to_dict()
-        return self.apply_clip(update_pt)
+        return self.apply_clip(update_pt, cut_pt)
 
-    def apply_clip(self, update_pt: bool = True) -> list[str]:
-        from volviz.iso.clip import clip_tetmesh
+    def apply_clip(self, update_pt: bool = True, cut_pt: bool = True) -> list[str]:
         from volviz.render.clipping import clip_vtk_prop
 
         clip = self.clip
@@ -302,20 +302,39 @@ class SceneController:
             if comp.type == "isosurface":
                 self._readd_isosurfaces(comp_id)
             elif _is_pt(prop):
-                whole = self._pt_meshes.setdefault(comp_id, prop.mesh)
-                try:
-                    prop.mesh = clip_tetmesh(whole, clip)
-                    prop.visible = comp.visible
-                except ValueError:  # everything clipped away
-                    prop.visible = False
+                self._pt_meshes.setdefault(comp_id, prop.mesh)
                 pt_ids.append(comp_id)
-                if update_pt and prop.visible:
-                    prop.update()
+                if cut_pt:
+                    self.set_pt_mesh(comp_id, self.cut_pt_mesh(comp_id))
+                    if update_pt and prop.visible:
+                        prop.update()
             elif hasattr(prop, "GetMapper"):
                 self._vtk_inputs[comp_id] = clip_vtk_prop(prop, clip, self._vtk_inputs.get(comp_id))
         self._sync_iso_overlay()
         self.plotter.render()
         return pt_ids
+
+    def cut_pt_mesh(self, comp_id: str, clip: Any = None, progress: Any = None) -> Any:
+        """Any thread: the PT volume's uncut mesh cut by ``clip`` (default: the session's), exactly
+        (``volviz.iso.clip.clip_tetmesh``); None when the clipping removes all of it."""
+        from volviz.iso.clip import clip_tetmesh
+
+        prop = self.props[comp_id]
+        whole = self._pt_meshes.get(comp_id, prop.mesh)
+        try:
+            return clip_tetmesh(whole, self.clip if clip is None else clip)
+        except ValueError:  # everything clipped away
+            return None
+
+    def set_pt_mesh(self, comp_id: str, mesh: Any) -> None:
+        """Show a cut mesh of ``cut_pt_mesh`` (None: nothing left, the volume is hidden); re-render it afterwards."""
+        prop = self.props[comp_id]
+        self._pt_meshes.setdefault(comp_id, prop.mesh)
+        if mesh is None:
+            prop.visible = False
+            return
+        prop.mesh = mesh
+        prop.visible = self.component(comp_id).visible
 
     def _readd_isosurfaces(self, comp_id: str) -> None:
         """New actors for an isosurface component's already extracted surfaces (after a clip or opacity change)."""
