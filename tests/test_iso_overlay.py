@@ -5,7 +5,8 @@ import numpy as np
 import pytest
 import pyvista as pv
 
-from volviz.iso.composite import render
+from volviz.iso.composite import fragments, render
+from volviz.render.iso_overlay import cut_at_depth
 from volviz.model.datasets import RegularVolume
 from volviz.model.demo import demo_tet_mesh
 from volviz.render.controller import SceneController
@@ -225,3 +226,19 @@ def test_vtk_projected_tetrahedra_are_cut_on_the_cpu():
     assert np.abs(shot(p) - full).max() > 0.05
     c.set_clip({"planes": [], "box": None})
     assert mapper.GetInput() is whole and np.abs(shot(p) - full).max() < 2 / 255
+
+
+def test_opaque_isosurfaces_stay_vtk_geometry_and_hide_what_is_behind_them_in_cpu_modes():
+    styles = [{"value": 0.3, "color": [1.0, 1.0, 1.0], "opacity": 1.0}, STYLES[1]]
+    c, p = scene([Component("iso", "isosurface", "b", settings={"styles": styles})])
+    c.set_iso_mode("exact")
+    assert [m.style.opacity for m in c.iso_overlay.meshes] == [0.4]    # only the translucent surface
+    depth = c.iso_overlay.depth
+    row, col = SIZE[1] // 2, SIZE[0] // 2
+    assert np.isfinite(depth[row, col])                                 # the opaque sphere is in the depth buffer
+    # the translucent outer sphere's back half (behind the opaque sphere) is cut: only its front fragment remains
+    frags = fragments(c.iso_overlay.meshes, c.iso_overlay.camera, SIZE, "spectrum")
+    assert np.diff(frags.ptr).reshape(SIZE[1], SIZE[0])[row, col] == 2
+    assert np.diff(cut_at_depth(frags, depth).ptr).reshape(SIZE[1], SIZE[0])[row, col] == 1
+    img = shot(p)
+    assert img[row, col].min() > 0.3                                    # white sphere seen through the blue shell

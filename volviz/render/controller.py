@@ -381,15 +381,22 @@ class SceneController:
                 if comp_id != "nature" and self.component(comp_id).type == "isosurface"}
 
     def _sync_iso_overlay(self) -> None:
-        """VTK's isosurface actors show only in "vtk" mode; the overlay gets the visible components' cut surfaces."""
+        """In a CPU mode the overlay draws the visible components' translucent surfaces; opaque surfaces stay VTK
+        actors, so they are the modes' opaque pass in the depth buffer (for PT volumes too). In "vtk" mode VTK draws
+        everything."""
         overlay = self.iso_overlay
         meshes, lod, shading = [], [], "spectrum"
         for comp_id, prop in self._iso_props().items():
             visible = self.component(comp_id).visible
-            prop.SetVisibility(visible and overlay is None)
+            prop.SetVisibility(visible)
+            for actor in prop.volviz_translucent:
+                actor.SetVisibility(overlay is None)
             if visible:
-                meshes.extend(prop.volviz_shown)
-                lod.extend(prop.volviz_lod or [None] * len(prop.volviz_shown))
+                levels = prop.volviz_lod or [None] * len(prop.volviz_shown)
+                for mesh, level in zip(prop.volviz_shown, levels):
+                    if mesh.style.opacity < 1.0:
+                        meshes.append(mesh)
+                        lod.append(level)
                 shading = prop.volviz_shading
         if overlay is not None:
             overlay.meshes, overlay.lod, overlay.shading = meshes, lod, shading

@@ -2,10 +2,12 @@
 exact per-pixel sorted reference, ``volviz.iso.composite``) shown in a PyVista plotter, composited with the opaque
 scene through the depth buffer exactly as volviz's PT volumes are (``volviz.render.pt_prop``):
 
-1. the plotter's scene is rendered with every volviz overlay off (the isosurface actors are hidden by the caller
-   while a CPU mode is on), and VTK's z-buffer is read back as eye-space depth;
-2. all surfaces of all isosurface components are rasterised ONCE into per-pixel fragment lists; fragments at or
-   behind the opaque depth of their pixel are dropped (the opaque scene is the mode's "opaque background" pass);
+1. the plotter's scene is rendered with every volviz overlay off (the translucent isosurface actors are hidden by
+   the caller while a CPU mode is on; opaque isosurfaces stay VTK actors), and VTK's z-buffer is read back as
+   eye-space depth;
+2. the translucent surfaces of all isosurface components are rasterised ONCE into per-pixel fragment lists;
+   fragments at or behind the opaque depth of their pixel are dropped (the opaque scene, opaque isosurfaces
+   included, is the mode's "opaque background" pass);
 3. the mode composites the remaining fragments over a transparent background; the premultiplied image is drawn as
    a full-window overlay with (SRC_ALPHA, ONE_MINUS_SRC_ALPHA), i.e. C = C_iso + (1 − α_iso)·C_scene. For 3/4-pass
    α_iso = 1 − Π(1 − α_i), so this equals the mode's Π(1 − α_i)·B + Σ e_i with B the scene colour; where the sum

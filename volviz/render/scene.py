@@ -253,11 +253,16 @@ def add_isosurfaces(plotter: Any, comp: Component, dataset: Any, t: Optional[flo
 
         shown = [replace(m, style=replace(m.style, opacity=m.style.opacity * comp.opacity)) for m in shown]
     assembly = vtk.vtkPropAssembly()
+    translucent = []  # the actors of translucent surfaces (hidden while a CPU mode draws those surfaces)
     for mesh in shown:
         if len(mesh.triangles):
-            assembly.AddPart(iso_actor(mesh, parallel=bool(plotter.camera.parallel_projection),
-                                       spectrum=spectrum and settings.shading == "spectrum"))
+            actor = iso_actor(mesh, parallel=bool(plotter.camera.parallel_projection),
+                              spectrum=spectrum and settings.shading == "spectrum")
+            assembly.AddPart(actor)
+            if mesh.style.opacity < 1.0:
+                translucent.append(actor)
     assembly.volviz_meshes, assembly.volviz_shown, assembly.volviz_shading = meshes, shown, settings.shading
+    assembly.volviz_translucent = translucent
     assembly.volviz_lod = None  # LOD chains of the shown surfaces (the CPU modes draw them view-dependently)
     if settings.lod:
         from volviz.iso.lod import build_lod
