@@ -57,6 +57,14 @@ def _requant(w, n0, n1, n2, steps, inverse):
         i0, i1 = (l0, n0) if b & 1 else (0, l0)
         j0, j1 = (l1, n1) if b & 2 else (0, l1)
         k0, k1 = (l2, n2) if b & 4 else (0, l2)
+        ist = np.int32(st)
+        if inverse and BIAS == 0.0 and ist == st:  # integer step: reconstruction is c * step (vectorised)
+            for i in range(i0, i1):
+                for j in range(j0, j1):
+                    row = w[i, j, k0:k1]
+                    for k in range(k1 - k0):
+                        row[k] *= ist
+            continue
         for i in range(i0, i1):
             for j in range(j0, j1):
                 for k in range(k0, k1):
