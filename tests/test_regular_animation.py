@@ -138,3 +138,27 @@ def test_damaged_store_and_bad_input_name_the_problem(tmp_path):
         A.decompress_series(store)
     with pytest.raises(ValueError, match="8-bit"):
         A.compress_series([v.astype(np.uint16) for v in vols], tmp_path / "e.vvs")
+
+
+def _store_bytes(path):
+    return {p.name: p.read_bytes() for p in sorted(path.iterdir())}
+
+
+def test_dask_cluster_encoding_is_bit_identical(tmp_path):
+    from distributed import LocalCluster
+
+    from volviz.regular.cli import compress_main
+
+    vols = _moving_series(20, shape=(20, 16, 18))  # IBBPBBPPB: I at 0, 9, 18 -> three parts
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None) as cluster:
+        for kw in ({}, {"mode": "quality", "quality": 70}):
+            A.compress_series(vols, tmp_path / "seq.vvs", **kw)
+            A.compress_series(vols, tmp_path / "dask.vvs", scheduler=cluster.scheduler_address, **kw)
+            seq, dist = _store_bytes(tmp_path / "seq.vvs"), _store_bytes(tmp_path / "dask.vvs")
+            assert len(seq) > 20 and seq == dist
+        # the CLI on the Storm series
+        pattern = str(data_file("storm/Storm.pvm-t01")).replace("t01", "t%02d")
+        args = [pattern, "--series", "--pattern", "IBBPBBPPB", "--quality", "80", "--quiet"]
+        assert compress_main(args + ["-o", str(tmp_path / "s1.vvs")]) == 0
+        assert compress_main(args + ["-o", str(tmp_path / "s2.vvs"), "--scheduler", cluster.scheduler_address]) == 0
+    assert _store_bytes(tmp_path / "s1.vvs") == _store_bytes(tmp_path / "s2.vvs")

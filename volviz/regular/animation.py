@@ -36,6 +36,7 @@ import json
 import math
 import os
 import shutil
+import tempfile
 import zlib
 from dataclasses import dataclass
 from pathlib import Path
@@ -265,12 +266,90 @@ def _predict(f: FrameInfo, mvs: list[np.ndarray], refs: dict[int, np.ndarray]) -
     return np.floor(sum(preds) / len(preds) + 0.5).astype(np.int32)
 
 
+def _segments(frames: list[FrameInfo]) -> list[list[int]]:
+    """Display indices grouped from each I volume to the next: the units of distributed encoding."""
+    parts: list[list[int]] = []
+    for f in frames:
+        if f.kind == "I" or not parts:
+            parts.append([])
+        parts[-1].append(f.display)
+    return parts
+
+
+def _encode_part(get: Callable[[int], np.ndarray] | dict[int, np.ndarray], frames: list[FrameInfo],
+                 order: list[int], targets: Sequence[int], kw: dict[str, Any], b_res: bool,
+                 search: str) -> list[tuple[int, dict[str, Any], dict[str, bytes]]]:
+    """Encode the display volumes ``targets``: walk the storage order from the first of them to the last, coding
+    every anchor on the way (an anchor outside ``targets`` -- the next I volume that trailing B volumes reference --
+    is coded only for its reconstruction) and skipping B volumes outside ``targets``. Returns (storage index,
+    record, {file name: bytes}) per target. Deterministic, so any split of the series gives the same bytes as one
+    sequential pass."""
+    fetch = get.__getitem__ if isinstance(get, dict) else get
+    pos = {d: i for i, d in enumerate(order)}
+    tset = set(targets)
+    first, last = min(pos[d] for d in tset), max(pos[d] for d in tset)
+    todo = [i for i in range(first, last + 1) if order[i] in tset or frames[order[i]].kind != "B"]
+    last_use: dict[int, int] = {}
+    for i in todo:
+        for r in frames[order[i]].refs:
+            last_use[r] = i
+    decoded: dict[int, np.ndarray] = {}
+    out = []
+    with tempfile.TemporaryDirectory(prefix="vvs-part") as td:
+        tmp = Path(td)
+        for i in todo:
+            d = order[i]
+            f = frames[d]
+            cur = fetch(d)
+            dtype = cur.dtype
+            lo, hi = int(np.iinfo(dtype).min), int(np.iinfo(dtype).max)
+            rec: dict[str, Any] = {"display": d, "type": f.kind, "refs": list(f.refs), "mv": [], "file": None}
+            files: dict[str, bytes] = {}
+            if f.kind == "I":
+                pred = None
+                residual = cur.astype(np.int32)
+            else:
+                mvs = [estimate_motion(cur, decoded[r], search) for r in f.refs]
+                for j, mv in enumerate(mvs):
+                    blob = zlib.compress(mv.tobytes(), 9)
+                    name = f"m{i:04d}_{j}.bin"
+                    files[name] = blob
+                    rec["mv"].append({"file": name, "crc": zlib.crc32(blob)})
+                pred = _predict(f, mvs, decoded)
+                residual = cur.astype(np.int32) - pred
+            if f.kind != "B" or b_res:
+                name = f"v{i:04d}.vvz"
+                vol = residual.astype(dtype) if pred is None else residual.astype(np.int16)
+                compress(RegularVolume(vol), tmp / name, **kw)
+                rec["file"] = name
+                files[name] = (tmp / name).read_bytes()
+                back = decompress(tmp / name).data.astype(np.int32)
+                (tmp / name).unlink()
+                rec_vol = back if pred is None else pred + back
+            else:
+                rec_vol = pred  # type: ignore[assignment]
+            if f.kind != "B":
+                decoded[d] = np.clip(rec_vol, lo, hi).astype(dtype)
+            for r in list(decoded):
+                if last_use.get(r, -1) <= i and r != d:
+                    del decoded[r]
+            if d in tset:
+                out.append((i, rec, files))
+    return out
+
+
 def compress_series(series: TimeSeries | Sequence[np.ndarray | RegularVolume], path: str | Path,
                     pattern: str = "IBBPBBPPB", mode: str = "lossless", quality: float | None = None,
                     search: str = "local", b_residual: bool | None = None,
-                    progress: Callable[[float, str], None] | None = None) -> dict[str, Any]:
+                    progress: Callable[[float, str], None] | None = None,
+                    scheduler: str | None = None) -> dict[str, Any]:
     """Encode a series of 8-bit volumes into the store directory ``path`` (replaced if it exists); returns
-    :func:`series_info`. ``b_residual`` defaults to True for lossless and False (MC only) otherwise."""
+    :func:`series_info`. ``b_residual`` defaults to True for lossless and False (MC only) otherwise.
+
+    ``scheduler``: address of a dask.distributed scheduler (``tcp://host:8786``, or a LocalCluster's address).
+    The series is then split at its I volumes into independent parts (each part also codes the next I volume for
+    the reconstruction its trailing B volumes need), one task per part; the client reads the volumes, sends each
+    task its volumes, and writes the returned files. The store is bit-identical to the sequential one."""
     if mode not in ("lossless", "quality"):
         raise ValueError(f"unknown mode {mode!r} (lossless, quality)")
     if mode == "quality" and quality is None:
@@ -283,57 +362,49 @@ def compress_series(series: TimeSeries | Sequence[np.ndarray | RegularVolume], p
     if first.ndim != 3 or first.dtype not in (np.uint8, np.int8):
         raise ValueError(f"series volumes must be 3D 8-bit arrays, got {first.dtype} {first.shape}")
     dtype, dims = first.dtype, first.shape
-    lo, hi = int(np.iinfo(dtype).min), int(np.iinfo(dtype).max)
+
+    def checked(d: int) -> np.ndarray:
+        cur = get(d)
+        if cur.shape != dims or cur.dtype != dtype:
+            raise ValueError(f"volume {d} has {cur.dtype} {cur.shape}, the series {dtype} {dims}")
+        return cur
+
     b_res = (mode == "lossless") if b_residual is None else bool(b_residual)
     path = Path(path)
     tmp = path.with_name(path.name + ".tmp")
     shutil.rmtree(tmp, ignore_errors=True)
     tmp.mkdir(parents=True)
     kw: dict[str, Any] = {"mode": mode} if mode == "lossless" else {"quality": quality}
-    decoded: dict[int, np.ndarray] = {}
-    records: list[dict[str, Any]] = []
-    last_use = {}
-    for i, d in enumerate(order):
-        for r in frames[d].refs:
-            last_use[r] = i
-    for i, d in enumerate(order):
-        f = frames[d]
-        cur = get(d)
-        if cur.shape != dims or cur.dtype != dtype:
-            raise ValueError(f"volume {d} has {cur.dtype} {cur.shape}, the series {dtype} {dims}")
-        rec: dict[str, Any] = {"display": d, "type": f.kind, "refs": list(f.refs), "mv": [], "file": None}
-        if f.kind == "I":
-            pred = None
-            residual = cur.astype(np.int32)
-        else:
-            mvs = [estimate_motion(cur, decoded[r], search) for r in f.refs]
-            for j, mv in enumerate(mvs):
-                blob = zlib.compress(mv.tobytes(), 9)
-                name = f"m{i:04d}_{j}.bin"
+    records: dict[int, dict[str, Any]] = {}
+
+    def store(results: list[tuple[int, dict[str, Any], dict[str, bytes]]]) -> None:
+        for i, rec, files in results:
+            for name, blob in files.items():
                 (tmp / name).write_bytes(blob)
-                rec["mv"].append({"file": name, "crc": zlib.crc32(blob)})
-            pred = _predict(f, mvs, decoded)
-            residual = cur.astype(np.int32) - pred
-        if f.kind != "B" or b_res:
-            name = f"v{i:04d}.vvz"
-            vol = residual.astype(dtype) if pred is None else residual.astype(np.int16)
-            compress(RegularVolume(vol), tmp / name, **kw)
-            rec["file"] = name
-            back = decompress(tmp / name).data.astype(np.int32)
-            rec_vol = back if pred is None else pred + back
-        else:
-            rec_vol = pred  # type: ignore[assignment]
-        if f.kind != "B":
-            decoded[d] = np.clip(rec_vol, lo, hi).astype(dtype)
-        for r in list(decoded):
-            if last_use.get(r, -1) <= i and r != d:
-                del decoded[r]
-        records.append(rec)
-        if progress:
-            progress((i + 1) / n, f"volume {d} ({f.kind})")
+            records[i] = rec
+            if progress:
+                progress(len(records) / n, f"volume {rec['display']} ({rec['type']})")
+
+    if scheduler is None:
+        store(_encode_part(checked, frames, order, list(range(n)), kw, b_res, search))
+    else:
+        from distributed import Client, as_completed
+
+        pos = {d: i for i, d in enumerate(order)}
+        with Client(scheduler) as client:
+            futures = []
+            for part in _segments(frames):
+                lo_i, hi_i = min(pos[d] for d in part), max(pos[d] for d in part)
+                need = {order[i] for i in range(lo_i, hi_i + 1) if order[i] in part or frames[order[i]].kind != "B"}
+                vols = {d: checked(d) for d in sorted(need)}
+                futures.append(client.submit(_encode_part, vols, frames, order, part, kw, b_res, search, pure=False))
+            for fut in as_completed(futures):
+                store(fut.result())
+    if sorted(records) != list(range(n)):
+        raise RuntimeError(f"series encoding produced storage records {sorted(records)}, expected 0..{n - 1}")
     meta = {"format": FORMAT, "version": VERSION, "dims": list(dims), "dtype": np.dtype(dtype).name, "n": n,
             "pattern": pattern.upper(), "mode": mode, "quality": quality, "b_residual": b_res, "search": search,
-            "storage": records}
+            "storage": [records[i] for i in range(n)]}
     (tmp / "series.json").write_text(json.dumps(meta, indent=1))
     if path.exists():
         shutil.rmtree(path)

@@ -1,7 +1,9 @@
 """``volviz compress``: the command-line front end of the wavelet codec (Guthe §2.2, §2.3).
 
-``volviz compress IN -o OUT --series [--pattern IBBPBBPPB] [--quality Q | --lossless]`` reads IN as a time series
-(e.g. ``Storm.pvm-t%02d``) and writes a motion-compensated I/P/B store directory (:mod:`.animation`).
+``volviz compress IN -o OUT --series [--pattern IBBPBBPPB] [--quality Q | --lossless] [--scheduler ADDRESS]`` reads
+IN as a time series (e.g. ``Storm.pvm-t%02d``) and writes a motion-compensated I/P/B store directory
+(:mod:`.animation`); with ``--scheduler`` the parts between I volumes are encoded on a dask.distributed cluster,
+bit-identical to a local run.
 
 ``volviz compress IN -o OUT [--quality Q | --psnr DB | --lossless] [--coder rans|arith]`` reads IN with
 ``volviz.io.read`` (any supported volume), or -- for volumes larger than memory -- a headerless raw file given with
@@ -73,11 +75,16 @@ def compress_main(argv: Sequence[str] | None = None) -> int:
     p.add_argument("--series", action="store_true",
                    help="INPUT is a time series of 8-bit volumes (e.g. Storm.pvm-t%%02d); OUTPUT a .vvs store directory")
     p.add_argument("--pattern", default="IBBPBBPPB", help="GOP pattern of --series (I, IPP, IBB, IBBPBBPPB, ...)")
+    p.add_argument("--scheduler", metavar="ADDRESS",
+                   help="--series only: encode on this dask.distributed scheduler (e.g. tcp://host:8786), one task "
+                   "per I-to-I part; the output is bit-identical to a local run")
     p.add_argument("--quiet", action="store_true")
     p.add_argument("--json", help="write the resulting info as JSON to this file")
     args = p.parse_args(list(argv) if argv is not None else None)
     if args.series:
         return _series_main(args)
+    if args.scheduler:
+        raise SystemExit("--scheduler applies to --series (a single volume is compressed out of core locally)")
     vol = _load(args)
     result = compress(vol, args.output, quality=args.quality, psnr=args.psnr, coder=args.coder,
                       progress=None if args.quiet else _progress_bar())
@@ -101,7 +108,7 @@ def _series_main(args: argparse.Namespace) -> int:
         raise SystemExit(f"{args.input}: not a time series (use a numbered pattern such as Storm.pvm-t%02d)")
     result = compress_series(series, args.output, pattern=args.pattern,
                              mode="lossless" if args.quality is None else "quality", quality=args.quality,
-                             progress=None if args.quiet else _progress_bar())
+                             progress=None if args.quiet else _progress_bar(), scheduler=args.scheduler)
     print(f"{result['n']} volumes {tuple(result['dims'])}  pattern {result['pattern']}  {result['mode']}  "
           f"{result['bytes']} bytes  ratio {result['ratio']:.2f}:1  {result['bits_per_voxel']:.3f} bits/voxel")
     if args.json:
