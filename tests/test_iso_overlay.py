@@ -242,3 +242,16 @@ def test_opaque_isosurfaces_stay_vtk_geometry_and_hide_what_is_behind_them_in_cp
     assert np.diff(cut_at_depth(frags, depth).ptr).reshape(SIZE[1], SIZE[0])[row, col] == 1
     img = shot(p)
     assert img[row, col].min() > 0.3                                    # white sphere seen through the blue shell
+
+
+def test_a_session_without_camera_stays_framed_through_clip_and_cpu_mode():
+    # regression: add_isosurfaces read ``plotter.camera``, which re-frames PyVista's "unset" camera to its default
+    s = Session(datasets=[DatasetRef("b", "/unused")], components=[iso_component()],
+                clip={"planes": [{"point": [11.5, 0.0, 0.0], "normal": [1.0, 0.0, 0.0]}], "box": None})
+    s.render.options["iso_mode"] = "3pass"
+    p = plotter()
+    SceneController(p, s, {"b": ball()}).build()
+    framed = p.renderer.GetActiveCamera().GetPosition()
+    assert np.linalg.norm(np.subtract(framed, (1.0, 1.0, 1.0))) > 10.0
+    shot(p)  # PyVista's first-render request must not re-frame (the translucent actors are hidden)
+    assert p.renderer.GetActiveCamera().GetPosition() == pytest.approx(framed)

@@ -50,6 +50,7 @@ class SceneController:
 
         ensure_lights(self.plotter)
         self.props = build_scene(self.plotter, self.session, self.datasets, spectrum=True)
+        self.plotter.camera_set = True  # build_scene chose the view; PyVista must not re-frame the visible props
         self._pt_meshes, self._vtk_inputs = {}, {}
         span = self.time_span()
         self.time = span[0] if span else 0.0

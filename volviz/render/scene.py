@@ -256,7 +256,8 @@ def add_isosurfaces(plotter: Any, comp: Component, dataset: Any, t: Optional[flo
     translucent = []  # the actors of translucent surfaces (hidden while a CPU mode draws those surfaces)
     for mesh in shown:
         if len(mesh.triangles):
-            actor = iso_actor(mesh, parallel=bool(plotter.camera.parallel_projection),
+            # (the VTK camera: pyvista's ``plotter.camera`` re-frames a camera it does not consider set)
+            actor = iso_actor(mesh, parallel=bool(plotter.renderer.GetActiveCamera().GetParallelProjection()),
                               spectrum=spectrum and settings.shading == "spectrum")
             assembly.AddPart(actor)
             if mesh.style.opacity < 1.0:
