@@ -23,6 +23,21 @@ def _wait(app, window, seconds: float = 120.0) -> None:
         time.sleep(0.02)
 
 
+def _iso_session(data_path: Path) -> Path:
+    """A session showing three semi-transparent isosurfaces of ``data_path`` (in a temporary folder)."""
+    import json
+    import tempfile
+
+    styles = [{"value": 0.6, "color": [0.2, 0.45, 1.0], "opacity": 0.3},
+              {"value": 1.4, "color": [0.3, 0.9, 0.4], "opacity": 0.35},
+              {"value": 2.8, "color": [1.0, 0.3, 0.15], "opacity": 0.6}]
+    doc = {"format": "volviz-session", "version": 1, "datasets": [{"id": "d", "path": str(data_path)}],
+           "components": [{"id": "isosurfaces", "type": "isosurface", "dataset": "d", "settings": {"styles": styles}}]}
+    path = Path(tempfile.mkdtemp()) / "isosurfaces.json"
+    path.write_text(json.dumps(doc))
+    return path
+
+
 def main(argv: list[str] | None = None) -> int:
     args = sys.argv[1:] if argv is None else argv
     out = Path(args[0] if args else "docs/screenshots")
@@ -62,6 +77,18 @@ def main(argv: list[str] | None = None) -> int:
     window.timeline.set_time(14.5)
     window.timeline_dock.raise_()
     shot("timeline-storm-series")
+    window.open_path(_iso_session(data / "bluntfin" / "bluntfinxyz.bin"))
+    _wait(app, window)
+    window.clipping.add_plane()
+    window.clipping.set_plane(0, (0.0, 0.0, -1.0), -3.0)  # keep z <= 3
+    window.render_settings.iso_mode.setCurrentText("4pass")
+    _wait(app, window)
+    window.clip_dock.raise_()
+    window.clipping.show_widget.setChecked(True)
+    for _ in range(100):  # the background overlay render
+        app.processEvents()
+        time.sleep(0.02)
+    shot("clipping-isosurfaces-4pass")
     window.dirty = False
     window.close()
     return 0

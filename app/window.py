@@ -18,7 +18,7 @@ from volviz.jobs import JobOutcome
 from volviz.session import CameraKey, Session, SessionError, relative_path
 from volviz_app.clip_widget import ClipPlaneWidget
 from volviz_app.docks.clipping import ClippingDock
-from volviz_app.docks.render_settings import RenderSettings
+from volviz_app.docks.render_settings import RENDERER_DEFAULTS, RenderSettings
 from volviz_app.gc_guard import GuiThreadCollector
 from volviz_app.docks.scene_tree import SceneTree
 from volviz_app.docks.statistics import Statistics
@@ -517,9 +517,9 @@ class MainWindow(QMainWindow):
         return True
 
     def _settings_changed(self, values: dict[str, Any]) -> None:
-        renderer_keys = ("sort", "table", "table_resolution")
+        current = {**RENDERER_DEFAULTS, **self.session.render.options}  # a missing option is its default
         rebuild = (values["method"] != self.session.render.method
-                   or any(values["options"].get(k) != self.session.render.options.get(k) for k in renderer_keys))
+                   or any(values["options"].get(k) != current[k] for k in RENDERER_DEFAULTS))
         budget_changed = values["options"].get("error_budget") != self.session.render.options.get("error_budget")
         iso_mode = values["options"].get("iso_mode", "vtk")
         iso_changed = iso_mode != self.session.render.options.get("iso_mode", "vtk")

@@ -143,7 +143,9 @@ def test_transparency_mode_from_render_settings_and_spectrum_shader_on_screen(qt
 
     assert window.apply_component_settings("iso", json.dumps({"styles": STYLES}))
     window.plotter.ren_win.SetMultiSamples(0)
+    controller = window.controller
     window.render_settings.iso_mode.setCurrentText("3pass")
+    assert window.controller is controller                # a mode switch does not rebuild the scene
     overlay = window.controller.iso_overlay
     assert overlay is not None and window.session.render.options["iso_mode"] == "3pass"
     qtbot.waitUntil(lambda: overlay.stats.get("method") == "iso 3pass" and overlay.stats.get("size") == (w, h),

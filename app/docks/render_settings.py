@@ -13,6 +13,7 @@ from volviz.render.controller import ISO_MODES
 METHODS = ("auto", "pt", "reference", "vtk")
 TABLE_KINDS = ("auto", "3d", "separable-1", "separable-2", "separable-4")
 SORTS = ("mpvo", "centroid", "power")
+RENDERER_DEFAULTS = {"sort": "mpvo", "table": "auto", "table_resolution": 128}  # what the widgets start with
 
 
 class RenderSettings(QWidget):
