@@ -113,3 +113,39 @@ def test_selection_follows_budget_and_camera(tree: LodTree) -> None:
         assert _shot(pl).max() == 0       # fully transparent TF: nothing drawn
     finally:
         pl.close()
+
+
+def test_session_with_a_lod_dataset_follows_camera_and_transfer_function(tree: LodTree) -> None:
+    from volviz.render.controller import SceneController
+    from volviz.render.export import offscreen_plotter
+    from volviz.render.scene import LOD_VOXELS, data_session, load_datasets, vvz_voxels
+    from volviz.session import CameraState, Component, DatasetRef, RenderSettings, Session
+
+    vvz = Path(tree.decoder.path)
+    assert vvz_voxels(vvz) == 72 ** 3 < LOD_VOXELS
+    assert "lod" not in data_session(vvz).datasets[0].options          # small files are decoded whole
+    session = Session(datasets=[DatasetRef(id="blob", path=str(vvz), options={"lod": True})],
+                      components=[Component(id="blob", type="volume", dataset="blob", settings={"budget": 8})],
+                      render=RenderSettings(size=SIZE, background=(0.0, 0.0, 0.0)))
+    datasets = load_datasets(session, None)
+    assert isinstance(datasets["blob"], LodTree)
+    plotter = offscreen_plotter(SIZE)
+    try:
+        controller = SceneController(plotter, session, datasets)
+        controller.build()
+        lod = controller.props["blob"]
+        assert isinstance(lod, LodVolume) and 1 <= lod.stats["blocks"] <= 8
+        far = _shot(plotter)
+        assert far.std() > 3.0                                              # default TF fitted to the data
+        controller.set_camera(CameraState(position=(36.0, -60.0, 36.0), focal_point=(36.0, 36.0, 36.0)))
+        near_sel = list(lod.selection.nodes)
+        assert _shot(plotter).std() > 3.0
+        controller.set_camera(CameraState(position=(400.0, -300.0, 250.0), focal_point=(36.0, 36.0, 36.0)))
+        assert list(lod.selection.nodes) != near_sel                        # a new view, a new selection
+        tf = controller.transfer_function("blob")
+        controller.set_transfer_function("blob", tf.scaled_extinction(0.0))
+        assert _shot(plotter).max() == 0                                    # the TF reaches the blocks
+        controller.set_visible("blob", False)
+        assert not lod.volume.GetVisibility()
+    finally:
+        plotter.close()

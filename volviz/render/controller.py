@@ -17,6 +17,12 @@ from volviz.session import CameraState, Component, Session
 ISO_MODES = ("vtk", "2pass", "3pass", "4pass", "exact")
 
 
+def _is_lod(prop: Any) -> bool:
+    from volviz.render.lod_volume import LodVolume
+
+    return isinstance(prop, LodVolume)
+
+
 def _is_pt(prop: Any) -> bool:
     from volviz.render.iso_overlay import IsoOverlay
     from volviz.render.pt_prop import PTVolume
@@ -103,6 +109,10 @@ class SceneController:
             prop.tf = tf.scaled_extinction(comp.opacity) if comp.opacity != 1.0 else tf
             if update:
                 prop.update()
+        elif _is_lod(prop):
+            prop.set_transfer_function(tf)
+            if update:
+                prop.update()             # the selection depends on the TF (transparent blocks, Eq. 2.7)
         elif prop is not None and prop.IsA("vtkVolume"):
             update_volume_property(prop.GetProperty(), tf, comp.opacity)
 
@@ -131,6 +141,8 @@ class SceneController:
                                               tf=self.transfer_function(comp_id), opacity=comp.opacity, name=comp_id)
         elif _is_pt(prop):
             prop.visible = bool(visible)
+        elif _is_lod(prop):
+            prop.volume.SetVisibility(bool(visible))
         elif prop is not None:
             prop.SetVisibility(bool(visible))
 
@@ -146,6 +158,9 @@ class SceneController:
             tf = self.transfer_function(comp_id)
             prop.tf = tf.scaled_extinction(comp.opacity) if comp.opacity != 1.0 else tf
             prop.update()
+        elif _is_lod(prop):
+            prop.opacity = comp.opacity
+            prop.set_transfer_function(self.transfer_function(comp_id))
         elif prop.IsA("vtkVolume"):
             from volviz.render.vtk_scene import update_volume_property
 
@@ -230,6 +245,8 @@ class SceneController:
             if pt and _is_pt(prop) and prop.visible:
                 prop.update()
                 stats[comp_id] = dict(prop.stats)
+            elif _is_lod(prop) and prop.volume.GetVisibility():
+                stats[comp_id] = dict(prop.update())
         if pt and self.iso_overlay is not None:
             self.iso_overlay.update()
             stats["iso"] = dict(self.iso_overlay.stats)
@@ -309,6 +326,8 @@ class SceneController:
                     self.set_pt_mesh(comp_id, self.cut_pt_mesh(comp_id))
                     if update_pt and prop.visible:
                         prop.update()
+            elif _is_lod(prop):
+                clip_vtk_prop(prop.volume, clip)       # mapper clipping planes, blocks untouched
             elif hasattr(prop, "GetMapper"):
                 self._vtk_inputs[comp_id] = clip_vtk_prop(prop, clip, self._vtk_inputs.get(comp_id))
         self._sync_iso_overlay()

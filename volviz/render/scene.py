@@ -47,7 +47,20 @@ def data_session(path: str | os.PathLike) -> Session:
     """A one-dataset session that shows ``path`` with its default visual (what opening a data file does); a file of a
     numbered series opens the whole series."""
     ref = DatasetRef(id="data", path=series_pattern(path) or str(Path(path).resolve()))
+    if Path(path).suffix.lower() == ".vvz" and vvz_voxels(path) > LOD_VOXELS:
+        ref.options["lod"] = True          # too large to decode whole: blocks per view (volviz.render.lod_volume)
     return Session(datasets=[ref], components=[Component(id="data", type="volume", dataset="data")])
+
+
+#: compressed volumes with more voxels than this open at a view-dependent level of detail instead of being decoded
+LOD_VOXELS = 256 ** 3
+
+
+def vvz_voxels(path: str | os.PathLike) -> int:
+    """Number of voxels of a ``.vvz`` file, from its header (nothing is decoded)."""
+    from volviz.regular.nodes import NodeDecoder
+
+    return int(np.prod(NodeDecoder(path).dims))
 
 
 def demo_session() -> Session:
@@ -126,9 +139,15 @@ NATURE_TYPES = ("terrain", "fog", "clouds", "sky")
 
 
 def read_any(path: Path, options: dict[str, Any], progress: Optional[ProgressCallback] = None) -> Any:
-    """A data file through ``volviz.io.read``, or a volviz-compressed volume (``.vvz``) through the wavelet decoder
+    """A data file through ``volviz.io.read``, or a volviz-compressed volume (``.vvz``): with the dataset option
+    ``lod`` a ``LodTree`` drawn at a view-dependent level of detail (``volviz.render.lod_volume``), else through the
+    wavelet decoder
     (damaged bricks are filled from the coarser level and reported as warnings, never silently)."""
     if path.suffix.lower() == ".vvz":
+        if options.get("lod"):           # level of detail: blocks decoded on demand for each view
+            from volviz.regular.lod import LodTree
+
+            return LodTree(path, cache_bytes=int(options.get("cache_mb", 256)) << 20)
         from volviz.regular.codec import decompress
 
         return decompress(path, progress=progress)
@@ -145,12 +164,15 @@ def build_scene(plotter: Any, session: Session, datasets: dict[str, Any], spectr
     ensure_transfer_functions(session, datasets)
     props: dict[str, Any] = {}
     pt_components = []
+    lod_components = []
     for comp in session.components:
         if not comp.visible or comp.type in NATURE_TYPES:
             continue
         dataset = component_dataset(comp, datasets)
         if comp.type == "isosurface":
             props[comp.id] = add_isosurfaces(plotter, comp, dataset, spectrum=spectrum, clip=session.clip)
+        elif is_lod(dataset):
+            lod_components.append((comp, dataset))   # selected for the final camera
         elif uses_pt(session, dataset):
             pt_components.append((comp, dataset))  # drawn last: they composite over the opaque scene's depth
         else:
@@ -170,9 +192,33 @@ def build_scene(plotter: Any, session: Session, datasets: dict[str, Any], spectr
     nature = build_nature(plotter, session, datasets)
     if nature is not None:
         props["nature"] = nature
+    for comp, dataset in lod_components:
+        props[comp.id] = add_lod_component(plotter, session, comp, dataset)
     for comp, dataset in pt_components:
         props[comp.id] = add_pt_component(plotter, session, comp, dataset)
     return props
+
+
+def is_lod(dataset: Any) -> bool:
+    from volviz.regular.lod import LodTree
+
+    return isinstance(dataset, LodTree)
+
+
+def add_lod_component(plotter: Any, session: Session, comp: Component, dataset: Any) -> Any:
+    """A compressed volume at a view-dependent level of detail (``volviz.render.lod_volume``); the component
+    setting ``budget`` is the number of blocks per view (default 256)."""
+    from volviz.render.lod_volume import LodVolume
+
+    if session.camera is None:
+        lo, hi = dataset.node_box((dataset.levels, (0, 0, 0)))
+        plotter.view_isometric()
+        plotter.renderer.ResetCamera(lo[0], hi[0], lo[1], hi[1], lo[2], hi[2])
+        plotter.camera_set = True
+    lod = LodVolume(plotter, dataset, component_transfer_function(session, comp),
+                    budget=int(comp.settings.get("budget", 256)), opacity=comp.opacity)
+    lod.update()
+    return lod
 
 
 PT_DATASETS = ("TetMesh", "UnstructuredMesh", "CurvilinearGrid")

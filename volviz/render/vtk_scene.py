@@ -82,6 +82,12 @@ def volume_grid(dataset: Any) -> Any:
 
 def default_transfer_function_for(dataset: Any, name: str = "default") -> Any:
     """The default transfer function over the data range (of every step, for a time series)."""
+    from volviz.regular.lod import LodTree
+
+    if isinstance(dataset, LodTree):
+        from volviz.render.lod_volume import lod_bounds, lod_scalar_range
+
+        return default_transfer_function(lod_scalar_range(dataset), bounds_diagonal(lod_bounds(dataset)), name)
     grid = volume_grid(dataset)
     if isinstance(dataset, TimeSeries):
         rng = dataset.scalar_range()
