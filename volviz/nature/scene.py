@@ -422,6 +422,7 @@ class NatureView:
         cam = camera or self._camera()
         if camera is not None:
             camera.apply_to(self.plotter.camera)
+            self._fit_clipping()  # the VTK side only: ``cam`` keeps the caller's range for the CPU overlay
         size = self.size or tuple(int(v) for v in self.plotter.window_size)
         w, h = size
         if self.sky_actor is not None:
