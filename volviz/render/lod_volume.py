@@ -15,6 +15,12 @@ level everywhere matches that level rendered as one volume (measured in ``tests/
 Where levels meet, the coarser block's samples differ from the finer one's by the node's approximation error (the
 quantity the selection bounds, Eq. 2.7). ``select`` and ``decode`` are Qt-free and thread-safe, so the app can run
 them in the job runner and call ``show`` on the GUI thread; ``update`` does all three.
+
+Cost on this machine (no GPU, llvmpipe): the multi-block mapper renders every block as its own ray-cast pass, about
+40 ms each, so the embryo (256^3) at 512^2 takes 2.7 s per frame with 64 blocks against 0.29 s for the whole volume
+as one block (vtkFixedPointVolumeRayCastMapper per block is no better: 1.8 s for 64 blocks). Selection and decoding
+take 0.02 and 0.05 s. LOD rendering therefore pays off here only for volumes that do not fit in memory; a ray caster
+of our own that walks the blocks in one pass is the way to interactive rates.
 """
 from __future__ import annotations
 
