@@ -80,6 +80,9 @@ class MainWindow(QMainWindow):
         self._current_job = None
         self._pending_tf: Optional[tuple[str, Any]] = None
         self._recording: Optional[list[CameraKey]] = None
+        self._iso_time_job: Any = None       # the isosurface extraction for a display time in flight
+        self._iso_time_pending: Optional[tuple[Any, float, bool]] = None  # the newest time asked for meanwhile
+        self.iso_time_shown: Optional[tuple[float, bool]] = None  # (time, interpolated) of the shown isosurfaces
         self._record_start = 0.0
 
         self._build_docks()
@@ -541,15 +544,60 @@ class MainWindow(QMainWindow):
 
     def _time_changed(self, t: float) -> None:
         if self.controller is not None and self.controller.time_series():
-            self.controller.set_time(t, update=False)
-            self.render()
-            self.refresh_iso_overlay()
+            self._show_time(t, None)
 
     def _interpolation_toggled(self, on: bool) -> None:
         if self.controller is not None:
-            self.controller.set_time(self.timeline.time, interpolate=on, update=False)
-            self.render()
-            self.refresh_iso_overlay()
+            self._show_time(self.timeline.time, on)
+
+    def _show_time(self, t: float, interpolate: Optional[bool]) -> None:
+        controller = self.controller
+        controller.set_time(t, interpolate=interpolate, update=False, isosurfaces=False)
+        if len(controller.time_isosurfaces()) < len(controller.time_series()):  # volumes changed: draw them
+            self.schedule_render()
+        self.refresh_time_isosurfaces()
+
+    def schedule_render(self) -> None:
+        """Draw once control returns to the event loop: a repaint of the viewport, which renders (Qt merges the
+        repaints asked for in one pass). One render per frame instead of two: ``render`` renders, then the widget's
+        paint renders again (pyvistaqt), each 10-70 ms on llvmpipe."""
+        self.plotter.interactor.update()
+
+    def refresh_time_isosurfaces(self) -> None:
+        """Re-extract the isosurfaces of time series for the display time in the background (issue #8: playback
+        never waits for the extraction). At most one extraction is in flight: a time requested meanwhile waits and
+        only the newest one is extracted next (cancelling the running extraction at every 33 ms playback tick would
+        starve it: no surface would ever be shown). The new actors replace the old ones on this thread."""
+        controller = self.controller
+        if controller is None or not controller.time_isosurfaces():
+            return
+        self._iso_time_pending = (controller, controller.time, controller.interpolate_time)
+        if self._iso_time_job is None:
+            self._start_time_isosurfaces()
+
+    def _start_time_isosurfaces(self) -> None:
+        pending, self._iso_time_pending = self._iso_time_pending, None
+        if pending is None or pending[0] is not self.controller:
+            return
+        controller, t, interpolate = pending
+        comp_ids = controller.time_isosurfaces()
+
+        def extract(progress: Any = None) -> dict[str, list[Any]]:
+            return {comp_id: controller.extract_isosurfaces(comp_id, t, interpolate, progress=progress)
+                    for comp_id in comp_ids}
+
+        def done(outcome: JobOutcome) -> None:
+            self._iso_time_job = None
+            if outcome.ok and self.controller is controller:
+                controller.show_isosurfaces(outcome.result)
+                self.iso_time_shown = (t, interpolate)
+                self.schedule_render()
+                self.refresh_iso_overlay()
+            elif outcome.error is not None:
+                self.show_error("Cannot extract the isosurfaces", str(outcome.error))
+            self._start_time_isosurfaces()
+
+        self._iso_time_job = self.jobs.submit(extract, name="isosurfaces", key="iso-time", on_done=done)
 
     # ------------------------------------------------------------------------------------------------ navigation
     def set_fly_mode(self, enabled: bool) -> None:

@@ -188,9 +188,12 @@ class SceneController:
             steps.update(float(t) for t in s.times)
         return sorted(steps)
 
-    def set_time(self, t: float, interpolate: Optional[bool] = None, update: bool = True) -> None:
+    def set_time(self, t: float, interpolate: Optional[bool] = None, update: bool = True,
+                 isosurfaces: bool = True) -> None:
         """Show display time ``t`` (blending neighbouring steps when interpolating). The CPU-mode isosurface overlay
-        re-renders at once when ``update`` (the app renders it in the background instead)."""
+        re-renders at once when ``update`` (the app renders it in the background instead). Isosurfaces of a time
+        series are re-extracted here when ``isosurfaces``; the app instead extracts them in the background
+        (``time_isosurfaces`` → ``extract_isosurfaces`` on a worker → ``show_isosurfaces``)."""
         from volviz.model.timeseries import frame_at
         from volviz.render.clipping import clip_vtk_prop
         from volviz.render.vtk_scene import volume_input
@@ -204,11 +207,9 @@ class SceneController:
                 continue
             comp = self.component(comp_id)
             if comp.type == "isosurface":  # re-extract at the new time (the 4D blend happens in prepare)
-                from volviz.render.scene import add_isosurfaces
-
-                self.plotter.remove_actor(prop, render=False)
                 comp.settings = {**comp.settings, "interpolate": self.interpolate_time}
-                self.props[comp_id] = add_isosurfaces(self.plotter, comp, series, self.time, clip=self.session.clip)
+                if isosurfaces:
+                    self.show_isosurfaces({comp_id: self.extract_isosurfaces(comp_id, self.time)})
             elif prop.IsA("vtkVolume"):
                 self._vtk_inputs.pop(comp_id, None)
                 prop.GetMapper().SetInputData(volume_input(frame_at(series, self.time, self.interpolate_time)))
@@ -218,28 +219,74 @@ class SceneController:
         if update and self.iso_overlay is not None:
             self.iso_overlay.update()
 
+    def time_isosurfaces(self) -> list[str]:
+        """The isosurface components shown from a time series (what a display-time change re-extracts)."""
+        series = self.time_series()
+        return [comp_id for comp_id in series
+                if self.props.get(comp_id) is not None and self.component(comp_id).type == "isosurface"]
+
+    def extract_isosurfaces(self, comp_id: str, t: float, interpolate: Optional[bool] = None,
+                            progress: Any = None) -> list[Any]:
+        """Any thread: the surfaces of an isosurface component at display time ``t`` (the 4D blend of the
+        neighbouring steps when interpolating, libMini note "4D Visualization"), cut by the component's own
+        clipping (``volviz.iso.prepare``); ``show_isosurfaces`` puts them on screen."""
+        from volviz.iso import IsoSettings, prepare
+        from volviz.render.scene import SceneError
+
+        comp = self.component(comp_id)
+        settings_doc = dict(comp.settings)  # a snapshot: the GUI thread replaces (never mutates) comp.settings
+        settings_doc["interpolate"] = self.interpolate_time if interpolate is None else bool(interpolate)
+        try:
+            settings = IsoSettings.from_dict(settings_doc)
+        except ValueError as exc:
+            raise SceneError(f"component {comp_id!r}: {exc}") from None
+        return list(prepare(self.dataset_of(comp_id), settings, float(t), progress=progress).meshes)
+
+    def show_isosurfaces(self, meshes: dict[str, list[Any]]) -> None:
+        """GUI thread: replace the actors of isosurface components by new extracted surfaces (``comp_id → meshes``,
+        from ``extract_isosurfaces``), cut by the scene's clipping; the overlay's meshes follow (not re-rendered)."""
+        from volviz.render.scene import add_isosurfaces
+
+        suppressed = getattr(self.plotter, "suppress_rendering", False)
+        self.plotter.suppress_rendering = True  # no render per added actor: the caller draws once afterwards
+        try:
+            for comp_id, surfaces in meshes.items():
+                prop = self.props.get(comp_id)
+                if prop is None:
+                    continue
+                self.plotter.remove_actor(prop, render=False)
+                self.props[comp_id] = add_isosurfaces(self.plotter, self.component(comp_id), None,
+                                                      clip=self.session.clip, meshes=surfaces)
+        finally:
+            self.plotter.suppress_rendering = suppressed
+        self._sync_iso_overlay()
+
     # -- camera -----------------------------------------------------------------------------------------------------
     def camera(self) -> CameraState:
         from volviz.render.vtk_scene import camera_state
 
         return camera_state(self.plotter)
 
-    def set_camera(self, camera: Optional[CameraState]) -> None:
+    def set_camera(self, camera: Optional[CameraState], update: bool = True) -> None:
+        """Apply ``camera`` (None: frame the scene); re-run the view-dependent parts when ``update`` (the app runs
+        them in the background instead)."""
         from volviz.render.vtk_scene import apply_camera
 
         apply_camera(self.plotter, camera)
-        self.update_views()
+        if update:
+            self.update_views()
 
     # -- view-dependent parts (terrain LOD, fog and cloud images) ---------------------------------------------------
     @property
     def nature(self) -> Any:
         return self.props.get("nature")
 
-    def update_views(self, pt: bool = True) -> dict[str, Any]:
-        """Re-run what depends on the camera (C-LOD terrain, fog and clouds, and PT volumes unless ``pt`` is false,
-        for callers that render those in the background); returns their statistics."""
+    def update_views(self, pt: bool = True, nature: bool = True) -> dict[str, Any]:
+        """Re-run what depends on the camera (C-LOD terrain, fog and clouds unless ``nature`` is false, and PT
+        volumes unless ``pt`` is false, for callers that render those in the background: ``nature.begin`` /
+        ``compute`` / ``finish``); returns their statistics."""
         stats: dict[str, Any] = {}
-        if self.nature is not None:
+        if nature and self.nature is not None:
             stats.update(self.nature.update())
         for comp_id, prop in self.props.items():
             if pt and _is_pt(prop) and prop.visible:
