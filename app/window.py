@@ -7,7 +7,7 @@ import logging
 import os
 import time
 from pathlib import Path
-from typing import Any, Optional
+from typing import Any, Callable, Optional
 
 from PySide6.QtCore import QByteArray, QSettings, QStandardPaths, Qt, QTimer
 from PySide6.QtGui import QAction, QKeySequence, QUndoGroup
@@ -52,6 +52,28 @@ def default_recovery_dir() -> Path:
     return Path(base or Path.home() / ".volviz") / "recovery"
 
 
+class OneInFlight:
+    """At most one background job of a kind: a request made while one runs waits, and only the newest waiting one
+    starts when it is done. (Cancelling the running job for every newer request, as a job key does, starves it while
+    requests keep coming: at 30 playback ticks a second no result would ever be shown.)"""
+
+    def __init__(self) -> None:
+        self.running = False
+        self._pending: Optional[Callable[[Callable[[], None]], None]] = None
+
+    def request(self, start: Callable[[Callable[[], None]], None]) -> None:
+        """``start(next_request)`` submits the job; its completion handler must call ``next_request()`` last."""
+        self._pending = start
+        if not self.running:
+            self._next()
+
+    def _next(self) -> None:
+        start, self._pending = self._pending, None
+        self.running = start is not None
+        if start is not None:
+            start(self._next)
+
+
 class MainWindow(QMainWindow):
     """volviz main window. ``open_path`` is the single code path behind File > Open and the command line."""
 
@@ -80,8 +102,9 @@ class MainWindow(QMainWindow):
         self._current_job = None
         self._pending_tf: Optional[tuple[str, Any]] = None
         self._recording: Optional[list[CameraKey]] = None
-        self._iso_time_job: Any = None       # the isosurface extraction for a display time in flight
-        self._iso_time_pending: Optional[tuple[Any, float, bool]] = None  # the newest time asked for meanwhile
+        self._iso_jobs = OneInFlight()     # isosurface extraction for the display time
+        self._nature_jobs = OneInFlight()  # the natural scene's view-dependent parts for the camera
+        self.nature_updates = 0            # background updates of the natural scene shown so far
         self.iso_time_shown: Optional[tuple[float, bool]] = None  # (time, interpolated) of the shown isosurfaces
         self._record_start = 0.0
 
@@ -565,39 +588,35 @@ class MainWindow(QMainWindow):
 
     def refresh_time_isosurfaces(self) -> None:
         """Re-extract the isosurfaces of time series for the display time in the background (issue #8: playback
-        never waits for the extraction). At most one extraction is in flight: a time requested meanwhile waits and
-        only the newest one is extracted next (cancelling the running extraction at every 33 ms playback tick would
-        starve it: no surface would ever be shown). The new actors replace the old ones on this thread."""
+        never waits for the extraction; ``OneInFlight``), then replace their actors on this thread."""
         controller = self.controller
         if controller is None or not controller.time_isosurfaces():
             return
-        self._iso_time_pending = (controller, controller.time, controller.interpolate_time)
-        if self._iso_time_job is None:
-            self._start_time_isosurfaces()
+        t, interpolate = controller.time, controller.interpolate_time
 
-    def _start_time_isosurfaces(self) -> None:
-        pending, self._iso_time_pending = self._iso_time_pending, None
-        if pending is None or pending[0] is not self.controller:
-            return
-        controller, t, interpolate = pending
-        comp_ids = controller.time_isosurfaces()
+        def start(next_request: Callable[[], None]) -> None:
+            comp_ids = controller.time_isosurfaces() if self.controller is controller else []
+            if not comp_ids:
+                next_request()
+                return
 
-        def extract(progress: Any = None) -> dict[str, list[Any]]:
-            return {comp_id: controller.extract_isosurfaces(comp_id, t, interpolate, progress=progress)
-                    for comp_id in comp_ids}
+            def extract(progress: Any = None) -> dict[str, list[Any]]:
+                return {comp_id: controller.extract_isosurfaces(comp_id, t, interpolate, progress=progress)
+                        for comp_id in comp_ids}
 
-        def done(outcome: JobOutcome) -> None:
-            self._iso_time_job = None
-            if outcome.ok and self.controller is controller:
-                controller.show_isosurfaces(outcome.result)
-                self.iso_time_shown = (t, interpolate)
-                self.schedule_render()
-                self.refresh_iso_overlay()
-            elif outcome.error is not None:
-                self.show_error("Cannot extract the isosurfaces", str(outcome.error))
-            self._start_time_isosurfaces()
+            def done(outcome: JobOutcome) -> None:
+                if outcome.ok and self.controller is controller:
+                    controller.show_isosurfaces(outcome.result)
+                    self.iso_time_shown = (t, interpolate)
+                    self.schedule_render()
+                    self.refresh_iso_overlay()
+                elif outcome.error is not None:
+                    self.show_error("Cannot extract the isosurfaces", str(outcome.error))
+                next_request()
 
-        self._iso_time_job = self.jobs.submit(extract, name="isosurfaces", key="iso-time", on_done=done)
+            self.jobs.submit(extract, name="isosurfaces", on_done=done)
+
+        self._iso_jobs.request(start)
 
     # ------------------------------------------------------------------------------------------------ navigation
     def set_fly_mode(self, enabled: bool) -> None:
@@ -616,23 +635,53 @@ class MainWindow(QMainWindow):
 
     def reset_camera(self) -> None:
         if self.controller is not None:
-            self.controller.set_camera(None)
-            self.render()
+            self.controller.set_camera(None, update=False)
+            self._camera_moved()
 
     def _camera_moved(self) -> None:
         """After the camera moved: refresh what depends on it (terrain LOD, fog and cloud images, PT volumes), then
         draw and re-measure the error estimate for the new view."""
         if self.controller is None:
             return
-        self.last_view_stats = self.controller.update_views(pt=False)
+        self.refresh_nature()
+        self.last_view_stats = self.controller.update_views(pt=False, nature=False)
         self.render()
         for comp_id in self.controller.pt_stats():
             self.refresh_pt(comp_id)
         self.refresh_iso_overlay()
 
+    def refresh_nature(self) -> None:
+        """Re-compute the natural scene's view-dependent parts (C-LOD terrain, fog and cloud images; issue #5) for
+        the newest camera in the background (``OneInFlight``): the camera is read when the job starts, the VTK data
+        replaced on this thread when it is done."""
+        controller = self.controller
+        view = controller.nature if controller is not None else None
+        if view is None:
+            return
+
+        def start(next_request: Callable[[], None]) -> None:
+            if self.controller is not controller or controller.nature is not view:
+                next_request()
+                return
+            request = view.begin()
+
+            def done(outcome: JobOutcome) -> None:
+                if outcome.ok and self.controller is controller and controller.nature is view:
+                    self.last_view_stats = view.finish(request, *outcome.result)
+                    self.nature_updates += 1
+                    self.schedule_render()
+                elif outcome.error is not None:
+                    self.show_error("Cannot update the natural scene", str(outcome.error))
+                next_request()
+
+            self.jobs.submit(view.compute, request, name="natural scene", on_done=done)
+
+        self._nature_jobs.request(start)
+
     def _viewport_resized(self) -> None:
         if self.controller is None:
             return
+        self.refresh_nature()  # its overlay image has the viewport's size
         size = tuple(int(v) for v in self.plotter.ren_win.GetSize())
         for comp_id, stats in self.controller.pt_stats().items():
             if stats and tuple(stats.get("size", size)) != size:
@@ -650,8 +699,8 @@ class MainWindow(QMainWindow):
 
     def go_to_bookmark(self, name: str) -> None:
         if self.controller is not None and name in self.session.bookmarks:
-            self.controller.set_camera(self.session.bookmarks[name])
-            self.render()
+            self.controller.set_camera(self.session.bookmarks[name], update=False)
+            self._camera_moved()
 
     def _ask_bookmark(self) -> None:
         name, ok = QInputDialog.getText(self, "Add bookmark", "Name:", text=f"view {len(self.session.bookmarks) + 1}")

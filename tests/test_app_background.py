@@ -113,3 +113,34 @@ def test_isosurface_playback_keeps_the_event_loop_live(qtbot, make_window, tmp_p
     changed = sum(1 for (_, a), (_, b) in zip(frames, frames[1:])
                   if len(a) != len(b) or any(x.shape != y.shape or not np.array_equal(x, y) for x, y in zip(a, b)))
     assert changed == len(frames) - 1, "the displayed isosurface did not change between frames"
+
+
+def overlay_pixels(view) -> np.ndarray:
+    from vtk.util.numpy_support import vtk_to_numpy
+
+    return vtk_to_numpy(view._overlay_image.GetPointData().GetScalars()).copy()
+
+
+def test_camera_move_updates_the_natural_scene_in_the_background(qtbot, make_window) -> None:
+    window = make_window()
+    window.resize(1000, 700)  # a render on llvmpipe grows with the pixels
+    qtbot.wait(300)  # the viewport's resize handling is over
+    window.open_demo()  # the app's default scene: terrain, fog, clouds and sky
+    wait_loaded(qtbot, window)
+    view = window.controller.nature
+    qtbot.waitUntil(lambda: not window._nature_jobs.running, timeout=60000)
+    mesh, overlay, updates = view._mesh, overlay_pixels(view), window.nature_updates
+    window.plotter.camera.azimuth = 40.0
+    window.plotter.camera.elevation = 10.0
+    window._camera_moved()  # what the end of a mouse interaction triggers: it draws the new view at once
+    assert view._mesh is mesh and np.array_equal(overlay_pixels(view), overlay), \
+        "the natural scene was updated on the GUI thread"
+    gaps = LoopGaps()
+    qtbot.waitUntil(lambda: window.nature_updates > updates, timeout=60000)
+    gaps.stop()
+    assert len(gaps.gaps) > 5
+    assert max(gaps.gaps) < 0.1, f"event loop stalled for {max(gaps.gaps) * 1000:.0f} ms after a camera move"
+    assert view._mesh is not mesh and view._mesh.n_cells > 0  # the terrain re-triangulated for the new view
+    changed = overlay_pixels(view)
+    assert changed.shape == overlay.shape and np.abs(changed.astype(int) - overlay).max() > 0
+    assert window.last_view_stats["terrain_triangles"] == view._mesh.n_cells

@@ -416,48 +416,67 @@ class NatureView:
             pc.clipping_range = (max(near, self._near), max(far, need))
 
     def update(self, camera: Any = None) -> dict[str, float]:
-        """Re-triangulate the terrain and re-render the overlay for ``camera`` (default: the plotter's camera)."""
-        import pyvista as pv
+        """Re-triangulate the terrain and re-render the overlay for ``camera`` (default: the plotter's camera), now.
+        An app renders it in the background instead: ``begin`` (GUI thread), ``compute`` (any thread), ``finish``
+        (GUI thread)."""
+        request = self.begin(camera)
+        return self.finish(request, *self.compute(request))
 
+    def begin(self, camera: Any = None) -> tuple[Any, tuple[int, int]]:
+        """GUI thread: the view to compute (``camera`` or the plotter's, and the image size); moves the sky dome
+        to the eye (the sky is at infinity)."""
         cam = camera or self._camera()
         if camera is not None:
             camera.apply_to(self.plotter.camera)
             self._fit_clipping()  # the VTK side only: ``cam`` keeps the caller's range for the CPU overlay
         size = self.size or tuple(int(v) for v in self.plotter.window_size)
-        w, h = size
         if self.sky_actor is not None:
             self.sky_actor.SetPosition(*np.asarray(cam.position, dtype=np.float64))
+        return cam, size
+
+    def compute(self, request: tuple[Any, tuple[int, int]],
+                progress: Any = None) -> tuple[Any, np.ndarray, dict[str, float]]:
+        """Any thread (one at a time): the C-LOD terrain mesh as VTK poly data (None without terrain), the fog and
+        cloud overlay as 8-bit straight RGBA rows bottom-up, and the statistics. ``progress(fraction, message)`` is
+        called between the stages (a job runner cancels there)."""
+        cam, size = request
+        w, h = size
         mesh = self.scene.terrain_mesh(cam, size)
         stats: dict[str, float] = {}
         depth = np.full((h, w), np.inf)
+        poly = None
         if mesh is not None:
+            if progress is not None:
+                progress(0.3, "terrain")
             poly = mesh.to_pyvista()
+            depth, _ = render_terrain(mesh.points, mesh.triangles, mesh.tcoords, cam, size, self.scene._pyramid)
+            stats["terrain_triangles"] = float(mesh.n_triangles)
+        if progress is not None:
+            progress(0.5, "fog and clouds")
+        overlay = self.scene.render_volumes(cam, size, mesh, depth, stats=stats)
+        return poly, _overlay_rgba(overlay), stats
+
+    def finish(self, request: tuple[Any, tuple[int, int]], poly: Any, overlay: np.ndarray,
+               stats: dict[str, float]) -> dict[str, float]:
+        """GUI thread: show a ``compute`` result (terrain mesh and overlay image)."""
+        if poly is not None:
             if self.terrain_actor is None:
                 self.terrain_actor = self.plotter.add_mesh(poly, texture=self._texture, lighting=False,
                                                            name="nature-terrain")
             else:
                 self.terrain_actor.mapper.SetInputData(poly)
             self._mesh = poly
-            depth, _ = render_terrain(mesh.points, mesh.triangles, mesh.tcoords, cam, size, self.scene._pyramid)
-            stats["terrain_triangles"] = float(mesh.n_triangles)
-        overlay = self.scene.render_volumes(cam, size, mesh, depth, stats=stats)
         self._set_overlay(overlay)
         self.last_stats = stats
         return stats
 
     def _set_overlay(self, overlay: np.ndarray) -> None:
-        """Show a premultiplied RGBA image in front of the scene with straight-alpha blending. Pure emission (α = 0,
-        colour > 0) is shown with α' = max(α, max colour): C + (1 − α') B instead of C + B (error ≤ α' B)."""
+        """Show an overlay image of ``_overlay_rgba`` (8-bit straight RGBA, rows bottom-up) in front of the scene."""
         import vtk
         from vtk.util.numpy_support import numpy_to_vtk
 
         h, w = overlay.shape[:2]
-        alpha = np.maximum(overlay[..., 3], overlay[..., :3].max(axis=-1))
-        alpha = np.clip(alpha, 0.0, 1.0)
-        safe = np.where(alpha > 1e-6, alpha, 1.0)
-        straight = np.clip(overlay[..., :3] / safe[..., None], 0.0, 1.0)
-        rgba = np.concatenate([straight, alpha[..., None]], axis=-1)[::-1]  # VTK rows start at the bottom
-        data = np.ascontiguousarray((rgba * 255.0 + 0.5).astype(np.uint8).reshape(-1, 4))
+        data = overlay.reshape(-1, 4)
         if self._overlay_image is None:
             self._overlay_image = vtk.vtkImageData()
             mapper = vtk.vtkImageMapper()
@@ -474,6 +493,18 @@ class NatureView:
         arr.SetNumberOfComponents(4)
         img.GetPointData().SetScalars(arr)
         img.Modified()
+
+
+def _overlay_rgba(overlay: np.ndarray) -> np.ndarray:
+    """A premultiplied RGBA image as 8-bit straight-alpha RGBA, rows bottom-up (VTK's order), for blending in front
+    of the scene. Pure emission (α = 0, colour > 0) is shown with α' = max(α, max colour): C + (1 − α') B instead of
+    C + B (error ≤ α' B)."""
+    alpha = np.maximum(overlay[..., 3], overlay[..., :3].max(axis=-1))
+    alpha = np.clip(alpha, 0.0, 1.0)
+    safe = np.where(alpha > 1e-6, alpha, 1.0)
+    straight = np.clip(overlay[..., :3] / safe[..., None], 0.0, 1.0)
+    rgba = np.concatenate([straight, alpha[..., None]], axis=-1)[::-1]  # VTK rows start at the bottom
+    return np.ascontiguousarray((rgba * 255.0 + 0.5).astype(np.uint8))
 
 
 def build_nature_components(plotter: Any, components: Sequence[Any], datasets: dict[str, Any], camera: Any = None,
