@@ -105,6 +105,8 @@ class MainWindow(QMainWindow):
         self._iso_jobs = OneInFlight()     # isosurface extraction for the display time
         self._nature_jobs = OneInFlight()  # the natural scene's view-dependent parts for the camera
         self.nature_updates = 0            # background updates of the natural scene shown so far
+        self._lod_jobs: dict[str, OneInFlight] = {}  # block selection of volumes at a level of detail
+        self.lod_shown: dict[str, int] = {}  # the block budget of the selection each LOD volume shows
         self.iso_time_shown: Optional[tuple[float, bool]] = None  # (time, interpolated) of the shown isosurfaces
         self._record_start = 0.0
 
@@ -409,6 +411,11 @@ class MainWindow(QMainWindow):
         self.tf_editor.setEnabled(tf is not None)
         if tf is None:
             return
+        if comp_id in self.controller.lod_volumes():  # too large to decode whole: the range from node statistics
+            from volviz.render.lod_volume import lod_scalar_range
+
+            self.tf_editor.set_transfer_function(tf, data_range=lod_scalar_range(self.controller.dataset_of(comp_id)))
+            return
         dataset = self.controller.dataset_of(comp_id)
         counts, edges = histogram(dataset)
         self.tf_editor.set_transfer_function(tf, data_range=(float(edges[0]), float(edges[-1])),
@@ -429,8 +436,11 @@ class MainWindow(QMainWindow):
         self._pending_tf = None
         volume = self.controller.pt_volume(comp_id)
         if volume is None:  # VTK mapper: the new colour/opacity functions draw at once
-            self.controller.set_transfer_function(comp_id, tf)
+            lod = comp_id in self.controller.lod_volumes()
+            self.controller.set_transfer_function(comp_id, tf, update=not lod)
             self.render()
+            if lod:  # the block selection depends on the TF (transparent blocks): re-select in the background
+                self.refresh_lod([comp_id])
             return
         # volviz PT volume: table build and rasterisation run in the background; a newer edit supersedes this one
         self.controller.set_transfer_function(comp_id, tf, update=False)
@@ -644,7 +654,8 @@ class MainWindow(QMainWindow):
         if self.controller is None:
             return
         self.refresh_nature()
-        self.last_view_stats = self.controller.update_views(pt=False, nature=False)
+        self.refresh_lod()
+        self.last_view_stats = self.controller.update_views(pt=False, nature=False, lod=False)
         self.render()
         for comp_id in self.controller.pt_stats():
             self.refresh_pt(comp_id)
@@ -678,10 +689,51 @@ class MainWindow(QMainWindow):
 
         self._nature_jobs.request(start)
 
+    def refresh_lod(self, comp_ids: Optional[list[str]] = None) -> None:
+        """Re-select the blocks of volumes at a level of detail for the current camera and TF in the background:
+        first a coarse selection (an eighth of the block budget) that shows quickly, then the full budget (the
+        refinement once the camera stopped); selection and decoding on a worker, the drawing on this thread."""
+        controller = self.controller
+        if controller is None:
+            return
+        for comp_id, volume in controller.lod_volumes().items():
+            if comp_ids is not None and comp_id not in comp_ids:
+                continue
+            jobs = self._lod_jobs.setdefault(comp_id, OneInFlight())
+            for budget in dict.fromkeys((max(1, volume.budget // 8), volume.budget)):
+                jobs.request(self._lod_step(controller, comp_id, volume, budget))
+
+    def _lod_step(self, controller: Any, comp_id: str, volume: Any, budget: int) -> Callable[..., None]:
+        def start(next_request: Callable[[], None]) -> None:
+            if self.controller is not controller or controller.props.get(comp_id) is not volume:
+                next_request()
+                return
+            camera = volume.camera()
+
+            def select(progress: Any = None) -> tuple[Any, list[Any], float, float]:
+                t0 = time.perf_counter()
+                selection = volume.select(camera, budget)
+                t1 = time.perf_counter()
+                return selection, volume.decode(selection), t1 - t0, time.perf_counter() - t1
+
+            def done(outcome: JobOutcome) -> None:
+                if outcome.ok and self.controller is controller and controller.props.get(comp_id) is volume:
+                    volume.show(*outcome.result)
+                    self.lod_shown[comp_id] = budget
+                    self.schedule_render()
+                elif outcome.error is not None:
+                    self.show_error("Cannot select the volume's level of detail", str(outcome.error))
+                next_request()
+
+            self.jobs.submit(select, name="level of detail", on_done=done)
+
+        return start
+
     def _viewport_resized(self) -> None:
         if self.controller is None:
             return
         self.refresh_nature()  # its overlay image has the viewport's size
+        self.refresh_lod()     # the block selection depends on the viewport's size
         size = tuple(int(v) for v in self.plotter.ren_win.GetSize())
         for comp_id, stats in self.controller.pt_stats().items():
             if stats and tuple(stats.get("size", size)) != size:

@@ -144,3 +144,37 @@ def test_camera_move_updates_the_natural_scene_in_the_background(qtbot, make_win
     changed = overlay_pixels(view)
     assert changed.shape == overlay.shape and np.abs(changed.astype(int) - overlay).max() > 0
     assert window.last_view_stats["terrain_triangles"] == view._mesh.n_cells
+
+
+def test_lod_volume_selects_in_the_background_coarse_first(qtbot, make_window, tmp_path: Path) -> None:
+    from volviz.model import RegularVolume
+    from volviz.regular.codec import compress
+
+    n = 48
+    x, y, z = np.meshgrid(*(np.linspace(-1, 1, n),) * 3, indexing="ij")
+    field = 200 * np.exp(-3 * ((x - 0.2) ** 2 + y ** 2 + (z + 0.1) ** 2)) + 40 * np.sin(4 * x) * np.cos(3 * y) + 45
+    vvz = tmp_path / "blob.vvz"
+    compress(RegularVolume(np.asfortranarray(np.clip(field, 0, 255).astype(np.uint8))), vvz, mode="lossless")
+    session = tmp_path / "lod.json"
+    session.write_text(json.dumps({
+        "format": "volviz-session", "version": 1,
+        "datasets": [{"id": "blob", "path": str(vvz), "options": {"lod": True}}],
+        "components": [{"id": "blob", "type": "volume", "dataset": "blob", "settings": {"budget": 16}}],
+        "camera": {"position": [400, -300, 250], "focal_point": [24, 24, 24], "view_up": [0, 0, 1]}}))
+    window = make_window()
+    window.resize(800, 600)
+    window.open_path(session)
+    wait_loaded(qtbot, window)
+    volume = window.controller.lod_volumes()["blob"]
+    qtbot.waitUntil(lambda: not window._lod_jobs.get("blob") or not window._lod_jobs["blob"].running, timeout=60000)
+    far = list(volume.selection.nodes)
+    shown: list[int] = []
+    show = volume.show
+    volume.show = lambda selection, *rest: (shown.append(len(selection.nodes)), show(selection, *rest))
+    window.plotter.camera.position = (24.0, -40.0, 24.0)  # close to the volume: finer blocks
+    window._camera_moved()
+    assert list(volume.selection.nodes) == far and not shown, "the blocks were selected on the GUI thread"
+    qtbot.waitUntil(lambda: window.lod_shown.get("blob") == 16 and len(shown) == 2, timeout=60000)
+    assert shown[0] <= 2 < shown[1] <= 16  # a coarse selection (budget / 8) first, then the full budget
+    assert list(volume.selection.nodes) == list(volume.select(volume.camera()).nodes)  # as if selected right here
+    assert volume.stats["blocks"] == shown[1]

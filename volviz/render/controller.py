@@ -281,10 +281,11 @@ class SceneController:
     def nature(self) -> Any:
         return self.props.get("nature")
 
-    def update_views(self, pt: bool = True, nature: bool = True) -> dict[str, Any]:
-        """Re-run what depends on the camera (C-LOD terrain, fog and clouds unless ``nature`` is false, and PT
-        volumes unless ``pt`` is false, for callers that render those in the background: ``nature.begin`` /
-        ``compute`` / ``finish``); returns their statistics."""
+    def update_views(self, pt: bool = True, nature: bool = True, lod: bool = True) -> dict[str, Any]:
+        """Re-run what depends on the camera (C-LOD terrain, fog and clouds unless ``nature`` is false, PT volumes
+        unless ``pt`` is false, volumes at a level of detail unless ``lod`` is false, for callers that do those in
+        the background: ``nature.begin`` / ``compute`` / ``finish``, ``lod_volumes`` ``select`` / ``decode`` /
+        ``show``); returns their statistics."""
         stats: dict[str, Any] = {}
         if nature and self.nature is not None:
             stats.update(self.nature.update())
@@ -292,12 +293,17 @@ class SceneController:
             if pt and _is_pt(prop) and prop.visible:
                 prop.update()
                 stats[comp_id] = dict(prop.stats)
-            elif _is_lod(prop) and prop.volume.GetVisibility():
+            elif lod and _is_lod(prop) and prop.volume.GetVisibility():
                 stats[comp_id] = dict(prop.update())
         if pt and self.iso_overlay is not None:
             self.iso_overlay.update()
             stats["iso"] = dict(self.iso_overlay.stats)
         return stats
+
+    def lod_volumes(self) -> dict[str, Any]:
+        """The visible volumes drawn at a level of detail (``volviz.render.lod_volume.LodVolume``) by component."""
+        return {comp_id: prop for comp_id, prop in self.props.items()
+                if _is_lod(prop) and prop.volume.GetVisibility()}
 
     def pt_volume(self, comp_id: str) -> Any:
         """The PT volume handle of a component, or None when it is drawn by VTK."""

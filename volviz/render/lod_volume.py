@@ -92,17 +92,24 @@ class LodVolume:
         self.tf = tf
         update_volume_property(self.volume.GetProperty(), tf, self.opacity)
 
-    def select(self, camera: LodCamera) -> Selection:
-        """Any thread: the blocks for ``camera`` under the block budget (Guthe §2.3.3)."""
-        return self.tree.select(camera, self.budget, tf=self.tf, mode=self.mode)
+    def camera(self) -> LodCamera:
+        """GUI thread: the plotter's current camera and viewport size, for ``select`` on another thread."""
+        w, h = (int(v) for v in self.plotter.ren_win.GetSize())
+        return lod_camera(self.plotter.renderer.GetActiveCamera(), (w, h))
+
+    def select(self, camera: LodCamera, budget: Optional[int] = None) -> Selection:
+        """Any thread: the blocks for ``camera`` under the block budget (Guthe §2.3.3; default ``self.budget``; the
+        app first shows a coarse selection under a smaller budget, then refines)."""
+        return self.tree.select(camera, self.budget if budget is None else int(budget), tf=self.tf, mode=self.mode)
 
     def decode(self, selection: Selection) -> list[Block]:
         """Any thread: the selected blocks' samples (decoded on demand through the tree's LRU cache)."""
         return [self.tree.block(key) for key in selection.nodes if key not in self._images] \
             if selection.nodes else []
 
-    def show(self, selection: Selection, blocks: list[Block]) -> None:
-        """GUI thread: draw ``selection`` (``blocks`` holds the ones not drawn before)."""
+    def show(self, selection: Selection, blocks: list[Block], select_s: float = 0.0, decode_s: float = 0.0) -> None:
+        """GUI thread: draw ``selection`` (``blocks`` holds the ones not drawn before); ``stats`` describe it, with
+        the seconds its selection and decoding took."""
         import vtk
 
         for b in blocks:
@@ -116,23 +123,26 @@ class LodVolume:
             mb.SetBlock(i, self._images[key])
         self.mapper.SetInputDataObject(mb)
         self.selection = selection
+        self.stats = self.show_stats(selection, blocks, select_s, decode_s)
 
     def update(self) -> dict[str, Any]:
         """Select for the plotter's current camera, decode and draw; returns the statistics."""
-        w, h = (int(v) for v in self.plotter.ren_win.GetSize())
         t0 = time.perf_counter()
-        sel = self.select(lod_camera(self.plotter.renderer.GetActiveCamera(), (w, h)))
+        sel = self.select(self.camera())
         t1 = time.perf_counter()
         blocks = self.decode(sel)
         t2 = time.perf_counter()
-        self.show(sel, blocks)
-        levels: dict[int, int] = {}
-        for level, _ in sel.nodes:
-            levels[level] = levels.get(level, 0) + 1
-        self.stats = {"blocks": len(sel.nodes), "levels": dict(sorted(levels.items())), "select_s": t1 - t0,
-                      "decode_s": t2 - t1, "new_blocks": len(blocks), "skipped_transparent": sel.skipped_transparent,
-                      "culled": sel.culled}
+        self.show(sel, blocks, t1 - t0, t2 - t1)
         return self.stats
+
+    def show_stats(self, selection: Selection, blocks: list[Block], select_s: float,
+                   decode_s: float) -> dict[str, Any]:
+        levels: dict[int, int] = {}
+        for level, _ in selection.nodes:
+            levels[level] = levels.get(level, 0) + 1
+        return {"blocks": len(selection.nodes), "levels": dict(sorted(levels.items())), "select_s": select_s,
+                "decode_s": decode_s, "new_blocks": len(blocks), "skipped_transparent": selection.skipped_transparent,
+                "culled": selection.culled}
 
     def remove(self) -> None:
         self.plotter.renderer.RemoveVolume(self.volume)
