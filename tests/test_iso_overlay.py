@@ -206,26 +206,48 @@ def test_overlay_follows_display_time_and_clip_of_a_time_series():
     assert np.abs(shot(p)[row, left] - np.asarray(BG)).max() < 3 / 255  # the clip holds at the new time
 
 
+_VTK_PT_CUT = """
+import numpy as np
+import sys
+sys.path.insert(0, %r)
+from test_iso_overlay import BG, SceneController, Session, Component, plotter, shot
+import pytest
+
+s = Session(components=[Component("demo", "demo", settings={"cells_per_edge": 6})])
+s.render.method = "vtk"  # VTK's projected tetrahedra, which ignore mapper clipping planes
+s.render.background = BG
+p = plotter()
+c = SceneController(p, s, {})
+c.build()
+mapper = c.props["demo"].GetMapper()
+assert mapper.IsA("vtkProjectedTetrahedraMapper")
+whole = mapper.GetInput()
+lo, hi = np.array(whole.GetBounds()[0::2]), np.array(whole.GetBounds()[1::2])
+mid = (lo + hi) / 2
+full = shot(p)
+c.set_clip({"planes": [{"point": list(mid), "normal": [1.0, 0.0, 0.0]}], "box": None})
+cut = mapper.GetInput()
+assert cut.GetBounds()[0] == pytest.approx(mid[0]) and cut.GetBounds()[1] == pytest.approx(hi[0])
+assert cut.GetNumberOfCells() < whole.GetNumberOfCells()
+assert np.abs(shot(p) - full).max() > 0.05
+c.set_clip({"planes": [], "box": None})
+assert mapper.GetInput() is whole and np.abs(shot(p) - full).max() < 2 / 255
+p.close()
+"""
+
+
 def test_vtk_projected_tetrahedra_are_cut_on_the_cpu():
-    s = Session(components=[Component("demo", "demo", settings={"cells_per_edge": 6})])
-    s.render.method = "vtk"  # VTK's projected tetrahedra, which ignore mapper clipping planes
-    s.render.background = BG
-    p = plotter()
-    c = SceneController(p, s, {})
-    c.build()
-    mapper = c.props["demo"].GetMapper()
-    assert mapper.IsA("vtkProjectedTetrahedraMapper")
-    whole = mapper.GetInput()
-    lo, hi = np.array(whole.GetBounds()[0::2]), np.array(whole.GetBounds()[1::2])
-    mid = (lo + hi) / 2
-    full = shot(p)
-    c.set_clip({"planes": [{"point": list(mid), "normal": [1.0, 0.0, 0.0]}], "box": None})
-    cut = mapper.GetInput()
-    assert cut.GetBounds()[0] == pytest.approx(mid[0]) and cut.GetBounds()[1] == pytest.approx(hi[0])
-    assert cut.GetNumberOfCells() < whole.GetNumberOfCells()
-    assert np.abs(shot(p) - full).max() > 0.05
-    c.set_clip({"planes": [], "box": None})
-    assert mapper.GetInput() is whole and np.abs(shot(p) - full).max() < 2 / 255
+    """Runs in a fresh process: once another render window of the process has drawn with
+    vtkProjectedTetrahedraMapper (the app tests do), VTK's mapper composites an input set again after a cut
+    differently from its first render (up to 47/255 on 17 % of the pixels, also between two such re-sets), which
+    says nothing about the clipping; in a clean process the restored image equals the first one."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    run = subprocess.run([sys.executable, "-c", _VTK_PT_CUT % str(Path(__file__).parent)], capture_output=True,
+                         text=True, timeout=300)
+    assert run.returncode == 0, run.stderr[-3000:]
 
 
 def test_opaque_isosurfaces_stay_vtk_geometry_and_hide_what_is_behind_them_in_cpu_modes():
