@@ -303,7 +303,7 @@ def emit(fmax, cutoff, root, levels, roots, off, origin, spacing, eye, planes, s
 
 
 # ----------------------------------------------------------------------------------------------- rendering
-@njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True, inline="always", error_model="numpy")
 def _coord(x, lo, step, n):
     f = (x - lo) / step
     if f <= 0.0:
@@ -314,7 +314,7 @@ def _coord(x, lo, step, n):
     return i0, f - i0
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always", error_model="numpy")
 def _lookup(table, s_lo, ds, dl, sf, sb, l, out):
     """Trilinear sample of the 3D pre-integration table (n, n, L, 4) at (sf, sb, l) (l clamps to the last slice)."""
     n = table.shape[0]
@@ -500,7 +500,7 @@ def _leaf_linear(cv, alpha, beta):
     beta[4, 2] = 0.5 * (s101 + s011 - s110 - s0)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, error_model="numpy")
 def _render_band(leaves, nleaf, boxes, root, origin, spacing, va, vm, m_scale, a_cut, table, s_lo, ds, dl, eye,
                  dirs, invd, dnorm, depth, near, row0, row1, img, trans):
     """Leaves front to back (the reverse of the back-to-front list) composited *under* the pixel with early ray
