@@ -15,7 +15,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from volviz.nature.raster import CUBE_EDGES, clipped_screen_box
+from volviz.nature.raster import CUBE_EDGES, clipped_screen_box, dealt_band, dealt_count
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -642,8 +642,9 @@ def _directions(rb, w, h, dirs, invd, dnorm):
 
 @njit(cache=True, nogil=True, parallel=True)
 def render(leaves, nleaf, root, origin, spacing, va, vm, m_scale, a_cut, table, s_lo, ds, dl, rb, vp, depth, bands,
-           w, h, img):
-    """Perspective only (all rays start at the eye ``vp[0:3]``)."""
+           w, h, img, threads=2):
+    """Perspective only (all rays start at the eye ``vp[0:3]``). ``threads``: Numba's thread count (the row bands
+    are dealt out so that each thread's contiguous share of iterations covers the whole image)."""
     boxes = np.empty((nleaf, 4), dtype=np.int64)
     _leaf_setup(leaves, nleaf, root, vp, w, h, origin, spacing, boxes)
     dirs = np.empty((h, w, 3))
@@ -652,6 +653,9 @@ def render(leaves, nleaf, root, origin, spacing, va, vm, m_scale, a_cut, table, 
     _directions(rb, w, h, dirs, invd, dnorm)
     trans = np.ones((h, w))
     eye = vp[0:3].copy()
-    for bi in prange(bands.shape[0] - 1):
-        _render_band(leaves, nleaf, boxes, root, origin, spacing, va, vm, m_scale, a_cut, table, s_lo, ds, dl, eye,
-                     dirs, invd, dnorm, depth, vp[14], bands[bi], bands[bi + 1], img, trans)
+    nb = bands.shape[0] - 1
+    for ii in prange(dealt_count(nb, threads)):
+        bi = dealt_band(ii, nb, threads)
+        if bi >= 0:
+            _render_band(leaves, nleaf, boxes, root, origin, spacing, va, vm, m_scale, a_cut, table, s_lo, ds, dl,
+                         eye, dirs, invd, dnorm, depth, vp[14], bands[bi], bands[bi + 1], img, trans)

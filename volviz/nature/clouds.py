@@ -39,6 +39,7 @@ import time
 from dataclasses import dataclass, field
 from typing import Any
 
+import numba
 import numpy as np
 
 from volviz.nature import _cloud_kernels as K
@@ -354,5 +355,6 @@ def render_cloud_image(frame: CloudFrame, shading: CloudShading, table: Any, cam
         rgba = np.ascontiguousarray(table.rgba)
         K.render(frame.leaves, len(frame.leaves), vol.root, np.asarray(vol.origin, float), np.asarray(vol.spacing, float),
                  va, vm, m_scale, a_cut, rgba, float(table.s_lo), float(table.ds), float(table.dl),
-                 camera.rays((w, h)).as_array(), vp, dep, row_bands(h), w, h, img)
+                 camera.rays((w, h)).as_array(), vp, dep, row_bands(h, 16), w, h, img,
+                 numba.get_num_threads())
     return img

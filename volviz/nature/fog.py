@@ -34,10 +34,12 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
+import numba
 import numpy as np
 from numba import njit, prange
 
-from volviz.nature.raster import PRISM_EDGES, clipped_screen_box, row_bands, view_params
+from volviz.nature.raster import (PRISM_EDGES, clipped_screen_box, dealt_band, dealt_count, row_bands,
+                                  view_params)
 
 
 @dataclass
@@ -189,9 +191,13 @@ def _pcp_band(pts, bot, top, eb, et, tris, planes, boxes, keep, rb, depth, near,
 
 
 @njit(cache=True, nogil=True, parallel=True)
-def _pcp(pts, bot, top, eb, et, tris, planes, boxes, keep, rb, depth, near, bands, emis, mip):
-    for b in prange(bands.shape[0] - 1):
-        _pcp_band(pts, bot, top, eb, et, tris, planes, boxes, keep, rb, depth, near, bands[b], bands[b + 1], emis, mip)
+def _pcp(pts, bot, top, eb, et, tris, planes, boxes, keep, rb, depth, near, bands, emis, mip, threads):
+    nb = bands.shape[0] - 1
+    for ii in prange(dealt_count(nb, threads)):
+        b = dealt_band(ii, nb, threads)
+        if b >= 0:
+            _pcp_band(pts, bot, top, eb, et, tris, planes, boxes, keep, rb, depth, near, bands[b], bands[b + 1], emis,
+                      mip)
 
 
 def pcp_integrals(points: np.ndarray, bottom: np.ndarray, top: np.ndarray, triangles: np.ndarray,
@@ -217,7 +223,8 @@ def pcp_integrals(points: np.ndarray, bottom: np.ndarray, top: np.ndarray, trian
     rb = camera.rays((w, h)).as_array()
     emis = np.zeros((h, w))
     mip = np.zeros((h, w))
-    _pcp(pts, bot, topv, eb, et, tris, planes, boxes, keep, rb, dep, float(vp[14]), row_bands(h), emis, mip)
+    _pcp(pts, bot, topv, eb, et, tris, planes, boxes, keep, rb, dep, float(vp[14]), row_bands(h, 16), emis, mip,
+         numba.get_num_threads())
     return emis, mip, int(keep.sum())
 
 

@@ -295,6 +295,23 @@ def row_bands(h: int, parts: int = 4) -> np.ndarray:
     return np.linspace(0, h, min(parts, h) + 1).round().astype(np.int64)
 
 
+@njit(cache=True, nogil=True, inline="always")
+def dealt_band(ii: int, nb: int, threads: int) -> int:
+    """The band for iteration ``ii`` of ``prange(dealt_count(nb, threads))``: prange gives each thread a contiguous
+    run of iterations, and this deals the bands out so that each run takes every ``threads``-th band (the whole
+    image, not one strip of it: clouds and fog are not spread evenly over the rows). -1 for padding iterations."""
+    nt = max(1, min(threads, nb))
+    per = (nb + nt - 1) // nt
+    bi = (ii % per) * nt + ii // per
+    return bi if bi < nb else -1
+
+
+@njit(cache=True, nogil=True, inline="always")
+def dealt_count(nb: int, threads: int) -> int:
+    nt = max(1, min(threads, nb))
+    return nt * ((nb + nt - 1) // nt)
+
+
 def render_terrain(points: np.ndarray, triangles: np.ndarray, tcoords: np.ndarray, camera: Any, size: tuple[int, int],
                    colour_pyramid: tuple[np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
     """Depth (H, W) float64 (inf where no terrain) and colour (H, W, 3) float32 of a terrain mesh.
