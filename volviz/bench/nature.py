@@ -64,9 +64,9 @@ NOTES = [
     "clouds 2, 200 (151,000) max 2.32.",
     "Frame rate: everything is CPU work in Numba (terrain z-buffer and mip-mapped shading, per-pixel PCP prisms, "
     "per-pixel pre-integrated cloud tetrahedra) on 2 cores; the load average of the run is in the header (under "
-    "load 3-6 the frame rate was 2-3 fps, on a quiet machine it is about 5). The clouds (per pixel and leaf: "
-    "ray/cube clip, <= 3 pieces, a trilinear lookup each) and the fog prisms (~5 M box pixels per frame) are the "
-    "largest costs; frames inside the cloud deck (2-5) take 0.2-0.3 s.",
+    "load 3-6 the frame rate was 2-3 fps). The clouds (per pixel and leaf: ray/cube clip, <= 3 pieces, a trilinear "
+    "lookup each) and the fog prisms (~5 M box pixels per frame) are the largest costs; both render 16 row bands "
+    "dealt out so that each thread gets bands from the whole image (before, one thread got the cloudy rows).",
     "Popping, the bound: with geomorphing, every step's LOD change is at most the reference's (max (d_L - d_R) <= "
     "0) and the total change is below the reference's (sum ratio < 1: the LOD image is smoother, so it changes less "
     "as the camera moves). Without geomorphing single steps exceed the reference's change (pops). The step is small "
