@@ -173,3 +173,15 @@ def test_million_tetrahedra_small_image():
     assert st.n_visible > 10 ** 5 and st.cycles == 0 and ref[..., 3].max() > 0.5
     e = _err(img, ref)
     assert e[0] <= 1.0 and e[1] <= 4.0, e
+
+
+def test_widened_table_is_kept_until_the_table_is_rebuilt():
+    from volviz.optics import build_table3d
+    from volviz.unstructured.raster import lut_args
+
+    table = build_table3d(TF, n_s=32, n_l=8)
+    first = lut_args(table)[0]
+    assert lut_args(table)[0] is first                          # converted once, not every frame
+    table.rebuild(TF.scaled_extinction(0.5))                    # same array, changed in place for a new TF
+    again = lut_args(table)[0]
+    assert again is not first and np.array_equal(again, table.rgba.astype(np.float64).ravel())

@@ -252,6 +252,20 @@ def _lookup_separable(flat: np.ndarray, n: int, nc: int, deg: int, s_lo: float, 
     return c0 * a, c1 * a, c2 * a, a
 
 
+def _widened(table: Any, values: np.ndarray) -> np.ndarray:
+    """``values`` as flat float64, converted once per table and kept on it (a 3D table is 32 MB in float64: not
+    worth redoing every frame); redone when the table was rebuilt for another TF or its array replaced."""
+    tf = getattr(table, "tf", None)
+    cached = getattr(table, "_volviz_flat64", None)
+    if cached is None or cached[0] is not values or cached[1] is not tf:
+        cached = (values, tf, np.ascontiguousarray(values, dtype=np.float64).ravel())
+        try:
+            table._volviz_flat64 = cached
+        except AttributeError:          # tables without an instance dict: convert every time
+            pass
+    return cached[2]
+
+
 def lut_args(table: Any, smooth: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(flat float64 data (float32 tables widened once: no conversion per tap), int64 [kind, n_s, n_l or channels, degree], float64 [s_lo, 1/ds, 1/dl or 1/l_max,
     kappa_max (3)]) of a ``Table3D`` (kind 0), a ``SeparableTable`` (kind 1) or an ``IsoTable`` (kind 2: its
@@ -270,11 +284,11 @@ def lut_args(table: Any, smooth: bool = False) -> tuple[np.ndarray, np.ndarray, 
         ip = np.array([2, len(isos), 8, 0], np.int64)
         fp = np.array([table.thicken, 1.0 if smooth else 0.0, 0.0, 0.0, 0.0, 0.0])
     elif hasattr(table, "rgba"):
-        flat = np.ascontiguousarray(table.rgba, dtype=np.float64).ravel()
+        flat = _widened(table, table.rgba)
         ip = np.array([0, table.rgba.shape[0], table.rgba.shape[2], 0], np.int64)
         fp = np.array([table.s_lo, 1.0 / table.ds, 1.0 / table.dl, 0.0, 0.0, 0.0])
     else:
-        flat = np.ascontiguousarray(table.data, dtype=np.float64).ravel()
+        flat = _widened(table, table.data)
         ip = np.array([1, table.data.shape[0], table.data.shape[2], table.degree], np.int64)
         k = np.asarray(table.kappa_max, dtype=np.float64)
         fp = np.array([table.s_lo, 1.0 / table.ds, 1.0 / table.l_max, k[0], k[1], k[2]])
