@@ -313,7 +313,8 @@ def _markdown(results: dict[str, Any], path: Path) -> None:
     if along:
         lines += ["", f"Along the camera path as a movie export renders it (frame i + 1 sorted in the background while "
                   f"frame i draws, `volviz.unstructured.prefetch`): **{along['frame_s']:.3f} s per frame**, of which "
-                  f"{along['sort_wait_s']:.3f} s waiting for the sort. With both cores already busy rasterising, "
+                  f"{along['sort_wait_s']:.3f} s in the sort stage (the wait for the background order and the zero-opacity "
+                  "filter). With both cores already busy rasterising, "
                   "the background sort takes its time from the raster: the order is ready, but the frame is not "
                   "faster than sorting in line."]
     cpu_ns = pt.get("cpu_s", float("nan")) / max(pt["fragments"], 1) * 1e9

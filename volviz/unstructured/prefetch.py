@@ -12,6 +12,7 @@ the frame sorts as usual, so a wrong guess costs time, never correctness.
 """
 from __future__ import annotations
 
+import time
 from typing import Any, Iterator, Optional, Sequence
 
 import numpy as np
@@ -110,12 +111,16 @@ def render_path(mesh: TetMesh, tf: Any, cameras: Sequence[Camera], size: tuple[i
         if cameras:
             pre.prefetch(cameras[0], size)
         for i, cam in enumerate(cameras):
+            t_wait = time.perf_counter()
             res = pre.take(cam, size)
+            t_wait = time.perf_counter() - t_wait
             if i + 1 < len(cameras):
                 pre.prefetch(cameras[i + 1], size)
             order = None if res is None else res.order
             img, st = render(mesh, tf, cam, size, "pt", sort=sort, nonconvex=nonconvex, order=order,
                              return_stats=True, **render_opts)
+            st.sort_s += t_wait
+            st.total_s += t_wait
             st.extra["sort_prefetched"] = res is not None
             if res is not None:
                 st.cycles, st.boundary_relations = res.cycles, res.boundary_relations
