@@ -60,18 +60,41 @@ class OneInFlight:
     def __init__(self) -> None:
         self.running = False
         self._pending: Optional[Callable[[Callable[[], None]], None]] = None
+        self._waiting: list[Callable[[], None]] = []   # ``settled`` callbacks of requests not started yet
+        self._current: list[Callable[[], None]] = []   # ... of the running job (it answers the requests before it)
 
-    def request(self, start: Callable[[Callable[[], None]], None]) -> None:
-        """``start(next_request)`` submits the job; its completion handler must call ``next_request()`` last."""
+    def request(self, start: Callable[[Callable[[], None]], None],
+                settled: Optional[Callable[[], None]] = None) -> None:
+        """``start(next_request)`` submits the job; its completion handler must call ``next_request()`` last.
+        ``settled()`` is called once a job started at or after this request is over (a newer request answers an
+        older one that never started)."""
         self._pending = start
+        if settled is not None:
+            self._waiting.append(settled)
         if not self.running:
             self._next()
 
     def _next(self) -> None:
+        over, self._current = self._current, []
         start, self._pending = self._pending, None
+        if start is not None:
+            self._current, self._waiting = self._waiting, []
         self.running = start is not None
+        for settled in over:
+            settled()
         if start is not None:
             start(self._next)
+
+
+def _import_gui_thread_modules() -> None:
+    """Import at start-up what the GUI thread later imports inside functions: a first ``import vtk`` (the natural
+    scene's overlay) took 0.2-0.5 s of a blocked event loop in the middle of loading a scene."""
+    import vtk  # noqa: F401
+
+    import volviz.nature.scene  # noqa: F401
+    import volviz.render.controller  # noqa: F401
+    import volviz.render.pt_prop  # noqa: F401
+    import volviz.render.scene  # noqa: F401
 
 
 class MainWindow(QMainWindow):
@@ -84,6 +107,7 @@ class MainWindow(QMainWindow):
 
         self.setWindowTitle("volviz")
         self.resize(1280, 820)
+        _import_gui_thread_modules()
         self.collector = GuiThreadCollector(self)  # cycles are freed on this thread, never in a worker
         self.settings = settings or QSettings("volviz", "volviz")
         self.recovery_dir = Path(recovery_dir) if recovery_dir else default_recovery_dir()
@@ -100,11 +124,17 @@ class MainWindow(QMainWindow):
         self.dirty = False
         self.last_stats: dict[str, Any] = {}
         self._current_job = None
+        self._load_serial = 0              # the newest open/rebuild; an older one's late callbacks do nothing
+        self._loading_views = False        # the newest scene is installed, its first views are computed
+        self._overlay_waiters: dict[str, list[Callable[[], None]]] = {}  # job key -> ``settled`` callbacks
         self._pending_tf: Optional[tuple[str, Any]] = None
         self._recording: Optional[list[CameraKey]] = None
         self._iso_jobs = OneInFlight()     # isosurface extraction for the display time
         self._nature_jobs = OneInFlight()  # the natural scene's view-dependent parts for the camera
+        self._volume_jobs = OneInFlight()  # blended volumes of time series for the display time
+        self.volume_time_shown: Optional[tuple[float, bool]] = None  # (time, interpolated) of the shown volumes
         self.nature_updates = 0            # background updates of the natural scene shown so far
+        self.nature_rebuilds = 0           # natural scenes rebuilt in the background (visibility toggles)
         self._lod_jobs: dict[str, OneInFlight] = {}  # block selection of volumes at a level of detail
         self.lod_shown: dict[str, int] = {}  # the block budget of the selection each LOD volume shows
         self.iso_time_shown: Optional[tuple[float, bool]] = None  # (time, interpolated) of the shown isosurfaces
@@ -275,62 +305,114 @@ class MainWindow(QMainWindow):
         self._add_recent(p)
 
     def _show_session(self, session: Session, session_path: Optional[Path], title: str,
-                      dirty: bool = False) -> None:
+                      dirty: bool = False, datasets: Optional[dict[str, Any]] = None) -> None:
+        """Show ``session``: its datasets are read (unless ``datasets`` are given) and the scene prepared in the
+        background (``SceneController.prepare``: reading, extraction, tetrahedralisation, natural scene), with
+        progress and cancel in the status bar; then the props are added on this thread (``install``) and the
+        view-dependent parts computed in the background. A newer open supersedes an older one; the current scene
+        stays until the new one is ready."""
+        from volviz.render.controller import SceneController
         from volviz.render.scene import load_datasets
 
+        self._load_serial += 1
+        serial = self._load_serial
+        self._loading_views = False
         self.status_label.setText(f"Loading {title}…")
         self._set_busy(True)
+        controller = SceneController(self.plotter, session, {}, on_screen=True)
+
+        def load(progress: Any = None) -> Any:
+            def part(lo: float, hi: float) -> Any:
+                return lambda fraction, message="": progress(lo + (hi - lo) * fraction, message)
+
+            controller.datasets = load_datasets(session, session_path, part(0.0, 0.6), loaded=datasets)
+            return controller.prepare(part(0.6, 1.0))
 
         def done(outcome: JobOutcome) -> None:
-            self._set_busy(False)
+            if serial != self._load_serial:
+                return
             if outcome.cancelled:
+                self._set_busy(False)
                 self.status_label.setText(f"Loading {title} cancelled")
                 return
             if outcome.error is not None:
+                self._set_busy(False)
                 self.status_label.setText(f"Could not load {title}")
                 self.show_error(f"Cannot open {title}", str(outcome.error))
                 return
-            self._install_session(session, session_path, outcome.result, title, dirty)
+            self._install_session(controller, outcome.result, session_path, title, dirty, serial)
 
-        self._current_job = self.jobs.submit(load_datasets, session, session_path, name=f"load {title}", key="load",
-                                             on_done=done)
+        self._current_job = self.jobs.submit(load, name=f"load {title}", key="load", on_done=done)
 
-    def _install_session(self, session: Session, session_path: Optional[Path], datasets: dict[str, Any],
-                         title: str, dirty: bool) -> None:
-        from volviz.render.controller import SceneController
-
+    def _install_session(self, controller: Any, prepared: Any, session_path: Optional[Path], title: str,
+                         dirty: bool, serial: int) -> None:
+        """GUI thread: replace the shown scene by a prepared one (no numerics here: props added, docks filled, one
+        render), then compute its view-dependent parts in the background; loading ends when they are shown."""
+        session = controller.session
         if self.controller is not None:
             self.controller.clear()
         self.plotter.clear()
-        controller = SceneController(self.plotter, session, datasets, on_screen=True)
+        self._current_job = None
         try:
-            controller.build()
+            controller.install(prepared, views=False)
         except Exception as exc:  # a scene that cannot be shown must not take the window down
             log.exception("building the scene for %s failed", title)
             controller.clear()
             self.controller = None
+            self._set_busy(False)
+            self.status_label.setText(f"Could not show {title}")
             self.show_error(f"Cannot show {title}", str(exc))
             return
-        self.session, self.session_path, self.datasets, self.controller = session, session_path, datasets, controller
+        self.session, self.session_path, self.datasets = session, session_path, controller.datasets
+        self.controller = controller
         if "window_state" in session.layout:
             self.restoreState(QByteArray.fromBase64(session.layout["window_state"].encode("ascii")))
         self.scene_tree.populate(session.components)
         self.render_settings.load(session.render)
         self.clipping.load(session.clip, controller.bounds())
         display_time = controller.time  # the session's display time, which set_steps would reset to the first step
-        self.timeline.set_steps(controller.time_steps())
-        if controller.time_series():
-            self.timeline.set_time(display_time)
+        self.timeline.blockSignals(True)  # the scene already shows the display time: no re-blend, no re-extraction
+        try:
+            self.timeline.set_steps(controller.time_steps())
+            if controller.time_series():
+                self.timeline.set_time(display_time)
+        finally:
+            self.timeline.blockSignals(False)
+        self.volume_time_shown = self.iso_time_shown = None
         self._refresh_bookmark_menu()
         self.title = title
         self.error_estimate = None
         self.last_error_rmse = None
         self.set_dirty(dirty)
         self.render()
-        for comp in session.components:
-            if controller.pt_volume(comp.id) is not None:
-                self.estimate_error(comp.id)
-        self.status_label.setText(f"Showing {title}")
+        self._show_first_views(controller, serial, title)
+
+    def _show_first_views(self, controller: Any, serial: int, title: str) -> None:
+        """Compute the new scene's view-dependent parts in the background (natural scene, LOD blocks, PT volumes,
+        the isosurfaces' CPU mode); the loading ends when all are shown (or failed, or were cancelled)."""
+        waiting = [1]
+
+        def settled() -> None:
+            waiting[0] -= 1
+            if waiting[0] == 0 and serial == self._load_serial and self.controller is controller:
+                self._loading_views = False
+                self._set_busy(False)
+                self.status_label.setText(f"Showing {title}")
+
+        self._loading_views = True
+        if controller.nature is not None:
+            waiting[0] += 1
+            self.refresh_nature(settled=settled)
+        lods = list(controller.lod_volumes())
+        waiting[0] += len(lods)
+        self.refresh_lod(lods, settled=settled)
+        for comp_id in controller.pt_stats():
+            waiting[0] += 1
+            self.refresh_pt(comp_id, settled=settled)
+        if controller.iso_overlay is not None:
+            waiting[0] += 1
+            self.refresh_iso_overlay(settled=settled)
+        settled()
 
     # ------------------------------------------------------------------------------------------------ rendering
     def estimate_error(self, comp_id: str, request: Optional[dict[str, Any]] = None) -> None:
@@ -416,10 +498,13 @@ class MainWindow(QMainWindow):
 
             self.tf_editor.set_transfer_function(tf, data_range=lod_scalar_range(self.controller.dataset_of(comp_id)))
             return
-        dataset = self.controller.dataset_of(comp_id)
-        counts, edges = histogram(dataset)
-        self.tf_editor.set_transfer_function(tf, data_range=(float(edges[0]), float(edges[-1])),
-                                             histogram=(counts, edges))
+        counts, edges = self.controller.histograms.get(comp_id) or histogram(self.controller.dataset_of(comp_id))
+        self.tf_editor.blockSignals(True)  # the scene already shows this TF: no preview re-render
+        try:
+            self.tf_editor.set_transfer_function(tf, data_range=(float(edges[0]), float(edges[-1])),
+                                                 histogram=(counts, edges))
+        finally:
+            self.tf_editor.blockSignals(False)
 
     def _tf_changed(self, tf: Any) -> None:
         comp_id = self.scene_tree.current_component()
@@ -446,26 +531,34 @@ class MainWindow(QMainWindow):
         self.controller.set_transfer_function(comp_id, tf, update=False)
         self.refresh_pt(comp_id)
 
-    def refresh_pt(self, comp_id: str) -> None:
+    def refresh_pt(self, comp_id: str, settled: Optional[Callable[[], None]] = None) -> None:
         """Re-render a PT volume for the current camera and TF: the depth read-back on this thread, the sort, table
         and rasterisation in the background (a newer request for the same volume supersedes a stale one), then the
-        image and a fresh error estimate."""
+        image and a fresh error estimate. ``settled()`` is called when a render for this request is over."""
         controller = self.controller
         volume = controller.pt_volume(comp_id) if controller is not None else None
         if volume is not None:
             self._refresh_overlay(volume, f"pt:{comp_id}", "volume", lambda: controller.pt_volume(comp_id),
-                                  lambda request: self.estimate_error(comp_id, request))
+                                  lambda request: self.estimate_error(comp_id, request), settled)
+        elif settled is not None:
+            settled()
 
-    def refresh_iso_overlay(self) -> None:
+    def refresh_iso_overlay(self, settled: Optional[Callable[[], None]] = None) -> None:
         """Re-render the isosurfaces' CPU transparency mode (when one is on) in the background, like a PT volume."""
         controller = self.controller
         overlay = controller.iso_overlay if controller is not None else None
         if overlay is not None:
-            self._refresh_overlay(overlay, "iso-overlay", "isosurfaces", lambda: controller.iso_overlay)
+            self._refresh_overlay(overlay, "iso-overlay", "isosurfaces", lambda: controller.iso_overlay,
+                                  settled=settled)
+        elif settled is not None:
+            settled()
 
-    def _refresh_overlay(self, handle: Any, key: str, what: str, current: Any, after: Any = None) -> None:
+    def _refresh_overlay(self, handle: Any, key: str, what: str, current: Any, after: Any = None,
+                         settled: Optional[Callable[[], None]] = None) -> None:
         controller = self.controller
         request = handle.begin()
+        if settled is not None:  # answered by this job or a newer one of the key (a superseded job reports nothing)
+            self._overlay_waiters.setdefault(key, []).append(settled)
 
         def done(outcome: JobOutcome) -> None:
             if outcome.ok and self.controller is controller and current() is handle:
@@ -475,6 +568,8 @@ class MainWindow(QMainWindow):
                     after(request)
             elif outcome.error is not None:
                 self.show_error(f"Cannot render the {what}", str(outcome.error))
+            for waiter in self._overlay_waiters.pop(key, []):
+                waiter()
 
         self.jobs.submit(handle.compute, request, name=what, key=key, on_done=done)
 
@@ -511,11 +606,54 @@ class MainWindow(QMainWindow):
         self.set_dirty()
 
     def _set_visibility(self, comp_id: str, visible: bool) -> None:
-        if self.controller is not None:
-            self.controller.set_visible(comp_id, visible)
-            self.set_dirty()
-            self.render()
-            self.refresh_iso_overlay()
+        from volviz.render.scene import NATURE_TYPES
+
+        if self.controller is None:
+            return
+        controller = self.controller
+        nature = controller.component(comp_id).type in NATURE_TYPES
+        controller.set_visible(comp_id, visible, nature=False)
+        self.set_dirty()
+        if nature:
+            self.rebuild_nature(comp_id, visible)
+            return
+        self.render()
+        self.refresh_iso_overlay()
+
+    def rebuild_nature(self, comp_id: str, visible: bool) -> None:
+        """A terrain / fog / clouds / sky component was shown or hidden: rebuild the natural scene in the background
+        (maps, fog prisms, cloud volumes; a newer toggle supersedes an older one), put it in on this thread, then
+        compute its first view in the background; the old one stays on screen meanwhile. A scene that cannot be
+        built (fog without terrain) leaves the component as it was, with a message."""
+        from volviz.render.scene import load_datasets
+
+        controller, session_path = self.controller, self.session_path
+
+        def prepare(progress: Any = None) -> Any:
+            load_datasets(controller.session, session_path, loaded=controller.datasets)  # a component shown anew
+            return controller.prepare_nature(progress)
+
+        def done(outcome: JobOutcome) -> None:
+            if self.controller is not controller:
+                return
+            if outcome.ok:
+                controller.install_nature(outcome.result, views=False)
+                self.nature_rebuilds += 1
+                if controller.nature is None:
+                    self.schedule_render()
+                self.refresh_nature()
+            elif outcome.error is not None:
+                controller.component(comp_id).visible = not visible
+                tree = self.scene_tree.tree
+                tree.blockSignals(True)
+                try:
+                    self.scene_tree.item(comp_id).setCheckState(
+                        0, Qt.CheckState.Unchecked if visible else Qt.CheckState.Checked)
+                finally:
+                    tree.blockSignals(False)
+                self.show_error(f"Cannot {'show' if visible else 'hide'} {comp_id}", str(outcome.error))
+
+        self.jobs.submit(prepare, name="natural scene", key="nature-build", on_done=done)
 
     def _set_opacity(self, comp_id: str, opacity: float) -> None:
         if self.controller is not None:
@@ -527,7 +665,6 @@ class MainWindow(QMainWindow):
     def apply_component_settings(self, comp_id: str, text: str) -> bool:
         """New settings for a component (JSON from the scene tree): validated through the session schema, then the
         scene is rebuilt with the same camera; a bad value gives a message naming the field and changes nothing."""
-        import copy
         import json
 
         from volviz.session import session_from_dict, session_to_dict
@@ -545,11 +682,9 @@ class MainWindow(QMainWindow):
             self.show_error("Invalid settings", f"{comp_id}: {exc}")
             return False
         candidate.camera = self.controller.camera()
-        previous = copy.deepcopy(self.session)
-        self._install_session(candidate, self.session_path, self.datasets, getattr(self, "title", ""), True)
-        if self.controller is None or self.controller.session is not candidate:  # could not be shown: keep the old
-            self._install_session(previous, self.session_path, self.datasets, getattr(self, "title", ""), True)
-            return False
+        candidate.layout.pop("window_state", None)  # the docks stay where they are
+        # prepared in the background; the current scene stays until the new one is ready (or shown on an error)
+        self._show_session(candidate, self.session_path, getattr(self, "title", ""), True, datasets=self.datasets)
         return True
 
     def _settings_changed(self, values: dict[str, Any]) -> None:
@@ -571,9 +706,10 @@ class MainWindow(QMainWindow):
             self._enforce_error_budget(self.last_error_rmse)
             return
         if rebuild and self.controller is not None:  # another renderer: rebuild the scene with the same camera
-            camera = self.controller.camera()
-            self.session.camera = camera
-            self._install_session(self.session, self.session_path, self.datasets, getattr(self, "title", ""), True)
+            self.session.camera = self.controller.camera()
+            self.session.layout.pop("window_state", None)
+            self._show_session(self.session, self.session_path, getattr(self, "title", ""), True,
+                               datasets=self.datasets)
 
     def _time_changed(self, t: float) -> None:
         if self.controller is not None and self.controller.time_series():
@@ -585,10 +721,52 @@ class MainWindow(QMainWindow):
 
     def _show_time(self, t: float, interpolate: Optional[bool]) -> None:
         controller = self.controller
-        controller.set_time(t, interpolate=interpolate, update=False, isosurfaces=False)
-        if len(controller.time_isosurfaces()) < len(controller.time_series()):  # volumes changed: draw them
-            self.schedule_render()
+        controller.set_time(t, interpolate=interpolate, update=False, isosurfaces=False, volumes=False)
+        self.refresh_time_volumes()
         self.refresh_time_isosurfaces()
+
+    def refresh_time_volumes(self) -> None:
+        """Blend the volumes of time series for the display time in the background (one blend in flight, the
+        newest display time next: ``OneInFlight``), then give them to VTK on this thread and draw once."""
+
+        def shown(controller: Any, result: dict[str, Any], key: tuple[float, bool]) -> None:
+            controller.show_volumes(result)
+            self.volume_time_shown = key
+
+        self._time_job(self._volume_jobs, "time blend", "Cannot show the volume at this time",
+                       lambda c: c.time_volumes(), lambda c: c.blend_volume, shown)
+
+    def _time_job(self, jobs: OneInFlight, name: str, error: str, comp_ids: Callable[[Any], list[str]],
+                  compute: Callable[[Any], Callable[..., Any]], shown: Callable[[Any, Any, tuple], None]) -> None:
+        """For the display time: ``compute(controller)(comp_id, t, interpolate, progress=...)`` for every component
+        of ``comp_ids(controller)`` on a worker (``OneInFlight``: playback never waits), then
+        ``shown(controller, results, (t, interpolate))`` on this thread and one repaint."""
+        controller = self.controller
+        if controller is None or not comp_ids(controller):
+            return
+        t, interpolate = controller.time, controller.interpolate_time
+
+        def start(next_request: Callable[[], None]) -> None:
+            ids = comp_ids(controller) if self.controller is controller else []
+            if not ids:
+                next_request()
+                return
+            fn = compute(controller)
+
+            def run(progress: Any = None) -> dict[str, Any]:
+                return {comp_id: fn(comp_id, t, interpolate, progress=progress) for comp_id in ids}
+
+            def done(outcome: JobOutcome) -> None:
+                if outcome.ok and self.controller is controller:
+                    shown(controller, outcome.result, (t, interpolate))
+                    self.schedule_render()
+                elif outcome.error is not None:
+                    self.show_error(error, str(outcome.error))
+                next_request()
+
+            self.jobs.submit(run, name=name, on_done=done)
+
+        jobs.request(start)
 
     def schedule_render(self) -> None:
         """Draw once control returns to the event loop: a repaint of the viewport, which renders (Qt merges the
@@ -598,35 +776,16 @@ class MainWindow(QMainWindow):
 
     def refresh_time_isosurfaces(self) -> None:
         """Re-extract the isosurfaces of time series for the display time in the background (issue #8: playback
-        never waits for the extraction; ``OneInFlight``), then replace their actors on this thread."""
-        controller = self.controller
-        if controller is None or not controller.time_isosurfaces():
-            return
-        t, interpolate = controller.time, controller.interpolate_time
+        never waits for the extraction; ``OneInFlight``), with their clipping and LOD chains, then replace their
+        actors on this thread."""
 
-        def start(next_request: Callable[[], None]) -> None:
-            comp_ids = controller.time_isosurfaces() if self.controller is controller else []
-            if not comp_ids:
-                next_request()
-                return
+        def shown(controller: Any, result: dict[str, Any], key: tuple[float, bool]) -> None:
+            controller.show_isosurfaces(result)
+            self.iso_time_shown = key
+            self.refresh_iso_overlay()
 
-            def extract(progress: Any = None) -> dict[str, list[Any]]:
-                return {comp_id: controller.extract_isosurfaces(comp_id, t, interpolate, progress=progress)
-                        for comp_id in comp_ids}
-
-            def done(outcome: JobOutcome) -> None:
-                if outcome.ok and self.controller is controller:
-                    controller.show_isosurfaces(outcome.result)
-                    self.iso_time_shown = (t, interpolate)
-                    self.schedule_render()
-                    self.refresh_iso_overlay()
-                elif outcome.error is not None:
-                    self.show_error("Cannot extract the isosurfaces", str(outcome.error))
-                next_request()
-
-            self.jobs.submit(extract, name="isosurfaces", on_done=done)
-
-        self._iso_jobs.request(start)
+        self._time_job(self._iso_jobs, "isosurfaces", "Cannot extract the isosurfaces",
+                       lambda c: c.time_isosurfaces(), lambda c: c.isosurface_parts, shown)
 
     # ------------------------------------------------------------------------------------------------ navigation
     def set_fly_mode(self, enabled: bool) -> None:
@@ -661,13 +820,15 @@ class MainWindow(QMainWindow):
             self.refresh_pt(comp_id)
         self.refresh_iso_overlay()
 
-    def refresh_nature(self) -> None:
+    def refresh_nature(self, settled: Optional[Callable[[], None]] = None) -> None:
         """Re-compute the natural scene's view-dependent parts (C-LOD terrain, fog and cloud images; issue #5) for
         the newest camera in the background (``OneInFlight``): the camera is read when the job starts, the VTK data
         replaced on this thread when it is done."""
         controller = self.controller
         view = controller.nature if controller is not None else None
         if view is None:
+            if settled is not None:
+                settled()
             return
 
         def start(next_request: Callable[[], None]) -> None:
@@ -678,7 +839,7 @@ class MainWindow(QMainWindow):
 
             def done(outcome: JobOutcome) -> None:
                 if outcome.ok and self.controller is controller and controller.nature is view:
-                    self.last_view_stats = view.finish(request, *outcome.result)
+                    self.last_view_stats = controller.finish_nature(view, request, outcome.result)
                     self.nature_updates += 1
                     self.schedule_render()
                 elif outcome.error is not None:
@@ -687,9 +848,10 @@ class MainWindow(QMainWindow):
 
             self.jobs.submit(view.compute, request, name="natural scene", on_done=done)
 
-        self._nature_jobs.request(start)
+        self._nature_jobs.request(start, settled)
 
-    def refresh_lod(self, comp_ids: Optional[list[str]] = None) -> None:
+    def refresh_lod(self, comp_ids: Optional[list[str]] = None,
+                    settled: Optional[Callable[[], None]] = None) -> None:
         """Re-select the blocks of volumes at a level of detail for the current camera and TF in the background:
         first a coarse selection (an eighth of the block budget) that shows quickly, then the full budget (the
         refinement once the camera stopped); selection and decoding on a worker, the drawing on this thread."""
@@ -700,8 +862,10 @@ class MainWindow(QMainWindow):
             if comp_ids is not None and comp_id not in comp_ids:
                 continue
             jobs = self._lod_jobs.setdefault(comp_id, OneInFlight())
-            for budget in dict.fromkeys((max(1, volume.budget // 8), volume.budget)):
-                jobs.request(self._lod_step(controller, comp_id, volume, budget))
+            budgets = list(dict.fromkeys((max(1, volume.budget // 8), volume.budget)))
+            for budget in budgets:  # ``settled()`` once per volume, when its full budget is shown
+                jobs.request(self._lod_step(controller, comp_id, volume, budget),
+                             settled if budget == budgets[-1] else None)
 
     def _lod_step(self, controller: Any, comp_id: str, volume: Any, budget: int) -> Callable[..., None]:
         def start(next_request: Callable[[], None]) -> None:
@@ -1058,8 +1222,10 @@ class MainWindow(QMainWindow):
             self.progress_bar.setValue(0)
 
     def cancel_current_job(self) -> None:
-        if self._current_job is not None:
+        if self._current_job is not None and not self._current_job.done():
             self._current_job.cancel()
+        elif self._loading_views:  # the scene is shown; stop computing its first views
+            self.jobs.runner.cancel_all()
 
     # ------------------------------------------------------------------------------------------------ closing
     def ask_unsaved_changes(self) -> QMessageBox.StandardButton:

@@ -142,6 +142,8 @@ def test_timeline_plays_the_storm_series(qtbot, make_window, tmp_path: Path) -> 
     qtbot.waitUntil(lambda: window.timeline.time > 5.0, timeout=10000)
     window.timeline.set_playing(False)
     assert window.controller.time == pytest.approx(window.timeline.time)
+    # the blended volume of the display time is made in the background, then shown
+    qtbot.waitUntil(lambda: window.volume_time_shown == (window.controller.time, True), timeout=10000)
     assert np.abs(viewport(window) - first).mean() > 0.2, "the volume did not change over time"
     window.timeline.set_time(1.5)  # between two steps: interpolated data
     a = window.controller.datasets["data"].frame(0).data.astype(np.float32)
@@ -419,10 +421,12 @@ def test_component_settings_edited_in_the_scene_tree(qtbot, make_window, tmp_pat
     settings["styles"][0]["value"] = 40  # a lower iso-value: a much larger surface
     tree.settings_edit.setPlainText(json.dumps(settings))
     tree.apply_button.click()
+    wait_loaded(qtbot, window)  # the scene is rebuilt in the background, then swapped in
     assert window.session.components[0].settings["styles"][0]["value"] == 40 and window.dirty
     assert (np.abs(viewport(window) - before).sum(axis=2) > 30).mean() > 0.01
     tree.settings_edit.setPlainText('{"styles": "many"}')  # invalid: refused with a message, nothing changes
     tree.apply_button.click()
+    qtbot.waitUntil(lambda: window.error_dialog is not None, timeout=30000)
     assert "iso" in window.error_dialog.text()
     assert window.session.components[0].settings["styles"][0]["value"] == 40
 

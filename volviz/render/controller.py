@@ -8,7 +8,8 @@ mode (``session.render.options["iso_mode"]``: "vtk" = VTK's own 2-pass blend, or
 """
 from __future__ import annotations
 
-from typing import Any, Optional
+from contextlib import contextmanager
+from typing import Any, Iterator, Optional
 
 from volviz.model import TimeSeries
 from volviz.session import CameraState, Component, Session
@@ -30,6 +31,18 @@ def _is_pt(prop: Any) -> bool:
     return isinstance(prop, PTVolume) and not isinstance(prop, IsoOverlay)
 
 
+@contextmanager
+def no_render(plotter: Any) -> Iterator[None]:
+    """PyVista renders after every added actor or mesh (``render=True``); inside this block it does not, and the
+    caller draws once afterwards (each render of a big scene on llvmpipe is 50-600 ms of a blocked GUI thread)."""
+    suppressed = getattr(plotter, "suppress_rendering", False)
+    plotter.suppress_rendering = True
+    try:
+        yield
+    finally:
+        plotter.suppress_rendering = suppressed
+
+
 def ensure_lights(plotter: Any) -> None:
     """Give a renderer without lights PyVista's default light kit again (``Plotter.clear`` removes all lights; unlit,
     VTK compiles shaders without normals, and the iso-spectrum shader cannot compile)."""
@@ -47,25 +60,47 @@ class SceneController:
         self.iso_overlay: Any = None      # IsoOverlay while a CPU transparency mode is on
         self._pt_meshes: dict[str, Any] = {}   # uncut tetrahedral meshes of clipped PT volumes
         self._vtk_inputs: dict[str, Any] = {}  # uncut inputs of clipped VTK tetrahedral volumes
+        self.histograms: dict[str, Any] = {}   # comp id -> (counts, edges) of its data, from ``prepare``
         self.time = 0.0
         self.interpolate_time = True
 
     # -- building ---------------------------------------------------------------------------------------------------
     def build(self) -> None:
-        from volviz.render.scene import build_scene
+        """Build the scene now (``prepare`` then ``install``, both on this thread)."""
+        self.install(self.prepare())
+
+    def prepare(self, progress: Any = None) -> Any:
+        """Any thread, before ``install``: the heavy part of building (``volviz.render.scene.prepare_scene``) at the
+        session's display time. Touches no plotter, so the app runs it in the background."""
+        from volviz.render.scene import prepare_scene
+
+        span = self.time_span()
+        t = span[0] if span else None
+        start = self.session.render.options.get("time")
+        if span and isinstance(start, (int, float)):
+            t = float(start)  # the session's display time
+        return prepare_scene(self.session, self.datasets, t, self.interpolate_time, progress)
+
+    def install(self, prepared: Any, views: bool = True) -> None:
+        """GUI thread: add the props of a ``prepare`` result to the plotter without rendering. The view-dependent
+        parts (PT images, LOD blocks, terrain and overlay) are drawn now when ``views``; the app instead updates them
+        in the background (``pt_volume``, ``lod_volumes``, ``nature``: ``begin`` / ``compute`` / ``finish``)."""
+        from volviz.render.scene import install_scene
 
         ensure_lights(self.plotter)
-        self.props = build_scene(self.plotter, self.session, self.datasets, spectrum=True)
-        self.plotter.camera_set = True  # build_scene chose the view; PyVista must not re-frame the visible props
-        self._pt_meshes, self._vtk_inputs = {}, {}
-        span = self.time_span()
-        self.time = span[0] if span else 0.0
-        start = self.session.render.options.get("time")
-        if span and isinstance(start, (int, float)) and start != self.time:
-            self.set_time(float(start))  # the session's display time
-        if self.clip.all_planes():
-            self.apply_clip()
-        self.set_iso_mode(self.iso_mode, update=True)
+        with no_render(self.plotter):  # the caller draws once afterwards
+            self.props = install_scene(self.plotter, self.session, self.datasets, prepared, spectrum=True,
+                                       views=views)
+            self.plotter.camera_set = True  # install_scene chose the view; PyVista must not re-frame the props
+            self._pt_meshes, self._vtk_inputs = {}, {}
+            self.histograms = dict(prepared.histograms)
+            self.time = prepared.time if prepared.time is not None else 0.0
+            for comp_id, cut in prepared.cut.items():  # PT meshes were cut in ``prepare``
+                if comp_id in self.props:
+                    self.set_pt_mesh(comp_id, cut)
+            if self.clip.all_planes():
+                self.apply_clip(update_pt=False, cut_pt=False, isosurfaces=False)
+            self.set_iso_mode(self.iso_mode, update=views)
 
     def clear(self) -> None:
         """Remove everything this controller added, including PT overlay renderers, which ``plotter.clear()`` keeps."""
@@ -116,13 +151,16 @@ class SceneController:
         elif prop is not None and prop.IsA("vtkVolume"):
             update_volume_property(prop.GetProperty(), tf, comp.opacity)
 
-    def set_visible(self, comp_id: str, visible: bool) -> None:
+    def set_visible(self, comp_id: str, visible: bool, nature: bool = True) -> None:
+        """Show or hide a component. A terrain / fog / clouds / sky component rebuilds the natural scene now unless
+        ``nature`` is false (the app rebuilds it in the background: ``prepare_nature``, ``install_nature``)."""
         from volviz.render.scene import NATURE_TYPES
 
         comp = self.component(comp_id)
         comp.visible = bool(visible)
         if comp.type in NATURE_TYPES:
-            self.rebuild_nature()
+            if nature:
+                self.rebuild_nature()
             return
         prop = self.props.get(comp_id)
         if comp.type == "isosurface":
@@ -189,15 +227,13 @@ class SceneController:
         return sorted(steps)
 
     def set_time(self, t: float, interpolate: Optional[bool] = None, update: bool = True,
-                 isosurfaces: bool = True) -> None:
+                 isosurfaces: bool = True, volumes: bool = True) -> None:
         """Show display time ``t`` (blending neighbouring steps when interpolating). The CPU-mode isosurface overlay
         re-renders at once when ``update`` (the app renders it in the background instead). Isosurfaces of a time
         series are re-extracted here when ``isosurfaces``; the app instead extracts them in the background
-        (``time_isosurfaces`` → ``extract_isosurfaces`` on a worker → ``show_isosurfaces``)."""
-        from volviz.model.timeseries import frame_at
-        from volviz.render.clipping import clip_vtk_prop
-        from volviz.render.vtk_scene import volume_input
-
+        (``time_isosurfaces`` → ``isosurface_parts`` on a worker → ``show_isosurfaces``). Volumes of a time series
+        are blended here when ``volumes``; the app instead blends them in the background (``time_volumes`` →
+        ``blend_volume`` on a worker → ``show_volumes``)."""
         if interpolate is not None:
             self.interpolate_time = bool(interpolate)
         self.time = float(t)
@@ -210,14 +246,38 @@ class SceneController:
                 comp.settings = {**comp.settings, "interpolate": self.interpolate_time}
                 if isosurfaces:
                     self.show_isosurfaces({comp_id: self.extract_isosurfaces(comp_id, self.time)})
-            elif prop.IsA("vtkVolume"):
-                self._vtk_inputs.pop(comp_id, None)
-                prop.GetMapper().SetInputData(volume_input(frame_at(series, self.time, self.interpolate_time)))
-                if self.clip.all_planes():
-                    self._vtk_inputs[comp_id] = clip_vtk_prop(prop, self.clip)
+            elif prop.IsA("vtkVolume") and volumes:
+                self.show_volumes({comp_id: self.blend_volume(comp_id, self.time)})
         self._sync_iso_overlay()
         if update and self.iso_overlay is not None:
             self.iso_overlay.update()
+
+    def time_volumes(self) -> list[str]:
+        """The VTK volumes shown from a time series (what a display-time change re-blends)."""
+        return [comp_id for comp_id in self.time_series()
+                if self.component(comp_id).type != "isosurface" and self.props.get(comp_id) is not None
+                and self.props[comp_id].IsA("vtkVolume")]
+
+    def blend_volume(self, comp_id: str, t: float, interpolate: Optional[bool] = None, progress: Any = None) -> Any:
+        """Any thread: the VTK input of a time-series volume at display time ``t`` (the 4D blend of the neighbouring
+        steps when interpolating, libMini note "4D Visualization"); ``show_volumes`` puts it on screen."""
+        from volviz.render.scene import prepared_volume_input
+
+        interpolate = self.interpolate_time if interpolate is None else bool(interpolate)
+        return prepared_volume_input(self.time_series()[comp_id], float(t), interpolate)
+
+    def show_volumes(self, inputs: dict[str, Any]) -> None:
+        """GUI thread: give time-series volumes new inputs (``comp_id → blend_volume(...)``), cut by the clipping."""
+        from volviz.render.clipping import clip_vtk_prop
+
+        for comp_id, data in inputs.items():
+            prop = self.props.get(comp_id)
+            if prop is None or data is None:
+                continue
+            self._vtk_inputs.pop(comp_id, None)
+            prop.GetMapper().SetInputData(data)
+            if self.clip.all_planes():
+                self._vtk_inputs[comp_id] = clip_vtk_prop(prop, self.clip)
 
     def time_isosurfaces(self) -> list[str]:
         """The isosurface components shown from a time series (what a display-time change re-extracts)."""
@@ -242,23 +302,34 @@ class SceneController:
             raise SceneError(f"component {comp_id!r}: {exc}") from None
         return list(prepare(self.dataset_of(comp_id), settings, float(t), progress=progress).meshes)
 
-    def show_isosurfaces(self, meshes: dict[str, list[Any]]) -> None:
-        """GUI thread: replace the actors of isosurface components by new extracted surfaces (``comp_id → meshes``,
-        from ``extract_isosurfaces``), cut by the scene's clipping; the overlay's meshes follow (not re-rendered)."""
-        from volviz.render.scene import add_isosurfaces
+    def isosurface_parts(self, comp_id: str, t: float, interpolate: Optional[bool] = None,
+                         progress: Any = None) -> Any:
+        """Any thread: ``extract_isosurfaces`` cut by the scene's clipping, with their LOD chains
+        (``volviz.render.scene.IsoParts``), so that ``show_isosurfaces`` only makes actors."""
+        from volviz.render.scene import isosurface_parts
 
-        suppressed = getattr(self.plotter, "suppress_rendering", False)
-        self.plotter.suppress_rendering = True  # no render per added actor: the caller draws once afterwards
-        try:
+        meshes = self.extract_isosurfaces(comp_id, t, interpolate, progress)
+        return isosurface_parts(self.component(comp_id), meshes=meshes, clip=self.session.clip)
+
+    def show_isosurfaces(self, meshes: dict[str, Any]) -> None:
+        """GUI thread: replace the actors of isosurface components by new surfaces (``comp_id →`` the meshes of
+        ``extract_isosurfaces``, or better the ``isosurface_parts``, whose clipping and LOD chains were made off this
+        thread and are redone here only when the clipping or opacity changed since); the overlay's meshes follow
+        (not re-rendered)."""
+        from volviz.render.scene import IsoParts, add_isosurface_actors, isosurface_parts
+
+        with no_render(self.plotter):  # no render per added actor: the caller draws once afterwards
             for comp_id, surfaces in meshes.items():
                 prop = self.props.get(comp_id)
                 if prop is None:
                     continue
+                comp = self.component(comp_id)
+                parts = surfaces if isinstance(surfaces, IsoParts) else None
+                if parts is None or parts.clip != self.clip.to_dict() or parts.opacity != comp.opacity:
+                    parts = isosurface_parts(comp, meshes=list(parts.meshes if parts else surfaces),
+                                             clip=self.session.clip)
                 self.plotter.remove_actor(prop, render=False)
-                self.props[comp_id] = add_isosurfaces(self.plotter, self.component(comp_id), None,
-                                                      clip=self.session.clip, meshes=surfaces)
-        finally:
-            self.plotter.suppress_rendering = suppressed
+                self.props[comp_id] = add_isosurface_actors(self.plotter, comp_id, parts)
         self._sync_iso_overlay()
 
     # -- camera -----------------------------------------------------------------------------------------------------
@@ -315,14 +386,38 @@ class SceneController:
         return {comp_id: dict(prop.stats) for comp_id, prop in self.props.items() if _is_pt(prop)}
 
     def rebuild_nature(self) -> None:
-        from volviz.render.scene import build_nature
+        """Rebuild the natural scene for the visible nature components now (``prepare_nature``, ``install_nature``)."""
+        self.install_nature(self.prepare_nature())
 
-        for name in ("nature-sky", "nature-terrain", "nature-overlay"):
-            self.plotter.remove_actor(name, render=False)
+    def prepare_nature(self, progress: Any = None) -> Any:
+        """Any thread: the NatureScene of the visible terrain / fog / clouds / sky components (None: none)."""
+        from volviz.render.scene import prepare_nature
+
+        return prepare_nature(self.session, self.datasets)
+
+    def install_nature(self, scene: Any, views: bool = True) -> Any:
+        """GUI thread: show a ``prepare_nature`` result. With ``views`` its first view is computed now; otherwise
+        the old terrain and overlay stay on screen until the new view's first ``finish_nature`` replaces them."""
+        from volviz.render.scene import install_nature
+
         self.props.pop("nature", None)
-        view = build_nature(self.plotter, self.session, self.datasets)
+        names = ("nature-sky", "nature-terrain", "nature-overlay") if views or scene is None else ()
+        for name in names:
+            self.plotter.remove_actor(name, render=False)
+        with no_render(self.plotter):
+            view = install_nature(self.plotter, scene, views)
         if view is not None:
             self.props["nature"] = view
+        return view
+
+    def finish_nature(self, view: Any, request: Any, result: tuple[Any, ...]) -> dict[str, Any]:
+        """GUI thread: show a computed view of the natural scene (``view.compute``); a scene without terrain drops
+        the terrain of the view it replaced."""
+        with no_render(self.plotter):  # the caller draws once afterwards
+            stats = view.finish(request, *result)
+            if view.terrain_actor is None:
+                self.plotter.remove_actor("nature-terrain", render=False)
+        return stats
 
     def bounds(self) -> tuple[float, float, float, float, float, float]:
         """(xmin, xmax, ymin, ymax, zmin, zmax) of everything the scene shows, including what VTK does not see:
@@ -361,7 +456,9 @@ class SceneController:
         self.session.clip = clip.to_dict() if isinstance(clip, ClipSettings) else self.clip.from_dict(clip).to_dict()
         return self.apply_clip(update_pt, cut_pt)
 
-    def apply_clip(self, update_pt: bool = True, cut_pt: bool = True) -> list[str]:
+    def apply_clip(self, update_pt: bool = True, cut_pt: bool = True, isosurfaces: bool = True) -> list[str]:
+        """Cut every prop by the session's clipping (isosurfaces only when ``isosurfaces``: ``install`` gets them
+        cut by ``prepare``); returns the ids of the PT volumes (see ``set_clip``)."""
         from volviz.render.clipping import clip_vtk_prop
 
         clip = self.clip
@@ -371,7 +468,8 @@ class SceneController:
                 continue
             comp = self.component(comp_id)
             if comp.type == "isosurface":
-                self._readd_isosurfaces(comp_id)
+                if isosurfaces:
+                    self._readd_isosurfaces(comp_id)
             elif _is_pt(prop):
                 self._pt_meshes.setdefault(comp_id, prop.mesh)
                 pt_ids.append(comp_id)
@@ -389,15 +487,12 @@ class SceneController:
 
     def cut_pt_mesh(self, comp_id: str, clip: Any = None, progress: Any = None) -> Any:
         """Any thread: the PT volume's uncut mesh cut by ``clip`` (default: the session's), exactly
-        (``volviz.iso.clip.clip_tetmesh``); None when the clipping removes all of it."""
-        from volviz.iso.clip import clip_tetmesh
+        (``volviz.iso.clip.clip_tetmesh``), with its topology built; None when the clipping removes all of it."""
+        from volviz.render.scene import cut_tetmesh
 
         prop = self.props[comp_id]
         whole = self._pt_meshes.get(comp_id, prop.mesh)
-        try:
-            return clip_tetmesh(whole, self.clip if clip is None else clip)
-        except ValueError:  # everything clipped away
-            return None
+        return cut_tetmesh(whole, self.clip if clip is None else clip)
 
     def set_pt_mesh(self, comp_id: str, mesh: Any) -> None:
         """Show a cut mesh of ``cut_pt_mesh`` (None: nothing left, the volume is hidden); re-render it afterwards."""

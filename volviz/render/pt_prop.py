@@ -240,8 +240,11 @@ class PTVolume:
 
     @visible.setter
     def visible(self, on: bool) -> None:
+        if bool(on) == self.visible:
+            return
         self._overlay.SetDraw(bool(on))
-        self.plotter.ren_win.Render()          # PyVista's screenshot() does not notice a foreign renderer's change
+        if not getattr(self.plotter, "suppress_rendering", False):
+            self.plotter.ren_win.Render()      # PyVista's screenshot() does not notice a foreign renderer's change
 
     def remove(self) -> None:
         """Detach the overlay from the plotter's render window."""

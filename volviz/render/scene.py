@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import os
 import re
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Optional
 
@@ -83,14 +84,16 @@ def demo_volume_session() -> Session:
 
 
 def load_datasets(session: Session, session_file: Optional[str | os.PathLike],
-                  progress: Optional[ProgressCallback] = None) -> dict[str, Any]:
-    """Read every dataset that a visible component uses, once each, with progress."""
+                  progress: Optional[ProgressCallback] = None,
+                  loaded: Optional[dict[str, Any]] = None) -> dict[str, Any]:
+    """Read every dataset that a visible component uses, once each, with progress; those already in ``loaded`` are
+    kept (the dict is filled in and returned)."""
     from volviz.nature.scene import nature_dataset_ids
 
     used = {c.dataset for c in session.components if c.visible and c.dataset is not None}
     used |= nature_dataset_ids([c for c in session.components if c.visible and c.type in NATURE_TYPES])
-    refs = [ref for ref in session.datasets if ref.id in used]
-    loaded: dict[str, Any] = {}
+    loaded = {} if loaded is None else loaded
+    refs = [ref for ref in session.datasets if ref.id in used and ref.id not in loaded]
     for i, ref in enumerate(refs):
         report(progress, i / max(len(refs), 1), f"reading {Path(ref.path).name}")
         path = resolve_path(session_file, ref.path) if session_file else Path(ref.path)
@@ -156,12 +159,157 @@ def read_any(path: Path, options: dict[str, Any], progress: Optional[ProgressCal
     return read(path, **options)
 
 
-def build_scene(plotter: Any, session: Session, datasets: dict[str, Any], spectrum: bool = True) -> dict[str, Any]:
-    """Add every visible component to ``plotter``; returns the VTK prop of each component by id, and under
-    ``"nature"`` the NatureView that draws the terrain, fog, clouds and sky components together."""
-    from volviz.render.vtk_scene import add_dataset, apply_camera
+@dataclass
+class PreparedScene:
+    """What ``prepare_scene`` computed off the GUI thread for ``install_scene`` (DESIGN.md "Background work")."""
+
+    time: Optional[float]                                   # display time of time series (None without one)
+    parts: dict[str, Any] = field(default_factory=dict)     # comp id -> IsoParts | TetMesh (PT) | VTK volume input
+    cut: dict[str, Any] = field(default_factory=dict)       # PT comp id -> mesh cut by the scene clip (None: all cut)
+    histograms: dict[str, Any] = field(default_factory=dict)  # comp id -> (counts, edges) of its data
+    nature: Any = None                                      # the NatureScene of the terrain/fog/clouds/sky components
+
+
+def prepare_scene(session: Session, datasets: dict[str, Any], t: Optional[float] = None, interpolate: bool = True,
+                  progress: Optional[ProgressCallback] = None) -> PreparedScene:
+    """Any thread: the heavy part of showing ``session`` (default transfer functions, isosurface extraction with
+    clipping and LOD chains, tetrahedralisation and mesh topology, VTK volume inputs and time blending at display
+    time ``t``, the natural scene's maps and volumes, data histograms). Touches no plotter; ``install_scene`` adds
+    the props on the GUI thread."""
+    from volviz.model import TimeSeries
+    from volviz.model.stats import histogram
+    from volviz.render.clipping import clip_settings
 
     ensure_transfer_functions(session, datasets)
+    prepared = PreparedScene(time=t)
+    clip = clip_settings(session.clip)
+    shown = [c for c in session.components if c.visible and c.type not in NATURE_TYPES]
+    for i, comp in enumerate(shown):
+        report(progress, i / max(len(shown) + 1, 1), f"preparing {comp.id}")
+        dataset = component_dataset(comp, datasets)
+        series = isinstance(dataset, TimeSeries)
+        if comp.type == "isosurface":
+            if series:  # the 4D blend of the display time (as ``SceneController.set_time`` does)
+                comp.settings = {**comp.settings, "interpolate": bool(interpolate)}
+            prepared.parts[comp.id] = isosurface_parts(comp, dataset, t if series else None, session.clip)
+            continue
+        if comp.transfer_function is not None and not is_lod(dataset):
+            prepared.histograms[comp.id] = histogram(dataset)
+        if is_lod(dataset):
+            continue
+        if uses_pt(session, dataset):
+            mesh = pt_mesh(dataset)
+            prepared.parts[comp.id] = mesh
+            if clip.all_planes():
+                prepared.cut[comp.id] = cut_tetmesh(mesh, clip)
+        else:
+            prepared.parts[comp.id] = prepared_volume_input(dataset, t, interpolate)
+    report(progress, len(shown) / max(len(shown) + 1, 1), "natural scene")
+    prepared.nature = prepare_nature(session, datasets)
+    report(progress, 1.0, "scene prepared")
+    return prepared
+
+
+def pt_mesh(dataset: Any) -> Any:
+    """Any thread: the tetrahedral mesh a PT volume draws for ``dataset``, with its topology built (cached on it)."""
+    from volviz.model.datasets import TetMesh
+    from volviz.unstructured.topology import topology
+
+    mesh = dataset
+    if not isinstance(dataset, TetMesh):
+        from volviz.unstructured.tetrahedralize import tetrahedralize
+
+        mesh = tetrahedralize(dataset, getattr(dataset, "active", None))
+    topology(mesh)
+    return mesh
+
+
+def cut_tetmesh(mesh: Any, clip: Any) -> Any:
+    """Any thread: ``mesh`` cut exactly by ``clip`` (``volviz.iso.clip.clip_tetmesh``) with its topology built; None
+    when the clipping removes all of it."""
+    from volviz.iso.clip import clip_tetmesh
+    from volviz.unstructured.topology import topology
+
+    try:
+        cut = clip_tetmesh(mesh, clip)
+    except ValueError:  # everything clipped away
+        return None
+    topology(cut)
+    return cut
+
+
+def prepared_volume_input(dataset: Any, t: Optional[float] = None, interpolate: bool = True) -> Any:
+    """Any thread: the VTK data object a volume mapper draws for ``dataset`` (a time series: blended at display
+    time ``t``, libMini note "4D Visualization"), or None when ``add_dataset`` does not draw it as a volume."""
+    from volviz.model import Image2D, TimeSeries
+    from volviz.render.vtk_scene import volume_grid, volume_input
+
+    if isinstance(dataset, TimeSeries):
+        from volviz.model.timeseries import frame_at
+
+        dataset = frame_at(dataset, float(dataset.times[0] if t is None else t), interpolate)
+    if isinstance(dataset, Image2D) or volume_grid(dataset).active_scalars is None:
+        return None
+    return volume_input(dataset)
+
+
+def add_volume_prop(plotter: Any, dataset: Any, data: Any, tf: Any, opacity: float, name: str) -> Any:
+    """GUI thread: a vtkVolume drawing ``data`` (from ``prepared_volume_input``; None: ``add_dataset`` instead)."""
+    import vtk
+
+    from volviz.model import RegularVolume, TimeSeries
+    from volviz.render.vtk_scene import add_dataset, vtk_volume_property
+
+    if data is None:
+        return add_dataset(plotter, dataset, tf=tf, opacity=opacity, name=name)
+    regular = isinstance(dataset.frame(0) if isinstance(dataset, TimeSeries) else dataset, RegularVolume)
+    mapper = vtk.vtkSmartVolumeMapper() if regular else vtk.vtkProjectedTetrahedraMapper()
+    mapper.SetInputData(data)
+    volume = vtk.vtkVolume()
+    volume.SetMapper(mapper)
+    volume.SetProperty(vtk_volume_property(tf, opacity))
+    plotter.add_actor(volume, name=name, reset_camera=False)
+    return volume
+
+
+def prepare_nature(session: Session, datasets: dict[str, Any]) -> Any:
+    """Any thread: the NatureScene of the session's visible terrain / fog / clouds / sky components (None when it has
+    none): maps read into height fields, fog prisms, cloud volumes and lighting; ``NatureView`` shows it."""
+    components = [c for c in session.components if c.visible and c.type in NATURE_TYPES]
+    if not components:
+        return None
+    from volviz.nature.scene import scene_from_components
+
+    try:
+        scene = scene_from_components(components, datasets)
+    except (ValueError, KeyError) as exc:
+        raise SceneError(f"natural scene: {exc}") from None
+    scene.finalize()
+    return scene
+
+
+def install_nature(plotter: Any, scene: Any, views: bool = True) -> Any:
+    """GUI thread: a NatureView of a prepared NatureScene (None: none); its first view is computed now when ``views``
+    (the app computes it in the background: ``begin`` / ``compute`` / ``finish``)."""
+    if scene is None:
+        return None
+    from volviz.nature.scene import NatureView
+
+    view = NatureView(plotter, scene)
+    if views:
+        view.update()
+    return view
+
+
+def install_scene(plotter: Any, session: Session, datasets: dict[str, Any], prepared: PreparedScene,
+                  spectrum: bool = True, views: bool = True) -> dict[str, Any]:
+    """GUI thread: add the props of a ``prepare_scene`` result to ``plotter``; returns the VTK prop of each
+    component by id, and under ``"nature"`` the NatureView that draws the terrain, fog, clouds and sky components
+    together. The view-dependent parts (PT volume images, LOD block selections, the natural scene's terrain and
+    overlay) are drawn now when ``views``; otherwise they stay empty until the caller updates them (the app does
+    that in the background)."""
+    from volviz.render.vtk_scene import apply_camera
+
     props: dict[str, Any] = {}
     pt_components = []
     lod_components = []
@@ -170,33 +318,37 @@ def build_scene(plotter: Any, session: Session, datasets: dict[str, Any], spectr
             continue
         dataset = component_dataset(comp, datasets)
         if comp.type == "isosurface":
-            props[comp.id] = add_isosurfaces(plotter, comp, dataset, spectrum=spectrum, clip=session.clip)
+            props[comp.id] = add_isosurface_actors(plotter, comp.id, prepared.parts[comp.id], spectrum=spectrum)
         elif is_lod(dataset):
             lod_components.append((comp, dataset))   # selected for the final camera
         elif uses_pt(session, dataset):
-            pt_components.append((comp, dataset))  # drawn last: they composite over the opaque scene's depth
+            pt_components.append((comp, prepared.parts[comp.id]))  # drawn last: over the opaque scene's depth
         else:
             tf = component_transfer_function(session, comp)
-            props[comp.id] = add_dataset(plotter, dataset, tf=tf, opacity=comp.opacity, name=comp.id)
+            props[comp.id] = add_volume_prop(plotter, dataset, prepared.parts.get(comp.id), tf, comp.opacity,
+                                             comp.id)
     plotter.set_background(session.render.background)
     if session.camera is None and pt_components:
-        from volviz.render.vtk_scene import volume_grid
-
         plotter.view_isometric()
-        bounds = np.array([volume_grid(d).bounds for _, d in pt_components])
-        lo, hi = bounds[:, 0::2].min(axis=0), bounds[:, 1::2].max(axis=0)
+        lo = np.min([m.points.min(axis=0) for _, m in pt_components], axis=0)
+        hi = np.max([m.points.max(axis=0) for _, m in pt_components], axis=0)
         plotter.renderer.ResetCamera(lo[0], hi[0], lo[1], hi[1], lo[2], hi[2])
         plotter.camera_set = True  # else PyVista re-frames its (empty) VTK props at the next render
     else:
         apply_camera(plotter, session.camera)
-    nature = build_nature(plotter, session, datasets)
+    nature = install_nature(plotter, prepared.nature, views)
     if nature is not None:
         props["nature"] = nature
     for comp, dataset in lod_components:
-        props[comp.id] = add_lod_component(plotter, session, comp, dataset)
-    for comp, dataset in pt_components:
-        props[comp.id] = add_pt_component(plotter, session, comp, dataset)
+        props[comp.id] = add_lod_component(plotter, session, comp, dataset, update=views)
+    for comp, mesh in pt_components:
+        props[comp.id] = add_pt_component(plotter, session, comp, mesh, update=views)
     return props
+
+
+def build_scene(plotter: Any, session: Session, datasets: dict[str, Any], spectrum: bool = True) -> dict[str, Any]:
+    """Add every visible component to ``plotter`` now (``prepare_scene`` then ``install_scene``)."""
+    return install_scene(plotter, session, datasets, prepare_scene(session, datasets), spectrum)
 
 
 def is_lod(dataset: Any) -> bool:
@@ -205,9 +357,10 @@ def is_lod(dataset: Any) -> bool:
     return isinstance(dataset, LodTree)
 
 
-def add_lod_component(plotter: Any, session: Session, comp: Component, dataset: Any) -> Any:
+def add_lod_component(plotter: Any, session: Session, comp: Component, dataset: Any, update: bool = True) -> Any:
     """A compressed volume at a view-dependent level of detail (``volviz.render.lod_volume``); the component
-    setting ``budget`` is the number of blocks per view (default 256)."""
+    setting ``budget`` is the number of blocks per view (default 256). Its blocks are selected now when ``update``
+    (the app selects them in the background: ``select`` / ``decode`` / ``show``)."""
     from volviz.render.lod_volume import LodVolume
 
     if session.camera is None:
@@ -217,7 +370,8 @@ def add_lod_component(plotter: Any, session: Session, comp: Component, dataset: 
         plotter.camera_set = True
     lod = LodVolume(plotter, dataset, component_transfer_function(session, comp),
                     budget=int(comp.settings.get("budget", 256)), opacity=comp.opacity)
-    lod.update()
+    if update:
+        lod.update()
     return lod
 
 
@@ -234,17 +388,21 @@ def uses_pt(session: Session, dataset: Any) -> bool:
     return session.render.method != "vtk" and type(dataset).__name__ in PT_DATASETS
 
 
-def add_pt_component(plotter: Any, session: Session, comp: Component, dataset: Any) -> Any:
-    """A volviz PT volume (``volviz.render.pt_prop``) for a component, with its TF scaled by its opacity."""
-    from volviz.render.pt_prop import add_pt_volume
+def add_pt_component(plotter: Any, session: Session, comp: Component, dataset: Any, update: bool = True) -> Any:
+    """A volviz PT volume (``volviz.render.pt_prop``) for a component, with its TF scaled by its opacity; rendered
+    now when ``update`` (the app renders it in the background: ``begin`` / ``compute`` / ``finish``)."""
+    from volviz.render.pt_prop import PTVolume
 
     tf = component_transfer_function(session, comp)
     if comp.opacity != 1.0:
         tf = tf.scaled_extinction(comp.opacity)
     method = "reference" if session.render.method == "reference" else "pt"
     scalars = getattr(dataset, "active", None)
-    return add_pt_volume(plotter, dataset, tf, method=method, scalars=scalars,
-                         **(pt_options(session.render.options) if method == "pt" else {}))
+    handle = PTVolume(plotter, dataset, tf, method=method, scalars=scalars,
+                      **(pt_options(session.render.options) if method == "pt" else {}))
+    if update:
+        handle.update()
+    return handle
 
 
 def pt_options(options: dict[str, Any]) -> dict[str, Any]:
@@ -265,22 +423,25 @@ def pt_options(options: dict[str, Any]) -> dict[str, Any]:
     return out
 
 
-def add_isosurfaces(plotter: Any, comp: Component, dataset: Any, t: Optional[float] = None,
-                    spectrum: bool = True, clip: Any = None, meshes: Optional[list[Any]] = None) -> Any:
-    """The isosurfaces of an ``isosurface`` component (settings: ``volviz.iso.IsoSettings``) as one prop assembly of
-    VTK actors, with the iso-spectrum shader when ``spectrum`` (drawn by VTK as the note's 2-pass blend).
+@dataclass
+class IsoParts:
+    """An isosurface component's surfaces ready for actors (``isosurface_parts``): the extracted ones (uncut by the
+    scene clipping), the shown ones (cut, opacity scaled) and the LOD chains of the shown ones."""
 
-    ``clip``: the scene's clipping (``session.clip`` or ClipSettings), cut exactly into the triangles on top of the
-    component's own. ``meshes``: the component's extracted surfaces when already known (re-clipping skips the
-    extraction). The assembly keeps the uncut surfaces as ``volviz_meshes`` and the shown ones as ``volviz_shown``
-    (the CPU transparency modes draw those, ``volviz.render.iso_overlay``).
+    meshes: list[Any]
+    shown: list[Any]
+    lod: Optional[list[Any]]
+    settings: Any
+    clip: dict[str, Any] = field(default_factory=dict)  # the scene clipping they were cut by (``to_dict``)
+    opacity: float = 1.0                                 # the component opacity they were scaled by
 
-    The shader needs the renderer's lights: a renderer without lights (``pyvista.Plotter.clear`` removes them)
-    compiles VTK's unlit shader, which declares no normals (``normalVCVSOutput`` undeclared); the scene controller
-    restores the light kit before building."""
-    import vtk
 
-    from volviz.iso import IsoSettings, iso_actor, prepare
+def isosurface_parts(comp: Component, dataset: Any = None, t: Optional[float] = None, clip: Any = None,
+                     meshes: Optional[list[Any]] = None, progress: Optional[ProgressCallback] = None) -> IsoParts:
+    """Any thread: the surfaces of an ``isosurface`` component (settings: ``volviz.iso.IsoSettings``) extracted at
+    display time ``t`` (skipped when ``meshes`` are known), cut exactly by the scene's ``clip`` (``session.clip`` or
+    ClipSettings) on top of the component's own clipping, scaled by its opacity, with their LOD chains."""
+    from volviz.iso import IsoSettings, prepare
     from volviz.iso.clip import clip_isosurfaces
     from volviz.render.clipping import clip_settings
 
@@ -291,43 +452,60 @@ def add_isosurfaces(plotter: Any, comp: Component, dataset: Any, t: Optional[flo
     if not settings.styles:
         raise SceneError(f"component {comp.id!r}: settings.styles lists no iso-values")
     if meshes is None:
-        meshes = prepare(dataset, settings, t).meshes
+        meshes = list(prepare(dataset, settings, t, progress=progress).meshes)
     scene_clip = clip_settings(clip)
     shown = clip_isosurfaces(meshes, scene_clip) if scene_clip.all_planes() else list(meshes)
     if comp.opacity < 1.0:  # the component's opacity scales every surface's
         from dataclasses import replace
 
         shown = [replace(m, style=replace(m.style, opacity=m.style.opacity * comp.opacity)) for m in shown]
-    assembly = vtk.vtkPropAssembly()
-    translucent = []  # the actors of translucent surfaces (hidden while a CPU mode draws those surfaces)
-    for mesh in shown:
-        if len(mesh.triangles):
-            # (the VTK camera: pyvista's ``plotter.camera`` re-frames a camera it does not consider set)
-            actor = iso_actor(mesh, parallel=bool(plotter.renderer.GetActiveCamera().GetParallelProjection()),
-                              spectrum=spectrum and settings.shading == "spectrum")
-            assembly.AddPart(actor)
-            if mesh.style.opacity < 1.0:
-                translucent.append(actor)
-    assembly.volviz_meshes, assembly.volviz_shown, assembly.volviz_shading = meshes, shown, settings.shading
-    assembly.volviz_translucent = translucent
-    assembly.volviz_lod = None  # LOD chains of the shown surfaces (the CPU modes draw them view-dependently)
+    lod = None  # LOD chains of the shown surfaces (the CPU modes draw them view-dependently)
     if settings.lod:
         from volviz.iso.lod import build_lod
 
-        assembly.volviz_lod = [(build_lod(m), settings.triangles_per_pixel2) if m.n_triangles else None
-                               for m in shown]
-    plotter.add_actor(assembly, name=comp.id, reset_camera=False)
+        lod = [(build_lod(m), settings.triangles_per_pixel2) if m.n_triangles else None for m in shown]
+    return IsoParts(list(meshes), shown, lod, settings, scene_clip.to_dict(), float(comp.opacity))
+
+
+def add_isosurface_actors(plotter: Any, name: str, parts: IsoParts, spectrum: bool = True) -> Any:
+    """GUI thread: the shown surfaces of ``parts`` as one prop assembly of VTK actors named ``name``, with the
+    iso-spectrum shader when ``spectrum`` (drawn by VTK as the note's 2-pass blend). The assembly keeps the uncut
+    surfaces as ``volviz_meshes`` and the shown ones as ``volviz_shown`` (the CPU transparency modes draw those,
+    ``volviz.render.iso_overlay``).
+
+    The shader needs the renderer's lights: a renderer without lights (``pyvista.Plotter.clear`` removes them)
+    compiles VTK's unlit shader, which declares no normals (``normalVCVSOutput`` undeclared); the scene controller
+    restores the light kit before building."""
+    import vtk
+
+    from volviz.iso import iso_actor
+
+    assembly = vtk.vtkPropAssembly()
+    translucent = []  # the actors of translucent surfaces (hidden while a CPU mode draws those surfaces)
+    # (the VTK camera: pyvista's ``plotter.camera`` re-frames a camera it does not consider set)
+    parallel = bool(plotter.renderer.GetActiveCamera().GetParallelProjection())
+    for mesh in parts.shown:
+        if len(mesh.triangles):
+            actor = iso_actor(mesh, parallel=parallel, spectrum=spectrum and parts.settings.shading == "spectrum")
+            assembly.AddPart(actor)
+            if mesh.style.opacity < 1.0:
+                translucent.append(actor)
+    assembly.volviz_meshes, assembly.volviz_shown = parts.meshes, parts.shown
+    assembly.volviz_shading = parts.settings.shading
+    assembly.volviz_translucent = translucent
+    assembly.volviz_lod = parts.lod
+    plotter.add_actor(assembly, name=name, reset_camera=False)
     return assembly
+
+
+def add_isosurfaces(plotter: Any, comp: Component, dataset: Any, t: Optional[float] = None,
+                    spectrum: bool = True, clip: Any = None, meshes: Optional[list[Any]] = None) -> Any:
+    """The isosurfaces of an ``isosurface`` component as one prop assembly, now: ``isosurface_parts`` (``clip``:
+    the scene's clipping; ``meshes``: the extracted surfaces when already known) then ``add_isosurface_actors``."""
+    return add_isosurface_actors(plotter, comp.id, isosurface_parts(comp, dataset, t, clip, meshes),
+                                 spectrum=spectrum)
 
 
 def build_nature(plotter: Any, session: Session, datasets: dict[str, Any]) -> Any:
     """The NatureView of the session's visible terrain / fog / clouds / sky components (None when it has none)."""
-    components = [c for c in session.components if c.visible and c.type in NATURE_TYPES]
-    if not components:
-        return None
-    from volviz.nature.scene import build_nature_components
-
-    try:
-        return build_nature_components(plotter, components, datasets)
-    except (ValueError, KeyError) as exc:
-        raise SceneError(f"natural scene: {exc}") from None
+    return install_nature(plotter, prepare_nature(session, datasets))
