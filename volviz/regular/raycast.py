@@ -13,7 +13,7 @@ How a ray is walked (``raycast_kernels.cast_blocks``):
   ``[p 16 2^L, (p + 1) 16 2^L]`` (clipped to the volume). A coarse index grid at the finest selected level's node size
   maps a position to its block in O(1); cells without a block are leapt over (one box exit each).
 - Inside a block the ray takes ``n = ceil(len / h)`` equal steps up to the block's exit, ``h = step x 2^level x
-  min(spacing)``: coarser blocks take longer steps. Segments never cross a block face, so each one samples a single
+  min(spacing)`` (``STEP`` = 0.5 by default): coarser blocks take longer steps. Segments never cross a block face, so each one samples a single
   brick (continuous trilinear field); between two blocks of one level the overlap makes the field continuous, between
   levels it jumps by the coarse node's approximation error (what the selection bounds, Eq. 2.7).
 - Each segment (s_f, s_b, l) is integrated with the separable table (Roettger §9.1, ``volviz.optics.build_separable``,
@@ -22,7 +22,8 @@ How a ray is walked (``raycast_kernels.cast_blocks``):
   a quadratic in l/l_max. Measured table error for the walkthrough TF over the 8-bit range, 256^2 entries, l up to
   the coarsest step: see ``segment_table`` and ``tests/test_regular_raycast.py``.
 - Blocks whose scalar range (with overlap) maps to ρ = 0 under the TF are marked inactive and leapt over whole
-  (§2.3.5; the selection has already dropped nodes transparent over their footprint + apron).
+  (§2.3.5; the selection has already dropped nodes transparent over their footprint + apron); a segment whose two
+  scalars both lie below (or above) the support of ρ is transparent without a table lookup (``zero_opacity_ends``).
 - Early ray termination (Guthe §2.1.6) when the transmittance falls to ``t_stop`` (default 2e-3, i.e. α > 0.998):
   what is behind could add at most ``t_stop · κ_max`` per channel, 0.51 of 255 for κ ≤ 1.
 
@@ -45,7 +46,14 @@ from . import raycast_kernels as K
 from .wavelet import HALF
 
 __all__ = ["BlockPool", "pack_blocks", "render_blocks", "render_reference", "segment_table", "as_camera",
-           "block_active", "T_STOP"]
+           "block_active", "zero_opacity_ends", "STEP", "T_STOP"]
+
+STEP = 0.5
+"""Default sample distance in voxels of each block's level. Pre-integration takes the scalar as linear between two
+samples, but trilinear interpolation is cubic along a ray: on the embryo (256^3, Q80, full resolution, 512^2) one
+voxel gives RMSE 0.56 against the exact reference, half a voxel 0.29 (the Q80 data's own error is 0.30), a quarter
+voxel no better; at half a voxel the LOD walkthrough's error equals VTK's multi-block mapper's, for 1.4x the time of
+one voxel."""
 
 T_STOP = 2e-3
 """Default early-termination transmittance: the colour behind is at most T_STOP·κ_max (0.51 of 255 for κ ≤ 1)."""
@@ -144,6 +152,18 @@ def block_active(pool: BlockPool, tf: TransferFunction) -> np.ndarray:
     return (m > 0).astype(np.uint8)
 
 
+def zero_opacity_ends(tf: TransferFunction) -> tuple[float, float]:
+    """(z_lo, z_hi) with ρ(s) = 0 for s < z_lo and for s > z_hi (ρ is piecewise linear and 0 outside the TF
+    range, so a linear segment with both ends on one of those sides is transparent; strict, because ρ may be
+    non-zero at a TF end itself). (inf, -inf) when ρ = 0 everywhere."""
+    s = np.asarray(tf.scalars, float)
+    pos = np.nonzero(np.asarray(tf.extinction, float) > 0)[0]
+    if pos.size == 0:
+        return math.inf, -math.inf
+    k, m = int(pos[0]), int(pos[-1])
+    return float(s[k - 1] if k > 0 else s[0]), float(s[m + 1] if m + 1 < s.size else s[-1])
+
+
 def segment_table(tf: TransferFunction, s_range: tuple[float, float], l_max: float, n_s: int = 256,
                   degree: int = 2) -> SeparableTable:
     """The separable table (Roettger §9.1) over ``s_range`` ∪ the TF range, colour polynomial over [0, l_max]."""
@@ -191,7 +211,7 @@ def _common(camera: Any, size: Sequence[int], origin: np.ndarray, spacing: np.nd
     return basis, np.array([w, h], np.int64), dep, np.ascontiguousarray(pl), nch
 
 
-def render_blocks(pool: BlockPool, tf: TransferFunction, camera: Any, size: Sequence[int], *, step: float = 1.0,
+def render_blocks(pool: BlockPool, tf: TransferFunction, camera: Any, size: Sequence[int], *, step: float = STEP,
                   depth: Optional[np.ndarray] = None, planes: Optional[np.ndarray] = None, t_near: float = 0.0,
                   t_stop: float = T_STOP, table: Optional[SeparableTable] = None,
                   active: Optional[np.ndarray] = None) -> np.ndarray:
@@ -218,7 +238,7 @@ def render_blocks(pool: BlockPool, tf: TransferFunction, camera: Any, size: Sequ
     K.cast_blocks(basis, wh, pool.spacing, hi, float(t_near), dep, pl, pool.data, pool.offset, pool.dims, pool.lo,
                   pool.hi, pool.scale, np.ascontiguousarray(active, np.uint8), pool.grid, pool.cell, table.data,
                   table.s_lo, table.ds, table.l_max, table.degree, np.ascontiguousarray(table.kappa_max, np.float64),
-                  float(step), float(t_stop), nch, out)
+                  *zero_opacity_ends(tf), float(step), float(t_stop), nch, out)
     return out
 
 

@@ -41,7 +41,7 @@ def _slab(o, d, hi):
     return t0, t1
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True, inline="always", error_model="numpy")
 def _box_exit(o, d, lo0, lo1, lo2, hi0, hi1, hi2):
     """Exit parameter of the ray from the box [lo, hi] (the ray is assumed to be inside)."""
     t1 = _BIG
@@ -89,7 +89,7 @@ def _sample_block(data, off, nx, ny, nz, x, y, z):
     return c0 + wx * (c1 - c0)
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True, inline="always", error_model="numpy")
 def _separable(tab, s_lo, ds, l_max, degree, kmax, sf, sb, length, seg):
     """Separable pre-integration (Roettger §9.1): α = 1 − exp(−l ρ̂(s_f, s_b)) (exact but for the bilinear ρ̂),
     colour = α · clamp(Σ C̃_i u^i, 0, κ_max), u = min(l / l_max, 1). Writes seg[0:4]; NaN scalars give 0."""
@@ -128,7 +128,7 @@ def _separable(tab, s_lo, ds, l_max, degree, kmax, sf, sb, length, seg):
         seg[ch] = acc * alpha
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def _ray_interval(basis, row, col, spacing, hi, t_near, depth, planes, o, d):
     """Fill o, d (index space) for pixel (row, col); returns (t0, t1, |D|) of the ray inside the volume box [0, hi],
     beyond t_near, before the pixel's depth limit and on the kept side of every clipping plane (n . x + w >= 0)."""
@@ -159,11 +159,12 @@ def _ray_interval(basis, row, col, spacing, hi, t_near, depth, planes, o, d):
     return t0, t1, math.sqrt(dl2)
 
 
-@numba.njit(cache=True, nogil=True, parallel=True)
+@numba.njit(cache=True, nogil=True, parallel=True, error_model="numpy")
 def cast_blocks(basis, size, spacing, hi, t_near, depth, planes, data, offset, dims, blo, bhi, scale, active,
-                grid, cell, tab, s_lo, ds, l_max, degree, kmax, step, t_stop, nch, out):
+                grid, cell, tab, s_lo, ds, l_max, degree, kmax, z_lo, z_hi, step, t_stop, nch, out):
     """Front-to-back ray casting over packed blocks (see ``volviz.regular.raycast``); out (H, W, 4) float32, zeroed
-    by the caller (pixels whose ray misses the volume are not written)."""
+    by the caller (pixels whose ray misses the volume are not written). ρ = 0 for scalars < z_lo and > z_hi:
+    segments with both ends there are transparent without a table lookup."""
     w = size[0]
     h = size[1]
     gx, gy, gz = grid.shape
@@ -215,6 +216,9 @@ def cast_blocks(basis, size, spacing, hi, t_near, depth, planes, data, offset, d
                         tk = t + k * hh
                         sb = _sample_block(data, off, nx, ny, nz, (o[0] + tk * d[0] - blo[b, 0]) / sc,
                                            (o[1] + tk * d[1] - blo[b, 1]) / sc, (o[2] + tk * d[2] - blo[b, 2]) / sc)
+                        if (sf < z_lo and sb < z_lo) or (sf > z_hi and sb > z_hi):
+                            sf = sb
+                            continue
                         _separable(tab, s_lo, ds, l_max, degree, kmax, sf, sb, length, seg)
                         if seg[3] > 0.0:
                             cr += trans * seg[0]

@@ -133,7 +133,11 @@ class _Overlay:
 
         h, w = img.shape[:2]
         rgba8 = unpremultiply_rgba8(img)[::-1]                        # VTK images start at the bottom row
-        self.data.SetDimensions(w, h, 1)
+        # vtkImageActor spans its first to last point: pixel centres on the image's border lie on the quad's edge,
+        # where rasterisation drops the top row and right column; a one-pixel edge border puts them inside
+        rgba8 = np.pad(rgba8, ((1, 1), (1, 1), (0, 0)), mode="edge")
+        self.data.SetOrigin(-1.0, -1.0, 0.0)
+        self.data.SetDimensions(w + 2, h + 2, 1)
         arr = numpy_to_vtk(np.ascontiguousarray(rgba8.reshape(-1, 4)), deep=True)
         arr.SetName("rgba")
         self.data.GetPointData().SetScalars(arr)
@@ -170,16 +174,18 @@ class LodVolume:
     """A LOD-rendered compressed volume attached to a plotter (see the module docstring)."""
 
     def __init__(self, plotter: Any, tree: LodTree, tf: Any, budget: int = 256, mode: str = "tf",
-                 opacity: float = 1.0, renderer: str = "volviz", step: float = 1.0) -> None:
+                 opacity: float = 1.0, renderer: str = "volviz", step: Optional[float] = None) -> None:
         """``renderer``: "volviz" (our ray caster) or "vtk" (vtkMultiBlockVolumeMapper); ``step``: the ray
-        caster's sample distance in voxels of each block's level."""
+        caster's sample distance in voxels of each block's level (default ``volviz.regular.raycast.STEP``)."""
         import vtk
 
         if renderer not in RENDERERS:
             raise ValueError(f"LOD renderer must be one of {RENDERERS}, got {renderer!r}")
         self.plotter, self.tree, self.tf = plotter, tree, tf
         self.budget, self.mode, self.opacity = int(budget), mode, float(opacity)
-        self.renderer, self.step = renderer, float(step)
+        from volviz.regular.raycast import STEP
+
+        self.renderer, self.step = renderer, float(STEP if step is None else step)
         self.mapper = vtk.vtkMultiBlockVolumeMapper()
         self.volume = vtk.vtkVolume()
         self.volume.SetMapper(self.mapper)
