@@ -195,6 +195,7 @@ class MainWindow(QMainWindow):
         self.render_settings.changed.connect(self._settings_changed)
         self.timeline.timeChanged.connect(self._time_changed)
         self.timeline.interpolationToggled.connect(self._interpolation_toggled)
+        self.timeline.play_button.toggled.connect(self._playing_changed)
         self.clipping.changed.connect(self.set_clip)
 
     def _build_menus(self) -> None:
@@ -714,6 +715,15 @@ class MainWindow(QMainWindow):
     def _time_changed(self, t: float) -> None:
         if self.controller is not None and self.controller.time_series():
             self._show_time(t, None)
+
+    def _playing_changed(self, playing: bool) -> None:
+        """During playback VTK draws at its interactive rate, as while the mouse moves the camera (its ray casters
+        then cast fewer rays); at the pause the still rate, and one full-quality frame."""
+        iren = self.plotter.iren.interactor if hasattr(self.plotter.iren, "interactor") else self.plotter.iren
+        rate = iren.GetDesiredUpdateRate() if playing else iren.GetStillUpdateRate()
+        self.plotter.ren_win.SetDesiredUpdateRate(rate)
+        if not playing:
+            self.schedule_render()
 
     def _interpolation_toggled(self, on: bool) -> None:
         if self.controller is not None:
