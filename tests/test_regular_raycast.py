@@ -13,7 +13,7 @@ from volviz.optics import TransferFunction
 from volviz.optics.metrics import max_abs, rmse
 from volviz.regular.codec import compress
 from volviz.regular.lod import Block, Camera as LodCamera, LodTree, Selection
-from volviz.regular.raycast import block_active, pack_blocks, render_blocks, render_reference
+from volviz.regular.raycast import block_active, pack_blocks, render_blocks, render_reference, sub_active
 from volviz.regular.wavelet import HALF
 from volviz.unstructured.camera import Camera
 
@@ -130,6 +130,21 @@ def test_lod_camera_selection_and_transparent_tf(tree: LodTree, volume: np.ndarr
     # a TF that is zero over the whole data range leaves every block inactive too
     high = TransferFunction([300.0, 400.0], [[1, 1, 1], [1, 1, 1]], [1.0, 1.0])
     assert not block_active(pool, high).any() and not render_blocks(pool, high, cam, SIZE).any()
+
+
+def test_transparent_sub_cells_are_leapt_without_changing_the_image(tree: LodTree, volume: np.ndarray) -> None:
+    core = TransferFunction([150.0, 200.0, 255.0], [[1, 0.5, 0.2], [1, 1, 0.6], [1, 1, 1]], [0.0, 0.1, 0.3])
+    pool = _pool(tree, _level(tree, 0).nodes)
+    blocks_on = block_active(pool, core)
+    subs_on = sub_active(pool, core)
+    per_block = np.array([subs_on[o:o + int(np.prod(d))].mean() for o, d in zip(pool.sub_offset, pool.sub_dims)])
+    assert 0 < blocks_on.sum() < pool.n_blocks                   # some blocks are leapt whole ...
+    assert per_block[blocks_on == 1].min() < 1.0                 # ... and some active blocks have clear sub-cells
+    assert not per_block[blocks_on == 0].any()
+    img = render_blocks(pool, core, CAM, SIZE)
+    ref = render_reference(volume, tree.origin, tree.spacing, core, CAM, SIZE, step=0.25)
+    assert ref[..., 3].max() > 0.5
+    assert rmse(img, ref) < 0.15 and max_abs(img, ref) < 1.0, (rmse(img, ref), max_abs(img, ref))
 
 
 def test_depth_limit_and_clipping_plane(tree: LodTree, volume: np.ndarray) -> None:

@@ -161,7 +161,8 @@ def _ray_interval(basis, row, col, spacing, hi, t_near, depth, planes, o, d):
 
 @numba.njit(cache=True, nogil=True, parallel=True, error_model="numpy")
 def cast_blocks(basis, size, spacing, hi, t_near, depth, planes, data, offset, dims, blo, bhi, scale, active,
-                grid, cell, tab, s_lo, ds, l_max, degree, kmax, z_lo, z_hi, step, t_stop, nch, out):
+                grid, cell, soff, sdims, sact, sub, tab, s_lo, ds, l_max, degree, kmax, z_lo, z_hi, step, t_stop,
+                nch, out):
     """Front-to-back ray casting over packed blocks (see ``volviz.regular.raycast``); out (H, W, 4) float32, zeroed
     by the caller (pixels whose ray misses the volume are not written). ρ = 0 for scalars < z_lo and > z_hi:
     segments with both ends there are transparent without a table lookup."""
@@ -205,29 +206,54 @@ def cast_blocks(basis, size, spacing, hi, t_near, depth, planes, data, offset, d
                         continue
                     sc = scale[b]
                     dt = step * sc * min_sp / dlen
-                    n = max(1, int(math.ceil((tb - t) / dt - 1e-6)))
-                    hh = (tb - t) / n
-                    length = hh * dlen
                     off = offset[b]
                     nx, ny, nz = dims[b, 0], dims[b, 1], dims[b, 2]
-                    sf = _sample_block(data, off, nx, ny, nz, (o[0] + t * d[0] - blo[b, 0]) / sc,
-                                       (o[1] + t * d[1] - blo[b, 1]) / sc, (o[2] + t * d[2] - blo[b, 2]) / sc)
-                    for k in range(1, n + 1):
-                        tk = t + k * hh
-                        sb = _sample_block(data, off, nx, ny, nz, (o[0] + tk * d[0] - blo[b, 0]) / sc,
-                                           (o[1] + tk * d[1] - blo[b, 1]) / sc, (o[2] + tk * d[2] - blo[b, 2]) / sc)
-                        if (sf < z_lo and sb < z_lo) or (sf > z_hi and sb > z_hi):
-                            sf = sb
+                    ux, uy, uz = sdims[b, 0], sdims[b, 1], sdims[b, 2]
+                    edge = sub * sc
+                    t_carry = -math.inf
+                    sf = 0.0
+                    while t < tb and trans > t_stop:       # the block's sub-cells along the ray
+                        te = t + eps
+                        si = min(max(int((o[0] + te * d[0] - blo[b, 0]) / edge), 0), ux - 1)
+                        sj = min(max(int((o[1] + te * d[1] - blo[b, 1]) / edge), 0), uy - 1)
+                        sk = min(max(int((o[2] + te * d[2] - blo[b, 2]) / edge), 0), uz - 1)
+                        lx = blo[b, 0] + si * edge
+                        ly = blo[b, 1] + sj * edge
+                        lz = blo[b, 2] + sk * edge
+                        hx = bhi[b, 0] if si == ux - 1 else min(lx + edge, bhi[b, 0])
+                        hy = bhi[b, 1] if sj == uy - 1 else min(ly + edge, bhi[b, 1])
+                        hz = bhi[b, 2] if sk == uz - 1 else min(lz + edge, bhi[b, 2])
+                        ts = min(_box_exit(o, d, lx, ly, lz, hx, hy, hz), tb)
+                        if ts <= t:
+                            ts = te
+                        if sact[soff[b] + (si * uy + sj) * uz + sk] == 0:   # transparent sub-cell: leap
+                            t = ts
                             continue
-                        _separable(tab, s_lo, ds, l_max, degree, kmax, sf, sb, length, seg)
-                        if seg[3] > 0.0:
-                            cr += trans * seg[0]
-                            cg += trans * seg[1]
-                            cb += trans * seg[2]
-                            trans *= 1.0 - seg[3]
-                            if trans <= t_stop:
-                                break
-                        sf = sb
+                        n = max(1, int(math.ceil((ts - t) / dt - 1e-6)))
+                        hh = (ts - t) / n
+                        length = hh * dlen
+                        if t != t_carry:
+                            sf = _sample_block(data, off, nx, ny, nz, (o[0] + t * d[0] - blo[b, 0]) / sc,
+                                               (o[1] + t * d[1] - blo[b, 1]) / sc, (o[2] + t * d[2] - blo[b, 2]) / sc)
+                        for k in range(1, n + 1):
+                            tk = t + k * hh
+                            sb = _sample_block(data, off, nx, ny, nz, (o[0] + tk * d[0] - blo[b, 0]) / sc,
+                                               (o[1] + tk * d[1] - blo[b, 1]) / sc,
+                                               (o[2] + tk * d[2] - blo[b, 2]) / sc)
+                            if (sf < z_lo and sb < z_lo) or (sf > z_hi and sb > z_hi):
+                                sf = sb
+                                continue
+                            _separable(tab, s_lo, ds, l_max, degree, kmax, sf, sb, length, seg)
+                            if seg[3] > 0.0:
+                                cr += trans * seg[0]
+                                cg += trans * seg[1]
+                                cb += trans * seg[2]
+                                trans *= 1.0 - seg[3]
+                                if trans <= t_stop:
+                                    break
+                            sf = sb
+                        t = ts
+                        t_carry = ts
                     t = tb
                 out[row, col, 0] = cr
                 out[row, col, 1] = cg
@@ -279,3 +305,28 @@ def cast_reference(basis, size, spacing, hi, t_near, depth, planes, vol, vdims, 
                 for c in range(3):
                     out[row, col_, c] = acc[c]
                 out[row, col_, 3] = 1.0 - trans
+
+
+@numba.njit(cache=True, nogil=True)
+def sub_ranges(data, offset, dims, soff, sdims, sub, out_min, out_max):
+    """Per block and sub-cell (i, j, k): min and max of the finite samples [sub i, sub (i + 1)] x ... (clipped to
+    the brick), i.e. of every sample that trilinear interpolation inside the sub-cell uses; +inf / -inf if none."""
+    for b in range(offset.shape[0]):
+        nx, ny, nz = dims[b, 0], dims[b, 1], dims[b, 2]
+        ux, uy, uz = sdims[b, 0], sdims[b, 1], sdims[b, 2]
+        for si in range(ux):
+            for sj in range(uy):
+                for sk in range(uz):
+                    lo = np.inf
+                    hi = -np.inf
+                    for i in range(si * sub, min((si + 1) * sub, nx - 1) + 1):
+                        for j in range(sj * sub, min((sj + 1) * sub, ny - 1) + 1):
+                            base = offset[b] + (i * ny + j) * nz
+                            for k in range(sk * sub, min((sk + 1) * sub, nz - 1) + 1):
+                                v = data[base + k]
+                                if v == v:
+                                    lo = min(lo, v)
+                                    hi = max(hi, v)
+                    m = soff[b] + (si * uy + sj) * uz + sk
+                    out_min[m] = lo
+                    out_max[m] = hi
