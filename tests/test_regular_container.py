@@ -125,8 +125,8 @@ def test_parse_header_fuzz_random(head, size):
 @given(pos=st.integers(min_value=8, max_value=59), value=st.integers(min_value=0, max_value=255),
        size=st.integers(min_value=HEADER_SIZE, max_value=1 << 20))
 def test_parse_header_fuzz_mutated(tmp_path_factory, pos, value, size):
-    from volviz.regular.container import MAGIC, _HDR, crc32
-    head = _HDR.pack(MAGIC, 1, HEADER_SIZE, 0, 64, 100, 164, 3, 0, 0, 0)
+    from volviz.regular.container import MAGIC, VERSION, _HDR, crc32
+    head = _HDR.pack(MAGIC, VERSION, HEADER_SIZE, 0, 64, 100, 164, 3, 0, 0, 0)
     head = bytearray(head + struct.pack("<I", crc32(head)))
     head[pos] = value
     head[60:64] = struct.pack("<I", crc32(bytes(head[:60])))  # a consistent checksum: the fields must be checked
@@ -138,8 +138,10 @@ def test_parse_header_fuzz_mutated(tmp_path_factory, pos, value, size):
     assert h["meta_off"] + h["meta_len"] <= size and h["table_off"] + 32 * h["table_count"] <= size
 
 
-def test_older_arith_coder_version_is_refused(tmp_path):
-    # arith coder version 2 changed the contexts: a version-1 stream must not be decoded with them
+@pytest.mark.parametrize("old_version", [None, 2])
+def test_older_arith_coder_version_is_refused(tmp_path, old_version):
+    # arith coder version 2 changed the contexts, version 3 added the S-transform model: older streams must not be
+    # decoded with them
     src, old = tmp_path / "a.vvz", tmp_path / "old.vvz"
     compress(RegularVolume(_smooth_volume((40, 20, 20))), src, coder="arith")
     rd = Reader(src)
@@ -147,11 +149,29 @@ def test_older_arith_coder_version_is_refused(tmp_path):
     with Writer(old) as w:
         for rec in rd.table:
             off, size = int(rec["offset"]), int(rec["size"])
-            w.add(int(rec["level"]), int(rec["kind"]), int(rec["tile"]), np.asarray(rd.payload[off:off + size]))
+            w.add(int(rec["level"]), int(rec["kind"]), int(rec["tile"]), np.asarray(rd.payload[off:off + size]),
+                  int(rec["transform"]))
         meta = dict(rd.meta)
-        assert meta["coder_version"] == 2
-        meta.pop("coder_version")  # files written before the field existed
+        assert meta["coder_version"] == 3
+        if old_version is None:
+            meta.pop("coder_version")  # files written before the field existed
+        else:
+            meta["coder_version"] = old_version
         w.close(meta)
     rd.close()
-    with pytest.raises(VVZError, match=r"old\.vvz.*arith coder version 1 is not supported"):
+    with pytest.raises(VVZError, match=rf"old\.vvz.*arith coder version {old_version or 1} is not supported"):
         decompress(old)
+
+
+def test_container_version_1_is_refused(tmp_path):
+    # version 2 added the per-brick transform field; a version-1 file (5/3 everywhere) is refused with a clear message
+    from volviz.regular.container import crc32
+    path = tmp_path / "v1.vvz"
+    compress(RegularVolume(_smooth_volume((20, 20, 20))), path)
+    raw = bytearray(path.read_bytes())
+    assert struct.unpack("<H", raw[8:10])[0] == 2
+    raw[8:10] = struct.pack("<H", 1)
+    raw[60:64] = struct.pack("<I", crc32(bytes(raw[:60])))
+    path.write_bytes(bytes(raw))
+    with pytest.raises(VVZError, match=r"v1\.vvz.*version 1 is not supported.*compress the volume again"):
+        decompress(path)

@@ -1,6 +1,7 @@
 """Wavelet codec for regular volumes: ``compress``, ``decompress``, ``info`` (Guthe §2.2.1-2.2.2, §2.3.1).
 
-Pipeline: integer 5/3 wavelet octree over 32^3 tiles (:mod:`.wavelet`), optional dead-zone quantisation
+Pipeline: integer 5/3 wavelet octree over 32^3 tiles (:mod:`.wavelet`; in lossless files each node may use the
+integer S-transform instead, chosen by coded size and recorded per brick), optional dead-zone quantisation
 (:mod:`.kernels`), significance map + rANS or adaptive arithmetic coding (:mod:`.entropy`), one checksummed brick
 per octree node in a ``.vvz`` file (:mod:`.container`).
 
@@ -40,12 +41,13 @@ from volviz.model.datasets import RegularVolume
 from . import kernels as K
 from .container import KIND_NODE, KIND_ROOT, CorruptBrickError, CorruptBrickWarning, Reader, VVZError, Writer
 from .entropy import CODER_VERSION, CODERS, capacity
-from .wavelet import HALF, TILE, level_shapes, n_tiles, subband_weights
+from .wavelet import HALF, TILE, TRANSFORM_53, TRANSFORM_HAAR, level_shapes, n_tiles, subband_weights
 
 Progress = Callable[[float, str], None]
 _INT_TYPES = {"uint8": 255, "int8": 255, "uint16": 65535, "int16": 65535}
 _SLAB_PLANES = 2 * TILE
 _PSNR_FULL_LIMIT = 1 << 25
+TRANSFORM_CHOICES = {"auto": -1, "5/3": TRANSFORM_53, "haar": TRANSFORM_HAAR}
 
 
 def quality_to_delta(quality: float) -> float:
@@ -118,15 +120,16 @@ class _Source:
 
 
 def _encode_array(a: np.ndarray, steps: np.ndarray, coder: int, level: int, writer: Writer, tile_base: int,
-                  low: np.ndarray) -> None:
+                  low: np.ndarray, choice: int = -1) -> None:
     """Encode every tile of ``a`` (a whole level or a z-slab of it) and stream the bricks."""
     ntiles = n_tiles(a.shape[0]) * n_tiles(a.shape[1]) * n_tiles(a.shape[2])
     cap = capacity(TILE ** 3)
     out = np.zeros(ntiles * cap, np.uint8)
     sizes = np.zeros(ntiles, np.int64)
-    K.run_tiles(K.encode_level, a, steps, coder, out, cap, sizes, low)
+    tfs = np.zeros(ntiles, np.int64)
+    K.run_tiles(K.encode_level, a, steps, coder, out, cap, sizes, low, tfs, choice)
     for t in range(ntiles):
-        writer.add(level, KIND_NODE, tile_base + t, out[t * cap:t * cap + int(sizes[t])])
+        writer.add(level, KIND_NODE, tile_base + t, out[t * cap:t * cap + int(sizes[t])], int(tfs[t]))
 
 
 def _root_dpcm(root: np.ndarray) -> np.ndarray:
@@ -192,13 +195,15 @@ def _psnr_sample(src: _Source) -> np.ndarray:
 
 
 def compress(volume: RegularVolume, path: str | Path, mode: str = "lossless", quality: float | None = None,
-             psnr: float | None = None, coder: str = "rans", progress: Progress | None = None) -> dict[str, Any]:
+             psnr: float | None = None, coder: str = "rans", progress: Progress | None = None,
+             transform: str = "auto") -> dict[str, Any]:
     """Compress ``volume`` to the ``.vvz`` file ``path`` (atomic write); returns :func:`info` of the result.
 
     ``mode`` is ``"lossless"``, ``"quality"`` (needs ``quality``) or ``"psnr"`` (needs ``psnr``); passing
     ``quality`` or ``psnr`` alone selects the mode. ``coder``: ``"rans"`` (fast) or ``"arith"`` (higher ratio).
     ``progress(fraction, message)`` is called as levels/slabs finish. ``volume.data`` may be a ``numpy.memmap``
-    (processed out of core).
+    (processed out of core). ``transform`` (lossless files; lossy files always use the 5/3): ``"auto"`` codes each
+    node with the 5/3 and the S-transform and keeps the smaller, ``"5/3"`` or ``"haar"`` forces one.
     """
     if quality is not None and mode == "lossless":
         mode = "quality"
@@ -208,6 +213,9 @@ def compress(volume: RegularVolume, path: str | Path, mode: str = "lossless", qu
         raise ValueError(f"unknown mode {mode!r} (lossless, quality, psnr)")
     if coder not in CODERS:
         raise ValueError(f"unknown coder {coder!r} ({', '.join(CODERS)})")
+    if transform not in TRANSFORM_CHOICES:
+        raise ValueError(f"unknown transform {transform!r} ({', '.join(TRANSFORM_CHOICES)})")
+    choice = TRANSFORM_CHOICES[transform]
     report = progress or (lambda f, m: None)
     data = volume.data
     shape = tuple(int(s) for s in data.shape)
@@ -259,7 +267,7 @@ def compress(volume: RegularVolume, path: str | Path, mode: str = "lossless", qu
                 slab = src.slab(z0, z1)
                 low = np.zeros(tuple((s + 1) // 2 for s in slab.shape), np.int32)
                 tile_base = n_tiles(shape[0]) * n_tiles(shape[1]) * (z0 // TILE)
-                _encode_array(slab, steps[1], ci, 1, writer, tile_base, low)
+                _encode_array(slab, steps[1], ci, 1, writer, tile_base, low, choice)
                 cur[:, :, z0 // 2:z0 // 2 + low.shape[2]] = low
                 src.release(z0, z1)
                 done += slab.size
@@ -267,7 +275,7 @@ def compress(volume: RegularVolume, path: str | Path, mode: str = "lossless", qu
                 del slab, low
             for lev in range(2, levels + 1):
                 low = np.zeros(shapes[lev], np.int32)
-                _encode_array(cur, steps[lev], ci, lev, writer, 0, low)
+                _encode_array(cur, steps[lev], ci, lev, writer, 0, low, choice)
                 done += cur.size
                 report(done / total_work, f"level {lev}")
                 cur = low
@@ -282,6 +290,7 @@ def compress(volume: RegularVolume, path: str | Path, mode: str = "lossless", qu
             "quality": None if quality is None else float(quality), "psnr_target": psnr,
             "psnr": None if measured is None or math.isinf(measured) else round(measured, 4),
             "psnr_scope": psnr_scope, "lossless": delta == 0.0, "peak": peak,
+            "transform": transform if delta == 0.0 else "5/3",
             "float_lo": src.lo, "float_hi": src.hi, "spacing": list(volume.spacing), "origin": list(volume.origin),
             "name": volume.name, "original_bytes": int(np.prod(shape)) * src.dtype.itemsize,
             "payload_bytes": payload,
@@ -315,6 +324,19 @@ def _check_meta(meta: dict[str, Any], name: str) -> tuple[tuple[int, int, int], 
     if levels != len(level_shapes(dims)) - 1:
         raise VVZError(name, f"{levels} levels do not match dims {dims}")
     return dims, levels, coder  # type: ignore[return-value]
+
+
+def transforms(table: np.ndarray, idx: Any, lossless: bool, name: str) -> np.ndarray:
+    """The per-brick transforms of the records ``table[idx]`` as int64, checked: 5/3 or S-transform, and the
+    S-transform only in lossless files (:class:`VVZError` naming the brick otherwise)."""
+    tfs = np.atleast_1d(table["transform"][idx]).astype(np.int64)
+    allowed = (TRANSFORM_53, TRANSFORM_HAAR) if lossless else (TRANSFORM_53,)
+    bad = np.nonzero(~np.isin(tfs, allowed))[0]
+    if bad.size:
+        i = int(np.atleast_1d(np.arange(len(table))[idx])[bad[0]])
+        raise VVZError(name, f"brick {i} (level {int(table[i]['level'])}, tile {int(table[i]['tile'])}) names "
+                       f"transform {int(tfs[bad[0]])}, not valid in a {'lossless' if lossless else 'lossy'} file")
+    return tfs
 
 
 def _tile_region(level: int, tile: int, shapes: list[tuple[int, int, int]]) -> tuple[tuple[int, int], ...]:
@@ -379,6 +401,7 @@ def decompress(path: str | Path, strict: bool = False, report: list[dict[str, An
                 raise VVZError(name, f"level {lev} tile {int(np.argmin(idx))} missing from the brick table")
             offs = table["offset"][idx].astype(np.int64)
             sizes = table["size"][idx].astype(np.int64)
+            tfs = transforms(table, idx, float(meta["delta"]) == 0.0, name)
             valid = np.ones(nt, np.uint8)
             for t in range(nt):
                 if not rd.brick_ok(int(idx[t])):
@@ -392,7 +415,7 @@ def decompress(path: str | Path, strict: bool = False, report: list[dict[str, An
             else:
                 a = np.empty(shp, np.int32)
                 lo, hi = -(1 << 31), (1 << 31) - 1
-            K.run_tiles(K.decode_level, cur, payload, offs, sizes, valid, steps[lev], ci, a, lo, hi, status)
+            K.run_tiles(K.decode_level, cur, payload, offs, sizes, tfs, valid, steps[lev], ci, a, lo, hi, status)
             for t in np.nonzero(status != 0)[0]:
                 fail(int(idx[t]), lev, int(t), "inconsistent stream")
             cur = a
@@ -432,7 +455,8 @@ def _to_dtype(a: np.ndarray, meta: dict[str, Any]) -> np.ndarray:
 
 
 def info(path: str | Path) -> dict[str, Any]:
-    """Summary of a ``.vvz`` file: dims, dtype, levels, bricks (and stripped all-zero nodes), ratio, PSNR, coder."""
+    """Summary of a ``.vvz`` file: dims, dtype, levels, bricks (and stripped all-zero nodes, and nodes coded with the
+    S-transform), ratio, PSNR, coder."""
     rd = Reader(path)
     try:
         meta = dict(rd.meta)
@@ -440,6 +464,7 @@ def info(path: str | Path) -> dict[str, Any]:
         table = rd.table
         meta.update(
             file_bytes=rd.file_size, bricks=int(len(table)), stripped_bricks=int(np.sum(table["size"] == 0)),
+            haar_bricks=int(np.sum(table["transform"] == TRANSFORM_HAAR)),
             ratio=float(meta["original_bytes"]) / rd.file_size,
             bits_per_voxel=8.0 * rd.file_size / float(np.prod(dims)),
         )

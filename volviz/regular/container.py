@@ -4,7 +4,7 @@ Layout (all integers little-endian)::
 
     offset 0   fixed header, 64 bytes
         0  magic      8s   b"VVZ\\x00\\r\\n\\x1a\\n"
-        8  version    u16  (1)
+        8  version    u16  (2; version 1 files -- before the per-brick transform field -- are refused)
         10 hdr_size   u16  (64)
         12 flags      u32  (0)
         16 meta_off   u64  metadata: UTF-8 JSON object (see codec.py for the keys)
@@ -18,8 +18,13 @@ Layout (all integers little-endian)::
     offset 64  brick payloads, in write order
     then       metadata JSON, then the brick table
 
-    brick record (32 bytes): level u8 | kind u8 (0 root, 1 node) | reserved u16 | tile u32 (x-fastest index of the
+    brick record (32 bytes): level u8 | kind u8 (0 root, 1 node) | transform u16 | tile u32 (x-fastest index of the
     tile within its level) | offset u64 | size u64 (0 = stripped all-zero node, no payload) | crc32 u32 | reserved u32
+
+    transform (version 2): the wavelet of this node's one level, 0 = integer 5/3 lifting (the default, and the only
+    one in lossy files), 1 = integer Haar / S-transform (lossless files: chosen per node by coded size, see
+    ``wavelet.py``); 0 for the root. A stripped node (size 0) still records its transform: its children are the
+    zero-detail inverse of that transform (5/3: linear interpolation, S-transform: constant 2x2x2 blocks).
 
 Reading never executes or unpickles anything: the metadata is JSON, the table a fixed numpy record layout, and every
 size and offset is checked against the file size before anything is allocated. Each brick carries its own CRC32, so
@@ -41,11 +46,11 @@ import numpy as np
 from volviz.io.errors import ReadError
 
 MAGIC = b"VVZ\x00\r\n\x1a\n"
-VERSION = 1
+VERSION = 2
 HEADER_SIZE = 64
 MAX_META = 16 << 20
 _HDR = struct.Struct("<8sHHIQQQQIII")
-BRICK_DTYPE = np.dtype([("level", "<u1"), ("kind", "<u1"), ("res0", "<u2"), ("tile", "<u4"), ("offset", "<u8"),
+BRICK_DTYPE = np.dtype([("level", "<u1"), ("kind", "<u1"), ("transform", "<u2"), ("tile", "<u4"), ("offset", "<u8"),
                         ("size", "<u8"), ("crc", "<u4"), ("res1", "<u4")])
 KIND_ROOT = 0
 KIND_NODE = 1
@@ -80,15 +85,15 @@ class Writer:
         self._f: BinaryIO = os.fdopen(fd, "w+b")
         self._f.write(b"\0" * HEADER_SIZE)
         self._pos = HEADER_SIZE
-        self._records: list[tuple[int, int, int, int, int, int]] = []
+        self._records: list[tuple[int, int, int, int, int, int, int]] = []
 
-    def add(self, level: int, kind: int, tile: int, payload: Any) -> None:
+    def add(self, level: int, kind: int, tile: int, payload: Any, transform: int = 0) -> None:
         data = memoryview(payload).cast("B")
         size = data.nbytes
         crc = crc32(data) if size else 0
         if size:
             self._f.write(data)
-        self._records.append((level, kind, tile, self._pos if size else 0, size, crc))
+        self._records.append((level, kind, tile, self._pos if size else 0, size, crc, transform))
         self._pos += size
 
     @property
@@ -102,6 +107,7 @@ class Writer:
             rec = np.array(self._records, dtype=np.int64)
             table["level"], table["kind"], table["tile"] = rec[:, 0], rec[:, 1], rec[:, 2]
             table["offset"], table["size"], table["crc"] = rec[:, 3], rec[:, 4], rec[:, 5]
+            table["transform"] = rec[:, 6]
         table_bytes = table.tobytes()
         meta_off = self._pos
         table_off = meta_off + len(meta_bytes)
@@ -150,7 +156,8 @@ def parse_header(head: bytes, file_size: int, name: str = "<vvz>") -> dict[str, 
     if crc32(head[:60]) != struct.unpack("<I", head[60:64])[0]:
         raise VVZError(name, f"header checksum mismatch (damaged header)")
     if version != VERSION:
-        raise VVZError(name, f".vvz version {version} is not supported (this reader knows version {VERSION})")
+        raise VVZError(name, f".vvz version {version} is not supported (this reader knows version {VERSION}); "
+                       "compress the volume again")
     if hdr_size != HEADER_SIZE:
         raise VVZError(name, f"bad header size {hdr_size}")
     if meta_len > MAX_META or meta_off < HEADER_SIZE or meta_off + meta_len > file_size:

@@ -37,7 +37,7 @@ from numba import njit
 CODER_RANS = 0
 CODER_ARITH = 1
 CODERS = {"rans": CODER_RANS, "arith": CODER_ARITH}
-CODER_VERSION = {"rans": 2, "arith": 2}  # rans 2: two interleaved states; arith 2: new contexts
+CODER_VERSION = {"rans": 2, "arith": 3}  # rans 2: two interleaved states; arith 2: new contexts; 3: S-transform model
 
 SB = 4  # sub-block edge of the significance map
 HALF_T = 16  # largest subband edge of a 32^3 tile (and of the root)
@@ -584,6 +584,29 @@ def _dec_bit(st, buf, probs, idx):
 
 
 @njit(cache=True, nogil=True)
+def _enc_init(base):
+    """Range encoder state [low, range, cache, cache_size, pos] writing from ``base``."""
+    st = np.zeros(5, np.int64)
+    st[1] = 0xFFFFFFFF
+    st[3] = 1
+    st[4] = base
+    return st
+
+
+@njit(cache=True, nogil=True)
+def _dec_init(buf, base, length):
+    """Range decoder state [code, range, pos, end] of the stream ``buf[base:base + length]`` (length >= 5)."""
+    st = np.zeros(4, np.int64)
+    st[1] = 0xFFFFFFFF
+    st[2] = base + 1
+    st[3] = base + length
+    for _ in range(4):
+        st[0] = (st[0] << 8) | buf[st[2]]
+        st[2] += 1
+    return st
+
+
+@njit(cache=True, nogil=True)
 def _dec_direct(st, buf, n):
     v = 0
     for _ in range(n):
@@ -669,10 +692,7 @@ def encode_arith(w, n0, n1, n2, root, out, base, uselow=False):
     if uselow and not root:
         _activity_map(w, (n0 + 1) // 2, (n1 + 1) // 2, (n2 + 1) // 2, am)
     probs = np.full(N_PROBS, _PTOT // 2, np.int64)
-    st = np.zeros(5, np.int64)
-    st[1] = 0xFFFFFFFF
-    st[3] = 1
-    st[4] = base
+    st = _enc_init(base)
     for r in range(nreg):
         c = reg[r, 6]
         _enc_bit(st, out, probs, _P_ANY + c, anyflag[r])
@@ -732,13 +752,7 @@ def decode_arith(buf, base, length, w, n0, n1, n2, root, uselow=False):
     if uselow and not root:
         _activity_map(w, (n0 + 1) // 2, (n1 + 1) // 2, (n2 + 1) // 2, am)
     probs = np.full(N_PROBS, _PTOT // 2, np.int64)
-    st = np.zeros(4, np.int64)
-    st[1] = 0xFFFFFFFF
-    st[2] = base + 1
-    st[3] = base + length
-    for _ in range(4):
-        st[0] = (st[0] << 8) | buf[st[2]]
-        st[2] += 1
+    st = _dec_init(buf, base, length)
     for r in range(nreg):
         c = reg[r, 6]
         lo0, hi0, lo1, hi1, lo2, hi2 = reg[r, 0], reg[r, 1], reg[r, 2], reg[r, 3], reg[r, 4], reg[r, 5]
@@ -790,3 +804,222 @@ def decode_arith(buf, base, length, w, n0, n1, n2, root, uselow=False):
 def capacity(n_coef: int) -> int:
     """Worst-case byte count of a coded tile of ``n_coef`` coefficients (both coders)."""
     return 6 * n_coef + 4096
+
+
+# ------------------------------------------------------- arith v3: block-interleaved coder for S-transform tiles
+# Probability layout of :func:`encode_haar_arith` (see its docstring).
+_NB7 = 7  # buckets of a magnitude (0, 1, 2, 3-4, 5-8, 9-16, 17+)
+_HB_BLOCK = 0
+_HB_ZERO = _HB_BLOCK + _NB7 * _NB7 * _NB7
+_HB_SIGN = _HB_ZERO + 8 * _NB7 * _NB7 * 3 * 3
+_HB_EXP = _HB_SIGN + 8 * 2 * 3
+_HB_MAN = _HB_EXP + 8 * _NB7 * _NB7 * 3 * N_EXP
+N_HPROBS = _HB_MAN + 8 * 32
+
+
+@njit(cache=True, nogil=True)
+def _b7(v):
+    """Bucket 0..6 of a non-negative magnitude: 0, 1, 2, 3-4, 5-8, 9-16, 17+."""
+    if v <= 2:
+        return v
+    if v <= 4:
+        return 3
+    if v <= 8:
+        return 4
+    if v <= 16:
+        return 5
+    return 6
+
+
+@njit(cache=True, nogil=True)
+def _hblock(w, i, j, k, l0, l1, l2, h0, h1, h2):
+    """Block contexts of lowpass position (i, j, k) of an S-transform tile: (bucket of |L|, bucket of half the
+    detail magnitudes of the three causal neighbour blocks, bucket of the largest |L| of the six face neighbours)."""
+    n = 0
+    for a in range(3):
+        x = i - 1 if a == 0 else i
+        y = j - 1 if a == 1 else j
+        z = k - 1 if a == 2 else k
+        if x < 0 or y < 0 or z < 0:
+            continue
+        for sb in range(1, 8):
+            if (sb & 1 and x >= h0) or (sb & 2 and y >= h1) or (sb & 4 and z >= h2):
+                continue
+            n += abs(w[l0 + x if sb & 1 else x, l1 + y if sb & 2 else y, l2 + z if sb & 4 else z])
+    am = 0
+    if i > 0:
+        am = max(am, abs(w[i - 1, j, k]))
+    if i + 1 < l0:
+        am = max(am, abs(w[i + 1, j, k]))
+    if j > 0:
+        am = max(am, abs(w[i, j - 1, k]))
+    if j + 1 < l1:
+        am = max(am, abs(w[i, j + 1, k]))
+    if k > 0:
+        am = max(am, abs(w[i, j, k - 1]))
+    if k + 1 < l2:
+        am = max(am, abs(w[i, j, k + 1]))
+    return _b7(abs(w[i, j, k])), _b7((n + 1) // 2), _b7(am)
+
+
+@njit(cache=True, nogil=True)
+def _hpred(w, i, j, k, l0, l1, l2, sb):
+    """Prediction of a single-axis S-transform detail from the lowpass slope, ``(L[+1] - L[-1] + 2) >> 2``
+    (S+P-style; 0 for the mixed subbands). A linear ramp of slope g has L[+1] - L[-1] = 4g and detail g."""
+    if sb == 1:
+        lm = w[i - 1, j, k] if i > 0 else w[i, j, k]
+        lp = w[i + 1, j, k] if i + 1 < l0 else w[i, j, k]
+    elif sb == 2:
+        lm = w[i, j - 1, k] if j > 0 else w[i, j, k]
+        lp = w[i, j + 1, k] if j + 1 < l1 else w[i, j, k]
+    elif sb == 4:
+        lm = w[i, j, k - 1] if k > 0 else w[i, j, k]
+        lp = w[i, j, k + 1] if k + 1 < l2 else w[i, j, k]
+    else:
+        return np.int64(0)
+    return (np.int64(lp) - np.int64(lm) + 2) >> 2
+
+
+@njit(cache=True, nogil=True)
+def _hdetail(w, i, j, k, l0, l1, l2, sb, lb, nb, cnt):
+    """Prediction, its size bucket and the zero-flag context of detail ``sb`` of block (i, j, k)."""
+    pr = _hpred(w, i, j, k, l0, l1, l2, sb)
+    pb = min(_b7(abs(pr)), 2)
+    return pr, pb, _HB_ZERO + (((sb * _NB7 + lb) * _NB7 + nb) * 3 + min(cnt, 2)) * 3 + pb
+
+
+@njit(cache=True, nogil=True)
+def _haar_any(w, n0, n1, n2):
+    l0 = (n0 + 1) // 2
+    l1 = (n1 + 1) // 2
+    l2 = (n2 + 1) // 2
+    for i in range(n0):
+        for j in range(n1):
+            for k in range(n2):
+                if (i >= l0 or j >= l1 or k >= l2) and w[i, j, k] != 0:
+                    return True
+    return False
+
+
+@njit(cache=True, nogil=True)
+def encode_haar_arith(w, n0, n1, n2, out, base):
+    """Adaptive binary arithmetic coding of the details of an S-transform tile (lossless files; the lowpass
+    ``w[:l0, :l1, :l2]`` is known to the decoder) into ``out[base:]``; returns the byte count (0 = all zero).
+
+    Block-interleaved order: the lowpass positions p (x slowest, z fastest); per p one flag "any of the (up to) 7
+    details of this 2x2x2 block non-zero" -- the significance map at block granularity, so empty space costs a few
+    thousandths of a bit per voxel -- then the details of the subbands b = 1..7 at p: each as the residual
+    r = d - pred (:func:`_hpred`) with zero flag, sign, unary bit length and mantissa (top bit modelled, the rest
+    raw). Contexts: the block's lowpass magnitude, the detail magnitudes of the three causal neighbour blocks, the
+    largest lowpass magnitude of the six face neighbours (non-causal: the lowpass is known), the subband, the
+    number of non-zero details already coded in the block, the prediction's size and sign. Measured on embryo
+    level 1 (S-transform on every tile): 0.91 bit/voxel against 1.01 with the subband coder of :func:`encode_arith`."""
+    if not _haar_any(w, n0, n1, n2):
+        return 0
+    l0 = (n0 + 1) // 2
+    l1 = (n1 + 1) // 2
+    l2 = (n2 + 1) // 2
+    h0 = n0 // 2
+    h1 = n1 // 2
+    h2 = n2 // 2
+    probs = np.full(N_HPROBS, _PTOT // 2, np.int64)
+    st = _enc_init(base)
+    for i in range(l0):
+        for j in range(l1):
+            for k in range(l2):
+                lb, nb, ab = _hblock(w, i, j, k, l0, l1, l2, h0, h1, h2)
+                anyd = 0
+                for sb in range(1, 8):
+                    if (sb & 1 and i >= h0) or (sb & 2 and j >= h1) or (sb & 4 and k >= h2):
+                        continue
+                    if w[l0 + i if sb & 1 else i, l1 + j if sb & 2 else j, l2 + k if sb & 4 else k] != 0:
+                        anyd = 1
+                        break
+                _enc_bit(st, out, probs, _HB_BLOCK + (lb * _NB7 + nb) * _NB7 + ab, anyd)
+                if not anyd:
+                    continue
+                cnt = 0
+                inb = 0
+                for sb in range(1, 8):
+                    if (sb & 1 and i >= h0) or (sb & 2 and j >= h1) or (sb & 4 and k >= h2):
+                        continue
+                    pr, pb, ctx = _hdetail(w, i, j, k, l0, l1, l2, sb, lb, nb, cnt)
+                    v = np.int64(w[l0 + i if sb & 1 else i, l1 + j if sb & 2 else j, l2 + k if sb & 4 else k]) - pr
+                    if v == 0:
+                        _enc_bit(st, out, probs, ctx, 0)
+                        continue
+                    _enc_bit(st, out, probs, ctx, 1)
+                    cnt += 1
+                    m = abs(v)
+                    ps = 0 if pr == 0 else (1 if pr > 0 else 2)
+                    _enc_bit(st, out, probs, _HB_SIGN + ((sb * 2 + (1 if lb > 0 else 0)) * 3 + ps), 1 if v < 0 else 0)
+                    e = _bitlen(m)
+                    ectx = _HB_EXP + (((sb * _NB7 + lb) * _NB7 + max(nb, _b7(inb))) * 3 + pb) * N_EXP
+                    inb += m
+                    for u in range(1, e):
+                        _enc_bit(st, out, probs, ectx + min(u, N_EXP - 1), 1)
+                    _enc_bit(st, out, probs, ectx + min(e, N_EXP - 1), 0)
+                    if e >= 2:
+                        _enc_bit(st, out, probs, _HB_MAN + sb * 32 + min(e, 31), (m >> (e - 2)) & 1)
+                        if e >= 3:
+                            _enc_direct(st, out, m & ((1 << (e - 2)) - 1), e - 2)
+    for _ in range(5):
+        _shift_low(st, out)
+    return st[4] - base
+
+
+@njit(cache=True, nogil=True)
+def decode_haar_arith(buf, base, length, w, n0, n1, n2):
+    """Inverse of :func:`encode_haar_arith`: the lowpass must be in ``w`` already; returns 0 (or -1 on an
+    inconsistent stream)."""
+    l0 = (n0 + 1) // 2
+    l1 = (n1 + 1) // 2
+    l2 = (n2 + 1) // 2
+    h0 = n0 // 2
+    h1 = n1 // 2
+    h2 = n2 // 2
+    for i in range(n0):  # all details zero first (the stripped case, and the blocks flagged empty)
+        for j in range(n1):
+            for k in range(n2):
+                if i >= l0 or j >= l1 or k >= l2:
+                    w[i, j, k] = 0
+    if length == 0:
+        return 0
+    if length < 5:
+        return -1
+    probs = np.full(N_HPROBS, _PTOT // 2, np.int64)
+    st = _dec_init(buf, base, length)
+    for i in range(l0):
+        for j in range(l1):
+            for k in range(l2):
+                lb, nb, ab = _hblock(w, i, j, k, l0, l1, l2, h0, h1, h2)
+                if _dec_bit(st, buf, probs, _HB_BLOCK + (lb * _NB7 + nb) * _NB7 + ab) == 0:
+                    continue
+                cnt = 0
+                inb = 0
+                for sb in range(1, 8):
+                    if (sb & 1 and i >= h0) or (sb & 2 and j >= h1) or (sb & 4 and k >= h2):
+                        continue
+                    pr, pb, ctx = _hdetail(w, i, j, k, l0, l1, l2, sb, lb, nb, cnt)
+                    v = np.int64(0)
+                    if _dec_bit(st, buf, probs, ctx) == 1:
+                        cnt += 1
+                        ps = 0 if pr == 0 else (1 if pr > 0 else 2)
+                        neg = _dec_bit(st, buf, probs, _HB_SIGN + ((sb * 2 + (1 if lb > 0 else 0)) * 3 + ps))
+                        ectx = _HB_EXP + (((sb * _NB7 + lb) * _NB7 + max(nb, _b7(inb))) * 3 + pb) * N_EXP
+                        e = 1
+                        while _dec_bit(st, buf, probs, ectx + min(e, N_EXP - 1)) == 1:
+                            e += 1
+                            if e > 40:
+                                return -1
+                        m = np.int64(1)
+                        if e >= 2:
+                            m = (m << 1) | _dec_bit(st, buf, probs, _HB_MAN + sb * 32 + min(e, 31))
+                            if e >= 3:
+                                m = (m << (e - 2)) | _dec_direct(st, buf, e - 2)
+                        inb += m
+                        v = -m if neg else m
+                    w[l0 + i if sb & 1 else i, l1 + j if sb & 2 else j, l2 + k if sb & 4 else k] = v + pr
+    if st[2] > st[3] + 4:
+        return -1
+    return 0

@@ -2,7 +2,8 @@
 (Guthe §2.2.1-2.2.2, §2.3.1).
 
 One *level* step maps an int32 array ``a`` (n0, n1, n2) to its lowpass ``low`` (ceil(n/2) per axis) plus one coded
-node per 32^3 tile. Tiles are numbered x fastest: ``t = t0 + c0 * (t1 + c1 * t2)``.
+node per 32^3 tile. Tiles are numbered x fastest: ``t = t0 + c0 * (t1 + c1 * t2)``. In lossless levels each tile
+is coded with the 5/3 and with the integer S-transform and keeps the smaller (``tfs[t]``, stored per brick).
 
 ``steps[0] > 0`` flags a lossless level: the decoder's lowpass equals the encoder's, so the arithmetic coder may use
 it as context. Quantisation (lossy modes): detail subband ``b`` uses step ``steps[b]``; a step <= 1 means no
@@ -23,8 +24,10 @@ from typing import Any, Callable
 import numpy as np
 from numba import njit
 
-from .entropy import CODER_RANS, decode_arith, decode_rans, encode_arith, encode_rans
-from .wavelet import HALF, TILE, forward_tile, inverse_tile, inverse_tile_with
+from .entropy import (CODER_RANS, decode_arith, decode_haar_arith, decode_rans, encode_arith, encode_haar_arith,
+                      encode_rans)
+from .wavelet import (HALF, TILE, TRANSFORM_53, TRANSFORM_HAAR, forward_tile, haar_forward_tile, inverse_tile,
+                      inverse_tile_t)
 
 ROUND = 0.40
 BIAS = 0.0
@@ -100,13 +103,29 @@ def _dequantise(w, n0, n1, n2, steps):
 
 
 @njit(cache=True, nogil=True)
-def encode_level(a, steps, coder, out, cap, sizes, low, first, stride):
+def _encode_tile(w, n0, n1, n2, coder, transform, lossless, out, base):
+    if coder == CODER_RANS:
+        return encode_rans(w, n0, n1, n2, False, out, base)
+    if transform == TRANSFORM_HAAR:
+        return encode_haar_arith(w, n0, n1, n2, out, base)
+    return encode_arith(w, n0, n1, n2, False, out, base, lossless)
+
+
+@njit(cache=True, nogil=True)
+def encode_level(a, steps, coder, out, cap, sizes, low, tfs, choice, first, stride):
     """Forward-transform, quantise and encode every tile of ``a``; the lowpass goes to ``low``, tile ``t``'s bytes to
-    ``out[t*cap : t*cap + sizes[t]]`` (``out`` zeroed)."""
+    ``out[t*cap : t*cap + sizes[t]]`` (``out`` zeroed) and its transform to ``tfs[t]``.
+
+    Lossless levels (``steps[0] > 0``) code each tile with the 5/3 and with the S-transform (the arithmetic coder
+    with its block-interleaved S-transform model, :func:`~.entropy.encode_haar_arith`) and keep the strictly smaller
+    (the 5/3 on ties, so an all-zero 5/3 brick stays the 5/3's linear interpolation); lossy levels use the 5/3.
+    ``choice`` >= 0 forces that transform on lossless levels (tests, comparisons); -1 chooses."""
     shape = a.shape
     c0 = (shape[0] + TILE - 1) // TILE
     c1 = (shape[1] + TILE - 1) // TILE
     c2 = (shape[2] + TILE - 1) // TILE
+    lossless = steps[0] > 0
+    alt = np.zeros(cap if lossless else 1, np.uint8)
     for t in range(first, c0 * c1 * c2, stride):
         t0, t1, t2, s0, s1, s2, n0, n1, n2 = _tile_box(t, c0, c1, shape)
         w = np.empty((TILE, TILE, TILE), np.int32)
@@ -114,7 +133,32 @@ def encode_level(a, steps, coder, out, cap, sizes, low, first, stride):
             for j in range(n1):
                 for k in range(n2):
                     w[i, j, k] = a[s0 + i, s1 + j, s2 + k]
-        forward_tile(w, n0, n1, n2)
+        tf = TRANSFORM_53
+        if lossless and choice == TRANSFORM_HAAR:
+            haar_forward_tile(w, n0, n1, n2)
+            sizes[t] = _encode_tile(w, n0, n1, n2, coder, TRANSFORM_HAAR, True, out, t * cap)
+            tf = TRANSFORM_HAAR
+        wh = w.copy() if lossless and choice < 0 else w
+        size = sizes[t]
+        if tf == TRANSFORM_53:
+            forward_tile(w, n0, n1, n2)
+            _quantise(w, n0, n1, n2, steps)
+            size = _encode_tile(w, n0, n1, n2, coder, TRANSFORM_53, lossless, out, t * cap)
+        if lossless and choice < 0 and size > 0:
+            haar_forward_tile(wh, n0, n1, n2)
+            size_h = _encode_tile(wh, n0, n1, n2, coder, TRANSFORM_HAAR, True, alt, 0)
+            if size_h < size:
+                for u in range(size):
+                    out[t * cap + u] = 0
+                for u in range(size_h):
+                    out[t * cap + u] = alt[u]
+                size = size_h
+                tf = TRANSFORM_HAAR
+                w = wh
+            for u in range(size_h):
+                alt[u] = 0
+        sizes[t] = size
+        tfs[t] = tf
         l0 = (n0 + 1) // 2
         l1 = (n1 + 1) // 2
         l2 = (n2 + 1) // 2
@@ -122,20 +166,26 @@ def encode_level(a, steps, coder, out, cap, sizes, low, first, stride):
             for j in range(l1):
                 for k in range(l2):
                     low[t0 * HALF + i, t1 * HALF + j, t2 * HALF + k] = w[i, j, k]
-        _quantise(w, n0, n1, n2, steps)
-        if coder == CODER_RANS:
-            sizes[t] = encode_rans(w, n0, n1, n2, False, out, t * cap)
-        else:
-            sizes[t] = encode_arith(w, n0, n1, n2, False, out, t * cap, steps[0] > 0)
 
 
 @njit(cache=True, nogil=True)
-def decode_level(low, payload, offsets, sizes, valid, steps, coder, a, lo, hi, status, first, stride):
+def decode_details(payload, offset, size, w, n0, n1, n2, coder, transform, lossless):
+    """Entropy-decode one brick's details into the tile buffer ``w`` (lowpass already in place); 0 or -1."""
+    if coder == CODER_RANS:
+        return decode_rans(payload, offset, size, w, n0, n1, n2, False)
+    if transform == TRANSFORM_HAAR:
+        return decode_haar_arith(payload, offset, size, w, n0, n1, n2)
+    return decode_arith(payload, offset, size, w, n0, n1, n2, False, lossless)
+
+
+@njit(cache=True, nogil=True)
+def decode_level(low, payload, offsets, sizes, tfs, valid, steps, coder, a, lo, hi, status, first, stride):
     """Inverse of :func:`encode_level`: tile ``t``'s bytes are ``payload[offsets[t]: offsets[t] + sizes[t]]``;
     tiles with ``valid[t] == 0`` (failed checksum) get zero details, i.e. the linear interpolation of the lowpass.
     ``status[t]`` is set to -1 where a stream turned out inconsistent (its details are then zeroed too).
     Samples are clipped to ``[lo, hi]`` on the way into ``a`` (of any integer dtype), so the finest level writes
-    the caller's output type directly (no int32 volume, no separate conversion pass)."""
+    the caller's output type directly (no int32 volume, no separate conversion pass). ``tfs[t]``: the tile's
+    transform (``TRANSFORM_53`` or ``TRANSFORM_HAAR``), from the brick table."""
     shape = a.shape
     c0 = (shape[0] + TILE - 1) // TILE
     c1 = (shape[1] + TILE - 1) // TILE
@@ -154,15 +204,12 @@ def decode_level(low, payload, offsets, sizes, valid, steps, coder, a, lo, hi, s
                 for k in range(l2):
                     dst[k] = src[k]
         n = sizes[t] if valid[t] else 0
-        if coder == CODER_RANS:
-            rc = decode_rans(payload, offsets[t], n, w, n0, n1, n2, False)
-        else:
-            rc = decode_arith(payload, offsets[t], n, w, n0, n1, n2, False, steps[0] > 0)
+        rc = decode_details(payload, offsets[t], n, w, n0, n1, n2, coder, tfs[t], steps[0] > 0)
         status[t] = rc
         if rc != 0:
             decode_rans(payload, 0, 0, w, n0, n1, n2, False)  # zero the details
         _dequantise(w, n0, n1, n2, steps)
-        inverse_tile_with(w, tmp, n0, n1, n2)
+        inverse_tile_t(w, tmp, n0, n1, n2, tfs[t])
         for i in range(n0):
             for j in range(n1):
                 src = w[i, j]

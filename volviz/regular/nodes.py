@@ -4,7 +4,9 @@ Node ``(level, (p0, p1, p2))`` is the 16^3 lowpass block ``p`` of pyramid level 
 resolution volume, level ``L`` = the root). Its sample ``i`` sits on full-resolution voxel ``2**level * (16 p + i)``
 (5/3 lowpass samples are the even samples). Brick ``(level, tile p)`` of the container holds the detail
 coefficients that reconstruct its (up to) 8 children ``(level - 1, 2 p + {0, 1}^3)``: decoding a node's brick with
-:func:`decode_children` yields all of them at once, exactly as the whole-volume decoder does (bit-exact).
+:meth:`NodeDecoder.children` yields all of them at once, exactly as the whole-volume decoder does (bit-exact), with
+the transform recorded for that brick (5/3, or the S-transform in lossless files); the node samples are then the
+lowpass of whichever transform each finer node used.
 
 :func:`node_statistics` measures, for every node, the quantities the LOD selector needs (§2.3.4):
 
@@ -26,32 +28,30 @@ import numpy as np
 from numba import njit
 
 from . import kernels as K
-from .codec import _check_meta, _root_undpcm, level_steps
+from .codec import _check_meta, _root_undpcm, level_steps, transforms
 from .container import KIND_NODE, KIND_ROOT, CorruptBrickError, Reader
-from .entropy import CODER_RANS, CODERS, decode_arith, decode_rans
-from .wavelet import HALF, TILE, inverse_tile, level_shapes, n_tiles
+from .entropy import CODERS, decode_rans
+from .wavelet import HALF, TILE, inverse_tile_t, level_shapes, n_tiles
 
 N_BINS = 8
 Key = tuple[int, tuple[int, int, int]]
 
 
 @njit(cache=True, nogil=True)
-def _decode_tile(low, payload, offset, size, steps, coder, n0, n1, n2):
-    """Decode one brick: lowpass block ``low`` (ceil(n/2) per axis) + coded details -> the (n0, n1, n2) samples."""
+def _decode_tile(low, payload, offset, size, steps, coder, transform, n0, n1, n2):
+    """Decode one brick: lowpass block ``low`` (ceil(n/2) per axis) + coded details -> the (n0, n1, n2) samples,
+    with the brick's own transform (5/3 or S-transform)."""
     w = np.zeros((TILE, TILE, TILE), np.int32)
     l0, l1, l2 = low.shape
     for i in range(l0):
         for j in range(l1):
             for k in range(l2):
                 w[i, j, k] = low[i, j, k]
-    if coder == CODER_RANS:
-        rc = decode_rans(payload, offset, size, w, n0, n1, n2, False)
-    else:
-        rc = decode_arith(payload, offset, size, w, n0, n1, n2, False, steps[0] > 0)
+    rc = K.decode_details(payload, offset, size, w, n0, n1, n2, coder, transform, steps[0] > 0)
     if rc != 0:
         decode_rans(payload, 0, 0, w, n0, n1, n2, False)
     K._dequantise(w, n0, n1, n2, steps)
-    inverse_tile(w, n0, n1, n2)
+    inverse_tile_t(w, np.empty((TILE, TILE, TILE), np.int32), n0, n1, n2, transform)
     return w[:n0, :n1, :n2].copy(), rc
 
 
@@ -182,9 +182,10 @@ class NodeDecoder:
             raise CorruptBrickError(self.path, f"brick of node level {level} tile {tile} {p} missing or failing its "
                                     "checksum")
         rec = self.reader.table[i]
+        tf = int(transforms(self.reader.table, i, float(self.meta["delta"]) == 0.0, self.path)[0])
         n = tuple(min(TILE, shp[a] - TILE * p[a]) for a in range(3))
         full, rc = _decode_tile(np.ascontiguousarray(data, np.int32), self.reader.payload, int(rec["offset"]),
-                                int(rec["size"]), self.steps[level], self.coder, n[0], n[1], n[2])
+                                int(rec["size"]), self.steps[level], self.coder, tf, n[0], n[1], n[2])
         if rc != 0:
             raise CorruptBrickError(self.path, f"brick of node level {level} tile {tile} {p}: inconsistent stream")
         self.decoded_bricks += 1

@@ -17,6 +17,18 @@ of 2x2x2 neighbouring tiles form the next level's 32^3 tile, until the root fits
 transformed on its own, so each node's details decode independently (random access, corrupt-brick isolation,
 out-of-core processing), at the cost of a slightly lower ratio than a whole-volume transform.
 
+Per-node transform choice (lossless files only, container version 2): a tile may instead use the integer Haar /
+S-transform (Said & Pearlman's reversible Haar, no overlap between neighbouring pairs)::
+
+    d[n] = x[2n+1] - x[2n]
+    s[n] = x[2n] + floor(d[n] / 2)          (= floor((x[2n] + x[2n+1]) / 2); a lone last sample passes through)
+
+with the same [s | d] layout, so the octree, the lowpass pyramid and the scan order stay the same. An isolated
+non-zero voxel touches one 2x2x2 block of S-transform coefficients (27 positions under the 5/3's 3-tap overlap), which
+pays on sparse noisy data such as the embryo's background; the encoder codes each tile both ways and keeps the
+smaller (``TRANSFORM_53`` / ``TRANSFORM_HAAR``, recorded per brick in the container). The 5/3 stays the default and
+is the only transform of lossy files.
+
 Kernels work on a C-ordered ``int32`` buffer ``w[i, j, k]`` (i along x) of shape (TILE, TILE, TILE) with active
 extents (n0, n1, n2). After the forward transform axis ``a`` holds ``[lowpass (ceil(n/2)) | highpass (n//2)]``.
 """
@@ -27,6 +39,8 @@ from numba import njit
 
 TILE = 32
 HALF = TILE // 2
+TRANSFORM_53 = 0
+TRANSFORM_HAAR = 1
 
 
 @njit(cache=True, nogil=True)
@@ -68,6 +82,15 @@ def _inv_line(x, n, tmp):
 
 
 @njit(cache=True, nogil=True)
+def _copy_box(src, dst, m0, m1, m2):
+    """``dst[:m0, :m1, :m2] = src[:m0, :m1, :m2]`` (3D views)."""
+    for i in range(m0):
+        for j in range(m1):
+            for k in range(m2):
+                dst[i, j, k] = src[i, j, k]
+
+
+@njit(cache=True, nogil=True)
 def _planes(v, m0, m1, m2, tmp, inverse):
     """Lift along axis 0 of the 3D view ``v`` (active box m0 x m1 x m2) one whole plane at a time, so the inner
     loops run over contiguous memory (strided line gathers hit cache-set conflicts at the 4 KiB plane stride)."""
@@ -101,10 +124,7 @@ def _planes(v, m0, m1, m2, tmp, inverse):
             for j in range(m1):
                 for k in range(m2):
                     tmp[2 * i + 1, j, k] = v[nl + i, j, k] + ((tmp[a, j, k] + tmp[b, j, k]) >> 1)
-    for i in range(m0):
-        for j in range(m1):
-            for k in range(m2):
-                v[i, j, k] = tmp[i, j, k]
+    _copy_box(tmp, v, m0, m1, m2)
 
 
 @njit(cache=True, nogil=True)
@@ -204,6 +224,113 @@ def inverse_tile(w, n0, n1, n2):
     """Inverse of :func:`forward_tile` (bit-exact): x, y, z."""
     tmp = np.empty((TILE, TILE, TILE), np.int32)
     inverse_tile_with(w, tmp, n0, n1, n2)
+
+
+@njit(cache=True, nogil=True)
+def _haar_planes(v, m0, m1, m2, tmp, inverse):
+    """S-transform along axis 0 of the 3D view ``v`` (active box m0 x m1 x m2), whole planes at a time."""
+    if m0 < 2:
+        return
+    nl = (m0 + 1) // 2
+    nh = m0 // 2
+    if not inverse:
+        for i in range(nh):
+            for j in range(m1):
+                a_row = v[2 * i, j]
+                b_row = v[2 * i + 1, j]
+                s_row = tmp[i, j]
+                d_row = tmp[nl + i, j]
+                for k in range(m2):
+                    d = b_row[k] - a_row[k]
+                    d_row[k] = d
+                    s_row[k] = a_row[k] + (d >> 1)
+        if nl > nh:
+            for j in range(m1):
+                for k in range(m2):
+                    tmp[nh, j, k] = v[m0 - 1, j, k]
+    else:
+        for i in range(nh):
+            for j in range(m1):
+                s_row = v[i, j]
+                d_row = v[nl + i, j]
+                a_row = tmp[2 * i, j]
+                b_row = tmp[2 * i + 1, j]
+                for k in range(m2):
+                    d = d_row[k]
+                    a = s_row[k] - (d >> 1)
+                    a_row[k] = a
+                    b_row[k] = a + d
+        if nl > nh:
+            for j in range(m1):
+                for k in range(m2):
+                    tmp[m0 - 1, j, k] = v[nh, j, k]
+    _copy_box(tmp, v, m0, m1, m2)
+
+
+@njit(cache=True, nogil=True)
+def _haar_lines(w, n0, n1, n2, inverse):
+    """S-transform of every contiguous line along axis 2."""
+    if n2 < 2:
+        return
+    nl = (n2 + 1) // 2
+    nh = n2 // 2
+    t = np.empty(TILE, np.int32)
+    for i in range(n0):
+        for j in range(n1):
+            x = w[i, j]
+            if not inverse:
+                for m in range(nh):
+                    d = x[2 * m + 1] - x[2 * m]
+                    t[nl + m] = d
+                    t[m] = x[2 * m] + (d >> 1)
+                if nl > nh:
+                    t[nh] = x[n2 - 1]
+            else:
+                for m in range(nh):
+                    d = x[nl + m]
+                    a = x[m] - (d >> 1)
+                    t[2 * m] = a
+                    t[2 * m + 1] = a + d
+                if nl > nh:
+                    t[n2 - 1] = x[nh]
+            for m in range(n2):
+                x[m] = t[m]
+
+
+@njit(cache=True, nogil=True)
+def haar_forward_tile(w, n0, n1, n2):
+    """One 3D level of the integer Haar / S-transform on the active box of ``w`` (in place): z, y, x; the same
+    [lowpass | highpass] layout per axis as :func:`forward_tile`."""
+    tmp = np.empty((TILE, TILE, TILE), np.int32)
+    _haar_lines(w, n0, n1, n2, False)
+    _haar_planes(w.transpose(1, 0, 2), n1, n0, n2, tmp, False)
+    _haar_planes(w, n0, n1, n2, tmp, False)
+
+
+@njit(cache=True, nogil=True)
+def haar_inverse_tile_with(w, tmp, n0, n1, n2):
+    """Inverse of :func:`haar_forward_tile` (bit-exact): x, y, z, with a caller-provided scratch tile."""
+    _haar_planes(w, n0, n1, n2, tmp, True)
+    _haar_planes(w.transpose(1, 0, 2), n1, n0, n2, tmp, True)
+    _haar_lines(w, n0, n1, n2, True)
+
+
+@njit(cache=True, nogil=True)
+def forward_tile_t(w, n0, n1, n2, transform):
+    """:func:`forward_tile` (``TRANSFORM_53``) or :func:`haar_forward_tile` (``TRANSFORM_HAAR``)."""
+    if transform == TRANSFORM_HAAR:
+        haar_forward_tile(w, n0, n1, n2)
+    else:
+        forward_tile(w, n0, n1, n2)
+
+
+@njit(cache=True, nogil=True)
+def inverse_tile_t(w, tmp, n0, n1, n2, transform):
+    """Inverse of :func:`forward_tile_t` with a scratch tile ``tmp``."""
+    if transform == TRANSFORM_HAAR:
+        haar_inverse_tile_with(w, tmp, n0, n1, n2)
+    else:
+        inverse_tile_with(w, tmp, n0, n1, n2)
 
 
 def n_tiles(n: int) -> int:
