@@ -216,3 +216,28 @@ def test_octree_nodes_with_mixed_transforms(mixed):
         assert seen[0] == 4 ** 3 and seen[1] == 2 ** 3  # every 16^3 leaf of the 64^3 volume was reached
     finally:
         dec.close()
+
+
+def test_node_statistics_follow_the_recorded_transforms(mixed):
+    from volviz.regular.nodes import _expand, node_statistics
+
+    data, path = mixed
+    dec = NodeDecoder(path)
+    try:
+        tfs = dec.transforms()
+        assert sorted(set(tfs[1].tolist())) == [TRANSFORM_53, TRANSFORM_HAAR]
+        stats, _, _ = node_statistics(data, tfs)
+        stats53, _, _ = node_statistics(data)
+    finally:
+        dec.close()
+    pyramid = _reference_pyramid(data, Reader(path).table.copy())
+    shapes = level_shapes(data.shape)
+    v_l = _expand(pyramid[1], shapes, 1)  # what the renderer shows for the level-1 nodes
+    for c in np.ndindex(2, 2, 2):
+        box = tuple(slice(32 * c[a], 32 * c[a] + 32) for a in range(3))
+        l2 = np.sqrt(np.sum((data[box].astype(np.float64) - v_l[box]) ** 2))
+        assert stats[1].l2[c] == pytest.approx(l2, rel=1e-12)
+    haar = tfs[1].reshape(2, 2, 2, order="F") == TRANSFORM_HAAR
+    assert not np.allclose(stats[1].l2[haar], stats53[1].l2[haar])  # the 5/3 assumption would differ there
+    assert np.allclose(stats[1].l2[~haar], stats53[1].l2[~haar])
+    assert (stats[0].l2 == 0).all()

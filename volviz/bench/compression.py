@@ -113,6 +113,10 @@ def _ours(vol: np.ndarray, peak: float, tmp: Path, reps: int, speed_at: set[str]
             else:
                 dec, rec = None, decompress(path).data
             rows.append(_row(f"vvz-{coder}", setting, path.stat().st_size, vol, rec, peak, dec))
+        path = tmp / f"{coder}_53.vvz"  # the same without the per-node S-transform choice, for comparison
+        compress(rv, path, coder=coder, transform="5/3")
+        rows.append(_row(f"vvz-{coder}", "lossless, 5/3 only", path.stat().st_size, vol, decompress(path).data,
+                         peak, None))
     return rows
 
 
@@ -203,7 +207,7 @@ def _plot(results: dict[str, list[dict[str, Any]]], out: Path) -> None:
             if pts:
                 ax.plot(*zip(*pts), st, label=method, ms=4)
         for r in rows:
-            if r["exact"]:
+            if r["exact"] and r["setting"] != "lossless, 5/3 only":
                 ax.axvline(r["bpv"], lw=0.6, color="grey", ls="--")
                 ax.annotate(f"{r['method']} lossless", (r["bpv"], ax.get_ylim()[0]), rotation=90, fontsize=6,
                             va="bottom", ha="right")
@@ -482,7 +486,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     for name, rows in results.items():
         s = {f"psnr_at_{b}bpv_{m}": _interp_psnr(rows, m, b) for b in (1.0, 0.25)
              for m in ("vvz-rans", "vvz-arith", "zfp", "wavelet+zstd")}
-        s.update({f"lossless_ratio_{r['method']}": r["ratio"] for r in rows if r["exact"]})
+        s.update({f"lossless_ratio_{r['method']}" + ("_5/3_only" if r["setting"] == "lossless, 5/3 only" else ""):
+                  r["ratio"] for r in rows if r["exact"]})
         summary[name] = s
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)

@@ -156,7 +156,7 @@ def forward_pyramid(vol: np.ndarray) -> tuple[list[tuple[tuple[int, int, int], n
         low = np.zeros(shapes[lev], np.int32)
         nt = n_tiles(cur.shape[0]) * n_tiles(cur.shape[1]) * n_tiles(cur.shape[2])
         det = np.zeros((nt, TILE, TILE, TILE), np.int32)
-        K.run_tiles(K.transform_level, cur, low, det)
+        K.run_tiles(K.transform_level, cur, low, det, np.zeros(nt, np.int64))
         pyr.append((cur.shape, det))
         cur = low
     return pyr, cur

@@ -26,8 +26,8 @@ from numba import njit
 
 from .entropy import (CODER_RANS, decode_arith, decode_haar_arith, decode_rans, encode_arith, encode_haar_arith,
                       encode_rans)
-from .wavelet import (HALF, TILE, TRANSFORM_53, TRANSFORM_HAAR, forward_tile, haar_forward_tile, inverse_tile,
-                      inverse_tile_t)
+from .wavelet import (HALF, TILE, TRANSFORM_53, TRANSFORM_HAAR, forward_tile, forward_tile_t, haar_forward_tile,
+                      inverse_tile, inverse_tile_t)
 
 ROUND = 0.40
 BIAS = 0.0
@@ -242,9 +242,10 @@ def decode_root(payload, offset, size, coder, root):
 
 
 @njit(cache=True, nogil=True)
-def transform_level(a, low, details, first, stride):
+def transform_level(a, low, details, tfs, first, stride):
     """Forward transform only (no coding): lowpass to ``low``, the full tile buffers (details in place) to
-    ``details`` of shape (ntiles, TILE, TILE, TILE). Used by the PSNR search."""
+    ``details`` of shape (ntiles, TILE, TILE, TILE); tile ``t`` uses transform ``tfs[t]``. Used by the PSNR search
+    (5/3 everywhere) and the node statistics (the transforms a file recorded)."""
     shape = a.shape
     c0 = (shape[0] + TILE - 1) // TILE
     c1 = (shape[1] + TILE - 1) // TILE
@@ -256,7 +257,7 @@ def transform_level(a, low, details, first, stride):
             for j in range(n1):
                 for k in range(n2):
                     w[i, j, k] = a[s0 + i, s1 + j, s2 + k]
-        forward_tile(w, n0, n1, n2)
+        forward_tile_t(w, n0, n1, n2, tfs[t])
         for i in range((n0 + 1) // 2):
             for j in range((n1 + 1) // 2):
                 for k in range((n2 + 1) // 2):

@@ -190,7 +190,7 @@ class LodTree:
             if kind in ("float", "int-quantised"):
                 data = np.clip(np.rint((data.astype(np.float64) - self._scale[0]) / max(self._scale[1], 1e-300)),
                                0, 65535)
-            loaded = node_statistics(data)
+            loaded = node_statistics(data, self.decoder.transforms())  # the nodes' own 5/3 or S-transform lowpass
             if save:
                 _save_stats(self.sidecar, self.decoder, *loaded)
         self.stats, self.bin_lo, self.bin_w = loaded

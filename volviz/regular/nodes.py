@@ -112,9 +112,14 @@ def _expand(low: np.ndarray, shapes: list[tuple[int, int, int]], level: int) -> 
     return cur
 
 
-def node_statistics(data: np.ndarray) -> tuple[list[LevelStats], float, float]:
+def node_statistics(data: np.ndarray, transforms: dict[int, np.ndarray] | None = None
+                    ) -> tuple[list[LevelStats], float, float]:
     """Statistics of every node of the wavelet octree of ``data`` (integer samples as the codec stores them);
-    returns (per-level stats, bin origin, bin width). Memory: two int32 copies of the volume."""
+    returns (per-level stats, bin origin, bin width). Memory: two int32 copies of the volume.
+
+    ``transforms`` (:meth:`NodeDecoder.transforms` of the file): the transform of every tile per level, so the
+    node samples are the lowpass the file's nodes really hold; without it every node is taken as 5/3 (exact for
+    lossy files and for lossless files without S-transform nodes)."""
     vh = np.ascontiguousarray(data, dtype=np.int32)
     shapes = level_shapes(vh.shape)
     lo, hi = float(vh.min()), float(vh.max())
@@ -125,7 +130,10 @@ def node_statistics(data: np.ndarray) -> tuple[list[LevelStats], float, float]:
         if lev > 0:
             low = np.zeros(shapes[lev], np.int32)
             nt = n_tiles(cur.shape[0]) * n_tiles(cur.shape[1]) * n_tiles(cur.shape[2])
-            K.run_tiles(K.transform_level, cur, low, np.zeros((nt, TILE, TILE, TILE), np.int32))
+            tfs = np.zeros(nt, np.int64) if transforms is None else np.asarray(transforms[lev], np.int64)
+            if tfs.shape != (nt,):
+                raise ValueError(f"transforms of level {lev}: {tfs.shape[0]} tiles given, the volume has {nt}")
+            K.run_tiles(K.transform_level, cur, low, np.zeros((nt, TILE, TILE, TILE), np.int32), tfs)
             cur = low
         vl = vh if lev == 0 else _expand(cur, shapes, lev)
         c = tuple(n_tiles(2 * s) for s in shapes[lev])  # 16-sample nodes per axis
@@ -153,6 +161,21 @@ class NodeDecoder:
         self.steps = level_steps(float(meta["delta"]), self.levels)
         self.index = {(int(r["kind"]), int(r["level"]), int(r["tile"])): i for i, r in enumerate(self.reader.table)}
         self.decoded_bricks = 0
+
+    def transforms(self) -> dict[int, np.ndarray]:
+        """The recorded transform of every brick, ``{level: int64 array indexed by tile}`` for levels 1..L (for
+        :func:`node_statistics`)."""
+        out = {}
+        lossless = float(self.meta["delta"]) == 0.0
+        for level in range(1, self.levels + 1):
+            shp = self.shapes[level - 1]
+            nt = n_tiles(shp[0]) * n_tiles(shp[1]) * n_tiles(shp[2])
+            idx = np.array([self.index.get((KIND_NODE, level, t), -1) for t in range(nt)], np.int64)
+            if (idx < 0).any():
+                raise CorruptBrickError(self.path, f"level {level} tile {int(np.argmin(idx))} missing from the "
+                                        "brick table")
+            out[level] = transforms(self.reader.table, idx, lossless, self.path)
+        return out
 
     def n_nodes(self, level: int) -> tuple[int, int, int]:
         return tuple(n_tiles(2 * s) for s in self.shapes[level])  # type: ignore[return-value]
