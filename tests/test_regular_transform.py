@@ -241,3 +241,34 @@ def test_node_statistics_follow_the_recorded_transforms(mixed):
     assert not np.allclose(stats[1].l2[haar], stats53[1].l2[haar])  # the 5/3 assumption would differ there
     assert np.allclose(stats[1].l2[~haar], stats53[1].l2[~haar])
     assert (stats[0].l2 == 0).all()
+
+
+def test_corrupt_s_transform_brick_is_named_and_the_rest_loads(mixed, tmp_path):
+    import warnings
+
+    from volviz.regular.container import CorruptBrickError, CorruptBrickWarning
+
+    data, src = mixed
+    path = tmp_path / "c.vvz"
+    path.write_bytes(src.read_bytes())
+    table = Reader(path).table.copy()
+    # level-1 tile 3 (t = 1, 1, 0: voxels x 32..64, y 32..64, z 0..32) lies in the sparse half: S-transform
+    i = int(np.nonzero((table["level"] == 1) & (table["kind"] == KIND_NODE) & (table["tile"] == 3))[0][0])
+    assert table[i]["transform"] == TRANSFORM_HAAR and table[i]["size"] > 0
+    raw = bytearray(path.read_bytes())
+    raw[int(table[i]["offset"]) + int(table[i]["size"]) // 2] ^= 0x5A
+    path.write_bytes(bytes(raw))
+    report: list = []
+    with pytest.warns(CorruptBrickWarning, match=rf"brick {i} \(node, level 1, tile 3"):
+        back = decompress(path, report=report).data
+    assert len(report) == 1 and report[0]["region"] == [[32, 64], [32, 64], [0, 32]]
+    mask = np.zeros(data.shape, bool)
+    mask[32:64, 32:64, 0:32] = True
+    assert np.array_equal(back[~mask], data[~mask])
+    # the damaged tile shows its own transform with zero details: constant 2x2x2 blocks of the S-transform lowpass
+    low = _reference_pyramid(data, table)[1][16:32, 16:32, 0:16]
+    assert np.array_equal(back[mask].reshape(32, 32, 32), np.repeat(np.repeat(np.repeat(low, 2, 0), 2, 1), 2, 2))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        with pytest.raises(CorruptBrickError, match="tile 3"):
+            decompress(path, strict=True)
