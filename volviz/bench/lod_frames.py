@@ -162,16 +162,18 @@ def _plot(rows: list[dict[str, Any]], shots: dict[int, tuple[np.ndarray, np.ndar
     import matplotlib.pyplot as plt
 
     b = [r["budget"] for r in rows]
-    fig, ax = plt.subplots(1, 5, figsize=(22, 4.4))
+    fig, ax = plt.subplots(1, 5, figsize=(22, 4.8))
     ax[0].plot(b, [r["render_s_per_frame"] for r in rows], "o-", label="volviz ray caster")
     ax[0].plot(b, [r["vtk_s_per_frame"] for r in rows], "s-", label="vtkMultiBlockVolumeMapper")
     ax[0].set(xscale="log", yscale="log", xlabel="block budget", ylabel="s / frame (512^2)")
+    ax[0].minorticks_off()
     ax[0].set_xticks(b, [str(v) for v in b])
     ax[0].legend()
     ax[1].plot(b, [r["rmse"] for r in rows], "o-", label="volviz vs exact")
     ax[1].plot(b, [r["vtk_rmse"] for r in rows], "s-", label="VTK vs exact")
     ax[1].plot(b, [r["vtk_rmse_vs_vtk_full"] for r in rows], "s--", label="VTK vs VTK full volume")
     ax[1].set(xscale="log", xlabel="block budget", ylabel="RMSE (8-bit)")
+    ax[1].minorticks_off()
     ax[1].set_xticks(b, [str(v) for v in b])
     ax[1].legend()
     top = max(shots)
@@ -179,7 +181,7 @@ def _plot(rows: list[dict[str, Any]], shots: dict[int, tuple[np.ndarray, np.ndar
                           (ax[3], shots[top][0], f"volviz ray caster, budget {top}"),
                           (ax[4], shots[top][1], f"vtkMultiBlockVolumeMapper, budget {top}")):
         a.imshow(np.clip(img, 0, 255).astype(np.uint8))
-        a.set_title(title)
+        a.set_title(title, fontsize=10)
         a.axis("off")
     fig.tight_layout()
     png.parent.mkdir(parents=True, exist_ok=True)

@@ -109,9 +109,10 @@ class _Overlay:
         self.siblings = plotter.__dict__.setdefault("_volviz_pt_overlays", [])
         self.siblings.append(self.renderer)
 
-    def depth(self, camera: Any, size: tuple[int, int]) -> Optional[np.ndarray]:
-        """Eye-space depth of the opaque scene (H, W), inf where none; None when the renderer has no visible actor
-        (nothing can hide the volume, and the extra render + read-back is skipped)."""
+    def depth(self, size: tuple[int, int]) -> Optional[np.ndarray]:
+        """Eye-space depth of the opaque scene (H, W), inf where none (with the clipping range of the render that
+        made it); None when the renderer has no visible actor (nothing can hide the volume, and the extra render +
+        read-back is skipped)."""
         from volviz.render.pt_prop import _read_buffers, zbuffer_to_depth
 
         if self.plotter.renderer.VisibleActorCount() == 0:
@@ -124,7 +125,8 @@ class _Overlay:
         z, _ = _read_buffers(ren_win, *size)
         for o, on in zip(self.siblings, shown):
             o.SetDraw(on)
-        return zbuffer_to_depth(z, camera.clipping_range, camera.parallel)
+        cam = self.plotter.renderer.GetActiveCamera()
+        return zbuffer_to_depth(z, cam.GetClippingRange(), bool(cam.GetParallelProjection()))
 
     def show(self, img: np.ndarray, visible: bool) -> None:
         from vtk.util.numpy_support import numpy_to_vtk
@@ -284,7 +286,7 @@ class LodVolume:
         w, h = (int(v) for v in self.plotter.ren_win.GetSize())
         cam = Camera.from_pyvista(self.plotter.renderer.GetActiveCamera())
         visible = bool(self.volume.GetVisibility())
-        depth = self._overlay.depth(cam, (w, h)) if visible else None
+        depth = self._overlay.depth((w, h)) if visible else None
         t1 = time.perf_counter()
         tf = self.tf.scaled_extinction(max(self.opacity, 0.0)) if self.opacity != 1.0 else self.tf
         table = self._segment_table(tf, self._pool)
