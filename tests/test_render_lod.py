@@ -152,6 +152,36 @@ def test_volviz_opaque_geometry_hides_the_volume_behind_it(tree: LodTree) -> Non
     assert float(np.sqrt((d ** 2).mean())) < 1.0 and float(np.percentile(d, 99.9)) < 3.0, (d.max(), d.mean())
 
 
+def test_volviz_ray_casts_in_the_background_worker_when_nothing_needs_the_plotter(tree: LodTree) -> None:
+    from concurrent.futures import ThreadPoolExecutor
+
+    pl = _plotter()
+    try:
+        lod = LodVolume(pl, tree, TF, budget=16)
+        lod.update()                                        # the first drawing learns that no depth is needed
+        assert lod.stats["prepared"] is False
+        pl.camera_position = [(150.0, -120.0, 100.0), (36.0, 36.0, 36.0), (0, 0, 1)]
+        cam = lod.camera()
+        with ThreadPoolExecutor(1) as ex:                   # the app's worker: select + decode
+            sel, blocks = ex.submit(lambda: (lambda s: (s, lod.decode(s)))(lod.select(cam))).result()
+        lod.show(sel, blocks)
+        assert lod.stats["prepared"] is True and lod.stats["render_s"] > 0
+        shown = lod.image.copy()
+        again = lod.draw()                                  # the same view drawn on this thread
+        assert max_abs(shown, again) == 0.0
+        moved = lod.select(cam)
+        moved_blocks = lod.decode(moved)
+        pl.camera_position = [(160.0, -110.0, 90.0), (36.0, 36.0, 36.0), (0, 0, 1)]   # moved before show
+        lod.show(moved, moved_blocks)
+        assert lod.stats["prepared"] is False                # drawn again for the camera it has now
+        assert max_abs(lod.image, shown) > 1.0
+        pl.add_mesh(pv.Sphere(radius=5.0, center=(0.0, 0.0, 0.0)), color="red")
+        lod.update()
+        assert lod.stats["prepared"] is False and lod.depth is not None   # opaque geometry: drawn with its depth
+    finally:
+        pl.close()
+
+
 @pytest.mark.parametrize("renderer", ["volviz", "vtk"])
 def test_selection_follows_budget_and_camera(tree: LodTree, renderer: str) -> None:
     pl = _plotter()

@@ -28,12 +28,15 @@ interpolation is continuous across the boundary of two blocks of one level: the 
 level everywhere matches that level rendered as one volume (measured in ``tests/test_render_lod.py``). Where levels
 meet, the coarser block's samples differ from the finer one's by the node's approximation error (the quantity the
 selection bounds, Eq. 2.7). ``select`` and ``decode`` are Qt-free and thread-safe, so the app can run them in the
-job runner and call ``show`` on the GUI thread (which, with the default renderer, ray casts there); ``update`` does
-all three. ``self.volume`` (a ``vtkVolume``) carries the visibility in both modes (with ``"volviz"`` it is not in
+job runner and call ``show`` on the GUI thread; ``update`` does all three. With the default renderer ``decode`` also
+ray casts the selection for the camera it was selected for (when the last drawing needed no opaque-scene depth,
+clipping planes or parallel projection), so ``show`` only uploads the image if camera, size and TF are unchanged;
+otherwise ``show`` ray casts on the GUI thread. ``self.volume`` (a ``vtkVolume``) carries the visibility in both modes (with ``"volviz"`` it is not in
 the renderer; its visibility switches the overlay).
 """
 from __future__ import annotations
 
+import threading
 import time
 from typing import Any, Optional
 
@@ -201,6 +204,10 @@ class LodVolume:
         self._table: Any = None
         self._table_key: Any = None
         self._overlay: Optional[_Overlay] = None
+        self._lock = threading.RLock()                  # guards the dicts below, _images and the table cache
+        self._cameras: dict[int, tuple[Selection, LodCamera]] = {}      # id(selection) -> its camera (last few)
+        self._prepared: dict[int, tuple[Any, ...]] = {}                  # id(selection) -> image made by decode
+        self._prepare_ok = False                        # the last draw needed no depth, planes or parallel camera
         if renderer == "vtk":
             plotter.renderer.AddVolume(self.volume)
         else:
@@ -226,21 +233,67 @@ class LodVolume:
     def select(self, camera: LodCamera, budget: Optional[int] = None) -> Selection:
         """Any thread: the blocks for ``camera`` under the block budget (Guthe §2.3.3; default ``self.budget``; the
         app first shows a coarse selection under a smaller budget, then refines)."""
-        return self.tree.select(camera, self.budget if budget is None else int(budget), tf=self.tf, mode=self.mode)
+        sel = self.tree.select(camera, self.budget if budget is None else int(budget), tf=self.tf, mode=self.mode)
+        if self.renderer == "volviz":
+            with self._lock:
+                self._cameras[id(sel)] = (sel, camera)
+                while len(self._cameras) > 4:
+                    self._cameras.pop(next(iter(self._cameras)))
+        return sel
 
     def decode(self, selection: Selection) -> list[Block]:
-        """Any thread: the selected blocks' samples (decoded on demand through the tree's LRU cache)."""
-        return [self.tree.block(key) for key in selection.nodes if key not in self._images] \
-            if selection.nodes else []
+        """Any thread: the selected blocks' samples (decoded on demand through the tree's LRU cache). With our
+        renderer, when the selection came from ``select`` and the last drawing needed no opaque-scene depth,
+        clipping planes or parallel projection, this also ray casts the selection for its camera, so that ``show``
+        on the GUI thread only uploads the image (if the camera, size and TF are still the same)."""
+        with self._lock:
+            held = set(self._images)
+        blocks = [self.tree.block(key) for key in selection.nodes if key not in held] if selection.nodes else []
+        if self.renderer == "volviz" and selection.nodes and self._prepare_ok:
+            self._prepare(selection, blocks)
+        return blocks
+
+    def _effective_tf(self) -> tuple[Any, str]:
+        tf = self.tf.scaled_extinction(max(self.opacity, 0.0)) if self.opacity != 1.0 else self.tf
+        return tf, repr(tf.to_dict())
+
+    def _prepare(self, selection: Selection, blocks: list[Block]) -> None:
+        from volviz.regular.raycast import pack_blocks, render_blocks
+        from volviz.unstructured.camera import Camera
+
+        with self._lock:
+            entry = self._cameras.get(id(selection))
+            held = dict(self._images)
+        if entry is None or entry[0] is not selection:
+            return
+        t0 = time.perf_counter()
+        cam = entry[1]
+        new = {b.key: b for b in blocks}
+        pool = pack_blocks([new[k] if k in new else held[k] if k in held else self.tree.block(k)
+                            for k in selection.nodes], self.tree.shapes[0], self.tree.origin, self.tree.spacing)
+        tf, tf_key = self._effective_tf()
+        t1 = time.perf_counter()
+        table = self._segment_table(tf, pool)
+        t2 = time.perf_counter()
+        img = render_blocks(pool, tf, Camera(cam.eye, cam.target, cam.up, cam.fov_y), (cam.width, cam.height),
+                            step=self.step, table=table)
+        t3 = time.perf_counter()
+        with self._lock:
+            self._prepared[id(selection)] = (selection, cam, tf_key, pool, img,
+                                             {"pack_s": t1 - t0, "table_s": t2 - t1, "render_s": t3 - t2})
+            while len(self._prepared) > 2:
+                self._prepared.pop(next(iter(self._prepared)))
 
     def show(self, selection: Selection, blocks: list[Block], select_s: float = 0.0, decode_s: float = 0.0) -> None:
         """GUI thread: draw ``selection`` (``blocks`` holds the ones not drawn before); ``stats`` describe it, with
         the seconds its selection and decoding took."""
-        for b in blocks:
-            self._images[b.key] = _image(b) if self.renderer == "vtk" else b
-        keep = set(selection.nodes)
-        for key in [k for k in self._images if k not in keep]:
-            del self._images[key]
+        with self._lock:
+            for b in blocks:
+                self._images[b.key] = _image(b) if self.renderer == "vtk" else b
+            keep = set(selection.nodes)
+            for key in [k for k in self._images if k not in keep]:
+                del self._images[key]
+            prepared = self._prepared.pop(id(selection), None)
         self.selection = selection
         self.stats = self.show_stats(selection, blocks, select_s, decode_s)
         if self.renderer == "vtk":
@@ -252,6 +305,8 @@ class LodVolume:
                 mb.SetBlock(i, self._images[key])
             self.mapper.SetInputDataObject(mb)
             return
+        if prepared is not None and self._use_prepared(selection, prepared):
+            return
         from volviz.regular.raycast import pack_blocks
 
         t0 = time.perf_counter()
@@ -259,6 +314,30 @@ class LodVolume:
                                  self.tree.spacing)
         self.stats["pack_s"] = time.perf_counter() - t0
         self.draw()
+
+    def _use_prepared(self, selection: Selection, prepared: tuple[Any, ...]) -> bool:
+        """GUI thread: show the image ``decode`` made, if it is still right for the plotter (same selection,
+        camera, size and TF; nothing that needs the depth, planes or a parallel camera; visible)."""
+        sel, cam, tf_key, pool, img, st = prepared
+        if sel is not selection or cam != self.camera() or tf_key != self._effective_tf()[1] \
+                or not self._prepare_check() or not self.volume.GetVisibility() or self._overlay is None:
+            return False
+        t0 = time.perf_counter()
+        self._pool, self.image, self.depth = pool, img, None
+        self._overlay.show(img, True)
+        self.stats.update({"renderer": "volviz", "prepared": True, "readback_s": 0.0, "draw_s": 0.0,
+                           "upload_s": time.perf_counter() - t0, "size": (img.shape[1], img.shape[0]), **st})
+        return True
+
+    def _prepare_check(self) -> bool:
+        """GUI thread: True when an image can be made away from the plotter (no visible actor whose depth would
+        clip the rays, no clipping planes, perspective camera); remembered for ``decode``."""
+        cam = self.plotter.renderer.GetActiveCamera()
+        planes = self.mapper.GetClippingPlanes()
+        ok = (self.plotter.renderer.VisibleActorCount() == 0 and not cam.GetParallelProjection()
+              and (planes is None or planes.GetNumberOfItems() == 0))
+        self._prepare_ok = ok
+        return ok
 
     def _segment_table(self, tf: Any, pool: Any) -> Any:
         """The separable table for ``tf`` over the data range of every level (cached per TF)."""
@@ -270,9 +349,10 @@ class LodVolume:
         lo, hi = min(lo, plo), max(hi, phi)
         l_max = self.step * float(1 << self.tree.levels) * float(np.min(self.tree.spacing))
         key = (repr(tf.to_dict()), lo, hi, l_max)
-        if key != self._table_key:
-            self._table, self._table_key = segment_table(tf, (lo, hi), l_max), key
-        return self._table
+        with self._lock:
+            if key != self._table_key:
+                self._table, self._table_key = segment_table(tf, (lo, hi), l_max), key
+            return self._table
 
     def draw(self) -> Optional[np.ndarray]:
         """GUI thread ("volviz" renderer): ray cast the shown selection for the plotter's current camera, against
@@ -288,7 +368,8 @@ class LodVolume:
         visible = bool(self.volume.GetVisibility())
         depth = self._overlay.depth((w, h)) if visible else None
         t1 = time.perf_counter()
-        tf = self.tf.scaled_extinction(max(self.opacity, 0.0)) if self.opacity != 1.0 else self.tf
+        tf = self._effective_tf()[0]
+        self._prepare_check()
         table = self._segment_table(tf, self._pool)
         t2 = time.perf_counter()
         img = render_blocks(self._pool, tf, cam, (w, h), step=self.step, depth=depth, table=table,
@@ -297,7 +378,7 @@ class LodVolume:
         self.image, self.depth = img, depth
         self._overlay.show(img, visible)
         t4 = time.perf_counter()
-        self.stats.update({"renderer": "volviz", "readback_s": t1 - t0, "table_s": t2 - t1, "render_s": t3 - t2,
+        self.stats.update({"renderer": "volviz", "prepared": False, "readback_s": t1 - t0, "table_s": t2 - t1, "render_s": t3 - t2,
                            "upload_s": t4 - t3, "draw_s": t4 - t0, "size": (w, h)})
         return img
 
