@@ -90,9 +90,10 @@ def _sample_block(data, off, nx, ny, nz, x, y, z):
 
 
 @numba.njit(cache=True, nogil=True, inline="always", error_model="numpy")
-def _separable(tab, s_lo, ds, l_max, degree, kmax, sf, sb, length, seg):
+def _separable(tab, s_lo, inv_ds, u, degree, kmax, sf, sb, length, seg):
     """Separable pre-integration (Roettger §9.1): α = 1 − exp(−l ρ̂(s_f, s_b)) (exact but for the bilinear ρ̂),
-    colour = α · clamp(Σ C̃_i u^i, 0, κ_max), u = min(l / l_max, 1). Writes seg[0:4]; NaN scalars give 0."""
+    colour = α · clamp(Σ C̃_i u^i, 0, κ_max), u = min(l / l_max, 1) (given, with 1 / ds). Writes seg[0:4]; NaN
+    scalars give 0."""
     n = tab.shape[0]
     if sf != sf or sb != sb:
         seg[0] = 0.0
@@ -100,8 +101,8 @@ def _separable(tab, s_lo, ds, l_max, degree, kmax, sf, sb, length, seg):
         seg[2] = 0.0
         seg[3] = 0.0
         return
-    i0, i1, wi = _axis((sf - s_lo) / ds, n)
-    j0, j1, wj = _axis((sb - s_lo) / ds, n)
+    i0, i1, wi = _axis((sf - s_lo) * inv_ds, n)
+    j0, j1, wj = _axis((sb - s_lo) * inv_ds, n)
     w00 = (1.0 - wi) * (1.0 - wj)
     w01 = (1.0 - wi) * wj
     w10 = wi * (1.0 - wj)
@@ -114,7 +115,6 @@ def _separable(tab, s_lo, ds, l_max, degree, kmax, sf, sb, length, seg):
         seg[1] = 0.0
         seg[2] = 0.0
         return
-    u = min(length / l_max, 1.0)
     for ch in range(3):
         acc = 0.0
         for d in range(degree, -1, -1):
@@ -170,6 +170,7 @@ def cast_blocks(basis, size, spacing, hi, t_near, depth, planes, data, offset, d
     h = size[1]
     gx, gy, gz = grid.shape
     min_sp = min(spacing[0], min(spacing[1], spacing[2]))
+    inv_ds = 1.0 / ds
     for chunk in numba.prange(nch):
         o = np.empty(3)
         d = np.empty(3)
@@ -210,6 +211,7 @@ def cast_blocks(basis, size, spacing, hi, t_near, depth, planes, data, offset, d
                     nx, ny, nz = dims[b, 0], dims[b, 1], dims[b, 2]
                     ux, uy, uz = sdims[b, 0], sdims[b, 1], sdims[b, 2]
                     edge = sub * sc
+                    inv_sc = 1.0 / sc
                     t_carry = -math.inf
                     sf = 0.0
                     while t < tb and trans > t_stop:       # the block's sub-cells along the ray
@@ -232,18 +234,22 @@ def cast_blocks(basis, size, spacing, hi, t_near, depth, planes, data, offset, d
                         n = max(1, int(math.ceil((ts - t) / dt - 1e-6)))
                         hh = (ts - t) / n
                         length = hh * dlen
+                        u = min(length / l_max, 1.0)
+                        # local (brick index) position at t and its increment per step
+                        px = (o[0] + t * d[0] - blo[b, 0]) * inv_sc
+                        py = (o[1] + t * d[1] - blo[b, 1]) * inv_sc
+                        pz = (o[2] + t * d[2] - blo[b, 2]) * inv_sc
+                        qx = hh * d[0] * inv_sc
+                        qy = hh * d[1] * inv_sc
+                        qz = hh * d[2] * inv_sc
                         if t != t_carry:
-                            sf = _sample_block(data, off, nx, ny, nz, (o[0] + t * d[0] - blo[b, 0]) / sc,
-                                               (o[1] + t * d[1] - blo[b, 1]) / sc, (o[2] + t * d[2] - blo[b, 2]) / sc)
+                            sf = _sample_block(data, off, nx, ny, nz, px, py, pz)
                         for k in range(1, n + 1):
-                            tk = t + k * hh
-                            sb = _sample_block(data, off, nx, ny, nz, (o[0] + tk * d[0] - blo[b, 0]) / sc,
-                                               (o[1] + tk * d[1] - blo[b, 1]) / sc,
-                                               (o[2] + tk * d[2] - blo[b, 2]) / sc)
+                            sb = _sample_block(data, off, nx, ny, nz, px + k * qx, py + k * qy, pz + k * qz)
                             if (sf < z_lo and sb < z_lo) or (sf > z_hi and sb > z_hi):
                                 sf = sb
                                 continue
-                            _separable(tab, s_lo, ds, l_max, degree, kmax, sf, sb, length, seg)
+                            _separable(tab, s_lo, inv_ds, u, degree, kmax, sf, sb, length, seg)
                             if seg[3] > 0.0:
                                 cr += trans * seg[0]
                                 cg += trans * seg[1]
