@@ -68,6 +68,10 @@ def test_user_errors_are_one_line_and_nonzero(tmp_path: Path) -> None:
         (["info", str(tmp_path / "missing.slc")], "missing.slc"),
         (["render", "demo", "-o", str(tmp_path / "x.png"), "--size", "big"], "WIDTHxHEIGHT"),
         (["frobnicate"], "invalid choice"),
+        (["compress", str(bad), "-o", str(tmp_path / "x.vvz"), "--quality", "80", "--transform", "haar"],
+         "--transform applies to lossless files"),
+        (["compress", str(bad), "-o", str(tmp_path / "x.vvz"), "--scheduler", "tcp://127.0.0.1:1"],
+         "--scheduler applies to --series"),
     ]:
         result = run_cli(*args)
         assert result.returncode == 2, (args, result.stderr)
@@ -86,3 +90,22 @@ def test_info_on_a_compressed_series(tmp_path: Path, capsys) -> None:
     desc = json.loads(capsys.readouterr().out)
     assert desc["n"] == 21 and desc["dims"] == [28, 28, 23] and desc["mode"] == "lossless"
     assert desc["ratio"] > 1.0
+
+
+def test_compress_transform_choice(tmp_path: Path, capsys) -> None:
+    """``--transform``: "5/3" codes no node with the S-transform, "auto" keeps the smaller of both per node (never
+    larger than the 5/3 alone), and both files decode to the same, original voxels."""
+    from volviz.io import read
+    from volviz.regular.codec import decompress, info
+
+    src = data_file("volumes/neghip.slc")
+    files = {t: tmp_path / f"{t.replace('/', '')}.vvz" for t in ("5/3", "auto")}
+    for transform, out in files.items():
+        assert main(["compress", str(src), "-o", str(out), "--transform", transform, "--quiet"]) == 0
+    capsys.readouterr()
+    only_53, auto = info(files["5/3"]), info(files["auto"])
+    assert only_53["haar_bricks"] == 0 and auto["haar_bricks"] > 0
+    assert auto["file_bytes"] <= only_53["file_bytes"]
+    original = read(src).data
+    for out in files.values():
+        assert np.array_equal(decompress(out).data, original)

@@ -167,7 +167,10 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     debug = "--debug" in (sys.argv[1:] if argv is None else argv)
     try:
         return run(argv)
-    except SystemExit as exc:  # --version / --help
+    except SystemExit as exc:  # --version / --help (an int code), or a sub-command's usage message (a str code)
+        if isinstance(exc.code, str):
+            print(f"volviz: error: {exc.code}", file=sys.stderr)
+            return 2
         return int(exc.code or 0)
     except KeyboardInterrupt:
         print("volviz: interrupted", file=sys.stderr)

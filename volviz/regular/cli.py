@@ -69,6 +69,9 @@ def compress_main(argv: Sequence[str] | None = None) -> int:
     mode.add_argument("--psnr", type=float, help="search the quantiser step to reach this PSNR (dB)")
     p.add_argument("--coder", choices=("rans", "arith"), default="rans",
                    help="rans: fast decoding (default); arith: adaptive arithmetic coding, higher ratio")
+    p.add_argument("--transform", choices=("auto", "5/3", "haar"), default="auto",
+                   help="lossless files: code each octree node with the 5/3 and the integer S-transform and keep the "
+                   "smaller (auto, default), or force one; lossy files always use the 5/3")
     p.add_argument("--raw", type=int, nargs=3, metavar=("NX", "NY", "NZ"),
                    help="INPUT is a headerless raw volume (x fastest), memory-mapped and compressed out of core")
     p.add_argument("--dtype", default="uint8", help="sample type of --raw input (uint8, uint16, int16, float32)")
@@ -83,11 +86,13 @@ def compress_main(argv: Sequence[str] | None = None) -> int:
     args = p.parse_args(list(argv) if argv is not None else None)
     if args.series:
         return _series_main(args)
+    if args.transform != "auto" and (args.quality is not None or args.psnr is not None):
+        raise SystemExit("--transform applies to lossless files (lossy files always use the 5/3 wavelet)")
     if args.scheduler:
         raise SystemExit("--scheduler applies to --series (a single volume is compressed out of core locally)")
     vol = _load(args)
     result = compress(vol, args.output, quality=args.quality, psnr=args.psnr, coder=args.coder,
-                      progress=None if args.quiet else _progress_bar())
+                      progress=None if args.quiet else _progress_bar(), transform=args.transform)
     _print_info(result)
     if args.json:
         with open(args.json, "w") as f:
@@ -120,7 +125,7 @@ def _series_main(args: argparse.Namespace) -> int:
 def _print_info(meta: dict[str, Any]) -> None:
     psnr = "lossless" if meta.get("lossless") else (f"{meta['psnr']:.2f} dB" if meta.get("psnr") else "n/a")
     print(f"dims {tuple(meta['dims'])} {meta['dtype']}  levels {meta['levels']}  bricks {meta['bricks']} "
-          f"({meta['stripped_bricks']} stripped)  coder {meta['coder']}")
+          f"({meta['stripped_bricks']} stripped, {meta.get('haar_bricks', 0)} S-transform)  coder {meta['coder']}")
     print(f"{meta['original_bytes']} -> {meta['file_bytes']} bytes  ratio {meta['ratio']:.2f}:1  "
           f"{meta['bits_per_voxel']:.3f} bits/voxel  PSNR {psnr}")
 
