@@ -15,6 +15,7 @@ from PySide6.QtWidgets import (QDockWidget, QFileDialog, QInputDialog, QLabel, Q
                                QProgressBar, QProgressDialog, QPushButton, QWidget)
 
 from volviz.jobs import JobOutcome
+from volviz.render.controller import no_render
 from volviz.session import CameraKey, Session, SessionError, relative_path
 from volviz_app.clip_widget import ClipPlaneWidget
 from volviz_app.docks.clipping import ClippingDock
@@ -34,6 +35,7 @@ PREVIEW_MS = 40          # live transfer-function preview: at most one re-render
 RESIZE_MS = 200          # overlays re-render once the viewport stopped resizing for 200 ms
 RECORD_MS = 250          # camera-path recording samples the camera four times a second
 MAX_RECENT = 8
+STAGE_MS = 30            # pause between GUI-thread stages of showing a new scene (other events run in between)
 
 
 def _data_filter() -> str:
@@ -318,6 +320,7 @@ class MainWindow(QMainWindow):
 
         self._load_serial += 1
         serial = self._load_serial
+        self.jobs.runner.cancel_all()  # the shown scene's background work (error estimates...) would delay this one
         self._loading_views = False
         self.status_label.setText(f"Loading {title}…")
         self._set_busy(True)
@@ -371,7 +374,7 @@ class MainWindow(QMainWindow):
             self.restoreState(QByteArray.fromBase64(session.layout["window_state"].encode("ascii")))
         self.scene_tree.populate(session.components)
         self.render_settings.load(session.render)
-        self.clipping.load(session.clip, controller.bounds())
+        self.clipping.load(session.clip, controller.installed_bounds)
         display_time = controller.time  # the session's display time, which set_steps would reset to the first step
         self.timeline.blockSignals(True)  # the scene already shows the display time: no re-blend, no re-extraction
         try:
@@ -386,8 +389,11 @@ class MainWindow(QMainWindow):
         self.error_estimate = None
         self.last_error_rmse = None
         self.set_dirty(dirty)
-        self.render()
-        self._show_first_views(controller, serial, title)
+        # the first render and the first views' GUI-thread parts (a PT volume's depth read-back renders too) in
+        # later turns of the event loop, with room for other events between them: in one turn they held it 160-330
+        # ms for a big PT scene under load
+        QTimer.singleShot(STAGE_MS, lambda: self.controller is controller and self.render())
+        QTimer.singleShot(2 * STAGE_MS, lambda: self._show_first_views(controller, serial, title))
 
     def _show_first_views(self, controller: Any, serial: int, title: str) -> None:
         """Compute the new scene's view-dependent parts in the background (natural scene, LOD blocks, PT volumes,
@@ -564,7 +570,8 @@ class MainWindow(QMainWindow):
 
         def done(outcome: JobOutcome) -> None:
             if outcome.ok and self.controller is controller and current() is handle:
-                handle.finish(request, *outcome.result)
+                with no_render(self.plotter):  # one render below, not two
+                    handle.finish(request, *outcome.result)
                 self.render()
                 if after is not None:
                     after(request)

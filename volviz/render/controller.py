@@ -92,6 +92,11 @@ class SceneController:
             self.props = install_scene(self.plotter, self.session, self.datasets, prepared, spectrum=True,
                                        views=views)
             self.plotter.camera_set = True  # install_scene chose the view; PyVista must not re-frame the props
+            self.installed_bounds = self.bounds()  # (what the clipping dock starts from)
+            if any(_is_pt(p) for p in self.props.values()):
+                # VTK fits the clipping range to its own props only: a previous scene's near plane cut through a PT
+                # mesh (a 700k-tetrahedron first frame took minutes instead of 0.3 s)
+                self.plotter.renderer.ResetCameraClippingRange(self.installed_bounds)
             self._pt_meshes, self._vtk_inputs = {}, {}
             self.histograms = dict(prepared.histograms)
             self.time = prepared.time if prepared.time is not None else 0.0

@@ -154,8 +154,10 @@ class PTVolume:
         return {"camera": cam, "depth": depth, "rgb": rgb, "size": (w, h), "tf": self.tf, "t_start": t_start,
                 "t_read": time.perf_counter()}
 
-    def compute(self, request: dict[str, Any], progress: Any = None) -> tuple[np.ndarray, Any]:
-        """Any-thread part: the volume image for a request of ``begin`` (pure NumPy/Numba, no VTK)."""
+    def compute(self, request: dict[str, Any], progress: Any = None) -> tuple[np.ndarray, Any, np.ndarray]:
+        """Any-thread part: the volume image for a request of ``begin`` (pure NumPy/Numba, no VTK), its statistics,
+        and the image as VTK will show it (straight-alpha 8-bit RGBA, bottom row first), made here so that ``finish``
+        on the GUI thread only hands it over."""
         if progress is not None:
             progress(0.0, "rendering volume")
         opts = dict(self.render_opts)
@@ -168,7 +170,7 @@ class PTVolume:
         img, st = render(self.mesh, request["tf"], request["camera"], request["size"], self.method,
                          depth=request["depth"], return_stats=True, **opts)
         st.extra["sort_prefetched"] = res is not None
-        return img, st
+        return img, st, np.ascontiguousarray(unpremultiply_rgba8(img)[::-1])
 
     def prefetch(self, camera: Camera, size: tuple[int, int] | None = None) -> None:
         """Sort the mesh for ``camera`` (the next frame's; ``size`` defaults to the window's) in the background, so
@@ -202,14 +204,17 @@ class PTVolume:
         exact = render(self.mesh, request["tf"], request["camera"], (sw, sh), "reference")
         return {"rmse": float(rmse(fast, exact)), "max": float(max_abs(fast, exact)), "size": (sw, sh)}
 
-    def finish(self, request: dict[str, Any], img: np.ndarray, st: Any) -> np.ndarray:
-        """GUI-thread part 2: show a computed image as the overlay and record the statistics."""
+    def finish(self, request: dict[str, Any], img: np.ndarray, st: Any, rgba8: np.ndarray | None = None) -> np.ndarray:
+        """GUI-thread part 2: show a computed image as the overlay and record the statistics. ``rgba8``: the image
+        as ``compute`` converted it (else converted here). The render window redraws unless the plotter's rendering
+        is suppressed (the caller then draws once itself)."""
         from vtk.util.numpy_support import numpy_to_vtk
 
         t_vol = time.perf_counter()
         w, h = request["size"]
         ren_win = self.plotter.ren_win
-        rgba8 = unpremultiply_rgba8(img)[::-1]                        # VTK images start at the bottom row
+        if rgba8 is None:
+            rgba8 = unpremultiply_rgba8(img)[::-1]                    # VTK images start at the bottom row
         self._data.SetDimensions(w, h, 1)
         arr = numpy_to_vtk(np.ascontiguousarray(rgba8.reshape(-1, 4)), deep=True)
         arr.SetName("rgba")
@@ -222,7 +227,8 @@ class PTVolume:
         oc.SetParallelScale(h / 2.0)
         oc.SetClippingRange(0.5, 1.5)
         self._overlay.DrawOn()
-        ren_win.Render()
+        if not getattr(self.plotter, "suppress_rendering", False):
+            ren_win.Render()
         t_end = time.perf_counter()
         depth = request["depth"]
         self.image, self.depth, self.scene_rgb, self.camera = img, depth, request["rgb"], request["camera"]
