@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from PySide6.QtCore import QTimer
+from PySide6.QtCore import Qt, QTimer
 
 from conftest import data_file
 from test_app_workflows import make_window, wait_loaded  # noqa: F401 (a fixture and a helper shared with it)
@@ -178,3 +178,122 @@ def test_lod_volume_selects_in_the_background_coarse_first(qtbot, make_window, t
     assert shown[0] <= 2 < shown[1] <= 16  # a coarse selection (budget / 8) first, then the full budget
     assert list(volume.selection.nodes) == list(volume.select(volume.camera()).nodes)  # as if selected right here
     assert volume.stats["blocks"] == shown[1]
+
+
+def test_session_load_prepares_in_the_background(qtbot, make_window, tmp_path: Path) -> None:
+    """A scene that takes seconds to prepare (a 676,000-tetrahedron mesh: generation, topology, first PT image) loads
+    while the event loop keeps running; the props reach the plotter only when it is ready."""
+    session = tmp_path / "big.json"
+    session.write_text(json.dumps({
+        "format": "volviz-session", "version": 1,
+        "components": [{"id": "demo", "type": "demo", "settings": {"cells_per_edge": 52}}],
+        "camera": {"position": [3.2, -2.4, 2.0], "focal_point": [0.5, 0.5, 0.5], "view_up": [0, 0, 1]}}))
+    window = make_window()
+    window.resize(1000, 600)  # a small viewport: renders (on this thread) are not what this test is about
+    qtbot.wait(300)  # the viewport's resize handling is over
+    window.open_demo_volume()  # a small scene first: the big one replaces it
+    wait_loaded(qtbot, window)
+    small = window.controller
+    qtbot.wait(300)
+    gaps = LoopGaps()
+    window.open_path(session)
+    assert window.controller is small and window.progress_bar.isVisible(), "the scene was built on the GUI thread"
+    wait_loaded(qtbot, window)
+    gaps.stop()
+    volume = window.controller.pt_volume("demo")
+    assert window.controller is not small and volume is not None
+    assert volume.mesh.tets.shape[0] == 52 ** 3 * 5 and volume.image is not None and volume.image[..., 3].max() > 0
+    assert window.status_label.text() == "Showing big.json"
+    assert len(gaps.gaps) > 20
+    assert max(gaps.gaps) < 0.1, f"event loop stalled for {max(gaps.gaps) * 1000:.0f} ms while loading"
+
+
+def test_newer_open_supersedes_an_older_one(qtbot, make_window) -> None:
+    window = make_window()
+    window.open_demo()
+    window.open_demo_volume()  # before the demo scene is ready
+    wait_loaded(qtbot, window)
+    qtbot.wait(500)  # a stale result would arrive now
+    assert window.title == "demo volume" and window.controller.nature is None
+    assert window.controller.pt_volume("demo") is not None
+
+
+def test_nature_visibility_toggles_rebuild_in_the_background(qtbot, make_window) -> None:
+    window = make_window()
+    window.resize(1000, 700)  # a render on llvmpipe grows with the pixels
+    window.open_demo()
+    wait_loaded(qtbot, window)
+    view = window.controller.nature
+    assert [f.name for f in view.scene.fogs] == ["ground_fog"]
+    before = overlay_pixels(view)
+    rebuilds, updates = window.nature_rebuilds, window.nature_updates
+    gaps = LoopGaps()
+    window.scene_tree.item("ground_fog").setCheckState(0, Qt.CheckState.Unchecked)  # what a click in the tree does
+    assert window.controller.nature is view and window.nature_rebuilds == rebuilds, \
+        "the natural scene was rebuilt on the GUI thread"
+    qtbot.waitUntil(lambda: window.nature_rebuilds > rebuilds and window.nature_updates > updates, timeout=60000)
+    gaps.stop()
+    new = window.controller.nature
+    assert new is not view and new.scene.fogs == [] and new.scene.terrain is not None
+    after = overlay_pixels(new)
+    assert after.shape == before.shape and np.abs(after.astype(int) - before).max() > 0  # the fog is gone
+    assert len(gaps.gaps) > 5
+    assert max(gaps.gaps) < 0.1, f"event loop stalled for {max(gaps.gaps) * 1000:.0f} ms during a rebuild"
+
+    window.scene_tree.item("ground_fog").setCheckState(0, Qt.CheckState.Checked)
+    qtbot.waitUntil(lambda: window.controller.nature is not new and not window._nature_jobs.running, timeout=60000)
+    qtbot.waitUntil(lambda: [f.name for f in window.controller.nature.scene.fogs] == ["ground_fog"], timeout=60000)
+    # fog without terrain cannot be built: a message, and the terrain stays shown and checked
+    shown = window.controller.nature
+    window.scene_tree.item("terrain").setCheckState(0, Qt.CheckState.Unchecked)
+    qtbot.waitUntil(lambda: window.error_dialog is not None, timeout=30000)
+    assert "terrain" in window.error_dialog.text() and "fog" in window.error_dialog.text()
+    assert window.controller.nature is shown and window.controller.component("terrain").visible
+    assert window.scene_tree.item("terrain").checkState(0) == Qt.CheckState.Checked
+
+
+def write_pvm_series(folder: Path, steps: int, n: int) -> list[np.ndarray]:
+    """A moving Gaussian blob, ``steps`` 8-bit PVM volumes of n³ voxels (x fastest, as PVM stores them)."""
+    x, y, z = np.meshgrid(*(np.linspace(-1, 1, n),) * 3, indexing="ij")
+    frames = []
+    for k in range(steps):
+        c = -0.5 + k / max(steps - 1, 1)
+        field = 230 * np.exp(-6 * ((x - c) ** 2 + y ** 2 + z ** 2)) + 20 * np.cos(5 * y + k)
+        data = np.clip(field + 20, 0, 255).astype(np.uint8)
+        (folder / f"blob.pvm-t{k + 1:02d}").write_bytes(f"PVM\n{n} {n} {n}\n1\n".encode() + data.tobytes("F"))
+        frames.append(data)
+    return frames
+
+
+def test_blended_time_series_playback_keeps_the_event_loop_live(qtbot, make_window, tmp_path: Path) -> None:
+    frames = write_pvm_series(tmp_path, 4, 128)
+    window = make_window()
+    window.resize(800, 600)
+    window.open_path(tmp_path / "blob.pvm-t01")
+    wait_loaded(qtbot, window)
+    volume = window.controller.props["data"]
+    first = volume.GetMapper().GetInput()
+    window.timeline.set_time(1.5)  # what the slider does: halfway between the first two steps
+    assert window.controller.time == 1.5
+    assert volume.GetMapper().GetInput() is first, "the volume was blended on the GUI thread"
+    qtbot.waitUntil(lambda: window.volume_time_shown == (1.5, True), timeout=30000)
+    from vtk.util.numpy_support import vtk_to_numpy
+
+    shown = vtk_to_numpy(volume.GetMapper().GetInput().GetPointData().GetScalars())
+    expected = 0.5 * (frames[0].astype(np.float32) + frames[1].astype(np.float32))
+    assert np.array_equal(shown, expected.ravel("F").astype(shown.dtype))
+    shown_times: set[float] = set()
+    sampler = QTimer()
+    sampler.setInterval(20)
+    sampler.timeout.connect(lambda: shown_times.add(window.volume_time_shown[0]))
+    sampler.start()
+    gaps = LoopGaps()
+    window.timeline.speed.setValue(0.5)  # half a step a second: 1.5 -> 2.75, no wrap-around
+    window.timeline.set_playing(True)
+    qtbot.wait(2500)
+    window.timeline.set_playing(False)
+    gaps.stop()
+    sampler.stop()
+    assert window.volume_time_shown[0] > 2.2 and len(shown_times) >= 5  # blended volumes followed the playback
+    assert len(gaps.gaps) > 25
+    assert max(gaps.gaps) < 0.1, f"event loop stalled for {max(gaps.gaps) * 1000:.0f} ms during playback"
