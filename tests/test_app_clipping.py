@@ -40,6 +40,16 @@ def open_session(qtbot, window: MainWindow, path: Path) -> None:
 
 
 def viewport(window: MainWindow) -> np.ndarray:
+    """The viewport once the isosurfaces show the current clipping (they are re-cut in the background)."""
+    import time
+
+    from PySide6.QtWidgets import QApplication
+
+    deadline = time.monotonic() + 30.0
+    while not window.isosurfaces_cut() and time.monotonic() < deadline:
+        QApplication.processEvents()
+        time.sleep(0.005)
+    assert window.isosurfaces_cut(), "the isosurfaces were not re-cut for the new clipping"
     window.plotter.render()
     return np.asarray(window.plotter.screenshot(None, return_img=True)).astype(np.float64)
 
@@ -60,8 +70,11 @@ def test_clip_plane_cuts_the_view_undo_and_survives_save_and_reopen(qtbot, make_
     assert np.abs(before[left] - background).max() > 20 and np.abs(before[right] - background).max() > 20
 
     dock = window.clipping
+    shown = window.controller.props["iso"].volviz_shown
     dock.add_button.click()                              # a plane through the centre, normal +x: keeps x >= 11.5
     assert len(window.session.clip["planes"]) == 1 and window.dirty
+    assert window.controller.props["iso"].volviz_shown is shown and not window.isosurfaces_cut(), \
+        "the isosurfaces were cut on the GUI thread"
     cut = viewport(window)
     assert np.abs(cut[left] - background).max() <= 3     # the left half is gone
     assert np.abs(cut[right] - before[right]).max() <= 3  # the right half is as it was

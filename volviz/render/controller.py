@@ -452,14 +452,21 @@ class SceneController:
 
         return clip_settings(self.session.clip)
 
-    def set_clip(self, clip: Any, update_pt: bool = True, cut_pt: bool = True) -> list[str]:
+    def set_clip(self, clip: Any, update_pt: bool = True, cut_pt: bool = True,
+                 isosurfaces: bool = True) -> list[str]:
         """Store new clipping (``session.clip`` JSON or ClipSettings) and cut every prop; returns the ids of the PT
         volumes affected. Their meshes are cut here when ``cut_pt`` and re-rendered when ``update_pt``; the app
-        instead cuts them in the background (``cut_pt_mesh`` on a worker, then ``set_pt_mesh``) and re-renders."""
+        instead cuts them in the background (``cut_pt_mesh`` on a worker, then ``set_pt_mesh``) and re-renders.
+        Isosurfaces are re-cut here when ``isosurfaces``; the app instead cuts them in the background
+        (``isosurface_meshes``, ``volviz.render.scene.isosurface_parts`` on a worker, ``show_isosurfaces``)."""
         from volviz.iso.clip import ClipSettings
 
         self.session.clip = clip.to_dict() if isinstance(clip, ClipSettings) else self.clip.from_dict(clip).to_dict()
-        return self.apply_clip(update_pt, cut_pt)
+        return self.apply_clip(update_pt, cut_pt, isosurfaces)
+
+    def isosurface_meshes(self) -> dict[str, list[Any]]:
+        """The extracted (uncut) surfaces of every shown isosurface component, for re-cutting them elsewhere."""
+        return {comp_id: list(prop.volviz_meshes) for comp_id, prop in self._iso_props().items()}
 
     def apply_clip(self, update_pt: bool = True, cut_pt: bool = True, isosurfaces: bool = True) -> list[str]:
         """Cut every prop by the session's clipping (isosurfaces only when ``isosurfaces``: ``install`` gets them
