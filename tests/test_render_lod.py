@@ -182,6 +182,27 @@ def test_volviz_ray_casts_in_the_background_worker_when_nothing_needs_the_plotte
         pl.close()
 
 
+def test_volviz_honours_the_mapper_clipping_planes(tree: LodTree) -> None:
+    import vtk
+
+    pl = _plotter()
+    try:
+        lod = LodVolume(pl, tree, TF, budget=16)
+        lod.update()
+        whole = lod.image.copy()
+        plane = vtk.vtkPlane()
+        plane.SetOrigin(36.0, 36.0, 36.0)
+        plane.SetNormal(0.0, 0.0, -1.0)                     # VTK keeps the side the normal points to: z <= 36
+        lod.mapper.AddClippingPlane(plane)                  # as volviz.render.clipping does for the controller
+        cut = lod.draw()
+        cam = Camera.from_pyvista(pl.renderer.GetActiveCamera())
+        same = render_blocks(lod._pool, TF, cam, SIZE, planes=np.array([[0.0, 0.0, -1.0, 36.0]]), table=lod._table)
+    finally:
+        pl.close()
+    assert cut[..., 3].sum() < 0.8 * whole[..., 3].sum()
+    assert max_abs(same, cut) == 0.0                        # the plane reaches the rays as n . X + w >= 0
+
+
 @pytest.mark.parametrize("renderer", ["volviz", "vtk"])
 def test_selection_follows_budget_and_camera(tree: LodTree, renderer: str) -> None:
     pl = _plotter()
