@@ -400,19 +400,9 @@ def _anim_markdown(anim: list[dict[str, Any]], lod: list[dict[str, Any]], cmd: s
                          f"{r['cache_hit_rate']:.2f} |")
         lines += ["", f"Node statistics (exact L2 errors, deviation histograms) took {lod[0]['stats_s']:.1f} s."]
         if "render_render_s_per_frame" in lod[0]:
-            lines += ["", "### Rendered walkthrough frames", "",
-                      "The same budgets drawn offscreen by `volviz.render.lod_volume.LodVolume` "
-                      "(vtkMultiBlockVolumeMapper, one-voxel block overlap) at 512^2: seconds per frame for "
-                      "selection + decoding + drawing (median after a cold first frame), and the error of the image "
-                      "against the full-resolution volume drawn by the same mapper as one block (8-bit RGB).", "",
-                      "| block budget | blocks drawn | s/frame | frames/s | RMSE | max |", "|---|---|---|---|---|---|"]
-            for r in lod:
-                lines.append(f"| {r['budget']} | {r['render_blocks']:.0f} | {r['render_render_s_per_frame']:.2f} | "
-                             f"{r['render_fps']:.2f} | {r['render_rmse']:.2f} | {r['render_max']:.0f} |")
-            lines += ["", "On llvmpipe (no GPU) the multi-block mapper pays about 40 ms per block and pass, so these "
-                      "frame rates are far below the single-volume renderer's (the embryo as one block: about 0.3 s "
-                      "per frame); the selection and decoding themselves take the milliseconds of the table above. "
-                      "A one-pass ray caster over the blocks is the open item."]
+            from volviz.bench import lod_frames
+
+            lines += [""] + lod_frames.markdown(lod)
     return "\n".join(lines) + "\n"
 
 
