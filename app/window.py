@@ -614,8 +614,9 @@ class MainWindow(QMainWindow):
                              on_done=done)
 
     def _recut_isosurfaces(self, controller: Any, settings: Any) -> None:
-        """Cut the isosurfaces' extracted surfaces by new clipping on a worker (with their LOD chains; a newer
-        clipping supersedes), then swap their actors here; ``isosurfaces_cut()`` tells when they show it."""
+        """Cut the isosurfaces' extracted surfaces by new clipping (or for a new opacity) on a worker, with their LOD
+        chains (a newer request supersedes), then swap their actors here; ``isosurfaces_cut()`` tells when the
+        clipping is shown."""
         from volviz.render.scene import isosurface_parts
 
         meshes = controller.isosurface_meshes()
@@ -698,11 +699,17 @@ class MainWindow(QMainWindow):
         self.jobs.submit(prepare, name="natural scene", key="nature-build", on_done=done)
 
     def _set_opacity(self, comp_id: str, opacity: float) -> None:
-        if self.controller is not None:
-            self.controller.set_opacity(comp_id, opacity)
-            self.set_dirty()
-            self.render()
-            self.refresh_iso_overlay()
+        if self.controller is None:
+            return
+        controller = self.controller
+        iso = controller.component(comp_id).type == "isosurface"
+        controller.set_opacity(comp_id, opacity, isosurfaces=not iso)
+        self.set_dirty()
+        if iso:  # the surfaces are re-made (opacity, clipping, LOD chains) in the background
+            self._recut_isosurfaces(controller, controller.clip)
+            return
+        self.render()
+        self.refresh_iso_overlay()
 
     def apply_component_settings(self, comp_id: str, text: str) -> bool:
         """New settings for a component (JSON from the scene tree): validated through the session schema, then the

@@ -197,3 +197,17 @@ def test_pt_volume_is_cut_in_the_background_and_re_rendered(qtbot, make_window):
     window.action_undo.trigger()
     qtbot.waitUntil(lambda: volume.image[..., 3].sum() == pytest.approx(alpha, rel=1e-6), timeout=60000)
     assert volume.mesh.n_cells == whole.n_cells
+
+
+def test_isosurface_opacity_is_remade_in_the_background(qtbot, make_window, session_file):
+    window = make_window()
+    open_session(qtbot, window, session_file)
+    before = viewport(window)
+    shown = window.controller.props["iso"].volviz_shown
+    window.scene_tree.opacity.setValue(30)  # the scene tree's opacity slider for the selected component ("iso")
+    assert window.controller.component("iso").opacity == pytest.approx(0.3)
+    assert window.controller.props["iso"].volviz_shown is shown, "the isosurfaces were re-made on the GUI thread"
+    qtbot.waitUntil(lambda: window.controller.props["iso"].volviz_shown is not shown, timeout=30000)
+    new = window.controller.props["iso"].volviz_shown
+    assert [m.style.opacity for m in new] == pytest.approx([0.3 * s["opacity"] for s in STYLES])
+    assert np.abs(viewport(window) - before).mean() > 0.5  # fainter surfaces

@@ -189,14 +189,17 @@ class SceneController:
         elif prop is not None:
             prop.SetVisibility(bool(visible))
 
-    def set_opacity(self, comp_id: str, opacity: float) -> None:
+    def set_opacity(self, comp_id: str, opacity: float, isosurfaces: bool = True) -> None:
+        """Set a component's opacity. An isosurface component's surfaces are re-made here when ``isosurfaces`` (the
+        app re-makes them in the background: ``isosurface_meshes``, ``isosurface_parts``, ``show_isosurfaces``)."""
         comp = self.component(comp_id)
         comp.opacity = float(min(max(opacity, 0.0), 1.0))
         prop = self.props.get(comp_id)
         if prop is None:
             return
         if comp.type == "isosurface":
-            self._readd_isosurfaces(comp_id)
+            if isosurfaces:
+                self._readd_isosurfaces(comp_id)
         elif _is_pt(prop):
             tf = self.transfer_function(comp_id)
             prop.tf = tf.scaled_extinction(comp.opacity) if comp.opacity != 1.0 else tf
