@@ -30,6 +30,10 @@ class GuiThreadCollector(QObject):
         gc.collect()
         gc.freeze()
 
+    def unfreeze(self) -> None:
+        """Undo ``freeze_long_lived`` (the window closes: its frozen objects may now be garbage)."""
+        gc.unfreeze()
+
     def check(self) -> None:
         counts = gc.get_count()
         if counts[0] > self.thresholds[0]:

@@ -1313,4 +1313,5 @@ class MainWindow(QMainWindow):
         self.controller = None  # late timer callbacks find no scene to update
         self.jobs.shutdown()
         self.plotter.close()
+        self.collector.unfreeze()  # what was long-lived while the window was open can be collected again
         super().closeEvent(event)
