@@ -8,6 +8,7 @@ import pytest
 from conftest import data_file
 from volviz.model.datasets import TetMesh
 from volviz.optics import TransferFunction
+from volviz.optics.metrics import max_abs, rmse
 from volviz.unstructured import synthetic as syn
 from volviz.unstructured.camera import Camera
 from volviz.unstructured.render import render
@@ -77,6 +78,34 @@ def test_camera_inside_mesh_near_plane_clipping():
     cam = Camera((0.45, 0.55, 0.5), (1.0, 0.8, 0.6), (0, 0, 1), 70.0, clipping_range=(0.05, 10.0))
     img, ref = _check(m, cam)
     assert ref[..., 3].min() > 0.0                                 # every pixel looks through the medium
+
+
+def test_near_plane_crossing_cells_get_the_box_of_their_visible_part():
+    """A cell crossing the near plane is drawn over the pixel box of its part in front of the plane (front vertices
+    and the edges' crossings of the plane), not the whole screen; a cell wholly behind the plane has no box. Before,
+    every crossing cell got the whole screen: a near plane through a large mesh took minutes per frame."""
+    cam = Camera((0.0, 0.0, 0.0), (0.0, 0.0, 1.0), (0, 1, 0), 60.0, clipping_range=(1.0, 100.0))
+    pts = np.array([[0.01, 0.01, 0.9], [0.05, 0.0, 1.2], [0.0, 0.05, 1.2], [0.03, 0.03, 1.5]])
+    crossing = TetMesh(pts, np.array([[0, 1, 2, 3]]), np.array([0.2, 0.5, 0.7, 0.4]))
+    size = (160, 120)
+    img, st = render(crossing, TF, cam, size, "pt", return_stats=True)
+    ref = render(crossing, TF, cam, size, "reference")
+    assert ref[..., 3].max() > 0.01                                # the part in front of the plane is seen
+    assert rmse(img, ref) <= 0.5 and max_abs(img, ref) <= 2.0
+    assert 0 < st.extra["box_pixels"] < 0.05 * size[0] * size[1]
+    behind = TetMesh(pts - np.array([0.0, 0.0, 0.5]), crossing.tets, crossing.scalars)
+    img, st = render(behind, TF, cam, size, "pt", return_stats=True)
+    assert st.extra["box_pixels"] == 0 and not img.any()
+
+
+def test_flat_cell_renders_nothing():
+    """A tetrahedron whose four vertices lie in one plane (zero volume) is no error and draws nothing."""
+    flat = TetMesh(np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.5, 0.5, 0.0]]),
+                   np.array([[0, 1, 2, 3]]), np.array([0.2, 0.5, 0.7, 0.4]))
+    cam = Camera.orbit(flat.points, 30, 20, 2.5)
+    for method in ("pt", "reference"):
+        img = render(flat, TF, cam, (32, 24), method)
+        assert np.isfinite(img).all() and np.abs(img).max() <= 1e-12
 
 
 @pytest.mark.parametrize("make", [syn.cavity_box, syn.holed_box], ids=["cavity", "hole"])

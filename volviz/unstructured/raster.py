@@ -60,37 +60,56 @@ def project_cells(pts: np.ndarray, tets: np.ndarray, scal: np.ndarray, cells: np
     vxy = np.empty((k, 8))
     for q in prange(k):
         c = cells[q]
-        # --- pixel box from the projected vertices (whole screen if a vertex is at/behind the near plane)
+        # --- pixel box from the projected vertices; a cell crossing the near plane gets the box of its part in
+        # front of it (front vertices and the edges' crossings of the plane), empty if it lies wholly behind it
         xmin, xmax, ymin, ymax = 1e300, -1e300, 1e300, -1e300
         full = False
+        cx = np.empty(4)
+        cy = np.empty(4)
+        cz = np.empty(4)
         for v in range(4):
             iv = tets[c, v]
             rel0 = pts[iv, 0] - frame[3, 0]
             rel1 = pts[iv, 1] - frame[3, 1]
             rel2 = pts[iv, 2] - frame[3, 2]
-            x = rel0 * frame[0, 0] + rel1 * frame[0, 1] + rel2 * frame[0, 2]
-            y = rel0 * frame[1, 0] + rel1 * frame[1, 1] + rel2 * frame[1, 2]
-            z = rel0 * frame[2, 0] + rel1 * frame[2, 1] + rel2 * frame[2, 2]
-            if not parallel:
-                if z <= near * (1.0 + 1e-9):
-                    full = True
-                    break
-                x /= z
-                y /= z
-            px = (x / scales[0] + 1.0) * width * 0.5 - 0.5
-            py = (1.0 - y / scales[1]) * height * 0.5 - 0.5
-            vxy[q, 2 * v] = px
-            vxy[q, 2 * v + 1] = py
-            xmin, xmax = min(xmin, px), max(xmax, px)
-            ymin, ymax = min(ymin, py), max(ymax, py)
+            cx[v] = rel0 * frame[0, 0] + rel1 * frame[0, 1] + rel2 * frame[0, 2]
+            cy[v] = rel0 * frame[1, 0] + rel1 * frame[1, 1] + rel2 * frame[1, 2]
+            cz[v] = rel0 * frame[2, 0] + rel1 * frame[2, 1] + rel2 * frame[2, 2]
+            if not parallel and cz[v] <= near * (1.0 + 1e-9):
+                full = True
+        for v in range(4):
+            if parallel or cz[v] > near * (1.0 + 1e-9):
+                x, y = cx[v], cy[v]
+                if not parallel:
+                    x /= cz[v]
+                    y /= cz[v]
+                px = (x / scales[0] + 1.0) * width * 0.5 - 0.5
+                py = (1.0 - y / scales[1]) * height * 0.5 - 0.5
+                vxy[q, 2 * v] = px
+                vxy[q, 2 * v + 1] = py
+                xmin, xmax = min(xmin, px), max(xmax, px)
+                ymin, ymax = min(ymin, py), max(ymax, py)
         if full:
-            box[q, 0], box[q, 1], box[q, 2], box[q, 3] = 0, width - 1, 0, height - 1
+            for a in range(3):
+                for b in range(a + 1, 4):
+                    za, zb = cz[a] - near, cz[b] - near
+                    if (za > 0.0) == (zb > 0.0):
+                        continue
+                    w = za / (za - zb)
+                    x = (cx[a] + w * (cx[b] - cx[a])) / near
+                    y = (cy[a] + w * (cy[b] - cy[a])) / near
+                    px = (x / scales[0] + 1.0) * width * 0.5 - 0.5
+                    py = (1.0 - y / scales[1]) * height * 0.5 - 0.5
+                    xmin, xmax = min(xmin, px), max(xmax, px)
+                    ymin, ymax = min(ymin, py), max(ymax, py)
             vxy[q, 0] = np.nan
+        if xmin > xmax:                 # wholly behind the near plane: nothing to draw
+            box[q, 0], box[q, 1], box[q, 2], box[q, 3] = 0, -1, 0, -1
         else:
-            box[q, 0] = max(int(math.floor(xmin)), 0)
-            box[q, 1] = min(int(math.ceil(xmax)), width - 1)
-            box[q, 2] = max(int(math.floor(ymin)), 0)
-            box[q, 3] = min(int(math.ceil(ymax)), height - 1)
+            box[q, 0] = max(int(math.floor(xmin)) - 1, 0) if full else max(int(math.floor(xmin)), 0)
+            box[q, 1] = min(int(math.ceil(xmax)) + 1, width - 1) if full else min(int(math.ceil(xmax)), width - 1)
+            box[q, 2] = max(int(math.floor(ymin)) - 1, 0) if full else max(int(math.floor(ymin)), 0)
+            box[q, 3] = min(int(math.ceil(ymax)) + 1, height - 1) if full else min(int(math.ceil(ymax)), height - 1)
         # --- face half-spaces as affine forms of (px, py)
         for f in range(4):
             n0, n1, n2 = face_n[c, f, 0], face_n[c, f, 1], face_n[c, f, 2]

@@ -175,6 +175,10 @@ def iter_ray_segments(mesh: TetMesh, camera: Camera, size: tuple[int, int], band
     ranges = cell_ranges(mesh)
     live = np.nonzero(~ranges.nan)[0]
     p = topo.points[topo.tets[live]]                            # (k, 4, 3) relative to origin
+    # zero-volume cells (all four vertices in one plane, to rounding) hold no medium and have no barycentric inverse
+    edges = p[:, 1:] - p[:, :1]
+    flat = np.abs(np.linalg.det(edges)) <= 1e-13 * np.einsum("kij,kij->k", edges, edges) ** 1.5
+    live, p = live[~flat], p[~flat]
     mat = np.concatenate([np.transpose(p, (0, 2, 1)), np.ones((len(live), 1, 4))], axis=1)
     minv = np.ascontiguousarray(np.linalg.inv(mat))
     gnorm = np.ascontiguousarray(np.sqrt((minv[:, :, :3] ** 2).sum(axis=2)))

@@ -221,6 +221,8 @@ def render(mesh: TetMesh, tf: Any, camera: Camera, size: tuple[int, int] = (512,
                                                         rb.as_array(), frame, np.array([hx, hy]),
                                                         bool(camera.parallel), near, w, h, SOS)[1][:, 24:30])
     stats.project_s = time.perf_counter() - t0
+    stats.extra["box_pixels"] = int(np.sum(np.clip(box[:, 1] - box[:, 0] + 1, 0, None)
+                                           * np.clip(box[:, 3] - box[:, 2] + 1, 0, None)))
     t0 = time.perf_counter()
     if method == "pt-st":
         if depth is not None:

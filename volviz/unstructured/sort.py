@@ -333,11 +333,15 @@ def is_convex(topo: Topology, rel_tol: float = 1e-9) -> bool:
     cached = topo.__dict__.get("_convex")
     if cached is not None:
         return cached
-    from scipy.spatial import ConvexHull
+    from scipy.spatial import ConvexHull, QhullError
 
     bf = topo.boundary
     verts = np.unique(topo.tets[bf[:, 0][:, None], FACES[bf[:, 1]]])
-    hull_pts = topo.points[verts][ConvexHull(topo.points[verts]).vertices]
+    try:
+        hull_pts = topo.points[verts][ConvexHull(topo.points[verts]).vertices]
+    except QhullError:          # all points in one plane (or fewer than 4): no volume, so no order can be wrong
+        topo.__dict__["_convex"] = True
+        return True
     scale = float(np.abs(topo.points).max()) or 1.0
     n = topo.face_n[bf[:, 0], bf[:, 1]]
     d = topo.face_d[bf[:, 0], bf[:, 1]]
