@@ -132,8 +132,8 @@ def test_volviz_opaque_geometry_hides_the_volume_behind_it(tree: LodTree) -> Non
         alpha_free = free.image[..., 3].copy()
         free.remove()
         pl.add_mesh(pv.Sphere(radius=22.0, center=(36.0, 36.0, 36.0)), color="red")
+        lod = LodVolume(pl, tree, TF, budget=16)     # not drawn yet; its overlay has switched multisampling off
         scene = _shot(pl).astype(float)
-        lod = LodVolume(pl, tree, TF, budget=16)
         lod.update()
         shot = _shot(pl).astype(float)
         cam = Camera.from_pyvista(pl.renderer.GetActiveCamera())

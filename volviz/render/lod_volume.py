@@ -11,8 +11,8 @@ Two renderers:
 
 - ``"volviz"`` (default): our one-pass ray caster over the selected blocks (``volviz.regular.raycast``: an index
   grid finds a sample's block in O(1), steps grow with the block's level, separable pre-integration, transparent
-  blocks leapt over, early ray termination). Its premultiplied image is drawn the way ``volviz.render.pt_prop``
-  draws its PT volumes: the opaque scene is rendered with every volviz overlay off, its z-buffer is read and turned
+  blocks leapt over, early ray termination). Its premultiplied image is drawn by ``volviz.render.image_overlay``, as
+  the PT volumes are: the opaque scene is rendered with every volviz overlay off, its z-buffer is read and turned
   into a per-pixel depth limit for the rays (skipped when the renderer has no visible actor), and the image goes
   into an overlay renderer on a higher layer with (SRC_ALPHA, ONE_MINUS_SRC_ALPHA) blending (8-bit round trip ≤
   1/255). The overlay joins the plotter's list of volviz overlays, so PT volumes and LOD volumes hide each other
@@ -44,6 +44,7 @@ import numpy as np
 
 from volviz.regular.lod import Block, Camera as LodCamera, LodTree, Selection
 from volviz.render.vtk_scene import update_volume_property, vtk_volume_property
+from volviz.render.image_overlay import ImageOverlay, unpremultiply_rgba8, zbuffer_to_depth
 
 RENDERERS = ("volviz", "vtk")
 
@@ -85,81 +86,23 @@ def _image(block: Block) -> Any:
     return img
 
 
-class _Overlay:
-    """A full-window premultiplied image on a higher layer of the plotter's render window (the mechanism of
-    ``volviz.render.pt_prop``: same layer scheme, same sibling list, same straight-alpha upload)."""
-
-    def __init__(self, plotter: Any) -> None:
-        import vtk
-
-        self.plotter = plotter
-        ren_win = plotter.ren_win
-        layer = max(1, ren_win.GetNumberOfLayers())
-        ren_win.SetNumberOfLayers(layer + 1)
-        self.renderer = vtk.vtkRenderer()
-        self.renderer.SetLayer(layer)
-        self.renderer.InteractiveOff()
-        self.renderer.SetViewport(plotter.renderer.GetViewport())
-        self.data = vtk.vtkImageData()
-        actor = vtk.vtkImageActor()
-        actor.GetMapper().SetInputData(self.data)
-        actor.InterpolateOff()
-        actor.ForceTranslucentOn()
-        self.renderer.AddActor(actor)
-        self.renderer.GetActiveCamera().ParallelProjectionOn()
-        ren_win.AddRenderer(self.renderer)
-        self.renderer.DrawOff()
-        self.siblings = plotter.__dict__.setdefault("_volviz_pt_overlays", [])
-        self.siblings.append(self.renderer)
+class _Overlay(ImageOverlay):
+    """The ray caster's image over the plotter's scene: ``volviz.render.image_overlay`` (the PT volumes' mechanism:
+    same layer scheme, same sibling list, same straight-alpha upload), taking premultiplied float images."""
 
     def depth(self, size: tuple[int, int]) -> Optional[np.ndarray]:
         """Eye-space depth of the opaque scene (H, W), inf where none (with the clipping range of the render that
         made it); None when the renderer has no visible actor (nothing can hide the volume, and the extra render +
         read-back is skipped)."""
-        from volviz.render.pt_prop import _read_buffers, zbuffer_to_depth
-
         if self.plotter.renderer.VisibleActorCount() == 0:
             return None
-        ren_win = self.plotter.ren_win
-        shown = [o.GetDraw() for o in self.siblings]
-        for o in self.siblings:
-            o.DrawOff()
-        ren_win.Render()
-        z, _ = _read_buffers(ren_win, *size)
-        for o, on in zip(self.siblings, shown):
-            o.SetDraw(on)
+        z, _ = self.opaque_buffers(size)
         cam = self.plotter.renderer.GetActiveCamera()
         return zbuffer_to_depth(z, cam.GetClippingRange(), bool(cam.GetParallelProjection()))
 
-    def show(self, img: np.ndarray, visible: bool) -> None:
-        from vtk.util.numpy_support import numpy_to_vtk
-
-        from volviz.render.pt_prop import unpremultiply_rgba8
-
-        h, w = img.shape[:2]
-        rgba8 = unpremultiply_rgba8(img)[::-1]                        # VTK images start at the bottom row
-        # vtkImageActor spans its first to last point: pixel centres on the image's border lie on the quad's edge,
-        # where rasterisation drops the top row and right column; a one-pixel edge border puts them inside
-        rgba8 = np.pad(rgba8, ((1, 1), (1, 1), (0, 0)), mode="edge")
-        self.data.SetOrigin(-1.0, -1.0, 0.0)
-        self.data.SetDimensions(w + 2, h + 2, 1)
-        arr = numpy_to_vtk(np.ascontiguousarray(rgba8.reshape(-1, 4)), deep=True)
-        arr.SetName("rgba")
-        self.data.GetPointData().SetScalars(arr)
-        self.data.Modified()
-        oc = self.renderer.GetActiveCamera()
-        oc.SetFocalPoint((w - 1) / 2.0, (h - 1) / 2.0, 0.0)
-        oc.SetPosition((w - 1) / 2.0, (h - 1) / 2.0, 1.0)
-        oc.SetViewUp(0.0, 1.0, 0.0)
-        oc.SetParallelScale(h / 2.0)
-        oc.SetClippingRange(0.5, 1.5)
-        self.renderer.SetDraw(bool(visible))
-        self.plotter.ren_win.Render()
-
-    def remove(self) -> None:
-        self.plotter.ren_win.RemoveRenderer(self.renderer)
-        if self.renderer in self.siblings:
-            self.siblings.remove(self.renderer)
+    def show_image(self, img: np.ndarray, visible: bool) -> None:
+        """Show a premultiplied float RGBA image (H, W, 4), row 0 at the top."""
+        self.show(unpremultiply_rgba8(img), visible)
 
 
 def _mapper_planes(mapper: Any) -> Optional[np.ndarray]:
@@ -324,7 +267,7 @@ class LodVolume:
             return False
         t0 = time.perf_counter()
         self._pool, self.image, self.depth = pool, img, None
-        self._overlay.show(img, True)
+        self._overlay.show_image(img, True)
         self.stats.update({"renderer": "volviz", "prepared": True, "readback_s": 0.0, "draw_s": 0.0,
                            "upload_s": time.perf_counter() - t0, "size": (img.shape[1], img.shape[0]), **st})
         return True
@@ -376,7 +319,7 @@ class LodVolume:
                             planes=_mapper_planes(self.mapper)) if visible else np.zeros((h, w, 4), np.float32)
         t3 = time.perf_counter()
         self.image, self.depth = img, depth
-        self._overlay.show(img, visible)
+        self._overlay.show_image(img, visible)
         t4 = time.perf_counter()
         self.stats.update({"renderer": "volviz", "prepared": False, "readback_s": t1 - t0, "table_s": t2 - t1, "render_s": t3 - t2,
                            "upload_s": t4 - t3, "draw_s": t4 - t0, "size": (w, h)})

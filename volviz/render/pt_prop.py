@@ -16,22 +16,15 @@ How a frame is made (``update``):
    ratio f/n = 1000 resolves about 1e-4 of the view distance;
 3. the volume is rendered by ``volviz.unstructured.render(..., depth=d)``: every ray segment is clipped at the opaque
    depth of its pixel, so the volume stops exactly at the surface (not at the cell containing it);
-4. the premultiplied result is un-premultiplied to 8-bit straight RGBA and drawn as a full-window image in an overlay
-   renderer (a higher layer) with VTK's (SRC_ALPHA, ONE_MINUS_SRC_ALPHA) blending, which gives the premultiplied
-   "over" C = C_vol + (1 - a_vol) C_scene. The 8-bit round trip costs at most about 1/255 per channel (measured in
-   the tests).
+4. the premultiplied result is drawn over the scene by ``volviz.render.image_overlay.ImageOverlay`` (straight-alpha
+   RGBA8 in an overlay renderer on a higher layer: the premultiplied "over" C = C_vol + (1 - a_vol) C_scene; the
+   8-bit round trip costs at most about 1/255 per channel, measured in the tests).
 
 Later renders of the plotter (screenshots, interaction) keep showing the last volume image over the live scene; call
 ``update()`` after the camera or the opaque geometry changed. Several PT volumes in one plotter are each clipped by
 the opaque depth and blended in the order they were added (their own depths are not interleaved: overlapping
-volumes should be merged into one mesh).
-
-Multisampling (PyVista's default, 4 samples) is switched off while a PT volume is in the plotter, and back on when the
-last one is removed: with MSAA a silhouette pixel of opaque geometry has a blended colour (object and what is behind
-it) but VTK's depth read-back gives one depth, so the volume was cut there by that one depth for the whole pixel: a
-one-pixel edge around opaque objects (max 18 of 255 against the compositing of the same opaque image, against 1.6
-without MSAA, on the test scene at 256x192). Compositing per sample would need every sample's depth, which VTK's
-``GetZbufferData`` does not give; an exact composite is preferred to antialiased silhouettes.
+volumes should be merged into one mesh). Multisampling is off while a volume is in the plotter (see
+``image_overlay``: with MSAA, silhouettes of opaque objects left a one-pixel edge).
 """
 from __future__ import annotations
 
@@ -41,54 +34,15 @@ from typing import Any
 import numpy as np
 
 from volviz.model.datasets import TetMesh
+from volviz.render.image_overlay import ImageOverlay, unpremultiply_rgba8, zbuffer_to_depth
 from volviz.unstructured.camera import Camera
 from volviz.unstructured.render import render
-
-
-def zbuffer_to_depth(z: np.ndarray, clipping_range: tuple[float, float], parallel: bool) -> np.ndarray:
-    """OpenGL window depth z in [0, 1] -> eye-space depth along the direction of projection; z >= 1 -> +inf."""
-    n, f = (float(v) for v in clipping_range)
-    z = np.asarray(z, dtype=np.float64)
-    if parallel:
-        d = n + z * (f - n)
-    else:
-        with np.errstate(divide="ignore"):
-            d = n * f / (f - z * (f - n))
-    d = np.where((z >= 1.0) | ~np.isfinite(z), np.inf, d)
-    return d
-
-
-def unpremultiply_rgba8(image: np.ndarray) -> np.ndarray:
-    """Premultiplied float RGBA (H, W, 4) -> straight-alpha uint8 RGBA (H, W, 4) for (SRC_ALPHA, 1 - SRC_ALPHA)."""
-    a = np.clip(image[..., 3:4], 0.0, 1.0)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        c = np.where(a > 0, image[..., :3] / a, 0.0)
-    out = np.empty(image.shape[:2] + (4,), np.uint8)
-    out[..., :3] = np.rint(np.clip(c, 0.0, 1.0) * 255.0)
-    out[..., 3] = np.rint(a[..., 0] * 255.0)
-    return out
-
-
-def _read_buffers(ren_win: Any, w: int, h: int) -> tuple[np.ndarray, np.ndarray]:
-    """(z (H, W) float64, rgb (H, W, 3) uint8), row 0 at the top."""
-    import vtk
-    from vtk.util.numpy_support import vtk_to_numpy
-
-    z = vtk.vtkFloatArray()
-    ren_win.GetZbufferData(0, 0, w - 1, h - 1, z)
-    rgb = vtk.vtkUnsignedCharArray()
-    ren_win.GetRGBACharPixelData(0, 0, w - 1, h - 1, 0, rgb)
-    zz = vtk_to_numpy(z).reshape(h, w)[::-1].astype(np.float64)
-    cc = vtk_to_numpy(rgb).reshape(h, w, 4)[::-1, :, :3].copy()
-    return zz, cc
 
 
 class PTVolume:
     """A volviz PT volume attached to a PyVista plotter (see the module docstring)."""
 
     def __init__(self, plotter: Any, mesh: Any, tf: Any, method: str = "pt", **render_opts: Any) -> None:
-        import vtk
-
         scalars = render_opts.pop("scalars", None)
         if not isinstance(mesh, TetMesh):
             from volviz.unstructured.tetrahedralize import tetrahedralize
@@ -107,27 +61,7 @@ class PTVolume:
         self.scene_rgb: np.ndarray | None = None      # last opaque scene colour (H, W, 3) uint8
         self.camera: Camera | None = None
         self._prefetcher: Any = None                  # sorts for a known next camera in the background
-        ren_win = plotter.ren_win
-        if "_volviz_pt_multisamples" not in plotter.__dict__:  # one depth per pixel (see the module docstring)
-            plotter.__dict__["_volviz_pt_multisamples"] = int(ren_win.GetMultiSamples())
-            ren_win.SetMultiSamples(0)
-        self._layer = max(1, ren_win.GetNumberOfLayers())
-        ren_win.SetNumberOfLayers(self._layer + 1)
-        self._overlay = vtk.vtkRenderer()
-        self._overlay.SetLayer(self._layer)
-        self._overlay.InteractiveOff()
-        self._overlay.SetViewport(plotter.renderer.GetViewport())
-        self._data = vtk.vtkImageData()
-        self._actor = vtk.vtkImageActor()
-        self._actor.GetMapper().SetInputData(self._data)
-        self._actor.InterpolateOff()
-        self._actor.ForceTranslucentOn()
-        self._overlay.AddActor(self._actor)
-        self._overlay.GetActiveCamera().ParallelProjectionOn()
-        ren_win.AddRenderer(self._overlay)
-        self._overlay.DrawOff()
-        self._siblings = plotter.__dict__.setdefault("_volviz_pt_overlays", [])
-        self._siblings.append(self._overlay)
+        self._overlay = ImageOverlay(plotter)
 
     def _mesh_far(self, cam: Camera) -> float:
         p = self.mesh.points
@@ -146,13 +80,7 @@ class PTVolume:
         t_start = time.perf_counter()
         ren_win = self.plotter.ren_win
         w, h = (int(v) for v in ren_win.GetSize())
-        shown = [o.GetDraw() for o in self._siblings]            # every PT overlay off: opaque depth only
-        for o in self._siblings:
-            o.DrawOff()
-        ren_win.Render()
-        z, rgb = _read_buffers(ren_win, w, h)
-        for o, on in zip(self._siblings, shown):
-            o.SetDraw(on)
+        z, rgb = self._overlay.opaque_buffers((w, h))             # every overlay off: opaque depth only
         vcam = self.plotter.renderer.GetActiveCamera()
         cam = Camera.from_pyvista(vcam)
         depth = zbuffer_to_depth(z, cam.clipping_range, cam.parallel)
@@ -179,7 +107,7 @@ class PTVolume:
         img, st = render(self.mesh, request["tf"], request["camera"], request["size"], self.method,
                          depth=request["depth"], return_stats=True, **opts)
         st.extra["sort_prefetched"] = res is not None
-        return img, st, np.ascontiguousarray(unpremultiply_rgba8(img)[::-1])
+        return img, st, unpremultiply_rgba8(img)
 
     def prefetch(self, camera: Camera, size: tuple[int, int] | None = None) -> None:
         """Sort the mesh for ``camera`` (the next frame's; ``size`` defaults to the window's) in the background, so
@@ -215,29 +143,11 @@ class PTVolume:
 
     def finish(self, request: dict[str, Any], img: np.ndarray, st: Any, rgba8: np.ndarray | None = None) -> np.ndarray:
         """GUI-thread part 2: show a computed image as the overlay and record the statistics. ``rgba8``: the image
-        as ``compute`` converted it (else converted here). The render window redraws unless the plotter's rendering
-        is suppressed (the caller then draws once itself)."""
-        from vtk.util.numpy_support import numpy_to_vtk
-
+        (straight alpha, row 0 at the top) as ``compute`` converted it (else converted here). The render window
+        redraws unless the plotter's rendering is suppressed (the caller then draws once itself)."""
         t_vol = time.perf_counter()
         w, h = request["size"]
-        ren_win = self.plotter.ren_win
-        if rgba8 is None:
-            rgba8 = unpremultiply_rgba8(img)[::-1]                    # VTK images start at the bottom row
-        self._data.SetDimensions(w, h, 1)
-        arr = numpy_to_vtk(np.ascontiguousarray(rgba8.reshape(-1, 4)), deep=True)
-        arr.SetName("rgba")
-        self._data.GetPointData().SetScalars(arr)
-        self._data.Modified()
-        oc = self._overlay.GetActiveCamera()
-        oc.SetFocalPoint((w - 1) / 2.0, (h - 1) / 2.0, 0.0)
-        oc.SetPosition((w - 1) / 2.0, (h - 1) / 2.0, 1.0)
-        oc.SetViewUp(0.0, 1.0, 0.0)
-        oc.SetParallelScale(h / 2.0)
-        oc.SetClippingRange(0.5, 1.5)
-        self._overlay.DrawOn()
-        if not getattr(self.plotter, "suppress_rendering", False):
-            ren_win.Render()
+        self._overlay.show(unpremultiply_rgba8(img) if rgba8 is None else rgba8)
         t_end = time.perf_counter()
         depth = request["depth"]
         self.image, self.depth, self.scene_rgb, self.camera = img, depth, request["rgb"], request["camera"]
@@ -251,26 +161,18 @@ class PTVolume:
 
     @property
     def visible(self) -> bool:
-        return bool(self._overlay.GetDraw())
+        return self._overlay.visible
 
     @visible.setter
     def visible(self, on: bool) -> None:
-        if bool(on) == self.visible:
-            return
-        self._overlay.SetDraw(bool(on))
-        if not getattr(self.plotter, "suppress_rendering", False):
-            self.plotter.ren_win.Render()      # PyVista's screenshot() does not notice a foreign renderer's change
+        self._overlay.visible = on
 
     def remove(self) -> None:
         """Detach the overlay from the plotter's render window."""
         if self._prefetcher is not None:
             self._prefetcher.close()
             self._prefetcher = None
-        self.plotter.ren_win.RemoveRenderer(self._overlay)
-        if self._overlay in self._siblings:
-            self._siblings.remove(self._overlay)
-        if not self._siblings and "_volviz_pt_multisamples" in self.plotter.__dict__:  # the last one: MSAA back
-            self.plotter.ren_win.SetMultiSamples(self.plotter.__dict__.pop("_volviz_pt_multisamples"))
+        self._overlay.remove()
 
 
 def add_pt_volume(plotter: Any, mesh: Any, tf: Any, **opts: Any) -> PTVolume:
