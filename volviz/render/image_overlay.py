@@ -1,7 +1,8 @@
 """volviz's own images (premultiplied float RGBA from a CPU renderer) drawn over a PyVista plotter's scene and
 composited with its opaque geometry through the depth buffer (Guthe §4.5: a volume behind an opaque surface is
-hidden, in front of it it blends). Shared by the projected-tetrahedra volumes (``pt_prop``), the isosurface
-overlay (``iso_overlay``) and the LOD block ray caster (``lod_volume``).
+hidden, in front of it it blends). ``ImageOverlay`` draws an image; ``OverlayView`` re-makes one in a GUI / worker /
+GUI split. Used by the projected-tetrahedra volumes (``pt_prop``), the isosurface overlay (``iso_overlay``) and the
+LOD block ray caster (``lod_volume``).
 
     overlay = ImageOverlay(plotter)
     z, rgb = overlay.opaque_buffers((w, h))     # the scene rendered with every volviz overlay off, read back
@@ -28,11 +29,12 @@ Compositing per sample would need every sample's depth, which ``GetZbufferData``
 """
 from __future__ import annotations
 
+import time
 from typing import Any
 
 import numpy as np
 
-__all__ = ["ImageOverlay", "read_buffers", "unpremultiply_rgba8", "zbuffer_to_depth"]
+__all__ = ["ImageOverlay", "OverlayView", "read_buffers", "unpremultiply_rgba8", "zbuffer_to_depth"]
 
 _SIBLINGS = "_volviz_pt_overlays"           # plotter attribute: every overlay renderer of the plotter
 _MULTISAMPLES = "_volviz_pt_multisamples"   # plotter attribute: the MSAA setting to restore
@@ -158,3 +160,82 @@ class ImageOverlay:
             self.siblings.remove(self.renderer)
         if not self.siblings and _MULTISAMPLES in self.plotter.__dict__:
             self.plotter.ren_win.SetMultiSamples(self.plotter.__dict__.pop(_MULTISAMPLES))
+
+
+class OverlayView:
+    """An image of ours (a CPU renderer's premultiplied RGBA) kept over a plotter's scene and re-made in three parts,
+    so that the app can run the middle one in its job runner:
+
+    - ``begin`` (GUI thread): render the opaque scene with every overlay off, read its depth, fix the camera (the far
+      plane extended to ``_far``, since VTK's clipping range covers only VTK's own props); returns a request;
+    - ``compute(request)`` (any thread, no VTK): the image and its statistics; subclasses implement it;
+    - ``finish(request, img, st)`` (GUI thread): show it and record the statistics.
+
+    ``update`` does all three. Subclasses: ``pt_prop.PTVolume`` and ``iso_overlay.IsoOverlay``."""
+
+    def __init__(self, plotter: Any) -> None:
+        self.plotter = plotter
+        self.stats: dict[str, Any] = {}
+        self.image: np.ndarray | None = None          # last premultiplied image (H, W, 4)
+        self.depth: np.ndarray | None = None          # last per-pixel depth limit (H, W)
+        self.scene_rgb: np.ndarray | None = None      # last opaque scene colour (H, W, 3) uint8
+        self.camera: Any = None
+        self._overlay = ImageOverlay(plotter)
+
+    def _far(self, camera: Any) -> float:
+        """The largest view depth of what this view draws (the far plane it needs)."""
+        return float(camera.clipping_range[1])
+
+    def update(self) -> np.ndarray:
+        """Re-make the image for the plotter's current camera and opaque scene; returns the premultiplied image."""
+        request = self.begin()
+        return self.finish(request, *self.compute(request))
+
+    def begin(self) -> dict[str, Any]:
+        """GUI-thread part 1: the opaque scene's depth and colour, the camera and the window size."""
+        from volviz.unstructured.camera import Camera
+
+        t_start = time.perf_counter()
+        w, h = (int(v) for v in self.plotter.ren_win.GetSize())
+        z, rgb = self._overlay.opaque_buffers((w, h))
+        cam = Camera.from_pyvista(self.plotter.renderer.GetActiveCamera())
+        depth = zbuffer_to_depth(z, cam.clipping_range, cam.parallel)
+        near, far = cam.clipping_range
+        cam = Camera(cam.position, cam.focal_point, cam.view_up, cam.view_angle, cam.parallel, cam.parallel_scale,
+                     (near, max(far, 1.01 * self._far(cam))))
+        return {"camera": cam, "depth": depth, "rgb": rgb, "size": (w, h), "t_start": t_start,
+                "t_read": time.perf_counter()}
+
+    def compute(self, request: dict[str, Any], progress: Any = None) -> tuple[Any, ...]:
+        """Any-thread part: (premultiplied image, statistics with ``total_s``[, straight-alpha RGBA8])."""
+        raise NotImplementedError
+
+    def finish(self, request: dict[str, Any], img: np.ndarray, st: Any, rgba8: np.ndarray | None = None) -> np.ndarray:
+        """GUI-thread part 2: show a computed image and record the statistics. ``rgba8``: the image (straight alpha,
+        row 0 at the top) as ``compute`` converted it (else converted here). The window redraws unless the
+        plotter's rendering is suppressed (the caller then draws once itself)."""
+        t_show = time.perf_counter()
+        w, h = request["size"]
+        self._overlay.show(unpremultiply_rgba8(img) if rgba8 is None else rgba8)
+        t_end = time.perf_counter()
+        depth = request["depth"]
+        self.image, self.depth, self.scene_rgb, self.camera = img, depth, request["rgb"], request["camera"]
+        readback = request["t_read"] - request["t_start"]
+        self.stats = {"readback_s": readback, "volume_s": st.total_s, "upload_s": t_end - t_show,
+                      "total_s": readback + st.total_s + (t_end - t_show), "size": (w, h),
+                      "occluded_px": int(np.isfinite(depth).sum())}
+        for key in ("sort_s", "project_s", "raster_s", "fragments", "n_visible"):
+            self.stats[key] = getattr(st, key, 0)
+        return img
+
+    @property
+    def visible(self) -> bool:
+        return self._overlay.visible
+
+    @visible.setter
+    def visible(self, on: bool) -> None:
+        self._overlay.visible = on
+
+    def remove(self) -> None:
+        """Detach the overlay from the plotter's render window."""
+        self._overlay.remove()

@@ -15,8 +15,8 @@ scene through the depth buffer exactly as volviz's PT volumes are (``volviz.rend
    read-back scene colour and drawn opaque (see ``finish``).
 
 The 8-bit overlay costs at most about 1/255 per channel against the float image (measured in the tests).
-``begin`` / ``compute`` / ``finish`` split the work like PTVolume: ``compute`` is pure NumPy/Numba and runs in a
-background worker; the app recomputes after every camera change. Surfaces of components with LOD on are drawn at
+``begin`` / ``compute`` / ``finish`` split the work as every ``image_overlay.OverlayView`` does: ``compute`` is pure
+NumPy/Numba and runs in a background worker; the app recomputes after every camera change. Surfaces of components with LOD on are drawn at
 the level their screen size asks for, geomorphed (``volviz.iso.lod``); the statistics report the triangles drawn.
 """
 from __future__ import annotations
@@ -30,15 +30,10 @@ import numpy as np
 from volviz.iso.composite import MODES, Fragments, composite, fragments, triangles_drawn
 from volviz.iso.extract import IsoMesh
 from volviz.iso.lod import lod_mesh, select_level
-from volviz.model.datasets import TetMesh
-from volviz.render.pt_prop import PTVolume
+from volviz.render.image_overlay import OverlayView
 from volviz.unstructured.camera import Camera
 
 __all__ = ["IsoOverlay", "cut_at_depth"]
-
-# PTVolume's overlay plumbing needs a mesh; the isosurface overlay never renders it.
-_PLACEHOLDER = TetMesh(np.eye(4, 3), np.array([[0, 1, 2, 3]]), np.zeros(4))
-
 
 def cut_at_depth(frags: Fragments, depth: np.ndarray) -> Fragments:
     """The fragments strictly in front of the opaque depth of their pixel (``depth`` (H, W), +inf = nothing)."""
@@ -51,12 +46,12 @@ def cut_at_depth(frags: Fragments, depth: np.ndarray) -> Fragments:
                      frags.n_triangles, frags.n_opaque_triangles, frags.seconds)
 
 
-class IsoOverlay(PTVolume):
+class IsoOverlay(OverlayView):
     """The isosurfaces of a scene drawn by one of the CPU transparency modes as a depth-composited overlay."""
 
     def __init__(self, plotter: Any, meshes: Sequence[IsoMesh] = (), mode: str = "3pass",
                  shading: str = "spectrum") -> None:
-        super().__init__(plotter, _PLACEHOLDER, tf=None)
+        super().__init__(plotter)
         self.meshes = list(meshes)
         self.lod: list[Any] = [None] * len(self.meshes)  # per mesh: (LodChain, triangles per pixel²) or None
         self.mode = mode
@@ -72,7 +67,7 @@ class IsoOverlay(PTVolume):
             raise ValueError(f"unknown transparency mode {mode!r}; choose from {MODES}")
         self._mode = mode
 
-    def _mesh_far(self, cam: Camera) -> float:
+    def _far(self, cam: Camera) -> float:
         pts = [m.points for m in self.meshes if len(m.points)]
         if not pts:
             return float(cam.clipping_range[1])

@@ -28,18 +28,19 @@ volumes should be merged into one mesh). Multisampling is off while a volume is 
 """
 from __future__ import annotations
 
-import time
 from typing import Any
 
 import numpy as np
 
 from volviz.model.datasets import TetMesh
-from volviz.render.image_overlay import ImageOverlay, unpremultiply_rgba8, zbuffer_to_depth
+from volviz.render.image_overlay import OverlayView, unpremultiply_rgba8, zbuffer_to_depth
 from volviz.unstructured.camera import Camera
 from volviz.unstructured.render import render
 
+__all__ = ["PTVolume", "add_pt_volume", "unpremultiply_rgba8", "zbuffer_to_depth"]
 
-class PTVolume:
+
+class PTVolume(OverlayView):
     """A volviz PT volume attached to a PyVista plotter (see the module docstring)."""
 
     def __init__(self, plotter: Any, mesh: Any, tf: Any, method: str = "pt", **render_opts: Any) -> None:
@@ -50,46 +51,25 @@ class PTVolume:
             mesh = tetrahedralize(mesh, scalars)
         if method not in ("pt", "reference"):
             raise ValueError(f"PT volume method must be 'pt' or 'reference', got {method!r}")
-        self.plotter = plotter
+        super().__init__(plotter)
         self.mesh = mesh
         self.tf = tf
         self.method = method
         self.render_opts = render_opts
-        self.stats: dict[str, Any] = {}
-        self.image: np.ndarray | None = None          # last premultiplied volume image (H, W, 4)
-        self.depth: np.ndarray | None = None          # last per-pixel depth limit (H, W)
-        self.scene_rgb: np.ndarray | None = None      # last opaque scene colour (H, W, 3) uint8
-        self.camera: Camera | None = None
         self._prefetcher: Any = None                  # sorts for a known next camera in the background
-        self._overlay = ImageOverlay(plotter)
 
-    def _mesh_far(self, cam: Camera) -> float:
+    def _far(self, cam: Camera) -> float:
         p = self.mesh.points
         lo, hi = p.min(axis=0), p.max(axis=0)
         corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
         fwd = cam.frame()[2]
         return float(((corners - cam.position) @ fwd).max())
 
-    def update(self) -> np.ndarray:
-        """Re-render the volume for the plotter's current camera and opaque scene; returns the premultiplied image."""
-        request = self.begin()
-        return self.finish(request, *self.compute(request))
-
     def begin(self) -> dict[str, Any]:
         """GUI-thread part 1: render the opaque scene, read its depth, fix the camera (see the module docstring)."""
-        t_start = time.perf_counter()
-        ren_win = self.plotter.ren_win
-        w, h = (int(v) for v in ren_win.GetSize())
-        z, rgb = self._overlay.opaque_buffers((w, h))             # every overlay off: opaque depth only
-        vcam = self.plotter.renderer.GetActiveCamera()
-        cam = Camera.from_pyvista(vcam)
-        depth = zbuffer_to_depth(z, cam.clipping_range, cam.parallel)
-        near, far = cam.clipping_range
-        far = max(far, 1.01 * self._mesh_far(cam))                  # VTK's range only covers its own props
-        cam = Camera(cam.position, cam.focal_point, cam.view_up, cam.view_angle, cam.parallel, cam.parallel_scale,
-                     (near, far))
-        return {"camera": cam, "depth": depth, "rgb": rgb, "size": (w, h), "tf": self.tf, "t_start": t_start,
-                "t_read": time.perf_counter()}
+        request = super().begin()
+        request["tf"] = self.tf
+        return request
 
     def compute(self, request: dict[str, Any], progress: Any = None) -> tuple[np.ndarray, Any, np.ndarray]:
         """Any-thread part: the volume image for a request of ``begin`` (pure NumPy/Numba, no VTK), its statistics,
@@ -142,38 +122,17 @@ class PTVolume:
         return {"rmse": float(rmse(fast, exact)), "max": float(max_abs(fast, exact)), "size": (sw, sh)}
 
     def finish(self, request: dict[str, Any], img: np.ndarray, st: Any, rgba8: np.ndarray | None = None) -> np.ndarray:
-        """GUI-thread part 2: show a computed image as the overlay and record the statistics. ``rgba8``: the image
-        (straight alpha, row 0 at the top) as ``compute`` converted it (else converted here). The render window
-        redraws unless the plotter's rendering is suppressed (the caller then draws once itself)."""
-        t_vol = time.perf_counter()
-        w, h = request["size"]
-        self._overlay.show(unpremultiply_rgba8(img) if rgba8 is None else rgba8)
-        t_end = time.perf_counter()
-        depth = request["depth"]
-        self.image, self.depth, self.scene_rgb, self.camera = img, depth, request["rgb"], request["camera"]
-        self.stats = {"readback_s": request["t_read"] - request["t_start"], "sort_s": st.sort_s,
-                      "project_s": st.project_s, "raster_s": st.raster_s, "volume_s": st.total_s,
-                      "upload_s": t_end - t_vol, "total_s": request["t_read"] - request["t_start"] + st.total_s
-                      + (t_end - t_vol), "fragments": st.fragments, "n_visible": st.n_visible,
-                      "occluded_px": int(np.isfinite(depth).sum()), "size": (w, h), "method": self.method,
-                      "sort_prefetched": bool(st.extra.get("sort_prefetched", False))}
+        """GUI-thread part 2: show a computed image as the overlay and record the statistics (``OverlayView``)."""
+        super().finish(request, img, st, rgba8)
+        self.stats.update(method=self.method, sort_prefetched=bool(st.extra.get("sort_prefetched", False)))
         return img
-
-    @property
-    def visible(self) -> bool:
-        return self._overlay.visible
-
-    @visible.setter
-    def visible(self, on: bool) -> None:
-        self._overlay.visible = on
 
     def remove(self) -> None:
         """Detach the overlay from the plotter's render window."""
         if self._prefetcher is not None:
             self._prefetcher.close()
             self._prefetcher = None
-        self._overlay.remove()
-
+        super().remove()
 
 def add_pt_volume(plotter: Any, mesh: Any, tf: Any, **opts: Any) -> PTVolume:
     """Add a volviz PT volume to ``plotter`` (composited through the depth buffer) and render it once.
