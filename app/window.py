@@ -3,8 +3,10 @@ statistics), menus, status bar with progress and cancel, sessions with autosave 
 everything is a call into volviz."""
 from __future__ import annotations
 
+import copy
 import logging
 import os
+import threading
 import time
 from pathlib import Path
 from typing import Any, Callable, Optional
@@ -126,6 +128,9 @@ class MainWindow(QMainWindow):
         self.dirty = False
         self.last_stats: dict[str, Any] = {}
         self._current_job = None
+        self._screenshot_serial = 0        # the newest screenshot export; an older one only cleans up
+        self.screenshot_result: Optional[bool] = None  # of the last export: None while it runs
+        self.screenshot_threads: set[int] = set()      # the threads its background steps ran on
         self._load_serial = 0              # the newest open/rebuild; an older one's late callbacks do nothing
         self._loading_views = False        # the newest scene is installed, its first views are computed
         self._overlay_waiters: dict[str, list[Callable[[], None]]] = {}  # job key -> ``settled`` callbacks
@@ -1140,32 +1145,94 @@ class MainWindow(QMainWindow):
         self.recent_menu.setEnabled(bool(self.recent_files()))
 
     # ------------------------------------------------------------------------------------------------ export
-    def export_screenshot(self, path: str | os.PathLike, size: Optional[tuple[int, int]] = None) -> bool:
-        """Re-render the current view offscreen at ``size`` (default: the viewport's) and write a PNG."""
-        from volviz.render.controller import SceneController
-        from volviz.render.export import offscreen_plotter, write_png
+    def export_screenshot(self, path: str | os.PathLike, size: Optional[tuple[int, int]] = None) -> None:
+        """Re-render the current view offscreen at ``size`` (default: the viewport's) and write a PNG, in the
+        background with progress and cancel in the status bar (a newer export supersedes an older one): the scene is
+        prepared on a worker, its props added to an offscreen plotter here, its CPU images (natural scene, LOD
+        blocks, PT volumes, iso overlay) rendered on a worker, the final VTK render here, the PNG encoded and written
+        on a worker. ``screenshot_result`` is None while it runs, then True (written) or False."""
+        from volviz.render.export import offscreen_scene, snapshot, write_png
 
         width, height = size or (self.plotter.interactor.width(), self.plotter.interactor.height())
-        plotter = offscreen_plotter((width, height))
-        try:
-            session = Session(datasets=self.session.datasets, components=self.session.components,
-                              transfer_functions=self.session.transfer_functions,
-                              camera=self.controller.camera() if self.controller else None,
-                              render=self.session.render, clip=self.session.clip)
-            controller = SceneController(plotter, session, self.datasets)
-            controller.build()
-            if self.controller is not None and self.controller.time_series():
-                controller.set_time(self.controller.time, self.controller.interpolate_time)
-            image = plotter.screenshot(None, return_img=True, window_size=[width, height])
-            write_png(image, path)
-        except Exception as exc:
-            log.exception("screenshot export failed")
-            self.show_error("Cannot export screenshot", f"{path}: {exc}")
-            return False
-        finally:
+        self._screenshot_serial += 1
+        serial = self._screenshot_serial
+        self.screenshot_result = None
+        self.screenshot_threads = set()
+        name = Path(path).name
+        live = self.controller
+        session = Session(datasets=self.session.datasets, components=copy.deepcopy(self.session.components),
+                          transfer_functions=copy.deepcopy(self.session.transfer_functions),
+                          camera=live.camera() if live else None, render=self.session.render,
+                          clip=self.session.clip)
+        plotter, controller = offscreen_scene(session, self.datasets, (width, height))
+        t = None
+        if live is not None and live.time_series():
+            t, controller.interpolate_time = live.time, live.interpolate_time
+        self.status_label.setText(f"Exporting {name}…")
+        self._set_busy(True)
+
+        def end(ok: bool, message: str, error: Optional[BaseException] = None) -> None:
             plotter.close()
-        self.status_label.setText(f"Exported {Path(path).name} ({width}x{height})")
-        return True
+            if serial != self._screenshot_serial:  # superseded: the newer export owns the status bar
+                return
+            self._current_job = None
+            self._set_busy(False)
+            self.status_label.setText(message)
+            if error is not None:
+                log.error("screenshot export failed: %s", error)
+                self.show_error("Cannot export screenshot", f"{path}: {error}")
+            self.screenshot_result = ok
+
+        def step(fn: Callable[..., Any], *args: Any, then: Callable[[Any], None]) -> None:
+            def run(*a: Any, progress: Any = None) -> Any:
+                self.screenshot_threads.add(threading.get_ident())
+                return fn(*a, progress=progress)
+
+            def done(outcome: JobOutcome) -> None:
+                if outcome.cancelled or serial != self._screenshot_serial:
+                    end(False, f"Export of {name} cancelled")
+                elif outcome.error is not None:
+                    end(False, f"Could not export {name}", outcome.error)
+                else:
+                    try:
+                        then(outcome.result)
+                    except Exception as exc:  # the VTK side failed: a message, the app keeps working
+                        log.exception("screenshot export failed")
+                        end(False, f"Could not export {name}", exc)
+
+            self._current_job = self.jobs.submit(run, *args, name=f"export {name}", key="screenshot", on_done=done)
+
+        def views(stage: int) -> None:
+            if stage == 2:
+                # the offscreen window's first render (its GL context, shaders, textures) at a tiny size in one turn
+                # of the event loop, the render at full size in a later one: together they held it ~50 ms longer
+                snapshot(plotter, (8, 8))
+                QTimer.singleShot(STAGE_MS, lambda: serial == self._screenshot_serial and views(3))
+                return
+            if stage == 3:
+                image = snapshot(plotter, (width, height))
+                step(lambda progress=None: write_png(image, path), then=lambda _: end(
+                    True, f"Exported {name} ({width}x{height})"))
+                return
+            requests = controller.begin_views(stage)
+            if not requests:
+                views(stage + 1)
+                return
+
+            def shown(results: Any) -> None:
+                controller.finish_views(requests, results)
+                views(stage + 1)
+
+            step(controller.compute_views, requests, then=shown)
+
+        def installed(prepared: Any) -> None:
+            controller.install(prepared, views=False)
+            views(0)
+
+        step(lambda progress=None: controller.prepare(progress, t), then=installed)
+        # the offscreen window's GL context is made by a first (empty) render, in its own turn of the event loop
+        QTimer.singleShot(STAGE_MS, lambda: serial == self._screenshot_serial and not controller.props
+                          and snapshot(plotter, (8, 8)))
 
     def export_movie(self, path: str | os.PathLike, path_name: Optional[str], through_time: bool,
                      fps: float = 24.0, size: Optional[tuple[int, int]] = None) -> bool:

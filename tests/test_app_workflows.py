@@ -205,7 +205,9 @@ def test_export_screenshot_any_size(qtbot, make_window, tmp_path: Path) -> None:
     window.open_demo()
     wait_loaded(qtbot, window)
     out = tmp_path / "shot.png"
-    assert window.export_screenshot(out, size=(1000, 333))
+    window.export_screenshot(out, size=(1000, 333))
+    qtbot.waitUntil(lambda: window.screenshot_result is not None, timeout=60000)  # rendered in the background
+    assert window.screenshot_result
     image = iio.imread(out)
     assert image.shape[:2] == (333, 1000)
     assert image[..., :3].std() > 3.0

@@ -69,16 +69,18 @@ class SceneController:
         """Build the scene now (``prepare`` then ``install``, both on this thread)."""
         self.install(self.prepare())
 
-    def prepare(self, progress: Any = None) -> Any:
-        """Any thread, before ``install``: the heavy part of building (``volviz.render.scene.prepare_scene``) at the
-        session's display time. Touches no plotter, so the app runs it in the background."""
+    def prepare(self, progress: Any = None, t: Optional[float] = None) -> Any:
+        """Any thread, before ``install``: the heavy part of building (``volviz.render.scene.prepare_scene``) at
+        display time ``t`` of a time series (default: the session's display time). Touches no plotter, so the app
+        runs it in the background."""
         from volviz.render.scene import prepare_scene
 
         span = self.time_span()
-        t = span[0] if span else None
-        start = self.session.render.options.get("time")
-        if span and isinstance(start, (int, float)):
-            t = float(start)  # the session's display time
+        if t is None or not span:
+            t = span[0] if span else None
+            start = self.session.render.options.get("time")
+            if span and isinstance(start, (int, float)):
+                t = float(start)  # the session's display time
         return prepare_scene(self.session, self.datasets, t, self.interpolate_time, progress)
 
     def install(self, prepared: Any, views: bool = True) -> None:
@@ -378,6 +380,52 @@ class SceneController:
             self.iso_overlay.update()
             stats["iso"] = dict(self.iso_overlay.stats)
         return stats
+
+    def begin_views(self, stage: int) -> list[tuple[str, Any, Any]]:
+        """GUI thread: the requests of the view-dependent parts for the current camera, in two stages because the
+        PT volumes and the isosurfaces' CPU mode read the opaque scene's depth: stage 0 the natural scene and the
+        volumes at a level of detail, stage 1 (after stage 0 is finished) the PT volumes and the iso overlay. Then
+        ``compute_views`` (any thread) and ``finish_views`` (GUI thread); ``update_views`` does all three here."""
+        requests: list[tuple[str, Any, Any]] = []
+        if stage == 0:
+            if self.nature is not None:
+                requests.append(("nature", self.nature, self.nature.begin()))
+            for volume in self.lod_volumes().values():
+                requests.append(("lod", volume, volume.camera()))
+            return requests
+        for prop in self.props.values():
+            if _is_pt(prop) and prop.visible:
+                requests.append(("overlay", prop, prop.begin()))
+        if self.iso_overlay is not None:
+            requests.append(("overlay", self.iso_overlay, self.iso_overlay.begin()))
+        return requests
+
+    @staticmethod
+    def compute_views(requests: list[tuple[str, Any, Any]], progress: Any = None) -> list[Any]:
+        """Any thread: the CPU images and meshes of ``begin_views`` requests (pure NumPy/Numba, no VTK calls)."""
+        from volviz.jobs import report
+
+        results: list[Any] = []
+        for i, (kind, handle, request) in enumerate(requests):
+            report(progress, i / max(len(requests), 1), f"rendering view {i + 1} of {len(requests)}")
+            if kind == "lod":
+                selection = handle.select(request)
+                results.append((selection, handle.decode(selection)))
+            else:
+                results.append(handle.compute(request))
+        report(progress, 1.0, "views rendered")
+        return results
+
+    def finish_views(self, requests: list[tuple[str, Any, Any]], results: list[Any]) -> None:
+        """GUI thread: show the results of ``compute_views`` (hands data to VTK; draws nothing)."""
+        with no_render(self.plotter):
+            for (kind, handle, request), result in zip(requests, results):
+                if kind == "nature":
+                    self.finish_nature(handle, request, result)
+                elif kind == "lod":
+                    handle.show(*result)
+                else:
+                    handle.finish(request, *result)
 
     def lod_volumes(self) -> dict[str, Any]:
         """The visible volumes drawn at a level of detail (``volviz.render.lod_volume.LodVolume``) by component."""

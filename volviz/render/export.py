@@ -33,18 +33,32 @@ def write_png(image: np.ndarray, path: str | os.PathLike) -> None:
     atomic_write_bytes(path, buffer.getvalue())
 
 
+def offscreen_scene(session: Session, datasets: dict[str, Any], size: tuple[int, int]) -> tuple[Any, Any]:
+    """An offscreen plotter of ``size`` and a ``SceneController`` of ``session`` over it, not built yet: ``build()``
+    here, or (the app) ``prepare`` on a worker, ``install(views=False)``, then ``begin_views`` / ``compute_views`` /
+    ``finish_views``, and ``snapshot``. The caller closes the plotter."""
+    from volviz.render.controller import SceneController
+
+    plotter = offscreen_plotter(size)
+    return plotter, SceneController(plotter, session, datasets)
+
+
+def snapshot(plotter: Any, size: tuple[int, int]) -> np.ndarray:
+    """Render the offscreen plotter (VTK side, the thread that owns it) and return the (H, W, 3) uint8 image."""
+    return np.asarray(plotter.screenshot(None, return_img=True, window_size=[int(size[0]), int(size[1])]))
+
+
 def render_session(session: Session, session_file: Optional[str | os.PathLike], size: tuple[int, int],
                    progress: Optional[ProgressCallback] = None) -> np.ndarray:
     """Render a session offscreen; returns the (H, W, 3) uint8 image."""
-    from volviz.render.controller import SceneController
     from volviz.render.scene import load_datasets
 
     datasets = load_datasets(session, session_file, progress)
     report(progress, 0.8, "rendering")
-    plotter = offscreen_plotter(size)
+    plotter, controller = offscreen_scene(session, datasets, size)
     try:
-        SceneController(plotter, session, datasets).build()
-        image = plotter.screenshot(None, return_img=True, window_size=[int(size[0]), int(size[1])])
+        controller.build()
+        image = snapshot(plotter, size)
     finally:
         plotter.close()
     report(progress, 1.0, "rendered")
@@ -123,14 +137,12 @@ def render_movie(session: Session, session_file: Optional[str | os.PathLike], ou
                  progress: Optional[ProgressCallback] = None) -> Path:
     """Render a movie offscreen: MP4 (H.264 through imageio-ffmpeg) for ``.mp4``, else a PNG sequence in the folder
     ``out`` (frame_00000.png, ...). The MP4 is written to a temporary file and renamed when complete."""
-    from volviz.render.controller import SceneController
     from volviz.render.scene import load_datasets
 
     datasets = load_datasets(session, session_file)
-    plotter = offscreen_plotter(size)
+    plotter, controller = offscreen_scene(session, datasets, size)
     target = Path(out)
     try:
-        controller = SceneController(plotter, session, datasets)
         controller.build()
         frames = movie_frames(controller, path_name, fps, through_time, duration)
         writer = _MovieWriter(target, fps)
@@ -142,8 +154,7 @@ def render_movie(session: Session, session_file: Optional[str | os.PathLike], ou
                     controller.set_camera(camera)
                 if t is not None:
                     controller.set_time(t)
-                image = plotter.screenshot(None, return_img=True, window_size=[int(size[0]), int(size[1])])
-                writer.append(np.asarray(image))
+                writer.append(snapshot(plotter, size))
                 report(progress, (i + 1) / len(frames), f"frame {i + 1} of {len(frames)}")
         except BaseException:
             writer.abort()
