@@ -128,6 +128,7 @@ class MainWindow(QMainWindow):
         self.dirty = False
         self.last_stats: dict[str, Any] = {}
         self._current_job = None
+        self.components_shown = 0          # components hidden at load, prepared in the background and added
         self._screenshot_serial = 0        # the newest screenshot export; an older one only cleans up
         self.screenshot_result: Optional[bool] = None  # of the last export: None while it runs
         self.screenshot_threads: set[int] = set()      # the threads its background steps ran on
@@ -660,13 +661,60 @@ class MainWindow(QMainWindow):
             return
         controller = self.controller
         nature = controller.component(comp_id).type in NATURE_TYPES
-        controller.set_visible(comp_id, visible, nature=False)
+        build = visible and controller.needs_build(comp_id)
+        controller.set_visible(comp_id, visible, nature=False, build=False)
         self.set_dirty()
         if nature:
             self.rebuild_nature(comp_id, visible)
             return
+        if build:
+            self.show_component(comp_id)
+            return
         self.render()
         self.refresh_iso_overlay()
+
+    def show_component(self, comp_id: str) -> None:
+        """A component hidden at load was shown: prepare it in the background (extraction, tetrahedralisation, VTK
+        volume input, histogram; a newer request for it supersedes), add its prop on this thread, then compute its
+        view-dependent parts in the background. ``components_shown`` counts the ones installed."""
+        from volviz.render.scene import load_datasets
+
+        controller, session_path = self.controller, self.session_path
+        self.status_label.setText(f"Preparing {comp_id}…")
+
+        def prepare(progress: Any = None) -> Any:
+            load_datasets(controller.session, session_path, loaded=controller.datasets)  # a component shown anew
+            return controller.prepare_component(comp_id, progress)
+
+        def done(outcome: JobOutcome) -> None:
+            if self.controller is not controller:
+                return
+            if outcome.ok:
+                if not controller.component(comp_id).visible or not controller.needs_build(comp_id):
+                    return  # hidden again meanwhile (or already shown)
+                controller.install_component(comp_id, outcome.result, views=False)
+                self.components_shown += 1
+                self.status_label.setText(f"Showing {comp_id}")
+                self.schedule_render()
+                self.refresh_pt(comp_id)
+                self.refresh_lod([comp_id])
+                self.refresh_iso_overlay()
+            elif outcome.error is not None:
+                self._revert_visibility(comp_id, True)
+                self.show_error(f"Cannot show {comp_id}", str(outcome.error))
+
+        self.jobs.submit(prepare, name=f"show {comp_id}", key=f"show:{comp_id}", on_done=done)
+
+    def _revert_visibility(self, comp_id: str, visible: bool) -> None:
+        """Showing (``visible``) or hiding a component failed: it keeps its previous state, and so does its box."""
+        self.controller.component(comp_id).visible = not visible
+        tree = self.scene_tree.tree
+        tree.blockSignals(True)
+        try:
+            self.scene_tree.item(comp_id).setCheckState(
+                0, Qt.CheckState.Unchecked if visible else Qt.CheckState.Checked)
+        finally:
+            tree.blockSignals(False)
 
     def rebuild_nature(self, comp_id: str, visible: bool) -> None:
         """A terrain / fog / clouds / sky component was shown or hidden: rebuild the natural scene in the background
@@ -691,14 +739,7 @@ class MainWindow(QMainWindow):
                     self.schedule_render()
                 self.refresh_nature()
             elif outcome.error is not None:
-                controller.component(comp_id).visible = not visible
-                tree = self.scene_tree.tree
-                tree.blockSignals(True)
-                try:
-                    self.scene_tree.item(comp_id).setCheckState(
-                        0, Qt.CheckState.Unchecked if visible else Qt.CheckState.Checked)
-                finally:
-                    tree.blockSignals(False)
+                self._revert_visibility(comp_id, visible)
                 self.show_error(f"Cannot {'show' if visible else 'hide'} {comp_id}", str(outcome.error))
 
         self.jobs.submit(prepare, name="natural scene", key="nature-build", on_done=done)

@@ -158,9 +158,11 @@ class SceneController:
         elif prop is not None and prop.IsA("vtkVolume"):
             update_volume_property(prop.GetProperty(), tf, comp.opacity)
 
-    def set_visible(self, comp_id: str, visible: bool, nature: bool = True) -> None:
+    def set_visible(self, comp_id: str, visible: bool, nature: bool = True, build: bool = True) -> None:
         """Show or hide a component. A terrain / fog / clouds / sky component rebuilds the natural scene now unless
-        ``nature`` is false (the app rebuilds it in the background: ``prepare_nature``, ``install_nature``)."""
+        ``nature`` is false (the app rebuilds it in the background: ``prepare_nature``, ``install_nature``). Another
+        component hidden at build time is built now unless ``build`` is false (the app prepares it in the
+        background: ``prepare_component``, ``install_component``)."""
         from volviz.render.scene import NATURE_TYPES
 
         comp = self.component(comp_id)
@@ -170,26 +172,58 @@ class SceneController:
                 self.rebuild_nature()
             return
         prop = self.props.get(comp_id)
+        if prop is None and visible:  # hidden at build time: add it now
+            if build:
+                self.install_component(comp_id, self.prepare_component(comp_id), views=True)
+            return
         if comp.type == "isosurface":
-            if prop is None and visible:  # hidden at build time: extract and add it now
-                from volviz.render.scene import add_isosurfaces
-
-                self.props[comp_id] = add_isosurfaces(self.plotter, comp, self.dataset_of(comp_id),
-                                                      self.time if self.time_series() else None,
-                                                      clip=self.session.clip)
             self._sync_iso_overlay()
             return
-        if prop is None and visible:  # hidden at build time: add it now
-            from volviz.render.vtk_scene import add_dataset
-
-            self.props[comp_id] = add_dataset(self.plotter, self.dataset_of(comp_id),
-                                              tf=self.transfer_function(comp_id), opacity=comp.opacity, name=comp_id)
-        elif _is_pt(prop):
+        if _is_pt(prop):
             prop.visible = bool(visible)
         elif _is_lod(prop):
             prop.volume.SetVisibility(bool(visible))
         elif prop is not None:
             prop.SetVisibility(bool(visible))
+
+    def needs_build(self, comp_id: str) -> bool:
+        """Whether showing the component needs ``prepare_component`` / ``install_component`` (it has no prop yet)."""
+        from volviz.render.scene import NATURE_TYPES
+
+        return self.component(comp_id).type not in NATURE_TYPES and self.props.get(comp_id) is None
+
+    def prepare_component(self, comp_id: str, progress: Any = None) -> Any:
+        """Any thread: the heavy part of showing a non-nature component that was hidden at build time
+        (``volviz.render.scene.prepare_component`` at the display time). Touches no plotter."""
+        from volviz.jobs import report
+        from volviz.render.scene import PreparedScene, ensure_transfer_functions, prepare_component
+
+        ensure_transfer_functions(self.session, self.datasets)
+        prepared = PreparedScene(time=self.time if self.time_series() else None)
+        report(progress, 0.0, f"preparing {comp_id}")
+        prepare_component(self.session, self.component(comp_id), self.datasets, prepared, prepared.time,
+                          self.interpolate_time)
+        report(progress, 1.0, f"{comp_id} prepared")
+        return prepared
+
+    def install_component(self, comp_id: str, prepared: Any, views: bool = True) -> Any:
+        """GUI thread: add the prop of a ``prepare_component`` result without rendering (a PT volume's image and a
+        LOD volume's blocks are drawn now when ``views``; the app updates them in the background)."""
+        from volviz.render.scene import install_component
+
+        comp = self.component(comp_id)
+        with no_render(self.plotter):
+            prop = install_component(self.plotter, self.session, comp, self.datasets, prepared, spectrum=True,
+                                     views=views)
+            self.props[comp_id] = prop
+            self.histograms.update(prepared.histograms)
+            if comp_id in prepared.cut:
+                self.set_pt_mesh(comp_id, prepared.cut[comp_id])
+            if comp.type != "isosurface" and self.clip.all_planes():
+                self.apply_clip(update_pt=False, cut_pt=False, isosurfaces=False)
+            if comp.type == "isosurface":
+                self._sync_iso_overlay()
+        return prop
 
     def set_opacity(self, comp_id: str, opacity: float, isosurfaces: bool = True) -> None:
         """Set a component's opacity. An isosurface component's surfaces are re-made here when ``isosurfaces`` (the

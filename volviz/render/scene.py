@@ -176,38 +176,46 @@ def prepare_scene(session: Session, datasets: dict[str, Any], t: Optional[float]
     clipping and LOD chains, tetrahedralisation and mesh topology, VTK volume inputs and time blending at display
     time ``t``, the natural scene's maps and volumes, data histograms). Touches no plotter; ``install_scene`` adds
     the props on the GUI thread."""
-    from volviz.model import TimeSeries
-    from volviz.model.stats import histogram
-    from volviz.render.clipping import clip_settings
-
     ensure_transfer_functions(session, datasets)
     prepared = PreparedScene(time=t)
-    clip = clip_settings(session.clip)
     shown = [c for c in session.components if c.visible and c.type not in NATURE_TYPES]
     for i, comp in enumerate(shown):
         report(progress, i / max(len(shown) + 1, 1), f"preparing {comp.id}")
-        dataset = component_dataset(comp, datasets)
-        series = isinstance(dataset, TimeSeries)
-        if comp.type == "isosurface":
-            if series:  # the 4D blend of the display time (as ``SceneController.set_time`` does)
-                comp.settings = {**comp.settings, "interpolate": bool(interpolate)}
-            prepared.parts[comp.id] = isosurface_parts(comp, dataset, t if series else None, session.clip)
-            continue
-        if comp.transfer_function is not None and not is_lod(dataset):
-            prepared.histograms[comp.id] = histogram(dataset)
-        if is_lod(dataset):
-            continue
-        if uses_pt(session, dataset):
-            mesh = pt_mesh(dataset)
-            prepared.parts[comp.id] = mesh
-            if clip.all_planes():
-                prepared.cut[comp.id] = cut_tetmesh(mesh, clip)
-        else:
-            prepared.parts[comp.id] = prepared_volume_input(dataset, t, interpolate)
+        prepare_component(session, comp, datasets, prepared, t, interpolate)
     report(progress, len(shown) / max(len(shown) + 1, 1), "natural scene")
     prepared.nature = prepare_nature(session, datasets)
     report(progress, 1.0, "scene prepared")
     return prepared
+
+
+def prepare_component(session: Session, comp: Component, datasets: dict[str, Any], prepared: PreparedScene,
+                      t: Optional[float] = None, interpolate: bool = True) -> None:
+    """Any thread: the heavy part of showing one non-nature component (isosurface extraction with clipping and LOD
+    chains, tetrahedralisation and topology, the VTK volume input at display time ``t``, its data histogram), put into
+    ``prepared``; ``install_component`` adds its prop on the GUI thread."""
+    from volviz.model import TimeSeries
+    from volviz.model.stats import histogram
+    from volviz.render.clipping import clip_settings
+
+    clip = clip_settings(session.clip)
+    dataset = component_dataset(comp, datasets)
+    series = isinstance(dataset, TimeSeries)
+    if comp.type == "isosurface":
+        if series:  # the 4D blend of the display time (as ``SceneController.set_time`` does)
+            comp.settings = {**comp.settings, "interpolate": bool(interpolate)}
+        prepared.parts[comp.id] = isosurface_parts(comp, dataset, t if series else None, session.clip)
+        return
+    if comp.transfer_function is not None and not is_lod(dataset):
+        prepared.histograms[comp.id] = histogram(dataset)
+    if is_lod(dataset):
+        return
+    if uses_pt(session, dataset):
+        mesh = pt_mesh(dataset)
+        prepared.parts[comp.id] = mesh
+        if clip.all_planes():
+            prepared.cut[comp.id] = cut_tetmesh(mesh, clip)
+    else:
+        prepared.parts[comp.id] = prepared_volume_input(dataset, t, interpolate)
 
 
 def pt_mesh(dataset: Any) -> Any:
@@ -339,16 +347,12 @@ def install_scene(plotter: Any, session: Session, datasets: dict[str, Any], prep
         if not comp.visible or comp.type in NATURE_TYPES:
             continue
         dataset = component_dataset(comp, datasets)
-        if comp.type == "isosurface":
-            props[comp.id] = add_isosurface_actors(plotter, comp.id, prepared.parts[comp.id], spectrum=spectrum)
-        elif is_lod(dataset):
+        if comp.type != "isosurface" and is_lod(dataset):
             lod_components.append((comp, dataset))   # selected for the final camera
-        elif uses_pt(session, dataset):
+        elif comp.type != "isosurface" and uses_pt(session, dataset):
             pt_components.append((comp, prepared.parts[comp.id]))  # drawn last: over the opaque scene's depth
         else:
-            tf = component_transfer_function(session, comp)
-            props[comp.id] = add_volume_prop(plotter, dataset, prepared.parts.get(comp.id), tf, comp.opacity,
-                                             comp.id)
+            props[comp.id] = install_component(plotter, session, comp, datasets, prepared, spectrum, views)
     plotter.set_background(session.render.background)
     if session.camera is None and pt_components:
         plotter.view_isometric()
@@ -361,11 +365,24 @@ def install_scene(plotter: Any, session: Session, datasets: dict[str, Any], prep
     nature = install_nature(plotter, prepared.nature, views)
     if nature is not None:
         props["nature"] = nature
-    for comp, dataset in lod_components:
-        props[comp.id] = add_lod_component(plotter, session, comp, dataset, update=views)
-    for comp, mesh in pt_components:
-        props[comp.id] = add_pt_component(plotter, session, comp, mesh, update=views)
+    for comp, _ in lod_components + pt_components:
+        props[comp.id] = install_component(plotter, session, comp, datasets, prepared, spectrum, views)
     return props
+
+
+def install_component(plotter: Any, session: Session, comp: Component, datasets: dict[str, Any],
+                      prepared: PreparedScene, spectrum: bool = True, views: bool = True) -> Any:
+    """GUI thread: add the prop of one non-nature component from its ``prepare_component`` result; a PT volume's
+    image and a LOD volume's blocks are drawn now when ``views`` (else the caller updates them in the background)."""
+    dataset = component_dataset(comp, datasets)
+    if comp.type == "isosurface":
+        return add_isosurface_actors(plotter, comp.id, prepared.parts[comp.id], spectrum=spectrum)
+    if is_lod(dataset):
+        return add_lod_component(plotter, session, comp, dataset, update=views)
+    if uses_pt(session, dataset):
+        return add_pt_component(plotter, session, comp, prepared.parts[comp.id], update=views)
+    tf = component_transfer_function(session, comp)
+    return add_volume_prop(plotter, dataset, prepared.parts.get(comp.id), tf, comp.opacity, comp.id)
 
 
 def build_scene(plotter: Any, session: Session, datasets: dict[str, Any], spectrum: bool = True) -> dict[str, Any]:

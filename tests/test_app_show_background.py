@@ -1,0 +1,43 @@
+"""Showing a component that was hidden at load (issue #5, "Background work"): its preparation (here generation,
+tetrahedral topology and the first PT image of a 320,000-tetrahedron mesh) runs on a worker, only adding its prop
+runs on the GUI thread. Under Xvfb with real widgets and real rendering."""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from PySide6.QtCore import Qt
+
+from test_app_background import LoopGaps
+from test_app_workflows import make_window, wait_loaded  # noqa: F401 (a fixture and a helper shared with it)
+
+
+def test_showing_a_hidden_component_prepares_it_in_the_background(qtbot, make_window, tmp_path: Path) -> None:
+    session = tmp_path / "hidden.json"
+    session.write_text(json.dumps({
+        "format": "volviz-session", "version": 1,
+        "components": [{"id": "small", "type": "demo", "settings": {"cells_per_edge": 6}},
+                       {"id": "big", "type": "demo", "visible": False, "settings": {"cells_per_edge": 40}}],
+        "camera": {"position": [3.2, -2.4, 2.0], "focal_point": [0.5, 0.5, 0.5], "view_up": [0, 0, 1]}}))
+    window = make_window()
+    window.resize(1000, 600)  # a small viewport: renders (on this thread) are not what this test is about
+    qtbot.wait(300)  # the viewport's resize handling is over
+    window.open_path(session)
+    wait_loaded(qtbot, window)
+    controller = window.controller
+    assert "big" not in controller.props
+    qtbot.wait(300)
+    gaps = LoopGaps()
+    window.scene_tree.item("big").setCheckState(0, Qt.CheckState.Checked)  # what a click on its box does
+    assert "big" not in controller.props, "the hidden component was built on the GUI thread"
+    qtbot.waitUntil(lambda: window.components_shown == 1, timeout=120000)
+    volume = controller.pt_volume("big")
+    assert volume is not None and volume.mesh.tets.shape[0] == 40 ** 3 * 5
+    qtbot.waitUntil(lambda: volume.image is not None, timeout=120000)  # its first image, also in the background
+    gaps.stop()
+    assert volume.image[..., 3].max() > 0
+    print(f"largest event-loop gap {max(gaps.gaps) * 1000:.0f} ms over {len(gaps.gaps)} ticks")
+    assert len(gaps.gaps) > 20
+    assert max(gaps.gaps) < 0.1, f"event loop stalled for {max(gaps.gaps) * 1000:.0f} ms while showing it"
+    window.scene_tree.item("big").setCheckState(0, Qt.CheckState.Unchecked)  # hiding needs no rebuild
+    assert not volume.visible and window.components_shown == 1
