@@ -56,6 +56,11 @@ def default_recovery_dir() -> Path:
     return Path(base or Path.home() / ".volviz") / "recovery"
 
 
+def _histogram_range(hist: Any) -> Optional[tuple[float, float]]:
+    """The data range a (counts, edges) histogram spans (None without one)."""
+    return None if hist is None else (float(hist[1][0]), float(hist[1][-1]))
+
+
 class OneInFlight:
     """At most one background job of a kind: a request made while one runs waits, and only the newest waiting one
     starts when it is done. (Cancelling the running job for every newer request, as a job key does, starves it while
@@ -129,6 +134,9 @@ class MainWindow(QMainWindow):
         self.last_stats: dict[str, Any] = {}
         self._current_job = None
         self.components_shown = 0          # components hidden at load, prepared in the background and added
+        self._histogram_job: Any = None
+        self.histograms_computed = 0       # TF-editor histograms computed in the background and shown
+        self.histogram_threads: set[int] = set()       # the threads they were computed on
         self._screenshot_serial = 0        # the newest screenshot export; an older one only cleans up
         self.screenshot_result: Optional[bool] = None  # of the last export: None while it runs
         self.screenshot_threads: set[int] = set()      # the threads its background steps ran on
@@ -503,8 +511,6 @@ class MainWindow(QMainWindow):
     def _select_component(self, comp_id: str) -> None:
         if self.controller is None:
             return
-        from volviz.model.stats import histogram
-
         tf = self.controller.transfer_function(comp_id)
         self.tf_editor.setEnabled(tf is not None)
         if tf is None:
@@ -514,13 +520,43 @@ class MainWindow(QMainWindow):
 
             self.tf_editor.set_transfer_function(tf, data_range=lod_scalar_range(self.controller.dataset_of(comp_id)))
             return
-        counts, edges = self.controller.histograms.get(comp_id) or histogram(self.controller.dataset_of(comp_id))
+        known = self.controller.histograms.get(comp_id)
         self.tf_editor.blockSignals(True)  # the scene already shows this TF: no preview re-render
         try:
-            self.tf_editor.set_transfer_function(tf, data_range=(float(edges[0]), float(edges[-1])),
-                                                 histogram=(counts, edges))
+            self.tf_editor.set_transfer_function(tf, data_range=_histogram_range(known), histogram=known)
         finally:
             self.tf_editor.blockSignals(False)
+        if known is None:
+            self._compute_histogram(comp_id)
+        elif self._histogram_job is not None:
+            self._histogram_job.cancel()  # an older selection's histogram is no longer wanted
+
+    def _compute_histogram(self, comp_id: str) -> None:
+        """The data histogram of a component that has none yet (hidden at load), for the TF editor: its dataset is
+        read and the histogram computed on a worker (``volviz.model.stats.histogram``) while the editor shows a
+        placeholder; a newer selection supersedes it. ``histograms_computed`` counts the ones shown."""
+        from volviz.model.stats import histogram
+        from volviz.render.scene import load_datasets
+
+        controller, session_path = self.controller, self.session_path
+        self.tf_editor.set_histogram_pending()
+
+        def compute(progress: Any = None) -> Any:
+            load_datasets(controller.session, session_path, loaded=controller.datasets, also=(comp_id,))  # hidden
+            self.histogram_threads.add(threading.get_ident())
+            return histogram(controller.dataset_of(comp_id))
+
+        def done(outcome: JobOutcome) -> None:
+            if outcome.ok and self.controller is controller:
+                controller.histograms[comp_id] = outcome.result
+                if self.scene_tree.current_component() == comp_id:
+                    self.tf_editor.set_histogram(outcome.result, _histogram_range(outcome.result))
+                    self.histograms_computed += 1
+            elif outcome.error is not None:
+                self.tf_editor.set_histogram(None, None)
+                self.show_error(f"Cannot compute the histogram of {comp_id}", str(outcome.error))
+
+        self._histogram_job = self.jobs.submit(compute, name=f"histogram {comp_id}", key="histogram", on_done=done)
 
     def _tf_changed(self, tf: Any) -> None:
         comp_id = self.scene_tree.current_component()

@@ -54,6 +54,7 @@ class TransferFunctionCanvas(QWidget):
         self.histogram: Optional[np.ndarray] = None
         self.histogram_edges: Optional[np.ndarray] = None
         self.log_histogram = False
+        self.histogram_pending = False  # computed in the background: a placeholder is drawn meanwhile
         self.selected: Optional[int] = None
         self._dragging = False
 
@@ -96,7 +97,10 @@ class TransferFunctionCanvas(QWidget):
         r = self._plot_rect()
         painter.fillRect(r, QColor(24, 24, 28))
         lo, hi = self._view_range()
-        if self.histogram is not None and self.histogram.size:
+        if self.histogram_pending:
+            painter.setPen(QColor(140, 140, 150))
+            painter.drawText(r, Qt.AlignmentFlag.AlignCenter, "computing histogram…")
+        elif self.histogram is not None and self.histogram.size:
             counts = np.log1p(self.histogram) if self.log_histogram else self.histogram.astype(np.float64)
             top = counts.max() or 1.0
             painter.setPen(Qt.PenStyle.NoPen)
@@ -246,14 +250,27 @@ class TransferFunctionEditor(QWidget):
     def set_transfer_function(self, tf: TransferFunction, data_range: Optional[tuple[float, float]] = None,
                               histogram: Optional[tuple[np.ndarray, np.ndarray]] = None) -> None:
         """Show ``tf`` for a new component (clears undo history)."""
-        self._data_range = data_range
-        if histogram is not None:
-            self.canvas.histogram, self.canvas.histogram_edges = histogram
-        else:
-            self.canvas.histogram = self.canvas.histogram_edges = None
+        self.set_histogram(histogram, data_range)
         self.undo_stack.clear()
         self._apply(tf, commit=False)
         self._committed_tf = tf
+
+    def set_histogram_pending(self) -> None:
+        """The histogram is being computed in the background: a placeholder, no fit to data until it arrives."""
+        self.canvas.histogram = self.canvas.histogram_edges = None
+        self.canvas.histogram_pending = True
+        self._data_range = None
+        self.fit_button.setEnabled(False)
+        self.canvas.update()
+
+    def set_histogram(self, histogram: Optional[tuple[np.ndarray, np.ndarray]],
+                      data_range: Optional[tuple[float, float]]) -> None:
+        """Show a histogram computed in the background (None: none) for the TF shown; undo history stays."""
+        self.canvas.histogram, self.canvas.histogram_edges = histogram if histogram is not None else (None, None)
+        self.canvas.histogram_pending = False
+        self._data_range = data_range
+        self.fit_button.setEnabled(True)
+        self.canvas.update()
 
     def edit(self, tf: TransferFunction, text: str) -> None:
         """Replace the transfer function as one undoable edit."""

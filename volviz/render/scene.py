@@ -85,12 +85,12 @@ def demo_volume_session() -> Session:
 
 def load_datasets(session: Session, session_file: Optional[str | os.PathLike],
                   progress: Optional[ProgressCallback] = None,
-                  loaded: Optional[dict[str, Any]] = None) -> dict[str, Any]:
-    """Read every dataset that a visible component uses, once each, with progress; those already in ``loaded`` are
-    kept (the dict is filled in and returned)."""
+                  loaded: Optional[dict[str, Any]] = None, also: tuple[str, ...] = ()) -> dict[str, Any]:
+    """Read every dataset that a visible component (or a component in ``also``) uses, once each, with progress;
+    those already in ``loaded`` are kept (the dict is filled in and returned)."""
     from volviz.nature.scene import nature_dataset_ids
 
-    used = {c.dataset for c in session.components if c.visible and c.dataset is not None}
+    used = {c.dataset for c in session.components if (c.visible or c.id in also) and c.dataset is not None}
     used |= nature_dataset_ids([c for c in session.components if c.visible and c.type in NATURE_TYPES])
     loaded = {} if loaded is None else loaded
     refs = [ref for ref in session.datasets if ref.id in used and ref.id not in loaded]
@@ -122,6 +122,8 @@ def ensure_transfer_functions(session: Session, datasets: dict[str, Any]) -> Non
 
     for comp in session.components:
         if comp.transfer_function is None and comp.type in ("volume", "mesh", "demo"):
+            if comp.dataset is not None and comp.dataset not in datasets:
+                continue  # a hidden component's data is not read: it gets its TF when shown
             name = comp.id
             while name in session.transfer_functions:
                 name += "'"
