@@ -41,3 +41,25 @@ def test_showing_a_hidden_component_prepares_it_in_the_background(qtbot, make_wi
     assert max(gaps.gaps) < 0.1, f"event loop stalled for {max(gaps.gaps) * 1000:.0f} ms while showing it"
     window.scene_tree.item("big").setCheckState(0, Qt.CheckState.Unchecked)  # hiding needs no rebuild
     assert not volume.visible and window.components_shown == 1
+
+
+def test_natural_scene_adds_its_actors_without_rendering(qtbot, make_window) -> None:
+    """The natural scene's sky, terrain and overlay are added with ``render=False`` (PyVista otherwise renders the
+    whole scene after each added actor, 50-600 ms of a blocked GUI thread on llvmpipe): installing a rebuilt scene
+    and finishing its first view draw nothing; the caller draws once."""
+    window = make_window()
+    window.open_demo()
+    wait_loaded(qtbot, window)
+    qtbot.waitUntil(lambda: not window._nature_jobs.running, timeout=60000)
+    controller = window.controller
+    scene = controller.prepare_nature()
+    renders = []
+    tag = window.plotter.ren_win.AddObserver("StartEvent", lambda *_: renders.append(1))
+    try:
+        view = controller.install_nature(scene, views=False)  # a new NatureView: sky dome added
+        request = view.begin()
+        controller.finish_nature(view, request, view.compute(request))  # terrain and overlay added
+    finally:
+        window.plotter.ren_win.RemoveObserver(tag)
+    assert view.sky_actor is not None and view.terrain_actor is not None and view._overlay_actor is not None
+    assert renders == [], f"{len(renders)} renders while the natural scene was put in"

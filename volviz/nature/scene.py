@@ -391,13 +391,15 @@ class NatureView:
         dome = sky_dome_mesh(radius, (0.0, 0.0, 0.0))  # moved to the eye by ``update``: the sky is at infinity
         if scene.sky is not None:
             sky_img = np.clip(scene.sky * 255.0, 0, 255).astype(np.uint8)
-            self.sky_actor = plotter.add_mesh(dome, texture=pv.Texture(sky_img), lighting=False, name="nature-sky")
+            self.sky_actor = plotter.add_mesh(dome, texture=pv.Texture(sky_img), lighting=False, name="nature-sky",
+                                              render=False)
         else:  # the CPU gradient of ``render_sky`` as a polar texture (rows: zenith at the top, horizon at the bottom)
             zen, hor = np.array([0.32, 0.5, 0.85]), np.array([0.78, 0.85, 0.95])
             t = np.sqrt(np.linspace(1.0, 0.0, 256))[:, None, None]
             grad = np.broadcast_to(hor + (zen - hor) * t, (256, 4, 3))
             sky_img = np.ascontiguousarray(np.clip(grad * 255.0 + 0.5, 0, 255).astype(np.uint8))
-            self.sky_actor = plotter.add_mesh(dome, texture=pv.Texture(sky_img), lighting=False, name="nature-sky")
+            self.sky_actor = plotter.add_mesh(dome, texture=pv.Texture(sky_img), lighting=False, name="nature-sky",
+                                              render=False)
 
     def _camera(self) -> Any:
         from volviz.unstructured.camera import Camera
@@ -462,7 +464,7 @@ class NatureView:
         if poly is not None:
             if self.terrain_actor is None:
                 self.terrain_actor = self.plotter.add_mesh(poly, texture=self._texture, lighting=False,
-                                                           name="nature-terrain")
+                                                           name="nature-terrain", render=False)
             else:
                 self.terrain_actor.mapper.SetInputData(poly)
             self._mesh = poly
@@ -485,7 +487,7 @@ class NatureView:
             mapper.SetColorLevel(127.5)
             actor = vtk.vtkActor2D()
             actor.SetMapper(mapper)
-            self.plotter.add_actor(actor, name="nature-overlay", reset_camera=False)
+            self.plotter.add_actor(actor, name="nature-overlay", reset_camera=False, render=False)
             self._overlay_actor = actor
         img = self._overlay_image
         img.SetDimensions(w, h, 1)

@@ -494,8 +494,7 @@ class SceneController:
         names = ("nature-sky", "nature-terrain", "nature-overlay") if views or scene is None else ()
         for name in names:
             self.plotter.remove_actor(name, render=False)
-        with no_render(self.plotter):
-            view = install_nature(self.plotter, scene, views)
+        view = install_nature(self.plotter, scene, views)  # adds its actors with ``render=False``
         if view is not None:
             self.props["nature"] = view
         return view
@@ -503,10 +502,9 @@ class SceneController:
     def finish_nature(self, view: Any, request: Any, result: tuple[Any, ...]) -> dict[str, Any]:
         """GUI thread: show a computed view of the natural scene (``view.compute``); a scene without terrain drops
         the terrain of the view it replaced."""
-        with no_render(self.plotter):  # the caller draws once afterwards
-            stats = view.finish(request, *result)
-            if view.terrain_actor is None:
-                self.plotter.remove_actor("nature-terrain", render=False)
+        stats = view.finish(request, *result)  # adds its actors with ``render=False``: the caller draws once
+        if view.terrain_actor is None:
+            self.plotter.remove_actor("nature-terrain", render=False)
         return stats
 
     def bounds(self) -> tuple[float, float, float, float, float, float]:
