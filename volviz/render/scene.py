@@ -265,43 +265,13 @@ def prepared_volume_input(dataset: Any, t: Optional[float] = None, interpolate: 
 
 def add_volume_prop(plotter: Any, dataset: Any, data: Any, tf: Any, opacity: float, name: str) -> Any:
     """GUI thread: a vtkVolume drawing ``data`` (from ``prepared_volume_input``; None: ``add_dataset`` instead)."""
-    import vtk
-
     from volviz.model import RegularVolume, TimeSeries
-    from volviz.render.vtk_scene import add_dataset, vtk_volume_property
+    from volviz.render.vtk_scene import add_dataset, volume_prop
 
     if data is None:
         return add_dataset(plotter, dataset, tf=tf, opacity=opacity, name=name)
     regular = isinstance(dataset.frame(0) if isinstance(dataset, TimeSeries) else dataset, RegularVolume)
-    mapper = vtk.vtkSmartVolumeMapper() if regular else vtk.vtkProjectedTetrahedraMapper()
-    if regular and software_opengl(plotter):
-        mapper.SetRequestedRenderModeToRayCast()  # VTK's CPU ray caster: 3.5x faster than its GPU one on llvmpipe
-    mapper.SetInputData(data)
-    volume = vtk.vtkVolume()
-    volume.SetMapper(mapper)
-    volume.SetProperty(vtk_volume_property(tf, opacity))
-    plotter.add_actor(volume, name=name, reset_camera=False)
-    return volume
-
-
-SOFTWARE_GL = ("llvmpipe", "softpipe", "swrast")
-
-
-def software_opengl(plotter: Any) -> bool:
-    """Whether ``plotter`` draws with a software OpenGL (Mesa llvmpipe), where VTK's CPU ray caster beats its GPU
-    ray caster on regular volumes: DESIGN.md measured 0.07 s against 0.26 s per frame for the embryo at 512²; in the
-    app, loading the embryo blocked the event loop 4.3 s with the GPU mapper and 1.2 s with the CPU one, and a Storm
-    playback frame took 450 ms against 230 ms (1400x900 window, load ~2.5). Asked once per plotter."""
-    known = plotter.__dict__.get("_volviz_software_gl")
-    if known is None:
-        ren_win = plotter.ren_win
-        text = ren_win.ReportCapabilities()
-        if "renderer string" not in text:  # no context yet: create it
-            ren_win.Render()
-            text = ren_win.ReportCapabilities()
-        known = any(name in text.lower() for name in SOFTWARE_GL)
-        plotter.__dict__["_volviz_software_gl"] = known
-    return known
+    return volume_prop(plotter, data, regular, tf, opacity, name)
 
 
 def prepare_nature(session: Session, datasets: dict[str, Any]) -> Any:
