@@ -152,32 +152,41 @@ def test_volviz_opaque_geometry_hides_the_volume_behind_it(tree: LodTree) -> Non
     assert float(np.sqrt((d ** 2).mean())) < 1.0 and float(np.percentile(d, 99.9)) < 3.0, (d.max(), d.mean())
 
 
-def test_volviz_ray_casts_in_the_background_worker_when_nothing_needs_the_plotter(tree: LodTree) -> None:
+def test_volviz_ray_casts_in_the_background_worker(tree: LodTree) -> None:
+    """``camera()`` (GUI thread) captures what the ray cast needs from the plotter (camera, opaque depth, planes);
+    ``decode`` on a worker then ray casts, and ``show`` only uploads, giving exactly the image a draw on the GUI
+    thread makes, with opaque geometry in the scene too; a camera moved before ``show`` is drawn again."""
     from concurrent.futures import ThreadPoolExecutor
+
+    def on_worker(cam):                                     # the app's worker: select + decode
+        with ThreadPoolExecutor(1) as ex:
+            return ex.submit(lambda: (lambda s: (s, lod.decode(s)))(lod.select(cam))).result()
 
     pl = _plotter()
     try:
         lod = LodVolume(pl, tree, TF, budget=16)
-        lod.update()                                        # the first drawing learns that no depth is needed
-        assert lod.stats["prepared"] is False
+        lod.update()
+        assert lod.stats["prepared"] is True and lod.depth is None          # nothing else in the scene
         pl.camera_position = [(150.0, -120.0, 100.0), (36.0, 36.0, 36.0), (0, 0, 1)]
-        cam = lod.camera()
-        with ThreadPoolExecutor(1) as ex:                   # the app's worker: select + decode
-            sel, blocks = ex.submit(lambda: (lambda s: (s, lod.decode(s)))(lod.select(cam))).result()
+        sel, blocks = on_worker(lod.camera())
         lod.show(sel, blocks)
         assert lod.stats["prepared"] is True and lod.stats["render_s"] > 0
         shown = lod.image.copy()
         again = lod.draw()                                  # the same view drawn on this thread
         assert max_abs(shown, again) == 0.0
-        moved = lod.select(cam)
-        moved_blocks = lod.decode(moved)
+        moved, moved_blocks = on_worker(lod.camera())
         pl.camera_position = [(160.0, -110.0, 90.0), (36.0, 36.0, 36.0), (0, 0, 1)]   # moved before show
         lod.show(moved, moved_blocks)
         assert lod.stats["prepared"] is False                # drawn again for the camera it has now
         assert max_abs(lod.image, shown) > 1.0
-        pl.add_mesh(pv.Sphere(radius=5.0, center=(0.0, 0.0, 0.0)), color="red")
-        lod.update()
-        assert lod.stats["prepared"] is False and lod.depth is not None   # opaque geometry: drawn with its depth
+        no_sphere = lod.image.copy()
+        pl.add_mesh(pv.Sphere(radius=22.0, center=(36.0, 36.0, 36.0)), color="red")
+        sel, blocks = on_worker(lod.camera())
+        lod.show(sel, blocks)
+        assert lod.stats["prepared"] is True and lod.depth is not None and np.isfinite(lod.depth).any()
+        with_depth = lod.image.copy()
+        assert max_abs(with_depth, lod.draw()) == 0.0       # the GUI-thread draw against the depth: the same image
+        assert with_depth[..., 3].sum() < no_sphere[..., 3].sum() - 1.0    # the sphere hides part of the volume
     finally:
         pl.close()
 

@@ -28,11 +28,12 @@ interpolation is continuous across the boundary of two blocks of one level: the 
 level everywhere matches that level rendered as one volume (measured in ``tests/test_render_lod.py``). Where levels
 meet, the coarser block's samples differ from the finer one's by the node's approximation error (the quantity the
 selection bounds, Eq. 2.7). ``select`` and ``decode`` are Qt-free and thread-safe, so the app can run them in the
-job runner and call ``show`` on the GUI thread; ``update`` does all three. With the default renderer ``decode`` also
-ray casts the selection for the camera it was selected for (when the last drawing needed no opaque-scene depth,
-clipping planes or parallel projection), so ``show`` only uploads the image if camera, size and TF are unchanged;
-otherwise ``show`` ray casts on the GUI thread. ``self.volume`` (a ``vtkVolume``) carries the visibility in both modes (with ``"volviz"`` it is not in
-the renderer; its visibility switches the overlay).
+job runner and call ``show`` on the GUI thread; ``update`` does all three. With the default renderer ``camera()``
+(GUI thread) also captures the view a ray cast needs from the plotter (the full camera, the opaque scene's depth
+when there is visible geometry, the clipping planes) and ``decode`` ray casts the selection for that view, so
+``show`` only uploads the image if camera, projection, size, planes and TF are unchanged; otherwise ``show`` ray
+casts on the GUI thread. ``self.volume`` (a ``vtkVolume``) carries the visibility in both modes (with ``"volviz"``
+it is not in the renderer; its visibility switches the overlay).
 """
 from __future__ import annotations
 
@@ -148,9 +149,9 @@ class LodVolume:
         self._table_key: Any = None
         self._overlay: Optional[_Overlay] = None
         self._lock = threading.RLock()                  # guards the dicts below, _images and the table cache
-        self._cameras: dict[int, tuple[Selection, LodCamera]] = {}      # id(selection) -> its camera (last few)
+        self._views: dict[int, tuple[Any, ...]] = {}    # id(LOD camera) -> its view (``camera``; last few)
+        self._cameras: dict[int, tuple[Selection, Any]] = {}            # id(selection) -> its view (last few)
         self._prepared: dict[int, tuple[Any, ...]] = {}                  # id(selection) -> image made by decode
-        self._prepare_ok = False                        # the last draw needed no depth, planes or parallel camera
         if renderer == "vtk":
             plotter.renderer.AddVolume(self.volume)
         else:
@@ -168,10 +169,27 @@ class LodVolume:
         if self.renderer == "volviz" and self._pool is not None:
             self.draw()
 
-    def camera(self) -> LodCamera:
-        """GUI thread: the plotter's current camera and viewport size, for ``select`` on another thread."""
+    def _lod_camera(self) -> LodCamera:
         w, h = (int(v) for v in self.plotter.ren_win.GetSize())
         return lod_camera(self.plotter.renderer.GetActiveCamera(), (w, h))
+
+    def camera(self) -> LodCamera:
+        """GUI thread: the plotter's current camera and viewport size, for ``select`` on another thread. With our
+        renderer it also captures what a ray cast of that view needs from the plotter (the full camera, the opaque
+        scene's depth when there is visible geometry, the clipping planes), so that ``decode`` can ray cast on the
+        worker too."""
+        from volviz.unstructured.camera import Camera
+
+        cam = self._lod_camera()
+        if self.renderer == "volviz" and self._overlay is not None and self.volume.GetVisibility():
+            depth = self._overlay.depth((cam.width, cam.height))
+            view = (cam, Camera.from_pyvista(self.plotter.renderer.GetActiveCamera()), depth,
+                    _mapper_planes(self.mapper))
+            with self._lock:
+                self._views[id(cam)] = view
+                while len(self._views) > 4:
+                    self._views.pop(next(iter(self._views)))
+        return cam
 
     def select(self, camera: LodCamera, budget: Optional[int] = None) -> Selection:
         """Any thread: the blocks for ``camera`` under the block budget (Guthe §2.3.3; default ``self.budget``; the
@@ -179,20 +197,23 @@ class LodVolume:
         sel = self.tree.select(camera, self.budget if budget is None else int(budget), tf=self.tf, mode=self.mode)
         if self.renderer == "volviz":
             with self._lock:
-                self._cameras[id(sel)] = (sel, camera)
+                view = self._views.get(id(camera))
+                if view is None or view[0] is not camera:
+                    return sel
+                self._cameras[id(sel)] = (sel, view)
                 while len(self._cameras) > 4:
                     self._cameras.pop(next(iter(self._cameras)))
         return sel
 
     def decode(self, selection: Selection) -> list[Block]:
         """Any thread: the selected blocks' samples (decoded on demand through the tree's LRU cache). With our
-        renderer, when the selection came from ``select`` and the last drawing needed no opaque-scene depth,
-        clipping planes or parallel projection, this also ray casts the selection for its camera, so that ``show``
-        on the GUI thread only uploads the image (if the camera, size and TF are still the same)."""
+        renderer, when the selection came from ``select`` for a ``camera()`` view, this also ray casts the selection
+        for that view (its camera, opaque depth and clipping planes), so that ``show`` on the GUI thread only
+        uploads the image (if camera, size, planes and TF are still the same)."""
         with self._lock:
             held = set(self._images)
         blocks = [self.tree.block(key) for key in selection.nodes if key not in held] if selection.nodes else []
-        if self.renderer == "volviz" and selection.nodes and self._prepare_ok:
+        if self.renderer == "volviz" and selection.nodes:
             self._prepare(selection, blocks)
         return blocks
 
@@ -210,7 +231,7 @@ class LodVolume:
         if entry is None or entry[0] is not selection:
             return
         t0 = time.perf_counter()
-        cam = entry[1]
+        lod_cam, cam, depth, planes = entry[1]
         new = {b.key: b for b in blocks}
         pool = pack_blocks([new[k] if k in new else held[k] if k in held else self.tree.block(k)
                             for k in selection.nodes], self.tree.shapes[0], self.tree.origin, self.tree.spacing)
@@ -218,11 +239,11 @@ class LodVolume:
         t1 = time.perf_counter()
         table = self._segment_table(tf, pool)
         t2 = time.perf_counter()
-        img = render_blocks(pool, tf, Camera(cam.eye, cam.target, cam.up, cam.fov_y), (cam.width, cam.height),
-                            step=self.step, table=table)
+        img = render_blocks(pool, tf, cam, (lod_cam.width, lod_cam.height), step=self.step, depth=depth,
+                            table=table, planes=planes)
         t3 = time.perf_counter()
         with self._lock:
-            self._prepared[id(selection)] = (selection, cam, tf_key, pool, img,
+            self._prepared[id(selection)] = (selection, entry[1], tf_key, pool, img,
                                              {"pack_s": t1 - t0, "table_s": t2 - t1, "render_s": t3 - t2})
             while len(self._prepared) > 2:
                 self._prepared.pop(next(iter(self._prepared)))
@@ -260,27 +281,25 @@ class LodVolume:
 
     def _use_prepared(self, selection: Selection, prepared: tuple[Any, ...]) -> bool:
         """GUI thread: show the image ``decode`` made, if it is still right for the plotter (same selection,
-        camera, size and TF; nothing that needs the depth, planes or a parallel camera; visible)."""
-        sel, cam, tf_key, pool, img, st = prepared
-        if sel is not selection or cam != self.camera() or tf_key != self._effective_tf()[1] \
-                or not self._prepare_check() or not self.volume.GetVisibility() or self._overlay is None:
+        camera, projection, size, clipping planes and TF; visible). The opaque depth is the one captured with the
+        camera (as a PT volume's image is made against the depth of its ``begin``)."""
+        sel, view, tf_key, pool, img, st = prepared
+        lod_cam, cam, depth, planes = view
+        now = _mapper_planes(self.mapper)
+        same_planes = (planes is None and now is None) or (planes is not None and now is not None
+                                                            and np.array_equal(planes, now))
+        vcam = self.plotter.renderer.GetActiveCamera()
+        if sel is not selection or lod_cam != self._lod_camera() or tf_key != self._effective_tf()[1] \
+                or bool(vcam.GetParallelProjection()) != cam.parallel \
+                or (cam.parallel and float(vcam.GetParallelScale()) != float(cam.parallel_scale)) or not same_planes \
+                or not self.volume.GetVisibility() or self._overlay is None:
             return False
         t0 = time.perf_counter()
-        self._pool, self.image, self.depth = pool, img, None
+        self._pool, self.image, self.depth = pool, img, depth
         self._overlay.show_image(img, True)
         self.stats.update({"renderer": "volviz", "prepared": True, "readback_s": 0.0, "draw_s": 0.0,
                            "upload_s": time.perf_counter() - t0, "size": (img.shape[1], img.shape[0]), **st})
         return True
-
-    def _prepare_check(self) -> bool:
-        """GUI thread: True when an image can be made away from the plotter (no visible actor whose depth would
-        clip the rays, no clipping planes, perspective camera); remembered for ``decode``."""
-        cam = self.plotter.renderer.GetActiveCamera()
-        planes = self.mapper.GetClippingPlanes()
-        ok = (self.plotter.renderer.VisibleActorCount() == 0 and not cam.GetParallelProjection()
-              and (planes is None or planes.GetNumberOfItems() == 0))
-        self._prepare_ok = ok
-        return ok
 
     def _segment_table(self, tf: Any, pool: Any) -> Any:
         """The separable table for ``tf`` over the data range of every level (cached per TF)."""
@@ -312,7 +331,6 @@ class LodVolume:
         depth = self._overlay.depth((w, h)) if visible else None
         t1 = time.perf_counter()
         tf = self._effective_tf()[0]
-        self._prepare_check()
         table = self._segment_table(tf, self._pool)
         t2 = time.perf_counter()
         img = render_blocks(self._pool, tf, cam, (w, h), step=self.step, depth=depth, table=table,
