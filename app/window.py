@@ -628,7 +628,8 @@ class MainWindow(QMainWindow):
 
     def set_clip(self, clip: dict[str, Any]) -> None:
         """New scene-wide clipping (from the clipping dock): every prop is cut; isosurfaces and PT volumes are cut
-        in the background (a 535k-triangle isosurface: 0.2 s of clipping and LOD chains), then re-rendered."""
+        in the background (a 535k-triangle isosurface: 0.2 s of clipping and LOD chains), then re-rendered; volumes
+        at a level of detail are ray cast again with the planes in the background."""
         if self.controller is None:
             return
         controller = self.controller
@@ -640,6 +641,7 @@ class MainWindow(QMainWindow):
         self.set_dirty()
         self.render()
         self.refresh_iso_overlay()
+        self.refresh_lod()      # ray cast again with the new planes, in the background
         settings = controller.clip
         self._recut_isosurfaces(controller, settings)
         for comp_id in pt_ids:  # the exact cut of a tetrahedral mesh runs in the background, then the re-render

@@ -178,6 +178,14 @@ def test_lod_volume_selects_in_the_background_coarse_first(qtbot, make_window, t
     assert shown[0] <= 2 < shown[1] <= 16  # a coarse selection (budget / 8) first, then the full budget
     assert list(volume.selection.nodes) == list(volume.select(volume.camera()).nodes)  # as if selected right here
     assert volume.stats["blocks"] == shown[1]
+    whole = volume.image.copy()
+    # a clipping plane (keep x >= 24, the volume's middle) is ray cast on a worker, not on the GUI thread
+    shown.clear()
+    window.set_clip({"planes": [{"point": [24.0, 0.0, 0.0], "normal": [1.0, 0.0, 0.0]}]})
+    qtbot.waitUntil(lambda: len(shown) == 2 and not window._lod_jobs["blob"].running, timeout=60000)
+    assert volume.stats["prepared"] is True, "the clipped view was ray cast on the GUI thread"
+    cut = volume.image
+    assert 0.0 < cut[..., 3].sum() < 0.9 * whole[..., 3].sum()     # part of the volume is cut away
 
 
 def test_session_load_prepares_in_the_background(qtbot, make_window, tmp_path: Path) -> None:
