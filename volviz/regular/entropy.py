@@ -632,6 +632,36 @@ def _dec_direct(st, buf, n):
     return v
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _enc_magnitude(st, out, probs, ectx, mctx, m):
+    """A magnitude m >= 1: its bit length e in unary (contexts ``ectx + min(u, N_EXP - 1)``), the bit below the
+    leading one (context ``mctx + min(e, 31)``), then the remaining e - 2 bits directly."""
+    e = _bitlen(m)
+    for u in range(1, e):
+        _enc_bit(st, out, probs, ectx + min(u, N_EXP - 1), 1)
+    _enc_bit(st, out, probs, ectx + min(e, N_EXP - 1), 0)
+    if e >= 2:
+        _enc_bit(st, out, probs, mctx + min(e, 31), (m >> (e - 2)) & 1)
+        if e >= 3:
+            _enc_direct(st, out, m & ((1 << (e - 2)) - 1), e - 2)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _dec_magnitude(st, buf, probs, ectx, mctx):
+    """Inverse of :func:`_enc_magnitude`; -1 on an inconsistent stream (a bit length over 40)."""
+    e = 1
+    while _dec_bit(st, buf, probs, ectx + min(e, N_EXP - 1)) == 1:
+        e += 1
+        if e > 40:
+            return np.int64(-1)
+    m = np.int64(1)
+    if e >= 2:
+        m = (m << 1) | _dec_bit(st, buf, probs, mctx + min(e, 31))
+        if e >= 3:
+            m = (m << (e - 2)) | _dec_direct(st, buf, e - 2)
+    return m
+
+
 @njit(cache=True, nogil=True)
 def _activity_map(w, l0, l1, l2, am):
     """``am[p]`` = bucket of (max - min) of the lowpass ``w[:l0, :l1, :l2]`` over the 3^3 neighbourhood of p
@@ -730,15 +760,7 @@ def encode_arith(w, n0, n1, n2, root, out, base, uselow=False):
                                 _enc_bit(st, out, probs, _P_SIGN + c, 1 if v < 0 else 0)
                                 m = abs(v)
                                 cs[i - lo0, j - lo1, k - lo2] += m
-                                e = _bitlen(m)
-                                for u in range(1, e):
-                                    _enc_bit(st, out, probs, _P_EXP + ectx + min(u, N_EXP - 1), 1)
-                                _enc_bit(st, out, probs, _P_EXP + ectx + min(e, N_EXP - 1), 0)
-                                if e >= 2:
-                                    top = (m >> (e - 2)) & 1
-                                    _enc_bit(st, out, probs, _P_MAN + c * 32 + min(e, 31), top)
-                                    if e >= 3:
-                                        _enc_direct(st, out, m & ((1 << (e - 2)) - 1), e - 2)
+                                _enc_magnitude(st, out, probs, _P_EXP + ectx, _P_MAN + c * 32, m)
     for _ in range(5):
         _shift_low(st, out)
     return st[4] - base
@@ -792,16 +814,9 @@ def decode_arith(buf, base, length, w, n0, n1, n2, root, uselow=False):
                                     w[i, j, k] = 0
                                     continue
                                 neg = _dec_bit(st, buf, probs, _P_SIGN + c)
-                                e = 1
-                                while _dec_bit(st, buf, probs, _P_EXP + ectx + min(e, N_EXP - 1)) == 1:
-                                    e += 1
-                                    if e > 40:
-                                        return -1
-                                m = np.int64(1)
-                                if e >= 2:
-                                    m = (m << 1) | _dec_bit(st, buf, probs, _P_MAN + c * 32 + min(e, 31))
-                                    if e >= 3:
-                                        m = (m << (e - 2)) | _dec_direct(st, buf, e - 2)
+                                m = _dec_magnitude(st, buf, probs, _P_EXP + ectx, _P_MAN + c * 32)
+                                if m < 0:
+                                    return -1
                                 cs[i - lo0, j - lo1, k - lo2] += m
                                 w[i, j, k] = -m if neg else m
     if st[2] > st[3] + 4:
@@ -961,16 +976,9 @@ def encode_haar_arith(w, n0, n1, n2, out, base):
                     m = abs(v)
                     ps = 0 if pr == 0 else (1 if pr > 0 else 2)
                     _enc_bit(st, out, probs, _HB_SIGN + ((sb * 2 + (1 if lb > 0 else 0)) * 3 + ps), 1 if v < 0 else 0)
-                    e = _bitlen(m)
                     ectx = _HB_EXP + (((sb * _NB7 + lb) * _NB7 + max(nb, _b7(inb))) * 3 + pb) * N_EXP
                     inb += m
-                    for u in range(1, e):
-                        _enc_bit(st, out, probs, ectx + min(u, N_EXP - 1), 1)
-                    _enc_bit(st, out, probs, ectx + min(e, N_EXP - 1), 0)
-                    if e >= 2:
-                        _enc_bit(st, out, probs, _HB_MAN + sb * 32 + min(e, 31), (m >> (e - 2)) & 1)
-                        if e >= 3:
-                            _enc_direct(st, out, m & ((1 << (e - 2)) - 1), e - 2)
+                    _enc_magnitude(st, out, probs, ectx, _HB_MAN + sb * 32, m)
     for _ in range(5):
         _shift_low(st, out)
     return st[4] - base
@@ -1015,16 +1023,9 @@ def decode_haar_arith(buf, base, length, w, n0, n1, n2):
                         ps = 0 if pr == 0 else (1 if pr > 0 else 2)
                         neg = _dec_bit(st, buf, probs, _HB_SIGN + ((sb * 2 + (1 if lb > 0 else 0)) * 3 + ps))
                         ectx = _HB_EXP + (((sb * _NB7 + lb) * _NB7 + max(nb, _b7(inb))) * 3 + pb) * N_EXP
-                        e = 1
-                        while _dec_bit(st, buf, probs, ectx + min(e, N_EXP - 1)) == 1:
-                            e += 1
-                            if e > 40:
-                                return -1
-                        m = np.int64(1)
-                        if e >= 2:
-                            m = (m << 1) | _dec_bit(st, buf, probs, _HB_MAN + sb * 32 + min(e, 31))
-                            if e >= 3:
-                                m = (m << (e - 2)) | _dec_direct(st, buf, e - 2)
+                        m = _dec_magnitude(st, buf, probs, ectx, _HB_MAN + sb * 32)
+                        if m < 0:
+                            return -1
                         inb += m
                         v = -m if neg else m
                     w[l0 + i if sb & 1 else i, l1 + j if sb & 2 else j, l2 + k if sb & 4 else k] = v + pr
