@@ -109,3 +109,11 @@ def test_compress_transform_choice(tmp_path: Path, capsys) -> None:
     original = read(src).data
     for out in files.values():
         assert np.array_equal(decompress(out).data, original)
+
+
+def test_output_cut_short_by_the_reader_is_not_an_error() -> None:
+    """``volviz info FILE | head -1``: the reader closing the pipe early ends volviz quietly."""
+    src = data_file("volumes/neghip.slc")
+    result = subprocess.run(f'"{sys.executable}" -m volviz.cli info "{src}" | head -c 1', shell=True,
+                            capture_output=True, text=True, timeout=300)
+    assert result.stdout and "error" not in result.stderr and "Traceback" not in result.stderr, result.stderr
