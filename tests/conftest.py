@@ -34,3 +34,17 @@ def data_file(relative: str) -> Path:
 def data() -> "type[data_file]":
     """The ``data_file`` function as a fixture: ``data("headsq/quarter.1")``."""
     return data_file
+
+
+def blob_vvz(path: Path, n: int) -> Path:
+    """A lossless ``.vvz`` of an n^3 8-bit test field (a Gaussian blob on a wavy background, values 5-245) at
+    ``path``: the volume of the LOD, ray-casting and app LOD tests."""
+    import numpy as np
+
+    from volviz.model.datasets import RegularVolume
+    from volviz.regular.codec import compress
+
+    x, y, z = np.meshgrid(*(np.linspace(-1, 1, n),) * 3, indexing="ij")
+    field = 200 * np.exp(-3 * ((x - 0.2) ** 2 + y ** 2 + (z + 0.1) ** 2)) + 40 * np.sin(4 * x) * np.cos(3 * y) + 45
+    compress(RegularVolume(np.asfortranarray(np.clip(field, 0, 255).astype(np.uint8))), path, mode="lossless")
+    return path

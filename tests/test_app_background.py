@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from PySide6.QtCore import Qt, QTimer
 
-from conftest import data_file
+from conftest import blob_vvz, data_file
 from test_app_workflows import make_window, wait_loaded  # noqa: F401 (a fixture and a helper shared with it)
 from volviz_app.window import MainWindow
 
@@ -147,14 +147,7 @@ def test_camera_move_updates_the_natural_scene_in_the_background(qtbot, make_win
 
 
 def test_lod_volume_selects_in_the_background_coarse_first(qtbot, make_window, tmp_path: Path) -> None:
-    from volviz.model import RegularVolume
-    from volviz.regular.codec import compress
-
-    n = 48
-    x, y, z = np.meshgrid(*(np.linspace(-1, 1, n),) * 3, indexing="ij")
-    field = 200 * np.exp(-3 * ((x - 0.2) ** 2 + y ** 2 + (z + 0.1) ** 2)) + 40 * np.sin(4 * x) * np.cos(3 * y) + 45
-    vvz = tmp_path / "blob.vvz"
-    compress(RegularVolume(np.asfortranarray(np.clip(field, 0, 255).astype(np.uint8))), vvz, mode="lossless")
+    vvz = blob_vvz(tmp_path / "blob.vvz", 48)
     session = tmp_path / "lod.json"
     session.write_text(json.dumps({
         "format": "volviz-session", "version": 1,

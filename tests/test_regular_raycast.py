@@ -8,10 +8,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from volviz.model.datasets import RegularVolume
+from conftest import blob_vvz
 from volviz.optics import TransferFunction
 from volviz.optics.metrics import max_abs, rmse
-from volviz.regular.codec import compress
 from volviz.regular.lod import Block, Camera as LodCamera, LodTree, Selection
 from volviz.regular.raycast import block_active, pack_blocks, render_blocks, render_reference, sub_active
 from volviz.regular.wavelet import HALF
@@ -25,12 +24,7 @@ CAM = Camera((150.0, -100.0, 85.0), (32.0, 32.0, 32.0), (0, 0, 1), 30.0)
 
 @pytest.fixture(scope="module")
 def tree(tmp_path_factory) -> LodTree:
-    x, y, z = np.meshgrid(*(np.linspace(-1, 1, N),) * 3, indexing="ij")
-    field = 200 * np.exp(-3 * ((x - 0.2) ** 2 + y ** 2 + (z + 0.1) ** 2)) + 40 * np.sin(4 * x) * np.cos(3 * y) + 45
-    vol = RegularVolume(np.asfortranarray(np.clip(field, 0, 255).astype(np.uint8)))
-    path = Path(tmp_path_factory.mktemp("raycast")) / "blob.vvz"
-    compress(vol, path, mode="lossless")
-    return LodTree(path, cache_bytes=32 << 20)
+    return LodTree(blob_vvz(Path(tmp_path_factory.mktemp("raycast")) / "blob.vvz", N), cache_bytes=32 << 20)
 
 
 @pytest.fixture(scope="module")

@@ -9,11 +9,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from conftest import blob_vvz
+
 pv = pytest.importorskip("pyvista")
 
-from volviz.model.datasets import RegularVolume  # noqa: E402
 from volviz.optics import TransferFunction  # noqa: E402
-from volviz.regular.codec import compress  # noqa: E402
 from volviz.regular.lod import LodTree, Selection  # noqa: E402
 from volviz.regular.wavelet import HALF  # noqa: E402
 from volviz.optics.metrics import max_abs, rmse  # noqa: E402
@@ -27,13 +27,8 @@ TF = TransferFunction([20.0, 100.0, 255.0], [[1.0, 0.6, 0.2], [0.3, 0.6, 1.0], [
 
 @pytest.fixture(scope="module")
 def tree(tmp_path_factory) -> LodTree:
-    n = 72                                              # not a multiple of the node size: partial edge nodes
-    x, y, z = np.meshgrid(*(np.linspace(-1, 1, n),) * 3, indexing="ij")
-    field = 200 * np.exp(-3 * ((x - 0.2) ** 2 + y ** 2 + (z + 0.1) ** 2)) + 40 * np.sin(4 * x) * np.cos(3 * y) + 45
-    vol = RegularVolume(np.asfortranarray(np.clip(field, 0, 255).astype(np.uint8)))
-    path = Path(tmp_path_factory.mktemp("lod")) / "blob.vvz"
-    compress(vol, path, mode="lossless")
-    return LodTree(path, cache_bytes=32 << 20)
+    # 72: not a multiple of the node size, so there are partial edge nodes
+    return LodTree(blob_vvz(Path(tmp_path_factory.mktemp("lod")) / "blob.vvz", 72), cache_bytes=32 << 20)
 
 
 def _shot(pl: "pv.Plotter") -> np.ndarray:
