@@ -104,6 +104,11 @@ def _import_gui_thread_modules() -> None:
     import volviz.render.controller  # noqa: F401
     import volviz.render.pt_prop  # noqa: F401
     import volviz.render.scene  # noqa: F401
+    import pyvista
+
+    # pyvista asks once per process whether this system can plot (it runs ``xset -q``) when the first offscreen plotter
+    # of an export is made: ~60 ms of a blocked event loop at the start of the first export, here at start-up instead
+    pyvista.system_supports_plotting()
 
 
 class MainWindow(QMainWindow):

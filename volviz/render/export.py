@@ -44,8 +44,15 @@ def offscreen_scene(session: Session, datasets: dict[str, Any], size: tuple[int,
 
 
 def snapshot(plotter: Any, size: tuple[int, int]) -> np.ndarray:
-    """Render the offscreen plotter (VTK side, the thread that owns it) and return the (H, W, 3) uint8 image."""
-    return np.asarray(plotter.screenshot(None, return_img=True, window_size=[int(size[0]), int(size[1])]))
+    """Render the offscreen plotter (VTK side, the thread that owns it) once at ``size`` and return the (H, W, 3) uint8
+    image. (``screenshot(window_size=...)`` renders twice: once after resizing and again after sizing back.)"""
+    width, height = int(size[0]), int(size[1])
+    if list(plotter.window_size) != [width, height]:
+        plotter.render_window.SetSize(width, height)  # no render here: the one render is below
+    if plotter._first_time:  # pyvista renders the first image itself (and places a camera that was never set)
+        return np.asarray(plotter.screenshot(None, return_img=True))
+    plotter.render()
+    return np.asarray(plotter.screenshot(None, return_img=True))
 
 
 def render_session(session: Session, session_file: Optional[str | os.PathLike], size: tuple[int, int],
