@@ -26,4 +26,7 @@ PYTHON=${PYTHON:-python3}
 [ -x .venv/bin/python ] || "$PYTHON" -m venv .venv
 .venv/bin/python -m pip install -q --upgrade pip
 .venv/bin/python -m pip install -q -e ".[test]"
+# Compile the Numba kernels once, now, into their on-disk cache: the first scene, first test or first benchmark does
+# not pay for it (about two minutes on 2 cores; seconds when the cache is already there).
+.venv/bin/volviz warmup
 echo "volviz is set up in $(pwd)/.venv"

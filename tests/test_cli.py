@@ -117,3 +117,33 @@ def test_output_cut_short_by_the_reader_is_not_an_error() -> None:
     result = subprocess.run(f'"{sys.executable}" -m volviz.cli info "{src}" | head -c 1', shell=True,
                             capture_output=True, text=True, timeout=300)
     assert result.stdout and "error" not in result.stderr and "Traceback" not in result.stderr, result.stderr
+
+
+WARMUP_PROBE = """
+import sys
+from numba.core import event
+compiled = []
+class Count(event.Listener):
+    def on_start(self, ev): pass
+    def on_end(self, ev): compiled.append(ev.data["dispatcher"].py_func.__qualname__)
+event.register("numba:compile", Count())
+from volviz.cli import main
+rc = main(["warmup"])
+assert not [m for m in sys.modules if m.startswith(("PySide6", "PyQt", "pyvistaqt"))], "Qt imported"
+print("compiled:", len(compiled), sorted(set(compiled)))
+sys.exit(rc)
+"""
+
+
+def test_warmup_leaves_every_kernel_it_uses_in_the_disk_cache() -> None:
+    """`volviz warmup` draws each kind of scene and runs each codec; run again in a new process, it finds every kernel
+    it needs in Numba's disk cache and compiles none (a kernel that cannot be cached would compile in every process,
+    on the user's first scene)."""
+    env = {k: v for k, v in __import__("os").environ.items() if k != "DISPLAY"}
+    runs = [subprocess.run([sys.executable, "-c", WARMUP_PROBE], capture_output=True, text=True, timeout=900, env=env)
+            for _ in range(2)]
+    for result in runs:
+        assert result.returncode == 0, result.stderr
+        assert all(name in result.stdout for name in ("natural scene", "tetrahedral volume", "compressed volume",
+                                                      "time series")), result.stdout
+    assert "compiled: 0 []" in runs[1].stdout, runs[1].stdout

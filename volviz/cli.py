@@ -63,6 +63,8 @@ def build_parser() -> argparse.ArgumentParser:
     compress = sub.add_parser("compress", help="compress a regular volume (see `volviz compress --help`)",
                               add_help=False)
     compress.add_argument("args", nargs=argparse.REMAINDER)
+
+    sub.add_parser("warmup", help="compile the rendering kernels once, ahead of first use (the setup script runs it)")
     return parser
 
 
@@ -109,7 +111,7 @@ def _print_info(desc: dict[str, Any]) -> None:
 def run(argv: Optional[Sequence[str]] = None) -> int:
     args = build_parser().parse_args(argv)
     if args.command is None:
-        raise UsageError("a command is needed: info, render, bench or compress (see volviz --help)")
+        raise UsageError("a command is needed: info, render, bench, compress or warmup (see volviz --help)")
     if args.command == "info":
         desc = describe(args.file)
         if args.json:
@@ -126,6 +128,8 @@ def run(argv: Optional[Sequence[str]] = None) -> int:
         from volviz.regular.cli import compress_main
 
         return int(compress_main(list(args.args)) or 0)
+    if args.command == "warmup":
+        return _warmup()
     raise UsageError(f"unknown command {args.command}")
 
 
@@ -153,6 +157,18 @@ def _render(args: argparse.Namespace) -> int:
                        through_time=args.time, duration=args.duration, progress=progress)
     print(file=sys.stderr)
     print(f"wrote {out} ({size[0]}x{size[1]})")
+    return 0
+
+
+def _warmup() -> int:
+    from volviz.warmup import warm_up
+
+    def progress(fraction: float, message: str) -> None:
+        print(f"\r{message} ({fraction:4.0%})\033[K", end="", file=sys.stderr, flush=True)
+
+    timings = warm_up(progress)
+    print(file=sys.stderr)
+    print("kernels ready: " + ", ".join(f"{name} {seconds:.1f} s" for name, seconds in timings))
     return 0
 
 

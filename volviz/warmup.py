@@ -1,0 +1,139 @@
+"""Compile volviz's Numba kernels ahead of their first use (``volviz warmup``; the setup script runs it at install).
+
+volviz's hot loops are Numba kernels cached on disk (``cache=True``). Without the cache, the first use of each one
+compiles it: seconds of CPU per renderer, and while a worker compiles, Numba's compiler lock and the garbage it makes
+stall every other thread that needs a kernel, the GUI thread included (measured: 100-130 ms event-loop stalls while
+the app loaded its first tetrahedral scene on a fresh install, none with the cache). Warming up renders each kind of
+scene the app and the CLI draw (natural scene, tetrahedral volume, compressed level-of-detail volume, isosurfaces and
+a blended volume of a time series), compresses with every coder and transform, and runs each unstructured method,
+all at tiny sizes through the same code paths, so the kernels and the type signatures they are called with are
+compiled once and written to the cache.
+"""
+from __future__ import annotations
+
+import json
+import tempfile
+import time
+from pathlib import Path
+from typing import Callable, Optional
+
+import numpy as np
+
+from volviz.jobs import ProgressCallback, report
+
+SIZE = (64, 48)
+
+
+def _blob(n: int, phase: float = 0.0) -> np.ndarray:
+    """A smooth uint8 blob of n^3 voxels (Fortran order, as the readers return volumes)."""
+    g = np.linspace(-1.0, 1.0, n)
+    x, y, z = np.meshgrid(g, g, g, indexing="ij")
+    field = 255.0 * np.exp(-3.0 * ((x - 0.2 * phase) ** 2 + y ** 2 + 1.5 * z ** 2))
+    return np.asfortranarray(np.clip(field, 0, 255).astype(np.uint8))
+
+
+def _render(doc: dict, folder: Path, name: str) -> None:
+    from volviz.render.export import render_session
+    from volviz.session import load
+
+    path = folder / f"{name}.json"
+    path.write_text(json.dumps({"format": "volviz-session", "version": 1, **doc}))
+    render_session(load(path), path, SIZE)
+
+
+def _natural_scene(folder: Path) -> None:
+    from volviz.render.export import render_session
+    from volviz.render.scene import demo_session
+
+    render_session(demo_session(), None, SIZE)
+
+
+def _tetrahedral_volume(folder: Path) -> None:
+    from volviz.optics import TransferFunction
+    from volviz.render.export import render_session
+    from volviz.render.scene import demo_volume_session
+    from volviz.unstructured import render
+    from volviz.unstructured.camera import Camera
+    from volviz.unstructured.synthetic import box_tets, holed_box
+
+    render_session(demo_volume_session(), None, SIZE)
+    mesh = box_tets(3)
+    tf = TransferFunction([0.0, 0.5, 1.0], [[1, 0, 0], [0, 1, 0], [0, 0, 1]], [0.0, 4.0, 1.0])
+    camera = Camera.orbit(mesh.points, 35, 25, 2.5)
+    for lookup in ("separable", "3d"):
+        for classification in ("post", "pre"):
+            render(mesh, tf, camera, (24, 24), lookup=lookup, n_s=32, n_l=16, classification=classification)
+    render(mesh, tf, camera, (24, 24), method="pt-st", n_s=32, n_l=16)
+    render(mesh, tf, camera, (24, 24), method="reference")
+    render(holed_box(4), tf, camera, (24, 24))  # a non-convex mesh: the sort's boundary-gap relations
+    clipped = demo_volume_session()
+    clipped.clip = {"planes": [], "box": {"lo": [0.0, 0.0, 0.0], "hi": [0.5, 0.5, 0.5]}}  # a cut mesh
+    render_session(clipped, None, SIZE)
+
+
+def _compressed_volume(folder: Path) -> None:
+    from volviz.model.datasets import RegularVolume
+    from volviz.regular.animation import compress_series, decompress_series
+    from volviz.regular.codec import compress, decompress
+
+    volume = RegularVolume(_blob(24))
+    for coder in ("rans", "arith"):
+        for transform in ("auto", "5/3", "haar"):
+            out = folder / f"blob-{coder}-{transform.replace('/', '')}.vvz"
+            compress(volume, out, mode="lossless", coder=coder, transform=transform)
+            decompress(out)
+        lossy = folder / f"blob-{coder}-q.vvz"
+        compress(volume, lossy, quality=60.0, coder=coder)
+        decompress(lossy)
+    frames = [_blob(16, phase=t) for t in range(4)]  # a motion-compensated I/P/B series, lossless and lossy
+    for mode, quality in (("lossless", None), ("quality", 60.0)):
+        store = folder / f"series-{mode}.vvs"
+        compress_series(frames, store, pattern="IBP", mode=mode, quality=quality)
+        decompress_series(store)
+    lod = folder / "lod.vvz"
+    compress(RegularVolume(_blob(40)), lod, mode="lossless")
+    _render({"datasets": [{"id": "blob", "path": str(lod), "options": {"lod": True}}],
+             "components": [{"id": "blob", "type": "volume", "dataset": "blob", "settings": {"budget": 16}}],
+             "camera": {"position": [120, -90, 80], "focal_point": [20, 20, 20], "view_up": [0, 0, 1]}},
+            folder, "lod")
+
+
+def _time_series(folder: Path) -> None:
+    import pyvista as pv
+
+    from volviz.render.controller import ISO_MODES
+
+    for t in range(3):
+        grid = pv.ImageData(dimensions=(24, 24, 24))
+        grid.point_data["density"] = _blob(24, phase=t).ravel(order="F")
+        grid.save(folder / f"series-t{t:02d}.vti")
+    dataset = [{"id": "series", "path": str(folder / "series-t%02d.vti")}]
+    camera = {"position": [80, -60, 50], "focal_point": [12, 12, 12], "view_up": [0, 0, 1]}
+    for mode in ISO_MODES:  # every way the app composites semi-transparent isosurfaces
+        _render({"datasets": dataset, "camera": camera, "render": {"options": {"time": 0.5, "iso_mode": mode}},
+                 "components": [{"id": "iso", "type": "isosurface", "dataset": "series", "settings": {
+                     "styles": [{"value": 60, "color": [0.2, 0.5, 1.0], "opacity": 0.4},
+                                {"value": 160, "color": [1.0, 0.8, 0.2], "opacity": 0.7}]}}]}, folder, "iso")
+    _render({"datasets": dataset, "camera": camera, "render": {"options": {"time": 1.5}},
+             "components": [{"id": "vol", "type": "volume", "dataset": "series"}]}, folder, "blend")
+
+
+EXERCISES: list[tuple[str, Callable[[Path], None]]] = [
+    ("natural scene", _natural_scene),
+    ("tetrahedral volume", _tetrahedral_volume),
+    ("compressed volume", _compressed_volume),
+    ("time series", _time_series),
+]
+
+
+def warm_up(progress: Optional[ProgressCallback] = None) -> list[tuple[str, float]]:
+    """Run every exercise once (compiling, or loading from the cache, what it uses); returns (name, seconds)."""
+    timings = []
+    with tempfile.TemporaryDirectory(prefix="volviz-warmup-") as tmp:
+        for i, (name, exercise) in enumerate(EXERCISES):
+            report(progress, i / len(EXERCISES), f"compiling the kernels of the {name}")
+            start = time.perf_counter()
+            exercise(Path(tmp))
+            timings.append((name, time.perf_counter() - start))
+    report(progress, 1.0, "kernels compiled")
+    return timings
