@@ -1,8 +1,6 @@
 """Natural scenes: the demo scene, session files for Yukon and St. Helens, the sky dome, and the PyVista view."""
 from __future__ import annotations
 
-import os
-from pathlib import Path
 
 import numpy as np
 import pytest

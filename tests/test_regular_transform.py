@@ -2,7 +2,6 @@
 the brick table (container version 2) and honoured by the whole-volume decoder and the on-demand node decoder."""
 from __future__ import annotations
 
-import struct
 
 import numpy as np
 import pytest

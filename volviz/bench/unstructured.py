@@ -106,7 +106,7 @@ def main(argv: list[str] | None = None) -> int:
     args = p.parse_args(argv)
 
     from volviz.io.plot3d import read_plot3d
-    from volviz.optics.metrics import error_heatmap, max_abs, rmse
+    from volviz.optics.metrics import max_abs, rmse
     from volviz.unstructured.render import render
     from volviz.unstructured.tetrahedralize import tetrahedralize
 

@@ -23,7 +23,7 @@ import numpy as np
 
 from volviz.model.datasets import RegularVolume
 
-from .codec import compress, info
+from .codec import compress
 
 
 def _progress_bar(stream: Any = None) -> Any:

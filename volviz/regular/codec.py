@@ -41,7 +41,7 @@ from volviz.model.datasets import RegularVolume
 from . import kernels as K
 from .container import KIND_NODE, KIND_ROOT, CorruptBrickError, CorruptBrickWarning, Reader, VVZError, Writer
 from .entropy import CODER_VERSION, CODERS, capacity
-from .wavelet import HALF, TILE, TRANSFORM_53, TRANSFORM_HAAR, level_shapes, n_tiles, subband_weights
+from .wavelet import TILE, TRANSFORM_53, TRANSFORM_HAAR, level_shapes, n_tiles, subband_weights
 
 Progress = Callable[[float, str], None]
 _INT_TYPES = {"uint8": 255, "int8": 255, "uint16": 65535, "int16": 65535}
@@ -381,7 +381,7 @@ def decompress(path: str | Path, strict: bool = False, report: list[dict[str, An
 
         ri = index.get((KIND_ROOT, levels, 0))
         if ri is None:
-            raise VVZError(name, f"root brick missing")
+            raise VVZError(name, "root brick missing")
         root = np.zeros(shapes[-1], np.int32)
         rec = table[ri]
         if rd.brick_ok(ri):

@@ -154,7 +154,7 @@ def parse_header(head: bytes, file_size: int, name: str = "<vvz>") -> dict[str, 
     (_, version, hdr_size, flags, meta_off, meta_len, table_off, table_count, meta_crc, table_crc,
      _) = _HDR.unpack(head[:60])
     if crc32(head[:60]) != struct.unpack("<I", head[60:64])[0]:
-        raise VVZError(name, f"header checksum mismatch (damaged header)")
+        raise VVZError(name, "header checksum mismatch (damaged header)")
     if version != VERSION:
         raise VVZError(name, f".vvz version {version} is not supported (this reader knows version {VERSION}); "
                        "compress the volume again")
@@ -189,15 +189,15 @@ class Reader:
         except OSError as exc:
             raise VVZError(name, f"cannot read ({exc})") from exc
         if crc32(meta_bytes) != h["meta_crc"]:
-            raise VVZError(name, f"metadata checksum mismatch (damaged metadata)")
+            raise VVZError(name, "metadata checksum mismatch (damaged metadata)")
         if crc32(table_bytes) != h["table_crc"]:
-            raise VVZError(name, f"brick table checksum mismatch (damaged table)")
+            raise VVZError(name, "brick table checksum mismatch (damaged table)")
         try:
             meta = json.loads(meta_bytes.decode("utf-8"))
         except (UnicodeDecodeError, json.JSONDecodeError) as exc:
             raise VVZError(name, f"metadata is not valid JSON ({exc})") from exc
         if not isinstance(meta, dict) or meta.get("format") != "volviz-vvz":
-            raise VVZError(name, f"metadata is not a volviz-vvz object")
+            raise VVZError(name, "metadata is not a volviz-vvz object")
         self.header = h
         self.meta: dict[str, Any] = meta
         self.table = np.frombuffer(table_bytes, BRICK_DTYPE)

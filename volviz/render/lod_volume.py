@@ -223,7 +223,6 @@ class LodVolume:
 
     def _prepare(self, selection: Selection, blocks: list[Block]) -> None:
         from volviz.regular.raycast import pack_blocks, render_blocks
-        from volviz.unstructured.camera import Camera
 
         with self._lock:
             entry = self._cameras.get(id(selection))
