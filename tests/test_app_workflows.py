@@ -152,6 +152,13 @@ def test_timeline_plays_the_storm_series(qtbot, make_window, tmp_path: Path) -> 
     from volviz.model.timeseries import frame_at
 
     assert np.allclose(frame_at(window.controller.datasets["data"], 1.5).data, 0.5 * (a + b))
+    # a scene without a time series: the timeline is disabled and back at its start
+    assert window.timeline.slider.value() > 0
+    window.open_demo_volume()
+    wait_loaded(qtbot, window)
+    assert window.timeline.steps == [] and not window.timeline.slider.isEnabled()
+    assert window.timeline.slider.value() == 0 and window.timeline.time == 0.0
+    assert window.timeline.label.text() == "no time series"
 
 
 def test_fly_forward_with_keys_moves_the_camera(qtbot, make_window) -> None:

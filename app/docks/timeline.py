@@ -63,6 +63,10 @@ class Timeline(QWidget):
         if not enabled:
             self.set_playing(False)
             self.span = (0.0, 0.0)
+            self.time = 0.0
+            self.slider.blockSignals(True)  # back at the start, not where the previous scene's series left it
+            self.slider.setValue(0)
+            self.slider.blockSignals(False)
             self.label.setText("no time series")
             return
         self.span = (self.steps[0], self.steps[-1])
