@@ -14,7 +14,7 @@ from typing import Any, Callable, Optional
 from PySide6.QtCore import QByteArray, QSettings, QStandardPaths, Qt, QTimer
 from PySide6.QtGui import QAction, QKeySequence, QUndoGroup
 from PySide6.QtWidgets import (QDockWidget, QFileDialog, QInputDialog, QLabel, QMainWindow, QMessageBox,
-                               QProgressBar, QProgressDialog, QPushButton, QWidget)
+                               QProgressBar, QPushButton, QWidget)
 
 from volviz.jobs import JobOutcome
 from volviz.render.controller import no_render
@@ -142,9 +142,9 @@ class MainWindow(QMainWindow):
         self._histogram_job: Any = None
         self.histograms_computed = 0       # TF-editor histograms computed in the background and shown
         self.histogram_threads: set[int] = set()       # the threads they were computed on
-        self._screenshot_serial = 0        # the newest screenshot export; an older one only cleans up
-        self.screenshot_result: Optional[bool] = None  # of the last export: None while it runs
-        self.screenshot_threads: set[int] = set()      # the threads its background steps ran on
+        self._export_run: Any = None       # the running screenshot or movie export (``frame_export``)
+        self.export_result: Optional[bool] = None  # of the last export: None while it runs
+        self.export_threads: set[int] = set()      # the threads its background steps ran on
         self._load_serial = 0              # the newest open/rebuild; an older one's late callbacks do nothing
         self._loading_views = False        # the newest scene is installed, its first views are computed
         self._overlay_waiters: dict[str, list[Callable[[], None]]] = {}  # job key -> ``settled`` callbacks
@@ -1231,131 +1231,60 @@ class MainWindow(QMainWindow):
     # ------------------------------------------------------------------------------------------------ export
     def export_screenshot(self, path: str | os.PathLike, size: Optional[tuple[int, int]] = None) -> None:
         """Re-render the current view offscreen at ``size`` (default: the viewport's) and write a PNG, in the
-        background with progress and cancel in the status bar (a newer export supersedes an older one): the scene is
-        prepared on a worker, its props added to an offscreen plotter here, its CPU images (natural scene, LOD
-        blocks, PT volumes, iso overlay) rendered on a worker, the final VTK render here, the PNG encoded and written
-        on a worker. ``screenshot_result`` is None while it runs, then True (written) or False."""
-        from volviz.render.export import offscreen_scene, snapshot, write_png
+        background with progress and cancel in the status bar (``volviz_app.frame_export``; a newer export supersedes
+        an older one). ``export_result`` is None while it runs, then True (written) or False."""
+        from volviz.render.export import ImageFile
 
-        width, height = size or (self.plotter.interactor.width(), self.plotter.interactor.height())
-        self._screenshot_serial += 1
-        serial = self._screenshot_serial
-        self.screenshot_result = None
-        self.screenshot_threads = set()
-        name = Path(path).name
+        size = size or (self.plotter.interactor.width(), self.plotter.interactor.height())
+        self._export(Path(path).name, size, lambda controller: [(None, None)], lambda: ImageFile(path))
+
+    def export_movie(self, path: str | os.PathLike, path_name: Optional[str], through_time: bool,
+                     fps: float = 24.0, size: Optional[tuple[int, int]] = None) -> None:
+        """Render a movie offscreen along the camera path ``path_name`` and/or through time, in the background like a
+        screenshot (``export_result``): MP4 through imageio-ffmpeg for ``.mp4``, else a PNG sequence in the folder
+        ``path``."""
+        from volviz.render.export import MovieWriter, movie_frames
+
+        self._export(Path(path).name, size or self.session.render.size,
+                     lambda controller: movie_frames(controller, path_name, fps, through_time),
+                     lambda: MovieWriter(Path(path), fps))
+
+    def _export(self, name: str, size: tuple[int, int], frames_of: Callable[[Any], list[Any]],
+                open_sink: Callable[[], Any]) -> None:
+        from volviz.render.export import offscreen_scene
+        from volviz_app.frame_export import FrameExport
+
+        if self._export_run is not None:
+            self._export_run.cancel()  # superseded: it ends quietly, the newer export owns the status bar
+        self.export_result = None
         live = self.controller
         session = Session(datasets=self.session.datasets, components=copy.deepcopy(self.session.components),
                           transfer_functions=copy.deepcopy(self.session.transfer_functions),
                           camera=live.camera() if live else None, render=self.session.render,
-                          clip=self.session.clip)
-        plotter, controller = offscreen_scene(session, self.datasets, (width, height))
+                          clip=self.session.clip, camera_paths=copy.deepcopy(self.session.camera_paths))
+        plotter, controller = offscreen_scene(session, self.datasets, size)
         t = None
         if live is not None and live.time_series():
             t, controller.interpolate_time = live.time, live.interpolate_time
         self.status_label.setText(f"Exporting {name}…")
         self._set_busy(True)
+        run: Any = None
 
-        def end(ok: bool, message: str, error: Optional[BaseException] = None) -> None:
-            plotter.close()
-            if serial != self._screenshot_serial:  # superseded: the newer export owns the status bar
+        def end(ok: bool, message: str) -> None:
+            self.export_threads |= run.threads
+            if run is not self._export_run:  # superseded
                 return
-            self._current_job = None
-            self._set_busy(False)
+            self._export_run = None
+            self.export_result = ok
+            if not self._busy_elsewhere():
+                self._set_busy(False)
             self.status_label.setText(message)
-            if error is not None:
-                log.error("screenshot export failed: %s", error)
-                self.show_error("Cannot export screenshot", f"{path}: {error}")
-            self.screenshot_result = ok
+            if not ok and not run.cancelled:
+                self.show_error("Cannot export", f"{name}: {message}")
 
-        def step(fn: Callable[..., Any], *args: Any, then: Callable[[Any], None]) -> None:
-            def run(*a: Any, progress: Any = None) -> Any:
-                self.screenshot_threads.add(threading.get_ident())
-                return fn(*a, progress=progress)
-
-            def done(outcome: JobOutcome) -> None:
-                if outcome.cancelled or serial != self._screenshot_serial:
-                    end(False, f"Export of {name} cancelled")
-                elif outcome.error is not None:
-                    end(False, f"Could not export {name}", outcome.error)
-                else:
-                    try:
-                        then(outcome.result)
-                    except Exception as exc:  # the VTK side failed: a message, the app keeps working
-                        log.exception("screenshot export failed")
-                        end(False, f"Could not export {name}", exc)
-
-            self._current_job = self.jobs.submit(run, *args, name=f"export {name}", key="screenshot", on_done=done)
-
-        def views(stage: int) -> None:
-            if stage == 2:
-                # the offscreen window's first render (its GL context, shaders, textures) at a tiny size in one turn
-                # of the event loop, the render at full size in a later one: together they held it ~50 ms longer
-                snapshot(plotter, (8, 8))
-                QTimer.singleShot(STAGE_MS, lambda: serial == self._screenshot_serial and views(3))
-                return
-            if stage == 3:
-                image = snapshot(plotter, (width, height))
-                step(lambda progress=None: write_png(image, path), then=lambda _: end(
-                    True, f"Exported {name} ({width}x{height})"))
-                return
-            requests = controller.begin_views(stage)
-            if not requests:
-                views(stage + 1)
-                return
-
-            def shown(results: Any) -> None:
-                controller.finish_views(requests, results)
-                views(stage + 1)
-
-            step(controller.compute_views, requests, then=shown)
-
-        def installed(prepared: Any) -> None:
-            controller.install(prepared, views=False)
-            views(0)
-
-        step(lambda progress=None: controller.prepare(progress, t), then=installed)
-        # the offscreen window's GL context is made by a first (empty) render, in its own turn of the event loop
-        QTimer.singleShot(STAGE_MS, lambda: serial == self._screenshot_serial and not controller.props
-                          and snapshot(plotter, (8, 8)))
-
-    def export_movie(self, path: str | os.PathLike, path_name: Optional[str], through_time: bool,
-                     fps: float = 24.0, size: Optional[tuple[int, int]] = None) -> bool:
-        """Render a movie offscreen along a camera path and/or through time, with a cancellable progress dialog."""
-        from volviz.jobs import Cancelled
-        from volviz.render.export import render_movie
-
-        if self.session_path is None and self.session.datasets:
-            self.show_error("Cannot export movie", "save the session first: the movie is rendered from it")
-            return False
-        size = size or self.session.render.size
-        dialog = QProgressDialog("Rendering movie…", "Cancel", 0, 1000, self)
-        dialog.setWindowModality(Qt.WindowModality.WindowModal)
-        dialog.setMinimumDuration(0)
-
-        def progress(fraction: float, message: str) -> None:
-            dialog.setValue(int(fraction * 1000))
-            dialog.setLabelText(message)
-            from PySide6.QtWidgets import QApplication
-
-            QApplication.processEvents()
-            if dialog.wasCanceled():
-                raise Cancelled()
-
-        session = self.capture_session(self.session_path or Path(path))
-        try:
-            render_movie(session, self.session_path, path, size, path_name=path_name, fps=fps,
-                         through_time=through_time, progress=progress)
-        except Cancelled:
-            self.status_label.setText("Movie export cancelled")
-            return False
-        except Exception as exc:
-            log.exception("movie export failed")
-            self.show_error("Cannot export movie", f"{path}: {exc}")
-            return False
-        finally:
-            dialog.close()
-        self.status_label.setText(f"Exported movie {Path(path).name}")
-        return True
+        self.export_threads = set()
+        run = FrameExport(self, plotter, controller, size, name, frames_of, open_sink, end, t)
+        self._export_run = run
 
     # ------------------------------------------------------------------------------------------------ dialogs
     def ask_file(self, title: str, name_filter: str, on_chosen: Any, save: bool = False,
@@ -1430,13 +1359,21 @@ class MainWindow(QMainWindow):
             self.status_label.setText(message)
 
     def _set_busy(self, busy: bool) -> None:
+        was = self.progress_bar.isVisible()
+        busy = busy or self._export_run is not None  # a running export keeps its progress bar and cancel button
         self.progress_bar.setVisible(busy)
         self.cancel_button.setVisible(busy)
-        if busy:
+        if busy and not was:
             self.progress_bar.setValue(0)
 
+    def _busy_elsewhere(self) -> bool:
+        """A job other than an export still shows progress (a scene loading, its first views)."""
+        return (self._current_job is not None and not self._current_job.done()) or self._loading_views
+
     def cancel_current_job(self) -> None:
-        if self._current_job is not None and not self._current_job.done():
+        if self._export_run is not None:  # an export runs alongside whatever else: the button stops it first
+            self._export_run.cancel()
+        elif self._current_job is not None and not self._current_job.done():
             self._current_job.cancel()
         elif self._loading_views:  # the scene is shown; stop computing its first views
             self.jobs.runner.cancel_all()

@@ -145,8 +145,8 @@ def test_transparency_mode_from_render_settings_and_spectrum_shader_on_screen(qt
     export = tmp_path / "export.png"
     w, h = window.plotter.ren_win.GetSize()
     window.export_screenshot(export, (w, h))
-    qtbot.waitUntil(lambda: window.screenshot_result is not None, timeout=60000)  # rendered in the background
-    assert window.screenshot_result
+    qtbot.waitUntil(lambda: window.export_result is not None, timeout=60000)  # rendered in the background
+    assert window.export_result
     import imageio.v3 as iio
     offscreen = iio.imread(export)[..., :3].astype(np.float64)
     assert offscreen.shape == vtk_image.shape

@@ -26,10 +26,10 @@ def test_screenshot_export_prepares_and_renders_in_the_background(qtbot, make_wi
     window.export_screenshot(out, size=(320, 200))
     assert not out.exists(), "the screenshot was prepared and rendered on the GUI thread"
     assert window.progress_bar.isVisible() and window.cancel_button.isVisible()
-    qtbot.waitUntil(lambda: window.screenshot_result is not None, timeout=120000)
+    qtbot.waitUntil(lambda: window.export_result is not None, timeout=120000)
     gaps.stop()
-    assert window.screenshot_result is True
-    assert window.screenshot_threads and threading.main_thread().ident not in window.screenshot_threads
+    assert window.export_result is True
+    assert window.export_threads and threading.main_thread().ident not in window.export_threads
     image = iio.imread(out)
     assert image.shape[:2] == (200, 320)
     assert image[..., :3].std() > 3.0
@@ -44,12 +44,60 @@ def test_screenshot_export_can_be_cancelled(qtbot, make_window, tmp_path: Path) 
     out = tmp_path / "shot.png"
     window.export_screenshot(out, size=(320, 200))
     window.cancel_current_job()
-    qtbot.waitUntil(lambda: window.screenshot_result is not None, timeout=120000)
-    assert window.screenshot_result is False
+    qtbot.waitUntil(lambda: window.export_result is not None, timeout=120000)
+    assert window.export_result is False
     assert not out.exists()
     assert "cancelled" in window.status_label.text()
     assert not window.progress_bar.isVisible()
     window.export_screenshot(out, size=(320, 200))  # the app keeps working
-    qtbot.waitUntil(lambda: window.screenshot_result is not None, timeout=120000)
-    assert window.screenshot_result is True and iio.imread(out).shape[:2] == (200, 320)
+    qtbot.waitUntil(lambda: window.export_result is not None, timeout=120000)
+    assert window.export_result is True and iio.imread(out).shape[:2] == (200, 320)
     assert np.asarray(iio.imread(out))[..., :3].std() > 3.0
+
+
+def test_movie_through_time_is_exported_in_the_background_and_cancel_leaves_no_partial_file(
+        qtbot, make_window, tmp_path: Path) -> None:
+    """A movie through a time series (the storm's isosurfaces, re-extracted for every frame) renders like a
+    screenshot: the isosurfaces, views and encoding on workers, only the VTK side here, the event loop live and the
+    app usable meanwhile; a cancelled MP4 leaves nothing behind."""
+    from test_app_background import storm_iso_session
+
+    window = make_window()
+    window.resize(1000, 700)
+    qtbot.wait(300)
+    window.open_path(storm_iso_session(tmp_path))
+    wait_loaded(qtbot, window)
+    frames = tmp_path / "frames"
+    gaps = LoopGaps()
+    window.export_movie(frames, None, through_time=True, fps=0.5, size=(160, 120))
+    assert not frames.exists() or not list(frames.iterdir()), "frames were rendered on the GUI thread"
+    assert window.progress_bar.isVisible() and window.cancel_button.isVisible()
+    qtbot.waitUntil(lambda: window.export_result is not None, timeout=300000)
+    gaps.stop()
+    assert window.export_result is True, window.status_label.text()
+    assert window.export_threads and threading.main_thread().ident not in window.export_threads
+    pngs = sorted(frames.glob("frame_*.png"))
+    span = window.controller.time_span()
+    assert len(pngs) == int(round((span[1] - span[0]) * 0.5)) + 1  # a frame per 2 units of time, both ends
+    images = [iio.imread(p)[..., :3].astype(int) for p in pngs]
+    assert all(image.shape == (120, 160, 3) for image in images)
+    changed = [np.abs(a - b).mean() for a, b in zip(images, images[1:])]
+    assert min(changed) > 0.0, "a frame repeated the one before: the isosurfaces did not follow the time"
+    assert "Exported frames" in window.status_label.text() and not window.progress_bar.isVisible()
+    print(gaps.summary())
+    gaps.assert_responsive("during a movie export", 50)
+
+    movie = tmp_path / "storm.mp4"
+    window.export_movie(movie, None, through_time=True, fps=0.5, size=(160, 120))
+    qtbot.waitUntil(lambda: "frame 3 of" in window.status_label.text(), timeout=120000)
+    window.cancel_current_job()
+    qtbot.waitUntil(lambda: window.export_result is not None, timeout=120000)
+    assert window.export_result is False and "cancelled" in window.status_label.text()
+    assert [p.name for p in tmp_path.iterdir() if ".mp4" in p.name] == [], "a partial movie was left behind"
+    assert not window.progress_bar.isVisible()
+    window.export_movie(movie, None, through_time=True, fps=0.5, size=(160, 120))  # the app keeps working
+    qtbot.waitUntil(lambda: window.export_result is not None, timeout=300000)
+    assert window.export_result is True
+    video = iio.imread(movie, index=None)
+    assert video.shape[0] == len(pngs) and video.shape[1:3] == (120, 160)
+    assert [p.name for p in tmp_path.iterdir() if ".mp4" in p.name] == ["storm.mp4"]

@@ -92,8 +92,8 @@ def test_save_session_and_export_screenshot(qtbot, window: MainWindow, tmp_path:
 
     shot = tmp_path / "shot.png"
     window.export_screenshot(shot, size=(300, 200))
-    qtbot.waitUntil(lambda: window.screenshot_result is not None, timeout=60000)  # rendered in the background
-    assert window.screenshot_result
+    qtbot.waitUntil(lambda: window.export_result is not None, timeout=60000)  # rendered in the background
+    assert window.export_result
     image = iio.imread(shot)
     assert image.shape[:2] == (200, 300)
     assert not_blank(image) > 0.02

@@ -200,7 +200,9 @@ def test_bookmarks_and_recorded_path_are_saved_and_render_a_movie(qtbot, make_wi
     doc = json.loads(session_file.read_text())
     assert "start" in doc["bookmarks"] and name in doc["camera_paths"]
     frames = tmp_path / "frames"
-    assert window.export_movie(frames, name, through_time=False, fps=4, size=(96, 64))
+    window.export_movie(frames, name, through_time=False, fps=4, size=(96, 64))
+    qtbot.waitUntil(lambda: window.export_result is not None, timeout=120000)  # rendered in the background
+    assert window.export_result is True
     pngs = sorted(frames.glob("frame_*.png"))
     assert len(pngs) >= 3
     assert iio.imread(pngs[0]).shape[:2] == (64, 96)
@@ -213,8 +215,8 @@ def test_export_screenshot_any_size(qtbot, make_window, tmp_path: Path) -> None:
     wait_loaded(qtbot, window)
     out = tmp_path / "shot.png"
     window.export_screenshot(out, size=(1000, 333))
-    qtbot.waitUntil(lambda: window.screenshot_result is not None, timeout=60000)  # rendered in the background
-    assert window.screenshot_result
+    qtbot.waitUntil(lambda: window.export_result is not None, timeout=60000)  # rendered in the background
+    assert window.export_result
     image = iio.imread(out)
     assert image.shape[:2] == (333, 1000)
     assert image[..., :3].std() > 3.0

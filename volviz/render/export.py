@@ -152,7 +152,7 @@ def render_movie(session: Session, session_file: Optional[str | os.PathLike], ou
     try:
         controller.build()
         frames = movie_frames(controller, path_name, fps, through_time, duration)
-        writer = _MovieWriter(target, fps)
+        writer = MovieWriter(target, fps)
         try:
             for i, (camera, t) in enumerate(frames):
                 if i + 1 < len(frames) and frames[i + 1][0] is not None:
@@ -172,7 +172,23 @@ def render_movie(session: Session, session_file: Optional[str | os.PathLike], ou
     return target
 
 
-class _MovieWriter:
+class ImageFile:
+    """A one-frame sink with ``MovieWriter``'s interface: the PNG ``target``, written atomically."""
+
+    def __init__(self, target: str | os.PathLike):
+        self.target = Path(target)
+
+    def append(self, image: np.ndarray) -> None:
+        write_png(image, self.target)
+
+    def close(self) -> None:
+        pass
+
+    def abort(self) -> None:
+        pass
+
+
+class MovieWriter:
     """MP4 through imageio-ffmpeg (to a temporary name, renamed at the end) or a PNG sequence in a folder."""
 
     def __init__(self, target: Path, fps: float):

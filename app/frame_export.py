@@ -1,0 +1,195 @@
+"""Screenshot and movie export in the background (issue #5: "export screenshot (PNG, any size, offscreen re-render)
+and movie along a camera path or through time, with progress"; background work stays off the UI thread).
+
+One mechanism for both: a screenshot is an export of one frame. The scene is prepared on a worker and its props
+added to an offscreen plotter on the GUI thread. Each frame then takes these steps:
+1. The GUI thread sets the frame's camera and display time. A worker re-extracts the time series' isosurfaces and
+   blends its volumes, and the GUI thread shows them.
+2. A worker computes the view-dependent CPU images (natural scene, LOD blocks, PT volumes, iso overlay) in the two
+   stages of ``SceneController.begin_views``. The GUI thread hands them to VTK.
+3. The GUI thread makes the final VTK render. A worker encodes and writes the frame.
+Between steps the event loop runs. Cancel (the status bar's button) stops at the running step. A newer export
+supersedes an older one. A partial movie is removed (``MovieWriter.abort``).
+"""
+from __future__ import annotations
+
+import logging
+import threading
+from typing import Any, Callable, Optional
+
+from PySide6.QtCore import QTimer
+
+log = logging.getLogger("volviz.app")
+
+STAGE_MS = 30  # pause between GUI-thread stages (other events run in between)
+
+Frame = tuple[Optional[Any], Optional[float]]  # (camera or None: keep, display time or None: keep)
+
+
+class FrameExport:
+    """One running export. ``window`` provides ``jobs`` (a ``JobBridge``), ``status_label`` and ``show_error``;
+    ``frames_of(controller)`` lists the frames once the scene is installed; ``open_sink()`` (on a worker) returns an
+    object with ``append(image)``, ``close()`` and ``abort()``; ``on_end(ok, message)`` runs once at the end."""
+
+    def __init__(self, window: Any, plotter: Any, controller: Any, size: tuple[int, int], name: str,
+                 frames_of: Callable[[Any], list[Frame]], open_sink: Callable[[], Any],
+                 on_end: Callable[[bool, str], None], t: Optional[float] = None) -> None:
+        self.window, self.plotter, self.controller = window, plotter, controller
+        self.size, self.name = (int(size[0]), int(size[1])), name
+        self.frames_of, self.open_sink, self.on_end = frames_of, open_sink, on_end
+        self.frames: list[Frame] = []
+        self.sink: Any = None
+        self.threads: set[int] = set()      # the threads its background steps ran on
+        self.cancelled = False
+        self.over = False
+        self._job: Any = None
+        self._step(lambda progress=None: controller.prepare(progress, t), then=self._installed,
+                   message="preparing the scene")
+        # the offscreen window's GL context is made by a first (empty) render, in its own turn of the event loop
+        QTimer.singleShot(STAGE_MS, lambda: not self.over and not controller.props and self._snapshot((8, 8)))
+
+    # -- control ----------------------------------------------------------------------------------------------------
+    def cancel(self) -> None:
+        """Stop at the running step; the export ends as cancelled."""
+        self.cancelled = True
+        if self._job is not None and not self._job.done():
+            self._job.cancel()
+
+    def _end(self, ok: bool, message: str, error: Optional[BaseException] = None) -> None:
+        if self.over:
+            return
+        self.over = True
+        self.plotter.close()
+        sink, self.sink = self.sink, None
+        if sink is not None and not ok:
+            try:
+                sink.abort()  # no partial movie left behind
+            except Exception:
+                log.exception("could not remove the partial export of %s", self.name)
+        if error is not None:
+            log.error("export of %s failed: %s", self.name, error)
+        self.on_end(ok, message if error is None else f"{message}: {error}")
+
+    def _step(self, fn: Callable[..., Any], then: Callable[[Any], None], message: str, frame: int = 0) -> None:
+        """Run ``fn(progress=...)`` on a worker, then ``then(result)`` here, unless cancelled or failed meanwhile."""
+        n = max(len(self.frames), 1)
+
+        def run(progress: Any = None) -> Any:
+            self.threads.add(threading.get_ident())
+
+            def scaled(fraction: float, text: str = "") -> None:
+                if progress is not None:
+                    prefix = f"{self.name}: frame {frame + 1} of {n}" if len(self.frames) > 1 else self.name
+                    progress((frame + fraction) / n, f"{prefix}: {text or message}")
+
+            scaled(0.0)
+            return fn(progress=scaled)
+
+        def done(outcome: Any) -> None:
+            if self.over:
+                return
+            if outcome.cancelled or self.cancelled:
+                self._end(False, f"Export of {self.name} cancelled")
+            elif outcome.error is not None:
+                self._end(False, f"Could not export {self.name}", outcome.error)
+            else:
+                try:
+                    then(outcome.result)
+                except Exception as exc:  # the VTK side failed: a message, the app keeps working
+                    log.exception("export of %s failed", self.name)
+                    self._end(False, f"Could not export {self.name}", exc)
+
+        # no job key: with one, a newer export's job would drop this one's completion (its plotter never closed)
+        self._job = self.window.jobs.submit(run, name=f"export {self.name}", on_done=done)
+
+    def _later(self, fn: Callable[[], None]) -> None:
+        """``fn`` in a later turn of the event loop, unless the export ended meanwhile."""
+        def go() -> None:
+            if self.over:
+                return
+            if self.cancelled:
+                self._end(False, f"Export of {self.name} cancelled")
+                return
+            try:
+                fn()
+            except Exception as exc:
+                log.exception("export of %s failed", self.name)
+                self._end(False, f"Could not export {self.name}", exc)
+
+        QTimer.singleShot(STAGE_MS, go)
+
+    # -- the frames -------------------------------------------------------------------------------------------------
+    def _installed(self, prepared: Any) -> None:
+        self.controller.install(prepared, views=False)
+        self.frames = list(self.frames_of(self.controller))
+        if not self.frames:
+            raise ValueError("there are no frames to export")
+        self._step(lambda progress=None: self.open_sink(), then=self._sink_opened, message="opening the output")
+
+    def _sink_opened(self, sink: Any) -> None:
+        self.sink = sink
+        self._frame(0)
+
+    def _frame(self, i: int) -> None:
+        camera, t = self.frames[i]
+        c = self.controller
+        if camera is not None:
+            c.set_camera(camera, update=False)
+        if t is not None and t != c.time:
+            c.set_time(t, update=False, isosurfaces=False, volumes=False)
+            isosurfaces, volumes = c.time_isosurfaces(), c.time_volumes()
+            if isosurfaces or volumes:
+                def parts(progress: Any = None) -> tuple[dict[str, Any], dict[str, Any]]:
+                    return ({k: c.isosurface_parts(k, t) for k in isosurfaces},
+                            {k: c.blend_volume(k, t) for k in volumes})
+
+                def show(result: tuple[dict[str, Any], dict[str, Any]]) -> None:
+                    c.show_isosurfaces(result[0])
+                    c.show_volumes(result[1])
+                    self._views(i, 0)
+
+                self._step(parts, then=show, message=f"the data at t = {t:.4g}", frame=i)
+                return
+        self._views(i, 0)
+
+    def _views(self, i: int, stage: int) -> None:
+        if stage == 2:
+            if i == 0:
+                # the offscreen window's first render with the scene (shaders, textures) at a tiny size in one turn
+                # of the event loop, the render at full size in a later one: together they held it ~50 ms longer
+                self._snapshot((8, 8))
+            self._later(lambda: self._render(i))
+            return
+        requests = self.controller.begin_views(stage)
+        if not requests:
+            self._views(i, stage + 1)
+            return
+
+        def shown(results: Any) -> None:
+            self.controller.finish_views(requests, results)
+            self._views(i, stage + 1)
+
+        self._step(lambda progress=None: self.controller.compute_views(requests, progress=progress), then=shown,
+                   message="rendering the views", frame=i)
+
+    def _render(self, i: int) -> None:
+        image = self._snapshot(self.size)
+        sink = self.sink
+
+        def written(_: Any) -> None:
+            if i + 1 < len(self.frames):
+                self._later(lambda: self._frame(i + 1))
+                return
+            self._step(lambda progress=None: sink.close(), then=self._closed, message="finishing", frame=i)
+
+        self._step(lambda progress=None: sink.append(image), then=written, message="writing", frame=i)
+
+    def _closed(self, _: Any) -> None:
+        self.sink = None
+        frames = f"{len(self.frames)} frames, " if len(self.frames) > 1 else ""
+        self._end(True, f"Exported {self.name} ({frames}{self.size[0]}x{self.size[1]})")
+
+    def _snapshot(self, size: tuple[int, int]) -> Any:
+        from volviz.render.export import snapshot
+
+        return snapshot(self.plotter, size)
