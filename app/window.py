@@ -1280,7 +1280,7 @@ class MainWindow(QMainWindow):
                 self._set_busy(False)
             self.status_label.setText(message)
             if not ok and not run.cancelled:
-                self.show_error("Cannot export", f"{name}: {message}")
+                self.show_error("Cannot export", message)
 
         self.export_threads = set()
         run = FrameExport(self, plotter, controller, size, name, frames_of, open_sink, end, t)

@@ -101,3 +101,24 @@ def test_movie_through_time_is_exported_in_the_background_and_cancel_leaves_no_p
     video = iio.imread(movie, index=None)
     assert video.shape[0] == len(pngs) and video.shape[1:3] == (120, 160)
     assert [p.name for p in tmp_path.iterdir() if ".mp4" in p.name] == ["storm.mp4"]
+
+
+def test_a_failed_export_reports_the_file_and_the_app_keeps_working(qtbot, make_window, tmp_path: Path) -> None:
+    window = make_window()
+    window.open_demo_volume()
+    wait_loaded(qtbot, window)
+    blocker = tmp_path / "not-a-folder"
+    blocker.write_text("a file where the PNG sequence's folder should go")
+    window.export_movie(blocker / "frames", None, through_time=False, fps=1.0, size=(64, 48))
+    qtbot.waitUntil(lambda: window.export_result is not None, timeout=120000)
+    assert window.export_result is False
+    assert window.error_dialog is not None and window.error_dialog.isVisible()
+    text = window.error_dialog.text()
+    assert text.startswith("Could not export frames:") and "not-a-folder" in text, text
+    assert window.status_label.text().startswith("Could not export frames")
+    assert not window.progress_bar.isVisible()
+    window.error_dialog.close()
+    out = tmp_path / "after.png"
+    window.export_screenshot(out, size=(64, 48))  # the app keeps working
+    qtbot.waitUntil(lambda: window.export_result is not None, timeout=120000)
+    assert window.export_result is True and iio.imread(out).shape[:2] == (48, 64)
