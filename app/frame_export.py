@@ -55,6 +55,27 @@ class FrameExport:
         if self._job is not None and not self._job.done():
             self._job.cancel()
 
+    def abandon(self, wait_s: float = 10.0) -> None:
+        """The window closes: stop now, without callbacks. The running step is cancelled and given ``wait_s`` to
+        return (it may be writing to the movie), then the partial movie is removed and the offscreen plotter closed."""
+        if self.over:
+            return
+        self.over = self.cancelled = True
+        job = self._job
+        if job is not None and not job.done():
+            job.cancel()
+            try:
+                job.outcome(timeout=wait_s)
+            except Exception:  # cancelled, failed or still running: the file is removed below either way
+                pass
+        self.plotter.close()
+        sink, self.sink = self.sink, None
+        if sink is not None:
+            try:
+                sink.abort()
+            except Exception:
+                log.exception("could not remove the partial export of %s", self.name)
+
     def _end(self, ok: bool, message: str, error: Optional[BaseException] = None) -> None:
         if self.over:
             return

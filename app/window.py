@@ -1399,6 +1399,9 @@ class MainWindow(QMainWindow):
         self.record_timer.stop()
         self.timeline.set_playing(False)
         self.controller = None  # late timer callbacks find no scene to update
+        if self._export_run is not None:  # no partial movie left behind, no callbacks into a closed window
+            self._export_run.abandon()
+            self._export_run = None
         self.jobs.shutdown()
         self.plotter.close()
         self.collector.unfreeze()  # what was long-lived while the window was open can be collected again

@@ -122,3 +122,23 @@ def test_a_failed_export_reports_the_file_and_the_app_keeps_working(qtbot, make_
     window.export_screenshot(out, size=(64, 48))  # the app keeps working
     qtbot.waitUntil(lambda: window.export_result is not None, timeout=120000)
     assert window.export_result is True and iio.imread(out).shape[:2] == (48, 64)
+
+
+def test_closing_the_window_during_a_movie_export_leaves_no_partial_movie(qtbot, make_window, tmp_path: Path) -> None:
+    from test_app_background import storm_iso_session
+
+    window = make_window()
+    window.open_path(storm_iso_session(tmp_path))
+    wait_loaded(qtbot, window)
+    movie = tmp_path / "storm.mp4"
+    window.export_movie(movie, None, through_time=True, fps=0.5, size=(160, 120))
+    # ffmpeg creates the file once its encoder has a few frames
+    qtbot.waitUntil(lambda: any(".mp4" in p.name for p in tmp_path.iterdir()), timeout=120000)
+    assert window.export_result is None
+    window.dirty = False
+    window.close()
+    # at once: the window is gone, so nothing later would clean up after it
+    assert [p.name for p in tmp_path.iterdir() if ".mp4" in p.name] == [], "a partial movie was left behind"
+    assert window.export_result is None  # abandoned, not reported to the closed window
+    qtbot.wait(500)                      # late timers and job completions find the export over
+    assert window.export_result is None and window.error_dialog is None
