@@ -67,6 +67,32 @@ def test_movie_mp4(tmp_path: Path) -> None:
     assert not list(tmp_path.glob(".*partial*"))
 
 
+def test_an_aborted_movie_leaves_nothing_it_wrote(tmp_path: Path) -> None:
+    """``MovieWriter.abort`` (cancel, failure, window closed): the partial MP4 and the frames written so far go; a
+    folder the export did not make, and what else is in it, stay."""
+    from volviz.render.export import MovieWriter
+
+    frame = np.full((64, 96, 3), 120, np.uint8)
+    made = MovieWriter(tmp_path / "new-folder", 4.0)
+    for _ in range(3):
+        made.append(frame)
+    assert len(list((tmp_path / "new-folder").glob("frame_*.png"))) == 3
+    made.abort()
+    assert not (tmp_path / "new-folder").exists()
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    (mine / "notes.txt").write_text("the user's")
+    into = MovieWriter(mine, 4.0)
+    into.append(frame)
+    into.abort()
+    assert sorted(p.name for p in mine.iterdir()) == ["notes.txt"]
+    movie = MovieWriter(tmp_path / "cut.mp4", 4.0)
+    for _ in range(12):
+        movie.append(frame)
+    movie.abort()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["mine"]
+
+
 def test_missing_camera_path_is_a_clear_error(tmp_path: Path, capsys) -> None:
     assert main(["render", str(storm_iso_session(tmp_path, 1.0)), "--path", "nope", "-o",
                  str(tmp_path / "x.mp4")]) == 2

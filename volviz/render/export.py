@@ -189,12 +189,15 @@ class ImageFile:
 
 
 class MovieWriter:
-    """MP4 through imageio-ffmpeg (to a temporary name, renamed at the end) or a PNG sequence in a folder."""
+    """MP4 through imageio-ffmpeg (to a temporary name, renamed at the end) or a PNG sequence in a folder. ``abort``
+    leaves nothing of an unfinished movie: the partial MP4, or the frames written so far (and the folder if it made
+    it)."""
 
     def __init__(self, target: Path, fps: float):
         self.target = target
         self.count = 0
         self.mp4 = target.suffix.lower() in (".mp4", ".m4v", ".mov")
+        self.made_folder = False
         if self.mp4:
             import imageio.v2 as iio2
 
@@ -202,14 +205,18 @@ class MovieWriter:
             self.writer = iio2.get_writer(self.tmp, format="FFMPEG", mode="I", fps=fps, codec="libx264",
                                           quality=8, pixelformat="yuv420p", macro_block_size=2)
         else:
+            self.made_folder = not target.exists()
             target.mkdir(parents=True, exist_ok=True)
+
+    def _frame_path(self, i: int) -> Path:
+        return self.target / f"frame_{i:05d}.png"
 
     def append(self, image: np.ndarray) -> None:
         if self.mp4:
             h, w = image.shape[:2]
             self.writer.append_data(image[: h - h % 2, : w - w % 2, :3])
         else:
-            write_png(image, self.target / f"frame_{self.count:05d}.png")
+            write_png(image, self._frame_path(self.count))
         self.count += 1
 
     def close(self) -> None:
@@ -223,3 +230,11 @@ class MovieWriter:
                 self.writer.close()
             finally:
                 self.tmp.unlink(missing_ok=True)
+            return
+        for i in range(self.count):
+            self._frame_path(i).unlink(missing_ok=True)
+        if self.made_folder:
+            try:
+                self.target.rmdir()
+            except OSError:  # something else was put there meanwhile: keep it
+                pass
