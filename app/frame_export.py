@@ -27,8 +27,7 @@ Frame = tuple[Optional[Any], Optional[float]]  # (camera or None: keep, display 
 
 
 class FrameExport:
-    """One running export. ``window`` provides ``jobs`` (a ``JobBridge``), ``status_label`` and ``show_error``;
-    ``frames_of(controller)`` lists the frames once the scene is installed; ``open_sink()`` (on a worker) returns an
+    """One running export. ``window`` provides ``jobs`` (a ``JobBridge``); ``frames_of(controller)`` lists the frames once the scene is installed; ``open_sink()`` (on a worker) returns an
     object with ``append(image)``, ``close()`` and ``abort()``; ``on_end(ok, message)`` runs once at the end."""
 
     def __init__(self, window: Any, plotter: Any, controller: Any, size: tuple[int, int], name: str,
@@ -145,11 +144,11 @@ class FrameExport:
         self.frames = list(self.frames_of(self.controller))
         if not self.frames:
             raise ValueError("there are no frames to export")
-        self._step(lambda progress=None: self.open_sink(), then=self._sink_opened, message="opening the output")
+        self._step(self._open_sink, then=lambda _: self._frame(0), message="opening the output")
 
-    def _sink_opened(self, sink: Any) -> None:
-        self.sink = sink
-        self._frame(0)
+    def _open_sink(self, progress: Any = None) -> None:
+        """Worker: open the output and keep it at once, so that an export cancelled meanwhile still removes it."""
+        self.sink = self.open_sink()
 
     def _frame(self, i: int) -> None:
         camera, t = self.frames[i]
