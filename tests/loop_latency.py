@@ -45,6 +45,7 @@ class _RendererThreads:
             tids = os.listdir("/proc/self/task")
         except OSError:
             return {}
+        self._named = {tid: self._named[tid] for tid in tids if tid in self._named}  # a reused id is read again
         for tid in tids:
             if tid not in self._named:
                 try:
