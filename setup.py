@@ -4,8 +4,12 @@ from setuptools import find_packages, setup
 core = find_packages(include=["volviz", "volviz.*"])
 app = ["volviz_app" + name[len("app"):] for name in find_packages(include=["app", "app.*"])]
 
+# the data folders are listed as packages of their own (namespace packages: no __init__.py), so that setuptools
+# ships their files without warning that importable folders were left out of ``packages``
+data = ["volviz_resources.presets", "volviz_resources.sessions"]
+
 setup(
-    packages=core + app + ["volviz_resources"],
+    packages=core + app + ["volviz_resources"] + data,
     package_dir={"volviz_app": "app", "volviz_resources": "resources"},
-    package_data={"volviz_resources": ["*.json", "presets/*.json", "sessions/*.json", "glsl/*.glsl"]},
+    package_data={"volviz_resources.presets": ["*.json"], "volviz_resources.sessions": ["*.json"]},
 )
