@@ -854,6 +854,30 @@ def _b7(v):
     return 6
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _hhas(i, j, k, h0, h1, h2, sb):
+    """Whether block (i, j, k) of an S-transform tile has a detail in subband ``sb`` (odd sizes lack the last one)."""
+    return not ((sb & 1 and i >= h0) or (sb & 2 and j >= h1) or (sb & 4 and k >= h2))
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _hat(i, j, k, l0, l1, l2, sb):
+    """Index of the subband ``sb`` detail of block (i, j, k) in an S-transform tile."""
+    return l0 + i if sb & 1 else i, l1 + j if sb & 2 else j, l2 + k if sb & 4 else k
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _hsign_ctx(sb, lb, pr):
+    """Sign context of a non-zero residual: subband, lowpass zero or not, sign of the prediction."""
+    return _HB_SIGN + ((sb * 2 + (1 if lb > 0 else 0)) * 3 + (0 if pr == 0 else (1 if pr > 0 else 2)))
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _hexp_ctx(sb, lb, nb, inb, pb):
+    """Magnitude context: subband, lowpass bucket, the larger of the neighbour and in-block sizes, prediction size."""
+    return _HB_EXP + (((sb * _NB7 + lb) * _NB7 + max(nb, _b7(inb))) * 3 + pb) * N_EXP
+
+
 @njit(cache=True, nogil=True)
 def _hblock(w, i, j, k, l0, l1, l2, h0, h1, h2):
     """Block contexts of lowpass position (i, j, k) of an S-transform tile: (bucket of |L|, bucket of half the
@@ -866,9 +890,8 @@ def _hblock(w, i, j, k, l0, l1, l2, h0, h1, h2):
         if x < 0 or y < 0 or z < 0:
             continue
         for sb in range(1, 8):
-            if (sb & 1 and x >= h0) or (sb & 2 and y >= h1) or (sb & 4 and z >= h2):
-                continue
-            n += abs(w[l0 + x if sb & 1 else x, l1 + y if sb & 2 else y, l2 + z if sb & 4 else z])
+            if _hhas(x, y, z, h0, h1, h2, sb):
+                n += abs(w[_hat(x, y, z, l0, l1, l2, sb)])
     am = 0
     if i > 0:
         am = max(am, abs(w[i - 1, j, k]))
@@ -953,9 +976,9 @@ def encode_haar_arith(w, n0, n1, n2, out, base):
                 lb, nb, ab = _hblock(w, i, j, k, l0, l1, l2, h0, h1, h2)
                 anyd = 0
                 for sb in range(1, 8):
-                    if (sb & 1 and i >= h0) or (sb & 2 and j >= h1) or (sb & 4 and k >= h2):
+                    if not _hhas(i, j, k, h0, h1, h2, sb):
                         continue
-                    if w[l0 + i if sb & 1 else i, l1 + j if sb & 2 else j, l2 + k if sb & 4 else k] != 0:
+                    if w[_hat(i, j, k, l0, l1, l2, sb)] != 0:
                         anyd = 1
                         break
                 _enc_bit(st, out, probs, _HB_BLOCK + (lb * _NB7 + nb) * _NB7 + ab, anyd)
@@ -964,19 +987,18 @@ def encode_haar_arith(w, n0, n1, n2, out, base):
                 cnt = 0
                 inb = 0
                 for sb in range(1, 8):
-                    if (sb & 1 and i >= h0) or (sb & 2 and j >= h1) or (sb & 4 and k >= h2):
+                    if not _hhas(i, j, k, h0, h1, h2, sb):
                         continue
                     pr, pb, ctx = _hdetail(w, i, j, k, l0, l1, l2, sb, lb, nb, cnt)
-                    v = np.int64(w[l0 + i if sb & 1 else i, l1 + j if sb & 2 else j, l2 + k if sb & 4 else k]) - pr
+                    v = np.int64(w[_hat(i, j, k, l0, l1, l2, sb)]) - pr
                     if v == 0:
                         _enc_bit(st, out, probs, ctx, 0)
                         continue
                     _enc_bit(st, out, probs, ctx, 1)
                     cnt += 1
                     m = abs(v)
-                    ps = 0 if pr == 0 else (1 if pr > 0 else 2)
-                    _enc_bit(st, out, probs, _HB_SIGN + ((sb * 2 + (1 if lb > 0 else 0)) * 3 + ps), 1 if v < 0 else 0)
-                    ectx = _HB_EXP + (((sb * _NB7 + lb) * _NB7 + max(nb, _b7(inb))) * 3 + pb) * N_EXP
+                    _enc_bit(st, out, probs, _hsign_ctx(sb, lb, pr), 1 if v < 0 else 0)
+                    ectx = _hexp_ctx(sb, lb, nb, inb, pb)
                     inb += m
                     _enc_magnitude(st, out, probs, ectx, _HB_MAN + sb * 32, m)
     for _ in range(5):
@@ -1014,21 +1036,20 @@ def decode_haar_arith(buf, base, length, w, n0, n1, n2):
                 cnt = 0
                 inb = 0
                 for sb in range(1, 8):
-                    if (sb & 1 and i >= h0) or (sb & 2 and j >= h1) or (sb & 4 and k >= h2):
+                    if not _hhas(i, j, k, h0, h1, h2, sb):
                         continue
                     pr, pb, ctx = _hdetail(w, i, j, k, l0, l1, l2, sb, lb, nb, cnt)
                     v = np.int64(0)
                     if _dec_bit(st, buf, probs, ctx) == 1:
                         cnt += 1
-                        ps = 0 if pr == 0 else (1 if pr > 0 else 2)
-                        neg = _dec_bit(st, buf, probs, _HB_SIGN + ((sb * 2 + (1 if lb > 0 else 0)) * 3 + ps))
-                        ectx = _HB_EXP + (((sb * _NB7 + lb) * _NB7 + max(nb, _b7(inb))) * 3 + pb) * N_EXP
+                        neg = _dec_bit(st, buf, probs, _hsign_ctx(sb, lb, pr))
+                        ectx = _hexp_ctx(sb, lb, nb, inb, pb)
                         m = _dec_magnitude(st, buf, probs, ectx, _HB_MAN + sb * 32)
                         if m < 0:
                             return -1
                         inb += m
                         v = -m if neg else m
-                    w[l0 + i if sb & 1 else i, l1 + j if sb & 2 else j, l2 + k if sb & 4 else k] = v + pr
+                    w[_hat(i, j, k, l0, l1, l2, sb)] = v + pr
     if st[2] > st[3] + 4:
         return -1
     return 0
