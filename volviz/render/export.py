@@ -49,9 +49,8 @@ def snapshot(plotter: Any, size: tuple[int, int]) -> np.ndarray:
     width, height = int(size[0]), int(size[1])
     if list(plotter.window_size) != [width, height]:
         plotter.render_window.SetSize(width, height)  # no render here: the one render is below
-    if plotter._first_time:  # pyvista renders the first image itself (and places a camera that was never set)
-        return np.asarray(plotter.screenshot(None, return_img=True))
-    plotter.render()
+    if not plotter._first_time:  # the first image pyvista renders itself (and places a camera that was never set)
+        plotter.render()
     return np.asarray(plotter.screenshot(None, return_img=True))
 
 
