@@ -106,37 +106,31 @@ class FrameExport:
             return fn(progress=scaled)
 
         def done(outcome: Any) -> None:
-            if self.over:
-                return
-            if outcome.cancelled or self.cancelled:
-                self._end(False, f"Export of {self.name} cancelled")
-            elif outcome.error is not None:
+            if outcome.error is not None and not (self.over or self.cancelled or outcome.cancelled):
                 self._end(False, f"Could not export {self.name}", outcome.error)
             else:
-                try:
-                    then(outcome.result)
-                except Exception as exc:  # the VTK side failed: a message, the app keeps working
-                    log.exception("export of %s failed", self.name)
-                    self._end(False, f"Could not export {self.name}", exc)
+                self._continue(lambda: then(outcome.result), outcome.cancelled)
 
         # no job key: with one, a newer export's job would drop this one's completion (its plotter never closed)
         self._job = self.window.jobs.submit(run, name=f"export {self.name}", on_done=done)
 
     def _later(self, fn: Callable[[], None]) -> None:
         """``fn`` in a later turn of the event loop, unless the export ended meanwhile."""
-        def go() -> None:
-            if self.over:
-                return
-            if self.cancelled:
-                self._end(False, f"Export of {self.name} cancelled")
-                return
-            try:
-                fn()
-            except Exception as exc:
-                log.exception("export of %s failed", self.name)
-                self._end(False, f"Could not export {self.name}", exc)
+        QTimer.singleShot(STAGE_MS, lambda: self._continue(fn))
 
-        QTimer.singleShot(STAGE_MS, go)
+    def _continue(self, fn: Callable[[], None], cancelled: bool = False) -> None:
+        """GUI thread: the next step ``fn``, unless the export is over or cancelled; a failure (the VTK side) ends it
+        with a message, and the app keeps working."""
+        if self.over:
+            return
+        if cancelled or self.cancelled:
+            self._end(False, f"Export of {self.name} cancelled")
+            return
+        try:
+            fn()
+        except Exception as exc:
+            log.exception("export of %s failed", self.name)
+            self._end(False, f"Could not export {self.name}", exc)
 
     # -- the frames -------------------------------------------------------------------------------------------------
     def _installed(self, prepared: Any) -> None:
