@@ -147,7 +147,9 @@ class MainWindow(QMainWindow):
         self.export_threads: set[int] = set()      # the threads its background steps ran on
         self._load_serial = 0              # the newest open/rebuild; an older one's late callbacks do nothing
         self._loading_views = False        # the newest scene is installed, its first views are computed
-        self._overlay_waiters: dict[str, list[Callable[[], None]]] = {}  # job key -> ``settled`` callbacks
+        self._overlay_jobs: dict[str, OneInFlight] = {}  # per overlay (a PT volume, the iso overlay): its renders
+        self.overlay_updates: dict[str, int] = {}  # per overlay: the renders shown so far
+        self._moving_scheduled = False     # a refresh for the camera the mouse is moving is queued
         self._pending_tf: Optional[tuple[str, Any]] = None
         self._recording: Optional[list[CameraKey]] = None
         self._iso_jobs = OneInFlight()     # isosurface extraction for the display time
@@ -167,6 +169,7 @@ class MainWindow(QMainWindow):
         self._build_status_bar()
         self.fly = FlyMode(self.plotter, on_camera_moved=self._camera_moved)
         self.clip_widget = ClipPlaneWidget(self.plotter, self.clipping)
+        self.plotter.iren.add_observer("InteractionEvent", lambda *args: self._schedule_camera_moving())
         self.plotter.iren.add_observer("EndInteractionEvent", lambda *args: QTimer.singleShot(0, self._camera_moved))
 
         self.preview_timer = QTimer(self, singleShot=True, interval=PREVIEW_MS)
@@ -584,19 +587,20 @@ class MainWindow(QMainWindow):
             if lod:  # the block selection depends on the TF (transparent blocks): re-select in the background
                 self.refresh_lod([comp_id])
             return
-        # volviz PT volume: table build and rasterisation run in the background; a newer edit supersedes this one
+        # volviz PT volume: table build and rasterisation run in the background; the newest edit renders next
         self.controller.set_transfer_function(comp_id, tf, update=False)
         self.refresh_pt(comp_id)
 
-    def refresh_pt(self, comp_id: str, settled: Optional[Callable[[], None]] = None) -> None:
+    def refresh_pt(self, comp_id: str, settled: Optional[Callable[[], None]] = None, estimate: bool = True) -> None:
         """Re-render a PT volume for the current camera and TF: the depth read-back on this thread, the sort, table
-        and rasterisation in the background (a newer request for the same volume supersedes a stale one), then the
-        image and a fresh error estimate. ``settled()`` is called when a render for this request is over."""
+        and rasterisation in the background (``_refresh_overlay``), then the image and, with ``estimate``, a fresh
+        error estimate. ``settled()`` is called when a render for this request is over."""
         controller = self.controller
         volume = controller.pt_volume(comp_id) if controller is not None else None
         if volume is not None:
-            self._refresh_overlay(volume, f"pt:{comp_id}", "volume", lambda: controller.pt_volume(comp_id),
-                                  lambda request: self.estimate_error(comp_id, request), settled)
+            after = (lambda request: self.estimate_error(comp_id, request)) if estimate else None
+            self._refresh_overlay(volume, f"pt:{comp_id}", "volume", lambda: controller.pt_volume(comp_id), after,
+                                  settled)
         elif settled is not None:
             settled()
 
@@ -612,24 +616,34 @@ class MainWindow(QMainWindow):
 
     def _refresh_overlay(self, handle: Any, key: str, what: str, current: Any, after: Any = None,
                          settled: Optional[Callable[[], None]] = None) -> None:
+        """Re-make an overlay image (``OverlayView``: ``begin`` here, ``compute`` on a worker, ``finish`` here) for
+        the current camera. One render per overlay in flight, the newest request next (``OneInFlight``): while the
+        camera or a TF keeps changing, every finished render is shown. (Superseding by a job key cancelled a render
+        for each newer request, but a render cannot stop inside its kernels: each ran to the end on a core and was
+        thrown away, and nothing was shown until the requests stopped.)"""
         controller = self.controller
-        request = handle.begin()
-        if settled is not None:  # answered by this job or a newer one of the key (a superseded job reports nothing)
-            self._overlay_waiters.setdefault(key, []).append(settled)
 
-        def done(outcome: JobOutcome) -> None:
-            if outcome.ok and self.controller is controller and current() is handle:
-                with no_render(self.plotter):  # one render below, not two
-                    handle.finish(request, *outcome.result)
-                self.render()
-                if after is not None:
-                    after(request)
-            elif outcome.error is not None:
-                self.show_error(f"Cannot render the {what}", str(outcome.error))
-            for waiter in self._overlay_waiters.pop(key, []):
-                waiter()
+        def start(next_request: Callable[[], None]) -> None:
+            if self.controller is not controller or current() is not handle:
+                next_request()
+                return
+            request = handle.begin()  # the camera and opaque depth of now, not of the request
 
-        self.jobs.submit(handle.compute, request, name=what, key=key, on_done=done)
+            def done(outcome: JobOutcome) -> None:
+                if outcome.ok and self.controller is controller and current() is handle:
+                    with no_render(self.plotter):  # one render below, not two
+                        handle.finish(request, *outcome.result)
+                    self.overlay_updates[key] = self.overlay_updates.get(key, 0) + 1
+                    self.render()
+                    if after is not None:
+                        after(request)
+                elif outcome.error is not None:
+                    self.show_error(f"Cannot render the {what}", str(outcome.error))
+                next_request()
+
+            self.jobs.submit(handle.compute, request, name=what, on_done=done)
+
+        self._overlay_jobs.setdefault(key, OneInFlight()).request(start, settled)
 
     def set_clip(self, clip: dict[str, Any]) -> None:
         """New scene-wide clipping (from the clipping dock): every prop is cut; isosurfaces and PT volumes are cut
@@ -953,6 +967,27 @@ class MainWindow(QMainWindow):
         if self.controller is not None:
             self.controller.set_camera(None, update=False)
             self._camera_moved()
+
+    def _schedule_camera_moving(self) -> None:
+        """A VTK interaction moved the camera (a mouse drag): refresh what follows it once control returns to the
+        event loop (one queued refresh however many motion events arrive before)."""
+        if not self._moving_scheduled:
+            self._moving_scheduled = True
+            QTimer.singleShot(0, self._camera_moving)
+
+    def _camera_moving(self) -> None:
+        """While the mouse moves the camera, the images of our own renderers follow it: the natural scene's fog and
+        clouds, PT volumes and the isosurface overlay are re-made in the background, one render of each in flight
+        and the newest camera next (``OneInFlight``), so each shows every render it finishes. VTK draws its own props
+        at once. The error estimate and the LOD re-selection wait for the end of the interaction
+        (``_camera_moved``)."""
+        self._moving_scheduled = False
+        if self.controller is None:
+            return
+        self.refresh_nature()
+        for comp_id in self.controller.pt_stats():
+            self.refresh_pt(comp_id, estimate=False)
+        self.refresh_iso_overlay()
 
     def _camera_moved(self) -> None:
         """After the camera moved: refresh what depends on it (terrain LOD, fog and cloud images, PT volumes), then

@@ -4,10 +4,11 @@ GUI thread. Under Xvfb with real widgets and real VTK rendering."""
 from __future__ import annotations
 
 import json
+import time
 from pathlib import Path
 
 import numpy as np
-from PySide6.QtCore import Qt, QTimer
+from PySide6.QtCore import QEvent, QPoint, Qt, QTimer
 
 from conftest import blob_vvz, data_file
 from loop_latency import LoopGaps
@@ -268,3 +269,77 @@ def test_blended_time_series_playback_keeps_the_event_loop_live(qtbot, make_wind
     sampler.stop()
     assert window.volume_time_shown[0] > 2.2 and len(shown_times) >= 5  # blended volumes followed the playback
     gaps.assert_responsive("during playback", 25)
+
+
+def test_pt_volume_follows_a_mouse_drag_of_the_camera(qtbot, make_window) -> None:
+    """While the mouse drags the camera (the button still held), the PT volume is re-rendered in the background for
+    the moving camera and each finished render is shown; after the release, the image is that of the final camera."""
+    from test_app_workflows import _mouse
+
+    window = make_window()
+    window.open_demo_volume()
+    wait_loaded(qtbot, window)
+    volume = window.controller.pt_volume("demo")
+    qtbot.waitUntil(lambda: volume.image is not None and not window._overlay_jobs["pt:demo"].running, timeout=60000)
+    before = window.overlay_updates.get("pt:demo", 0)
+    shown_before = np.asarray(volume.camera.position).copy()
+    canvas = window.plotter.interactor
+    centre = QPoint(canvas.width() // 2, canvas.height() // 2)
+    held = Qt.MouseButton.LeftButton
+    _mouse(canvas, QEvent.Type.MouseButtonPress, centre, held)
+    gaps = LoopGaps()
+    seen: list[np.ndarray] = []  # the VTK camera after each motion event
+    for k in range(1, 41):
+        _mouse(canvas, QEvent.Type.MouseMove, centre + QPoint(4 * k, k), held)
+        seen.append(np.asarray(window.plotter.camera.position, dtype=float).copy())
+        qtbot.wait(25)
+    qtbot.waitUntil(lambda: window.overlay_updates.get("pt:demo", 0) >= before + 2, timeout=60000)
+    gaps.stop()
+    during = np.asarray(volume.camera.position)
+    assert not np.allclose(during, shown_before), "the volume image did not follow the drag"
+    assert any(np.allclose(during, c) for c in seen), "the image shown is not of a camera the drag passed through"
+    gaps.assert_responsive("while dragging the camera", 10)
+    _mouse(canvas, QEvent.Type.MouseButtonRelease, centre + QPoint(160, 40), Qt.MouseButton.NoButton)
+    final = np.asarray(window.plotter.camera.position, dtype=float).copy()
+    qtbot.waitUntil(lambda: np.allclose(volume.camera.position, final)
+                    and not window._overlay_jobs["pt:demo"].running, timeout=60000)
+    assert volume.image[..., 3].max() > 0
+
+
+def test_pt_volume_keeps_showing_renders_while_flying(qtbot, make_window) -> None:
+    """Fly mode asks for a new PT image at every key repeat, faster than a render takes: each finished render is
+    shown while the keys are held (one render in flight, the newest camera next), none is thrown away for a newer
+    request, and the last one is of the final camera."""
+    from PySide6.QtGui import QKeyEvent
+    from PySide6.QtWidgets import QApplication
+
+    window = make_window()
+    window.open_demo_volume()
+    wait_loaded(qtbot, window)
+    volume = window.controller.pt_volume("demo")
+    jobs = window._overlay_jobs
+    qtbot.waitUntil(lambda: volume.image is not None and not jobs["pt:demo"].running, timeout=60000)
+    window.set_fly_mode(True)
+    canvas = window.plotter.interactor
+    before = window.overlay_updates.get("pt:demo", 0)
+    started = [0]
+    compute = volume.compute
+
+    def counted(*args, **kwargs):
+        started[0] += 1
+        return compute(*args, **kwargs)
+
+    volume.compute = counted  # the real render, counted
+    presses = 0
+    t_end = time.monotonic() + 3.0
+    while time.monotonic() < t_end:
+        QApplication.sendEvent(canvas, QKeyEvent(QEvent.Type.KeyPress, Qt.Key.Key_W, Qt.KeyboardModifier.NoModifier))
+        presses += 1
+        qtbot.wait(30)
+    shown_while_flying = window.overlay_updates.get("pt:demo", 0) - before
+    final = np.asarray(window.plotter.camera.position, dtype=float).copy()
+    qtbot.waitUntil(lambda: not jobs["pt:demo"].running, timeout=60000)
+    assert shown_while_flying >= 2, f"{shown_while_flying} renders shown during {presses} key presses"
+    assert window.overlay_updates["pt:demo"] - before == started[0], "a finished render was thrown away"
+    assert started[0] < presses
+    assert np.allclose(volume.camera.position, final)
