@@ -33,6 +33,7 @@ from volviz_app.workers import JobBridge
 log = logging.getLogger(__name__)
 
 AUTOSAVE_MS = 60_000
+MOVING_SCALE = 2         # while the mouse moves the camera, PT volumes and the CPU isosurfaces render at 1/2 x 1/2
 PREVIEW_MS = 40          # live transfer-function preview: at most one re-render per 40 ms while dragging
 RESIZE_MS = 200          # overlays re-render once the viewport stopped resizing for 200 ms
 RECORD_MS = 250          # camera-path recording samples the camera four times a second
@@ -591,31 +592,33 @@ class MainWindow(QMainWindow):
         self.controller.set_transfer_function(comp_id, tf, update=False)
         self.refresh_pt(comp_id)
 
-    def refresh_pt(self, comp_id: str, settled: Optional[Callable[[], None]] = None, estimate: bool = True) -> None:
+    def refresh_pt(self, comp_id: str, settled: Optional[Callable[[], None]] = None, estimate: bool = True,
+                   scale: int = 1) -> None:
         """Re-render a PT volume for the current camera and TF: the depth read-back on this thread, the sort, table
         and rasterisation in the background (``_refresh_overlay``), then the image and, with ``estimate``, a fresh
-        error estimate. ``settled()`` is called when a render for this request is over."""
+        error estimate. ``scale`` > 1: a preview that many times smaller in each direction. ``settled()`` is called
+        when a render for this request is over."""
         controller = self.controller
         volume = controller.pt_volume(comp_id) if controller is not None else None
         if volume is not None:
             after = (lambda request: self.estimate_error(comp_id, request)) if estimate else None
             self._refresh_overlay(volume, f"pt:{comp_id}", "volume", lambda: controller.pt_volume(comp_id), after,
-                                  settled)
+                                  settled, scale)
         elif settled is not None:
             settled()
 
-    def refresh_iso_overlay(self, settled: Optional[Callable[[], None]] = None) -> None:
+    def refresh_iso_overlay(self, settled: Optional[Callable[[], None]] = None, scale: int = 1) -> None:
         """Re-render the isosurfaces' CPU transparency mode (when one is on) in the background, like a PT volume."""
         controller = self.controller
         overlay = controller.iso_overlay if controller is not None else None
         if overlay is not None:
             self._refresh_overlay(overlay, "iso-overlay", "isosurfaces", lambda: controller.iso_overlay,
-                                  settled=settled)
+                                  settled=settled, scale=scale)
         elif settled is not None:
             settled()
 
     def _refresh_overlay(self, handle: Any, key: str, what: str, current: Any, after: Any = None,
-                         settled: Optional[Callable[[], None]] = None) -> None:
+                         settled: Optional[Callable[[], None]] = None, scale: int = 1) -> None:
         """Re-make an overlay image (``OverlayView``: ``begin`` here, ``compute`` on a worker, ``finish`` here) for
         the current camera. One render per overlay in flight, the newest request next (``OneInFlight``): while the
         camera or a TF keeps changing, every finished render is shown. (Superseding by a job key cancelled a render
@@ -627,7 +630,7 @@ class MainWindow(QMainWindow):
             if self.controller is not controller or current() is not handle:
                 next_request()
                 return
-            request = handle.begin()  # the camera and opaque depth of now, not of the request
+            request = handle.begin(scale)  # the camera and opaque depth of now, not of the request
 
             def done(outcome: JobOutcome) -> None:
                 if outcome.ok and self.controller is controller and current() is handle:
@@ -979,15 +982,16 @@ class MainWindow(QMainWindow):
         """While the mouse moves the camera, the images of our own renderers follow it: the natural scene's fog and
         clouds, PT volumes and the isosurface overlay are re-made in the background, one render of each in flight
         and the newest camera next (``OneInFlight``), so each shows every render it finishes. VTK draws its own props
-        at once. The error estimate and the LOD re-selection wait for the end of the interaction
-        (``_camera_moved``)."""
+        at once. PT volumes and the isosurface overlay render previews at 1 / ``MOVING_SCALE`` of the window's size in
+        each direction (a quarter of the pixels, magnified smoothly); the full-size images, the error estimate and
+        the LOD re-selection follow at the end of the interaction (``_camera_moved``)."""
         self._moving_scheduled = False
         if self.controller is None:
             return
         self.refresh_nature()
         for comp_id in self.controller.pt_stats():
-            self.refresh_pt(comp_id, estimate=False)
-        self.refresh_iso_overlay()
+            self.refresh_pt(comp_id, estimate=False, scale=MOVING_SCALE)
+        self.refresh_iso_overlay(scale=MOVING_SCALE)
 
     def _camera_moved(self) -> None:
         """After the camera moved: refresh what depends on it (terrain LOD, fog and cloud images, PT volumes), then

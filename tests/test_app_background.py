@@ -273,7 +273,8 @@ def test_blended_time_series_playback_keeps_the_event_loop_live(qtbot, make_wind
 
 def test_pt_volume_follows_a_mouse_drag_of_the_camera(qtbot, make_window) -> None:
     """While the mouse drags the camera (the button still held), the PT volume is re-rendered in the background for
-    the moving camera and each finished render is shown; after the release, the image is that of the final camera."""
+    the moving camera at half the size in each direction and each finished render is shown; after the release, the
+    image is the full-size one of the final camera."""
     from test_app_workflows import _mouse
 
     window = make_window()
@@ -298,12 +299,14 @@ def test_pt_volume_follows_a_mouse_drag_of_the_camera(qtbot, make_window) -> Non
     during = np.asarray(volume.camera.position)
     assert not np.allclose(during, shown_before), "the volume image did not follow the drag"
     assert any(np.allclose(during, c) for c in seen), "the image shown is not of a camera the drag passed through"
+    w, h = (int(v) for v in window.plotter.ren_win.GetSize())
+    assert volume.image.shape[:2] == (h // 2, w // 2), "a preview while moving: a quarter of the pixels"
     gaps.assert_responsive("while dragging the camera", 10)
     _mouse(canvas, QEvent.Type.MouseButtonRelease, centre + QPoint(160, 40), Qt.MouseButton.NoButton)
     final = np.asarray(window.plotter.camera.position, dtype=float).copy()
     qtbot.waitUntil(lambda: np.allclose(volume.camera.position, final)
                     and not window._overlay_jobs["pt:demo"].running, timeout=60000)
-    assert volume.image[..., 3].max() > 0
+    assert volume.image.shape[:2] == (h, w) and volume.image[..., 3].max() > 0  # full size once it stopped
 
 
 def test_pt_volume_keeps_showing_renders_while_flying(qtbot, make_window) -> None:

@@ -150,3 +150,34 @@ def test_prefetched_sort_for_the_next_camera_is_used_and_changes_nothing(scene):
     finally:
         pl.camera_position = old
         h.update()
+
+
+def test_block_min_keeps_the_nearest_depth_of_each_block():
+    from volviz.render.image_overlay import block_min
+
+    d = np.arange(30, dtype=float).reshape(5, 6)[::-1].copy()   # rows 24..29 on top, 0..5 at the bottom
+    d[1, 4] = -1.0
+    out = block_min(d, (3, 2))                                      # 2 x 2 blocks (the last row joins the second)
+    assert out.shape == (2, 3)
+    assert np.array_equal(out, [[18.0, 20.0, -1.0], [0.0, 2.0, 4.0]])
+    assert np.array_equal(block_min(d, (6, 5)), d)                  # same size: unchanged
+
+
+def test_preview_renders_a_smaller_image_cut_at_the_nearest_depth(scene):
+    """``begin(scale=2)`` (the app's preview while the camera moves): half the size in each direction, the same
+    camera, each pixel cut at the nearest opaque depth under it; the screen shows it magnified over the scene."""
+    pl, mesh, h = scene
+    request = h.begin(scale=2)
+    assert request["size"] == (SIZE[0] // 2, SIZE[1] // 2) and request["preview"]
+    assert request["depth"].shape == (SIZE[1] // 2, SIZE[0] // 2) and request["rgb"].shape[:2] == (24, 32)
+    img = h.finish(request, *h.compute(request))
+    assert img.shape == (24, 32, 4) and h.stats["size"] == (32, 24)
+    expected = render(mesh, TF, request["camera"], (32, 24), "pt", depth=request["depth"])
+    assert np.array_equal(img, expected)
+    opaque, shot = _frames(pl, h)
+    assert shot.shape == (SIZE[1], SIZE[0], 3) and np.abs(shot - opaque).max() > 0.5   # magnified to the window
+    sphere = np.all(np.abs(opaque - np.array([0.2, 0.6, 0.9])) < 0.02, axis=-1)
+    inner = sphere & np.roll(sphere, 2, 0) & np.roll(sphere, -2, 0) & np.roll(sphere, 2, 1) & np.roll(sphere, -2, 1)
+    assert inner.sum() > 5 and np.abs(shot[inner] - opaque[inner]).max() <= 1.5 / 255  # still hidden by the sphere
+    h.update()                                                       # back to the full size for the other tests
+    assert h.image.shape == (SIZE[1], SIZE[0], 4)

@@ -34,7 +34,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["ImageOverlay", "OverlayView", "read_buffers", "unpremultiply_rgba8", "zbuffer_to_depth"]
+__all__ = ["ImageOverlay", "OverlayView", "block_min", "read_buffers", "unpremultiply_rgba8", "zbuffer_to_depth"]
 
 _SIBLINGS = "_volviz_pt_overlays"           # plotter attribute: every overlay renderer of the plotter
 _MULTISAMPLES = "_volviz_pt_multisamples"   # plotter attribute: the MSAA setting to restore
@@ -50,6 +50,16 @@ def zbuffer_to_depth(z: np.ndarray, clipping_range: tuple[float, float], paralle
         with np.errstate(divide="ignore"):
             d = n * f / (f - z * (f - n))
     return np.where((z >= 1.0) | ~np.isfinite(z), np.inf, d)
+
+
+def block_min(depth: np.ndarray, size: tuple[int, int]) -> np.ndarray:
+    """A (H, W) depth image reduced to ``size`` (w, h) pixels covering the same view: each is the minimum of the
+    pixels it covers, so a smaller image is cut at the nearest opaque surface under each of its pixels."""
+    big_h, big_w = depth.shape
+    w, h = (int(v) for v in size)
+    rows = (np.arange(h) * big_h) // h
+    cols = (np.arange(w) * big_w) // w
+    return np.minimum.reduceat(np.minimum.reduceat(depth, rows, axis=0), cols, axis=1)
 
 
 def unpremultiply_rgba8(image: np.ndarray) -> np.ndarray:
@@ -118,9 +128,10 @@ class ImageOverlay:
             o.SetDraw(on)
         return out
 
-    def show(self, rgba8: np.ndarray, visible: bool = True, render: bool = True) -> None:
+    def show(self, rgba8: np.ndarray, visible: bool = True, render: bool = True, smooth: bool = False) -> None:
         """Upload straight-alpha RGBA8 (H, W, 4), row 0 at the top, and redraw the window unless ``render`` is False
-        or the plotter's rendering is suppressed."""
+        or the plotter's rendering is suppressed. The image fills the window whatever its size; ``smooth``: an image
+        smaller than the window (a preview) is magnified with linear interpolation instead of pixel blocks."""
         from vtk.util.numpy_support import numpy_to_vtk
 
         h, w = rgba8.shape[:2]
@@ -137,6 +148,7 @@ class ImageOverlay:
         oc.SetViewUp(0.0, 1.0, 0.0)
         oc.SetParallelScale(h / 2.0)
         oc.SetClippingRange(0.5, 1.5)
+        self.actor.SetInterpolate(bool(smooth))
         self.renderer.SetDraw(bool(visible))
         if render and not getattr(self.plotter, "suppress_rendering", False):
             self.plotter.ren_win.Render()
@@ -191,8 +203,11 @@ class OverlayView:
         request = self.begin()
         return self.finish(request, *self.compute(request))
 
-    def begin(self) -> dict[str, Any]:
-        """GUI-thread part 1: the opaque scene's depth and colour, the camera and the window size."""
+    def begin(self, scale: int = 1) -> dict[str, Any]:
+        """GUI-thread part 1: the opaque scene's depth and colour, the camera and the image size: the window's, or
+        for a preview (``scale`` > 1, e.g. while the camera moves) the window's divided by ``scale``, with the depth
+        limit of each preview pixel the nearest opaque depth under it (``block_min``) and the scene colour at its
+        first pixel."""
         from volviz.unstructured.camera import Camera
 
         t_start = time.perf_counter()
@@ -203,7 +218,12 @@ class OverlayView:
         near, far = cam.clipping_range
         cam = Camera(cam.position, cam.focal_point, cam.view_up, cam.view_angle, cam.parallel, cam.parallel_scale,
                      (near, max(far, 1.01 * self._far(cam))))
-        return {"camera": cam, "depth": depth, "rgb": rgb, "size": (w, h), "t_start": t_start,
+        size = (w, h)
+        if scale > 1:
+            size = (max(1, w // int(scale)), max(1, h // int(scale)))
+            depth = block_min(depth, size)
+            rgb = rgb[(np.arange(size[1]) * h) // size[1]][:, (np.arange(size[0]) * w) // size[0]]
+        return {"camera": cam, "depth": depth, "rgb": rgb, "size": size, "preview": scale > 1, "t_start": t_start,
                 "t_read": time.perf_counter()}
 
     def compute(self, request: dict[str, Any], progress: Any = None) -> tuple[Any, ...]:
@@ -216,7 +236,7 @@ class OverlayView:
         plotter's rendering is suppressed (the caller then draws once itself)."""
         t_show = time.perf_counter()
         w, h = request["size"]
-        self._overlay.show(unpremultiply_rgba8(img) if rgba8 is None else rgba8)
+        self._overlay.show(unpremultiply_rgba8(img) if rgba8 is None else rgba8, smooth=request.get("preview", False))
         t_end = time.perf_counter()
         depth = request["depth"]
         self.image, self.depth, self.scene_rgb, self.camera = img, depth, request["rgb"], request["camera"]

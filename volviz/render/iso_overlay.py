@@ -74,8 +74,8 @@ class IsoOverlay(OverlayView):
         p = np.concatenate(pts)
         return float(((p - cam.position) @ cam.frame()[2]).max())
 
-    def begin(self) -> dict[str, Any]:
-        request = super().begin()
+    def begin(self, scale: int = 1) -> dict[str, Any]:
+        request = super().begin(scale)
         cam = request["camera"]
         near = min(cam.clipping_range[0], 1e-3 * cam.clipping_range[1])  # VTK's range ignores the hidden actors
         request["camera"] = Camera(cam.position, cam.focal_point, cam.view_up, cam.view_angle, cam.parallel,

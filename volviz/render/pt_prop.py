@@ -65,9 +65,10 @@ class PTVolume(OverlayView):
         fwd = cam.frame()[2]
         return float(((corners - cam.position) @ fwd).max())
 
-    def begin(self) -> dict[str, Any]:
-        """GUI-thread part 1: render the opaque scene, read its depth, fix the camera (see the module docstring)."""
-        request = super().begin()
+    def begin(self, scale: int = 1) -> dict[str, Any]:
+        """GUI-thread part 1: render the opaque scene, read its depth, fix the camera (see the module docstring);
+        ``scale`` > 1: a preview image that much smaller (``OverlayView.begin``)."""
+        request = super().begin(scale)
         request["tf"] = self.tf
         return request
 
