@@ -36,6 +36,7 @@ AUTOSAVE_MS = 60_000
 MOVING_SCALE = 2         # while the mouse moves the camera, PT volumes and the CPU isosurfaces render at 1/2 x 1/2
 PREVIEW_MS = 40          # live transfer-function preview: at most one re-render per 40 ms while dragging
 RESIZE_MS = 200          # overlays re-render once the viewport stopped resizing for 200 ms
+FLY_SETTLE_MS = 300      # fly mode: full-size images once no key moved the camera for 300 ms
 RECORD_MS = 250          # camera-path recording samples the camera four times a second
 MAX_RECENT = 8
 STAGE_MS = 30            # pause between GUI-thread stages of showing a new scene (other events run in between)
@@ -168,7 +169,10 @@ class MainWindow(QMainWindow):
         self._build_docks()
         self._build_menus()
         self._build_status_bar()
-        self.fly = FlyMode(self.plotter, on_camera_moved=self._camera_moved)
+        self.fly = FlyMode(self.plotter, on_camera_moved=self._fly_moved)
+        # fly mode has no end-of-interaction event: the camera has stopped once no key moved it for a while
+        self.fly_settle_timer = QTimer(self, singleShot=True, interval=FLY_SETTLE_MS)
+        self.fly_settle_timer.timeout.connect(self._camera_moved)
         self.clip_widget = ClipPlaneWidget(self.plotter, self.clipping)
         self.plotter.iren.add_observer("InteractionEvent", lambda *args: self._schedule_camera_moving())
         self.plotter.iren.add_observer("EndInteractionEvent", lambda *args: QTimer.singleShot(0, self._camera_moved))
@@ -992,6 +996,12 @@ class MainWindow(QMainWindow):
         for comp_id in self.controller.pt_stats():
             self.refresh_pt(comp_id, estimate=False, scale=MOVING_SCALE)
         self.refresh_iso_overlay(scale=MOVING_SCALE)
+
+    def _fly_moved(self) -> None:
+        """A fly-mode step moved the camera: previews follow it as during a mouse drag (``_camera_moving``), and
+        the full-size images once the keys have stopped for ``FLY_SETTLE_MS``."""
+        self._camera_moving()
+        self.fly_settle_timer.start()
 
     def _camera_moved(self) -> None:
         """After the camera moved: refresh what depends on it (terrain LOD, fog and cloud images, PT volumes), then

@@ -310,9 +310,9 @@ def test_pt_volume_follows_a_mouse_drag_of_the_camera(qtbot, make_window) -> Non
 
 
 def test_pt_volume_keeps_showing_renders_while_flying(qtbot, make_window) -> None:
-    """Fly mode asks for a new PT image at every key repeat, faster than a render takes: each finished render is
-    shown while the keys are held (one render in flight, the newest camera next), none is thrown away for a newer
-    request, and the last one is of the final camera."""
+    """Fly mode asks for a new PT image at every key repeat, faster than a render takes: each finished render (a
+    half-size preview) is shown while the keys are held (one render in flight, the newest camera next), none is
+    thrown away for a newer request, and once the keys stop the full-size image of the final camera follows."""
     from PySide6.QtGui import QKeyEvent
     from PySide6.QtWidgets import QApplication
 
@@ -340,8 +340,11 @@ def test_pt_volume_keeps_showing_renders_while_flying(qtbot, make_window) -> Non
         presses += 1
         qtbot.wait(30)
     shown_while_flying = window.overlay_updates.get("pt:demo", 0) - before
+    w, h = (int(v) for v in window.plotter.ren_win.GetSize())
+    assert volume.image.shape[:2] == (h // 2, w // 2), "previews while flying: a quarter of the pixels"
     final = np.asarray(window.plotter.camera.position, dtype=float).copy()
-    qtbot.waitUntil(lambda: not jobs["pt:demo"].running, timeout=60000)
+    # the keys have stopped: the full-size image of the final camera follows
+    qtbot.waitUntil(lambda: volume.image.shape[:2] == (h, w) and not jobs["pt:demo"].running, timeout=60000)
     assert shown_while_flying >= 2, f"{shown_while_flying} renders shown during {presses} key presses"
     assert window.overlay_updates["pt:demo"] - before == started[0], "a finished render was thrown away"
     assert started[0] < presses
