@@ -22,6 +22,8 @@ Robustness (the ground truth must not depend on round-off):
 """
 from __future__ import annotations
 
+import warnings
+
 from typing import Any, Callable, Iterator
 
 import numpy as np
@@ -135,8 +137,12 @@ def _composite_front_to_back(pix: np.ndarray, rgba: np.ndarray, out: np.ndarray)
 
 
 def screen_bboxes(cam: Camera, pts_world: np.ndarray, tets: np.ndarray, size: tuple[int, int]) -> np.ndarray:
-    """Per-tetrahedron inclusive pixel box (c0, c1, r0, r1), grown by one pixel; the whole screen when a vertex is at
-    or in front of the near plane (the exact per-pixel test then decides); empty (c0 > c1) when off screen."""
+    """Per-element (rows of ``tets``: 4 vertex ids, or a triangle with one repeated) inclusive pixel box
+    (c0, c1, r0, r1), grown by one pixel; empty (c0 > c1) when off screen. An element with a vertex at or behind the
+    near plane gets the box of its part in front of it (the front vertices and the edges' crossings of the plane):
+    rays start at the near plane, so nothing behind it is ever sampled. Empty when it lies wholly behind. (The whole
+    screen, as before, made the SXMPVO boundary sampling test 768 M pixels for a camera inside the Blunt Fin's box:
+    2.2 s of a frame's sort.)"""
     w, h = size
     proj = cam.project(pts_world, size)
     q = proj[tets]                                            # (m, 4, 3)
@@ -147,9 +153,48 @@ def screen_bboxes(cam: Camera, pts_world: np.ndarray, tets: np.ndarray, size: tu
         c1 = np.ceil(np.nan_to_num(q[..., 0].max(axis=1), nan=0.0, posinf=1e9, neginf=-1e9)) + 1
         r0 = np.floor(np.nan_to_num(q[..., 1].min(axis=1), nan=0.0, posinf=1e9, neginf=-1e9)) - 1
         r1 = np.ceil(np.nan_to_num(q[..., 1].max(axis=1), nan=0.0, posinf=1e9, neginf=-1e9)) + 1
-    c0[behind], r0[behind], c1[behind], r1[behind] = 0, 0, w - 1, h - 1
+    if behind.any():
+        c0[behind], c1[behind], r0[behind], r1[behind] = _front_part_boxes(cam, pts_world, tets[behind], q[behind],
+                                                                          near, size)
     box = np.stack([np.clip(c0, 0, w), np.clip(c1, -1, w - 1), np.clip(r0, 0, h), np.clip(r1, -1, h - 1)], axis=1)
     return box.astype(np.int64)
+
+
+def _front_part_boxes(cam: Camera, pts_world: np.ndarray, elems: np.ndarray, q: np.ndarray, near: float,
+                      size: tuple[int, int]) -> tuple[np.ndarray, ...]:
+    """(c0, c1, r0, r1) of the elements' parts in front of the near plane (``screen_bboxes``), grown by one pixel;
+    c0 > c1 for an element wholly behind it. ``q``: their projected vertices (k, V, 3)."""
+    k, nv = elems.shape
+    z = q[..., 2] - near * (1.0 + 1e-9)
+    xs = [np.where(z > 0, q[..., 0], np.nan)]
+    ys = [np.where(z > 0, q[..., 1], np.nan)]
+    pw = pts_world[elems]                                     # (k, V, 3)
+    for a in range(nv):
+        for b in range(a + 1, nv):
+            cross = (z[:, a] > 0) != (z[:, b] > 0)
+            x = np.full(k, np.nan)
+            y = np.full(k, np.nan)
+            if cross.any():
+                za, zb = q[cross, a, 2] - near, q[cross, b, 2] - near
+                t = np.clip(za / (za - zb), 0.0, 1.0)[:, None]
+                on_plane = cam.project(pw[cross, a] + t * (pw[cross, b] - pw[cross, a]), size)
+                x[cross], y[cross] = on_plane[:, 0], on_plane[:, 1]
+            xs.append(x[:, None])
+            ys.append(y[:, None])
+    x_all, y_all = np.concatenate(xs, axis=1), np.concatenate(ys, axis=1)
+    seen = np.isfinite(x_all).any(axis=1) & np.isfinite(y_all).any(axis=1)
+    with np.errstate(invalid="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)       # all-NaN rows: elements wholly behind the plane
+        c0 = np.floor(np.nanmin(x_all, axis=1)) - 1
+        c1 = np.ceil(np.nanmax(x_all, axis=1)) + 1
+        r0 = np.floor(np.nanmin(y_all, axis=1)) - 1
+        r1 = np.ceil(np.nanmax(y_all, axis=1)) + 1
+    w, h = size
+    c0 = np.where(seen, np.nan_to_num(c0, posinf=1e9, neginf=-1e9), w)
+    c1 = np.where(seen, np.nan_to_num(c1, posinf=1e9, neginf=-1e9), -1)
+    r0 = np.where(seen, np.nan_to_num(r0, posinf=1e9, neginf=-1e9), h)
+    r1 = np.where(seen, np.nan_to_num(r1, posinf=1e9, neginf=-1e9), -1)
+    return c0, c1, r0, r1
 
 
 def depth_limits(depth: np.ndarray | None, w: int, h: int) -> np.ndarray:
