@@ -33,7 +33,7 @@ from volviz_app.workers import JobBridge
 log = logging.getLogger(__name__)
 
 AUTOSAVE_MS = 60_000
-MOVING_SCALE = 2         # while the mouse moves the camera, PT volumes and the CPU isosurfaces render at 1/2 x 1/2
+MOVING_SCALE = 2         # while the camera moves, fog, clouds, PT volumes and CPU isosurfaces render at 1/2 x 1/2
 PREVIEW_MS = 40          # live transfer-function preview: at most one re-render per 40 ms while dragging
 RESIZE_MS = 200          # overlays re-render once the viewport stopped resizing for 200 ms
 FLY_SETTLE_MS = 300      # fly mode: full-size images once no key moved the camera for 300 ms
@@ -984,15 +984,15 @@ class MainWindow(QMainWindow):
 
     def _camera_moving(self) -> None:
         """While the mouse moves the camera, the images of our own renderers follow it: the natural scene's fog and
-        clouds, PT volumes and the isosurface overlay are re-made in the background, one render of each in flight
-        and the newest camera next (``OneInFlight``), so each shows every render it finishes. VTK draws its own props
-        at once. PT volumes and the isosurface overlay render previews at 1 / ``MOVING_SCALE`` of the window's size in
-        each direction (a quarter of the pixels, magnified smoothly); the full-size images, the error estimate and
-        the LOD re-selection follow at the end of the interaction (``_camera_moved``)."""
+        clouds (with the terrain's C-LOD mesh), PT volumes and the isosurface overlay are re-made in the background,
+        one render of each in flight and the newest camera next (``OneInFlight``), so each shows every render it
+        finishes. VTK draws its own props at once. The images are previews at 1 / ``MOVING_SCALE`` of the window's
+        size in each direction (a quarter of the pixels, magnified smoothly); the full-size images, the error
+        estimate and the LOD re-selection follow at the end of the interaction (``_camera_moved``)."""
         self._moving_scheduled = False
         if self.controller is None:
             return
-        self.refresh_nature()
+        self.refresh_nature(scale=MOVING_SCALE)
         for comp_id in self.controller.pt_stats():
             self.refresh_pt(comp_id, estimate=False, scale=MOVING_SCALE)
         self.refresh_iso_overlay(scale=MOVING_SCALE)
@@ -1016,7 +1016,7 @@ class MainWindow(QMainWindow):
             self.refresh_pt(comp_id)
         self.refresh_iso_overlay()
 
-    def refresh_nature(self, settled: Optional[Callable[[], None]] = None) -> None:
+    def refresh_nature(self, settled: Optional[Callable[[], None]] = None, scale: int = 1) -> None:
         """Re-compute the natural scene's view-dependent parts (C-LOD terrain, fog and cloud images; issue #5) for
         the newest camera in the background (``OneInFlight``): the camera is read when the job starts, the VTK data
         replaced on this thread when it is done."""
@@ -1031,7 +1031,7 @@ class MainWindow(QMainWindow):
             if self.controller is not controller or controller.nature is not view:
                 next_request()
                 return
-            request = view.begin()
+            request = view.begin(scale=scale)
 
             def done(outcome: JobOutcome) -> None:
                 if outcome.ok and self.controller is controller and controller.nature is view:

@@ -350,3 +350,29 @@ def test_pt_volume_keeps_showing_renders_while_flying(qtbot, make_window) -> Non
     assert window.overlay_updates["pt:demo"] - before == started[0], "a finished render was thrown away"
     assert started[0] < presses
     assert np.allclose(volume.camera.position, final)
+
+
+def test_natural_scene_follows_a_mouse_drag_with_previews(qtbot, make_window) -> None:
+    """The demo scene's fog and clouds (and the terrain's C-LOD mesh) follow a mouse drag while the button is held,
+    as half-size previews magnified to the window; the full-size view follows the release."""
+    from test_app_workflows import _mouse
+
+    window = make_window()
+    window.open_demo()
+    wait_loaded(qtbot, window)
+    view = window.controller.nature
+    qtbot.waitUntil(lambda: not window._nature_jobs.running, timeout=60000)
+    updates, mesh = window.nature_updates, view._mesh
+    canvas = window.plotter.interactor
+    centre = QPoint(canvas.width() // 2, canvas.height() // 2)
+    held = Qt.MouseButton.LeftButton
+    _mouse(canvas, QEvent.Type.MouseButtonPress, centre, held)
+    for k in range(1, 21):
+        _mouse(canvas, QEvent.Type.MouseMove, centre + QPoint(3 * k, 0), held)
+        qtbot.wait(25)
+    qtbot.waitUntil(lambda: window.nature_updates > updates, timeout=60000)
+    assert view.shown_scale == 2 and view._mesh is not mesh
+    w, h = (int(v) for v in window.plotter.window_size)
+    assert view._overlay_image.GetDimensions()[:2] == (w, h)  # magnified to the window
+    _mouse(canvas, QEvent.Type.MouseButtonRelease, centre + QPoint(60, 0), Qt.MouseButton.NoButton)
+    qtbot.waitUntil(lambda: view.shown_scale == 1 and not window._nature_jobs.running, timeout=60000)

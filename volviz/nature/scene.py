@@ -378,6 +378,7 @@ class NatureView:
         self._near = 0.1
         self._mesh = None
         self.last_stats: dict[str, float] = {}
+        self.shown_scale = 1          # the preview scale of the overlay shown (``compute``)
         if scene.terrain is not None and scene.colour_map is not None:
             img = np.clip(scene.colour_map.transpose(1, 0, 2)[::-1] * 255.0, 0, 255).astype(np.uint8)
             self._texture = pv.Texture(np.ascontiguousarray(img))
@@ -424,9 +425,9 @@ class NatureView:
         request = self.begin(camera)
         return self.finish(request, *self.compute(request))
 
-    def begin(self, camera: Any = None) -> tuple[Any, tuple[int, int]]:
-        """GUI thread: the view to compute (``camera`` or the plotter's, and the image size); moves the sky dome
-        to the eye (the sky is at infinity)."""
+    def begin(self, camera: Any = None, scale: int = 1) -> tuple[Any, tuple[int, int], int]:
+        """GUI thread: the view to compute (``camera`` or the plotter's, the image size and the preview ``scale``,
+        see ``compute``); moves the sky dome to the eye (the sky is at infinity)."""
         cam = camera or self._camera()
         if camera is not None:
             camera.apply_to(self.plotter.camera)
@@ -434,16 +435,21 @@ class NatureView:
         size = self.size or tuple(int(v) for v in self.plotter.window_size)
         if self.sky_actor is not None:
             self.sky_actor.SetPosition(*np.asarray(cam.position, dtype=np.float64))
-        return cam, size
+        return cam, size, max(1, int(scale))
 
-    def compute(self, request: tuple[Any, tuple[int, int]],
+    def compute(self, request: tuple[Any, tuple[int, int], int],
                 progress: Any = None) -> tuple[Any, np.ndarray, dict[str, float]]:
         """Any thread (one at a time): the C-LOD terrain mesh as VTK poly data (None without terrain), the fog and
         cloud overlay as 8-bit straight RGBA rows bottom-up, and the statistics. ``progress(fraction, message)`` is
-        called between the stages (a job runner cancels there)."""
-        cam, size = request
-        w, h = size
+        called between the stages (a job runner cancels there). A preview (``scale`` > 1, e.g. while the camera
+        moves) renders the fog and clouds at 1/scale of the size in each direction and magnifies them (``_magnify``);
+        the terrain mesh and the clouds' levels of detail are those of the full size (the same frustum), so nothing
+        pops when the full-size view follows."""
+        cam, size, scale = request
         mesh = self.scene.terrain_mesh(cam, size)
+        if scale > 1:
+            size = (max(1, size[0] // scale), max(1, size[1] // scale))
+        w, h = size
         stats: dict[str, float] = {}
         depth = np.full((h, w), np.inf)
         poly = None
@@ -455,8 +461,10 @@ class NatureView:
             stats["terrain_triangles"] = float(mesh.n_triangles)
         if progress is not None:
             progress(0.5, "fog and clouds")
-        overlay = self.scene.render_volumes(cam, size, mesh, depth, stats=stats)
-        return poly, _overlay_rgba(overlay), stats
+        overlay = _overlay_rgba(self.scene.render_volumes(cam, size, mesh, depth, stats=stats))
+        if scale > 1:
+            overlay = _magnify(overlay, request[1])
+        return poly, overlay, stats
 
     def finish(self, request: tuple[Any, tuple[int, int]], poly: Any, overlay: np.ndarray,
                stats: dict[str, float]) -> dict[str, float]:
@@ -470,6 +478,7 @@ class NatureView:
             self._mesh = poly
         self._set_overlay(overlay)
         self.last_stats = stats
+        self.shown_scale = int(request[2])
         return stats
 
     def _set_overlay(self, overlay: np.ndarray) -> None:
@@ -495,6 +504,15 @@ class NatureView:
         arr.SetNumberOfComponents(4)
         img.GetPointData().SetScalars(arr)
         img.Modified()
+
+
+def _magnify(rgba8: np.ndarray, size: tuple[int, int]) -> np.ndarray:
+    """A straight-alpha RGBA8 image resampled bilinearly to ``size`` (W, H) pixels over the same view (Pillow:
+    premultiplied while filtering, so no colour bleeds from transparent pixels; pixel centres aligned)."""
+    from PIL import Image
+
+    img = Image.fromarray(np.ascontiguousarray(rgba8), "RGBA").convert("RGBa")
+    return np.asarray(img.resize((int(size[0]), int(size[1])), Image.Resampling.BILINEAR).convert("RGBA"))
 
 
 def _overlay_rgba(overlay: np.ndarray) -> np.ndarray:
