@@ -181,3 +181,20 @@ def test_preview_renders_a_smaller_image_cut_at_the_nearest_depth(scene):
     assert inner.sum() > 5 and np.abs(shot[inner] - opaque[inner]).max() <= 1.5 / 255  # still hidden by the sphere
     h.update()                                                       # back to the full size for the other tests
     assert h.image.shape == (SIZE[1], SIZE[0], 4)
+
+
+def test_bleed_colour_gives_transparent_edge_pixels_their_neighbours_colour():
+    """Magnified previews interpolate straight alpha: a transparent pixel beside visible ones takes their mean colour
+    (no dark fringe), keeps alpha 0; visible pixels and transparent ones away from any are unchanged."""
+    from volviz.render.image_overlay import bleed_colour
+
+    img = np.zeros((4, 5, 4), np.uint8)
+    img[1, 1] = [200, 40, 0, 255]
+    img[1, 2] = [100, 80, 0, 128]
+    out = bleed_colour(img)
+    assert np.array_equal(out[1, 1], img[1, 1]) and np.array_equal(out[1, 2], img[1, 2])
+    assert np.array_equal(out[..., 3], img[..., 3])
+    assert np.array_equal(out[0, 0], [200, 40, 0, 0])            # one visible neighbour
+    assert np.array_equal(out[0, 1], [150, 60, 0, 0])            # the mean of two
+    assert np.array_equal(out[1, 3], [100, 80, 0, 0])
+    assert np.array_equal(out[:, 4], np.zeros((4, 4))) and np.array_equal(out[3, 0], [0, 0, 0, 0])
