@@ -33,7 +33,7 @@ from volviz_app.workers import JobBridge
 log = logging.getLogger(__name__)
 
 AUTOSAVE_MS = 60_000
-MOVING_SCALE = 2         # while the camera moves, fog, clouds, PT volumes and CPU isosurfaces render at 1/2 x 1/2
+MOVING_SCALE = 2         # previews while the camera moves or a TF point is dragged: 1/2 x 1/2 of the window
 PREVIEW_MS = 40          # live transfer-function preview: at most one re-render per 40 ms while dragging
 RESIZE_MS = 200          # overlays re-render once the viewport stopped resizing for 200 ms
 FLY_SETTLE_MS = 300      # fly mode: full-size images once no key moved the camera for 300 ms
@@ -152,7 +152,7 @@ class MainWindow(QMainWindow):
         self._overlay_jobs: dict[str, OneInFlight] = {}  # per overlay (a PT volume, the iso overlay): its renders
         self.overlay_updates: dict[str, int] = {}  # per overlay: the renders shown so far
         self._moving_scheduled = False     # a refresh for the camera the mouse is moving is queued
-        self._pending_tf: Optional[tuple[str, Any]] = None
+        self._pending_tf: Optional[tuple[str, Any, bool]] = None  # (component, TF, a finished edit)
         self._recording: Optional[list[CameraKey]] = None
         self._iso_jobs = OneInFlight()     # isosurface extraction for the display time
         self._nature_jobs = OneInFlight()  # the natural scene's view-dependent parts for the camera
@@ -162,8 +162,8 @@ class MainWindow(QMainWindow):
         self.nature_rebuilds = 0           # natural scenes rebuilt in the background (visibility toggles)
         self._lod_jobs: dict[str, OneInFlight] = {}  # block selection of volumes at a level of detail
         self.lod_shown: dict[str, int] = {}  # the block budget of the selection each LOD volume shows
-        self.iso_time_shown: Optional[tuple[float, bool]] = None
-        self.isosurface_clip_shown: Optional[dict[str, Any]] = None  # the clipping the shown isosurfaces are cut by  # (time, interpolated) of the shown isosurfaces
+        self.iso_time_shown: Optional[tuple[float, bool]] = None  # (time, interpolated) of the shown isosurfaces
+        self.isosurface_clip_shown: Optional[dict[str, Any]] = None  # the clipping the shown isosurfaces are cut by
         self._record_start = 0.0
 
         self._build_docks()
@@ -575,14 +575,15 @@ class MainWindow(QMainWindow):
         comp_id = self.scene_tree.current_component()
         if comp_id is None or self.controller is None:
             return
-        self._pending_tf = (comp_id, tf)
+        # a finished edit renders at full size; a drag under way (the editor's TF not yet committed) as a preview
+        self._pending_tf = (comp_id, tf, tf is self.tf_editor.committed_transfer_function)
         if not self.preview_timer.isActive():
             self.preview_timer.start()
 
     def _apply_pending_tf(self) -> None:
         if self._pending_tf is None or self.controller is None:
             return
-        comp_id, tf = self._pending_tf
+        comp_id, tf, finished = self._pending_tf
         self._pending_tf = None
         volume = self.controller.pt_volume(comp_id)
         if volume is None:  # VTK mapper: the new colour/opacity functions draw at once
@@ -592,9 +593,10 @@ class MainWindow(QMainWindow):
             if lod:  # the block selection depends on the TF (transparent blocks): re-select in the background
                 self.refresh_lod([comp_id])
             return
-        # volviz PT volume: table build and rasterisation run in the background; the newest edit renders next
+        # volviz PT volume: table build and rasterisation run in the background; the newest edit renders next, while
+        # dragging as a preview (``MOVING_SCALE``), a finished edit at full size with a fresh error estimate
         self.controller.set_transfer_function(comp_id, tf, update=False)
-        self.refresh_pt(comp_id)
+        self.refresh_pt(comp_id, estimate=finished, scale=1 if finished else MOVING_SCALE)
 
     def refresh_pt(self, comp_id: str, settled: Optional[Callable[[], None]] = None, estimate: bool = True,
                    scale: int = 1) -> None:

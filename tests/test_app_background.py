@@ -376,3 +376,41 @@ def test_natural_scene_follows_a_mouse_drag_with_previews(qtbot, make_window) ->
     assert view._overlay_image.GetDimensions()[:2] == (w, h)  # magnified to the window
     _mouse(canvas, QEvent.Type.MouseButtonRelease, centre + QPoint(60, 0), Qt.MouseButton.NoButton)
     qtbot.waitUntil(lambda: view.shown_scale == 1 and not window._nature_jobs.running, timeout=60000)
+
+
+def test_dragging_a_transfer_function_point_previews_the_pt_volume(qtbot, make_window) -> None:
+    """While a TF control point is dragged (button held), the PT volume re-renders with the live TF as half-size
+    previews; the release (a finished, undoable edit) renders it at full size with the committed TF."""
+    from test_app_workflows import _mouse
+
+    window = make_window()
+    window.open_demo_volume()
+    wait_loaded(qtbot, window)
+    volume = window.controller.pt_volume("demo")
+    qtbot.waitUntil(lambda: volume.image is not None and not window._overlay_jobs["pt:demo"].running, timeout=60000)
+    w, h = (int(v) for v in window.plotter.ren_win.GetSize())
+    full_before = volume.image.copy()
+    editor = window.tf_editor
+    tf0 = editor.transfer_function
+    canvas = editor.canvas
+    index = int(np.argmax(tf0.extinction))  # the most opaque point: dragged down, the volume thins out
+    p = canvas.to_screen(tf0.scalars[index], tf0.extinction[index])
+    start = QPoint(int(p.x()), int(p.y()))
+    end = QPoint(start.x(), canvas._plot_rect().bottom() - 2)
+    held = Qt.MouseButton.LeftButton
+    updates = window.overlay_updates.get("pt:demo", 0)
+    _mouse(canvas, QEvent.Type.MouseButtonPress, start, held)
+    for k in range(1, 11):
+        _mouse(canvas, QEvent.Type.MouseMove, start + (end - start) * (k / 10), held)
+        qtbot.wait(30)
+    qtbot.waitUntil(lambda: window.overlay_updates.get("pt:demo", 0) > updates and volume.tf is editor.transfer_function
+                    and not window._overlay_jobs["pt:demo"].running, timeout=60000)
+    assert volume.image.shape[:2] == (h // 2, w // 2), "a preview while dragging"
+    assert editor.undo_stack.count() == 0  # the edit is not finished yet
+    live = editor.transfer_function
+    assert volume.tf is live and live.extinction[index] < tf0.extinction[index]
+    _mouse(canvas, QEvent.Type.MouseButtonRelease, end, Qt.MouseButton.NoButton)
+    qtbot.waitUntil(lambda: volume.image.shape[:2] == (h, w) and not window._overlay_jobs["pt:demo"].running,
+                    timeout=60000)
+    assert editor.undo_stack.count() == 1 and volume.tf is editor.committed_transfer_function
+    assert volume.image[..., 3].sum() < full_before[..., 3].sum()  # thinner with the lowered point

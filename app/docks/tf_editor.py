@@ -247,6 +247,11 @@ class TransferFunctionEditor(QWidget):
     def transfer_function(self) -> TransferFunction:
         return self._tf
 
+    @property
+    def committed_transfer_function(self) -> TransferFunction:
+        """The function as of the last finished edit (``changed`` with another one: a drag under way)."""
+        return self._committed_tf
+
     def set_transfer_function(self, tf: TransferFunction, data_range: Optional[tuple[float, float]] = None,
                               histogram: Optional[tuple[np.ndarray, np.ndarray]] = None) -> None:
         """Show ``tf`` for a new component (clears undo history)."""
