@@ -466,7 +466,7 @@ class NatureView:
             overlay = _magnify(overlay, request[1])
         return poly, overlay, stats
 
-    def finish(self, request: tuple[Any, tuple[int, int]], poly: Any, overlay: np.ndarray,
+    def finish(self, request: tuple[Any, tuple[int, int], int], poly: Any, overlay: np.ndarray,
                stats: dict[str, float]) -> dict[str, float]:
         """GUI thread: show a ``compute`` result (terrain mesh and overlay image)."""
         if poly is not None:
