@@ -33,7 +33,7 @@ from typing import Any
 import numpy as np
 
 from volviz.model.datasets import TetMesh
-from volviz.render.image_overlay import OverlayView, unpremultiply_rgba8, zbuffer_to_depth
+from volviz.render.image_overlay import OverlayView, overlay_rgba8, unpremultiply_rgba8, zbuffer_to_depth
 from volviz.unstructured.camera import Camera
 from volviz.unstructured.render import render
 
@@ -74,8 +74,8 @@ class PTVolume(OverlayView):
 
     def compute(self, request: dict[str, Any], progress: Any = None) -> tuple[np.ndarray, Any, np.ndarray]:
         """Any-thread part: the volume image for a request of ``begin`` (pure NumPy/Numba, no VTK), its statistics,
-        and the image as VTK will show it (straight-alpha 8-bit RGBA, bottom row first), made here so that ``finish``
-        on the GUI thread only hands it over."""
+        and the image as VTK will show it (``overlay_rgba8``: straight-alpha 8-bit RGBA, a preview's edge colours
+        bled), made here so that ``finish`` on the GUI thread only hands it over."""
         if progress is not None:
             progress(0.0, "rendering volume")
         opts = dict(self.render_opts)
@@ -88,7 +88,7 @@ class PTVolume(OverlayView):
         img, st = render(self.mesh, request["tf"], request["camera"], request["size"], self.method,
                          depth=request["depth"], return_stats=True, **opts)
         st.extra["sort_prefetched"] = res is not None
-        return img, st, unpremultiply_rgba8(img)
+        return img, st, overlay_rgba8(img, request.get("preview", False))
 
     def prefetch(self, camera: Camera, size: tuple[int, int] | None = None) -> None:
         """Sort the mesh for ``camera`` (the next frame's; ``size`` defaults to the window's) in the background, so
