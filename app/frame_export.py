@@ -27,8 +27,9 @@ Frame = tuple[Optional[Any], Optional[float]]  # (camera or None: keep, display 
 
 
 class FrameExport:
-    """One running export. ``window`` provides ``jobs`` (a ``JobBridge``); ``frames_of(controller)`` lists the frames once the scene is installed; ``open_sink()`` (on a worker) returns an
-    object with ``append(image)``, ``close()`` and ``abort()``; ``on_end(ok, message)`` runs once at the end."""
+    """One running export. ``window`` provides ``jobs`` (a ``JobBridge``); ``frames_of(controller)`` lists the
+    frames once the scene is installed; ``open_sink()`` (on a worker) returns an object with ``append(image)``,
+    ``close()`` and ``abort()``; ``on_end(ok, message)`` runs once at the end."""
 
     def __init__(self, window: Any, plotter: Any, controller: Any, size: tuple[int, int], name: str,
                  frames_of: Callable[[Any], list[Frame]], open_sink: Callable[[], Any],
@@ -67,11 +68,15 @@ class FrameExport:
                 job.outcome(timeout=wait_s)
             except Exception:  # cancelled, failed or still running: the file is removed below either way
                 pass
+        self._release(abort=True)
+
+    def _release(self, abort: bool) -> None:
+        """Close the offscreen plotter and let go of the output; ``abort``: remove what was written of it."""
         self.plotter.close()
         sink, self.sink = self.sink, None
-        if sink is not None:
+        if sink is not None and abort:
             try:
-                sink.abort()
+                sink.abort()  # no partial movie left behind
             except Exception:
                 log.exception("could not remove the partial export of %s", self.name)
 
@@ -79,13 +84,7 @@ class FrameExport:
         if self.over:
             return
         self.over = True
-        self.plotter.close()
-        sink, self.sink = self.sink, None
-        if sink is not None and not ok:
-            try:
-                sink.abort()  # no partial movie left behind
-            except Exception:
-                log.exception("could not remove the partial export of %s", self.name)
+        self._release(abort=not ok)
         if error is not None:
             log.error("export of %s failed: %s", self.name, error)
         self.on_end(ok, message if error is None else f"{message}: {error}")
