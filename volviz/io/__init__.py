@@ -16,6 +16,10 @@ Readers (each returns a ``volviz.model`` dataset, convertible with ``.to_pyvista
 - anything meshio reads                   -> UnstructuredMesh
 - a numbered series (list, glob, ``%d``)  -> TimeSeries with lazy frames (``read_series``)
 
+More formats come from reader plugins (entry-point group ``volviz.readers``, see ``volviz.io.registry``); the
+optional ``volviz-vtk-readers`` plugin in ``plugins/`` adds Exodus II, OpenFOAM, CGNS, EnSight, netCDF CF, Tecplot,
+AVS UCD, Fluent and the multiblock / parallel VTK XML files.
+
 Float data holding NaN/Inf raises ReadError unless ``allow_nonfinite=True`` is passed, which keeps the values and
 emits a ``NonFiniteWarning`` with their count.
 """
@@ -25,41 +29,23 @@ from typing import Any
 
 from volviz.io.errors import NonFiniteWarning, PathLike, ReadError
 from volviz.io.raw import read_raw, read_slice_stack
-from volviz.io.registry import FORMATS, call_reader, format_of, is_pattern
+from volviz.io.registry import (ReaderSpec, call_reader, format_of, is_pattern, open_dialog_filter, reader_specs,
+                                supported_formats)
 from volviz.io.series import expand_pattern, read_series
 
 
 def read(path: PathLike, **options: Any):
     """Read any supported file (or a series pattern: a glob, ``name%02d.ext`` or a list) into a model dataset.
 
-    The format comes from the extension, else the file's magic bytes. Options go to the format's reader
-    (e.g. ``q=`` for PLOT3D, ``dims=, dtype=, byteorder=`` for raw files, ``vtk_compatible=`` for DEM,
-    ``allow_nonfinite=``). Raises ReadError for bad or unsupported files.
+    The format comes from the reader registry (options, folder markers, the name, else the file's magic bytes).
+    Options go to the format's reader (e.g. ``q=`` for PLOT3D, ``dims=, dtype=, byteorder=`` for raw files,
+    ``vtk_compatible=`` for DEM, ``blocks=`` for multiblock files, ``allow_nonfinite=``). Raises ReadError for bad
+    or unsupported files.
     """
     if is_pattern(path):
         return read_series(path, **options)
     kind = format_of(path, options)
     return call_reader(kind, path, options)
-
-
-def supported_formats() -> list[tuple[str, tuple[str, ...]]]:
-    """``[(description, (glob, ...)), ...]`` of the formats ``read`` recognises by name (for Open dialogs).
-
-    meshio's many formats are one extra entry.
-    """
-    from volviz.io.meshio_reader import meshio_extensions
-
-    taken = {g[1:] for _, globs in FORMATS for g in globs if g.startswith("*.")}
-    mesh = tuple(f"*{e}" for e in meshio_extensions() if e not in taken)
-    return list(FORMATS) + [("Meshes (meshio)", mesh)]
-
-
-def open_dialog_filter() -> str:
-    """A Qt-style file filter string: ``All supported (...);;PVM volume (*.pvm *.pvm-t*);;...;;All files (*)``."""
-    formats = supported_formats()
-    everything = " ".join(g for _, globs in formats for g in globs)
-    parts = [f"All supported ({everything})"] + [f"{d} ({' '.join(g)})" for d, g in formats] + ["All files (*)"]
-    return ";;".join(parts)
 
 
 def __getattr__(name: str):
@@ -77,7 +63,7 @@ def __getattr__(name: str):
 
 
 __all__ = [
-    "NonFiniteWarning", "ReadError", "expand_pattern", "open_dialog_filter", "read", "read_dem", "read_image", "read_meshio",
+    "NonFiniteWarning", "ReadError", "ReaderSpec", "reader_specs", "expand_pattern", "open_dialog_filter", "read", "read_dem", "read_image", "read_meshio",
     "read_metaimage", "read_plot3d", "read_pnm", "read_pvm", "read_raw", "read_series", "read_slc",
     "read_slice_stack", "read_vtk_file", "read_vtkhdf", "supported_formats",
 ]

@@ -1,130 +1,324 @@
-"""Format dispatch for ``volviz.io.read``: by extension first, then by the file's magic bytes."""
+"""The reader registry: one ``ReaderSpec`` per file format, volviz's own and those plugins add.
+
+A spec says how a format is recognised -- file-name patterns, a content sniffer over the first bytes, the marker
+files of a folder it opens, options that select it -- and where its loader lives (``"module:function"``, imported
+only when a file of that format is read, so ``import volviz.io`` stays light). Third-party packages add specs
+through the entry-point group ``volviz.readers``: each entry point names a ReaderSpec, a list of them, or a
+function returning either.
+
+``format_of`` picks the spec of a path:
+
+1. an option that selects a reader (``dims=`` -> raw, ``q=`` -> PLOT3D);
+2. a folder: the first spec whose marker file exists in it;
+3. by name: among the specs whose patterns match, one whose sniffer accepts the first bytes, else one without a
+   sniffer;
+4. by content: the first spec whose sniffer accepts the bytes (a format that needs its extension gets a
+   "looks like ... give it its extension" error instead);
+5. the only spec matching the name (its loader then says what is wrong with the content), else a catch-all spec
+   (meshio) matching the name, else a ReadError that lists every supported format.
+"""
 from __future__ import annotations
 
+import fnmatch
+import importlib
 import inspect
 import os
 import re
+import stat
+import warnings
+from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any, Callable, Iterable, Union
 
 from volviz.io._checks import check_file, read_bytes
 from volviz.io.errors import PathLike, ReadError
 
-# (description, glob patterns) for open dialogs; order = how they are listed
-FORMATS: list[tuple[str, tuple[str, ...]]] = [
-    ("PLOT3D grid (+ q solution)", ("*.xyz", "*.x", "*.p3d", "*xyz*.bin")),
-    ("PVM volume", ("*.pvm", "*.pvm-t*")),
-    ("SLC volume", ("*.slc",)),
-    ("MetaImage", ("*.mhd", "*.mha")),
-    ("VTK legacy", ("*.vtk",)),
-    ("VTK XML", ("*.vti", "*.vtu", "*.vts", "*.vtr", "*.vtp")),
-    ("VTKHDF", ("*.vtkhdf", "*.hdf")),
-    ("PGM/PPM image", ("*.pgm", "*.ppm", "*.pnm")),
-    ("USGS DEM", ("*.dem",)),
-    ("Raster image", ("*.png", "*.jpg", "*.jpeg", "*.tif", "*.tiff", "*.bmp")),
-]
-_PVM_NAME = re.compile(r"\.pvm(-t\d+)?$", re.I)
-_PLOT3D_EXT = {".xyz", ".x", ".p3d", ".g", ".grd"}
+ENTRY_POINT_GROUP = "volviz.readers"
+HEAD_BYTES = 4096
+Sniffer = Callable[[bytes], bool]
 
 
-def _loader(kind: str) -> Callable[..., Any]:
-    """The reader function of a format kind (imported lazily, so ``import volviz.io`` stays light)."""
-    if kind == "pvm":
-        from volviz.io.pvm import read_pvm as f
-    elif kind == "pnm":
-        from volviz.io.pnm import read_pnm as f
-    elif kind == "slc":
-        from volviz.io.slc import read_slc as f
-    elif kind == "dem":
-        from volviz.io.dem import read_dem as f
-    elif kind == "metaimage":
-        from volviz.io.metaimage import read_metaimage as f
-    elif kind == "vtk":
-        from volviz.io.vtkfiles import read_vtk_file as f
-    elif kind == "vtkhdf":
-        from volviz.io.vtkhdf import read_vtkhdf as f
-    elif kind == "plot3d":
-        f = _read_plot3d_auto
-    elif kind == "raw":
-        from volviz.io.raw import read_raw as f
-    elif kind == "meshio":
-        from volviz.io.meshio_reader import read_meshio as f
-    elif kind == "image":
-        from volviz.io.image import read_image as f
-    else:  # pragma: no cover
-        raise KeyError(kind)
-    return f
+class PluginWarning(UserWarning):
+    """A reader plugin could not be loaded or registers a name that is already taken; it is skipped."""
 
 
-def _read_plot3d_auto(path: PathLike, q: PathLike | None = None, **options):
+@dataclass(frozen=True)
+class ReaderSpec:
+    """One file format volviz reads.
+
+    ``patterns``: globs matched case-insensitively against the file name (``"*.ex2"``), listed in open dialogs; or
+    a ``"module:function"`` returning them (computed once, for readers whose list comes from a library).
+    ``sniff``: ``f(first_bytes) -> bool`` (or ``"module:function"``) telling whether the content is this format.
+    ``loader``: ``"module:function"`` taking ``(path, **options)`` and returning a ``volviz.model`` dataset.
+    ``folder_markers``: paths relative to a folder whose presence means this reader opens the folder itself.
+    ``select_options``: options that pick this reader whatever the file is called (``dims`` for raw volumes).
+    ``sniff_opens``: False when the loader needs the file's extension, so a file recognised only by content is
+    refused with a hint to rename it. ``claims_name``: False for extensions other formats share (``.dat``, ``.inp``):
+    the name then picks this reader only when its sniffer accepts the content too. ``catch_all``: match by name only after every other spec failed.
+    ``arrays`` and ``options``: what the reader offers and takes, for documentation and ``volviz info``.
+    """
+
+    name: str
+    description: str
+    patterns: Union[tuple[str, ...], str]
+    loader: str
+    sniff: Union[Sniffer, str, None] = None
+    folder_markers: tuple[str, ...] = ()
+    select_options: tuple[str, ...] = ()
+    sniff_opens: bool = True
+    claims_name: bool = True
+    catch_all: bool = False
+    arrays: str = ""
+    options: tuple[str, ...] = ()
+    listed: bool = True
+    _cache: dict = field(default_factory=dict, compare=False, repr=False)
+
+    @property
+    def opens_folders(self) -> bool:
+        return bool(self.folder_markers)
+
+    def globs(self) -> tuple[str, ...]:
+        """The file-name patterns (resolved and cached on first use when given as ``"module:function"``)."""
+        if isinstance(self.patterns, tuple):
+            return self.patterns
+        if "globs" not in self._cache:
+            self._cache["globs"] = tuple(_resolve(self.patterns)())
+        return self._cache["globs"]
+
+    def matches_name(self, name: str) -> bool:
+        low = name.lower()
+        return any(fnmatch.fnmatchcase(low, g.lower()) for g in self.globs())
+
+    def accepts(self, head: bytes) -> bool:
+        """Whether the sniffer recognises ``head`` (False without a sniffer)."""
+        if self.sniff is None:
+            return False
+        sniff = _resolve(self.sniff) if isinstance(self.sniff, str) else self.sniff
+        return bool(sniff(head))
+
+    def opens_folder(self, folder: Path) -> bool:
+        return any((folder / marker).exists() for marker in self.folder_markers)
+
+    def load_function(self) -> Callable[..., Any]:
+        return _resolve(self.loader)
+
+
+def _resolve(target: str) -> Callable[..., Any]:
+    module, _, attr = target.partition(":")
+    if not module or not attr:
+        raise ValueError(f"reader target {target!r} is not 'module:function'")
+    return getattr(importlib.import_module(module), attr)
+
+
+# -- volviz's own readers -----------------------------------------------------------------------------------------------
+def _sniff_slc(head: bytes) -> bool:
+    return head.lstrip()[:6] in (b"11111\n", b"11111 ", b"11111\r")
+
+
+def _sniff_metaimage(head: bytes) -> bool:
+    low = head[:HEAD_BYTES].lower()
+    return b"ndims" in low and b"elementdatafile" in low and b"dimsize" in low
+
+
+def _sniff_vtk_xml(head: bytes) -> bool:
+    return head.lstrip().startswith((b"<?xml", b"<VTKFile")) and b"<VTKFile" in head
+
+
+def read_plot3d_auto(path: PathLike, q: PathLike | None = None, **options: Any):
+    """PLOT3D grid, with its solution file given as ``q=`` or found next to it by name."""
     from volviz.io.plot3d import companion_q_file, read_plot3d
 
     return read_plot3d(path, q if q is not None else companion_q_file(path), **options)
 
 
-def _sniff(path: Path, head: bytes) -> str | None:
-    from volviz.io.pnm import is_pnm
-    from volviz.io.pvm import is_pvm
+BUILTIN_READERS: list[ReaderSpec] = [
+    ReaderSpec("plot3d", "PLOT3D grid (+ q solution)", ("*.xyz", "*.x", "*.p3d", "*.g", "*.grd", "*xyz*.bin",
+                                                         "*xyz*.dat", "*xyz"),
+               "volviz.io.registry:read_plot3d_auto", select_options=("q",),
+               arrays="point: Density, Momentum, StagnationEnergy and derived quantities",
+               options=("q", "block", "gamma", "allow_nonfinite")),
+    ReaderSpec("pvm", "PVM volume", ("*.pvm", "*.pvm-t*"), "volviz.io.pvm:read_pvm", sniff="volviz.io.pvm:is_pvm",
+               arrays="one scalar volume"),
+    ReaderSpec("slc", "SLC volume", ("*.slc",), "volviz.io.slc:read_slc", sniff=_sniff_slc, arrays="one scalar volume"),
+    ReaderSpec("metaimage", "MetaImage", ("*.mhd", "*.mha"), "volviz.io.metaimage:read_metaimage",
+               sniff=_sniff_metaimage, arrays="one scalar volume or image", options=("allow_nonfinite",)),
+    ReaderSpec("vtk", "VTK legacy", ("*.vtk",), "volviz.io.vtkfiles:read_vtk_file",
+               sniff=lambda head: head.startswith(b"# vtk DataFile"), sniff_opens=False,
+               arrays="every point and cell array", options=("allow_nonfinite",)),
+    ReaderSpec("vtk-xml", "VTK XML", ("*.vti", "*.vtu", "*.vts", "*.vtr", "*.vtp"), "volviz.io.vtkfiles:read_vtk_file",
+               sniff=_sniff_vtk_xml, sniff_opens=False, arrays="every point and cell array",
+               options=("allow_nonfinite",)),
+    ReaderSpec("vtkhdf", "VTKHDF", ("*.vtkhdf", "*.hdf"), "volviz.io.vtkhdf:read_vtkhdf",
+               sniff=lambda head: head.startswith(b"\x89HDF\r\n\x1a\n"),
+               arrays="every point and cell array; transient files as a time series", options=("allow_nonfinite",)),
+    ReaderSpec("pnm", "PGM/PPM image", ("*.pgm", "*.ppm", "*.pnm"), "volviz.io.pnm:read_pnm",
+               sniff="volviz.io.pnm:is_pnm", arrays="grey levels or RGB"),
+    ReaderSpec("dem", "USGS DEM", ("*.dem",), "volviz.io.dem:read_dem", arrays="heights in metres",
+               options=("vtk_compatible",)),
+    ReaderSpec("image", "Raster image", ("*.png", "*.jpg", "*.jpeg", "*.tif", "*.tiff", "*.bmp"),
+               "volviz.io.image:read_image", arrays="grey levels or RGB"),
+    ReaderSpec("raw", "Raw volume", (), "volviz.io.raw:read_raw", select_options=("dims",), listed=False,
+               arrays="one scalar volume", options=("dims", "dtype", "byteorder", "header_bytes")),
+    ReaderSpec("meshio", "Meshes (meshio)", "volviz.io.registry:meshio_globs", "volviz.io.meshio_reader:read_meshio",
+               catch_all=True, arrays="every point and cell array", options=("file_format", "allow_nonfinite")),
+]
 
-    if is_pvm(head):
-        return "pvm"
-    if is_pnm(head):
-        return "pnm"
-    if head.lstrip()[:6] == b"11111\n" or head.lstrip()[:6] == b"11111 " or head.lstrip()[:6] == b"11111\r":
-        return "slc"
-    if head.startswith(b"# vtk DataFile"):
-        return "vtk"
-    if head.startswith(b"\x89HDF\r\n\x1a\n"):
-        return "vtkhdf"
-    low = head[:4096].lower()
-    if b"ndims" in low and b"elementdatafile" in low and b"dimsize" in low:
-        return "metaimage"
-    return None
+
+def meshio_globs() -> tuple[str, ...]:
+    from volviz.io.meshio_reader import meshio_extensions
+
+    return tuple(f"*{e}" for e in meshio_extensions())
 
 
-def format_of(path: PathLike, options: dict) -> str:
-    """The format kind of ``path``: from the extension, else the magic bytes; ReadError if unknown."""
+# -- the registry -----------------------------------------------------------------------------------------------------
+_registry: list[ReaderSpec] | None = None
+
+
+def _plugin_specs() -> Iterable[ReaderSpec]:
+    from importlib.metadata import entry_points
+
+    for ep in entry_points(group=ENTRY_POINT_GROUP):
+        try:
+            value = ep.load()
+            if callable(value) and not isinstance(value, ReaderSpec):
+                value = value()
+            items = [value] if isinstance(value, ReaderSpec) else list(value)
+            bad = [type(v).__name__ for v in items if not isinstance(v, ReaderSpec)]
+            if bad:
+                raise TypeError(f"yields {', '.join(bad)} instead of ReaderSpec")
+        except Exception as exc:  # a broken plugin must not break reading other files
+            warnings.warn(f"reader plugin {ep.name!r} ({ep.value}) is skipped: {exc}", PluginWarning, stacklevel=3)
+            continue
+        yield from items
+
+
+def reader_specs(refresh: bool = False) -> list[ReaderSpec]:
+    """Every registered reader: volviz's own first, then the plugins' (in entry-point order), the catch-all last.
+
+    The entry points are read once; ``refresh=True`` reads them again (after installing a plugin at run time).
+    """
+    global _registry
+    if _registry is None or refresh:
+        specs = [s for s in BUILTIN_READERS if not s.catch_all]
+        taken = {s.name for s in BUILTIN_READERS}
+        for spec in _plugin_specs():
+            if spec.name in taken:
+                warnings.warn(f"reader plugin spec {spec.name!r} is skipped: the name is already registered",
+                              PluginWarning, stacklevel=2)
+                continue
+            taken.add(spec.name)
+            specs.append(spec)
+        _registry = specs + [s for s in BUILTIN_READERS if s.catch_all]
+    return _registry
+
+
+def get_reader(name: str) -> ReaderSpec:
+    """The spec registered under ``name``; KeyError listing the names otherwise."""
+    for spec in reader_specs():
+        if spec.name == name:
+            return spec
+    raise KeyError(f"no reader named {name!r}; registered: {', '.join(s.name for s in reader_specs())}")
+
+
+def supported_formats() -> list[tuple[str, tuple[str, ...]]]:
+    """``[(description, (glob, ...)), ...]`` of the formats ``read`` recognises by name (for Open dialogs).
+
+    The catch-all reader (meshio) lists only the extensions no other reader claims.
+    """
+    out: list[tuple[str, tuple[str, ...]]] = []
+    taken: set[str] = set()
+    for spec in reader_specs():
+        if not spec.listed:
+            continue
+        globs = tuple(g for g in spec.globs() if g.lower() not in taken) if spec.catch_all else spec.globs()
+        taken.update(g.lower() for g in globs)
+        if globs:
+            out.append((spec.description, globs))
+    return out
+
+
+def open_dialog_filter() -> str:
+    """A Qt-style file filter string: ``All supported (...);;PVM volume (*.pvm *.pvm-t*);;...;;All files (*)``."""
+    formats = supported_formats()
+    everything = " ".join(g for _, globs in formats for g in globs)
+    parts = [f"All supported ({everything})"] + [f"{d} ({' '.join(g)})" for d, g in formats] + ["All files (*)"]
+    return ";;".join(parts)
+
+
+def _described(specs: Iterable[ReaderSpec]) -> str:
+    return "; ".join(f"{s.description} ({' '.join(s.globs())})" for s in specs)
+
+
+def _folder_spec(p: Path) -> ReaderSpec:
+    for spec in reader_specs():
+        if spec.opens_folder(p):
+            return spec
+    folders = [s for s in reader_specs() if s.opens_folders]
+    known = "; ".join(f"{s.description} (holding {' or '.join(s.folder_markers)})" for s in folders)
+    raise ReadError(p, "is a directory, not a file" + (f", and not a folder volviz opens: {known}" if known else ""))
+
+
+def _is_dir(path: PathLike) -> bool:
+    try:
+        return stat.S_ISDIR(os.stat(os.fspath(path)).st_mode)
+    except (OSError, ValueError, TypeError):
+        return False
+
+
+def spec_of(path: PathLike, options: dict | None = None) -> ReaderSpec:
+    """The reader spec for ``path`` (see the module docstring for the order); ReadError if none fits."""
+    options = options or {}
+    specs = reader_specs()
+    for spec in specs:
+        if any(k in options for k in spec.select_options):
+            return spec
+    if _is_dir(path):
+        return _folder_spec(Path(os.fspath(path)))
     p = check_file(path)
-    name = p.name.lower()
+    head = read_bytes(p, HEAD_BYTES)
+    named = [s for s in specs if not s.catch_all and s.matches_name(p.name) and (s.claims_name or s.accepts(head))]
+    for candidates in ([s for s in named if s.accepts(head)], [s for s in named if s.sniff is None]):
+        if candidates:
+            return candidates[0]
+    for spec in specs:
+        if spec.accepts(head):
+            if not spec.sniff_opens:
+                raise ReadError(p, f"looks like a {spec.description} file; give it its extension "
+                                   f"({' '.join(g[1:] for g in spec.globs())})")
+            return spec
+    if len(named) == 1:
+        return named[0]  # its loader says what is wrong with the content
+    if named:
+        raise ReadError(p, f"is named like {' or '.join(s.description for s in named)}, but its content fits none of "
+                           f"them (first bytes {head[:16]!r})")
+    catch_all = [s for s in specs if s.catch_all and s.matches_name(p.name)]
+    if catch_all:
+        return catch_all[0]
     ext = p.suffix.lower()
-    if _PVM_NAME.search(name):
-        return "pvm"
-    by_ext = {".pgm": "pnm", ".ppm": "pnm", ".pnm": "pnm", ".slc": "slc", ".dem": "dem", ".mhd": "metaimage",
-              ".mha": "metaimage", ".vtk": "vtk", ".vti": "vtk", ".vtu": "vtk", ".vts": "vtk", ".vtr": "vtk",
-              ".vtp": "vtk", ".vtkhdf": "vtkhdf", ".hdf": "vtkhdf", ".png": "image", ".jpg": "image",
-              ".jpeg": "image", ".tif": "image", ".tiff": "image", ".bmp": "image"}
-    if "dims" in options:
-        return "raw"
-    if ext in by_ext:
-        return by_ext[ext]
-    if ext in _PLOT3D_EXT or "q" in options or ("xyz" in name and ext in (".bin", ".dat", "")):
-        return "plot3d"
-    head = read_bytes(p, 4096)
-    sniffed = _sniff(p, head)
-    if sniffed is not None:
-        if sniffed == "vtk" and ext not in (".vtk",):
-            raise ReadError(p, "looks like a VTK legacy file; give it the .vtk extension")
-        return sniffed
-    if head.lstrip().startswith((b"<?xml", b"<VTKFile")):
-        raise ReadError(p, "looks like a VTK XML file; give it its .vti/.vtu/.vts/.vtr/.vtp extension")
+    if len(named) == 1:
+        return named[0]  # its loader says what is wrong with the content
+    if named:
+        raise ReadError(p, f"is named like {' or '.join(s.description for s in named)}, but its content fits none of "
+                           f"them (first bytes {head[:16]!r})")
     if ext == ".raw":
         raise ReadError(p, "a .raw file has no header: call volviz.io.read_raw(path, dims, dtype, byteorder) or "
                            "open the .mhd header that describes it")
-    from volviz.io.meshio_reader import meshio_extensions
-
-    if ext and ext in meshio_extensions():
-        return "meshio"
-    if re.search(r"\.\d+$", name):
+    if re.search(r"\.\d+$", p.name):
         raise ReadError(p, "looks like one slice of a numbered stack; use volviz.io.read_slice_stack(pattern, "
                            "dims, dtype, byteorder) or read_series(pattern)")
     raise ReadError(p, f"unknown data format (extension {ext or 'none'!r}, first bytes {head[:8]!r}); supported: "
-                       + "; ".join(f"{d} ({' '.join(g)})" for d, g in FORMATS) + "; and meshio's formats")
+                       + _described(s for s in specs if s.listed))
+
+
+def format_of(path: PathLike, options: dict) -> str:
+    """The name of the reader spec for ``path``: from options, folder markers, the name, else the content."""
+    return spec_of(path, options).name
 
 
 def call_reader(kind: str, path: PathLike, options: dict):
-    """Call the reader of ``kind``; ``allow_nonfinite`` is dropped for readers of integer-only formats, any
-    other option the reader does not take is a TypeError naming it."""
-    f = _loader(kind)
+    """Call the reader registered as ``kind``; ``allow_nonfinite`` is dropped for readers of integer-only formats,
+    any other option the reader does not take is a TypeError naming it."""
+    f = get_reader(kind).load_function()
     params = inspect.signature(f).parameters
     accepts_kwargs = any(p.kind is inspect.Parameter.VAR_KEYWORD for p in params.values())
     opts = dict(options)
