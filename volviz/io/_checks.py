@@ -30,8 +30,36 @@ def check_file(path: PathLike) -> Path:
     if stat.S_ISDIR(st.st_mode):
         raise ReadError(p, "is a directory, not a file")
     if not stat.S_ISREG(st.st_mode):
-        raise ReadError(p, "is not a regular file (device, pipe or socket)")
+        raise ReadError(p, f"is {path_kind(st.st_mode)}, not a regular file")
     return p
+
+
+def path_kind(mode: int) -> str:
+    """What a file mode (``os.stat(...).st_mode``) is, in words: ``"a FIFO (named pipe)"``, ``"a folder"`` ..."""
+    for test, words in ((stat.S_ISREG, "a regular file"), (stat.S_ISDIR, "a folder"),
+                        (stat.S_ISLNK, "a symbolic link"), (stat.S_ISFIFO, "a FIFO (named pipe)"),
+                        (stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"),
+                        (stat.S_ISSOCK, "a socket")):
+        if test(mode):
+            return words
+    return "not a regular file"
+
+
+def describe_bytes(data: bytes | str) -> str:
+    """Describe content for an error message without quoting it: ``"empty"``, ``"text"`` or ``"binary data"``.
+
+    Messages never echo file contents (they may be binary, huge or private); they say what kind of content it is."""
+    if not data:
+        return "empty"
+    sample = data[:4096].encode("utf-8", "replace") if isinstance(data, str) else data[:4096]
+    try:
+        text = sample.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        if exc.start < len(sample) - 3:  # not just a multi-byte character cut at the sample's end
+            return "binary data"
+        text = sample[:exc.start].decode("utf-8")
+    controls = sum(1 for c in text if ord(c) < 32 and c not in "\t\n\r\f")
+    return "binary data" if controls else "text"
 
 
 def open_file(path: PathLike):
@@ -125,7 +153,7 @@ def parse_int(path: PathLike, token: bytes | str, what: str) -> int:
         text = token.decode("ascii") if isinstance(token, bytes) else token
         return int(text.strip())
     except (ValueError, UnicodeDecodeError):
-        raise ReadError(path, f"{what} {token[:40]!r} is not an integer") from None
+        raise ReadError(path, f"{what} is {describe_bytes(token)}, not an integer") from None
 
 
 def parse_float(path: PathLike, token: bytes | str, what: str, positive: bool = False) -> float:
@@ -133,7 +161,7 @@ def parse_float(path: PathLike, token: bytes | str, what: str, positive: bool = 
         text = token.decode("ascii") if isinstance(token, bytes) else token
         value = float(text.strip().replace("D", "E").replace("d", "e"))
     except (ValueError, UnicodeDecodeError):
-        raise ReadError(path, f"{what} {token[:40]!r} is not a number") from None
+        raise ReadError(path, f"{what} is {describe_bytes(token)}, not a number") from None
     if not np.isfinite(value):
         raise ReadError(path, f"{what} is {value}, not a finite number")
     if positive and value <= 0:

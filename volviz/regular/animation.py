@@ -34,8 +34,6 @@ from __future__ import annotations
 
 import json
 import math
-import os
-import shutil
 import tempfile
 import zlib
 from dataclasses import dataclass
@@ -45,6 +43,7 @@ from typing import Any, Callable, Sequence
 import numpy as np
 from numba import njit
 
+from volviz.io.atomic import new_temp_dir, recover_directory, replace_directory
 from volviz.io.errors import ReadError
 from volviz.model.datasets import RegularVolume, TimeSeries
 
@@ -371,9 +370,8 @@ def compress_series(series: TimeSeries | Sequence[np.ndarray | RegularVolume], p
 
     b_res = (mode == "lossless") if b_residual is None else bool(b_residual)
     path = Path(path)
-    tmp = path.with_name(path.name + ".tmp")
-    shutil.rmtree(tmp, ignore_errors=True)
-    tmp.mkdir(parents=True)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = new_temp_dir(path)  # the new store is written beside the old one, which stays until it is complete
     kw: dict[str, Any] = {"mode": mode} if mode == "lossless" else {"quality": quality}
     records: dict[int, dict[str, Any]] = {}
 
@@ -406,15 +404,14 @@ def compress_series(series: TimeSeries | Sequence[np.ndarray | RegularVolume], p
             "pattern": pattern.upper(), "mode": mode, "quality": quality, "b_residual": b_res, "search": search,
             "storage": [records[i] for i in range(n)]}
     (tmp / "series.json").write_text(json.dumps(meta, indent=1))
-    if path.exists():
-        shutil.rmtree(path)
-    os.replace(tmp, path)
+    replace_directory(tmp, path)  # a kill at any moment leaves one complete store (recovered on the next open)
     return series_info(path)
 
 
 # -- decoder and player ----------------------------------------------------------------------------------------------
 def _read_meta(path: Path) -> dict[str, Any]:
     name = str(path)
+    recover_directory(path)  # a replacement interrupted by a kill: put the old store back or finish the swap
     try:
         meta = json.loads((path / "series.json").read_text())
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
