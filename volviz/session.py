@@ -5,6 +5,13 @@ scene components and their settings, transfer functions, camera, camera paths an
 window layout. Loading validates every field and names the offending one (``components[1].opacity: ...``); a newer
 version is refused; older versions are migrated step by step through ``MIGRATIONS``. Nothing read is executed or
 unpickled: the file is parsed with ``json`` and every value is checked against the schema below.
+
+Untrusted files cannot make loading slow, deep or large: the file must be a regular file (a FIFO or device is refused
+before it is opened, so it can never block the reader) of at most ``MAX_SESSION_BYTES``; before parsing, a scan of
+the bytes bounds the nesting depth (``MAX_DEPTH``) and the number of values (``MAX_VALUES``); while parsing, numbers
+longer than ``MAX_NUMBER_CHARS`` are refused; after parsing, every string, key, list and object is held to
+``MAX_STRING_CHARS``, ``MAX_KEY_CHARS`` and ``MAX_ITEMS``. Messages name the file and the field and describe bad
+values instead of quoting them (only short identifiers are quoted).
 """
 from __future__ import annotations
 
@@ -12,15 +19,27 @@ import copy
 import json
 import math
 import os
+import re
+import stat
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable
 
-from volviz.io.atomic import atomic_write_bytes
+import numpy as np
+
+from volviz.io._checks import path_kind
+from volviz.io.atomic import OutputPathError, atomic_write_bytes
 
 FORMAT = "volviz-session"
 VERSION = 1
-MAX_SESSION_BYTES = 64 * 1024 * 1024
+MAX_SESSION_BYTES = 16 * 1024 * 1024  # ample for MAX_VALUES values
+MAX_DEPTH = 64               # nesting of lists and objects
+MAX_VALUES = 1_000_000       # values (numbers, strings, lists, objects) in the whole document
+MAX_ITEMS = 65_536           # items of one list or members of one object (transfer-function points, camera keys)
+MAX_NUMBER_CHARS = 100       # characters of one number (Python would parse a 5000-digit integer, slowly)
+MAX_STRING_CHARS = 65_536    # characters of one string value
+MAX_KEY_CHARS = 128          # characters of one object key (keys appear in field paths of error messages)
+MAX_OPTION_ITEMS = 16        # items of a list-valued dataset option (dims, spacing, ...)
 
 COMPONENT_TYPES = ("volume", "mesh", "isosurface", "terrain", "fog", "clouds", "sky", "demo")
 RENDER_METHODS = ("auto", "pt", "reference", "vtk")
@@ -123,7 +142,7 @@ class _Reader:
         if not isinstance(value, str):
             raise self.fail(where, f"expected a string, got {_kind(value)}")
         if choices is not None and value not in choices:
-            raise self.fail(where, f"expected one of {', '.join(choices)}, got {value!r}")
+            raise self.fail(where, f"expected one of {', '.join(choices)}, got {_quote(value)}")
         return value
 
     def boolean(self, value: Any, where: str) -> bool:
@@ -187,8 +206,19 @@ def _kind(value: Any) -> str:
     if isinstance(value, (int, float)):
         return repr(value)
     if isinstance(value, str):
-        return f"the string {value[:40]!r}"
+        return f"the string {_quote(value)}" if _SAFE_TEXT.match(value) else _quote(value)
     return {dict: "an object", list: "a list"}.get(type(value), type(value).__name__)
+
+
+_SAFE_TEXT = re.compile(r"[A-Za-z0-9_.:+/ -]{1,40}\Z")
+
+
+def _quote(text: str) -> str:
+    """A string from the file for a message: a short identifier is quoted (it is what the user wrote and needs to
+    find); anything else is described, never echoed."""
+    if _SAFE_TEXT.match(text):
+        return repr(text)
+    return "an empty string" if not text else f"a string of {len(text)} characters"
 
 
 def _validate_transfer_function(reader: _Reader, value: Any, where: str) -> dict[str, Any]:
@@ -218,11 +248,13 @@ def session_from_dict(doc: Any, source: str | os.PathLike | None = None) -> Sess
         o = r.obj(item, where)
         r.known_keys(o, where, {"id", "path", "options"})
         ref = DatasetRef(id=r.string(o.get("id"), f"{where}.id"), path=r.string(o.get("path"), f"{where}.path"),
-                         options=r.json_value(r.obj(o.get("options", {}), f"{where}.options"), f"{where}.options"))
+                         options=_read_options(r, o.get("options", {}), f"{where}.options"))
         if not ref.path:
             raise r.fail(f"{where}.path", "must not be empty")
+        if "\0" in ref.path or len(ref.path) > 4096:
+            raise r.fail(f"{where}.path", "is not a usable file name (NUL character or over 4096 characters)")
         if ref.id in ids:
-            raise r.fail(f"{where}.id", f"duplicate dataset id {ref.id!r}")
+            raise r.fail(f"{where}.id", f"duplicate dataset id {_quote(ref.id)}")
         ids.add(ref.id)
         session.datasets.append(ref)
 
@@ -246,12 +278,12 @@ def session_from_dict(doc: Any, source: str | os.PathLike | None = None) -> Sess
             settings=r.json_value(r.obj(o.get("settings", {}), f"{where}.settings"), f"{where}.settings"),
         )
         if comp.id in component_ids:
-            raise r.fail(f"{where}.id", f"duplicate component id {comp.id!r}")
+            raise r.fail(f"{where}.id", f"duplicate component id {_quote(comp.id)}")
         component_ids.add(comp.id)
         if comp.dataset is not None and comp.dataset not in ids:
-            raise r.fail(f"{where}.dataset", f"no dataset with id {comp.dataset!r}")
+            raise r.fail(f"{where}.dataset", f"no dataset with id {_quote(comp.dataset)}")
         if comp.transfer_function is not None and comp.transfer_function not in session.transfer_functions:
-            raise r.fail(f"{where}.transfer_function", f"no transfer function named {comp.transfer_function!r}")
+            raise r.fail(f"{where}.transfer_function", f"no transfer function named {_quote(comp.transfer_function)}")
         session.components.append(comp)
 
     if d.get("camera") is not None:
@@ -287,6 +319,36 @@ def session_from_dict(doc: Any, source: str | os.PathLike | None = None) -> Sess
     session.layout = r.json_value(r.obj(d.get("layout", {}), "layout"), "layout")
     session.clip = _read_clip(r, d.get("clip", {"planes": [], "box": None}))
     return session
+
+
+def _read_options(r: _Reader, value: Any, where: str) -> dict[str, Any]:
+    """Dataset options go to a reader as keyword arguments: names are identifiers and values are plain data only
+    (strings, finite numbers, booleans, null, or short lists of those). Which options a reader takes is the reader
+    registry's business, checked when the dataset is read."""
+    options = r.obj(value, where)
+    out: dict[str, Any] = {}
+    for key, item in options.items():
+        at = f"{where}.{key}"
+        if not _OPTION_NAME.match(key):
+            raise r.fail(where, "option names are identifiers (letters, digits and _, at most 64 characters)")
+        if isinstance(item, list):
+            if len(item) > MAX_OPTION_ITEMS:
+                raise r.fail(at, f"a list of {len(item)} items; an option list holds at most {MAX_OPTION_ITEMS}")
+            out[key] = [_option_scalar(r, v, f"{at}[{i}]") for i, v in enumerate(item)]
+        else:
+            out[key] = _option_scalar(r, item, at)
+    return out
+
+
+_OPTION_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]{0,63}\Z")
+
+
+def _option_scalar(r: _Reader, value: Any, where: str) -> Any:
+    if value is None or isinstance(value, (bool, str)):
+        return value
+    if isinstance(value, (int, float)):
+        return r.number(value, where) if isinstance(value, float) else value
+    raise r.fail(where, f"expected a string, number, boolean or null, got {_kind(value)}")
 
 
 def _read_clip(r: _Reader, value: Any) -> dict[str, Any]:
@@ -382,12 +444,65 @@ def relative_path(session_file: str | os.PathLike, dataset_path: str | os.PathLi
 
 
 def loads(text: str, source: str | os.PathLike | None = None) -> Session:
+    """Parse and validate a session document held in memory (see :func:`load` for files)."""
     src = None if source is None else str(source)
+    _check_structure(text.encode("utf-8", "surrogatepass"), src)
     try:
         doc = json.loads(text, parse_constant=lambda name: _reject_constant(name, src))
     except json.JSONDecodeError as exc:
         raise SessionError(src, f"not valid JSON: {exc.msg} at line {exc.lineno} column {exc.colno}") from None
+    except (RecursionError, ValueError, MemoryError) as exc:  # bounded by _check_structure; kept as a last guard
+        raise SessionError(src, f"cannot be parsed ({type(exc).__name__})") from None
+    _check_sizes(doc, src)
     return session_from_dict(migrate(doc, src), src)
+
+
+_STRING = re.compile(rb'"[^"]*"')
+_NUMBER_CHARS = bytes.maketrans(b"-+0123456789.eE", b"#" * 15)
+_NOT_BRACKETS = bytes(c for c in range(256) if c not in b"[]{}")
+_DEPTH_STEP = np.zeros(256, np.int8)
+_DEPTH_STEP[[ord("["), ord("{")]] = 1
+_DEPTH_STEP[[ord("]"), ord("}")]] = -1
+
+
+def _check_structure(data: bytes, source: str | None) -> None:
+    """Bound value count, number length and nesting depth before ``json`` sees the text, with C-speed scans of the
+    bytes between strings (no Python work per value): a hostile file is refused without deep recursion, slow
+    big-number conversion or a huge allocation."""
+    if b"\\" in data:  # drop escaped backslashes and quotes, so that every remaining quote opens or closes a string
+        data = data.replace(b"\\\\", b"").replace(b'\\"', b"")
+    outside = _STRING.sub(b"", data)
+    values = outside.count(b",") + outside.count(b"[") + outside.count(b"{") + 1
+    if values > MAX_VALUES:
+        raise SessionError(source, f"holds about {values} values; a session holds at most {MAX_VALUES}")
+    if b"#" * (MAX_NUMBER_CHARS + 1) in outside.translate(_NUMBER_CHARS, b"#"):
+        raise SessionError(source, f"holds a number longer than {MAX_NUMBER_CHARS} characters")
+    brackets = np.frombuffer(outside.translate(None, _NOT_BRACKETS), np.uint8)
+    if brackets.size:
+        depth = int(np.cumsum(_DEPTH_STEP[brackets], dtype=np.int32).max())
+        if depth > MAX_DEPTH:
+            raise SessionError(source, f"nests lists and objects {depth} deep; at most {MAX_DEPTH} are allowed")
+
+
+def _check_sizes(doc: Any, source: str | None) -> None:
+    """Every string, key, list and object of a parsed document within its limit; names the field that is not."""
+    stack: list[tuple[Any, str]] = [(doc, "")]
+    while stack:
+        value, where = stack.pop()
+        if isinstance(value, (dict, list)) and len(value) > MAX_ITEMS:
+            raise SessionError(source, f"holds {len(value)} items; at most {MAX_ITEMS} are allowed", where or None)
+        if isinstance(value, dict):
+            for key, item in value.items():
+                if len(key) > MAX_KEY_CHARS or not key.isprintable():
+                    raise SessionError(source, f"has a key of {len(key)} characters; keys are at most "
+                                               f"{MAX_KEY_CHARS} printable characters", where or None)
+                if isinstance(item, (dict, list, str)):
+                    stack.append((item, f"{where}.{key}" if where else key))
+        elif isinstance(value, list):
+            stack.extend((item, f"{where}[{i}]") for i, item in enumerate(value) if isinstance(item, (dict, list, str)))
+        elif len(value) > MAX_STRING_CHARS:
+            raise SessionError(source, f"is a string of {len(value)} characters; at most {MAX_STRING_CHARS}",
+                               where or None)
 
 
 def _reject_constant(name: str, source: str | None) -> None:
@@ -395,24 +510,57 @@ def _reject_constant(name: str, source: str | None) -> None:
 
 
 def load(path: str | os.PathLike) -> Session:
-    """Read and validate a session file. Raises ``SessionError`` naming the file and the offending field."""
+    """Read and validate a session file. Raises ``SessionError`` naming the file and the offending field.
+
+    Only a regular file is opened (a FIFO or device would block or never end); dataset paths that name a folder,
+    FIFO or device are refused too (missing ones are reported when the dataset is read)."""
     p = Path(path)
-    if not p.exists():
-        raise SessionError(p, "no such file")
-    if p.is_dir():
-        raise SessionError(p, "is a folder, not a session file")
-    try:
-        size = p.stat().st_size
-        if size > MAX_SESSION_BYTES:
-            raise SessionError(p, f"is {size} bytes; a session file is at most {MAX_SESSION_BYTES} bytes")
-        data = p.read_bytes()
-    except OSError as exc:
-        raise SessionError(p, f"cannot be read: {exc.strerror or exc}") from None
+    data = _read_regular(p)
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError:
-        raise SessionError(p, "is not UTF-8 text") from None
-    return loads(text, p)
+        raise SessionError(p, "is not UTF-8 text (binary data)") from None
+    session = loads(text, p)
+    for i, ref in enumerate(session.datasets):
+        _check_dataset_path(p, ref.path, f"datasets[{i}].path")
+    return session
+
+
+def _read_regular(p: Path) -> bytes:
+    try:
+        mode = os.stat(p).st_mode
+    except FileNotFoundError:
+        raise SessionError(p, "no such file") from None
+    except (OSError, ValueError) as exc:
+        raise SessionError(p, f"cannot be read: {getattr(exc, 'strerror', None) or exc}") from None
+    if stat.S_ISDIR(mode):
+        raise SessionError(p, "is a folder, not a session file")
+    if not stat.S_ISREG(mode):
+        raise SessionError(p, f"is {path_kind(mode)}, not a session file")
+    try:  # O_NONBLOCK: should the path have become a FIFO since the stat, opening it does not wait for a writer
+        fd = os.open(p, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
+        with os.fdopen(fd, "rb") as handle:
+            st = os.fstat(handle.fileno())
+            if not stat.S_ISREG(st.st_mode):
+                raise SessionError(p, f"is {path_kind(st.st_mode)}, not a session file")
+            if st.st_size > MAX_SESSION_BYTES:
+                raise SessionError(p, f"is {st.st_size} bytes; a session file is at most {MAX_SESSION_BYTES} bytes")
+            data = handle.read(MAX_SESSION_BYTES + 1)
+    except OSError as exc:
+        raise SessionError(p, f"cannot be read: {exc.strerror or exc}") from None
+    if len(data) > MAX_SESSION_BYTES:
+        raise SessionError(p, f"is over {MAX_SESSION_BYTES} bytes; a session file is at most that")
+    return data
+
+
+def _check_dataset_path(session_file: Path, stored: str, where: str) -> None:
+    """A dataset path that exists must not be a folder, FIFO or device (those would be refused or block later)."""
+    try:
+        mode = os.stat(resolve_path(session_file, stored)).st_mode
+    except (OSError, ValueError, RuntimeError):  # missing (reported when read), a pattern, or unresolvable
+        return
+    if not stat.S_ISREG(mode):
+        raise SessionError(session_file, f"is {path_kind(mode)}, not a data file", where)
 
 
 def dumps(session: Session) -> str:
@@ -429,5 +577,7 @@ def save(session: Session, path: str | os.PathLike) -> None:
     session_from_dict(json.loads(text), p)  # never write what could not be read back
     try:
         atomic_write_bytes(p, text.encode("utf-8"))
+    except OutputPathError as exc:
+        raise SessionError(p, f"cannot be written: {exc.problem}") from None
     except OSError as exc:
         raise SessionError(p, f"cannot be written: {exc.strerror or exc}") from None
