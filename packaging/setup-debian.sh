@@ -26,6 +26,10 @@ PYTHON=${PYTHON:-python3}
 [ -x .venv/bin/python ] || "$PYTHON" -m venv .venv
 .venv/bin/python -m pip install -q --upgrade pip
 .venv/bin/python -m pip install -q -e ".[test]"
+# volviz's own optional plugins (plugins/*: extra readers, the Dask compression backend), each its own distribution
+for plugin in plugins/*/pyproject.toml; do
+  .venv/bin/python -m pip install -q -e "$(dirname "$plugin")"
+done
 # Compile the Numba kernels once, now, into their on-disk cache: the first scene, first test or first benchmark does
 # not pay for it (about two minutes on 2 cores; seconds when the cache is already there).
 .venv/bin/volviz warmup || echo "warning: volviz warmup failed (see above); kernels will compile at first use" >&2

@@ -121,7 +121,9 @@ def _sniff_metaimage(head: bytes) -> bool:
 
 
 def _sniff_vtk_xml(head: bytes) -> bool:
-    return head.lstrip().startswith((b"<?xml", b"<VTKFile")) and b"<VTKFile" in head
+    m = re.search(rb'<VTKFile[^>]*\btype="([A-Za-z]+)"', head)
+    return m is not None and m.group(1) in (b"ImageData", b"UnstructuredGrid", b"StructuredGrid", b"RectilinearGrid",
+                                            b"PolyData")
 
 
 def read_plot3d_auto(path: PathLike, q: PathLike | None = None, **options: Any):
