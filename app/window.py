@@ -23,10 +23,15 @@ from volviz_app.clip_widget import ClipPlaneWidget
 from volviz_app.docks.clipping import ClippingDock
 from volviz_app.docks.render_settings import RENDERER_DEFAULTS, RenderSettings
 from volviz_app.gc_guard import GuiThreadCollector
+from volviz_app.help import HelpMenu
+from volviz_app.errors import open_error
+from volviz_app.layout import WindowLayout, scrolled
+from volviz_app.recent import RecentFiles
 from volviz_app.docks.scene_tree import SceneTree
 from volviz_app.docks.statistics import Statistics
 from volviz_app.docks.tf_editor import TransferFunctionEditor
 from volviz_app.docks.timeline import Timeline
+from volviz_app.drop import FileDrop
 from volviz_app.navigation import FlyMode
 from volviz_app.workers import JobBridge
 
@@ -38,7 +43,6 @@ PREVIEW_MS = 40          # live transfer-function preview: at most one re-render
 RESIZE_MS = 200          # overlays re-render once the viewport stopped resizing for 200 ms
 FLY_SETTLE_MS = 300      # fly mode: full-size images once no key moved the camera for 300 ms
 RECORD_MS = 250          # camera-path recording samples the camera four times a second
-MAX_RECENT = 8
 STAGE_MS = 30            # pause between GUI-thread stages of showing a new scene (other events run in between)
 
 
@@ -122,7 +126,6 @@ class MainWindow(QMainWindow):
         from pyvistaqt import QtInteractor
 
         self.setWindowTitle("volviz")
-        self.resize(1280, 820)
         _import_gui_thread_modules()
         self.collector = GuiThreadCollector(self)  # cycles are freed on this thread, never in a worker
         self.settings = settings or QSettings("volviz", "volviz")
@@ -169,6 +172,8 @@ class MainWindow(QMainWindow):
         self._build_docks()
         self._build_menus()
         self._build_status_bar()
+        self.resize(*self.layout_keeper.default_size())
+        self.layout_keeper.restore()
         self.fly = FlyMode(self.plotter, on_camera_moved=self._fly_moved)
         # fly mode has no end-of-interaction event: the camera has stopped once no key moved it for a while
         self.fly_settle_timer = QTimer(self, singleShot=True, interval=FLY_SETTLE_MS)
@@ -191,11 +196,10 @@ class MainWindow(QMainWindow):
         self.collector.freeze_long_lived()
 
     # ------------------------------------------------------------------------------------------------ construction
-    def _dock(self, title: str, name: str, widget: QWidget, area: Qt.DockWidgetArea) -> QDockWidget:
+    def _dock(self, title: str, name: str, widget: QWidget, scroll: bool = True) -> QDockWidget:
         dock = QDockWidget(title, self)
         dock.setObjectName(name)
-        dock.setWidget(widget)
-        self.addDockWidget(area, dock)
+        dock.setWidget(scrolled(widget) if scroll else widget)
         return dock
 
     def _build_docks(self) -> None:
@@ -205,17 +209,17 @@ class MainWindow(QMainWindow):
         self.timeline = Timeline()
         self.statistics = Statistics()
         self.clipping = ClippingDock()
-        right, left, bottom = (Qt.DockWidgetArea.RightDockWidgetArea, Qt.DockWidgetArea.LeftDockWidgetArea,
-                               Qt.DockWidgetArea.BottomDockWidgetArea)
-        self.tf_dock = self._dock("Transfer function", "tfDock", self.tf_editor, right)
-        self.scene_dock = self._dock("Scene", "sceneDock", self.scene_tree, left)
-        self.settings_dock = self._dock("Render settings", "settingsDock", self.render_settings, left)
-        self.timeline_dock = self._dock("Timeline", "timelineDock", self.timeline, bottom)
-        self.stats_dock = self._dock("Statistics", "statsDock", self.statistics, right)
-        self.clip_dock = self._dock("Clipping", "clipDock", self.clipping, right)
-        self.tabifyDockWidget(self.stats_dock, self.clip_dock)
+        self.tf_dock = self._dock("Transfer function", "tfDock", self.tf_editor)
+        self.scene_dock = self._dock("Scene", "sceneDock", self.scene_tree)
+        self.settings_dock = self._dock("Render settings", "settingsDock", self.render_settings)
+        self.timeline_dock = self._dock("Timeline", "timelineDock", self.timeline, scroll=False)
+        self.stats_dock = self._dock("Statistics", "statsDock", self.statistics)
+        self.clip_dock = self._dock("Clipping", "clipDock", self.clipping)
         self.docks = [self.tf_dock, self.scene_dock, self.settings_dock, self.timeline_dock, self.stats_dock,
                       self.clip_dock]
+        self.layout_keeper = WindowLayout(self, self.settings, [self.tf_dock, self.scene_dock, self.settings_dock,
+                                                                self.clip_dock, self.stats_dock], [self.timeline_dock])
+        self.layout_keeper.arrange()
 
         self.tf_editor.changed.connect(self._tf_changed)
         self.tf_editor.committed.connect(self._tf_committed)
@@ -265,6 +269,8 @@ class MainWindow(QMainWindow):
         for dock in self.docks:
             view_menu.addAction(dock.toggleViewAction())
         view_menu.addSeparator()
+        self._action(view_menu, "Reset &Layout", "", self.layout_keeper.reset)
+        view_menu.addSeparator()
         self.action_fly = self._action(view_menu, "&Fly Mode", "F", self.set_fly_mode)
         self.action_fly.setCheckable(True)
         self._action(view_menu, "&Reset Camera", "R", self.reset_camera)
@@ -275,7 +281,9 @@ class MainWindow(QMainWindow):
         camera_menu.addSeparator()
         self.action_record = self._action(camera_menu, "&Record Camera Path", "Ctrl+R", self.set_recording)
         self.action_record.setCheckable(True)
-        self._refresh_recent_menu()
+        self.help = HelpMenu(self, self.menuBar().addMenu("&Help"), self.plotter.ren_win)
+        self.recent = RecentFiles(self.settings, self.recent_menu, self.open_path)
+        self.file_drop = FileDrop([self, self.plotter.interactor], self.open_path)
 
     def _activate_undo_stack(self, stack: Any) -> None:
         import shiboken6
@@ -322,27 +330,25 @@ class MainWindow(QMainWindow):
         from volviz.session import load
 
         p = Path(path)
-        if not p.exists():
-            self.show_error("Cannot open", f"{p}: no such file")
+        try:
+            if not p.exists():
+                raise FileNotFoundError(p)
+            session, session_path = (load(p), p) if is_session_file(p) else (data_session(p), None)
+        except Exception as exc:  # the file's fault or ours: a message in the user's terms, the scene stays
+            self.show_error(f"Cannot open {p.name}", open_error(p, exc))
             return
-        if is_session_file(p):
-            try:
-                session = load(p)
-            except SessionError as exc:
-                self.show_error("Cannot open session", str(exc))
-                return
-            self._show_session(session, p, p.name)
-        else:
-            self._show_session(data_session(p), None, p.name)
-        self._add_recent(p)
+        # File > Open Recent lists it once it has opened
+        self._show_session(session, session_path, p.name, path=p, on_shown=lambda: self.recent.add(p))
 
     def _show_session(self, session: Session, session_path: Optional[Path], title: str,
-                      dirty: bool = False, datasets: Optional[dict[str, Any]] = None) -> None:
+                      dirty: bool = False, datasets: Optional[dict[str, Any]] = None, path: Optional[Path] = None,
+                      on_shown: Optional[Callable[[], None]] = None) -> None:
         """Show ``session``: its datasets are read (unless ``datasets`` are given) and the scene prepared in the
         background (``SceneController.prepare``: reading, extraction, tetrahedralisation, natural scene), with
         progress and cancel in the status bar; then the props are added on this thread (``install``) and the
         view-dependent parts computed in the background. A newer open supersedes an older one; the current scene
-        stays until the new one is ready."""
+        stays until the new one is ready, and stays on when the new one fails (a message names ``path``, the file
+        opened, and what is wrong with it). ``on_shown()`` runs once the new scene is installed."""
         from volviz.render.controller import SceneController
         from volviz.render.scene import load_datasets
 
@@ -371,31 +377,39 @@ class MainWindow(QMainWindow):
             if outcome.error is not None:
                 self._set_busy(False)
                 self.status_label.setText(f"Could not load {title}")
-                self.show_error(f"Cannot open {title}", str(outcome.error))
+                self.show_error(f"Cannot open {title}", open_error(path, outcome.error, title))
                 return
-            self._install_session(controller, outcome.result, session_path, title, dirty, serial)
+            if self._install_session(controller, outcome.result, session_path, title, dirty, serial, path) and on_shown:
+                on_shown()
 
         self._current_job = self.jobs.submit(load, name=f"load {title}", key="load", on_done=done)
 
     def _install_session(self, controller: Any, prepared: Any, session_path: Optional[Path], title: str,
-                         dirty: bool, serial: int) -> None:
+                         dirty: bool, serial: int, path: Optional[Path] = None) -> bool:
         """GUI thread: replace the shown scene by a prepared one (no numerics here: props added, docks filled, one
-        render), then compute its view-dependent parts in the background; loading ends when they are shown."""
+        render), then compute its view-dependent parts in the background; loading ends when they are shown. A scene
+        that cannot be installed is taken out again and the previous one rebuilt (False)."""
         session = controller.session
-        if self.controller is not None:
+        previous = self.controller
+        camera = previous.camera() if previous is not None else None  # install places the new scene's camera
+        if previous is not None:
             self.controller.clear()
         self.plotter.clear()
         self._current_job = None
         try:
             controller.install(prepared, views=False)
-        except Exception as exc:  # a scene that cannot be shown must not take the window down
+        except Exception as exc:  # a scene that cannot be shown must not take the window down, nor the old scene
             log.exception("building the scene for %s failed", title)
             controller.clear()
             self.controller = None
             self._set_busy(False)
             self.status_label.setText(f"Could not show {title}")
-            self.show_error(f"Cannot show {title}", str(exc))
-            return
+            self.show_error(f"Cannot open {title}", open_error(path, exc, title))
+            if previous is not None:  # the window's state still describes it: show it again, same camera
+                self.session.camera = camera
+                self._show_session(self.session, self.session_path, getattr(self, "title", ""), self.dirty,
+                                   datasets=self.datasets)
+            return False
         self.session, self.session_path, self.datasets = session, session_path, controller.datasets
         self.controller = controller
         if "window_state" in session.layout:
@@ -423,6 +437,7 @@ class MainWindow(QMainWindow):
         # ms for a big PT scene under load
         QTimer.singleShot(STAGE_MS, lambda: self.controller is controller and self.render())
         QTimer.singleShot(2 * STAGE_MS, lambda: self._show_first_views(controller, serial, title))
+        return True
 
     def _show_first_views(self, controller: Any, serial: int, title: str) -> None:
         """Compute the new scene's view-dependent parts in the background (natural scene, LOD blocks, PT volumes,
@@ -1194,7 +1209,7 @@ class MainWindow(QMainWindow):
         self.session, self.session_path = session, target
         if self.controller is not None:
             self.controller.session = session
-        self._add_recent(target)
+        self.recent.add(target)
         self.set_dirty(False)
         self.clear_recovery()
         self.status_label.setText(f"Saved {target.name}")
@@ -1203,7 +1218,12 @@ class MainWindow(QMainWindow):
     # -- autosave and recovery ------------------------------------------------------------------------------------
     @property
     def recovery_file(self) -> Path:
-        return self.recovery_dir / "recovery.json"
+        """This window's own recovery file (``volviz_app.recovery``): other windows never write or delete it."""
+        from volviz_app.recovery import window_file
+
+        if "_own_recovery_file" not in self.__dict__:
+            self.__dict__["_own_recovery_file"] = window_file(self.recovery_dir)
+        return self.__dict__["_own_recovery_file"]
 
     def autosave(self) -> bool:
         """Write the current state to the recovery file (only when there are unsaved changes)."""
@@ -1226,8 +1246,11 @@ class MainWindow(QMainWindow):
         self.recovery_file.unlink(missing_ok=True)
 
     def offer_recovery(self) -> bool:
-        """If a previous run left a recovery file, ask (without blocking) whether to restore it."""
-        if not self.recovery_file.exists():
+        """If a crashed window (its process is gone) left a recovery file, claim it as this window's own and ask
+        (without blocking) whether to restore it."""
+        from volviz_app.recovery import claim, orphaned
+
+        if not any(claim(orphan, self.recovery_file) for orphan in orphaned(self.recovery_dir)):
             return False
         box = QMessageBox(QMessageBox.Icon.Question, "Recover unsaved work",
                           "volviz did not shut down cleanly last time. Restore the unsaved work it kept?",
@@ -1259,25 +1282,9 @@ class MainWindow(QMainWindow):
                 ref.path = relative_path(origin, resolve_path(self.recovery_file, ref.path))
         self._show_session(session, Path(origin) if origin else None, "recovered session", dirty=True)
 
-    # -- recent files ------------------------------------------------------------------------------------------------
     def recent_files(self) -> list[str]:
-        value = self.settings.value("recent_files", [])
-        if isinstance(value, str):
-            value = [value]
-        return [str(v) for v in (value or [])]
-
-    def _add_recent(self, path: Path) -> None:
-        entry = str(Path(path).resolve())
-        files = [entry] + [f for f in self.recent_files() if f != entry]
-        self.settings.setValue("recent_files", files[:MAX_RECENT])
-        self._refresh_recent_menu()
-
-    def _refresh_recent_menu(self) -> None:
-        self.recent_menu.clear()
-        for f in self.recent_files():
-            action = self.recent_menu.addAction(f)
-            action.triggered.connect(lambda checked=False, p=f: self.open_path(p))
-        self.recent_menu.setEnabled(bool(self.recent_files()))
+        """File > Open Recent: the files that opened, newest first (``volviz_app.recent``)."""
+        return self.recent.files()
 
     # ------------------------------------------------------------------------------------------------ export
     def export_screenshot(self, path: str | os.PathLike, size: Optional[tuple[int, int]] = None) -> None:
@@ -1340,8 +1347,9 @@ class MainWindow(QMainWindow):
     # ------------------------------------------------------------------------------------------------ dialogs
     def ask_file(self, title: str, name_filter: str, on_chosen: Any, save: bool = False,
                  default_name: str = "") -> QFileDialog:
-        """A non-blocking file dialog (kept as ``self.file_dialog``); ``on_chosen(path)`` runs when accepted."""
-        dialog = QFileDialog(self, title, "", name_filter)
+        """A non-blocking file dialog (kept as ``self.file_dialog``) that starts in the folder used last;
+        ``on_chosen(path)`` runs when accepted."""
+        dialog = QFileDialog(self, title, self.recent.last_folder(), name_filter)
         dialog.setOption(QFileDialog.Option.DontUseNativeDialog, True)
         if save:
             dialog.setAcceptMode(QFileDialog.AcceptMode.AcceptSave)
@@ -1350,7 +1358,7 @@ class MainWindow(QMainWindow):
                 dialog.selectFile(default_name)
         else:
             dialog.setFileMode(QFileDialog.FileMode.ExistingFile)
-        dialog.fileSelected.connect(lambda path: path and on_chosen(path))
+        dialog.fileSelected.connect(lambda path: path and (self.recent.remember_folder(path), on_chosen(path)))
         dialog.open()
         self.file_dialog = dialog
         return dialog
@@ -1445,6 +1453,7 @@ class MainWindow(QMainWindow):
                 event.ignore()
                 return
         self.clear_recovery()
+        self.layout_keeper.save()
         self.autosave_timer.stop()
         self.preview_timer.stop()
         self.record_timer.stop()

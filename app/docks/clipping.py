@@ -15,6 +15,8 @@ from PySide6.QtGui import QUndoCommand, QUndoStack
 from PySide6.QtWidgets import (QCheckBox, QDoubleSpinBox, QFormLayout, QGroupBox, QHBoxLayout, QListWidget,
                                QPushButton, QVBoxLayout, QWidget)
 
+from volviz_app.docks import set_tooltips
+
 NO_CLIP: dict[str, Any] = {"planes": [], "box": None}
 LIMIT = 1e9
 
@@ -24,6 +26,7 @@ def _spin(decimals: int = 4) -> QDoubleSpinBox:
     box.setRange(-LIMIT, LIMIT)
     box.setDecimals(decimals)
     box.setKeyboardTracking(False)  # typed values apply on Enter / focus out, not per keystroke
+    box.setMinimumWidth(64)         # not as wide as the longest value of the range: three fit in a narrow dock
     return box
 
 
@@ -89,6 +92,22 @@ class ClippingDock(QWidget):
         self.box_hi = [_spin() for _ in range(3)]
         self.undo_button = QPushButton("Undo")
         self.redo_button = QPushButton("Redo")
+        self.show_widget.setText("Drag in the viewport")
+        set_tooltips(
+            (self.show_widget, "Show the selected plane and the box in the viewport, where they can be dragged"),
+            (self.plane_list, "The clipping planes; select one to edit it"),
+            (self.add_button, "Add a plane through the scene's centre"),
+            (self.remove_button, "Remove the selected plane"),
+            (self.flip_button, "Keep the other side of the selected plane"),
+            (self.offset, "The selected plane keeps the points x with x·n ≥ offset"),
+            (self.box_enabled, "Crop the scene to an axis-aligned box"),
+            (self.undo_button, "Undo the last clipping edit"),
+            (self.redo_button, "Redo the clipping edit undone last"),
+            *[(box, f"The {axis} component of the selected plane's normal (it points to the part kept)")
+              for box, axis in zip(self.normal, "xyz")],
+            *[(box, f"The box's {end} {axis} bound")
+              for boxes, end in ((self.box_lo, "lower"), (self.box_hi, "upper")) for box, axis in zip(boxes, "xyz")],
+        )
 
         planes = QGroupBox("Clipping planes (keep x·n ≥ offset)")
         form = QFormLayout(planes)

@@ -50,6 +50,17 @@ class RenderSettings(QWidget):
             box.setRange(16, 16384)
         self.width_box.setValue(1024)
         self.height_box.setValue(768)
+        self.method.setToolTip("Renderer: auto (volviz's PT for meshes, VTK for grids), pt (volviz's pre-integrated "
+                               "projected tetrahedra), reference (exact ray integration, slow), vtk (VTK's mappers)")
+        self.table_kind.setToolTip("Pre-integration table of volviz's renderer: a 3D table, or separable polynomial "
+                                   "tables of degree 1, 2 or 4; auto picks per cell by its optical depth")
+        self.table_resolution.setToolTip("Entries per axis of the pre-integration table (finer: more accurate, "
+                                         "slower to build)")
+        self.sort.setToolTip("Visibility sort of the cells: MPVO (exact for convex meshes), centroid distance, or "
+                             "power distance")
+        self.width_box.setToolTip("Width in pixels of exported screenshots and movies")
+        self.height_box.setToolTip("Height in pixels of exported movies (screenshots keep the viewport's aspect "
+                                   "ratio)")
         form = QFormLayout(self)
         form.addRow("Renderer", self.method)
         form.addRow("Table", self.table_kind)

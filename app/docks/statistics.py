@@ -6,6 +6,14 @@ from typing import Any, Optional
 from PySide6.QtWidgets import QFormLayout, QLabel, QWidget
 
 
+TIPS = {"frame": "Time to draw the last frame, and the frame rate it allows",
+        "split": "Where volviz's renderer spent the last frame: visibility sort, projection, rasterisation",
+        "cells": "Cells of the datasets shown",
+        "method": "The renderer and table that drew the last frame",
+        "error": "Error of the current view measured against the exact reference (8-bit units)",
+        "iso": "The isosurfaces' transparency mode, triangles and drawing time"}
+
+
 class Statistics(QWidget):
     FIELDS = (("frame", "Frame time"), ("split", "Sort / project / raster"), ("cells", "Cells drawn"),
               ("method", "Method"), ("error", "Error estimate"), ("iso", "Isosurfaces"))
@@ -16,6 +24,7 @@ class Statistics(QWidget):
         self.labels: dict[str, QLabel] = {}
         for key, title in self.FIELDS:
             self.labels[key] = QLabel("–")
+            self.labels[key].setToolTip(TIPS[key])
             form.addRow(title, self.labels[key])
 
     def show_stats(self, stats: dict[str, Any]) -> None:

@@ -16,7 +16,10 @@ from PySide6.QtWidgets import (QCheckBox, QColorDialog, QComboBox, QFileDialog, 
                                QPushButton, QSizePolicy, QVBoxLayout, QWidget)
 
 from volviz.optics import TransferFunction
+from volviz_app.docks import set_tooltips
 
+GESTURES = ("Click: add a point · drag a point: move it · right-click: remove it · double-click: "
+            "change its colour")
 POINT_RADIUS = 5.0
 MARGIN = 8.0
 COLOR_BAR_HEIGHT = 18.0
@@ -224,7 +227,19 @@ class TransferFunctionEditor(QWidget):
         self.import_button.clicked.connect(self._ask_import)
         self.export_button.clicked.connect(self._ask_export)
         self.info = QLabel("")
-
+        self.hint = QLabel(GESTURES)
+        self.hint.setWordWrap(True)
+        self.hint.setStyleSheet("color: palette(placeholder-text)")
+        set_tooltips(
+            (self.canvas, GESTURES),
+            (self.presets, "Colour presets: recolour the function over its range (the opacity curve stays)"),
+            (self.fit_button, "Stretch the function over the data's range"),
+            (self.log_box, "Draw the histogram on a logarithmic scale (long-tailed data such as CT)"),
+            (self.undo_button, "Undo the last transfer-function edit"),
+            (self.redo_button, "Redo the transfer-function edit undone last"),
+            (self.import_button, "Take the colours from a ParaView colour map (JSON)"),
+            (self.export_button, "Save the function as a ParaView colour map (JSON)"),
+        )
         row1 = QHBoxLayout()
         for w in (self.presets, self.fit_button, self.log_box):
             row1.addWidget(w)
@@ -236,6 +251,7 @@ class TransferFunctionEditor(QWidget):
         layout.addLayout(row1)
         layout.addLayout(row2)
         layout.addWidget(self.info)
+        layout.addWidget(self.hint)
 
         self.canvas.pointsEdited.connect(self._canvas_edited)
         self.canvas.editFinished.connect(self._canvas_finished)

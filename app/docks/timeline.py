@@ -5,7 +5,7 @@ import time
 from typing import Optional
 
 from PySide6.QtCore import Qt, QTimer, Signal
-from PySide6.QtWidgets import (QCheckBox, QDoubleSpinBox, QHBoxLayout, QLabel, QPushButton, QSlider, QVBoxLayout,
+from PySide6.QtWidgets import (QCheckBox, QDoubleSpinBox, QHBoxLayout, QLabel, QPushButton, QSizePolicy, QSlider,
                                QWidget)
 
 SLIDER_STEPS = 1000
@@ -24,26 +24,37 @@ class Timeline(QWidget):
         self.time = 0.0
         self.play_button = QPushButton("Play")
         self.play_button.setCheckable(True)
-        self.back_button = QPushButton("◀ Step")
-        self.forward_button = QPushButton("Step ▶")
+        self.play_button.setToolTip("Play the time series (again: pause)")
+        self.back_button = QPushButton("◀")
+        self.back_button.setToolTip("Step back to the previous time step")
+        self.forward_button = QPushButton("▶")
+        self.forward_button.setToolTip("Step forward to the next time step")
+        for button in (self.play_button, self.back_button, self.forward_button):
+            button.setMaximumWidth(56)
         self.speed = QDoubleSpinBox()
         self.speed.setRange(0.01, 1000.0)
         self.speed.setValue(1.0)
-        self.speed.setSuffix(" steps/s")
+        self.speed.setSuffix(" /s")
+        self.speed.setToolTip("Playback speed in time steps per second")
         self.loop = QCheckBox("Loop")
         self.loop.setChecked(True)
-        self.interpolate = QCheckBox("4D interpolation")
+        self.loop.setToolTip("Start again from the first step after the last one")
+        self.interpolate = QCheckBox("Interpolate")
         self.interpolate.setChecked(True)
+        self.interpolate.setToolTip("4D interpolation: show the data blended between time steps (off: the nearest "
+                                    "step)")
         self.slider = QSlider(Qt.Orientation.Horizontal)
         self.slider.setRange(0, SLIDER_STEPS)
+        self.slider.setToolTip("Display time: drag to scrub through the series")
         self.label = QLabel("no time series")
-        row = QHBoxLayout()
-        for w in (self.back_button, self.play_button, self.forward_button, self.speed, self.loop, self.interpolate):
+        self.setSizePolicy(QSizePolicy.Policy.Preferred, QSizePolicy.Policy.Fixed)
+        row = QHBoxLayout(self)  # one row: the timeline takes little of the window's height
+        row.setContentsMargins(6, 2, 6, 2)
+        for w in (self.back_button, self.play_button, self.forward_button):
             row.addWidget(w)
-        layout = QVBoxLayout(self)
-        layout.addWidget(self.slider)
-        layout.addLayout(row)
-        layout.addWidget(self.label)
+        row.addWidget(self.slider, 1)
+        for w in (self.label, self.speed, self.loop, self.interpolate):
+            row.addWidget(w)
         self.timer = QTimer(self)
         self.timer.setInterval(33)
         self.timer.timeout.connect(self._tick)
@@ -68,6 +79,7 @@ class Timeline(QWidget):
             self.slider.setValue(0)
             self.slider.blockSignals(False)
             self.label.setText("no time series")
+            self.label.setToolTip("Open a series of numbered files (or a session with one) to play it here")
             return
         self.span = (self.steps[0], self.steps[-1])
         self.set_time(self.steps[0])
@@ -103,7 +115,8 @@ class Timeline(QWidget):
         self.slider.blockSignals(True)
         self.slider.setValue(int(round(frac * SLIDER_STEPS)))
         self.slider.blockSignals(False)
-        self.label.setText(f"t = {self.time:.4g}  (steps {lo:.4g} … {hi:.4g}, {len(self.steps)} steps)")
+        self.label.setText(f"t = {self.time:.4g}")
+        self.label.setToolTip(f"Display time {self.time:.6g} of the steps {lo:.4g} … {hi:.4g} ({len(self.steps)} steps)")
         self.timeChanged.emit(self.time)
 
     def _slider_moved(self, value: int) -> None:
