@@ -499,8 +499,9 @@ def _check_sizes(doc: Any, source: str | None) -> None:
                 if isinstance(item, (dict, list, str)):
                     stack.append((item, f"{where}.{key}" if where else key))
         elif isinstance(value, list):
-            stack.extend((item, f"{where}[{i}]") for i, item in enumerate(value) if isinstance(item, (dict, list, str)))
-        elif len(value) > MAX_STRING_CHARS:
+            stack.extend((item, f"{where}[{i}]") for i, item in enumerate(value)
+                         if isinstance(item, (dict, list, str)))
+        elif isinstance(value, str) and len(value) > MAX_STRING_CHARS:
             raise SessionError(source, f"is a string of {len(value)} characters; at most {MAX_STRING_CHARS}",
                                where or None)
 
@@ -554,13 +555,22 @@ def _read_regular(p: Path) -> bytes:
 
 
 def _check_dataset_path(session_file: Path, stored: str, where: str) -> None:
-    """A dataset path that exists must not be a folder, FIFO or device (those would be refused or block later)."""
+    """A dataset path that exists must be a regular file or a folder that a reader opens (an OpenFOAM case ...);
+    a FIFO, device or other folder is refused here, before anything tries to read it."""
     try:
-        mode = os.stat(resolve_path(session_file, stored)).st_mode
+        path = resolve_path(session_file, stored)
+        mode = os.stat(path).st_mode
     except (OSError, ValueError, RuntimeError):  # missing (reported when read), a pattern, or unresolvable
         return
-    if not stat.S_ISREG(mode):
-        raise SessionError(session_file, f"is {path_kind(mode)}, not a data file", where)
+    if stat.S_ISREG(mode) or (stat.S_ISDIR(mode) and _read_as_folder(path)):
+        return
+    raise SessionError(session_file, f"is {path_kind(mode)}, not a data file", where)
+
+
+def _read_as_folder(folder: Path) -> bool:
+    from volviz.io.registry import reader_specs
+
+    return any(spec.opens_folder(folder) for spec in reader_specs())
 
 
 def dumps(session: Session) -> str:
