@@ -2,8 +2,6 @@
 registered through the ``volviz.readers`` entry-point group (a real dist-info folder on sys.path)."""
 from __future__ import annotations
 
-import textwrap
-
 import numpy as np
 import pytest
 
@@ -11,11 +9,15 @@ import volviz.io as vio
 from volviz.io import registry
 from volviz.model import RegularVolume
 
+from dist_info import install_dist
+
 PLUGIN_MODULE = '''
 import numpy as np
 
 from volviz.io import ReaderSpec, ReadError
 from volviz.model import RegularVolume
+
+from dist_info import install_dist
 
 
 def read_fancy(path, scale=1):
@@ -36,12 +38,8 @@ SPECS = [ReaderSpec("fancy", "Fancy volume", ("*.fancy",), "fancy_reader:read_fa
 @pytest.fixture
 def fancy_plugin(tmp_path, monkeypatch):
     """Install a reader plugin the way pip would: a module and a dist-info folder with entry_points.txt."""
-    site = tmp_path / "site"
-    dist = site / "fancy_reader-1.0.dist-info"
-    dist.mkdir(parents=True)
-    (dist / "METADATA").write_text("Metadata-Version: 2.1\nName: fancy-reader\nVersion: 1.0\n")
-    (dist / "entry_points.txt").write_text("[volviz.readers]\nfancy = fancy_reader:SPECS\n")
-    (site / "fancy_reader.py").write_text(textwrap.dedent(PLUGIN_MODULE))
+    site = install_dist(tmp_path / "site", "fancy-reader", {"volviz.readers": {"fancy": "fancy_reader:SPECS"}},
+                        {"fancy_reader": PLUGIN_MODULE})
     monkeypatch.syspath_prepend(str(site))
     registry.reader_specs(refresh=True)
     yield site
@@ -77,14 +75,10 @@ def test_plugin_is_gone_after_refresh_without_it(fancy_plugin, tmp_path):
 
 
 def test_broken_plugin_warns_and_is_skipped(tmp_path, monkeypatch):
-    site = tmp_path / "site"
-    dist = site / "broken_reader-1.0.dist-info"
-    dist.mkdir(parents=True)
-    (dist / "METADATA").write_text("Metadata-Version: 2.1\nName: broken-reader\nVersion: 1.0\n")
-    (dist / "entry_points.txt").write_text("[volviz.readers]\nbroken = no_such_module_here:SPECS\n"
-                                           "dup = broken_specs:SPECS\n")
-    (site / "broken_specs.py").write_text("from volviz.io import ReaderSpec\n"
-                                          "SPECS = ReaderSpec('pvm', 'Another PVM', ('*.pvm',), 'x:y')\n")
+    site = install_dist(tmp_path / "site", "broken-reader",
+                        {"volviz.readers": {"broken": "no_such_module_here:SPECS", "dup": "broken_specs:SPECS"}},
+                        {"broken_specs": "from volviz.io import ReaderSpec\n"
+                                         "SPECS = ReaderSpec('pvm', 'Another PVM', ('*.pvm',), 'x:y')\n"})
     monkeypatch.syspath_prepend(str(site))
     try:
         with pytest.warns(registry.PluginWarning) as record:

@@ -341,14 +341,16 @@ def compress_series(series: TimeSeries | Sequence[np.ndarray | RegularVolume], p
                     pattern: str = "IBBPBBPPB", mode: str = "lossless", quality: float | None = None,
                     search: str = "local", b_residual: bool | None = None,
                     progress: Callable[[float, str], None] | None = None,
-                    scheduler: str | None = None) -> dict[str, Any]:
+                    scheduler: str | None = None, backend: str = "dask") -> dict[str, Any]:
     """Encode a series of 8-bit volumes into the store directory ``path`` (replaced if it exists); returns
     :func:`series_info`. ``b_residual`` defaults to True for lossless and False (MC only) otherwise.
 
-    ``scheduler``: address of a dask.distributed scheduler (``tcp://host:8786``, or a LocalCluster's address).
-    The series is then split at its I volumes into independent parts (each part also codes the next I volume for
-    the reconstruction its trailing B volumes need), one task per part; the client reads the volumes, sends each
-    task its volumes, and writes the returned files. The store is bit-identical to the sequential one."""
+    ``scheduler``: address of a cluster for the compression ``backend`` (entry-point group
+    ``volviz.compression_backends``; ``"dask"``, from plugins/volviz-dask, takes a dask.distributed scheduler's
+    address such as ``tcp://host:8786``). The series is then split at its I volumes into independent parts (each
+    part also codes the next I volume for the reconstruction its trailing B volumes need), one task per part; the
+    client reads the volumes, sends each task its volumes, and writes the returned files. The store is
+    bit-identical to the sequential one."""
     if mode not in ("lossless", "quality"):
         raise ValueError(f"unknown mode {mode!r} (lossless, quality)")
     if mode == "quality" and quality is None:
@@ -386,18 +388,18 @@ def compress_series(series: TimeSeries | Sequence[np.ndarray | RegularVolume], p
     if scheduler is None:
         store(_encode_part(checked, frames, order, list(range(n)), kw, b_res, search))
     else:
-        from distributed import Client, as_completed
+        from .backends import compression_backend
 
         pos = {d: i for i, d in enumerate(order)}
-        with Client(scheduler) as client:
-            futures = []
+
+        def tasks():
             for part in _segments(frames):
                 lo_i, hi_i = min(pos[d] for d in part), max(pos[d] for d in part)
                 need = {order[i] for i in range(lo_i, hi_i + 1) if order[i] in part or frames[order[i]].kind != "B"}
-                vols = {d: checked(d) for d in sorted(need)}
-                futures.append(client.submit(_encode_part, vols, frames, order, part, kw, b_res, search, pure=False))
-            for fut in as_completed(futures):
-                store(fut.result())
+                yield ({d: checked(d) for d in sorted(need)}, frames, order, part, kw, b_res, search)
+
+        for result in compression_backend(backend)(scheduler, _encode_part, tasks()):
+            store(result)
     if sorted(records) != list(range(n)):
         raise RuntimeError(f"series encoding produced storage records {sorted(records)}, expected 0..{n - 1}")
     meta = {"format": FORMAT, "version": VERSION, "dims": list(dims), "dtype": np.dtype(dtype).name, "n": n,

@@ -2,7 +2,8 @@
 
 ``volviz compress IN -o OUT --series [--pattern IBBPBBPPB] [--quality Q | --lossless] [--scheduler ADDRESS]`` reads
 IN as a time series (e.g. ``Storm.pvm-t%02d``) and writes a motion-compensated I/P/B store directory
-(:mod:`.animation`); with ``--scheduler`` the parts between I volumes are encoded on a dask.distributed cluster,
+(:mod:`.animation`); with ``--scheduler`` the parts between I volumes are encoded on a dask.distributed cluster
+(the ``dask`` compression backend of the volviz-dask plugin, :mod:`.backends`),
 bit-identical to a local run.
 
 ``volviz compress IN -o OUT [--quality Q | --psnr DB | --lossless] [--coder rans|arith]`` reads IN with
@@ -80,7 +81,7 @@ def compress_main(argv: Sequence[str] | None = None) -> int:
     p.add_argument("--pattern", default="IBBPBBPPB", help="GOP pattern of --series (I, IPP, IBB, IBBPBBPPB, ...)")
     p.add_argument("--scheduler", metavar="ADDRESS",
                    help="--series only: encode on this dask.distributed scheduler (e.g. tcp://host:8786), one task "
-                   "per I-to-I part; the output is bit-identical to a local run")
+                   "per I-to-I part; the output is bit-identical to a local run (needs the volviz-dask plugin)")
     p.add_argument("--quiet", action="store_true")
     p.add_argument("--json", help="write the resulting info as JSON to this file")
     args = p.parse_args(list(argv) if argv is not None else None)
@@ -108,6 +109,13 @@ def _series_main(args: argparse.Namespace) -> int:
 
     if args.psnr is not None or args.raw:
         raise SystemExit("--series supports --lossless or --quality (not --psnr or --raw)")
+    if args.scheduler:
+        from .backends import BackendMissing, compression_backend
+
+        try:
+            compression_backend("dask")
+        except BackendMissing as exc:
+            raise SystemExit(f"--scheduler: {exc}") from None
     series = read(args.input)
     if not isinstance(series, TimeSeries):
         raise SystemExit(f"{args.input}: not a time series (use a numbered pattern such as Storm.pvm-t%02d)")
