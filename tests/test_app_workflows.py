@@ -4,6 +4,8 @@ from __future__ import annotations
 import gc
 
 import json
+import subprocess
+import sys
 from pathlib import Path
 
 import imageio.v3 as iio
@@ -252,9 +254,13 @@ def test_autosave_and_recovery_after_a_crash(qtbot, make_window, tmp_path: Path)
     assert window.dirty
     assert window.autosave()  # what the 60 s timer runs
     assert window.recovery_file.exists()
-    # "crash": the window goes away without a clean close, so the recovery file stays
+    # "crash": the process owning the autosave ends without a clean close, so its recovery file stays (here the file
+    # passes to a process that has ended; tests/test_app_recovery.py SIGKILLs a real app process)
     window.dirty = False
     window.autosave_timer.stop()
+    ended = subprocess.Popen([sys.executable, "-c", "pass"])
+    ended.wait()
+    window.recovery_file.rename(window.recovery_file.with_name(f"recovery-{ended.pid}-0.json"))
 
     restarted = make_window()
     assert restarted.offer_recovery()
