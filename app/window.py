@@ -12,13 +12,14 @@ from pathlib import Path
 from typing import Any, Callable, Optional
 
 from PySide6.QtCore import QByteArray, QSettings, QStandardPaths, Qt, QTimer
-from PySide6.QtGui import QAction, QKeySequence, QUndoGroup
+from PySide6.QtGui import QAction, QKeySequence, QUndoGroup, QUndoStack
 from PySide6.QtWidgets import (QDockWidget, QFileDialog, QInputDialog, QLabel, QMainWindow, QMessageBox,
                                QProgressBar, QPushButton, QWidget)
 
 from volviz.jobs import JobOutcome
 from volviz.render.controller import no_render
 from volviz.session import CameraKey, Session, SessionError, relative_path
+from volviz_app.array_choice import ArrayChoice
 from volviz_app.clip_widget import ClipPlaneWidget
 from volviz_app.docks.clipping import ClippingDock
 from volviz_app.docks.render_settings import RENDERER_DEFAULTS, RenderSettings
@@ -251,9 +252,11 @@ class MainWindow(QMainWindow):
         self._action(file_menu, "&Quit", QKeySequence.StandardKey.Quit, self.close)
 
         edit_menu = self.menuBar().addMenu("&Edit")
-        # Edit > Undo / Redo act on the stack edited last (transfer function or clipping)
+        # Edit > Undo / Redo act on the stack edited last (transfer function, clipping, or the scene: arrays shown)
         self.undo_group = QUndoGroup(self)
-        for stack in (self.tf_editor.undo_stack, self.clipping.undo_stack):
+        self.scene_undo_stack = QUndoStack(self)
+        self.array_choice = ArrayChoice(self, self.scene_tree.array, self.scene_undo_stack)
+        for stack in (self.tf_editor.undo_stack, self.clipping.undo_stack, self.scene_undo_stack):
             self.undo_group.addStack(stack)
             stack.indexChanged.connect(lambda _index, s=stack: self._activate_undo_stack(s))
         self.undo_group.setActiveStack(self.tf_editor.undo_stack)
@@ -539,6 +542,7 @@ class MainWindow(QMainWindow):
     def _select_component(self, comp_id: str) -> None:
         if self.controller is None:
             return
+        self.array_choice.show_component(comp_id)
         tf = self.controller.transfer_function(comp_id)
         self.tf_editor.setEnabled(tf is not None)
         if tf is None:

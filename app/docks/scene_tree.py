@@ -5,8 +5,8 @@ import json
 from typing import Any, Optional
 
 from PySide6.QtCore import Qt, Signal
-from PySide6.QtWidgets import (QHBoxLayout, QLabel, QPlainTextEdit, QPushButton, QSlider, QTreeWidget, QTreeWidgetItem,
-                               QVBoxLayout, QWidget)
+from PySide6.QtWidgets import (QComboBox, QHBoxLayout, QLabel, QPlainTextEdit, QPushButton, QSlider, QTreeWidget,
+                               QTreeWidgetItem, QVBoxLayout, QWidget)
 
 KIND_LABELS = {"volume": "Volume", "mesh": "Mesh", "isosurface": "Isosurface", "terrain": "Terrain", "fog": "Ground fog",
                "clouds": "Clouds", "sky": "Sky", "demo": "Demo volume"}
@@ -33,6 +33,11 @@ class SceneTree(QWidget):
         row = QHBoxLayout()
         row.addWidget(self.opacity_label)
         row.addWidget(self.opacity, 1)
+        self.array = QComboBox()  # filled by the window (``volviz_app.array_choice``)
+        self.array_label = QLabel("Array")
+        array_row = QHBoxLayout()
+        array_row.addWidget(self.array_label)
+        array_row.addWidget(self.array, 1)
         self.settings_edit = QPlainTextEdit()
         self.settings_edit.setPlaceholderText("component settings (JSON)")
         self.settings_edit.setMaximumHeight(140)
@@ -44,6 +49,7 @@ class SceneTree(QWidget):
         self.apply_button.setToolTip("Check the settings above and rebuild the component with them")
         layout = QVBoxLayout(self)
         layout.addWidget(self.tree, 1)
+        layout.addLayout(array_row)
         layout.addLayout(row)
         layout.addWidget(self.settings_edit)
         layout.addWidget(self.apply_button)

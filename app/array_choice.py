@@ -1,0 +1,95 @@
+"""The array selector of the scene tree: which array of its dataset the selected component shows.
+
+The choices are ``volviz.model.arrays.list_arrays``'s (a scalar array by name; a vector or tensor array as its
+magnitude or one component). A choice is one undoable step on the window's undo stack; it sets the component setting
+``"array"`` (saved with the session) and re-prepares the component through the window's settings path
+(``apply_component_settings``), which keeps the camera and the docks as they are."""
+from __future__ import annotations
+
+import json
+from typing import Any, Optional
+
+from PySide6.QtCore import Qt
+from PySide6.QtGui import QUndoCommand, QUndoStack
+from PySide6.QtWidgets import QComboBox
+
+
+class SetArray(QUndoCommand):
+    """Show array ``after`` instead of ``before`` (None: the dataset's default) in component ``comp_id``."""
+
+    def __init__(self, choice: "ArrayChoice", comp_id: str, before: Optional[str], after: str) -> None:
+        super().__init__(f"Show {after} in {comp_id}")
+        self.choice, self.comp_id, self.before, self.after = choice, comp_id, before, after
+
+    def redo(self) -> None:
+        self.choice.apply(self.comp_id, self.after)
+
+    def undo(self) -> None:
+        self.choice.apply(self.comp_id, self.before)
+
+
+class ArrayChoice:
+    """Fills ``combo`` for the component the scene tree selects and turns a user's choice into a ``SetArray`` on
+    ``undo_stack``. ``window`` provides ``controller``, ``session`` and ``apply_component_settings``."""
+
+    def __init__(self, window: Any, combo: QComboBox, undo_stack: QUndoStack) -> None:
+        self.window, self.combo, self.undo_stack = window, combo, undo_stack
+        self.comp_id: Optional[str] = None
+        self.shown: Optional[str] = None   # the spec the selected component shows
+        combo.setToolTip("The array the selected component shows: a scalar array, or a vector array's magnitude or "
+                         "one of its components (point and cell arrays of the dataset)")
+        combo.setEnabled(False)
+        combo.activated.connect(self._chosen)
+
+    def current(self, comp_id: str) -> Optional[str]:
+        """The array spec the component's settings name (None: the dataset's default)."""
+        comp = self.window.controller.component(comp_id)
+        value = comp.settings.get("array")
+        return str(value) if value else None
+
+    def show_component(self, comp_id: Optional[str]) -> None:
+        """List the arrays of ``comp_id``'s dataset (nothing for a component without one, e.g. the sky)."""
+        from volviz.model.arrays import default_array, list_arrays
+
+        self.comp_id, self.shown = comp_id, None
+        self.combo.clear()
+        controller = self.window.controller
+        infos, shown = [], None
+        if comp_id is not None and controller is not None and controller.component(comp_id).dataset is not None:
+            dataset = controller.datasets.get(controller.component(comp_id).dataset)
+            if dataset is not None:  # (a hidden component's dataset is read when it is shown)
+                infos = list_arrays(dataset)
+                self.shown = shown = self.current(comp_id) or default_array(dataset)
+        for info in infos:
+            for spec in info.choices:
+                lo, hi = info.range
+                bad = f", {info.nonfinite:,} non-finite" if info.nonfinite else ""
+                self.combo.addItem(spec, spec)
+                self.combo.setItemData(self.combo.count() - 1, f"{info.association} array, range {lo:.4g} … "
+                                       f"{hi:.4g}{bad}", Qt.ItemDataRole.ToolTipRole)
+        if shown is not None and self.combo.findData(shown) < 0:
+            self.combo.addItem(shown, shown)
+        self.combo.setCurrentIndex(max(self.combo.findData(shown), 0) if shown is not None else -1)
+        self.combo.setEnabled(self.combo.count() > 1)
+
+    def choose(self, spec: str) -> None:
+        """The user picked ``spec`` for the selected component: one undoable step (nothing if it is shown now)."""
+        comp_id = self.comp_id
+        if comp_id is None or self.window.controller is None:
+            return
+        if spec != self.shown:
+            self.undo_stack.push(SetArray(self, comp_id, self.current(comp_id), spec))
+
+    def apply(self, comp_id: str, spec: Optional[str]) -> None:
+        """Set (None: remove) the component setting ``"array"`` and re-prepare the component."""
+        settings = dict(self.window.controller.component(comp_id).settings)
+        if spec is None:
+            settings.pop("array", None)
+        else:
+            settings["array"] = spec
+        self.window.apply_component_settings(comp_id, json.dumps(settings))
+
+    def _chosen(self, index: int) -> None:
+        spec = self.combo.itemData(index)
+        if spec is not None:
+            self.choose(str(spec))
