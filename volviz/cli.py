@@ -8,112 +8,228 @@ from __future__ import annotations
 import argparse
 import importlib
 import json
+import math
 import os
 import sys
+import warnings
+from contextlib import contextmanager
 from pathlib import Path
-from typing import Any, Optional, Sequence
+from typing import Any, Iterator, Optional, Sequence
 
 import volviz
+from volviz.argtypes import MAX_MOVIE_FRAMES, MAX_MOVIE_SECONDS, UsageError, UsageParser, float_in, image_size
 
-BENCHMARKS = ("tables", "unstructured", "compression", "nature", "iso")
+#: the benchmarks of ``volviz bench NAME`` (module ``volviz.bench.NAME``) and what each measures
+BENCHMARKS = {
+    "tables": "pre-integration tables: build time and error against the exact ray integral",
+    "unstructured": "projected tetrahedra on the Blunt Fin against VTK's unstructured volume mappers",
+    "compression": "the wavelet codec against blosc2, zfp and wavelet + zstd (ratio, PSNR, speed)",
+    "nature": "the natural scene (terrain, fog, clouds): frame time and error along a flight",
+    "iso": "multiple semi-transparent isosurfaces: compositing modes against the exact order",
+}
+#: commands whose arguments go, unread here, to their own parser (``volviz.regular.cli``, ``volviz.bench.NAME``)
+PASSED_ON = ("bench", "compress")
+MOVIE_FPS = float_in(0.0, 240.0, low_open=True)
 
 
-class UsageError(Exception):
-    """A bad command-line value."""
+def _array_spec(text: str) -> str:
+    """An argument type: an array spec ``NAME``, ``NAME:c`` or ``NAME:magnitude`` (``volviz.model.arrays``)."""
+    from volviz.model.arrays import parse_array_spec
 
-
-def _size(text: str) -> tuple[int, int]:
     try:
-        w, h = (int(v) for v in text.lower().split("x"))
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected WIDTHxHEIGHT, e.g. 800x600, got {text!r}") from None
-    if not (1 <= w <= 16384 and 1 <= h <= 16384):
-        raise argparse.ArgumentTypeError(f"image size must be 1..16384 on each side, got {text!r}")
-    return (w, h)
+        return str(parse_array_spec(text))
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
 
 
-class _Parser(argparse.ArgumentParser):
-    def error(self, message: str) -> None:  # one line, no usage dump
-        raise UsageError(message)
+def _data_options(command: argparse.ArgumentParser) -> None:
+    command.add_argument("--array", type=_array_spec, metavar="NAME[:c]",
+                         help="the array to show: NAME, NAME:0.. (one component) or NAME:magnitude")
+    command.add_argument("--q", metavar="FILE", help="the PLOT3D solution (q) file of a PLOT3D grid file")
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = _Parser(prog="volviz", description="Accurate, fast volume rendering.")
+    parser = UsageParser(prog="volviz", description="Accurate, fast volume rendering.")
     parser.add_argument("--version", action="version", version=f"volviz {volviz.__version__}")
     parser.add_argument("--debug", action="store_true", help="show tracebacks of unexpected errors")
-    sub = parser.add_subparsers(dest="command", parser_class=_Parser)
+    sub = parser.add_subparsers(dest="command", parser_class=UsageParser)
 
-    info = sub.add_parser("info", help="describe a data file or a compressed volume")
+    info = sub.add_parser("info", help="describe a data file or a compressed volume",
+                          description="Kind, dimensions, every array (association, components, range, non-finite "
+                          "values), time steps and series membership of a data file, or a .vvz/.vvs file's header.")
     info.add_argument("file")
     info.add_argument("--json", action="store_true", help="print JSON instead of text")
+    _data_options(info)
 
-    render = sub.add_parser("render", help="render a session or data file offscreen to PNG")
-    render.add_argument("target", help="a session (.json), a data file, or 'demo'")
-    render.add_argument("-o", "--output", required=True, help="output PNG")
-    render.add_argument("--size", type=_size, default=None, help="WIDTHxHEIGHT (default: the session's, or 1024x768)")
-    render.add_argument("--path", default=None, help="render a movie along this recorded camera path")
-    render.add_argument("--time", action="store_true", help="render a movie through the time series")
-    render.add_argument("--fps", type=float, default=24.0, help="movie frames per second (default 24)")
-    render.add_argument("--duration", type=float, default=None, help="movie length in seconds (default: the path's)")
+    render = sub.add_parser("render", help="render a session or data file offscreen to an image or a movie",
+                            description="Render offscreen to an image (.png, .jpg/.jpeg, .tif/.tiff) or, with "
+                            "--orbit, --time or --path, to a movie (.mp4, .m4v, .mov, or a folder of PNG frames).")
+    render.add_argument("target", help="a session (.json), a data file (a member of a numbered series shows its own "
+                        "time step), 'demo' or 'demo-volume'")
+    render.add_argument("-o", "--output", required=True,
+                        help="the image or movie; the format follows the extension")
+    render.add_argument("--size", type=image_size, default=None,
+                        help="WIDTHxHEIGHT (default: the session's, or 1024x768)")
+    _data_options(render)
+    render.add_argument("--path", default=None, help="a movie along this recorded camera path of the session")
+    render.add_argument("--orbit", action="store_true",
+                        help="a movie orbiting the view: one full turn around the view-up axis over --duration")
+    render.add_argument("--time", action="store_true", help="a movie through the time series")
+    render.add_argument("--fps", type=MOVIE_FPS, default=24.0, help="movie frames per second (default 24)")
+    render.add_argument("--duration", type=float_in(0.0, MAX_MOVIE_SECONDS, low_open=True), default=None,
+                        help="movie length in seconds (default: the path's, 8 s for --orbit, the series' time span "
+                        "for --time)")
 
-    bench = sub.add_parser("bench", help="speed-against-error benchmarks", add_help=False)
-    bench.add_argument("name", choices=BENCHMARKS)
-    bench.add_argument("args", nargs=argparse.REMAINDER)
+    bench = sub.add_parser("bench", help="speed-against-error benchmarks",
+                           description="Speed-against-error benchmarks; `volviz bench NAME --help` shows the options "
+                           "of one.")
+    names = bench.add_subparsers(dest="name", metavar="NAME", parser_class=UsageParser, required=True)
+    for name, text in BENCHMARKS.items():
+        names.add_parser(name, help=text, add_help=False)
 
-    compress = sub.add_parser("compress", help="compress a regular volume (see `volviz compress --help`)",
-                              add_help=False)
-    compress.add_argument("args", nargs=argparse.REMAINDER)
-
-    sub.add_parser("warmup", help="compile the rendering kernels once, ahead of first use (the setup script runs it)")
+    sub.add_parser("compress", help="compress a regular volume or a time series (see `volviz compress --help`)",
+                   add_help=False)
+    sub.add_parser("warmup", help="compile the rendering kernels once, ahead of first use (the setup script runs it)",
+                   description="Compile the rendering kernels once into Numba's disk cache, ahead of first use.")
     return parser
 
 
-def describe(path: str) -> dict[str, Any]:
-    """Kind, dimensions, counts, ranges and time steps of a data file (or a .vvz compressed volume)."""
-    p = Path(path)
-    if p.suffix.lower() == ".vvz":
-        from volviz.regular.codec import info as vvz_info
+@contextmanager
+def _reading(path: str | os.PathLike, q: Optional[str]) -> Iterator[None]:
+    """Reading ``path`` (with the PLOT3D solution file ``q``) inside: a missing ``q`` is a usage error, and a solution
+    file given alone says what to do instead of failing to read."""
+    from volviz.io import ReadError
 
-        return {"file": str(p), **vvz_info(p)}
-    if p.suffix.lower() == ".vvs":
+    if q is not None and not Path(q).is_file():
+        raise UsageError(f"--q {q}: no such file")
+    try:
+        yield
+    except ReadError:
+        hint = None if q else plot3d_solution_hint(path)
+        if hint:
+            raise UsageError(hint) from None
+        raise
+
+
+def plot3d_solution_hint(path: str | os.PathLike) -> Optional[str]:
+    """What to do with a PLOT3D solution (q) file opened alone, or None when ``path`` is not one."""
+    from volviz.io.plot3d import read_flow_conditions
+
+    p = Path(path)
+    try:
+        read_flow_conditions(p)
+    except Exception:  # noqa: BLE001 -- any failure: it is not a solution file, and the caller reports the original
+        return None
+    name = p.name
+    grids = [p.with_name(name[::-1].replace(q[::-1], g[::-1], 1)[::-1])
+             for q, g in (("q", "xyz"), ("Q", "XYZ"), (".q", ".x"), (".q", ".xyz")) if q in name]
+    grid = next((g for g in grids if g != p and g.is_file()), None)
+    example = f"volviz render {grid or 'GRID_FILE'} --q {p} -o image.png"
+    return (f"{p} is a PLOT3D solution (q) file: open its grid file and give this one with --q, e.g. {example}")
+
+
+def describe(path: str, array: Optional[str] = None, q: Optional[str] = None) -> dict[str, Any]:
+    """Kind, dimensions, counts, arrays (association, components, range, non-finite values), time steps and series
+    membership of a data file (or the header of a .vvz compressed volume / .vvs compressed series)."""
+    p = Path(path)
+    if p.suffix.lower() in (".vvz", ".vvs"):
+        if array is not None or q is not None:
+            raise UsageError("--array and --q apply to data files, not to compressed volumes")
+        if p.suffix.lower() == ".vvz":
+            from volviz.regular.codec import info as vvz_info
+
+            return {"file": str(p), **vvz_info(p)}
         from volviz.regular.animation import series_info
 
         return {"file": str(p), **series_info(p)}
-    from volviz.io import read
     from volviz.model import TimeSeries
+    from volviz.model.arrays import default_array, list_arrays, select_array
 
-    dataset = read(p)
+    from volviz.io import read
+
+    with _reading(p, q):
+        dataset = read(p, **({"q": q} if q else {}))
+    base = dataset.frame(0) if isinstance(dataset, TimeSeries) else dataset
     desc: dict[str, Any] = {"file": str(p), "kind": dataset.kind, "dimensions": list(dataset.dimensions),
                             "points": dataset.n_points, "cells": dataset.n_cells}
-    lo, hi = dataset.scalar_range()
-    desc["range"] = [lo, hi]
+    shown = array or default_array(base)
+    if shown is not None:
+        try:
+            desc["range"] = _finite(select_array(base, shown).scalar_range())
+        except ValueError as exc:
+            raise UsageError(f"--array {array}: {exc}") from None
+        desc["array"] = shown
+    desc["arrays"] = [{"name": a.name, "association": a.association, "components": a.components,
+                       "range": _finite(a.range), "nonfinite": a.nonfinite, "choices": a.choices}
+                      for a in list_arrays(base)]
     if isinstance(dataset, TimeSeries):
         desc["time_steps"] = dataset.n_steps
         desc["times"] = [float(dataset.times[0]), float(dataset.times[-1])]
+    series = _series_membership(p)
+    if series is not None:
+        desc["series"] = series
     for attr in ("spacing", "origin"):
         if hasattr(dataset, attr):
             desc[attr] = list(getattr(dataset, attr))
-    arrays = getattr(dataset, "point_data", None)
-    if arrays:
-        desc["arrays"] = sorted(arrays)
     return desc
+
+
+def _finite(pair: Sequence[float]) -> list[Optional[float]]:
+    """A (min, max) pair for JSON: NaN (no finite value) becomes null."""
+    return [float(v) if math.isfinite(v) else None for v in pair]
+
+
+def _series_membership(path: Path) -> Optional[dict[str, Any]]:
+    """Which numbered series ``path`` belongs to (the pattern, its position, its time), or None."""
+    from volviz.io.series import expand_pattern
+    from volviz.render.export import member_time
+    from volviz.render.scene import series_pattern
+
+    pattern = series_pattern(path)
+    if pattern is None:
+        return None
+    members = [m.resolve() for _, m in expand_pattern(pattern)]
+    return {"pattern": pattern, "member": members.index(path.resolve()) + 1, "members": len(members),
+            "time": member_time(path, pattern)}
 
 
 def _print_info(desc: dict[str, Any]) -> None:
     width = max(len(k) for k in desc)
     for key, value in desc.items():
-        if isinstance(value, list):
-            value = " x ".join(str(v) for v in value) if key == "dimensions" else ", ".join(f"{v:g}" if isinstance(
-                v, float) else str(v) for v in value)
+        if key == "arrays":
+            _print_arrays(value, width)
+            continue
+        if key == "series":
+            value = (f"member {value['member']} of {value['members']} of the series {value['pattern']} (time "
+                     f"{value['time']:g}); `volviz render` shows this member's time step")
+        elif isinstance(value, list):
+            value = " x ".join(str(v) for v in value) if key == "dimensions" else ", ".join(
+                f"{v:g}" if isinstance(v, float) else "none" if v is None else str(v) for v in value)
         print(f"{key:<{width}}  {value}")
 
 
+def _print_arrays(arrays: list[dict[str, Any]], width: int) -> None:
+    """One line per array: name, association, components, finite range, non-finite values, the specs to choose."""
+    if not arrays:
+        print(f"{'arrays':<{width}}  none")
+    names = max((len(a["name"]) for a in arrays), default=0)
+    for i, a in enumerate(arrays):
+        lo, hi = a["range"]
+        rng = "no finite values" if lo is None else f"{lo:g} .. {hi:g}"
+        choices = f"  (--array {' | '.join(a['choices'])})" if a["components"] > 1 else ""
+        print(f"{'arrays' if i == 0 else '':<{width}}  {a['name']:<{names}}  {a['association']:<5}  "
+              f"{a['components']} component{'s' if a['components'] > 1 else ' '}  range {rng}  "
+              f"non-finite {a['nonfinite']}{choices}")
+
+
 def run(argv: Optional[Sequence[str]] = None) -> int:
-    args = build_parser().parse_args(argv)
+    args, rest = build_parser().parse_known_args(argv)
+    if rest and args.command not in PASSED_ON:
+        raise UsageError(f"unrecognized arguments: {' '.join(rest)}")
     if args.command is None:
         raise UsageError("a command is needed: info, render, bench, compress or warmup (see volviz --help)")
     if args.command == "info":
-        desc = describe(args.file)
+        desc = describe(args.file, args.array, args.q)
         if args.json:
             print(json.dumps(desc, indent=2))
         else:
@@ -123,41 +239,70 @@ def run(argv: Optional[Sequence[str]] = None) -> int:
         return _render(args)
     if args.command == "bench":
         module = importlib.import_module(f"volviz.bench.{args.name}")
-        return int(module.main(list(args.args)) or 0)
+        return int(module.main(list(rest)) or 0)
     if args.command == "compress":
         from volviz.regular.cli import compress_main
 
-        return int(compress_main(list(args.args)) or 0)
+        return int(compress_main(list(rest)) or 0)
     if args.command == "warmup":
         return _warmup()
     raise UsageError(f"unknown command {args.command}")
 
 
 def _render(args: argparse.Namespace) -> int:
-    from volviz.render.export import is_session_file, render_movie, render_to_png
-    from volviz.session import load
+    from volviz.render.export import (check_image_size, check_output, is_session_file, open_target, render_movie,
+                                      render_to_file)
 
+    movie = args.path is not None or args.time or args.orbit
+    if args.path is not None and args.orbit:
+        raise UsageError("--orbit and --path each move the camera: give one")
+    if not movie and args.duration is not None:
+        raise UsageError("--duration applies to movies (--orbit, --time or --path)")
+    if args.duration is not None and args.fps * args.duration > MAX_MOVIE_FRAMES:
+        raise UsageError(f"--duration {args.duration:g} at --fps {args.fps:g} makes "
+                         f"{args.fps * args.duration:.0f} frames; at most {MAX_MOVIE_FRAMES}")
     target = Path(args.target)
-    session = load(target) if is_session_file(target) else None
-    size = args.size or (session.render.size if session is not None else (1024, 768))
-    movie = args.path is not None or args.time or Path(args.output).suffix.lower() in (".mp4", ".m4v", ".mov")
+    data_file = str(args.target) not in ("demo", "demo-volume") and not is_session_file(target)
+    if not data_file and (args.array is not None or args.q is not None):
+        raise UsageError("--array and --q apply to data files (a session names the array of each component)")
+    if data_file and not target.exists():
+        raise UsageError(f"{target}: no such file (give a session, a data file, 'demo' or 'demo-volume')")
+    check_output(args.output, movie)
+    session, session_file = open_target(args.target, args.array, args.q)
+    size = args.size or session.render.size
+    check_image_size(size)
+    datasets: dict[str, Any] = {}
+    if data_file:
+        _read_for_render(session, datasets, args)
     if not movie:
-        out = render_to_png(args.target, args.output, size)
+        out = render_to_file(session, session_file, args.output, size, datasets=datasets)
         print(f"wrote {out} ({size[0]}x{size[1]})")
         return 0
-    if session is None:
-        raise UsageError("movies are rendered from a session file (camera paths and time live there)")
-    if args.fps <= 0:
-        raise UsageError(f"--fps must be positive, got {args.fps}")
 
     def progress(fraction: float, message: str) -> None:
         print(f"\r{message} ({fraction:4.0%})", end="", file=sys.stderr, flush=True)
 
-    out = render_movie(session, target, args.output, size, path_name=args.path, fps=args.fps,
-                       through_time=args.time, duration=args.duration, progress=progress)
+    out = render_movie(session, session_file, args.output, size, path_name=args.path, fps=args.fps,
+                       through_time=args.time, duration=args.duration, progress=progress, orbit=args.orbit,
+                       datasets=datasets)
     print(file=sys.stderr)
     print(f"wrote {out} ({size[0]}x{size[1]})")
     return 0
+
+
+def _read_for_render(session: Any, datasets: dict[str, Any], args: argparse.Namespace) -> None:
+    """Read a data file's dataset into ``datasets`` (a PLOT3D solution file given alone says what to do) and check
+    that it has the ``--array`` asked for (a usage error naming the arrays it has)."""
+    from volviz.render.scene import read_any, shown_array
+
+    ref = session.datasets[0]
+    with _reading(args.target, args.q):
+        datasets[ref.id] = read_any(Path(ref.path), ref.options)
+    if args.array is not None:
+        try:
+            shown_array(datasets[ref.id], args.array)
+        except ValueError as exc:
+            raise UsageError(f"--array {args.array}: {exc}") from None
 
 
 def _warmup() -> int:
@@ -174,19 +319,35 @@ def _warmup() -> int:
 
 def user_errors() -> tuple[type[BaseException], ...]:
     from volviz.io import ReadError
+    from volviz.io.atomic import OutputPathError
+    from volviz.render.export import ExportError
     from volviz.render.scene import SceneError
     from volviz.session import SessionError
 
-    return (UsageError, ReadError, SessionError, SceneError, FileNotFoundError, IsADirectoryError, PermissionError)
+    return (UsageError, ReadError, SessionError, SceneError, ExportError, OutputPathError, FileNotFoundError,
+            IsADirectoryError, PermissionError)
+
+
+def _one_line(text: object) -> str:
+    return " ".join(str(text).splitlines())
+
+
+def _show_warning(message: Warning | str, category: type[Warning], filename: str, lineno: int, file: Any = None,
+                  line: Optional[str] = None) -> None:
+    """Warnings (e.g. a file's non-finite values) as one line ``volviz: warning: ...``, without source lines."""
+    print(f"volviz: warning: {_one_line(message)}", file=sys.stderr)
 
 
 def main(argv: Optional[Sequence[str]] = None) -> int:
     debug = "--debug" in (sys.argv[1:] if argv is None else argv)
     try:
-        return run(argv)
+        with warnings.catch_warnings():
+            if not debug:
+                warnings.showwarning = _show_warning
+            return run(argv)
     except SystemExit as exc:  # --version / --help (an int code), or a sub-command's usage message (a str code)
         if isinstance(exc.code, str):
-            print(f"volviz: error: {exc.code}", file=sys.stderr)
+            print(f"volviz: error: {_one_line(exc.code)}", file=sys.stderr)
             return 2
         return int(exc.code or 0)
     except KeyboardInterrupt:
@@ -197,11 +358,12 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         return 0
     except Exception as exc:
         if isinstance(exc, user_errors()):
-            print(f"volviz: error: {exc}", file=sys.stderr)
+            print(f"volviz: error: {_one_line(exc)}", file=sys.stderr)
             return 2
         if debug:
             raise
-        print(f"volviz: internal error: {type(exc).__name__}: {exc} (run with --debug for details)", file=sys.stderr)
+        print(f"volviz: internal error: {type(exc).__name__}: {_one_line(exc)} (run with --debug for details)",
+              file=sys.stderr)
         return 1
 
 

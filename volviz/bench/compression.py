@@ -26,6 +26,8 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
+from volviz.argtypes import UsageParser, int_in
+
 DATA = Path(os.environ.get("VOLVIZ_DATA", Path(__file__).resolve().parents[3] / "shared" / "data"))
 QUALITIES = (90, 86, 84, 82, 80, 75, 70, 65, 60, 55, 50)  # integer steps: Q >= 95 is lossless
 BIG_QUALITIES = (90, 80, 70, 60, 50)  # field512: fewer settings, each compress takes seconds
@@ -441,19 +443,20 @@ def main_animation(args: argparse.Namespace, argv: Sequence[str] | None) -> int:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    p = argparse.ArgumentParser(prog="volviz bench compression", description=__doc__.splitlines()[0])
-    p.add_argument("--volumes", nargs="+", default=["embryo", "headsq", "neghip", "field512"])
-    p.add_argument("--reps", type=int, default=3)
+    p = UsageParser(prog="volviz bench compression", description=__doc__.splitlines()[0])
+    p.add_argument("--volumes", nargs="+", choices=("embryo", "headsq", "neghip", "field512"),
+                   default=["embryo", "headsq", "neghip", "field512"])
+    p.add_argument("--reps", type=int_in(1, 1000), default=3)
     p.add_argument("--json", help="write all rows as JSON")
     p.add_argument("--out", default=str(Path(__file__).resolve().parents[2] / "docs" / "bench"),
                    help="directory of compression.md and compression.png")
     p.add_argument("--animation", action="store_true",
                    help="run the animation + LOD section instead (writes compression-animation.md)")
-    p.add_argument("--anim-steps", type=int, default=64, help="generated series length (0: Storm only)")
-    p.add_argument("--anim-size", type=int, default=128, help="generated series edge length")
-    p.add_argument("--lod-budgets", type=int, nargs="*", default=[128, 256, 512])
-    p.add_argument("--lod-frames", type=int, default=12)
-    p.add_argument("--lod-render-frames", type=int, default=3,
+    p.add_argument("--anim-steps", type=int_in(0, 10_000), default=64, help="generated series length (0: Storm only)")
+    p.add_argument("--anim-size", type=int_in(2, 1024), default=128, help="generated series edge length")
+    p.add_argument("--lod-budgets", type=int_in(1, 1_000_000), nargs="*", default=[128, 256, 512])
+    p.add_argument("--lod-frames", type=int_in(1, 10_000), default=12)
+    p.add_argument("--lod-render-frames", type=int_in(0, 10_000), default=3,
                    help="rendered walkthrough frames per budget (0: CPU side only)")
     args = p.parse_args(list(argv) if argv is not None else None)
     if args.animation:

@@ -13,7 +13,6 @@ shading differences; VTK's depth peeling dropped all translucent geometry on llv
 """
 from __future__ import annotations
 
-import argparse
 import json
 import os
 import platform
@@ -25,6 +24,8 @@ from pathlib import Path
 from typing import Any, Callable
 
 import numpy as np
+
+from volviz.argtypes import MAX_IMAGE_SIDE, UsageParser, int_in
 
 from volviz.iso.animate import extract_at
 from volviz.iso.composite import MODES, composite, fragments, triangles_drawn
@@ -95,10 +96,10 @@ def _vtk_blend(meshes: list[IsoMesh], cam: Camera, size: int, reps: int) -> tupl
 
 
 def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(prog="volviz bench iso", description=__doc__.split("\n\n")[0])
+    p = UsageParser(prog="volviz bench iso", description=__doc__.split("\n\n")[0])
     p.add_argument("--data", default=str(DEFAULT_DATA), help="folder with storm/ and bluntfin/")
-    p.add_argument("--size", type=int, default=384)
-    p.add_argument("--reps", type=int, default=3, help="timed repetitions per mode (after a warm-up)")
+    p.add_argument("--size", type=int_in(1, MAX_IMAGE_SIDE), default=384, help="image width and height")
+    p.add_argument("--reps", type=int_in(1, 1000), default=3, help="timed repetitions per mode (after a warm-up)")
     p.add_argument("--no-vtk", action="store_true", help="skip the VTK translucent-rendering peer")
     p.add_argument("--out", default=str(REPO / "docs" / "bench"))
     p.add_argument("--json", default=None, help="also write the results as JSON")

@@ -16,7 +16,6 @@ Writes docs/bench/nature.md and nature_frames.png (LOD frames, references and x8
 """
 from __future__ import annotations
 
-import argparse
 import json
 import os
 import shlex
@@ -26,6 +25,8 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+
+from volviz.argtypes import UsageParser, float_in, image_size, int_in, joined
 
 DEFAULT_DATA = Path(os.environ.get("VOLVIZ_DATA", Path(__file__).resolve().parents[2].parent / "shared" / "data"))
 REPO = Path(__file__).resolve().parents[2]
@@ -206,29 +207,39 @@ def _terrain_sweep(scene: Any, cams: list[Any], size: tuple[int, int], spec: str
     return out
 
 
+#: a C,c pair of LOD bounds (Roettger's C-LOD: global and local resolution), both positive
+LOD = joined(float_in(0.0, 1e9, low_open=True), 2, ",")
+
+
+def _lod_list(text: str) -> str:
+    """An argument type: ``C,c;C,c;...`` (or '' for none), checked and kept as text."""
+    for item in text.split(";") if text else ():
+        LOD(item)
+    return text
+
+
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="volviz bench nature", description=__doc__.splitlines()[0])
-    ap.add_argument("--size", default="512x384", help="image size WxH (default 512x384)")
-    ap.add_argument("--frames", type=int, default=8, help="frames along the path (default 8)")
-    ap.add_argument("--reps", type=int, default=3, help="timed runs per frame, median reported (default 3)")
-    ap.add_argument("--cloud-shape", default="513x513x65", help="cloud volume points (default 513x513x65)")
-    ap.add_argument("--terrain-lod", default="9,30", help="terrain C,c (default 9,30)")
-    ap.add_argument("--cloud-lod", default="2,8", help="cloud C,c (default 2,8)")
-    ap.add_argument("--popping-frames", type=int, default=13, help="frames of the dense popping sub-path (0: skip)")
-    ap.add_argument("--popping-step", type=float, default=0.05, help="camera step of that sub-path in world units")
-    ap.add_argument("--sweep", default="2,10;2,20;2,50;2,100;2,200",
+    ap = UsageParser(prog="volviz bench nature", description=__doc__.splitlines()[0])
+    ap.add_argument("--size", type=image_size, default=(512, 384), help="image size WxH (default 512x384)")
+    ap.add_argument("--frames", type=int_in(1, 10_000), default=8, help="frames along the path (default 8)")
+    ap.add_argument("--reps", type=int_in(1, 1000), default=3, help="timed runs per frame, median reported (default 3)")
+    ap.add_argument("--cloud-shape", type=joined(int_in(2, 4097), 3, "x"), default=(513, 513, 65),
+                    help="cloud volume points (default 513x513x65)")
+    ap.add_argument("--terrain-lod", type=LOD, default=(9.0, 30.0), help="terrain C,c (default 9,30)")
+    ap.add_argument("--cloud-lod", type=LOD, default=(2.0, 8.0), help="cloud C,c (default 2,8)")
+    ap.add_argument("--popping-frames", type=int_in(0, 10_000), default=13,
+                    help="frames of the dense popping sub-path (0: skip)")
+    ap.add_argument("--popping-step", type=float_in(0.0, 1e6, low_open=True), default=0.05,
+                    help="camera step of that sub-path in world units")
+    ap.add_argument("--sweep", type=_lod_list, default="2,10;2,20;2,50;2,100;2,200",
                     help="cloud C,c settings for the tetrahedra-vs-error sweep on frames 0 and 3 ('' to skip)")
-    ap.add_argument("--terrain-sweep", default="9,30;9,80;9,160",
+    ap.add_argument("--terrain-sweep", type=_lod_list, default="9,30;9,80;9,160",
                     help="terrain C,c settings for the triangles-vs-error sweep on frames 0 and 3 ('' to skip)")
     ap.add_argument("--data", type=Path, default=DEFAULT_DATA)
     ap.add_argument("--json", type=Path, default=None, help="write the results as JSON")
     ap.add_argument("--out", type=Path, default=REPO / "docs" / "bench" / "nature.md")
     args = ap.parse_args(argv)
-    w, h = (int(v) for v in args.size.lower().split("x"))
-    size = (w, h)
-    cloud_shape = tuple(int(v) for v in args.cloud_shape.lower().split("x"))
-    tc = tuple(float(v) for v in args.terrain_lod.split(","))
-    cc = tuple(float(v) for v in args.cloud_lod.split(","))
+    size, cloud_shape, tc, cc = args.size, args.cloud_shape, args.terrain_lod, args.cloud_lod
     from volviz.optics.metrics import error_heatmap, max_abs, rmse
 
     t_build = time.perf_counter()

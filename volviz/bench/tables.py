@@ -11,7 +11,6 @@ Peers: the thesis's software pre-integration times (Roettger Table 9.4, Pentium 
 """
 from __future__ import annotations
 
-import argparse
 import json
 import os
 import platform
@@ -23,6 +22,8 @@ from pathlib import Path
 from typing import Any, Callable
 
 import numpy as np
+
+from volviz.argtypes import UsageParser, int_in
 
 from volviz.optics import (TransferFunction, build_separable, build_table2d, build_table3d, build_zot,
                            integrate_segment, load_preset)
@@ -257,15 +258,13 @@ def _plot(result: dict, path: Path) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="volviz bench tables", description=__doc__.split("\n")[0])
+    parser = UsageParser(prog="volviz bench tables", description=__doc__.split("\n")[0])
     parser.add_argument("--json", metavar="OUT", help="also write the raw results as JSON")
     parser.add_argument("--out", metavar="DIR", default=None, help="report directory (default: <repo>/docs/bench)")
-    parser.add_argument("--repeats", type=int, default=5)
-    parser.add_argument("--points", type=int, default=200_000, help="random segments for the error")
+    parser.add_argument("--repeats", type=int_in(1, 1000), default=5)
+    parser.add_argument("--points", type=int_in(1, 100_000_000), default=200_000, help="random segments for the error")
     parser.add_argument("--quick", action="store_true", help="small sizes only (smoke run)")
     args = parser.parse_args([] if argv is None else argv)
-    if args.repeats < 1 or args.points < 1:
-        parser.error("--repeats and --points must be >= 1")
     result = run(quick=args.quick, repeats=args.repeats, n_points=args.points)
     out_dir = Path(args.out) if args.out else Path(__file__).resolve().parents[2] / "docs" / "bench"
     command = "volviz bench tables " + " ".join(shlex.quote(a) for a in (argv or []))

@@ -21,9 +21,19 @@ from typing import Any
 
 import numpy as np
 
+from volviz.argtypes import MAX_IMAGE_SIDE, UsageParser, int_in
+
 DEFAULT_DATA = Path(os.environ.get("VOLVIZ_DATA", Path(__file__).resolve().parents[2].parent / "shared" / "data"))
 VTK_MAPPERS = ("vtkProjectedTetrahedraMapper", "vtkUnstructuredGridVolumeRayCastMapper",
                "vtkUnstructuredGridVolumeZSweepMapper")
+
+
+def _mapper_list(text: str) -> str:
+    """An argument type: 'all', 'none' or a comma list of ``VTK_MAPPERS`` names, kept as text."""
+    unknown = [name for name in text.split(",") if name not in VTK_MAPPERS] if text not in ("all", "none") else []
+    if unknown:
+        raise argparse.ArgumentTypeError(f"unknown VTK mapper {unknown[0]!r} (known: {', '.join(VTK_MAPPERS)})")
+    return text
 
 
 def bluntfin_tf() -> Any:
@@ -91,16 +101,17 @@ def _rgb_err(a: np.ndarray, b: np.ndarray) -> tuple[float, float]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(prog="volviz bench unstructured", description=__doc__.split("\n\n")[0])
+    p = UsageParser(prog="volviz bench unstructured", description=__doc__.split("\n\n")[0])
     p.add_argument("--dataset", default=str(DEFAULT_DATA / "bluntfin"), help="folder with bluntfinxyz.bin/q.bin")
-    p.add_argument("--size", type=int, default=512)
-    p.add_argument("--frames", type=int, default=4, help="camera path length")
-    p.add_argument("--reps", type=int, default=3, help="timed repetitions per frame (after a warm-up)")
+    p.add_argument("--size", type=int_in(1, MAX_IMAGE_SIDE), default=512, help="image width and height")
+    p.add_argument("--frames", type=int_in(1, 10_000), default=4, help="camera path length")
+    p.add_argument("--reps", type=int_in(1, 1000), default=3, help="timed repetitions per frame (after a warm-up)")
     p.add_argument("--sort", default="mpvo", choices=("mpvo", "centroid", "power"))
     p.add_argument("--lookup", default="auto", choices=("auto", "separable", "3d"), help="pre-integration lookup")
     p.add_argument("--no-compare-3d", dest="compare_3d", action="store_false",
                    help="skip the extra pt run with the 3D table")
-    p.add_argument("--vtk", default="all", help="comma list of VTK mappers to run, 'all' or 'none'")
+    p.add_argument("--vtk", type=_mapper_list, default="all",
+                   help=f"comma list of VTK mappers to run ({', '.join(VTK_MAPPERS)}), 'all' or 'none'")
     p.add_argument("--out", default=str(Path(__file__).resolve().parents[2] / "docs" / "bench"))
     p.add_argument("--json", default=None, help="also write the results as JSON")
     args = p.parse_args(argv)

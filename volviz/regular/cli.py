@@ -22,6 +22,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
+from volviz.argtypes import UsageParser, float_in, int_in
 from volviz.model.datasets import RegularVolume
 
 from .codec import compress
@@ -58,27 +59,41 @@ def _load(args: argparse.Namespace) -> RegularVolume:
     return vol
 
 
+def _gop_pattern(text: str) -> str:
+    """An argument type: a GOP pattern ``frame_types`` accepts (I first, then I, P and B)."""
+    from .animation import frame_types
+
+    try:
+        frame_types(1, text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+    return text
+
+
 def compress_main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``volviz compress``; returns the process exit code."""
-    p = argparse.ArgumentParser(prog="volviz compress", description="Compress a regular volume to .vvz "
-                                "(integer 5/3 wavelet octree + rANS / arithmetic coding)")
+    p = UsageParser(prog="volviz compress", description="Compress a regular volume to .vvz "
+                    "(integer 5/3 wavelet octree + rANS / arithmetic coding)")
     p.add_argument("input")
     p.add_argument("-o", "--output", required=True, help="output .vvz file")
     mode = p.add_mutually_exclusive_group()
     mode.add_argument("--lossless", action="store_true", help="bit-exact (default)")
-    mode.add_argument("--quality", type=float, help="0..100; 90 ~ 1 voxel-unit quantiser step")
-    mode.add_argument("--psnr", type=float, help="search the quantiser step to reach this PSNR (dB)")
+    mode.add_argument("--quality", type=float_in(0.0, 100.0), help="0..100; 90 ~ 1 voxel-unit quantiser step")
+    mode.add_argument("--psnr", type=float_in(0.0, 200.0, low_open=True),
+                      help="search the quantiser step to reach this PSNR (dB)")
     p.add_argument("--coder", choices=("rans", "arith"), default="rans",
                    help="rans: fast decoding (default); arith: adaptive arithmetic coding, higher ratio")
     p.add_argument("--transform", choices=("auto", "5/3", "haar"), default="auto",
                    help="lossless files: code each octree node with the 5/3 and the integer S-transform and keep the "
                    "smaller (auto, default), or force one; lossy files always use the 5/3")
-    p.add_argument("--raw", type=int, nargs=3, metavar=("NX", "NY", "NZ"),
+    p.add_argument("--raw", type=int_in(1), nargs=3, metavar=("NX", "NY", "NZ"),
                    help="INPUT is a headerless raw volume (x fastest), memory-mapped and compressed out of core")
-    p.add_argument("--dtype", default="uint8", help="sample type of --raw input (uint8, uint16, int16, float32)")
+    p.add_argument("--dtype", default="uint8", choices=("uint8", "uint16", "int16", "float32"),
+                   help="sample type of --raw input")
     p.add_argument("--series", action="store_true",
                    help="INPUT is a time series of 8-bit volumes (e.g. Storm.pvm-t%%02d); OUTPUT a .vvs store directory")
-    p.add_argument("--pattern", default="IBBPBBPPB", help="GOP pattern of --series (I, IPP, IBB, IBBPBBPPB, ...)")
+    p.add_argument("--pattern", type=_gop_pattern, default="IBBPBBPPB",
+                   help="GOP pattern of --series (I, IPP, IBB, IBBPBBPPB, ...)")
     p.add_argument("--scheduler", metavar="ADDRESS",
                    help="--series only: encode on this dask.distributed scheduler (e.g. tcp://host:8786), one task "
                    "per I-to-I part; the output is bit-identical to a local run (needs the volviz-dask plugin)")
