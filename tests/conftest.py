@@ -48,3 +48,31 @@ def blob_vvz(path: Path, n: int) -> Path:
     field = 200 * np.exp(-3 * ((x - 0.2) ** 2 + y ** 2 + (z + 0.1) ** 2)) + 40 * np.sin(4 * x) * np.cos(3 * y) + 45
     compress(RegularVolume(np.asfortranarray(np.clip(field, 0, 255).astype(np.uint8))), path, mode="lossless")
     return path
+
+
+@pytest.fixture
+def make_window(qtbot, tmp_path: Path):
+    """``make_window()`` opens another app window (settings and recovery folder in tmp_path); all are closed at
+    teardown."""
+    import gc
+
+    from PySide6.QtCore import QSettings
+
+    from volviz_app.window import MainWindow
+
+    created = []
+
+    def make() -> MainWindow:
+        settings = QSettings(str(tmp_path / "settings.ini"), QSettings.Format.IniFormat)
+        win = MainWindow(settings=settings, recovery_dir=tmp_path / "recovery")  # closed below, not by qtbot:
+        win.resize(1400, 900)
+        win.show()
+        qtbot.waitExposed(win)
+        created.append(win)
+        return win
+
+    yield make
+    for win in created:
+        win.dirty = False  # no "save changes?" prompt at teardown
+        win.close()
+    gc.collect()  # free the closed windows here, on the GUI thread

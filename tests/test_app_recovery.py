@@ -2,7 +2,6 @@
 file, and the autosave of a really crashed process (SIGKILL) is offered to exactly one window."""
 from __future__ import annotations
 
-import gc
 import os
 import subprocess
 import sys
@@ -14,7 +13,6 @@ from conftest import data_file
 
 pytest.importorskip("PySide6")
 
-from PySide6.QtCore import QSettings  # noqa: E402
 from PySide6.QtWidgets import QMessageBox  # noqa: E402
 
 from volviz_app.window import MainWindow  # noqa: E402
@@ -49,27 +47,6 @@ app.exec()
 """
 
 
-@pytest.fixture
-def windows(qtbot, tmp_path: Path):
-    created: list[MainWindow] = []
-
-    def make() -> MainWindow:
-        settings = QSettings(str(tmp_path / f"settings{len(created)}.ini"), QSettings.Format.IniFormat)
-        win = MainWindow(settings=settings, recovery_dir=tmp_path / "recovery")
-        win.resize(800, 600)
-        win.show()
-        qtbot.waitExposed(win)
-        created.append(win)
-        return win
-
-    yield make
-    for win in created:
-        if win.isVisible():
-            win.dirty = False
-            win.close()
-    gc.collect()
-
-
 def open_and_edit(qtbot, window: MainWindow, opacity: int) -> None:
     window.open_path(data_file("volumes/neghip.slc"))
     qtbot.waitUntil(lambda: not window.progress_bar.isVisible() and window.controller is not None, timeout=60000)
@@ -77,7 +54,7 @@ def open_and_edit(qtbot, window: MainWindow, opacity: int) -> None:
     assert window.dirty
 
 
-def test_two_windows_autosave_and_recover_independently(qtbot, windows, tmp_path: Path) -> None:
+def test_two_windows_autosave_and_recover_independently(qtbot, make_window, tmp_path: Path) -> None:
     recovery = tmp_path / "recovery"
     recovery.mkdir()
     crash = subprocess.run([sys.executable, "-c", CRASHING_APP, str(recovery), str(data_file("volumes/neghip.slc")),
@@ -87,7 +64,7 @@ def test_two_windows_autosave_and_recover_independently(qtbot, windows, tmp_path
     orphan = Path(crash.stdout.strip())
     assert orphan.parent == recovery and orphan.exists()
 
-    first, second = windows(), windows()
+    first, second = make_window(), make_window()
     assert first.recovery_file != second.recovery_file
     assert first.offer_recovery()  # claims the crashed process's file ...
     assert not second.offer_recovery()  # ... so the other window has nothing to offer
@@ -105,6 +82,6 @@ def test_two_windows_autosave_and_recover_independently(qtbot, windows, tmp_path
     second.close()  # a clean close deletes this window's autosave only
     assert not second.recovery_file.exists()
     assert first.recovery_file.exists()
-    third = windows()
+    third = make_window()
     assert not third.offer_recovery()  # the first window is alive: its autosave is not an orphan
     assert first.recovery_file.exists()

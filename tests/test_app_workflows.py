@@ -1,8 +1,6 @@
 """What a user does in the app, under Xvfb with real widgets and real VTK rendering (issue: the desktop application)."""
 from __future__ import annotations
 
-import gc
-
 import json
 import subprocess
 import sys
@@ -11,33 +9,13 @@ from pathlib import Path
 import imageio.v3 as iio
 import numpy as np
 import pytest
-from PySide6.QtCore import QEvent, QPoint, QPointF, QSettings, Qt, QTimer
+from PySide6.QtCore import QEvent, QPoint, QPointF, Qt, QTimer
 from PySide6.QtGui import QMouseEvent
 from PySide6.QtWidgets import QApplication, QMessageBox
 
 from conftest import data_file
 from loop_latency import LoopGaps
 from volviz_app.window import MainWindow
-
-
-@pytest.fixture
-def make_window(qtbot, tmp_path: Path):
-    created = []
-
-    def make() -> MainWindow:
-        settings = QSettings(str(tmp_path / "settings.ini"), QSettings.Format.IniFormat)
-        win = MainWindow(settings=settings, recovery_dir=tmp_path / "recovery")  # closed below, not by qtbot:
-        win.resize(1400, 900)
-        win.show()
-        qtbot.waitExposed(win)
-        created.append(win)
-        return win
-
-    yield make
-    for win in created:
-        win.dirty = False  # no "save changes?" prompt at teardown
-        win.close()
-    gc.collect()  # free the closed windows here, on the GUI thread
 
 
 def wait_loaded(qtbot, window: MainWindow) -> None:
