@@ -219,45 +219,51 @@ def test_raw_zero_dims(tmp_path):
 # ---------------------------------------------------------------- NaN / Inf
 
 
-def test_nan_in_raw_float_is_reported_or_counted(tmp_path):
+def test_nan_in_raw_float_is_read_and_counted(tmp_path):
     data = np.arange(24, dtype=np.float32)
     data[[3, 10]] = np.nan
     data[17] = np.inf
     path = tmp_path / "v.raw"
     path.write_bytes(data.tobytes())
-    with pytest.raises(vio.ReadError, match=r"3 non-finite values of 24 \(2 NaN, 1 Inf; first at index \(3,\)\)"):
-        vio.read_raw(path, (2, 3, 4), "f4")
-    with pytest.warns(vio.NonFiniteWarning, match="3 non-finite values"):
-        vol = vio.read_raw(path, (2, 3, 4), "f4", allow_nonfinite=True)
+    with pytest.warns(vio.NonFiniteWarning, match=r"3 non-finite values of 24 \(2 NaN, 1 Inf; first at index \(3,\)\)"):
+        vol = vio.read_raw(path, (2, 3, 4), "f4")
     assert int(np.count_nonzero(~np.isfinite(vol.data))) == 3
+    with pytest.raises(vio.ReadError, match="3 non-finite values"):   # strict reading refuses them
+        vio.read_raw(path, (2, 3, 4), "f4", allow_nonfinite=False)
 
 
-def test_nan_in_metaimage_vti_and_plot3d(tmp_path):
+def test_nan_in_metaimage_vti_and_plot3d_is_read_and_counted(tmp_path):
     import pyvista as pv
+
+    from volviz.model.arrays import list_arrays
 
     data = np.ones((3, 3, 3), np.float64)
     data[1, 1, 1] = -np.inf
     (tmp_path / "v.raw").write_bytes(data.ravel(order="F").tobytes())
     (tmp_path / "v.mhd").write_text("NDims = 3\nDimSize = 3 3 3\nElementType = MET_DOUBLE\nElementDataFile = v.raw\n")
-    read_error(tmp_path / "v.mhd", "1 non-finite values")
+    with pytest.warns(vio.NonFiniteWarning, match="1 non-finite values"):
+        assert list_arrays(vio.read(tmp_path / "v.mhd"))[0].nonfinite == 1
     img = pv.ImageData(dimensions=(3, 3, 3))
     img.point_data["a"] = data.ravel(order="F") * np.nan
     img.save(tmp_path / "n.vti")
-    read_error(tmp_path / "n.vti", "point array 'a' holds 27 non-finite values")
-    with pytest.warns(vio.NonFiniteWarning):
-        assert np.isnan(vio.read(tmp_path / "n.vti", allow_nonfinite=True).data).all()
+    with pytest.warns(vio.NonFiniteWarning, match="point array 'a' holds 27 non-finite values"):
+        assert np.isnan(vio.read(tmp_path / "n.vti").data).all()
+    read_error(tmp_path / "n.vti", "point array 'a' holds 27 non-finite values", allow_nonfinite=False)
     dims = np.array([2, 2, 2], "<i4").tobytes()
     (tmp_path / "g.xyz").write_bytes(dims + np.arange(24, dtype="<f4").tobytes())
     q = np.ones(40, "<f4")
     q[5] = np.nan
     (tmp_path / "g.q").write_bytes(dims + np.zeros(4, "<f4").tobytes() + q.tobytes())
-    with pytest.raises(vio.ReadError, match=r"g.q: q solution holds 1 non-finite"):
-        vio.read(tmp_path / "g.xyz", q=tmp_path / "g.q")
+    with pytest.warns(vio.NonFiniteWarning, match=r"g.q: q solution holds 1 non-finite"):
+        grid = vio.read(tmp_path / "g.xyz", q=tmp_path / "g.q")
+    assert {a.name: a.nonfinite for a in list_arrays(grid)}["Density"] == 1
     q[5] = 1.0
     q[0] = -1.0  # negative density: log of a negative number in the entropy
     (tmp_path / "g.q").write_bytes(dims + np.zeros(4, "<f4").tobytes() + q.tobytes())
-    with pytest.raises(vio.ReadError, match="derived function"):
-        vio.read(tmp_path / "g.xyz", q=tmp_path / "g.q")
+    with pytest.warns(vio.NonFiniteWarning, match="derived function"):
+        grid = vio.read(tmp_path / "g.xyz", q=tmp_path / "g.q")
+    counts = {a.name: a.nonfinite for a in list_arrays(grid)}
+    assert counts["Density"] == 0 and counts["Entropy"] == 8    # every point: this q has a negative pressure
 
 
 # ---------------------------------------------------------------- permissions and directories

@@ -20,8 +20,8 @@ More formats come from reader plugins (entry-point group ``volviz.readers``, see
 optional ``volviz-vtk-readers`` plugin in ``plugins/`` adds Exodus II, OpenFOAM, CGNS, EnSight, netCDF CF, Tecplot,
 AVS UCD, Fluent and the multiblock / parallel VTK XML files.
 
-Float data holding NaN/Inf raises ReadError unless ``allow_nonfinite=True`` is passed, which keeps the values and
-emits a ``NonFiniteWarning`` with their count.
+Float data holding NaN/Inf is kept (renderers draw it transparent) with a ``NonFiniteWarning`` giving the count;
+``allow_nonfinite=False`` refuses it with a ReadError instead.
 """
 from __future__ import annotations
 

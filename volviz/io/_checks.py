@@ -127,7 +127,7 @@ def require_bytes(path: PathLike, needed: int, available: int, what: str) -> Non
                               f"header is wrong")
 
 
-def check_finite(path: PathLike, values: np.ndarray, allow_nonfinite: bool = False, what: str = "data") -> int:
+def check_finite(path: PathLike, values: np.ndarray, allow_nonfinite: bool = True, what: str = "data") -> int:
     """Count NaN/Inf in float data. Raise ReadError unless ``allow_nonfinite``; then warn with the count.
 
     Returns the number of non-finite values (0 for integer data).

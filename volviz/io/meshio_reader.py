@@ -22,7 +22,7 @@ def meshio_extensions() -> list[str]:
     return sorted(meshio.extension_to_filetypes)
 
 
-def read_meshio(path: PathLike, file_format: str | None = None, allow_nonfinite: bool = False) -> UnstructuredMesh:
+def read_meshio(path: PathLike, file_format: str | None = None, allow_nonfinite: bool = True) -> UnstructuredMesh:
     """Read a mesh with meshio and convert it (cells as VTK type ids)."""
     import meshio
     from meshio._vtk_common import meshio_to_vtk_type

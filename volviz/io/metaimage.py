@@ -65,7 +65,7 @@ def _floats(path: PathLike, fields: dict[str, str], keys: tuple[str, ...], n: in
     return (default,) * n
 
 
-def read_metaimage(path: PathLike, allow_nonfinite: bool = False) -> RegularVolume | Image2D:
+def read_metaimage(path: PathLike, allow_nonfinite: bool = True) -> RegularVolume | Image2D:
     """Read .mhd (+ data file) or .mha into RegularVolume (3D) or Image2D (2D, any number of channels).
 
     Problems with a separate data file are reported against the header, naming the data file too."""

@@ -214,7 +214,7 @@ def read_plot3d_xyz(path: PathLike, block: int | None = None, **layout_options) 
     return points, iblank, layout
 
 
-def read_plot3d_q(path: PathLike, block: int | None = None, allow_nonfinite: bool = False, gamma: float = 1.4,
+def read_plot3d_q(path: PathLike, block: int | None = None, allow_nonfinite: bool = True, gamma: float = 1.4,
                   **layout_options) -> tuple[np.ndarray, FlowConditions, Plot3DLayout]:
     """Solution Q (ni, nj, nk, 5) in the file's precision, the flow conditions and the detected layout."""
     size = file_size(path)
@@ -278,7 +278,7 @@ def _derived(q: np.ndarray, cond: FlowConditions, r_gas: float) -> dict[str, np.
 
 def read_plot3d(xyz_path: PathLike, q_path: PathLike | None = None, *, block: int | None = None,
                 functions: tuple[str, ...] | None = DERIVED, gamma: float = 1.4, r_gas: float = 1.0,
-                allow_nonfinite: bool = False, **layout_options) -> CurvilinearGrid:
+                allow_nonfinite: bool = True, **layout_options) -> CurvilinearGrid:
     """Read a PLOT3D grid (and solution) into a CurvilinearGrid.
 
     With a q file the point data holds ``Density``, ``Momentum`` (vector), ``StagnationEnergy`` (file precision)

@@ -50,7 +50,7 @@ def _size_problem(path: PathLike, dims: Sequence[int], disk: np.dtype, header_by
 
 def read_raw(path: PathLike, dims: Sequence[int], dtype: object, byteorder: str = "little", header_bytes: int = 0,
              spacing: Sequence[float] = (1.0, 1.0, 1.0), origin: Sequence[float] = (0.0, 0.0, 0.0),
-             allow_nonfinite: bool = False, name: str = "scalars") -> RegularVolume | Image2D:
+             allow_nonfinite: bool = True, name: str = "scalars") -> RegularVolume | Image2D:
     """Read a headerless volume (dims (nx, ny, nz), x fastest) or image (dims (nx, ny) -> Image2D (ny, nx))."""
     dims = check_dims(path, dims, "raw dimensions")
     if len(dims) not in (2, 3):
@@ -72,7 +72,7 @@ def read_raw(path: PathLike, dims: Sequence[int], dtype: object, byteorder: str 
 def read_slice_stack(pattern: str | Sequence[PathLike], dims: Sequence[int], dtype: object,
                      byteorder: str = "little", header_bytes: int = 0,
                      spacing: Sequence[float] = (1.0, 1.0, 1.0), origin: Sequence[float] = (0.0, 0.0, 0.0),
-                     allow_nonfinite: bool = False, name: str = "scalars") -> RegularVolume:
+                     allow_nonfinite: bool = True, name: str = "scalars") -> RegularVolume:
     """Stack numbered slice files (e.g. ``headsq/quarter.%d`` or ``headsq/quarter.*``) into one RegularVolume.
 
     ``dims`` is (nx, ny) of one slice, or (nx, ny, nz) to also check the number of slices. Slices are ordered by

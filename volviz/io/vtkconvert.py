@@ -1,9 +1,11 @@
 """VTK data objects -> volviz model datasets (shared by the VTK legacy/XML and VTKHDF readers).
 
-vtkImageData -> RegularVolume (the active point scalars, else the first point array), vtkStructuredGrid and
-vtkRectilinearGrid -> CurvilinearGrid (every point array), vtkUnstructuredGrid / vtkPolyData -> UnstructuredMesh
-(cells grouped by VTK type and size; cell data permuted to that grouping). Composite data (multiblock,
-partitioned) is merged with vtkAppendFilter first. Float arrays are checked for NaN/Inf.
+Every numeric point and cell array is kept. vtkImageData -> RegularVolume (``data`` is the active point scalars, else
+the first array that varies, vectors by their magnitude; ``arrays`` holds every point array; cell-only images are
+converted to point data by VTK's cell-to-point filter), vtkStructuredGrid and vtkRectilinearGrid -> CurvilinearGrid,
+vtkUnstructuredGrid / vtkPolyData -> UnstructuredMesh (cells grouped by VTK type and size; cell data permuted to that
+grouping). Composite data (multiblock, partitioned) is merged with vtkAppendFilter first. Float arrays are checked
+for NaN/Inf (kept and counted by default).
 """
 from __future__ import annotations
 
@@ -13,9 +15,11 @@ import numpy as np
 
 from volviz.io._checks import check_finite
 from volviz.io.errors import PathLike, ReadError
-from volviz.model import CurvilinearGrid, RegularVolume, UnstructuredMesh
+from volviz.model import CELL_SIZES, CurvilinearGrid, RegularVolume, UnstructuredMesh
 
 _VTK_POLYHEDRON = 42
+# VTK's quadratic cell types with a linear counterpart: edge, triangle, quad, tetra, hexahedron, wedge, pyramid
+_QUADRATIC = (21, 22, 23, 24, 25, 26, 27, 28, 29, 30, 31, 32, 33)
 
 
 def _arrays(path: PathLike, attributes, n: int, allow_nonfinite: bool, where: str) -> dict[str, np.ndarray]:
@@ -66,7 +70,7 @@ def merge_composite(path: PathLike, obj):
     return out
 
 
-def vtk_to_model(path: PathLike, obj, allow_nonfinite: bool = False):
+def vtk_to_model(path: PathLike, obj, allow_nonfinite: bool = True):
     """Convert a VTK data object to the matching volviz model dataset."""
     from vtkmodules.util.numpy_support import vtk_to_numpy
 
@@ -80,22 +84,7 @@ def vtk_to_model(path: PathLike, obj, allow_nonfinite: bool = False):
         raise ReadError(path, f"the {obj.GetClassName()} in the file has no points")
     pd = obj.GetPointData()
     if obj.IsA("vtkImageData"):
-        dims = obj.GetDimensions()
-        name = _active_name(pd)
-        arrays = _arrays(path, pd, n_points, allow_nonfinite, "point")
-        if not arrays:
-            raise ReadError(path, "image data without point data arrays (cell-only data is not supported)")
-        if name not in arrays:
-            name = next(iter(arrays))
-        values = arrays[name]
-        if values.ndim != 1:
-            raise ReadError(path, f"image array {name!r} has {values.shape[1]} components; a volume needs scalars")
-        direction = np.array([obj.GetDirectionMatrix().GetElement(i, j) for i in range(3) for j in range(3)])
-        if not np.allclose(direction, np.eye(3).ravel()):
-            warnings.warn(f"{path}: image direction matrix {direction.tolist()} is ignored (volumes are "
-                          "axis-aligned)", UserWarning, stacklevel=3)
-        return RegularVolume(values.reshape(dims, order="F"), spacing=obj.GetSpacing(), origin=obj.GetOrigin(),
-                             name=name, source=str(path))
+        return _image(path, obj, allow_nonfinite)
     if obj.IsA("vtkStructuredGrid") or obj.IsA("vtkRectilinearGrid"):
         ext = obj.GetExtent()
         dims = (ext[1] - ext[0] + 1, ext[3] - ext[2] + 1, ext[5] - ext[4] + 1)
@@ -111,8 +100,13 @@ def vtk_to_model(path: PathLike, obj, allow_nonfinite: bool = False):
         arrays = _arrays(path, pd, n_points, allow_nonfinite, "point")
         point_data = {k: (v.reshape(dims, order="F") if v.ndim == 1 else v.reshape(tuple(dims) + v.shape[1:], order="F"))
                       for k, v in arrays.items()}
+        cells = tuple(max(n - 1, 1) for n in dims)
+        cell_data = {k: v.reshape(cells + v.shape[1:], order="F")
+                     for k, v in _arrays(path, obj.GetCellData(), obj.GetNumberOfCells(), allow_nonfinite,
+                                         "cell").items()}
         active = _active_name(pd)
-        return CurvilinearGrid(points, point_data, active=active if active in point_data else None, source=str(path))
+        return CurvilinearGrid(points, point_data, active=active if active in point_data else None, source=str(path),
+                               cell_data=cell_data)
     return _unstructured(path, obj, allow_nonfinite)
 
 
@@ -122,6 +116,8 @@ def _unstructured(path: PathLike, obj, allow_nonfinite: bool) -> UnstructuredMes
     grid = pv.wrap(obj)
     if not isinstance(grid, pv.UnstructuredGrid):
         grid = grid.cast_to_unstructured_grid()
+    if np.any(np.isin(np.asarray(grid.celltypes), _QUADRATIC)):
+        grid = grid.linear_copy()   # quadratic cells drawn through their corner nodes (PyVista's linear copy)
     points = np.asarray(grid.points, dtype=np.float64)
     check_finite(path, points, False, "point coordinates")
     types = np.asarray(grid.celltypes)
@@ -135,7 +131,8 @@ def _unstructured(path: PathLike, obj, allow_nonfinite: bool) -> UnstructuredMes
     for ctype, size in sorted({(int(t), int(s)) for t, s in keys}):
         idx = np.flatnonzero((types == ctype) & (sizes == size))
         block = conn[(offsets[idx][:, None] + np.arange(size)[None, :])] if size else np.empty((len(idx), 0), np.int64)
-        cells.append((ctype, block))
+        corners = CELL_SIZES.get(ctype, size)
+        cells.append((ctype, block[:, :corners] if size > corners else block))
         order.append(idx)
     perm = np.concatenate(order) if order else np.empty(0, np.int64)
     pd, cd = obj.GetPointData(), obj.GetCellData()
@@ -144,3 +141,32 @@ def _unstructured(path: PathLike, obj, allow_nonfinite: bool) -> UnstructuredMes
     active = _active_name(pd)
     return UnstructuredMesh(points, cells, point_data, cell_data,
                             active=active if active in point_data else None, source=str(path))
+
+
+def _image(path: PathLike, obj, allow_nonfinite: bool) -> RegularVolume:
+    """vtkImageData -> RegularVolume keeping every point array (cell arrays through VTK's cell-to-point filter)."""
+    import vtk
+
+    from volviz.model.arrays import default_array, scalar_of
+
+    if obj.GetPointData().GetNumberOfArrays() == 0 and obj.GetCellData().GetNumberOfArrays() > 0:
+        to_points = vtk.vtkCellDataToPointData()
+        to_points.SetInputData(obj)
+        to_points.Update()
+        obj = to_points.GetOutput()
+    pd = obj.GetPointData()
+    dims = tuple(obj.GetDimensions())
+    arrays = {k: v.reshape(dims + v.shape[1:], order="F")
+              for k, v in _arrays(path, pd, obj.GetNumberOfPoints(), allow_nonfinite, "point").items()}
+    if not arrays:
+        raise ReadError(path, "image data without numeric point or cell data arrays")
+    direction = np.array([obj.GetDirectionMatrix().GetElement(i, j) for i in range(3) for j in range(3)])
+    if not np.allclose(direction, np.eye(3).ravel()):
+        warnings.warn(f"{path}: image direction matrix {direction.tolist()} is ignored (volumes are "
+                      "axis-aligned)", UserWarning, stacklevel=3)
+    volume = RegularVolume(np.zeros(dims, np.uint8), spacing=obj.GetSpacing(), origin=obj.GetOrigin(),
+                           source=str(path), arrays=arrays)
+    active = _active_name(pd)
+    spec = active if active in arrays and arrays[active].ndim == 3 else default_array(volume)
+    volume.data, volume.name = scalar_of(arrays, spec), spec
+    return volume

@@ -97,7 +97,7 @@ def check_xml_header(path: PathLike, head: bytes, size: int, expected_type: str)
                                   f"{size} bytes can hold")
 
 
-def read_vtk_file(path: PathLike, allow_nonfinite: bool = False):
+def read_vtk_file(path: PathLike, allow_nonfinite: bool = True):
     """Read .vtk/.vti/.vtu/.vts/.vtr/.vtp with VTK's reader and convert to the matching model type."""
     import vtk
     from pathlib import Path

@@ -85,7 +85,7 @@ def _read_step(path: PathLike, step: int | None, allow_nonfinite: bool):
     return vtk_to_model(path, _run(path, reader), allow_nonfinite)
 
 
-def read_vtkhdf(path: PathLike, allow_nonfinite: bool = False):
+def read_vtkhdf(path: PathLike, allow_nonfinite: bool = True):
     """Read a VTKHDF file: a model dataset, or a TimeSeries (lazy frames) when the file is transient."""
     _kind, times = _inspect(path)
     if times is None:

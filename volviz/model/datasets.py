@@ -49,6 +49,7 @@ class RegularVolume:
     origin: tuple[float, float, float] = (0.0, 0.0, 0.0)
     name: str = "scalars"
     source: str = ""
+    arrays: dict[str, np.ndarray] = field(default_factory=dict)  # every point array of the file, by name
 
     def __post_init__(self) -> None:
         if self.data.ndim != 3:
@@ -59,6 +60,9 @@ class RegularVolume:
         self.origin = _as_vec3(self.origin, "origin")
         if min(self.spacing) <= 0 or not all(np.isfinite(self.spacing)):
             raise ValueError(f"RegularVolume spacing must be positive and finite, got {self.spacing}")
+        for name, arr in self.arrays.items():
+            if arr.shape[:3] != self.data.shape:
+                raise ValueError(f"point array {name!r} has shape {arr.shape}, volume is {self.data.shape}")
 
     kind = "regular volume"
 
@@ -99,6 +103,7 @@ class CurvilinearGrid:
     point_data: dict[str, np.ndarray] = field(default_factory=dict)
     active: str | None = None
     source: str = ""
+    cell_data: dict[str, np.ndarray] = field(default_factory=dict)  # (nx-1, ny-1, nz-1[, c]) per array
 
     kind = "curvilinear grid"
 
@@ -108,6 +113,10 @@ class CurvilinearGrid:
         for name, arr in self.point_data.items():
             if arr.shape[:3] != self.points.shape[:3]:
                 raise ValueError(f"point array {name!r} has shape {arr.shape}, grid is {self.points.shape[:3]}")
+        cells = tuple(max(n - 1, 1) for n in self.points.shape[:3])
+        for name, arr in self.cell_data.items():
+            if arr.shape[:3] != cells:
+                raise ValueError(f"cell array {name!r} has shape {arr.shape}, grid has {cells} cells")
         if self.active is None and self.point_data:
             self.active = next(iter(self.point_data))
 
@@ -139,6 +148,9 @@ class CurvilinearGrid:
                 grid.point_data[name] = arr.ravel(order="F")
             else:
                 grid.point_data[name] = arr.reshape(-1, arr.shape[-1], order="F")
+        for name, arr in self.cell_data.items():
+            n = int(np.prod(arr.shape[:3]))
+            grid.cell_data[name] = arr.reshape((n,) + arr.shape[3:], order="F")
         if self.active:
             grid.set_active_scalars(self.active)
         return grid

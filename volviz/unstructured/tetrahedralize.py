@@ -204,7 +204,10 @@ def _unstructured_tets(points: np.ndarray, cells: list[tuple[int, np.ndarray]]
     counts: dict[str, int] = {}
     n = len(points)
     hexes = [np.asarray(c, dtype=np.int64) for t, c in cells if t == VTK_HEXAHEDRON and len(c)]
-    colour = _hex_vertex_colours(np.concatenate(hexes), n) if hexes else np.zeros(n, dtype=np.int64)
+    try:
+        colour = _hex_vertex_colours(np.concatenate(hexes), n) if hexes else np.zeros(n, dtype=np.int64)
+    except ValueError:   # no conforming 5-split: VTK's ordered triangulation of every cell
+        return _vtk_tets(points, cells)
     # quad diagonals of prisms/pyramids through the smallest (colour, id): on faces shared with a hexahedron that is
     # the colour-0 diagonal the 5-split uses, so mixed meshes conform too
     rank = np.maximum(colour, 0) * n + np.arange(n)
@@ -226,6 +229,26 @@ def _unstructured_tets(points: np.ndarray, cells: list[tuple[int, np.ndarray]]
             counts[f"ignored type {cell_type}"] = counts.get(f"ignored type {cell_type}", 0) + len(conn)
     tets = np.concatenate(parts) if parts else np.empty((0, 4), dtype=np.int64)
     return tets, counts
+
+
+def _vtk_tets(points: np.ndarray, cells: list[tuple[int, np.ndarray]]) -> tuple[np.ndarray, dict[str, int]]:
+    """Conforming tetrahedra of any linear 3D cells by VTK's vtkDataSetTriangleFilter (its ordered triangulator
+    splits shared faces alike by global point ids), for hexahedral meshes whose vertex graph is not bipartite; the
+    points are kept as they are."""
+    import pyvista as pv
+    import vtk
+
+    solid = {int(t): np.asarray(c, dtype=np.int64) for t, c in cells
+             if t in (VTK_TETRA, VTK_HEXAHEDRON, VTK_WEDGE, VTK_PYRAMID) and len(c)}
+    triangulate = vtk.vtkDataSetTriangleFilter()
+    triangulate.SetInputData(pv.UnstructuredGrid(solid, points))
+    triangulate.TetrahedraOnlyOn()
+    triangulate.Update()
+    out = pv.wrap(triangulate.GetOutput())
+    if out.n_points != len(points):
+        raise ValueError("VTK's triangulation added points; the mesh cannot be tetrahedralised in place")
+    counts = {"ordered triangulation": sum(len(c) for c in solid.values())}
+    return np.asarray(out.cell_connectivity, dtype=np.int64).reshape(-1, 4), counts
 
 
 def _from_pyvista(grid: Any, scalars: str | None) -> CurvilinearGrid | UnstructuredMesh:

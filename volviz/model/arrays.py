@@ -1,0 +1,204 @@
+"""The arrays a dataset offers and the choice of the one it shows.
+
+A dataset keeps every point and cell array of its file. What a view draws is one scalar per point: a scalar array,
+one component of a vector/tensor array, or its magnitude, named by an array spec ``NAME``, ``NAME:c`` (component
+``c``, from 0) or ``NAME:magnitude``. Cell arrays are shown as point scalars through VTK's cell-to-point filter (the
+average of the cells around each point, as ParaView does). Non-finite values are kept and counted; the renderers draw
+them transparent.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from typing import Any, Union
+
+import numpy as np
+
+from volviz.model.datasets import CurvilinearGrid, RegularVolume, TetMesh, TimeSeries, UnstructuredMesh
+
+MAGNITUDE = "magnitude"
+MAX_COMPONENTS = 9           # tensors: 3x3
+
+
+@dataclass(frozen=True)
+class ArraySpec:
+    """A parsed array spec: the array's ``name`` and ``component`` (an index, ``"magnitude"``, or None for a
+    scalar array / the default of a vector: its magnitude)."""
+
+    name: str
+    component: Union[int, str, None] = None
+
+    def __str__(self) -> str:
+        return self.name if self.component is None else f"{self.name}:{self.component}"
+
+
+def parse_array_spec(text: str) -> ArraySpec:
+    """``"T"`` -> ArraySpec("T"), ``"V:1"`` -> component 1, ``"V:magnitude"`` (or ``"V:mag"``) -> the magnitude.
+    A name may itself hold colons: only a trailing ``:digits`` or ``:magnitude`` is read as the component."""
+    if not isinstance(text, str) or not text.strip():
+        raise ValueError("an array spec is NAME, NAME:COMPONENT or NAME:magnitude, got an empty one")
+    name, sep, tail = text.rpartition(":")
+    if sep and name:
+        if tail.isdigit():
+            component = int(tail)
+            if component >= MAX_COMPONENTS:
+                raise ValueError(f"array spec {text!r}: component {component} is out of range 0..{MAX_COMPONENTS - 1}")
+            return ArraySpec(name, component)
+        if tail.lower() in ("magnitude", "mag"):
+            return ArraySpec(name, MAGNITUDE)
+    return ArraySpec(text)
+
+
+@dataclass
+class ArrayInfo:
+    """What ``list_arrays`` says of one array."""
+
+    name: str
+    association: str                   # "point" | "cell"
+    components: int
+    range: tuple[float, float]         # finite min and max of the scalar (of the magnitude for vectors)
+    nonfinite: int                     # number of NaN / Inf values
+    choices: list[str] = field(default_factory=list)
+
+    @property
+    def varies(self) -> bool:
+        lo, hi = self.range
+        return bool(np.isfinite(lo) and np.isfinite(hi) and hi > lo)
+
+
+def _base(dataset: Any) -> Any:
+    return dataset.frame(0) if isinstance(dataset, TimeSeries) else dataset
+
+
+def _arrays_of(dataset: Any) -> list[tuple[str, str, np.ndarray, int]]:
+    """(name, association, values, n_components) of every array; values keep the dataset's layout."""
+    d = _base(dataset)
+    out: list[tuple[str, str, np.ndarray, int]] = []
+    if isinstance(d, RegularVolume):
+        arrays = d.arrays or {d.name: d.data}
+        out += [(k, "point", v, 1 if v.ndim == 3 else int(v.shape[3])) for k, v in arrays.items()]
+    elif isinstance(d, CurvilinearGrid):
+        out += [(k, "point", v, 1 if v.ndim == 3 else int(v.shape[3])) for k, v in d.point_data.items()]
+        out += [(k, "cell", v, 1 if v.ndim == 3 else int(v.shape[3])) for k, v in d.cell_data.items()]
+    elif isinstance(d, UnstructuredMesh):
+        out += [(k, "point", v, 1 if v.ndim == 1 else int(np.prod(v.shape[1:]))) for k, v in d.point_data.items()]
+        out += [(k, "cell", v, 1 if v.ndim == 1 else int(np.prod(v.shape[1:]))) for k, v in d.cell_data.items()]
+    elif isinstance(d, TetMesh):
+        out.append((d.name, "point", d.scalars, 1))
+    return [item for item in out if item[2].dtype.kind in "biuf"]
+
+
+def _as_vectors(values: np.ndarray, association: str, n_components: int, dataset: Any) -> np.ndarray:
+    """Values as (..., n_components) with the component axis last (scalars keep their shape)."""
+    d = _base(dataset)
+    spatial = 3 if isinstance(d, (RegularVolume, CurvilinearGrid)) else 1
+    if n_components == 1 and values.ndim == spatial:
+        return values
+    return values.reshape(values.shape[:spatial] + (n_components,))
+
+
+def _reduce(vectors: np.ndarray, spec: ArraySpec, n_components: int, spatial: int) -> np.ndarray:
+    """One scalar per sample: the array itself, one component, or the magnitude (the default of vectors)."""
+    if n_components == 1 and vectors.ndim == spatial:
+        if spec.component not in (None, 0, MAGNITUDE):
+            raise ValueError(f"array {spec.name!r} is a scalar array: it has no component {spec.component}")
+        return vectors
+    if spec.component is None or spec.component == MAGNITUDE:
+        return np.linalg.norm(vectors.astype(np.float64), axis=-1)
+    if not 0 <= int(spec.component) < n_components:
+        raise ValueError(f"array {spec.name!r} has {n_components} components: component {spec.component} is out of "
+                         f"range 0..{n_components - 1}")
+    return np.ascontiguousarray(vectors[..., int(spec.component)])
+
+
+def _finite_range(values: np.ndarray) -> tuple[tuple[float, float], int]:
+    if values.dtype.kind not in "fc":
+        return ((float(values.min()), float(values.max())) if values.size else (float("nan"),) * 2), 0
+    finite = np.isfinite(values)
+    bad = int(values.size - np.count_nonzero(finite))
+    if bad == values.size:
+        return (float("nan"), float("nan")), bad
+    kept = values[finite] if bad else values
+    return (float(kept.min()), float(kept.max())), bad
+
+
+def list_arrays(dataset: Any) -> list[ArrayInfo]:
+    """Every numeric array of ``dataset`` (the first frame of a time series) with its range, number of non-finite
+    values and the specs a user can choose for it."""
+    d = _base(dataset)
+    spatial = 3 if isinstance(d, (RegularVolume, CurvilinearGrid)) else 1
+    infos = []
+    for name, association, values, n in _arrays_of(d):
+        vectors = _as_vectors(values, association, n, d)
+        shown = _reduce(vectors, ArraySpec(name), n, spatial)
+        rng, _ = _finite_range(shown)
+        _, bad = _finite_range(values)
+        choices = [name] if n == 1 else [f"{name}:{MAGNITUDE}"] + [f"{name}:{c}" for c in range(n)]
+        infos.append(ArrayInfo(name, association, n, rng, bad, choices))
+    return infos
+
+
+def default_array(dataset: Any) -> str | None:
+    """The spec a first open shows: the dataset's active array when it varies, else the first point array that
+    varies, else the first cell array that varies, else the first array (vectors by their magnitude)."""
+    infos = list_arrays(dataset)
+    if not infos:
+        return None
+    active = getattr(_base(dataset), "active", None) or getattr(_base(dataset), "name", None)
+    ordered = ([i for i in infos if i.name == active] + [i for i in infos if i.association == "point"]
+               + [i for i in infos if i.association == "cell"])
+    chosen = next((i for i in ordered if i.varies), ordered[0])
+    return chosen.choices[0]
+
+
+def scalar_of(arrays: dict[str, np.ndarray], spec: str) -> np.ndarray:
+    """The (nx, ny, nz) scalar of ``spec`` among a regular volume's point arrays."""
+    parsed = parse_array_spec(spec)
+    if parsed.name not in arrays:
+        raise ValueError(f"no array {parsed.name!r}; the volume has {', '.join(sorted(arrays))}")
+    values = arrays[parsed.name]
+    return _reduce(values, parsed, 1 if values.ndim == 3 else int(values.shape[3]), 3)
+
+
+def _cell_to_point(dataset: Any, name: str, scalar: np.ndarray) -> np.ndarray:
+    """A cell scalar averaged onto the points by VTK's cell-to-point filter (as ParaView shows cell data)."""
+    grid = dataset.to_pyvista() if not isinstance(dataset, CurvilinearGrid) else CurvilinearGrid(
+        dataset.points, source=dataset.source).to_pyvista()
+    grid.clear_data()
+    flat = scalar.reshape(-1, order="F") if isinstance(dataset, CurvilinearGrid) else scalar
+    grid.cell_data["volviz_cell_scalar"] = np.asarray(flat, dtype=np.float64)
+    points = grid.cell_data_to_point_data()
+    values = np.asarray(points.point_data["volviz_cell_scalar"])
+    if isinstance(dataset, CurvilinearGrid):
+        return values.reshape(dataset.dimensions, order="F")
+    return values
+
+
+def select_array(dataset: Any, spec: str | None) -> Any:
+    """``dataset`` showing the array ``spec`` (None: ``default_array``): a dataset of the same kind whose active
+    point scalar is that array's scalar, component or magnitude, named by the spec. ValueError (naming the
+    available arrays) when the dataset has no such array."""
+    if isinstance(dataset, TimeSeries):
+        chosen = spec if spec is not None else default_array(dataset)
+        return TimeSeries(dataset.times, [None] * len(dataset), source=dataset.source,
+                          loader=lambda i: select_array(dataset.frame(i), chosen))
+    if spec is None:
+        spec = default_array(dataset)
+        if spec is None:
+            return dataset
+    parsed = parse_array_spec(spec)
+    found = [(n, a, v, c) for n, a, v, c in _arrays_of(dataset) if n == parsed.name]
+    if not found:
+        names = ", ".join(i.name for i in list_arrays(dataset)) or "none"
+        raise ValueError(f"no array {parsed.name!r}; the arrays are: {names}")
+    name, association, values, n = found[0]
+    spatial = 3 if isinstance(dataset, (RegularVolume, CurvilinearGrid)) else 1
+    scalar = _reduce(_as_vectors(values, association, n, dataset), parsed, n, spatial)
+    key = str(parsed)
+    if isinstance(dataset, RegularVolume):
+        return replace(dataset, data=scalar, name=key, arrays=dataset.arrays or {dataset.name: dataset.data})
+    if isinstance(dataset, TetMesh):
+        return dataset
+    if association == "cell":
+        scalar = _cell_to_point(dataset, name, scalar)
+    point_data = {**dataset.point_data, key: scalar}
+    return replace(dataset, point_data=point_data, active=key)
