@@ -62,6 +62,25 @@ def expand_pattern(pattern: str | PathLike | Sequence[PathLike]) -> list[tuple[i
     return items
 
 
+def series_times(items: Sequence[tuple[int | None, object]]) -> list[float]:
+    """The times of a series' members (``expand_pattern`` items): the numbers in their names when those increase
+    strictly along the series (``t01`` -> 1.0), else 0, 1, 2..."""
+    numbers = [n for n, _ in items]
+    if all(n is not None for n in numbers) and all(a < b for a, b in zip(numbers, numbers[1:])):  # type: ignore
+        return [float(n) for n in numbers]  # type: ignore[arg-type]
+    return [float(i) for i in range(len(items))]
+
+
+def member_time(pattern: str | PathLike, member: PathLike) -> float | None:
+    """The time at which ``read_series(pattern)`` shows the file ``member`` (None when it is not in the series)."""
+    items = expand_pattern(pattern)
+    target = os.path.realpath(os.fspath(member))
+    for (_, path), t in zip(items, series_times(items)):
+        if os.path.realpath(os.fspath(path)) == target:
+            return t
+    return None
+
+
 def read_series(paths_or_pattern: str | PathLike | Sequence[PathLike],
                 reader: Callable[..., object] | None = None, times: Sequence[float] | None = None,
                 **options) -> TimeSeries:
@@ -75,12 +94,8 @@ def read_series(paths_or_pattern: str | PathLike | Sequence[PathLike],
     if reader is None:
         from volviz.io import read as reader  # type: ignore[no-redef]
     paths = [p for _, p in items]
-    numbers = [n for n, _ in items]
     if times is None:
-        if all(n is not None for n in numbers) and all(a < b for a, b in zip(numbers, numbers[1:])):
-            times = [float(n) for n in numbers]  # type: ignore[arg-type]
-        else:
-            times = [float(i) for i in range(len(paths))]
+        times = series_times(items)
     if len(times) != len(paths):
         raise ValueError(f"{len(times)} times given for {len(paths)} files")
     first = reader(paths[0], **options)

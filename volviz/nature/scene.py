@@ -388,7 +388,7 @@ class NatureView:
         else:
             self._texture = None
             radius = 3000.0
-        self.dome_radius = radius
+        self.dome_radius = self._base_dome_radius = radius
         dome = sky_dome_mesh(radius, (0.0, 0.0, 0.0))  # moved to the eye by ``update``: the sky is at infinity
         if scene.sky is not None:
             sky_img = np.clip(scene.sky * 255.0, 0, 255).astype(np.uint8)
@@ -407,6 +407,19 @@ class NatureView:
 
         self._fit_clipping()
         return Camera.from_pyvista(self.plotter.camera)
+
+    def _fit_dome(self, eye: Any) -> None:
+        """Grow the sky dome (centred on the eye, see ``begin``) to twice the distance from the eye to the farthest
+        corner of the terrain, so that it never hides the terrain however far the camera backs away (a camera framed
+        on the whole terrain sits more than the dome's base radius away from its far side)."""
+        if self.sky_actor is None or self.scene.terrain is None:
+            return
+        b = self.scene.terrain.bounds()
+        corners = np.array([[x, y, z] for x in b[0:2] for y in b[2:4] for z in b[4:6]], dtype=np.float64)
+        far = float(np.linalg.norm(corners - np.asarray(eye, dtype=np.float64), axis=1).max())
+        scale = max(1.0, 2.0 * far / self._base_dome_radius)
+        self.sky_actor.SetScale(scale, scale, scale)
+        self.dome_radius = self._base_dome_radius * scale
 
     def _fit_clipping(self) -> None:
         """Make the plotter camera's clipping range hold the sky dome around the eye. A session camera applied before
@@ -428,6 +441,7 @@ class NatureView:
     def begin(self, camera: Any = None, scale: int = 1) -> tuple[Any, tuple[int, int], int]:
         """GUI thread: the view to compute (``camera`` or the plotter's, the image size and the preview ``scale``,
         see ``compute``); moves the sky dome to the eye (the sky is at infinity)."""
+        self._fit_dome(camera.position if camera is not None else self.plotter.camera.position)
         cam = camera or self._camera()
         if camera is not None:
             camera.apply_to(self.plotter.camera)

@@ -255,7 +255,7 @@ class SceneController:
         out = {}
         for comp in self.session.components:
             if comp.dataset is not None and isinstance(self.datasets.get(comp.dataset), TimeSeries):
-                out[comp.id] = self.datasets[comp.dataset]
+                out[comp.id] = self.dataset_of(comp.id)
         return out
 
     def time_span(self) -> Optional[tuple[float, float]]:
@@ -387,7 +387,12 @@ class SceneController:
         them in the background instead)."""
         from volviz.render.vtk_scene import apply_camera
 
-        apply_camera(self.plotter, camera)
+        if camera is None:
+            from volviz.render.framing import frame_scene
+
+            frame_scene(self.plotter, self.props)
+        else:
+            apply_camera(self.plotter, camera)
         if update:
             self.update_views()
 

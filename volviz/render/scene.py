@@ -14,7 +14,7 @@ from typing import Any, Optional
 import numpy as np
 
 from volviz.jobs import ProgressCallback, report
-from volviz.session import Component, DatasetRef, Session, resolve_path
+from volviz.session import Component, DatasetRef, RenderSettings, Session, resolve_path
 
 
 class SceneError(Exception):
@@ -45,12 +45,53 @@ def series_pattern(path: str | os.PathLike) -> Optional[str]:
 
 
 def data_session(path: str | os.PathLike) -> Session:
-    """A one-dataset session that shows ``path`` with its default visual (what opening a data file does); a file of a
-    numbered series opens the whole series."""
-    ref = DatasetRef(id="data", path=series_pattern(path) or str(Path(path).resolve()))
+    """A one-dataset session that shows ``path`` with its default visual (what opening a data file does): a file of a
+    numbered series opens the whole series at that file's time step; a height map (DEM, PGM) opens as a terrain
+    under a sky (``terrain_session``)."""
+    if is_height_map(path):
+        return terrain_session(path)
+    pattern = series_pattern(path)
+    ref = DatasetRef(id="data", path=pattern or str(Path(path).resolve()))
     if Path(path).suffix.lower() == ".vvz" and vvz_voxels(path) > LOD_VOXELS:
         ref.options["lod"] = True          # too large to decode whole: blocks per view (volviz.render.lod_volume)
-    return Session(datasets=[ref], components=[Component(id="data", type="volume", dataset="data")])
+    session = Session(datasets=[ref], components=[Component(id="data", type="volume", dataset="data")])
+    if pattern is not None:
+        from volviz.io.series import member_time
+
+        t = member_time(pattern, path)
+        if t is not None:
+            session.render.options["time"] = t   # the session's display time (``SceneController.prepare``)
+    return session
+
+
+HEIGHT_MAP_SUFFIXES = (".dem", ".pgm")
+RELIEF = 0.1        # a grey-level height map opened directly rises to at most 1/10 of its width
+
+
+def is_height_map(path: str | os.PathLike) -> bool:
+    """Whether opening ``path`` should show a terrain: a USGS DEM, or a grey PGM (not part of a numbered series)."""
+    p = Path(path)
+    return p.suffix.lower() in HEIGHT_MAP_SUFFIXES and p.is_file() and series_pattern(p) is None
+
+
+def terrain_session(path: str | os.PathLike) -> Session:
+    """A height map (DEM in metres, PGM in grey levels) as a natural scene: its C-LOD terrain under a sky, moved
+    to the origin; a PGM's grey levels are scaled so that its relief is at most ``RELIEF`` of its width (a DEM keeps
+    its true heights)."""
+    from volviz.io import read
+
+    image = read(path)
+    settings: dict[str, Any] = {"origin": [0.0, 0.0]}
+    if Path(path).suffix.lower() == ".pgm":
+        rows, cols = image.data.shape[:2]
+        lo, hi = image.scalar_range()
+        span = hi - lo if np.isfinite(hi - lo) and hi > lo else 1.0
+        settings["height_scale"] = min(1.0, RELIEF * max(rows, cols) / span)
+    ref = DatasetRef(id="height_map", path=str(Path(path).resolve()))
+    return Session(datasets=[ref], components=[Component(id="terrain", type="terrain", dataset="height_map",
+                                                         settings=settings),
+                                               Component(id="sky", type="sky")],
+                   render=RenderSettings(background=(0.78, 0.85, 0.95)))
 
 
 #: compressed volumes with more voxels than this open at a view-dependent level of detail instead of being decoded
@@ -72,8 +113,6 @@ def demo_session() -> Session:
 
     camera = CameraState(position=(500.0, -150.0, 330.0), focal_point=(500.0, 600.0, 80.0), view_up=(0.0, 0.0, 1.0),
                          view_angle=60.0)
-    from volviz.session import RenderSettings
-
     return Session(components=demo_components(), camera=camera,
                    render=RenderSettings(size=(1024, 768), background=(0.78, 0.85, 0.95)))
 
@@ -113,7 +152,27 @@ def component_dataset(comp: Component, datasets: dict[str, Any]) -> Any:
         return datasets[key]
     if comp.dataset is None:
         raise SceneError(f"component {comp.id!r} ({comp.type}) names no dataset")
-    return datasets[comp.dataset]
+    if comp.type in NATURE_TYPES:
+        return datasets[comp.dataset]
+    try:
+        return shown_array(datasets[comp.dataset], comp.settings.get("array"))
+    except ValueError as exc:
+        raise SceneError(f"component {comp.id!r}: {exc}") from None
+
+
+def shown_array(dataset: Any, spec: Optional[str]) -> Any:
+    """``dataset`` showing the array ``spec`` (None: its default array; ``volviz.model.arrays``), made once per spec
+    and kept on the dataset, so the tetrahedralisation and topology cached on it are made once too."""
+    from volviz.model import Image2D
+
+    if isinstance(dataset, Image2D) or is_lod(dataset):
+        return dataset
+    from volviz.model.arrays import select_array
+
+    views = dataset.__dict__.setdefault("volviz_views", {})
+    if spec not in views:
+        views[spec] = select_array(dataset, spec)
+    return views[spec]
 
 
 def ensure_transfer_functions(session: Session, datasets: dict[str, Any]) -> None:
@@ -326,12 +385,13 @@ def install_scene(plotter: Any, session: Session, datasets: dict[str, Any], prep
         else:
             props[comp.id] = install_component(plotter, session, comp, datasets, prepared, spectrum, views)
     plotter.set_background(session.render.background)
-    if session.camera is None and pt_components:
-        plotter.view_isometric()
-        lo = np.min([m.points.min(axis=0) for _, m in pt_components], axis=0)
-        hi = np.max([m.points.max(axis=0) for _, m in pt_components], axis=0)
-        plotter.renderer.ResetCamera(lo[0], hi[0], lo[1], hi[1], lo[2], hi[2])
-        plotter.camera_set = True  # else PyVista re-frames its (empty) VTK props at the next render
+    if session.camera is None:  # framed on every component before the view-dependent parts are drawn
+        from volviz.render.framing import frame_bounds, scene_bounds
+
+        pt_props = {comp.id: _MeshBounds(mesh) for comp, mesh in pt_components}
+        if prepared.nature is not None:
+            pt_props["nature"] = _NatureBounds(prepared.nature)
+        frame_bounds(plotter, scene_bounds({**props, **pt_props, **{c.id: _LodBounds(d) for c, d in lod_components}}))
     else:
         apply_camera(plotter, session.camera)
     nature = install_nature(plotter, prepared.nature, views)
@@ -340,6 +400,25 @@ def install_scene(plotter: Any, session: Session, datasets: dict[str, Any], prep
     for comp, _ in lod_components + pt_components:
         props[comp.id] = install_component(plotter, session, comp, datasets, prepared, spectrum, views)
     return props
+
+
+@dataclass
+class _MeshBounds:
+    """What ``volviz.render.framing.prop_bounds`` reads of a PT volume before it exists: its mesh."""
+    mesh: Any
+
+
+@dataclass
+class _NatureBounds:
+    """... of a natural scene before its view exists: the scene (with ``terrain_actor`` marking it a nature view)."""
+    scene: Any
+    terrain_actor: Any = None
+
+
+@dataclass
+class _LodBounds:
+    """... of a LOD volume before it exists: its tree."""
+    tree: Any
 
 
 def install_component(plotter: Any, session: Session, comp: Component, datasets: dict[str, Any],

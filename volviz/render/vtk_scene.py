@@ -81,26 +81,26 @@ def volume_grid(dataset: Any) -> Any:
 
 
 def default_transfer_function_for(dataset: Any, name: str = "default") -> Any:
-    """The default transfer function over the data range (of every step, for a time series)."""
+    """The first-look transfer function of a dataset: placed from the histogram of its shown scalar (of every step,
+    for a time series) by ``volviz.optics.auto_tf``; a compressed LOD volume gets the ramp over its range."""
     from volviz.regular.lod import LodTree
 
     if isinstance(dataset, LodTree):
         from volviz.render.lod_volume import lod_bounds, lod_scalar_range
 
         return default_transfer_function(lod_scalar_range(dataset), bounds_diagonal(lod_bounds(dataset)), name)
+    from volviz.model.stats import scalar_values
+    from volviz.optics.auto_tf import auto_transfer_function, mean_chord
+
     grid = volume_grid(dataset)
-    if isinstance(dataset, TimeSeries):
-        rng = dataset.scalar_range()
-    else:
-        rng = grid.get_data_range() if grid.active_scalars is not None else (0.0, 1.0)
-    return default_transfer_function(rng, bounds_diagonal(grid.bounds), name)
+    return auto_transfer_function(scalar_values(dataset), mean_chord(grid.bounds), name)
 
 
 def volume_input(dataset: Any) -> Any:
     """The VTK data object a volume mapper draws for ``dataset`` (tetrahedralised for non-image grids)."""
     import vtk
 
-    grid = volume_grid(dataset)
+    grid = transparent_nonfinite(volume_grid(dataset))
     if isinstance(dataset, RegularVolume):
         return grid
     if isinstance(dataset, TetMesh):
@@ -110,6 +110,23 @@ def volume_input(dataset: Any) -> Any:
     tets.SetInputData(ugrid)
     tets.Update()
     return tets.GetOutput()
+
+
+def transparent_nonfinite(grid: Any) -> Any:
+    """``grid`` with NaN/Inf of its active scalars replaced by a value below their finite range, which VTK's mappers
+    draw transparent (the transfer functions are not clamped: ``TransferFunction.to_vtk``), as volviz's own
+    renderers draw non-finite samples. Also keeps NaN out of VTK's scalar-range bookkeeping."""
+    values = grid.active_scalars
+    if values is None or values.dtype.kind != "f" or np.isfinite(values).all():
+        return grid
+    finite = values[np.isfinite(values)]
+    lo, hi = (float(finite.min()), float(finite.max())) if finite.size else (0.0, 1.0)
+    cleaned = np.where(np.isfinite(values), values, lo - max(hi - lo, abs(lo), 1.0))
+    grid = grid.copy(deep=False)
+    name = grid.active_scalars_name
+    grid.point_data[name] = cleaned.astype(values.dtype)
+    grid.set_active_scalars(name)
+    return grid
 
 
 def add_dataset(plotter: Any, dataset: Any, tf: Any = None, opacity: float = 1.0, name: Optional[str] = None) -> Any:
@@ -123,7 +140,7 @@ def add_dataset(plotter: Any, dataset: Any, tf: Any = None, opacity: float = 1.0
     if grid.active_scalars is None:
         return plotter.add_mesh(grid, opacity=opacity, name=name)
     if tf is None:
-        tf = default_transfer_function(grid.get_data_range(), bounds_diagonal(grid.bounds))
+        tf = default_transfer_function_for(dataset)
     return volume_prop(plotter, volume_input(dataset), isinstance(dataset, RegularVolume), tf, opacity, name)
 
 

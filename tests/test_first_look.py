@@ -1,0 +1,115 @@
+"""The first look at a file: the automatic transfer function (volviz.optics.auto_tf), the framing of the camera
+(volviz.render.framing), height maps as terrain scenes and series members at their own time step."""
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+
+from conftest import data_file
+from volviz.optics.auto_tf import (TARGET_DEPTH, auto_transfer_function, foreground, mean_chord,
+                                   prefers_log_histogram, robust_range)
+
+
+def test_mean_chord_is_cauchys_formula():
+    assert mean_chord((0, 1, 0, 1, 0, 1)) == pytest.approx(2.0 / 3.0)           # 4 V / S of the unit cube
+    assert mean_chord((0, 0.4, 0, 0.1, 0, 0.01)) == pytest.approx(4 * 4e-4 / 0.09)
+    assert mean_chord((0, 5, 0, 2, 0, 0)) == 5.0                                  # flat: its largest side
+
+
+def test_background_bin_is_left_out_and_stays_transparent():
+    rng = np.random.default_rng(1)
+    values = np.concatenate([np.zeros(70_000), rng.uniform(100, 200, 30_000)])   # 70 % air, as in a CT scan
+    fg = foreground(values)
+    assert fg.size == 30_000 and fg.min() >= 100
+    lo, hi = robust_range(values)
+    assert lo == pytest.approx(102, abs=1) and hi == pytest.approx(199.5, abs=1)
+    tf = auto_transfer_function(values, chord=10.0)
+    assert _rho(tf, np.array([0.0, 50.0]))[0] == 0.0 and _rho(tf, np.array([50.0]))[0] == 0.0
+    assert tf.scalars[0] == 0.0 and tf.scalars[-1] == pytest.approx(values.max())  # the whole range is covered
+
+
+def test_peak_extinction_gives_the_target_depth_for_the_mean_sample():
+    values = np.random.default_rng(2).normal(5.0, 1.0, 200_000)
+    chord = 3.0
+    tf = auto_transfer_function(values, chord)
+    depth = float(np.mean(_rho(tf, values))) * chord
+    assert depth == pytest.approx(TARGET_DEPTH, rel=0.02)       # the mean sample along a chord, whatever the units
+    scaled = auto_transfer_function(values * 1e6 + 3e9, chord)
+    assert float(np.mean(_rho(scaled, values * 1e6 + 3e9))) * chord == pytest.approx(depth, rel=1e-6)
+
+
+def test_degenerate_data_gives_a_valid_function():
+    for values in (np.full(100, 7.0), np.full(10, np.nan), np.array([np.inf, 1.0, np.nan, 2.0])):
+        tf = auto_transfer_function(values, chord=2.0)
+        assert np.all(np.isfinite(tf.scalars)) and np.all(np.isfinite(_rho(tf, tf.scalars)))
+
+
+def test_long_tailed_histograms_prefer_the_log_scale():
+    assert prefers_log_histogram(np.array([90_000, 30, 40, 35, 20, 25]))
+    assert not prefers_log_histogram(np.array([10, 20, 30, 25, 15]))
+
+
+def test_framing_fills_80_percent_of_the_limiting_dimension():
+    import pyvista as pv
+
+    from volviz.render.framing import frame_bounds
+
+    plotter = pv.Plotter(off_screen=True, window_size=(320, 240))
+    try:
+        bounds = (0.0, 9780.0, 0.0, 13950.0, 682.0, 2511.0)
+        plotter.add_mesh(pv.Box(bounds), color="white")
+        plotter.set_background("black")
+        frame_bounds(plotter, bounds)
+        image = plotter.screenshot(None, return_img=True)
+    finally:
+        plotter.close()
+    rows, cols = np.nonzero(image[..., 0] > 60)
+    centre = np.array([120, 160])
+    reach = max((rows.max() - centre[0] + 1) / 120, (centre[0] - rows.min()) / 120,
+                (cols.max() - centre[1] + 1) / 160, (centre[1] - cols.min()) / 160)
+    assert reach == pytest.approx(0.8, abs=0.02)
+
+
+def _render(session, size=(160, 120)):
+    from volviz.render.export import render_session
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return render_session(session, None, size)
+
+
+def test_height_maps_open_as_terrain_scenes():
+    from volviz.render.scene import data_session
+
+    dem = data_session(data_file("terrain/SainteHelens.dem"))
+    assert [c.type for c in dem.components] == ["terrain", "sky"]
+    assert dem.components[0].settings == {"origin": [0.0, 0.0]}                     # true heights in metres
+    from volviz.io import read
+
+    pgm = data_session(data_file("yukon/Yukon.map.pgm"))
+    lo, hi = read(data_file("yukon/Yukon.map.pgm")).scalar_range()
+    assert pgm.components[0].settings["height_scale"] == pytest.approx(0.1 * 689 / (hi - lo))  # relief: 1/10 width
+    image = _render(dem)
+    sky = np.array([0.78, 0.85, 0.95]) * 255
+    ground = np.abs(image.astype(float) - sky).sum(axis=2) > 60
+    assert 0.15 < ground.mean() < 0.8                   # the terrain fills the view instead of a speck of it
+    rows, cols = np.nonzero(ground)
+    assert abs(rows.mean() - 60) < 25 and abs(cols.mean() - 80) < 25             # ... around the centre
+
+
+def test_series_member_opens_at_its_time_step():
+    from volviz.render.scene import data_session
+
+    first = data_session(data_file("storm/Storm.pvm-t01"))
+    member = data_session(data_file("storm/Storm.pvm-t05"))
+    assert member.datasets[0].path.endswith("Storm.pvm-t%02d")
+    assert member.render.options["time"] == 5.0 and first.render.options["time"] == 1.0
+    background = _render(first)                  # the storm's first step is empty
+    storm = _render(member)
+    assert np.abs(storm.astype(int) - background.astype(int)).max() > 60
+
+
+def _rho(tf, s):
+    return tf.evaluate(np.asarray(s, dtype=np.float64))[1]

@@ -1,0 +1,109 @@
+"""A transfer function placed from the data's histogram: the legible first look at data nobody has shaped yet.
+
+The opacity ramp runs between robust percentiles of the values (2 % and 99.5 %), computed without the background: a
+histogram bin at either end of the range that holds more than ``BACKGROUND_FRACTION`` of the values (the air around a
+CT scan, the zero outside a simulation's domain) is left out, and so stays transparent. The colour is a cool-warm map
+over the same percentiles. The peak extinction is set so that a ray crossing the data's bounding box reaches an
+optical depth of about ``TARGET_DEPTH`` for the average sample, whatever the data's units and spread: the image is
+neither faint nor a solid block. Values above the upper percentile keep the peak opacity and colour; the function
+spans the whole finite range, because volviz draws scalars outside a transfer function's range as transparent.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from volviz.optics.transfer_function import TransferFunction
+
+BACKGROUND_FRACTION = 0.2      # an end bin holding more than this share of the values is background
+LOW_PERCENTILE, HIGH_PERCENTILE = 2.0, 99.5
+TARGET_DEPTH = 3.0             # optical depth of the mean sample along a chord of the bounding box
+MIN_DEPTH, MAX_DEPTH = 1.5, 60.0   # bounds of the peak extinction times the chord length
+MAX_SAMPLES = 2_000_000        # the statistics use an even subsample of larger data
+COOL_WARM = ((0.23, 0.30, 0.75), (0.55, 0.69, 0.94), (0.87, 0.87, 0.87), (0.96, 0.60, 0.48), (0.71, 0.02, 0.15))
+RAMP = (0.0, 0.08, 0.3, 0.65, 1.0)     # extinction at the five colour stops, as a share of the peak
+
+
+def finite_sample(values: np.ndarray) -> np.ndarray:
+    """The finite values of ``values`` as float64, an even subsample when there are more than ``MAX_SAMPLES``."""
+    flat = np.asarray(values).reshape(-1)
+    if flat.size > MAX_SAMPLES:
+        flat = flat[:: int(np.ceil(flat.size / MAX_SAMPLES))]
+    flat = flat.astype(np.float64)
+    return flat[np.isfinite(flat)]
+
+
+def foreground(values: np.ndarray, bins: int = 256) -> np.ndarray:
+    """``values`` without a dominant background bin at either end of their range (see the module docstring)."""
+    lo, hi = float(values.min()), float(values.max())
+    if hi <= lo:
+        return values
+    counts, edges = np.histogram(values, bins=bins, range=(lo, hi))
+    keep = np.ones(values.size, dtype=bool)
+    if counts[0] > BACKGROUND_FRACTION * values.size:
+        keep &= values > edges[1]
+    if counts[-1] > BACKGROUND_FRACTION * values.size:
+        keep &= values < edges[-2]
+    return values[keep] if keep.any() else values
+
+
+def robust_range(values: np.ndarray) -> tuple[float, float]:
+    """The 2 % and 99.5 % percentiles of the foreground values (the full range when those coincide)."""
+    fg = foreground(values)
+    lo, hi = (float(v) for v in np.percentile(fg, [LOW_PERCENTILE, HIGH_PERCENTILE]))
+    if hi <= lo:
+        lo, hi = float(values.min()), float(values.max())
+    return lo, hi
+
+
+def mean_chord(bounds: tuple[float, ...]) -> float:
+    """The mean length of the straight lines through a box, 4 V / S (Cauchy's formula for convex bodies): the
+    ray length that sets the peak extinction. A box flat in one or more axes gets its largest side instead."""
+    sides = np.maximum(np.subtract(bounds[1::2], bounds[0::2]), 0.0)
+    volume = float(np.prod(sides))
+    surface = 2.0 * float(sides[0] * sides[1] + sides[1] * sides[2] + sides[2] * sides[0])
+    if volume > 0 and surface > 0:
+        return 4.0 * volume / surface
+    return float(sides.max()) if sides.max() > 0 else 1.0
+
+
+def auto_transfer_function(values: np.ndarray, chord: float, name: str = "auto") -> TransferFunction:
+    """A transfer function for ``values`` (any shape; NaN/Inf ignored) seen through a volume whose rays are about
+    ``chord`` long (``mean_chord`` of its bounding box)."""
+    sample = finite_sample(values)
+    chord = float(chord) if np.isfinite(chord) and chord > 0 else 1.0
+    if sample.size == 0:
+        return _ramp(0.0, 1.0, 0.0, 1.0, TARGET_DEPTH / chord, name)
+    full_lo, full_hi = float(sample.min()), float(sample.max())
+    if full_hi <= full_lo:   # constant data: a faint uniform fog around the one value
+        pad = max(abs(full_lo) * 1e-3, 1e-6)
+        return _ramp(full_lo - pad, full_hi + pad, full_lo - pad, full_hi + pad, MIN_DEPTH / chord, name)
+    lo, hi = robust_range(sample)
+    shape = np.interp(sample, np.linspace(lo, hi, len(RAMP)), RAMP)
+    mean = float(shape.mean())
+    depth = TARGET_DEPTH / mean if mean > 0 else MAX_DEPTH
+    rho_max = float(np.clip(depth, MIN_DEPTH, MAX_DEPTH)) / chord
+    return _ramp(full_lo, full_hi, lo, hi, rho_max, name)
+
+
+def _ramp(full_lo: float, full_hi: float, lo: float, hi: float, rho_max: float, name: str) -> TransferFunction:
+    """Cool-warm colour and the extinction ``RAMP`` between ``lo`` and ``hi``, held flat out to the full range."""
+    stops = list(np.linspace(lo, hi, len(RAMP)))
+    colors = [list(c) for c in COOL_WARM]
+    extinction = [r * rho_max for r in RAMP]
+    if full_lo < stops[0]:
+        stops.insert(0, full_lo)
+        colors.insert(0, colors[0])
+        extinction.insert(0, 0.0)
+    if full_hi > stops[-1]:
+        stops.append(full_hi)
+        colors.append(colors[-1])
+        extinction.append(extinction[-1])
+    return TransferFunction(stops, colors, extinction, name=name)
+
+
+def prefers_log_histogram(counts: np.ndarray) -> bool:
+    """Whether a histogram is long-tailed enough to be read on a log scale: its tallest bin is more than 20 times
+    its median non-empty bin (a CT scan's air, a simulation's far field)."""
+    counts = np.asarray(counts, dtype=np.float64)
+    nonzero = counts[counts > 0]
+    return bool(nonzero.size > 1 and counts.max() > 20.0 * float(np.median(nonzero)))

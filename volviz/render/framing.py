@@ -1,0 +1,110 @@
+"""Framing the camera on what a scene shows: the bounds of every visible component, volviz's own views included
+(PT volumes and the natural scene draw image overlays, which VTK's ResetCamera does not see), and a camera that makes
+those bounds fill a given share of the viewport."""
+from __future__ import annotations
+
+from typing import Any, Optional
+
+import numpy as np
+
+Bounds = tuple[float, float, float, float, float, float]
+
+FILL = 0.8                                    # share of the viewport's limiting dimension the data fills
+ISOMETRIC = (1.0, 1.0, 1.0)                   # from the focal point towards the camera, as VTK's isometric view
+
+
+def _valid(bounds: Any) -> bool:
+    b = np.asarray(bounds, dtype=np.float64)
+    return b.shape == (6,) and bool(np.all(np.isfinite(b))) and bool(np.all(b[1::2] >= b[0::2]))
+
+
+def prop_bounds(prop: Any) -> Optional[Bounds]:
+    """The world bounds of one component's prop: a NatureView (its terrain, else its clouds), a PT volume (its
+    mesh), a LOD volume (its samples), a VTK prop (what VTK reports); None when hidden or empty."""
+    scene = getattr(prop, "scene", None)
+    if scene is not None and hasattr(prop, "terrain_actor"):
+        if getattr(scene, "terrain", None) is not None:
+            b = scene.terrain.bounds()
+            return tuple(float(v) for v in b) if _valid(b) else None  # type: ignore[return-value]
+        clouds = getattr(scene, "cloud_lod", None)
+        return tuple(clouds.volume.bounds()) if clouds is not None else None  # type: ignore[return-value]
+    mesh = getattr(prop, "mesh", None)
+    if mesh is not None and hasattr(mesh, "points"):
+        if not getattr(prop, "visible", True) or not len(mesh.points):
+            return None
+        lo, hi = mesh.points.min(axis=0), mesh.points.max(axis=0)
+        return (lo[0], hi[0], lo[1], hi[1], lo[2], hi[2])
+    tree = getattr(prop, "tree", None)
+    if tree is not None:
+        from volviz.render.lod_volume import lod_bounds
+
+        return lod_bounds(tree)
+    if hasattr(prop, "GetBounds"):
+        if hasattr(prop, "GetVisibility") and not prop.GetVisibility():
+            return None
+        b = prop.GetBounds()
+        return tuple(float(v) for v in b) if b is not None and _valid(b) else None  # type: ignore[return-value]
+    return None
+
+
+def scene_bounds(props: dict[str, Any]) -> Optional[Bounds]:
+    """The union of the bounds of every component prop (None when nothing has bounds)."""
+    boxes = [b for b in (prop_bounds(p) for p in props.values()) if b is not None]
+    if not boxes:
+        return None
+    arr = np.asarray(boxes, dtype=np.float64)
+    return tuple(float(v) for v in np.ravel(np.column_stack([arr[:, 0::2].min(axis=0),  # type: ignore[return-value]
+                                                              arr[:, 1::2].max(axis=0)])))
+
+
+def framing_distance(bounds: Bounds, direction: Any, view_up: Any, view_angle: float, aspect: float,
+                     fill: float = FILL) -> tuple[np.ndarray, float]:
+    """(focal point, distance) of a perspective camera looking along ``-direction`` at the box's centre from which
+    every corner of the box projects inside ``fill`` of the viewport (exactly at ``fill`` in the limiting
+    dimension)."""
+    lo, hi = np.asarray(bounds[0::2], float), np.asarray(bounds[1::2], float)
+    centre = 0.5 * (lo + hi)
+    d = np.asarray(direction, float)
+    d = d / np.linalg.norm(d)
+    right = np.cross(np.asarray(view_up, float), d)
+    right = right / np.linalg.norm(right)
+    up = np.cross(d, right)
+    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])]) - centre
+    tan_v = np.tan(np.radians(view_angle) / 2.0) * fill
+    tan_h = tan_v * aspect
+    need = np.maximum(np.abs(corners @ right) / tan_h, np.abs(corners @ up) / tan_v) + corners @ d
+    distance = float(need.max())
+    extent = float(np.linalg.norm(hi - lo))
+    return centre, max(distance, 1e-3 * extent, 1e-9)
+
+
+def frame_bounds(plotter: Any, bounds: Optional[Bounds], fill: float = FILL) -> None:
+    """Point the plotter's camera at ``bounds`` from the isometric direction (z up) so they fill ``fill`` of the
+    viewport; with no bounds, VTK's own reset."""
+    camera = plotter.renderer.GetActiveCamera()
+    if bounds is None:
+        plotter.view_isometric()
+        plotter.reset_camera()
+        return
+    width, height = plotter.window_size
+    aspect = width / max(height, 1)
+    up = (0.0, 0.0, 1.0)
+    centre, distance = framing_distance(bounds, ISOMETRIC, up, camera.GetViewAngle(), aspect, fill)
+    direction = np.asarray(ISOMETRIC) / np.linalg.norm(ISOMETRIC)
+    camera.SetFocalPoint(*centre)
+    camera.SetPosition(*(centre + distance * direction))
+    camera.SetViewUp(*up)
+    if camera.GetParallelProjection():
+        lo, hi = np.asarray(bounds[0::2]), np.asarray(bounds[1::2])
+        camera.SetParallelScale(0.5 * float(np.linalg.norm(hi - lo)) / fill)
+    renderer = plotter.renderer
+    renderer.ResetCameraClippingRange()               # what VTK draws (the sky dome included) ...
+    near, far = camera.GetClippingRange()
+    renderer.ResetCameraClippingRange(*bounds)        # ... and volviz's own views
+    camera.SetClippingRange(min(near, camera.GetClippingRange()[0]), max(far, camera.GetClippingRange()[1]))
+    plotter.camera_set = True          # else PyVista re-frames its own props at the next render
+
+
+def frame_scene(plotter: Any, props: dict[str, Any], fill: float = FILL) -> None:
+    """Frame every visible component of a scene (``scene_bounds``)."""
+    frame_bounds(plotter, scene_bounds(props), fill)
