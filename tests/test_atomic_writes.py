@@ -201,3 +201,19 @@ def test_replacing_a_store_keeps_the_old_one_until_the_new_one_is_in(tmp_path: P
     with pytest.raises(OutputPathError, match="symbolic link"):
         compress_series(frames, link, pattern="I")
     assert temp_name(target).name.startswith(f".s.vvs.volviz-tmp-{os.getpid()}-")
+
+
+def test_compressed_volume_writes_refuse_a_fifo_and_clean_up_after_killed_ones(tmp_path: Path) -> None:
+    from volviz.model.datasets import RegularVolume
+    from volviz.regular.codec import compress
+
+    volume = RegularVolume(np.arange(512, dtype=np.uint8).reshape(8, 8, 8) % 7)
+    fifo = tmp_path / "pipe.vvz"
+    os.mkfifo(fifo)
+    with pytest.raises(OutputPathError, match="FIFO"):
+        compress(volume, fifo, mode="lossless")
+    fifo.unlink()
+    stale = tmp_path / f".v.vvz.volviz-tmp-{dead_pid()}-5"
+    stale.write_bytes(b"half a file")
+    compress(volume, tmp_path / "v.vvz", mode="lossless")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["v.vvz"]

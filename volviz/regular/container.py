@@ -36,13 +36,13 @@ from __future__ import annotations
 import json
 import os
 import struct
-import tempfile
 import zlib
 from pathlib import Path
 from typing import Any, BinaryIO
 
 import numpy as np
 
+from volviz.io.atomic import check_output_path, remove_stale_temporaries, temp_name
 from volviz.io.errors import ReadError
 
 MAGIC = b"VVZ\x00\r\n\x1a\n"
@@ -78,11 +78,10 @@ class Writer:
     fsyncs and renames atomically. Use as a context manager (an exception removes the temporary file)."""
 
     def __init__(self, path: str | os.PathLike) -> None:
-        self.path = Path(path)
-        directory = self.path.parent if str(self.path.parent) else Path(".")
-        fd, tmp = tempfile.mkstemp(prefix=self.path.name + ".", suffix=".tmp", dir=directory)
-        self._tmp = Path(tmp)
-        self._f: BinaryIO = os.fdopen(fd, "w+b")
+        self.path = check_output_path(path)  # a regular file or nothing: never a device, FIFO or symlink
+        remove_stale_temporaries(self.path.parent)  # of earlier writes that were killed before their rename
+        self._tmp = temp_name(self.path)
+        self._f: BinaryIO = open(self._tmp, "x+b")
         self._f.write(b"\0" * HEADER_SIZE)
         self._pos = HEADER_SIZE
         self._records: list[tuple[int, int, int, int, int, int, int]] = []
