@@ -25,7 +25,8 @@ from volviz_app.docks.clipping import ClippingDock
 from volviz_app.docks.render_settings import RENDERER_DEFAULTS, RenderSettings
 from volviz_app.gc_guard import GuiThreadCollector
 from volviz_app.help import HelpMenu
-from volviz_app.errors import open_error
+from volviz_app.errors import hide_temporary_names, open_error
+from volviz_app.export_dialogs import ExportDialogs
 from volviz_app.layout import WindowLayout, scrolled
 from volviz_app.recent import RecentFiles
 from volviz_app.docks.scene_tree import SceneTree
@@ -246,8 +247,10 @@ class MainWindow(QMainWindow):
                                                    self._ask_save_session_as)
         file_menu.addSeparator()
         self.action_export_screenshot = self._action(file_menu, "&Export Screenshot…", "Ctrl+E",
-                                                     self._ask_export_screenshot)
-        self.action_export_movie = self._action(file_menu, "Export &Movie…", "Ctrl+Shift+E", self._ask_export_movie)
+                                                     lambda: self.export_dialogs.ask_screenshot())
+        self.action_export_movie = self._action(file_menu, "Export &Movie…", "Ctrl+Shift+E",
+                                                lambda: self.export_dialogs.ask_movie())
+        self.export_dialogs = ExportDialogs(self)
         file_menu.addSeparator()
         self._action(file_menu, "&Quit", QKeySequence.StandardKey.Quit, self.close)
 
@@ -1292,23 +1295,24 @@ class MainWindow(QMainWindow):
 
     # ------------------------------------------------------------------------------------------------ export
     def export_screenshot(self, path: str | os.PathLike, size: Optional[tuple[int, int]] = None) -> None:
-        """Re-render the current view offscreen at ``size`` (default: the viewport's) and write a PNG, in the
-        background with progress and cancel in the status bar (``volviz_app.frame_export``; a newer export supersedes
-        an older one). ``export_result`` is None while it runs, then True (written) or False."""
+        """Re-render the current view offscreen at ``size`` (default: the viewport's) and write an image (PNG, JPEG
+        or TIFF by the extension), in the background with progress and cancel in the status bar
+        (``volviz_app.frame_export``; a newer export supersedes an older one). ``export_result`` is None while it runs,
+        then True (written) or False."""
         from volviz.render.export import ImageFile
 
         size = size or (self.plotter.interactor.width(), self.plotter.interactor.height())
         self._export(Path(path).name, size, lambda controller: [(None, None)], lambda: ImageFile(path))
 
     def export_movie(self, path: str | os.PathLike, path_name: Optional[str], through_time: bool,
-                     fps: float = 24.0, size: Optional[tuple[int, int]] = None) -> None:
-        """Render a movie offscreen along the camera path ``path_name`` and/or through time, in the background like a
-        screenshot (``export_result``): MP4 through imageio-ffmpeg for ``.mp4``, else a PNG sequence in the folder
-        ``path``."""
+                     fps: float = 24.0, size: Optional[tuple[int, int]] = None, orbit: bool = False) -> None:
+        """Render a movie offscreen along the camera path ``path_name`` (or, with ``orbit``, one turn around the
+        current view) and/or through time, in the background like a screenshot (``export_result``): MP4 through
+        imageio-ffmpeg for ``.mp4``, else a PNG sequence in the folder ``path``."""
         from volviz.render.export import MovieWriter, movie_frames
 
         self._export(Path(path).name, size or self.session.render.size,
-                     lambda controller: movie_frames(controller, path_name, fps, through_time),
+                     lambda controller: movie_frames(controller, path_name, fps, through_time, orbit=orbit),
                      lambda: MovieWriter(Path(path), fps))
 
     def _export(self, name: str, size: tuple[int, int], frames_of: Callable[[Any], list[Any]],
@@ -1342,7 +1346,7 @@ class MainWindow(QMainWindow):
                 self._set_busy(False)
             self.status_label.setText(message)
             if not ok and not run.cancelled:
-                self.show_error("Cannot export", message)
+                self.show_error("Cannot export", hide_temporary_names(message))
 
         self.export_threads = set()
         run = FrameExport(self, plotter, controller, size, name, frames_of, open_sink, end, t)
@@ -1382,25 +1386,6 @@ class MainWindow(QMainWindow):
     def _ask_save_session_as(self) -> None:
         self.ask_file("Save session", "volviz sessions (*.json)", self.save_session, save=True,
                       default_name="session.json")
-
-    def _ask_export_screenshot(self) -> None:
-        self.ask_file("Export screenshot", "PNG images (*.png)",
-                      lambda path: self.export_screenshot(path, self.session.render.size), save=True,
-                      default_name="volviz.png")
-
-    def _ask_export_movie(self) -> None:
-        paths = list(self.session.camera_paths)
-        through_time = bool(self.controller and self.controller.time_series())
-        if not paths and not through_time:
-            self.show_error("Cannot export movie", "record a camera path (Camera menu) or open a time series first")
-            return
-        choices = paths + (["(through time)"] if through_time else [])
-        choice, ok = QInputDialog.getItem(self, "Export movie", "Camera path:", choices, 0, False)
-        if not ok:
-            return
-        self.ask_file("Export movie", "MP4 video (*.mp4)", lambda path: self.export_movie(
-            path, None if choice == "(through time)" else choice, choice == "(through time)"), save=True,
-            default_name="volviz.mp4")
 
     def show_error(self, title: str, text: str) -> None:
         """A non-blocking error dialog (the app keeps running); also logged."""
