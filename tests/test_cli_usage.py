@@ -240,3 +240,19 @@ def test_info_of_a_series_member_and_of_plot3d_files(capsys: pytest.CaptureFixtu
     assert main(["info", str(solution)]) == 2
     line = one_line_error(capsys)
     assert "PLOT3D solution (q) file" in line and "--q" in line and "bluntfinxyz.bin" in line
+
+
+def test_a_failed_write_names_the_output_not_a_temporary(capsys: pytest.CaptureFixture[str]) -> None:
+    """/proc takes no new files: the write fails after rendering, and the message names what the user gave."""
+    assert main(["render", "demo-volume", "-o", "/proc/volviz-test.png", "--size", "64x48"]) == 2
+    line = one_line_error(capsys)
+    assert line.startswith("volviz: error: cannot write /proc/volviz-test.png: ") and "volviz-tmp" not in line
+
+
+def test_image_sizes_beyond_what_renders_here_are_refused() -> None:
+    from volviz.render.export import ExportError, check_image_size
+
+    check_image_size((64, 48))
+    for size in [(8193, 16), (0, 10), (2 ** 40, 2 ** 40)]:
+        with pytest.raises(ExportError, match="cannot be rendered"):
+            check_image_size(size)

@@ -181,8 +181,7 @@ def _finite(pair: Sequence[float]) -> list[Optional[float]]:
 
 def _series_membership(path: Path) -> Optional[dict[str, Any]]:
     """Which numbered series ``path`` belongs to (the pattern, its position, its time), or None."""
-    from volviz.io.series import expand_pattern
-    from volviz.render.export import member_time
+    from volviz.io.series import expand_pattern, member_time
     from volviz.render.scene import series_pattern
 
     pattern = series_pattern(path)
@@ -190,7 +189,7 @@ def _series_membership(path: Path) -> Optional[dict[str, Any]]:
         return None
     members = [m.resolve() for _, m in expand_pattern(pattern)]
     return {"pattern": pattern, "member": members.index(path.resolve()) + 1, "members": len(members),
-            "time": member_time(path, pattern)}
+            "time": member_time(pattern, path)}
 
 
 def _print_info(desc: dict[str, Any]) -> None:

@@ -179,8 +179,8 @@ def open_target(target: str | os.PathLike, array: Optional[str] = None,
                 q: Optional[str | os.PathLike] = None) -> tuple[Session, Optional[Path]]:
     """The session a command-line target names, and its file: ``demo``, ``demo-volume``, a session file, or a data
     file shown with the array spec ``array`` (``volviz.model.arrays``) and the PLOT3D solution file ``q``. A member
-    of a numbered series opens the whole series at that member's time step."""
-    from volviz.render.scene import data_session, demo_session, demo_volume_session, series_pattern
+    of a numbered series opens the whole series at that member's time step (``data_session``)."""
+    from volviz.render.scene import data_session, demo_session, demo_volume_session
     from volviz.session import load
 
     if str(target) in ("demo", "demo-volume"):
@@ -194,23 +194,7 @@ def open_target(target: str | os.PathLike, array: Optional[str] = None,
         ref.options["q"] = str(Path(q).resolve())
     if array is not None:
         comp.settings["array"] = str(array)
-    pattern = series_pattern(path)
-    if pattern is not None and "time" not in session.render.options:
-        session.render.options["time"] = member_time(path, pattern)
     return session, None
-
-
-def member_time(path: str | os.PathLike, pattern: str) -> float:
-    """The display time of the file ``path`` in the series ``pattern``: its number when the numbers increase along
-    the series, else its index (the times ``volviz.io.read_series`` gives)."""
-    from volviz.io.series import expand_pattern
-
-    items = expand_pattern(pattern)
-    numbers = [n for n, _ in items]
-    index = [p.resolve() for _, p in items].index(Path(path).resolve())
-    if all(n is not None for n in numbers) and all(a < b for a, b in zip(numbers, numbers[1:])):
-        return float(numbers[index])  # type: ignore[arg-type]
-    return float(index)
 
 
 def render_to_file(session: Session, session_file: Optional[str | os.PathLike], out: str | os.PathLike,
