@@ -2,6 +2,8 @@
 
     xvfb-run -a -s "-screen 0 1600x1000x24" .venv/bin/python -m volviz_app.screenshots docs/screenshots
 
+With ``--layout`` only the window's default layout at a laptop's 1366x740 and at 1280x860 is shot.
+
 Each shot shows the real window on real data with one dock in front; the data comes from ../shared/data or
 $VOLVIZ_DATA, the natural scene is the built-in demo.
 """
@@ -38,8 +40,13 @@ def _iso_session(data_path: Path) -> Path:
     return path
 
 
+LAYOUT_SIZES = ((1366, 740), (1280, 860))  # a 1366x768 laptop screen less its panel; the default window
+
+
 def main(argv: list[str] | None = None) -> int:
     args = sys.argv[1:] if argv is None else argv
+    layout_only = "--layout" in args  # only the window at LAYOUT_SIZES (the default layout on the demo scene)
+    args = [a for a in args if a != "--layout"]
     out = Path(args[0] if args else "docs/screenshots")
     out.mkdir(parents=True, exist_ok=True)
     data = Path(os.environ.get("VOLVIZ_DATA", Path(__file__).resolve().parent.parent.parent / "shared" / "data"))
@@ -52,6 +59,7 @@ def main(argv: list[str] | None = None) -> int:
     window = MainWindow()
     window.resize(1400, 860)
     window.show()
+    window.layout_keeper.arrange()  # the default arrangement, whatever a previous launch left
 
     def shot(name: str) -> None:
         for _ in range(5):
@@ -62,6 +70,13 @@ def main(argv: list[str] | None = None) -> int:
 
     window.open_demo()
     _wait(app, window)
+    for width, height in LAYOUT_SIZES:
+        window.resize(width, height)
+        shot(f"window-{width}x{height}")
+    if layout_only:
+        window.close()
+        return 0
+    window.resize(1400, 860)
     window.scene_dock.raise_()
     shot("scene-tree-natural-scene")
     window.open_path(data / "volumes" / "neghip.slc")
