@@ -159,9 +159,13 @@ def describe(path: str, array: Optional[str] = None, q: Optional[str] = None) ->
         except ValueError as exc:
             raise UsageError(f"--array {array}: {exc}") from None
         desc["array"] = shown
-    desc["arrays"] = [{"name": a.name, "association": a.association, "components": a.components,
-                       "range": _finite(a.range), "nonfinite": a.nonfinite, "choices": a.choices}
-                      for a in list_arrays(base)]
+    else:  # an image or height map: its values, no named arrays
+        desc["range"] = _finite(base.scalar_range())
+    arrays = list_arrays(base)
+    if arrays:
+        desc["arrays"] = [{"name": a.name, "association": a.association, "components": a.components,
+                           "range": _finite(a.range), "nonfinite": a.nonfinite, "choices": a.choices}
+                          for a in arrays]
     if isinstance(dataset, TimeSeries):
         desc["time_steps"] = dataset.n_steps
         desc["times"] = [float(dataset.times[0]), float(dataset.times[-1])]
@@ -209,8 +213,6 @@ def _print_info(desc: dict[str, Any]) -> None:
 
 def _print_arrays(arrays: list[dict[str, Any]], width: int) -> None:
     """One line per array: name, association, components, finite range, non-finite values, the specs to choose."""
-    if not arrays:
-        print(f"{'arrays':<{width}}  none")
     names = max((len(a["name"]) for a in arrays), default=0)
     for i, a in enumerate(arrays):
         lo, hi = a["range"]
