@@ -22,7 +22,8 @@ def storm_iso_session(tmp_path: Path, time: float) -> Path:
             "styles": [{"value": 40, "color": [0.2, 0.5, 1.0], "opacity": 0.3},
                        {"value": 120, "color": [1.0, 0.8, 0.2], "opacity": 0.6}]}}],
         "camera": {"position": [80, -40, 60], "focal_point": [14, 14, 11], "view_up": [0, 0, 1], "view_angle": 30},
-        "render": {"options": {"time": time}, "background": [0, 0, 0]},
+        # the lit pixels measured are the surfaces': no outline box or orientation axes
+        "render": {"options": {"time": time, "outline": False, "axes": False}, "background": [0, 0, 0]},
     }
     path = tmp_path / f"storm-iso-{time}.json"
     path.write_text(json.dumps(doc))

@@ -95,6 +95,7 @@ class SceneController:
                                        views=views)
             self.plotter.camera_set = True  # install_scene chose the view; PyVista must not re-frame the props
             self.installed_bounds = self.bounds()  # (what the clipping dock starts from)
+            self.decorate()
             if any(_is_pt(p) for p in self.props.values()):
                 # VTK fits the clipping range to its own props only: a previous scene's near plane cut through a PT
                 # mesh (a 700k-tetrahedron first frame took minutes instead of 0.3 s)
@@ -119,6 +120,13 @@ class SceneController:
             self.iso_overlay = None
         self.props = {}
         self.plotter.clear()
+
+    def decorate(self) -> None:
+        """(Re)draw the scalar bar, orientation axes and outline box as the session's render options say
+        (``volviz.render.decorations``); call after a transfer function, visibility or option changed."""
+        from volviz.render.decorations import apply_decorations
+
+        apply_decorations(self.plotter, self.session, self.props, self.datasets)
 
     def component(self, comp_id: str) -> Component:
         for comp in self.session.components:
@@ -157,6 +165,7 @@ class SceneController:
                 prop.update()             # the selection depends on the TF (transparent blocks, Eq. 2.7)
         elif prop is not None and prop.IsA("vtkVolume"):
             update_volume_property(prop.GetProperty(), tf, comp.opacity)
+        self.decorate()      # the scalar bar shows the new colours and range
 
     def set_visible(self, comp_id: str, visible: bool, nature: bool = True, build: bool = True) -> None:
         """Show or hide a component. A terrain / fog / clouds / sky component rebuilds the natural scene now unless

@@ -1,0 +1,128 @@
+"""What frames the data on screen: a scalar bar (the colour legend of the shown array with its name and range),
+the orientation axes and the outline box of the data. Each is a render option of the session (``scalar_bar``,
+``axes``, ``outline``; on unless set to false), so it is saved with the session and can be switched off."""
+from __future__ import annotations
+
+from typing import Any, Optional
+
+import numpy as np
+
+from volviz.session import Session
+
+DECORATIONS = ("scalar_bar", "axes", "outline")
+OUTLINE_NAME = "volviz-outline"
+SCALAR_BAR_NAME = "volviz-scalar-bar"
+TITLE_CHAR_PX = 7          # about the width of one character of the 12-point title
+
+
+def decoration_enabled(session: Session, name: str) -> bool:
+    """Whether the decoration ``name`` (one of ``DECORATIONS``) is on in the session's render options."""
+    return bool(session.render.options.get(name, True))
+
+
+def _legend_component(session: Session) -> Optional[Any]:
+    """The first visible component with a transfer function: the one the scalar bar explains."""
+    return next((c for c in session.components
+                 if c.visible and c.transfer_function is not None and c.transfer_function in session.transfer_functions),
+                None)
+
+
+def _contrast(background: Any) -> tuple[float, float, float]:
+    """Black or white, whichever reads better on ``background``."""
+    luminance = float(np.dot(np.asarray(background, dtype=np.float64)[:3], (0.299, 0.587, 0.114)))
+    return (0.1, 0.1, 0.1) if luminance > 0.5 else (0.92, 0.92, 0.92)
+
+
+def apply_decorations(plotter: Any, session: Session, props: dict[str, Any], datasets: dict[str, Any]) -> None:
+    """Show or hide the scalar bar, orientation axes and outline box of the scene in ``plotter`` as the session's
+    render options say (``props``: the components' props, whose bounds the outline draws; ``datasets``: the loaded
+    datasets, whose shown array names the scalar bar). Safe to call again after any change: it replaces what it
+    added before."""
+    plotter.remove_actor(OUTLINE_NAME, render=False)
+    _remove_scalar_bar(plotter)
+    colour = _contrast(session.render.background)
+    if decoration_enabled(session, "outline"):
+        from volviz.render.framing import scene_bounds
+
+        data = {k: p for k, p in props.items() if k != "nature"}   # a landscape needs no box around it
+        bounds = scene_bounds(data)
+        if bounds is not None:
+            import pyvista as pv
+
+            plotter.add_mesh(pv.Box(bounds).outline(), color=colour, name=OUTLINE_NAME, pickable=False,
+                             reset_camera=False, render=False, line_width=1)
+    axes = getattr(plotter.renderer, "axes_widget", None)
+    if decoration_enabled(session, "axes"):
+        if axes is None:
+            plotter.add_axes(color=colour, interactive=False)
+        else:
+            plotter.renderer.show_axes()
+    elif axes is not None:
+        plotter.renderer.hide_axes()
+    comp = _legend_component(session) if decoration_enabled(session, "scalar_bar") else None
+    if comp is not None:
+        _add_scalar_bar(plotter, session, comp, _array_title(comp, datasets), colour)
+
+
+def _add_scalar_bar(plotter: Any, session: Session, comp: Any, title: str, colour: tuple[float, float, float]) -> None:
+    import vtk
+
+    from volviz.optics import TransferFunction
+
+    tf = TransferFunction.from_dict(session.transfer_functions[comp.transfer_function])
+    ctf, _ = tf.to_vtk(1.0)
+    ctf.ClampingOn()
+    bar = vtk.vtkScalarBarActor()
+    bar.SetLookupTable(ctf)
+    bar.SetTitle(str(title))
+    bar.SetNumberOfLabels(5)
+    bar.SetLabelFormat("%-#6.3g")
+    bar.SetOrientationToVertical()          # at the right edge, as ParaView places it
+    width = max(int(plotter.window_size[0]), 1)
+    bar.SetPosition(min(0.82, 1.0 - (TITLE_CHAR_PX * len(title) + 12) / width), 0.15)  # the title starts at x
+    bar.SetWidth(0.12)
+    bar.SetHeight(0.7)
+    bar.SetMaximumWidthInPixels(110)
+    bar.SetBarRatio(0.25)
+    bar.UnconstrainedFontSizeOn()
+    for text in (bar.GetTitleTextProperty(), bar.GetLabelTextProperty()):
+        text.SetColor(*colour)
+        text.ShadowOff()
+        text.ItalicOff()
+        text.BoldOff()
+        text.SetFontSize(12)
+    plotter.add_actor(bar, name=SCALAR_BAR_NAME, reset_camera=False, render=False, pickable=False)
+
+
+def _array_title(comp: Any, datasets: dict[str, Any]) -> str:
+    """The name of the array a component shows (its ``array`` setting, else its dataset's default array)."""
+    if comp.settings.get("array"):
+        return _readable(str(comp.settings["array"]))
+    from volviz.render.scene import SceneError, component_dataset
+
+    try:
+        shown = component_dataset(comp, datasets)
+    except (SceneError, KeyError):
+        return str(comp.id)
+    if hasattr(shown, "frame"):
+        shown = shown.frame(0)
+    return _readable(str(getattr(shown, "active", None) or getattr(shown, "name", None) or comp.id))
+
+
+def _readable(spec: str) -> str:
+    """An array spec as a legend title: ``V:magnitude`` -> ``V (magnitude)``, ``V:1`` -> ``V[1]``."""
+    from volviz.model.arrays import MAGNITUDE, parse_array_spec
+
+    parsed = parse_array_spec(spec)
+    if parsed.component == MAGNITUDE:
+        return f"{parsed.name} (magnitude)"
+    return parsed.name if parsed.component is None else f"{parsed.name}[{parsed.component}]"
+
+
+def _remove_scalar_bar(plotter: Any) -> None:
+    plotter.remove_actor(SCALAR_BAR_NAME, render=False)
+
+
+def scalar_bar_actor(plotter: Any) -> Optional[Any]:
+    """The scalar bar ``apply_decorations`` added (None when off or when nothing has a transfer function)."""
+    return plotter.renderer.actors.get(SCALAR_BAR_NAME)
