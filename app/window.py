@@ -21,6 +21,7 @@ from volviz.render.controller import no_render
 from volviz.session import CameraKey, Session, SessionError, relative_path
 from volviz_app.array_choice import ArrayChoice
 from volviz_app.clip_widget import ClipPlaneWidget
+from volviz_app.decoration_toggles import DecorationToggles
 from volviz_app.docks.clipping import ClippingDock
 from volviz_app.docks.render_settings import RENDERER_DEFAULTS, RenderSettings
 from volviz_app.gc_guard import GuiThreadCollector
@@ -277,6 +278,8 @@ class MainWindow(QMainWindow):
         view_menu.addSeparator()
         self._action(view_menu, "Reset &Layout", "", self.layout_keeper.reset)
         view_menu.addSeparator()
+        self.decorations = DecorationToggles(self, view_menu)
+        view_menu.addSeparator()
         self.action_fly = self._action(view_menu, "&Fly Mode", "F", self.set_fly_mode)
         self.action_fly.setCheckable(True)
         self._action(view_menu, "&Reset Camera", "R", self.reset_camera)
@@ -422,6 +425,7 @@ class MainWindow(QMainWindow):
             self.restoreState(QByteArray.fromBase64(session.layout["window_state"].encode("ascii")))
         self.scene_tree.populate(session.components)
         self.render_settings.load(session.render)
+        self.decorations.sync()
         self.clipping.load(session.clip, controller.installed_bounds)
         display_time = controller.time  # the session's display time, which set_steps would reset to the first step
         self.timeline.blockSignals(True)  # the scene already shows the display time: no re-blend, no re-extraction
