@@ -12,7 +12,7 @@ from PySide6.QtCore import QEvent, QPoint, Qt, QTimer
 
 from conftest import blob_vvz, data_file
 from loop_latency import LoopGaps
-from test_app_workflows import make_window, wait_loaded  # noqa: F401 (a fixture and a helper shared with it)
+from test_app_workflows import wait_loaded  # a helper shared with it (the make_window fixture is in conftest.py)
 from volviz_app.window import MainWindow
 
 

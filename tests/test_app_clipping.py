@@ -11,7 +11,7 @@ import pyvista as pv
 
 from volviz.iso.composite import render
 from volviz.unstructured.camera import Camera
-from test_app_workflows import make_window  # noqa: F401  (the shared window fixture)
+
 from volviz_app.window import MainWindow
 
 STYLES = [{"value": 0.3, "color": [1.0, 0.3, 0.2], "opacity": 0.5},

@@ -10,7 +10,7 @@ import imageio.v3 as iio
 import numpy as np
 
 from loop_latency import LoopGaps
-from test_app_workflows import make_window, wait_loaded  # noqa: F401 (a fixture and a helper shared with it)
+from test_app_workflows import wait_loaded  # a helper shared with it (the make_window fixture is in conftest.py)
 
 
 def test_screenshot_export_prepares_and_renders_in_the_background(qtbot, make_window, tmp_path: Path) -> None:

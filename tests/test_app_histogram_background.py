@@ -12,7 +12,7 @@ import numpy as np
 
 from conftest import data_file
 from loop_latency import LoopGaps
-from test_app_workflows import make_window, wait_loaded  # noqa: F401 (a fixture and a helper shared with it)
+from test_app_workflows import wait_loaded  # a helper shared with it (the make_window fixture is in conftest.py)
 
 
 def test_histogram_of_a_later_selected_component_is_computed_in_the_background(qtbot, make_window,

@@ -9,7 +9,7 @@ from pathlib import Path
 from PySide6.QtCore import Qt
 
 from loop_latency import LoopGaps
-from test_app_workflows import make_window, wait_loaded  # noqa: F401 (a fixture and a helper shared with it)
+from test_app_workflows import wait_loaded  # a helper shared with it (the make_window fixture is in conftest.py)
 
 
 def test_showing_a_hidden_component_prepares_it_in_the_background(qtbot, make_window, tmp_path: Path) -> None:

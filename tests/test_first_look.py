@@ -113,3 +113,24 @@ def test_series_member_opens_at_its_time_step():
 
 def _rho(tf, s):
     return tf.evaluate(np.asarray(s, dtype=np.float64))[1]
+
+
+def test_flat_grids_and_surface_meshes_are_drawn_as_coloured_surfaces():
+    """A 2D curvilinear grid carrying a cell array (netCDF CF) shows as a surface coloured through the transfer
+    function, its NaN (land in an ocean field) not drawn."""
+    from volviz.render.scene import data_session
+    from volviz.render.vtk_scene import is_surface
+
+    from volviz.io import read
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        grid = read(data_file("ecosystem/sampleCurveGrid4.nc"))
+        ocean = read(data_file("ecosystem/tos_O1_2001-2002.nc"))
+    assert is_surface(grid) and is_surface(ocean)
+    for path in ("ecosystem/sampleCurveGrid4.nc", "ecosystem/tos_O1_2001-2002.nc"):
+        image = _render(data_session(data_file(path)))
+        background = image[0, 0].astype(int)
+        drawn = np.abs(image.astype(int) - background).sum(axis=2) > 40
+        assert drawn.mean() > 0.15                                   # a surface, not an empty volume
+        assert len(np.unique(image[drawn].reshape(-1, 3) // 16, axis=0)) > 10   # ... in many colours

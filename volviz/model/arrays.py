@@ -198,7 +198,9 @@ def select_array(dataset: Any, spec: str | None) -> Any:
         return replace(dataset, data=scalar, name=key, arrays=dataset.arrays or {dataset.name: dataset.data})
     if isinstance(dataset, TetMesh):
         return dataset
-    if association == "cell":
+    cell_data = dataset.cell_data
+    if association == "cell":   # shown at the points; the view keeps no cell array of the same name
         scalar = _cell_to_point(dataset, name, scalar)
+        cell_data = {k: v for k, v in cell_data.items() if k != key}
     point_data = {**dataset.point_data, key: scalar}
-    return replace(dataset, point_data=point_data, active=key)
+    return replace(dataset, point_data=point_data, cell_data=cell_data, active=key)

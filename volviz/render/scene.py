@@ -311,13 +311,13 @@ def prepared_volume_input(dataset: Any, t: Optional[float] = None, interpolate: 
     """Any thread: the VTK data object a volume mapper draws for ``dataset`` (a time series: blended at display
     time ``t``, libMini note "4D Visualization"), or None when ``add_dataset`` does not draw it as a volume."""
     from volviz.model import Image2D, TimeSeries
-    from volviz.render.vtk_scene import volume_grid, volume_input
+    from volviz.render.vtk_scene import is_surface, volume_grid, volume_input
 
     if isinstance(dataset, TimeSeries):
         from volviz.model.timeseries import frame_at
 
         dataset = frame_at(dataset, float(dataset.times[0] if t is None else t), interpolate)
-    if isinstance(dataset, Image2D) or volume_grid(dataset).active_scalars is None:
+    if isinstance(dataset, Image2D) or is_surface(dataset) or volume_grid(dataset).active_scalars is None:
         return None
     return volume_input(dataset)
 
@@ -473,9 +473,11 @@ def uses_pt(session: Session, dataset: Any) -> bool:
     session asks for VTK's own mappers (render method "vtk"); regular volumes go to VTK's ray casters."""
     from volviz.model import TimeSeries
 
+    from volviz.render.vtk_scene import is_surface
+
     if isinstance(dataset, TimeSeries):
         return False  # time-varying meshes stay on VTK's mapper for now
-    return session.render.method != "vtk" and type(dataset).__name__ in PT_DATASETS
+    return session.render.method != "vtk" and type(dataset).__name__ in PT_DATASETS and not is_surface(dataset)
 
 
 def add_pt_component(plotter: Any, session: Session, comp: Component, dataset: Any, update: bool = True) -> Any:

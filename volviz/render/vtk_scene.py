@@ -141,6 +141,8 @@ def add_dataset(plotter: Any, dataset: Any, tf: Any = None, opacity: float = 1.0
         return plotter.add_mesh(grid, opacity=opacity, name=name)
     if tf is None:
         tf = default_transfer_function_for(dataset)
+    if is_surface(dataset):
+        return _add_surface(plotter, grid, tf, opacity, name)
     return volume_prop(plotter, volume_input(dataset), isinstance(dataset, RegularVolume), tf, opacity, name)
 
 
@@ -179,6 +181,38 @@ def volume_prop(plotter: Any, data: Any, regular: bool, tf: Any, opacity: float,
     volume.SetProperty(vtk_volume_property(tf, opacity))
     plotter.add_actor(volume, name=name, reset_camera=False)
     return volume
+
+
+VOLUME_CELL_TYPES = (10, 12, 13, 14)   # VTK tetrahedron, hexahedron, wedge, pyramid
+
+
+def is_surface(dataset: Any) -> bool:
+    """Whether ``dataset`` (the first frame of a time series) has no volume: a curvilinear grid flat in one index
+    direction (an ocean surface, a 2D simulation) or a mesh of surface cells only. Such data is drawn as a surface
+    coloured by its array, not as a volume."""
+    if isinstance(dataset, TimeSeries):
+        dataset = dataset.frame(0)
+    if isinstance(dataset, CurvilinearGrid):
+        return min(dataset.dimensions) < 2
+    if isinstance(dataset, UnstructuredMesh):
+        return not any(int(t) in VOLUME_CELL_TYPES and len(c) for t, c in dataset.cells)
+    return False
+
+
+def _add_surface(plotter: Any, grid: Any, tf: Any, opacity: float, name: Optional[str]) -> Any:
+    """A surface coloured by its active scalars through the transfer function's colours (NaN transparent)."""
+    ctf, _ = tf.to_vtk(1.0)
+    ctf.ClampingOn()
+    ctf.SetNanColor(0.5, 0.5, 0.5)
+    ctf.SetNanOpacity(0.0)           # NaN (land in an ocean field, a solver's failed points) is not drawn
+    surface = grid.extract_surface(algorithm="dataset_surface") if hasattr(grid, "extract_surface") else grid
+    actor = plotter.add_mesh(surface, scalars=grid.active_scalars_name, opacity=opacity, name=name,
+                             nan_opacity=0.0, show_scalar_bar=False, reset_camera=False, render=False)
+    mapper = actor.GetMapper()
+    mapper.SetLookupTable(ctf)
+    mapper.SetScalarRange(*tf.range)
+    mapper.SetUseLookupTableScalarRange(True)
+    return actor
 
 
 def _add_image(plotter: Any, image: Image2D, name: Optional[str]) -> Any:
