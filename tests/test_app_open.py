@@ -31,9 +31,10 @@ def drop(target, paths: list[Path]) -> bool:
     return entered and event.isAccepted()
 
 
-def props(window: MainWindow) -> list[int]:
-    renderer = window.plotter.renderer
-    return [id(renderer.GetViewProps().GetItemAsObject(i)) for i in range(renderer.GetViewProps().GetNumberOfItems())]
+def props(window: MainWindow) -> list[str]:
+    """The renderer's props by their C++ addresses (a Python wrapper may be made anew for each lookup)."""
+    items = window.plotter.renderer.GetViewProps()
+    return [items.GetItemAsObject(i).__this__ for i in range(items.GetNumberOfItems())]
 
 
 def test_drop_a_file_on_the_window_or_viewport_opens_it(qtbot, window: MainWindow) -> None:
