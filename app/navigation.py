@@ -38,9 +38,12 @@ class FlyMode(QObject):
         if enabled:
             self.navigator.speed = max(scene_size, 1e-9) * 0.25  # cross a quarter of the scene per second
 
-    def set_ground(self, ground: Optional[Callable[[float, float], float]], clearance: float = 0.0) -> None:
+    def set_ground(self, ground: Optional[Callable[[float, float], float]], clearance: float = 0.0,
+                   obstacle: Optional[Callable[..., Optional[float]]] = None) -> None:
+        """Keep the eye ``clearance`` above ``ground(x, y)`` and short of ``obstacle`` (opaque geometry)."""
         self.navigator.ground = ground
         self.navigator.clearance = clearance
+        self.navigator.obstacle = obstacle
 
     def _camera(self) -> Any:
         from volviz.render.vtk_scene import camera_state

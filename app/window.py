@@ -990,8 +990,13 @@ class MainWindow(QMainWindow):
         self.fly.set_enabled(enabled, size)
         nature = self.controller.nature if self.controller is not None else None
         terrain = getattr(getattr(nature, "scene", None), "terrain", None)
-        # over terrain the flight is collision-free: the camera stays 1 % of the scene size above the ground
-        self.fly.set_ground(terrain.height_at if terrain is not None else None, clearance=0.01 * size)
+        # collision-free flight: the eye stays a clearance (the render option fly_clearance, a share of the scene
+        # size, 1 % by default) above the terrain and short of opaque geometry
+        from volviz.render.collision import OpaqueObstacles, fly_clearance
+
+        self.fly.set_ground(terrain.height_at if terrain is not None else None,
+                            clearance=fly_clearance(self.session.render.options) * size,
+                            obstacle=OpaqueObstacles(self.plotter.renderer))
         self.action_fly.setChecked(enabled)
         self.status_label.setText("Fly mode: W/A/S/D or arrows move, Q/E sink/rise, drag to look, +/- speed"
                                   if enabled else "Orbit mode")

@@ -77,13 +77,17 @@ def orbit_path(center: Sequence[float], radius: float, height: float, keys: int 
 class FlyNavigator:
     """Fly-through motion: move along the view direction / right / up, and mouse-look (yaw about the up axis,
     pitch about the right axis, pitch limited short of the poles). ``ground(x, y)`` (optional) gives the terrain height
-    under a point; the camera is kept ``clearance`` above it."""
+    under a point; the camera is kept ``clearance`` above it. ``obstacle(start, end)`` (optional) gives the distance
+    from ``start`` at which the segment to ``end`` first meets opaque geometry (None: free); the camera stops
+    ``clearance`` short of it."""
 
     def __init__(self, speed: float = 1.0, ground: Optional[Callable[[float, float], float]] = None,
-                 clearance: float = 0.0, world_up: Sequence[float] = (0.0, 0.0, 1.0)):
+                 clearance: float = 0.0, world_up: Sequence[float] = (0.0, 0.0, 1.0),
+                 obstacle: Optional[Callable[[np.ndarray, np.ndarray], Optional[float]]] = None):
         self.speed = float(speed)
         self.ground = ground
         self.clearance = float(clearance)
+        self.obstacle = obstacle
         self.world_up = np.asarray(world_up, dtype=np.float64) / np.linalg.norm(world_up)
 
     def _axes(self, cam: CameraState) -> tuple[np.ndarray, np.ndarray, float]:
@@ -102,7 +106,14 @@ class FlyNavigator:
         """Translate camera and focal point together by ``speed * dt`` along the camera's axes."""
         f, r, dist = self._axes(cam)
         delta = self.speed * dt * (forward * f + right * r + up * self.world_up)
-        pos = np.asarray(cam.position) + delta
+        start = np.asarray(cam.position, dtype=np.float64)
+        travel = float(np.linalg.norm(delta))
+        if self.obstacle is not None and travel > 0:
+            direction = delta / travel
+            hit = self.obstacle(start, start + direction * (travel + self.clearance))
+            if hit is not None:
+                delta = direction * max(0.0, min(travel, float(hit) - self.clearance))
+        pos = start + delta
         if self.ground is not None:
             floor = float(self.ground(pos[0], pos[1])) + self.clearance
             if pos[2] < floor:
