@@ -49,6 +49,19 @@ def test_degenerate_data_gives_a_valid_function():
 def test_long_tailed_histograms_prefer_the_log_scale():
     assert prefers_log_histogram(np.array([90_000, 30, 40, 35, 20, 25]))
     assert not prefers_log_histogram(np.array([10, 20, 30, 25, 15]))
+    assert not prefers_log_histogram(np.array([5, 900, 1000, 200, 8, 0, 1]))      # 2 of 6 bins under 1 %
+
+    from volviz.io import read
+    from volviz.model.arrays import select_array
+    from volviz.model.stats import histogram
+
+    def log_scale(name):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            return prefers_log_histogram(histogram(select_array(read(data_file(name)), None))[0])
+
+    assert log_scale("volumes/embryo.slc") and log_scale("volumes/HeadMRVolume.mhd")
+    assert not log_scale("bluntfin/bluntfinxyz.bin")
 
 
 def test_framing_fills_80_percent_of_the_limiting_dimension():

@@ -289,6 +289,10 @@ class TransferFunctionEditor(QWidget):
         """Show a histogram computed in the background (None: none) for the TF shown; undo history stays."""
         self.canvas.histogram, self.canvas.histogram_edges = histogram if histogram is not None else (None, None)
         self.canvas.histogram_pending = False
+        if histogram is not None:   # long-tailed data (CT's air, a far field) reads better on a log scale
+            from volviz.optics.auto_tf import prefers_log_histogram
+
+            self.log_box.setChecked(prefers_log_histogram(histogram[0]))
         self._data_range = data_range
         self.fit_button.setEnabled(True)
         self.canvas.update()

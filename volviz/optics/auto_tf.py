@@ -102,8 +102,9 @@ def _ramp(full_lo: float, full_hi: float, lo: float, hi: float, rho_max: float, 
 
 
 def prefers_log_histogram(counts: np.ndarray) -> bool:
-    """Whether a histogram is long-tailed enough to be read on a log scale: its tallest bin is more than 20 times
-    its median non-empty bin (a CT scan's air, a simulation's far field)."""
+    """Whether a histogram is long-tailed enough to be read on a log scale: more than half of its non-empty bins
+    would be drawn under 1 % of the tallest bar on a linear scale (the air of a CT scan, the empty space around a
+    molecule: 62-98 % of the bins in the volumes here, 14 % for the Blunt Fin's density)."""
     counts = np.asarray(counts, dtype=np.float64)
     nonzero = counts[counts > 0]
-    return bool(nonzero.size > 1 and counts.max() > 20.0 * float(np.median(nonzero)))
+    return bool(nonzero.size > 1 and np.mean(nonzero < 0.01 * counts.max()) > 0.5)
