@@ -332,8 +332,16 @@ class MainWindow(QMainWindow):
 
         self._show_session(demo_volume_session(), None, "demo volume")
 
-    def open_path(self, path: str | os.PathLike) -> None:
-        """Open a session file or a data file (the path behind every Open action and the command line)."""
+    def open_paths(self, paths: list[str]) -> None:
+        """Open what the Open dialog chose: a PLOT3D grid and its solution file together, else the first file."""
+        from volviz.io.plot3d_pairs import grid_and_solution
+
+        pair = grid_and_solution(paths)
+        self.open_path(pair[0], q=pair[1]) if pair else paths and self.open_path(paths[0])
+
+    def open_path(self, path: str | os.PathLike, q: Optional[str | os.PathLike] = None) -> None:
+        """Open a session file or a data file (the path behind every Open action and the command line); ``q``: the
+        solution file of a PLOT3D grid."""
         from volviz.render.export import is_session_file
         from volviz.render.scene import data_session
         from volviz.session import load
@@ -1363,7 +1371,7 @@ class MainWindow(QMainWindow):
 
     # ------------------------------------------------------------------------------------------------ dialogs
     def ask_file(self, title: str, name_filter: str, on_chosen: Any, save: bool = False,
-                 default_name: str = "") -> QFileDialog:
+                 default_name: str = "", multiple: bool = False) -> QFileDialog:
         """A non-blocking file dialog (kept as ``self.file_dialog``) that starts in the folder used last;
         ``on_chosen(path)`` runs when accepted."""
         dialog = QFileDialog(self, title, self.recent.last_folder(), name_filter)
@@ -1373,15 +1381,21 @@ class MainWindow(QMainWindow):
             dialog.setFileMode(QFileDialog.FileMode.AnyFile)
             if default_name:
                 dialog.selectFile(default_name)
+        elif multiple:   # ``on_chosen(paths)`` gets the list
+            dialog.setFileMode(QFileDialog.FileMode.ExistingFiles)
+            dialog.filesSelected.connect(lambda paths: paths and (self.recent.remember_folder(paths[0]),
+                                                                  on_chosen(list(paths))))
         else:
             dialog.setFileMode(QFileDialog.FileMode.ExistingFile)
-        dialog.fileSelected.connect(lambda path: path and (self.recent.remember_folder(path), on_chosen(path)))
+        dialog.fileSelected.connect(lambda path: path and not multiple and (self.recent.remember_folder(path),
+                                                                            on_chosen(path)))
         dialog.open()
         self.file_dialog = dialog
         return dialog
 
     def _ask_open_data(self) -> None:
-        self.ask_file("Open data", _data_filter(), self.open_path)
+        self.ask_file("Open data (a PLOT3D grid with its solution: select both)", _data_filter(), self.open_paths,
+                      multiple=True)
 
     def _ask_open_session(self) -> None:
         self.ask_file("Open session", "volviz sessions (*.json);;All files (*)", self.open_path)

@@ -113,17 +113,12 @@ def _reading(path: str | os.PathLike, q: Optional[str]) -> Iterator[None]:
 
 def plot3d_solution_hint(path: str | os.PathLike) -> Optional[str]:
     """What to do with a PLOT3D solution (q) file opened alone, or None when ``path`` is not one."""
-    from volviz.io.plot3d import read_flow_conditions
+    from volviz.io.plot3d_pairs import grid_of_solution, is_plot3d_solution
 
     p = Path(path)
-    try:
-        read_flow_conditions(p)
-    except Exception:  # noqa: BLE001 -- any failure: it is not a solution file, and the caller reports the original
+    if not is_plot3d_solution(p):
         return None
-    name = p.name
-    grids = [p.with_name(name[::-1].replace(q[::-1], g[::-1], 1)[::-1])
-             for q, g in (("q", "xyz"), ("Q", "XYZ"), (".q", ".x"), (".q", ".xyz")) if q in name]
-    grid = next((g for g in grids if g != p and g.is_file()), None)
+    grid = grid_of_solution(p)
     example = f"volviz render {grid or 'GRID_FILE'} --q {p} -o image.png"
     return (f"{p} is a PLOT3D solution (q) file: open its grid file and give this one with --q, e.g. {example}")
 

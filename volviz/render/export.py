@@ -188,10 +188,8 @@ def open_target(target: str | os.PathLike, array: Optional[str] = None,
     path = Path(target)
     if is_session_file(path):
         return load(path), path
-    session = data_session(path)
-    ref, comp = session.datasets[0], session.components[0]
-    if q is not None:
-        ref.options["q"] = str(Path(q).resolve())
+    session = data_session(path, q)
+    comp = session.components[0]
     if array is not None:
         comp.settings["array"] = str(array)
     return session, None

@@ -44,14 +44,28 @@ def series_pattern(path: str | os.PathLike) -> Optional[str]:
     return str(p.parent.resolve() / f"{head}{number}{tail}")
 
 
-def data_session(path: str | os.PathLike) -> Session:
+def data_session(path: str | os.PathLike, q: Optional[str | os.PathLike] = None) -> Session:
     """A one-dataset session that shows ``path`` with its default visual (what opening a data file does): a file of a
     numbered series opens the whole series at that file's time step; a height map (DEM, PGM) opens as a terrain
-    under a sky (``terrain_session``)."""
+    under a sky (``terrain_session``); a PLOT3D grid opens with the solution file ``q`` (default: the one named like
+    it), and a PLOT3D solution file opened alone opens with the grid named like it (a ReadError says what to do
+    when there is none)."""
+    from volviz.io.plot3d_pairs import grid_of_solution, is_plot3d_solution
+
     if is_height_map(path):
         return terrain_session(path)
+    if q is None and Path(path).is_file() and is_plot3d_solution(path):
+        grid = grid_of_solution(path)
+        if grid is None:
+            from volviz.io import ReadError
+
+            raise ReadError(path, "is a PLOT3D solution (q) file: open it together with its grid (xyz) file (select "
+                                  "both files in the Open dialog; on the command line: GRID --q SOLUTION)")
+        path, q = grid, path
     pattern = series_pattern(path)
     ref = DatasetRef(id="data", path=pattern or str(Path(path).resolve()))
+    if q is not None:
+        ref.options["q"] = str(Path(q).resolve())
     if Path(path).suffix.lower() == ".vvz" and vvz_voxels(path) > LOD_VOXELS:
         ref.options["lod"] = True          # too large to decode whole: blocks per view (volviz.render.lod_volume)
     session = Session(datasets=[ref], components=[Component(id="data", type="volume", dataset="data")])
