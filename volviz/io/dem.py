@@ -23,7 +23,7 @@ import re
 
 import numpy as np
 
-from volviz.io._checks import describe_dims, file_size, read_bytes
+from volviz.io._checks import describe_bytes, describe_dims, file_size, read_bytes
 from volviz.io.errors import PathLike, ReadError, human_bytes
 from volviz.model import Image2D
 
@@ -37,7 +37,8 @@ def _field(path: PathLike, rec: bytes, start: int, width: int, what: str, kind=f
     try:
         value = kind(float(text)) if kind is int and "." in text else kind(text)
     except (ValueError, OverflowError):
-        raise ReadError(path, f"DEM header field {what} at column {start + 1} is {text[:30]!r}, not a number") from None
+        raise ReadError(path, f"DEM header field {what} at column {start + 1} is {describe_bytes(text)}, not a "
+                              "number") from None
     if kind is float and not np.isfinite(value):
         raise ReadError(path, f"DEM header field {what} is {value}")
     return value
@@ -93,8 +94,8 @@ def _read_profiles(path: PathLike, buf: bytes, h: dict):
         for _ in range(4):
             m = _INT6.match(buf, pos)
             if m is None:
-                if not ints and buf[pos:].strip() == b"" and column > 0:
-                    return out  # the file ends early, as VTK tolerates (status == EOF)
+                if not ints and buf[pos:].strip() == b"":
+                    raise ReadError(path, f"DEM file ends after {column} of the header's {n_profiles} profiles")
                 raise ReadError(path, f"DEM profile {column + 1} header at byte {pos} is not four integers")
             ints.append(int(m.group(1)))
             pos = m.end()
@@ -158,5 +159,8 @@ def read_dem(path: PathLike, vtk_compatible: bool = False) -> Image2D:
         for r, c, (_, _, _, _, values) in zip(row_idx, col_idx, profiles):
             grid[r:r + len(values), c] = values * (dz * elev)
         origin = (x0 * plane, y0 * plane)
+    if not np.isfinite(grid).all():
+        raise ReadError(path, f"DEM heights overflow: elevations times the vertical resolution {dz:g} are not finite "
+                              "numbers")
     return Image2D(np.ascontiguousarray(grid[::-1]), spacing=(dx * plane, dy * plane), origin=origin,
                    source=str(path))

@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from volviz.io._checks import (
-    check_dims, check_finite, describe_dims, file_size, parse_float, parse_int, read_at, read_bytes, require_bytes,
+    check_dims, check_finite, describe_bytes, describe_dims, file_size, parse_float, parse_int, read_at, read_bytes, require_bytes,
 )
 from volviz.io.errors import PathLike, ReadError, human_bytes
 from volviz.model import Image2D, RegularVolume
@@ -22,6 +22,7 @@ ELEMENT_TYPES = {
     "MET_DOUBLE": "f8",
 }
 _HEADER_LIMIT = 65536
+DEFLATE_MAX_RATIO = 1032  # zlib's deflate cannot expand data by more than about 1032:1
 _TRUE = {"true", "1", "yes"}
 
 
@@ -43,15 +44,21 @@ def parse_mhd_header(path: PathLike, head: bytes) -> tuple[dict[str, str], int]:
             continue
         key, sep, value = line.partition(b"=")
         if not sep:
-            raise ReadError(path, f"MetaImage header line {line[:40]!r} is not 'Key = Value'")
+            raise ReadError(path, f"MetaImage header line {_line_number(head, pos)} is not 'Key = Value' (it is "
+                                  f"{describe_bytes(line)})")
         try:
             k = key.strip().decode("ascii")
             v = value.strip().decode("utf-8")
         except UnicodeDecodeError:
-            raise ReadError(path, f"MetaImage header line {line[:40]!r} is not text") from None
+            raise ReadError(path, f"MetaImage header line {_line_number(head, pos)} is not text") from None
         fields[k.lower()] = v
         if k.lower() == "elementdatafile":
             return fields, min(pos, len(head))
+
+
+def _line_number(head: bytes, end: int) -> str:
+    """``"3"``: the 1-based number of the header line that ends just before offset ``end``."""
+    return str(head.count(b"\n", 0, max(end - 1, 0)) + 1)
 
 
 def _floats(path: PathLike, fields: dict[str, str], keys: tuple[str, ...], n: int, default: float,
@@ -88,12 +95,12 @@ def _read_metaimage(path: PathLike, allow_nonfinite: bool) -> RegularVolume | Im
         raise ReadError(path, "MetaImage header has no DimSize")
     dim_tokens = fields["dimsize"].split()
     if len(dim_tokens) != ndims:
-        raise ReadError(path, f"MetaImage DimSize {fields['dimsize']!r} does not have NDims = {ndims} values")
+        raise ReadError(path, f"MetaImage DimSize has {len(dim_tokens)} values, not NDims = {ndims}")
     dims = check_dims(path, [parse_int(path, t, "MetaImage DimSize") for t in dim_tokens], "MetaImage DimSize")
     etype = fields.get("elementtype", "").upper()
     if etype not in ELEMENT_TYPES:
-        raise ReadError(path, f"MetaImage ElementType {fields.get('elementtype')!r} is not supported "
-                              f"(one of {', '.join(ELEMENT_TYPES)})")
+        raise ReadError(path, f"MetaImage ElementType is {'missing' if not etype else 'not one of'} the supported "
+                              f"types ({', '.join(ELEMENT_TYPES)})")
     channels = parse_int(path, fields.get("elementnumberofchannels", "1"), "MetaImage ElementNumberOfChannels")
     if channels < 1 or (ndims == 3 and channels != 1):
         raise ReadError(path, f"MetaImage with {channels} channels per voxel is not supported in {ndims}D")
@@ -115,7 +122,7 @@ def _read_metaimage(path: PathLike, allow_nonfinite: bool) -> RegularVolume | Im
     if data_name.upper() == "LOCAL":
         data_path, data_size, offset = Path(path), size, header_end
     elif data_name.upper() == "LIST" or "%" in data_name or len(data_name.split()) > 1:
-        raise ReadError(path, f"MetaImage ElementDataFile {data_name!r} (a list or pattern of slice files) is not "
+        raise ReadError(path, "MetaImage ElementDataFile names a list or pattern of slice files, which is not "
                               "supported; use one data file")
     else:
         data_path = Path(path).parent / data_name
@@ -143,6 +150,10 @@ def _read_metaimage(path: PathLike, allow_nonfinite: bool) -> RegularVolume | Im
             require_bytes(data_path, stored, data_size - offset, "MetaImage CompressedDataSize")
         if stored <= 0:
             raise ReadError(data_path, "MetaImage compressed data is empty")
+        if n_bytes > DEFLATE_MAX_RATIO * stored + 64:
+            raise ReadError(data_path, f"{what} needs {n_bytes} bytes ({human_bytes(n_bytes)}), more than its "
+                                       f"{stored} compressed bytes can inflate to (zlib expands at most "
+                                       f"{DEFLATE_MAX_RATIO}:1)")
         packed = read_at(data_path, offset, stored)
         try:
             inflater = zlib.decompressobj()

@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from volviz.io._checks import (
-    check_dims, describe_dims, file_size, parse_float, parse_int, read_at, read_bytes, require_bytes,
+    check_dims, describe_bytes, describe_dims, file_size, parse_float, parse_int, read_at, read_bytes, require_bytes,
 )
 from volviz.io.errors import PathLike, ReadError
 from volviz.model import RegularVolume
@@ -32,7 +32,7 @@ def is_pvm(head: bytes) -> bool:
 def parse_pvm_header(path: PathLike, head: bytes) -> tuple[int, tuple[int, int, int], tuple[float, float, float], int, int]:
     """Parse the text header: ``(version, dims, spacing, bytes_per_voxel, data_offset)``; ReadError if malformed."""
     if head.startswith(DDS_MAGICS):
-        raise ReadError(path, f"is a DDS-compressed PVM file ({head[:7].decode()!r}); libMini DDS decompression is "
+        raise ReadError(path, f"is a DDS-compressed PVM file (DDS v3{chr(head[6])}); libMini DDS decompression is "
                               "not supported - decompress it first (e.g. libMini's pvm2raw/pvm2pvm tools)")
     if head.startswith(b"PVM\n"):
         version, n_lines = 1, 2
@@ -41,8 +41,8 @@ def parse_pvm_header(path: PathLike, head: bytes) -> tuple[int, tuple[int, int, 
     elif head.startswith(b"PVM3\n"):
         version, n_lines = 3, 3
     else:
-        raise ReadError(path, f"not a PVM file: starts with {head[:8]!r}, expected 'PVM', 'PVM2' or 'PVM3' "
-                              "followed by a newline")
+        raise ReadError(path, f"not a PVM file: starts with {describe_bytes(head[:16])}, not 'PVM', 'PVM2' or "
+                              "'PVM3' followed by a newline")
     pos = head.index(b"\n") + 1
     lines = []
     for _ in range(n_lines):
@@ -54,13 +54,13 @@ def parse_pvm_header(path: PathLike, head: bytes) -> tuple[int, tuple[int, int, 
         pos = end + 1
     dim_tokens = lines[0].split()
     if len(dim_tokens) != 3:
-        raise ReadError(path, f"PVM dimension line {lines[0][:40]!r} must hold three integers")
+        raise ReadError(path, f"PVM dimension line holds {len(dim_tokens)} fields, not three integers")
     dims = check_dims(path, [parse_int(path, t, "PVM dimension") for t in dim_tokens], "PVM dimensions")
     spacing = (1.0, 1.0, 1.0)
     if version >= 2:
         sp_tokens = lines[1].split()
         if len(sp_tokens) != 3:
-            raise ReadError(path, f"PVM spacing line {lines[1][:40]!r} must hold three numbers")
+            raise ReadError(path, f"PVM spacing line holds {len(sp_tokens)} fields, not three numbers")
         spacing = tuple(parse_float(path, t, "PVM spacing", positive=True) for t in sp_tokens)  # type: ignore
     bpv = parse_int(path, lines[-1], "PVM bytes per voxel")
     if bpv in (3, 4):

@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Iterable, Union
 
-from volviz.io._checks import check_file, read_bytes
+from volviz.io._checks import check_file, describe_bytes, read_bytes
 from volviz.io.errors import PathLike, ReadError
 
 ENTRY_POINT_GROUP = "volviz.readers"
@@ -292,7 +292,7 @@ def spec_of(path: PathLike, options: dict | None = None) -> ReaderSpec:
         return named[0]  # its loader says what is wrong with the content
     if named:
         raise ReadError(p, f"is named like {' or '.join(s.description for s in named)}, but its content fits none of "
-                           f"them (first bytes {head[:16]!r})")
+                           f"them (its content is {describe_bytes(head)})")
     catch_all = [s for s in specs if s.catch_all and s.matches_name(p.name)]
     if catch_all:
         return catch_all[0]
@@ -301,15 +301,15 @@ def spec_of(path: PathLike, options: dict | None = None) -> ReaderSpec:
         return named[0]  # its loader says what is wrong with the content
     if named:
         raise ReadError(p, f"is named like {' or '.join(s.description for s in named)}, but its content fits none of "
-                           f"them (first bytes {head[:16]!r})")
+                           f"them (its content is {describe_bytes(head)})")
     if ext == ".raw":
         raise ReadError(p, "a .raw file has no header: call volviz.io.read_raw(path, dims, dtype, byteorder) or "
                            "open the .mhd header that describes it")
     if re.search(r"\.\d+$", p.name):
         raise ReadError(p, "looks like one slice of a numbered stack; use volviz.io.read_slice_stack(pattern, "
                            "dims, dtype, byteorder) or read_series(pattern)")
-    raise ReadError(p, f"unknown data format (extension {ext or 'none'!r}, first bytes {head[:8]!r}); supported: "
-                       + _described(s for s in specs if s.listed))
+    raise ReadError(p, f"unknown data format (extension {ext or 'none'!r}, content: {describe_bytes(head)}); "
+                       "supported: " + _described(s for s in specs if s.listed))
 
 
 def format_of(path: PathLike, options: dict) -> str:

@@ -18,25 +18,26 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from volviz.io._checks import check_dims, describe_dims, file_size, read_bytes, require_bytes
+from volviz.io._checks import check_dims, describe_bytes, describe_dims, file_size, read_bytes, require_bytes
 from volviz.io.errors import PathLike, ReadError
 from volviz.model import RegularVolume
 
 SLC_MAGIC = 11111
 
 # Real files are sloppy: every slice of shared/data/volumes/embryo.slc decodes to 65535 of its 65536 voxels (the
-# encoder dropped the last voxel). vtkSLCReader leaves such voxels uninitialised; we set them to 0 and accept a
-# slice that is short by at most one row (nx voxels). A larger shortfall is reported as corruption.
-_SHORT_SLICES = "a slice may decode up to one row short; the missing voxels are 0"
+# encoder dropped the last voxel). vtkSLCReader leaves such voxels uninitialised; we set that one voxel to 0. Any
+# larger shortfall means the header's dimensions do not describe the data (an x size one too large would otherwise
+# pad every slice with a row of zeros) and is refused, as is code that does not end exactly at its slice's end.
+_SLICE_SLACK = 1
 _WS = b" \t\n\r\v\f"
 
 
 @njit(cache=True, nogil=True)
-def rle_decode_slice(src: np.ndarray, start: int, stop: int, out: np.ndarray) -> int:
+def rle_decode_slice(src: np.ndarray, start: int, stop: int, out: np.ndarray) -> tuple[int, int]:
     """Decode SLC run-length code ``src[start:stop]`` into ``out``.
 
-    Returns the number of voxels written, ``-1`` if the code writes past ``out`` and ``-2`` if it reads past
-    ``stop`` in the middle of a run. Decoding stops at a zero count byte or at ``stop``.
+    Returns ``(voxels written, position after the code)``; the count is ``-1`` if the code writes past ``out`` and
+    ``-2`` if it reads past ``stop`` in the middle of a run. Decoding stops after a zero count byte or at ``stop``.
     """
     pos = start
     n = 0
@@ -48,22 +49,22 @@ def rle_decode_slice(src: np.ndarray, start: int, stop: int, out: np.ndarray) ->
         if count == 0:
             break
         if n + count > size:
-            return -1
+            return -1, pos
         if c & 0x80:
             if pos + count > stop:
-                return -2
+                return -2, pos
             for k in range(count):
                 out[n + k] = src[pos + k]
             pos += count
         else:
             if pos >= stop:
-                return -2
+                return -2, pos
             v = src[pos]
             pos += 1
             for k in range(count):
                 out[n + k] = v
         n += count
-    return n
+    return n, pos
 
 
 class _Scanner:
@@ -90,16 +91,16 @@ class _Scanner:
         try:
             return int(tok)
         except ValueError:
-            raise ReadError(self.path, f"SLC {what} {tok[:20]!r} is not an integer") from None
+            raise ReadError(self.path, f"SLC {what} is {describe_bytes(tok)}, not an integer") from None
 
     def number(self, what: str) -> float:
         tok = self.token(what)
         try:
             value = float(tok)
         except ValueError:
-            raise ReadError(self.path, f"SLC {what} {tok[:20]!r} is not a number") from None
+            raise ReadError(self.path, f"SLC {what} is {describe_bytes(tok)}, not a number") from None
         if not np.isfinite(value) or value <= 0:
-            raise ReadError(self.path, f"SLC {what} must be a positive finite number, got {tok[:20]!r}")
+            raise ReadError(self.path, f"SLC {what} must be a positive finite number, got {value:g}")
         return value
 
     def integer_then_x(self, what: str) -> int:
@@ -127,7 +128,7 @@ def parse_slc_header(path: PathLike, buf: bytes):
     sc = _Scanner(path, buf)
     first = buf[:16].lstrip()
     if not first.startswith(b"11111"):
-        raise ReadError(path, f"not an SLC file: starts with {buf[:8]!r}, expected the magic number 11111")
+        raise ReadError(path, f"not an SLC file: starts with {describe_bytes(buf[:16])}, not the magic number 11111")
     magic = sc.integer("magic number")
     if magic != SLC_MAGIC:
         raise ReadError(path, f"not an SLC file: magic number {magic}, expected {SLC_MAGIC}")
@@ -166,6 +167,8 @@ def read_slc(path: PathLike) -> RegularVolume:
     buf = np.frombuffer(read_bytes(path), dtype=np.uint8)
     if compression == 0:
         require_bytes(path, offset + plane * nz, len(buf), what)
+        if len(buf) != offset + plane * nz:
+            raise ReadError(path, f"{len(buf) - offset - plane * nz} bytes follow the {what}")
         volume = buf[offset:offset + plane * nz].copy()
     else:
         raw = buf.tobytes()
@@ -176,11 +179,16 @@ def read_slc(path: PathLike) -> RegularVolume:
             start = sc.pos
             if start + n > len(buf):
                 raise ReadError(path, f"slice {z} claims {n} compressed bytes but only {len(buf) - start} remain")
-            got = rle_decode_slice(buf, start, start + n, volume[z * plane:(z + 1) * plane])
-            if got < plane - nx or got > plane:  # see _SHORT_SLICES
+            got, end = rle_decode_slice(buf, start, start + n, volume[z * plane:(z + 1) * plane])
+            if got < plane - _SLICE_SLACK or got > plane:
                 problem = {-1: "decodes to more voxels than a slice holds",
-                           -2: "ends in the middle of a run"}.get(got, f"decodes to {got} of {plane} voxels")
+                           -2: "ends in the middle of a run"}.get(got, f"decodes to {got} of the {plane} voxels of "
+                                                                      f"the header's {nx}x{ny} slice")
                 raise ReadError(path, f"run-length code of slice {z} {problem}")
+            if end != start + n:
+                raise ReadError(path, f"run-length code of slice {z} ends after {end - start} of its {n} bytes")
             volume[z * plane + got:(z + 1) * plane] = 0
             sc.pos = start + n
+        if sc.pos != len(buf):
+            raise ReadError(path, f"{len(buf) - sc.pos} bytes follow the last of the header's {nz} slices")
     return RegularVolume(volume.reshape(dims, order="F"), spacing=spacing, name="SLCImage", source=str(path))

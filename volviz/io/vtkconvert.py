@@ -71,7 +71,17 @@ def merge_composite(path: PathLike, obj):
 
 
 def vtk_to_model(path: PathLike, obj, allow_nonfinite: bool = True):
-    """Convert a VTK data object to the matching volviz model dataset."""
+    """Convert a VTK data object to the matching volviz model dataset.
+
+    What the model refuses (zero spacing, connectivity outside the points, arrays of the wrong shape) comes out as
+    a ReadError naming the file, never as the model's ValueError."""
+    try:
+        return _to_model(path, obj, allow_nonfinite)
+    except (ValueError, IndexError, OverflowError) as exc:
+        raise ReadError(path, f"the file's data set is inconsistent: {exc}") from None
+
+
+def _to_model(path: PathLike, obj, allow_nonfinite: bool):
     from vtkmodules.util.numpy_support import vtk_to_numpy
 
     if obj is None:
@@ -164,6 +174,9 @@ def _image(path: PathLike, obj, allow_nonfinite: bool) -> RegularVolume:
     if not np.allclose(direction, np.eye(3).ravel()):
         warnings.warn(f"{path}: image direction matrix {direction.tolist()} is ignored (volumes are "
                       "axis-aligned)", UserWarning, stacklevel=3)
+    for what, values in (("origin", obj.GetOrigin()), ("spacing", obj.GetSpacing())):
+        if not np.all(np.isfinite(values)):
+            raise ReadError(path, f"image {what} {tuple(values)} is not finite")
     volume = RegularVolume(np.zeros(dims, np.uint8), spacing=obj.GetSpacing(), origin=obj.GetOrigin(),
                            source=str(path), arrays=arrays)
     active = _active_name(pd)
