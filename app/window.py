@@ -36,6 +36,7 @@ from volviz_app.docks.tf_editor import TransferFunctionEditor
 from volviz_app.docks.timeline import Timeline
 from volviz_app.drop import FileDrop
 from volviz_app.navigation import FlyMode
+from volviz_app.nonfinite_status import NonFiniteStatus
 from volviz_app.workers import JobBridge
 
 log = logging.getLogger(__name__)
@@ -196,6 +197,7 @@ class MainWindow(QMainWindow):
         self.plotter.iren.add_observer("ConfigureEvent", lambda *args: self.resize_timer.start())
         self.record_timer = QTimer(self, interval=RECORD_MS)
         self.record_timer.timeout.connect(self._record_sample)
+        self.nonfinite = NonFiniteStatus(self)  # the status bar's note on non-finite values
         self.collector.freeze_long_lived()
 
     # ------------------------------------------------------------------------------------------------ construction
@@ -468,6 +470,7 @@ class MainWindow(QMainWindow):
                 self._loading_views = False
                 self._set_busy(False)
                 self.status_label.setText(f"Showing {title}")
+                self.nonfinite.report(title)  # NaN / Inf counts, once, when they arrive
 
         self._loading_views = True
         if controller.nature is not None:

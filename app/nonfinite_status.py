@@ -1,0 +1,55 @@
+"""The status bar's one note on non-finite values: once a scene is shown, the arrays of its datasets that hold NaN or
+Inf values are named with their counts ("Showing x.vti — 12 non-finite values in density (drawn transparent)").
+
+The counts are ``volviz.model.arrays.list_arrays``'s, computed in the background (a large float volume takes a
+while to scan); the note appears when they arrive, and only if the same scene is still shown."""
+from __future__ import annotations
+
+from typing import Any
+
+from volviz.jobs import JobOutcome
+
+
+def nonfinite_note(datasets: dict[str, Any]) -> str:
+    """``"12 non-finite values in density; 3 in p (drawn transparent)"``, or ``""`` when every value is finite.
+    Datasets without named arrays (height maps, LOD trees) add nothing."""
+    from volviz.model.arrays import list_arrays
+
+    counts: list[tuple[str, int]] = []
+    for dataset in datasets.values():
+        try:
+            infos = list_arrays(dataset)
+        except (TypeError, ValueError, AttributeError):  # a dataset kind that lists no arrays
+            continue
+        counts += [(info.name, info.nonfinite) for info in infos if info.nonfinite]
+    if not counts:
+        return ""
+    (first, n), rest = counts[0], counts[1:]
+    parts = [f"{n:,} non-finite values in {first}"] + [f"{m:,} in {name}" for name, m in rest]
+    return "; ".join(parts) + " (drawn transparent)"
+
+
+class NonFiniteStatus:
+    """Appends ``nonfinite_note`` of the shown scene's datasets to ``window.status_label`` (``window`` provides
+    ``controller``, ``datasets``, ``jobs`` and ``status_label``). ``note`` is the last note shown."""
+
+    def __init__(self, window: Any) -> None:
+        self.window = window
+        self.note = ""
+
+    def report(self, title: str) -> None:
+        """The scene titled ``title`` is shown: count its non-finite values in the background, then say so once."""
+        window = self.window
+        controller, datasets = window.controller, dict(window.datasets)
+        self.note = ""
+
+        def count(progress: Any = None) -> str:
+            return nonfinite_note(datasets)
+
+        def done(outcome: JobOutcome) -> None:
+            if outcome.error is not None or not outcome.result or window.controller is not controller:
+                return
+            self.note = str(outcome.result)
+            window.status_label.setText(f"Showing {title} — {self.note}")
+
+        window.jobs.submit(count, name="count non-finite values", key="nonfinite", on_done=done)
