@@ -25,6 +25,7 @@ Float data holding NaN/Inf is kept (renderers draw it transparent) with a ``NonF
 """
 from __future__ import annotations
 
+import functools
 from typing import Any
 
 from volviz.io.errors import NonFiniteWarning, PathLike, ReadError
@@ -34,18 +35,22 @@ from volviz.io.registry import (ReaderSpec, call_reader, format_of, is_pattern, 
 from volviz.io.series import expand_pattern, read_series
 
 
-def read(path: PathLike, **options: Any):
+def read(path: PathLike, isolate: bool | None = None, **options: Any):
     """Read any supported file (or a series pattern: a glob, ``name%02d.ext`` or a list) into a model dataset.
 
     The format comes from the reader registry (options, folder markers, the name, else the file's magic bytes).
     Options go to the format's reader (e.g. ``q=`` for PLOT3D, ``dims=, dtype=, byteorder=`` for raw files,
     ``vtk_compatible=`` for DEM, ``blocks=`` for multiblock files, ``allow_nonfinite=``). Raises ReadError for bad
-    or unsupported files.
+    or unsupported files. Readers of native code (VTK, HDF5) run in a child process with memory and time limits, so
+    a file that crashes them gives a ReadError too; ``isolate=False`` (or ``VOLVIZ_ISOLATE=0``) reads in-process,
+    for debugging (``volviz.io.isolated``).
     """
     if is_pattern(path):
-        return read_series(path, **options)
+        if isolate is None:
+            return read_series(path, **options)
+        return read_series(path, reader=functools.partial(read, isolate=isolate), **options)
     kind = format_of(path, options)
-    return call_reader(kind, path, options)
+    return call_reader(kind, path, options, isolate)
 
 
 def __getattr__(name: str):

@@ -56,6 +56,8 @@ class ReaderSpec:
     refused with a hint to rename it. ``claims_name``: False for extensions other formats share (``.dat``, ``.inp``):
     the name then picks this reader only when its sniffer accepts the content too. ``catch_all``: match by name only after every other spec failed.
     ``arrays`` and ``options``: what the reader offers and takes, for documentation and ``volviz info``.
+    ``isolated``: the loader runs native code that a malformed file can crash (VTK's readers, HDF5, netCDF): ``read``
+    runs it in a child process with memory and time limits (``volviz.io.isolated``).
     """
 
     name: str
@@ -71,6 +73,7 @@ class ReaderSpec:
     arrays: str = ""
     options: tuple[str, ...] = ()
     listed: bool = True
+    isolated: bool = False
     _cache: dict = field(default_factory=dict, compare=False, repr=False)
 
     @property
@@ -146,13 +149,14 @@ BUILTIN_READERS: list[ReaderSpec] = [
                sniff=_sniff_metaimage, arrays="one scalar volume or image", options=("allow_nonfinite",)),
     ReaderSpec("vtk", "VTK legacy", ("*.vtk",), "volviz.io.vtkfiles:read_vtk_file",
                sniff=lambda head: head.startswith(b"# vtk DataFile"), sniff_opens=False,
-               arrays="every point and cell array", options=("allow_nonfinite",)),
+               arrays="every point and cell array", options=("allow_nonfinite",), isolated=True),
     ReaderSpec("vtk-xml", "VTK XML", ("*.vti", "*.vtu", "*.vts", "*.vtr", "*.vtp"), "volviz.io.vtkfiles:read_vtk_file",
                sniff=_sniff_vtk_xml, sniff_opens=False, arrays="every point and cell array",
-               options=("allow_nonfinite",)),
+               options=("allow_nonfinite",), isolated=True),
     ReaderSpec("vtkhdf", "VTKHDF", ("*.vtkhdf", "*.hdf"), "volviz.io.vtkhdf:read_vtkhdf",
                sniff=lambda head: head.startswith(b"\x89HDF\r\n\x1a\n"),
-               arrays="every point and cell array; transient files as a time series", options=("allow_nonfinite",)),
+               arrays="every point and cell array; transient files as a time series", options=("allow_nonfinite",),
+               isolated=True),
     ReaderSpec("pnm", "PGM/PPM image", ("*.pgm", "*.ppm", "*.pnm"), "volviz.io.pnm:read_pnm",
                sniff="volviz.io.pnm:is_pnm", arrays="grey levels or RGB"),
     ReaderSpec("dem", "USGS DEM", ("*.dem",), "volviz.io.dem:read_dem", arrays="heights in metres",
@@ -162,7 +166,8 @@ BUILTIN_READERS: list[ReaderSpec] = [
     ReaderSpec("raw", "Raw volume", (), "volviz.io.raw:read_raw", select_options=("dims",), listed=False,
                arrays="one scalar volume", options=("dims", "dtype", "byteorder", "header_bytes")),
     ReaderSpec("meshio", "Meshes (meshio)", "volviz.io.registry:meshio_globs", "volviz.io.meshio_reader:read_meshio",
-               catch_all=True, arrays="every point and cell array", options=("file_format", "allow_nonfinite")),
+               catch_all=True, arrays="every point and cell array", options=("file_format", "allow_nonfinite"),
+               isolated=True),
 ]
 
 
@@ -317,10 +322,14 @@ def format_of(path: PathLike, options: dict) -> str:
     return spec_of(path, options).name
 
 
-def call_reader(kind: str, path: PathLike, options: dict):
-    """Call the reader registered as ``kind``; ``allow_nonfinite`` is dropped for readers of integer-only formats,
-    any other option the reader does not take is a TypeError naming it."""
-    f = get_reader(kind).load_function()
+class ReaderOptionError(TypeError):
+    """An option the reader does not take."""
+
+
+def loader_call(kind: str, loader: str, options: dict) -> tuple[Callable[..., Any], dict]:
+    """The loader function named ``loader`` and the options to call it with: ``allow_nonfinite`` is dropped for
+    readers of integer-only formats, any other option it does not take is a ReaderOptionError naming it."""
+    f = _resolve(loader)
     params = inspect.signature(f).parameters
     accepts_kwargs = any(p.kind is inspect.Parameter.VAR_KEYWORD for p in params.values())
     opts = dict(options)
@@ -328,7 +337,23 @@ def call_reader(kind: str, path: PathLike, options: dict):
         opts.pop("allow_nonfinite")
     unknown = [k for k in opts if k not in params and not accepts_kwargs]
     if unknown:
-        raise TypeError(f"the {kind} reader does not take option(s) {', '.join(unknown)}")
+        raise ReaderOptionError(f"the {kind} reader does not take option(s) {', '.join(unknown)}")
+    return f, opts
+
+
+def call_reader(kind: str, path: PathLike, options: dict, isolate: bool | None = None):
+    """Call the reader registered as ``kind`` (see ``loader_call`` for the options).
+
+    A spec marked ``isolated`` runs in a child process (``volviz.io.isolated``) unless ``isolate=False`` or the
+    environment variable ``VOLVIZ_ISOLATE=0`` turns isolation off (for debugging a reader in one process).
+    """
+    spec = get_reader(kind)
+    if spec.isolated:
+        from volviz.io import isolated
+
+        if isolated.isolation_enabled(isolate):
+            return isolated.read_isolated(spec, path, options)
+    f, opts = loader_call(kind, spec.loader, options)
     return f(os.fspath(path), **opts)
 
 

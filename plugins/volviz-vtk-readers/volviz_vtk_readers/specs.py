@@ -67,30 +67,37 @@ def is_vtk_parallel(head: bytes) -> bool:
 
 _R = "volviz_vtk_readers.readers:"
 _BLOCKS = ("blocks", "time_index", "allow_nonfinite")
+
+
+def _spec(*args, **kwargs) -> ReaderSpec:
+    """Every loader here runs a VTK C++ reader, which a malformed file can crash: ``read`` runs it isolated."""
+    return ReaderSpec(*args, isolated=True, **kwargs)
+
+
 SPECS: list[ReaderSpec] = [  # netCDF before Exodus: a netCDF file known by content alone opens as netCDF
-    ReaderSpec("netcdf-cf", "netCDF (CF conventions)", ("*.nc", "*.nc4", "*.cdf", "*.netcdf"), _R + "read_netcdf_cf",
-               sniff=is_netcdf, arrays="every variable on the chosen dimensions (fill values as NaN)",
-               options=("dimensions", "spherical", "time_index", "allow_nonfinite")),
-    ReaderSpec("exodus", "Exodus II", ("*.e", "*.ex2", "*.exo", "*.exii", "*.g", "*.gen"), _R + "read_exodus",
-               sniff=is_netcdf,
-               arrays="every nodal variable (point data) and element variable (cell data), ObjectId",
-               options=_BLOCKS),
-    ReaderSpec("openfoam", "OpenFOAM case", ("*.foam",), _R + "read_openfoam", folder_markers=("system/controlDict",),
-               arrays="every cell field, also interpolated to the points", options=_BLOCKS),
-    ReaderSpec("cgns", "CGNS", ("*.cgns", "*.adf", "*.hdf5cgns"), _R + "read_cgns", sniff=is_cgns,
-               arrays="every point and cell (FlowSolution) array", options=_BLOCKS),
-    ReaderSpec("ensight", "EnSight", ("*.case",), _R + "read_ensight", sniff=is_ensight_case,
-               arrays="every point and cell variable", options=_BLOCKS),
-    ReaderSpec("tecplot", "Tecplot ASCII", ("*.dat", "*.plt", "*.tec"), _R + "read_tecplot", sniff=is_tecplot,
-               claims_name=False, arrays="every variable of every zone", options=("blocks", "allow_nonfinite")),
-    ReaderSpec("avs-ucd", "AVS UCD", ("*.inp", "*.ucd"), _R + "read_avs_ucd", sniff=is_avs_ucd, claims_name=False,
-               arrays="every node and cell component", options=("allow_nonfinite",)),
-    ReaderSpec("fluent", "Fluent case", ("*.cas", "*.dat"), _R + "read_fluent", sniff=is_fluent, claims_name=False,
-               arrays="every cell field of the case's .dat file", options=("blocks", "allow_nonfinite")),
-    ReaderSpec("vtk-multiblock", "VTK multiblock", ("*.vtm", "*.vtmb", "*.vtpd"), _R + "read_vtk_multiblock",
-               sniff=is_vtk_multiblock, sniff_opens=False, arrays="every point and cell array of every block",
-               options=("blocks", "allow_nonfinite")),
-    ReaderSpec("vtk-parallel", "VTK parallel XML", ("*.pvtu", "*.pvti", "*.pvts", "*.pvtr", "*.pvtp"),
-               _R + "read_vtk_parallel", sniff=is_vtk_parallel, sniff_opens=False,
-               arrays="every point and cell array, pieces joined", options=("allow_nonfinite",)),
+    _spec("netcdf-cf", "netCDF (CF conventions)", ("*.nc", "*.nc4", "*.cdf", "*.netcdf"), _R + "read_netcdf_cf",
+          sniff=is_netcdf, arrays="every variable on the chosen dimensions (fill values as NaN)",
+          options=("dimensions", "spherical", "time_index", "allow_nonfinite")),
+    _spec("exodus", "Exodus II", ("*.e", "*.ex2", "*.exo", "*.exii", "*.g", "*.gen"), _R + "read_exodus",
+          sniff=is_netcdf,
+          arrays="every nodal variable (point data) and element variable (cell data), ObjectId",
+          options=_BLOCKS),
+    _spec("openfoam", "OpenFOAM case", ("*.foam",), _R + "read_openfoam", folder_markers=("system/controlDict",),
+          arrays="every cell field, also interpolated to the points", options=_BLOCKS),
+    _spec("cgns", "CGNS", ("*.cgns", "*.adf", "*.hdf5cgns"), _R + "read_cgns", sniff=is_cgns,
+          arrays="every point and cell (FlowSolution) array", options=_BLOCKS),
+    _spec("ensight", "EnSight", ("*.case",), _R + "read_ensight", sniff=is_ensight_case,
+          arrays="every point and cell variable", options=_BLOCKS),
+    _spec("tecplot", "Tecplot ASCII", ("*.dat", "*.plt", "*.tec"), _R + "read_tecplot", sniff=is_tecplot,
+          claims_name=False, arrays="every variable of every zone", options=("blocks", "allow_nonfinite")),
+    _spec("avs-ucd", "AVS UCD", ("*.inp", "*.ucd"), _R + "read_avs_ucd", sniff=is_avs_ucd, claims_name=False,
+          arrays="every node and cell component", options=("allow_nonfinite",)),
+    _spec("fluent", "Fluent case", ("*.cas", "*.dat"), _R + "read_fluent", sniff=is_fluent, claims_name=False,
+          arrays="every cell field of the case's .dat file", options=("blocks", "allow_nonfinite")),
+    _spec("vtk-multiblock", "VTK multiblock", ("*.vtm", "*.vtmb", "*.vtpd"), _R + "read_vtk_multiblock",
+          sniff=is_vtk_multiblock, sniff_opens=False, arrays="every point and cell array of every block",
+          options=("blocks", "allow_nonfinite")),
+    _spec("vtk-parallel", "VTK parallel XML", ("*.pvtu", "*.pvti", "*.pvts", "*.pvtr", "*.pvtp"),
+          _R + "read_vtk_parallel", sniff=is_vtk_parallel, sniff_opens=False,
+          arrays="every point and cell array, pieces joined", options=("allow_nonfinite",)),
 ]

@@ -1,0 +1,145 @@
+"""The reader child: ``python -m volviz.io.isolated`` (started by ``volviz.io.isolated``, not by hand).
+
+It reads one JSON request per line on stdin -- ``{"path", "kind", "loader", "options", "frame", "memory", "workdir",
+"sys_path"}`` -- runs the loader under a memory limit (RLIMIT_AS: the address space it has now plus the request's
+budget), writes the arrays of the result as ``a0.npy, a1.npy, ...`` into ``workdir`` and answers one JSON line on
+stdout: ``{"ok": true, "header": ..., "warnings": [...]}`` or ``{"ok": false, "error": ..., ...}``. It leaves at the
+end of its stdin, and with its parent (Linux: PR_SET_PDEATHSIG).
+"""
+from __future__ import annotations
+
+import json
+import os
+import sys
+import warnings
+from collections import OrderedDict
+from typing import Any, BinaryIO
+
+SERIES_CACHE = 2  # transient files kept open for their lazy frames
+
+
+def _protocol_stdout() -> BinaryIO:
+    """Our own copy of stdout for the answers; fd 1 then points at stderr, so prints cannot break the protocol."""
+    out = os.fdopen(os.dup(1), "wb", buffering=0)
+    os.dup2(2, 1)
+    sys.stdout = sys.stderr
+    return out
+
+
+def _die_with_parent() -> None:
+    try:
+        import ctypes
+        import signal
+
+        libc = ctypes.CDLL(None, use_errno=True)
+        libc.prctl(1, int(signal.SIGKILL))  # PR_SET_PDEATHSIG
+        if os.getppid() == 1:
+            os._exit(0)
+    except (OSError, AttributeError):  # not Linux: the child still leaves when its stdin closes
+        pass
+
+
+class _MemoryLimit:
+    """RLIMIT_AS lowered to the present address space plus ``budget`` for the duration of one read."""
+
+    def __init__(self, budget: int) -> None:
+        self.budget = budget
+
+    def __enter__(self) -> None:
+        import resource
+
+        from volviz.io.isolated import proc_bytes
+
+        self._old = resource.getrlimit(resource.RLIMIT_AS)
+        if self.budget > 0:
+            hard = self._old[1]
+            soft = (proc_bytes("/proc/self/status", "VmSize") or 0) + self.budget
+            resource.setrlimit(resource.RLIMIT_AS, (soft if hard == resource.RLIM_INFINITY else min(soft, hard), hard))
+
+    def __exit__(self, *exc: Any) -> None:
+        import resource
+
+        resource.setrlimit(resource.RLIMIT_AS, self._old)
+
+
+class Child:
+    def __init__(self) -> None:
+        self.series: OrderedDict[str, Any] = OrderedDict()
+
+    def _load(self, request: dict) -> Any:
+        from volviz.io.registry import loader_call
+
+        f, opts = loader_call(request["kind"], request["loader"], request["options"])
+        frame = request.get("frame")
+        if frame is None:
+            return f(request["path"], **opts)
+        key = json.dumps([request["loader"], request["path"], request["options"]], sort_keys=True)
+        series = self.series.pop(key, None)
+        if series is None:
+            series = f(request["path"], **opts)
+        self.series[key] = series
+        while len(self.series) > SERIES_CACHE:
+            self.series.popitem(last=False)
+        if not hasattr(series, "frame"):
+            raise TypeError(f"frame {frame} was asked of a {type(series).__name__}, not a time series")
+        return series.frame(frame)
+
+    def handle(self, request: dict) -> dict:
+        import numpy as np
+
+        from volviz.io.errors import ReadError
+        from volviz.io.isolated.codec import CodecError, encode
+        from volviz.io.registry import ReaderOptionError
+
+        for entry in request.get("sys_path", []):
+            if isinstance(entry, str) and entry not in sys.path:
+                sys.path.append(entry)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            try:
+                with _MemoryLimit(int(request.get("memory", 0))):
+                    dataset = self._load(request)
+                    header, arrays = encode(dataset)
+                    for i, arr in enumerate(arrays):
+                        np.save(os.path.join(request["workdir"], f"a{i}.npy"), arr, allow_pickle=False)
+                answer: dict = {"ok": True, "header": header}
+            except ReadError as exc:
+                answer = {"ok": False, "error": "read", "path": exc.path, "problem": exc.problem}
+            except CodecError as exc:
+                answer = {"ok": False, "error": "refused", "message": str(exc)}
+            except ReaderOptionError as exc:
+                answer = {"ok": False, "error": "options", "message": str(exc)}
+            except MemoryError:
+                answer = {"ok": False, "error": "memory"}
+            except Exception as exc:  # reported to the parent, which names the file
+                answer = {"ok": False, "error": "exception", "type": type(exc).__name__, "message": str(exc)[:2000]}
+            finally:
+                dataset = arrays = None
+        answer["warnings"] = [[w.category.__name__, str(w.message)[:2000]] for w in caught[:50]]
+        return answer
+
+
+def main() -> None:
+    out = _protocol_stdout()
+    _die_with_parent()
+    import numpy  # noqa: F401 - the imports every read needs, done before the parent is told we are ready
+
+    import volviz.io.registry  # noqa: F401
+    try:
+        import vtk  # noqa: F401
+    except ImportError:  # pragma: no cover - VTK is a dependency; readers report its absence themselves
+        pass
+    out.write(json.dumps({"ready": True, "pid": os.getpid()}).encode() + b"\n")
+    child = Child()
+    for line in sys.stdin.buffer:
+        try:
+            request = json.loads(line)
+        except ValueError:
+            answer = {"ok": False, "error": "exception", "type": "ValueError", "message": "request is not JSON"}
+        else:
+            answer = child.handle(request)
+        out.write(json.dumps(answer).encode() + b"\n")
+
+
+if __name__ == "__main__":
+    main()
