@@ -9,20 +9,20 @@ from __future__ import annotations
 import logging
 import os
 import re
-import tempfile
 from pathlib import Path
 from typing import Optional
 
 log = logging.getLogger("volviz.app")
 
-_PARTIAL = re.compile(r"\S*\.partial\b\S*")  # MovieWriter's and the atomic writers' temporary names
+# volviz's own temporaries: the atomic writers' ``.NAME.volviz-tmp-PID-RANDOM`` (and older ``.partial`` names) and
+# the working folders it makes in the temporary directory (``volviz-...``, ``vvs-part...``); a user's own file in
+# /tmp is named as it is
+_TEMPORARY = re.compile(r"[^\s:]*(?:\.volviz-tmp-[^\s:]*|\.partial\b|/volviz-[\w.-]*/|/vvs-part[\w.-]*/)[^\s:]*")
 
 
 def hide_temporary_names(text: str) -> str:
-    """``text`` with internal temporary file names (the temporary folder, ``.x.partial`` names) replaced by words."""
-    tmp = re.escape(tempfile.gettempdir().rstrip(os.sep) + os.sep)
-    text = re.sub(tmp + r"\S+", "a temporary file", text)
-    return _PARTIAL.sub("a temporary file", text)
+    """``text`` with volviz's internal temporary file names replaced by words (see ``_TEMPORARY``)."""
+    return _TEMPORARY.sub("a temporary file", text)
 
 
 def _problem(exc: BaseException, path: Optional[Path]) -> Optional[str]:

@@ -27,7 +27,9 @@ def session_file(tmp_path: Path) -> Path:
     grid.save(tmp_path / "ball.vti")
     doc = {"format": "volviz-session", "version": 1, "datasets": [{"id": "b", "path": "ball.vti"}],
            "components": [{"id": "iso", "type": "isosurface", "dataset": "b", "settings": {"styles": STYLES}}],
-           "camera": {"position": [11.5, -45.0, 11.5], "focal_point": [11.5, 11.5, 11.5], "view_up": [0, 0, 1]}}
+           "camera": {"position": [11.5, -45.0, 11.5], "focal_point": [11.5, 11.5, 11.5], "view_up": [0, 0, 1]},
+           # the viewport is compared with CPU renders of the surfaces: no decorations
+           "render": {"options": {"scalar_bar": False, "axes": False, "outline": False}}}
     path = tmp_path / "ball.json"
     path.write_text(json.dumps(doc))
     return path

@@ -14,6 +14,7 @@ from volviz.session import CameraState, Component, DatasetRef, Session
 
 SIZE = (160, 120)
 BG = (0.1, 0.1, 0.12)
+PLAIN = {"scalar_bar": False, "axes": False, "outline": False}  # images compared with CPU renders: no decorations
 STYLES = [{"value": 0.3, "color": [1.0, 0.3, 0.2], "opacity": 0.5}, {"value": 0.8, "color": [0.2, 0.4, 1.0],
                                                                        "opacity": 0.4}]
 
@@ -45,6 +46,7 @@ def scene(components: list[Component], clip: dict | None = None) -> tuple[SceneC
     s = Session(datasets=[DatasetRef("b", "/unused")], components=components,
                 camera=CameraState((11.5, -40.0, 11.5), (11.5, 11.5, 11.5), (0.0, 0.0, 1.0)))
     s.render.background = BG
+    s.render.options.update(PLAIN)
     if clip is not None:
         s.clip = clip
     p = plotter()
@@ -191,6 +193,7 @@ def test_overlay_follows_display_time_and_clip_of_a_time_series():
     s = Session(datasets=[DatasetRef("b", "/unused")], components=[iso_component()],
                 camera=CameraState((11.5, -40.0, 11.5), (11.5, 11.5, 11.5), (0.0, 0.0, 1.0)))
     s.render.background = BG
+    s.render.options.update(PLAIN)
     s.render.options["iso_mode"] = "4pass"
     p = plotter()
     c = SceneController(p, s, {"b": TimeSeries([0.0, 1.0], [small, big])})
@@ -210,12 +213,13 @@ _VTK_PT_CUT = """
 import numpy as np
 import sys
 sys.path.insert(0, %r)
-from test_iso_overlay import BG, SceneController, Session, Component, plotter, shot
+from test_iso_overlay import BG, PLAIN, SceneController, Session, Component, plotter, shot
 import pytest
 
 s = Session(components=[Component("demo", "demo", settings={"cells_per_edge": 6})])
 s.render.method = "vtk"  # VTK's projected tetrahedra, which ignore mapper clipping planes
 s.render.background = BG
+s.render.options.update(PLAIN)
 p = plotter()
 c = SceneController(p, s, {})
 c.build()

@@ -239,7 +239,8 @@ def test_session_with_a_lod_dataset_follows_camera_and_transfer_function(tree: L
     assert "lod" not in data_session(vvz).datasets[0].options          # small files are decoded whole
     session = Session(datasets=[DatasetRef(id="blob", path=str(vvz), options={"lod": True})],
                       components=[Component(id="blob", type="volume", dataset="blob", settings={"budget": 8})],
-                      render=RenderSettings(size=SIZE, background=(0.0, 0.0, 0.0)))
+                      render=RenderSettings(size=SIZE, background=(0.0, 0.0, 0.0),   # the image is the volume's:
+                                            options={"scalar_bar": False, "axes": False, "outline": False}))
     datasets = load_datasets(session, None)
     assert isinstance(datasets["blob"], LodTree)
     plotter = offscreen_plotter(SIZE)

@@ -172,6 +172,12 @@ class SceneController:
         ``nature`` is false (the app rebuilds it in the background: ``prepare_nature``, ``install_nature``). Another
         component hidden at build time is built now unless ``build`` is false (the app prepares it in the
         background: ``prepare_component``, ``install_component``)."""
+        try:
+            self._set_visible(comp_id, visible, nature, build)
+        finally:
+            self.decorate()        # the outline and the scalar bar follow what is shown
+
+    def _set_visible(self, comp_id: str, visible: bool, nature: bool, build: bool) -> None:
         from volviz.render.scene import NATURE_TYPES
 
         comp = self.component(comp_id)
