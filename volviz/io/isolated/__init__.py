@@ -148,7 +148,7 @@ def engine(spec: Any) -> str:
     return "the reader"
 
 
-# -- the exchange folder ------------------------------------------------------------------------------------------------
+# -- the exchange folder -----------------------------------------------------------------------------------------------
 _cleaned = threading.Event()
 
 
@@ -190,7 +190,7 @@ def _workdir(data_bytes: int) -> str:
     return tempfile.mkdtemp(prefix=f"{WORKDIR_PREFIX}{os.getpid()}-", dir=base)
 
 
-# -- one read -----------------------------------------------------------------------------------------------------------
+# -- one read ----------------------------------------------------------------------------------------------------------
 def _plain(value: Any, name: str) -> Any:
     """An option value as JSON (paths as strings, tuples as lists); TypeError for anything else."""
     if value is None or isinstance(value, (bool, int, float, str)):

@@ -171,7 +171,8 @@ class Worker:
 
 
 class Pool:
-    """Warm children waiting for requests; ``take`` hands one out (starting one if none waits), ``give`` takes it back."""
+    """Warm children waiting for requests: ``take`` hands one out (starting one if none waits), ``give`` takes it
+    back."""
 
     def __init__(self, max_idle: int = MAX_IDLE) -> None:
         self.max_idle = max_idle
