@@ -1,16 +1,18 @@
 """VTKHDF files (VTK's HDF5 format), including transient ones, through ``vtkHDFReader``.
 
-The file is first checked with h5py: HDF5 signature, a ``/VTKHDF`` group with a ``Type`` attribute, and (for
-transient data) ``/VTKHDF/Steps`` with ``Values``. Static files give one dataset; transient files give a TimeSeries
+The file is first checked with h5py: HDF5 signature, a ``/VTKHDF`` group with a ``Type`` attribute, every count
+against the datasets it describes (``volviz.io.vtkhdfcheck``), and (for transient data) ``/VTKHDF/Steps`` with
+``Values``; h5py's own exceptions on damaged metadata become ReadError. Static files give one dataset; transient files give a TimeSeries
 whose frames are read lazily, one vtkHDFReader update per step.
 """
 from __future__ import annotations
 
 import numpy as np
 
-from volviz.io._checks import check_finite, file_size, read_bytes
+from volviz.io._checks import check_finite, describe_bytes, file_size, read_bytes
 from volviz.io.errors import PathLike, ReadError
 from volviz.io.vtkconvert import vtk_to_model
+from volviz.io.vtkhdfcheck import check_structure
 from volviz.model import TimeSeries
 
 HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
@@ -23,17 +25,13 @@ def _inspect(path: PathLike) -> tuple[str, np.ndarray | None]:
     size = file_size(path)
     head = read_bytes(path, 8)
     if head != HDF5_SIGNATURE:
-        raise ReadError(path, f"not an HDF5/VTKHDF file: starts with {head!r}")
+        raise ReadError(path, f"not an HDF5/VTKHDF file: starts with {describe_bytes(head)}, not the HDF5 signature")
     try:
         with h5py.File(path, "r") as f:
             if "VTKHDF" not in f or not isinstance(f["VTKHDF"], h5py.Group):
                 raise ReadError(path, "HDF5 file without a /VTKHDF group: not a VTKHDF file")
             root = f["VTKHDF"]
-            kind = root.attrs.get("Type")
-            if kind is None:
-                raise ReadError(path, "/VTKHDF has no Type attribute")
-            kind = kind.decode() if isinstance(kind, bytes) else str(kind)
-            _check_dataset_sizes(path, root, size)
+            kind = check_structure(path, root, size)
             times = None
             if "Steps" in root:
                 steps = root["Steps"]
@@ -48,28 +46,15 @@ def _inspect(path: PathLike) -> tuple[str, np.ndarray | None]:
         raise
     except PermissionError:
         raise ReadError(path, "permission denied (the file is not readable)") from None
-    except (OSError, KeyError, ValueError, TypeError) as exc:
-        raise ReadError(path, f"HDF5 library could not read the file ({exc})") from None
+    except (RuntimeError, OSError, KeyError, ValueError, TypeError, AttributeError, IndexError) as exc:
+        raise ReadError(path, f"HDF5 library could not read the file's structure ({type(exc).__name__}: "
+                              f"{_printable(exc)})") from None
     return kind, times
 
 
-def _check_dataset_sizes(path: PathLike, root, size: int) -> None:
-    """No dataset may claim more bytes than the file could hold after decompression (deflate stays under
-    ~1032:1), so a corrupt shape cannot make VTK allocate a huge array."""
-    import h5py
-
-    budget = 1100 * size + (1 << 20)
-    found: list[tuple[str, int]] = []
-
-    def visit(name: str, obj) -> None:
-        if isinstance(obj, h5py.Dataset):
-            found.append((name, int(np.prod(obj.shape, dtype=object)) * obj.dtype.itemsize))
-
-    root.visititems(visit)
-    for name, nbytes in found:
-        if nbytes > budget:
-            raise ReadError(path, f"dataset /VTKHDF/{name} claims {nbytes} bytes, more than the file's {size} bytes "
-                                  "can hold even compressed")
+def _printable(exc: Exception) -> str:
+    """An exception's message, shortened, with anything that is not printable text replaced."""
+    return "".join(c if c.isprintable() else "?" for c in str(exc)[:200])
 
 
 def _read_step(path: PathLike, step: int | None, allow_nonfinite: bool):
