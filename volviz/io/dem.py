@@ -136,6 +136,10 @@ def read_dem(path: PathLike, vtk_compatible: bool = False) -> Image2D:
     profiles = _read_profiles(path, buf, h)
     if not profiles:
         raise ReadError(path, "DEM holds no elevation profiles")
+    peak = max(float(np.abs(p[4]).max(initial=0)) for p in profiles)
+    if not (np.isfinite(peak * dz * elev) and np.isfinite(low)):
+        raise ReadError(path, f"DEM heights overflow: elevations times the vertical resolution {dz:g} are not finite "
+                              "numbers")
     if vtk_compatible:
         grid = np.full((rows, cols), low, dtype=np.float64)  # row 0 = south here, flipped below
         for row_id, col_id, _x, _y, values in profiles:
@@ -159,8 +163,5 @@ def read_dem(path: PathLike, vtk_compatible: bool = False) -> Image2D:
         for r, c, (_, _, _, _, values) in zip(row_idx, col_idx, profiles):
             grid[r:r + len(values), c] = values * (dz * elev)
         origin = (x0 * plane, y0 * plane)
-    if not np.isfinite(grid).all():
-        raise ReadError(path, f"DEM heights overflow: elevations times the vertical resolution {dz:g} are not finite "
-                              "numbers")
     return Image2D(np.ascontiguousarray(grid[::-1]), spacing=(dx * plane, dy * plane), origin=origin,
                    source=str(path))

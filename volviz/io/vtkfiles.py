@@ -37,7 +37,7 @@ def _run(path: PathLike, reader) -> object:
     text = capture.GetOutput()
     if isinstance(text, bytes):  # a message quoting bytes of the file that are not UTF-8
         text = text.decode("utf-8", "replace")
-    text = "".join(c if c.isprintable() or c == "\n" else "?" for c in text.strip())
+    text = "".join(c if (c.isprintable() and c.isascii()) or c == "\n" else "?" for c in text.strip())
     if reader.GetErrorCode() or "ERROR:" in text:
         lines = [ln.split("): ", 1)[-1].strip() for ln in text.splitlines()
                  if ln.strip() and not ln.startswith("ERROR:")]
@@ -47,22 +47,26 @@ def _run(path: PathLike, reader) -> object:
 
 
 def read_vtk_file(path: PathLike, allow_nonfinite: bool = True):
-    """Read .vtk/.vti/.vtu/.vts/.vtr/.vtp with VTK's reader and convert to the matching model type."""
-    import vtk
+    """Read .vtk/.vti/.vtu/.vts/.vtr/.vtp with VTK's reader and convert to the matching model type.
+
+    The file is checked first (VTK is imported only for a file that passed)."""
     from pathlib import Path
 
     ext = Path(path).suffix.lower()
     if ext == ".vtk":
         check_legacy_file(path)
+    elif ext in XML_READERS:
+        check_xml_file(path, XML_READERS[ext][0])
+    else:
+        raise ReadError(path, f"extension {ext!r} is not a VTK format ({', '.join(['.vtk', *XML_READERS])})")
+    import vtk
+
+    if ext == ".vtk":
         reader = vtk.vtkDataSetReader()
         reader.ReadAllScalarsOn()
         reader.ReadAllVectorsOn()
         reader.ReadAllFieldsOn()
-    elif ext in XML_READERS:
-        expected, cls = XML_READERS[ext]
-        check_xml_file(path, expected)
-        reader = getattr(vtk, cls)()
     else:
-        raise ReadError(path, f"extension {ext!r} is not a VTK format ({', '.join(['.vtk', *XML_READERS])})")
+        reader = getattr(vtk, XML_READERS[ext][1])()
     reader.SetFileName(str(path))
     return vtk_to_model(path, _run(path, reader), allow_nonfinite)
