@@ -352,7 +352,7 @@ class MainWindow(QMainWindow):
         try:
             if not p.exists():
                 raise FileNotFoundError(p)
-            session, session_path = (load(p), p) if is_session_file(p) else (data_session(p), None)
+            session, session_path = (load(p), p) if is_session_file(p) else (data_session(p, q), None)
         except Exception as exc:  # the file's fault or ours: a message in the user's terms, the scene stays
             self.show_error(f"Cannot open {p.name}", open_error(p, exc))
             return
