@@ -26,6 +26,7 @@ BENCHMARKS = {
     "compression": "the wavelet codec against blosc2, zfp and wavelet + zstd (ratio, PSNR, speed)",
     "nature": "the natural scene (terrain, fog, clouds): frame time and error along a flight",
     "iso": "multiple semi-transparent isosurfaces: compositing modes against the exact order",
+    "isolation": "crash-isolated reading: isolated against in-process read time on every shared dataset",
 }
 #: commands whose arguments go, unread here, to their own parser (``volviz.regular.cli``, ``volviz.bench.NAME``)
 PASSED_ON = ("bench", "compress")

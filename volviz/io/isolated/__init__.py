@@ -10,15 +10,17 @@ volviz.io.isolated``) under
 - a time limit: ``60 s + 0.5 s per MB`` of data; ``VOLVIZ_READ_SECONDS`` sets it instead.
 
 The child answers with a JSON description of the dataset (``codec``); its arrays come back as ``.npy`` files in a
-private folder on ``/dev/shm`` (memory, where there is room) or the temporary folder, read with
-``allow_pickle=False`` and checked against that description. A crash, abort, out-of-memory or time-out becomes a
-``ReadError`` naming the file and what happened, and the calling process goes on. Children are kept warm between
-reads (``prewarm()`` starts one ahead of the first read). A time series' lazy frames are read the same way.
+private folder on ``/dev/shm`` (memory, where there is room) or the temporary folder, read (large ones mapped
+copy-on-write, not copied) with ``allow_pickle=False`` and checked against that description. A crash, abort,
+out-of-memory or time-out becomes a ``ReadError`` naming the file and what happened, and the calling process goes
+on. Children are kept warm between reads (``prewarm()`` starts one ahead of the first read). A time series' lazy
+frames are read the same way.
 
 ``VOLVIZ_ISOLATE=0`` (or ``volviz.io.read(path, isolate=False)``) reads in-process, to debug a reader.
 """
 from __future__ import annotations
 
+import math
 import os
 import re
 import shutil
@@ -37,6 +39,7 @@ from volviz.io.isolated.worker import ChildDied, ChildTimedOut, Pool
 
 GIB = 1 << 30
 WORKDIR_PREFIX = "volviz-read-"
+MAP_BYTES = 1 << 20  # arrays from this size on are mapped, smaller ones copied (each mapping costs a page and a slot)
 _FALSE = ("0", "false", "no", "off")
 _SIZE = re.compile(r"\s*(\d+(?:\.\d+)?)\s*([kmgt]?)i?b?\s*", re.I)
 _WARNINGS = {c.__name__: c for c in (NonFiniteWarning, UserWarning, RuntimeWarning, DeprecationWarning,
@@ -206,6 +209,14 @@ def _plain(value: Any, name: str) -> Any:
     raise TypeError(f"option {name}={value!r} cannot be passed to an isolated reader (plain values only)")
 
 
+def _load_array(path: str, nbytes: int) -> np.ndarray:
+    """A .npy file the child wrote (no pickles). A large one is mapped copy-on-write rather than copied: its pages
+    stay where the child wrote them (memory, on /dev/shm) and outlive the file's removal."""
+    if nbytes >= MAP_BYTES and os.name == "posix":
+        return np.asarray(np.load(path, mmap_mode="c", allow_pickle=False))
+    return np.load(path, allow_pickle=False)
+
+
 def _reemit(caught: Any) -> None:
     for item in caught if isinstance(caught, list) else []:
         if isinstance(item, list) and len(item) == 2 and all(isinstance(t, str) for t in item):
@@ -274,7 +285,8 @@ class _Read:
         header = answer.get("header")
         try:
             specs = array_specs(header)
-            arrays = [np.load(os.path.join(workdir, f"a{i}.npy"), allow_pickle=False) for i in range(len(specs))]
+            arrays = [_load_array(os.path.join(workdir, f"a{i}.npy"), dtype.itemsize * math.prod(shape))
+                      for i, (dtype, shape) in enumerate(specs)]
             dataset = decode(header, arrays)
         except (CodecError, OSError, ValueError, TypeError, IndexError) as exc:
             raise self.fail(f"the isolated reader's result is not a valid dataset ({exc})") from None

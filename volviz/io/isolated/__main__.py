@@ -67,22 +67,34 @@ class Child:
         self.series: OrderedDict[str, Any] = OrderedDict()
 
     def _load(self, request: dict) -> Any:
+        """The loader's dataset, or with ``frame`` one frame of the time series it returns. A lazy series stays open
+        here (the last few, keyed by loader, path, options and the file's mtime and size) for its later frames,
+        holding frame 0 only: a frame handed back is dropped again."""
         from volviz.io.registry import loader_call
 
         f, opts = loader_call(request["kind"], request["loader"], request["options"])
         frame = request.get("frame")
-        if frame is None:
-            return f(request["path"], **opts)
-        key = json.dumps([request["loader"], request["path"], request["options"]], sort_keys=True)
-        series = self.series.pop(key, None)
+        try:
+            st = os.stat(request["path"])
+            stamp = [st.st_mtime_ns, st.st_size]
+        except OSError:
+            stamp = None
+        key = json.dumps([request["loader"], request["path"], request["options"], stamp], sort_keys=True)
+        series = self.series.pop(key, None) if frame is not None else None
         if series is None:
             series = f(request["path"], **opts)
-        self.series[key] = series
-        while len(self.series) > SERIES_CACHE:
-            self.series.popitem(last=False)
+        if getattr(series, "loader", None) is not None and hasattr(series, "frame"):
+            self.series[key] = series
+            while len(self.series) > SERIES_CACHE:
+                self.series.popitem(last=False)
+        if frame is None:
+            return series
         if not hasattr(series, "frame"):
             raise TypeError(f"frame {frame} was asked of a {type(series).__name__}, not a time series")
-        return series.frame(frame)
+        item = series.frame(frame)
+        if frame != 0:
+            series.frames[frame] = None
+        return item
 
     def handle(self, request: dict) -> dict:
         import numpy as np
