@@ -1416,6 +1416,8 @@ class MainWindow(QMainWindow):
     def show_error(self, title: str, text: str) -> None:
         """A non-blocking error dialog (the app keeps running); also logged."""
         log.error("%s: %s", title, text)
+        if self.controller is None:
+            self.plotter.render()  # a window with no scene yet shows its empty viewport, not an undrawn white one
         dialog = QMessageBox(QMessageBox.Icon.Critical, title, text, QMessageBox.StandardButton.Ok, self)
         dialog.setWindowModality(Qt.WindowModality.WindowModal)
         dialog.open()

@@ -147,3 +147,28 @@ def test_flat_grids_and_surface_meshes_are_drawn_as_coloured_surfaces():
         drawn = np.abs(image.astype(int) - background).sum(axis=2) > 40
         assert drawn.mean() > 0.15                                   # a surface, not an empty volume
         assert len(np.unique(image[drawn].reshape(-1, 3) // 16, axis=0)) > 10   # ... in many colours
+
+
+def test_pictures_open_flat_and_face_on():
+    """A photo or a texture (not a height map) is a flat picture seen face-on, in its own colours."""
+    from volviz.render.framing import view_direction
+    from volviz.render.scene import data_session
+
+    assert view_direction((0, 4, 0, 2, 0, 0)) == ((0.0, 0.0, 1.0), (0.0, 1.0, 0.0))
+    assert view_direction((0, 1, 0, 1, 0, 1))[0] == (1.0, 1.0, 1.0)
+    for name in ("sky/clouds.jpeg", "yukon/Yukon.texmap.ppm"):
+        session = data_session(data_file(name))
+        assert [c.type for c in session.components] == ["volume"]
+        image = _render(session, (160, 120))
+        drawn = np.abs(image.astype(int) - image[0, 0].astype(int)).sum(axis=2) > 30
+        assert drawn.mean() > 0.4                          # face-on, filling the view
+        assert session.transfer_functions == {}            # no transfer function: the picture's own colours
+
+
+def test_messages_for_headerless_data_say_what_to_open(tmp_path):
+    from volviz.io import ReadError, read
+
+    with pytest.raises(ReadError, match=r"is the raw data of HeadMRVolume.mhd: open HeadMRVolume.mhd"):
+        read(data_file("volumes/HeadMRVolume.raw"))
+    with pytest.raises(ReadError, match=r"numbered slices without a header: .* MetaImage header \(.mhd\)"):
+        read(data_file("headsq/quarter.1"))

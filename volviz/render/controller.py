@@ -126,7 +126,12 @@ class SceneController:
         (``volviz.render.decorations``); call after a transfer function, visibility or option changed."""
         from volviz.render.decorations import apply_decorations
 
-        apply_decorations(self.plotter, self.session, self.props, self.datasets)
+        apply_decorations(self.plotter, self.session, self.shown_props(), self.datasets)
+
+    def shown_props(self) -> dict[str, Any]:
+        """The props of the visible components (the natural scene's view under ``"nature"``)."""
+        visible = {c.id for c in self.session.components if c.visible}
+        return {k: p for k, p in self.props.items() if k == "nature" or k in visible}
 
     def component(self, comp_id: str) -> Component:
         for comp in self.session.components:
@@ -405,7 +410,7 @@ class SceneController:
         if camera is None:
             from volviz.render.framing import frame_scene
 
-            frame_scene(self.plotter, self.props)
+            frame_scene(self.plotter, self.shown_props())
         else:
             apply_camera(self.plotter, camera)
         if update:

@@ -20,7 +20,8 @@ def _valid(bounds: Any) -> bool:
 
 def prop_bounds(prop: Any) -> Optional[Bounds]:
     """The world bounds of one component's prop: a NatureView (its terrain, else its clouds), a PT volume (its
-    mesh), a LOD volume (its samples), a VTK prop (what VTK reports); None when hidden or empty."""
+    mesh), a LOD volume (its samples), a VTK prop (what VTK reports); None when empty or a hidden VTK prop (callers
+    leave out the props of hidden components)."""
     scene = getattr(prop, "scene", None)
     if scene is not None and hasattr(prop, "terrain_actor"):
         if getattr(scene, "terrain", None) is not None:
@@ -29,8 +30,8 @@ def prop_bounds(prop: Any) -> Optional[Bounds]:
         clouds = getattr(scene, "cloud_lod", None)
         return tuple(clouds.volume.bounds()) if clouds is not None else None  # type: ignore[return-value]
     mesh = getattr(prop, "mesh", None)
-    if mesh is not None and hasattr(mesh, "points"):
-        if not getattr(prop, "visible", True) or not len(mesh.points):
+    if mesh is not None and hasattr(mesh, "points"):   # (an overlay is hidden until its first image: not checked)
+        if not len(mesh.points):
             return None
         lo, hi = mesh.points.min(axis=0), mesh.points.max(axis=0)
         return (lo[0], hi[0], lo[1], hi[1], lo[2], hi[2])
@@ -78,9 +79,20 @@ def framing_distance(bounds: Bounds, direction: Any, view_up: Any, view_angle: f
     return centre, max(distance, 1e-3 * extent, 1e-9)
 
 
+def view_direction(bounds: Bounds) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
+    """(direction towards the camera, view up) for a box: face-on for flat data (an image, a 2D grid: seen along its
+    thin axis), else the isometric view with z up."""
+    sides = np.subtract(bounds[1::2], bounds[0::2])
+    thin = int(np.argmin(sides))
+    if sides[thin] <= 1e-9 * max(float(np.max(sides)), 1e-300):
+        return ((0.0, 0.0, 1.0), (0.0, 1.0, 0.0)) if thin == 2 else \
+               (((1.0, 0.0, 0.0), (0.0, 0.0, 1.0)) if thin == 0 else ((0.0, -1.0, 0.0), (0.0, 0.0, 1.0)))
+    return ISOMETRIC, (0.0, 0.0, 1.0)
+
+
 def frame_bounds(plotter: Any, bounds: Optional[Bounds], fill: float = FILL) -> None:
-    """Point the plotter's camera at ``bounds`` from the isometric direction (z up) so they fill ``fill`` of the
-    viewport; with no bounds, VTK's own reset."""
+    """Point the plotter's camera at ``bounds`` (from ``view_direction``) so they fill ``fill`` of the viewport;
+    with no bounds, VTK's own reset."""
     camera = plotter.renderer.GetActiveCamera()
     if bounds is None:
         plotter.view_isometric()
@@ -88,9 +100,9 @@ def frame_bounds(plotter: Any, bounds: Optional[Bounds], fill: float = FILL) -> 
         return
     width, height = plotter.window_size
     aspect = width / max(height, 1)
-    up = (0.0, 0.0, 1.0)
-    centre, distance = framing_distance(bounds, ISOMETRIC, up, camera.GetViewAngle(), aspect, fill)
-    direction = np.asarray(ISOMETRIC) / np.linalg.norm(ISOMETRIC)
+    view, up = view_direction(bounds)
+    centre, distance = framing_distance(bounds, view, up, camera.GetViewAngle(), aspect, fill)
+    direction = np.asarray(view) / np.linalg.norm(view)
     camera.SetFocalPoint(*centre)
     camera.SetPosition(*(centre + distance * direction))
     camera.SetViewUp(*up)

@@ -193,10 +193,14 @@ def ensure_transfer_functions(session: Session, datasets: dict[str, Any]) -> Non
     """Give every volume-like component without a transfer function a default one fitted to its data."""
     from volviz.render.vtk_scene import default_transfer_function_for
 
+    from volviz.model import Image2D
+
     for comp in session.components:
         if comp.transfer_function is None and comp.type in ("volume", "mesh", "demo"):
             if comp.dataset is not None and comp.dataset not in datasets:
                 continue  # a hidden component's data is not read: it gets its TF when shown
+            if isinstance(datasets.get(comp.dataset), Image2D):
+                continue  # an image shows its own colours (``vtk_scene.add_dataset``)
             name = comp.id
             while name in session.transfer_functions:
                 name += "'"

@@ -72,7 +72,7 @@ def volume_grid(dataset: Any) -> Any:
     if isinstance(dataset, TimeSeries):
         dataset = dataset.frame(0)
     grid = dataset.to_pyvista() if isinstance(dataset, (TetMesh, UnstructuredMesh, CurvilinearGrid,
-                                                        RegularVolume)) else dataset
+                                                        RegularVolume, Image2D)) else dataset
     scalars = grid.active_scalars
     if scalars is not None and np.asarray(scalars).ndim > 1:
         grid.point_data["magnitude"] = np.linalg.norm(np.asarray(scalars), axis=1)
@@ -200,11 +200,13 @@ def is_surface(dataset: Any) -> bool:
 
 
 def _add_surface(plotter: Any, grid: Any, tf: Any, opacity: float, name: Optional[str]) -> Any:
-    """A surface coloured by its active scalars through the transfer function's colours (NaN transparent)."""
+    """A surface coloured by its active scalars through the transfer function's colours; the cells touching NaN/Inf
+    (land in an ocean field, a solver's failed points) are left out."""
     ctf, _ = tf.to_vtk(1.0)
     ctf.ClampingOn()
-    ctf.SetNanColor(0.5, 0.5, 0.5)
-    ctf.SetNanOpacity(0.0)           # NaN (land in an ocean field, a solver's failed points) is not drawn
+    values = np.asarray(grid.active_scalars)
+    if values.dtype.kind == "f" and not np.isfinite(values).all():   # cells touching NaN/Inf are not drawn
+        grid = grid.extract_points(np.flatnonzero(np.isfinite(values)), adjacent_cells=False)
     surface = grid.extract_surface(algorithm="dataset_surface") if hasattr(grid, "extract_surface") else grid
     actor = plotter.add_mesh(surface, scalars=grid.active_scalars_name, opacity=opacity, name=name,
                              nan_opacity=0.0, show_scalar_bar=False, reset_camera=False, render=False)
@@ -216,20 +218,19 @@ def _add_surface(plotter: Any, grid: Any, tf: Any, opacity: float, name: Optiona
 
 
 def _add_image(plotter: Any, image: Image2D, name: Optional[str]) -> Any:
+    """A 2D raster (a photo, a texture, a grey image) as a flat picture on the z = 0 plane, in its own colours (grey
+    levels for one channel). Height maps open as terrain scenes instead (``volviz.render.scene.terrain_session``)."""
     grid = image.to_pyvista()
     if image.channels >= 3:
         colors = np.asarray(image.data[..., :3], dtype=np.float64).reshape(-1, 3)
         scale = float(image.maxval or max(colors.max(), 1.0))
         grid.point_data["rgb"] = np.clip(colors / scale * 255.0, 0, 255).astype(np.uint8)
-        return plotter.add_mesh(grid, scalars="rgb", rgb=True, name=name)
-    heights = np.asarray(grid.point_data["values"], dtype=np.float64)
-    extent = max(image.data.shape[0] * image.spacing[1], image.data.shape[1] * image.spacing[0])
-    span = float(np.nanmax(heights) - np.nanmin(heights)) or 1.0
-    surface = grid.extract_surface(algorithm="dataset_surface")
-    surface.point_data["height"] = heights
-    factor = 0.25 * extent / span if span > 0.5 * extent else 1.0  # exaggerate only flat-looking raw grey maps
-    warped = surface.warp_by_scalar("height", factor=factor)
-    return plotter.add_mesh(warped, scalars="height", cmap="gist_earth", name=name, smooth_shading=True)
+        return plotter.add_mesh(grid, scalars="rgb", rgb=True, name=name, reset_camera=False)
+    values = np.asarray(grid.point_data["values"], dtype=np.float64)
+    finite = values[np.isfinite(values)]
+    limits = (float(finite.min()), float(finite.max())) if finite.size else (0.0, 1.0)
+    return plotter.add_mesh(grid, scalars="values", cmap="gray", clim=limits, show_scalar_bar=False, name=name,
+                            nan_opacity=0.0, reset_camera=False)
 
 
 def apply_camera(plotter: Any, camera: Optional[CameraState]) -> None:
