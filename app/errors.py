@@ -65,8 +65,11 @@ def open_error(path: Optional[str | os.PathLike], exc: BaseException, what: str 
                 "Check that it is a complete file of the type its name says. The details are in the log; please "
                 "report them with the file.")
     kind = "session" if p is not None and p.suffix.lower() == ".json" else "file"
-    advice = ("Check the field named above in the session file, or open the data file itself."
-              if kind == "session" else
-              "Check that the file is complete (a download or copy may have stopped early) and of the type its "
-              "name says; File > Open Data lists the types volviz reads.")
+    advice = (getattr(exc, "advice", None) or
+              ("Check the field named above in the session file, or open the data file itself."
+               if kind == "session" else
+               "Check that the file is complete (a download or copy may have stopped early) and of the type its "
+               "name says; File > Open Data lists the types volviz reads."))
+    if advice[:1].islower():
+        advice = advice[0].upper() + advice[1:] + "."
     return f"volviz cannot open {name}{where}:\n{hide_temporary_names(problem)}\n\n{advice}"

@@ -11,16 +11,18 @@ class ReadError(Exception):
     """A file could not be read as a dataset. The message always names the file and the problem.
 
     ``ReadError(path, "header claims 100000x100000x100000 voxels (1e15 bytes) but the file holds 18 KB")`` reads
-    ``"<path>: header claims ..."``. The parts are kept as ``.path`` and ``.problem``.
+    ``"<path>: header claims ..."``. The parts are kept as ``.path`` and ``.problem``; ``.advice`` (optional) says
+    what to do instead, and follows the problem in the message.
     """
 
-    def __init__(self, path: PathLike, problem: str) -> None:
+    def __init__(self, path: PathLike, problem: str, advice: str | None = None) -> None:
         self.path = os.fspath(path) if not isinstance(path, str) else path
         self.problem = str(problem)
-        super().__init__(f"{self.path}: {self.problem}")
+        self.advice = advice          # what to do, when the reader knows better than "check the file"
+        super().__init__(f"{self.path}: {self.problem}" + (f"; {advice}" if advice else ""))
 
-    def __reduce__(self):  # keep the two-argument form picklable (background jobs send errors across threads)
-        return (type(self), (self.path, self.problem))
+    def __reduce__(self):  # picklable (background jobs send errors across threads)
+        return (type(self), (self.path, self.problem, self.advice))
 
 
 class NonFiniteWarning(UserWarning):

@@ -310,14 +310,16 @@ def spec_of(path: PathLike, options: dict | None = None) -> ReaderSpec:
     if ext == ".raw":
         headers = sorted(h.name for h in p.parent.glob(p.stem + ".mh[da]"))
         if headers:
-            raise ReadError(p, f"is the raw data of {headers[0]}: open {headers[0]}, the header that describes it")
-        raise ReadError(p, "is raw data without a header: volviz needs its dimensions and sample type; write a "
-                           "MetaImage header (.mhd) naming them next to it and open that (in Python: "
-                           "volviz.io.read_raw)")
+            raise ReadError(p, f"is the raw data of {headers[0]}",
+                            f"open {headers[0]}, the header that describes it")
+        raise ReadError(p, "is raw data without a header: volviz needs its dimensions and sample type",
+                        "write a MetaImage header (.mhd) naming them next to it and open that (in Python: "
+                        "volviz.io.read_raw)")
     if re.search(r"\.\d+$", p.name):
         raise ReadError(p, "looks like one slice of a stack of numbered slices without a header: volviz needs the "
-                           "slices' size and sample type; write a MetaImage header (.mhd) whose ElementDataFile "
-                           "lists the slices (or a pattern) and open that (in Python: volviz.io.read_slice_stack)")
+                           "slices' size and sample type",
+                        "write a MetaImage header (.mhd) whose ElementDataFile lists the slices (or a pattern) and "
+                        "open that (in Python: volviz.io.read_slice_stack)")
     raise ReadError(p, f"unknown data format (extension {ext or 'none'!r}, content: {describe_bytes(head)}); "
                        "supported: " + _described(s for s in specs if s.listed))
 

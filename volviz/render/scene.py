@@ -59,8 +59,9 @@ def data_session(path: str | os.PathLike, q: Optional[str | os.PathLike] = None)
         if grid is None:
             from volviz.io import ReadError
 
-            raise ReadError(path, "is a PLOT3D solution (q) file: open it together with its grid (xyz) file (select "
-                                  "both files in the Open dialog; on the command line: GRID --q SOLUTION)")
+            raise ReadError(path, "is a PLOT3D solution (q) file, and no grid (xyz) file named like it is beside it",
+                            "open it together with its grid file: select both files in the Open dialog (on the "
+                            "command line: GRID --q SOLUTION)")
         path, q = grid, path
     pattern = series_pattern(path)
     ref = DatasetRef(id="data", path=pattern or str(Path(path).resolve()))
