@@ -23,6 +23,7 @@ from typing import Any
 
 STARTUP_SECONDS = 120.0  # a cold start on a loaded machine; not counted in a read's time limit
 MAX_IDLE = 2
+MAX_REQUESTS = 200  # a child is replaced after this many reads (what a reader leaks goes with it)
 TAIL_BYTES = 8192
 SIGNAL_WHAT = {
     signal.SIGSEGV: "crashed (segmentation fault)",
@@ -132,6 +133,8 @@ class Worker:
         """Send one request and return the decoded answer; ChildTimedOut (the child is killed) or ChildDied."""
         self.wait_ready()
         self.requests += 1
+        self._tail.clear()  # what this request makes the child print explains its death, not an earlier request's
+        self._tail_size = 0
         try:
             self.proc.stdin.write(json.dumps(message).encode() + b"\n")
             self.proc.stdin.flush()
@@ -190,8 +193,8 @@ class Pool:
         return Worker()
 
     def give(self, worker: Worker) -> None:
-        if not worker.alive:
-            worker.kill()
+        if not worker.alive or worker.requests >= MAX_REQUESTS:
+            worker.close()
             return
         with self._lock:
             if len(self._idle) < self.max_idle:
