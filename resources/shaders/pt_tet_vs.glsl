@@ -1,0 +1,32 @@
+//VTK::System::Dec
+
+// Projected tetrahedra, pre-integrated (Roettger Ch. 8, digest section 6.4): each tetrahedron is 4 vertices of a
+// static buffer; every vertex carries its cell's four face planes, the scalar's affine form and the cell's scalar
+// range. They are the same at the 4 vertices, so the ordinary varyings below are constant across each face.
+in vec4 vertexMC;
+in vec4 ptPlane0;
+in vec4 ptPlane1;
+in vec4 ptPlane2;
+in vec4 ptPlane3;
+in vec4 ptScalar;
+in vec4 ptRange;
+
+uniform mat4 MCDCMatrix;
+
+out vec4 cellPlane0;
+out vec4 cellPlane1;
+out vec4 cellPlane2;
+out vec4 cellPlane3;
+out vec4 cellScalar;
+out vec4 cellRange;
+
+void main()
+{
+  cellPlane0 = ptPlane0;
+  cellPlane1 = ptPlane1;
+  cellPlane2 = ptPlane2;
+  cellPlane3 = ptPlane3;
+  cellScalar = ptScalar;
+  cellRange = ptRange;
+  gl_Position = MCDCMatrix * vertexMC;
+}
