@@ -189,3 +189,28 @@ def test_limits_follow_the_file_size_and_the_environment(monkeypatch) -> None:
     monkeypatch.setenv("VOLVIZ_READ_MEMORY", "1.5G")
     monkeypatch.setenv("VOLVIZ_READ_SECONDS", "7")
     assert (limits.memory(1000), limits.seconds(10 ** 9)) == (3 << 29, 7.0)
+
+
+def test_a_reader_child_started_from_a_thread_that_ended_keeps_serving() -> None:
+    """The app reads on worker threads that come and go: a warm child started from one of them must outlive it
+    (a parent-death signal tied to the starting thread killed it, and the next read looked like an out-of-memory
+    death)."""
+    import threading
+    import warnings
+
+    path = data_file("ecosystem/tos_O1_2001-2002.nc")
+    got: list = []
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        worker = threading.Thread(target=lambda: got.append(vio.read(path)))
+        worker.start()
+        worker.join()
+        series = got[0]
+        frames = [series.frame(i) for i in (1, 12, 23)]          # read by the warm child, from this thread
+    direct = vio.read(path, isolate=False)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for frame, i in zip(frames, (1, 12, 23)):
+            expected = direct.frame(i)
+            for name, values in expected.cell_data.items():
+                np.testing.assert_array_equal(frame.cell_data[name], values)

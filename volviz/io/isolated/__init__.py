@@ -298,7 +298,8 @@ class _Read:
         kind = answer.get("error")
         if kind == "read":
             path, problem = str(answer.get("path", "")), str(answer.get("problem", ""))
-            return ReadError(self.shown if path in (self.path, "") else path, problem)
+            advice = answer.get("advice") if isinstance(answer.get("advice"), str) else None
+            return ReadError(self.shown if path in (self.path, "") else path, problem, advice)
         if kind == "options":
             return TypeError(str(answer.get("message")))
         if kind == "memory":

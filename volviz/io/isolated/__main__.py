@@ -27,16 +27,21 @@ def _protocol_stdout() -> BinaryIO:
 
 
 def _die_with_parent() -> None:
-    try:
-        import ctypes
-        import signal
+    """Leave when the parent process is gone, even in the middle of a read: a watchdog thread compares the parent's
+    id every half second (PR_SET_PDEATHSIG would fire when the parent *thread* that started this child ends, and
+    the app starts readers from short-lived worker threads). Between reads the child also leaves at the end of its
+    stdin."""
+    import threading
+    import time
 
-        libc = ctypes.CDLL(None, use_errno=True)
-        libc.prctl(1, int(signal.SIGKILL))  # PR_SET_PDEATHSIG
-        if os.getppid() == 1:
-            os._exit(0)
-    except (OSError, AttributeError):  # not Linux: the child still leaves when its stdin closes
-        pass
+    parent = os.getppid()
+
+    def watch() -> None:
+        while os.getppid() == parent:
+            time.sleep(0.5)
+        os._exit(0)
+
+    threading.Thread(target=watch, name="volviz-reader-watchdog", daemon=True).start()
 
 
 class _MemoryLimit:
@@ -116,7 +121,8 @@ class Child:
                         np.save(os.path.join(request["workdir"], f"a{i}.npy"), arr, allow_pickle=False)
                 answer: dict = {"ok": True, "header": header}
             except ReadError as exc:
-                answer = {"ok": False, "error": "read", "path": exc.path, "problem": exc.problem}
+                answer = {"ok": False, "error": "read", "path": exc.path, "problem": exc.problem,
+                          "advice": exc.advice}
             except CodecError as exc:
                 answer = {"ok": False, "error": "refused", "message": str(exc)}
             except ReaderOptionError as exc:
