@@ -533,25 +533,22 @@ class SceneController:
         return stats
 
     def bounds(self) -> tuple[float, float, float, float, float, float]:
-        """(xmin, xmax, ymin, ymax, zmin, zmax) of everything the scene shows, including what VTK does not see:
-        PT volumes (overlays) and isosurfaces drawn by a CPU mode (their actors are hidden); uncut extents."""
-        import numpy as np
+        """(xmin, xmax, ymin, ymax, zmin, zmax) of everything the visible components show, including what VTK does
+        not see (PT volumes, isosurfaces drawn by a CPU mode, the natural scene's terrain and clouds; not the sky
+        dome around the eye); uncut extents."""
+        from volviz.render.framing import points_bounds, prop_bounds, union
 
-        lo, hi = np.full(3, np.inf), np.full(3, -np.inf)
-        vb = self.plotter.renderer.ComputeVisiblePropBounds()
-        if vb[0] <= vb[1]:
-            lo, hi = np.minimum(lo, vb[0::2]), np.maximum(hi, vb[1::2])
-        for comp_id, prop in self.props.items():
-            pts = []
+        boxes = []
+        for comp_id, prop in self.shown_props().items():
             if _is_pt(prop):
-                pts = [self._pt_meshes.get(comp_id, prop.mesh).points]
+                boxes.append(points_bounds(self._pt_meshes.get(comp_id, prop.mesh).points))
             elif comp_id in self._iso_props():
-                pts = [m.points for m in prop.volviz_meshes if len(m.points)]
-            for p in pts:
-                lo, hi = np.minimum(lo, p.min(axis=0)), np.maximum(hi, p.max(axis=0))
-        if not np.all(lo <= hi):
-            return (-1.0, 1.0, -1.0, 1.0, -1.0, 1.0)
-        return tuple(float(v) for pair in zip(lo, hi) for v in pair)  # type: ignore[return-value]
+                boxes += [points_bounds(m.points) for m in prop.volviz_meshes if len(m.points)]
+            else:
+                box = prop_bounds(prop)
+                if box is not None:
+                    boxes.append(box)
+        return union(boxes) or (-1.0, 1.0, -1.0, 1.0, -1.0, 1.0)
 
     # -- clipping (scene-wide) --------------------------------------------------------------------------------------
     @property

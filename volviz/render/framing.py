@@ -23,18 +23,16 @@ def prop_bounds(prop: Any) -> Optional[Bounds]:
     mesh), a LOD volume (its samples), a VTK prop (what VTK reports); None when empty or a hidden VTK prop (callers
     leave out the props of hidden components)."""
     scene = getattr(prop, "scene", None)
-    if scene is not None and hasattr(prop, "terrain_actor"):
+    if scene is not None and hasattr(prop, "terrain_actor"):   # the terrain and the clouds above it (not the sky)
+        parts = []
         if getattr(scene, "terrain", None) is not None:
-            b = scene.terrain.bounds()
-            return tuple(float(v) for v in b) if _valid(b) else None  # type: ignore[return-value]
-        clouds = getattr(scene, "cloud_lod", None)
-        return tuple(clouds.volume.bounds()) if clouds is not None else None  # type: ignore[return-value]
+            parts.append(scene.terrain.bounds())
+        if getattr(scene, "cloud_lod", None) is not None:
+            parts.append(scene.cloud_lod.volume.bounds())
+        return union([tuple(float(v) for v in b) for b in parts if _valid(b)])  # type: ignore[misc]
     mesh = getattr(prop, "mesh", None)
     if mesh is not None and hasattr(mesh, "points"):   # (an overlay is hidden until its first image: not checked)
-        if not len(mesh.points):
-            return None
-        lo, hi = mesh.points.min(axis=0), mesh.points.max(axis=0)
-        return (lo[0], hi[0], lo[1], hi[1], lo[2], hi[2])
+        return points_bounds(mesh.points) if len(mesh.points) else None
     tree = getattr(prop, "tree", None)
     if tree is not None:
         from volviz.render.lod_volume import lod_bounds
@@ -48,14 +46,23 @@ def prop_bounds(prop: Any) -> Optional[Bounds]:
     return None
 
 
-def scene_bounds(props: dict[str, Any]) -> Optional[Bounds]:
-    """The union of the bounds of every component prop (None when nothing has bounds)."""
-    boxes = [b for b in (prop_bounds(p) for p in props.values()) if b is not None]
+def union(boxes: list[Bounds]) -> Optional[Bounds]:
+    """The smallest box holding every box of ``boxes`` (None for none)."""
     if not boxes:
         return None
     arr = np.asarray(boxes, dtype=np.float64)
     return tuple(float(v) for v in np.ravel(np.column_stack([arr[:, 0::2].min(axis=0),  # type: ignore[return-value]
                                                               arr[:, 1::2].max(axis=0)])))
+
+
+def points_bounds(points: np.ndarray) -> Bounds:
+    lo, hi = points.min(axis=0), points.max(axis=0)
+    return (float(lo[0]), float(hi[0]), float(lo[1]), float(hi[1]), float(lo[2]), float(hi[2]))
+
+
+def scene_bounds(props: dict[str, Any]) -> Optional[Bounds]:
+    """The union of the bounds of every component prop (None when nothing has bounds)."""
+    return union([b for b in (prop_bounds(p) for p in props.values()) if b is not None])
 
 
 def framing_distance(bounds: Bounds, direction: Any, view_up: Any, view_angle: float, aspect: float,
