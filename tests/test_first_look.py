@@ -172,3 +172,20 @@ def test_messages_for_headerless_data_say_what_to_open(tmp_path):
         read(data_file("volumes/HeadMRVolume.raw"))
     with pytest.raises(ReadError, match=r"numbered slices without a header: .* sample type; write a MetaImage header"):
         read(data_file("headsq/quarter.1"))
+
+
+def test_demo_scene_bounds_are_its_terrain_and_clouds_not_the_sky_dome():
+    from volviz.render.export import offscreen_scene
+    from volviz.render.scene import demo_session
+
+    plotter, controller = offscreen_scene(demo_session(), {}, (160, 120))
+    try:
+        controller.build()
+        nature = controller.nature.scene
+        terrain, clouds = nature.terrain.bounds(), nature.cloud_lod.volume.bounds()
+        expected = (min(terrain[0], clouds[0]), max(terrain[1], clouds[1]), min(terrain[2], clouds[2]),
+                    max(terrain[3], clouds[3]), min(terrain[4], clouds[4]), max(terrain[5], clouds[5]))
+        assert controller.bounds() == pytest.approx(expected)
+        assert controller.bounds()[:4] == pytest.approx((0.0, 1000.0, 0.0, 1000.0))    # the dome is 3 km wide
+    finally:
+        plotter.close()
