@@ -25,8 +25,13 @@ How a frame is drawn:
   cells overlap per pixel on the Blunt Fin, which an 8-bit target does not accumulate accurately.
 - Opaque geometry: when the mapper draws (translucent pass, after the opaque one), the framebuffer pass's depth
   texture holds the opaque scene (translucent props do not write depth); the shader reads it (texelFetch) and each
-  segment ends at the opaque depth of its pixel, so a cell straddling a surface is integrated only up to it. The shader writes depth 0, so GL's depth test never drops a
-  fragment whose exit face lies behind the surface.
+  segment ends at the opaque depth of its pixel, so a cell straddling a surface is integrated only up to it. The
+  shader writes depth 0, so GL's depth test never drops a fragment whose exit face lies behind the surface.
+
+Not handled yet: clipping planes and box crop, isosurfaces and pre-classification (the CPU ``pt`` has them), a
+renderer that does not fill its window (the ray basis is built for the renderer's size with its origin at the
+framebuffer's corner: tested with full-window renderers only), depth peeling for other translucent props of the
+same renderer (the pass draws them in order). Call ``remove()`` before closing the plotter.
 """
 from __future__ import annotations
 
