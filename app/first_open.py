@@ -114,10 +114,9 @@ def _dimensions(window: Any) -> str:
 
 
 def _shown_array(window: Any) -> str:
-    from volviz.render.decorations import scalar_bar_actor
+    from volviz.render.decorations import scalar_bar_title
 
-    bar = scalar_bar_actor(window.plotter)
-    return bar.GetTitle() if bar is not None else ""
+    return scalar_bar_title(window.plotter) or ""
 
 
 def _describe(window: Any, record: FirstOpen) -> None:

@@ -1431,7 +1431,7 @@ class MainWindow(QMainWindow):
         bar.setUpdatesEnabled(False)
         bar.setValue(int(round(fraction * 1000)))
         bar.setUpdatesEnabled(True)
-        if message:
+        if message and bar.isVisible():  # background work after loading (error estimates) keeps "Showing ..."
             self.status_label.setText(message)
 
     def _set_busy(self, busy: bool) -> None:

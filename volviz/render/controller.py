@@ -408,9 +408,10 @@ class SceneController:
         from volviz.render.vtk_scene import apply_camera
 
         if camera is None:
+            from volviz.render.decorations import legend_margin
             from volviz.render.framing import frame_scene
 
-            frame_scene(self.plotter, self.shown_props())
+            frame_scene(self.plotter, self.shown_props(), right_margin=legend_margin(self.session))
         else:
             apply_camera(self.plotter, camera)
         if update:

@@ -12,12 +12,21 @@ from volviz.session import Session
 DECORATIONS = ("scalar_bar", "axes", "outline")
 OUTLINE_NAME = "volviz-outline"
 SCALAR_BAR_NAME = "volviz-scalar-bar"
-TITLE_CHAR_PX = 7          # about the width of one character of the 12-point title
+SCALAR_BAR_TITLE_NAME = "volviz-scalar-bar-title"
 
 
 def decoration_enabled(session: Session, name: str) -> bool:
     """Whether the decoration ``name`` (one of ``DECORATIONS``) is on in the session's render options."""
     return bool(session.render.options.get(name, True))
+
+
+LEGEND_MARGIN = 0.2        # the share of the viewport's width at its right that framing keeps for the scalar bar
+
+
+def legend_margin(session: Session) -> float:
+    """How much of the viewport's width, at its right, the scalar bar takes (0 when none is shown)."""
+    shown = decoration_enabled(session, "scalar_bar") and _legend_component(session) is not None
+    return LEGEND_MARGIN if shown else 0.0
 
 
 def _legend_component(session: Session) -> Optional[Any]:
@@ -74,24 +83,32 @@ def _add_scalar_bar(plotter: Any, session: Session, comp: Any, title: str, colou
     ctf.ClampingOn()
     bar = vtk.vtkScalarBarActor()
     bar.SetLookupTable(ctf)
-    bar.SetTitle(str(title))
     bar.SetNumberOfLabels(5)
     bar.SetLabelFormat("%-#6.3g")
     bar.SetOrientationToVertical()          # at the right edge, as ParaView places it
-    width = max(int(plotter.window_size[0]), 1)
-    bar.SetPosition(min(0.82, 1.0 - (TITLE_CHAR_PX * len(title) + 12) / width), 0.15)  # the title starts at x
+    bar.SetPosition(0.84, 0.12)
     bar.SetWidth(0.12)
-    bar.SetHeight(0.7)
+    bar.SetHeight(0.72)
     bar.SetMaximumWidthInPixels(110)
     bar.SetBarRatio(0.25)
     bar.UnconstrainedFontSizeOn()
-    for text in (bar.GetTitleTextProperty(), bar.GetLabelTextProperty()):
+    label = bar.GetLabelTextProperty()
+    # the title is a text of its own, right-aligned above the bar: a long array name runs left, not off the window
+    heading = vtk.vtkTextActor()
+    heading.SetInput(str(title))
+    heading.GetPositionCoordinate().SetCoordinateSystemToNormalizedViewport()
+    heading.SetPosition(0.98, 0.86)
+    heading_text = heading.GetTextProperty()
+    heading_text.SetJustificationToRight()
+    heading_text.SetVerticalJustificationToBottom()
+    for text in (heading_text, label):
         text.SetColor(*colour)
         text.ShadowOff()
         text.ItalicOff()
         text.BoldOff()
         text.SetFontSize(12)
     plotter.add_actor(bar, name=SCALAR_BAR_NAME, reset_camera=False, render=False, pickable=False)
+    plotter.add_actor(heading, name=SCALAR_BAR_TITLE_NAME, reset_camera=False, render=False, pickable=False)
 
 
 def _array_title(comp: Any, datasets: dict[str, Any]) -> str:
@@ -121,8 +138,15 @@ def _readable(spec: str) -> str:
 
 def _remove_scalar_bar(plotter: Any) -> None:
     plotter.remove_actor(SCALAR_BAR_NAME, render=False)
+    plotter.remove_actor(SCALAR_BAR_TITLE_NAME, render=False)
 
 
 def scalar_bar_actor(plotter: Any) -> Optional[Any]:
     """The scalar bar ``apply_decorations`` added (None when off or when nothing has a transfer function)."""
     return plotter.renderer.actors.get(SCALAR_BAR_NAME)
+
+
+def scalar_bar_title(plotter: Any) -> Optional[str]:
+    """The scalar bar's title (the shown array's name), None without a scalar bar."""
+    heading = plotter.renderer.actors.get(SCALAR_BAR_TITLE_NAME)
+    return None if heading is None else str(heading.GetInput())

@@ -97,9 +97,9 @@ def view_direction(bounds: Bounds) -> tuple[tuple[float, float, float], tuple[fl
     return ISOMETRIC, (0.0, 0.0, 1.0)
 
 
-def frame_bounds(plotter: Any, bounds: Optional[Bounds], fill: float = FILL) -> None:
-    """Point the plotter's camera at ``bounds`` (from ``view_direction``) so they fill ``fill`` of the viewport;
-    with no bounds, VTK's own reset."""
+def frame_bounds(plotter: Any, bounds: Optional[Bounds], fill: float = FILL, right_margin: float = 0.0) -> None:
+    """Point the plotter's camera at ``bounds`` (from ``view_direction``) so they fill ``fill`` of the viewport
+    left of a ``right_margin`` share of its width (kept for the scalar bar); with no bounds, VTK's own reset."""
     camera = plotter.renderer.GetActiveCamera()
     if bounds is None:
         plotter.view_isometric()
@@ -108,10 +108,14 @@ def frame_bounds(plotter: Any, bounds: Optional[Bounds], fill: float = FILL) -> 
     width, height = plotter.window_size
     aspect = width / max(height, 1)
     view, up = view_direction(bounds)
-    centre, distance = framing_distance(bounds, view, up, camera.GetViewAngle(), aspect, fill)
+    centre, distance = framing_distance(bounds, view, up, camera.GetViewAngle(), aspect * (1.0 - right_margin), fill)
     direction = np.asarray(view) / np.linalg.norm(view)
-    camera.SetFocalPoint(*centre)
-    camera.SetPosition(*(centre + distance * direction))
+    right = np.cross(np.asarray(up, float), direction)
+    right /= np.linalg.norm(right)
+    # the data's centre moves left of the window's centre by half the margin: the camera moves right by that much
+    shift = right_margin * distance * np.tan(np.radians(camera.GetViewAngle()) / 2.0) * aspect
+    camera.SetFocalPoint(*(centre + shift * right))
+    camera.SetPosition(*(centre + shift * right + distance * direction))
     camera.SetViewUp(*up)
     if camera.GetParallelProjection():
         lo, hi = np.asarray(bounds[0::2]), np.asarray(bounds[1::2])
@@ -124,6 +128,6 @@ def frame_bounds(plotter: Any, bounds: Optional[Bounds], fill: float = FILL) -> 
     plotter.camera_set = True          # else PyVista re-frames its own props at the next render
 
 
-def frame_scene(plotter: Any, props: dict[str, Any], fill: float = FILL) -> None:
+def frame_scene(plotter: Any, props: dict[str, Any], fill: float = FILL, right_margin: float = 0.0) -> None:
     """Frame every visible component of a scene (``scene_bounds``)."""
-    frame_bounds(plotter, scene_bounds(props), fill)
+    frame_bounds(plotter, scene_bounds(props), fill, right_margin)

@@ -405,12 +405,14 @@ def install_scene(plotter: Any, session: Session, datasets: dict[str, Any], prep
             props[comp.id] = install_component(plotter, session, comp, datasets, prepared, spectrum, views)
     plotter.set_background(session.render.background)
     if session.camera is None:  # framed on every component before the view-dependent parts are drawn
+        from volviz.render.decorations import legend_margin
         from volviz.render.framing import frame_bounds, scene_bounds
 
         pt_props = {comp.id: _MeshBounds(mesh) for comp, mesh in pt_components}
         if prepared.nature is not None:
             pt_props["nature"] = _NatureBounds(prepared.nature)
-        frame_bounds(plotter, scene_bounds({**props, **pt_props, **{c.id: _LodBounds(d) for c, d in lod_components}}))
+        frame_bounds(plotter, scene_bounds({**props, **pt_props, **{c.id: _LodBounds(d) for c, d in lod_components}}),
+                     right_margin=legend_margin(session))
     else:
         apply_camera(plotter, session.camera)
     nature = install_nature(plotter, prepared.nature, views)
