@@ -123,6 +123,38 @@ def test_hard_cases(case):
     assert e[0] <= RMSE and e[1] <= MAX, e
 
 
+def test_clipping_plane_cuts_segments():
+    """A clipping plane through the middle of a box, keeping the half toward the camera: each ray's segment ends at
+    the plane, so the image equals the reference with the plane's depth along each pixel ray as its far limit. A box
+    crop around the whole mesh changes nothing."""
+    mesh = syn.box_tets(5, jitter=0.3)
+    size = (40, 32)
+    cam = Camera.orbit(mesh.points, 30, 20, 2.5)
+    normal = cam.position - cam.focal_point
+    rb = cam.rays(size)
+    px, py = np.meshgrid(np.arange(size[0]), np.arange(size[1]))
+    o = rb.o0 + px[..., None] * rb.ox + py[..., None] * rb.oy
+    d = rb.d0 + px[..., None] * rb.dx + py[..., None] * rb.dy
+    depth = ((np.asarray(cam.focal_point) - o) @ normal) / (d @ normal)     # the ray parameter t at the plane
+    ref = render(mesh, TF, cam, size, "reference", depth=depth)
+    full = render(mesh, TF, cam, size, "reference")
+    assert 0.05 < ref[..., 3].max() and np.abs(full - ref).max() > 0.1      # the plane cuts a visible part
+
+    pl = _plotter(size, cam)
+    vol = GLPTVolume(pl, mesh, TF)
+    vol.set_clip_planes([(normal, cam.focal_point)])
+    img = pl.screenshot(return_img=True)
+    vol.set_clip_planes(box=(-0.1, 1.1, -0.1, 1.1, -0.1, 1.1))
+    pl.ren_win.Render()
+    boxed = pl.screenshot(return_img=True)
+    vol.remove()
+    pl.close()
+    e = _err(img, ref[..., :3])
+    assert e[0] <= RMSE and e[1] <= MAX, e
+    e = _err(boxed, full[..., :3])
+    assert e[0] <= RMSE and e[1] <= MAX, e
+
+
 def test_opaque_sphere_inside_bluntfin(bluntfin):
     """An opaque sphere inside the fin: each ray's segments end at the sphere's depth (cells straddling it are
     integrated only up to it), then the volume is composited over the sphere. Expected: the reference clipped at the

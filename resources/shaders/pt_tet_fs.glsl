@@ -5,10 +5,10 @@
 //
 // The pixel ray O + t D (D . forward = 1, so t is the depth along the direction of projection) is rebuilt from
 // gl_FragCoord with the camera's affine ray basis, exactly as the CPU renderer's rays. The segment inside the cell
-// is the ray clipped against the cell's four face planes (n . x <= d inside), then against the near plane, the far
-// plane and the opaque scene's depth at this pixel. The scalar is affine in the cell, s(x) = g . x + c, clamped to
-// the cell's vertex range at both ends. The pre-integrated RGBA of (s_f, s_b, length) comes from the table; the
-// output is premultiplied, composited back to front with (ONE, ONE_MINUS_SRC_ALPHA).
+// is the ray clipped against the cell's four face planes (n . x <= d inside), the user's clipping planes, the near
+// plane, the far plane and the opaque scene's depth at this pixel. The scalar is affine in the cell,
+// s(x) = g . x + c, clamped to the cell's vertex range at both ends. The pre-integrated RGBA of (s_f, s_b, length)
+// comes from the table; the output is premultiplied, composited back to front with (ONE, ONE_MINUS_SRC_ALPHA).
 
 flat in vec4 cellPlane0;
 flat in vec4 cellPlane1;
@@ -28,6 +28,9 @@ uniform vec2 clipRange;
 uniform int parallelView;
 uniform int useDepth;
 uniform sampler2D opaqueDepth;
+
+uniform int clipCount;       // user clipping planes (n, d), n . x <= d kept, relative to the mesh centre
+uniform vec4 clipPlanes[8];
 
 uniform int lookupKind;      // 0: 3D table, 1: separable table
 uniform sampler3D ptTable;
@@ -111,6 +114,10 @@ void main()
   clipPlane(cellPlane1, o, d, t0, t1);
   clipPlane(cellPlane2, o, d, t0, t1);
   clipPlane(cellPlane3, o, d, t0, t1);
+  for (int i = 0; i < clipCount; ++i)
+  {
+    clipPlane(clipPlanes[i], o, d, t0, t1);
+  }
   if (!(t1 > t0))
   {
     discard;

@@ -28,7 +28,9 @@ How a frame is drawn:
   segment ends at the opaque depth of its pixel, so a cell straddling a surface is integrated only up to it. The
   shader writes depth 0, so GL's depth test never drops a fragment whose exit face lies behind the surface.
 
-Not handled yet: clipping planes and box crop, isosurfaces and pre-classification (the CPU ``pt`` has them), a
+Clipping planes and a box crop (``set_clip_planes``) cut each fragment's ray segment, as the near plane does.
+
+Not handled yet: isosurfaces and pre-classification (the CPU ``pt`` has them), a
 renderer that does not fill its window (the ray basis is built for the renderer's size with its origin at the
 framebuffer's corner: tested with full-window renderers only), depth peeling for other translucent props of the
 same renderer (the pass draws them in order). Call ``remove()`` before closing the plotter.
@@ -49,6 +51,7 @@ __all__ = ["GLPTVolume", "shader_source"]
 
 _PASS_MARK = "_volviz_gl_pt_pass"      # renderer attribute: the framebuffer pass installed on it
 _USERS = "_volviz_gl_pt_volumes"       # renderer attribute: the GLPTVolumes drawing in it
+_MAX_CLIP = 8                          # clipping planes the fragment shader takes
 _LOOKUPS = ("auto", "3d", "separable")
 
 
@@ -131,6 +134,7 @@ class GLPTVolume:
         self._table_tex: Any = None
         self._depth_tex: Any = None
         self._table_dirty = True
+        self._clip = np.zeros((0, 4))
         self.tf = tf
         self._vis = visible_cells(mesh, tf.scalars, tf.extinction)
 
@@ -288,6 +292,9 @@ class GLPTVolume:
         program.SetUniformf("viewHeight", float(h))
         program.SetUniform2f("clipRange", [float(x) for x in cam.clipping_range])
         program.SetUniformi("parallelView", int(cam.parallel))
+        program.SetUniformi("clipCount", len(self._clip))
+        if len(self._clip):
+            program.SetUniform4fv("clipPlanes", len(self._clip), [float(x) for x in self._clip.ravel()])
         depth = getattr(self.renderer, _PASS_MARK).GetDepthTexture()    # the opaque scene's (module docstring)
         depth.Activate()
         self._depth_tex = depth
@@ -314,6 +321,25 @@ class GLPTVolume:
         self._vis = visible_cells(self.mesh, tf.scalars, tf.extinction)
         self._table_dirty = True
         self._order_key = None
+
+    def set_clip_planes(self, planes: Any = (), box: Any = None) -> None:
+        """Clip the volume per fragment (the exact ray segment is cut, not the cells): ``planes`` is a sequence of
+        (normal, origin), each keeping the half-space its normal points into (VTK's convention for a mapper's
+        clipping planes); ``box`` (xmin, xmax, ymin, ymax, zmin, zmax) crops to an axis-aligned box. At most 8 in
+        all; no arguments removes them."""
+        rows = []
+        for normal, origin in planes:
+            n = np.asarray(normal, np.float64).reshape(3)
+            n = n / np.linalg.norm(n)
+            rows.append(np.append(-n, -n @ (np.asarray(origin, np.float64).reshape(3) - self.topo.origin)))
+        if box is not None:
+            b = np.asarray(box, np.float64).reshape(3, 2) - self.topo.origin[:, None]
+            for axis in range(3):
+                e = np.eye(3)[axis]
+                rows += [np.append(-e, -b[axis, 0]), np.append(e, b[axis, 1])]
+        if len(rows) > _MAX_CLIP:
+            raise ValueError(f"at most {_MAX_CLIP} clipping planes, got {len(rows)}")
+        self._clip = np.array(rows, np.float64).reshape(-1, 4)
 
     def remove(self) -> None:
         """Take the volume out of the renderer; the last GL PT volume of a renderer removes the float target (call
