@@ -26,7 +26,10 @@ How a frame is drawn:
 - Opaque geometry: when the mapper draws (translucent pass, after the opaque one), the framebuffer pass's depth
   texture holds the opaque scene (translucent props do not write depth); the shader reads it (texelFetch) and each
   segment ends at the opaque depth of its pixel, so a cell straddling a surface is integrated only up to it. The
-  shader writes depth 0, so GL's depth test never drops a fragment whose exit face lies behind the surface.
+  shader writes depth 0, so GL's depth test never drops a fragment whose exit face lies behind the surface. The
+  texture is sampled while attached to the framebuffer being drawn (with depth writes off), which llvmpipe handles;
+  GL calls such a read-while-attached a feedback loop, so check it on each hardware driver (copying the depth with
+  ``vtkTextureObject.CopyFromFrameBuffer`` into a texture of our own read zeros here).
 
 Clipping planes and a box crop (``set_clip_planes``) cut each fragment's ray segment, as the near plane does.
 
