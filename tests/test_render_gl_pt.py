@@ -155,6 +155,31 @@ def test_clipping_plane_cuts_segments():
     assert e[0] <= RMSE and e[1] <= MAX, e
 
 
+def test_prefetched_and_reused_orders():
+    """A background sort for the next camera is taken by the render for that camera (and gives the same image); with
+    reuse_order the last order is kept for a moved camera."""
+    mesh = syn.cavity_box(6)
+    size = (40, 32)
+    cams = [Camera.orbit(mesh.points, a, 20, 2.5) for a in (30, 60)]
+    pl = _plotter(size, cams[0])
+    vol = GLPTVolume(pl, mesh, TF)
+    pl.screenshot(return_img=True)
+    vol.prefetch(cams[1])
+    cams[1].apply_to(pl.renderer.GetActiveCamera())
+    pl.ren_win.Render()
+    img = pl.screenshot(return_img=True)
+    assert vol.stats["sort_prefetched"] and not vol.stats["order_reused"]
+    order = vol.order
+    vol.reuse_order = True
+    cams[0].apply_to(pl.renderer.GetActiveCamera())
+    pl.ren_win.Render()
+    assert vol.stats["order_reused"] and np.array_equal(vol.order, order)
+    vol.remove()
+    pl.close()
+    e = _err(img, render(mesh, TF, cams[1], size, "reference")[..., :3])
+    assert e[0] <= RMSE and e[1] <= MAX, e
+
+
 def test_opaque_sphere_inside_bluntfin(bluntfin):
     """An opaque sphere inside the fin: each ray's segments end at the sphere's depth (cells straddling it are
     integrated only up to it), then the volume is composited over the sphere. Expected: the reference clipped at the

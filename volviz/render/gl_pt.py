@@ -114,7 +114,9 @@ class GLPTVolume:
 
     ``lookup``: "3d" (default; n_s x n_s x n_l trilinear, ``table_size``), "separable" (degree ``degree``) or
     "auto" (as the CPU ``pt``). ``sort``/``nonconvex``: as ``visibility_order``. ``stats`` holds the last frame's
-    CPU-side timings (sort, index upload) and counts."""
+    CPU-side timings (sort, index upload) and counts. ``prefetch(camera)`` sorts for a known next camera in the
+    background; ``reuse_order = True`` keeps the last order for every camera (e.g. during a mouse drag: the image is
+    then exact per cell but may composite some overlapping cells in the wrong order)."""
 
     def __init__(self, plotter: Any, mesh: TetMesh, tf: Any, *, lookup: str = "3d", n_s: int | None = None,
                  n_l: int = 64, degree: int | None = None, sort: str = "mpvo", nonconvex: str = "auto") -> None:
@@ -131,7 +133,11 @@ class GLPTVolume:
         self.lookup, self.n_s, self.n_l, self.degree = lookup, n_s, n_l, degree
         self.sort, self.nonconvex = sort, nonconvex
         self.stats: dict[str, Any] = {}
-        self.order: np.ndarray | None = None
+        self.order: np.ndarray | None = None       # the drawn cells, back to front
+        self.reuse_order = False                    # keep the last order whatever the camera (during interaction)
+        self._sorted: np.ndarray | None = None      # the last full visibility order (all cells)
+        self._cycles = 0
+        self._prefetcher: Any = None
         self._order_key: Any = None
         self._table: Any = None
         self._table_tex: Any = None
@@ -208,27 +214,46 @@ class GLPTVolume:
         return Camera.from_pyvista(self.renderer.GetActiveCamera())
 
     def _on_start(self, *_: Any) -> None:
-        """Before each render: the back-to-front index buffer for this camera (unchanged cameras keep theirs)."""
+        """Before each render: the back-to-front index buffer for this camera (unchanged cameras keep theirs; a
+        prefetched order for this camera is taken; with ``reuse_order`` the last order is kept for any camera)."""
         from vtk.util.numpy_support import numpy_to_vtk
 
         from volviz.unstructured.sort import visibility_order
 
         cam = self._camera()
         size = tuple(int(v) for v in self.renderer.GetSize())
-        key = (tuple(cam.position), tuple(cam.focal_point), tuple(cam.view_up), cam.parallel, size)
+        key = (tuple(cam.position), tuple(cam.focal_point), tuple(cam.view_up), cam.view_angle, cam.parallel,
+               cam.parallel_scale, size)
         if key == self._order_key and self.order is not None:
             return
         t0 = time.perf_counter()
-        res = visibility_order(self.topo, cam, size, self.sort, self.nonconvex)
+        reused = self.reuse_order and self._sorted is not None
+        res = None if reused or self._prefetcher is None else self._prefetcher.take(cam, size)
+        prefetched = res is not None
+        if not reused:
+            res = res or visibility_order(self.topo, cam, size, self.sort, self.nonconvex)
+            self._sorted, self._cycles = res.order, int(res.cycles)
         t1 = time.perf_counter()
-        cells = res.order[self._vis[res.order]]
+        cells = self._sorted[self._vis[self._sorted]]
         offsets, conn = _triangles(cells)
         polys = self.polydata.GetPolys()
         polys.SetData(numpy_to_vtk(offsets, deep=True), numpy_to_vtk(conn, deep=True))
         self.polydata.Modified()
         self.order, self._order_key = cells, key
         self.stats = {"sort_s": t1 - t0, "order_s": time.perf_counter() - t1, "n_visible": int(len(cells)),
-                      "cycles": int(res.cycles)}
+                      "cycles": self._cycles, "sort_prefetched": prefetched, "order_reused": reused}
+
+    def prefetch(self, camera: Camera, size: tuple[int, int] | None = None) -> None:
+        """Sort for ``camera`` (the next frame's; ``size`` defaults to the renderer's) on a background worker, so
+        that the render for that camera skips the sort (``volviz.unstructured.prefetch``; another camera sorts as
+        usual)."""
+        from volviz.unstructured.prefetch import SortPrefetcher
+
+        if self._prefetcher is None:
+            self._prefetcher = SortPrefetcher(self.mesh, sort=self.sort, nonconvex=self.nonconvex)
+        if size is None:
+            size = tuple(int(v) for v in self.renderer.GetSize())
+        self._prefetcher.prefetch(camera, size)
 
     def _on_end(self, *_: Any) -> None:
         for tex in (self._table_tex, self._depth_tex):
@@ -347,6 +372,9 @@ class GLPTVolume:
     def remove(self) -> None:
         """Take the volume out of the renderer; the last GL PT volume of a renderer removes the float target (call
         it before closing the plotter: VTK complains when a framebuffer pass outlives its context's resources)."""
+        if self._prefetcher is not None:
+            self._prefetcher.close()
+            self._prefetcher = None
         for obj, tag in self._observers:
             obj.RemoveObserver(tag)
         self._observers = []
