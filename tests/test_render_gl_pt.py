@@ -168,12 +168,12 @@ def test_prefetched_and_reused_orders():
     cams[1].apply_to(pl.renderer.GetActiveCamera())
     pl.ren_win.Render()
     img = pl.screenshot(return_img=True)
-    assert vol.stats["sort_prefetched"] and not vol.stats["order_reused"]
+    assert vol.stats["sorted"] and vol.stats["sort_prefetched"] and not vol.stats["order_reused"]
     order = vol.order
     vol.reuse_order = True
     cams[0].apply_to(pl.renderer.GetActiveCamera())
     pl.ren_win.Render()
-    assert vol.stats["order_reused"] and np.array_equal(vol.order, order)
+    assert vol.stats["order_reused"] and not vol.stats["sorted"] and np.array_equal(vol.order, order)
     vol.remove()
     pl.close()
     e = _err(img, render(mesh, TF, cams[1], size, "reference")[..., :3])
@@ -242,8 +242,8 @@ def test_second_translucent_actor_keeps_its_pixels():
 
 
 def test_tf_edit_replaces_only_the_table():
-    """set_tf: the next render uses the new table (and the new zero-opacity culling); the vertex buffer's arrays are
-    not touched."""
+    """set_tf: the next render uses the new table and the new zero-opacity culling of the same order (no new sort);
+    the vertex buffer's arrays are not touched."""
     mesh = syn.box_tets(4, jitter=0.2)
     size = (48, 40)
     cam = Camera.orbit(mesh.points, 50, 30, 2.5)
@@ -257,6 +257,7 @@ def test_tf_edit_replaces_only_the_table():
     img = pl.screenshot(return_img=True)
     assert stamps == [vol.polydata.GetPointData().GetArray(i).GetMTime() for i in range(6)]
     assert vol.stats["n_visible"] < mesh.n_cells                    # rho = 0 below 0.6: inner cells culled
+    assert not vol.stats["sorted"]                                  # culled again, not sorted again
     vol.remove()
     pl.close()
     assert _err(first, render(mesh, TF, cam, size, "reference")[..., :3])[0] <= RMSE

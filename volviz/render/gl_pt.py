@@ -113,8 +113,9 @@ class GLPTVolume:
     """A TetMesh drawn by the GPU pre-integrated PT pass in a PyVista plotter's renderer (module docstring).
 
     ``lookup``: "3d" (default; n_s x n_s x n_l trilinear, ``table_size``), "separable" (degree ``degree``) or
-    "auto" (as the CPU ``pt``). ``sort``/``nonconvex``: as ``visibility_order``. ``stats`` holds the last frame's
-    CPU-side timings (sort, index upload) and counts. ``prefetch(camera)`` sorts for a known next camera in the
+    "auto" (as the CPU ``pt``). ``sort``/``nonconvex``: as ``visibility_order``. ``stats`` holds the last new index
+    buffer's CPU-side seconds (``sort_s``, ``order_s``), the number of cells drawn, and whether a new order was made
+    for the camera (``sorted``: here or by ``prefetch``), taken from ``prefetch`` or reused. ``prefetch(camera)`` sorts for a known next camera in the
     background; ``reuse_order = True`` keeps the last order for every camera (e.g. during a mouse drag: the image is
     then exact per cell but may composite some overlapping cells in the wrong order)."""
 
@@ -136,6 +137,7 @@ class GLPTVolume:
         self.order: np.ndarray | None = None       # the drawn cells, back to front
         self.reuse_order = False                    # keep the last order whatever the camera (during interaction)
         self._sorted: np.ndarray | None = None      # the last full visibility order (all cells)
+        self._recull = False                        # the TF changed: cull the last order again (no new sort)
         self._cycles = 0
         self._prefetcher: Any = None
         self._order_key: Any = None
@@ -224,15 +226,17 @@ class GLPTVolume:
         size = tuple(int(v) for v in self.renderer.GetSize())
         key = (tuple(cam.position), tuple(cam.focal_point), tuple(cam.view_up), cam.view_angle, cam.parallel,
                cam.parallel_scale, size)
-        if key == self._order_key and self.order is not None:
+        same = key == self._order_key and self._sorted is not None
+        if same and not self._recull:
             return
         t0 = time.perf_counter()
-        reused = self.reuse_order and self._sorted is not None
-        res = None if reused or self._prefetcher is None else self._prefetcher.take(cam, size)
+        reused = not same and self.reuse_order and self._sorted is not None
+        res = None if same or reused or self._prefetcher is None else self._prefetcher.take(cam, size)
         prefetched = res is not None
-        if not reused:
+        if not (same or reused):
             res = res or visibility_order(self.topo, cam, size, self.sort, self.nonconvex)
             self._sorted, self._cycles = res.order, int(res.cycles)
+        self._recull = False
         t1 = time.perf_counter()
         cells = self._sorted[self._vis[self._sorted]]
         offsets, conn = _triangles(cells)
@@ -241,7 +245,8 @@ class GLPTVolume:
         self.polydata.Modified()
         self.order, self._order_key = cells, key
         self.stats = {"sort_s": t1 - t0, "order_s": time.perf_counter() - t1, "n_visible": int(len(cells)),
-                      "cycles": self._cycles, "sort_prefetched": prefetched, "order_reused": reused}
+                      "cycles": self._cycles, "sorted": not (same or reused), "sort_prefetched": prefetched,
+                      "order_reused": reused}
 
     def prefetch(self, camera: Camera, size: tuple[int, int] | None = None) -> None:
         """Sort for ``camera`` (the next frame's; ``size`` defaults to the renderer's) on a background worker, so
@@ -344,11 +349,12 @@ class GLPTVolume:
     # --- public --------------------------------------------------------------------------------------------------
     def set_tf(self, tf: Any) -> None:
         """A new transfer function: the table texture is rebuilt at the next render and the zero-opacity culling
-        follows it (the vertex buffer stays)."""
+        follows it (a new index buffer from the same visibility order: the sort does not depend on the TF; the
+        vertex buffer stays)."""
         self.tf = tf
         self._vis = visible_cells(self.mesh, tf.scalars, tf.extinction)
         self._table_dirty = True
-        self._order_key = None
+        self._recull = True
 
     def set_clip_planes(self, planes: Any = (), box: Any = None) -> None:
         """Clip the volume per fragment (the exact ray segment is cut, not the cells): ``planes`` is a sequence of
