@@ -115,9 +115,10 @@ class GLPTVolume:
     ``lookup``: "3d" (default; n_s x n_s x n_l trilinear, ``table_size``), "separable" (degree ``degree``) or
     "auto" (as the CPU ``pt``). ``sort``/``nonconvex``: as ``visibility_order``. ``stats`` holds the last new index
     buffer's CPU-side seconds (``sort_s``, ``order_s``), the number of cells drawn, and whether a new order was made
-    for the camera (``sorted``: here or by ``prefetch``), taken from ``prefetch`` or reused. ``prefetch(camera)`` sorts for a known next camera in the
-    background; ``reuse_order = True`` keeps the last order for every camera (e.g. during a mouse drag: the image is
-    then exact per cell but may composite some overlapping cells in the wrong order)."""
+    for the camera (``sorted``: here or by ``prefetch``), taken from ``prefetch`` or reused. ``prefetch(camera)``
+    sorts for a known next camera in the background; ``reuse_order = True`` keeps the last order for every camera
+    (e.g. during a mouse drag: the image is then exact per cell but may composite some overlapping cells in the wrong
+    order)."""
 
     def __init__(self, plotter: Any, mesh: TetMesh, tf: Any, *, lookup: str = "3d", n_s: int | None = None,
                  n_l: int = 64, degree: int | None = None, sort: str = "mpvo", nonconvex: str = "auto") -> None:
