@@ -27,6 +27,7 @@ BENCHMARKS = {
     "nature": "the natural scene (terrain, fog, clouds): frame time and error along a flight",
     "iso": "multiple semi-transparent isosurfaces: compositing modes against the exact order",
     "isolation": "crash-isolated reading: isolated against in-process read time on every shared dataset",
+    "robustness": "fuzz campaign: mutated shared files through volviz's readers and VTK's, side by side",
 }
 #: commands whose arguments go, unread here, to their own parser (``volviz.regular.cli``, ``volviz.bench.NAME``)
 PASSED_ON = ("bench", "compress")

@@ -159,6 +159,10 @@ def read_dem(path: PathLike, vtk_compatible: bool = False) -> Image2D:
             span_rows = max(float(r) + len(p[4]) for r, p in zip(row_f, profiles))
         n_cols, n_rows = _grid_fits(path, float(col_f.max()) + 1.0, span_rows, size, "DEM profiles span")
         col_idx, row_idx = col_f.astype(np.int64), row_f.astype(np.int64)
+        if len(np.unique(col_idx)) < len(profiles):  # a resolution that does not fit the profiles' x positions
+            raise ReadError(path, f"DEM horizontal resolution {dx:g} puts {len(profiles)} profiles (x "
+                                  f"{xs.min():g} to {xs.max():g}) on {len(np.unique(col_idx))} columns: the header "
+                                  "does not match the profiles")
         grid = np.full((n_rows, n_cols), low, dtype=np.float64)
         for r, c, (_, _, _, _, values) in zip(row_idx, col_idx, profiles):
             grid[r:r + len(values), c] = values * (dz * elev)

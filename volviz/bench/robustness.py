@@ -1,0 +1,884 @@
+"""Benchmark: a standing fuzz campaign against every reader (``volviz bench robustness``).
+
+Every file in the shared data folder is mutated (bit flips; truncation at every header boundary; numeric header
+fields set to 0, -1, 2^31-1, 2^63-1, NaN and non-numbers, as text or as binary integers; XML attributes swapped,
+flipped and enlarged; HDF5 metadata damaged, byte-wise and through h5py) and each mutated file is read twice, side
+by side: by ``volviz.io.read`` (isolated as it is by default) and by VTK's own reader of the same format. Each side
+runs in a long-lived worker child with a memory limit, and the bench waits for each answer with a time limit, so a
+crash, an abort, a hang or a memory blow-up of either side is counted, not fatal (the worker is then replaced).
+
+Per format and side the report counts: cases, clean errors (volviz: ``ReadError``; VTK: an error message or an
+empty output), other exceptions, crashes, hangs, memory blow-ups, silent garbage (a read that succeeds although the
+truncated file lost data, or with a grid size other than the original's, or inconsistent / non-finite geometry)
+and the slowest refusal. Writes a section of ``docs/reliability.md`` (or ``--out FILE``) and optionally ``--json``.
+
+Targets (volviz issue 15), over at least 10,000 cases: 0 crashes or hangs of the volviz process, 0 exceptions other
+than volviz's own, 0 silent garbage, every refusal under 1 s. The mutations are also used by the tests
+(``tests/test_io_fuzz_readers.py``).
+"""
+from __future__ import annotations
+
+import json
+import os
+import platform
+import random
+import re
+import shlex
+import signal
+import struct
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+import zlib
+from collections import Counter, defaultdict
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable, Optional
+
+from volviz.argtypes import UsageParser, int_in
+
+DEFAULT_DATA = Path(os.environ.get("VOLVIZ_DATA", Path(__file__).resolve().parents[2].parent / "shared" / "data"))
+REPORT = Path(__file__).resolve().parents[2] / "docs" / "reliability.md"
+SECTION = "## Fuzz campaign"
+REFUSAL_TARGET_S = 1.0
+VTK_SECONDS = 5.0
+
+#: what a numeric header field is set to (text), and as a binary integer
+TEXT_VALUES = (b"0", b"-1", b"2147483647", b"9223372036854775807", b"nan", b"abc", b"-2147483648", b"4294967295",
+               b"1e308", b"")
+INT_VALUES = (0, -1, 2**31 - 1, 2**63 - 1, -2**31, 2**32 - 1)
+_NUMBER = re.compile(rb"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eEdD][-+]?\d+)?")
+_TAG = re.compile(rb"<[A-Za-z][^<>]{0,4000}>")
+_ATTR = re.compile(rb'([A-Za-z_]+)="([^"]{0,4000})"')
+_ALTERNATIVES = {b"LittleEndian": b"BigEndian", b"BigEndian": b"LittleEndian", b"UInt32": b"UInt64",
+                 b"UInt64": b"UInt32", b"binary": b"ascii", b"ascii": b"appended", b"appended": b"binary",
+                 b"Float32": b"Float64", b"Float64": b"Int8", b"Int64": b"Int32", b"Int32": b"UInt8",
+                 b"UInt8": b"Float64", b"vtkZLibDataCompressor": b"vtkLZ4DataCompressor"}
+
+
+# -- the files ---------------------------------------------------------------------------------------------------------
+@dataclass
+class Source:
+    """One file of the data folder to mutate, and how both sides read it.
+
+    ``target`` is the file read (the mutated file itself, or the descriptor beside it: a .mhd for its .raw, the
+    ``case.foam`` of an OpenFOAM case, the PLOT3D grid for its solution); ``links`` are the unchanged files put
+    beside the mutated one (symbolic links); ``layout`` is how its header looks ("text", "xml", "binary", "hdf5",
+    "none"); ``endian`` the byte order of binary header fields; ``vtk`` the name of VTK's reader recipe (None: VTK
+    has no reader of the format)."""
+
+    fmt: str
+    path: Path
+    root: Path
+    target: str
+    links: dict[str, Path] = field(default_factory=dict)
+    options: dict = field(default_factory=dict)
+    vtk_options: dict = field(default_factory=dict)
+    layout: str = "text"
+    endian: str = ">"
+    vtk: Optional[str] = None
+    header_end: int = 0
+
+    @property
+    def name(self) -> str:
+        return str(self.path.relative_to(self.root))
+
+
+#: format label, VTK recipe, header layout, binary byte order, by file-name pattern
+_KINDS = (
+    ("*.pvm*", "pvm", None, "text", ">"), ("*.slc", "slc", "slc", "text", ">"), ("*.pgm", "pnm", "pnm", "text", ">"),
+    ("*.ppm", "pnm", "pnm", "text", ">"), ("*.mhd", "metaimage", "mhd", "text", ">"),
+    ("*.raw", "metaimage", "mhd", "none", ">"), ("*.dem", "dem", "dem", "text", ">"),
+    ("*xyz.bin", "plot3d", "plot3d", "binary", ">"), ("*q.bin", "plot3d", "plot3d", "binary", ">"),
+    ("*.vtk", "vtk-legacy", "vtk-legacy", "text", ">"), ("*.vti", "vti", "vti", "xml", "<"),
+    ("*.vtu", "vtu", "vtu", "xml", "<"), ("*.vtkhdf", "vtkhdf", "vtkhdf", "hdf5", "<"),
+    ("*.jpeg", "jpeg", "jpeg", "binary", ">"), ("*.ex2", "exodus", "exodus", "binary", ">"),
+    ("*.cgns", "cgns", "cgns", "binary", ">"), ("*.nc", "netcdf", "netcdf", "binary", ">"),
+    ("quarter.*", "raw", "raw", "none", "<"),
+)
+
+
+def _header_end(data: bytes, layout: str) -> int:
+    """Bytes at the start holding the header: the printable prefix of a text file (at most 4 KB, the DEM's first
+    records included), the first KB of a binary one, the tags of an XML file up to 64 KB."""
+    if layout == "none":
+        return 0
+    if layout in ("binary", "hdf5"):
+        return min(len(data), 1024)
+    limit = 65536 if layout == "xml" else 4096
+    for i, byte in enumerate(data[:limit]):
+        if byte >= 127 or (byte < 32 and byte not in (9, 10, 13)):
+            return i
+    return min(len(data), limit)
+
+
+def sources(root: Path) -> list[Source]:
+    """Every file under ``root`` as a Source (OpenFOAM case files are read through their ``case.foam``)."""
+    import fnmatch
+
+    found: list[Source] = []
+    for folder, dirs, files in os.walk(root):
+        dirs.sort()
+        here = Path(folder)
+        foam = next((p / "case.foam" for p in [here, *here.parents] if (p / "case.foam").exists()), None)
+        for name in sorted(files):
+            path = here / name
+            if foam is not None:
+                if name != "case.foam":
+                    found.append(Source("openfoam", path, root, "", layout="text", vtk="openfoam"))
+                continue
+            kind = next((k for k in _KINDS if fnmatch.fnmatch(name.lower(), k[0])), None)
+            if kind is None:
+                continue
+            src = Source(kind[1], path, root, name, layout=kind[3], endian=kind[4], vtk=kind[2])
+            _complete(src)
+            found.append(src)
+    for src in found:
+        src.header_end = _header_end(src.path.read_bytes()[:65536], src.layout)
+    return found
+
+
+def _complete(src: Source) -> None:
+    """The companions and options of the formats read as pairs or with options."""
+    folder, name = src.path.parent, src.path.name
+    if src.fmt == "metaimage" and name.endswith(".raw"):
+        src.target = name[:-4] + ".mhd"
+        src.links[src.target] = folder / src.target
+    elif src.fmt == "metaimage":
+        raw = re.search(rb"ElementDataFile\s*=\s*(\S+)", src.path.read_bytes())
+        if raw:
+            src.links[raw.group(1).decode()] = folder / raw.group(1).decode()
+    elif src.fmt == "plot3d":
+        grid, q = name.replace("q.bin", "xyz.bin"), name.replace("xyz.bin", "q.bin")
+        src.links.update({n: folder / n for n in (grid, q) if n != name})
+        src.target = grid
+        src.options = {"q": q}
+    elif src.fmt == "raw":
+        src.options = {"dims": [64, 64, 1], "dtype": "uint16", "byteorder": "little"}
+
+
+# -- mutations ---------------------------------------------------------------------------------------------------------
+@dataclass
+class Mutation:
+    """A change to one file: ``kind`` (bitflip, truncate, field, xml-swap, xml-flip, xml-enlarge, hdf5-meta,
+    hdf5-field), what it did in words, and the new bytes (None for hdf5-field, applied to the written file)."""
+
+    kind: str
+    detail: str
+    data: Optional[bytes]
+    edit: Optional[Callable[[Path], None]] = None
+
+
+def number_spans(data: bytes, end: int) -> list[tuple[int, int]]:
+    """(start, stop) of every number in the first ``end`` bytes."""
+    return [m.span() for m in _NUMBER.finditer(data, 0, end)]
+
+
+def xml_attributes(data: bytes) -> list[tuple[int, int]]:
+    """(start, stop) of every attribute value of every XML tag (appended raw data excluded)."""
+    stop = data.find(b"<AppendedData")
+    spans = []
+    for tag in _TAG.finditer(data, 0, len(data) if stop < 0 else stop + 200):
+        for m in _ATTR.finditer(data, tag.start(), tag.end()):
+            spans.append(m.span(2))
+    return spans
+
+
+def boundaries(src: Source, data: bytes) -> list[int]:
+    """Where a header ends a part: after each line, tag, word (text and XML headers), 4-byte field (binary headers),
+    record (DEM: 1024 bytes); plus the header's end, the middle and one byte short of the whole file."""
+    end = max(src.header_end, 0)
+    cuts: set[int] = {0, end, len(data) // 2, len(data) - 1}
+    if src.layout in ("text", "xml"):
+        cuts.update(m.end() for m in re.finditer(rb"[\n> ]", data[:end]))
+    elif src.layout in ("binary", "hdf5"):
+        cuts.update(range(0, min(end, 256), 4))
+    if src.fmt == "dem":
+        cuts.update(range(1024, min(len(data), 16384), 1024))
+    if src.layout == "xml":
+        for start, stop in xml_attributes(data)[:200]:
+            cuts.update((start, stop))
+    return sorted(c for c in cuts if 0 <= c < len(data))
+
+
+def flip_bits(data: bytes, rng: random.Random, end: int) -> Mutation:
+    out = bytearray(data)
+    where = []
+    for _ in range(rng.randint(1, 8)):
+        pos = rng.randrange(end) if end and rng.random() < 0.6 else rng.randrange(len(out))
+        out[pos] ^= 1 << rng.randrange(8)
+        where.append(pos)
+    return Mutation("bitflip", f"bits flipped at {sorted(where)}", bytes(out))
+
+
+def truncate(data: bytes, at: int) -> Mutation:
+    return Mutation("truncate", f"cut at byte {at} of {len(data)}", data[:at])
+
+
+def set_field(src: Source, data: bytes, rng: random.Random, index: int | None = None,
+              value: Any = None) -> Optional[Mutation]:
+    """A numeric header field set to one of the values (text headers), or a 4/8-byte integer or a NaN double
+    written over a field of a binary header."""
+    if src.layout in ("binary", "hdf5"):
+        end = max(4, min(src.header_end, len(data)) - 8)
+        pos = (rng.randrange(end) // 4) * 4 if index is None else index
+        value = rng.choice((*INT_VALUES, "nan")) if value is None else value
+        if value == "nan":
+            raw = struct.pack(src.endian + "d", float("nan"))
+        elif -2**31 <= value < 2**32 and rng.random() < 0.7:
+            raw = struct.pack(src.endian + ("i" if value < 2**31 else "I"), value)
+        else:
+            raw = struct.pack(src.endian + ("q" if value < 2**63 else "Q"), value)
+        out = data[:pos] + raw + data[pos + len(raw):]
+        return Mutation("field", f"binary field at byte {pos} set to {value}", out)
+    spans = number_spans(data, src.header_end) if src.layout == "text" else [
+        s for a in xml_attributes(data) for s in ((a[0] + m.start(), a[0] + m.end())
+                                                   for m in _NUMBER.finditer(data[a[0]:a[1]]))]
+    if not spans:
+        return None
+    start, stop = spans[rng.randrange(len(spans)) if index is None else index % len(spans)]
+    new = rng.choice(TEXT_VALUES) if value is None else value
+    return Mutation("field", f"field {data[start:stop][:20]!r} at byte {start} set to {new!r}",
+                    data[:start] + new + data[stop:])
+
+
+def xml_mutation(data: bytes, rng: random.Random, kind: str) -> Optional[Mutation]:
+    """``xml-swap``: two attribute values exchanged; ``xml-flip``: a value's words reversed or a keyword replaced
+    by another (byte order, header type, format, data type); ``xml-enlarge``: a number multiplied by up to 2^31,
+    raised by one, or a value repeated thousands of times."""
+    spans = xml_attributes(data)
+    if len(spans) < 2:
+        return None
+    a = spans[rng.randrange(len(spans))]
+    old = data[a[0]:a[1]]
+    if kind == "xml-swap":
+        b = spans[rng.randrange(len(spans))]
+        (a, b) = sorted((a, b))
+        if a == b or a[1] > b[0]:
+            return None
+        new = data[:a[0]] + data[b[0]:b[1]] + data[a[1]:b[0]] + old + data[b[1]:]
+        return Mutation(kind, f"attribute values {old[:20]!r} and {data[b[0]:b[1]][:20]!r} swapped", new)
+    if kind == "xml-flip":
+        value = _ALTERNATIVES.get(old) or b" ".join(reversed(old.split())) or b"-"
+    else:
+        numbers = list(_NUMBER.finditer(old))
+        how = rng.random()
+        if numbers and how < 0.7:
+            m = numbers[rng.randrange(len(numbers))]
+            factor = rng.choice((2, 1000, 2**20, 2**31))
+            try:
+                big = str(int(m.group()) * factor + rng.choice((0, 1))).encode()
+            except ValueError:
+                big = m.group() + b"e300"
+            value = old[:m.start()] + big + old[m.end():]
+        else:
+            value = (old + b" ") * rng.choice((2, 1000, 20000))
+    return Mutation(kind, f"attribute {old[:20]!r} -> {value[:20]!r} ({len(value)} bytes)",
+                    data[:a[0]] + value + data[a[1]:])
+
+
+def hdf5_object_addresses(path: Path) -> list[int]:
+    """File addresses of the object headers of every group and dataset of an HDF5 file (its metadata)."""
+    import h5py
+
+    found: list[int] = [0]
+    with h5py.File(path, "r") as f:
+        def visit(_name: str, obj: Any) -> None:
+            found.append(h5py.h5o.get_info(obj.id).addr)
+        f.visititems(visit)
+    return sorted(set(found))
+
+
+def hdf5_meta(data: bytes, addresses: list[int], rng: random.Random) -> Mutation:
+    """Bytes of the superblock or an object header overwritten (a flipped bit, a zero, 0xFF, a large count)."""
+    out = bytearray(data)
+    base = rng.choice(addresses)
+    pos = min(len(out) - 8, base + rng.randrange(96))
+    how = rng.randrange(4)
+    if how == 0:
+        out[pos] ^= 1 << rng.randrange(8)
+    elif how == 1:
+        out[pos:pos + 4] = b"\0\0\0\0"
+    elif how == 2:
+        out[pos:pos + 4] = b"\xff\xff\xff\xff"
+    else:
+        out[pos:pos + 8] = struct.pack("<q", rng.choice(INT_VALUES[1:4]))
+    return Mutation("hdf5-meta", f"object header at {base}: byte {pos} damaged ({how})", bytes(out))
+
+
+def hdf5_field(path: Path, rng: random.Random) -> Mutation:
+    """A value of one of the VTKHDF count/offset/extent datasets or attributes set through h5py (0, -1, 2^31-1,
+    2^63-1, NaN) -- a file whose HDF5 structure is intact and whose VTKHDF content lies."""
+    import h5py
+    import numpy as np
+
+    with h5py.File(path, "r") as f:
+        names: list[str] = []
+        f.visititems(lambda n, o: names.append(n) if isinstance(o, h5py.Dataset) and o.size and o.dtype.kind in "iuf"
+                     and o.ndim <= 2 else None)
+        attrs = [(n, a) for n in ["", *names] for a in (f[n] if n else f).attrs
+                 if np.asarray((f[n] if n else f).attrs[a]).dtype.kind in "iuf"]
+    choice = rng.random()
+    value = rng.choice((*INT_VALUES[:4], "nan"))
+    if attrs and choice < 0.25:
+        obj, attr = rng.choice(attrs)
+
+        def edit(p: Path) -> None:
+            with h5py.File(p, "r+") as f:
+                target = f[obj] if obj else f
+                old = np.array(target.attrs[attr])
+                flat = old.reshape(-1).copy()
+                flat[rng.randrange(flat.size)] = _cast(value, flat.dtype)
+                target.attrs[attr] = flat.reshape(old.shape)
+        return Mutation("hdf5-field", f"attribute {obj}/{attr} element set to {value}", None, edit)
+    name = rng.choice([n for n in names if re.search(r"Number|Offset|Types|Steps|Parts|Connectivity", n)] or names)
+
+    def edit(p: Path) -> None:
+        with h5py.File(p, "r+") as f:
+            ds = f[name]
+            idx = tuple(rng.randrange(s) for s in ds.shape)
+            ds[idx] = _cast(value, ds.dtype)
+    return Mutation("hdf5-field", f"dataset {name} element set to {value}", None, edit)
+
+
+def _cast(value: Any, dtype: Any) -> Any:
+    import numpy as np
+
+    dtype = np.dtype(dtype)
+    if value == "nan":
+        return np.nan if dtype.kind == "f" else np.iinfo(dtype).max
+    if dtype.kind == "f":
+        return float(value)
+    info = np.iinfo(dtype)
+    return np.array(value).astype(np.int64 if value < 2**63 else np.uint64).astype(dtype) \
+        if not info.min <= value <= info.max else value
+
+
+RANDOM_KINDS = {"text": ("bitflip", "field", "field", "truncate"), "none": ("bitflip", "truncate"),
+                "binary": ("bitflip", "field", "truncate"), "xml": ("bitflip", "field", "xml-swap", "xml-flip",
+                                                                    "xml-enlarge", "truncate"),
+                "hdf5": ("bitflip", "hdf5-meta", "hdf5-meta", "hdf5-field", "hdf5-field", "truncate")}
+
+
+def random_mutation(src: Source, data: bytes, rng: random.Random, addresses: list[int] | None = None,
+                    kind: str | None = None) -> Mutation:
+    """One random mutation of the kinds that fit the file's layout (a bit flip where a kind does not apply)."""
+    kind = kind or rng.choice(RANDOM_KINDS[src.layout])
+    found: Optional[Mutation] = None
+    if kind == "truncate":
+        cuts = boundaries(src, data)
+        found = truncate(data, rng.choice(cuts) if rng.random() < 0.7 else rng.randrange(len(data)))
+    elif kind == "field":
+        found = set_field(src, data, rng)
+    elif kind.startswith("xml"):
+        found = xml_mutation(data, rng, kind)
+    elif kind == "hdf5-meta":
+        found = hdf5_meta(data, addresses or [0], rng)
+    elif kind == "hdf5-field":
+        found = hdf5_field(src.path, rng)
+    return found or flip_bits(data, rng, src.header_end)
+
+
+def systematic(src: Source, data: bytes) -> list[Mutation]:
+    """Truncation at every header boundary and every text header field set to every value (the first 40 fields)."""
+    found = [truncate(data, at) for at in boundaries(src, data)]
+    if src.layout == "text":
+        rng = random.Random(0)
+        for i in range(min(40, len(number_spans(data, src.header_end)))):
+            found += [m for v in TEXT_VALUES if (m := set_field(src, data, rng, i, v)) is not None]
+    return found
+
+
+def cases(srcs: list[Source], total: int, seed: int) -> list[tuple[Source, Mutation]]:
+    """``total`` cases spread evenly over the formats (round-robin), within a format over its files; each file's
+    systematic mutations first, then random ones."""
+    by_fmt: dict[str, list[Source]] = defaultdict(list)
+    for s in srcs:
+        by_fmt[s.fmt].append(s)
+    per_fmt = {f: total // len(by_fmt) + (i < total % len(by_fmt)) for i, f in enumerate(sorted(by_fmt))}
+    out: list[tuple[Source, Mutation]] = []
+    for fmt, count in per_fmt.items():
+        files = by_fmt[fmt]
+        shares = [count // len(files) + (i < count % len(files)) for i in range(len(files))]
+        for src, share in zip(files, shares):
+            if share == 0:
+                continue
+            data = src.path.read_bytes()
+            rng = random.Random(f"{seed}:{src.name}")
+            fixed = systematic(src, data)
+            rng.shuffle(fixed)
+            chosen = fixed[: share // 2]
+            addresses = hdf5_object_addresses(src.path) if src.layout == "hdf5" else None
+            while len(chosen) < share:
+                chosen.append(random_mutation(src, data, rng, addresses))
+            out += [(src, m) for m in chosen]
+    random.Random(seed).shuffle(out)
+    return out
+
+
+# -- the two sides: workers --------------------------------------------------------------------------------------------
+def fingerprint_volviz(dataset: Any) -> dict:
+    """Grid size, a CRC of every array, and whether the dataset is consistent: it survives the isolation codec's
+    checks (shapes, dtypes, indices) and its spacing and origin are finite."""
+    import math
+
+    import numpy as np
+
+    from volviz.io.isolated.codec import CodecError, decode, encode
+
+    frames = [dataset.frame(i) for i in frames_to_read(len(dataset))] \
+        if getattr(dataset, "kind", "") == "time series" else [dataset]
+    problem, crc, n = "", 0, 0
+    for frame in frames:
+        try:
+            header, arrays = encode(frame)
+            decode(header, arrays)
+        except (CodecError, ValueError, TypeError) as exc:
+            problem, arrays = f"inconsistent: {exc}", []
+        for name in ("spacing", "origin"):
+            values = getattr(frame, name, None)
+            if values is not None and not all(math.isfinite(float(v)) for v in values):
+                problem = f"{name} {tuple(values)} is not finite"
+        for a in arrays:
+            crc = zlib.crc32(np.ascontiguousarray(a).tobytes(), crc)
+        n += int(getattr(frame, "n_points", 0))
+    return {"n_points": n, "crc": crc, "problem": problem}
+
+
+def frames_to_read(count: int) -> list[int]:
+    """The frames of a time series a case reads: all of up to 30, else the first two and the last."""
+    return list(range(count)) if count <= 30 else [0, 1, count - 1]
+
+
+#: VTK's reader of each format: (module, class); imported alone, so a replaced worker starts quickly
+VTK_READERS = {"slc": ("vtkIOImage", "vtkSLCReader"), "pnm": ("vtkIOImage", "vtkPNMReader"),
+               "mhd": ("vtkIOImage", "vtkMetaImageReader"), "dem": ("vtkIOImage", "vtkDEMReader"),
+               "jpeg": ("vtkIOImage", "vtkJPEGReader"), "raw": ("vtkIOImage", "vtkImageReader2"),
+               "vtk-legacy": ("vtkIOLegacy", "vtkDataSetReader"), "vti": ("vtkIOXML", "vtkXMLImageDataReader"),
+               "vtu": ("vtkIOXML", "vtkXMLUnstructuredGridReader"), "vtkhdf": ("vtkIOHDF", "vtkHDFReader"),
+               "exodus": ("vtkIOExodus", "vtkExodusIIReader"), "cgns": ("vtkIOCGNSReader", "vtkCGNSReader"),
+               "netcdf": ("vtkIONetCDF", "vtkNetCDFCFReader"), "plot3d": ("vtkIOParallel", "vtkMultiBlockPLOT3DReader"),
+               "openfoam": ("vtkIOGeometry", "vtkOpenFOAMReader")}
+
+
+def _vtk_reader(recipe: str, path: str, options: dict) -> Any:
+    import importlib
+
+    module, name = VTK_READERS[recipe]
+    r = getattr(importlib.import_module(f"vtkmodules.{module}"), name)()
+    folder = os.path.dirname(path)
+    if recipe == "plot3d":
+        r.SetXYZFileName(path)
+        r.SetQFileName(os.path.join(folder, options["q"]))
+        r.AutoDetectFormatOn()
+        return r
+    r.SetFileName(path)
+    if recipe == "raw":
+        r.SetDataScalarTypeToUnsignedShort()
+        r.SetDataByteOrderToLittleEndian()
+        r.SetDataExtent(0, 63, 0, 63, 0, 0)
+    return r
+
+
+def fingerprint_vtk(output: Any) -> dict:
+    """Points of every leaf of VTK's output and a CRC of the arrays (coordinates, point and cell data)."""
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    from vtkmodules.vtkCommonDataModel import vtkDataSet
+
+    leaves = []
+    if output.IsA("vtkCompositeDataSet"):
+        it = output.NewIterator()
+        it.InitTraversal()
+        while not it.IsDoneWithTraversal():
+            leaves.append(it.GetCurrentDataObject())
+            it.GoToNextItem()
+    else:
+        leaves = [output]
+    n, crc = 0, 0
+    for leaf in leaves:
+        if not isinstance(leaf, vtkDataSet):
+            continue
+        n += leaf.GetNumberOfPoints()
+        arrays = [leaf.GetPoints().GetData()] if hasattr(leaf, "GetPoints") and leaf.GetPoints() else []
+        for data in (leaf.GetPointData(), leaf.GetCellData()):
+            arrays += [data.GetArray(i) for i in range(data.GetNumberOfArrays())]
+        for a in arrays:
+            if a is not None:
+                crc = zlib.crc32(vtk_to_numpy(a).tobytes(), crc)
+    return {"n_points": n, "crc": crc, "problem": ""}
+
+
+def _serve_volviz(request: dict) -> dict:
+    import warnings
+
+    import volviz.io as vio
+    from volviz.io import isolated
+
+    options = dict(request["options"])
+    if "q" in options:
+        options["q"] = os.path.join(os.path.dirname(request["path"]), options["q"])
+    if "dims" in options:
+        options["dims"] = tuple(options["dims"])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            result = vio.read(request["path"], **options)
+            return {"status": "ok", **fingerprint_volviz(result)}
+        except vio.ReadError as exc:  # naming the file read or the file beside it that is wrong
+            return {"status": "error", "message": str(exc)[:300],
+                    "named": str(exc).startswith(os.path.dirname(request["path"]))}
+        finally:
+            isolated.prewarm()  # a reader child that crashed is replaced now, not in the next case's time
+
+
+def _serve_vtk(request: dict) -> dict:
+    from vtkmodules.vtkCommonCore import vtkOutputWindow, vtkStringOutputWindow
+    from vtkmodules.vtkCommonExecutionModel import vtkStreamingDemandDrivenPipeline
+
+    window = vtkStringOutputWindow()
+    vtkOutputWindow.SetInstance(window)
+    reader = _vtk_reader(request["recipe"], request["path"], request["options"])
+    errors: list[str] = []
+    reader.AddObserver("ErrorEvent", lambda *_: errors.append("error"))
+    reader.UpdateInformation()
+    steps = reader.GetOutputInformation(0).Get(vtkStreamingDemandDrivenPipeline.TIME_STEPS()) or [None]
+    found = {"n_points": 0, "crc": 0, "problem": ""}
+    for i in frames_to_read(len(steps)):
+        reader.UpdateTimeStep(steps[i]) if steps[i] is not None else reader.Update()
+        output = reader.GetOutputDataObject(0)
+        if output is not None:
+            part = fingerprint_vtk(output)
+            found = {"n_points": found["n_points"] + part["n_points"], "crc": zlib.crc32(str(part["crc"]).encode(),
+                                                                                         found["crc"]), "problem": ""}
+    text = window.GetOutput() or ""
+    if errors or "ERROR" in text or found["n_points"] == 0:
+        return {"status": "error", "message": (text.strip().splitlines() or ["empty output"])[-1][:300],
+                "named": True}
+    return {"status": "ok", **found}
+
+
+def worker(side: str) -> None:
+    """A worker child: one JSON request per line on stdin, one JSON answer per line on the protocol descriptor
+    (stdout is pointed at stderr so that readers printing cannot break the protocol)."""
+    out = os.fdopen(os.dup(1), "w", buffering=1)
+    os.dup2(2, 1)
+    serve = _serve_volviz if side == "volviz" else _serve_vtk
+    for line in sys.stdin:
+        request = json.loads(line)
+        t0 = time.perf_counter()
+        try:
+            answer = serve(request)
+        except MemoryError:
+            answer = {"status": "memory", "message": "MemoryError"}
+        except Exception as exc:  # counted: the point of the bench
+            answer = {"status": "exception", "message": f"{type(exc).__name__}: {exc}"[:300]}
+        answer["seconds"] = time.perf_counter() - t0
+        out.write(json.dumps(answer) + "\n")
+
+
+class Worker:
+    """The parent's end of a worker child with a memory limit; a request that outlives ``seconds`` kills it."""
+
+    def __init__(self, side: str, memory: int, seconds: float, folder: Path) -> None:
+        self.side, self.memory, self.seconds = side, memory, seconds
+        self.log = folder / f"{side}-stderr.log"
+        self.proc: Optional[subprocess.Popen] = None
+        self.restarts = 0
+
+    def _start(self) -> subprocess.Popen:
+        import resource
+
+        def limit() -> None:
+            resource.setrlimit(resource.RLIMIT_AS, (self.memory, resource.RLIM_INFINITY))
+
+        env = dict(os.environ, VOLVIZ_READ_SECONDS="10", PYTHONUNBUFFERED="1")
+        with open(self.log, "ab") as err:
+            return subprocess.Popen([sys.executable, "-m", "volviz.bench.robustness", "--worker", self.side],
+                                    stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=err,
+                                    preexec_fn=limit, env=env, text=True)
+
+    def ask(self, request: dict) -> dict:
+        if self.proc is None or self.proc.poll() is not None:
+            self.proc = self._start()
+            self.restarts += 1
+        os.truncate(self.log, 0)
+        box: list[str] = []
+        t0 = time.perf_counter()
+        try:
+            self.proc.stdin.write(json.dumps(request) + "\n")
+            self.proc.stdin.flush()
+        except OSError:
+            pass
+        reader = threading.Thread(target=lambda: box.append(self.proc.stdout.readline()), daemon=True)
+        reader.start()
+        reader.join(self.seconds)
+        elapsed = time.perf_counter() - t0
+        if reader.is_alive():
+            self.kill()
+            reader.join()
+            return {"status": "hang", "seconds": elapsed, "message": f"no answer within {self.seconds:.0f} s"}
+        if box and box[0]:
+            return json.loads(box[0])
+        code = self.proc.wait()
+        tail = self.log.read_bytes()[-4000:].decode("utf-8", "replace")
+        self.proc = None
+        if "bad_alloc" in tail or code == -signal.SIGKILL or "MemoryError" in tail:
+            return {"status": "memory", "seconds": elapsed, "message": f"exit {code}: out of memory"}
+        name = signal.Signals(-code).name if code < 0 else f"exit {code}"
+        return {"status": "crash", "seconds": elapsed, "message": f"{name}: {tail.strip()[-200:]}"}
+
+    def kill(self) -> None:
+        if self.proc is not None:
+            self.proc.kill()
+            self.proc.wait()
+            self.proc = None
+
+    def close(self) -> None:
+        if self.proc is not None and self.proc.poll() is None:
+            self.proc.stdin.close()
+            self.proc.wait(timeout=30)
+        self.proc = None
+
+
+# -- the campaign ------------------------------------------------------------------------------------------------------
+def prepare_folder(src: Source, base: Path, index: int) -> Path:
+    """A folder holding the file to mutate's companions (symbolic links); for OpenFOAM a mirror of the case."""
+    folder = base / f"s{index}"
+    if folder.exists():
+        return folder
+    if src.fmt == "openfoam":
+        case = next(p for p in src.path.parents if (p / "case.foam").exists())
+        for f in case.rglob("*"):
+            if f.is_file():
+                (folder / f.relative_to(case)).parent.mkdir(parents=True, exist_ok=True)
+                (folder / f.relative_to(case)).symlink_to(f)
+        src.target = "case.foam"
+        src.links = {}
+        return folder
+    folder.mkdir(parents=True)
+    for name, path in src.links.items():
+        (folder / name).symlink_to(path)
+    return folder
+
+
+def mutated_path(src: Source, folder: Path) -> Path:
+    if src.fmt == "openfoam":
+        case = next(p for p in src.path.parents if (p / "case.foam").exists())
+        return folder / src.path.relative_to(case)
+    return folder / src.path.name
+
+
+def _judge(answer: dict, original: Optional[dict], mutation: Mutation) -> str:
+    """The outcome of one read: clean, exception, crash, hang, memory, garbage or accepted."""
+    status = answer["status"]
+    if status == "error":
+        return "clean" if answer.get("named", True) else "exception"
+    if status != "ok":
+        return status
+    if answer.get("problem"):
+        return "garbage"
+    if original is None:
+        return "accepted"
+    same = (answer["n_points"], answer["crc"]) == (original["n_points"], original["crc"])
+    if mutation.kind == "truncate" and not same:
+        return "garbage"  # the file lost bytes and the reader made up the rest
+    if answer["n_points"] != original["n_points"]:
+        return "garbage"  # a changed size was accepted though the data did not change with it
+    return "accepted"
+
+
+OUTCOMES = ("clean", "exception", "crash", "hang", "memory", "garbage", "accepted")
+
+
+def run(data: Path, total: int, seed: int, formats: list[str] | None, minutes: float = 0.0,
+        progress: bool = True) -> dict:
+    """The campaign: ``total`` cases (fewer when ``minutes`` > 0 runs out first), counted per format and side."""
+    srcs = [s for s in sources(data) if not formats or s.fmt in formats]
+    todo = cases(srcs, total, seed)
+    t_start = time.perf_counter()
+    stats: dict[tuple[str, str], Counter] = defaultdict(Counter)
+    slowest: dict[tuple[str, str], float] = defaultdict(float)
+    examples: dict[tuple[str, str, str], list[dict]] = defaultdict(list)
+    contained: Counter = Counter()
+    with tempfile.TemporaryDirectory(prefix="volviz-bench-robustness-") as tmp:
+        base = Path(tmp)
+        sides = {"volviz": Worker("volviz", 6 << 30, 40.0, base), "vtk": Worker("vtk", 3 << 30, VTK_SECONDS, base)}
+        index = {id(s): i for i, s in enumerate(srcs)}
+        originals: dict[tuple[int, str], Optional[dict]] = {}
+        done = 0
+        for n, (src, mutation) in enumerate(todo):
+            if minutes > 0 and time.perf_counter() - t_start > 60 * minutes:
+                break
+            done = n + 1
+            folder = prepare_folder(src, base, index[id(src)])
+            target = mutated_path(src, folder)
+            requests = {"volviz": {"path": str(folder / src.target), "options": src.options},
+                        "vtk": {"path": str(folder / src.target), "options": src.options, "recipe": src.vtk}}
+            active = [s for s in sides if s == "volviz" or src.vtk]
+            for side in active:
+                if (index[id(src)], side) not in originals:
+                    place(target, src.path.read_bytes())
+                    first = sides[side].ask(requests[side])
+                    originals[(index[id(src)], side)] = first if first["status"] == "ok" else None
+            place(target, mutation.data if mutation.data is not None else src.path.read_bytes())
+            if mutation.edit is not None:
+                try:
+                    mutation.edit(target)
+                except Exception as exc:  # h5py refused the edit: the case is a plain copy
+                    mutation = Mutation("hdf5-field", f"edit failed ({exc})", None)
+            answers: dict[str, dict] = {}
+            threads = [threading.Thread(target=lambda s=s: answers.__setitem__(s, sides[s].ask(requests[s])))
+                       for s in active]
+            for t in threads:
+                t.start()
+            for t in threads:
+                t.join()
+            for side, answer in answers.items():
+                outcome = _judge(answer, originals[(index[id(src)], side)], mutation)
+                key = (src.fmt, side)
+                stats[key][outcome] += 1
+                stats[key]["cases"] += 1
+                if outcome == "clean":
+                    slowest[key] = max(slowest[key], answer["seconds"])
+                    stats[key]["slow"] += answer["seconds"] >= REFUSAL_TARGET_S
+                    if side == "volviz" and re.search(r"crashed|ran out of memory|time limit", answer["message"]):
+                        contained[src.fmt] += 1
+                if outcome not in ("clean", "accepted") and len(examples[(src.fmt, side, outcome)]) < 5:
+                    examples[(src.fmt, side, outcome)].append(
+                        {"file": src.name, "mutation": mutation.kind, "detail": mutation.detail[:160],
+                         "message": answer.get("message", "")[:240]})
+            if progress and (n + 1) % 200 == 0:
+                rate = (n + 1) / (time.perf_counter() - t_start)
+                print(f"{n + 1}/{len(todo)} cases, {rate:.1f}/s", file=sys.stderr, flush=True)
+        for w in sides.values():
+            w.close()
+    return {"stats": {f"{k[0]}|{k[1]}": dict(v) for k, v in stats.items()},
+            "slowest": {f"{k[0]}|{k[1]}": v for k, v in slowest.items()}, "contained": dict(contained),
+            "examples": {"|".join(k): v for k, v in examples.items()}, "cases": done, "planned": len(todo),
+            "seed": seed,
+            "seconds": time.perf_counter() - t_start, "files": len(srcs),
+            "restarts": {s: w.restarts for s, w in sides.items()}}
+
+
+def place(target: Path, data: bytes) -> None:
+    """Write the case's bytes at ``target`` (replacing the symbolic link of a mirrored case)."""
+    if target.is_symlink():
+        target.unlink()
+    target.write_bytes(data)
+
+
+# -- the report --------------------------------------------------------------------------------------------------------
+def _targets(result: dict) -> list[str]:
+    volviz = [v for k, v in result["stats"].items() if k.endswith("|volviz")]
+    total = sum(v.get("cases", 0) for v in volviz)
+    bad = {o: sum(v.get(o, 0) for v in volviz) for o in ("crash", "hang", "memory", "exception", "garbage")}
+    slow = max((v for k, v in result["slowest"].items() if k.endswith("|volviz")), default=0.0)
+    n_slow = sum(v.get("slow", 0) for v in volviz)
+    ok = lambda flag: "met" if flag else "NOT met"  # noqa: E731
+    return [
+        f"- cases: {total} (target at least 10,000) — {ok(total >= 10000)}",
+        f"- crashes, hangs, memory blow-ups of the volviz process: {bad['crash']}, {bad['hang']}, {bad['memory']} "
+        f"— {ok(bad['crash'] + bad['hang'] + bad['memory'] == 0)}",
+        f"- exceptions other than ReadError (or a ReadError not naming the file): {bad['exception']} — "
+        f"{ok(bad['exception'] == 0)}",
+        f"- silent garbage: {bad['garbage']} — {ok(bad['garbage'] == 0)}",
+        f"- slowest refusal: {slow:.2f} s, refusals of 1 s or more: {n_slow} (target: every refusal under "
+        f"{REFUSAL_TARGET_S:.0f} s) — {ok(slow < REFUSAL_TARGET_S)}",
+    ]
+
+
+def report(result: dict, command: str) -> str:
+    load = os.getloadavg() if hasattr(os, "getloadavg") else (float("nan"),) * 3
+    lines = [
+        SECTION,
+        "",
+        f"Command: `{command}` — {time.strftime('%Y-%m-%d')}, {platform.machine()}, {os.cpu_count()} cores shared "
+        f"with other work (load {load[0]:.1f}), Python {platform.python_version()}; {result['cases']} cases over "
+        f"{result['files']} files in {result['seconds'] / 60:.1f} min (seed {result['seed']})" + (
+            f"; stopped by `--minutes` after {result['cases']} of {result['planned']} planned cases." if
+            result["cases"] < result["planned"] else "."),
+        "",
+        "Each case is one mutated copy of a file of `../shared/data` (bit flips; truncation at every header "
+        "boundary; header fields set to 0, -1, 2^31-1, 2^63-1, NaN, non-numbers, as text or binary integers; XML "
+        "attributes swapped, flipped and enlarged; HDF5 object headers damaged and VTKHDF counts set through h5py), "
+        "read by `volviz.io.read` (isolated as by default) and by VTK's reader of the format, each side in a worker "
+        "child with a memory limit (volviz 6 GiB, VTK 3 GiB) and a time limit (volviz 40 s, with "
+        "`VOLVIZ_READ_SECONDS=10` for its own reader child; VTK 5 s). *clean*: volviz's `ReadError` naming the "
+        "file, VTK's error message or empty output; *garbage*: a read that succeeds although the truncated file "
+        "lost data, or with a grid size other than the original's, or with inconsistent arrays or non-finite "
+        "spacing/origin; *accepted*: a read of the original's size (a flipped data bit cannot be told apart); "
+        "*contained*: volviz refusals where its reader child crashed, ran out of memory or time (VTK's failure "
+        "caught by the isolation, not by a header check).",
+        "",
+        "### Targets",
+        "",
+        *_targets(result),
+        "",
+        "### Per format: volviz | VTK",
+        "",
+        "| format | cases | clean | other exceptions | crashes | hangs | memory | garbage | accepted | slowest "
+        "refusal | contained |",
+        "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
+    ]
+    fmts = sorted({k.split("|")[0] for k in result["stats"]})
+    for fmt in fmts:
+        v = result["stats"].get(f"{fmt}|volviz", {})
+        t = result["stats"].get(f"{fmt}|vtk")
+        cell = lambda o: f"{v.get(o, 0)} \\| {t.get(o, 0) if t else '—'}"  # noqa: E731
+        slow = f"{result['slowest'].get(f'{fmt}|volviz', 0):.2f} s \\| " + (
+            f"{result['slowest'].get(f'{fmt}|vtk', 0):.2f} s" if t else "—")
+        lines.append(f"| {fmt} | {v.get('cases', 0)} | " + " | ".join(cell(o) for o in OUTCOMES) +
+                     f" | {slow} | {result['contained'].get(fmt, 0)} |")
+    lines += ["", "VTK has no PVM reader (—). Examples of each failure (at most five per format, side and kind):", ""]
+    for key, items in sorted(result["examples"].items()):
+        for item in items:
+            lines.append(f"- {key.replace('|', ' / ')}: `{item['file']}` {item['mutation']} ({item['detail']}): "
+                         f"{item['message']}".replace("\n", " "))
+    return "\n".join(lines) + "\n"
+
+
+def write_section(path: Path, text: str) -> None:
+    """Replace (or append) the campaign's section of ``path``, keeping every other section."""
+    old = path.read_text(encoding="utf-8") if path.exists() else ""
+    start = old.find(SECTION + "\n")
+    if start >= 0:
+        rest = re.search(r"^## ", old[start + len(SECTION):], re.M)
+        end = start + len(SECTION) + rest.start() if rest else len(old)
+        new = old[:start] + text + ("\n" + old[end:] if rest else "")
+    else:
+        new = old.rstrip("\n") + "\n\n" + text
+    path.write_text(new, encoding="utf-8")
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = UsageParser(prog="volviz bench robustness", description=__doc__.split("\n")[0])
+    parser.add_argument("--data", metavar="DIR", type=Path, default=DEFAULT_DATA,
+                        help="the shared data folder (default: $VOLVIZ_DATA or ../shared/data)")
+    parser.add_argument("--cases", type=int_in(1, 10_000_000), default=10000, help="mutated files (default 10000)")
+    parser.add_argument("--seed", type=int_in(0, 2**31), default=1)
+    parser.add_argument("--formats", nargs="+", metavar="FORMAT", help="only these formats (pvm slc pnm metaimage "
+                        "dem plot3d vtk-legacy vti vtu vtkhdf jpeg exodus cgns netcdf openfoam raw)")
+    parser.add_argument("--minutes", type=float, default=0.0,
+                        help="stop starting new cases after this many minutes (0: no limit); the report says so")
+    parser.add_argument("--out", metavar="FILE", type=Path, default=REPORT,
+                        help="the markdown file whose section is written (default docs/reliability.md)")
+    parser.add_argument("--json", metavar="OUT", help="also write the raw results as JSON")
+    args = parser.parse_args([] if argv is None else argv)
+    if not args.data.is_dir():
+        parser.error(f"--data {args.data} is not a folder (set VOLVIZ_DATA)")
+    result = run(args.data.resolve(), args.cases, args.seed, args.formats, args.minutes)
+    command = " ".join(["volviz bench robustness", *(shlex.quote(a) for a in argv or [])])
+    write_section(args.out, report(result, command))
+    if args.json:
+        Path(args.json).write_text(json.dumps(result, indent=1), encoding="utf-8")
+    print("\n".join([f"wrote {args.out}", *_targets(result)]))
+    return 0
+
+
+if __name__ == "__main__":
+    if sys.argv[1:2] == ["--worker"]:
+        worker(sys.argv[2])
+        sys.exit(0)
+    sys.exit(main(sys.argv[1:]))
