@@ -318,3 +318,27 @@ def test_exodus_name_with_text_content(tmp_path):
     path.write_text("hello")
     with pytest.raises(vio.ReadError, match=r"mesh\.exo: not a Exodus II file: starts with b'hello'"):
         vio.read(path)
+
+
+def test_ensight_gold_case_written_by_vtk(tmp_path):
+    """An EnSight Gold case (VTK's own writer; no sample file ships with the shared data) against VTK's reader."""
+    beam = _beam()
+    beam.cell_data["BlockId"] = np.ones(beam.n_cells, dtype=np.int32)   # the part each cell belongs to
+    writer = vtk.vtkEnSightWriter()
+    writer.SetInputData(beam)
+    writer.SetPath(str(tmp_path) + "/")
+    writer.SetBaseName("beam")
+    writer.SetTimeStep(0)
+    writer.SetNumberOfBlocks(1)
+    writer.Write()
+    writer.WriteCaseFile(1)
+    case = tmp_path / "beam.0.case"
+    reader = vtk.vtkGenericEnSightReader()
+    reader.SetCaseFileName(str(case))
+    reader.Update()
+    ref = _leaf(reader.GetOutput(), 0)
+    mesh = vio.read(case)
+    assert isinstance(mesh, UnstructuredMesh) and [(t, c.shape) for t, c in mesh.cells] == [(12, (40, 8))]
+    _assert_same(mesh, ref)
+    assert {"height_n", "disp_n"} <= set(mesh.point_data)                # EnSight names per-node variables so
+    np.testing.assert_allclose(mesh.point_data["height_n"], beam.point_data["height"], rtol=1e-6)
