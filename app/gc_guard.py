@@ -40,6 +40,10 @@ class GuiThreadCollector(QObject):
             generation = 0
             if counts[1] > self.thresholds[1]:
                 generation = 1
-                if counts[2] > self.thresholds[2]:
+                if counts[2] > self.thresholds[2] and not self.interacting:
                     generation = 2
             gc.collect(generation)
+
+    #: set while the user drags the camera: a full collection (tens of ms, scanning every object the scene made
+    #: after ``freeze_long_lived``) waits for the end of the interaction, young generations are still collected
+    interacting = False

@@ -35,6 +35,7 @@ from volviz_app.docks.statistics import Statistics
 from volviz_app.docks.tf_editor import TransferFunctionEditor
 from volviz_app.docks.timeline import Timeline
 from volviz_app.drop import FileDrop
+from volviz_app.interaction_renders import SingleRenderDuringInteraction
 from volviz_app.navigation import FlyMode
 from volviz_app.nonfinite_status import NonFiniteStatus
 from volviz_app.workers import JobBridge
@@ -179,12 +180,16 @@ class MainWindow(QMainWindow):
         self.resize(*self.layout_keeper.default_size())
         self.layout_keeper.restore()
         self.fly = FlyMode(self.plotter, on_camera_moved=self._fly_moved)
+        self.single_render = SingleRenderDuringInteraction(self.plotter)  # one render per move of a drag
         # fly mode has no end-of-interaction event: the camera has stopped once no key moved it for a while
         self.fly_settle_timer = QTimer(self, singleShot=True, interval=FLY_SETTLE_MS)
         self.fly_settle_timer.timeout.connect(self._camera_moved)
         self.clip_widget = ClipPlaneWidget(self.plotter, self.clipping)
+        self.plotter.iren.add_observer("StartInteractionEvent", lambda *args: setattr(self.collector, "interacting",
+                                                                                      True))
         self.plotter.iren.add_observer("InteractionEvent", lambda *args: self._schedule_camera_moving())
-        self.plotter.iren.add_observer("EndInteractionEvent", lambda *args: QTimer.singleShot(0, self._camera_moved))
+        self.plotter.iren.add_observer("EndInteractionEvent", lambda *args: (
+            setattr(self.collector, "interacting", False), QTimer.singleShot(0, self._camera_moved)))
 
         self.preview_timer = QTimer(self, singleShot=True, interval=PREVIEW_MS)
         self.preview_timer.timeout.connect(self._apply_pending_tf)
@@ -680,7 +685,10 @@ class MainWindow(QMainWindow):
                     with no_render(self.plotter):  # one render below, not two
                         handle.finish(request, *outcome.result)
                     self.overlay_updates[key] = self.overlay_updates.get(key, 0) + 1
-                    self.render()
+                    if request.get("preview"):  # while the camera moves: drawn by the next paint, in its own turn
+                        self.plotter.update()   # of the event loop, not in the one that also handles the mouse
+                    else:
+                        self.render()
                     if after is not None:
                         after(request)
                 elif outcome.error is not None:
