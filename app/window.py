@@ -13,13 +13,14 @@ from typing import Any, Callable, Optional
 
 from PySide6.QtCore import QByteArray, QSettings, QStandardPaths, Qt, QTimer
 from PySide6.QtGui import QAction, QKeySequence, QUndoGroup, QUndoStack
-from PySide6.QtWidgets import (QDockWidget, QFileDialog, QInputDialog, QLabel, QMainWindow, QMessageBox,
+from PySide6.QtWidgets import (QDockWidget, QFileDialog, QLabel, QMainWindow, QMessageBox,
                                QProgressBar, QPushButton, QWidget)
 
 from volviz.jobs import JobOutcome
 from volviz.render.controller import no_render
 from volviz.session import CameraKey, Session, SessionError, relative_path
 from volviz_app.array_choice import ArrayChoice
+from volviz_app.camera_bookmarks import CameraBookmarks
 from volviz_app.clip_widget import ClipPlaneWidget
 from volviz_app.decoration_toggles import DecorationToggles
 from volviz_app.docks.clipping import ClippingDock
@@ -122,7 +123,7 @@ def _import_gui_thread_modules() -> None:
     pyvista.system_supports_plotting()
 
 
-class MainWindow(QMainWindow):
+class MainWindow(CameraBookmarks, QMainWindow):
     """volviz main window. ``open_path`` is the single code path behind File > Open and the command line."""
 
     def __init__(self, parent: Optional[QWidget] = None, settings: Optional[QSettings] = None,
@@ -1153,66 +1154,6 @@ class MainWindow(QMainWindow):
         overlay = self.controller.iso_overlay
         if overlay is not None and tuple(overlay.stats.get("size", size)) != size:
             self.refresh_iso_overlay()
-
-    def add_bookmark(self, name: str) -> None:
-        if self.controller is None:
-            return
-        self.session.bookmarks[name] = self.controller.camera()
-        self._refresh_bookmark_menu()
-        self.set_dirty()
-
-    def go_to_bookmark(self, name: str) -> None:
-        if self.controller is not None and name in self.session.bookmarks:
-            self.controller.set_camera(self.session.bookmarks[name], update=False)
-            self._camera_moved()
-
-    def _ask_bookmark(self) -> None:
-        name, ok = QInputDialog.getText(self, "Add bookmark", "Name:", text=f"view {len(self.session.bookmarks) + 1}")
-        if ok and name:
-            self.add_bookmark(name)
-
-    def _refresh_bookmark_menu(self) -> None:
-        self.bookmark_menu.clear()
-        for name in self.session.bookmarks:
-            action = self.bookmark_menu.addAction(name)
-            action.triggered.connect(lambda checked=False, n=name: self.go_to_bookmark(n))
-        self.bookmark_menu.setEnabled(bool(self.session.bookmarks))
-
-    def set_recording(self, recording: bool) -> Optional[str]:
-        """Start or stop recording a camera path; stopping stores it in the session and returns its name."""
-        self.action_record.setChecked(recording)
-        if recording and self.controller is not None:
-            self._recording = []
-            self._record_start = time.perf_counter()
-            self._record_sample()
-            self.record_timer.start()
-            self.status_label.setText("Recording camera path…")
-            return None
-        self.record_timer.stop()
-        keys, self._recording = self._recording, None
-        if not keys:
-            return None
-        self._record_sample_into(keys)
-        if len(keys) < 2:
-            return None
-        name = f"path {len(self.session.camera_paths) + 1}"
-        self.session.camera_paths[name] = keys
-        self.set_dirty()
-        self.status_label.setText(f"Recorded camera path {name!r} ({len(keys)} keys, {keys[-1].time:.1f} s)")
-        return name
-
-    def _record_sample(self) -> None:
-        if self._recording is not None:
-            self._record_sample_into(self._recording)
-
-    def _record_sample_into(self, keys: list[CameraKey]) -> None:
-        if self.controller is None:
-            return
-        t = time.perf_counter() - self._record_start
-        cam = self.controller.camera()
-        if keys and (t <= keys[-1].time or cam == keys[-1].camera):
-            return
-        keys.append(CameraKey(t, cam))
 
     # ------------------------------------------------------------------------------------------------ saving
     def capture_session(self, target: Path) -> Session:
