@@ -10,7 +10,7 @@ from __future__ import annotations
 import struct
 from pathlib import Path
 
-from volviz.io._checks import check_file, read_bytes
+from volviz.io._checks import check_file, describe_bytes, read_bytes
 from volviz.io.errors import PathLike, ReadError
 
 HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
@@ -150,4 +150,4 @@ def check_container(path: PathLike, what: str, netcdf: bool = True, hdf5: bool =
         return p
     expected = [name for ok, name in ((netcdf, "netCDF (CDF\\x01, CDF\\x02, CDF\\x05)"), (hdf5, "HDF5"),
                                       (adf, "CGNS ADF")) if ok]
-    raise ReadError(p, f"not a {what} file: starts with {head[:8]!r}, expected {' or '.join(expected)}")
+    raise ReadError(p, f"not a {what} file: its content is {describe_bytes(head)}, expected {' or '.join(expected)}")

@@ -20,7 +20,7 @@ from typing import Any, Callable, Iterator, Sequence
 
 import numpy as np
 
-from volviz.io._checks import check_file, read_bytes
+from volviz.io._checks import check_file, describe_bytes, read_bytes
 from volviz.io.errors import PathLike, ReadError
 from volviz.io.vtkconvert import vtk_to_model
 from volviz.io.vtkfiles import _run
@@ -144,7 +144,7 @@ def _check_sniffed(path: PathLike, sniff: Callable[[bytes], bool], what: str) ->
     p = check_file(path)
     head = read_bytes(p, 4096)
     if not sniff(head):
-        raise ReadError(p, f"not a {what} file (starts with {head[:24]!r})")
+        raise ReadError(p, f"not a {what} file (its content is {describe_bytes(head)})")
     return p
 
 
