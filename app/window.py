@@ -345,7 +345,10 @@ class MainWindow(CameraBookmarks, QMainWindow):
         from volviz.io.plot3d_pairs import grid_and_solution
 
         pair = grid_and_solution(paths)
-        self.open_path(pair[0], q=pair[1]) if pair else paths and self.open_path(paths[0])
+        if pair is not None:
+            self.open_path(pair[0], q=pair[1])
+        elif paths:
+            self.open_path(paths[0])
 
     def open_path(self, path: str | os.PathLike, q: Optional[str | os.PathLike] = None) -> None:
         """Open a session file or a data file (the path behind every Open action and the command line); ``q``: the

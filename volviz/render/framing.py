@@ -18,18 +18,23 @@ def _valid(bounds: Any) -> bool:
     return b.shape == (6,) and bool(np.all(np.isfinite(b))) and bool(np.all(b[1::2] >= b[0::2]))
 
 
+def nature_bounds(scene: Any) -> Optional[Bounds]:
+    """The bounds of a NatureScene: its terrain and the clouds above it (not the sky dome around the eye)."""
+    parts = []
+    if getattr(scene, "terrain", None) is not None:
+        parts.append(scene.terrain.bounds())
+    if getattr(scene, "cloud_lod", None) is not None:
+        parts.append(scene.cloud_lod.volume.bounds())
+    return union([tuple(float(v) for v in b) for b in parts if _valid(b)])  # type: ignore[misc]
+
+
 def prop_bounds(prop: Any) -> Optional[Bounds]:
     """The world bounds of one component's prop: a NatureView (its terrain, else its clouds), a PT volume (its
     mesh), a LOD volume (its samples), a VTK prop (what VTK reports); None when empty or a hidden VTK prop (callers
     leave out the props of hidden components)."""
     scene = getattr(prop, "scene", None)
-    if scene is not None and hasattr(prop, "terrain_actor"):   # the terrain and the clouds above it (not the sky)
-        parts = []
-        if getattr(scene, "terrain", None) is not None:
-            parts.append(scene.terrain.bounds())
-        if getattr(scene, "cloud_lod", None) is not None:
-            parts.append(scene.cloud_lod.volume.bounds())
-        return union([tuple(float(v) for v in b) for b in parts if _valid(b)])  # type: ignore[misc]
+    if scene is not None and hasattr(prop, "terrain_actor"):
+        return nature_bounds(scene)
     mesh = getattr(prop, "mesh", None)
     if mesh is not None and hasattr(mesh, "points"):   # (an overlay is hidden until its first image: not checked)
         return points_bounds(mesh.points) if len(mesh.points) else None

@@ -406,13 +406,14 @@ def install_scene(plotter: Any, session: Session, datasets: dict[str, Any], prep
     plotter.set_background(session.render.background)
     if session.camera is None:  # framed on every component before the view-dependent parts are drawn
         from volviz.render.decorations import legend_margin
-        from volviz.render.framing import frame_bounds, scene_bounds
+        from volviz.render.framing import frame_bounds, nature_bounds, points_bounds, prop_bounds, union
+        from volviz.render.lod_volume import lod_bounds
 
-        pt_props = {comp.id: _MeshBounds(mesh) for comp, mesh in pt_components}
+        boxes = [prop_bounds(p) for p in props.values()] + [points_bounds(m.points) for _, m in pt_components]
+        boxes += [lod_bounds(d) for _, d in lod_components]
         if prepared.nature is not None:
-            pt_props["nature"] = _NatureBounds(prepared.nature)
-        frame_bounds(plotter, scene_bounds({**props, **pt_props, **{c.id: _LodBounds(d) for c, d in lod_components}}),
-                     right_margin=legend_margin(session))
+            boxes.append(nature_bounds(prepared.nature))
+        frame_bounds(plotter, union([b for b in boxes if b is not None]), right_margin=legend_margin(session))
     else:
         apply_camera(plotter, session.camera)
     nature = install_nature(plotter, prepared.nature, views)
@@ -421,25 +422,6 @@ def install_scene(plotter: Any, session: Session, datasets: dict[str, Any], prep
     for comp, _ in lod_components + pt_components:
         props[comp.id] = install_component(plotter, session, comp, datasets, prepared, spectrum, views)
     return props
-
-
-@dataclass
-class _MeshBounds:
-    """What ``volviz.render.framing.prop_bounds`` reads of a PT volume before it exists: its mesh."""
-    mesh: Any
-
-
-@dataclass
-class _NatureBounds:
-    """... of a natural scene before its view exists: the scene (with ``terrain_actor`` marking it a nature view)."""
-    scene: Any
-    terrain_actor: Any = None
-
-
-@dataclass
-class _LodBounds:
-    """... of a LOD volume before it exists: its tree."""
-    tree: Any
 
 
 def install_component(plotter: Any, session: Session, comp: Component, datasets: dict[str, Any],
