@@ -170,7 +170,9 @@ class SceneController:
                 prop.update()             # the selection depends on the TF (transparent blocks, Eq. 2.7)
         elif prop is not None and prop.IsA("vtkVolume"):
             update_volume_property(prop.GetProperty(), tf, comp.opacity)
-        self.decorate()      # the scalar bar shows the new colours and range
+        from volviz.render.decorations import update_legend
+
+        update_legend(self.plotter, self.session, self.datasets)   # the scalar bar shows the new colours and range
 
     def set_visible(self, comp_id: str, visible: bool, nature: bool = True, build: bool = True) -> None:
         """Show or hide a component. A terrain / fog / clouds / sky component rebuilds the natural scene now unless

@@ -48,7 +48,6 @@ def apply_decorations(plotter: Any, session: Session, props: dict[str, Any], dat
     datasets, whose shown array names the scalar bar). Safe to call again after any change: it replaces what it
     added before."""
     plotter.remove_actor(OUTLINE_NAME, render=False)
-    _remove_scalar_bar(plotter)
     colour = _contrast(session.render.background)
     if decoration_enabled(session, "outline"):
         from volviz.render.framing import scene_bounds
@@ -68,9 +67,15 @@ def apply_decorations(plotter: Any, session: Session, props: dict[str, Any], dat
             plotter.renderer.show_axes()
     elif axes is not None:
         plotter.renderer.hide_axes()
+    update_legend(plotter, session, datasets)
+
+
+def update_legend(plotter: Any, session: Session, datasets: dict[str, Any]) -> None:
+    """Redraw only the scalar bar (after a transfer-function edit: the outline and axes stay as they are)."""
+    _remove_scalar_bar(plotter)
     comp = _legend_component(session) if decoration_enabled(session, "scalar_bar") else None
     if comp is not None:
-        _add_scalar_bar(plotter, session, comp, _array_title(comp, datasets), colour)
+        _add_scalar_bar(plotter, session, comp, _array_title(comp, datasets), _contrast(session.render.background))
 
 
 def _add_scalar_bar(plotter: Any, session: Session, comp: Any, title: str, colour: tuple[float, float, float]) -> None:
