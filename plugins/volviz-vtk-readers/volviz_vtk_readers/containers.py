@@ -17,6 +17,8 @@ HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 NETCDF_MAGICS = (b"CDF\x01", b"CDF\x02", b"CDF\x05")
 _NC_TYPE_SIZE = {1: 1, 2: 1, 3: 2, 4: 4, 5: 4, 6: 8, 7: 1, 8: 2, 9: 4, 10: 8, 11: 8}
 _HEADER_LIMIT = 64 << 20  # a netCDF header larger than this is not parsed (only its magic is checked)
+#: CF attributes whose text names other variables of the file (CF conventions §5, §7.1)
+_REFERENCES = ("bounds", "coordinates")
 
 
 def is_netcdf(head: bytes) -> bool:
@@ -50,24 +52,45 @@ class _Cursor:
         return struct.unpack(">q", self.take(8))[0] if self.version in (2, 5) else struct.unpack(">I", self.take(4))[0]
 
     def name(self) -> str:
+        """A name: UTF-8 text without control characters (the format's rule for names)."""
         n = self.count()
-        return self.take(n + (-n % 4))[:n].decode("utf-8", "replace")
+        raw = self.take(n + (-n % 4))[:n]
+        try:
+            text = raw.decode("utf-8")
+        except UnicodeDecodeError:
+            raise ValueError(f"a name at byte {self.pos - n - (-n % 4)} is not UTF-8 text") from None
+        if not text or any(ord(ch) < 32 or ord(ch) == 127 for ch in text):
+            raise ValueError(f"a name at byte {self.pos - n - (-n % 4)} is empty or holds control characters")
+        return text
 
-    def attributes(self) -> None:
+    def attributes(self) -> dict[str, str]:
+        """The attribute list; returns the text attributes (type NC_CHAR) by name."""
         tag, n = self.int32(), self.count()
         if tag not in (0, 0x0C):
             raise ValueError(f"attribute list tag {tag:#x}")
+        texts = {}
         for _ in range(n):
-            self.name()
+            name = self.name()
             nc_type, k = self.int32(), self.count()
             size = _NC_TYPE_SIZE.get(nc_type)
             if size is None:
                 raise ValueError(f"attribute type {nc_type}")
-            self.take(k * size + (-(k * size) % 4))
+            value = self.take(k * size + (-(k * size) % 4))
+            if nc_type == 2:
+                texts[name] = value[:k].rstrip(b"\0").decode("utf-8", "replace")
+        return texts
 
 
 def _netcdf_end(data: bytes) -> int:
-    """The number of bytes the variables of a netCDF classic file reach (EOFError if ``data`` is too short)."""
+    """The number of bytes the variables of a netCDF classic file reach, after checking the header's layout against
+    itself (EOFError if ``data`` is too short to hold the header; ValueError naming the first inconsistency).
+    Names are UTF-8 text without control characters; a CF ``bounds`` or ``coordinates`` attribute names variables
+    the file holds (a damaged name would make the reader take another variable for the grid).
+
+    From the netCDF classic format specification (the ``vsize`` and ``begin`` of each variable): a variable's
+    ``vsize`` is the product of its dimension lengths (the record dimension left out) times the size of its type,
+    rounded up to 4 bytes, or 2^32-1 for a variable too large for the field; every ``begin`` lies after the header;
+    the fixed-size variables do not overlap; the data ends with the last variable's unpadded values."""
     c = _Cursor(data, data[3])
     numrecs = c.count()
     tag, n_dims = c.int32(), c.count()
@@ -81,23 +104,45 @@ def _netcdf_end(data: bytes) -> int:
     tag, n_vars = c.int32(), c.count()
     if tag not in (0, 0x0B):
         raise ValueError(f"variable list tag {tag:#x}")
-    fixed_end, records = c.pos, []
+    variables, references = [], []
     for _ in range(n_vars):
-        c.name()
+        name = c.name()
         ids = [c.count() for _ in range(c.count())]
-        c.attributes()
-        c.int32()  # nc_type
+        texts = c.attributes()
+        references += [(name, key, ref) for key in _REFERENCES for ref in texts.get(key, "").split()]
+        nc_type = c.int32()
         vsize, begin = c.count(), c.offset()
         if any(i >= len(dims) for i in ids):
-            raise ValueError(f"variable uses dimension id {max(ids)} of {len(dims)}")
-        if ids and dims[ids[0]] == 0:
-            records.append((begin, vsize))
-        else:
-            fixed_end = max(fixed_end, begin + vsize - 3)  # the last variable's padding may be missing
+            raise ValueError(f"variable {name!r} uses dimension id {max(ids)} of {len(dims)}")
+        size = _NC_TYPE_SIZE.get(nc_type) if nc_type <= (11 if c.version == 5 else 6) else None
+        if size is None:
+            raise ValueError(f"variable {name!r} has type {nc_type}")
+        record = bool(ids) and dims[ids[0]] == 0
+        exact = size
+        for i in ids[1:] if record else ids:
+            exact *= dims[i]
+        if vsize not in (exact, exact + (-exact % 4)) and not (vsize == 0xFFFFFFFF and exact > 0xFFFFFFFB):
+            raise ValueError(f"variable {name!r} has {exact} bytes by its dimensions but a size field of {vsize}")
+        variables.append((name, begin, exact, exact + (-exact % 4), record))
+    header_end = c.pos
+    names = {v[0] for v in variables}
+    for name, key, ref in references:
+        if ref not in names:
+            raise ValueError(f"variable {name!r} names {ref!r} in its {key!r} attribute, but the file has no variable "
+                             "of that name")
+    fixed = sorted((b, e, n) for n, b, e, _, r in variables if not r)
+    records = [(b, e, p) for _, b, e, p, r in variables if r]
+    for name, begin, *_ in variables:
+        if begin < header_end:
+            raise ValueError(f"variable {name!r} starts at byte {begin}, inside the {header_end}-byte header")
+    for (b0, e0, n0), (b1, _, n1) in zip(fixed, fixed[1:]):
+        if b0 + e0 > b1:
+            raise ValueError(f"variables {n0!r} and {n1!r} overlap")
+    end = max([header_end, *(b + e for b, e, _ in fixed)])
     if records and numrecs not in (0, 0xFFFFFFFF, -1):
-        record_size = sum(v for _, v in records)
-        fixed_end = max(fixed_end, max(b + v for b, v in records) + (numrecs - 1) * record_size - 3)
-    return fixed_end
+        record_size = records[0][1] if len(records) == 1 else sum(p for _, _, p in records)
+        end = max(end, max(b + e for b, e, _ in records) + (numrecs - 1) * record_size)
+    return end
 
 
 def _hdf5_end(path: PathLike, head: bytes) -> int:

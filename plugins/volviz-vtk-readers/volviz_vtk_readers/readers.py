@@ -28,6 +28,7 @@ from volviz.model import TimeSeries
 
 from volviz_vtk_readers import specs
 from volviz_vtk_readers.containers import check_container
+from volviz_vtk_readers.foamcheck import check_time_folder
 
 
 class _Pass:
@@ -213,6 +214,15 @@ def _openfoam(path: PathLike) -> Any:
     return reader
 
 
+def _check_openfoam_time(path: PathLike, reader: Any, index: int) -> None:
+    """The field files of the time step about to be read are complete (``foamcheck``): VTK drops a damaged one
+    silently."""
+    names = reader.GetTimeNames()
+    if names is not None and 0 <= index < names.GetNumberOfValues():
+        case = Path(path) if Path(path).is_dir() else Path(path).parent
+        check_time_folder(case, case / names.GetValue(index))
+
+
 def _openfoam_blocks(reader: Any) -> list[str]:
     return [reader.GetPatchArrayName(i) for i in range(reader.GetNumberOfPatchArrays())]
 
@@ -222,6 +232,7 @@ def read_openfoam(path: PathLike, blocks: Sequence[str] | str | None = None, tim
     """OpenFOAM (a ``.foam`` file in the case folder, or the folder): the internal mesh by default, every field as
     cell data and interpolated to the points; ``blocks=["patch/movingWall", ...]`` picks patches instead or too."""
     reader = _openfoam(path)
+    _check_openfoam_time(path, reader, time_index or 0)
     names = _openfoam_blocks(reader)
     chosen = set(_pick(path, names, blocks)) if blocks is not None else {"internalMesh"}
     for name in names:

@@ -1,0 +1,143 @@
+"""The checks the VTK-readers plugin makes before VTK reads a netCDF classic file or an OpenFOAM time step: a file
+whose header contradicts itself, or that lost bytes, is refused with a ReadError naming it, where VTK would read it
+with a field missing or a grid of another size (cases found by ``volviz bench robustness``)."""
+from __future__ import annotations
+
+import shutil
+import struct
+
+import numpy as np
+import pytest
+from scipy.io import netcdf_file
+
+import volviz.io as vio
+from volviz_vtk_readers.containers import _netcdf_end, check_container
+
+from conftest import data_file
+
+CURVE = "ecosystem/sampleCurveGrid4.nc"
+
+
+def _dimension_length_at(data: bytes, name: bytes) -> int:
+    """The byte offset of the length field of dimension ``name`` in a CDF-1 header."""
+    at = data.index(struct.pack(">I", len(name)) + name)
+    return at + 4 + len(name) + (-len(name) % 4)
+
+
+@pytest.mark.parametrize("name", [CURVE, "ecosystem/tos_O1_2001-2002.nc"])
+def test_netcdf_cut_by_its_last_byte_is_refused(tmp_path, name):
+    data = data_file(name).read_bytes()
+    assert _netcdf_end(data) == len(data)  # the data of the last variable reach exactly the end of the file
+    cut = tmp_path / "cut.nc"
+    cut.write_bytes(data[:-1])
+    with pytest.raises(vio.ReadError, match=rf"cut\.nc: netCDF: the netCDF header places data up to byte "
+                                            rf"{len(data)}, but the file holds {len(data) - 1} bytes"):
+        vio.read(cut)
+
+
+def test_netcdf_dimension_length_that_disagrees_with_the_variable_sizes(tmp_path):
+    data = bytearray(data_file(CURVE).read_bytes())
+    at = _dimension_length_at(bytes(data), b"x")
+    (length,) = struct.unpack(">I", data[at:at + 4])
+    data[at:at + 4] = struct.pack(">I", length + 1)
+    bad = tmp_path / "grown.nc"
+    bad.write_bytes(bytes(data))
+    with pytest.raises(vio.ReadError, match=r"grown\.nc: netCDF: malformed netCDF header \(variable '\w+' has "
+                                            r"\d+ bytes by its dimensions but a size field of \d+\)"):
+        vio.read(bad)
+
+
+def test_netcdf_variable_placed_inside_the_header(tmp_path):
+    path = tmp_path / "v.nc"
+    with netcdf_file(path, "w", version=1) as nc:
+        nc.createDimension("x", 4)
+        nc.createVariable("a", "f", ("x",))[:] = np.arange(4, dtype=np.float32)
+    data = bytearray(path.read_bytes())
+    begin = len(data) - 16                   # the one variable's 16 bytes end the file; its begin field is before
+    at = bytes(data).rindex(struct.pack(">I", begin))
+    data[at:at + 4] = struct.pack(">I", 8)
+    path.write_bytes(bytes(data))
+    with pytest.raises(vio.ReadError, match=r"v\.nc: netCDF: malformed netCDF header \(variable 'a' starts at "
+                                            r"byte 8, inside the \d+-byte header\)"):
+        check_container(path, "netCDF")
+
+
+def test_netcdf_damaged_attribute_name_is_refused(tmp_path):
+    """A damaged byte in the name ``bounds`` of an attribute would make VTK's CF reader lose the curvilinear grid
+    and read another variable as a regular volume of another size."""
+    data = bytearray(data_file(CURVE).read_bytes())
+    at = data.index(b"bounds\0\0")
+    data[at + 4:at + 8] = b"\x7f\xff\xff\xff"
+    bad = tmp_path / "name.nc"
+    bad.write_bytes(bytes(data))
+    with pytest.raises(vio.ReadError, match=rf"name\.nc: netCDF: malformed netCDF header \(a name at byte {at} is "
+                                            r"not UTF-8 text\)"):
+        vio.read(bad)
+
+
+def test_netcdf_bounds_naming_a_missing_variable_is_refused(tmp_path):
+    data = data_file(CURVE).read_bytes()
+    bad = tmp_path / "bounds.nc"
+    bad.write_bytes(data.replace(b"bounds_lon", b"bounds_lom", 1))  # the attribute's value, before the variable
+    with pytest.raises(vio.ReadError, match=r"bounds\.nc: netCDF: malformed netCDF header \(variable 'lon' names "
+                                            r"'bounds_lom' in its 'bounds' attribute, but the file has no variable"):
+        vio.read(bad)
+
+
+@pytest.mark.parametrize("version", [1, 2])
+def test_netcdf_written_without_padding_or_with_one_record_variable_is_accepted(tmp_path, version):
+    """Odd-sized variables (no padding after the last one) and a single record variable (records not padded)."""
+    path = tmp_path / "ok.nc"
+    with netcdf_file(path, "w", version=version) as nc:
+        nc.createDimension("t", None)
+        nc.createDimension("x", 3)
+        nc.createVariable("a", "b", ("t", "x"))[:] = np.ones((5, 3))
+        nc.createVariable("c", "h", ("x",))[:] = [1, 2, 3]
+    assert check_container(path, "netCDF") == path
+    assert _netcdf_end(path.read_bytes()) == path.stat().st_size
+
+
+@pytest.fixture
+def cavity(tmp_path):
+    case = tmp_path / "cavity"
+    shutil.copytree(data_file("ecosystem/openfoam-cavity"), case)
+    return case
+
+
+@pytest.mark.parametrize("field, keep, problem", [
+    ("0.5/p", 37, "has no complete FoamFile header"),           # cut inside the banner comment
+    ("0.5/U", 162, "has no complete FoamFile header"),
+    ("0.5/p", 900, "ends before its boundaryField"),             # cut inside internalField
+    ("2.5/p", -120, "ends inside its boundaryField"),            # cut inside boundaryField
+])
+def test_openfoam_field_file_cut_short_is_refused(cavity, field, keep, problem):
+    """VTK's reader drops such a field silently (the step opens without it); the frame that reads it is refused."""
+    path = cavity / field
+    data = path.read_bytes()
+    path.write_bytes(data[:keep])
+    step = ["0", "0.5", "1", "1.5", "2", "2.5"].index(field.split("/")[0])
+    message = rf"cavity: the OpenFOAM (field )?file {field} {problem}"
+    if step == 0:
+        with pytest.raises(vio.ReadError, match=message):
+            vio.read(cavity / "case.foam")
+        return
+    series = vio.read(cavity / "case.foam")
+    with pytest.raises(vio.ReadError, match=message):
+        series.frame(step)
+    other = 1 if step != 1 else 2
+    assert set(series.frame(other).cell_data) == {"p", "U"}   # the other steps still read, with every field
+
+
+def test_openfoam_first_step_damaged_refuses_the_open(cavity):
+    path = cavity / "0" / "p"
+    path.write_bytes(path.read_bytes()[:318])
+    with pytest.raises(vio.ReadError, match=r"cavity: the OpenFOAM file 0/p has no complete FoamFile header: it is "
+                                            r"damaged or not an OpenFOAM file; repair it, or move it out"):
+        vio.read(cavity / "case.foam")
+
+
+def test_openfoam_backup_files_in_a_time_folder_are_left_alone(cavity):
+    (cavity / "0" / "p.orig").write_text("an old copy, cut")
+    (cavity / "0" / "notes~").write_text("editor backup")
+    series = vio.read(cavity / "case.foam")
+    assert set(series.frame(0).cell_data) == {"p", "U"}
