@@ -1,7 +1,11 @@
-"""Ordinary raster images (PNG, JPEG, TIFF, BMP) through Pillow -> Image2D (e.g. the sky/clouds.jpeg photo).
+"""Ordinary raster images (PNG, JPEG, TIFF, BMP) -> Image2D (e.g. the sky/clouds.jpeg photo).
 
-The header is read first; images of more than ``MAX_PIXELS`` pixels are refused before decoding (a small
-compressed file can describe a gigantic image).
+The header is read first (Pillow); images of more than ``MAX_PIXELS`` pixels are refused before decoding (a small
+compressed file can describe a gigantic image). PNG, TIFF and BMP are decoded by Pillow; JPEG by VTK's
+``vtkJPEGReader`` (the same libjpeg-turbo, the same pixels), because libjpeg reports a damaged stream (a premature
+end of the data, an image taller than its data) only as a warning, which Pillow ignores and fills the missing rows
+with grey, while VTK's reader treats it as the error it is. The reader runs in the isolated reader process
+(``volviz.io.isolated``): these decoders are native code.
 """
 from __future__ import annotations
 
@@ -28,12 +32,34 @@ def read_image(path: PathLike) -> Image2D:
                     raise ReadError(path, f"image size {width}x{height} must be positive")
                 if width * height > MAX_PIXELS:
                     raise ReadError(path, f"image claims {width}x{height} pixels, more than the limit of {MAX_PIXELS}")
-                if im.mode not in ("L", "I;16", "I;16B", "RGB", "RGBA"):
-                    im = im.convert("RGBA" if "A" in im.getbands() else "RGB")
-                data = np.array(im)
+                if im.format == "JPEG" and im.mode in ("L", "RGB"):
+                    data = _jpeg_pixels(path)
+                else:
+                    if im.mode not in ("L", "I;16", "I;16B", "RGB", "RGBA"):
+                        im = im.convert("RGBA" if "A" in im.getbands() else "RGB")
+                    data = np.array(im)
         except ReadError:
             raise
         except (UnidentifiedImageError, OSError, ValueError, SyntaxError, Image.DecompressionBombError) as exc:
             raise ReadError(path, f"not a readable image ({type(exc).__name__}: {str(exc)[:200]})") from None
     maxval = 65535 if data.dtype == np.uint16 else 255
     return Image2D(data, maxval=maxval, source=str(path))
+
+
+def _jpeg_pixels(path: PathLike) -> np.ndarray:
+    """A JPEG's pixels by ``vtkJPEGReader`` (libjpeg's warnings are errors there): (rows, cols) grey or
+    (rows, cols, 3), row 0 at the top."""
+    import vtk
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+
+    from volviz.io.vtkfiles import _run
+
+    reader = vtk.vtkJPEGReader()
+    reader.SetFileName(str(path))
+    out = _run(path, reader)
+    width, height, _ = out.GetDimensions()
+    scalars = out.GetPointData().GetScalars()
+    if scalars is None or width * height == 0:
+        raise ReadError(path, "the JPEG decoder returned no pixels: the file is damaged")
+    pixels = vtk_to_numpy(scalars).reshape(height, width, -1)[::-1]
+    return np.ascontiguousarray(pixels[..., 0] if pixels.shape[2] == 1 else pixels)

@@ -162,7 +162,7 @@ BUILTIN_READERS: list[ReaderSpec] = [
     ReaderSpec("dem", "USGS DEM", ("*.dem",), "volviz.io.dem:read_dem", arrays="heights in metres",
                options=("vtk_compatible",)),
     ReaderSpec("image", "Raster image", ("*.png", "*.jpg", "*.jpeg", "*.tif", "*.tiff", "*.bmp"),
-               "volviz.io.image:read_image", arrays="grey levels or RGB"),
+               "volviz.io.image:read_image", arrays="grey levels or RGB", isolated=True),
     ReaderSpec("raw", "Raw volume", (), "volviz.io.raw:read_raw", select_options=("dims",), listed=False,
                arrays="one scalar volume", options=("dims", "dtype", "byteorder", "header_bytes")),
     ReaderSpec("meshio", "Meshes (meshio)", "volviz.io.registry:meshio_globs", "volviz.io.meshio_reader:read_meshio",

@@ -40,7 +40,7 @@ def _run(path: PathLike, reader) -> object:
     text = "".join(c if (c.isprintable() and c.isascii()) or c == "\n" else "?" for c in text.strip())
     if reader.GetErrorCode() or "ERROR:" in text:
         lines = [ln.split("): ", 1)[-1].strip() for ln in text.splitlines()
-                 if ln.strip() and not ln.startswith("ERROR:")]
+                 if ln.strip() and not ln.startswith(("ERROR:", "Warning:"))]
         detail = "; ".join(lines[:2]) if lines else f"VTK error code {reader.GetErrorCode()}"
         raise ReadError(path, f"VTK's {reader.GetClassName()} failed: {detail[:300]}")
     return reader.GetOutputDataObject(0)
