@@ -214,3 +214,34 @@ def test_a_reader_child_started_from_a_thread_that_ended_keeps_serving() -> None
             expected = direct.frame(i)
             for name, values in expected.cell_data.items():
                 np.testing.assert_array_equal(frame.cell_data[name], values)
+
+
+def test_block_names_are_listed_in_the_reader_child(tmp_path) -> None:
+    """``list_blocks`` runs VTK's reader too: a multiblock file whose piece crashes VTK gives a ReadError naming the
+    file, and the names of a sound file equal those found in-process."""
+    import vtk
+
+    from volviz_vtk_readers import list_blocks
+    from volviz_vtk_readers.readers import list_blocks as list_blocks_here
+
+    folder = tmp_path / "parts"
+    folder.mkdir()
+    isolation_loaders.crash_vti(folder / "piece.vti")
+    vtm = tmp_path / "damaged.vtm"
+    vtm.write_text('<?xml version="1.0"?>\n<VTKFile type="vtkMultiBlockDataSet" version="1.0">\n'
+                   '<vtkMultiBlockDataSet><DataSet index="0" name="piece" file="parts/piece.vti"/>'
+                   '</vtkMultiBlockDataSet>\n</VTKFile>\n')
+    with pytest.raises(vio.ReadError, match=r"damaged\.vtm: VTK's reader crashed \(segmentation fault\) reading it"):
+        list_blocks(vtm)
+    still_reads()
+    mb = vtk.vtkMultiBlockDataSet()
+    for i, name in enumerate(("left", "right")):
+        image = vtk.vtkImageData()
+        image.SetDimensions(2, 2, 2 + i)
+        mb.SetBlock(i, image)
+        mb.GetMetaData(i).Set(vtk.vtkCompositeDataSet.NAME(), name)
+    writer = vtk.vtkXMLMultiBlockDataWriter()
+    writer.SetInputData(mb)
+    writer.SetFileName(str(tmp_path / "two.vtm"))
+    writer.Write()
+    assert list_blocks(tmp_path / "two.vtm") == list_blocks_here(tmp_path / "two.vtm") == ["left", "right"]

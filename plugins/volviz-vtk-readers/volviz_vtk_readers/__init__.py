@@ -31,7 +31,14 @@ from volviz_vtk_readers.specs import SPECS
 __all__ = ["SPECS", "list_blocks"]
 
 
-def list_blocks(path):  # the readers module imports VTK; keep ``import volviz_vtk_readers`` light
-    from volviz_vtk_readers.readers import list_blocks as _list_blocks
+def list_blocks(path):
+    """The names ``blocks=`` takes for this file (``readers.list_blocks``), found by VTK's reader in the isolated
+    reader process like a read (``volviz.io.isolated``), unless isolation is off."""
+    from volviz.io import isolated
+    from volviz.io.registry import spec_of
+
+    if isolated.isolation_enabled():
+        return isolated.names_isolated(spec_of(path), path, "volviz_vtk_readers.readers:list_blocks")
+    from volviz_vtk_readers.readers import list_blocks as _list_blocks  # imports VTK: only when it is used
 
     return _list_blocks(path)

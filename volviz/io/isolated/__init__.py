@@ -223,11 +223,18 @@ def _reemit(caught: Any) -> None:
             warnings.warn(item[1], _WARNINGS.get(item[0], UserWarning), stacklevel=4)
 
 
-class _Read:
-    """One isolated call of a spec's loader on one path (with ``frame`` for a lazy frame of a time series)."""
+MAX_NAMES = 100_000     # names a ``names_isolated`` call may return
+MAX_NAME_CHARS = 4096
 
-    def __init__(self, spec: Any, path: PathLike, options: dict, limits_: Limits) -> None:
+
+class _Read:
+    """One isolated call of a spec's loader on one path (with ``frame`` for a lazy frame of a time series); with
+    ``loader`` and ``result="names"`` the call of another function of the reader that returns a list of names."""
+
+    def __init__(self, spec: Any, path: PathLike, options: dict, limits_: Limits, loader: str | None = None,
+                 result: str = "dataset") -> None:
         self.spec, self.limits = spec, limits_
+        self.loader, self.result = loader or spec.loader, result
         self.shown = os.fspath(path)
         self.path = os.path.abspath(self.shown)
         self.options = {k: _plain(v, k) for k, v in options.items()}
@@ -239,8 +246,8 @@ class _Read:
     def __call__(self, frame: int | None = None) -> Any:
         memory, seconds = self.limits.memory(self.size), self.limits.seconds(self.size)
         workdir = _workdir(self.size)
-        request = {"path": self.path, "kind": self.spec.name, "loader": self.spec.loader, "options": self.options,
-                   "frame": frame, "memory": memory, "workdir": workdir,
+        request = {"path": self.path, "kind": self.spec.name, "loader": self.loader, "options": self.options,
+                   "frame": frame, "result": self.result, "memory": memory, "workdir": workdir,
                    "sys_path": [p for p in sys.path if isinstance(p, str)]}
         try:
             answer = self._ask(request, seconds)
@@ -282,6 +289,12 @@ class _Read:
         _reemit(answer.get("warnings"))
         if not answer.get("ok"):
             raise self._error(answer, memory)
+        if self.result == "names":
+            names = answer.get("names")
+            if not (isinstance(names, list) and len(names) <= MAX_NAMES
+                    and all(isinstance(n, str) and len(n) <= MAX_NAME_CHARS for n in names)):
+                raise self.fail("the isolated reader's answer is not a list of names")
+            return names
         header = answer.get("header")
         try:
             specs = array_specs(header)
@@ -326,3 +339,9 @@ class _FrameLoader:
 def read_isolated(spec: Any, path: PathLike, options: dict, limits_: Limits | None = None) -> Any:
     """Run ``spec``'s loader on ``path`` with ``options`` in a reader child (see the module docstring)."""
     return _Read(spec, path, options, limits_ or limits)()
+
+
+def names_isolated(spec: Any, path: PathLike, function: str, limits_: Limits | None = None) -> list[str]:
+    """Run ``function`` (``"module:name"``, taking the path, returning a list of strings: the block names of a
+    file) in a reader child under ``spec``'s limits; the names come back as JSON, checked to be strings."""
+    return _Read(spec, path, {}, limits_ or limits, loader=function, result="names")()

@@ -67,6 +67,15 @@ class _MemoryLimit:
         resource.setrlimit(resource.RLIMIT_AS, self._old)
 
 
+def _names(value: Any) -> list[str]:
+    """A loader's list of names, checked (the parent checks again)."""
+    from volviz.io.isolated.codec import CodecError
+
+    if not isinstance(value, (list, tuple)) or not all(isinstance(v, str) for v in value):
+        raise CodecError(f"the function returned a {type(value).__name__}, not a list of names")
+    return list(value)
+
+
 class Child:
     def __init__(self) -> None:
         self.series: OrderedDict[str, Any] = OrderedDict()
@@ -116,10 +125,13 @@ class Child:
             try:
                 with _MemoryLimit(int(request.get("memory", 0))):
                     dataset = self._load(request)
-                    header, arrays = encode(dataset)
-                    for i, arr in enumerate(arrays):
-                        np.save(os.path.join(request["workdir"], f"a{i}.npy"), arr, allow_pickle=False)
-                answer: dict = {"ok": True, "header": header}
+                    if request.get("result") == "names":
+                        answer: dict = {"ok": True, "names": _names(dataset)}
+                    else:
+                        header, arrays = encode(dataset)
+                        for i, arr in enumerate(arrays):
+                            np.save(os.path.join(request["workdir"], f"a{i}.npy"), arr, allow_pickle=False)
+                        answer = {"ok": True, "header": header}
             except ReadError as exc:
                 answer = {"ok": False, "error": "read", "path": exc.path, "problem": exc.problem,
                           "advice": exc.advice}
