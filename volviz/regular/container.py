@@ -42,6 +42,7 @@ from typing import Any, BinaryIO
 
 import numpy as np
 
+from volviz.io._checks import describe_bytes
 from volviz.io.atomic import check_output_path, remove_stale_temporaries, temp_name
 from volviz.io.errors import ReadError
 
@@ -149,7 +150,7 @@ def parse_header(head: bytes, file_size: int, name: str = "<vvz>") -> dict[str, 
     if len(head) < HEADER_SIZE or file_size < HEADER_SIZE:
         raise VVZError(name, f"truncated file ({file_size} bytes, a .vvz header alone is {HEADER_SIZE})")
     if head[:8] != MAGIC:
-        raise VVZError(name, f"not a .vvz file (wrong magic {head[:8]!r})")
+        raise VVZError(name, f"not a .vvz file: it starts with {describe_bytes(head)}, not the .vvz signature")
     (_, version, hdr_size, flags, meta_off, meta_len, table_off, table_count, meta_crc, table_crc,
      _) = _HDR.unpack(head[:60])
     if crc32(head[:60]) != struct.unpack("<I", head[60:64])[0]:
