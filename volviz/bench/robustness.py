@@ -381,39 +381,54 @@ def random_mutation(src: Source, data: bytes, rng: random.Random, addresses: lis
     return found or flip_bits(data, rng, src.header_end)
 
 
-def systematic(src: Source, data: bytes) -> list[Mutation]:
-    """Truncation at every header boundary and every text header field set to every value (the first 40 fields)."""
-    found = [truncate(data, at) for at in boundaries(src, data)]
+def systematic_recipes(src: Source, data: bytes) -> list[tuple]:
+    """The systematic cases as recipes (a few numbers each, turned into bytes by ``make_mutation`` when the case
+    runs): truncation at every header boundary and every text header field set to every value (the first 40)."""
+    found: list[tuple] = [("truncate", at) for at in boundaries(src, data)]
     if src.layout == "text":
-        rng = random.Random(0)
         for i in range(min(40, len(number_spans(data, src.header_end)))):
-            found += [m for v in TEXT_VALUES if (m := set_field(src, data, rng, i, v)) is not None]
+            found += [("field", i, v) for v in TEXT_VALUES]
     return found
 
 
-def cases(srcs: list[Source], total: int, seed: int) -> list[tuple[Source, Mutation]]:
+def make_mutation(src: Source, data: bytes, recipe: tuple, addresses: list[int] | None = None) -> Mutation:
+    """The mutation a recipe describes: ``("truncate", at)``, ``("field", index, value)`` or ``("random", seed)``
+    (a random mutation drawn with its own generator, so a case is the same whenever it is made)."""
+    if recipe[0] == "truncate":
+        return truncate(data, recipe[1])
+    if recipe[0] == "field":
+        found = set_field(src, data, random.Random(0), recipe[1], recipe[2])
+        if found is not None:
+            return found
+    return random_mutation(src, data, random.Random(str(recipe[-1])), addresses)
+
+
+def systematic(src: Source, data: bytes) -> list[Mutation]:
+    """Truncation at every header boundary and every text header field set to every value (the first 40 fields)."""
+    return [make_mutation(src, data, r) for r in systematic_recipes(src, data)]
+
+
+def cases(srcs: list[Source], total: int, seed: int) -> list[tuple[Source, tuple]]:
     """``total`` cases spread evenly over the formats (round-robin), within a format over its files; each file's
-    systematic mutations first, then random ones."""
+    systematic mutations first, then random ones. A case is a recipe (``make_mutation``): the mutated bytes are made
+    only when the case runs, so the plan of 10,000 cases takes kilobytes, not gigabytes."""
     by_fmt: dict[str, list[Source]] = defaultdict(list)
     for s in srcs:
         by_fmt[s.fmt].append(s)
     per_fmt = {f: total // len(by_fmt) + (i < total % len(by_fmt)) for i, f in enumerate(sorted(by_fmt))}
-    out: list[tuple[Source, Mutation]] = []
+    out: list[tuple[Source, tuple]] = []
     for fmt, count in per_fmt.items():
         files = by_fmt[fmt]
         shares = [count // len(files) + (i < count % len(files)) for i in range(len(files))]
         for src, share in zip(files, shares):
             if share == 0:
                 continue
-            data = src.path.read_bytes()
             rng = random.Random(f"{seed}:{src.name}")
-            fixed = systematic(src, data)
+            fixed = systematic_recipes(src, src.path.read_bytes())
             rng.shuffle(fixed)
             chosen = fixed[: share // 2]
-            addresses = hdf5_object_addresses(src.path) if src.layout == "hdf5" else None
-            while len(chosen) < share:
-                chosen.append(random_mutation(src, data, rng, addresses))
-            out += [(src, m) for m in chosen]
+            chosen += [("random", f"{seed}:{src.name}:{k}") for k in range(share - len(chosen))]
+            out += [(src, r) for r in chosen]
     random.Random(seed).shuffle(out)
     return out
 
@@ -708,10 +723,15 @@ def run(data: Path, total: int, seed: int, formats: list[str] | None, minutes: f
         index = {id(s): i for i, s in enumerate(srcs)}
         originals: dict[tuple[int, str], Optional[dict]] = {}
         done = 0
-        for n, (src, mutation) in enumerate(todo):
+        addresses: dict[int, list[int]] = {}
+        for n, (src, recipe) in enumerate(todo):
             if minutes > 0 and time.perf_counter() - t_start > 60 * minutes:
                 break
             done = n + 1
+            data = src.path.read_bytes()
+            if src.layout == "hdf5" and id(src) not in addresses:
+                addresses[id(src)] = hdf5_object_addresses(src.path)
+            mutation = make_mutation(src, data, recipe, addresses.get(id(src)))
             folder = prepare_folder(src, base, index[id(src)])
             target = mutated_path(src, folder)
             requests = {"volviz": {"path": str(folder / src.target), "options": src.options},
@@ -719,10 +739,10 @@ def run(data: Path, total: int, seed: int, formats: list[str] | None, minutes: f
             active = [s for s in sides if s == "volviz" or src.vtk]
             for side in active:
                 if (index[id(src)], side) not in originals:
-                    place(target, src.path.read_bytes())
+                    place(target, data)
                     first = sides[side].ask(requests[side])
                     originals[(index[id(src)], side)] = first if first["status"] == "ok" else None
-            place(target, mutation.data if mutation.data is not None else src.path.read_bytes())
+            place(target, mutation.data if mutation.data is not None else data)
             if mutation.edit is not None:
                 try:
                     mutation.edit(target)
