@@ -715,6 +715,7 @@ def run(data: Path, total: int, seed: int, formats: list[str] | None, minutes: f
     t_start = time.perf_counter()
     stats: dict[tuple[str, str], Counter] = defaultdict(Counter)
     slowest: dict[tuple[str, str], float] = defaultdict(float)
+    slowest_case: dict[tuple[str, str], dict] = {}
     examples: dict[tuple[str, str, str], list[dict]] = defaultdict(list)
     contained: Counter = Counter()
     with tempfile.TemporaryDirectory(prefix="volviz-bench-robustness-") as tmp:
@@ -761,6 +762,9 @@ def run(data: Path, total: int, seed: int, formats: list[str] | None, minutes: f
                 stats[key][outcome] += 1
                 stats[key]["cases"] += 1
                 if outcome == "clean":
+                    if answer["seconds"] > slowest[key]:
+                        slowest_case[key] = {"file": src.name, "mutation": mutation.kind,
+                                             "detail": mutation.detail[:160], "message": answer["message"][:240]}
                     slowest[key] = max(slowest[key], answer["seconds"])
                     stats[key]["slow"] += answer["seconds"] >= REFUSAL_TARGET_S
                     if side == "volviz" and re.search(r"crashed|ran out of memory|time limit", answer["message"]):
@@ -776,6 +780,7 @@ def run(data: Path, total: int, seed: int, formats: list[str] | None, minutes: f
             w.close()
     return {"stats": {f"{k[0]}|{k[1]}": dict(v) for k, v in stats.items()},
             "slowest": {f"{k[0]}|{k[1]}": v for k, v in slowest.items()}, "contained": dict(contained),
+            "slowest_case": {f"{k[0]}|{k[1]}": v for k, v in slowest_case.items()},
             "examples": {"|".join(k): v for k, v in examples.items()}, "cases": done, "planned": len(todo),
             "seed": seed,
             "seconds": time.perf_counter() - t_start, "files": len(srcs),
@@ -851,6 +856,12 @@ def report(result: dict, command: str) -> str:
             f"{result['slowest'].get(f'{fmt}|vtk', 0):.2f} s" if t else "—")
         lines.append(f"| {fmt} | {v.get('cases', 0)} | " + " | ".join(cell(o) for o in OUTCOMES) +
                      f" | {slow} | {result['contained'].get(fmt, 0)} |")
+    lines += ["", "The slowest volviz refusal of each format (time on the loaded machine, both sides reading at once):",
+              ""]
+    for key, item in sorted(result.get("slowest_case", {}).items()):
+        if key.endswith("|volviz"):
+            lines.append(f"- {key.split('|')[0]}: {result['slowest'][key]:.2f} s, `{item['file']}` {item['mutation']} "
+                         f"({item['detail']}): {item['message']}".replace("\n", " "))
     lines += ["", "VTK has no PVM reader (—). Examples of each failure (at most five per format, side and kind):", ""]
     for key, items in sorted(result["examples"].items()):
         for item in items:

@@ -267,6 +267,7 @@ class _Read:
         try:
             answer = worker.request(request, seconds)
         except (ChildTimedOut, ChildDied):
+            _pool.prewarm()  # the next read finds a child started, not a cold start
             raise
         except BaseException:
             worker.kill()  # interrupted while the child works: it cannot be reused

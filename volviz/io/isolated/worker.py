@@ -195,6 +195,7 @@ class Pool:
     def give(self, worker: Worker) -> None:
         if not worker.alive or worker.requests >= MAX_REQUESTS:
             worker.close()
+            self.prewarm()  # its successor starts now, not when the next read waits for it
             return
         with self._lock:
             if len(self._idle) < self.max_idle:
