@@ -56,10 +56,13 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--debug", action="store_true", help="show tracebacks of unexpected errors")
     sub = parser.add_subparsers(dest="command", parser_class=UsageParser)
 
-    info = sub.add_parser("info", help="describe a data file or a compressed volume",
+    info = sub.add_parser("info", help="describe a data file or a compressed volume, or the OpenGL in use",
                           description="Kind, dimensions, every array (association, components, range, non-finite "
-                          "values), time steps and series membership of a data file, or a .vvz/.vvs file's header.")
-    info.add_argument("file")
+                          "values), time steps and series membership of a data file, or a .vvz/.vvs file's header. "
+                          "With --gl (no file needed): the OpenGL vendor, renderer and version of an offscreen "
+                          "render window, and the backend the render setting backend=auto picks for each view kind.")
+    info.add_argument("file", nargs="?")
+    info.add_argument("--gl", action="store_true", help="describe the OpenGL driver and the backends auto picks")
     info.add_argument("--json", action="store_true", help="print JSON instead of text")
     _data_options(info)
 
@@ -175,6 +178,17 @@ def describe(path: str, array: Optional[str] = None, q: Optional[str] = None) ->
     return desc
 
 
+def describe_gl() -> dict[str, Any]:
+    """The OpenGL driver of an offscreen VTK render window and the backend "auto" picks on it for each view kind
+    (``volviz.render.backend``)."""
+    from volviz.render.backend import VIEW_KINDS, choose_backend, offscreen_gl_info
+
+    info = offscreen_gl_info()
+    return {"opengl_vendor": info.vendor, "opengl_renderer": info.renderer, "opengl_version": info.version,
+            "software_rasteriser": info.software,
+            "auto_backend": {kind: choose_backend("auto", kind, info) for kind in VIEW_KINDS}}
+
+
 def _finite(pair: Sequence[float]) -> list[Optional[float]]:
     """A (min, max) pair for JSON: NaN (no finite value) becomes null."""
     return [float(v) if math.isfinite(v) else None for v in pair]
@@ -199,7 +213,9 @@ def _print_info(desc: dict[str, Any]) -> None:
         if key == "arrays":
             _print_arrays(value, width)
             continue
-        if key == "series":
+        if key == "auto_backend":
+            value = ", ".join(f"{kind}: {backend}" for kind, backend in value.items())
+        elif key == "series":
             value = (f"member {value['member']} of {value['members']} of the series {value['pattern']} (time "
                      f"{value['time']:g}); `volviz render` shows this member's time step")
         elif isinstance(value, list):
@@ -227,7 +243,11 @@ def run(argv: Optional[Sequence[str]] = None) -> int:
     if args.command is None:
         raise UsageError("a command is needed: info, render, bench, compress or warmup (see volviz --help)")
     if args.command == "info":
-        desc = describe(args.file, args.array, args.q)
+        if args.file is None and not args.gl:
+            raise UsageError("info needs a file, or --gl (see volviz info --help)")
+        desc = describe(args.file, args.array, args.q) if args.file is not None else {}
+        if args.gl:
+            desc.update(describe_gl())
         if args.json:
             print(json.dumps(desc, indent=2))
         else:

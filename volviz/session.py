@@ -43,6 +43,7 @@ MAX_OPTION_ITEMS = 16        # items of a list-valued dataset option (dims, spac
 
 COMPONENT_TYPES = ("volume", "mesh", "isosurface", "terrain", "fog", "clouds", "sky", "demo")
 RENDER_METHODS = ("auto", "pt", "reference", "vtk")
+RENDER_BACKENDS = ("auto", "gpu", "cpu")   # render option "backend" (volviz.render.backend)
 
 
 class SessionError(Exception):
@@ -316,6 +317,8 @@ def session_from_dict(doc: Any, source: str | os.PathLike | None = None) -> Sess
                          for i, v in enumerate(r.vector(rs.get("background", [0.1, 0.1, 0.12]), "render.background"))),
         options=r.json_value(r.obj(rs.get("options", {}), "render.options"), "render.options"),
     )
+    if "backend" in session.render.options:
+        r.string(session.render.options["backend"], "render.options.backend", RENDER_BACKENDS)
     session.layout = r.json_value(r.obj(d.get("layout", {}), "layout"), "layout")
     session.clip = _read_clip(r, d.get("clip", {"planes": [], "box": None}))
     return session

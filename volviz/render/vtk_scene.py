@@ -146,35 +146,18 @@ def add_dataset(plotter: Any, dataset: Any, tf: Any = None, opacity: float = 1.0
     return volume_prop(plotter, volume_input(dataset), isinstance(dataset, RegularVolume), tf, opacity, name)
 
 
-SOFTWARE_GL = ("llvmpipe", "softpipe", "swrast")
-
-
-def software_opengl(plotter: Any) -> bool:
-    """Whether ``plotter`` draws with a software OpenGL (Mesa llvmpipe), where VTK's CPU ray caster beats its GPU
-    ray caster on regular volumes: DESIGN.md measured 0.07 s against 0.26 s per frame for the embryo at 512²; in the
-    app, loading the embryo blocked the event loop 4.3 s with the GPU mapper and 1.2 s with the CPU one, and a Storm
-    playback frame took 450 ms against 230 ms (1400x900 window, load ~2.5). Asked once per plotter."""
-    known = plotter.__dict__.get("_volviz_software_gl")
-    if known is None:
-        ren_win = plotter.ren_win
-        text = ren_win.ReportCapabilities()
-        if "renderer string" not in text:  # no context yet: create it
-            ren_win.Render()
-            text = ren_win.ReportCapabilities()
-        known = any(name in text.lower() for name in SOFTWARE_GL)
-        plotter.__dict__["_volviz_software_gl"] = known
-    return known
-
-
-def volume_prop(plotter: Any, data: Any, regular: bool, tf: Any, opacity: float, name: Optional[str]) -> Any:
+def volume_prop(plotter: Any, data: Any, regular: bool, tf: Any, opacity: float, name: Optional[str],
+                backend: str = "auto") -> Any:
     """Add a ``vtkVolume`` drawing the VTK dataset ``data`` with ``tf`` to ``plotter``: regular volumes through
-    vtkSmartVolumeMapper (its CPU ray caster on a software OpenGL, see ``software_opengl``), others through
-    vtkProjectedTetrahedraMapper. Returns the volume."""
+    vtkSmartVolumeMapper (its CPU ray caster where ``backend`` picks "cpu": by default on a software OpenGL, see
+    ``volviz.render.backend``), others through vtkProjectedTetrahedraMapper. Returns the volume."""
     import vtk
 
+    from volviz.render.backend import choose_backend, plotter_gl_info
+
     mapper = vtk.vtkSmartVolumeMapper() if regular else vtk.vtkProjectedTetrahedraMapper()
-    if regular and software_opengl(plotter):
-        mapper.SetRequestedRenderModeToRayCast()  # VTK's CPU ray caster: 3.5x faster than its GPU one on llvmpipe
+    if regular and choose_backend(backend, "regular", plotter_gl_info(plotter)) == "cpu":
+        mapper.SetRequestedRenderModeToRayCast()  # VTK's CPU ray caster
     mapper.SetInputData(data)
     volume = vtk.vtkVolume()
     volume.SetMapper(mapper)

@@ -1,0 +1,118 @@
+"""Which renderer draws a view: the GPU path through VTK's OpenGL or volviz's CPU path, chosen from the render setting
+``backend`` ("auto", "gpu", "cpu") and the OpenGL driver a render window runs on.
+
+View kinds with both paths:
+
+- ``"pt"``: unstructured (tetrahedral) volumes by pre-integrated projected tetrahedra (Roettger Ch. 8-9): the GPU
+  pass ``volviz.render.gl_pt.GLPTVolume`` (VTK draws it at every render) or the CPU ``volviz.render.pt_prop.PTVolume``
+  (an image made by ``volviz.unstructured.render`` off the GUI thread and pasted over VTK's scene).
+- ``"regular"``: regular volumes by VTK's ray casters: ``vtkSmartVolumeMapper``'s GPU ray caster or its CPU one.
+
+``auto`` takes the GPU path on a hardware OpenGL driver. On a software rasteriser (Mesa llvmpipe, softpipe, swrast,
+Google SwiftShader) the GPU's work runs on the same CPU cores, so ``auto`` takes the path measured faster there:
+
+- PT: the CPU ``pt``. ``docs/bench/pt-gl/unstructured.md`` (Blunt Fin, 187,318 tetrahedra, llvmpipe, 2 cores) has
+  0.37 s / 0.67 s per frame (CPU ``pt`` / GL PT) at 256², 1.09 / 1.69 s at 512², 2.6 / 5.2 s at 1024² and 6.1 / 6.2 s
+  at 1920x1080: the CPU path is faster at every size measured. In the app it also renders off the GUI thread and
+  draws half-size previews while the camera moves, where the GL pass blocks the GUI thread for a full-size draw.
+- regular: VTK's CPU ray caster (DESIGN.md: the embryo 256³ at 512² takes 0.07 s against 0.26 s with the GPU ray
+  caster on llvmpipe; in the app, loading the embryo blocked the event loop 4.3 s with the GPU mapper and 1.2 s
+  with the CPU one, and a Storm playback frame took 450 ms against 230 ms).
+
+    info = gl_info(plotter.ren_win)              # GLInfo(vendor, renderer, version)
+    choose_backend("auto", "pt", info)           # "cpu" on llvmpipe, "gpu" on a hardware driver
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+from volviz.session import RENDER_BACKENDS
+
+__all__ = ["RENDER_BACKENDS", "VIEW_KINDS", "GLInfo", "backend_setting", "choose_backend", "gl_info",
+           "is_software_renderer", "offscreen_gl_info", "parse_capabilities", "plotter_gl_info"]
+
+VIEW_KINDS = ("pt", "regular")
+SOFTWARE_RENDERERS = ("llvmpipe", "softpipe", "swrast", "swiftshader", "software rasterizer")
+_FASTER_ON_SOFTWARE = {"pt": "cpu", "regular": "cpu"}     # measured (module docstring)
+
+
+@dataclass(frozen=True)
+class GLInfo:
+    """The OpenGL driver of a render window, as ``glGetString`` reports it ("" where unknown)."""
+
+    vendor: str = ""
+    renderer: str = ""
+    version: str = ""
+
+    @property
+    def software(self) -> bool:
+        return is_software_renderer(self.renderer)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"vendor": self.vendor, "renderer": self.renderer, "version": self.version, "software": self.software}
+
+
+def is_software_renderer(renderer: str) -> bool:
+    """Whether an OpenGL renderer string names a software rasteriser (llvmpipe, softpipe, swrast, SwiftShader)."""
+    text = renderer.lower()
+    return any(name in text for name in SOFTWARE_RENDERERS)
+
+
+def parse_capabilities(text: str) -> GLInfo:
+    """The vendor, renderer and version lines of ``vtkOpenGLRenderWindow.ReportCapabilities()``."""
+    found = {}
+    for line in text.splitlines():
+        for key in ("vendor", "renderer", "version"):
+            prefix = f"OpenGL {key} string:"
+            if line.startswith(prefix):
+                found[key] = line[len(prefix):].strip()
+    return GLInfo(**found)
+
+
+def gl_info(render_window: Any) -> GLInfo:
+    """The OpenGL driver of a VTK render window (its context is made by one render when it has none yet)."""
+    text = render_window.ReportCapabilities()
+    if "renderer string" not in text:
+        render_window.Render()
+        text = render_window.ReportCapabilities()
+    return parse_capabilities(text)
+
+
+def plotter_gl_info(plotter: Any) -> GLInfo:
+    """``gl_info`` of a PyVista plotter's render window, asked once per plotter."""
+    known = plotter.__dict__.get("_volviz_gl_info")
+    if known is None:
+        known = gl_info(plotter.ren_win)
+        plotter.__dict__["_volviz_gl_info"] = known
+    return known
+
+
+def offscreen_gl_info() -> GLInfo:
+    """The OpenGL driver of VTK's offscreen render windows on this machine (a tiny one, made and closed here)."""
+    from volviz.render.export import offscreen_plotter
+
+    plotter = offscreen_plotter((8, 8))
+    try:
+        return gl_info(plotter.ren_win)
+    finally:
+        plotter.close()
+
+
+def backend_setting(options: dict[str, Any]) -> str:
+    """The render option ``backend`` ("auto" when missing)."""
+    value = options.get("backend", "auto")
+    return value if value in RENDER_BACKENDS else "auto"
+
+
+def choose_backend(setting: str, view_kind: str, info: GLInfo) -> str:
+    """"gpu" or "cpu" for a view of ``view_kind`` (``VIEW_KINDS``) under the render setting ``setting``
+    (``RENDER_BACKENDS``): an explicit "gpu" or "cpu" is honoured; "auto" is "gpu" on a hardware driver and the path
+    measured faster on a software rasteriser (module docstring)."""
+    if setting not in RENDER_BACKENDS:
+        raise ValueError(f"unknown backend {setting!r}; choose one of {', '.join(RENDER_BACKENDS)}")
+    if view_kind not in VIEW_KINDS:
+        raise ValueError(f"unknown view kind {view_kind!r}; choose one of {', '.join(VIEW_KINDS)}")
+    if setting != "auto":
+        return setting
+    return _FASTER_ON_SOFTWARE[view_kind] if info.software else "gpu"
