@@ -25,10 +25,15 @@ def _is_lod(prop: Any) -> bool:
 
 
 def _is_pt(prop: Any) -> bool:
-    from volviz.render.iso_overlay import IsoOverlay
-    from volviz.render.pt_prop import PTVolume
+    """A PT volume on either backend (``volviz.render.pt_view``)."""
+    from volviz.render.pt_view import is_pt_view
 
-    return isinstance(prop, PTVolume) and not isinstance(prop, IsoOverlay)
+    return is_pt_view(prop)
+
+
+def _is_cpu_pt(prop: Any) -> bool:
+    """A PT volume whose images volviz renders (``begin`` / ``compute`` / ``finish``); the GPU's VTK draws."""
+    return _is_pt(prop) and prop.backend == "cpu"
 
 
 @contextmanager
@@ -58,7 +63,6 @@ class SceneController:
         self.datasets = datasets
         self.props: dict[str, Any] = {}
         self.iso_overlay: Any = None      # IsoOverlay while a CPU transparency mode is on
-        self._pt_meshes: dict[str, Any] = {}   # uncut tetrahedral meshes of clipped PT volumes
         self._vtk_inputs: dict[str, Any] = {}  # uncut inputs of clipped VTK tetrahedral volumes
         self.histograms: dict[str, Any] = {}   # comp id -> (counts, edges) of its data, from ``prepare``
         self.time = 0.0
@@ -100,11 +104,11 @@ class SceneController:
                 # VTK fits the clipping range to its own props only: a previous scene's near plane cut through a PT
                 # mesh (a 700k-tetrahedron first frame took minutes instead of 0.3 s)
                 self.plotter.renderer.ResetCameraClippingRange(self.installed_bounds)
-            self._pt_meshes, self._vtk_inputs = {}, {}
+            self._vtk_inputs = {}
             self.histograms = dict(prepared.histograms)
             self.time = prepared.time if prepared.time is not None else 0.0
-            for comp_id, cut in prepared.cut.items():  # PT meshes were cut in ``prepare``
-                if comp_id in self.props:
+            for comp_id, cut in prepared.cut.items():  # PT meshes were cut in ``prepare`` (the GPU clips itself)
+                if _is_cpu_pt(self.props.get(comp_id)):
                     self.set_pt_mesh(comp_id, cut)
             if self.clip.all_planes():
                 self.apply_clip(update_pt=False, cut_pt=False, isosurfaces=False)
@@ -161,7 +165,7 @@ class SceneController:
         comp.transfer_function = name
         prop = self.props.get(comp_id)
         if _is_pt(prop):
-            prop.tf = tf.scaled_extinction(comp.opacity) if comp.opacity != 1.0 else tf
+            prop.set_tf(tf.scaled_extinction(comp.opacity) if comp.opacity != 1.0 else tf)
             if update:
                 prop.update()
         elif _is_lod(prop):
@@ -260,7 +264,7 @@ class SceneController:
                 self._readd_isosurfaces(comp_id)
         elif _is_pt(prop):
             tf = self.transfer_function(comp_id)
-            prop.tf = tf.scaled_extinction(comp.opacity) if comp.opacity != 1.0 else tf
+            prop.set_tf(tf.scaled_extinction(comp.opacity) if comp.opacity != 1.0 else tf)
             prop.update()
         elif _is_lod(prop):
             prop.opacity = comp.opacity
@@ -456,7 +460,7 @@ class SceneController:
                 requests.append(("lod", volume, volume.camera()))
             return requests
         for prop in self.props.values():
-            if _is_pt(prop) and prop.visible:
+            if _is_cpu_pt(prop) and prop.visible:
                 requests.append(("overlay", prop, prop.begin()))
         if self.iso_overlay is not None:
             requests.append(("overlay", self.iso_overlay, self.iso_overlay.begin()))
@@ -495,13 +499,18 @@ class SceneController:
                 if _is_lod(prop) and prop.volume.GetVisibility()}
 
     def pt_volume(self, comp_id: str) -> Any:
-        """The PT volume handle of a component, or None when it is drawn by VTK."""
+        """The PT volume of a component whose images volviz renders (the CPU backend: ``begin`` / ``compute`` /
+        ``finish``), or None when VTK draws it (the GPU backend, or VTK's own mappers)."""
         prop = self.props.get(comp_id)
-        return prop if _is_pt(prop) else None
+        return prop if _is_cpu_pt(prop) else None
 
     def pt_stats(self) -> dict[str, Any]:
         """The last frame statistics of every PT volume (sort / project / raster seconds, fragments, method)."""
         return {comp_id: dict(prop.stats) for comp_id, prop in self.props.items() if _is_pt(prop)}
+
+    def pt_backends(self) -> dict[str, str]:
+        """The backend ("gpu" or "cpu") of every PT volume (``volviz.render.backend``)."""
+        return {comp_id: prop.backend for comp_id, prop in self.props.items() if _is_pt(prop)}
 
     def rebuild_nature(self) -> None:
         """Rebuild the natural scene for the visible nature components now (``prepare_nature``, ``install_nature``)."""
@@ -544,7 +553,7 @@ class SceneController:
         boxes = []
         for comp_id, prop in self.shown_props().items():
             if _is_pt(prop):
-                boxes.append(points_bounds(self._pt_meshes.get(comp_id, prop.mesh).points))
+                boxes.append(prop.bounds())
             elif comp_id in self._iso_props():
                 boxes += [points_bounds(m.points) for m in prop.volviz_meshes if len(m.points)]
             else:
@@ -563,7 +572,7 @@ class SceneController:
     def set_clip(self, clip: Any, update_pt: bool = True, cut_pt: bool = True,
                  isosurfaces: bool = True) -> list[str]:
         """Store new clipping (``session.clip`` JSON or ClipSettings) and cut every prop; returns the ids of the PT
-        volumes affected. Their meshes are cut here when ``cut_pt`` and re-rendered when ``update_pt``; the app
+        volumes drawn from a cut mesh (CPU backend; a GPU volume clips per fragment, at once). Their meshes are cut here when ``cut_pt`` and re-rendered when ``update_pt``; the app
         instead cuts them in the background (``cut_pt_mesh`` on a worker, then ``set_pt_mesh``) and re-renders.
         Isosurfaces are re-cut here when ``isosurfaces``; the app instead cuts them in the background
         (``isosurface_meshes``, ``volviz.render.scene.isosurface_parts`` on a worker, ``show_isosurfaces``)."""
@@ -578,7 +587,8 @@ class SceneController:
 
     def apply_clip(self, update_pt: bool = True, cut_pt: bool = True, isosurfaces: bool = True) -> list[str]:
         """Cut every prop by the session's clipping (isosurfaces only when ``isosurfaces``: ``install`` gets them
-        cut by ``prepare``); returns the ids of the PT volumes (see ``set_clip``)."""
+        cut by ``prepare``); returns the ids of the PT volumes drawn from a cut mesh (the CPU backend; see
+        ``set_clip``)."""
         from volviz.render.clipping import clip_vtk_prop
 
         clip = self.clip
@@ -591,7 +601,8 @@ class SceneController:
                 if isosurfaces:
                     self._readd_isosurfaces(comp_id)
             elif _is_pt(prop):
-                self._pt_meshes.setdefault(comp_id, prop.mesh)
+                if prop.set_clip(clip):        # the GPU clips per fragment; the CPU draws a cut mesh
+                    continue
                 pt_ids.append(comp_id)
                 if cut_pt:
                     self.set_pt_mesh(comp_id, self.cut_pt_mesh(comp_id))
@@ -610,14 +621,11 @@ class SceneController:
         (``volviz.iso.clip.clip_tetmesh``), with its topology built; None when the clipping removes all of it."""
         from volviz.render.scene import cut_tetmesh
 
-        prop = self.props[comp_id]
-        whole = self._pt_meshes.get(comp_id, prop.mesh)
-        return cut_tetmesh(whole, self.clip if clip is None else clip)
+        return cut_tetmesh(self.props[comp_id].whole_mesh, self.clip if clip is None else clip)
 
     def set_pt_mesh(self, comp_id: str, mesh: Any) -> None:
         """Show a cut mesh of ``cut_pt_mesh`` (None: nothing left, the volume is hidden); re-render it afterwards."""
         prop = self.props[comp_id]
-        self._pt_meshes.setdefault(comp_id, prop.mesh)
         if mesh is None:
             prop.visible = False
             return

@@ -22,7 +22,10 @@ How a frame is drawn:
 - Compositing: premultiplied "over" (ONE, ONE_MINUS_SRC_ALPHA) through a 1x1 premultiplied actor texture, which
   makes VTK set and restore the blend state; the actor is translucent and drawn in order (no OIT, no depth peeling
   for this renderer), into a float32 colour target (a ``vtkFramebufferPass`` around ``vtkRenderStepsPass``): ~95
-  cells overlap per pixel on the Blunt Fin, which an 8-bit target does not accumulate accurately.
+  cells overlap per pixel on the Blunt Fin, which an 8-bit target does not accumulate accurately. The window's
+  multisampling is off while the volume is in it (as for volviz's CPU overlays): with MSAA on, the other layers
+  (the orientation axes) were antialiased and the volume's renderer was not, and the same view differed from the
+  CPU backend's by up to 255 at the axes.
 - Opaque geometry: when the mapper draws (translucent pass, after the opaque one), the framebuffer pass's depth
   texture holds the opaque scene (translucent props do not write depth); the shader reads it (texelFetch) and each
   segment ends at the opaque depth of its pixel, so a cell straddling a surface is integrated only up to it. The
@@ -47,6 +50,8 @@ from typing import Any
 import numpy as np
 
 from volviz.model.datasets import TetMesh
+from volviz.render.image_overlay import hold_single_sample, release_single_sample
+from volviz.render.pt_view import PTView
 from volviz.unstructured.camera import Camera
 from volviz.unstructured.topology import FACES, cell_ranges, topology, visible_cells
 
@@ -109,7 +114,7 @@ def _triangles(cells: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.arange(0, len(conn) + 1, 3, dtype=np.int64), conn
 
 
-class GLPTVolume:
+class GLPTVolume(PTView):
     """A TetMesh drawn by the GPU pre-integrated PT pass in a PyVista plotter's renderer (module docstring).
 
     ``lookup``: "3d" (default; n_s x n_s x n_l trilinear, ``table_size``), "separable" (degree ``degree``) or
@@ -118,7 +123,10 @@ class GLPTVolume:
     for the camera (``sorted``: here or by ``prefetch``), taken from ``prefetch`` or reused. ``prefetch(camera)``
     sorts for a known next camera in the background; ``reuse_order = True`` keeps the last order for every camera
     (e.g. during a mouse drag: the image is then exact per cell but may composite some overlapping cells in the wrong
-    order)."""
+    order). ``camera``: the camera of the last draw. The GPU side of the PT view interface
+    ``volviz.render.pt_view.PTView``: VTK draws it at every render, so ``update`` has nothing to do."""
+
+    backend = "gpu"
 
     def __init__(self, plotter: Any, mesh: TetMesh, tf: Any, *, lookup: str = "3d", n_s: int | None = None,
                  n_l: int = 64, degree: int | None = None, sort: str = "mpvo", nonconvex: str = "auto") -> None:
@@ -130,11 +138,12 @@ class GLPTVolume:
             raise ValueError(f"unknown lookup {lookup!r}; choose one of {_LOOKUPS}")
         self.plotter = plotter
         self.renderer = plotter.renderer
-        self.mesh = mesh
+        self.mesh = self.whole_mesh = mesh           # clipping cuts per fragment: the mesh stays whole
         self.topo = topology(mesh)
         self.lookup, self.n_s, self.n_l, self.degree = lookup, n_s, n_l, degree
         self.sort, self.nonconvex = sort, nonconvex
-        self.stats: dict[str, Any] = {}
+        self.stats: dict[str, Any] = {"method": "pt-gl"}
+        self.camera: Camera | None = None
         self.order: np.ndarray | None = None       # the drawn cells, back to front
         self.reuse_order = False                    # keep the last order whatever the camera (during interaction)
         self._sorted: np.ndarray | None = None      # the last full visibility order (all cells)
@@ -168,6 +177,7 @@ class GLPTVolume:
         self.actor.SetTexture(self._premultiplied_texture())
 
         self._install_pass()
+        hold_single_sample(plotter, self)          # the float target is single-sample; so is the window meanwhile
         def on_update_shader(caller: Any, event: str, program: Any = None) -> None:
             self._on_update_shader(program)
 
@@ -223,7 +233,9 @@ class GLPTVolume:
 
         from volviz.unstructured.sort import visibility_order
 
-        cam = self._camera()
+        if not self.actor.GetVisibility():
+            return
+        cam = self.camera = self._camera()
         size = tuple(int(v) for v in self.renderer.GetSize())
         key = (tuple(cam.position), tuple(cam.focal_point), tuple(cam.view_up), cam.view_angle, cam.parallel,
                cam.parallel_scale, size)
@@ -245,8 +257,8 @@ class GLPTVolume:
         polys.SetData(numpy_to_vtk(offsets, deep=True), numpy_to_vtk(conn, deep=True))
         self.polydata.Modified()
         self.order, self._order_key = cells, key
-        self.stats = {"sort_s": t1 - t0, "order_s": time.perf_counter() - t1, "n_visible": int(len(cells)),
-                      "cycles": self._cycles, "sorted": not (same or reused), "sort_prefetched": prefetched,
+        self.stats = {"method": "pt-gl", "sort_s": t1 - t0, "order_s": time.perf_counter() - t1,
+                      "n_visible": int(len(cells)), "cycles": self._cycles, "sorted": not (same or reused), "sort_prefetched": prefetched,
                       "order_reused": reused}
 
     def prefetch(self, camera: Camera, size: tuple[int, int] | None = None) -> None:
@@ -376,6 +388,23 @@ class GLPTVolume:
             raise ValueError(f"at most {_MAX_CLIP} clipping planes, got {len(rows)}")
         self._clip = np.array(rows, np.float64).reshape(-1, 4)
 
+    def set_clip(self, clip: Any) -> bool:
+        """Clip by ``volviz.iso.clip.ClipSettings`` (its planes and box) per fragment (``set_clip_planes``); returns
+        True (``PTView.set_clip``: nothing for the caller to cut)."""
+        self.set_clip_planes([(p.normal, p.point) for p in clip.all_planes()])
+        return True
+
+    def update(self) -> None:
+        """Nothing to re-make: the next render sorts for its camera and draws (``PTView.update``)."""
+
+    @property
+    def visible(self) -> bool:
+        return bool(self.actor.GetVisibility())
+
+    @visible.setter
+    def visible(self, on: bool) -> None:
+        self.actor.SetVisibility(bool(on))
+
     def remove(self) -> None:
         """Take the volume out of the renderer; the last GL PT volume of a renderer removes the float target (call
         it before closing the plotter: VTK complains when a framebuffer pass outlives its context's resources)."""
@@ -390,6 +419,7 @@ class GLPTVolume:
         if self._table_tex is not None and ren_win is not None:
             self._table_tex.ReleaseGraphicsResources(ren_win)
         self._table_tex = self._depth_tex = None
+        release_single_sample(self.plotter, self)
         users = getattr(self.renderer, _USERS, [])
         if self in users:
             users.remove(self)

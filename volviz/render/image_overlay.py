@@ -39,6 +39,7 @@ __all__ = ["ImageOverlay", "OverlayView", "bleed_colour", "block_min", "overlay_
 
 _SIBLINGS = "_volviz_pt_overlays"           # plotter attribute: every overlay renderer of the plotter
 _MULTISAMPLES = "_volviz_pt_multisamples"   # plotter attribute: the MSAA setting to restore
+_SINGLE_SAMPLE_HOLDERS = "_volviz_single_sample_holders"   # plotter attribute: what keeps MSAA off
 
 
 def zbuffer_to_depth(z: np.ndarray, clipping_range: tuple[float, float], parallel: bool) -> np.ndarray:
@@ -119,6 +120,24 @@ def read_buffers(ren_win: Any, w: int, h: int) -> tuple[np.ndarray, np.ndarray]:
     return zz, cc
 
 
+def hold_single_sample(plotter: Any, holder: Any) -> None:
+    """Multisampling off while ``holder`` is in the plotter (one colour and depth per pixel: the overlays read the
+    depth back, the GL PT pass draws into a single-sample float target; module docstring)."""
+    if _MULTISAMPLES not in plotter.__dict__:
+        plotter.__dict__[_MULTISAMPLES] = int(plotter.ren_win.GetMultiSamples())
+        plotter.ren_win.SetMultiSamples(0)
+    plotter.__dict__.setdefault(_SINGLE_SAMPLE_HOLDERS, []).append(holder)
+
+
+def release_single_sample(plotter: Any, holder: Any) -> None:
+    """``holder`` is gone: the last one restores the plotter's multisampling."""
+    holders = plotter.__dict__.get(_SINGLE_SAMPLE_HOLDERS, [])
+    if holder in holders:
+        holders.remove(holder)
+    if not holders and _MULTISAMPLES in plotter.__dict__:
+        plotter.ren_win.SetMultiSamples(plotter.__dict__.pop(_MULTISAMPLES))
+
+
 class ImageOverlay:
     """One full-window image over a plotter's scene (see the module docstring). Starts hidden."""
 
@@ -127,12 +146,10 @@ class ImageOverlay:
 
         self.plotter = plotter
         ren_win = plotter.ren_win
-        if _MULTISAMPLES not in plotter.__dict__:          # one depth per pixel (see the module docstring)
-            plotter.__dict__[_MULTISAMPLES] = int(ren_win.GetMultiSamples())
-            ren_win.SetMultiSamples(0)
         layer = max(1, ren_win.GetNumberOfLayers())
         ren_win.SetNumberOfLayers(layer + 1)
         self.renderer = vtk.vtkRenderer()
+        hold_single_sample(plotter, self.renderer)
         self.renderer.SetLayer(layer)
         self.renderer.InteractiveOff()
         self.renderer.SetViewport(plotter.renderer.GetViewport())
@@ -203,8 +220,7 @@ class ImageOverlay:
         self.plotter.ren_win.RemoveRenderer(self.renderer)
         if self.renderer in self.siblings:
             self.siblings.remove(self.renderer)
-        if not self.siblings and _MULTISAMPLES in self.plotter.__dict__:
-            self.plotter.ren_win.SetMultiSamples(self.plotter.__dict__.pop(_MULTISAMPLES))
+        release_single_sample(self.plotter, self.renderer)
 
 
 class OverlayView:

@@ -34,14 +34,18 @@ import numpy as np
 
 from volviz.model.datasets import TetMesh
 from volviz.render.image_overlay import OverlayView, overlay_rgba8, unpremultiply_rgba8, zbuffer_to_depth
+from volviz.render.pt_view import PTView
 from volviz.unstructured.camera import Camera
 from volviz.unstructured.render import render
 
 __all__ = ["PTVolume", "add_pt_volume", "unpremultiply_rgba8", "zbuffer_to_depth"]
 
 
-class PTVolume(OverlayView):
-    """A volviz PT volume attached to a PyVista plotter (see the module docstring)."""
+class PTVolume(OverlayView, PTView):
+    """A volviz PT volume attached to a PyVista plotter (see the module docstring). The CPU side of the PT view
+    interface ``volviz.render.pt_view.PTView``; ``mesh`` is what is drawn (a cut of ``whole_mesh`` under clipping)."""
+
+    backend = "cpu"
 
     def __init__(self, plotter: Any, mesh: Any, tf: Any, method: str = "pt", **render_opts: Any) -> None:
         scalars = render_opts.pop("scalars", None)
@@ -53,6 +57,7 @@ class PTVolume(OverlayView):
             raise ValueError(f"PT volume method must be 'pt' or 'reference', got {method!r}")
         super().__init__(plotter)
         self.mesh = mesh
+        self.whole_mesh = mesh                        # uncut: what clipping cuts and ``bounds`` measures
         self.tf = tf
         self.method = method
         self.render_opts = render_opts
@@ -127,6 +132,15 @@ class PTVolume(OverlayView):
         super().finish(request, img, st, rgba8)
         self.stats.update(method=self.method, sort_prefetched=bool(st.extra.get("sort_prefetched", False)))
         return img
+
+    def set_tf(self, tf: Any) -> None:
+        """A new transfer function for the next image (``update``, or ``begin`` / ``compute`` / ``finish``)."""
+        self.tf = tf
+
+    def set_clip(self, clip: Any) -> bool:
+        """Clipping is not done here: the caller shows an exact cut of ``whole_mesh`` as ``mesh``
+        (``volviz.render.scene.cut_tetmesh``, ``SceneController.set_pt_mesh``); returns False (``PTView.set_clip``)."""
+        return False
 
     def remove(self) -> None:
         """Detach the overlay from the plotter's render window."""

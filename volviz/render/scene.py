@@ -14,6 +14,7 @@ from typing import Any, Optional
 import numpy as np
 
 from volviz.jobs import ProgressCallback, report
+from volviz.render.backend import backend_setting
 from volviz.session import Component, DatasetRef, RenderSettings, Session, resolve_path
 
 
@@ -123,7 +124,7 @@ def vvz_voxels(path: str | os.PathLike) -> int:
 def demo_session() -> Session:
     """The built-in procedural natural scene (fractal terrain, Perlin ground fog and clouds, sky), generated at
     start-up from no files."""
-    from volviz.nature.scene import demo_components
+    from volviz.render.demo import demo_components
     from volviz.session import CameraState
 
     camera = CameraState(position=(500.0, -150.0, 330.0), focal_point=(500.0, 600.0, 80.0), view_up=(0.0, 0.0, 1.0),
@@ -341,15 +342,17 @@ def prepared_volume_input(dataset: Any, t: Optional[float] = None, interpolate: 
     return volume_input(dataset)
 
 
-def add_volume_prop(plotter: Any, dataset: Any, data: Any, tf: Any, opacity: float, name: str) -> Any:
-    """GUI thread: a vtkVolume drawing ``data`` (from ``prepared_volume_input``; None: ``add_dataset`` instead)."""
+def add_volume_prop(plotter: Any, dataset: Any, data: Any, tf: Any, opacity: float, name: str,
+                    backend: str = "auto") -> Any:
+    """GUI thread: a vtkVolume drawing ``data`` (from ``prepared_volume_input``; None: ``add_dataset`` instead);
+    ``backend``: the render option (``volviz.render.backend``), which picks VTK's GPU or CPU ray caster."""
     from volviz.model import RegularVolume, TimeSeries
     from volviz.render.vtk_scene import add_dataset, volume_prop
 
     if data is None:
         return add_dataset(plotter, dataset, tf=tf, opacity=opacity, name=name)
     regular = isinstance(dataset.frame(0) if isinstance(dataset, TimeSeries) else dataset, RegularVolume)
-    return volume_prop(plotter, data, regular, tf, opacity, name)
+    return volume_prop(plotter, data, regular, tf, opacity, name, backend)
 
 
 def prepare_nature(session: Session, datasets: dict[str, Any]) -> Any:
@@ -436,7 +439,8 @@ def install_component(plotter: Any, session: Session, comp: Component, datasets:
     if uses_pt(session, dataset):
         return add_pt_component(plotter, session, comp, prepared.parts[comp.id], update=views)
     tf = component_transfer_function(session, comp)
-    return add_volume_prop(plotter, dataset, prepared.parts.get(comp.id), tf, comp.opacity, comp.id)
+    return add_volume_prop(plotter, dataset, prepared.parts.get(comp.id), tf, comp.opacity, comp.id,
+                           backend_setting(session.render.options))
 
 
 def build_scene(plotter: Any, session: Session, datasets: dict[str, Any], spectrum: bool = True) -> dict[str, Any]:
@@ -484,20 +488,32 @@ def uses_pt(session: Session, dataset: Any) -> bool:
 
 
 def add_pt_component(plotter: Any, session: Session, comp: Component, dataset: Any, update: bool = True) -> Any:
-    """A volviz PT volume (``volviz.render.pt_prop``) for a component, with its TF scaled by its opacity; rendered
-    now when ``update`` (the app renders it in the background: ``begin`` / ``compute`` / ``finish``)."""
-    from volviz.render.pt_prop import PTVolume
-
+    """A PT volume for a component (``volviz.render.pt_view``), with its TF scaled by its opacity: drawn on the GPU
+    (``volviz.render.gl_pt``) or the CPU (``volviz.render.pt_prop``) as the render option ``backend`` picks for this
+    plotter's OpenGL (``volviz.render.backend``; the exact "reference" method is CPU only). A CPU volume's image is
+    rendered now when ``update`` (the app renders it in the background: ``begin`` / ``compute`` / ``finish``)."""
     tf = component_transfer_function(session, comp)
     if comp.opacity != 1.0:
         tf = tf.scaled_extinction(comp.opacity)
     method = "reference" if session.render.method == "reference" else "pt"
-    scalars = getattr(dataset, "active", None)
-    handle = PTVolume(plotter, dataset, tf, method=method, scalars=scalars,
-                      **(pt_options(session.render.options) if method == "pt" else {}))
+    opts = pt_options(session.render.options) if method == "pt" else {}
+    if method == "pt" and pt_backend(plotter, session) == "gpu":
+        from volviz.render.gl_pt import GLPTVolume
+
+        return GLPTVolume(plotter, dataset, tf, **{"lookup": "auto", **opts})   # the table the CPU path picks
+    from volviz.render.pt_prop import PTVolume
+
+    handle = PTVolume(plotter, dataset, tf, method=method, scalars=getattr(dataset, "active", None), **opts)
     if update:
         handle.update()
     return handle
+
+
+def pt_backend(plotter: Any, session: Session) -> str:
+    """"gpu" or "cpu": where the session's PT volumes are drawn in ``plotter`` (``volviz.render.backend``)."""
+    from volviz.render.backend import choose_backend, plotter_gl_info
+
+    return choose_backend(backend_setting(session.render.options), "pt", plotter_gl_info(plotter))
 
 
 def pt_options(options: dict[str, Any]) -> dict[str, Any]:

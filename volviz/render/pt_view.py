@@ -1,0 +1,47 @@
+"""The interface of a projected-tetrahedra volume in a plotter (Roettger Ch. 8-9), whichever renderer draws it
+(``volviz.render.backend``): ``volviz.render.gl_pt.GLPTVolume`` on the GPU (VTK draws it at every render) or
+``volviz.render.pt_prop.PTVolume`` on the CPU (an image re-made by ``update``, or by ``begin`` / ``compute`` /
+``finish`` in the app's background jobs, and pasted over VTK's scene). ``SceneController`` talks to both through it.
+"""
+from __future__ import annotations
+
+from typing import Any
+
+from volviz.render.framing import Bounds, points_bounds
+
+__all__ = ["PTView", "is_pt_view"]
+
+
+class PTView:
+    """What both PT volumes offer. Attributes: ``backend`` ("gpu" or "cpu"), ``mesh`` (the TetMesh drawn),
+    ``whole_mesh`` (uncut), ``tf``, ``stats`` (the last frame's: ``method``, ``sort_s``, ...), ``visible``."""
+
+    backend = ""
+    whole_mesh: Any
+    stats: dict[str, Any]
+    visible: bool
+
+    def set_tf(self, tf: Any) -> None:
+        """Draw with a new transfer function from the next frame on."""
+        raise NotImplementedError
+
+    def set_clip(self, clip: Any) -> bool:
+        """Clip by ``volviz.iso.clip.ClipSettings``. True: done; False: this view clips only by drawing a cut mesh,
+        which the caller makes (``volviz.render.scene.cut_tetmesh``) and sets as ``mesh``."""
+        raise NotImplementedError
+
+    def update(self) -> Any:
+        """Make the view current for the plotter's camera and scene now."""
+        raise NotImplementedError
+
+    def remove(self) -> None:
+        """Take the volume out of the plotter."""
+        raise NotImplementedError
+
+    def bounds(self) -> Bounds:
+        """(xmin, xmax, ymin, ymax, zmin, zmax) of the uncut mesh."""
+        return points_bounds(self.whole_mesh.points)
+
+
+def is_pt_view(prop: Any) -> bool:
+    return isinstance(prop, PTView)
