@@ -17,6 +17,7 @@ from PySide6.QtWidgets import (QDockWidget, QFileDialog, QLabel, QMainWindow, QM
                                QProgressBar, QPushButton, QWidget)
 
 from volviz.jobs import JobOutcome
+from volviz.render.backend import plotter_gl_info
 from volviz.render.controller import no_render
 from volviz.session import CameraKey, Session, SessionError, relative_path
 from volviz_app.array_choice import ArrayChoice
@@ -542,7 +543,8 @@ class MainWindow(CameraBookmarks, QMainWindow):
         self.plotter.render()
         elapsed = time.perf_counter() - start
         stats: dict[str, Any] = {"frame_seconds": elapsed, "method": self.session.render.method,
-                                 "cells": sum(getattr(d, "n_cells", 0) for d in self.datasets.values())}
+                                 "cells": sum(getattr(d, "n_cells", 0) for d in self.datasets.values()),
+                                 "gl": plotter_gl_info(self.plotter).renderer}
         pt = self.controller.pt_stats() if self.controller is not None else {}
         if pt:  # volviz's own renderer: the split of its last frame
             last = list(pt.values())
@@ -551,7 +553,7 @@ class MainWindow(CameraBookmarks, QMainWindow):
                          project_seconds=sum(s.get("project_s", 0.0) for s in last),
                          raster_seconds=sum(s.get("raster_s", 0.0) for s in last),
                          method=", ".join(sorted({str(s.get("method")) for s in last})),
-                         error=getattr(self, "error_estimate", None))
+                         error=getattr(self, "error_estimate", None), backends=self.controller.pt_backends())
         overlay = self.controller.iso_overlay if self.controller is not None else None
         if overlay is not None and overlay.stats:
             st = overlay.stats
@@ -1427,6 +1429,8 @@ class MainWindow(CameraBookmarks, QMainWindow):
         self.preview_timer.stop()
         self.record_timer.stop()
         self.timeline.set_playing(False)
+        if self.controller is not None:  # before the plotter closes: the GPU PT pass frees its GL resources
+            self.controller.clear()
         self.controller = None  # late timer callbacks find no scene to update
         if self._export_run is not None:  # no partial movie left behind, no callbacks into a closed window
             self._export_run.abandon()

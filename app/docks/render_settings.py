@@ -1,5 +1,5 @@
-"""Render settings dock: renderer method, pre-integration table kind and resolution, sort mode, error budget, export
-image size. The table and sort settings apply to volviz's PT renderer ("auto" picks the table by each cell's optical
+"""Render settings dock: renderer method, backend (GPU or CPU, ``volviz.render.backend``), pre-integration table kind
+and resolution, sort mode, error budget, export image size. The table and sort settings apply to volviz's PT renderer ("auto" picks the table by each cell's optical
 depth); the error budget is checked against the measured error of the current view (see MainWindow.estimate_error)."""
 from __future__ import annotations
 
@@ -9,11 +9,13 @@ from PySide6.QtCore import Signal
 from PySide6.QtWidgets import QComboBox, QDoubleSpinBox, QFormLayout, QSpinBox, QWidget
 
 from volviz.render.controller import ISO_MODES
+from volviz.session import RENDER_BACKENDS
 
 METHODS = ("auto", "pt", "reference", "vtk")
 TABLE_KINDS = ("auto", "3d", "separable-1", "separable-2", "separable-4")
 SORTS = ("mpvo", "centroid", "power")
-RENDERER_DEFAULTS = {"sort": "mpvo", "table": "auto", "table_resolution": 128}  # what the widgets start with
+RENDERER_DEFAULTS = {"sort": "mpvo", "table": "auto", "table_resolution": 128,   # what the widgets start with
+                     "backend": "auto"}
 
 
 class RenderSettings(QWidget):
@@ -25,6 +27,11 @@ class RenderSettings(QWidget):
         super().__init__(parent)
         self.method = QComboBox()
         self.method.addItems(METHODS)
+        self.backend = QComboBox()
+        self.backend.addItems(RENDER_BACKENDS)
+        self.backend.setToolTip("Where volumes are drawn: gpu (VTK's OpenGL; for meshes with volviz's PT shaders), "
+                                "cpu (volviz's renderer, VTK's CPU ray caster), or auto: the GPU on a hardware "
+                                "OpenGL, the faster CPU path on a software one such as llvmpipe")
         self.table_kind = QComboBox()
         self.table_kind.addItems(TABLE_KINDS)
         self.table_resolution = QComboBox()
@@ -63,6 +70,7 @@ class RenderSettings(QWidget):
                                    "ratio)")
         form = QFormLayout(self)
         form.addRow("Renderer", self.method)
+        form.addRow("Backend", self.backend)
         form.addRow("Table", self.table_kind)
         form.addRow("Table resolution", self.table_resolution)
         form.addRow("Sort", self.sort)
@@ -70,7 +78,7 @@ class RenderSettings(QWidget):
         form.addRow("Isosurfaces", self.iso_mode)
         form.addRow("Export width", self.width_box)
         form.addRow("Export height", self.height_box)
-        for combo in (self.method, self.table_kind, self.table_resolution, self.sort, self.iso_mode):
+        for combo in (self.method, self.backend, self.table_kind, self.table_resolution, self.sort, self.iso_mode):
             combo.currentTextChanged.connect(self._emit)
         for box in (self.error_budget, self.width_box, self.height_box):
             box.valueChanged.connect(self._emit)
@@ -78,7 +86,7 @@ class RenderSettings(QWidget):
 
     def settings(self) -> dict[str, Any]:
         return {"method": self.method.currentText(), "size": (self.width_box.value(), self.height_box.value()),
-                "options": {"table": self.table_kind.currentText(),
+                "options": {"backend": self.backend.currentText(), "table": self.table_kind.currentText(),
                             "table_resolution": int(self.table_resolution.currentText()),
                             "sort": self.sort.currentText(), "error_budget": self.error_budget.value(),
                             "iso_mode": self.iso_mode.currentText()}}
@@ -89,6 +97,7 @@ class RenderSettings(QWidget):
         self.width_box.setValue(render.size[0])
         self.height_box.setValue(render.size[1])
         opts = render.options
+        self.backend.setCurrentText(str(opts.get("backend", "auto")))
         self.table_kind.setCurrentText(str(opts.get("table", "auto")))
         self.table_resolution.setCurrentText(str(opts.get("table_resolution", 128)))
         self.sort.setCurrentText(str(opts.get("sort", "mpvo")))

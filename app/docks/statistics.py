@@ -1,4 +1,5 @@
-"""Statistics dock: frame time split, cells drawn, and the current method's measured error estimate."""
+"""Statistics dock: frame time split, cells drawn, the current method's measured error estimate, the OpenGL renderer
+and the backend that draws each PT volume (``volviz.render.backend``)."""
 from __future__ import annotations
 
 from typing import Any, Optional
@@ -11,12 +12,16 @@ TIPS = {"frame": "Time to draw the last frame, and the frame rate it allows",
         "cells": "Cells of the datasets shown",
         "method": "The renderer and table that drew the last frame",
         "error": "Error of the current view measured against the exact reference (8-bit units)",
-        "iso": "The isosurfaces' transparency mode, triangles and drawing time"}
+        "iso": "The isosurfaces' transparency mode, triangles and drawing time",
+        "gl": "The OpenGL renderer of the viewport (a software rasteriser such as llvmpipe runs on the CPU)",
+        "backends": "Where each PT volume is drawn: gpu (VTK's OpenGL with volviz's shaders) or cpu (volviz's "
+                    "renderer, an image over the scene); the render setting Backend chooses"}
 
 
 class Statistics(QWidget):
     FIELDS = (("frame", "Frame time"), ("split", "Sort / project / raster"), ("cells", "Cells drawn"),
-              ("method", "Method"), ("error", "Error estimate"), ("iso", "Isosurfaces"))
+              ("method", "Method"), ("error", "Error estimate"), ("iso", "Isosurfaces"), ("gl", "OpenGL"),
+              ("backends", "PT backend"))
 
     def __init__(self, parent: Optional[QWidget] = None):
         super().__init__(parent)
@@ -38,6 +43,9 @@ class Statistics(QWidget):
         error = stats.get("error")
         self.labels["error"].setText("–" if error is None else str(error))
         self.labels["iso"].setText(str(stats.get("iso", "–")))
+        self.labels["gl"].setText(str(stats.get("gl", "–")))
+        backends = stats.get("backends")
+        self.labels["backends"].setText(", ".join(f"{k}: {v}" for k, v in backends.items()) if backends else "–")
 
     def text(self, key: str) -> str:
         return self.labels[key].text()
