@@ -98,7 +98,7 @@ def test_session_files(name: str, monkeypatch) -> None:
 
 
 def test_demo_components_build_without_data() -> None:
-    from volviz.nature.scene import demo_components
+    from volviz.render.demo import demo_components
 
     comps = demo_components()
     assert {c.type for c in comps} == {"terrain", "fog", "clouds", "sky"}

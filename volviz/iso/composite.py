@@ -33,7 +33,7 @@ from numba import njit, prange
 from volviz.iso.extract import IsoMesh, merge_meshes
 from volviz.iso.raster import clip_near_plane, rasterize
 from volviz.iso.spectrum import fit_spectrum, spectrum_alpha
-from volviz.unstructured.camera import Camera
+from volviz.model.camera import Camera
 
 __all__ = ["MODES", "Fragments", "fragments", "composite", "render", "render_modes", "RenderStats"]
 

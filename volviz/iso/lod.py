@@ -21,7 +21,7 @@ from typing import Sequence
 import numpy as np
 
 from volviz.iso.extract import IsoMesh
-from volviz.unstructured.camera import Camera
+from volviz.model.camera import Camera
 
 __all__ = ["LodChain", "build_lod", "screen_radius", "select_level", "lod_mesh", "lod_meshes"]
 

@@ -21,7 +21,7 @@ from volviz.iso.extract import IsoMesh, IsoStyle, extract
 from volviz.iso.lod import LodChain, build_lod, lod_meshes
 from volviz.model.datasets import RegularVolume, TimeSeries
 from volviz.model.timeseries import frame_at
-from volviz.unstructured.camera import Camera
+from volviz.model.camera import Camera
 
 __all__ = ["IsoSettings", "PreparedIso", "prepare", "render_iso"]
 

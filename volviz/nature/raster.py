@@ -1,7 +1,7 @@
 """CPU rasterisation of the (opaque) terrain: a float64 z-buffer and a lit, textured colour image.
 
 The volumes of a natural scene (fog prisms, clouds) are composited over this depth: a pixel's fog and cloud segments
-end where its ray meets the terrain. Conventions are those of ``volviz.unstructured.camera.Camera``: pixel centres at
+end where its ray meets the terrain. Conventions are those of ``volviz.model.camera.Camera``: pixel centres at
 integer (col, row), row 0 at the top, depth = distance along the direction of projection (the ray parameter t).
 
 Triangles are clipped against the near plane in camera space (Sutherland–Hodgman, one plane) and rasterised with

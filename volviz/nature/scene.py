@@ -208,25 +208,8 @@ def demo_scene(seed: int = 0, terrain_size: int = 257, cloud_shape: tuple[int, i
     return scene
 
 
-def demo_components() -> list[Any]:
-    """Session components of the procedural natural scene (no datasets): fractal terrain, Perlin ground fog, Perlin
-    clouds, sky gradient — what ``demo_scene`` builds, for a session or the app's default scene."""
-    from volviz.session import Component
-
-    return [
-        Component(id="terrain", type="terrain", settings={"size": 257, "seed": 1, "relief": 160.0,
-                                                          "extent": [1000.0, 1000.0], "C": 9.0, "c": 40.0}),
-        Component(id="ground_fog", type="fog", settings={"level": 55.0, "thickness": 25.0, "seed": 2,
-                                                         "mode": "attenuated", "density": 0.04,
-                                                         "colour": [0.85, 0.87, 0.95]}),
-        Component(id="clouds", type="clouds", settings={"shape": [129, 129, 17], "seed": 3, "coverage": 0.25,
-                                                        "base_height": 190.0, "rho_max": 0.06}),
-        Component(id="sky", type="sky"),
-    ]
-
-
 def demo_camera(scene: NatureScene | None = None) -> Any:
-    from volviz.unstructured.camera import Camera
+    from volviz.model.camera import Camera
 
     return Camera((500.0, -150.0, 330.0), (500.0, 600.0, 80.0), (0.0, 0.0, 1.0), 60.0,
                   clipping_range=(5.0, 10000.0))
@@ -403,7 +386,7 @@ class NatureView:
                                               render=False)
 
     def _camera(self) -> Any:
-        from volviz.unstructured.camera import Camera
+        from volviz.model.camera import Camera
 
         self._fit_clipping()
         return Camera.from_pyvista(self.plotter.camera)
@@ -544,7 +527,7 @@ def _overlay_rgba(overlay: np.ndarray) -> np.ndarray:
 def build_nature_components(plotter: Any, components: Sequence[Any], datasets: dict[str, Any], camera: Any = None,
                             size: tuple[int, int] | None = None) -> NatureView:
     """Add the session's terrain / fog / clouds / sky components to ``plotter`` and render the first overlay for
-    ``camera`` (a ``volviz.unstructured.camera.Camera``, a ``volviz.session.CameraState`` or None for the
+    ``camera`` (a ``volviz.model.camera.Camera``, a ``volviz.session.CameraState`` or None for the
     plotter's). Call ``view.update()`` again after the camera moves."""
     scene = scene_from_components(components, datasets)
     view = NatureView(plotter, scene, size)
@@ -554,7 +537,7 @@ def build_nature_components(plotter: Any, components: Sequence[Any], datasets: d
 
 
 def _as_camera(camera: Any, scene: NatureScene) -> Any:
-    from volviz.unstructured.camera import Camera
+    from volviz.model.camera import Camera
 
     if isinstance(camera, Camera):
         return camera

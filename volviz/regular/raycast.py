@@ -46,7 +46,7 @@ import numpy as np
 from volviz.optics import TransferFunction
 from volviz.optics.integrate import _tf_arrays
 from volviz.optics.separable import SeparableTable, build_separable
-from volviz.unstructured.camera import Camera
+from volviz.model.camera import Camera
 
 from . import raycast_kernels as K
 from .wavelet import HALF
@@ -210,7 +210,7 @@ def segment_table(tf: TransferFunction, s_range: tuple[float, float], l_max: flo
 
 
 def as_camera(camera: Any) -> Camera:
-    """A ``volviz.unstructured.camera.Camera`` from itself or a ``volviz.regular.lod.Camera`` (pinhole)."""
+    """A ``volviz.model.camera.Camera`` from itself or a ``volviz.regular.lod.Camera`` (pinhole)."""
     if isinstance(camera, Camera):
         return camera
     if hasattr(camera, "eye") and hasattr(camera, "fov_y"):
