@@ -228,6 +228,19 @@ def pcp_integrals(points: np.ndarray, bottom: np.ndarray, top: np.ndarray, trian
     return emis, mip, int(keep.sum())
 
 
+def layer_emission(bottom: np.ndarray, top: np.ndarray, layer: FogLayer,
+                   emission: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Per-vertex (e_bottom, e_top) of a layer: ``emission`` or 1 where the layer has thickness; the MIP mode uses 0
+    at the bottom and the thickness at the top (§10.4)."""
+    thick = np.asarray(top, dtype=np.float64) - np.asarray(bottom, dtype=np.float64)
+    if layer.mode == "mip":
+        return np.zeros_like(thick), np.maximum(thick, 0.0)
+    if emission is None:
+        present = (thick > 0).astype(np.float64)
+        return present, present
+    return emission
+
+
 def render_layer(points: np.ndarray, bottom: np.ndarray, top: np.ndarray, triangles: np.ndarray, layer: FogLayer,
                  camera: Any, size: tuple[int, int], depth: np.ndarray | None = None,
                  emission: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[np.ndarray, int]:
@@ -236,14 +249,7 @@ def render_layer(points: np.ndarray, bottom: np.ndarray, top: np.ndarray, triang
     ``emission`` = (e_bottom, e_top) per vertex (default 1 where the layer has thickness, 0 elsewhere); the MIP mode
     uses 0 at the bottom and the thickness at the top (§10.4).
     """
-    thick = np.asarray(top, dtype=np.float64) - np.asarray(bottom, dtype=np.float64)
-    if layer.mode == "mip":
-        eb, et = np.zeros_like(thick), np.maximum(thick, 0.0)
-    elif emission is None:
-        present = (thick > 0).astype(np.float64)
-        eb, et = present, present
-    else:
-        eb, et = emission
+    eb, et = layer_emission(bottom, top, layer, emission)
     emis, mip, drawn = pcp_integrals(points, bottom, top, triangles, eb, et, camera, size, depth)
     col = np.asarray(layer.colour, dtype=np.float64)
     out = np.zeros(emis.shape + (4,))
