@@ -36,12 +36,13 @@ def check_dataset_sizes(path: PathLike, root, size: int) -> None:
 
     def visit(name: str, obj) -> None:
         if isinstance(obj, h5py.Dataset):
-            found.append((name, int(np.prod(obj.shape, dtype=object)) * obj.dtype.itemsize))
+            found.append((name, int(np.prod(obj.shape or (), dtype=object)) * obj.dtype.itemsize))  # None: empty
 
     root.visititems(visit)
+    prefix = root.name.rstrip("/")  # "/VTKHDF", or "" for a whole file
     for name, nbytes in found:
         if nbytes > budget:
-            raise ReadError(path, f"dataset /VTKHDF/{name} claims {nbytes} bytes, more than the file's {size} bytes "
+            raise ReadError(path, f"dataset {prefix}/{name} claims {nbytes} bytes, more than the file's {size} bytes "
                                   "can hold even compressed")
 
 

@@ -2,8 +2,9 @@
 
 netCDF classic files (CDF-1, CDF-2, CDF-5) have their header parsed far enough to know where every variable's data
 ends; HDF5 files (netCDF-4, Exodus on HDF5, CGNS/HDF5) have their superblock's end-of-file address read; CGNS ADF
-files start with ``ADF Database Version``. A file shorter than its header says is truncated, and is refused with a
-ReadError before a VTK reader (which may crash on it) sees it.
+files start with ``ADF Database Version`` and have their node tree walked (``volviz_vtk_readers.adf``). A file
+shorter than its header says is truncated, and is refused with a ReadError before a VTK reader (which may crash on
+it) sees it.
 """
 from __future__ import annotations
 
@@ -192,6 +193,9 @@ def check_container(path: PathLike, what: str, netcdf: bool = True, hdf5: bool =
                                "file is truncated")
         return p
     if adf and b"ADF Database Version" in head[:48]:
+        from volviz_vtk_readers.adf import check_adf
+
+        check_adf(p)  # the whole node tree: tags, addresses, dimensions against data chunks
         return p
     expected = [name for ok, name in ((netcdf, "netCDF (CDF\\x01, CDF\\x02, CDF\\x05)"), (hdf5, "HDF5"),
                                       (adf, "CGNS ADF")) if ok]

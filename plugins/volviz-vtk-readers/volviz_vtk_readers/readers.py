@@ -243,7 +243,10 @@ def read_openfoam(path: PathLike, blocks: Sequence[str] | str | None = None, tim
 
 # -- CGNS, EnSight, Tecplot, Fluent, multiblock VTK: blocks chosen from the output tree -------------------------------
 def _cgns(path: PathLike) -> Any:
-    check_container(path, "CGNS", netcdf=False, adf=True)
+    from volviz_vtk_readers.cgnshdf5 import check_cgns_hdf5
+
+    p = check_container(path, "CGNS", netcdf=False, adf=True)  # ADF: the node tree is walked there
+    check_cgns_hdf5(p)  # HDF5: every object's metadata and dataset sizes
     reader = _information(path, _reader("vtkCGNSReader", path))
     reader.EnableAllBases()
     reader.EnableAllPointArrays()
