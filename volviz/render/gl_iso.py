@@ -1,0 +1,313 @@
+"""Many semi-transparent isosurfaces drawn by VTK's OpenGL pipeline in the transparency modes of the libMini note
+§4 ("Real-Time Rendering of Multiple Iso-surfaces and Multiple Volumes"), with the note's iso-spectrum shading
+("Shaded Iso-Surfaces"); the GPU counterpart of the CPU compositor ``volviz.iso.composite``.
+
+    iso = GLIsoSurfaces(plotter, meshes, mode="4pass")   # IsoMeshes of any number of volumes
+    plotter.show() / plotter.screenshot()
+    iso.set_mode("3pass"); iso.remove()
+
+Every pass runs over all surfaces of all volumes at once (the note: "each render pass must be executed for all
+volumes"): the translucent surfaces of every mesh are one vertex buffer (in ``meshes`` order, the CPU's draw order)
+drawn by one actor per pass, so the per-pixel sums and products are order-independent across volumes. Opaque
+surfaces (opacity 1) are one opaque actor. All actors share one shader program (``resources/shaders/iso_surface_*``):
+
+- ``"2pass"``: the opaque pass, then the translucent surfaces blended unsorted in draw order, C ← e + (1 − α)·C
+  (VTK's straight-alpha blending of the colour c and α).
+- ``"3pass"``: the opaque pass (B); an attenuation pass writing (0, α) under the same blending, C ← (1 − α)·C, so
+  C = Π(1 − α_i)·B and the alpha 1 − Π(1 − α_i)(1 − α_B); an emission pass writing (e, 0) with premultiplied
+  blending (ONE, ONE_MINUS_SRC_ALPHA; a 1x1 premultiplied actor texture makes VTK set and restore it), C ← C + e.
+  The window's fixed-point colour saturates at 1 as in composite.py.
+- ``"4pass"``: as 3pass, with a back-face pass between them: the back faces of the translucent surfaces (triangles
+  are wound so that GL's facing is the CPU's, the geometric normal oriented by the vertex normals) are drawn with
+  depth writes into volviz's own framebuffer (a float depth texture, cleared per frame; bound and unbound in the
+  mappers' ``UpdateShaderEvent`` observers), and the emission shader discards fragments behind that z_b
+  (``gl_FragCoord.z`` against the texel; the same program computes both, so a back face at z_b itself counts, as the
+  CPU's depth ≤ z_b). The scene's depth buffer is never written by the translucent passes.
+- ``"exact"``: VTK's (dual) depth peeling of the renderer, ``peels`` layers at most and occlusion ratio 0, with the
+  same shading: the translucent actor writes the straight colour at the ``//VTK::DepthPeeling`` tags.
+
+The passes are ordinary actors in the renderer's translucent pass, drawn in the order they were added (the renderer's
+OIT is off while 2/3/4-pass is shown; depth peeling on for exact), and each restores the GL state it changes (blend
+function, depth mask, framebuffer binding), so other props of the renderer render normally; the renderer's OIT and
+depth-peeling settings are restored by ``remove``. Other translucent props of the renderer are blended unsorted in
+the 2/3/4-pass modes (no OIT) and peeled with the surfaces in exact mode.
+
+Shading, per fragment in GLSL, as composite.py: μ = |n·v| per vertex, interpolated and clamped to [0, 1]; α = the
+surface opacity ("flat") or 1 − clamp(μ^a − b, 0, 1) with the least-squares (a, b) of the surface's opacity
+("spectrum"); colour c·(k_a + (1 − k_a)·μ), k_a = ``volviz.iso.composite.AMBIENT``. The view ray v is built from the
+vertex buffer's points (relative to the meshes' centre), so VTK's automatic shift and scale of the vertex buffer is
+turned off: VTK rescales each axis of data more than about 32 units across, which bends v (with it on, μ on the
+Storm scene of ``volviz bench iso`` was off by up to 0.17 and the image by RMSE 1.9 instead of 0.4).
+
+Measured on llvmpipe (Mesa, VTK 9.7.2) against ``volviz.iso.composite.render`` of the same mode, 8-bit units of
+RGB, two synthetic 24³ volumes with three overlapping translucent surfaces and an opaque one at 256², perspective
+and parallel, spectrum and flat shading (``tests/test_render_gl_iso.py``): RMSE 0.49-0.67 in every mode, 99.9% of
+the pixels within 2.1, at most 2 pixels over 3 (silhouette pixels, up to 111, that GL's edge rule and the CPU
+rasteriser's assign differently). The rest is 8-bit rounding of each blend step in the window's colour buffer. The
+pixels no surface covers are exactly those of the scene without the surfaces, opaque and translucent props included.
+On the real scenes of ``volviz bench iso`` (Storm, two overlapping Storm volumes, Blunt Fin; 384², docs/bench/iso.md):
+RMSE 0.31-0.59 against the CPU mode, 1 to 13 pixels over 3 (silhouettes); frame time (render + read-back, llvmpipe
+on 2 shared cores) 10-13 ms for 2-pass, 20-36 ms 3-pass, 37-45 ms 4-pass, 85-124 ms exact, where the CPU compositor
+takes 60-165 ms per frame.
+
+Not handled or not tested: a renderer with its own render pass (``renderer.SetPass``, e.g. the float target of
+``volviz.render.gl_pt``; untested, and exact mode's depth peeling is the renderer's own, which does not run under a
+custom pass); renderers that do not fill their window (the back-face texture is the renderer's size,
+read at ``gl_FragCoord``); multisampled windows (the tests use one sample per pixel, as the CPU compositor does).
+"""
+from __future__ import annotations
+
+from typing import Any, Sequence
+
+import numpy as np
+
+from volviz.iso.composite import AMBIENT, MODES
+from volviz.iso.extract import IsoMesh
+from volviz.iso.spectrum import fit_spectrum
+from volviz.render.gl_pt import GLPTVolume, shader_source
+
+__all__ = ["GLIsoSurfaces", "iso_polydata"]
+
+_OPAQUE, _OVER, _ATTENUATE, _BACK, _EMIT = range(5)
+_ATTRIBUTES = ("isoNormal", "isoStyle", "isoFit")
+_GL_DEPTH_BUFFER_BIT = 0x0100
+
+
+def _oriented_triangles(m: IsoMesh) -> np.ndarray:
+    """The mesh's triangles wound so that the right-hand normal agrees with the vertex normals (as composite.py orients
+    the geometric normal to tell back faces), so GL's ``gl_FrontFacing`` is the CPU's front."""
+    tris = np.asarray(m.triangles, np.int64).reshape(-1, 3)
+    if not len(tris):
+        return tris
+    p, n = m.points, m.normals
+    gn = np.cross(p[tris[:, 1]] - p[tris[:, 0]], p[tris[:, 2]] - p[tris[:, 0]])
+    vn = n[tris[:, 0]] + n[tris[:, 1]] + n[tris[:, 2]]
+    flip = np.einsum("ij,ij->i", gn, vn) < 0.0
+    out = tris.copy()
+    out[flip, 1], out[flip, 2] = tris[flip, 2], tris[flip, 1]
+    return out
+
+
+def iso_polydata(meshes: Sequence[IsoMesh], centre: np.ndarray, shading: str = "spectrum") -> Any:
+    """One vtkPolyData of ``meshes`` in their order: points relative to ``centre`` (float32), triangles wound as
+    ``_oriented_triangles``, and per-vertex attributes ``isoNormal`` (unit normal), ``isoStyle`` (colour, opacity)
+    and ``isoFit`` (the iso-spectrum (a, b) of translucent surfaces with ``shading="spectrum"``, else (0, 0))."""
+    import vtk
+    from vtk.util.numpy_support import numpy_to_vtk
+
+    pts, tris, cols = [], [], {k: [] for k in _ATTRIBUTES}
+    base = 0
+    for m in meshes:
+        st = m.style
+        n = len(m.points)
+        fit = (0.0, 0.0)
+        if shading == "spectrum" and 0.0 < float(st.opacity) < 1.0:
+            f = fit_spectrum(float(st.opacity))
+            fit = (f.a, f.b)
+        pts.append(np.asarray(m.points, np.float64) - centre)
+        tris.append(_oriented_triangles(m) + base)
+        cols["isoNormal"].append(np.asarray(m.normals, np.float64).reshape(n, 3))
+        cols["isoStyle"].append(np.tile([*st.color, float(st.opacity)], (n, 1)))
+        cols["isoFit"].append(np.tile(fit, (n, 1)))
+        base += n
+    pd = vtk.vtkPolyData()
+    vp = vtk.vtkPoints()
+    allp = np.concatenate(pts) if pts else np.zeros((0, 3))
+    vp.SetData(numpy_to_vtk(np.ascontiguousarray(allp, np.float32), deep=True))
+    pd.SetPoints(vp)
+    for name, parts in cols.items():
+        width = {"isoNormal": 3, "isoStyle": 4, "isoFit": 2}[name]
+        arr = np.concatenate(parts) if parts else np.zeros((0, width))
+        va = numpy_to_vtk(np.ascontiguousarray(arr, np.float32), deep=True)
+        va.SetName(name)
+        pd.GetPointData().AddArray(va)
+    conn = np.concatenate(tris) if tris else np.zeros((0, 3), np.int64)
+    cells = vtk.vtkCellArray()
+    cells.SetData(numpy_to_vtk(np.arange(0, 3 * len(conn) + 1, 3, dtype=np.int64), deep=True),
+                  numpy_to_vtk(np.ascontiguousarray(conn.reshape(-1), np.int64), deep=True))
+    pd.SetPolys(cells)
+    return pd
+
+
+class GLIsoSurfaces:
+    """The isosurfaces ``meshes`` (of any number of volumes) in a PyVista plotter's renderer, drawn in ``mode`` (one
+    of ``volviz.iso.composite.MODES``) with ``shading`` "spectrum" or "flat" (module docstring). ``lighting=False``
+    leaves colours unlit (as composite.py's ``lighting``). ``peels``: depth-peeling layers at most in exact mode."""
+
+    def __init__(self, plotter: Any, meshes: Sequence[IsoMesh], mode: str = "3pass", shading: str = "spectrum",
+                 lighting: bool = True, peels: int = 64) -> None:
+        import vtk
+
+        if shading not in ("spectrum", "flat"):
+            raise ValueError(f"shading must be 'spectrum' or 'flat', got {shading!r}")
+        self.plotter = plotter
+        self.renderer = plotter.renderer
+        self.meshes = list(meshes)
+        self.shading = shading
+        self.ambient = AMBIENT if lighting else 1.0
+        self.peels = int(peels)
+        ren = self.renderer
+        self._saved = (ren.GetUseDepthPeeling(), ren.GetUseOIT(), ren.GetMaximumNumberOfPeels(),
+                       ren.GetOcclusionRatio())
+        pts = [m.points for m in self.meshes if len(m.points)]
+        allp = np.concatenate(pts) if pts else np.zeros((1, 3))
+        self.centre = 0.5 * (allp.min(axis=0) + allp.max(axis=0))
+        opaque = [m for m in self.meshes if m.style.opaque and m.n_triangles]
+        clear = [m for m in self.meshes if not m.style.opaque and m.n_triangles]
+        self._fbo: Any = None
+        self._fbo_size: tuple[int, int] | None = None
+        self._back_tex: Any = None
+        self._pushed = False
+        self.actors: dict[int, Any] = {}
+        self._observers: list[tuple[Any, int]] = []
+        if opaque:
+            self._add(_OPAQUE, iso_polydata(opaque, self.centre, shading))
+        if clear:
+            pd = iso_polydata(clear, self.centre, shading)
+            for kind in (_OVER, _ATTENUATE, _BACK, _EMIT):
+                self._add(kind, pd)
+        self._observers.append((ren, ren.AddObserver(vtk.vtkCommand.EndEvent, self._on_end)))
+        self.mode = ""
+        self.set_mode(mode)
+
+    # --- set-up --------------------------------------------------------------------------------------------------
+    def _add(self, kind: int, pd: Any) -> None:
+        import vtk
+
+        mapper = vtk.vtkOpenGLPolyDataMapper()
+        mapper.SetInputData(pd)
+        mapper.ScalarVisibilityOff()
+        # vertexMC must be the points as given (relative to the centre already): VTK's automatic shift and per-axis
+        # scale of the vertex buffer (applied to data more than ~32 units across) would bend the view rays
+        mapper.SetVBOShiftScaleMethod(vtk.vtkPolyDataMapper.DISABLE_SHIFT_SCALE)
+        for name in _ATTRIBUTES:
+            mapper.MapDataArrayToVertexAttribute(name, name, vtk.vtkDataObject.FIELD_ASSOCIATION_POINTS, -1)
+        sp = vtk.vtkShaderProperty()
+        sp.SetVertexShaderCode(shader_source("iso_surface_vs.glsl"))
+        sp.SetFragmentShaderCode(shader_source("iso_surface_fs.glsl"))
+        actor = vtk.vtkActor()
+        actor.SetMapper(mapper)
+        actor.SetShaderProperty(sp)
+        actor.SetPosition(*self.centre)
+        if kind == _OPAQUE:
+            actor.ForceOpaqueOn()
+        else:
+            actor.ForceTranslucentOn()
+        if kind == _EMIT:
+            actor.SetTexture(GLPTVolume._premultiplied_texture())   # (ONE, ONE_MINUS_SRC_ALPHA), restored by VTK
+
+        def on_update_shader(caller: Any, event: str, program: Any = None) -> None:
+            self._on_update_shader(kind, program)
+
+        on_update_shader.CallDataType = vtk.VTK_OBJECT      # type: ignore[attr-defined]
+        self._observers.append((mapper, mapper.AddObserver(vtk.vtkCommand.UpdateShaderEvent, on_update_shader)))
+        self.actors[kind] = actor
+        self.renderer.AddActor(actor)
+
+    # --- per draw ------------------------------------------------------------------------------------------------
+    def _on_update_shader(self, kind: int, program: Any) -> None:
+        """Uniforms of the pass (the actors share one program) and, for the back-face pass of 4-pass, volviz's own
+        depth target bound in place of the scene's framebuffer until the emission pass."""
+        if program is None:
+            return
+        cam = self.renderer.GetActiveCamera()
+        eye = np.asarray(cam.GetPosition(), np.float64)
+        fwd = np.asarray(cam.GetFocalPoint(), np.float64) - eye
+        fwd /= max(float(np.linalg.norm(fwd)), 1e-300)
+        program.SetUniform3f("isoEye", [float(v) for v in eye - self.centre])
+        program.SetUniform3f("isoForward", [float(v) for v in fwd])
+        program.SetUniformi("isoParallel", int(bool(cam.GetParallelProjection())))
+        program.SetUniformi("isoPass", kind)
+        program.SetUniformf("isoAmbient", float(self.ambient))
+        program.SetUniformi("isoClipZ", int(kind == _EMIT and self.mode == "4pass"))
+        state = self.renderer.GetState()
+        if kind == _BACK:
+            self._bind_back_target(state)
+        elif kind == _EMIT and self.mode == "4pass":
+            if self._pushed:
+                state.PopFramebufferBindings()
+                self._pushed = False
+            self._back_tex.Activate()
+            program.SetUniformi("isoBackDepth", self._back_tex.GetTextureUnit())
+
+    def _bind_back_target(self, state: Any) -> None:
+        """Bind (making it at the renderer's size when needed) the framebuffer with a float depth texture into which
+        the back faces are drawn with depth writes on; its depth is cleared to the far plane."""
+        import vtk
+
+        ren_win = self.renderer.GetRenderWindow()
+        size = tuple(int(v) for v in self.renderer.GetSize())
+        state.PushFramebufferBindings()
+        self._pushed = True
+        if self._fbo is None or self._fbo_size != size:
+            self._release_target()
+            fbo = vtk.vtkOpenGLFramebufferObject()
+            fbo.SetContext(ren_win)
+            fbo.Bind()
+            color = vtk.vtkTextureObject()
+            color.SetContext(ren_win)
+            color.Allocate2D(size[0], size[1], 4, vtk.VTK_UNSIGNED_CHAR)
+            depth = vtk.vtkTextureObject()
+            depth.SetContext(ren_win)
+            depth.SetMinificationFilter(vtk.vtkTextureObject.Nearest)
+            depth.SetMagnificationFilter(vtk.vtkTextureObject.Nearest)
+            depth.AllocateDepth(size[0], size[1], vtk.vtkTextureObject.Float32)
+            fbo.AddColorAttachment(0, color)
+            fbo.AddDepthAttachment(depth)
+            self._fbo, self._fbo_size, self._back_tex = fbo, size, depth
+        self._fbo.Bind()
+        self._fbo.ActivateDrawBuffer(0)
+        state.vtkglDepthMask(True)        # VTK's actor restores the mask after the draw
+        state.vtkglClearDepth(1.0)        # VTK's clear value (vtkOpenGLRenderer::Clear)
+        state.vtkglClear(_GL_DEPTH_BUFFER_BIT)
+
+    def _on_end(self, *_: Any) -> None:
+        state = self.renderer.GetState()
+        if self._pushed:                  # the emission pass did not run: give the scene its framebuffer back
+            state.PopFramebufferBindings()
+            self._pushed = False
+        if self._back_tex is not None:
+            self._back_tex.Deactivate()
+
+    def _release_target(self) -> None:
+        ren_win = self.renderer.GetRenderWindow()
+        if self._fbo is not None and ren_win is not None:
+            self._fbo.ReleaseGraphicsResources(ren_win)
+            self._back_tex.ReleaseGraphicsResources(ren_win)
+        self._fbo = self._back_tex = self._fbo_size = None
+
+    # --- public --------------------------------------------------------------------------------------------------
+    def set_mode(self, mode: str) -> None:
+        """Show the surfaces in ``mode`` (2pass, 3pass, 4pass or exact) from the next render on."""
+        if mode not in MODES:
+            raise ValueError(f"unknown transparency mode {mode!r}; choose from {MODES}")
+        self.mode = mode
+        shown = {"2pass": (_OVER,), "exact": (_OVER,), "3pass": (_ATTENUATE, _EMIT),
+                 "4pass": (_ATTENUATE, _BACK, _EMIT)}[mode]
+        for kind, actor in self.actors.items():
+            actor.SetVisibility(kind == _OPAQUE or kind in shown)
+        ren = self.renderer
+        if mode == "exact":
+            ren.SetUseDepthPeeling(True)
+            ren.SetMaximumNumberOfPeels(self.peels)
+            ren.SetOcclusionRatio(0.0)
+        else:
+            ren.SetUseDepthPeeling(False)
+            ren.SetUseOIT(False)
+
+    def remove(self) -> None:
+        """Take the surfaces out of the renderer and restore its depth-peeling and OIT settings (call before closing
+        the plotter)."""
+        for obj, tag in self._observers:
+            obj.RemoveObserver(tag)
+        self._observers = []
+        for actor in self.actors.values():
+            self.renderer.RemoveActor(actor)
+        self.actors = {}
+        self._release_target()
+        peel, oit, n, ratio = self._saved
+        ren = self.renderer
+        ren.SetUseDepthPeeling(peel)
+        ren.SetUseOIT(oit)
+        ren.SetMaximumNumberOfPeels(n)
+        ren.SetOcclusionRatio(ratio)
