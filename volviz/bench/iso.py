@@ -8,8 +8,11 @@ composite, after a warm-up), triangles a GPU would draw in the mode (opaque once
 depth peeling, 2 passes per layer), fragments, RMSE / max abs error (8-bit units) against the exact mode. Also: the
 iso-spectrum fits, background extraction time per 4D frame, view-dependent LOD triangle counts and geomorph popping,
 and VTK's translucent rendering as a peer (same meshes; VTK lighting and constant opacity, so its error includes
-shading differences; VTK's depth peeling dropped all translucent geometry on llvmpipe here). Writes
-``docs/bench/iso.md`` + ``iso.png`` (images side by side) and optionally ``--json OUT``.
+shading differences; VTK's depth peeling dropped all translucent geometry on llvmpipe here). GPU rows: the same modes
+drawn by VTK's OpenGL pipeline (``volviz.render.gl_iso``: multi-pass actors, depth peeling for exact; one sample per
+pixel), median time of ``--reps`` frames (render + read-back of the window, after a warm-up) and the difference of
+the screen (8-bit RGB, alpha 1) from the CPU compositor's image of the same mode. Writes ``docs/bench/iso.md`` +
+``iso.png`` (images side by side) and optionally ``--json OUT``.
 """
 from __future__ import annotations
 
@@ -95,12 +98,42 @@ def _vtk_blend(meshes: list[IsoMesh], cam: Camera, size: int, reps: int) -> tupl
     return t, rgba
 
 
+def _gpu_modes(meshes: list[IsoMesh], cam: Camera, size: int, reps: int, cpu: dict[str, np.ndarray]
+               ) -> dict[str, dict[str, float]]:
+    """Per mode: GPU frame time (s) and RMSE / max (8-bit units) of the screen against the CPU image ``cpu[mode]``."""
+    import pyvista as pv
+
+    from volviz.render.gl_iso import GLIsoSurfaces
+    pl = pv.Plotter(off_screen=True, window_size=(size, size))
+    pl.ren_win.SetMultiSamples(0)
+    pl.set_background(BG[:3])
+    cam.apply_to(pl.renderer.GetActiveCamera())
+    pl.camera_set = True
+    iso = GLIsoSurfaces(pl, meshes, mode="2pass")
+
+    def frame() -> np.ndarray:
+        pl.ren_win.Render()
+        return np.asarray(pl.screenshot(return_img=True), dtype=np.float64)[..., :3] / 255.0
+    rows = {}
+    for mode in MODES:
+        iso.set_mode(mode)
+        t, img = _median(frame, reps)
+        rgba = np.concatenate([img, np.ones(img.shape[:2] + (1,))], axis=-1)
+        ref = np.clip(cpu[mode], 0.0, 1.0)
+        over = int((np.abs(rgba - ref).max(axis=-1) * 255.0 > 3.0).sum())
+        rows[mode] = {"seconds": t, "rmse": rmse(rgba, ref), "max_abs": max_abs(rgba, ref), "pixels_over_3": over}
+    iso.remove()
+    pl.close()
+    return rows
+
+
 def main(argv: list[str] | None = None) -> int:
     p = UsageParser(prog="volviz bench iso", description=__doc__.split("\n\n")[0])
     p.add_argument("--data", default=str(DEFAULT_DATA), help="folder with storm/ and bluntfin/")
     p.add_argument("--size", type=int_in(1, MAX_IMAGE_SIDE), default=384, help="image width and height")
     p.add_argument("--reps", type=int_in(1, 1000), default=3, help="timed repetitions per mode (after a warm-up)")
     p.add_argument("--no-vtk", action="store_true", help="skip the VTK translucent-rendering peer")
+    p.add_argument("--no-gpu", action="store_true", help="skip the GPU (VTK OpenGL) rows of the four modes")
     p.add_argument("--out", default=str(REPO / "docs" / "bench"))
     p.add_argument("--json", default=None, help="also write the results as JSON")
     args = p.parse_args(argv)
@@ -128,6 +161,8 @@ def main(argv: list[str] | None = None) -> int:
         scene = {"note": note, "triangles": fr.n_triangles, "opaque_triangles": fr.n_opaque_triangles,
                  "fragments": int(len(fr.depth)), "max_depth_complexity": int(counts.max()),
                  "mean_depth_complexity_covered": float(counts[counts > 0].mean()), "modes": rows}
+        if not args.no_gpu:
+            scene["gpu"] = _gpu_modes(meshes, cam, args.size, args.reps, imgs)
         if not args.no_vtk:
             t, vimg = _vtk_blend(meshes, cam, args.size, args.reps)
             scene["vtk_blend"] = {"seconds": t, "rmse": rmse(vimg, imgs["exact"]),
@@ -135,7 +170,9 @@ def main(argv: list[str] | None = None) -> int:
             imgs["VTK blend"] = vimg
         images[name] = imgs
         results["scenes"][name] = scene
-        print(name, {m: (round(r["seconds"], 3), round(r["rmse"], 2)) for m, r in rows.items()}, flush=True)
+        print(name, {m: (round(r["seconds"], 3), round(r["rmse"], 2)) for m, r in rows.items()},
+              {f"{m} gpu": (round(r["seconds"], 3), round(r["rmse"], 2)) for m, r in scene.get("gpu", {}).items()},
+              flush=True)
     results["spectrum_fits"] = [vars(fit_spectrum(o)) for o in (0.3, 0.4)]
     results["animation"] = _animation(data)
     results["lod"] = _lod(data, size)
@@ -224,6 +261,15 @@ def _markdown(res: dict[str, Any], path: Path) -> None:
             v = sc["vtk_blend"]
             L.append(f"| VTK translucent blending (peer; Phong, constant opacity) | {v['seconds']:.3f} | — | — | "
                      f"{v['rmse']:.2f} | {v['max_abs']:.1f} |")
+        if "gpu" in sc:
+            L += ["", "GPU (VTK OpenGL on this machine's driver, `volviz.render.gl_iso`): frame time (render + read-back) "
+                  "and the screen's difference from the CPU image of the same mode. Pixels over 3 lie on silhouettes, "
+                  "which GL's and the CPU's edge rules assign differently (checked on the Storm scene).", "",
+                  "| mode | GPU frame time (s) | RMSE vs CPU mode | max vs CPU mode | pixels over 3 |",
+                  "|---|---|---|---|---|"]
+            for mode, r in sc["gpu"].items():
+                L.append(f"| {mode} (GPU) | {r['seconds']:.3f} | {r['rmse']:.2f} | {r['max_abs']:.1f} | "
+                         f"{r['pixels_over_3']} |")
         L.append("")
     L += ["## Iso-spectrum fit (least squares, α(μ) = 1 − clamp(μ^a − b, 0, 1) vs 1 − exp(−τ0/μ))", "",
           "| opacity at normal incidence | τ0 | a | b | RMS error | max error |", "|---|---|---|---|---|---|"]
