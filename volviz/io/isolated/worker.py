@@ -194,8 +194,9 @@ class Pool:
 
     def give(self, worker: Worker) -> None:
         if not worker.alive or worker.requests >= MAX_REQUESTS:
-            worker.close()
             self.prewarm()  # its successor starts now, not when the next read waits for it
+            # the old child leaves in the background: the read that retired it does not wait for its exit
+            threading.Thread(target=worker.close, name="volviz-reader-close", daemon=True).start()
             return
         with self._lock:
             if len(self._idle) < self.max_idle:
