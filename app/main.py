@@ -10,6 +10,8 @@ from typing import Optional, Sequence
 def main(argv: Optional[Sequence[str]] = None) -> int:
     parser = argparse.ArgumentParser(prog="volviz-app", description="volviz desktop application")
     parser.add_argument("target", nargs="?", help="a session file (.json) or a data file; default: the demo scene")
+    parser.add_argument("--screenshot", metavar="PNG", help="show the scene, save the window as PNG and quit (a check "
+                        "that the app starts and renders)")
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(levelname)s %(name)s: %(message)s")
 
@@ -20,6 +22,19 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     app = QApplication.instance() or QApplication(sys.argv[:1])
     app.setApplicationName("volviz")
     app.setOrganizationName("volviz")
+    app.setWindowIcon(_icon())
+    if args.screenshot:  # a throwaway window: the user's settings and recovery files stay untouched
+        import tempfile
+        from pathlib import Path
+
+        from PySide6.QtCore import QSettings
+
+        from volviz_app.smoke import screenshot
+
+        scratch = Path(tempfile.mkdtemp(prefix="volviz-app-check-"))
+        window = MainWindow(settings=QSettings(str(scratch / "settings.ini"), QSettings.Format.IniFormat),
+                            recovery_dir=scratch / "recovery")
+        return screenshot(app, window, args.target, Path(args.screenshot))
     window = MainWindow()
     window.show()
     if args.target:
@@ -28,6 +43,14 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         window.open_demo()
     window.offer_recovery()
     return int(app.exec())
+
+
+def _icon():
+    from importlib import resources
+
+    from PySide6.QtGui import QIcon
+
+    return QIcon(str(resources.files("volviz_resources") / "icons" / "volviz.svg"))
 
 
 if __name__ == "__main__":

@@ -256,6 +256,9 @@ def run(argv: Optional[Sequence[str]] = None) -> int:
     if args.command == "render":
         return _render(args)
     if args.command == "bench":
+        from volviz.bench import require_plotting
+
+        require_plotting(args.name)
         module = importlib.import_module(f"volviz.bench.{args.name}")
         return int(module.main(list(rest)) or 0)
     if args.command == "compress":

@@ -195,10 +195,9 @@ def _interp_psnr(rows: list[dict[str, Any]], method: str, bpv: float) -> float |
 
 
 def _plot(results: dict[str, list[dict[str, Any]]], out: Path) -> None:
-    import matplotlib
+    from volviz.bench import pyplot
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     fig, axes = plt.subplots(1, len(results), figsize=(5.5 * len(results), 4.5))
     axes = np.atleast_1d(axes)

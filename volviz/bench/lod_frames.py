@@ -156,10 +156,9 @@ def render_walkthrough(tree: Any, volume: np.ndarray, tf: Any, budgets: Sequence
 
 def _plot(rows: list[dict[str, Any]], shots: dict[int, tuple[np.ndarray, np.ndarray]], exact: np.ndarray,
           png: Path) -> None:
-    import matplotlib
+    from volviz.bench import pyplot
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     b = [r["budget"] for r in rows]
     fig, ax = plt.subplots(1, 5, figsize=(22, 4.8))

@@ -338,10 +338,9 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _write_report(out: Path, result: dict[str, Any], images: list[tuple[np.ndarray, ...]]) -> None:
-    import matplotlib
+    from volviz.bench import pyplot
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     out.parent.mkdir(parents=True, exist_ok=True)
     png = out.with_name(out.stem + "_frames.png")

@@ -230,10 +230,9 @@ def _fmt(v: Any) -> str:
 
 
 def _plot(result: dict, path: Path) -> None:
-    import matplotlib
+    from volviz.bench import pyplot
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     fig, axes = plt.subplots(1, 2, figsize=(12, 5), sharey=True)
     methods = sorted({r["method"] for r in result["rows"]})

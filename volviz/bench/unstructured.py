@@ -344,10 +344,9 @@ def _size_scan(mesh: Any, tf: Any, cams: list[Any], sizes: list[tuple[int, int]]
 
 
 def _plots(results: dict[str, Any], images: dict[str, np.ndarray], ref: np.ndarray, out: Path) -> None:
-    import matplotlib
+    from volviz.bench import pyplot
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     from volviz.optics.metrics import error_heatmap
 

@@ -41,6 +41,11 @@ def output_kind(path: str | os.PathLike, movie: bool = False) -> str:
     suffix = p.suffix.lower()
     if movie:
         if suffix in MOVIE_FORMATS:
+            import importlib.util
+
+            if importlib.util.find_spec("imageio_ffmpeg") is None:
+                raise ExportError(f"{p}: writing {suffix} movies needs imageio-ffmpeg, which is not installed: pip "
+                                  "install 'volviz[movies]' (or give a folder to receive PNG frames)")
             return MOVIE_FORMATS[suffix]
         if not suffix or p.is_dir():
             return "folder"

@@ -1,0 +1,42 @@
+"""``volviz-app --screenshot PNG [TARGET]``: open the demo scene (or TARGET), wait for its first complete image, save
+the window as PNG and quit -- the check that an installed or packaged app starts and renders (``packaging/``)."""
+from __future__ import annotations
+
+import time
+from pathlib import Path
+from typing import Any
+
+TIMEOUT_S = 180.0
+
+
+def _pump(app: Any, until: Any, seconds: float) -> bool:
+    start = time.perf_counter()
+    while not until():
+        if time.perf_counter() - start > seconds:
+            return False
+        app.processEvents()
+        time.sleep(0.01)
+    return True
+
+
+def screenshot(app: Any, window: Any, target: str | None, out: Path) -> int:
+    """Show ``target`` (None: the demo) in ``window``, save its grab to ``out``; 0 when it showed, 1 otherwise."""
+    window.resize(1024, 700)
+    window.show()
+    _pump(app, lambda: window.isVisible(), 10.0)
+    if target:
+        window.open_path(target)
+    else:
+        window.open_demo()
+    shown = _pump(app, lambda: window.error_dialog is not None or (
+        window.controller is not None and not window.progress_bar.isVisible()), TIMEOUT_S)
+    _pump(app, lambda: False, 0.5)
+    window.plotter.render()
+    window.grab().save(str(out))
+    window.dirty = False
+    failed = window.error_dialog is not None or not shown
+    if failed:
+        print(f"volviz-app: the scene was not shown within {TIMEOUT_S:.0f} s" if not shown else
+              "volviz-app: opening the scene gave an error (see the screenshot)")
+    window.close()
+    return 1 if failed else 0

@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# Build the one-folder app with PyInstaller (dist/volviz/volviz-app) and check that it starts and renders the demo
+# scene: the built app opens it under Xvfb, saves its window as PNG and quits; the PNG must show the scene.
+# Run after packaging/setup-debian.sh:  bash packaging/build-app.sh [DIST_DIR]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+dist="${1:-dist}"
+work="$(mktemp -d)"
+trap 'rm -rf "$work"' EXIT
+.venv/bin/python -m pip install -q -e ".[packaging]"
+.venv/bin/pyinstaller --noconfirm --log-level WARN --distpath "$dist" --workpath "$work/build" packaging/volviz.spec
+app="$(cd "$dist/volviz" && pwd)/volviz-app"
+echo "built $app ($(du -sh "$dist/volviz" | cut -f1))"
+# a small VTK XML volume: its reader runs in the isolated reader process, which the packaged app starts as itself
+.venv/bin/python -c "import pyvista as pv, numpy as np; g = pv.ImageData(dimensions=(24, 24, 24)); \
+x = np.linspace(-1, 1, 24); X, Y, Z = np.meshgrid(x, x, x, indexing='ij'); \
+g.point_data['density'] = np.exp(-4 * (X**2 + Y**2 + Z**2)).ravel(order='F'); g.save('$work/blob.vti')"
+# the checks run from another folder, with no virtual environment on PATH: only what was packaged is used
+for target in demo "$work/blob.vti"; do
+    (cd "$work" && env -u VIRTUAL_ENV PATH=/usr/bin:/bin xvfb-run -a -s "-screen 0 1280x900x24" \
+        "$app" --screenshot "$work/check.png" $([ "$target" = demo ] || echo "$target"))
+    .venv/bin/python - "$work/check.png" "$target" <<'PY'
+import sys
+
+import numpy as np
+from PIL import Image
+
+rgb = np.asarray(Image.open(sys.argv[1]).convert("RGB"), dtype=float)
+spread = rgb.reshape(-1, 3).std(axis=0).mean()
+print(f"the packaged app showed {sys.argv[2]}: {rgb.shape[1]}x{rgb.shape[0]} window, colour spread {spread:.1f}")
+sys.exit(0 if spread > 10 else "the packaged app's window is blank")
+PY
+done
