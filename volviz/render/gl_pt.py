@@ -19,20 +19,28 @@ How a frame is drawn:
   the near and far planes and the opaque scene's depth at the pixel; the exact (s_f, s_b, l) of that segment look up
   the 3D table (Roettger §8.4, trilinear) or the separable one (§9.1: exact opacity 1 - exp(-l rho_hat), colour
   polynomial in l), both float 3D textures.
-- Compositing: premultiplied "over" (ONE, ONE_MINUS_SRC_ALPHA) through a 1x1 premultiplied actor texture, which
-  makes VTK set and restore the blend state; the actor is translucent and drawn in order (no OIT, no depth peeling
-  for this renderer), into a float32 colour target (a ``vtkFramebufferPass`` around ``vtkRenderStepsPass``): ~95
-  cells overlap per pixel on the Blunt Fin, which an 8-bit target does not accumulate accurately. The window's
-  multisampling is off while the volume is in it (as for volviz's CPU overlays): with MSAA on, the other layers
-  (the orientation axes) were antialiased and the volume's renderer was not, and the same view differed from the
-  CPU backend's by up to 255 at the axes.
-- Opaque geometry: when the mapper draws (translucent pass, after the opaque one), the framebuffer pass's depth
-  texture holds the opaque scene (translucent props do not write depth); the shader reads it (texelFetch) and each
-  segment ends at the opaque depth of its pixel, so a cell straddling a surface is integrated only up to it. The
-  shader writes depth 0, so GL's depth test never drops a fragment whose exit face lies behind the surface. The
-  texture is sampled while attached to the framebuffer being drawn (with depth writes off), which llvmpipe handles;
-  GL calls such a read-while-attached a feedback loop, so check it on each hardware driver (copying the depth with
-  ``vtkTextureObject.CopyFromFrameBuffer`` into a texture of our own read zeros here).
+- Compositing: the cells are composited back to front with premultiplied "over" (ONE, ONE_MINUS_SRC_ALPHA, set
+  and restored by VTK through a 1x1 premultiplied actor texture) into the volume's own float32 RGBA target, cleared
+  to transparent black each frame (~95 cells overlap per pixel on the Blunt Fin, which an 8-bit target does not
+  accumulate accurately). A second actor drawn right after the cells (``resolve_actor``: one triangle covering the
+  viewport, with the volume's bounds so that VTK culls both together) binds the scene's framebuffer again and
+  composites that image "over" the scene. Both actors are translucent and drawn in order (no OIT, no depth peeling
+  for this renderer); other props of the renderer are drawn by VTK as usual (a translucent prop added later is
+  blended over the volume; pixels the volume does not cover are the scene's).
+- Opaque geometry: when the cells draw (translucent pass, after the opaque one), the depth buffer of the framebuffer
+  being drawn holds the opaque scene (translucent props do not write depth); it is blitted into the volume's own
+  depth texture, which the shader reads (texelFetch): each segment ends at the opaque depth of its pixel, so a cell
+  straddling a surface is integrated only up to it. The volume's colour target has no depth attachment, so GL's depth
+  test never drops a fragment whose exit face lies behind the surface.
+- Multisampling: by default the window's multisampling is switched off while the volume is in it (one colour per
+  pixel, as volviz's CPU overlays: the two backends then give the same viewport image). With
+  ``keep_multisampling=True`` it stays on: the opaque scene (and translucent props) are antialiased in the window's
+  multisampled framebuffer as without the volume, the depth blit resolves the opaque depth to one sample per pixel,
+  and the resolve composites the volume's single-sample image over every sample. Measured on llvmpipe (4 samples,
+  ``tests/test_render_gl_pt.py``): against the reference clipped at the single-sample depth over the antialiased
+  opaque image, RMSE 0.32 / max 2.6 away from an opaque sphere's silhouette; on silhouette pixels (partly covered)
+  up to 37 and next to them up to 6.5, since the volume is integrated to one sample's depth rather than each
+  sample's (exact there would need per-sample shading of every cell).
 
 Clipping planes and a box crop (``set_clip_planes``) cut each fragment's ray segment, as the near plane does.
 
@@ -61,6 +69,8 @@ _PASS_MARK = "_volviz_gl_pt_pass"      # renderer attribute: the framebuffer pas
 _USERS = "_volviz_gl_pt_volumes"       # renderer attribute: the GLPTVolumes drawing in it
 _MAX_CLIP = 8                          # clipping planes the fragment shader takes
 _LOOKUPS = ("auto", "3d", "separable")
+_GL_DRAW_FRAMEBUFFER_BINDING, _GL_READ_FRAMEBUFFER, _GL_DRAW_FRAMEBUFFER = 0x8CA6, 0x8CA8, 0x8CA9
+_GL_DEPTH_BUFFER_BIT, _GL_COLOR_BUFFER_BIT, _GL_NEAREST, _GL_DEPTH_WRITEMASK = 0x100, 0x4000, 0x2600, 0x0B72
 
 
 def shader_source(name: str) -> str:
@@ -108,6 +118,22 @@ def _polydata(mesh: TetMesh) -> Any:
     return pd
 
 
+def _resolve_polydata(bounds: np.ndarray) -> Any:
+    """The resolve's geometry: the 8 corners of ``bounds`` (3, 2), so that VTK culls it with the cells, and the
+    triangle (0, 1, 2), which ``pt_resolve_vs.glsl`` places over the viewport by ``gl_VertexID``."""
+    import vtk
+    from vtk.util.numpy_support import numpy_to_vtk
+
+    corners = np.array([[bounds[0, i & 1], bounds[1, (i >> 1) & 1], bounds[2, (i >> 2) & 1]] for i in range(8)])
+    pd = vtk.vtkPolyData()
+    pd.SetPoints(vtk.vtkPoints())
+    pd.GetPoints().SetData(numpy_to_vtk(np.ascontiguousarray(corners, np.float32), deep=True))
+    offsets, conn = (numpy_to_vtk(np.array(v, np.int64), deep=True) for v in ([0, 3], [0, 1, 2]))
+    pd.SetPolys(vtk.vtkCellArray())
+    pd.GetPolys().SetData(offsets, conn)
+    return pd
+
+
 def _triangles(cells: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(offsets, connectivity) of the 4 faces of each cell in ``cells`` (in that order), for vtkCellArray.SetData."""
     conn = ((4 * cells.astype(np.int64))[:, None] + FACES.reshape(1, 12)).reshape(-1)
@@ -124,12 +150,15 @@ class GLPTVolume(PTView):
     sorts for a known next camera in the background; ``reuse_order = True`` keeps the last order for every camera
     (e.g. during a mouse drag: the image is then exact per cell but may composite some overlapping cells in the wrong
     order). ``camera``: the camera of the last draw. The GPU side of the PT view interface
-    ``volviz.render.pt_view.PTView``: VTK draws it at every render, so ``update`` has nothing to do."""
+    ``volviz.render.pt_view.PTView``: VTK draws it at every render, so ``update`` has nothing to do.
+    ``keep_multisampling``: leave the window's multisampling on (module docstring; default off while the volume is
+    shown)."""
 
     backend = "gpu"
 
     def __init__(self, plotter: Any, mesh: TetMesh, tf: Any, *, lookup: str = "3d", n_s: int | None = None,
-                 n_l: int = 64, degree: int | None = None, sort: str = "mpvo", nonconvex: str = "auto") -> None:
+                 n_l: int = 64, degree: int | None = None, sort: str = "mpvo", nonconvex: str = "auto",
+                 keep_multisampling: bool = False) -> None:
         import vtk
 
         if not isinstance(mesh, TetMesh):
@@ -153,7 +182,9 @@ class GLPTVolume(PTView):
         self._order_key: Any = None
         self._table: Any = None
         self._table_tex: Any = None
-        self._depth_tex: Any = None
+        self._targets: tuple[Any, ...] | None = None   # colour texture, its FBO, depth texture, its FBO, format
+        self._bound = False                         # the volume's colour target is bound (cells drawn, no resolve yet)
+        self._drawn = False                         # the cells were drawn this frame
         self._table_dirty = True
         self._clip = np.zeros((0, 4))
         self.tf = tf
@@ -175,19 +206,35 @@ class GLPTVolume(PTView):
         self.actor.ForceTranslucentOn()
         self.actor.GetProperty().FrontfaceCullingOn()
         self.actor.SetTexture(self._premultiplied_texture())
+        self.resolve_mapper = vtk.vtkOpenGLPolyDataMapper()
+        self.resolve_mapper.ScalarVisibilityOff()
+        pts = self.topo.points
+        self.resolve_mapper.SetInputData(_resolve_polydata(np.stack([pts.min(axis=0), pts.max(axis=0)], axis=1)))
+        rsp = vtk.vtkShaderProperty()
+        rsp.SetVertexShaderCode(shader_source("pt_resolve_vs.glsl"))
+        rsp.SetFragmentShaderCode(shader_source("pt_resolve_fs.glsl"))
+        self.resolve_actor = vtk.vtkActor()
+        self.resolve_actor.SetMapper(self.resolve_mapper)
+        self.resolve_actor.SetShaderProperty(rsp)
+        self.resolve_actor.SetPosition(*self.topo.origin)
+        self.resolve_actor.ForceTranslucentOn()
+        self.resolve_actor.SetTexture(self._premultiplied_texture())
 
-        self._install_pass()
-        hold_single_sample(plotter, self)          # the float target is single-sample; so is the window meanwhile
-        def on_update_shader(caller: Any, event: str, program: Any = None) -> None:
-            self._on_update_shader(program)
-
-        on_update_shader.CallDataType = vtk.VTK_OBJECT      # type: ignore[attr-defined]
+        self.renderer.SetUseDepthPeeling(False)    # translucent props drawn in order: the cells, then the resolve
+        self.renderer.SetUseOIT(False)
+        self.keep_multisampling = keep_multisampling
+        if not keep_multisampling:
+            hold_single_sample(plotter, self)      # one colour per pixel, as the CPU backend's overlays
+        GLPTVolume._on_program.CallDataType = vtk.VTK_OBJECT     # type: ignore[attr-defined]
         self._observers = [
-            (self.mapper, self.mapper.AddObserver(vtk.vtkCommand.UpdateShaderEvent, on_update_shader)),
+            (self.mapper, self.mapper.AddObserver(vtk.vtkCommand.UpdateShaderEvent, self._on_program)),
+            (self.resolve_mapper, self.resolve_mapper.AddObserver(vtk.vtkCommand.UpdateShaderEvent,
+                                                                  self._on_program)),
             (self.renderer, self.renderer.AddObserver(vtk.vtkCommand.StartEvent, self._on_start)),
             (self.renderer, self.renderer.AddObserver(vtk.vtkCommand.EndEvent, self._on_end)),
         ]
         self.renderer.AddActor(self.actor)
+        self.renderer.AddActor(self.resolve_actor)
 
     # --- set-up --------------------------------------------------------------------------------------------------
     @staticmethod
@@ -205,8 +252,16 @@ class GLPTVolume(PTView):
         tex.PremultipliedAlphaOn()
         return tex
 
+    def _on_program(self, caller: Any, event: str, program: Any = None) -> None:
+        """UpdateShaderEvent of either mapper (its program being bound): the cells' or the resolve's set-up."""
+        if program is not None:
+            (self._on_update_shader if caller is self.mapper else self._on_resolve)(program)
+
     def _install_pass(self) -> None:
-        """A float32 colour target around VTK's standard render steps, translucent props drawn in order."""
+        """A float32 colour target around VTK's standard render steps (a ``vtkFramebufferPass``, its depth texture
+        holding the opaque scene), translucent props drawn in order; shared by the GL layers that use it
+        (``volviz.render.gl_fog``; ``self.renderer``, ``self`` counted as a user). GLPTVolume itself draws into its
+        own target (module docstring) and works with or without it."""
         import vtk
 
         ren = self.renderer
@@ -274,9 +329,108 @@ class GLPTVolume(PTView):
         self._prefetcher.prefetch(camera, size)
 
     def _on_end(self, *_: Any) -> None:
-        for tex in (self._table_tex, self._depth_tex):
-            if tex is not None:
-                tex.Deactivate()
+        self._restore()                            # only if the resolve did not draw
+        self._drawn = False
+        if self._table_tex is not None:
+            self._table_tex.Deactivate()
+        if self._targets is not None:
+            self._targets[0].Deactivate()
+            self._targets[2].Deactivate()
+
+    def _make_targets(self, w: int, h: int, depth_format: int) -> tuple[Any, ...]:
+        """The volume's (w, h) float32 RGBA target and its copy of the opaque depth (``depth_format``: the scene's
+        depth attachment's, as a depth blit needs), each attached to a framebuffer object of its own (made again when
+        the size changes)."""
+        import vtk
+
+        t = self._targets
+        if t is not None and (t[0].GetWidth(), t[0].GetHeight()) == (w, h) and t[4] == depth_format:
+            return t
+        self._release_targets()
+        ren_win = self.renderer.GetRenderWindow()
+        colour = vtk.vtkTextureObject()
+        colour.SetContext(ren_win)
+        colour.Create2D(w, h, 4, vtk.VTK_FLOAT, False)
+        depth = vtk.vtkTextureObject()
+        depth.SetContext(ren_win)
+        depth.AllocateDepth(w, h, depth_format)
+        fbos = []
+        for tex, attach in ((colour, "colour"), (depth, "depth")):      # read by texelFetch: no filtering
+            fbo = vtk.vtkOpenGLFramebufferObject()
+            fbo.SetContext(ren_win)
+            fbo.SaveCurrentBindingsAndBuffers()
+            fbo.Bind()
+            if attach == "colour":
+                fbo.AddColorAttachment(0, tex)
+            else:
+                fbo.AddDepthAttachment(tex)
+            fbo.RestorePreviousBindingsAndBuffers()
+            fbos.append(fbo)
+        self._targets = (colour, fbos[0], depth, fbos[1], depth_format)
+        return self._targets
+
+    def _release_targets(self) -> None:
+        ren_win = self.renderer.GetRenderWindow()
+        if self._targets is not None and ren_win is not None:
+            for obj in self._targets[:4]:
+                obj.ReleaseGraphicsResources(ren_win)
+        self._targets = None
+
+    def _bind_target(self, w: int, h: int) -> Any:
+        """Copy the scene's depth at this point of the frame (after the opaque pass: the opaque geometry's; one sample
+        of each pixel when the window is multisampled) into the volume's depth texture, then bind and clear the
+        volume's colour target for the cells. Returns the depth texture."""
+        import vtk
+
+        ren_win = self.renderer.GetRenderWindow()
+        state = ren_win.GetState()
+        scene = [0]
+        state.vtkglGetIntegerv(_GL_DRAW_FRAMEBUFFER_BINDING, scene)
+        colour, colour_fbo, depth, depth_fbo, _ = self._make_targets(w, h, self._scene_depth_format(scene[0]))
+        colour_fbo.SaveCurrentBindingsAndBuffers()
+        self._bound = True
+        state.vtkglBindFramebuffer(_GL_READ_FRAMEBUFFER, scene[0])
+        state.vtkglBindFramebuffer(_GL_DRAW_FRAMEBUFFER, depth_fbo.GetFBOIndex())
+        mask = [1]
+        state.vtkglGetBooleanv(_GL_DEPTH_WRITEMASK, mask)
+        state.vtkglDepthMask(True)                  # a depth blit writes through the depth write mask
+        vtk.vtkOpenGLFramebufferObject.Blit((0, w, 0, h), (0, w, 0, h), _GL_DEPTH_BUFFER_BIT, _GL_NEAREST)
+        state.vtkglDepthMask(bool(mask[0]))
+        colour_fbo.Bind()
+        colour_fbo.ActivateDrawBuffer(0)
+        state.vtkglClearColor(0.0, 0.0, 0.0, 0.0)
+        state.vtkglClear(_GL_COLOR_BUFFER_BIT)
+        return depth
+
+    def _scene_depth_format(self, fbo_index: int) -> int:
+        """The vtkTextureObject depth format matching the depth attachment of the framebuffer being drawn (the window's
+        render framebuffer or a render pass's): GL blits depth only between equal formats."""
+        import vtk
+
+        fb = getattr(self.renderer, _PASS_MARK, None)
+        if fb is not None:
+            tex = fb.GetDepthTexture()
+        else:
+            tex = self.renderer.GetRenderWindow().GetRenderFramebuffer().GetDepthAttachmentAsTextureObject()
+        internal = tex.GetInternalFormat(vtk.VTK_FLOAT, 1, False) if tex is not None else 0
+        return {0x81A5: vtk.vtkTextureObject.Fixed16, 0x81A6: vtk.vtkTextureObject.Fixed24,
+                0x81A7: vtk.vtkTextureObject.Fixed32, 0x8CAC: vtk.vtkTextureObject.Float32}.get(
+                    internal, vtk.vtkTextureObject.Fixed32)
+
+    def _restore(self) -> None:
+        """The scene's framebuffer again."""
+        if self._bound:
+            self._targets[1].RestorePreviousBindingsAndBuffers()
+            self._bound = False
+
+    def _on_resolve(self, program: Any) -> None:
+        """The resolve's draw: back to the scene's framebuffer; the volume's image goes over it."""
+        self._restore()
+        colour = self._targets[0] if self._targets is not None else None
+        if colour is not None:
+            colour.Activate()
+            program.SetUniformi("ptAccum", colour.GetTextureUnit())
+        program.SetUniformi("ptDrawn", int(self._drawn and colour is not None))
 
     def _build_table(self) -> Any:
         from volviz.unstructured.render import _table_for, auto_lookup, table_size
@@ -341,9 +495,9 @@ class GLPTVolume(PTView):
         program.SetUniformi("clipCount", len(self._clip))
         if len(self._clip):
             program.SetUniform4fv("clipPlanes", len(self._clip), [float(x) for x in self._clip.ravel()])
-        depth = getattr(self.renderer, _PASS_MARK).GetDepthTexture()    # the opaque scene's (module docstring)
+        depth = self._bind_target(w, h)            # the opaque scene's depth, the volume's own colour target
         depth.Activate()
-        self._depth_tex = depth
+        self._drawn = True
         program.SetUniformi("useDepth", 1)
         program.SetUniformi("opaqueDepth", depth.GetTextureUnit())
         table = self._table
@@ -404,6 +558,7 @@ class GLPTVolume(PTView):
     @visible.setter
     def visible(self, on: bool) -> None:
         self.actor.SetVisibility(bool(on))
+        self.resolve_actor.SetVisibility(bool(on))
 
     def remove(self) -> None:
         """Take the volume out of the renderer; the last GL PT volume of a renderer removes the float target (call
@@ -415,16 +570,11 @@ class GLPTVolume(PTView):
             obj.RemoveObserver(tag)
         self._observers = []
         self.renderer.RemoveActor(self.actor)
+        self.renderer.RemoveActor(self.resolve_actor)
         ren_win = self.renderer.GetRenderWindow()
         if self._table_tex is not None and ren_win is not None:
             self._table_tex.ReleaseGraphicsResources(ren_win)
-        self._table_tex = self._depth_tex = None
-        release_single_sample(self.plotter, self)
-        users = getattr(self.renderer, _USERS, [])
-        if self in users:
-            users.remove(self)
-        if not users and getattr(self.renderer, _PASS_MARK, None) is not None:
-            if ren_win is not None:
-                getattr(self.renderer, _PASS_MARK).ReleaseGraphicsResources(ren_win)
-            self.renderer.SetPass(None)
-            setattr(self.renderer, _PASS_MARK, None)
+        self._table_tex = None
+        self._release_targets()
+        if not self.keep_multisampling:
+            release_single_sample(self.plotter, self)
