@@ -26,7 +26,7 @@ def test_software_renderers_are_recognised(renderer: str, software: bool) -> Non
 
 
 def test_auto_picks_the_gpu_on_hardware_and_the_measured_faster_path_on_llvmpipe() -> None:
-    for kind in ("pt", "regular"):
+    for kind in ("pt", "regular", "nature"):
         assert choose_backend("auto", kind, HARDWARE) == "gpu"
         assert choose_backend("auto", kind, LLVMPIPE) == "cpu"
         for setting in ("gpu", "cpu"):                      # an explicit setting is honoured on either driver

@@ -130,23 +130,27 @@ class NatureScene:
             return self.lod.full_mesh()
         return self.lod.update(camera.position, frustum_planes(camera, size, margin=0.05))
 
+    def volume_order(self, eye: Sequence[float]) -> list[tuple[str, Any]]:
+        """The volume layers in compositing order for an eye position: ("fog", _Fog) per prism layer and
+        ("clouds", None), farthest (by |eye height - the layer's mid height|) first; both backends composite them so
+        (exact for layers that do not interleave along a ray)."""
+        eye_z = float(eye[2])
+        items: list[tuple[float, str, Any]] = [(abs(eye_z - fog.mid_height), "fog", fog) for fog in self.fogs]
+        if self.cloud_lod is not None:
+            b = self.cloud_lod.volume.bounds()
+            items.append((abs(eye_z - 0.5 * (b[4] + b[5])), "clouds", None))
+        items.sort(key=lambda it: -it[0])  # farthest layer first
+        return [(kind, fog) for _, kind, fog in items]
+
     def render_volumes(self, camera: Any, size: tuple[int, int], mesh: TerrainMesh | None, depth: np.ndarray,
                        full: bool = False, stats: dict[str, float] | None = None) -> np.ndarray:
         """The premultiplied RGBA overlay of every prism layer and the clouds, clipped at ``depth``."""
         w, h = size
         stats = {} if stats is None else stats
-        eye_z = float(camera.position[2])
-        items: list[tuple[float, str, Any]] = []
-        for fog in self.fogs:
-            items.append((abs(eye_z - fog.mid_height), "fog", fog))
-        if self.cloud_lod is not None:
-            b = self.cloud_lod.volume.bounds()
-            items.append((abs(eye_z - 0.5 * (b[4] + b[5])), "clouds", None))
-        items.sort(key=lambda it: -it[0])  # farthest layer first
         overlay = np.zeros((h, w, 4))
         stats.setdefault("fog_prisms", 0.0)
         stats.setdefault("fog_s", 0.0)
-        for _, kind, fog in items:
+        for kind, fog in self.volume_order(camera.position):
             t0 = time.perf_counter()
             if kind == "fog" and mesh is not None:
                 bottom = mesh.points[:, 2] if fog.bottom == "terrain" else mesh.layers[fog.bottom]
@@ -343,7 +347,10 @@ def scene_from_components(components: Sequence[Any], datasets: dict[str, Any]) -
 
 # --------------------------------------------------------------------------------------------------- PyVista
 class NatureView:
-    """A ``NatureScene`` inside a PyVista plotter: terrain mesh, sky dome and the volume overlay (see module doc)."""
+    """A ``NatureScene`` inside a PyVista plotter: terrain mesh, sky dome and the volume overlay (see module doc).
+    The CPU backend of the natural-scene view; ``volviz.render.gl_nature.GLNatureView`` is the GPU one."""
+
+    backend = "cpu"
 
     def __init__(self, plotter: Any, scene: NatureScene, size: tuple[int, int] | None = None) -> None:
         import pyvista as pv
@@ -466,6 +473,14 @@ class NatureView:
     def finish(self, request: tuple[Any, tuple[int, int], int], poly: Any, overlay: np.ndarray,
                stats: dict[str, float]) -> dict[str, float]:
         """GUI thread: show a ``compute`` result (terrain mesh and overlay image)."""
+        self._show_terrain(poly)
+        self._set_overlay(overlay)
+        self.last_stats = stats
+        self.shown_scale = int(request[2])
+        return stats
+
+    def _show_terrain(self, poly: Any) -> None:
+        """The C-LOD terrain mesh (VTK poly data; None: keep the shown one) as the textured terrain actor."""
         if poly is not None:
             if self.terrain_actor is None:
                 self.terrain_actor = self.plotter.add_mesh(poly, texture=self._texture, lighting=False,
@@ -473,10 +488,12 @@ class NatureView:
             else:
                 self.terrain_actor.mapper.SetInputData(poly)
             self._mesh = poly
-        self._set_overlay(overlay)
-        self.last_stats = stats
-        self.shown_scale = int(request[2])
-        return stats
+
+    def remove(self) -> None:
+        """Take the view's actors (sky, terrain, overlay) out of the plotter."""
+        for name in ("nature-sky", "nature-terrain", "nature-overlay"):
+            self.plotter.remove_actor(name, render=False)
+        self.terrain_actor = self._overlay_actor = self._overlay_image = None
 
     def _set_overlay(self, overlay: np.ndarray) -> None:
         """Show an overlay image of ``_overlay_rgba`` (8-bit straight RGBA, rows bottom-up) in front of the scene."""

@@ -116,8 +116,8 @@ class SceneController:
 
     def clear(self) -> None:
         """Remove everything this controller added, including PT overlay renderers, which ``plotter.clear()`` keeps."""
-        for prop in self.props.values():
-            if _is_pt(prop):
+        for comp_id, prop in self.props.items():
+            if _is_pt(prop) or comp_id == "nature":
                 prop.remove()
         if self.iso_overlay is not None:
             self.iso_overlay.remove()
@@ -525,13 +525,16 @@ class SceneController:
     def install_nature(self, scene: Any, views: bool = True) -> Any:
         """GUI thread: show a ``prepare_nature`` result. With ``views`` its first view is computed now; otherwise
         the old terrain and overlay stay on screen until the new view's first ``finish_nature`` replaces them."""
-        from volviz.render.scene import install_nature
+        from volviz.render.scene import install_nature, view_backend
 
-        self.props.pop("nature", None)
+        old = self.props.pop("nature", None)
+        backend = view_backend(self.plotter, self.session, "nature")
+        if old is not None and "gpu" in (old.backend, backend):
+            old.remove()   # the GL layers go with their view (float targets, observers)
         names = ("nature-sky", "nature-terrain", "nature-overlay") if views or scene is None else ()
         for name in names:
             self.plotter.remove_actor(name, render=False)
-        view = install_nature(self.plotter, scene, views)  # adds its actors with ``render=False``
+        view = install_nature(self.plotter, scene, views, backend)  # adds its actors with ``render=False``
         if view is not None:
             self.props["nature"] = view
         return view

@@ -379,6 +379,15 @@ class GLFogLayer:
         if remake:
             self._upload()
 
+    def set_geometry(self, points: np.ndarray, bottom: np.ndarray, top: np.ndarray, triangles: np.ndarray,
+                     emission: tuple[np.ndarray, np.ndarray] | None = None) -> None:
+        """New prisms (arguments as the constructor's), e.g. the next frame's C-LOD terrain triangles: the vertex
+        buffer is built and uploaded again (``drawn`` prisms, 6 vertices and 31 floats each); the target stays."""
+        self._geometry = (np.asarray(points, dtype=np.float64), np.asarray(bottom, dtype=np.float64),
+                          np.asarray(top, dtype=np.float64), np.asarray(triangles, dtype=np.int64))
+        self._emission = emission
+        self._upload()
+
     @property
     def visible(self) -> bool:
         return bool(getattr(self, "_visible", True))

@@ -371,14 +371,19 @@ def prepare_nature(session: Session, datasets: dict[str, Any]) -> Any:
     return scene
 
 
-def install_nature(plotter: Any, scene: Any, views: bool = True) -> Any:
-    """GUI thread: a NatureView of a prepared NatureScene (None: none); its first view is computed now when ``views``
-    (the app computes it in the background: ``begin`` / ``compute`` / ``finish``)."""
+def install_nature(plotter: Any, scene: Any, views: bool = True, backend: str = "cpu") -> Any:
+    """GUI thread: a view of a prepared NatureScene (None: none): ``NatureView`` (fog and clouds rendered on the CPU
+    as an overlay) or, for ``backend`` "gpu", ``volviz.render.gl_nature.GLNatureView`` (drawn by VTK's OpenGL; see
+    ``view_backend``). Its first view is computed now when ``views`` (the app computes it in the background:
+    ``begin`` / ``compute`` / ``finish``)."""
     if scene is None:
         return None
-    from volviz.nature.scene import NatureView
+    if backend == "gpu":
+        from volviz.render.gl_nature import GLNatureView as View
+    else:
+        from volviz.nature.scene import NatureView as View
 
-    view = NatureView(plotter, scene)
+    view = View(plotter, scene)
     if views:
         view.update()
     return view
@@ -419,7 +424,7 @@ def install_scene(plotter: Any, session: Session, datasets: dict[str, Any], prep
         frame_bounds(plotter, union([b for b in boxes if b is not None]), right_margin=legend_margin(session))
     else:
         apply_camera(plotter, session.camera)
-    nature = install_nature(plotter, prepared.nature, views)
+    nature = install_nature(plotter, prepared.nature, views, view_backend(plotter, session, "nature"))
     if nature is not None:
         props["nature"] = nature
     for comp, _ in lod_components + pt_components:
@@ -511,9 +516,15 @@ def add_pt_component(plotter: Any, session: Session, comp: Component, dataset: A
 
 def pt_backend(plotter: Any, session: Session) -> str:
     """"gpu" or "cpu": where the session's PT volumes are drawn in ``plotter`` (``volviz.render.backend``)."""
+    return view_backend(plotter, session, "pt")
+
+
+def view_backend(plotter: Any, session: Session, view_kind: str) -> str:
+    """"gpu" or "cpu": where the session's views of ``view_kind`` ("pt", "nature", "iso", ...) are drawn in
+    ``plotter``, as the render option ``backend`` picks for the plotter's OpenGL (``volviz.render.backend``)."""
     from volviz.render.backend import choose_backend, plotter_gl_info
 
-    return choose_backend(backend_setting(session.render.options), "pt", plotter_gl_info(plotter))
+    return choose_backend(backend_setting(session.render.options), view_kind, plotter_gl_info(plotter))
 
 
 def pt_options(options: dict[str, Any]) -> dict[str, Any]:
@@ -619,4 +630,4 @@ def add_isosurfaces(plotter: Any, comp: Component, dataset: Any, t: Optional[flo
 
 def build_nature(plotter: Any, session: Session, datasets: dict[str, Any]) -> Any:
     """The NatureView of the session's visible terrain / fog / clouds / sky components (None when it has none)."""
-    return install_nature(plotter, prepare_nature(session, datasets))
+    return install_nature(plotter, prepare_nature(session, datasets), backend=view_backend(plotter, session, "nature"))

@@ -1,0 +1,239 @@
+"""The natural scene on the GPU backend: terrain C-LOD, sky dome, ground fog / cloud layers and C-LOD clouds all
+drawn by VTK's OpenGL pipeline into the scene's own depth buffer (Roettger Ch. 10-11, digest §8-9); the GPU side of
+``volviz.nature.scene.NatureView``, whose calls it keeps (``update``, ``begin`` / ``compute`` / ``finish``,
+``remove``, ``last_stats``, ``scene`` for the bounds), so the controller and the app only choose the class
+(``volviz.render.backend``, view kind "nature").
+
+- Terrain with geomorphing and the sky dome: ``NatureView``'s VTK meshes, unchanged (this class is its subclass).
+- Prism layers (ground fog, cloud layers between two height fields; §10.3-10.4): one ``volviz.render.gl_fog.
+  GLFogLayer`` each, on the frame's C-LOD terrain triangles and morphed layer heights (``GLFogLayer.set_geometry``
+  every frame: the prisms follow the terrain's LOD as on the CPU), reading the opaque depth of the terrain and sky.
+- Clouds (§11.3-11.6): the frame's C-LOD leaves as 5 tetrahedra each (``CloudFrame.to_tetmesh``, back to front)
+  with the morphed table field, drawn by ``CloudPTVolume``, a ``volviz.render.gl_pt.GLPTVolume`` whose fragments
+  scale the segment length by the second field as the CPU clouds do (Eq. 11.9, l' = l m̄ with m the modulating field
+  over its maximum at the middle of the segment; NPR §11.6.2: the table is indexed by f, γ modulates), looked up in
+  the scene's own cloud table (the CPU's, 64 x 64 x 128 over the root cube's diagonal).
+- The layers are composited in ``NatureScene.volume_order`` (farthest layer first), the CPU's order: their actors
+  are re-added to the renderer in that order when it changes.
+
+``compute`` (any thread) does the LOD work only: the terrain's C-LOD mesh, the clouds' refinement, morphing and leaf
+list, the tetrahedra's topology and modulation forms; ``finish`` (GUI thread) uploads them and VTK draws everything at
+every render, at the window's full size (a preview ``scale`` is ignored). No image is made on the CPU.
+
+What ``GLPTVolume`` lacks for the clouds (``CloudPTVolume`` works around it through its private members, listed
+there): a per-cell length modulation attribute, a caller-given back-to-front order (the leaves' BSP order; MPVO would
+sample the non-conforming leaf mesh's boundaries), a caller-given table (its own is built per mesh over the mesh's
+longest edge), and a public way to replace the mesh. Per frame the cloud vertex buffer is rebuilt and uploaded:
+4 vertices x 31 float32 per tetrahedron (496 bytes) plus 12 indices (48 bytes), ``stats["cloud_upload_bytes"]``.
+
+Errors against the CPU ``NatureView`` of the same camera and LOD (8-bit screen units), measured on llvmpipe in
+``tests/test_render_gl_nature.py``: see the bounds there.
+"""
+from __future__ import annotations
+
+import time
+from types import SimpleNamespace
+from typing import Any
+
+import numpy as np
+
+from volviz.model.datasets import TetMesh
+from volviz.nature.clouds import CloudFrame, CloudShading
+from volviz.nature.scene import NatureScene, NatureView
+from volviz.render.gl_fog import GLFogLayer
+from volviz.render.gl_pt import GLPTVolume, _polydata, shader_source
+from volviz.render.image_overlay import hold_single_sample, release_single_sample
+from volviz.unstructured.topology import topology, visible_cells
+
+__all__ = ["CloudPTVolume", "GLNatureView", "cloud_tetrahedra", "modulation_forms"]
+
+BYTES_PER_TET = 4 * 31 * 4 + 12 * 4         # vertex buffer (4 vertices x 31 float32) + index buffer (12 uint32)
+
+# (anchor in gl_pt's shader, text added after it): the modulation attribute passed through as a flat varying, and the
+# length scaled by the modulating field at the middle of the clipped segment
+_VS_PATCH = (("in vec4 ptRange;", "\nin vec4 ptModulate;"),
+             ("flat out vec4 cellRange;", "\nflat out vec4 cellModulate;"),
+             ("cellRange = ptRange;", "\n  cellModulate = ptModulate;"))
+_FS_PATCH = (("flat in vec4 cellRange;", "\nflat in vec4 cellModulate;"),
+             ("float len = (t1 - t0) * length(d);",
+              "\n  len *= max(dot(cellModulate.xyz, o + 0.5 * (t0 + t1) * d) + cellModulate.w, 0.0);"))
+
+
+def _patched(name: str, patches: tuple[tuple[str, str], ...]) -> str:
+    text = shader_source(name)
+    for anchor, added in patches:
+        if text.count(anchor) != 1:
+            raise RuntimeError(f"gl_pt's {name} changed: the clouds' modulation needs the line {anchor!r} once")
+        text = text.replace(anchor, anchor + added)
+    return text
+
+
+def cloud_tetrahedra(frame: CloudFrame, shading: CloudShading, eye: Any) -> tuple[TetMesh, np.ndarray]:
+    """The frame's leaves as tetrahedra in back-to-front order for ``eye`` with the morphed table field, and the
+    modulating field per point over its maximum (the CPU's ``m_scale``): γ / γ_max for NPR, f / f_max otherwise."""
+    vol = frame.lod.volume
+    mesh, other = frame.to_tetmesh(shading.table_field, eye=eye)
+    m_max = float(vol.gamma.max() if shading.table_field == "f" else vol.f.max())
+    return mesh, other / max(m_max, 1e-12)
+
+
+def modulation_forms(mesh: TetMesh, modulation: np.ndarray) -> np.ndarray:
+    """Per tetrahedron (m, 4) float32 (g, c): the affine form g . x + c of the per-point ``modulation`` with x
+    relative to the mesh's centre (``topology(mesh).origin``, where GLPTVolume places its actor)."""
+    topo = topology(mesh)
+    p = topo.points[topo.tets]
+    v = np.asarray(modulation, np.float64)[topo.tets]
+    g = np.linalg.solve(p[:, 1:] - p[:, :1], (v[:, 1:] - v[:, :1])[..., None])[..., 0]
+    c = v[:, 0] - np.einsum("ij,ij->i", g, p[:, 0])
+    return np.ascontiguousarray(np.concatenate([g, c[:, None]], axis=1), np.float32)
+
+
+class CloudPTVolume(GLPTVolume):
+    """C-LOD cloud tetrahedra on the GPU PT pass (module docstring): the shading's table, the length modulated per
+    fragment (Eq. 11.9), the given back-to-front order, and ``set_frame`` for the next frame's mesh.
+
+    Private members of ``GLPTVolume`` used (what a public API would replace): ``_build_table`` (overridden to return
+    the scene's table), ``_sorted`` / ``_order_key`` (the given order, kept by ``reuse_order``), ``_vis`` (culling
+    of the new mesh), ``gl_pt._polydata`` (the new mesh's vertex buffer)."""
+
+    def __init__(self, plotter: Any, mesh: TetMesh, modulation: np.ndarray, shading: CloudShading, table: Any
+                 ) -> None:
+        import vtk
+
+        self._cloud_table = table
+        super().__init__(plotter, mesh, shading.tf, lookup="3d")
+        sp = self.actor.GetShaderProperty()
+        sp.SetVertexShaderCode(_patched("pt_tet_vs.glsl", _VS_PATCH))
+        sp.SetFragmentShaderCode(_patched("pt_tet_fs.glsl", _FS_PATCH))
+        self.mapper.MapDataArrayToVertexAttribute("ptModulate", "ptModulate",
+                                                  vtk.vtkDataObject.FIELD_ASSOCIATION_POINTS, -1)
+        self.stats = {"method": "pt-gl clouds"}
+        self._attach(modulation)
+
+    def _build_table(self) -> Any:
+        return self._cloud_table
+
+    def _attach(self, modulation: np.ndarray) -> None:
+        """The modulation forms on the vertex buffer; the mesh's own (back-to-front) order for every camera."""
+        from vtk.util.numpy_support import numpy_to_vtk
+
+        forms = np.repeat(modulation_forms(self.mesh, modulation), 4, axis=0)
+        arr = numpy_to_vtk(forms, deep=True)
+        arr.SetName("ptModulate")
+        self.polydata.GetPointData().AddArray(arr)
+        self.reuse_order = True
+        self._sorted = np.arange(self.topo.n_tets, dtype=np.int64)
+        self._order_key = None
+
+    def set_frame(self, mesh: TetMesh, modulation: np.ndarray) -> None:
+        """The next frame's tetrahedra (back to front) and modulating field: a new vertex buffer, the same table."""
+        self.mesh = self.whole_mesh = mesh
+        self.topo = topology(mesh)
+        self._vis = visible_cells(mesh, self.tf.scalars, self.tf.extinction)
+        self.polydata = _polydata(mesh)
+        self.mapper.SetInputData(self.polydata)
+        self.actor.SetPosition(*self.topo.origin)
+        self._attach(modulation)
+
+
+class GLNatureView(NatureView):
+    """A ``NatureScene`` in a PyVista plotter, fog and clouds on the GPU (module docstring). ``layers``: the
+    ``GLFogLayer`` of each prism layer by name; ``clouds``: the ``CloudPTVolume`` (None without clouds or before the
+    first frame)."""
+
+    backend = "gpu"
+
+    def __init__(self, plotter: Any, scene: NatureScene, size: tuple[int, int] | None = None) -> None:
+        super().__init__(plotter, scene, size)
+        self.layers: dict[str, GLFogLayer] = {}
+        self.clouds: CloudPTVolume | None = None
+        hold_single_sample(plotter, self)       # the float targets are single-sample (gl_pt)
+
+    def compute(self, request: tuple[Any, tuple[int, int], int],
+                progress: Any = None) -> tuple[Any, Any, dict[str, float]]:
+        """Any thread: the LOD work of a frame (no image): the terrain's C-LOD mesh as VTK poly data and as the
+        ``TerrainMesh`` the prisms stand on, the clouds' tetrahedra with their topology and modulation, statistics
+        (``lod_s``: seconds spent here)."""
+        cam, size, _ = request
+        t0 = time.perf_counter()
+        scene = self.scene
+        mesh = scene.terrain_mesh(cam, size)
+        stats: dict[str, float] = {}
+        poly = None
+        if mesh is not None:
+            poly = mesh.to_pyvista()
+            stats["terrain_triangles"] = float(mesh.n_triangles)
+        clouds = None
+        if scene.cloud_lod is not None:
+            if progress is not None:
+                progress(0.5, "clouds")
+            assert scene.cloud_shading is not None
+            frame = scene.cloud_lod.update(cam, size)
+            tets, modulation = cloud_tetrahedra(frame, scene.cloud_shading, cam.position)
+            topology(tets)                       # cached on the mesh: the GUI thread only uploads
+            clouds = (tets, modulation)
+            stats["cloud_tets"] = float(frame.n_tets)
+            stats["cloud_upload_bytes"] = float(frame.n_tets * BYTES_PER_TET)
+        stats["lod_s"] = time.perf_counter() - t0
+        return poly, SimpleNamespace(mesh=mesh, clouds=clouds, eye=np.asarray(cam.position, np.float64)), stats
+
+    def finish(self, request: tuple[Any, tuple[int, int], int], poly: Any, frame: Any,
+               stats: dict[str, float]) -> dict[str, float]:
+        """GUI thread: the terrain mesh, the prisms on it and the cloud tetrahedra to VTK (drawn at the next
+        render); ``upload_s``: seconds spent here."""
+        t0 = time.perf_counter()
+        self._show_terrain(poly)
+        scene, mesh = self.scene, frame.mesh
+        for kind, fog in scene.volume_order(frame.eye):    # made in this order: the first frame moves nothing
+            if kind == "fog" and mesh is not None:
+                bottom = mesh.points[:, 2] if fog.bottom == "terrain" else mesh.layers[fog.bottom]
+                args = (mesh.points, bottom, mesh.layers[fog.top], mesh.triangles)
+                if fog.name in self.layers:
+                    self.layers[fog.name].set_geometry(*args)
+                else:
+                    self.layers[fog.name] = GLFogLayer(self.plotter, *args, fog.layer)
+            elif kind == "clouds" and frame.clouds is not None:
+                if self.clouds is None:
+                    assert scene.cloud_shading is not None
+                    self.clouds = CloudPTVolume(self.plotter, *frame.clouds, scene.cloud_shading, scene.cloud_table)
+                else:
+                    self.clouds.set_frame(*frame.clouds)
+        stats["fog_prisms"] = float(sum(layer.drawn for layer in self.layers.values()))
+        self._sort_layers(frame.eye)
+        stats["upload_s"] = time.perf_counter() - t0
+        self.last_stats = stats
+        self.shown_scale = 1
+        return stats
+
+    def _sort_layers(self, eye: np.ndarray) -> None:
+        """The layers' actors in the renderer in the CPU's compositing order (``NatureScene.volume_order``)."""
+        actors: list[Any] = []
+        for kind, fog in self.scene.volume_order(eye):
+            if kind == "fog" and fog.name in self.layers:
+                actors += [self.layers[fog.name].actor, self.layers[fog.name].resolve_actor]
+            elif kind == "clouds" and self.clouds is not None:
+                actors.append(self.clouds.actor)
+        props = self.plotter.renderer.GetViewProps()
+        shown = [props.GetItemAsObject(i) for i in range(props.GetNumberOfItems())]
+        position = {id(p): i for i, p in enumerate(shown)}
+        now = [position.get(id(a), -1) for a in actors]
+        if now != sorted(now):
+            # moved in the renderer's prop list only: RemoveActor would release the actors' GL resources. (Moving
+            # the GL PT actor before the renderer's first render left the whole image black on llvmpipe; the
+            # actors are made in the first frame's order, so only later frames move them.)
+            for actor in actors:
+                props.RemoveItem(actor)
+            for actor in actors:
+                props.AddItem(actor)
+
+    def remove(self) -> None:
+        """Take the prisms, clouds, terrain and sky out of the plotter and free the GL targets (call before closing
+        the plotter)."""
+        for layer in self.layers.values():
+            layer.remove()
+        self.layers = {}
+        if self.clouds is not None:
+            self.clouds.remove()
+            self.clouds = None
+        release_single_sample(self.plotter, self)
+        super().remove()
