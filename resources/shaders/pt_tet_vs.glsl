@@ -11,6 +11,16 @@ in vec4 ptPlane2;
 in vec4 ptPlane3;
 in vec4 ptScalar;
 in vec4 ptRange;
+#ifdef PT_SMOOTH
+in vec4 ptNormalX;
+in vec4 ptNormalY;
+in vec4 ptNormalZ;
+in vec4 ptBary;
+flat out vec4 cellNormalX;
+flat out vec4 cellNormalY;
+flat out vec4 cellNormalZ;
+flat out vec4 cellBary;
+#endif
 
 uniform mat4 MCDCMatrix;
 
@@ -29,5 +39,11 @@ void main()
   cellPlane3 = ptPlane3;
   cellScalar = ptScalar;
   cellRange = ptRange;
+#ifdef PT_SMOOTH
+  cellNormalX = ptNormalX;
+  cellNormalY = ptNormalY;
+  cellNormalZ = ptNormalZ;
+  cellBary = ptBary;
+#endif
   gl_Position = MCDCMatrix * vertexMC;
 }
