@@ -33,10 +33,14 @@ How a frame is drawn:
   straddling a surface is integrated only up to it. The volume's colour target has no depth attachment, so GL's depth
   test never drops a fragment whose exit face lies behind the surface.
 - Multisampling: by default the window's multisampling is switched off while the volume is in it (one colour per
-  pixel, as volviz's CPU overlays: the two backends then give the same viewport image). With
-  ``keep_multisampling=True`` it stays on: the opaque scene (and translucent props) are antialiased in the window's
-  multisampled framebuffer as without the volume, the depth blit resolves the opaque depth to one sample per pixel,
-  and the resolve composites the volume's single-sample image over every sample. Measured on llvmpipe (4 samples,
+  pixel, as volviz's CPU overlays: the two backends then give the same viewport image), and the renderer draws
+  into a float32 scene target (a ``vtkFramebufferPass``, ``_install_pass``, shared with ``volviz.render.gl_fog``'s
+  layers, which read its depth texture; the volume itself does not need it and blits its depth from it). With
+  ``keep_multisampling=True`` it stays on and no scene target is installed (its single-sample texture would undo
+  the antialiasing, as it does when a fog layer in the same renderer installs one): the opaque scene (and
+  translucent props) are antialiased in the window's multisampled framebuffer as without the volume, the depth blit
+  resolves the opaque depth to one sample per pixel, and the resolve composites the volume's single-sample image
+  over every sample. Measured on llvmpipe (4 samples,
   ``tests/test_render_gl_pt.py``): against the reference clipped at the single-sample depth over the antialiased
   opaque image, RMSE 0.32 / max 2.6 away from an opaque sphere's silhouette; on silhouette pixels (partly covered)
   up to 37 and next to them up to 6.5, since the volume is integrated to one sample's depth rather than each
@@ -268,6 +272,7 @@ class GLPTVolume(PTView):
         self.keep_multisampling = keep_multisampling
         if not keep_multisampling:
             hold_single_sample(plotter, self)      # one colour per pixel, as the CPU backend's overlays
+            self._install_pass()                   # the renderer's float32 scene target, as the GL fog layers'
         GLPTVolume._on_program.CallDataType = vtk.VTK_OBJECT     # type: ignore[attr-defined]
         self._observers = [
             (self.mapper, self.mapper.AddObserver(vtk.vtkCommand.UpdateShaderEvent, self._on_program)),
@@ -657,3 +662,11 @@ class GLPTVolume(PTView):
         self._release_targets()
         if not self.keep_multisampling:
             release_single_sample(self.plotter, self)
+        users = getattr(self.renderer, _USERS, [])
+        if self in users:
+            users.remove(self)
+        if not users and getattr(self.renderer, _PASS_MARK, None) is not None:
+            if ren_win is not None:
+                getattr(self.renderer, _PASS_MARK).ReleaseGraphicsResources(ren_win)
+            self.renderer.SetPass(None)
+            setattr(self.renderer, _PASS_MARK, None)
