@@ -338,6 +338,30 @@ def test_tf_edit_replaces_only_the_table():
     assert e[0] <= RMSE and e[1] <= MAX, e
 
 
+def test_auto_lookup_follows_the_tf():
+    """lookup="auto" picks the table as the CPU ``pt`` does (separable up to an optical depth of 24 per cell, else
+    3D) and the fragment shader is made for it: a TF edit that crosses the limit switches table and shader, and both
+    images are within the bound of the reference."""
+    mesh = syn.box_tets(4, jitter=0.2)
+    size = (48, 40)
+    cam = Camera.orbit(mesh.points, 50, 30, 2.5)
+    dense = TF.scaled_extinction(10.0)
+    pl = _plotter(size, cam)
+    vol = GLPTVolume(pl, mesh, TF, lookup="auto")
+    first = pl.screenshot(return_img=True)
+    separable = not hasattr(vol._table, "rgba")
+    vol.set_tf(dense)
+    pl.ren_win.Render()
+    img = pl.screenshot(return_img=True)
+    three_d = hasattr(vol._table, "rgba")
+    vol.remove()
+    pl.close()
+    assert separable and three_d
+    for shot, tf in ((first, TF), (img, dense)):
+        e = _err(shot, render(mesh, tf, cam, size, "reference")[..., :3])
+        assert e[0] <= RMSE and e[1] <= MAX, e
+
+
 ISO = build_iso_table([IsoSurface(0.2, (1.0, 0.9, 0.2), 0.5),
                        IsoSurface(0.3, (1.0, 0.2, 0.1), 0.6, back_color=(0.2, 1.0, 0.2)),
                        IsoSurface(0.55, (0.1, 0.3, 1.0), 0.8)], n_s=512, s_range=(0.0, 0.9))

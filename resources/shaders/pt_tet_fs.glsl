@@ -47,7 +47,12 @@ uniform sampler2D opaqueDepth;
 uniform int clipCount;       // user clipping planes (n, d), n . x <= d kept, relative to the mesh centre
 uniform vec4 clipPlanes[8];
 
-uniform int lookupKind;      // 0: 3D table, 1: separable table, 2: exact isosurfaces, 3: pre-classified
+// PT_KIND, defined when the shader is made (one program per kind: llvmpipe executes every branch of a fragment
+// shader under a lane mask, so a run-time switch would pay for all kinds): 0 3D table, 1 separable table, 2 exact
+// isosurfaces, 3 pre-classified.
+#ifndef PT_KIND
+#define PT_KIND 0
+#endif
 uniform int rowCount;        // 2: isosurfaces (rows: value, opacity; front colour; back colour), 3: TF points
 uniform float isoThicken;
 uniform sampler3D ptTable;
@@ -304,30 +309,24 @@ void main()
   float len = (t1 - t0) * length(d);
   float sf = dot(cellScalar.xyz, o + t0 * d) + cellScalar.w;
   float sb = dot(cellScalar.xyz, o + t1 * d) + cellScalar.w;
-  vec4 rgba;
-  if (lookupKind >= 2)
-  {
-    float sfc = clamp(sf, cellRange.x, cellRange.y);
-    float sbc = clamp(sb, cellRange.x, cellRange.y);
-    if (lookupKind == 3)
-    {
-      rgba = preclassified(sfc, sbc, len);
-    }
-    else
-    {
-#ifdef PT_SMOOTH
-      rgba = isoSegment(sfc, sbc, shadeAt(o + t0 * d), shadeAt(o + t1 * d));
+#if PT_KIND >= 2
+  float sfc = clamp(sf, cellRange.x, cellRange.y);
+  float sbc = clamp(sb, cellRange.x, cellRange.y);
+#if PT_KIND == 3
+  vec4 rgba = preclassified(sfc, sbc, len);
+#elif defined(PT_SMOOTH)
+  vec4 rgba = isoSegment(sfc, sbc, shadeAt(o + t0 * d), shadeAt(o + t1 * d));
 #else
-      rgba = isoSegment(sfc, sbc, 1.0, 1.0);
+  vec4 rgba = isoSegment(sfc, sbc, 1.0, 1.0);
 #endif
-    }
-  }
-  else
-  {
-    float u = tableIndex(sf, cellRange.xy);
-    float v = tableIndex(sb, cellRange.xy);
-    rgba = lookupKind == 1 ? lookupSeparable(u, v, len) : lookup3d(u, v, len);
-  }
+#else
+  float u = tableIndex(sf, cellRange.xy);
+  float v = tableIndex(sb, cellRange.xy);
+#if PT_KIND == 1
+  vec4 rgba = lookupSeparable(u, v, len);
+#else
+  vec4 rgba = lookup3d(u, v, len);
+#endif
+#endif
   gl_FragData[0] = rgba;
-  gl_FragDepth = 0.0;
 }
