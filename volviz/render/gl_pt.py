@@ -164,10 +164,15 @@ def _resolve_polydata(bounds: np.ndarray) -> Any:
     return pd
 
 
-def _triangles(cells: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(offsets, connectivity) of the 4 faces of each cell in ``cells`` (in that order), for vtkCellArray.SetData."""
-    conn = ((4 * cells.astype(np.int64))[:, None] + FACES.reshape(1, 12)).reshape(-1)
-    return np.arange(0, len(conn) + 1, 3, dtype=np.int64), conn
+def _triangles(cells: np.ndarray, offsets: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """(offsets, connectivity), int32, of the 4 faces of each cell in ``cells`` (in that order), for
+    vtkCellArray.SetData; ``offsets``: 0, 3, 6, ... for at least as many triangles, sliced instead of made. 32-bit
+    arrays handed to VTK without a copy: 3 ms for the Blunt Fin's 750,000 triangles, 28 ms with 64-bit copies."""
+    conn = ((4 * cells.astype(np.int32))[:, None] + FACES.reshape(1, 12).astype(np.int32)).reshape(-1)
+    n = len(conn) // 3 + 1
+    if offsets is None or len(offsets) < n:
+        offsets = np.arange(0, 3 * n, 3, dtype=np.int32)
+    return offsets[:n], conn
 
 
 def _shader(name: str, smooth: bool, kind: int = 0) -> str:
@@ -227,6 +232,8 @@ class GLPTVolume(PTView):
         self.order: np.ndarray | None = None       # the drawn cells, back to front
         self.reuse_order = False                    # keep the last order whatever the camera (during interaction)
         self._sorted: np.ndarray | None = None      # the last full visibility order (all cells)
+        self._offsets: np.ndarray | None = None     # 0, 3, 6, ...: the index buffer's triangle offsets
+        self._cell_arrays: tuple[np.ndarray, np.ndarray] | None = None   # the arrays VTK's cells share
         self._recull = False                        # the TF changed: cull the last order again (no new sort)
         self._cycles = 0
         self._prefetcher: Any = None
@@ -338,8 +345,6 @@ class GLPTVolume(PTView):
     def _on_start(self, *_: Any) -> None:
         """Before each render: the back-to-front index buffer for this camera (unchanged cameras keep theirs; a
         prefetched order for this camera is taken; with ``reuse_order`` the last order is kept for any camera)."""
-        from vtk.util.numpy_support import numpy_to_vtk
-
         from volviz.unstructured.sort import visibility_order
 
         if not self.actor.GetVisibility():
@@ -362,14 +367,24 @@ class GLPTVolume(PTView):
         self._recull = False
         t1 = time.perf_counter()
         cells = self._sorted[self._vis[self._sorted]]
-        offsets, conn = _triangles(cells)
-        polys = self.polydata.GetPolys()
-        polys.SetData(numpy_to_vtk(offsets, deep=True), numpy_to_vtk(conn, deep=True))
-        self.polydata.Modified()
+        self._set_index_buffer(cells)
         self.order, self._order_key = cells, key
         self.stats = {"method": "pt-gl", "sort_s": t1 - t0, "order_s": time.perf_counter() - t1,
                       "n_visible": int(len(cells)), "cycles": self._cycles, "sorted": not (same or reused), "sort_prefetched": prefetched,
                       "order_reused": reused}
+
+    def _set_index_buffer(self, cells: np.ndarray) -> None:
+        """Draw ``cells`` back to front (4 triangles each) from the next render on: the polydata's cells are 32-bit
+        numpy arrays shared with VTK (kept referenced here), VTK builds and uploads the index buffer from them."""
+        from vtk.util.numpy_support import numpy_to_vtk
+
+        if len(self.topo.tets) * 4 >= 2 ** 31:
+            raise ValueError("too many tetrahedra for 32-bit vertex indices")
+        offsets, conn = _triangles(cells, self._offsets)
+        self._offsets = offsets.base if offsets.base is not None else offsets
+        self._cell_arrays = (offsets, conn)
+        self.polydata.GetPolys().SetData(numpy_to_vtk(offsets, deep=False), numpy_to_vtk(conn, deep=False))
+        self.polydata.Modified()
 
     def prefetch(self, camera: Camera, size: tuple[int, int] | None = None) -> None:
         """Sort for ``camera`` (the next frame's; ``size`` defaults to the renderer's) on a background worker, so
