@@ -32,13 +32,14 @@ def one_line_error(capsys: pytest.CaptureFixture[str]) -> str:
 
 
 @pytest.mark.parametrize("args, words", [
-    (["--help"], "{info,render,bench,compress,warmup}"),
+    (["--help"], "{info,render,bench,compress,schema,warmup}"),
     (["info", "--help"], "--array"),
     (["render", "--help"], "--orbit"),
     (["bench", "--help"], "unstructured"),
     (["bench", "nature", "--help"], "--cloud-shape"),
     (["compress", "--help"], "--lossless"),
     (["warmup", "--help"], "usage: volviz warmup"),
+    (["schema", "--help"], "--output"),
 ])
 def test_every_command_answers_help(args: list[str], words: str, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(args) == 0

@@ -18,7 +18,7 @@ def sample_session() -> S.Session:
     return S.Session(
         datasets=[S.DatasetRef(id="fin", path="data/bluntfinxyz.bin", options={"q": "data/bluntfinq.bin"})],
         components=[S.Component(id="fin", type="mesh", dataset="fin", opacity=0.75, transfer_function="ramp",
-                                settings={"method": "pt", "table": [128, 128, 64]})],
+                                settings={"array": "Density", "budget": 128})],
         transfer_functions={"ramp": tf},
         camera=cam,
         camera_paths={"orbit": [S.CameraKey(0.0, cam), S.CameraKey(2.5, S.CameraState(position=(0, 5, 1)))]},
@@ -130,7 +130,7 @@ def test_relative_paths(tmp_path: Path) -> None:
 def test_older_versions_are_migrated_step_by_step(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """Version 1 is the first format; this exercises the migration chain the way a version 2 will use it."""
     def v1_to_v2(doc: dict) -> dict:
-        doc["render"]["options"]["migrated"] = True
+        doc["render"]["options"]["time"] = 1.5   # a version 2 would rename or convert fields like this
         return doc
 
     doc = S.session_to_dict(sample_session())
@@ -139,6 +139,6 @@ def test_older_versions_are_migrated_step_by_step(tmp_path: Path, monkeypatch: p
     monkeypatch.setattr(S, "VERSION", 2)
     monkeypatch.setitem(S.MIGRATIONS, 1, v1_to_v2)
     loaded = S.load(path)
-    assert loaded.render.options["migrated"] is True
+    assert loaded.render.options["time"] == 1.5
     S.save(loaded, tmp_path / "new.json")
     assert json.loads((tmp_path / "new.json").read_text())["version"] == 2

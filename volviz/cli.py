@@ -94,6 +94,11 @@ def build_parser() -> argparse.ArgumentParser:
 
     sub.add_parser("compress", help="compress a regular volume or a time series (see `volviz compress --help`)",
                    add_help=False)
+    schema = sub.add_parser("schema", help="print the JSON schema of a session file",
+                            description="The JSON schema (draft 2020-12) of a volviz session file: every component "
+                            "type's settings and the render options with their types, ranges and defaults "
+                            "(docs/session.schema.json holds it).")
+    schema.add_argument("-o", "--output", default=None, help="write it to this file instead of printing it")
     sub.add_parser("warmup", help="compile the rendering kernels once, ahead of first use (the setup script runs it)",
                    description="Compile the rendering kernels once into Numba's disk cache, ahead of first use.")
     return parser
@@ -241,7 +246,7 @@ def run(argv: Optional[Sequence[str]] = None) -> int:
     if rest and args.command not in PASSED_ON:
         raise UsageError(f"unrecognized arguments: {' '.join(rest)}")
     if args.command is None:
-        raise UsageError("a command is needed: info, render, bench, compress or warmup (see volviz --help)")
+        raise UsageError("a command is needed: info, render, bench, compress, schema or warmup (see volviz --help)")
     if args.command == "info":
         if args.file is None and not args.gl:
             raise UsageError("info needs a file, or --gl (see volviz info --help)")
@@ -267,6 +272,16 @@ def run(argv: Optional[Sequence[str]] = None) -> int:
         return int(compress_main(list(rest)) or 0)
     if args.command == "warmup":
         return _warmup()
+    if args.command == "schema":
+        from volviz.model.session_schema import session_schema_text
+
+        if args.output:
+            from volviz.io.atomic import atomic_write_bytes
+
+            atomic_write_bytes(args.output, session_schema_text().encode("utf-8"))
+        else:
+            sys.stdout.write(session_schema_text())
+        return 0
     raise UsageError(f"unknown command {args.command}")
 
 

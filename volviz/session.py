@@ -23,12 +23,13 @@ import re
 import stat
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any, Callable, get_args
 
 import numpy as np
 
 from volviz.io._checks import path_kind
 from volviz.io.atomic import OutputPathError, atomic_write_bytes
+from volviz.model.settings import Backend, SettingsError, validate_render_options, validate_settings
 
 FORMAT = "volviz-session"
 VERSION = 1
@@ -43,7 +44,7 @@ MAX_OPTION_ITEMS = 16        # items of a list-valued dataset option (dims, spac
 
 COMPONENT_TYPES = ("volume", "mesh", "isosurface", "terrain", "fog", "clouds", "sky", "demo")
 RENDER_METHODS = ("auto", "pt", "reference", "vtk")
-RENDER_BACKENDS = ("auto", "gpu", "cpu")   # render option "backend" (volviz.render.backend)
+RENDER_BACKENDS = get_args(Backend)   # render option "backend" (volviz.render.backend)
 
 
 class SessionError(Exception):
@@ -278,6 +279,10 @@ def session_from_dict(doc: Any, source: str | os.PathLike | None = None) -> Sess
                                else r.string(o.get("transfer_function"), f"{where}.transfer_function")),
             settings=r.json_value(r.obj(o.get("settings", {}), f"{where}.settings"), f"{where}.settings"),
         )
+        try:
+            validate_settings(comp.type, comp.settings, f"{where}.settings")
+        except SettingsError as exc:
+            raise r.fail(*exc.problems[0]) from None
         if comp.id in component_ids:
             raise r.fail(f"{where}.id", f"duplicate component id {_quote(comp.id)}")
         component_ids.add(comp.id)
@@ -317,8 +322,10 @@ def session_from_dict(doc: Any, source: str | os.PathLike | None = None) -> Sess
                          for i, v in enumerate(r.vector(rs.get("background", [0.1, 0.1, 0.12]), "render.background"))),
         options=r.json_value(r.obj(rs.get("options", {}), "render.options"), "render.options"),
     )
-    if "backend" in session.render.options:
-        r.string(session.render.options["backend"], "render.options.backend", RENDER_BACKENDS)
+    try:
+        validate_render_options(session.render.options)
+    except SettingsError as exc:
+        raise r.fail(*exc.problems[0]) from None
     session.layout = r.json_value(r.obj(d.get("layout", {}), "layout"), "layout")
     session.clip = _read_clip(r, d.get("clip", {"planes": [], "box": None}))
     return session

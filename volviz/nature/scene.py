@@ -21,6 +21,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
+from volviz.model.settings import TerrainSettings, typed_settings
 from volviz.nature.clouds import CloudLOD, CloudShading, CloudVolume, build_cloud_table, render_cloud_image
 from volviz.nature.fog import FogLayer, render_layer
 from volviz.nature.heightfield import HeightField, grid_from_image, resample_bilinear
@@ -274,73 +275,63 @@ def scene_from_components(components: Sequence[Any], datasets: dict[str, Any]) -
             by_type.setdefault(comp.type, []).append(comp)
     terrain = None
     texture = None
-    settings: dict[str, Any] = {}
+    settings = TerrainSettings()
     if "terrain" in by_type:
         comp = by_type["terrain"][0]
-        settings = comp.settings
+        settings = typed_settings("terrain", comp.settings, f"component {comp.id!r} settings")
         if comp.dataset is None:
-            h = noise.fractal_terrain(int(settings.get("size", 257)), seed=int(settings.get("seed", 1)),
-                                      relief=float(settings.get("relief", 160.0)))
-            ext = settings.get("extent", [1000.0, 1000.0])
+            h = noise.fractal_terrain(settings.size or 257, seed=settings.seed, relief=settings.relief)
+            ext = settings.extent or (1000.0, 1000.0)
             terrain = HeightField(h, (ext[0] / (h.shape[0] - 1), ext[1] / (h.shape[1] - 1)))
         else:
             image = _dataset(comp, datasets)
-            extent = settings.get("extent")
-            terrain = HeightField.from_image(image, tuple(extent) if extent else None,
-                                             float(settings.get("height_scale", 1.0)), settings.get("size"))
-            if "origin" in settings:  # e.g. UTM coordinates of a DEM moved to the origin
-                terrain = HeightField(terrain.heights, terrain.spacing, tuple(settings["origin"]), terrain.source)
+            terrain = HeightField.from_image(image, settings.extent, settings.height_scale, settings.size)
+            if settings.origin is not None:  # e.g. UTM coordinates of a DEM moved to the origin
+                terrain = HeightField(terrain.heights, terrain.spacing, settings.origin, terrain.source)
         tex = _setting_dataset(comp, "texture_dataset", datasets)
         if tex is not None:
             texture = np.asarray(tex.data, dtype=np.float32) / float(getattr(tex, "maxval", None) or 255)
     sky = None
     if "sky" in by_type and by_type["sky"][0].dataset:
         sky = sky_texture(_dataset(by_type["sky"][0], datasets))
-    scene = NatureScene(terrain, texture, sky, big_c=float(settings.get("C", 12.0)),
-                        small_c=float(settings.get("c", 60.0)))
+    scene = NatureScene(terrain, texture, sky, big_c=settings.C, small_c=settings.c)
     for comp in by_type.get("fog", []):
-        st = comp.settings
+        fog = typed_settings("fog", comp.settings, f"component {comp.id!r} settings")
         if terrain is None:
             raise ValueError(f"component {comp.id!r}: a fog layer needs a terrain component")
         if comp.dataset is None:
-            thick = noise.fog_map(terrain.heights, float(st.get("level", 50.0)), float(st.get("thickness", 25.0)),
-                                  seed=int(st.get("seed", 2)))
+            thick = noise.fog_map(terrain.heights, fog.level, fog.thickness, seed=fog.seed)
         else:
-            thick = _image_grid(_dataset(comp, datasets)) * float(st.get("thickness_scale", 1.0))
+            thick = _image_grid(_dataset(comp, datasets)) * fog.thickness_scale
         base_img = _setting_dataset(comp, "base_dataset", datasets)
         base = None
         if base_img is not None:
-            base = _image_grid(base_img) * float(st.get("base_scale", 1.0)) + float(st.get("base_offset", 0.0))
-        layer = FogLayer(colour=tuple(st.get("colour", (0.75, 0.75, 1.0))), density=float(st.get("density", 0.05)),
-                         mode=str(st.get("mode", "attenuated")), mip_gain=float(st.get("mip_gain", 0.05)))
-        scene.add_fog(comp.id, thick, layer, base, float(st.get("weight", 4.0)))
+            base = _image_grid(base_img) * fog.base_scale + fog.base_offset
+        layer = FogLayer(colour=fog.colour, density=fog.density, mode=fog.mode, mip_gain=fog.mip_gain)
+        scene.add_fog(comp.id, thick, layer, base, fog.weight)
     for comp in by_type.get("clouds", [])[:1]:
-        st = comp.settings
+        st = typed_settings("clouds", comp.settings, f"component {comp.id!r} settings")
         if comp.dataset is not None:
             vol = _dataset(comp, datasets)
             dens = np.asarray(vol.data, dtype=np.float64)
             dens = (dens - dens.min()) / max(float(np.ptp(dens)), 1e-12)
         else:
-            shape = tuple(int(v) for v in st.get("shape", (129, 129, 17)))
-            dens = noise.cloud_density(shape, seed=int(st.get("seed", 3)), coverage=float(st.get("coverage", 0.25)))
+            dens = noise.cloud_density(st.shape, seed=st.seed, coverage=st.coverage)
         if terrain is not None:
             ext_default = list(terrain.extent)
         else:
             ext_default = [1000.0, 1000.0]
-        ext = st.get("extent", ext_default)
-        thickness = float(st.get("thickness", ext[0] * (dens.shape[2] - 1) / (dens.shape[0] - 1)))
-        origin = (terrain.origin[0] if terrain else 0.0, terrain.origin[1] if terrain else 0.0,
-                  float(st.get("base_height", 190.0)))
+        ext = st.extent or ext_default
+        thickness = st.thickness or ext[0] * (dens.shape[2] - 1) / (dens.shape[0] - 1)
+        origin = (terrain.origin[0] if terrain else 0.0, terrain.origin[1] if terrain else 0.0, st.base_height)
         spacing = (ext[0] / (dens.shape[0] - 1), ext[1] / (dens.shape[1] - 1), thickness / (dens.shape[2] - 1))
         light = noise.cloud_light(np.ascontiguousarray(dens, dtype=np.float32), spacing, soft=1.0)
         try:
             volume = CloudVolume(dens, light, spacing, origin)
         except ValueError:  # sizes without a common power-of-two cell count: resample (§11.3.1)
             volume = CloudVolume.fit(dens, light, (ext[0], ext[1], thickness), origin)
-        shading_name = st.get("shading", "npr")
-        rho = float(st.get("rho_max", 0.06))
-        shading = CloudShading.physical(rho) if shading_name == "physical" else CloudShading.npr(rho)
-        scene.add_clouds(volume, shading, float(st.get("C", 2.0)), float(st.get("c", 8.0)))
+        shading = CloudShading.physical(st.rho_max) if st.shading == "physical" else CloudShading.npr(st.rho_max)
+        scene.add_clouds(volume, shading, st.C, st.c)
     scene.finalize()
     return scene
 

@@ -1,0 +1,281 @@
+"""Typed, validated settings of every component kind and the render options of a session (pydantic v2 models).
+
+Each component type of a session (``volviz.session.COMPONENT_TYPES``) has one settings model here; the session
+loader validates a component's ``settings`` object against it (``validate_settings``), so an unknown key, a wrong
+type or a value out of range is refused with the field's path, and the defaults live in one place (the model)
+instead of in the ``.get(key, default)`` calls of the code that uses them. ``RenderOptions`` does the same for
+``render.options``. Every option with a fixed set of values is a ``Literal`` defined once below; the app builds its
+settings forms from these models (field titles, descriptions, bounds, units in ``json_schema_extra``), and
+``volviz schema`` exports them as part of the session's JSON schema (``volviz.model.session_schema``).
+"""
+from __future__ import annotations
+
+from typing import Any, Literal, Optional, Union
+
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
+
+__all__ = ["Settings", "TerrainSettings", "FogSettings", "CloudSettings", "SkySettings", "VolumeSettings",
+           "MeshSettings", "IsoStyleSettings", "IsosurfaceSettings", "DemoSettings", "RenderOptions",
+           "SETTINGS_MODELS", "FogMode", "CloudShadingName", "IsoMode", "IsoShading", "IsoOverlayMode", "Backend",
+           "SortName", "settings_model", "validate_settings", "validate_render_options", "typed_settings",
+           "SettingsError"]
+
+FogMode = Literal["emissive", "attenuated", "mip"]
+CloudShadingName = Literal["npr", "physical"]
+IsoMode = Literal["2pass", "3pass", "4pass", "exact"]
+IsoOverlayMode = Literal["vtk", "2pass", "3pass", "4pass", "exact"]
+IsoShading = Literal["spectrum", "flat"]
+Backend = Literal["auto", "gpu", "cpu"]
+SortName = Literal["mpvo", "centroid", "power"]
+TableName = Literal["auto", "3d", "separable-1", "separable-2", "separable-4"]
+
+Vec2 = tuple[float, float]
+Vec3 = tuple[float, float, float]
+Colour = tuple[float, float, float]
+
+
+def _unit(unit: str) -> dict[str, Any]:
+    return {"unit": unit}
+
+
+class SettingsError(ValueError):
+    """Settings that do not fit their model: ``problems`` are ``(field path, message)`` pairs."""
+
+    def __init__(self, problems: list[tuple[str, str]]) -> None:
+        self.problems = problems
+        super().__init__("; ".join(f"{path}: {message}" if path else message for path, message in problems))
+
+
+class Settings(BaseModel):
+    """Base of every settings model: unknown keys are refused, values are checked on assignment too."""
+
+    model_config = ConfigDict(extra="forbid", validate_assignment=True, populate_by_name=True)
+
+
+class TerrainSettings(Settings):
+    """Terrain C-LOD (Roettger Ch. 9): a height map dataset, or a procedural fractal terrain without one."""
+
+    size: Optional[int] = Field(None, ge=3, le=8193, title="Grid size",
+                                description="points per side: of the procedural terrain (default 257), or the height "
+                                            "map resampled to it")
+    seed: int = Field(1, ge=0, title="Seed", description="random seed of the procedural terrain")
+    relief: float = Field(160.0, gt=0, le=1e6, title="Relief", description="height range of the procedural terrain",
+                          json_schema_extra=_unit("m"))
+    extent: Optional[Vec2] = Field(None, title="Extent", description="world size (x, y); default: the height map's "
+                                   "spacing, or 1000 x 1000 for the procedural terrain", json_schema_extra=_unit("m"))
+    height_scale: float = Field(1.0, gt=0, le=1e6, title="Height scale", description="heights multiplied by this")
+    origin: Optional[Vec2] = Field(None, title="Origin", description="the terrain's corner (x, y; e.g. UTM "
+                                   "coordinates moved to the origin)", json_schema_extra=_unit("m"))
+    C: float = Field(12.0, gt=0, le=1e4, title="Global resolution C", description="C-LOD: the larger, the finer "
+                     "(Roettger §9.2, d/l < C)")
+    c: float = Field(60.0, gt=0, le=1e5, title="Local resolution c", description="C-LOD: the larger, the more "
+                     "roughness is refined (§9.2, d/(l·d2) < c)")
+    texture_dataset: Optional[str] = Field(None, title="Texture", description="id of an RGB image dataset draped "
+                                           "over the terrain", json_schema_extra={"dataset": True})
+
+
+class FogSettings(Settings):
+    """Ground fog / cloud layer: PCP prisms on the terrain (Roettger §10.3)."""
+
+    level: float = Field(50.0, title="Level", description="height of the procedural fog's surface",
+                         json_schema_extra=_unit("m"))
+    thickness: float = Field(25.0, ge=0, title="Thickness", description="thickness of the procedural fog",
+                             json_schema_extra=_unit("m"))
+    seed: int = Field(2, ge=0, title="Seed", description="random seed of the procedural fog map")
+    thickness_scale: float = Field(1.0, ge=0, title="Thickness scale", description="fog-map values (the "
+                                   "component's dataset) times this give the thickness")
+    base_dataset: Optional[str] = Field(None, title="Base", description="id of an image dataset giving the layer's "
+                                        "bottom height (a cloud layer); default: the terrain",
+                                        json_schema_extra={"dataset": True})
+    base_scale: float = Field(1.0, title="Base scale", description="base-map values times this")
+    base_offset: float = Field(0.0, title="Base offset", description="added to the base height",
+                               json_schema_extra=_unit("m"))
+    colour: Colour = Field((0.75, 0.75, 1.0), title="Colour", json_schema_extra={"colour": True})
+    density: float = Field(0.05, ge=0, le=1e3, title="Density", description="emission / optical density per unit "
+                           "length at emission 1", json_schema_extra=_unit("1/m"))
+    mode: FogMode = Field("attenuated", title="Mode", description="emissive (additive), attenuated (the integral as "
+                          "optical depth) or mip (§10.4)")
+    mip_gain: float = Field(0.05, ge=0, title="MIP gain", description="intensity per unit of layer thickness")
+    weight: float = Field(4.0, ge=0, le=1e3, title="LOD weight", description="how much the layer refines the "
+                          "terrain mesh under it")
+
+    @field_validator("colour")
+    @classmethod
+    def _colour_in_range(cls, value: Colour) -> Colour:
+        if any(not 0.0 <= v <= 1.0 for v in value):
+            raise ValueError("colour components must be in 0..1")
+        return value
+
+
+class CloudSettings(Settings):
+    """Volumetric C-LOD clouds (Roettger Ch. 11): a density dataset, or procedural Perlin clouds without one."""
+
+    shape: tuple[int, int, int] = Field((129, 129, 17), title="Grid shape", description="samples of the procedural "
+                                        "cloud volume (x, y, z); each 3..1025")
+    seed: int = Field(3, ge=0, title="Seed")
+    coverage: float = Field(0.25, ge=0, le=1, title="Coverage", description="share of the sky the procedural clouds "
+                            "cover")
+    extent: Optional[Vec2] = Field(None, title="Extent", description="world size (x, y); default: the terrain's",
+                                   json_schema_extra=_unit("m"))
+    thickness: Optional[float] = Field(None, gt=0, title="Thickness", description="vertical size; default: the "
+                                       "grid's aspect", json_schema_extra=_unit("m"))
+    base_height: float = Field(190.0, title="Base height", json_schema_extra=_unit("m"))
+    shading: CloudShadingName = Field("npr", title="Shading", description="npr (non-photorealistic, §11.6) or physical")
+    rho_max: float = Field(0.06, gt=0, le=10, title="Maximum density", description="optical density of the densest "
+                           "cloud", json_schema_extra=_unit("1/m"))
+    C: float = Field(2.0, gt=0, le=1e4, title="Global resolution C", description="cloud C-LOD (§11.3)")
+    c: float = Field(8.0, gt=0, le=1e5, title="Local resolution c")
+
+    @field_validator("shape")
+    @classmethod
+    def _shape_in_range(cls, value: tuple[int, int, int]) -> tuple[int, int, int]:
+        if any(not 3 <= v <= 1025 for v in value):
+            raise ValueError("each size must be in 3..1025")
+        return value
+
+
+class SkySettings(Settings):
+    """The sky dome (no settings)."""
+
+
+class VolumeSettings(Settings):
+    """A volume: regular (ray cast, LOD from .vvz) or unstructured (projected tetrahedra)."""
+
+    array: Optional[str] = Field(None, title="Array", description="the shown array (NAME, NAME:component, "
+                                 "NAME:magnitude); default: the dataset's first", json_schema_extra={"array": True})
+    budget: int = Field(256, ge=1, le=1 << 20, title="Block budget", description="compressed .vvz volumes: bricks "
+                        "decoded per view")
+    interpolate: bool = Field(True, title="Interpolate in time", description="time series: blend the two nearest "
+                              "steps")
+
+
+class MeshSettings(VolumeSettings):
+    """A surface mesh or a mesh shown as a volume."""
+
+
+class IsoStyleSettings(Settings):
+    """One isosurface: its value, colour and opacity."""
+
+    value: float = Field(title="Iso-value")
+    color: Colour = Field((1.0, 1.0, 1.0), title="Colour", json_schema_extra={"colour": True})
+    opacity: float = Field(0.5, ge=0, le=1, title="Opacity")
+
+
+class IsosurfaceSettings(Settings):
+    """Several semi-transparent isosurfaces of one volume (libMini note §4)."""
+
+    styles: list[IsoStyleSettings] = Field(default_factory=list, max_length=64, title="Surfaces")
+    mode: IsoMode = Field("4pass", title="Transparency mode")
+    shading: IsoShading = Field("spectrum", title="Shading")
+    clip: dict[str, Any] = Field(default_factory=lambda: {"planes": [], "box": None}, title="Clipping",
+                                 description="planes and box of this component (volviz.iso.clip)")
+    lod: bool = Field(False, title="Level of detail")
+    triangles_per_pixel2: float = Field(0.25, gt=0, le=100, title="Triangles per pixel²", description="LOD target")
+    interpolate: bool = Field(True, title="Interpolate in time")
+    scalars: Optional[str] = Field(None, title="Array", json_schema_extra={"array": True})
+
+
+class DemoSettings(Settings):
+    """The built-in demo volume (a tetrahedralised analytic field)."""
+
+    cells_per_edge: int = Field(20, ge=2, le=200, title="Cells per edge")
+    array: Optional[str] = Field(None, title="Array", json_schema_extra={"array": True})
+
+
+#: the settings model of each component type
+SETTINGS_MODELS: dict[str, type[Settings]] = {
+    "terrain": TerrainSettings, "fog": FogSettings, "clouds": CloudSettings, "sky": SkySettings,
+    "volume": VolumeSettings, "mesh": MeshSettings, "isosurface": IsosurfaceSettings, "demo": DemoSettings,
+}
+
+
+class RenderOptions(Settings):
+    """``render.options`` of a session: how every view is drawn."""
+
+    backend: Backend = Field("auto", title="Backend", description="gpu (VTK's OpenGL with volviz's shaders), cpu "
+                             "(volviz's own renderers), or auto (the GPU on a hardware driver; on a software "
+                             "rasteriser the one measured faster)")
+    sort: SortName = Field("mpvo", title="Cell sort", description="PT visibility order: mpvo (exact for convex "
+                           "meshes, with Guthe's boundary relations otherwise), centroid or power")
+    table: TableName = Field("auto", title="Pre-integration table", description="auto (by optical depth), 3d, or "
+                             "separable with a colour polynomial of degree 1, 2 or 4 (Roettger §9.1)")
+    table_resolution: int = Field(128, ge=16, le=1024, title="Table resolution")
+    iso_mode: IsoOverlayMode = Field("vtk", title="Isosurface mode", description="vtk (VTK's own blending) or a "
+                                     "transparency mode of the libMini note")
+    error_budget: Optional[float] = Field(None, gt=0, le=255, title="Error budget", description="largest RMSE (8-bit "
+                                          "units) a faster, approximate setting may cost while the camera moves")
+    time: Optional[float] = Field(None, title="Time", description="the display time of time series")
+    fly_clearance: float = Field(0.01, ge=0, le=0.5, title="Fly clearance", description="fly mode keeps this share "
+                                 "of the scene's size from opaque geometry")
+    scalar_bar: bool = Field(True, title="Scalar bar")
+    axes: bool = Field(True, title="Axes")
+    outline: bool = Field(True, title="Outline box")
+
+
+def settings_model(component_type: str) -> type[Settings]:
+    """The settings model of a component type (KeyError for an unknown type)."""
+    return SETTINGS_MODELS[component_type]
+
+
+def _kind(value: Any) -> str:
+    """What a JSON value is, in words (as the session loader says it)."""
+    for types, word in ((bool, "true or false"), ((int, float), "a number"), (str, "a string"), (list, "a list"),
+                        (dict, "an object"), (type(None), "null")):
+        if isinstance(value, types):
+            return word
+    return type(value).__name__
+
+
+_EXPECTED = {"string_type": "a string", "bool_type": "true or false", "bool_parsing": "true or false",
+             "int_type": "a whole number", "int_parsing": "a whole number", "int_from_float": "a whole number",
+             "float_type": "a number", "float_parsing": "a number", "finite_number": "a finite number",
+             "tuple_type": "a list", "list_type": "a list", "dict_type": "an object", "model_type": "an object"}
+
+
+def _message(err: Any) -> str:
+    """A pydantic error in the words of the session loader: choices listed, the kind of a wrong value named."""
+    kind, value = err["type"], err.get("input")
+    if kind == "extra_forbidden":
+        return "unknown setting"
+    if kind == "literal_error":  # every Literal here is of strings
+        if not isinstance(value, str):
+            return f"expected a string, got {_kind(value)}"
+        choices = [c.strip().strip("'") for c in err["ctx"]["expected"].replace(" or ", ", ").split(",")]
+        return f"expected one of {', '.join(choices)}, got {value!r}"
+    if kind in _EXPECTED:
+        return f"expected {_EXPECTED[kind]}, got {_kind(value)}"
+    return str(err["msg"])
+
+
+def _problems(exc: ValidationError, where: str) -> list[tuple[str, str]]:
+    out = []
+    for err in exc.errors():
+        loc = "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in err["loc"])
+        out.append((f"{where}{loc}", _message(err)))
+    return out
+
+
+def typed_settings(component_type: str, settings: dict[str, Any], where: str = "settings") -> Settings:
+    """The model instance of a component's settings (SettingsError naming the field path of each problem)."""
+    model = settings_model(component_type)
+    try:
+        return model.model_validate(settings)
+    except ValidationError as exc:
+        raise SettingsError(_problems(exc, where)) from None
+
+
+def validate_settings(component_type: str, settings: dict[str, Any], where: str = "settings") -> dict[str, Any]:
+    """``settings`` checked against its model; returned as given (only the keys set), as sessions store them."""
+    typed_settings(component_type, settings, where)
+    return settings
+
+
+def validate_render_options(options: dict[str, Any], where: str = "render.options") -> RenderOptions:
+    """``render.options`` as a ``RenderOptions`` (SettingsError naming the field path of each problem)."""
+    try:
+        return RenderOptions.model_validate(options)
+    except ValidationError as exc:
+        raise SettingsError(_problems(exc, where)) from None
+
+
+AnySettings = Union[tuple(SETTINGS_MODELS.values())]  # type: ignore[valid-type]
