@@ -55,7 +55,11 @@ uniform vec4 clipPlanes[8];
 #endif
 uniform int rowCount;        // 2: isosurfaces (rows: value, opacity; front colour; back colour), 3: TF points
 uniform float isoThicken;
+#if PT_KIND == 1
+uniform sampler2DArray ptTable;   // the separable table's layers: bilinear in (s_f, s_b) within a layer
+#else
 uniform sampler3D ptTable;
+#endif
 uniform vec4 tableAxis;      // s_lo, 1 / ds, n_s, 0
 uniform vec4 tableLength;    // 1 / dl (3D) or 1 / l_max (separable), n_l, degree, 0
 uniform vec3 kappaMax;
@@ -107,14 +111,13 @@ vec4 lookup3d(float u, float v, float len)
 vec4 lookupSeparable(float u, float v, float len)
 {
   int layers = int(tableLength.z) + 1;
-  float nz = float(layers);
-  vec4 head = texture(ptTable, vec3(u, v, 0.5 / nz));
+  vec4 head = texture(ptTable, vec3(u, v, 0.0));
   float alpha = 1.0 - exp(-len * head.x);
   float w = clamp(len * tableLength.x, 0.0, 1.0);
   vec3 chroma = vec3(0.0);
   for (int i = layers - 1; i >= 1; --i)
   {
-    chroma = chroma * w + texture(ptTable, vec3(u, v, (float(i) + 0.5) / nz)).rgb;
+    chroma = chroma * w + texture(ptTable, vec3(u, v, float(i))).rgb;
   }
   chroma = chroma * w + head.yzw;
   return vec4(clamp(chroma, vec3(0.0), kappaMax) * alpha, alpha);

@@ -567,7 +567,7 @@ class GLPTVolume(PTView):
         elif hasattr(table, "rgba"):                                 # 3D: x = l, y = s_b, z = s_f
             data = np.ascontiguousarray(table.rgba, dtype=np.float32)
             nx, ny, nz = data.shape[2], data.shape[1], data.shape[0]
-        else:                                                       # separable: x = s_f, y = s_b, z = layer
+        else:                                                       # separable: x = s_f, y = s_b, layers
             n, deg = table.n_s, table.degree
             layers = np.zeros((deg + 1, n, n, 4), np.float32)
             d = table.data.transpose(1, 0, 2)                       # (s_b, s_f, channels)
@@ -580,7 +580,10 @@ class GLPTVolume(PTView):
             self._table_tex.ReleaseGraphicsResources(ren_win)
         tex = vtk.vtkTextureObject()
         tex.SetContext(ren_win)
-        tex.Create3DFromRaw(nx, ny, nz, 4, vtk.VTK_FLOAT, data)
+        if hasattr(table, "kappa_max"):          # separable: a 2D array, bilinear within each layer (4 taps, not 8)
+            tex.Create2DArrayFromRaw(nx, ny, 4, vtk.VTK_FLOAT, nz, data)
+        else:
+            tex.Create3DFromRaw(nx, ny, nz, 4, vtk.VTK_FLOAT, data)
         tex.SetMinificationFilter(vtk.vtkTextureObject.Linear)
         tex.SetMagnificationFilter(vtk.vtkTextureObject.Linear)
         tex.SetWrapS(vtk.vtkTextureObject.ClampToEdge)
