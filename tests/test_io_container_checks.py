@@ -141,3 +141,15 @@ def test_openfoam_backup_files_in_a_time_folder_are_left_alone(cavity):
     (cavity / "0" / "notes~").write_text("editor backup")
     series = vio.read(cavity / "case.foam")
     assert set(series.frame(0).cell_data) == {"p", "U"}
+
+
+def test_netcdf_unit_text_that_is_not_text_is_refused(tmp_path):
+    """A NaN written over the ``units`` of ``lat`` ("degrees_north"): VTK's CF reader would no longer see a latitude
+    and read another variable as a regular volume."""
+    data = data_file(CURVE).read_bytes()
+    at = data.index(b"degrees_north") + 8
+    bad = tmp_path / "units.nc"
+    bad.write_bytes(data[:at] + struct.pack(">d", float("nan")) + data[at + 8:])
+    with pytest.raises(vio.ReadError, match=r"units\.nc: netCDF: malformed netCDF header \(the 'units' attribute "
+                                            r"at byte \d+ is not printable text\)"):
+        vio.read(bad)

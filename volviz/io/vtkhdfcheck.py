@@ -143,6 +143,11 @@ class _Structure:
                 if len(values) != parts:
                     self.fail(f"{self.where}/{name + '/' if name else ''}{label} has {len(values)} entries, "
                               f"NumberOfPoints {parts}")
+            # connectivity ids index the part's points: a part (a time step's) with ids has points
+            empty = np.flatnonzero((ids[name] > 0) & (n_points == 0))
+            if len(empty):
+                self.fail(f"{self.where}/NumberOfPoints entry {int(empty[0])} is 0, but that part's "
+                          f"{name + '/' if name else ''}cells connect {int(ids[name][empty[0]])} point ids")
         if "Steps" in self.group:
             self.steps(n_points, topologies, cells, ids)
             return

@@ -57,6 +57,7 @@ class _Check:
         self.order, self.header, self.ratio = "<", 4, 1
         self.whole: list[int] | None = None
         self.piece: _Piece | None = None
+        self.piece_extents: list[list[int]] = []
         self.section = ""
         self.coordinate = 0
         self.appended_start: int | None = None
@@ -139,6 +140,7 @@ class _Check:
             w = self.whole
             if any(e[2 * i] < w[2 * i] or e[2 * i + 1] > w[2 * i + 1] for i in range(3)):
                 self.fail(f"Piece Extent {e} reaches outside the WholeExtent {w}")
+            self.piece_extents.append(e)
             dims = tuple(e[2 * i + 1] - e[2 * i] + 1 for i in range(3))
             cells = int(np.prod([max(d - 1, 1) for d in dims], dtype=object))
             self.piece = _Piece(int(np.prod(dims, dtype=object)), cells, dims)  # type: ignore[arg-type]
@@ -317,6 +319,20 @@ class _Check:
                 self.data_array(attrs, m.end(), bool(self_closing))
         if not seen_root:
             self.fail("file has no <VTKFile> element")
+        self.pieces_cover_the_whole_extent()
+
+    def pieces_cover_the_whole_extent(self) -> None:
+        """A structured file's pieces fill its WholeExtent (VTK leaves the points no piece covers unset): their
+        bounding box is the whole extent and they hold at least its points."""
+        if self.expected not in STRUCTURED or self.whole is None or not self.piece_extents:
+            return
+        w, pieces = self.whole, self.piece_extents
+        box = [f(p[k] for p in pieces) for k in range(6) for f in ((min,) if k % 2 == 0 else (max,))]
+        points = sum(int(np.prod([p[2 * i + 1] - p[2 * i] + 1 for i in range(3)], dtype=object)) for p in pieces)
+        whole = int(np.prod([w[2 * i + 1] - w[2 * i] + 1 for i in range(3)], dtype=object))
+        if box != list(w) or points < whole:
+            self.fail(f"pieces (extents {pieces}) do not fill the WholeExtent {w}: points outside every piece "
+                      "would be made up")
 
 
 def _attrs(text: bytes) -> dict[str, str]:

@@ -20,6 +20,8 @@ _NC_TYPE_SIZE = {1: 1, 2: 1, 3: 2, 4: 4, 5: 4, 6: 8, 7: 1, 8: 2, 9: 4, 10: 8, 11
 _HEADER_LIMIT = 64 << 20  # a netCDF header larger than this is not parsed (only its magic is checked)
 #: CF attributes whose text names other variables of the file (CF conventions §5, §7.1)
 _REFERENCES = ("bounds", "coordinates")
+#: CF attributes a reader interprets (units, axes, names, calendars): their text must be printable text
+_CF_TEXT = ("units", "axis", "positive", "standard_name", "calendar", *_REFERENCES)
 
 
 def is_netcdf(head: bytes) -> bool:
@@ -79,14 +81,18 @@ class _Cursor:
             value = self.take(k * size + (-(k * size) % 4))
             if nc_type == 2:
                 texts[name] = value[:k].rstrip(b"\0").decode("utf-8", "replace")
+                if name in _CF_TEXT and not texts[name].isprintable():
+                    raise ValueError(f"the {name!r} attribute at byte {self.pos - len(value)} is not printable text")
         return texts
 
 
 def _netcdf_end(data: bytes) -> int:
     """The number of bytes the variables of a netCDF classic file reach, after checking the header's layout against
     itself (EOFError if ``data`` is too short to hold the header; ValueError naming the first inconsistency).
-    Names are UTF-8 text without control characters; a CF ``bounds`` or ``coordinates`` attribute names variables
-    the file holds (a damaged name would make the reader take another variable for the grid).
+    Names are UTF-8 text without control characters; the CF attributes a reader interprets (``units``, ``axis``,
+    ``positive``, ``standard_name``, ``calendar``, ``bounds``, ``coordinates``) are printable text, and ``bounds``
+    and ``coordinates`` name variables the file holds (a damaged unit or name would make the reader take another
+    variable for the grid).
 
     From the netCDF classic format specification (the ``vsize`` and ``begin`` of each variable): a variable's
     ``vsize`` is the product of its dimension lengths (the record dimension left out) times the size of its type,
