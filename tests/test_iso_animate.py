@@ -12,7 +12,7 @@ from volviz.iso.animate import IsoAnimator, IsoFrame, extract_at, playback_times
 from volviz.iso.composite import render
 from volviz.iso.extract import IsoStyle
 from volviz.jobs import JobRunner
-from volviz.unstructured.camera import Camera
+from volviz.model.camera import Camera
 
 STYLES = [IsoStyle(30, (0.2, 0.4, 1.0), 0.3), IsoStyle(80, (0.2, 1.0, 0.3), 0.4), IsoStyle(150, (1.0, 0.2, 0.1), 1.0)]
 F = 8  # display frames per time step

@@ -10,7 +10,7 @@ from volviz.iso.extract import IsoMesh, IsoStyle, extract, extract_many
 from volviz.iso.spectrum import exact_alpha, fit_spectrum, spectrum_alpha
 from volviz.model.datasets import RegularVolume
 from volviz.optics.metrics import max_abs
-from volviz.unstructured.camera import Camera
+from volviz.model.camera import Camera
 from volviz.unstructured.synthetic import box_tets
 
 N = 17

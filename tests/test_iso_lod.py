@@ -8,7 +8,7 @@ from volviz.iso.extract import IsoStyle, extract
 from volviz.iso.lod import build_lod, lod_mesh, lod_meshes, select_level
 from volviz.model.datasets import RegularVolume
 from volviz.optics.metrics import rmse
-from volviz.unstructured.camera import Camera
+from volviz.model.camera import Camera
 
 
 def _chain():

@@ -6,7 +6,7 @@ import numpy as np
 from volviz.iso.composite import fragments, render
 from volviz.iso.extract import IsoMesh, IsoStyle
 from volviz.iso.raster import clip_near_plane, rasterize
-from volviz.unstructured.camera import Camera
+from volviz.model.camera import Camera
 
 
 def _area(pts: np.ndarray, tris: np.ndarray) -> float:

@@ -12,7 +12,7 @@ from volviz.iso.composite import render
 from volviz.iso.extract import IsoStyle
 from volviz.iso.scene import IsoSettings, prepare, render_iso
 from volviz.optics.metrics import max_abs
-from volviz.unstructured.camera import Camera
+from volviz.model.camera import Camera
 
 SETTINGS = IsoSettings([IsoStyle(30, (0.2, 0.45, 1.0), 0.3), IsoStyle(150, (1.0, 0.25, 0.1), 1.0)], mode="3pass",
                        clip=ClipSettings((ClipPlane((13.5, 0, 0), (-1, 0, 0)),), BoxCrop((0, 0, 0), (27, 27, 15))),

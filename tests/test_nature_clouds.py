@@ -10,7 +10,7 @@ import pytest
 from volviz.nature import _cloud_kernels as K
 from volviz.nature import noise
 from volviz.nature.clouds import CloudLOD, CloudShading, CloudVolume, build_cloud_table, kmax, render_cloud_image
-from volviz.unstructured.camera import Camera
+from volviz.model.camera import Camera
 
 SIZE = (48, 36)
 

@@ -8,7 +8,7 @@ from volviz.nature import fog, noise
 from volviz.nature.heightfield import HeightField
 from volviz.nature.raster import bake_colour_map, mip_pyramid, render_terrain
 from volviz.nature.terrain import TerrainLOD
-from volviz.unstructured.camera import Camera
+from volviz.model.camera import Camera
 
 SIZE = (48, 36)
 

@@ -8,7 +8,7 @@ import pytest
 from conftest import REPO, data_file, data_root
 from volviz.nature.scene import NatureView, demo_camera, demo_scene, nature_dataset_ids, scene_from_components
 from volviz.nature.sky import sky_dome_mesh
-from volviz.unstructured.camera import Camera
+from volviz.model.camera import Camera
 
 SESSIONS = REPO / "resources" / "sessions"
 

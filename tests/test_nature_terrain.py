@@ -123,7 +123,7 @@ def test_layers_morph_with_the_terrain_and_culling() -> None:
     mesh = lod.update((10.0, 20.0, 6.0))
     # the morphed top minus the morphed terrain is the linearly morphed thickness (>= 2 everywhere)
     assert np.all(mesh.layers["fog_top"] - mesh.points[:, 2] >= 2.0 - 1e-12)
-    from volviz.unstructured.camera import Camera
+    from volviz.model.camera import Camera
 
     cam = Camera((-10, 32, 20), (30, 32, 0), (0, 0, 1), 40.0, clipping_range=(0.5, 500))
     culled = lod.update(cam.position, frustum_planes(cam, (64, 48)))

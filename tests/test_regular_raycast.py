@@ -14,7 +14,7 @@ from volviz.optics.metrics import max_abs, rmse
 from volviz.regular.lod import Block, Camera as LodCamera, LodTree, Selection
 from volviz.regular.raycast import block_active, pack_blocks, render_blocks, render_reference, sub_active
 from volviz.regular.wavelet import HALF
-from volviz.unstructured.camera import Camera
+from volviz.model.camera import Camera
 
 N = 65                    # 2^6 + 1: every level's last sample lies on the volume's last sample
 SIZE = (80, 60)

@@ -32,7 +32,7 @@ from volviz.nature.heightfield import HeightField
 from volviz.nature.terrain import TerrainLOD
 from volviz.render.gl_fog import GLFogLayer
 from volviz.render.image_overlay import read_buffers, zbuffer_to_depth
-from volviz.unstructured.camera import Camera
+from volviz.model.camera import Camera
 
 RMSE, MAX = 0.4, 0.75
 COLOUR = (0.8, 0.85, 1.0)

@@ -19,7 +19,7 @@ from volviz.regular.wavelet import HALF  # noqa: E402
 from volviz.optics.metrics import max_abs, rmse  # noqa: E402
 from volviz.regular.raycast import render_blocks, render_reference  # noqa: E402
 from volviz.render.lod_volume import LodVolume  # noqa: E402
-from volviz.unstructured.camera import Camera  # noqa: E402
+from volviz.model.camera import Camera  # noqa: E402
 
 SIZE = (160, 120)
 TF = TransferFunction([20.0, 100.0, 255.0], [[1.0, 0.6, 0.2], [0.3, 0.6, 1.0], [1.0, 1.0, 1.0]], [0.0, 0.08, 0.2])

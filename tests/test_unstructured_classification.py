@@ -9,7 +9,7 @@ import pytest
 
 from volviz.optics import TransferFunction, build_table3d, integrate_preclassified, integrate_segment
 from volviz.unstructured import synthetic as syn
-from volviz.unstructured.camera import Camera
+from volviz.model.camera import Camera
 from volviz.unstructured.render import render
 
 #: a thin opacity peak at 0.5 between two transparent ends: what pre-classification loses

@@ -9,7 +9,7 @@ import pytest
 from volviz.model.datasets import TetMesh
 from volviz.optics.isosurface import IsoSurface, build_iso_table
 from volviz.unstructured import synthetic as syn
-from volviz.unstructured.camera import Camera
+from volviz.model.camera import Camera
 from volviz.unstructured.render import render
 
 SIZE = (48, 40)

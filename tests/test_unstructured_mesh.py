@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from volviz.model.datasets import VTK_HEXAHEDRON, VTK_PYRAMID, VTK_TETRA, VTK_WEDGE, TetMesh, UnstructuredMesh
-from volviz.unstructured.camera import Camera
+from volviz.model.camera import Camera
 from volviz.unstructured.synthetic import box_grid, holed_box
 from volviz.unstructured.tetrahedralize import tetrahedralize
 from volviz.unstructured.topology import topology, visible_cells

@@ -5,7 +5,7 @@ import numpy as np
 
 from volviz.optics import TransferFunction
 from volviz.unstructured import synthetic as syn
-from volviz.unstructured.camera import Camera
+from volviz.model.camera import Camera
 from volviz.unstructured.prefetch import SortPrefetcher, render_path, same_view
 from volviz.unstructured.render import render
 

@@ -135,7 +135,7 @@ def test_two_volumes_both_see_the_opaque_depth():
 
 
 def test_prefetched_sort_for_the_next_camera_is_used_and_changes_nothing(scene):
-    from volviz.unstructured.camera import Camera
+    from volviz.model.camera import Camera
 
     pl, mesh, h = scene
     old = pl.camera_position

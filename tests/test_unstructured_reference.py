@@ -10,7 +10,7 @@ import pytest
 from volviz.model.datasets import TetMesh
 from volviz.optics import TransferFunction
 from volviz.unstructured import synthetic as syn
-from volviz.unstructured.camera import Camera
+from volviz.model.camera import Camera
 from volviz.unstructured.render import render
 
 N = 5                                          # 5^3 points, spacing 1/4, 320 tetrahedra

@@ -10,7 +10,7 @@ from volviz.model.datasets import TetMesh
 from volviz.optics import TransferFunction
 from volviz.optics.metrics import max_abs, rmse
 from volviz.unstructured import synthetic as syn
-from volviz.unstructured.camera import Camera
+from volviz.model.camera import Camera
 from volviz.unstructured.render import render
 
 TF = TransferFunction([0.0, 0.3, 0.6, 0.9], [[1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 1, 1]], [0.0, 3.0, 6.0, 1.0])

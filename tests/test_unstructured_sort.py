@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from volviz.unstructured import synthetic as syn
-from volviz.unstructured.camera import Camera
+from volviz.model.camera import Camera
 from volviz.unstructured.reference import order_violations
 from volviz.unstructured.sort import is_convex, visibility_order
 from volviz.unstructured.topology import topology

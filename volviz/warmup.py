@@ -53,7 +53,7 @@ def _tetrahedral_volume(folder: Path) -> None:
     from volviz.render.export import render_session
     from volviz.render.scene import demo_volume_session
     from volviz.unstructured import render
-    from volviz.unstructured.camera import Camera
+    from volviz.model.camera import Camera
     from volviz.unstructured.synthetic import box_tets, holed_box
 
     render_session(demo_volume_session(), None, SIZE)

@@ -36,7 +36,7 @@ from volviz.iso.extract import IsoMesh, IsoStyle, extract
 from volviz.iso.lod import build_lod, lod_mesh, select_level
 from volviz.iso.spectrum import fit_spectrum
 from volviz.optics.metrics import error_heatmap, max_abs, rmse
-from volviz.unstructured.camera import Camera
+from volviz.model.camera import Camera
 
 DEFAULT_DATA = Path(os.environ.get("VOLVIZ_DATA", Path(__file__).resolve().parents[2].parent / "shared" / "data"))
 REPO = Path(__file__).resolve().parents[2]

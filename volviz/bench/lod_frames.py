@@ -56,7 +56,7 @@ def _references(plotter: Any, tree: Any, volume: np.ndarray, tf: Any, views: lis
 
     from volviz.regular.raycast import render_reference
     from volviz.render.vtk_scene import vtk_volume_property
-    from volviz.unstructured.camera import Camera
+    from volviz.model.camera import Camera
 
     grid = pv.ImageData(dimensions=volume.shape, spacing=tuple(tree.spacing), origin=tuple(tree.origin))
     grid.point_data["scalars"] = np.asarray(volume, np.float32).ravel(order="F")

@@ -290,7 +290,7 @@ def frame_count(fps: float, seconds: float) -> int:
 def _prefetch_sorts(controller: Any, camera: Any, size: tuple[int, int]) -> None:
     """Start sorting every visible PT volume for the next frame's camera while this frame renders
     (``volviz.unstructured.prefetch``)."""
-    from volviz.unstructured.camera import Camera
+    from volviz.model.camera import Camera
 
     cam = Camera(camera.position, camera.focal_point, camera.view_up, camera.view_angle, camera.parallel,
                  camera.parallel_scale)

@@ -66,7 +66,7 @@ import numpy as np
 
 from volviz.nature.fog import FogLayer, layer_emission
 from volviz.render.gl_pt import _PASS_MARK, _USERS, GLPTVolume, shader_source
-from volviz.unstructured.camera import Camera
+from volviz.model.camera import Camera
 
 __all__ = ["GLFogLayer", "add_fog_layer", "expand_includes", "prism_attributes"]
 

@@ -257,7 +257,7 @@ class OverlayView:
         for a preview (``scale`` > 1, e.g. while the camera moves) the window's divided by ``scale``, with the depth
         limit of each preview pixel the nearest opaque depth under it (``block_min``) and the scene colour at its
         first pixel."""
-        from volviz.unstructured.camera import Camera
+        from volviz.model.camera import Camera
 
         t_start = time.perf_counter()
         w, h = (int(v) for v in self.plotter.ren_win.GetSize())

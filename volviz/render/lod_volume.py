@@ -178,7 +178,7 @@ class LodVolume:
         renderer it also captures what a ray cast of that view needs from the plotter (the full camera, the opaque
         scene's depth when there is visible geometry, the clipping planes), so that ``decode`` can ray cast on the
         worker too."""
-        from volviz.unstructured.camera import Camera
+        from volviz.model.camera import Camera
 
         cam = self._lod_camera()
         if self.renderer == "volviz" and self._overlay is not None and self.volume.GetVisibility():
@@ -321,7 +321,7 @@ class LodVolume:
         if self._pool is None or self._overlay is None:
             return None
         from volviz.regular.raycast import render_blocks
-        from volviz.unstructured.camera import Camera
+        from volviz.model.camera import Camera
 
         t0 = time.perf_counter()
         w, h = (int(v) for v in self.plotter.ren_win.GetSize())

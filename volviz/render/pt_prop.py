@@ -35,7 +35,7 @@ import numpy as np
 from volviz.model.datasets import TetMesh
 from volviz.render.image_overlay import OverlayView, overlay_rgba8, unpremultiply_rgba8, zbuffer_to_depth
 from volviz.render.pt_view import PTView
-from volviz.unstructured.camera import Camera
+from volviz.model.camera import Camera
 from volviz.unstructured.render import render
 
 __all__ = ["PTVolume", "add_pt_volume", "unpremultiply_rgba8", "zbuffer_to_depth"]

@@ -8,7 +8,7 @@ and the exact reference ray caster (Roettger Ch. 8-9, Guthe Ch. 3).
 Sorting for the next camera can run in a worker thread (the Numba kernels release the GIL):
 ``visibility_order(mesh, camera, size).order`` is then passed to ``render(..., order=...)``.
 """
-from volviz.unstructured.camera import Camera
+from volviz.model.camera import Camera
 from volviz.unstructured.render import RenderStats, render
 from volviz.unstructured.sort import SortResult, visibility_order
 from volviz.unstructured.tetrahedralize import TetrahedralizeReport, tetrahedralize

@@ -19,7 +19,7 @@ import numpy as np
 
 from volviz.jobs import JobRunner
 from volviz.model.datasets import TetMesh
-from volviz.unstructured.camera import Camera
+from volviz.model.camera import Camera
 from volviz.unstructured.sort import SortResult, visibility_order
 from volviz.unstructured.topology import topology
 

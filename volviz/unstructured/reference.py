@@ -30,7 +30,7 @@ import numpy as np
 from numba import njit
 
 from volviz.model.datasets import TetMesh
-from volviz.unstructured.camera import Camera
+from volviz.model.camera import Camera
 from volviz.unstructured.raster import SOS
 from volviz.unstructured.topology import cell_ranges, topology
 

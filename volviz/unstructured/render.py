@@ -23,7 +23,7 @@ import numpy as np
 
 from volviz.model.datasets import TetMesh
 from volviz.optics.integrate import integrate_preclassified
-from volviz.unstructured.camera import Camera
+from volviz.model.camera import Camera
 from volviz.unstructured.iso import iso_lut, iso_segment_rgba, iso_visible, vertex_shade
 from volviz.unstructured.project import raster_triangles, shirley_tuchman
 from volviz.unstructured.raster import SOS, TILE, bin_tiles, lut_args, project_cells, raster_tiles, ray_images

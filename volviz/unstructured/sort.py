@@ -27,7 +27,7 @@ import numpy as np
 from numba import njit, prange
 
 from volviz.model.datasets import TetMesh
-from volviz.unstructured.camera import Camera
+from volviz.model.camera import Camera
 from volviz.unstructured.topology import FACES, Topology, topology
 
 METHODS = ("mpvo", "centroid", "power")
