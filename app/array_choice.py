@@ -1,36 +1,24 @@
 """The array selector of the scene tree: which array of its dataset the selected component shows.
 
 The choices are ``volviz.model.arrays.list_arrays``'s (a scalar array by name; a vector or tensor array as its
-magnitude or one component). A choice is one undoable step on the window's undo stack; it sets the component setting
-``"array"`` (saved with the session) and re-prepares the component through the window's settings path
-(``apply_component_settings``), which keeps the camera and the docks as they are."""
+magnitude or one component). A choice is one undoable step on the window's undo stack
+(``volviz_app.component_settings``); it sets the component setting ``"array"`` (saved with the session) and
+re-prepares the component through the window's settings path (``apply_component_settings``), which keeps the camera
+and the docks as they are."""
 from __future__ import annotations
 
-import json
 from typing import Any, Optional
 
 from PySide6.QtCore import Qt
-from PySide6.QtGui import QUndoCommand, QUndoStack
+from PySide6.QtGui import QUndoStack
 from PySide6.QtWidgets import QComboBox
 
-
-class SetArray(QUndoCommand):
-    """Show array ``after`` instead of ``before`` (None: the dataset's default) in component ``comp_id``."""
-
-    def __init__(self, choice: "ArrayChoice", comp_id: str, before: Optional[str], after: str) -> None:
-        super().__init__(f"Show {after} in {comp_id}")
-        self.choice, self.comp_id, self.before, self.after = choice, comp_id, before, after
-
-    def redo(self) -> None:
-        self.choice.apply(self.comp_id, self.after)
-
-    def undo(self) -> None:
-        self.choice.apply(self.comp_id, self.before)
+from volviz_app.component_settings import edit_settings
 
 
 class ArrayChoice:
-    """Fills ``combo`` for the component the scene tree selects and turns a user's choice into a ``SetArray`` on
-    ``undo_stack``. ``window`` provides ``controller``, ``session`` and ``apply_component_settings``."""
+    """Fills ``combo`` for the component the scene tree selects and turns a user's choice into an undoable settings
+    edit on ``undo_stack``. ``window`` provides ``controller``, ``session`` and ``apply_component_settings``."""
 
     def __init__(self, window: Any, combo: QComboBox, undo_stack: QUndoStack) -> None:
         self.window, self.combo, self.undo_stack = window, combo, undo_stack
@@ -75,19 +63,21 @@ class ArrayChoice:
     def choose(self, spec: str) -> None:
         """The user picked ``spec`` for the selected component: one undoable step (nothing if it is shown now)."""
         comp_id = self.comp_id
-        if comp_id is None or self.window.controller is None:
+        if comp_id is None or self.window.controller is None or spec == self.shown:
             return
-        if spec != self.shown:
-            self.undo_stack.push(SetArray(self, comp_id, self.current(comp_id), spec))
+        before = dict(self.window.controller.component(comp_id).settings)
+        edit_settings(self.window, self.undo_stack, comp_id, before, {**before, "array": spec},
+                      f"Show {spec} in {comp_id}")
 
-    def apply(self, comp_id: str, spec: Optional[str]) -> None:
-        """Set (None: remove) the component setting ``"array"`` and re-prepare the component."""
-        settings = dict(self.window.controller.component(comp_id).settings)
-        if spec is None:
-            settings.pop("array", None)
-        else:
-            settings["array"] = spec
-        self.window.apply_component_settings(comp_id, json.dumps(settings))
+    def names(self, comp_id: str) -> list[str]:
+        """The names of the arrays of ``comp_id``'s dataset (none while it is not read, or without a dataset)."""
+        from volviz.model.arrays import list_arrays
+
+        controller = self.window.controller
+        if controller is None or controller.component(comp_id).dataset is None:
+            return []
+        dataset = controller.datasets.get(controller.component(comp_id).dataset)
+        return [] if dataset is None else [info.name for info in list_arrays(dataset)]
 
     def _chosen(self, index: int) -> None:
         spec = self.combo.itemData(index)

@@ -22,6 +22,7 @@ from volviz.render.controller import no_render
 from volviz.session import CameraKey, Session, SessionError, relative_path
 from volviz_app.array_choice import ArrayChoice
 from volviz_app.camera_bookmarks import CameraBookmarks
+from volviz_app.component_settings import edit_settings
 from volviz_app.clip_widget import ClipPlaneWidget
 from volviz_app.decoration_toggles import DecorationToggles
 from volviz_app.docks.clipping import ClippingDock
@@ -238,7 +239,8 @@ class MainWindow(CameraBookmarks, QMainWindow):
         self.scene_tree.componentSelected.connect(self._select_component)
         self.scene_tree.visibilityChanged.connect(self._set_visibility)
         self.scene_tree.opacityChanged.connect(self._set_opacity)
-        self.scene_tree.settingsEdited.connect(self.apply_component_settings)
+        self.scene_tree.settingsEdited.connect(lambda comp_id, before, after: edit_settings(
+            self, self.scene_undo_stack, comp_id, before, after))
         self.render_settings.changed.connect(self._settings_changed)
         self.timeline.timeChanged.connect(self._time_changed)
         self.timeline.interpolationToggled.connect(self._interpolation_toggled)
@@ -443,7 +445,7 @@ class MainWindow(CameraBookmarks, QMainWindow):
         self.controller = controller
         if "window_state" in session.layout:
             self.restoreState(QByteArray.fromBase64(session.layout["window_state"].encode("ascii")))
-        self.scene_tree.populate(session.components)
+        self.scene_tree.populate(session.components, [ref.id for ref in session.datasets], self.array_choice.names)
         self.render_settings.load(session.render)
         self.decorations.sync()
         self.clipping.load(session.clip, controller.installed_bounds)
@@ -874,17 +876,15 @@ class MainWindow(CameraBookmarks, QMainWindow):
         self.render()
         self.refresh_iso_overlay()
 
-    def apply_component_settings(self, comp_id: str, text: str) -> bool:
-        """New settings for a component (JSON from the scene tree): validated through the session schema, then the
-        scene is rebuilt with the same camera; a bad value gives a message naming the field and changes nothing."""
-        import json
-
+    def apply_component_settings(self, comp_id: str, settings: dict[str, Any]) -> bool:
+        """New settings for a component (the scene tree's form, an undo step): validated through the session schema,
+        then the scene is rebuilt with the same camera and marked dirty; a bad value gives a message naming the field
+        and changes nothing. Undoable edits go through ``volviz_app.component_settings.edit_settings``."""
         from volviz.session import session_from_dict, session_to_dict
 
         if self.controller is None:
             return False
         try:
-            settings = json.loads(text)
             doc = session_to_dict(self.session)
             for comp in doc["components"]:
                 if comp["id"] == comp_id:

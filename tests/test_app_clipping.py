@@ -154,12 +154,12 @@ def test_transparency_mode_from_render_settings_and_spectrum_shader_on_screen(qt
     assert offscreen.shape == vtk_image.shape
     assert np.abs(offscreen - vtk_image).mean() < 1.0
     flat = [c for c in window.session.components if c.id == "iso"][0]
-    assert window.apply_component_settings("iso", json.dumps({**flat.settings, "shading": "flat"}))
+    assert window.apply_component_settings("iso", {**flat.settings, "shading": "flat"})
     qtbot.waitUntil(lambda: not window.progress_bar.isVisible(), timeout=60000)  # rebuilt in the background
     window.plotter.ren_win.SetMultiSamples(0)
     assert np.abs(viewport(window) - vtk_image).mean() > 0.5  # constant opacity looks different
 
-    assert window.apply_component_settings("iso", json.dumps({"styles": STYLES}))
+    assert window.apply_component_settings("iso", {"styles": STYLES})
     qtbot.waitUntil(lambda: not window.progress_bar.isVisible(), timeout=60000)  # rebuilt in the background
     window.plotter.ren_win.SetMultiSamples(0)
     controller = window.controller

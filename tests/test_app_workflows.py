@@ -401,21 +401,27 @@ def test_component_settings_edited_in_the_scene_tree(qtbot, make_window, tmp_pat
     window = make_window()
     window.open_path(session_file)
     wait_loaded(qtbot, window)
-    tree = window.scene_tree
-    assert json.loads(tree.settings_edit.toPlainText())["styles"][0]["value"] == 200
+    form = window.scene_tree.form
+    value = form.editor("styles").table.cellWidget(0, 0)  # the first surface's iso-value in the styles table
+    assert value.value() == 200
     before = viewport(window)
-    settings = json.loads(tree.settings_edit.toPlainText())
-    settings["styles"][0]["value"] = 40  # a lower iso-value: a much larger surface
-    tree.settings_edit.setPlainText(json.dumps(settings))
-    tree.apply_button.click()
+    value.lineEdit().selectAll()
+    qtbot.keyClicks(value.lineEdit(), "40")  # a lower iso-value: a much larger surface
+    qtbot.keyClick(value.lineEdit(), Qt.Key.Key_Return)
     wait_loaded(qtbot, window)  # the scene is rebuilt in the background, then swapped in
     assert window.session.components[0].settings["styles"][0]["value"] == 40 and window.dirty
     assert (np.abs(viewport(window) - before).sum(axis=2) > 30).mean() > 0.01
-    tree.settings_edit.setPlainText('{"styles": "many"}')  # invalid: refused with a message, nothing changes
-    tree.apply_button.click()
-    qtbot.waitUntil(lambda: window.error_dialog is not None, timeout=30000)
-    assert "iso" in window.error_dialog.text()
+    # the spin box allows 0 (the bound of a "greater than" field), the model refuses it: a message names the field
+    controller, form = window.controller, window.scene_tree.form
+    density = form.editor("triangles_per_pixel2")
+    assert density.minimum() == 0.0
+    density.setValue(0.0)
+    density.editingFinished.emit()
+    assert "triangles_per_pixel2" in form.problem("triangles_per_pixel2")
+    assert not window.progress_bar.isVisible() and window.controller is controller  # nothing rebuilt
+    assert window.session.components[0].settings == form.settings
     assert window.session.components[0].settings["styles"][0]["value"] == 40
+    assert "triangles_per_pixel2" not in window.session.components[0].settings
 
 
 def test_error_budget_switches_to_the_most_accurate_table(qtbot, make_window) -> None:

@@ -1,25 +1,31 @@
-"""Scene tree dock: the session's components with visibility check boxes and an opacity slider."""
+"""Scene tree dock: the session's components with visibility check boxes, an opacity slider, the array shown and
+the selected component's settings as a form (``volviz_app.settings_form``)."""
 from __future__ import annotations
 
-import json
-from typing import Any, Optional
+from typing import Any, Callable, Optional, Sequence
 
 from PySide6.QtCore import Qt, Signal
-from PySide6.QtWidgets import (QComboBox, QHBoxLayout, QLabel, QPlainTextEdit, QPushButton, QSlider, QTreeWidget,
-                               QTreeWidgetItem, QVBoxLayout, QWidget)
+from PySide6.QtWidgets import (QComboBox, QGroupBox, QHBoxLayout, QLabel, QSlider, QTreeWidget, QTreeWidgetItem,
+                               QVBoxLayout, QWidget)
+
+from volviz_app.settings_form import SettingsForm
 
 KIND_LABELS = {"volume": "Volume", "mesh": "Mesh", "isosurface": "Isosurface", "terrain": "Terrain", "fog": "Ground fog",
                "clouds": "Clouds", "sky": "Sky", "demo": "Demo volume"}
 
 
+#: settings the form leaves to another editor of the dock: the array combo box (``volviz_app.array_choice``)
+FORM_SKIPS = ("array",)
+
+
 class SceneTree(QWidget):
-    """Components with visibility check boxes, an opacity slider and their settings as editable JSON (validated by
-    the window through the session schema before anything changes)."""
+    """Components with visibility check boxes, an opacity slider, and the selected one's settings as a form built
+    from its settings model; each edit the form accepts is reported by ``settingsEdited(id, before, after)``."""
 
     visibilityChanged = Signal(str, bool)
     opacityChanged = Signal(str, float)
     componentSelected = Signal(str)
-    settingsEdited = Signal(str, str)  # component id, JSON text
+    settingsEdited = Signal(str, dict, dict)  # component id, settings before, settings after
 
     def __init__(self, parent: Optional[QWidget] = None):
         super().__init__(parent)
@@ -38,40 +44,49 @@ class SceneTree(QWidget):
         array_row = QHBoxLayout()
         array_row.addWidget(self.array_label)
         array_row.addWidget(self.array, 1)
-        self.settings_edit = QPlainTextEdit()
-        self.settings_edit.setPlaceholderText("component settings (JSON)")
-        self.settings_edit.setMaximumHeight(140)
-        self.apply_button = QPushButton("Apply settings")
-        self.apply_button.clicked.connect(self._apply_settings)
+        self.settings_box = QGroupBox("Settings")
+        self.settings_layout = QVBoxLayout(self.settings_box)
+        self.form: Optional[SettingsForm] = None
         self.tree.setToolTip("The scene's components: tick to show, untick to hide; select one to edit it")
         self.opacity.setToolTip("Opacity of the selected component")
-        self.settings_edit.setToolTip("The selected component's settings as JSON (see the README for the keys)")
-        self.apply_button.setToolTip("Check the settings above and rebuild the component with them")
+        self.settings_box.setToolTip("The selected component's settings: a change applies at once (Edit > Undo "
+                                     "takes it back)")
         layout = QVBoxLayout(self)
         layout.addWidget(self.tree, 1)
         layout.addLayout(array_row)
         layout.addLayout(row)
-        layout.addWidget(self.settings_edit)
-        layout.addWidget(self.apply_button)
+        layout.addWidget(self.settings_box)
         self.tree.itemChanged.connect(self._item_changed)
         self.tree.currentItemChanged.connect(self._current_changed)
         self.opacity.valueChanged.connect(self._opacity_moved)
         self._filling = False
+        self._components: dict[str, Any] = {}
+        self._datasets: Sequence[str] = ()
+        self._arrays: Callable[[str], list[str]] = lambda comp_id: []
 
-    def populate(self, components: list[Any]) -> None:
+    def populate(self, components: list[Any], datasets: Sequence[str] = (),
+                 arrays: Optional[Callable[[str], list[str]]] = None) -> None:
+        """List ``components``; their forms offer ``datasets`` (ids) for dataset fields and ``arrays(component id)``
+        for array fields. The selected component stays selected if it is still there (else the first is)."""
+        selected = self.current_component()
         self._filling = True
         self.tree.clear()
+        self._components = {comp.id: comp for comp in components}
+        self._datasets = list(datasets)
+        self._arrays = arrays or (lambda comp_id: [])
         for comp in components:
             item = QTreeWidgetItem([comp.id, KIND_LABELS.get(comp.type, comp.type)])
             item.setData(0, Qt.ItemDataRole.UserRole, comp.id)
             item.setData(0, Qt.ItemDataRole.UserRole + 1, comp.opacity)
-            item.setData(0, Qt.ItemDataRole.UserRole + 2, json.dumps(comp.settings, indent=1))
             item.setFlags(item.flags() | Qt.ItemFlag.ItemIsUserCheckable)
             item.setCheckState(0, Qt.CheckState.Checked if comp.visible else Qt.CheckState.Unchecked)
             self.tree.addTopLevelItem(item)
         self._filling = False
         if self.tree.topLevelItemCount():
-            self.tree.setCurrentItem(self.tree.topLevelItem(0))
+            self.tree.setCurrentItem(self.item(selected) if selected in self._components else
+                                     self.tree.topLevelItem(0))
+        else:
+            self._show_form(None)
 
     def item(self, comp_id: str) -> QTreeWidgetItem:
         for i in range(self.tree.topLevelItemCount()):
@@ -95,14 +110,26 @@ class SceneTree(QWidget):
             return
         self._filling = True
         self.opacity.setValue(int(round(float(current.data(0, Qt.ItemDataRole.UserRole + 1)) * 100)))
-        self.settings_edit.setPlainText(current.data(0, Qt.ItemDataRole.UserRole + 2) or "{}")
         self._filling = False
-        self.componentSelected.emit(current.data(0, Qt.ItemDataRole.UserRole))
+        comp_id = current.data(0, Qt.ItemDataRole.UserRole)
+        self._show_form(comp_id)
+        self.componentSelected.emit(comp_id)
 
-    def _apply_settings(self) -> None:
-        comp_id = self.current_component()
-        if comp_id is not None:
-            self.settingsEdited.emit(comp_id, self.settings_edit.toPlainText())
+    def _show_form(self, comp_id: Optional[str]) -> None:
+        """Swap in the settings form of ``comp_id`` (none for None)."""
+        if self.form is not None:
+            self.settings_layout.removeWidget(self.form)
+            self.form.setParent(None)  # gone from the dock now, deleted once its signal handlers returned
+            self.form.deleteLater()
+            self.form = None
+        comp = self._components.get(comp_id) if comp_id is not None else None
+        self.settings_box.setTitle(f"Settings of {comp_id}" if comp is not None else "Settings")
+        if comp is None:
+            return
+        self.form = SettingsForm(comp.type, comp.settings, self._datasets, lambda: self._arrays(comp.id),
+                                 FORM_SKIPS)
+        self.form.committed.connect(lambda before, after: self.settingsEdited.emit(comp.id, before, after))
+        self.settings_layout.addWidget(self.form)
 
     def _opacity_moved(self, value: int) -> None:
         item = self.tree.currentItem()
