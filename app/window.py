@@ -18,7 +18,7 @@ from PySide6.QtWidgets import (QDockWidget, QFileDialog, QLabel, QMainWindow, QM
 
 from volviz.jobs import JobOutcome
 from volviz.render.backend import plotter_gl_info
-from volviz.render.controller import no_render
+from volviz.render.controller import iso_summary, no_render
 from volviz.session import CameraKey, Session, SessionError, relative_path
 from volviz_app.array_choice import ArrayChoice
 from volviz_app.camera_bookmarks import CameraBookmarks
@@ -556,11 +556,9 @@ class MainWindow(CameraBookmarks, QMainWindow):
                          raster_seconds=sum(s.get("raster_s", 0.0) for s in last),
                          method=", ".join(sorted({str(s.get("method")) for s in last})),
                          error=getattr(self, "error_estimate", None), backends=self.controller.pt_backends())
-        overlay = self.controller.iso_overlay if self.controller is not None else None
-        if overlay is not None and overlay.stats:
-            st = overlay.stats
-            stats["iso"] = (f"{st['method']}: {st['triangles']:,} triangles, {st['triangles_drawn']:,} drawn, "
-                            f"{st['volume_s'] * 1000:.0f} ms")
+        iso = self.controller.iso_stats() if self.controller is not None else {}
+        if iso:
+            stats["iso"] = iso_summary(iso)
         self.last_stats = stats
         self.statistics.show_stats(stats)
 

@@ -29,7 +29,8 @@ def session_file(tmp_path: Path) -> Path:
            "components": [{"id": "iso", "type": "isosurface", "dataset": "b", "settings": {"styles": STYLES}}],
            "camera": {"position": [11.5, -45.0, 11.5], "focal_point": [11.5, 11.5, 11.5], "view_up": [0, 0, 1]},
            # the viewport is compared with CPU renders of the surfaces: no decorations
-           "render": {"options": {"scalar_bar": False, "axes": False, "outline": False}}}
+           # the note's modes by the CPU overlay (auto takes the GPU's, tests/test_app_iso_backend.py)
+           "render": {"options": {"scalar_bar": False, "axes": False, "outline": False, "backend": "cpu"}}}
     path = tmp_path / "ball.json"
     path.write_text(json.dumps(doc))
     return path

@@ -1,4 +1,5 @@
-"""The isosurface transparency modes and the scene-wide clipping in a real (offscreen) VTK scene."""
+"""The isosurface transparency modes on the CPU backend (the overlay, ``volviz.render.iso_overlay``) and the
+scene-wide clipping in a real (offscreen) VTK scene. The GPU backend's view: ``tests/test_render_gl_iso_view.py``."""
 from __future__ import annotations
 
 import numpy as np
@@ -15,6 +16,7 @@ from volviz.session import CameraState, Component, DatasetRef, Session
 SIZE = (160, 120)
 BG = (0.1, 0.1, 0.12)
 PLAIN = {"scalar_bar": False, "axes": False, "outline": False}  # images compared with CPU renders: no decorations
+CPU = {"backend": "cpu"}   # the note's modes by the CPU overlay (auto takes the GPU's GLIsoView, also on llvmpipe)
 STYLES = [{"value": 0.3, "color": [1.0, 0.3, 0.2], "opacity": 0.5}, {"value": 0.8, "color": [0.2, 0.4, 1.0],
                                                                        "opacity": 0.4}]
 
@@ -46,7 +48,7 @@ def scene(components: list[Component], clip: dict | None = None) -> tuple[SceneC
     s = Session(datasets=[DatasetRef("b", "/unused")], components=components,
                 camera=CameraState((11.5, -40.0, 11.5), (11.5, 11.5, 11.5), (0.0, 0.0, 1.0)))
     s.render.background = BG
-    s.render.options.update(PLAIN)
+    s.render.options.update(PLAIN, **CPU)
     if clip is not None:
         s.clip = clip
     p = plotter()
@@ -193,7 +195,7 @@ def test_overlay_follows_display_time_and_clip_of_a_time_series():
     s = Session(datasets=[DatasetRef("b", "/unused")], components=[iso_component()],
                 camera=CameraState((11.5, -40.0, 11.5), (11.5, 11.5, 11.5), (0.0, 0.0, 1.0)))
     s.render.background = BG
-    s.render.options.update(PLAIN)
+    s.render.options.update(PLAIN, **CPU)
     s.render.options["iso_mode"] = "4pass"
     p = plotter()
     c = SceneController(p, s, {"b": TimeSeries([0.0, 1.0], [small, big])})

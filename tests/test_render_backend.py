@@ -26,9 +26,9 @@ def test_software_renderers_are_recognised(renderer: str, software: bool) -> Non
 
 
 def test_auto_picks_the_gpu_on_hardware_and_the_measured_faster_path_on_llvmpipe() -> None:
-    for kind in ("pt", "regular", "nature"):
+    for kind in ("pt", "regular", "nature", "iso"):
         assert choose_backend("auto", kind, HARDWARE) == "gpu"
-        assert choose_backend("auto", kind, LLVMPIPE) == "cpu"
+        assert choose_backend("auto", kind, LLVMPIPE) == ("gpu" if kind == "iso" else "cpu")   # docs/bench/iso.md
         for setting in ("gpu", "cpu"):                      # an explicit setting is honoured on either driver
             assert choose_backend(setting, kind, HARDWARE) == setting
             assert choose_backend(setting, kind, LLVMPIPE) == setting

@@ -20,12 +20,20 @@ Google SwiftShader) the GPU's work runs on the same CPU cores, so ``auto`` takes
   off the GUI thread). Auto takes the CPU on a software rasteriser: the demo scene on llvmpipe (2 shared cores,
   ~25k cloud tetrahedra, ~60k fog prisms) took 0.61 s per frame on the CPU against 1.47 s on the GL path at
   512x384 (0.57 s of it LOD selection and upload, 0.91 s llvmpipe's draw) and 0.18 / 0.63 s at 64x48.
+- ``"iso"``: the isosurfaces' transparency modes of the libMini note §4 (2-pass, 3-pass, 4-pass, exact):
+  ``volviz.render.gl_iso.GLIsoView`` (the passes as VTK actors, drawn at every render) or the CPU
+  ``volviz.render.iso_overlay.IsoOverlay`` (fragment lists composited off the GUI thread, pasted over the scene).
+  Auto takes the GPU on a software rasteriser too: ``docs/bench/iso.md`` (384², llvmpipe, 2 shared cores; the Storm,
+  two overlapping Storm volumes and the Blunt Fin) has 10-13 / 61-107 ms per frame (GPU / CPU) for 2-pass, 20-36 /
+  83-165 ms for 3-pass, 37-45 / 106-150 ms for 4-pass and 85-124 / 102-149 ms for exact: the GPU is faster in every
+  mode on every scene, the GPU's time including the read-back of the frame.
 - regular: VTK's CPU ray caster (DESIGN.md: the embryo 256³ at 512² takes 0.07 s against 0.26 s with the GPU ray
   caster on llvmpipe; in the app, loading the embryo blocked the event loop 4.3 s with the GPU mapper and 1.2 s
   with the CPU one, and a Storm playback frame took 450 ms against 230 ms).
 
     info = gl_info(plotter.ren_win)              # GLInfo(vendor, renderer, version)
     choose_backend("auto", "pt", info)           # "cpu" on llvmpipe, "gpu" on a hardware driver
+    choose_backend("auto", "iso", info)          # "gpu" on both
 """
 from __future__ import annotations
 
@@ -37,9 +45,9 @@ from volviz.session import RENDER_BACKENDS
 __all__ = ["RENDER_BACKENDS", "VIEW_KINDS", "GLInfo", "backend_setting", "choose_backend", "gl_info",
            "is_software_renderer", "offscreen_gl_info", "parse_capabilities", "plotter_gl_info"]
 
-VIEW_KINDS = ("pt", "regular", "nature")
+VIEW_KINDS = ("pt", "regular", "nature", "iso")
 SOFTWARE_RENDERERS = ("llvmpipe", "softpipe", "swrast", "swiftshader", "software rasterizer")
-_FASTER_ON_SOFTWARE = {"pt": "cpu", "regular": "cpu", "nature": "cpu"}     # measured (module docstring)
+_FASTER_ON_SOFTWARE = {"pt": "cpu", "regular": "cpu", "nature": "cpu", "iso": "gpu"}     # measured (module docstring)
 
 
 @dataclass(frozen=True)

@@ -3,8 +3,12 @@
 ``SceneController`` owns the mapping from session components to VTK props. Transfer-function edits, visibility,
 opacity and display time update the props in place (no rebuild), so live previews stay cheap. The scene-wide clipping
 (``session.clip``, ``set_clip``) cuts every prop alike (``volviz.render.clipping``); the isosurfaces' transparency
-mode (``session.render.options["iso_mode"]``: "vtk" = VTK's own 2-pass blend, or one of the CPU modes "2pass",
-"3pass", "4pass", "exact" drawn as a depth-composited overlay, ``volviz.render.iso_overlay``) is chosen per scene.
+mode (``session.render.options["iso_mode"]``: "vtk" = VTK's own 2-pass blend, or one of the modes "2pass", "3pass",
+"4pass", "exact" of the libMini note §4) is chosen per scene. A note mode is drawn by the ``iso_view`` of the backend
+that ``volviz.render.backend`` picks for the view kind "iso": on "gpu" ``volviz.render.gl_iso.GLIsoView`` (passes of
+VTK actors, drawn at every render), on "cpu" ``volviz.render.iso_overlay.IsoOverlay`` (a depth-composited overlay
+image, re-made by ``update`` or ``begin`` / ``compute`` / ``finish``; also ``iso_overlay``, what the app renders in
+the background).
 """
 from __future__ import annotations
 
@@ -16,6 +20,15 @@ from volviz.session import CameraState, Component, Session
 
 
 ISO_MODES = ("vtk", "2pass", "3pass", "4pass", "exact")
+
+
+def iso_summary(stats: dict[str, Any]) -> str:
+    """One line of an isosurface view's statistics (``SceneController.iso_stats``: ``volviz.render.iso_overlay.
+    IsoOverlay`` or ``volviz.render.gl_iso.GLIsoView``): the mode, the triangles, those a GPU draws per frame where
+    known, and the seconds of the last image (CPU) or frame (GPU)."""
+    drawn = stats.get("triangles_drawn")
+    drawn_text = "" if drawn is None else f", {drawn:,} drawn"
+    return f"{stats['method']}: {stats['triangles']:,} triangles{drawn_text}, {stats['volume_s'] * 1000:.0f} ms"
 
 
 def _is_lod(prop: Any) -> bool:
@@ -62,7 +75,7 @@ class SceneController:
         self.session = session
         self.datasets = datasets
         self.props: dict[str, Any] = {}
-        self.iso_overlay: Any = None      # IsoOverlay while a CPU transparency mode is on
+        self.iso_view: Any = None         # GLIsoView or IsoOverlay while a mode of the note is on
         self._vtk_inputs: dict[str, Any] = {}  # uncut inputs of clipped VTK tetrahedral volumes
         self.histograms: dict[str, Any] = {}   # comp id -> (counts, edges) of its data, from ``prepare``
         self.time = 0.0
@@ -119,9 +132,9 @@ class SceneController:
         for comp_id, prop in self.props.items():
             if _is_pt(prop) or comp_id == "nature":
                 prop.remove()
-        if self.iso_overlay is not None:
-            self.iso_overlay.remove()
-            self.iso_overlay = None
+        if self.iso_view is not None:
+            self.iso_view.remove()
+            self.iso_view = None
         self.props = {}
         self.plotter.clear()
 
@@ -442,9 +455,9 @@ class SceneController:
                 stats[comp_id] = dict(prop.stats)
             elif lod and _is_lod(prop) and prop.volume.GetVisibility():
                 stats[comp_id] = dict(prop.update())
-        if pt and self.iso_overlay is not None:
-            self.iso_overlay.update()
-            stats["iso"] = dict(self.iso_overlay.stats)
+        if pt and self.iso_view is not None:
+            self.iso_view.update()
+            stats["iso"] = dict(self.iso_view.stats)
         return stats
 
     def begin_views(self, stage: int) -> list[tuple[str, Any, Any]]:
@@ -647,28 +660,48 @@ class SceneController:
 
     # -- isosurface transparency mode (per scene) -------------------------------------------------------------------
     @property
+    def iso_overlay(self) -> Any:
+        """The isosurfaces' CPU overlay (``IsoOverlay``: ``begin`` / ``compute`` / ``finish``) while a mode of the note
+        is drawn on the CPU backend; None otherwise (VTK draws the GPU's ``GLIsoView`` at every render)."""
+        view = self.iso_view
+        return view if view is not None and view.backend == "cpu" else None
+
+    def iso_stats(self) -> dict[str, Any]:
+        """The isosurface view's last statistics (``iso_summary`` prints them); {} with
+        none."""
+        view = self.iso_view
+        if view is not None and view.backend == "gpu":
+            view.update()
+        return dict(view.stats) if view is not None else {}
+
+    @property
     def iso_mode(self) -> str:
         mode = self.session.render.options.get("iso_mode", "vtk")
         return mode if mode in ISO_MODES else "vtk"
 
     def set_iso_mode(self, mode: str, update: bool = True) -> None:
-        """Draw the isosurfaces with VTK's blend ("vtk") or a CPU mode through the overlay (rendered now when
-        ``update``; the app renders it in the background: ``iso_overlay.begin`` / ``compute`` / ``finish``)."""
+        """Draw the isosurfaces with VTK's blend ("vtk") or a mode of the note on the backend's ``iso_view`` (the CPU
+        overlay is rendered now when ``update``; the app renders it in the background: ``iso_overlay.begin`` /
+        ``compute`` / ``finish``)."""
+        from volviz.render.scene import view_backend
+
         if mode not in ISO_MODES:
             raise ValueError(f"unknown isosurface mode {mode!r}; choose from {ISO_MODES}")
         if mode != "vtk" or "iso_mode" in self.session.render.options:
             self.session.render.options["iso_mode"] = mode
-        isos = self._iso_props()
-        if mode == "vtk" or not isos:
-            if self.iso_overlay is not None:
-                self.iso_overlay.remove()
-                self.iso_overlay = None
-        elif self.iso_overlay is None:
-            from volviz.render.iso_overlay import IsoOverlay
-
-            self.iso_overlay = IsoOverlay(self.plotter, mode=mode)
-        if self.iso_overlay is not None:
-            self.iso_overlay.mode = mode
+        backend = view_backend(self.plotter, self.session, "iso")
+        view = self.iso_view
+        if view is not None and (mode == "vtk" or not self._iso_props() or view.backend != backend):
+            view.remove()
+            view = self.iso_view = None
+        if view is None and mode != "vtk" and self._iso_props():
+            if backend == "gpu":
+                from volviz.render.gl_iso import GLIsoView as View
+            else:
+                from volviz.render.iso_overlay import IsoOverlay as View
+            view = self.iso_view = View(self.plotter, mode=mode)
+        if view is not None:
+            view.mode = mode
         self._sync_iso_overlay()
         if update and self.iso_overlay is not None:
             self.iso_overlay.update()
@@ -680,10 +713,10 @@ class SceneController:
                 if comp_id != "nature" and self.component(comp_id).type == "isosurface"}
 
     def _sync_iso_overlay(self) -> None:
-        """In a CPU mode the overlay draws the visible components' translucent surfaces; opaque surfaces stay VTK
-        actors, so they are the modes' opaque pass in the depth buffer (for PT volumes too). In "vtk" mode VTK draws
-        everything."""
-        overlay = self.iso_overlay
+        """In a mode of the note the iso view (either backend) draws the visible components' translucent surfaces;
+        opaque surfaces stay VTK actors, so they are the modes' opaque pass in the depth buffer (for PT volumes too).
+        In "vtk" mode VTK draws everything."""
+        overlay = self.iso_view
         meshes, lod, shading = [], [], "spectrum"
         for comp_id, prop in self._iso_props().items():
             visible = self.component(comp_id).visible
@@ -698,4 +731,4 @@ class SceneController:
                         lod.append(level)
                 shading = prop.volviz_shading
         if overlay is not None:
-            overlay.meshes, overlay.lod, overlay.shading = meshes, lod, shading
+            overlay.set_surfaces(meshes, lod, shading)

@@ -6,6 +6,10 @@
     plotter.show() / plotter.screenshot()
     iso.set_mode("3pass"); iso.remove()
 
+``GLIsoView`` is the scene controller's isosurface view on the GPU backend (``volviz.render.backend``, view kind
+"iso"): the calls of the CPU overlay ``volviz.render.iso_overlay.IsoOverlay`` (``mode``, ``set_surfaces``, ``update``,
+``remove``, ``stats``, ``backend``) over a ``GLIsoSurfaces`` made again when the surfaces change.
+
 Every pass runs over all surfaces of all volumes at once (the note: "each render pass must be executed for all
 volumes"): the translucent surfaces of every mesh are one vertex buffer (in ``meshes`` order, the CPU's draw order)
 drawn by one actor per pass, so the per-pixel sums and products are order-independent across volumes. Opaque
@@ -57,6 +61,7 @@ read at ``gl_FragCoord``); multisampled windows (the tests use one sample per pi
 """
 from __future__ import annotations
 
+import time
 from typing import Any, Sequence
 
 import numpy as np
@@ -65,8 +70,10 @@ from volviz.iso.composite import AMBIENT, MODES
 from volviz.iso.extract import IsoMesh
 from volviz.iso.spectrum import fit_spectrum
 from volviz.render.gl_pt import GLPTVolume, shader_source
+from volviz.render.image_overlay import hold_single_sample, release_single_sample
+from volviz.render.iso_overlay import IsoModeView
 
-__all__ = ["GLIsoSurfaces", "iso_polydata"]
+__all__ = ["GLIsoSurfaces", "GLIsoView", "iso_polydata"]
 
 _OPAQUE, _OVER, _ATTENUATE, _BACK, _EMIT = range(5)
 _ATTRIBUTES = ("isoNormal", "isoStyle", "isoFit")
@@ -311,3 +318,89 @@ class GLIsoSurfaces:
         ren.SetUseOIT(oit)
         ren.SetMaximumNumberOfPeels(n)
         ren.SetOcclusionRatio(ratio)
+
+
+class GLIsoView(IsoModeView):
+    """The translucent isosurfaces of a scene in one transparency mode on the GPU (``GLIsoSurfaces``), behind the calls
+    the scene controller makes of the CPU ``IsoOverlay``: ``mode`` (set: the next render draws in it),
+    ``set_surfaces(meshes, lod, shading)`` (the visible components' translucent surfaces; opaque ones stay the
+    components' VTK actors, which the passes see in the depth buffer as the CPU overlay sees them in the read-back
+    depth), ``update`` (the statistics; VTK draws the passes at every render, there is no image to re-make),
+    ``remove`` and ``stats``.
+
+    The surfaces are drawn at full resolution: the LOD chains (``lod``) set the CPU rasteriser's work per camera and
+    are not used here (as VTK's own "vtk" mode draws the full surfaces). The window is held single-sample while the
+    view exists (the back-face target of 4-pass and the CPU compositor it is measured against have one sample per
+    pixel). ``stats``: ``method`` ("iso <mode> (gpu)"), ``triangles`` (translucent triangles uploaded),
+    ``triangles_drawn`` (per frame: once per pass for 2/3/4-pass; None for exact, whose number of peeled layers VTK
+    does not report), ``volume_s`` (the renderer's last frame, the passes and the rest of the scene) and ``size``."""
+
+    backend = "gpu"
+
+    def __init__(self, plotter: Any, meshes: Sequence[IsoMesh] = (), mode: str = "3pass",
+                 shading: str = "spectrum") -> None:
+        import vtk
+
+        self.plotter = plotter
+        self.meshes: list[IsoMesh] = []
+        self.lod: list[Any] = []
+        self.shading = shading
+        self.surfaces: GLIsoSurfaces | None = None
+        self.stats: dict[str, Any] = {}
+        self._built = False
+        self._frame_start = 0.0
+        self._frame_s = 0.0
+        self.mode = mode
+        hold_single_sample(plotter, self)
+        ren = plotter.renderer
+        self._observers = [(ren, ren.AddObserver(vtk.vtkCommand.StartEvent, self._on_start)),
+                           (ren, ren.AddObserver(vtk.vtkCommand.EndEvent, self._on_end))]
+        self.set_surfaces(list(meshes), [None] * len(meshes), shading)
+
+    def _mode_changed(self, mode: str) -> None:
+        if self.surfaces is not None:
+            self.surfaces.set_mode(mode)
+
+    def set_surfaces(self, meshes: Sequence[IsoMesh], lod: Sequence[Any], shading: str) -> None:
+        """Draw ``meshes`` (translucent surfaces of any number of volumes) from the next render on; the vertex buffer
+        is made again only when the meshes or the shading changed (the controller passes the same meshes after
+        every visibility, clipping or mode call)."""
+        meshes = list(meshes)
+        same = (shading == self.shading and len(meshes) == len(self.meshes)
+                and all(a is b for a, b in zip(meshes, self.meshes)))
+        self.meshes, self.lod, self.shading = meshes, list(lod), shading
+        if same and self._built:
+            return
+        self._built = True
+        if self.surfaces is not None:
+            self.surfaces.remove()
+            self.surfaces = None
+        if any(m.n_triangles for m in self.meshes):
+            self.surfaces = GLIsoSurfaces(self.plotter, self.meshes, self.mode, shading)
+
+    def _on_start(self, *_: Any) -> None:
+        self._frame_start = time.perf_counter()
+
+    def _on_end(self, *_: Any) -> None:
+        self._frame_s = time.perf_counter() - self._frame_start
+
+    def update(self) -> dict[str, Any]:
+        """The statistics of the last render (nothing to re-make: VTK draws the passes at every render)."""
+        n = sum(m.n_triangles for m in self.meshes)
+        passes = {"2pass": 1, "3pass": 2, "4pass": 3}.get(self.mode)
+        self.stats = {"method": f"iso {self.mode} (gpu)", "triangles": n,
+                      "triangles_drawn": None if passes is None else passes * n, "volume_s": self._frame_s,
+                      "size": tuple(int(v) for v in self.plotter.renderer.GetSize())}
+        return self.stats
+
+    def remove(self) -> None:
+        """Take the surfaces out of the renderer (its depth-peeling and OIT settings restored) and give the window
+        its multisampling back."""
+        for obj, tag in self._observers:
+            obj.RemoveObserver(tag)
+        self._observers = []
+        if self.surfaces is not None:
+            self.surfaces.remove()
+            self.surfaces = None
+        self._built = False
+        release_single_sample(self.plotter, self)

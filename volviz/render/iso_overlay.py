@@ -33,7 +33,7 @@ from volviz.iso.lod import lod_mesh, select_level
 from volviz.render.image_overlay import OverlayView
 from volviz.unstructured.camera import Camera
 
-__all__ = ["IsoOverlay", "cut_at_depth"]
+__all__ = ["IsoModeView", "IsoOverlay", "cut_at_depth"]
 
 def cut_at_depth(frags: Fragments, depth: np.ndarray) -> Fragments:
     """The fragments strictly in front of the opaque depth of their pixel (``depth`` (H, W), +inf = nothing)."""
@@ -46,16 +46,11 @@ def cut_at_depth(frags: Fragments, depth: np.ndarray) -> Fragments:
                      frags.n_triangles, frags.n_opaque_triangles, frags.seconds)
 
 
-class IsoOverlay(OverlayView):
-    """The isosurfaces of a scene drawn by one of the CPU transparency modes as a depth-composited overlay."""
+class IsoModeView:
+    """The ``mode`` of an isosurface view (one of ``volviz.iso.composite.MODES``, checked when set); a subclass
+    applies a new mode in ``_mode_changed``."""
 
-    def __init__(self, plotter: Any, meshes: Sequence[IsoMesh] = (), mode: str = "3pass",
-                 shading: str = "spectrum") -> None:
-        super().__init__(plotter)
-        self.meshes = list(meshes)
-        self.lod: list[Any] = [None] * len(self.meshes)  # per mesh: (LodChain, triangles per pixel²) or None
-        self.mode = mode
-        self.shading = shading
+    _mode = "3pass"
 
     @property
     def mode(self) -> str:
@@ -66,6 +61,29 @@ class IsoOverlay(OverlayView):
         if mode not in MODES:
             raise ValueError(f"unknown transparency mode {mode!r}; choose from {MODES}")
         self._mode = mode
+        self._mode_changed(mode)
+
+    def _mode_changed(self, mode: str) -> None:
+        """Called after every change of ``mode``."""
+
+
+class IsoOverlay(OverlayView, IsoModeView):
+    """The isosurfaces of a scene drawn by one of the CPU transparency modes as a depth-composited overlay."""
+
+    backend = "cpu"
+
+    def __init__(self, plotter: Any, meshes: Sequence[IsoMesh] = (), mode: str = "3pass",
+                 shading: str = "spectrum") -> None:
+        super().__init__(plotter)
+        self.meshes = list(meshes)
+        self.lod: list[Any] = [None] * len(self.meshes)  # per mesh: (LodChain, triangles per pixel²) or None
+        self.mode = mode
+        self.shading = shading
+
+    def set_surfaces(self, meshes: Sequence[IsoMesh], lod: Sequence[Any], shading: str) -> None:
+        """Draw ``meshes`` with their LOD chains (``lod``: per mesh (LodChain, triangles per pixel²) or None) and
+        ``shading`` from the next image on."""
+        self.meshes, self.lod, self.shading = list(meshes), list(lod), shading
 
     def _far(self, cam: Camera) -> float:
         pts = [m.points for m in self.meshes if len(m.points)]
