@@ -31,8 +31,10 @@ class ArrayChoice:
 
     def current(self, comp_id: str) -> Optional[str]:
         """The array spec the component's settings name (None: the dataset's default)."""
+        from volviz.model.settings import array_key
+
         comp = self.window.controller.component(comp_id)
-        value = comp.settings.get("array")
+        value = comp.settings.get(array_key(comp.type))
         return str(value) if value else None
 
     def show_component(self, comp_id: Optional[str]) -> None:
@@ -65,8 +67,11 @@ class ArrayChoice:
         comp_id = self.comp_id
         if comp_id is None or self.window.controller is None or spec == self.shown:
             return
-        before = dict(self.window.controller.component(comp_id).settings)
-        edit_settings(self.window, self.undo_stack, comp_id, before, {**before, "array": spec},
+        from volviz.model.settings import array_key
+
+        comp = self.window.controller.component(comp_id)
+        before = dict(comp.settings)
+        edit_settings(self.window, self.undo_stack, comp_id, before, {**before, array_key(comp.type): spec},
                       f"Show {spec} in {comp_id}")
 
     def names(self, comp_id: str) -> list[str]:

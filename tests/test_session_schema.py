@@ -88,3 +88,13 @@ def test_defaults_live_in_the_models():
     model = FogSettings()
     with pytest.raises(ValueError):
         model.density = -1.0   # assignments are validated too
+
+
+def test_the_shown_array_key_of_every_component_type_is_a_setting():
+    from volviz.model.settings import array_key
+
+    for kind, model in SETTINGS_MODELS.items():
+        if "array" in model.model_fields or "scalars" in model.model_fields:
+            assert typed_settings(kind, {array_key(kind): "Density:1"}).model_dump()[array_key(kind)] == "Density:1"
+    with pytest.raises(SettingsError, match=r"settings\.array: unknown setting"):
+        typed_settings("isosurface", {"array": "Density"})

@@ -17,7 +17,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_valida
 __all__ = ["Settings", "TerrainSettings", "FogSettings", "CloudSettings", "SkySettings", "VolumeSettings",
            "MeshSettings", "IsoStyleSettings", "IsosurfaceSettings", "DemoSettings", "RenderOptions",
            "SETTINGS_MODELS", "FogMode", "CloudShadingName", "IsoMode", "IsoShading", "IsoOverlayMode", "Backend",
-           "SortName", "settings_model", "validate_settings", "validate_render_options", "typed_settings",
+           "SortName", "array_key", "settings_model", "validate_settings", "validate_render_options", "typed_settings",
            "SettingsError"]
 
 FogMode = Literal["emissive", "attenuated", "mip"]
@@ -210,6 +210,11 @@ class RenderOptions(Settings):
     scalar_bar: bool = Field(True, title="Scalar bar")
     axes: bool = Field(True, title="Axes")
     outline: bool = Field(True, title="Outline box")
+
+
+def array_key(component_type: str) -> str:
+    """The settings key naming the array a component shows: ``scalars`` for isosurfaces, ``array`` otherwise."""
+    return "scalars" if component_type == "isosurface" else "array"
 
 
 def settings_model(component_type: str) -> type[Settings]:

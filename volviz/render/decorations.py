@@ -7,6 +7,7 @@ from typing import Any, Optional
 
 import numpy as np
 
+from volviz.model.settings import array_key
 from volviz.session import Session
 
 DECORATIONS = ("scalar_bar", "axes", "outline")
@@ -118,8 +119,9 @@ def _add_scalar_bar(plotter: Any, session: Session, comp: Any, title: str, colou
 
 def _array_title(comp: Any, datasets: dict[str, Any]) -> str:
     """The name of the array a component shows (its ``array`` setting, else its dataset's default array)."""
-    if comp.settings.get("array"):
-        return _readable(str(comp.settings["array"]))
+    shown = comp.settings.get(array_key(comp.type))
+    if shown:
+        return _readable(str(shown))
     from volviz.render.scene import SceneError, component_dataset
 
     try:

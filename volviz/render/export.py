@@ -185,6 +185,7 @@ def open_target(target: str | os.PathLike, array: Optional[str] = None,
     """The session a command-line target names, and its file: ``demo``, ``demo-volume``, a session file, or a data
     file shown with the array spec ``array`` (``volviz.model.arrays``) and the PLOT3D solution file ``q``. A member
     of a numbered series opens the whole series at that member's time step (``data_session``)."""
+    from volviz.model.settings import array_key
     from volviz.render.scene import data_session, demo_session, demo_volume_session
     from volviz.session import load
 
@@ -196,7 +197,7 @@ def open_target(target: str | os.PathLike, array: Optional[str] = None,
     session = data_session(path, q)
     comp = session.components[0]
     if array is not None:
-        comp.settings["array"] = str(array)
+        comp.settings[array_key(comp.type)] = str(array)
     return session, None
 
 
