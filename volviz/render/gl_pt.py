@@ -12,13 +12,13 @@ How a frame is drawn:
   to the mesh's centre (``topology``: meshes offset by 1e6 keep their precision; the actor is placed at the centre).
 - Per render (the renderer's ``StartEvent``): the back-to-front cell order for the camera (``visibility_order``, as
   the CPU ``pt``) with zero-opacity and NaN cells culled (Roettger §9.1) becomes the index buffer, 4 triangles per
-  cell; nothing else is uploaded.
+  cell, as 32-bit arrays shared with VTK (no copy); nothing else is uploaded.
 - Per fragment (``resources/shaders/pt_tet_fs.glsl``): only back (exit) faces are rasterised (front faces culled),
   so a cell cut by the near plane (camera inside the mesh) is still drawn. The pixel ray is rebuilt from
   ``gl_FragCoord`` with the camera's affine ray basis (no interpolated varyings), clipped against the cell's planes,
   the near and far planes and the opaque scene's depth at the pixel; the exact (s_f, s_b, l) of that segment look up
   the 3D table (Roettger §8.4, trilinear) or the separable one (§9.1: exact opacity 1 - exp(-l rho_hat), colour
-  polynomial in l), both float 3D textures. The fragment shader is made for one kind of segment evaluation
+  polynomial in l; its layers a 2D texture array, bilinear within a layer), both float32. The fragment shader is made for one kind of segment evaluation
   (``PT_KIND``: 3D table, separable table, isosurfaces, pre-classified; VTK recompiles it when the kind changes):
   llvmpipe runs every branch of a fragment shader under a lane mask, so a run-time switch between kinds made every
   fragment pay for all of them (measured at 512^2 on the Blunt Fin: 3.7 s per frame with the four kinds behind a
@@ -63,9 +63,19 @@ against the CPU reference on llvmpipe (``tests/test_render_gl_pt.py``, 8-bit): t
 0.49 (camera inside 0.16 / 0.29), smooth 0.17 / 0.50 and 0.22 / 0.50, pre-classified 0.24-0.28 / 0.50: the screen's
 rounding.
 
-Not handled yet: a renderer that does not fill its window (the ray basis is built for the renderer's size with its origin at the
-framebuffer's corner: tested with full-window renderers only), depth peeling for other translucent props of the
-same renderer (the pass draws them in order). Call ``remove()`` before closing the plotter.
+Timings on llvmpipe (Mesa 22.3, 2 cores shared with other work; Blunt Fin, 3D table; ``volviz bench unstructured``,
+docs/bench/pt-gl): 0.89 s per frame at 512^2 (the CPU ``pt``: 0.88 s with the 3D table, 1.21 s with the separable
+one); at 1920x1080, alternating with the CPU ``pt`` in one process, 8.5 against 7.9 s (medians of 8 frames), of which
+the table lookup is about 1.8 s (the same frames with a constant instead of the lookup: 6.8 s); the rest is
+llvmpipe's rasterisation, clipping arithmetic and float32 blending of ~150 M fragments. Things that did not help
+there: a half-float table (same time), an early ``discard`` (llvmpipe masks lanes and still runs the code after it).
+In a 64^2 window the CPU-side cost with a GPU (sort, index buffer build and upload, one draw submission) is 0.031 s
+per frame, the whole frame on llvmpipe 0.15 s (its vertex stage runs on the CPU).
+
+Not handled yet: a renderer that does not fill its window (the ray basis, the targets and the depth blit assume the
+renderer's size with its origin at the framebuffer's corner: tested with full-window renderers only), depth peeling
+for other translucent props of the same renderer (the pass draws them in order). Call ``remove()`` before closing
+the plotter.
 """
 from __future__ import annotations
 
