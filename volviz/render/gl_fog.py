@@ -60,6 +60,7 @@ float target is). Call ``remove()`` before closing the plotter.
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -68,14 +69,14 @@ from volviz.nature.fog import FogLayer, layer_emission
 from volviz.render.gl_pt import _PASS_MARK, _USERS, GLPTVolume, shader_source
 from volviz.model.camera import Camera
 
-__all__ = ["GLFogLayer", "add_fog_layer", "expand_includes", "prism_attributes"]
+__all__ = ["GLFogLayer", "PrismBuffers", "add_fog_layer", "buffers_polydata", "expand_includes", "prism_attributes", "prism_buffers"]
 
 _MODES = {"emissive": 0, "attenuated": 1, "mip": 2}
 _GL_FUNC_ADD, _GL_MAX = 0x8006, 0x8008
 _GL_BLEND_EQUATION_RGB, _GL_BLEND_EQUATION_ALPHA = 0x8009, 0x883D
 _GL_COLOR_BUFFER_BIT = 0x4000
 _ATTRIBUTES = ("fogSide0", "fogSide1", "fogSide2", "fogBottom", "fogTop", "fogEmBottom", "fogEmTop")
-# the 8 triangles of a prism (vertices 0-2 bottom, 3-5 top), oriented outward per prism in ``_prism_polydata``
+# the 8 triangles of a prism (vertices 0-2 bottom, 3-5 top), oriented outward per prism in ``prism_buffers``
 _PRISM_TRIANGLES = np.array([[0, 2, 1], [3, 4, 5], [0, 1, 4], [0, 4, 3], [1, 2, 5], [1, 5, 4], [2, 0, 3], [2, 3, 5]])
 
 
@@ -131,19 +132,32 @@ def prism_attributes(points: np.ndarray, bottom: np.ndarray, top: np.ndarray, tr
     return idx, centre, out
 
 
-def _prism_polydata(points: np.ndarray, bottom: np.ndarray, top: np.ndarray, triangles: np.ndarray,
-                    emission_bottom: np.ndarray, emission_top: np.ndarray) -> tuple[Any, np.ndarray, int]:
-    """(vtkPolyData of the kept prisms relative to the centre with their attributes at every vertex, the centre, the
-    number of prisms). Each prism's 8 triangles are wound outward (front faces culled: only exit faces draw)."""
-    import vtk
-    from vtk.util.numpy_support import numpy_to_vtk
+@dataclass
+class PrismBuffers:
+    """A layer's prism vertex buffer as NumPy arrays (``prism_buffers``), made on any thread and handed to VTK without
+    a copy (``GLFogLayer.set_buffers``): ``points`` (6k, 3) float32 relative to ``centre``, ``attributes`` (name ->
+    (6k, 3) float32, each prism's forms at its 6 vertices), ``connectivity`` (24k,) int64 (8 outward triangles per
+    prism), ``drawn`` = k prisms."""
 
-    idx, centre, attrs = prism_attributes(points, bottom, top, triangles, emission_bottom, emission_top)
-    tk = np.asarray(triangles, dtype=np.int64).reshape(-1, 3)[idx]
-    pts = np.asarray(points, dtype=np.float64)
-    xy = pts[tk][..., :2]                                                 # (k, 3, 2)
-    zb = np.asarray(bottom, dtype=np.float64)[tk]
-    zt = np.asarray(top, dtype=np.float64)[tk]
+    points: np.ndarray
+    attributes: dict[str, np.ndarray]
+    connectivity: np.ndarray
+    centre: np.ndarray
+    drawn: int
+
+
+def prism_buffers(points: np.ndarray, bottom: np.ndarray, top: np.ndarray, triangles: np.ndarray, layer: FogLayer,
+                  emission: tuple[np.ndarray, np.ndarray] | None = None) -> PrismBuffers:
+    """Any thread, NumPy only: the vertex buffer of the layer's kept prisms (``prism_attributes``; the emission of
+    ``layer``'s mode, ``volviz.nature.fog.layer_emission``). Each prism's 8 triangles are wound outward (front faces
+    culled: only exit faces draw)."""
+    points, bottom, top = (np.asarray(a, dtype=np.float64) for a in (points, bottom, top))
+    triangles = np.asarray(triangles, dtype=np.int64).reshape(-1, 3)
+    eb, et = layer_emission(bottom, top, layer, emission)
+    idx, centre, attrs = prism_attributes(points, bottom, top, triangles, eb, et)
+    tk = triangles[idx]
+    xy = points[tk][..., :2]                                              # (k, 3, 2)
+    zb, zt = bottom[tk], top[tk]
     verts = np.concatenate([np.concatenate([xy, zb[..., None]], axis=2),
                             np.concatenate([xy, zt[..., None]], axis=2)], axis=1) - centre   # (k, 6, 3)
     k = len(idx)
@@ -154,20 +168,33 @@ def _prism_polydata(points: np.ndarray, bottom: np.ndarray, top: np.ndarray, tri
     flip = outward < 0
     faces[flip] = faces[flip][:, ::-1]
     conn = (faces + 6 * np.arange(k)[:, None, None]).reshape(-1)
+    repeated = {name: np.ascontiguousarray(np.repeat(arr, 6, axis=0), np.float32) for name, arr in attrs.items()}
+    return PrismBuffers(np.ascontiguousarray(verts.reshape(-1, 3), np.float32), repeated,
+                        np.ascontiguousarray(conn, np.int64), centre, k)
+
+
+def buffers_polydata(points: np.ndarray, attributes: dict[str, np.ndarray],
+                     connectivity: np.ndarray | None = None) -> Any:
+    """A vtkPolyData sharing NumPy vertex buffers (no copy; the VTK arrays keep them referenced): float32 ``points``
+    (n, 3), named float32 per-vertex ``attributes``, triangles ``connectivity`` (3 indices each; None: no cells yet,
+    as the GL PT pass, whose order sets them)."""
+    import vtk
+    from vtk.util.numpy_support import numpy_to_vtk
 
     pd = vtk.vtkPolyData()
     vp = vtk.vtkPoints()
-    vp.SetData(numpy_to_vtk(np.ascontiguousarray(verts.reshape(-1, 3), np.float32), deep=True))
+    vp.SetData(numpy_to_vtk(points, deep=False))
     pd.SetPoints(vp)
-    for name, arr in attrs.items():
-        va = numpy_to_vtk(np.ascontiguousarray(np.repeat(arr, 6, axis=0), np.float32), deep=True)
+    for name, arr in attributes.items():
+        va = numpy_to_vtk(arr, deep=False)
         va.SetName(name)
         pd.GetPointData().AddArray(va)
     cells = vtk.vtkCellArray()
-    cells.SetData(numpy_to_vtk(np.arange(0, len(conn) + 1, 3, dtype=np.int64), deep=True),
-                  numpy_to_vtk(conn.astype(np.int64), deep=True))
+    if connectivity is not None:
+        cells.SetData(numpy_to_vtk(np.arange(0, len(connectivity) + 1, 3, dtype=np.int64), deep=True),
+                      numpy_to_vtk(connectivity, deep=False))
     pd.SetPolys(cells)
-    return pd, centre, k
+    return pd
 
 
 def _resolve_polydata(bounds: np.ndarray) -> Any:
@@ -202,8 +229,8 @@ class GLFogLayer:
     density, gain or mode."""
 
     def __init__(self, plotter: Any, points: np.ndarray, bottom: np.ndarray, top: np.ndarray,
-                 triangles: np.ndarray, layer: FogLayer, emission: tuple[np.ndarray, np.ndarray] | None = None
-                 ) -> None:
+                 triangles: np.ndarray, layer: FogLayer, emission: tuple[np.ndarray, np.ndarray] | None = None,
+                 buffers: PrismBuffers | None = None) -> None:
         import vtk
 
         self.plotter = plotter
@@ -230,7 +257,10 @@ class GLFogLayer:
                                                           vtk.vtkDataObject.FIELD_ASSOCIATION_POINTS, -1)
         self.resolve_actor = self._translucent_actor(self.resolve_mapper, "fog_resolve_vs.glsl",
                                                      "fog_resolve_fs.glsl")
-        self._upload()
+        if buffers is None:
+            self._upload()
+        else:
+            self.set_buffers(buffers)
 
         GLPTVolume._install_pass(self)         # the shared float colour target and opaque depth texture
         self._observers = [
@@ -271,10 +301,15 @@ class GLFogLayer:
 
     def _upload(self) -> None:
         """The static prism buffer and the resolve triangle for the current layer (its mode picks the emission)."""
-        pts, bot, top, tris = self._geometry
-        eb, et = layer_emission(bot, top, self.layer, self._emission)
-        pd, centre, self.drawn = _prism_polydata(pts, bot, top, tris, eb, et)
-        self.centre = centre
+        self.set_buffers(prism_buffers(*self._geometry, self.layer, self._emission))
+
+    def set_buffers(self, buffers: PrismBuffers) -> None:
+        """GUI thread: show a ``prism_buffers`` result (made for this layer's optics, e.g. on a worker for the next
+        frame's C-LOD triangles): the prisms' and the resolve's poly data to the mappers, uploaded at the next
+        render."""
+        pd = buffers_polydata(buffers.points, buffers.attributes, buffers.connectivity)
+        self.drawn = buffers.drawn
+        centre = self.centre = buffers.centre
         self.mapper.SetInputData(pd)
         self.actor.SetPosition(*centre)
         bounds = np.array(pd.GetBounds(), np.float64).reshape(3, 2) if self.drawn else np.zeros((3, 2))
@@ -380,13 +415,18 @@ class GLFogLayer:
             self._upload()
 
     def set_geometry(self, points: np.ndarray, bottom: np.ndarray, top: np.ndarray, triangles: np.ndarray,
-                     emission: tuple[np.ndarray, np.ndarray] | None = None) -> None:
+                     emission: tuple[np.ndarray, np.ndarray] | None = None, buffers: PrismBuffers | None = None
+                     ) -> None:
         """New prisms (arguments as the constructor's), e.g. the next frame's C-LOD terrain triangles: the vertex
-        buffer is built and uploaded again (``drawn`` prisms, 6 vertices and 31 floats each); the target stays."""
+        buffer is built (unless ``buffers``, ``prism_buffers`` of the same arguments, were made elsewhere) and
+        uploaded again (``drawn`` prisms, 6 vertices and 31 floats each); the target stays."""
         self._geometry = (np.asarray(points, dtype=np.float64), np.asarray(bottom, dtype=np.float64),
                           np.asarray(top, dtype=np.float64), np.asarray(triangles, dtype=np.int64))
         self._emission = emission
-        self._upload()
+        if buffers is None:
+            self._upload()
+        else:
+            self.set_buffers(buffers)
 
     @property
     def visible(self) -> bool:

@@ -16,9 +16,12 @@ drawn by VTK's OpenGL pipeline into the scene's own depth buffer (Roettger Ch. 1
 - The layers are composited in ``NatureScene.volume_order`` (farthest layer first), the CPU's order: their actors
   are re-added to the renderer in that order when it changes.
 
-``compute`` (any thread) does the LOD work only: the terrain's C-LOD mesh, the clouds' refinement, morphing and leaf
-list, the tetrahedra's topology and modulation forms; ``finish`` (GUI thread) uploads them and VTK draws everything at
-every render, at the window's full size (a preview ``scale`` is ignored). No image is made on the CPU.
+``compute`` (any thread) does the LOD work and builds the vertex buffers as NumPy arrays: the terrain's C-LOD mesh,
+the clouds' refinement, morphing and leaf list, the tetrahedra's topology, cell attributes and modulation forms
+(``cloud_buffers``) and each layer's prisms (``gl_fog.prism_buffers``); ``finish`` (GUI thread) only hands them to
+VTK, sharing the arrays (``gl_fog.buffers_polydata``), and VTK uploads them and draws everything at the next render,
+at the window's full size (a preview ``scale`` is ignored). No image is made on the CPU. (The first frame's cloud
+volume also builds gl_pt's own buffer once, in its constructor.)
 
 What ``GLPTVolume`` lacks for the clouds (``CloudPTVolume`` works around it through its private members, listed
 there): a per-cell length modulation attribute, a caller-given back-to-front order (the leaves' BSP order; MPVO would
@@ -32,6 +35,7 @@ Errors against the CPU ``NatureView`` of the same camera and LOD (8-bit screen u
 from __future__ import annotations
 
 import time
+from dataclasses import dataclass
 from types import SimpleNamespace
 from typing import Any
 
@@ -40,12 +44,12 @@ import numpy as np
 from volviz.model.datasets import TetMesh
 from volviz.nature.clouds import CloudFrame, CloudShading
 from volviz.nature.scene import NatureScene, NatureView
-from volviz.render.gl_fog import GLFogLayer
-from volviz.render.gl_pt import GLPTVolume, _polydata, shader_source
+from volviz.render.gl_fog import GLFogLayer, buffers_polydata, prism_buffers
+from volviz.render.gl_pt import GLPTVolume, _cell_attributes, shader_source
 from volviz.render.image_overlay import hold_single_sample, release_single_sample
 from volviz.unstructured.topology import topology, visible_cells
 
-__all__ = ["CloudPTVolume", "GLNatureView", "cloud_tetrahedra", "modulation_forms"]
+__all__ = ["CloudBuffers", "CloudPTVolume", "GLNatureView", "cloud_buffers", "cloud_tetrahedra", "modulation_forms"]
 
 BYTES_PER_TET = 4 * 31 * 4 + 12 * 4         # vertex buffer (4 vertices x 31 float32) + index buffer (12 uint32)
 
@@ -88,15 +92,37 @@ def modulation_forms(mesh: TetMesh, modulation: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(np.concatenate([g, c[:, None]], axis=1), np.float32)
 
 
+@dataclass
+class CloudBuffers:
+    """A frame's cloud vertex buffer as NumPy arrays (``cloud_buffers``, any thread): ``points`` (4m, 3) float32
+    relative to the mesh's centre, ``attributes`` (gl_pt's cell attributes and ``ptModulate``, (4m, 4) float32, each
+    tetrahedron's at its 4 vertices), ``visible`` (m,) the cells with some opacity under the cloud TF."""
+
+    points: np.ndarray
+    attributes: dict[str, np.ndarray]
+    visible: np.ndarray
+
+
+def cloud_buffers(mesh: TetMesh, modulation: np.ndarray, shading: CloudShading) -> CloudBuffers:
+    """Any thread, NumPy only: the vertex buffer of ``CloudPTVolume`` for ``mesh`` and its per-point ``modulation``
+    (gl_pt's static buffer, 4 vertices per tetrahedron, with the modulation forms added) and the TF's culling."""
+    topo = topology(mesh)
+    attributes = _cell_attributes(mesh)
+    attributes["ptModulate"] = modulation_forms(mesh, modulation)
+    return CloudBuffers(np.ascontiguousarray(topo.points[topo.tets].reshape(-1, 3), np.float32),
+                        {k: np.repeat(v, 4, axis=0) for k, v in attributes.items()},
+                        visible_cells(mesh, shading.tf.scalars, shading.tf.extinction))
+
+
 class CloudPTVolume(GLPTVolume):
     """C-LOD cloud tetrahedra on the GPU PT pass (module docstring): the shading's table, the length modulated per
     fragment (Eq. 11.9), the given back-to-front order, and ``set_frame`` for the next frame's mesh.
 
     Private members of ``GLPTVolume`` used (what a public API would replace): ``_build_table`` (overridden to return
     the scene's table), ``_sorted`` / ``_order_key`` (the given order, kept by ``reuse_order``), ``_vis`` (culling
-    of the new mesh), ``gl_pt._polydata`` (the new mesh's vertex buffer)."""
+    of the new mesh), ``gl_pt._cell_attributes`` (the new mesh's vertex attributes)."""
 
-    def __init__(self, plotter: Any, mesh: TetMesh, modulation: np.ndarray, shading: CloudShading, table: Any
+    def __init__(self, plotter: Any, mesh: TetMesh, buffers: CloudBuffers, shading: CloudShading, table: Any
                  ) -> None:
         import vtk
 
@@ -108,32 +134,23 @@ class CloudPTVolume(GLPTVolume):
         self.mapper.MapDataArrayToVertexAttribute("ptModulate", "ptModulate",
                                                   vtk.vtkDataObject.FIELD_ASSOCIATION_POINTS, -1)
         self.stats = {"method": "pt-gl clouds"}
-        self._attach(modulation)
+        self.set_frame(mesh, buffers)
 
     def _build_table(self) -> Any:
         return self._cloud_table
 
-    def _attach(self, modulation: np.ndarray) -> None:
-        """The modulation forms on the vertex buffer; the mesh's own (back-to-front) order for every camera."""
-        from vtk.util.numpy_support import numpy_to_vtk
-
-        forms = np.repeat(modulation_forms(self.mesh, modulation), 4, axis=0)
-        arr = numpy_to_vtk(forms, deep=True)
-        arr.SetName("ptModulate")
-        self.polydata.GetPointData().AddArray(arr)
+    def set_frame(self, mesh: TetMesh, buffers: CloudBuffers) -> None:
+        """The next frame's tetrahedra (back to front) as ``cloud_buffers`` made them: a new vertex buffer (shared
+        with VTK, uploaded at the next render), the mesh's own order for every camera, the same table."""
+        self.mesh = self.whole_mesh = mesh
+        self.topo = topology(mesh)
+        self._vis = buffers.visible
+        self.polydata = buffers_polydata(buffers.points, buffers.attributes)
+        self.mapper.SetInputData(self.polydata)
+        self.actor.SetPosition(*self.topo.origin)
         self.reuse_order = True
         self._sorted = np.arange(self.topo.n_tets, dtype=np.int64)
         self._order_key = None
-
-    def set_frame(self, mesh: TetMesh, modulation: np.ndarray) -> None:
-        """The next frame's tetrahedra (back to front) and modulating field: a new vertex buffer, the same table."""
-        self.mesh = self.whole_mesh = mesh
-        self.topo = topology(mesh)
-        self._vis = visible_cells(mesh, self.tf.scalars, self.tf.extinction)
-        self.polydata = _polydata(mesh)
-        self.mapper.SetInputData(self.polydata)
-        self.actor.SetPosition(*self.topo.origin)
-        self._attach(modulation)
 
 
 class GLNatureView(NatureView):
@@ -152,8 +169,8 @@ class GLNatureView(NatureView):
     def compute(self, request: tuple[Any, tuple[int, int], int],
                 progress: Any = None) -> tuple[Any, Any, dict[str, float]]:
         """Any thread: the LOD work of a frame (no image): the terrain's C-LOD mesh as VTK poly data and as the
-        ``TerrainMesh`` the prisms stand on, the clouds' tetrahedra with their topology and modulation, statistics
-        (``lod_s``: seconds spent here)."""
+        ``TerrainMesh`` the prisms stand on, the clouds' tetrahedra with their vertex buffer (``cloud_buffers``), each
+        prism layer's vertex buffer (``prism_buffers``), statistics (``lod_s``: seconds spent here)."""
         cam, size, _ = request
         t0 = time.perf_counter()
         scene = self.scene
@@ -170,28 +187,33 @@ class GLNatureView(NatureView):
             assert scene.cloud_shading is not None
             frame = scene.cloud_lod.update(cam, size)
             tets, modulation = cloud_tetrahedra(frame, scene.cloud_shading, cam.position)
-            topology(tets)                       # cached on the mesh: the GUI thread only uploads
-            clouds = (tets, modulation)
+            clouds = (tets, cloud_buffers(tets, modulation, scene.cloud_shading))
             stats["cloud_tets"] = float(frame.n_tets)
             stats["cloud_upload_bytes"] = float(frame.n_tets * BYTES_PER_TET)
+        prisms = {}
+        if mesh is not None:
+            for fog in scene.fogs:
+                bottom = mesh.points[:, 2] if fog.bottom == "terrain" else mesh.layers[fog.bottom]
+                geometry = (mesh.points, bottom, mesh.layers[fog.top], mesh.triangles)
+                prisms[fog.name] = (geometry, prism_buffers(*geometry, fog.layer))
         stats["lod_s"] = time.perf_counter() - t0
-        return poly, SimpleNamespace(mesh=mesh, clouds=clouds, eye=np.asarray(cam.position, np.float64)), stats
+        return poly, SimpleNamespace(mesh=mesh, clouds=clouds, prisms=prisms,
+                                     eye=np.asarray(cam.position, np.float64)), stats
 
     def finish(self, request: tuple[Any, tuple[int, int], int], poly: Any, frame: Any,
                stats: dict[str, float]) -> dict[str, float]:
-        """GUI thread: the terrain mesh, the prisms on it and the cloud tetrahedra to VTK (drawn at the next
-        render); ``upload_s``: seconds spent here."""
+        """GUI thread: the terrain mesh and the vertex buffers of the prisms and cloud tetrahedra made by ``compute``
+        to VTK (uploaded and drawn at the next render); ``upload_s``: seconds spent here."""
         t0 = time.perf_counter()
         self._show_terrain(poly)
         scene, mesh = self.scene, frame.mesh
         for kind, fog in scene.volume_order(frame.eye):    # made in this order: the first frame moves nothing
-            if kind == "fog" and mesh is not None:
-                bottom = mesh.points[:, 2] if fog.bottom == "terrain" else mesh.layers[fog.bottom]
-                args = (mesh.points, bottom, mesh.layers[fog.top], mesh.triangles)
+            if kind == "fog" and fog.name in frame.prisms:
+                geometry, buffers = frame.prisms[fog.name]
                 if fog.name in self.layers:
-                    self.layers[fog.name].set_geometry(*args)
+                    self.layers[fog.name].set_geometry(*geometry, buffers=buffers)
                 else:
-                    self.layers[fog.name] = GLFogLayer(self.plotter, *args, fog.layer)
+                    self.layers[fog.name] = GLFogLayer(self.plotter, *geometry, fog.layer, buffers=buffers)
             elif kind == "clouds" and frame.clouds is not None:
                 if self.clouds is None:
                     assert scene.cloud_shading is not None
