@@ -410,8 +410,11 @@ class MainWindow(CameraBookmarks, QMainWindow):
                 self.status_label.setText(f"Could not load {title}")
                 self.show_error(f"Cannot open {title}", open_error(path, outcome.error, title))
                 return
-            if self._install_session(controller, outcome.result, session_path, title, dirty, serial, path) and on_shown:
-                on_shown()
+            if self._install_session(controller, outcome.result, session_path, title, dirty, serial, path):
+                if datasets is None:  # another file or scene: the old one's settings edits are not undone on it
+                    self.scene_undo_stack.clear()
+                if on_shown:
+                    on_shown()
 
         self._current_job = self.jobs.submit(load, name=f"load {title}", key="load", on_done=done)
 

@@ -172,3 +172,22 @@ def test_optional_setting_set_back_to_default_in_the_scene(qtbot, make_window) -
     window.action_undo.trigger()
     wait_loaded(qtbot, window)
     assert _settings(window, "terrain")["extent"] == [1000.0, 1000.0]
+
+
+def test_opening_another_scene_forgets_the_settings_edits_of_the_old_one(qtbot, make_window) -> None:
+    """An Undo after opening another scene must not apply the old scene's settings to a component of the same id."""
+    window = make_window()
+    window.open_demo()
+    wait_loaded(qtbot, window)
+    _select(window, "ground_fog")  # the fog's form is shown
+    density = window.scene_tree.form.editor("density")
+    density.lineEdit().selectAll()
+    qtbot.keyClicks(density.lineEdit(), "0.2")
+    qtbot.keyClick(density.lineEdit(), Qt.Key.Key_Return)
+    wait_loaded(qtbot, window)
+    assert window.scene_undo_stack.canUndo()
+    window.dirty = False
+    window.open_demo()                                                # the same ids, a new scene
+    wait_loaded(qtbot, window)
+    assert not window.scene_undo_stack.canUndo()
+    assert _settings(window, "ground_fog")["density"] == pytest.approx(0.04)
