@@ -69,7 +69,8 @@ from volviz.nature.fog import FogLayer, layer_emission
 from volviz.render.gl_pt import _PASS_MARK, _USERS, GLPTVolume, shader_source
 from volviz.model.camera import Camera
 
-__all__ = ["GLFogLayer", "PrismBuffers", "add_fog_layer", "buffers_polydata", "expand_includes", "prism_attributes", "prism_buffers"]
+__all__ = ["GLFogLayer", "PrismBuffers", "add_fog_layer", "buffers_polydata", "expand_includes", "prism_attributes",
+           "prism_buffers"]
 
 _MODES = {"emissive": 0, "attenuated": 1, "mip": 2}
 _GL_FUNC_ADD, _GL_MAX = 0x8006, 0x8008

@@ -206,7 +206,7 @@ class GLNatureView(NatureView):
         to VTK (uploaded and drawn at the next render); ``upload_s``: seconds spent here."""
         t0 = time.perf_counter()
         self._show_terrain(poly)
-        scene, mesh = self.scene, frame.mesh
+        scene = self.scene
         for kind, fog in scene.volume_order(frame.eye):    # made in this order: the first frame moves nothing
             if kind == "fog" and fog.name in frame.prisms:
                 geometry, buffers = frame.prisms[fog.name]
