@@ -44,8 +44,14 @@ uniform int parallelView;
 uniform int useDepth;
 uniform sampler2D opaqueDepth;
 
-uniform int clipCount;       // user clipping planes (n, d), n . x <= d kept, relative to the mesh centre
-uniform vec4 clipPlanes[8];
+// PT_CLIPS user clipping planes (n, d), n . x <= d kept, relative to the mesh centre; their number is compiled in
+// (a loop to a uniform count over a uniform array cost llvmpipe a third of the fragment's arithmetic, also with 0).
+#ifndef PT_CLIPS
+#define PT_CLIPS 0
+#endif
+#if PT_CLIPS > 0
+uniform vec4 clipPlanes[PT_CLIPS];
+#endif
 
 // PT_KIND, defined when the shader is made (one program per kind: llvmpipe executes every branch of a fragment
 // shader under a lane mask, so a run-time switch would pay for all kinds): 0 3D table, 1 separable table, 2 exact
@@ -301,10 +307,12 @@ void main()
   clipPlane(cellPlane1, o, d, t0, t1);
   clipPlane(cellPlane2, o, d, t0, t1);
   clipPlane(cellPlane3, o, d, t0, t1);
-  for (int i = 0; i < clipCount; ++i)
+#if PT_CLIPS > 0
+  for (int i = 0; i < PT_CLIPS; ++i)
   {
     clipPlane(clipPlanes[i], o, d, t0, t1);
   }
+#endif
   if (!(t1 > t0))
   {
     discard;

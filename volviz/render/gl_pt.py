@@ -185,10 +185,11 @@ def _triangles(cells: np.ndarray, offsets: np.ndarray | None = None) -> tuple[np
     return offsets[:n], conn
 
 
-def _shader(name: str, smooth: bool, kind: int = 0) -> str:
+def _shader(name: str, smooth: bool, kind: int = 0, clips: int = 0) -> str:
     """A pass shader for one kind of segment evaluation (``PT_KIND``: 0 3D table, 1 separable, 2 isosurfaces, 3
-    pre-classified), with ``PT_SMOOTH`` defined for smooth isosurfaces."""
-    head = f"#define PT_KIND {kind}\n" + ("#define PT_SMOOTH\n" if smooth else "")
+    pre-classified) and ``clips`` user clipping planes (``PT_CLIPS``), with ``PT_SMOOTH`` defined for smooth
+    isosurfaces."""
+    head = f"#define PT_KIND {kind}\n#define PT_CLIPS {clips}\n" + ("#define PT_SMOOTH\n" if smooth else "")
     return shader_source(name).replace("//VTK::System::Dec\n", "//VTK::System::Dec\n" + head, 1)
 
 
@@ -264,7 +265,7 @@ class GLPTVolume(PTView):
         self.mapper.ScalarVisibilityOff()
         sp = vtk.vtkShaderProperty()
         sp.SetVertexShaderCode(_shader("pt_tet_vs.glsl", smooth))
-        self._kind = -1
+        self._kind: tuple[int, int] = (-1, -1)   # the fragment shader's (PT_KIND, PT_CLIPS)
         attributes = self.polydata.GetPointData()
         for name in (attributes.GetArrayName(i) for i in range(attributes.GetNumberOfArrays())):
             self.mapper.MapDataArrayToVertexAttribute(name, name, vtk.vtkDataObject.FIELD_ASSOCIATION_POINTS, -1)
@@ -528,18 +529,18 @@ class GLPTVolume(PTView):
         return lookup, self.degree or auto_degree
 
     def _apply_kind(self) -> None:
-        """The fragment shader made for this volume's segment evaluation (recompiled by VTK when it changes, e.g.
-        an "auto" lookup switching tables with the TF)."""
+        """The fragment shader made for this volume's segment evaluation and number of clipping planes (recompiled by
+        VTK when either changes, e.g. an "auto" lookup switching tables with the TF, or a new clipping plane)."""
         if self.iso is not None:
             kind = 2
         elif self.classification == "pre":
             kind = 3
         else:
             kind = 0 if self._resolved_lookup()[0] == "3d" else 1
-        if kind != self._kind:
-            self._kind = kind
+        if (kind, len(self._clip)) != self._kind:
+            self._kind = (kind, len(self._clip))
             self.actor.GetShaderProperty().SetFragmentShaderCode(
-                _shader("pt_tet_fs.glsl", self.iso is not None and self.iso_shading == "smooth", kind))
+                _shader("pt_tet_fs.glsl", self.iso is not None and self.iso_shading == "smooth", *self._kind))
 
     def _build_table(self) -> Any:
         from volviz.unstructured.render import Preclassified, _table_for, table_size
@@ -619,7 +620,6 @@ class GLPTVolume(PTView):
         program.SetUniformf("viewHeight", float(h))
         program.SetUniform2f("clipRange", [float(x) for x in cam.clipping_range])
         program.SetUniformi("parallelView", int(cam.parallel))
-        program.SetUniformi("clipCount", len(self._clip))
         if len(self._clip):
             program.SetUniform4fv("clipPlanes", len(self._clip), [float(x) for x in self._clip.ravel()])
         depth = self._bind_target(w, h)            # the opaque scene's depth, the volume's own colour target
