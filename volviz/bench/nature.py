@@ -12,6 +12,12 @@ same run is that full-resolution pipeline (speed ratio). Per frame the error is 
 overlay and cloud overlay. Temporal popping: along a dense sub-path, the RMSE between consecutive LOD frames against
 that between consecutive reference frames, with geomorphing on and off. Sweeps: cloud tetrahedra and terrain
 triangles against their error.
+
+The GPU backend on the same frames (``volviz.render.gl_nature.GLNatureView``; ``--no-gpu`` skips it, ``_GLFrames``):
+per frame its frame rate at the image's size (``gl_fps``: LOD work and buffer building, handing them to VTK, the
+draw), its per-frame CPU cost in a 64 x 48 window with llvmpipe's vertex work for the prisms and tetrahedra taken out
+by a draw with each cut to one (``gl_cpu_side_s``, ``gl_draw_work_s``), its RMSE against the same reference
+(``gl_rmse``, with the app's CPU backend view's for comparison) and its cloud tetrahedra; means in ``summary``.
 Writes docs/bench/nature.md and nature_frames.png (LOD frames, references and x8 error heat maps).
 """
 from __future__ import annotations
@@ -178,6 +184,103 @@ def _split(scene: Any, cam: Any, size: tuple[int, int]) -> dict[str, float]:
     return out
 
 
+class _GLFrames:
+    """The GPU backend (``volviz.render.gl_nature.GLNatureView``) on the same frames: a window of the report's size
+    for the frame rate and the image, and a 64x48 window, where llvmpipe's fill is negligible, for the CPU side
+    (as the pt-gl bench, ``volviz.bench.unstructured``). Both draw the same LOD work (one ``compute`` per frame, for
+    the report's size), so the small window draws the large one's prisms and tetrahedra."""
+
+    SMALL = (64, 48)
+
+    def __init__(self, scene: Any, size: tuple[int, int], reps: int) -> None:
+        import pyvista as pv
+
+        from volviz.nature.scene import NatureView
+        from volviz.render.gl_nature import GLNatureView
+
+        self.size, self.reps = size, reps
+        self.plotters = [pv.Plotter(off_screen=True, window_size=list(s)) for s in (size, self.SMALL)]
+        for pl in self.plotters:
+            pl.ren_win.SetMultiSamples(0)
+        self.views = [GLNatureView(pl, scene) for pl in self.plotters]
+        self._prisms: dict[str, Any] = {}
+        # the app's CPU backend in the same kind of window (VTK's terrain and sky, the CPU's fog and cloud overlay)
+        self.cpu_plotter = pv.Plotter(off_screen=True, window_size=list(size))
+        self.cpu_plotter.ren_win.SetMultiSamples(0)
+        for pl in self.plotters + [self.cpu_plotter]:
+            pl.camera_set = True            # PyVista must not re-frame the cameras the views set
+        self.cpu_view = NatureView(self.cpu_plotter, scene)
+
+    def _render(self, index: int) -> float:
+        t0 = time.perf_counter()
+        self.plotters[index].ren_win.Render()
+        return time.perf_counter() - t0
+
+    def _one_each(self) -> None:
+        """Cut every prism layer to its first prism and the clouds to their first tetrahedron (until the next frame)."""
+        from volviz.bench.unstructured import _one_cell_order
+        from volviz.render.gl_fog import PrismBuffers
+
+        view = self.views[1]
+        for name, layer in view.layers.items():
+            b = self._prisms[name][1]
+            layer.set_buffers(PrismBuffers(b.points[:6], {k: v[:6] for k, v in b.attributes.items()},
+                                           b.connectivity[:24], b.centre, min(b.drawn, 1)))
+        if view.clouds is not None:
+            _one_cell_order(view.clouds)
+
+    def cpu_view_image(self, cam: Any) -> np.ndarray:
+        """The app's CPU backend (``NatureView``) for ``cam`` in a window of the image's size (RGB in [0, 1])."""
+        self.cpu_view.update(cam)
+        self.cpu_plotter.ren_win.Render()
+        return self.cpu_plotter.screenshot(return_img=True).astype(np.float64) / 255.0
+
+    def frame(self, cam: Any) -> tuple[dict[str, float], np.ndarray]:
+        """Medians over ``reps`` of one frame's parts (``gl_*`` keys) and the large window's image (RGB in [0, 1])."""
+        parts: dict[str, list[float]] = {k: [] for k in ("lod", "upload", "render", "small_upload", "small_render",
+                                                         "small_same", "small_one")}
+        img = np.zeros(0)
+        stats: dict[str, float] = {}
+        for _ in range(self.reps):
+            big, small = self.views
+            request = big.begin(cam)
+            small.begin(cam)                       # the small window's camera and sky dome
+            t0 = time.perf_counter()
+            result = big.compute(request)
+            parts["lod"].append(time.perf_counter() - t0)
+            stats = big.finish(request, *result)
+            parts["upload"].append(stats["upload_s"])
+            parts["render"].append(self._render(0))
+            parts["small_upload"].append(small.finish(request, *result)["upload_s"])
+            self._prisms = result[1].prisms        # (geometry, PrismBuffers) by layer name
+            parts["small_render"].append(self._render(1))
+            parts["small_same"].append(self._render(1))
+            self._one_each()
+            self._render(1)                        # the small index and vertex buffers built and uploaded
+            parts["small_one"].append(self._render(1))
+        img = self.plotters[0].screenshot(return_img=True).astype(np.float64) / 255.0
+        med = {k: float(np.median(v)) for k, v in parts.items()}
+        draw_work = max(med["small_same"] - med["small_one"], 0.0)
+        gl_upload = max(med["small_render"] - med["small_same"], 0.0)
+        out = {"gl_frame_s": med["lod"] + med["upload"] + med["render"],
+               "gl_lod_s": med["lod"], "gl_upload_s": med["upload"], "gl_render_s": med["render"],
+               "gl_cpu_side_s": med["lod"] + med["small_upload"] + gl_upload + med["small_one"],
+               "gl_cpu_side_total_s": med["lod"] + med["small_upload"] + med["small_render"],
+               "gl_vbo_upload_s": gl_upload, "gl_submit_s": med["small_one"], "gl_draw_work_s": draw_work,
+               "gl_cloud_tets": int(stats.get("cloud_tets", 0)), "gl_fog_prisms": int(stats.get("fog_prisms", 0))}
+        out["gl_fps"] = 1.0 / max(out["gl_frame_s"], 1e-9)
+        return out, img
+
+    def close(self) -> dict[str, str]:
+        from volviz.render.backend import gl_info
+
+        info = gl_info(self.plotters[0].ren_win).to_dict()
+        for view, pl in zip(self.views + [self.cpu_view], self.plotters + [self.cpu_plotter]):
+            view.remove()
+            pl.close()
+        return info
+
+
 def _terrain_sweep(scene: Any, cams: list[Any], size: tuple[int, int], spec: str) -> list[dict[str, float]]:
     """Terrain triangles against the terrain + sky error (LOD vs full mesh, no volumes) for C,c settings."""
     from volviz.nature.raster import render_sky, render_terrain
@@ -235,6 +338,7 @@ def main(argv: list[str] | None = None) -> int:
                     help="cloud C,c settings for the tetrahedra-vs-error sweep on frames 0 and 3 ('' to skip)")
     ap.add_argument("--terrain-sweep", type=_lod_list, default="9,30;9,80;9,160",
                     help="terrain C,c settings for the triangles-vs-error sweep on frames 0 and 3 ('' to skip)")
+    ap.add_argument("--no-gpu", action="store_true", help="skip the GPU backend's columns (GLNatureView)")
     ap.add_argument("--data", type=Path, default=DEFAULT_DATA)
     ap.add_argument("--json", type=Path, default=None, help="write the results as JSON")
     ap.add_argument("--out", type=Path, default=REPO / "docs" / "bench" / "nature.md")
@@ -248,6 +352,9 @@ def main(argv: list[str] | None = None) -> int:
     vol = scene.cloud_lod.volume
     cams = path_cameras(args.frames)
     scene.render(cams[0], size)  # warm-up (JIT, caches)
+    gl = None if args.no_gpu else _GLFrames(scene, size, args.reps)
+    if gl is not None:
+        gl.frame(cams[0])        # warm-up (shaders, tables, targets)
     rows, images = [], []
     for i, cam in enumerate(cams):
         frame, stats = _timed(scene, cam, size, args.reps)
@@ -263,6 +370,17 @@ def main(argv: list[str] | None = None) -> int:
                "reference_prisms": int(ref.stats.get("fog_prisms", 0)),
                "reference_tets": int(ref.stats.get("cloud_tets", 0)),
                "rmse": rmse(_rgba(frame.rgb), _rgba(ref.rgb)), "max_abs": max_abs(_rgba(frame.rgb), _rgba(ref.rgb))}
+        if gl is not None:
+            parts, gl_img = gl.frame(cam)
+            cpu_view = gl.cpu_view_image(cam)
+            row.update(parts, gl_rmse=rmse(_rgba(gl_img), _rgba(ref.rgb)),
+                       gl_max_abs=max_abs(_rgba(gl_img), _rgba(ref.rgb)),
+                       cpu_view_rmse=rmse(_rgba(cpu_view), _rgba(ref.rgb)),
+                       gl_vs_cpu_view_rmse=rmse(_rgba(gl_img), _rgba(cpu_view)))
+            print(f"frame {i} gpu: {row['gl_frame_s']:.3f} s ({row['gl_fps']:.1f} fps), CPU side "
+                  f"{row['gl_cpu_side_s']:.3f} s (+ llvmpipe's draw work {row['gl_draw_work_s']:.3f} s), "
+                  f"{row['gl_cloud_tets']} tets, RMSE {row['gl_rmse']:.2f} (the app's CPU backend "
+                  f"{row['cpu_view_rmse']:.2f}; GPU vs it {row['gl_vs_cpu_view_rmse']:.2f})", flush=True)
         row.update(_split(scene, cam, size))
         rows.append(row)
         images.append((frame.rgb, ref.rgb, error_heatmap(frame.rgb, ref.rgb, gain=8.0)))
@@ -326,6 +444,17 @@ def main(argv: list[str] | None = None) -> int:
         "mean_cloud_rmse": float(np.mean([r["cloud_rmse"] for r in rows])),
         "build_s": t_build,
     }
+    if gl is not None:
+        summary.update({
+            "gl_fps": float(len(rows) / sum(r["gl_frame_s"] for r in rows)),
+            "gl_cpu_side_s": float(np.mean([r["gl_cpu_side_s"] for r in rows])),
+            "gl_draw_work_s": float(np.mean([r["gl_draw_work_s"] for r in rows])),
+            "gl_mean_rmse": float(np.mean([r["gl_rmse"] for r in rows])),
+            "gl_max_rmse": float(max(r["gl_rmse"] for r in rows)),
+            "cpu_view_mean_rmse": float(np.mean([r["cpu_view_rmse"] for r in rows])),
+            "gl_vs_cpu_view_mean_rmse": float(np.mean([r["gl_vs_cpu_view_rmse"] for r in rows])),
+            "gl_mean_cloud_tets": float(np.mean([r["gl_cloud_tets"] for r in rows])),
+            "gl": gl.close()})
     command = "volviz bench nature " + " ".join(shlex.quote(a) for a in (argv if argv is not None else sys.argv[1:]))
     result = {"command": command, "load": " / ".join(f"{v:.1f}" for v in os.getloadavg()), "source": source, "size": list(size), "cloud_shape": list(cloud_shape),
               "terrain_lod": list(tc), "cloud_lod": list(cc), "frames": rows, "summary": summary, "popping": popping,
@@ -364,7 +493,7 @@ def _write_report(out: Path, result: dict[str, Any], images: list[tuple[np.ndarr
         f"Scene: {result['source']}; clouds {' x '.join(map(str, result['cloud_shape']))} points "
         f"({s['full_resolution_tets']:,} tetrahedra at full resolution); image {result['size'][0]} x "
         f"{result['size'][1]}; terrain C, c = {result['terrain_lod']}; clouds C, c = {result['cloud_lod']}. "
-        f"CPU only (2 shared cores; other jobs were running: load average {result.get('load', '?')}), times are medians "
+        f"The CPU pipeline (2 shared cores; other jobs were running: load average {result.get('load', '?')}), medians "
         f"after a warm-up. "
         f"Reference = the same pipeline at full resolution (every terrain triangle and prism, every non-empty cloud "
         f"cell). Errors in 8-bit units on the final RGB.",
@@ -379,6 +508,31 @@ def _write_report(out: Path, result: dict[str, Any], images: list[tuple[np.ndarr
                      f"{r['total_s']:.3f} | {r['fps']:.1f} | {r['rmse']:.2f} | {r['max_abs']:.0f} | "
                      f"{r['terrain_rmse']:.2f} | {r['fog_rmse']:.2f} | {r['cloud_rmse']:.2f} | "
                      f"{r['reference_s']:.1f} |")
+    if "gl_fps" in s:
+        lines += [
+            "",
+            f"GPU backend (``volviz.render.gl_nature.GLNatureView``, VTK's OpenGL on {s['gl']['renderer']}): the same "
+            "frames, one LOD computation each (terrain C-LOD, cloud refinement and morphing, the prism and cloud "
+            "vertex buffers: LOD s) handed to VTK (upload s) and drawn (render s) in a window of the image's size; "
+            "fps = 1 / their sum. CPU side = the same frame's per-frame CPU cost drawn in a 64 x 48 window, where "
+            "fill is negligible: LOD s + handing the buffers to VTK + VTK's buffer upload (the first draw minus the "
+            "same draw again) + a draw submission (the draw with every prism layer cut to one prism and the clouds "
+            "to one tetrahedron: callbacks, uniforms, VTK's traversal, the driver's calls, the terrain and sky); "
+            "llvmpipe's own vertex work for the prisms and tetrahedra (the full draw minus the cut one), which a "
+            "GPU takes off the CPU, is its own column. RMSE and max against the same full-resolution reference; "
+            "'CPU view RMSE' is the app's CPU backend (``NatureView``: VTK's terrain and sky, the CPU's fog and "
+            "cloud overlay) against it, and 'GPU vs CPU view' the two backends' difference: the GPU's error is "
+            "the app's terrain (VTK's texture sampling, not the CPU raster's mip-mapped shading), not its volumes.",
+            "",
+            "| frame | cloud tets | fog prisms | LOD s | upload s | render s | fps | CPU side s "
+            "| llvmpipe vertex work s | RMSE | max | CPU view RMSE | GPU vs CPU view |",
+            "|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+        ]
+        for r in result["frames"]:
+            lines.append(f"| {r['frame']} | {r['gl_cloud_tets']:,} | {r['gl_fog_prisms']:,} | {r['gl_lod_s']:.3f} | "
+                         f"{r['gl_upload_s']:.3f} | {r['gl_render_s']:.3f} | {r['gl_fps']:.1f} | "
+                         f"{r['gl_cpu_side_s']:.3f} | {r['gl_draw_work_s']:.3f} | {r['gl_rmse']:.2f} | "
+                         f"{r['gl_max_abs']:.0f} | {r['cpu_view_rmse']:.2f} | {r['gl_vs_cpu_view_rmse']:.2f} |")
     lines += [
         "",
         "Summary against the issue's targets:",
@@ -396,6 +550,11 @@ def _write_report(out: Path, result: dict[str, Any], images: list[tuple[np.ndarr
         f"- tetrahedra and RMSE targets together: "
         f"{'met' if s['mean_cloud_tets'] < 10000 and s['max_rmse'] <= 3 else 'NOT met'}",
     ]
+    if "gl_fps" in s:
+        lines.append(f"- GPU backend: {s['gl_fps']:.2f} fps, CPU side {s['gl_cpu_side_s']:.3f} s per frame (+ "
+                     f"llvmpipe's vertex work {s['gl_draw_work_s']:.3f} s), {s['gl_mean_cloud_tets']:,.0f} cloud "
+                     f"tetrahedra per frame, RMSE mean {s['gl_mean_rmse']:.2f}, max {s['gl_max_rmse']:.2f} (the "
+                     f"app's CPU backend {s['cpu_view_mean_rmse']:.2f}; GPU vs it {s['gl_vs_cpu_view_mean_rmse']:.2f})")
     pop = result.get("popping") or {}
     if pop:
         on, off = pop["geomorph"], pop["no_geomorph"]
