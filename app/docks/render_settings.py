@@ -29,9 +29,9 @@ class RenderSettings(QWidget):
         self.method.addItems(METHODS)
         self.backend = QComboBox()
         self.backend.addItems(RENDER_BACKENDS)
-        self.backend.setToolTip("Where volumes are drawn: gpu (VTK's OpenGL; for meshes with volviz's PT shaders), "
-                                "cpu (volviz's renderer, VTK's CPU ray caster), or auto: the GPU on a hardware "
-                                "OpenGL, the faster CPU path on a software one such as llvmpipe")
+        self.backend.setToolTip("Where volumes, isosurfaces and the natural scene are drawn: gpu (VTK's OpenGL with "
+                                "volviz's shaders), cpu (volviz's renderers, VTK's CPU ray caster), or auto: the GPU "
+                                "on a hardware OpenGL, the path measured faster on a software one such as llvmpipe")
         self.table_kind = QComboBox()
         self.table_kind.addItems(TABLE_KINDS)
         self.table_resolution = QComboBox()
@@ -49,8 +49,9 @@ class RenderSettings(QWidget):
                                      "the most accurate pre-integration table")
         self.iso_mode = QComboBox()
         self.iso_mode.addItems(ISO_MODES)
-        self.iso_mode.setToolTip("Transparency of isosurfaces: VTK's 2-pass blend on the GPU, or volviz's CPU modes "
-                                 "(2-pass, order-independent 3-pass and 4-pass, exact sorted fragments)")
+        self.iso_mode.setToolTip("Transparency of isosurfaces: VTK's 2-pass blend, or volviz's modes (2-pass, "
+                                 "order-independent 3-pass and 4-pass, exact sorted fragments) on the Backend's "
+                                 "renderer: gpu (VTK's OpenGL) or cpu (volviz's compositor)")
         self.width_box = QSpinBox()
         self.height_box = QSpinBox()
         for box in (self.width_box, self.height_box):
