@@ -10,7 +10,7 @@ import pytest
 import pyvista as pv
 
 from volviz.iso.composite import render
-from volviz.unstructured.camera import Camera
+from volviz.model.camera import Camera
 
 from volviz_app.window import MainWindow
 

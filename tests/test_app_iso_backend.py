@@ -23,7 +23,7 @@ from test_app_workflows import viewport, wait_loaded
 from volviz.iso.composite import render
 from volviz.render.gl_iso import GLIsoView
 from volviz.render.iso_overlay import IsoOverlay
-from volviz.unstructured.camera import Camera
+from volviz.model.camera import Camera
 from volviz_app.window import MainWindow
 
 RMSE, SHARE = 0.8, 0.001

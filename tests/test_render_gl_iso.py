@@ -24,7 +24,7 @@ from volviz.iso.composite import MODES, render
 from volviz.iso.extract import IsoMesh, IsoStyle, extract
 from volviz.model.datasets import RegularVolume
 from volviz.render.gl_iso import GLIsoSurfaces
-from volviz.unstructured.camera import Camera
+from volviz.model.camera import Camera
 
 SIZE = (256, 256)
 BG = (0.1, 0.1, 0.15, 1.0)

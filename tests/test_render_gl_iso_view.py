@@ -23,7 +23,7 @@ from volviz.render.controller import SceneController
 from volviz.render.gl_iso import GLIsoView
 from volviz.render.iso_overlay import IsoOverlay
 from volviz.session import CameraState, DatasetRef, Session
-from volviz.unstructured.camera import Camera
+from volviz.model.camera import Camera
 
 RMSE, P999, OVER3_PIXELS = 0.8, 2.5, 8
 HALF = {"planes": [{"point": [11.5, 0.0, 0.0], "normal": [1.0, 0.0, 0.0]}], "box": None}

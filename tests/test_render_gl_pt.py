@@ -25,7 +25,7 @@ from volviz.optics.isosurface import IsoSurface, build_iso_table
 from volviz.render.gl_pt import GLPTVolume
 from volviz.render.image_overlay import read_buffers, zbuffer_to_depth
 from volviz.unstructured import synthetic as syn
-from volviz.unstructured.camera import Camera
+from volviz.model.camera import Camera
 from volviz.unstructured.render import render
 
 TF = TransferFunction([0.0, 0.3, 0.6, 0.9], [[1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 1, 1]], [0.0, 3.0, 6.0, 1.0])

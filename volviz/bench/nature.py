@@ -87,7 +87,7 @@ NOTES = [
 
 def path_cameras(n: int, t0: float = 0.0, t1: float = 1.0) -> list[Any]:
     """n cameras along the piecewise-linear key path between path parameters t0 and t1 (0..1)."""
-    from volviz.unstructured.camera import Camera
+    from volviz.model.camera import Camera
 
     out = []
     for t in np.linspace(t0, t1, n):

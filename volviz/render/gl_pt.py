@@ -88,7 +88,7 @@ import numpy as np
 from volviz.model.datasets import TetMesh
 from volviz.render.image_overlay import hold_single_sample, release_single_sample
 from volviz.render.pt_view import PTView
-from volviz.unstructured.camera import Camera
+from volviz.model.camera import Camera
 from volviz.unstructured.iso import iso_visible
 from volviz.unstructured.topology import FACES, cell_ranges, topology, visible_cells
 

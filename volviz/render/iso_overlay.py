@@ -31,7 +31,7 @@ from volviz.iso.composite import MODES, Fragments, composite, fragments, triangl
 from volviz.iso.extract import IsoMesh
 from volviz.iso.lod import lod_mesh, select_level
 from volviz.render.image_overlay import OverlayView
-from volviz.unstructured.camera import Camera
+from volviz.model.camera import Camera
 
 __all__ = ["IsoModeView", "IsoOverlay", "cut_at_depth"]
 
