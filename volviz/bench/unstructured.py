@@ -127,10 +127,11 @@ def gl_pt_frames(mesh: Any, tf: Any, cams: list[Any], size: tuple[int, int], rep
     ``split``: also take the frame apart, for each camera after its timed frame: the same frame again (no new sort
     or index buffer: ``same_s``), then with an index buffer of one cell (its first render rebuilds that small index
     buffer; the second, ``one_cell_s``, is a draw submission whose vertex and fragment work is negligible: the
-    Python callbacks, uniforms, VTK's render traversal and the driver's draw call). Medians: ``ibo_s`` = frame -
-    same - sort - order (VTK's index buffer build and upload), ``draw_work_s`` = same - one_cell (the full draw's
-    vertex and fragment work, which a GPU takes off the CPU) and ``cpu_side_proper_s`` = sort + order + ibo_s +
-    one_cell_s."""
+    Python callbacks, uniforms, VTK's render traversal and the driver's draw call). These three are the process's
+    CPU seconds (llvmpipe's threads included; other jobs on the machine are not), paired per camera; medians:
+    ``ibo_s`` = frame - same - sort - order (VTK's index buffer build and upload; sort and order are the volume's
+    own timings), ``draw_work_s`` = same - one_cell (the full draw's vertex and fragment work, which a GPU takes
+    off the CPU) and ``cpu_side_proper_s`` = sort + order + ibo_s + one_cell_s."""
     import pyvista as pv
 
     from volviz.render.gl_pt import GLPTVolume
@@ -142,7 +143,7 @@ def gl_pt_frames(mesh: Any, tf: Any, cams: list[Any], size: tuple[int, int], rep
     cams[0].apply_to(pl.renderer.GetActiveCamera())
     pl.camera_set = True
     pl.screenshot(return_img=True)
-    frame, cpu, sort, order, same, one = [], [], [], [], [], []
+    frame, cpu, sort, order, same, one = [], [], [], [], [], []          # same, one: CPU seconds
     for _ in range(reps):
         for cam in cams[1:] + cams[:1] if len(cams) > 1 else cams * 2:     # each render a new camera
             cam.apply_to(pl.renderer.GetActiveCamera())
@@ -167,7 +168,7 @@ def gl_pt_frames(mesh: Any, tf: Any, cams: list[Any], size: tuple[int, int], rep
     res = {"frame_s": float(np.median(frame)), "cpu_s": float(np.median(cpu)), "sort_s": float(np.median(sort)),
            "order_s": float(np.median(order)), "frames_timed": len(frame), "lookup": lookup, "gl_renderer": renderer}
     if split:
-        f, sa, on, so, od = (np.array(v) for v in (frame, same, one, sort, order))
+        f, sa, on, so, od = (np.array(v) for v in (cpu, same, one, sort, order))
         res["same_s"], res["one_cell_s"] = float(np.median(sa)), float(np.median(on))
         res["ibo_s"] = float(np.median(np.maximum(f - sa - so - od, 0.0)))
         res["draw_work_s"] = float(np.median(sa - on))
@@ -176,9 +177,10 @@ def gl_pt_frames(mesh: Any, tf: Any, cams: list[Any], size: tuple[int, int], rep
 
 
 def _timed_render(pl: Any) -> float:
-    t0 = time.perf_counter()
+    """The process CPU seconds of one render."""
+    c0 = time.process_time()
     pl.ren_win.Render()
-    return time.perf_counter() - t0
+    return time.process_time() - c0
 
 
 def _one_cell_order(vol: Any) -> None:
@@ -487,7 +489,7 @@ def _markdown(results: dict[str, Any], path: Path) -> None:
                   f"**{gl['cpu_side_proper_s']:.3f} s** = sort {gl['cpu_side_sort_s']:.3f} s + index buffer "
                   f"{gl['cpu_side_order_s']:.3f} s (the cell order as VTK cells, numpy) + "
                   f"{gl['cpu_side_ibo_s']:.3f} s (VTK's index buffer build and upload: the frame minus the same frame "
-                  "drawn again without a new order, minus sort and order) + "
+                  "drawn again without a new order, minus sort and order, in process CPU seconds) + "
                   f"{gl['cpu_side_one_cell_s']:.3f} s (a draw submission: the same frame with an index buffer of "
                   "one cell, drawn twice, the second timed: callbacks, uniforms, VTK's traversal, the driver's draw "
                   f"call); the full draw's vertex and fragment work, {gl['cpu_side_draw_work_s']:.3f} s (the "

@@ -64,13 +64,15 @@ against the CPU reference on llvmpipe (``tests/test_render_gl_pt.py``, 8-bit): t
 rounding.
 
 Timings on llvmpipe (Mesa 22.3, 2 cores shared with other work; Blunt Fin, 3D table; ``volviz bench unstructured``,
-docs/bench/pt-gl): 0.89 s per frame at 512^2 (the CPU ``pt``: 0.88 s with the 3D table, 1.21 s with the separable
-one); at 1920x1080, alternating with the CPU ``pt`` in one process, 8.5 against 7.9 s (medians of 8 frames), of which
-the table lookup is about 1.8 s (the same frames with a constant instead of the lookup: 6.8 s); the rest is
-llvmpipe's rasterisation, clipping arithmetic and float32 blending of ~150 M fragments. Things that did not help
-there: a half-float table (same time), an early ``discard`` (llvmpipe masks lanes and still runs the code after it).
-In a 64^2 window the CPU-side cost with a GPU (sort, index buffer build and upload, one draw submission) is 0.031 s
-per frame, the whole frame on llvmpipe 0.15 s (its vertex stage runs on the CPU).
+docs/bench/pt-gl, one run): 1.11 s per frame at 512^2 (the CPU ``pt`` in the same run: 0.88 s with the 3D table,
+1.17 s with the separable one), 3.4 s at 1024^2 (``pt`` 4.3 s) and 4.7 s at 1920x1080 (``pt`` 6.0 s). What the
+fragment shader costs there (1920x1080, the same frames with parts of the shader replaced): the table lookup about
+a third, the ray clipping and the rest of the arithmetic most of the remainder; rasterising and blending alone (a
+constant colour) 0.8 s. Compiling the kind of lookup and the number of clipping planes into the shader instead of
+switching or looping on uniforms made it 1.5-2x faster; a half-float table and an early ``discard`` (llvmpipe masks
+lanes and still runs the code after it) did not help. In a 64^2 window the CPU-side cost with a GPU (sort, index
+buffer build and upload, one draw submission) is 0.056 s per frame, the whole frame on llvmpipe 0.22 s (its vertex
+stage runs on the CPU); vtkProjectedTetrahedraMapper takes 0.54 s there.
 
 Not handled yet: a renderer that does not fill its window (the ray basis, the targets and the depth blit assume the
 renderer's size with its origin at the framebuffer's corner: tested with full-window renderers only), depth peeling
