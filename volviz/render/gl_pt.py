@@ -66,10 +66,12 @@ rounding.
 Timings on llvmpipe (Mesa 22.3, 2 cores shared with other work; Blunt Fin, 3D table; ``volviz bench unstructured``,
 docs/bench/pt-gl, one run): 1.11 s per frame at 512^2 (the CPU ``pt`` in the same run: 0.88 s with the 3D table,
 1.17 s with the separable one), 3.4 s at 1024^2 (``pt`` 4.3 s) and 4.7 s at 1920x1080 (``pt`` 6.0 s). What the
-fragment shader costs there (1920x1080, the same frames with parts of the shader replaced): the table lookup about
-a third, the ray clipping and the rest of the arithmetic most of the remainder; rasterising and blending alone (a
-constant colour) 0.8 s. Compiling the kind of lookup and the number of clipping planes into the shader instead of
-switching or looping on uniforms made it 1.5-2x faster; a half-float table and an early ``discard`` (llvmpipe masks
+fragment shader costs there (1920x1080, the same frames with parts of the shader replaced; the machine was shared,
+so these varied between runs): the table lookup a fifth to a half of the frame, the ray clipping and the rest of the
+arithmetic most of the remainder; rasterising and blending alone (a constant colour) 0.8 s. Compiled into the
+shader instead of switched or looped on uniforms: the kind of lookup (512^2: 3.7 s per frame with the four kinds
+behind a uniform, 1.4 s compiled) and the number of clipping planes (960x540, the shader without its lookup: 1.45 s
+with a loop over a uniform count of 0, 0.91 s compiled); a half-float table and an early ``discard`` (llvmpipe masks
 lanes and still runs the code after it) did not help. In a 64^2 window the CPU-side cost with a GPU (sort, index
 buffer build and upload, one draw submission) is 0.056 s per frame, the whole frame on llvmpipe 0.22 s (its vertex
 stage runs on the CPU); vtkProjectedTetrahedraMapper takes 0.54 s there.
