@@ -1,6 +1,7 @@
 """Render settings dock: renderer method, backend (GPU or CPU, ``volviz.render.backend``), pre-integration table kind
-and resolution, sort mode, error budget, export image size. The table and sort settings apply to volviz's PT renderer ("auto" picks the table by each cell's optical
-depth); the error budget is checked against the measured error of the current view (see MainWindow.estimate_error)."""
+and resolution, sort mode, error budget, export image size. The table and sort settings apply to volviz's PT renderer
+("auto" picks the table by each cell's optical depth); the error budget is checked against the measured error of the
+current view (see MainWindow.estimate_error)."""
 from __future__ import annotations
 
 from typing import Any, Optional

@@ -10,8 +10,8 @@ from PySide6.QtWidgets import (QComboBox, QGroupBox, QHBoxLayout, QLabel, QSlide
 
 from volviz_app.settings_form import SettingsForm
 
-KIND_LABELS = {"volume": "Volume", "mesh": "Mesh", "isosurface": "Isosurface", "terrain": "Terrain", "fog": "Ground fog",
-               "clouds": "Clouds", "sky": "Sky", "demo": "Demo volume"}
+KIND_LABELS = {"volume": "Volume", "mesh": "Mesh", "isosurface": "Isosurface", "terrain": "Terrain",
+               "fog": "Ground fog", "clouds": "Clouds", "sky": "Sky", "demo": "Demo volume"}
 
 
 #: settings the form leaves to another editor of the dock: the array combo box (``volviz_app.array_choice``)

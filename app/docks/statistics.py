@@ -34,7 +34,8 @@ class Statistics(QWidget):
 
     def show_stats(self, stats: dict[str, Any]) -> None:
         frame = stats.get("frame_seconds")
-        self.labels["frame"].setText("–" if frame is None else f"{frame * 1000:.1f} ms ({1.0 / max(frame, 1e-9):.1f} fps)")
+        self.labels["frame"].setText("–" if frame is None
+                                     else f"{frame * 1000:.1f} ms ({1.0 / max(frame, 1e-9):.1f} fps)")
         split = [stats.get(k) for k in ("sort_seconds", "project_seconds", "raster_seconds")]
         self.labels["split"].setText(" / ".join("–" if v is None else f"{v * 1000:.1f} ms" for v in split))
         cells = stats.get("cells")

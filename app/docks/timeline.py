@@ -116,7 +116,8 @@ class Timeline(QWidget):
         self.slider.setValue(int(round(frac * SLIDER_STEPS)))
         self.slider.blockSignals(False)
         self.label.setText(f"t = {self.time:.4g}")
-        self.label.setToolTip(f"Display time {self.time:.6g} of the steps {lo:.4g} … {hi:.4g} ({len(self.steps)} steps)")
+        self.label.setToolTip(f"Display time {self.time:.6g} of the steps {lo:.4g} … {hi:.4g} "
+                              f"({len(self.steps)} steps)")
         self.timeChanged.emit(self.time)
 
     def _slider_moved(self, value: int) -> None:

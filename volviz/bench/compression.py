@@ -257,7 +257,8 @@ def _markdown(results: dict[str, Any], peaks: dict[str, float], cmd: str, png: s
              "", f"![rate-distortion]({png})", ""]
     for name, rows in results.items():
         lines += [f"## {name} (PSNR peak {peaks[name]:g})", "",
-                  "| method | setting | bits/voxel | ratio | PSNR (dB) | exact | decode MB/s |", "|---|---|---|---|---|---|---|"]
+                  "| method | setting | bits/voxel | ratio | PSNR (dB) | exact | decode MB/s |",
+                  "|---|---|---|---|---|---|---|"]
         for r in rows:
             ps = "inf" if not math.isfinite(r["psnr"]) else f"{r['psnr']:.2f}"
             sp = "" if r["decode_mb_s"] is None else f"{r['decode_mb_s']:.0f}"
@@ -360,8 +361,10 @@ def _lod_walkthrough(vol: np.ndarray, tmp: Path, budgets: Sequence[int], frames:
                 decoded.append(tree.decoder.decoded_bricks - before)
                 nblocks.append(len(sel.nodes))
                 skipped.append(sel.skipped_transparent)
-        rows.append({"budget": budget, "blocks": float(np.mean(nblocks)), "ms_per_frame": 1e3 * statistics.median(times),
-                     "bricks_decoded_per_frame": float(np.mean(decoded)), "transparent_skipped": float(np.mean(skipped)),
+        rows.append({"budget": budget, "blocks": float(np.mean(nblocks)),
+                     "ms_per_frame": 1e3 * statistics.median(times),
+                     "bricks_decoded_per_frame": float(np.mean(decoded)),
+                     "transparent_skipped": float(np.mean(skipped)),
                      "cache_hit_rate": tree.cache.hits / max(1, tree.cache.hits + tree.cache.misses),
                      "stats_s": stats_s})
     if render_frames > 0:        # the same budgets drawn offscreen (volviz.render.lod_volume) at 512^2

@@ -262,7 +262,8 @@ def _markdown(res: dict[str, Any], path: Path) -> None:
             L.append(f"| VTK translucent blending (peer; Phong, constant opacity) | {v['seconds']:.3f} | — | — | "
                      f"{v['rmse']:.2f} | {v['max_abs']:.1f} |")
         if "gpu" in sc:
-            L += ["", "GPU (VTK OpenGL on this machine's driver, `volviz.render.gl_iso`): frame time (render + read-back) "
+            L += ["",
+                  "GPU (VTK OpenGL on this machine's driver, `volviz.render.gl_iso`): frame time (render + read-back) "
                   "and the screen's difference from the CPU image of the same mode. Pixels over 3 lie on silhouettes, "
                   "which GL's and the CPU's edge rules assign differently (checked on the Storm scene).", "",
                   "| mode | GPU frame time (s) | RMSE vs CPU mode | max vs CPU mode | pixels over 3 |",

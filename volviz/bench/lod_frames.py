@@ -200,18 +200,18 @@ def markdown(rows: list[dict[str, Any]]) -> list[str]:
              "The same budgets drawn offscreen at 512^2 by `volviz.render.lod_volume.LodVolume` with both renderers "
              "in the same run: our one-pass ray caster (`volviz.regular.raycast`: index grid, steps of "
              f"{r0.get('step', 0.5):g} voxel of each block's level, separable pre-integration, transparent blocks "
-             "leapt over, early termination at transmittance 2e-3) and VTK's vtkMultiBlockVolumeMapper (one ray-cast pass per block). Seconds per frame "
-             "= selection + decoding + drawing + screenshot read-back (median after a cold first frame, the cache "
-             "cold per renderer). Errors: 8-bit RGB over black against the exact float64 reference of the "
-             f"full-resolution volume (trilinear, steps of {r0['ref_step']:g} voxel, every segment integrated "
-             "exactly; halving its step changes it by RMSE "
+             "leapt over, early termination at transmittance 2e-3) and VTK's vtkMultiBlockVolumeMapper (one ray-cast "
+             "pass per block). Seconds per frame = selection + decoding + drawing + screenshot read-back (median after "
+             "a cold first frame, the cache cold per renderer). Errors: 8-bit RGB over black against the exact float64 "
+             f"reference of the full-resolution volume (trilinear, steps of {r0['ref_step']:g} voxel, every segment "
+             "integrated exactly; halving its step changes it by RMSE "
              f"{r0.get('ref_halved_rmse', float('nan')):.3f} / max {r0.get('ref_halved_max', float('nan')):.2f}; "
              f"{r0['ref_s']:.1f} s per reference frame). VTK drawing the full volume as one block scores RMSE "
              f"{r0['vtk_full_rmse']:.2f} / max {r0['vtk_full_max']:.0f} against it (its own optical model: opacity "
              "per unit distance, no pre-integration), so VTK is also compared with that image (its LOD error alone).",
              "",
-             "| block budget | blocks | volviz s/frame | volviz frames/s | ray-cast kernel s | volviz RMSE | volviz max | "
-             "VTK s/frame | VTK frames/s | VTK RMSE | VTK max | VTK RMSE vs VTK full | speed-up |",
+             "| block budget | blocks | volviz s/frame | volviz frames/s | ray-cast kernel s | volviz RMSE | "
+             "volviz max | VTK s/frame | VTK frames/s | VTK RMSE | VTK max | VTK RMSE vs VTK full | speed-up |",
              "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rs:
         lines.append(f"| {r['budget']} | {r['blocks']:.0f} | {r['render_s_per_frame']:.2f} | {r['fps']:.2f} | "

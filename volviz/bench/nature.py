@@ -1,4 +1,5 @@
-"""``volviz bench nature``: a fly-through of a natural scene at 512 x 384 along a fixed camera path (Roettger Ch. 10–11).
+"""``volviz bench nature``: a fly-through of a natural scene at 512 x 384 along a fixed camera path (Roettger
+Ch. 10–11).
 
 Scene: the Yukon height field of the libMini demo (1000 x 1000 units, 0.33 per grey level, its colour texture, its
 ground-fog map at 0.15 per grey level) with a 513 x 513 x 65 Perlin-noise cloud volume (83.9 million tetrahedra at
@@ -322,7 +323,7 @@ def _lod_list(text: str) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = UsageParser(prog="volviz bench nature", description=__doc__.splitlines()[0])
+    ap = UsageParser(prog="volviz bench nature", description=__doc__.split("\n\n")[0])
     ap.add_argument("--size", type=image_size, default=(512, 384), help="image size WxH (default 512x384)")
     ap.add_argument("--frames", type=int_in(1, 10_000), default=8, help="frames along the path (default 8)")
     ap.add_argument("--reps", type=int_in(1, 1000), default=3, help="timed runs per frame, median reported (default 3)")
@@ -456,7 +457,8 @@ def main(argv: list[str] | None = None) -> int:
             "gl_mean_cloud_tets": float(np.mean([r["gl_cloud_tets"] for r in rows])),
             "gl": gl.close()})
     command = "volviz bench nature " + " ".join(shlex.quote(a) for a in (argv if argv is not None else sys.argv[1:]))
-    result = {"command": command, "load": " / ".join(f"{v:.1f}" for v in os.getloadavg()), "source": source, "size": list(size), "cloud_shape": list(cloud_shape),
+    result = {"command": command, "load": " / ".join(f"{v:.1f}" for v in os.getloadavg()), "source": source,
+              "size": list(size), "cloud_shape": list(cloud_shape),
               "terrain_lod": list(tc), "cloud_lod": list(cc), "frames": rows, "summary": summary, "popping": popping,
               "sweep": sweep, "terrain_sweep": terrain_sweep}
     if args.json:
@@ -566,8 +568,8 @@ def _write_report(out: Path, result: dict[str, Any], images: list[tuple[np.ndarr
             "",
             "| | sum d_L / sum d_R | max d_L | max d_R | max (d_L - d_R) |",
             "|---|---|---|---|---|",
-            f"| geomorphing on | {on['variation_ratio']:.3f} | {on['max_lod_step']:.3f} | {max(pop['ref_steps']):.3f} | "
-            f"{on['max_excess']:.3f} |",
+            f"| geomorphing on | {on['variation_ratio']:.3f} | {on['max_lod_step']:.3f} | "
+            f"{max(pop['ref_steps']):.3f} | {on['max_excess']:.3f} |",
             f"| geomorphing off | {off['variation_ratio']:.3f} | {off['max_lod_step']:.3f} | "
             f"{max(pop['ref_steps']):.3f} | {off['max_excess']:.3f} |",
         ]

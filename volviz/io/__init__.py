@@ -68,7 +68,7 @@ def __getattr__(name: str):
 
 
 __all__ = [
-    "NonFiniteWarning", "ReadError", "ReaderSpec", "reader_specs", "expand_pattern", "open_dialog_filter", "read", "read_dem", "read_image", "read_meshio",
-    "read_metaimage", "read_plot3d", "read_pnm", "read_pvm", "read_raw", "read_series", "read_slc",
-    "read_slice_stack", "read_vtk_file", "read_vtkhdf", "supported_formats",
+    "NonFiniteWarning", "ReadError", "ReaderSpec", "reader_specs", "expand_pattern", "open_dialog_filter", "read",
+    "read_dem", "read_image", "read_meshio", "read_metaimage", "read_plot3d", "read_pnm", "read_pvm", "read_raw",
+    "read_series", "read_slc", "read_slice_stack", "read_vtk_file", "read_vtkhdf", "supported_formats",
 ]

@@ -73,7 +73,8 @@ def _vtk_grid(h: dict) -> tuple[float, float]:
     east, west = max(c[2, 0], c[3, 0]), min(c[1, 0], c[0, 0])
     north, south = max(c[2, 1], c[1, 1]), min(c[0, 1], c[3, 1])
     with np.errstate(all="ignore"):
-        return (np.floor((east - west) / h["resolution"][0] + 1.0), np.floor((north - south) / h["resolution"][1] + 1.0))
+        return (np.floor((east - west) / h["resolution"][0] + 1.0),
+                np.floor((north - south) / h["resolution"][1] + 1.0))
 
 
 def _grid_fits(path: PathLike, cols: float, rows: float, size: int, what: str) -> tuple[int, int]:

@@ -11,7 +11,8 @@ from pathlib import Path
 import numpy as np
 
 from volviz.io._checks import (
-    check_dims, check_finite, describe_bytes, describe_dims, file_size, parse_float, parse_int, read_at, read_bytes, require_bytes,
+    check_dims, check_finite, describe_bytes, describe_dims, file_size, parse_float, parse_int, read_at, read_bytes,
+    require_bytes,
 )
 from volviz.io.errors import PathLike, ReadError, human_bytes
 from volviz.model import Image2D, RegularVolume

@@ -193,7 +193,8 @@ def _choose_block(path: PathLike, layout: Plot3DLayout, block: int | None) -> in
     return block
 
 
-def read_plot3d_xyz(path: PathLike, block: int | None = None, **layout_options) -> tuple[np.ndarray, np.ndarray | None, Plot3DLayout]:
+def read_plot3d_xyz(path: PathLike, block: int | None = None,
+                    **layout_options) -> tuple[np.ndarray, np.ndarray | None, Plot3DLayout]:
     """Grid points (ni, nj, nk, 3) float64, IBLANK (ni, nj, nk) int32 or None, and the detected layout."""
     size = file_size(path)
     head = read_bytes(path, 65536)
@@ -222,7 +223,6 @@ def read_plot3d_q(path: PathLike, block: int | None = None, allow_nonfinite: boo
     layout = detect_layout(path, "q", head, size, **layout_options)
     b = _choose_block(path, layout, block)
     dims = layout.dims[b]
-    n = dims[0] * dims[1] * dims[2]
     mk = 4 if layout.record_markers else 0
     pos = _block_offset("q", layout, b)
     real = f"{layout.byteorder}f{layout.precision}"

@@ -29,7 +29,8 @@ def is_pvm(head: bytes) -> bool:
     return head.startswith((b"PVM\n", b"PVM2\n", b"PVM3\n")) or head.startswith(DDS_MAGICS)
 
 
-def parse_pvm_header(path: PathLike, head: bytes) -> tuple[int, tuple[int, int, int], tuple[float, float, float], int, int]:
+def parse_pvm_header(path: PathLike,
+                     head: bytes) -> tuple[int, tuple[int, int, int], tuple[float, float, float], int, int]:
     """Parse the text header: ``(version, dims, spacing, bytes_per_voxel, data_offset)``; ReadError if malformed."""
     if head.startswith(DDS_MAGICS):
         raise ReadError(path, f"is a DDS-compressed PVM file (DDS v3{chr(head[6])}); libMini DDS decompression is "

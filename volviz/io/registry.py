@@ -54,7 +54,8 @@ class ReaderSpec:
     ``select_options``: options that pick this reader whatever the file is called (``dims`` for raw volumes).
     ``sniff_opens``: False when the loader needs the file's extension, so a file recognised only by content is
     refused with a hint to rename it. ``claims_name``: False for extensions other formats share (``.dat``, ``.inp``):
-    the name then picks this reader only when its sniffer accepts the content too. ``catch_all``: match by name only after every other spec failed.
+    the name then picks this reader only when its sniffer accepts the content too.
+    ``catch_all``: match by name only after every other spec failed.
     ``arrays`` and ``options``: what the reader offers and takes, for documentation and ``volviz info``.
     ``isolated``: the loader runs native code that a malformed file can crash (VTK's readers, HDF5, netCDF): ``read``
     runs it in a child process with memory and time limits (``volviz.io.isolated``).
@@ -113,7 +114,7 @@ def _resolve(target: str) -> Callable[..., Any]:
     return getattr(importlib.import_module(module), attr)
 
 
-# -- volviz's own readers -----------------------------------------------------------------------------------------------
+# -- volviz's own readers ----------------------------------------------------------------------------------------------
 def _sniff_slc(head: bytes) -> bool:
     return head.lstrip()[:6] in (b"11111\n", b"11111 ", b"11111\r")
 

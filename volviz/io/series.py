@@ -112,4 +112,5 @@ def read_series(paths_or_pattern: str | PathLike | Sequence[PathLike],
 
     frames: list = [first] + [None] * (len(paths) - 1)
     return TimeSeries(np.asarray(times, dtype=np.float64), frames, loader=load,
-                      source=os.fspath(os.path.commonpath([str(p) for p in paths])) if len(paths) > 1 else str(paths[0]))
+                      source=os.fspath(os.path.commonpath([str(p) for p in paths])) if len(paths) > 1
+                             else str(paths[0]))

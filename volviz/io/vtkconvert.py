@@ -108,7 +108,8 @@ def _to_model(path: PathLike, obj, allow_nonfinite: bool):
         check_finite(path, pts, False, "point coordinates")
         points = pts.reshape(tuple(dims) + (3,), order="F")
         arrays = _arrays(path, pd, n_points, allow_nonfinite, "point")
-        point_data = {k: (v.reshape(dims, order="F") if v.ndim == 1 else v.reshape(tuple(dims) + v.shape[1:], order="F"))
+        point_data = {k: (v.reshape(dims, order="F") if v.ndim == 1
+                          else v.reshape(tuple(dims) + v.shape[1:], order="F"))
                       for k, v in arrays.items()}
         cells = tuple(max(n - 1, 1) for n in dims)
         cell_data = {k: v.reshape(cells + v.shape[1:], order="F")

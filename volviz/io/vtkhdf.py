@@ -2,8 +2,8 @@
 
 The file is first checked with h5py: HDF5 signature, a ``/VTKHDF`` group with a ``Type`` attribute, every count
 against the datasets it describes (``volviz.io.vtkhdfcheck``), and (for transient data) ``/VTKHDF/Steps`` with
-``Values``; h5py's own exceptions on damaged metadata become ReadError. Static files give one dataset; transient files give a TimeSeries
-whose frames are read lazily, one vtkHDFReader update per step.
+``Values``; h5py's own exceptions on damaged metadata become ReadError. Static files give one dataset; transient files
+give a TimeSeries whose frames are read lazily, one vtkHDFReader update per step.
 """
 from __future__ import annotations
 

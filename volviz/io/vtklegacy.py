@@ -196,7 +196,7 @@ class _Scan:
     # -- FIELD blocks -----------------------------------------------------------------------------------------------
     def field(self, args: list[bytes], pos: int, left: int) -> int:
         """Walk a ``FIELD name n`` block from ``pos``; returns where it ends (or where the walk had to stop)."""
-        n = self.counts(args[1:], 1, f"FIELD array count")[0]
+        n = self.counts(args[1:], 1, "FIELD array count")[0]
         if 8 * n > left:  # the shortest array is a line like "a 0 0 int"
             self.fail(f"FIELD announces {n} arrays, more than the {left} bytes after it can hold")
         for k in range(n):

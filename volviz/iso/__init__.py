@@ -3,7 +3,8 @@ Roettger 2007): extraction, order-independent compositing modes, iso-spectrum sh
 view-dependent LOD. Entry points for a scene builder: ``IsoSettings``, ``prepare`` (background) and ``render_iso``
 (per view); ``iso_actor`` for a VTK actor per surface."""
 from volviz.iso.animate import IsoAnimator, IsoFrame, extract_at, playback_times
-from volviz.iso.clip import BoxCrop, ClipPlane, ClipSettings, clip_isosurface, clip_isosurfaces, clip_tetmesh, clip_volume
+from volviz.iso.clip import (BoxCrop, ClipPlane, ClipSettings, clip_isosurface, clip_isosurfaces, clip_tetmesh,
+                             clip_volume)
 from volviz.iso.composite import MODES, composite, fragments, render, render_modes
 from volviz.iso.extract import IsoMesh, IsoStyle, extract, extract_many
 from volviz.iso.lod import LodChain, build_lod, lod_mesh, lod_meshes, select_level

@@ -328,7 +328,8 @@ class TimeSeries:
     def __post_init__(self) -> None:
         self.times = np.asarray(self.times, dtype=np.float64)
         if self.times.ndim != 1 or len(self.times) != len(self.frames):
-            raise ValueError(f"TimeSeries needs one time per frame: {self.times.shape} times, {len(self.frames)} frames")
+            raise ValueError(f"TimeSeries needs one time per frame: {self.times.shape} times, "
+                             f"{len(self.frames)} frames")
         if len(self.times) == 0:
             raise ValueError("TimeSeries needs at least one frame")
         if np.any(np.diff(self.times) <= 0):

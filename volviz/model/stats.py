@@ -1,4 +1,5 @@
-"""Summary statistics of a dataset's active scalar: the values and their histogram (for the transfer-function editor)."""
+"""Summary statistics of a dataset's active scalar: the values and their histogram
+(for the transfer-function editor)."""
 from __future__ import annotations
 
 from typing import Any

@@ -131,7 +131,7 @@ def decide(delta, fmax, cutoff, root, levels, roots, off, origin, spacing, eye, 
     for lv in range(levels):
         end = n
         s = root >> lv
-        na, nb, nc = roots[0] << lv, roots[1] << lv, roots[2] << lv
+        nb, nc = roots[1] << lv, roots[2] << lv
         ex, ey, ez = spacing[0] * s, spacing[1] * s, spacing[2] * s
         edge = max(ex, max(ey, ez))
         for t in range(start, end):

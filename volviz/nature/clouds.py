@@ -353,7 +353,8 @@ def render_cloud_image(frame: CloudFrame, shading: CloudShading, table: Any, cam
     img = np.zeros((h, w, 4))
     if len(frame.leaves):
         rgba = np.ascontiguousarray(table.rgba)
-        K.render(frame.leaves, len(frame.leaves), vol.root, np.asarray(vol.origin, float), np.asarray(vol.spacing, float),
+        K.render(frame.leaves, len(frame.leaves), vol.root,
+                 np.asarray(vol.origin, float), np.asarray(vol.spacing, float),
                  va, vm, m_scale, a_cut, rgba, float(table.s_lo), float(table.ds), float(table.dl),
                  camera.rays((w, h)).as_array(), vp, dep, row_bands(h, 16), w, h, img,
                  numba.get_num_threads())

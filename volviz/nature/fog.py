@@ -159,7 +159,8 @@ def _pcp_band(pts, bot, top, eb, et, tris, planes, boxes, keep, rb, depth, near,
             for j in range(3):
                 ca[k, j] = (planes[p, k, 0] * rb[j, 0] + planes[p, k, 1] * rb[j, 1] + planes[p, k, 2] * rb[j, 2]
                             + (planes[p, k, 3] if j == 0 else 0.0))
-                cb[k, j] = planes[p, k, 0] * rb[3 + j, 0] + planes[p, k, 1] * rb[3 + j, 1] + planes[p, k, 2] * rb[3 + j, 2]
+                cb[k, j] = (planes[p, k, 0] * rb[3 + j, 0] + planes[p, k, 1] * rb[3 + j, 1]
+                            + planes[p, k, 2] * rb[3 + j, 2])
         for row in range(y_lo, y_hi + 1):
             for col in range(boxes[p, 0], boxes[p, 1] + 1):
                 t0 = near

@@ -111,7 +111,8 @@ class HeightField:
         i, j = min(int(u), n - 2), min(int(v), n - 2)
         fu, fv = u - i, v - j
         h = self.heights
-        return float((1 - fu) * ((1 - fv) * h[i, j] + fv * h[i, j + 1]) + fu * ((1 - fv) * h[i + 1, j] + fv * h[i + 1, j + 1]))
+        return float((1 - fu) * ((1 - fv) * h[i, j] + fv * h[i, j + 1])
+                     + fu * ((1 - fv) * h[i + 1, j] + fv * h[i + 1, j + 1]))
 
     def sample(self, grid: np.ndarray) -> np.ndarray:
         """Resample another x-major grid (e.g. a fog map) to this height field's (N, N) samples."""
@@ -127,7 +128,8 @@ class HeightField:
 
     @classmethod
     def from_array(cls, grid: np.ndarray, extent: tuple[float, float], height_scale: float = 1.0,
-                   origin: tuple[float, float] = (0.0, 0.0), size: int | None = None, source: str = "") -> "HeightField":
+                   origin: tuple[float, float] = (0.0, 0.0), size: int | None = None,
+                   source: str = "") -> "HeightField":
         """From an x-major grid of any size: resampled to ``size`` (default: the next 2^n + 1) over ``extent``."""
         g = np.asarray(grid, dtype=np.float64)
         if g.ndim != 2:

@@ -199,7 +199,8 @@ def mip_pyramid(image: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         n = (a.shape[0] - 1) // 2 + 1
         pad = np.pad(a, ((1, 1), (1, 1), (0, 0)), mode="edge")
         rows = 0.25 * pad[0:-2:2] + 0.5 * pad[1:-1:2] + 0.25 * pad[2::2]
-        levels.append(np.ascontiguousarray(0.25 * rows[:, 0:-2:2] + 0.5 * rows[:, 1:-1:2] + 0.25 * rows[:, 2::2])[:n, :n])
+        levels.append(np.ascontiguousarray(0.25 * rows[:, 0:-2:2] + 0.5 * rows[:, 1:-1:2]
+                                           + 0.25 * rows[:, 2::2])[:n, :n])
     meta = np.zeros((len(levels), 2), dtype=np.int64)
     off = 0
     for k, lev in enumerate(levels):
@@ -276,7 +277,8 @@ def _shade(depth, uvbuf, flat, meta, out):
 def bake_colour_map(normals: np.ndarray, texture: np.ndarray | None = None, light=(0.4, 0.3, 0.85),
                     ambient: float = 0.45, diffuse: float = 0.65, base_color=(0.55, 0.5, 0.42)) -> np.ndarray:
     """The terrain's static light map times its colour texture on the height-field grid, (N, N, 3) float32
-    (Roettger §4.4: static ambient + diffuse light map). ``normals[i, j]`` x-major; the texture image has row 0 north."""
+    (Roettger §4.4: static ambient + diffuse light map).
+    ``normals[i, j]`` x-major; the texture image has row 0 north."""
     from volviz.nature.heightfield import grid_from_image, resample_bilinear
 
     n = normals.shape[0]

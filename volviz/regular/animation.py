@@ -6,7 +6,8 @@ Encoder
   error ``sum (cur(x) - ref(x + v))^2`` (reference samples clamped at the volume border). ``search="local"`` is the
   thesis's local search from the zero vector (move to the best of the 26 neighbouring vectors while the error drops;
   the axis-only 6-neighbourhood stalled in diagonal error valleys on a test field), starting from the best of
-  the zero vector and the vectors of the three causal neighbour blocks (a standard video-coding predictor); ``search="full"`` tries all 31^3 vectors (ties keep the earlier, zero-first candidate).
+  the zero vector and the vectors of the three causal neighbour blocks (a standard video-coding predictor);
+  ``search="full"`` tries all 31^3 vectors (ties keep the earlier, zero-first candidate).
 - **Windowed motion compensation** (Watanabe and Singhal, §2.2.3, Fig. 2.15): each block predicts a 12^3 window (its
   8^3 core plus a 2-voxel apron) weighted by the separable cosine window ``w(o)`` (offset ``o`` from the core start):
   ``1/2 (1 - cos(pi (o + 2.5) / 4))`` for ``o`` in [-2, 2), 1 in [2, 6), ``1/2 (1 + cos(pi (o - 5.5) / 4))`` in

@@ -91,7 +91,8 @@ def compress_main(argv: Sequence[str] | None = None) -> int:
     p.add_argument("--dtype", default="uint8", choices=("uint8", "uint16", "int16", "float32"),
                    help="sample type of --raw input")
     p.add_argument("--series", action="store_true",
-                   help="INPUT is a time series of 8-bit volumes (e.g. Storm.pvm-t%%02d); OUTPUT a .vvs store directory")
+                   help="INPUT is a time series of 8-bit volumes (e.g. Storm.pvm-t%%02d); "
+                   "OUTPUT a .vvs store directory")
     p.add_argument("--pattern", type=_gop_pattern, default="IBBPBBPPB",
                    help="GOP pattern of --series (I, IPP, IBB, IBBPBBPPB, ...)")
     p.add_argument("--scheduler", metavar="ADDRESS",

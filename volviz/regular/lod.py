@@ -163,8 +163,9 @@ class LodTree:
     def __init__(self, path: str | Path, cache_bytes: int = 256 << 20, volume: RegularVolume | None = None,
                  sidecar: bool = True) -> None:
         """Open ``path``. Node statistics come from the sidecar ``PATH.lod.npz`` when it matches the file (same
-        brick-table checksum), else from ``volume`` (the original, in memory) or one full decode of the file; in the latter case
-        (with ``sidecar``) they are saved next to the file (atomic write; silently skipped when not writable)."""
+        brick-table checksum), else from ``volume`` (the original, in memory) or one full decode of the file; in the
+        latter case (with ``sidecar``) they are saved next to the file (atomic write; silently skipped when not
+        writable)."""
         self.decoder = NodeDecoder(path)
         meta = self.decoder.meta
         self.levels = self.decoder.levels

@@ -588,8 +588,9 @@ class SceneController:
     def set_clip(self, clip: Any, update_pt: bool = True, cut_pt: bool = True,
                  isosurfaces: bool = True) -> list[str]:
         """Store new clipping (``session.clip`` JSON or ClipSettings) and cut every prop; returns the ids of the PT
-        volumes drawn from a cut mesh (CPU backend; a GPU volume clips per fragment, at once). Their meshes are cut here when ``cut_pt`` and re-rendered when ``update_pt``; the app
-        instead cuts them in the background (``cut_pt_mesh`` on a worker, then ``set_pt_mesh``) and re-renders.
+        volumes drawn from a cut mesh (CPU backend; a GPU volume clips per fragment, at once). Their meshes are cut here
+        when ``cut_pt`` and re-rendered when ``update_pt``; the app instead cuts them in the background (``cut_pt_mesh``
+        on a worker, then ``set_pt_mesh``) and re-renders.
         Isosurfaces are re-cut here when ``isosurfaces``; the app instead cuts them in the background
         (``isosurface_meshes``, ``volviz.render.scene.isosurface_parts`` on a worker, ``show_isosurfaces``)."""
         from volviz.iso.clip import ClipSettings

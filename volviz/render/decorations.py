@@ -33,7 +33,8 @@ def legend_margin(session: Session) -> float:
 def _legend_component(session: Session) -> Optional[Any]:
     """The first visible component with a transfer function: the one the scalar bar explains."""
     return next((c for c in session.components
-                 if c.visible and c.transfer_function is not None and c.transfer_function in session.transfer_functions),
+                 if c.visible and c.transfer_function is not None
+                 and c.transfer_function in session.transfer_functions),
                 None)
 
 

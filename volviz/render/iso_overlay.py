@@ -16,8 +16,9 @@ scene through the depth buffer exactly as volviz's PT volumes are (``volviz.rend
 
 The 8-bit overlay costs at most about 1/255 per channel against the float image (measured in the tests).
 ``begin`` / ``compute`` / ``finish`` split the work as every ``image_overlay.OverlayView`` does: ``compute`` is pure
-NumPy/Numba and runs in a background worker; the app recomputes after every camera change. Surfaces of components with LOD on are drawn at
-the level their screen size asks for, geomorphed (``volviz.iso.lod``); the statistics report the triangles drawn.
+NumPy/Numba and runs in a background worker; the app recomputes after every camera change. Surfaces of components with
+LOD on are drawn at the level their screen size asks for, geomorphed (``volviz.iso.lod``); the statistics report the
+triangles drawn.
 """
 from __future__ import annotations
 

@@ -338,8 +338,8 @@ class LodVolume:
         self.image, self.depth = img, depth
         self._overlay.show_image(img, visible)
         t4 = time.perf_counter()
-        self.stats.update({"renderer": "volviz", "prepared": False, "readback_s": t1 - t0, "table_s": t2 - t1, "render_s": t3 - t2,
-                           "upload_s": t4 - t3, "draw_s": t4 - t0, "size": (w, h)})
+        self.stats.update({"renderer": "volviz", "prepared": False, "readback_s": t1 - t0, "table_s": t2 - t1,
+                           "render_s": t3 - t2, "upload_s": t4 - t3, "draw_s": t4 - t0, "size": (w, h)})
         return img
 
     def update(self) -> dict[str, Any]:

@@ -286,11 +286,12 @@ def _widened(table: Any, values: np.ndarray) -> np.ndarray:
 
 
 def lut_args(table: Any, smooth: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(flat float64 data (float32 tables widened once: no conversion per tap), int64 [kind, n_s, n_l or channels, degree], float64 [s_lo, 1/ds, 1/dl or 1/l_max,
-    kappa_max (3)]) of a ``Table3D`` (kind 0), a ``SeparableTable`` (kind 1) or an ``IsoTable`` (kind 2: its
-    isosurfaces evaluated exactly, not its texture) or a ``Preclassified`` TF (kind 3: each segment's ends classified
-    exactly, ``_preclassified``) for the raster kernels. ``smooth``: shade isosurfaces (kind 2) with the per-pixel
-    intensities the rasteriser interpolates (``volviz.unstructured.iso.vertex_shade``)."""
+    """(flat float64 data (float32 tables widened once: no conversion per tap), int64 [kind, n_s, n_l or channels,
+    degree], float64 [s_lo, 1/ds, 1/dl or 1/l_max, kappa_max (3)]) of a ``Table3D`` (kind 0), a ``SeparableTable``
+    (kind 1) or an ``IsoTable`` (kind 2: its isosurfaces evaluated exactly, not its texture) or a ``Preclassified`` TF
+    (kind 3: each segment's ends classified exactly, ``_preclassified``) for the raster kernels. ``smooth``: shade
+    isosurfaces (kind 2) with the per-pixel intensities the rasteriser interpolates
+    (``volviz.unstructured.iso.vertex_shade``)."""
     if hasattr(table, "preclassified_tf"):                  # exact pre-classified segments (kind 3)
         tf = table.preclassified_tf
         flat = np.concatenate([tf.scalars, tf.colors.ravel(), tf.extinction]).astype(np.float64)

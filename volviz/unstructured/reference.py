@@ -66,9 +66,9 @@ def _ray_interval(minv: np.ndarray, gnorm: np.ndarray, o: np.ndarray, d: np.ndar
 
 
 @njit(cache=True, nogil=True)
-def _band_segments(minv: np.ndarray, gnorm: np.ndarray, svals: np.ndarray, cells: np.ndarray, bbox: np.ndarray, rb: np.ndarray,
-                   near: float, far: float, tol: float, width: int, row0: int, row1: int, count_only: bool,
-                   pix: np.ndarray, seg: np.ndarray, far_px: np.ndarray) -> int:
+def _band_segments(minv: np.ndarray, gnorm: np.ndarray, svals: np.ndarray, cells: np.ndarray, bbox: np.ndarray,
+                   rb: np.ndarray, near: float, far: float, tol: float, width: int, row0: int, row1: int,
+                   count_only: bool, pix: np.ndarray, seg: np.ndarray, far_px: np.ndarray) -> int:
     """Intersect every pixel ray of rows [row0, row1) with the candidate cells; returns the number of segments.
     ``far_px`` (H, W): per-pixel far limits, or (0, 0) for none."""
     use_far = far_px.shape[0] > 0
@@ -246,7 +246,8 @@ def iter_ray_segments(mesh: TetMesh, camera: Camera, size: tuple[int, int], band
             band_rows = max(1, rows // 2)
             continue
         pix, seg = np.empty(n, np.int64), np.empty((n, 5))
-        _band_segments(minv, gnorm, svals, sel, box[sel], rb, near, far, tol, w, row, row + rows, False, pix, seg, far_px)
+        _band_segments(minv, gnorm, svals, sel, box[sel], rb, near, far, tol, w, row, row + rows, False,
+                       pix, seg, far_px)
         if extra_vals is not None:              # the same rays and cells again, with the extra field's values
             seg_x = np.empty((n, 5))
             _band_segments(minv, gnorm, extra_vals, sel, box[sel], rb, near, far, tol, w, row, row + rows, False,

@@ -126,8 +126,8 @@ def render(mesh: TetMesh, tf: Any, camera: Camera, size: tuple[int, int] = (512,
     ``order`` (a back-to-front cell order, e.g. from a background sort) skips the sort. ``lookup`` picks the
     pre-integration for "pt": "separable" (Roettger §9.1, n_s x n_s (default 256) with a colour polynomial of
     ``degree`` (default 2); exact opacity), "3d" (n_s x n_s x n_l, default n_s = 128, trilinear) or "auto" (by the
-    largest optical depth of a cell, see ``auto_lookup``); l_max = the longest edge, over the data and TF range. "pt-st" always uses the 3D table. ``table`` overrides it (a ``Table3D`` or a
-    ``SeparableTable``).
+    largest optical depth of a cell, see ``auto_lookup``); l_max = the longest edge, over the data and TF range. "pt-st"
+    always uses the 3D table. ``table`` overrides it (a ``Table3D`` or a ``SeparableTable``).
     ``depth`` (H, W): a per-pixel far limit on the depth along the direction of projection (the ray parameter t of
     ``Camera.rays``), e.g. opaque geometry from a z-buffer; every ray segment is clipped at it ("pt" and
     "reference"; "pt-st" refuses it).

@@ -7,13 +7,13 @@ Roettger §8.1 and Guthe §4.3 (§3.1 of the thesis):
   for orthographic views the power "depth" (c . f) + r, i.e. the far end of the sphere along the view direction).
 - ``"mpvo"``: Williams' MPVO as a topological sort (Kahn) of the face-adjacency graph, each shared face directed by the
   side of its plane the eye lies on. Correct for convex, connected, acyclic meshes.
-- Non-convex or disconnected meshes (``"mpvo"`` adds them automatically unless the mesh is convex): the missing relations
-  between boundary faces are *sampled at the pixel centres of the image being rendered*, the image-space variant of XMPVO
-  (Cook, Max, Silva, Williams 2004, "SXMPVO"). Every boundary face is ray-cast at every pixel centre it covers; along each
-  pixel ray, a boundary face where the ray re-enters the mesh (cell B) after the ray has left it (cell A) yields the
-  relation "B before A". Together with the MPVO relations, every pair of cells met consecutively along any pixel ray is
-  ordered, which is exactly what a rasteriser that samples those pixel centres needs: the order is correct for that
-  image (it is not a total depth order for rays between pixel centres, which are never drawn).
+- Non-convex or disconnected meshes (``"mpvo"`` adds them automatically unless the mesh is convex): the missing
+  relations between boundary faces are *sampled at the pixel centres of the image being rendered*, the image-space
+  variant of XMPVO (Cook, Max, Silva, Williams 2004, "SXMPVO"). Every boundary face is ray-cast at every pixel centre it
+  covers; along each pixel ray, a boundary face where the ray re-enters the mesh (cell B) after the ray has left it
+  (cell A) yields the relation "B before A". Together with the MPVO relations, every pair of cells met consecutively
+  along any pixel ray is ordered, which is exactly what a rasteriser that samples those pixel centres needs: the order
+  is correct for that image (it is not a total depth order for rays between pixel centres, which are never drawn).
 - Visibility cycles (real ones, or ones created by combining relations that hold on different rays) stall Kahn's
   algorithm. They are broken by emitting the farthest remaining cell (by centroid depth); ``SortResult.cycles`` counts
   the breaks.

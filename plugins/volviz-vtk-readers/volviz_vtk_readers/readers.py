@@ -157,7 +157,7 @@ def _reader(cls: str, file_name: PathLike, setter: str = "SetFileName") -> Any:
     return reader
 
 
-# -- Exodus II -----------------------------------------------------------------------------------------------------------
+# -- Exodus II ---------------------------------------------------------------------------------------------------------
 def _exodus(path: PathLike) -> Any:
     import vtk
 
@@ -191,7 +191,7 @@ def read_exodus(path: PathLike, blocks: Sequence[str] | str | None = None, time_
                     _convert(path, None, allow_nonfinite))
 
 
-# -- OpenFOAM ------------------------------------------------------------------------------------------------------------
+# -- OpenFOAM ----------------------------------------------------------------------------------------------------------
 def _openfoam(path: PathLike) -> Any:
     p = Path(path)
     if p.is_dir():
@@ -334,7 +334,7 @@ def read_vtk_parallel(path: PathLike, allow_nonfinite: bool = True):
     return vtk_to_model(path, _run(path, reader), allow_nonfinite=allow_nonfinite)
 
 
-# -- netCDF CF -----------------------------------------------------------------------------------------------------------
+# -- netCDF CF ---------------------------------------------------------------------------------------------------------
 def read_netcdf_cf(path: PathLike, dimensions: str | None = None, spherical: bool = True,
                    time_index: int | None = None, allow_nonfinite: bool = True):
     """netCDF with CF conventions: every variable on ``dimensions`` (default: the reader's first set, e.g.
@@ -356,7 +356,7 @@ def read_netcdf_cf(path: PathLike, dimensions: str | None = None, spherical: boo
     return _in_time(path, reader, read_netcdf_cf, options, time_index, _convert(path, None, allow_nonfinite))
 
 
-# -- AVS UCD -------------------------------------------------------------------------------------------------------------
+# -- AVS UCD -----------------------------------------------------------------------------------------------------------
 def read_avs_ucd(path: PathLike, allow_nonfinite: bool = True):
     """AVS UCD (.inp, ASCII or binary): the mesh with every node and cell component."""
     p = _check_sniffed(path, specs.is_avs_ucd, "AVS UCD")
@@ -368,7 +368,7 @@ def read_avs_ucd(path: PathLike, allow_nonfinite: bool = True):
     return vtk_to_model(path, _run(path, reader), allow_nonfinite=allow_nonfinite)
 
 
-# -- block listing -------------------------------------------------------------------------------------------------------
+# -- block listing -----------------------------------------------------------------------------------------------------
 _TREE_READERS: dict[str, Callable[[PathLike], Any]] = {
     "cgns": _cgns, "ensight": _ensight, "tecplot": _tecplot, "fluent": _fluent, "vtk-multiblock": _vtk_multiblock}
 
