@@ -47,7 +47,7 @@ def bluntfin_tf() -> Any:
 
 def camera_path(points: np.ndarray, n: int) -> list[Any]:
     """n perspective views orbiting the fin (azimuth 20..110 degrees, elevation 25, 30 degree view angle)."""
-    from volviz.unstructured.camera import Camera
+    from volviz.model.camera import Camera
 
     return [Camera.orbit(points, 20.0 + 90.0 * i / max(n - 1, 1), 25.0, 1.6, view_angle=30.0, up=(0, 0, 1))
             for i in range(n)]
