@@ -389,7 +389,8 @@ def _plots(results: dict[str, Any], images: dict[str, np.ndarray], ref: np.ndarr
         if name == "reference":
             continue
         ax.scatter(r["frame_s"], max(r["rmse_rgb"], 1e-3), s=40)
-        ax.annotate(name.replace("vtkUnstructuredGridVolume", "UG").replace("Mapper", ""), (r["frame_s"], r["rmse_rgb"]),
+        ax.annotate(name.replace("vtkUnstructuredGridVolume", "UG").replace("Mapper", ""),
+                    (r["frame_s"], r["rmse_rgb"]),
                     fontsize=8)
     ax.set_xscale("log")
     ax.set_yscale("log")
@@ -462,8 +463,8 @@ def _markdown(results: dict[str, Any], path: Path) -> None:
     if along:
         lines += ["", f"Along the camera path as a movie export renders it (frame i + 1 sorted in the background while "
                   f"frame i draws, `volviz.unstructured.prefetch`): **{along['frame_s']:.3f} s per frame**, of which "
-                  f"{along['sort_wait_s']:.3f} s in the sort stage (the wait for the background order and the zero-opacity "
-                  "filter). With both cores already busy rasterising, "
+                  f"{along['sort_wait_s']:.3f} s in the sort stage (the wait for the background order and the "
+                  "zero-opacity filter). With both cores already busy rasterising, "
                   "the background sort takes its time from the raster: the order is ready, but the frame is not "
                   "faster than sorting in line."]
     cpu_ns = pt.get("cpu_s", float("nan")) / max(pt["fragments"], 1) * 1e9

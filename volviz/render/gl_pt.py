@@ -18,8 +18,9 @@ How a frame is drawn:
   ``gl_FragCoord`` with the camera's affine ray basis (no interpolated varyings), clipped against the cell's planes,
   the near and far planes and the opaque scene's depth at the pixel; the exact (s_f, s_b, l) of that segment look up
   the 3D table (Roettger §8.4, trilinear) or the separable one (§9.1: exact opacity 1 - exp(-l rho_hat), colour
-  polynomial in l; its layers a 2D texture array, bilinear within a layer), both float32. The fragment shader is made for one kind of segment evaluation
-  (``PT_KIND``: 3D table, separable table, isosurfaces, pre-classified; VTK recompiles it when the kind changes):
+  polynomial in l; its layers a 2D texture array, bilinear within a layer), both float32. The fragment shader is
+  made for one kind of segment evaluation (``PT_KIND``: 3D table, separable table, isosurfaces, pre-classified; VTK
+  recompiles it when the kind changes):
   llvmpipe runs every branch of a fragment shader under a lane mask, so a run-time switch between kinds made every
   fragment pay for all of them (measured at 512^2 on the Blunt Fin: 3.7 s per frame with the four kinds behind a
   uniform, 1.8 s with the two table kinds, 1.4 s with the 3D table alone).
@@ -385,7 +386,8 @@ class GLPTVolume(PTView):
         self._set_index_buffer(cells)
         self.order, self._order_key = cells, key
         self.stats = {"method": "pt-gl", "sort_s": t1 - t0, "order_s": time.perf_counter() - t1,
-                      "n_visible": int(len(cells)), "cycles": self._cycles, "sorted": not (same or reused), "sort_prefetched": prefetched,
+                      "n_visible": int(len(cells)), "cycles": self._cycles, "sorted": not (same or reused),
+                      "sort_prefetched": prefetched,
                       "order_reused": reused}
 
     def _set_index_buffer(self, cells: np.ndarray) -> None:
