@@ -15,7 +15,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from test_iso_overlay import BG, PLAIN, SIZE, ball, iso_component, plotter
+from test_iso_overlay import BG, PLAIN, SIZE, ball, iso_component
+from test_iso_overlay import plotter as new_plotter
 
 from volviz.iso.composite import MODES, render
 from volviz.model.datasets import RegularVolume, TimeSeries
@@ -26,6 +27,21 @@ from volviz.session import CameraState, DatasetRef, Session
 from volviz.model.camera import Camera
 
 RMSE, P999, OVER3_PIXELS = 0.8, 2.5, 8
+_OPEN: list = []   # the plotters a test made, closed after it (a window left to the interpreter's exit outlives
+                   # the X server pytest-xvfb stops first, and Xlib then ends the process with status 1)
+
+
+@pytest.fixture(autouse=True)
+def _close_plotters():
+    yield
+    while _OPEN:
+        _OPEN.pop().close()
+
+
+def plotter():
+    p = new_plotter()
+    _OPEN.append(p)
+    return p
 HALF = {"planes": [{"point": [11.5, 0.0, 0.0], "normal": [1.0, 0.0, 0.0]}], "box": None}
 
 
