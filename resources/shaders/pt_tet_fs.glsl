@@ -32,17 +32,8 @@ uniform vec3 shadeLight;     // the headlight's direction (unit)
 uniform float shadeAmbient;
 #endif
 
-uniform vec3 rayO0;
-uniform vec3 rayOx;
-uniform vec3 rayOy;
-uniform vec3 rayD0;
-uniform vec3 rayDx;
-uniform vec3 rayDy;
-uniform float viewHeight;
-uniform vec2 clipRange;
-uniform int parallelView;
+//VOLVIZ::include ray_pixel.glsl
 uniform int useDepth;
-uniform sampler2D opaqueDepth;
 
 // PT_CLIPS user clipping planes (n, d), n . x <= d kept, relative to the mesh centre; their number is compiled in
 // (a loop to a uniform count over a uniform array cost llvmpipe a third of the fragment's arithmetic, also with 0).
@@ -88,18 +79,6 @@ void clipPlane(vec4 plane, vec3 o, vec3 d, inout float t0, inout float t1)
   {
     t1 = -1.0e30;
   }
-}
-
-float opaqueLimit()
-{
-  float z = texelFetch(opaqueDepth, ivec2(gl_FragCoord.xy), 0).r;
-  if (z >= 1.0)
-  {
-    return 1.0e30;
-  }
-  float n = clipRange.x;
-  float f = clipRange.y;
-  return parallelView == 1 ? n + z * (f - n) : n * f / (f - z * (f - n));
 }
 
 float tableIndex(float s, vec2 range)
@@ -293,10 +272,9 @@ float shadeAt(vec3 x)         // the vertex intensities interpolated linearly in
 
 void main()
 {
-  float px = gl_FragCoord.x - 0.5;
-  float py = viewHeight - gl_FragCoord.y - 0.5;
-  vec3 o = rayO0 + px * rayOx + py * rayOy;
-  vec3 d = rayD0 + px * rayDx + py * rayDy;
+  vec3 o;
+  vec3 d;
+  pixelRay(o, d);
   float t0 = clipRange.x;
   float t1 = clipRange.y;
   if (useDepth == 1)

@@ -69,7 +69,7 @@ from volviz.nature.fog import FogLayer, layer_emission
 from volviz.render.gl_pt import _PASS_MARK, _USERS, GLPTVolume, shader_source
 from volviz.model.camera import Camera
 
-__all__ = ["GLFogLayer", "PrismBuffers", "add_fog_layer", "buffers_polydata", "expand_includes", "prism_attributes",
+__all__ = ["GLFogLayer", "PrismBuffers", "add_fog_layer", "buffers_polydata", "prism_attributes",
            "prism_buffers"]
 
 _MODES = {"emissive": 0, "attenuated": 1, "mip": 2}
@@ -79,16 +79,6 @@ _GL_COLOR_BUFFER_BIT = 0x4000
 _ATTRIBUTES = ("fogSide0", "fogSide1", "fogSide2", "fogBottom", "fogTop", "fogEmBottom", "fogEmTop")
 # the 8 triangles of a prism (vertices 0-2 bottom, 3-5 top), oriented outward per prism in ``prism_buffers``
 _PRISM_TRIANGLES = np.array([[0, 2, 1], [3, 4, 5], [0, 1, 4], [0, 4, 3], [1, 2, 5], [1, 5, 4], [2, 0, 3], [2, 3, 5]])
-
-
-def expand_includes(name: str) -> str:
-    """The GLSL source ``resources/shaders/<name>`` with its ``//VOLVIZ::include <file>`` lines replaced by those
-    files (the shared pixel-ray code, ``ray_pixel.glsl``)."""
-    lines = []
-    for line in shader_source(name).splitlines():
-        head, _, rest = line.partition("//VOLVIZ::include ")
-        lines.append(shader_source(rest.strip()) if not head.strip() and rest else line)
-    return "\n".join(lines) + "\n"
 
 
 def _affine(xy: np.ndarray, values: np.ndarray) -> np.ndarray:
@@ -280,8 +270,8 @@ class GLFogLayer:
         import vtk
 
         sp = vtk.vtkShaderProperty()
-        sp.SetVertexShaderCode(expand_includes(vs))
-        sp.SetFragmentShaderCode(expand_includes(fs))
+        sp.SetVertexShaderCode(shader_source(vs))
+        sp.SetFragmentShaderCode(shader_source(fs))
         actor = vtk.vtkActor()
         actor.SetMapper(mapper)
         actor.SetShaderProperty(sp)

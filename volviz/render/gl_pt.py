@@ -109,8 +109,15 @@ _GL_DEPTH_BUFFER_BIT, _GL_COLOR_BUFFER_BIT, _GL_NEAREST, _GL_DEPTH_WRITEMASK = 0
 
 
 def shader_source(name: str) -> str:
-    """The text of ``resources/shaders/<name>`` (package ``volviz_resources``)."""
-    return (resources.files("volviz_resources") / "shaders" / name).read_text(encoding="utf-8")
+    """The text of ``resources/shaders/<name>`` (package ``volviz_resources``), its ``//VOLVIZ::include <file>``
+    lines replaced by those files (the pixel ray and opaque depth shared by the ray-segment shaders,
+    ``ray_pixel.glsl``)."""
+    text = (resources.files("volviz_resources") / "shaders" / name).read_text(encoding="utf-8")
+    lines = []
+    for line in text.splitlines():
+        head, _, rest = line.partition("//VOLVIZ::include ")
+        lines.append(shader_source(rest.strip()) if not head.strip() and rest else line)
+    return "\n".join(lines) + "\n"
 
 
 def _cell_attributes(mesh: TetMesh, smooth: bool = False) -> dict[str, np.ndarray]:
