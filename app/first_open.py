@@ -23,6 +23,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Optional
 
+from volviz_app.smoke import pump_events
+
 WINDOW_SIZE = (1366, 768)
 TIMEOUT_S = 300.0
 NOTE_CHARS = 320         # an error dialog's text is cut there in the table (the screenshot shows all of it)
@@ -140,16 +142,6 @@ def _describe(window: Any, record: FirstOpen) -> None:
         record.notes.append(f"status bar: {status}")
 
 
-def _pump(app: Any, until: Any, seconds: float) -> bool:
-    start = time.perf_counter()
-    while not until():
-        if time.perf_counter() - start > seconds:
-            return False
-        app.processEvents()
-        time.sleep(0.005)
-    return True
-
-
 def open_one(app: Any, path: Path, root: Path, out: Path, workdir: Path) -> FirstOpen:
     """Open ``path`` in a fresh window, time it to the first complete image, grab the window into ``out``."""
     from PySide6.QtCore import QSettings
@@ -162,21 +154,21 @@ def open_one(app: Any, path: Path, root: Path, out: Path, workdir: Path) -> Firs
     window.resize(*WINDOW_SIZE)
     window.show()
     window.layout_keeper.arrange()
-    _pump(app, lambda: window.isVisible() and window.plotter.interactor.isVisible(), 10.0)
+    pump_events(app, lambda: window.isVisible() and window.plotter.interactor.isVisible(), 10.0)
     for _ in range(20):  # the first show's layout and initial render settle before the clock starts
         app.processEvents()
         time.sleep(0.01)
 
     start = time.perf_counter()
     window.open_path(path)
-    done = _pump(app, lambda: window.error_dialog is not None or (
+    done = pump_events(app, lambda: window.error_dialog is not None or (
         window.controller is not None and not window.progress_bar.isVisible()), TIMEOUT_S)
     if window.error_dialog is None and done:
         window.plotter.render()
     record.seconds = time.perf_counter() - start
     if not done:
         record.notes.append(f"not shown after {TIMEOUT_S:.0f} s")
-    _pump(app, lambda: False, 0.3)  # the status bar's non-finite note, repaints
+    pump_events(app, lambda: False, 0.3)  # the status bar's non-finite note, repaints
     _describe(window, record)
     shot = out / (_slug(record.name) + ".png")
     grab(window).save(str(shot))
@@ -187,7 +179,7 @@ def open_one(app: Any, path: Path, root: Path, out: Path, workdir: Path) -> Firs
         window.error_dialog.close()
     window.close()
     window.deleteLater()
-    _pump(app, lambda: False, 0.1)
+    pump_events(app, lambda: False, 0.1)
     return record
 
 

@@ -9,13 +9,14 @@ from typing import Any
 TIMEOUT_S = 180.0
 
 
-def _pump(app: Any, until: Any, seconds: float) -> bool:
+def pump_events(app: Any, until: Any, seconds: float) -> bool:
+    """Process Qt events until ``until()`` is true (True) or ``seconds`` have passed (False)."""
     start = time.perf_counter()
     while not until():
         if time.perf_counter() - start > seconds:
             return False
         app.processEvents()
-        time.sleep(0.01)
+        time.sleep(0.005)
     return True
 
 
@@ -23,14 +24,14 @@ def screenshot(app: Any, window: Any, target: str | None, out: Path) -> int:
     """Show ``target`` (None: the demo) in ``window``, save its grab to ``out``; 0 when it showed, 1 otherwise."""
     window.resize(1024, 700)
     window.show()
-    _pump(app, lambda: window.isVisible(), 10.0)
+    pump_events(app, lambda: window.isVisible(), 10.0)
     if target:
         window.open_path(target)
     else:
         window.open_demo()
-    shown = _pump(app, lambda: window.error_dialog is not None or (
+    shown = pump_events(app, lambda: window.error_dialog is not None or (
         window.controller is not None and not window.progress_bar.isVisible()), TIMEOUT_S)
-    _pump(app, lambda: False, 0.5)
+    pump_events(app, lambda: False, 0.5)
     window.plotter.render()
     window.grab().save(str(out))
     window.dirty = False
