@@ -114,10 +114,10 @@ def _import_gui_thread_modules() -> None:
     scene's overlay) took 0.2-0.5 s of a blocked event loop in the middle of loading a scene."""
     import vtk  # noqa: F401
 
-    import volviz.nature.scene  # noqa: F401
+    import volviz.nature.nature_scene  # noqa: F401
     import volviz.render.controller  # noqa: F401
     import volviz.render.pt_prop  # noqa: F401
-    import volviz.render.scene  # noqa: F401
+    import volviz.render.scene_builder  # noqa: F401
     import pyvista
 
     # pyvista asks once per process whether this system can plot (it runs ``xset -q``) when the first offscreen plotter
@@ -333,13 +333,13 @@ class MainWindow(CameraBookmarks, QMainWindow):
 
     # ------------------------------------------------------------------------------------------------ opening
     def open_demo(self) -> None:
-        from volviz.render.scene import demo_session
+        from volviz.render.scene_builder import demo_session
 
         self._show_session(demo_session(), None, "demo scene")
 
     def open_demo_volume(self) -> None:
         """The tetrahedral demo volume (an analytic field on a tetrahedralised cube), drawn by volviz's PT."""
-        from volviz.render.scene import demo_volume_session
+        from volviz.render.scene_builder import demo_volume_session
 
         self._show_session(demo_volume_session(), None, "demo volume")
 
@@ -357,7 +357,7 @@ class MainWindow(CameraBookmarks, QMainWindow):
         """Open a session file or a data file (the path behind every Open action and the command line); ``q``: the
         solution file of a PLOT3D grid."""
         from volviz.render.export import is_session_file
-        from volviz.render.scene import data_session
+        from volviz.render.scene_builder import data_session
         from volviz.session import load
 
         p = Path(path)
@@ -381,7 +381,7 @@ class MainWindow(CameraBookmarks, QMainWindow):
         stays until the new one is ready, and stays on when the new one fails (a message names ``path``, the file
         opened, and what is wrong with it). ``on_shown()`` runs once the new scene is installed."""
         from volviz.render.controller import SceneController
-        from volviz.render.scene import load_datasets
+        from volviz.render.scene_builder import load_datasets
 
         self._load_serial += 1
         serial = self._load_serial
@@ -600,7 +600,7 @@ class MainWindow(CameraBookmarks, QMainWindow):
         read and the histogram computed on a worker (``volviz.model.stats.histogram``) while the editor shows a
         placeholder; a newer selection supersedes it. ``histograms_computed`` counts the ones shown."""
         from volviz.model.stats import histogram
-        from volviz.render.scene import load_datasets
+        from volviz.render.scene_builder import load_datasets
 
         controller, session_path = self.controller, self.session_path
         self.tf_editor.set_histogram_pending()
@@ -743,7 +743,7 @@ class MainWindow(CameraBookmarks, QMainWindow):
         """Cut the isosurfaces' extracted surfaces by new clipping (or for a new opacity) on a worker, with their LOD
         chains (a newer request supersedes), then swap their actors here; ``isosurfaces_cut()`` tells when the
         clipping is shown."""
-        from volviz.render.scene import isosurface_parts
+        from volviz.render.scene_builder import isosurface_parts
 
         meshes = controller.isosurface_meshes()
         if not meshes:
@@ -775,7 +775,7 @@ class MainWindow(CameraBookmarks, QMainWindow):
         self.set_dirty()
 
     def _set_visibility(self, comp_id: str, visible: bool) -> None:
-        from volviz.render.scene import NATURE_TYPES
+        from volviz.render.scene_builder import NATURE_TYPES
 
         if self.controller is None:
             return
@@ -797,7 +797,7 @@ class MainWindow(CameraBookmarks, QMainWindow):
         """A component hidden at load was shown: prepare it in the background (extraction, tetrahedralisation, VTK
         volume input, histogram; a newer request for it supersedes), add its prop on this thread, then compute its
         view-dependent parts in the background. ``components_shown`` counts the ones installed."""
-        from volviz.render.scene import load_datasets
+        from volviz.render.scene_builder import load_datasets
 
         controller, session_path = self.controller, self.session_path
         self.status_label.setText(f"Preparing {comp_id}…")
@@ -841,7 +841,7 @@ class MainWindow(CameraBookmarks, QMainWindow):
         (maps, fog prisms, cloud volumes; a newer toggle supersedes an older one), put it in on this thread, then
         compute its first view in the background; the old one stays on screen meanwhile. A scene that cannot be
         built (fog without terrain) leaves the component as it was, with a message."""
-        from volviz.render.scene import load_datasets
+        from volviz.render.scene_builder import load_datasets
 
         controller, session_path = self.controller, self.session_path
 

@@ -231,7 +231,7 @@ def test_selection_follows_budget_and_camera(tree: LodTree, renderer: str) -> No
 def test_session_with_a_lod_dataset_follows_camera_and_transfer_function(tree: LodTree) -> None:
     from volviz.render.controller import SceneController
     from volviz.render.export import offscreen_plotter
-    from volviz.render.scene import LOD_VOXELS, data_session, load_datasets, vvz_voxels
+    from volviz.render.scene_builder import LOD_VOXELS, data_session, load_datasets, vvz_voxels
     from volviz.session import CameraState, Component, DatasetRef, RenderSettings, Session
 
     vvz = Path(tree.decoder.path)

@@ -101,7 +101,7 @@ def test_missing_camera_path_is_a_clear_error(tmp_path: Path, capsys) -> None:
 
 
 def test_render_settings_map_to_the_pt_renderer() -> None:
-    from volviz.render.scene import pt_options
+    from volviz.render.scene_builder import pt_options
 
     assert pt_options({}) == {}
     assert pt_options({"table": "3d", "table_resolution": 64, "sort": "centroid"}) == \

@@ -43,7 +43,7 @@ def _render(doc: dict, folder: Path, name: str) -> None:
 
 def _natural_scene(folder: Path) -> None:
     from volviz.render.export import render_session
-    from volviz.render.scene import demo_session
+    from volviz.render.scene_builder import demo_session
 
     render_session(demo_session(), None, SIZE)
 
@@ -51,7 +51,7 @@ def _natural_scene(folder: Path) -> None:
 def _tetrahedral_volume(folder: Path) -> None:
     from volviz.optics import TransferFunction
     from volviz.render.export import render_session
-    from volviz.render.scene import demo_volume_session
+    from volviz.render.scene_builder import demo_volume_session
     from volviz.unstructured import render
     from volviz.model.camera import Camera
     from volviz.unstructured.synthetic import box_tets, holed_box

@@ -107,7 +107,7 @@ def build_scene(data: Path, cloud_shape: tuple[int, int, int], terrain_c: tuple[
     from volviz.nature.clouds import CloudShading, CloudVolume
     from volviz.nature.fog import FogLayer
     from volviz.nature.heightfield import HeightField, grid_from_image
-    from volviz.nature.scene import NatureScene
+    from volviz.nature.nature_scene import NatureScene
     from volviz.nature.sky import sky_texture
 
     yukon = data / "yukon" / "Yukon.map.pgm"
@@ -196,7 +196,7 @@ class _GLFrames:
     def __init__(self, scene: Any, size: tuple[int, int], reps: int) -> None:
         import pyvista as pv
 
-        from volviz.nature.scene import NatureView
+        from volviz.nature.nature_scene import NatureView
         from volviz.render.gl_nature import GLNatureView
 
         self.size, self.reps = size, reps

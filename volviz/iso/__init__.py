@@ -8,7 +8,7 @@ from volviz.iso.clip import (BoxCrop, ClipPlane, ClipSettings, clip_isosurface, 
 from volviz.iso.composite import MODES, composite, fragments, render, render_modes
 from volviz.iso.extract import IsoMesh, IsoStyle, extract, extract_many
 from volviz.iso.lod import LodChain, build_lod, lod_mesh, lod_meshes, select_level
-from volviz.iso.scene import IsoSettings, PreparedIso, prepare, render_iso
+from volviz.iso.component import IsoSettings, PreparedIso, prepare, render_iso
 from volviz.iso.spectrum import SpectrumFit, fit_spectrum, spectrum_alpha
 from volviz.iso.vtk_spectrum import apply_spectrum_shader, iso_actor
 

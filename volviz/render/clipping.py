@@ -9,7 +9,7 @@ How each prop honours them:
 - VTK's projected tetrahedra (vtkProjectedTetrahedraMapper ignores clipping planes): its input is cut exactly and
   re-tetrahedralised (``volviz.iso.clip.clip_grid``);
 - volviz PT volumes: the tetrahedral mesh is cut exactly (``clip_tetmesh``) and re-rendered by the caller;
-- isosurfaces: the triangles are cut exactly (``clip_isosurfaces``, in ``volviz.render.scene.add_isosurfaces``);
+- isosurfaces: the triangles are cut exactly (``clip_isosurfaces``, in ``volviz.render.scene_builder.add_isosurfaces``);
 - any other actor (surfaces, height fields): mapper clipping planes, which OpenGL honours for at most
   ``MAX_GL_PLANES`` planes; further planes are left out with a logged warning.
 """

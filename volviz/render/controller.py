@@ -87,10 +87,10 @@ class SceneController:
         self.install(self.prepare())
 
     def prepare(self, progress: Any = None, t: Optional[float] = None) -> Any:
-        """Any thread, before ``install``: the heavy part of building (``volviz.render.scene.prepare_scene``) at
+        """Any thread, before ``install``: the heavy part of building (``volviz.render.scene_builder.prepare_scene``) at
         display time ``t`` of a time series (default: the session's display time). Touches no plotter, so the app
         runs it in the background."""
-        from volviz.render.scene import prepare_scene
+        from volviz.render.scene_builder import prepare_scene
 
         span = self.time_span()
         if t is None or not span:
@@ -104,7 +104,7 @@ class SceneController:
         """GUI thread: add the props of a ``prepare`` result to the plotter without rendering. The view-dependent
         parts (PT images, LOD blocks, terrain and overlay) are drawn now when ``views``; the app instead updates them
         in the background (``pt_volume``, ``lod_volumes``, ``nature``: ``begin`` / ``compute`` / ``finish``)."""
-        from volviz.render.scene import install_scene
+        from volviz.render.scene_builder import install_scene
 
         ensure_lights(self.plotter)
         with no_render(self.plotter):  # the caller draws once afterwards
@@ -157,13 +157,13 @@ class SceneController:
         raise KeyError(comp_id)
 
     def dataset_of(self, comp_id: str) -> Any:
-        from volviz.render.scene import component_dataset
+        from volviz.render.scene_builder import component_dataset
 
         return component_dataset(self.component(comp_id), self.datasets)
 
     # -- transfer functions, visibility, opacity --------------------------------------------------------------------
     def transfer_function(self, comp_id: str) -> Any:
-        from volviz.render.scene import component_transfer_function
+        from volviz.render.scene_builder import component_transfer_function
 
         return component_transfer_function(self.session, self.component(comp_id))
 
@@ -202,7 +202,7 @@ class SceneController:
             self.decorate()        # the outline and the scalar bar follow what is shown
 
     def _set_visible(self, comp_id: str, visible: bool, nature: bool, build: bool) -> None:
-        from volviz.render.scene import NATURE_TYPES
+        from volviz.render.scene_builder import NATURE_TYPES
 
         comp = self.component(comp_id)
         comp.visible = bool(visible)
@@ -227,15 +227,15 @@ class SceneController:
 
     def needs_build(self, comp_id: str) -> bool:
         """Whether showing the component needs ``prepare_component`` / ``install_component`` (it has no prop yet)."""
-        from volviz.render.scene import NATURE_TYPES
+        from volviz.render.scene_builder import NATURE_TYPES
 
         return self.component(comp_id).type not in NATURE_TYPES and self.props.get(comp_id) is None
 
     def prepare_component(self, comp_id: str, progress: Any = None) -> Any:
         """Any thread: the heavy part of showing a non-nature component that was hidden at build time
-        (``volviz.render.scene.prepare_component`` at the display time). Touches no plotter."""
+        (``volviz.render.scene_builder.prepare_component`` at the display time). Touches no plotter."""
         from volviz.jobs import report
-        from volviz.render.scene import PreparedScene, ensure_transfer_functions, prepare_component
+        from volviz.render.scene_builder import PreparedScene, ensure_transfer_functions, prepare_component
 
         ensure_transfer_functions(self.session, self.datasets)
         prepared = PreparedScene(time=self.time if self.time_series() else None)
@@ -248,7 +248,7 @@ class SceneController:
     def install_component(self, comp_id: str, prepared: Any, views: bool = True) -> Any:
         """GUI thread: add the prop of a ``prepare_component`` result without rendering (a PT volume's image and a
         LOD volume's blocks are drawn now when ``views``; the app updates them in the background)."""
-        from volviz.render.scene import install_component
+        from volviz.render.scene_builder import install_component
 
         comp = self.component(comp_id)
         with no_render(self.plotter):
@@ -344,7 +344,7 @@ class SceneController:
     def blend_volume(self, comp_id: str, t: float, interpolate: Optional[bool] = None, progress: Any = None) -> Any:
         """Any thread: the VTK input of a time-series volume at display time ``t`` (the 4D blend of the neighbouring
         steps when interpolating, libMini note "4D Visualization"); ``show_volumes`` puts it on screen."""
-        from volviz.render.scene import prepared_volume_input
+        from volviz.render.scene_builder import prepared_volume_input
 
         interpolate = self.interpolate_time if interpolate is None else bool(interpolate)
         return prepared_volume_input(self.time_series()[comp_id], float(t), interpolate)
@@ -374,7 +374,7 @@ class SceneController:
         neighbouring steps when interpolating, libMini note "4D Visualization"), cut by the component's own
         clipping (``volviz.iso.prepare``); ``show_isosurfaces`` puts them on screen."""
         from volviz.iso import IsoSettings, prepare
-        from volviz.render.scene import SceneError
+        from volviz.render.scene_builder import SceneError
 
         comp = self.component(comp_id)
         settings_doc = dict(comp.settings)  # a snapshot: the GUI thread replaces (never mutates) comp.settings
@@ -388,8 +388,8 @@ class SceneController:
     def isosurface_parts(self, comp_id: str, t: float, interpolate: Optional[bool] = None,
                          progress: Any = None) -> Any:
         """Any thread: ``extract_isosurfaces`` cut by the scene's clipping, with their LOD chains
-        (``volviz.render.scene.IsoParts``), so that ``show_isosurfaces`` only makes actors."""
-        from volviz.render.scene import isosurface_parts
+        (``volviz.render.scene_builder.IsoParts``), so that ``show_isosurfaces`` only makes actors."""
+        from volviz.render.scene_builder import isosurface_parts
 
         meshes = self.extract_isosurfaces(comp_id, t, interpolate, progress)
         return isosurface_parts(self.component(comp_id), meshes=meshes, clip=self.session.clip)
@@ -399,7 +399,7 @@ class SceneController:
         ``extract_isosurfaces``, or better the ``isosurface_parts``, whose clipping and LOD chains were made off this
         thread and are redone here only when the clipping or opacity changed since); the overlay's meshes follow
         (not re-rendered)."""
-        from volviz.render.scene import IsoParts, add_isosurface_actors, isosurface_parts
+        from volviz.render.scene_builder import IsoParts, add_isosurface_actors, isosurface_parts
 
         with no_render(self.plotter):  # no render per added actor: the caller draws once afterwards
             for comp_id, surfaces in meshes.items():
@@ -531,14 +531,14 @@ class SceneController:
 
     def prepare_nature(self, progress: Any = None) -> Any:
         """Any thread: the NatureScene of the visible terrain / fog / clouds / sky components (None: none)."""
-        from volviz.render.scene import prepare_nature
+        from volviz.render.scene_builder import prepare_nature
 
         return prepare_nature(self.session, self.datasets)
 
     def install_nature(self, scene: Any, views: bool = True) -> Any:
         """GUI thread: show a ``prepare_nature`` result. With ``views`` its first view is computed now; otherwise
         the old terrain and overlay stay on screen until the new view's first ``finish_nature`` replaces them."""
-        from volviz.render.scene import install_nature, view_backend
+        from volviz.render.scene_builder import install_nature, view_backend
 
         old = self.props.pop("nature", None)
         backend = view_backend(self.plotter, self.session, "nature")
@@ -592,7 +592,7 @@ class SceneController:
         when ``cut_pt`` and re-rendered when ``update_pt``; the app instead cuts them in the background (``cut_pt_mesh``
         on a worker, then ``set_pt_mesh``) and re-renders.
         Isosurfaces are re-cut here when ``isosurfaces``; the app instead cuts them in the background
-        (``isosurface_meshes``, ``volviz.render.scene.isosurface_parts`` on a worker, ``show_isosurfaces``)."""
+        (``isosurface_meshes``, ``volviz.render.scene_builder.isosurface_parts`` on a worker, ``show_isosurfaces``)."""
         from volviz.iso.clip import ClipSettings
 
         self.session.clip = clip.to_dict() if isinstance(clip, ClipSettings) else self.clip.from_dict(clip).to_dict()
@@ -636,7 +636,7 @@ class SceneController:
     def cut_pt_mesh(self, comp_id: str, clip: Any = None, progress: Any = None) -> Any:
         """Any thread: the PT volume's uncut mesh cut by ``clip`` (default: the session's), exactly
         (``volviz.iso.clip.clip_tetmesh``), with its topology built; None when the clipping removes all of it."""
-        from volviz.render.scene import cut_tetmesh
+        from volviz.render.scene_builder import cut_tetmesh
 
         return cut_tetmesh(self.props[comp_id].whole_mesh, self.clip if clip is None else clip)
 
@@ -651,7 +651,7 @@ class SceneController:
 
     def _readd_isosurfaces(self, comp_id: str) -> None:
         """New actors for an isosurface component's already extracted surfaces (after a clip or opacity change)."""
-        from volviz.render.scene import add_isosurfaces
+        from volviz.render.scene_builder import add_isosurfaces
 
         prop = self.props[comp_id]
         self.plotter.remove_actor(prop, render=False)
@@ -684,7 +684,7 @@ class SceneController:
         """Draw the isosurfaces with VTK's blend ("vtk") or a mode of the note on the backend's ``iso_view`` (the CPU
         overlay is rendered now when ``update``; the app renders it in the background: ``iso_overlay.begin`` /
         ``compute`` / ``finish``)."""
-        from volviz.render.scene import view_backend
+        from volviz.render.scene_builder import view_backend
 
         if mode not in ISO_MODES:
             raise ValueError(f"unknown isosurface mode {mode!r}; choose from {ISO_MODES}")

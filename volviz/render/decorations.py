@@ -123,7 +123,7 @@ def _array_title(comp: Any, datasets: dict[str, Any]) -> str:
     shown = comp.settings.get(array_key(comp.type))
     if shown:
         return _readable(str(shown))
-    from volviz.render.scene import SceneError, component_dataset
+    from volviz.render.scene_builder import SceneError, component_dataset
 
     try:
         shown = component_dataset(comp, datasets)

@@ -1,5 +1,5 @@
-"""The built-in demo scene as a session: the procedural natural scene (``volviz.nature.scene.demo_scene``) written
-as session components, with no datasets."""
+"""The built-in demo scene as a session: the procedural natural scene (``volviz.nature.nature_scene.demo_scene``)
+written as session components, with no datasets."""
 from __future__ import annotations
 
 from volviz.session import Component

@@ -166,7 +166,7 @@ def render_session(session: Session, session_file: Optional[str | os.PathLike], 
                    progress: Optional[ProgressCallback] = None,
                    datasets: Optional[dict[str, Any]] = None) -> np.ndarray:
     """Render a session offscreen (its datasets read now unless given); returns the (H, W, 3) uint8 image."""
-    from volviz.render.scene import load_datasets
+    from volviz.render.scene_builder import load_datasets
 
     datasets = load_datasets(session, session_file, progress, loaded=datasets)
     report(progress, 0.8, "rendering")
@@ -186,7 +186,7 @@ def open_target(target: str | os.PathLike, array: Optional[str] = None,
     file shown with the array spec ``array`` (``volviz.model.arrays``) and the PLOT3D solution file ``q``. A member
     of a numbered series opens the whole series at that member's time step (``data_session``)."""
     from volviz.model.settings import array_key
-    from volviz.render.scene import data_session, demo_session, demo_volume_session
+    from volviz.render.scene_builder import data_session, demo_session, demo_volume_session
     from volviz.session import load
 
     if str(target) in ("demo", "demo-volume"):
@@ -260,7 +260,7 @@ def movie_frames(controller: Any, path_name: Optional[str], fps: float, through_
     cameras: list[Optional[Any]] = [None]
     if path_name is not None:
         if path_name not in session.camera_paths:
-            from volviz.render.scene import SceneError
+            from volviz.render.scene_builder import SceneError
 
             known = ", ".join(sorted(session.camera_paths)) or "none"
             raise SceneError(f"the session has no camera path named {path_name!r} (it has: {known})")
@@ -309,7 +309,7 @@ def render_movie(session: Session, session_file: Optional[str | os.PathLike], ou
     """Render a movie offscreen (``movie_frames``): MP4/MOV (H.264 through imageio-ffmpeg) for ``.mp4``, ``.m4v``
     and ``.mov``, else a PNG sequence in the folder ``out`` (frame_00000.png, ...). The output and the size are
     checked first; the MP4 is written to a temporary file and renamed when complete."""
-    from volviz.render.scene import load_datasets
+    from volviz.render.scene_builder import load_datasets
 
     check_output(out, movie=True)
     check_image_size(size)

@@ -139,7 +139,8 @@ class PTVolume(OverlayView, PTView):
 
     def set_clip(self, clip: Any) -> bool:
         """Clipping is not done here: the caller shows an exact cut of ``whole_mesh`` as ``mesh``
-        (``volviz.render.scene.cut_tetmesh``, ``SceneController.set_pt_mesh``); returns False (``PTView.set_clip``)."""
+        (``volviz.render.scene_builder.cut_tetmesh``, ``SceneController.set_pt_mesh``); returns False
+        (``PTView.set_clip``)."""
         return False
 
     def remove(self) -> None:

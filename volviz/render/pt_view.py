@@ -27,7 +27,7 @@ class PTView:
 
     def set_clip(self, clip: Any) -> bool:
         """Clip by ``volviz.iso.clip.ClipSettings``. True: done; False: this view clips only by drawing a cut mesh,
-        which the caller makes (``volviz.render.scene.cut_tetmesh``) and sets as ``mesh``."""
+        which the caller makes (``volviz.render.scene_builder.cut_tetmesh``) and sets as ``mesh``."""
         raise NotImplementedError
 
     def update(self) -> Any:

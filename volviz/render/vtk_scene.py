@@ -202,7 +202,8 @@ def _add_surface(plotter: Any, grid: Any, tf: Any, opacity: float, name: Optiona
 
 def _add_image(plotter: Any, image: Image2D, name: Optional[str]) -> Any:
     """A 2D raster (a photo, a texture, a grey image) as a flat picture on the z = 0 plane, in its own colours (grey
-    levels for one channel). Height maps open as terrain scenes instead (``volviz.render.scene.terrain_session``)."""
+    levels for one channel). Height maps open as terrain scenes instead
+    (``volviz.render.scene_builder.terrain_session``)."""
     grid = image.to_pyvista()
     if image.channels >= 3:
         colors = np.asarray(image.data[..., :3], dtype=np.float64).reshape(-1, 3)

@@ -10,7 +10,7 @@ from conftest import data_file
 from volviz.iso.clip import BoxCrop, ClipPlane, ClipSettings
 from volviz.iso.composite import render
 from volviz.iso.extract import IsoStyle
-from volviz.iso.scene import IsoSettings, prepare, render_iso
+from volviz.iso.component import IsoSettings, prepare, render_iso
 from volviz.optics.metrics import max_abs
 from volviz.model.camera import Camera
 

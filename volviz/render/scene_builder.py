@@ -143,7 +143,7 @@ def load_datasets(session: Session, session_file: Optional[str | os.PathLike],
                   loaded: Optional[dict[str, Any]] = None, also: tuple[str, ...] = ()) -> dict[str, Any]:
     """Read every dataset that a visible component (or a component in ``also``) uses, once each, with progress;
     those already in ``loaded`` are kept (the dict is filled in and returned)."""
-    from volviz.nature.scene import nature_dataset_ids
+    from volviz.nature.nature_scene import nature_dataset_ids
 
     used = {c.dataset for c in session.components if (c.visible or c.id in also) and c.dataset is not None}
     used |= nature_dataset_ids([c for c in session.components if c.visible and c.type in NATURE_TYPES])
@@ -361,7 +361,7 @@ def prepare_nature(session: Session, datasets: dict[str, Any]) -> Any:
     components = [c for c in session.components if c.visible and c.type in NATURE_TYPES]
     if not components:
         return None
-    from volviz.nature.scene import scene_from_components
+    from volviz.nature.nature_scene import scene_from_components
 
     try:
         scene = scene_from_components(components, datasets)
@@ -381,7 +381,7 @@ def install_nature(plotter: Any, scene: Any, views: bool = True, backend: str = 
     if backend == "gpu":
         from volviz.render.gl_nature import GLNatureView as View
     else:
-        from volviz.nature.scene import NatureView as View
+        from volviz.nature.nature_scene import NatureView as View
 
     view = View(plotter, scene)
     if views:
