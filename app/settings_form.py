@@ -153,7 +153,7 @@ class _Editor:
         raise NotImplementedError
 
 
-class _Check(_Editor):
+class _CheckBox(_Editor):
     def __init__(self, edited: Callable[[], None]) -> None:
         super().__init__(QCheckBox(), edited)
         self.widget.toggled.connect(lambda _on: self.edited())
@@ -431,7 +431,7 @@ class SettingsForm(QWidget):
         if hints.get("array"):
             return _Choice(arrays(), edited)
         if annotation is bool:
-            return _Check(edited)
+            return _CheckBox(edited)
         if origin is Literal:
             return _Choice(typing.get_args(annotation), edited)
         if annotation in (int, float):

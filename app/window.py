@@ -26,7 +26,7 @@ from volviz_app.component_settings import edit_settings
 from volviz_app.clip_widget import ClipPlaneWidget
 from volviz_app.decoration_toggles import DecorationToggles
 from volviz_app.docks.clipping import ClippingDock
-from volviz_app.docks.render_settings import RENDERER_DEFAULTS, RenderSettings
+from volviz_app.docks.render_settings import RENDERER_DEFAULTS, RenderSettingsDock
 from volviz_app.gc_guard import GuiThreadCollector
 from volviz_app.help import HelpMenu
 from volviz_app.errors import hide_temporary_names, open_error
@@ -218,7 +218,7 @@ class MainWindow(CameraBookmarks, QMainWindow):
     def _build_docks(self) -> None:
         self.tf_editor = TransferFunctionEditor()
         self.scene_tree = SceneTree()
-        self.render_settings = RenderSettings()
+        self.render_settings = RenderSettingsDock()
         self.timeline = Timeline()
         self.statistics = Statistics()
         self.clipping = ClippingDock()

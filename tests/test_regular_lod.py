@@ -9,7 +9,7 @@ import pytest
 from volviz.model.datasets import RegularVolume
 from volviz.optics import TransferFunction
 from volviz.regular.codec import compress
-from volviz.regular.lod import Camera, LodTree, eq27_error
+from volviz.regular.lod import LodCamera, LodTree, eq27_error
 
 
 @pytest.fixture(scope="module")
@@ -38,7 +38,7 @@ def test_budget_respected_and_selection_partitions_the_volume(noisy):
     data, path = noisy
     tree = LodTree(path, volume=RegularVolume(data))
     assert tree.levels == 2
-    cam = Camera(eye=(300.0, 20.0, 40.0), target=(32.0, 32.0, 32.0), fov_y=40, height=512)
+    cam = LodCamera(eye=(300.0, 20.0, 40.0), target=(32.0, 32.0, 32.0), fov_y=40, height=512)
     for budget in (1, 7, 8, 15, 20, 40):
         sel = tree.select(cam, budget)
         assert 1 <= len(sel.nodes) <= budget
@@ -52,19 +52,19 @@ def test_closer_and_higher_error_nodes_refine_first(noisy):
     data, path = noisy
     tree = LodTree(path, volume=RegularVolume(data))
     # from far above (+z), all top-layer level-1 nodes have the same depth: the noisiest one refines first
-    top = Camera(eye=(32.0, 32.0, 5000.0), target=(32.0, 32.0, 0.0), fov_y=5, height=1024)
+    top = LodCamera(eye=(32.0, 32.0, 5000.0), target=(32.0, 32.0, 0.0), fov_y=5, height=1024)
     sel = tree.select(top, 15)
     refined = {k for k in sel.nodes if k[0] == 0}
     assert len(refined) == 8 and all(p[0] < 2 and p[1] < 2 and p[2] >= 2 for _, p in refined)
     errs = {p: tree.l2_error((1, p)) for p in [(a, b, 1) for a in (0, 1) for b in (0, 1)]}
     assert max(errs, key=errs.get) == (0, 0, 1)
     # close to the +x face, depth outweighs the 5x larger error of the noisy -x block: a +x node refines first
-    side = Camera(eye=(66.0, 16.0, 40.0), target=(0.0, 16.0, 40.0), fov_y=90, height=1024)
+    side = LodCamera(eye=(66.0, 16.0, 40.0), target=(0.0, 16.0, 40.0), fov_y=90, height=1024)
     sel = tree.select(side, 15)
     leaves = [p for lvl, p in sel.nodes if lvl == 0]
     assert leaves and all(p[0] >= 2 for p in leaves)
     # looking away from the volume: everything culled
-    away = Camera(eye=(120.0, 16.0, 16.0), target=(500.0, 16.0, 16.0))
+    away = LodCamera(eye=(120.0, 16.0, 16.0), target=(500.0, 16.0, 16.0))
     sel = tree.select(away, 50)
     assert sel.nodes == [] and sel.culled == 1
 
@@ -72,7 +72,7 @@ def test_closer_and_higher_error_nodes_refine_first(noisy):
 def test_full_budget_is_lossless_and_blocks_overlap_by_one_voxel(noisy):
     data, path = noisy
     tree = LodTree(path, cache_bytes=1 << 30)
-    cam = Camera(eye=(32.0, 32.0, 200.0), target=(32.0, 32.0, 0.0), fov_y=90, height=4096)
+    cam = LodCamera(eye=(32.0, 32.0, 200.0), target=(32.0, 32.0, 0.0), fov_y=90, height=4096)
     sel = tree.select(cam, 10_000)
     assert all(k[0] == 0 for k in sel.nodes) and len(sel.nodes) == 64
     assert np.array_equal(tree.reconstruct(sel), data.astype(np.int32))
@@ -87,7 +87,7 @@ def test_transparent_blocks_are_skipped(noisy):
     data, path = noisy
     tree = LodTree(path, volume=RegularVolume(data))
     tf = TransferFunction([150.0, 255.0], [[1, 1, 1], [1, 0, 0]], [0.0, 2.0])  # rho > 0 only above 150
-    cam = Camera(eye=(32.0, 32.0, 200.0), target=(32.0, 32.0, 0.0), fov_y=90, height=4096)
+    cam = LodCamera(eye=(32.0, 32.0, 200.0), target=(32.0, 32.0, 0.0), fov_y=90, height=4096)
     sel = tree.select(cam, 10_000, tf=tf, mode="tf")
     assert sel.skipped_transparent > 0
     cover = _covered(tree, sel)
@@ -138,7 +138,7 @@ def test_prefetch_in_a_worker_thread_fills_the_cache(noisy):
 
     data, path = noisy
     tree = LodTree(path, volume=RegularVolume(data))
-    cam = Camera(eye=(32.0, 32.0, 200.0), target=(32.0, 32.0, 0.0), fov_y=90, height=4096)
+    cam = LodCamera(eye=(32.0, 32.0, 200.0), target=(32.0, 32.0, 0.0), fov_y=90, height=4096)
     sel = tree.select(cam, 64)
     with ThreadPoolExecutor(1) as ex:
         assert ex.submit(tree.prefetch, sel).result() == 1 + 8  # root's and the 8 level-1 nodes' bricks
@@ -150,7 +150,7 @@ def test_prefetch_in_a_worker_thread_fills_the_cache(noisy):
 def test_back_to_front_order(noisy):
     data, path = noisy
     tree = LodTree(path, volume=RegularVolume(data))
-    cam = Camera(eye=(300.0, 20.0, 40.0), target=(32.0, 32.0, 32.0), fov_y=40, height=512)
+    cam = LodCamera(eye=(300.0, 20.0, 40.0), target=(32.0, 32.0, 32.0), fov_y=40, height=512)
     order = tree.back_to_front(tree.select(cam, 8), cam)
     assert sorted(order) == sorted(tree.select(cam, 8).nodes)
     assert order[0][1][0] == 0 and order[-1][1][0] == 1  # the -x blocks first, the +x (near) ones last

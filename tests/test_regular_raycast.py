@@ -11,7 +11,7 @@ import pytest
 from conftest import blob_vvz
 from volviz.optics import TransferFunction
 from volviz.optics.metrics import max_abs, rmse
-from volviz.regular.lod import Block, Camera as LodCamera, LodTree, Selection
+from volviz.regular.lod import Block, LodCamera, LodTree, Selection
 from volviz.regular.raycast import block_active, pack_blocks, render_blocks, render_reference, sub_active
 from volviz.regular.wavelet import HALF
 from volviz.model.camera import Camera

@@ -19,7 +19,7 @@ RENDERER_DEFAULTS = {"sort": "mpvo", "table": "auto", "table_resolution": 128,  
                      "backend": "auto"}
 
 
-class RenderSettings(QWidget):
+class RenderSettingsDock(QWidget):
     """Edits ``session.render``; emits ``changed(dict)`` with the new settings."""
 
     changed = Signal(dict)

@@ -334,7 +334,7 @@ def _lod_walkthrough(vol: np.ndarray, tmp: Path, budgets: Sequence[int], frames:
     from volviz.model.datasets import RegularVolume
     from volviz.optics import TransferFunction
     from volviz.regular.codec import compress
-    from volviz.regular.lod import Camera, LodTree
+    from volviz.regular.lod import LodCamera, LodTree
 
     path = tmp / "lod.vvz"
     compress(RegularVolume(np.asfortranarray(vol)), path, quality=80)
@@ -350,7 +350,7 @@ def _lod_walkthrough(vol: np.ndarray, tmp: Path, budgets: Sequence[int], frames:
         for f in range(frames + 1):
             ang = 2 * math.pi * f / 24
             eye = c + 1.6 * float(vol.shape[0]) * np.array([math.cos(ang), math.sin(ang), 0.3])
-            cam = Camera(eye=tuple(eye), target=tuple(c), fov_y=30, width=512, height=512)
+            cam = LodCamera(eye=tuple(eye), target=tuple(c), fov_y=30, width=512, height=512)
             before = tree.decoder.decoded_bricks
             t0 = time.perf_counter()
             sel = tree.select(cam, budget, tf=tf, mode="tf")

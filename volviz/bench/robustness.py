@@ -593,7 +593,7 @@ def worker(side: str) -> None:
         out.write(json.dumps(answer) + "\n")
 
 
-class Worker:
+class BenchWorker:
     """The parent's end of a worker child with a memory limit; a request that outlives ``seconds`` kills it."""
 
     def __init__(self, side: str, memory: int, seconds: float, folder: Path) -> None:
@@ -720,7 +720,8 @@ def run(data: Path, total: int, seed: int, formats: list[str] | None, minutes: f
     contained: Counter = Counter()
     with tempfile.TemporaryDirectory(prefix="volviz-bench-robustness-") as tmp:
         base = Path(tmp)
-        sides = {"volviz": Worker("volviz", 6 << 30, 40.0, base), "vtk": Worker("vtk", 3 << 30, VTK_SECONDS, base)}
+        sides = {"volviz": BenchWorker("volviz", 6 << 30, 40.0, base),
+                 "vtk": BenchWorker("vtk", 3 << 30, VTK_SECONDS, base)}
         index = {id(s): i for i, s in enumerate(srcs)}
         originals: dict[tuple[int, str], Optional[dict]] = {}
         done = 0
@@ -794,7 +795,7 @@ def run(data: Path, total: int, seed: int, formats: list[str] | None, minutes: f
 RETIME_REPS = 3
 
 
-def _retime(slow: list[tuple[Source, tuple, float]], worker: "Worker", base: Path, index: dict[int, int],
+def _retime(slow: list[tuple[Source, tuple, float]], worker: "BenchWorker", base: Path, index: dict[int, int],
             addresses: dict[int, list[int]]) -> list[dict]:
     """Each volviz refusal that took 1 s or more, read again ``RETIME_REPS`` times after the campaign: the median
     tells a slow check from a moment of load on the shared machine (or a reader child that was starting after a

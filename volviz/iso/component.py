@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 from typing import Any, Callable, Optional, Sequence
 
 from volviz.iso.clip import ClipSettings, clip_isosurfaces, clip_volume
-from volviz.iso.composite import MODES, RenderStats, render
+from volviz.iso.composite import MODES, IsoRenderStats, render
 from volviz.iso.extract import IsoMesh, IsoStyle, extract
 from volviz.iso.lod import LodChain, build_lod, lod_meshes
 from volviz.model.datasets import RegularVolume, TimeSeries
@@ -112,7 +112,7 @@ def prepare(dataset: Any, settings: IsoSettings, t: float | None = None,
 
 def render_iso(prepared: Sequence[PreparedIso], settings: Sequence[IsoSettings] | IsoSettings, camera: Camera,
                size: tuple[int, int] = (512, 512), mode: str | None = None,
-               background: Sequence[float] = (0.0, 0.0, 0.0, 0.0)) -> tuple[Any, RenderStats]:
+               background: Sequence[float] = (0.0, 0.0, 0.0, 0.0)) -> tuple[Any, IsoRenderStats]:
     """Per view: all components' surfaces (LOD chosen per surface) pooled into ONE set of passes (note §4).
 
     ``mode`` defaults to the first component's; shading likewise. Returns the premultiplied float RGBA image

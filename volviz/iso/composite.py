@@ -35,7 +35,7 @@ from volviz.iso.raster import clip_near_plane, rasterize
 from volviz.iso.spectrum import fit_spectrum, spectrum_alpha
 from volviz.model.camera import Camera
 
-__all__ = ["MODES", "Fragments", "fragments", "composite", "render", "render_modes", "RenderStats"]
+__all__ = ["MODES", "Fragments", "fragments", "composite", "render", "render_modes", "IsoRenderStats"]
 
 MODES = ("2pass", "3pass", "4pass", "exact")
 _MODE_ID = {"exact": 0, "2pass": 1, "3pass": 2, "4pass": 3}
@@ -58,7 +58,7 @@ class Fragments:
 
 
 @dataclass
-class RenderStats:
+class IsoRenderStats:
     mode: str
     seconds: float
     triangles: int
@@ -217,12 +217,12 @@ def triangles_drawn(frags: Fragments, mode: str) -> int:
 
 def render(meshes: Sequence[IsoMesh], camera: Camera, size: tuple[int, int] = (256, 256), mode: str = "exact",
            background: Sequence[float] = (0.0, 0.0, 0.0, 0.0), shading: str = "spectrum", lighting: bool = True
-           ) -> tuple[np.ndarray, RenderStats]:
+           ) -> tuple[np.ndarray, IsoRenderStats]:
     """Rasterise and composite in one call: image (H, W, 4) premultiplied float64 and its statistics."""
     t0 = time.perf_counter()
     fr = fragments(meshes, camera, size, shading=shading, lighting=lighting)
     img = composite(fr, mode, background)
-    return img, RenderStats(mode, time.perf_counter() - t0, fr.n_triangles, triangles_drawn(fr, mode), len(fr.depth))
+    return img, IsoRenderStats(mode, time.perf_counter() - t0, fr.n_triangles, triangles_drawn(fr, mode), len(fr.depth))
 
 
 def render_modes(meshes: Sequence[IsoMesh], camera: Camera, size: tuple[int, int] = (256, 256),

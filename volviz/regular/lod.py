@@ -3,7 +3,7 @@
 Usage (the render layer)::
 
     tree = LodTree("head.vvz", cache_bytes=256 << 20)     # statistics: one full decode, or pass volume=
-    cam = Camera(eye=(..), target=(..), fov_y=30, height=512)
+    cam = LodCamera(eye=(..), target=(..), fov_y=30, height=512)
     sel = tree.select(cam, budget=512, tf=tf)             # greedy refinement, transparent blocks skipped
     for block in tree.blocks(sel):                        # decoded via the LRU cache, one-voxel overlap
         block.origin, block.spacing, block.data           # a float32 brick to draw as its own volume
@@ -43,8 +43,9 @@ from .nodes import HALF, Key, LevelStats, NodeDecoder, node_statistics
 
 
 @dataclass(frozen=True)
-class Camera:
-    """Pinhole camera in world coordinates: vertical field of view ``fov_y`` (degrees), image ``width x height``."""
+class LodCamera:
+    """The selection's pinhole camera in world coordinates: vertical field of view ``fov_y`` (degrees) and the image
+    ``width x height`` the pixel error is measured in (``volviz.model.camera.Camera`` carries no image size)."""
     eye: tuple[float, float, float]
     target: tuple[float, float, float]
     up: tuple[float, float, float] = (0.0, 0.0, 1.0)
@@ -264,7 +265,7 @@ class LodTree:
         return float(self._tf_err[level][key[1]])
 
     # -- selection -------------------------------------------------------------------------------------------------
-    def select(self, camera: Camera, budget: int, tf: Any = None, mode: str = "l2",
+    def select(self, camera: LodCamera, budget: int, tf: Any = None, mode: str = "l2",
                max_error: float = 0.0) -> Selection:
         """Greedy refinement under a block budget (see the module docstring)."""
         if budget < 1:
@@ -340,7 +341,7 @@ class LodTree:
         sel.priority = chosen
         return sel
 
-    def back_to_front(self, selection: Selection, camera: Camera) -> list[Key]:
+    def back_to_front(self, selection: Selection, camera: LodCamera) -> list[Key]:
         """The selected nodes sorted by decreasing distance of their box centres from the eye (the drawing order
         for "over" compositing of non-overlapping blocks, §2.3.6)."""
         e = np.asarray(camera.eye, float)

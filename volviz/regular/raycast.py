@@ -210,7 +210,7 @@ def segment_table(tf: TransferFunction, s_range: tuple[float, float], l_max: flo
 
 
 def as_camera(camera: Any) -> Camera:
-    """A ``volviz.model.camera.Camera`` from itself or a ``volviz.regular.lod.Camera`` (pinhole)."""
+    """A ``volviz.model.camera.Camera`` from itself or a ``volviz.regular.lod.LodCamera`` (pinhole)."""
     if isinstance(camera, Camera):
         return camera
     if hasattr(camera, "eye") and hasattr(camera, "fov_y"):

@@ -43,7 +43,7 @@ from typing import Any, Optional
 
 import numpy as np
 
-from volviz.regular.lod import Block, Camera as LodCamera, LodTree, Selection
+from volviz.regular.lod import Block, LodCamera, LodTree, Selection
 from volviz.render.vtk_scene import update_volume_property, vtk_volume_property
 from volviz.render.image_overlay import ImageOverlay, unpremultiply_rgba8, zbuffer_to_depth
 

@@ -9,9 +9,9 @@ Sorting for the next camera can run in a worker thread (the Numba kernels releas
 ``visibility_order(mesh, camera, size).order`` is then passed to ``render(..., order=...)``.
 """
 from volviz.model.camera import Camera
-from volviz.unstructured.render import RenderStats, render
+from volviz.unstructured.render import UnstructuredRenderStats, render
 from volviz.unstructured.sort import SortResult, visibility_order
 from volviz.unstructured.tetrahedralize import TetrahedralizeReport, tetrahedralize
 
-__all__ = ["Camera", "RenderStats", "SortResult", "TetrahedralizeReport", "render", "tetrahedralize",
+__all__ = ["Camera", "UnstructuredRenderStats", "SortResult", "TetrahedralizeReport", "render", "tetrahedralize",
            "visibility_order"]

@@ -101,8 +101,8 @@ def render_path(mesh: TetMesh, tf: Any, cameras: Sequence[Camera], size: tuple[i
                 sort: str = "mpvo", nonconvex: str = "auto", runner: Optional[JobRunner] = None,
                 **render_opts: Any) -> Iterator[tuple[np.ndarray, Any]]:
     """Render ``cameras`` in order with ``volviz.unstructured.render(method="pt")``, sorting camera i + 1 in the
-    background while frame i rasterises. Yields ``(image, RenderStats)``; ``stats.sort_s`` is then only the wait for
-    the prefetched order plus the zero-opacity filter, and ``stats.extra["sort_prefetched"]`` says whether the
+    background while frame i rasterises. Yields ``(image, UnstructuredRenderStats)``; ``stats.sort_s`` is then only the
+    wait for the prefetched order plus the zero-opacity filter, and ``stats.extra["sort_prefetched"]`` says whether the
     order came from the background. Images equal those of separate ``render`` calls exactly."""
     from volviz.unstructured.render import render
 

@@ -11,7 +11,7 @@ Methods:
 - ``"reference"``: the exact float64 ray caster (``reference``).
 
 The image is premultiplied float RGBA (H, W, 4), row 0 at the top; ``size`` is (W, H). With ``return_stats=True`` the
-call returns ``(image, RenderStats)`` with the time split into sort / project / raster seconds.
+call returns ``(image, UnstructuredRenderStats)`` with the time split into sort / project / raster seconds.
 """
 from __future__ import annotations
 
@@ -55,7 +55,7 @@ class Preclassified:
 
 
 @dataclass
-class RenderStats:
+class UnstructuredRenderStats:
     """Timings (seconds) and counts of one frame."""
 
     method: str
@@ -120,7 +120,8 @@ def render(mesh: TetMesh, tf: Any, camera: Camera, size: tuple[int, int] = (512,
            sort: str = "mpvo", nonconvex: str = "auto", order: np.ndarray | None = None, lookup: str = "auto",
            n_s: int | None = None, n_l: int = 64, degree: int | None = None, table: Any = None, t_min: float = 1e-3,
            depth: np.ndarray | None = None, iso: Any = None, iso_mode: str = "exact", iso_shading: str = "flat",
-           classification: str = "post", return_stats: bool = False) -> np.ndarray | tuple[np.ndarray, RenderStats]:
+           classification: str = "post", return_stats: bool = False
+           ) -> np.ndarray | tuple[np.ndarray, UnstructuredRenderStats]:
     """Render ``mesh`` with transfer function ``tf`` seen by ``camera`` into a (H, W, 4) premultiplied RGBA image.
 
     ``order`` (a back-to-front cell order, e.g. from a background sort) skips the sort. ``lookup`` picks the
@@ -164,7 +165,7 @@ def render(mesh: TetMesh, tf: Any, camera: Camera, size: tuple[int, int] = (512,
     if isinstance(camera, dict):
         camera = Camera.from_dict(camera)
     w, h = (int(v) for v in size)
-    stats = RenderStats(method, (w, h), n_tets=mesh.n_cells)
+    stats = UnstructuredRenderStats(method, (w, h), n_tets=mesh.n_cells)
     t_start = time.perf_counter()
     if iso is not None and method == "pt-st":
         raise ValueError('isosurfaces need method "pt" or "reference"')
