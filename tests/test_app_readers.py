@@ -198,3 +198,27 @@ def test_non_finite_values_open_and_are_counted_once_in_the_status_bar(qtbot, ma
     assert text == "Showing holes.vti — 29 non-finite values in density (drawn transparent)"
     assert text.count("non-finite") == 1
     assert data_share(window) > 0.05
+
+
+def test_a_read_warning_reaches_the_status_bar_each_time_the_file_opens(qtbot, make_window, tmp_path: Path) -> None:
+    """tos_O1 with its dimension ``lat`` renamed ``lau`` (a one-bit flip): valid netCDF, but VTK's CF reader takes the
+    latitudes for data. The window says so (the file's name and the doubt; the full path in the tooltip), again on a
+    second open of the same file, and not for the next file, which reads cleanly."""
+    data = data_file("ecosystem/tos_O1_2001-2002.nc").read_bytes()
+    at = data.index(b"\x00\x00\x00\x03lat")
+    path = tmp_path / "lau.nc"
+    path.write_bytes(data[:at + 4] + b"lau" + data[at + 7:])
+
+    window = small_window(make_window)
+    for _ in range(2):
+        window.open_path(path)
+        wait_loaded(qtbot, window)
+        assert window.error_dialog is None, window.error_dialog.text()
+        text = window.status_label.text()
+        assert text.startswith("Showing lau.nc — lau.nc: variable 'lat' has cell bounds ('lat_bnds') as a coordinate "
+                               "has, but it is not one"), text
+        assert text.endswith("…") and len(text) < 200
+        assert window.status_label.toolTip().startswith(f"{path}: variable 'lat' has cell bounds")
+    window.open_path(data_file("volumes/neghip.slc"))
+    wait_loaded(qtbot, window)
+    assert window.status_label.text() == "Showing neghip.slc" and window.status_label.toolTip() == ""

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import shutil
 import struct
+import warnings
 
 import numpy as np
 import pytest
@@ -82,6 +83,59 @@ def test_netcdf_bounds_naming_a_missing_variable_is_refused(tmp_path):
     with pytest.raises(vio.ReadError, match=r"bounds\.nc: netCDF: malformed netCDF header \(variable 'lon' names "
                                             r"'bounds_lom' in its 'bounds' attribute, but the file has no variable"):
         vio.read(bad)
+
+
+TOS = "ecosystem/tos_O1_2001-2002.nc"
+
+
+def _renamed_dimension(data: bytes, old: bytes, new: bytes) -> bytes:
+    """A CDF-1 file whose dimension ``old`` is called ``new`` (a one-bit flip in the fuzz campaign): still valid
+    netCDF, but the coordinate variable ``old`` is no longer on a dimension of its own name."""
+    at = data.index(struct.pack(">I", len(old)) + old)
+    assert at < 64  # the dimension list comes first in the header
+    return data[:at + 4] + new + data[at + 4 + len(new):]
+
+
+def test_netcdf_coordinate_whose_dimension_was_renamed_is_read_with_a_warning(tmp_path):
+    """``lat`` renamed ``lau`` in the dimension list: VTK's CF reader then takes the latitudes for the data and shows a
+    line of 170 points instead of the 180x170 map; the read says so, naming the file and the variable."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", vio.ReadWarning)  # the valid file warns of nothing
+        original = vio.read(data_file(TOS))
+    bad = tmp_path / "lau.nc"
+    bad.write_bytes(_renamed_dimension(data_file(TOS).read_bytes(), b"lat", b"lau"))
+    with pytest.warns(vio.ReadWarning, match=r"lau\.nc: variable 'lat' has cell bounds \('lat_bnds'\) as a "
+                                             r"coordinate has, but it is not one: it is on dimension 'lau'"):
+        misread = vio.read(bad)
+    assert misread.n_points == 170 and original.frame(0).n_points == 181 * 171
+
+
+def test_netcdf_auxiliary_coordinates_with_bounds_warn_of_nothing(tmp_path):
+    """2D latitudes named in the data's ``coordinates`` attribute (CF §5.2) may have bounds; a coordinate variable of
+    its own dimension too. A variable with bounds that is neither is the doubtful case."""
+    from volviz_vtk_readers.containers import _cf_notes
+
+    coord = ("lat", ["lat"], {"bounds": "lat_bnds"})
+    aux = ("lat2d", ["y", "x"], {"bounds": "lat2d_v"})
+    data = ("t", ["y", "x"], {"coordinates": "lat2d"})
+    assert _cf_notes([coord, aux, data]) == []
+    notes = _cf_notes([coord, aux, ("t", ["y", "x"], {})])
+    assert len(notes) == 1 and notes[0].startswith("variable 'lat2d' has cell bounds ('lat2d_v')") \
+        and "on dimensions ('y', 'x')" in notes[0]
+
+
+def test_the_fuzz_campaign_counts_a_warned_read_apart_from_silent_garbage(tmp_path):
+    from volviz.bench import robustness as rb
+
+    bad = tmp_path / "lau.nc"
+    bad.write_bytes(_renamed_dimension(data_file(TOS).read_bytes(), b"lat", b"lau"))
+    answer = rb._serve_volviz({"path": str(bad), "options": {}})
+    assert answer["status"] == "ok" and "variable 'lat' has cell bounds" in answer["warned"]
+    original = rb._serve_volviz({"path": str(data_file(TOS)), "options": {}})
+    assert original["warned"] == "" and original["n_points"] != answer["n_points"]
+    mutation = rb.Mutation("bitflip", "bits flipped at [34]", None)
+    assert rb._judge(answer, original, mutation) == "warned"
+    assert rb._judge({**answer, "warned": ""}, original, mutation) == "garbage"
 
 
 @pytest.mark.parametrize("version", [1, 2])

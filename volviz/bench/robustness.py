@@ -536,11 +536,13 @@ def _serve_volviz(request: dict) -> dict:
         options["q"] = os.path.join(os.path.dirname(request["path"]), options["q"])
     if "dims" in options:
         options["dims"] = tuple(options["dims"])
-    with warnings.catch_warnings():
+    with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("ignore")
+        warnings.simplefilter("always", vio.ReadWarning)  # a doubt the reader states is not silent
         try:
             result = vio.read(request["path"], **options)
-            return {"status": "ok", **fingerprint_volviz(result)}
+            warned = next((str(w.message)[:300] for w in caught if issubclass(w.category, vio.ReadWarning)), "")
+            return {"status": "ok", **fingerprint_volviz(result), "warned": warned}
         except vio.ReadError as exc:  # naming the file read or the file beside it that is wrong
             return {"status": "error", "message": str(exc)[:300],
                     "named": str(exc).startswith(os.path.dirname(request["path"]))}
@@ -686,7 +688,7 @@ def mutated_path(src: Source, folder: Path) -> Path:
 
 
 def _judge(answer: dict, original: Optional[dict], mutation: Mutation) -> str:
-    """The outcome of one read: clean, exception, crash, hang, memory, garbage or accepted."""
+    """The outcome of one read: clean, exception, crash, hang, memory, garbage, warned or accepted."""
     status = answer["status"]
     if status == "error":
         return "clean" if answer.get("named", True) else "exception"
@@ -694,6 +696,8 @@ def _judge(answer: dict, original: Optional[dict], mutation: Mutation) -> str:
         return status
     if answer.get("problem"):
         return "garbage"
+    if answer.get("warned"):
+        return "warned"  # read, with a ReadWarning naming the file and what is doubtful
     if original is None:
         return "accepted"
     same = (answer["n_points"], answer["crc"]) == (original["n_points"], original["crc"])
@@ -704,7 +708,7 @@ def _judge(answer: dict, original: Optional[dict], mutation: Mutation) -> str:
     return "accepted"
 
 
-OUTCOMES = ("clean", "exception", "crash", "hang", "memory", "garbage", "accepted")
+OUTCOMES = ("clean", "exception", "crash", "hang", "memory", "garbage", "warned", "accepted")
 
 
 def run(data: Path, total: int, seed: int, formats: list[str] | None, minutes: float = 0.0,
@@ -776,7 +780,7 @@ def run(data: Path, total: int, seed: int, formats: list[str] | None, minutes: f
                 if outcome not in ("clean", "accepted") and len(examples[(src.fmt, side, outcome)]) < 5:
                     examples[(src.fmt, side, outcome)].append(
                         {"file": src.name, "mutation": mutation.kind, "detail": mutation.detail[:160],
-                         "message": answer.get("message", "")[:240]})
+                         "message": (answer.get("message") or answer.get("warned", ""))[:240]})
             if progress and (n + 1) % 200 == 0:
                 rate = (n + 1) / (time.perf_counter() - t_start)
                 print(f"{n + 1}/{len(todo)} cases, {rate:.1f}/s", file=sys.stderr, flush=True)
@@ -870,7 +874,9 @@ def report(result: dict, command: str) -> str:
         "`VOLVIZ_READ_SECONDS=10` for its own reader child; VTK 5 s). *clean*: volviz's `ReadError` naming the "
         "file, VTK's error message or empty output; *garbage*: a read that succeeds although the truncated file "
         "lost data, or with a grid size other than the original's, or with inconsistent arrays or non-finite "
-        "spacing/origin; *accepted*: a read of the original's size (a flipped data bit cannot be told apart); "
+        "spacing/origin; *warned*: a read that succeeds with a `ReadWarning` naming the file and what will be "
+        "shown other than meant (e.g. a CF coordinate the reader takes for data); *accepted*: a read of the "
+        "original's size (a flipped data bit cannot be told apart); "
         "*contained*: volviz refusals where its reader child crashed, ran out of memory or time (VTK's failure "
         "caught by the isolation, not by a header check).",
         "",
@@ -880,9 +886,9 @@ def report(result: dict, command: str) -> str:
         "",
         "### Per format: volviz | VTK",
         "",
-        "| format | cases | clean | other exceptions | crashes | hangs | memory | garbage | accepted | slowest "
-        "refusal | contained |",
-        "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
+        "| format | cases | clean | other exceptions | crashes | hangs | memory | garbage | warned | accepted | "
+        "slowest refusal | contained |",
+        "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
     fmts = sorted({k.split("|")[0] for k in result["stats"]})
     for fmt in fmts:

@@ -28,7 +28,7 @@ from __future__ import annotations
 import functools
 from typing import Any
 
-from volviz.io.errors import NonFiniteWarning, PathLike, ReadError
+from volviz.io.errors import NonFiniteWarning, PathLike, ReadError, ReadWarning
 from volviz.io.raw import read_raw, read_slice_stack
 from volviz.io.registry import (ReaderSpec, call_reader, format_of, is_pattern, open_dialog_filter, reader_specs,
                                 supported_formats)
@@ -68,7 +68,8 @@ def __getattr__(name: str):
 
 
 __all__ = [
-    "NonFiniteWarning", "ReadError", "ReaderSpec", "reader_specs", "expand_pattern", "open_dialog_filter", "read",
-    "read_dem", "read_image", "read_meshio", "read_metaimage", "read_plot3d", "read_pnm", "read_pvm", "read_raw",
-    "read_series", "read_slc", "read_slice_stack", "read_vtk_file", "read_vtkhdf", "supported_formats",
+    "NonFiniteWarning", "ReadError", "ReadWarning", "ReaderSpec", "reader_specs", "expand_pattern",
+    "open_dialog_filter", "read", "read_dem", "read_image", "read_meshio", "read_metaimage", "read_plot3d",
+    "read_pnm", "read_pvm", "read_raw", "read_series", "read_slc", "read_slice_stack", "read_vtk_file", "read_vtkhdf",
+    "supported_formats",
 ]

@@ -25,6 +25,11 @@ class ReadError(Exception):
         return (type(self), (self.path, self.problem, self.advice))
 
 
+class ReadWarning(UserWarning):
+    """A file was read, but something in it will likely be shown other than its author meant (a coordinate the reader
+    takes for data, an orientation that is ignored): the message names the file and the doubt."""
+
+
 class NonFiniteWarning(UserWarning):
     """Emitted when a reader was called with ``allow_nonfinite=True`` and the data holds NaN or Inf values."""
 

@@ -14,7 +14,7 @@ import warnings
 import numpy as np
 
 from volviz.io._checks import check_finite
-from volviz.io.errors import PathLike, ReadError
+from volviz.io.errors import PathLike, ReadError, ReadWarning
 from volviz.model import CELL_SIZES, CurvilinearGrid, RegularVolume, UnstructuredMesh
 
 _VTK_POLYHEDRON = 42
@@ -174,7 +174,7 @@ def _image(path: PathLike, obj, allow_nonfinite: bool) -> RegularVolume:
     direction = np.array([obj.GetDirectionMatrix().GetElement(i, j) for i in range(3) for j in range(3)])
     if not np.allclose(direction, np.eye(3).ravel()):
         warnings.warn(f"{path}: image direction matrix {direction.tolist()} is ignored (volumes are "
-                      "axis-aligned)", UserWarning, stacklevel=3)
+                      "axis-aligned)", ReadWarning, stacklevel=3)
     for what, values in (("origin", obj.GetOrigin()), ("spacing", obj.GetSpacing())):
         if not np.all(np.isfinite(values)):
             raise ReadError(path, f"image {what} {tuple(values)} is not finite")

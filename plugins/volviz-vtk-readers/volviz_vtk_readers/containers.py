@@ -9,10 +9,11 @@ it) sees it.
 from __future__ import annotations
 
 import struct
+import warnings
 from pathlib import Path
 
 from volviz.io._checks import check_file, describe_bytes, read_bytes
-from volviz.io.errors import PathLike, ReadError
+from volviz.io.errors import PathLike, ReadError, ReadWarning
 
 HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 NETCDF_MAGICS = (b"CDF\x01", b"CDF\x02", b"CDF\x05")
@@ -87,6 +88,11 @@ class _Cursor:
 
 
 def _netcdf_end(data: bytes) -> int:
+    """The number of bytes the variables of a netCDF classic file reach (``_netcdf_layout``)."""
+    return _netcdf_layout(data)[0]
+
+
+def _netcdf_layout(data: bytes) -> tuple[int, list[str]]:
     """The number of bytes the variables of a netCDF classic file reach, after checking the header's layout against
     itself (EOFError if ``data`` is too short to hold the header; ValueError naming the first inconsistency).
     Names are UTF-8 text without control characters; the CF attributes a reader interprets (``units``, ``axis``,
@@ -97,26 +103,29 @@ def _netcdf_end(data: bytes) -> int:
     From the netCDF classic format specification (the ``vsize`` and ``begin`` of each variable): a variable's
     ``vsize`` is the product of its dimension lengths (the record dimension left out) times the size of its type,
     rounded up to 4 bytes, or 2^32-1 for a variable too large for the field; every ``begin`` lies after the header;
-    the fixed-size variables do not overlap; the data ends with the last variable's unpadded values."""
+    the fixed-size variables do not overlap; the data ends with the last variable's unpadded values.
+
+    Also returns notes on what a CF reader will misread although the file is valid netCDF (``_cf_notes``)."""
     c = _Cursor(data, data[3])
     numrecs = c.count()
     tag, n_dims = c.int32(), c.count()
     if tag not in (0, 0x0A):
         raise ValueError(f"dimension list tag {tag:#x}")
-    dims = []
+    dims, dim_names = [], []
     for _ in range(n_dims):
-        c.name()
+        dim_names.append(c.name())
         dims.append(c.count())
     c.attributes()
     tag, n_vars = c.int32(), c.count()
     if tag not in (0, 0x0B):
         raise ValueError(f"variable list tag {tag:#x}")
-    variables, references = [], []
+    variables, references, cf_vars = [], [], []
     for _ in range(n_vars):
         name = c.name()
         ids = [c.count() for _ in range(c.count())]
         texts = c.attributes()
         references += [(name, key, ref) for key in _REFERENCES for ref in texts.get(key, "").split()]
+        cf_vars.append((name, ids, texts))
         nc_type = c.int32()
         vsize, begin = c.count(), c.offset()
         if any(i >= len(dims) for i in ids):
@@ -130,6 +139,7 @@ def _netcdf_end(data: bytes) -> int:
             exact *= dims[i]
         if vsize not in (exact, exact + (-exact % 4)) and not (vsize == 0xFFFFFFFF and exact > 0xFFFFFFFB):
             raise ValueError(f"variable {name!r} has {exact} bytes by its dimensions but a size field of {vsize}")
+        cf_vars[-1] = (name, [dim_names[i] for i in ids], texts)
         variables.append((name, begin, exact, exact + (-exact % 4), record))
     header_end = c.pos
     names = {v[0] for v in variables}
@@ -149,7 +159,27 @@ def _netcdf_end(data: bytes) -> int:
     if records and numrecs not in (0, 0xFFFFFFFF, -1):
         record_size = records[0][1] if len(records) == 1 else sum(p for _, _, p in records)
         end = max(end, max(b + e for b, e, _ in records) + (numrecs - 1) * record_size)
-    return end
+    return end, _cf_notes(cf_vars)
+
+
+def _cf_notes(variables: list[tuple[str, list[str], dict[str, str]]]) -> list[str]:
+    """What a CF reader will misread in a valid netCDF file: a variable with cell bounds (CF §7.1: the ``bounds``
+    attribute belongs to coordinates) that is neither a coordinate variable (one dimension of its own name, NUG §2.3.1,
+    CF §1.3) nor an auxiliary coordinate named in a ``coordinates`` attribute (CF §5). The file may be valid (CF does
+    not forbid ``bounds`` elsewhere), but a coordinate whose dimension or name was changed looks exactly like this, and
+    the reader then takes it for data: the grid shown is another one than the file's author meant."""
+    auxiliary = {ref for _, _, texts in variables for ref in texts.get("coordinates", "").split()}
+    notes = []
+    for name, dims, texts in variables:
+        bounds = texts.get("bounds", "").strip()
+        if not bounds or dims == [name] or name in auxiliary:
+            continue
+        on = f"dimension {dims[0]!r}" if len(dims) == 1 else f"dimensions {tuple(dims)!r}"
+        notes.append(f"variable {name!r} has cell bounds ({bounds!r}) as a coordinate has, but it is not one: it is on "
+                     f"{on}, not on a dimension of its own name, and no variable names it in a 'coordinates' "
+                     "attribute (CF §5, §7.1); the reader takes it for data, so the grid shown may not be the one "
+                     "the file's data variables are on")
+    return notes
 
 
 def _hdf5_end(path: PathLike, head: bytes) -> int:
@@ -168,8 +198,10 @@ def _hdf5_end(path: PathLike, head: bytes) -> int:
     return int.from_bytes(head[at:at + width], "little")
 
 
-def check_container(path: PathLike, what: str, netcdf: bool = True, hdf5: bool = True, adf: bool = False) -> Path:
-    """Check ``path`` is a regular file in one of the allowed containers and not shorter than its header says."""
+def check_container(path: PathLike, what: str, netcdf: bool = True, hdf5: bool = True, adf: bool = False,
+                    cf: bool = False) -> Path:
+    """Check ``path`` is a regular file in one of the allowed containers and not shorter than its header says. With
+    ``cf`` (a file read by CF conventions), a netCDF classic header's ``_cf_notes`` are emitted as ReadWarnings."""
     p = check_file(path)
     size = p.stat().st_size
     head = read_bytes(p, 65536)
@@ -177,7 +209,7 @@ def check_container(path: PathLike, what: str, netcdf: bool = True, hdf5: bool =
         data = head
         while True:
             try:
-                end = _netcdf_end(data)
+                end, notes = _netcdf_layout(data)
                 break
             except EOFError:
                 if len(data) >= min(size, _HEADER_LIMIT):
@@ -191,6 +223,8 @@ def check_container(path: PathLike, what: str, netcdf: bool = True, hdf5: bool =
         if end > size:
             raise ReadError(p, f"{what}: the netCDF header places data up to byte {end}, but the file holds {size} "
                                "bytes: the file is truncated")
+        for note in notes if cf else []:
+            warnings.warn(ReadWarning(f"{p}: {note}"), stacklevel=2)
         return p
     if hdf5 and head.startswith(HDF5_SIGNATURE):
         end = _hdf5_end(p, head)

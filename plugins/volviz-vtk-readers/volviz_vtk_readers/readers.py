@@ -339,7 +339,7 @@ def read_netcdf_cf(path: PathLike, dimensions: str | None = None, spherical: boo
                    time_index: int | None = None, allow_nonfinite: bool = True):
     """netCDF with CF conventions: every variable on ``dimensions`` (default: the reader's first set, e.g.
     ``"(lat, lon)"``); fill values become NaN; lat/lon grids on the unit sphere unless ``spherical=False``."""
-    check_container(path, "netCDF")
+    check_container(path, "netCDF", cf=True)
     reader = _reader("vtkNetCDFCFReader", path)
     reader.SetSphericalCoordinates(bool(spherical))
     reader.ReplaceFillValueWithNanOn()

@@ -33,7 +33,7 @@ from typing import Any
 
 import numpy as np
 
-from volviz.io.errors import NonFiniteWarning, PathLike, ReadError, human_bytes
+from volviz.io.errors import NonFiniteWarning, PathLike, ReadError, ReadWarning, human_bytes
 from volviz.io.isolated.codec import CodecError, array_specs, decode
 from volviz.io.isolated.worker import ChildDied, ChildTimedOut, Pool
 
@@ -42,7 +42,7 @@ WORKDIR_PREFIX = "volviz-read-"
 MAP_BYTES = 1 << 20  # arrays from this size on are mapped, smaller ones copied (each mapping costs a page and a slot)
 _FALSE = ("0", "false", "no", "off")
 _SIZE = re.compile(r"\s*(\d+(?:\.\d+)?)\s*([kmgt]?)i?b?\s*", re.I)
-_WARNINGS = {c.__name__: c for c in (NonFiniteWarning, UserWarning, RuntimeWarning, DeprecationWarning,
+_WARNINGS = {c.__name__: c for c in (NonFiniteWarning, ReadWarning, UserWarning, RuntimeWarning, DeprecationWarning,
                                      FutureWarning, ResourceWarning)}
 
 

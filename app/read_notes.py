@@ -1,0 +1,58 @@
+"""The read warnings of the files a scene shows: a ``volviz.io.ReadWarning`` (a file that was read but will likely be
+shown other than its author meant, e.g. a CF coordinate the reader takes for data) raised on any thread while the
+datasets load is kept by ``READ_NOTES`` until the scene is shown; ``NonFiniteStatus`` then puts it in the status bar.
+
+Warnings reach Python's ``warnings.showwarning`` on the thread that raised them (a background job's); the hook here
+keeps the ReadWarnings under a lock and passes every warning on to the handler it replaced (stderr by default)."""
+from __future__ import annotations
+
+import threading
+import warnings
+from pathlib import Path
+from typing import Any, Iterable
+
+from volviz.io import ReadWarning
+
+
+class ReadNotes:
+    """ReadWarning messages raised since the last ``take``."""
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self._notes: list[str] = []
+
+    def install(self) -> None:
+        """Hook ``warnings.showwarning`` (once; again after a ``warnings.catch_warnings`` block restored it) and show
+        every ReadWarning, not only the first from one place: a file opened again warns again."""
+        previous = warnings.showwarning
+        if getattr(previous, "read_notes", None) is self:
+            return
+
+        def show(message: Any, category: type[Warning], filename: str, lineno: int, file: Any = None,
+                 line: str | None = None) -> None:
+            if issubclass(category, ReadWarning):
+                with self._lock:
+                    self._notes.append(str(message))
+            previous(message, category, filename, lineno, file, line)
+
+        show.read_notes = self  # type: ignore[attr-defined]
+        warnings.showwarning = show
+        warnings.filterwarnings("always", category=ReadWarning)
+
+    def take(self, paths: Iterable[str] = ()) -> list[str]:
+        """The notes kept so far that name one of the files ``paths`` (by file name), without repeats; all are
+        forgotten (those of a scene that was replaced before it was shown included)."""
+        with self._lock:
+            notes, self._notes = self._notes, []
+        names = {Path(p).name for p in paths}
+        return [n for n in dict.fromkeys(notes) if any(name and name in n for name in names)]
+
+
+READ_NOTES = ReadNotes()
+
+
+def short_note(note: str, limit: int = 160) -> str:
+    """A ReadWarning for the status bar: the file's name instead of its full path, at most ``limit`` characters."""
+    head, sep, rest = note.partition(": ")
+    text = f"{Path(head).name}: {rest}" if sep and ("/" in head or "\\" in head) else note
+    return text if len(text) <= limit else text[:limit - 1].rstrip() + "…"
