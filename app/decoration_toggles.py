@@ -8,7 +8,7 @@ from typing import Any
 from PySide6.QtGui import QAction
 from PySide6.QtWidgets import QMenu
 
-TOGGLES = (("scalar_bar", "Scalar &Bar", "The colour legend of the shown array, with its name and range"),
+TOGGLES = (("scalar_bar", "Scalar &Bar", "The color legend of the shown array, with its name and range"),
            ("axes", "Orientation &Axes", "The x, y, z axes in the corner of the viewport"),
            ("outline", "&Outline Box", "The box around the data"))
 

@@ -201,12 +201,12 @@ def _slug(name: str) -> str:
     return "".join(c if c.isalnum() or c in "-_." else "_" for c in name.replace("/", "__"))
 
 
-def save_small_png(path: Path, colours: int = 256) -> None:
+def save_small_png(path: Path, colors: int = 256) -> None:
     """Rewrite ``path`` as an 8-bit palette PNG (a window grab shrinks 3-5 times, legibly)."""
     from PIL import Image
 
     with Image.open(path) as image:
-        small = image.convert("RGB").quantize(colors=colours, method=Image.Quantize.MEDIANCUT, dither=Image.Dither.NONE)
+        small = image.convert("RGB").quantize(colors=colors, method=Image.Quantize.MEDIANCUT, dither=Image.Dither.NONE)
     small.save(path, optimize=True)
 
 

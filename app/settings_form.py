@@ -2,13 +2,13 @@
 
 One row per field of the model: its title as the label, its description as the tooltip, and an editor chosen by the
 field's type: a check box (bool), a combo box of the choices (``Literal``), a spin box with the field's bounds and
-unit (int, float), a row of spin boxes (fixed-length tuples), a colour button (``{"colour": True}``), a combo box of
+unit (int, float), a row of spin boxes (fixed-length tuples), a color button (``{"color": True}``), a combo box of
 the session's datasets (``{"dataset": True}``) or of the dataset's arrays (``{"array": True}``), a table of surfaces
 (the isosurfaces' ``styles``); a nested object without a model (the isosurfaces' clipping) is shown read-only.
 
 A field the session sets has its label ticked; unticking it removes the key, so the model's default applies again
 (sessions store only the settings that were set). Every committed edit (a spin box's editing finished, a combo box's
-or check box's change, a colour chosen) is checked with ``typed_settings`` first: a refused value shows the problem
+or check box's change, a color chosen) is checked with ``typed_settings`` first: a refused value shows the problem
 next to its field and changes nothing; an accepted one is emitted as the whole new settings dict (``committed``).
 """
 from __future__ import annotations
@@ -27,7 +27,7 @@ from PySide6.QtWidgets import (QAbstractSpinBox, QCheckBox, QColorDialog, QCombo
 
 from volviz.model.settings import IsoStyleSettings, SettingsError, settings_model, typed_settings
 
-__all__ = ["SettingsForm", "ColourButton", "FloatBox", "StylesTable", "field_bounds"]
+__all__ = ["SettingsForm", "ColorButton", "FloatBox", "StylesTable", "field_bounds"]
 
 DECIMALS = 6                      # digits after the point a float spin box keeps (trailing zeros are not shown)
 FLOAT_LIMIT = 1e9                 # the range of a float field without bounds
@@ -110,8 +110,8 @@ def _number_box(annotation: Any, info: Optional[FieldInfo] = None) -> QAbstractS
     return box
 
 
-class ColourButton(QPushButton):
-    """A button showing an RGB colour (components 0..1); clicking it opens a colour dialog (``dialog``), and a colour
+class ColorButton(QPushButton):
+    """A button showing an RGB color (components 0..1); clicking it opens a color dialog (``dialog``), and a color
     chosen there is shown and reported by ``chosen``."""
 
     chosen = Signal()
@@ -124,18 +124,18 @@ class ColourButton(QPushButton):
 
     def set_rgb(self, rgb: Sequence[float]) -> None:
         self.rgb = (float(rgb[0]), float(rgb[1]), float(rgb[2]))
-        colour = QColor.fromRgbF(*self.rgb)
-        self.setText(colour.name())
-        text = "black" if colour.lightnessF() > 0.5 else "white"
-        self.setStyleSheet(f"background-color: {colour.name()}; color: {text}")
+        color = QColor.fromRgbF(*self.rgb)
+        self.setText(color.name())
+        text = "black" if color.lightnessF() > 0.5 else "white"
+        self.setStyleSheet(f"background-color: {color.name()}; color: {text}")
 
     def _pick(self) -> None:
         self.dialog = QColorDialog(QColor.fromRgbF(*self.rgb), self)
         self.dialog.colorSelected.connect(self._chosen)
         self.dialog.open()
 
-    def _chosen(self, colour: QColor) -> None:
-        self.set_rgb((colour.redF(), colour.greenF(), colour.blueF()))
+    def _chosen(self, color: QColor) -> None:
+        self.set_rgb((color.redF(), color.greenF(), color.blueF()))
         self.chosen.emit()
 
 
@@ -228,9 +228,9 @@ class _Vector(_Editor):
             box.blockSignals(False)
 
 
-class _Colour(_Editor):
+class _Color(_Editor):
     def __init__(self, edited: Callable[[], None]) -> None:
-        super().__init__(ColourButton(), edited)
+        super().__init__(ColorButton(), edited)
         self.widget.chosen.connect(self.edited)
 
     def value(self) -> list[float]:
@@ -257,7 +257,7 @@ class _ReadOnly(_Editor):
 
 
 class StylesTable(QWidget):
-    """The isosurfaces' ``styles``: a table of surfaces (iso-value, colour, opacity) with Add and Remove buttons;
+    """The isosurfaces' ``styles``: a table of surfaces (iso-value, color, opacity) with Add and Remove buttons;
     ``edited`` reports a committed change."""
 
     edited = Signal()
@@ -289,7 +289,7 @@ class StylesTable(QWidget):
                  "opacity": self.table.cellWidget(row, 2).value()} for row in range(self.table.rowCount())]
 
     def set_styles(self, styles: Sequence[dict[str, Any]]) -> None:
-        """Show ``styles`` (a missing colour or opacity as the model's default), reporting nothing."""
+        """Show ``styles`` (a missing color or opacity as the model's default), reporting nothing."""
         self.table.setRowCount(0)
         for style in styles:
             self._append(style)
@@ -301,16 +301,16 @@ class StylesTable(QWidget):
         self.table.insertRow(row)
         value = _number_box(float, fields["value"])
         value.setValue(float(style.get("value", 0.0)))
-        colour = ColourButton()
-        colour.set_rgb(style.get("color", _default(fields["color"])))
+        color = ColorButton()
+        color.set_rgb(style.get("color", _default(fields["color"])))
         opacity = _number_box(float, fields["opacity"])
         opacity.setValue(float(style.get("opacity", _default(fields["opacity"]))))
-        for column, widget in enumerate((value, colour, opacity)):
+        for column, widget in enumerate((value, color, opacity)):
             widget.setToolTip(fields[("value", "color", "opacity")[column]].title or "")
             self.table.setCellWidget(row, column, widget)
         value.editingFinished.connect(self.edited)
         opacity.editingFinished.connect(self.edited)
-        colour.chosen.connect(self.edited)
+        color.chosen.connect(self.edited)
 
     def add_surface(self) -> None:
         """A new surface after the selected one (or the last), a copy of it; reported as an edit."""
@@ -424,8 +424,8 @@ class SettingsForm(QWidget):
         edited = lambda: self._edited(name)  # noqa: E731
         hints, annotation = _hints(info), _without_none(info.annotation)
         origin = typing.get_origin(annotation)
-        if hints.get("colour"):
-            return _Colour(edited)
+        if hints.get("color"):
+            return _Color(edited)
         if hints.get("dataset"):
             return _Choice(datasets, edited)
         if hints.get("array"):

@@ -637,7 +637,7 @@ class MainWindow(CameraBookmarks, QMainWindow):
         comp_id, tf, finished = self._pending_tf
         self._pending_tf = None
         volume = self.controller.pt_volume(comp_id)
-        if volume is None:  # VTK mapper: the new colour/opacity functions draw at once
+        if volume is None:  # VTK mapper: the new color/opacity functions draw at once
             lod = comp_id in self.controller.lod_volumes()
             self.controller.set_transfer_function(comp_id, tf, update=not lod)
             self.render()

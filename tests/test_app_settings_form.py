@@ -12,7 +12,7 @@ from PySide6.QtWidgets import QCheckBox, QComboBox, QDoubleSpinBox, QLabel, QSpi
 
 from test_app_workflows import viewport, wait_loaded
 from volviz.model.settings import SETTINGS_MODELS
-from volviz_app.settings_form import ColourButton, SettingsForm, StylesTable
+from volviz_app.settings_form import ColorButton, SettingsForm, StylesTable
 
 DATASETS = ["height_map", "fog_map"]
 ARRAYS = ["density", "temperature"]
@@ -39,8 +39,8 @@ def test_form_of_each_component_type_has_the_models_widgets(qtbot, kind: str) ->
         label = form.rows[name].label
         assert label.text() == (info.title or name) and label.toolTip().startswith(info.description or label.text())
         annotation = _bare(info.annotation)
-        if extra.get("colour"):
-            assert isinstance(widget, ColourButton)
+        if extra.get("color"):
+            assert isinstance(widget, ColorButton)
         elif extra.get("dataset") or extra.get("array"):
             names = DATASETS if extra.get("dataset") else ARRAYS
             assert isinstance(widget, QComboBox)

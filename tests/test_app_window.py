@@ -23,7 +23,7 @@ def viewport_image(window: MainWindow) -> np.ndarray:
 
 
 def not_blank(image: np.ndarray) -> float:
-    """Fraction of pixels that differ clearly from the corner (background) colour."""
+    """Fraction of pixels that differ clearly from the corner (background) color."""
     background = image[0, 0, :3].astype(int)
     return float((np.abs(image[..., :3].astype(int) - background).sum(axis=2) > 30).mean())
 

@@ -128,8 +128,8 @@ def _rho(tf, s):
     return tf.evaluate(np.asarray(s, dtype=np.float64))[1]
 
 
-def test_flat_grids_and_surface_meshes_are_drawn_as_coloured_surfaces():
-    """A 2D curvilinear grid carrying a cell array (netCDF CF) shows as a surface coloured through the transfer
+def test_flat_grids_and_surface_meshes_are_drawn_as_colored_surfaces():
+    """A 2D curvilinear grid carrying a cell array (netCDF CF) shows as a surface colored through the transfer
     function, its NaN (land in an ocean field) not drawn."""
     from volviz.render.scene_builder import data_session
     from volviz.render.vtk_scene import is_surface
@@ -146,11 +146,11 @@ def test_flat_grids_and_surface_meshes_are_drawn_as_coloured_surfaces():
         background = image[0, 0].astype(int)
         drawn = np.abs(image.astype(int) - background).sum(axis=2) > 40
         assert drawn.mean() > 0.15                                   # a surface, not an empty volume
-        assert len(np.unique(image[drawn].reshape(-1, 3) // 16, axis=0)) > 10   # ... in many colours
+        assert len(np.unique(image[drawn].reshape(-1, 3) // 16, axis=0)) > 10   # ... in many colors
 
 
 def test_pictures_open_flat_and_face_on():
-    """A photo or a texture (not a height map) is a flat picture seen face-on, in its own colours."""
+    """A photo or a texture (not a height map) is a flat picture seen face-on, in its own colors."""
     from volviz.render.framing import view_direction
     from volviz.render.scene_builder import data_session
 
@@ -162,7 +162,7 @@ def test_pictures_open_flat_and_face_on():
         image = _render(session, (160, 120))
         drawn = np.abs(image.astype(int) - image[0, 0].astype(int)).sum(axis=2) > 30
         assert drawn.mean() > 0.4                          # face-on, filling the view
-        assert session.transfer_functions == {}            # no transfer function: the picture's own colours
+        assert session.transfer_functions == {}            # no transfer function: the picture's own colors
 
 
 def test_messages_for_headerless_data_say_what_to_open(tmp_path):

@@ -101,7 +101,7 @@ def test_two_overlapping_volumes_match_the_optical_model_by_hand(sign):
     np.testing.assert_allclose(img, np.broadcast_to(exact, img.shape), atol=1e-12)
     np.testing.assert_allclose(_flat(meshes, "3pass", bg)[0], np.broadcast_to(three, img.shape), atol=1e-12)
     np.testing.assert_allclose(_flat(meshes, "4pass", bg)[0], np.broadcast_to(four, img.shape), atol=1e-12)
-    # 3-pass error = the neglected self-attenuation a1·e2 (colour channels)
+    # 3-pass error = the neglected self-attenuation a1·e2 (color channels)
     err = _flat(meshes, "3pass", bg)[0] - img
     np.testing.assert_allclose(err[..., :3], np.broadcast_to(a1 * e2[:3], err[..., :3].shape), atol=1e-12)
 

@@ -6,7 +6,7 @@ import pytest
 
 from volviz.nature import fog, noise
 from volviz.nature.heightfield import HeightField
-from volviz.nature.raster import bake_colour_map, mip_pyramid, render_terrain
+from volviz.nature.raster import bake_color_map, mip_pyramid, render_terrain
 from volviz.nature.terrain import TerrainLOD
 from volviz.model.camera import Camera
 
@@ -23,7 +23,7 @@ def fog_scene():
 
 
 def terrain_depth(hf, mesh, cam):
-    depth, _ = render_terrain(mesh.points, mesh.triangles, mesh.tcoords, cam, SIZE, mip_pyramid(bake_colour_map(hf.normals())))
+    depth, _ = render_terrain(mesh.points, mesh.triangles, mesh.tcoords, cam, SIZE, mip_pyramid(bake_color_map(hf.normals())))
     return depth
 
 
@@ -84,7 +84,7 @@ def test_render_layer_modes() -> None:
     at, _ = fog.render_layer(mesh.points, z, top, mesh.triangles, fog.FogLayer(mode="attenuated", density=0.1), cam, SIZE, depth)
     mp, _ = fog.render_layer(mesh.points, z, top, mesh.triangles, fog.FogLayer(mode="mip"), cam, SIZE, depth)
     assert np.all(em[..., 3] == 0) and em[..., :3].max() > 0
-    # attenuated: alpha = 1 - exp(-tau), colour = kappa * alpha with tau the emissive integral / colour
+    # attenuated: alpha = 1 - exp(-tau), color = kappa * alpha with tau the emissive integral / color
     tau = em[..., 2] / 1.0
     np.testing.assert_allclose(at[..., 3], 1 - np.exp(-tau), atol=1e-12)
     np.testing.assert_allclose(at[..., 0], 0.75 * at[..., 3], atol=1e-12)

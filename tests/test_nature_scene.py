@@ -122,7 +122,7 @@ def test_components_with_missing_datasets_are_refused() -> None:
 def test_sky_shows_with_the_plotters_own_camera(demo) -> None:
     """The app's path: the session camera is applied to an empty renderer (VTK's default clipping range 0.01 ..
     1000.01), then the view renders with the plotter's camera. The dome (radius 3 x the extent) must not be clipped
-    away: the top rows show the sky gradient, not the background colour."""
+    away: the top rows show the sky gradient, not the background color."""
     import pyvista as pv
 
     size = (128, 96)
@@ -194,7 +194,7 @@ def test_preview_keeps_the_terrain_and_magnifies_a_smaller_overlay(demo) -> None
     assert poly2.n_cells == poly.n_cells and np.array_equal(np.asarray(poly2.points), np.asarray(poly.points))
     assert st_prev["cloud_tets"] == st_full["cloud_tets"]   # (fog prisms drawn differ: those covering no pixel)
 
-    def shown(rgba8: np.ndarray) -> np.ndarray:  # what blending shows: premultiplied colour and alpha, 8-bit units
+    def shown(rgba8: np.ndarray) -> np.ndarray:  # what blending shows: premultiplied color and alpha, 8-bit units
         a = rgba8[..., 3:].astype(float) / 255.0
         return np.concatenate([rgba8[..., :3] * a, rgba8[..., 3:].astype(float)], axis=-1)
 
@@ -203,7 +203,7 @@ def test_preview_keeps_the_terrain_and_magnifies_a_smaller_overlay(demo) -> None
     print(f"preview vs full overlay: mean {err.mean():.2f}, rmse {rmse:.2f}")
     assert 0 < rmse < 8.0, rmse      # measured 6.0 (2.3 mean) at 160 x 120: silhouettes at half resolution
     # bilinear magnification, pixel centres aligned: a constant stays, a ramp in x stays a ramp inside, and a
-    # transparent pixel's colour does not bleed into its neighbours
+    # transparent pixel's color does not bleed into its neighbours
     ramp = np.zeros((4, 6, 4), np.uint8)
     ramp[..., 0] = 40 * np.arange(6)[None, :]
     ramp[..., 3] = 255

@@ -64,7 +64,7 @@ def test_constant_scalar_closed_form():
 
 
 @pytest.mark.parametrize("rho", [1e-8, 0.3, 5.0, 50.0, 1e6])
-def test_constant_rho_with_linear_colour_closed_form(rho):
+def test_constant_rho_with_linear_color_closed_form(rho):
     tf = TransferFunction([0.0, 1.0], [[0.2, 0.9, 0.0], [1.0, 0.1, 0.5]], [rho, rho])
     k0, k1 = tf.colors
     for s_f, s_b, length in [(0.0, 1.0, 1.0), (1.0, 0.0, 2.0), (0.3, 0.6, 0.01)]:
@@ -121,7 +121,7 @@ def test_large_optical_depth_has_no_negative_transmittance_or_overshoot():
 
 
 def test_step_transfer_function_closed_form():
-    # ρ jumps from 0 to 3 at s = 0.5 (over 1e-12), colour constant: α = 1 − exp(−3 · l · fraction above 0.5)
+    # ρ jumps from 0 to 3 at s = 0.5 (over 1e-12), color constant: α = 1 − exp(−3 · l · fraction above 0.5)
     step = TransferFunction([0.0, 0.5, 0.5 + 1e-12, 1.0], [[0.2, 0.4, 0.8]] * 4, [0.0, 0.0, 3.0, 3.0])
     for s_f, s_b, length in [(0.0, 1.0, 1.0), (1.0, 0.0, 2.0), (0.25, 0.75, 4.0), (0.4, 0.9, 0.5)]:
         frac = (max(s_f, s_b) - 0.5) / abs(s_b - s_f)
@@ -169,11 +169,11 @@ def test_all_zero_opacity_is_all_zero():
 def test_rho_up_to_a_million():
     tf = TransferFunction([0, 1], [[0.0, 1.0, 0.5], [1.0, 0.0, 0.5]], [1e6, 1e6])
     out = integrate_segment(tf, 0.0, 1.0, 1.0)
-    # colour ≈ front colour + (κ_b − κ_a)/(ρ l): only the first 1e-6 of the segment is seen
+    # color ≈ front color + (κ_b − κ_a)/(ρ l): only the first 1e-6 of the segment is seen
     np.testing.assert_allclose(out, [1e-6, 1 - 1e-6, 0.5, 1.0], atol=1e-15)
     ramp = TransferFunction([0, 1], [[1, 1, 1]] * 2, [0, 1e6])
     out = integrate_segment(ramp, [0.0, 1.0, 0.0], [1.0, 0.0, 1e-9], [1.0, 1.0, 1e-3])
-    # ramp from 0: depth at t is 1e6 t²/2 → colour = α = 1; ramp reversed: α = 1; tiny segment: depth 5e-10
+    # ramp from 0: depth at t is 1e6 t²/2 → color = α = 1; ramp reversed: α = 1; tiny segment: depth 5e-10
     np.testing.assert_allclose(out[0], [1, 1, 1, 1], atol=1e-15)
     np.testing.assert_allclose(out[1], [1, 1, 1, 1], atol=1e-15)
     assert out[2, 3] == pytest.approx(-np.expm1(-1e6 * 0.5e-9 * 1e-3), rel=1e-9)

@@ -180,7 +180,7 @@ def test_rho_hat_and_c0_exact(hard):
     np.testing.assert_allclose(kmean[0], [0, 0.5, 1], atol=1e-14)
 
 
-def test_separable_opacity_exact_and_colour_converges_with_degree(smooth):
+def test_separable_opacity_exact_and_color_converges_with_degree(smooth):
     errs = {}
     for degree in (1, 2, 4):
         t = build_separable(smooth, n_s=64, l_max=1.0, degree=degree)
@@ -189,7 +189,7 @@ def test_separable_opacity_exact_and_colour_converges_with_degree(smooth):
         for l in (0.3, 1.0, 4.0):  # α = 1 − exp(−l ρ̂) is exact at the nodes for any l
             np.testing.assert_allclose(t.lookup(sf, sb, l)[..., 3], integrate_segment(smooth, sf, sb, l)[..., 3],
                                        atol=2e-7)
-        # the colour polynomial interpolates the samples l = (i/n)·l_max
+        # the color polynomial interpolates the samples l = (i/n)·l_max
         for i in range(1, degree + 1):
             l = i / degree
             np.testing.assert_allclose(t.lookup(sf, sb, l), integrate_segment(smooth, sf, sb, l), atol=2e-6)
@@ -240,7 +240,7 @@ def test_thin_peak_tf_converges_to_the_heaviside_limit():
     assert prev < 1e-12  # crossing segments have depth area·l/|Δs| ≥ 100 here, others exactly 0
 
 
-def test_iso_texture_multiple_coloured_surfaces_and_weights():
+def test_iso_texture_multiple_colored_surfaces_and_weights():
     isos = [IsoSurface(0.3, (1, 0, 0)), IsoSurface(0.6, (0, 1, 0), opacity=0.5, back_color=(0, 0, 1))]
     t = build_iso_table(isos, n_s=101, s_range=(0, 1))
     np.testing.assert_allclose(t.lookup(0.1, 0.5), [1, 0, 0, 1], atol=1e-6)  # increasing: red first, opaque

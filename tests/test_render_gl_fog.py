@@ -35,7 +35,7 @@ from volviz.render.image_overlay import read_buffers, zbuffer_to_depth
 from volviz.model.camera import Camera
 
 RMSE, MAX = 0.4, 0.75
-COLOUR = (0.8, 0.85, 1.0)
+COLOR = (0.8, 0.85, 1.0)
 GROUND = (0.3, 0.25, 0.2)
 OBLIQUE = Camera((-4, -6, 12), (16, 16, 2), (0, 0, 1), 50, clipping_range=(0.5, 80))
 TOP_DOWN = Camera((16, 0, 24), (16, 14, 0), (0, 0, 1), 45, clipping_range=(0.5, 80))
@@ -57,7 +57,7 @@ def terrain():
 
 def _plotter(size, cam, scene) -> pv.Plotter:
     pl = pv.Plotter(off_screen=True, window_size=size)
-    pl.ren_win.SetMultiSamples(0)          # one colour and depth per pixel (the float target is not multisampled)
+    pl.ren_win.SetMultiSamples(0)          # one color and depth per pixel (the float target is not multisampled)
     pl.set_background("black")
     cam.apply_to(pl.renderer.GetActiveCamera())
     pl.camera_set = True                   # keep PyVista from resetting the camera at the first render
@@ -110,7 +110,7 @@ def _check(screen: np.ndarray, expected_rgb: np.ndarray, label: str) -> None:
 
 
 def _layer(mode: str) -> fog.FogLayer:
-    return fog.FogLayer(colour=COLOUR, density={"emissive": 0.1, "attenuated": 0.4, "mip": 0.0}[mode], mode=mode,
+    return fog.FogLayer(color=COLOR, density={"emissive": 0.1, "attenuated": 0.4, "mip": 0.0}[mode], mode=mode,
                         mip_gain=0.3)
 
 
@@ -142,9 +142,9 @@ def test_emissive_matches_the_reference_integral(terrain, field):
     eb, et = (fogged, fogged) if field == "constant" else (np.zeros_like(z), np.maximum(top - z, 0.0))
     scene = [(terrain[4], {"color": GROUND, "lighting": False})]
     base, _ = _opaque(size, TOP_DOWN, scene)
-    layer = fog.FogLayer(colour=COLOUR, density=0.15, mode="emissive")
+    layer = fog.FogLayer(color=COLOR, density=0.15, mode="emissive")
     emis, _ = fog.reference_integrals(mesh.points, z, z, top, mesh.triangles, eb, et, TOP_DOWN, size, steps=4000)
-    expected = layer.density * emis[..., None] * np.asarray(COLOUR) + base
+    expected = layer.density * emis[..., None] * np.asarray(COLOR) + base
     assert emis.max() * layer.density > 0.3
     e = _err(_gpu(size, TOP_DOWN, scene, terrain, layer, (eb, et)), expected)
     print(field, "RMSE / max", e)

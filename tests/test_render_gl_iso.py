@@ -11,7 +11,7 @@ Measured here (llvmpipe, Mesa, VTK 9.7.2), over the 16 cases (2 cameras × 2 sha
 pixels of the opaque core and of a surface, which GL's edge rule covers and the CPU rasteriser's does not, or the
 other way round). Bounds, with a small margin: RMSE <= 0.8, 99.9th percentile <= 2.5, at most 8 pixels over 3 (the
 max is not bounded: it is a silhouette pixel's). Everything under 3 is 8-bit rounding: each blend step of the
-2/3/4 passes (and each peel) rounds to 1/255 in the window's colour buffer. The same scene 25 times larger and far
+2/3/4 passes (and each peel) rounds to 1/255 in the window's color buffer. The same scene 25 times larger and far
 from the origin gives the same numbers.
 """
 from __future__ import annotations

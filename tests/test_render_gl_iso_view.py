@@ -6,7 +6,7 @@ switch to the CPU backend's overlay.
 
 Scene: the 24³ ball of ``tests/test_iso_overlay.py`` with two nested translucent surfaces, 160x120, one sample per
 pixel. Errors in 8-bit units of RGB against the CPU image composited over the background and clipped to [0, 1] (the
-window's colour saturates there). Measured here over the 4 modes and the 5 states: RMSE 0.46-0.64, 99.9th
+window's color saturates there). Measured here over the 4 modes and the 5 states: RMSE 0.46-0.64, 99.9th
 percentile at most 2.41, at most 1 pixel over 3 (a silhouette pixel, up to 98: GL's edge rule and the CPU
 rasteriser's). Bounds as ``tests/test_render_gl_iso.py``'s: RMSE <= 0.8, 99.9th percentile <= 2.5, at most 8 pixels
 over 3.

@@ -89,10 +89,10 @@ def _yukon_crop():
     comps = [Component(id="terrain", type="terrain", dataset="map",
                        settings={"extent": [250.0, 250.0], "height_scale": 0.33, "texture_dataset": "tex"}),
              Component(id="ground_fog", type="fog", dataset="fog",
-                       settings={"thickness_scale": 0.15, "density": 0.05, "colour": [0.75, 0.75, 1.0]}),
+                       settings={"thickness_scale": 0.15, "density": 0.05, "color": [0.75, 0.75, 1.0]}),
              Component(id="cloud_layer", type="fog", dataset="thick",
                        settings={"thickness_scale": 0.4, "base_dataset": "base", "base_scale": 0.15,
-                                 "base_offset": 150.0, "density": 0.02, "colour": [0.7, 0.85, 1.0], "weight": 2.0})]
+                                 "base_offset": 150.0, "density": 0.02, "color": [0.7, 0.85, 1.0], "weight": 2.0})]
     return scene_from_components(comps, datasets)
 
 

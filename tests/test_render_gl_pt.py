@@ -1,7 +1,7 @@
 """The GPU pre-integrated projected tetrahedra pass (``volviz.render.gl_pt``, Roettger Ch. 8-9) on llvmpipe, offscreen:
 its screen image (8-bit, premultiplied over black) against the exact float64 reference.
 
-Bounds: RMSE <= 1 and max <= 4 in 8-bit units of premultiplied colour (issue #16's target). The screen is 8-bit, so
+Bounds: RMSE <= 1 and max <= 4 in 8-bit units of premultiplied color (issue #16's target). The screen is 8-bit, so
 rounding alone costs up to 0.5 per channel (RMSE ~0.29); the rest is the float32 arithmetic of the shader and the
 table's interpolation. Measured here (llvmpipe, Mesa, VTK 9.7.2): Blunt Fin 256^2 3D table RMSE 0.46 / max 1.77,
 separable 0.27 / 0.87; hard cases (40 x 32), 3D table / separable: one tetrahedron 0.17 / 0.76 and 0.27 / 2.06,
@@ -39,7 +39,7 @@ def _err(screen: np.ndarray, ref_rgb: np.ndarray) -> tuple[float, float]:
 
 def _plotter(size: tuple[int, int], cam: Camera, samples: int = 0) -> pv.Plotter:
     pl = pv.Plotter(off_screen=True, window_size=size)
-    pl.ren_win.SetMultiSamples(samples)    # 0: one colour and depth per pixel, as the exact reference
+    pl.ren_win.SetMultiSamples(samples)    # 0: one color and depth per pixel, as the exact reference
     pl.set_background("black")
     cam.apply_to(pl.renderer.GetActiveCamera())
     pl.camera_set = True                   # keep PyVista from resetting the camera at the first render
@@ -132,7 +132,7 @@ def test_hard_cases(case, lookup):
     assert ref[..., 3].max() > 0.05
     img = _gl_image(mesh, tf, cam, size, lookup=lookup)
     if lookup == "separable" and case in _BEYOND_SEPARABLE:
-        # the degree-2 colour polynomial is valid to an optical depth of ~6 per cell (auto_lookup); here a cell is
+        # the degree-2 color polynomial is valid to an optical depth of ~6 per cell (auto_lookup); here a cell is
         # ~40 deep and the table itself is off (the CPU "pt" with the same table: RMSE 5.3 / max 27 against the
         # reference), so the pass is held to the CPU "pt" with that table
         cpu = render(mesh, tf, cam, size, "pt", lookup="separable")
@@ -203,7 +203,7 @@ def test_prefetched_and_reused_orders():
 def test_opaque_sphere_inside_bluntfin(bluntfin):
     """An opaque sphere inside the fin: each ray's segments end at the sphere's depth (cells straddling it are
     integrated only up to it), then the volume is composited over the sphere. Expected: the reference clipped at the
-    sphere's depth (read from a plain plotter with the sphere alone) over the sphere's colour."""
+    sphere's depth (read from a plain plotter with the sphere alone) over the sphere's color."""
     mesh, tf = bluntfin
     size = (128, 128)
     cam = Camera.orbit(mesh.points, 40, 25, 1.6, up=(0, 0, 1))
@@ -274,7 +274,7 @@ def test_multisampled_window_keeps_antialiased_opaque_edges():
     without the volume, the cells are integrated into the volume's own single-sample float target up to a copy of the
     opaque depth (one sample per pixel) and the result is composited over every sample. Expected: the reference
     clipped at the single-sample depth over the antialiased opaque image, within the bound away from the sphere's
-    silhouette (the pixels whose antialiased colour differs from the single-sample one, and their neighbours); there
+    silhouette (the pixels whose antialiased color differs from the single-sample one, and their neighbours); there
     the volume is integrated to one sample's depth, not to each sample's (measured: up to 37 on the silhouette, 6.5
     next to it, where the sphere's depth changes fast across a pixel). Where the volume is not, the screen is the
     antialiased opaque scene exactly."""
@@ -370,7 +370,7 @@ ISO_SIZE = (48, 40)
 
 @pytest.mark.parametrize("inside", [False, True], ids=["outside", "camera-inside"])
 def test_exact_isosurfaces_match_reference(inside):
-    """Three semi-transparent isosurfaces, one with another colour seen from its high side (Roettger §8.8-8.10), the
+    """Three semi-transparent isosurfaces, one with another color seen from its high side (Roettger §8.8-8.10), the
     §8.13 Heaviside limit evaluated on each fragment's exact segment, as the CPU ``iso_mode="exact"``, against the
     reference (measured: RMSE 0.24 / max 0.49 outside, 0.16 / 0.29 from inside: the screen's rounding). Only cells
     an isovalue crosses are drawn."""

@@ -59,7 +59,9 @@ def test_a_saved_session_satisfies_the_schema(tmp_path):
     ({"density": -1}, r"components\[0\]\.settings\.density: Input should be greater than or equal to 0"),
     ({"density": "thick"}, r"components\[0\]\.settings\.density: expected a number, got a string"),
     ({"mode": "foggy"}, r"components\[0\]\.settings\.mode: expected one of emissive, attenuated, mip, got 'foggy'"),
-    ({"colour": [1, 2, 0]}, r"components\[0\]\.settings\.colour: Value error, colour components must be in 0\.\.1"),
+    ({"colour": [1, 2, 0]}, r"components\[0\]\.settings\.colour: Value error, color components must be in 0\.\.1"),
+    ({"color": [1, 2, 0]}, r"components\[0\]\.settings\.color: Value error, color components must be in 0\.\.1"),
+    ({"color": [1, 1, 1], "colour": [1, 1, 1]}, r"components\[0\]\.settings\.colour: unknown setting"),
 ])
 def test_component_settings_are_refused_with_their_field_path(settings, message):
     doc = {"format": "volviz-session", "version": 1, "components": [{"id": "f", "type": "fog", "settings": settings}]}
@@ -81,13 +83,30 @@ def test_render_options_are_refused_with_their_field_path(options, message):
 
 def test_defaults_live_in_the_models():
     fog = typed_settings("fog", {})
-    assert (fog.mode, fog.density, fog.colour, fog.weight) == ("attenuated", 0.05, (0.75, 0.75, 1.0), 4.0)
+    assert (fog.mode, fog.density, fog.color, fog.weight) == ("attenuated", 0.05, (0.75, 0.75, 1.0), 4.0)
     with pytest.raises(SettingsError) as info:
         typed_settings("clouds", {"shape": [2, 129, 17]}, "settings")
     assert info.value.problems == [("settings.shape", "Value error, each size must be in 3..1025")]
     model = FogSettings()
     with pytest.raises(ValueError):
         model.density = -1.0   # assignments are validated too
+
+
+def test_a_session_saved_with_the_former_colour_key_opens_and_saves_color(tmp_path):
+    """Sessions written before the API spelt it "color" name the fog's color "colour": they open with that color
+    and are saved with "color"."""
+    doc = {"format": "volviz-session", "version": 1,
+           "components": [{"id": "fog", "type": "fog", "settings": {"density": 0.1, "colour": [0.85, 0.87, 0.95]}}]}
+    path = tmp_path / "old.json"
+    path.write_text(json.dumps(doc))
+    session = S.load(path)
+    assert session.components[0].settings == {"density": 0.1, "color": [0.85, 0.87, 0.95]}
+    assert typed_settings("fog", session.components[0].settings).color == (0.85, 0.87, 0.95)
+    assert typed_settings("fog", doc["components"][0]["settings"]).color == (0.85, 0.87, 0.95)
+    S.save(session, tmp_path / "new.json")
+    saved = json.loads((tmp_path / "new.json").read_text())
+    assert saved["components"][0]["settings"] == {"density": 0.1, "color": [0.85, 0.87, 0.95]}
+    SessionDocument.model_validate(saved)
 
 
 def test_the_shown_array_key_of_every_component_type_is_a_setting():

@@ -30,7 +30,7 @@ def test_preclassified_closed_forms():
     # post-classification sees the whole peak: optical depth = integral of rho over the segment = 12 * 0.05 * l
     post = integrate_segment(PEAK, 0.2, 0.8, 1.0)
     assert post[3] == pytest.approx(1.0 - math.exp(-12 * 0.05 / 0.6), rel=1e-9)
-    # constant ends: alpha = 1 - exp(-l rho), colour = kappa alpha
+    # constant ends: alpha = 1 - exp(-l rho), color = kappa alpha
     tf = TransferFunction([0.0, 1.0], [[0.2, 0.4, 0.6], [0.2, 0.4, 0.6]], [2.0, 2.0])
     got = integrate_preclassified(tf, 0.3, 0.3, 0.7)
     a = 1.0 - math.exp(-1.4)

@@ -1,5 +1,5 @@
-"""Isosurfaces through projected tetrahedra (Roettger §8.8-8.10, §8.13): several coloured, semi-transparent surfaces
-with side-dependent colours, "pt" (exact Heaviside per pixel segment, or the bilinear texture) against the
+"""Isosurfaces through projected tetrahedra (Roettger §8.8-8.10, §8.13): several colored, semi-transparent surfaces
+with side-dependent colors, "pt" (exact Heaviside per pixel segment, or the bilinear texture) against the
 "reference" (the Heaviside limit on exact ray segments)."""
 from __future__ import annotations
 
@@ -20,7 +20,7 @@ ISO = build_iso_table([IsoSurface(0.3, (1.0, 0.2, 0.1), 0.6, back_color=(0.2, 1.
 def test_reference_isosurface_closed_form():
     """s = x on the unit right tetrahedron. Seen along z, s is constant along every ray: no surface is crossed.
     Seen along +x, a ray at (y, z) runs from x = 0 to x = 1 - y - z and crosses s = 0.3 (and 0.55) iff its exit is
-    beyond it: exact opacities 0.6 and 1 - 0.4 x 0.2 and the composited front colours."""
+    beyond it: exact opacities 0.6 and 1 - 0.4 x 0.2 and the composited front colors."""
     pts = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], float)
     m = TetMesh(pts, np.array([[0, 1, 2, 3]]), pts[:, 0].copy())
     along_z = Camera((0.5, 0.5, 5.0), (0.5, 0.5, 0.0), (0, 1, 0), parallel=True, parallel_scale=0.5,
@@ -34,7 +34,7 @@ def test_reference_isosurface_closed_form():
     exit_x = 1.0 - y - z                                                  # the ray enters at x = 0
     hit, second = exit_x > 0.3, exit_x > 0.55
     one = hit & ~second
-    # seen from the low side (s increasing along the ray): the first surface's front colour with its opacity
+    # seen from the low side (s increasing along the ray): the first surface's front color with its opacity
     assert np.allclose(img[one, 3], 0.6) and np.allclose(img[one, :3], 0.6 * np.array([1.0, 0.2, 0.1]))
     assert np.allclose(img[second, 3], 1 - 0.4 * 0.2)
     assert np.allclose(img[second, :3], 0.6 * np.array([1.0, 0.2, 0.1]) + 0.4 * 0.8 * np.array([0.1, 0.3, 1.0]))
@@ -70,7 +70,7 @@ def test_pt_texture_isosurfaces_are_close():
 def test_smooth_isosurfaces_match_reference_and_darken_towards_the_silhouette():
     """Smooth shading (Roettger §8.9): the spherical surface s = 0.3 around the centre of a fine grid, headlight.
     pt equals the reference (the same linear interpolation of vertex intensities, evaluated where the ray crosses
-    the surface), the surface facing the camera keeps its flat colour and it darkens towards its silhouette."""
+    the surface), the surface facing the camera keeps its flat color and it darkens towards its silhouette."""
     m = syn.box_tets(10)                                                   # s = distance from the centre
     one = build_iso_table([IsoSurface(0.3, (1.0, 0.8, 0.4), 1.0)], n_s=256, s_range=(0.0, 0.9))
     cam = Camera((0.5, 0.5, 3.0), (0.5, 0.5, 0.5), (0, 1, 0), parallel=True, parallel_scale=0.4,
@@ -82,7 +82,7 @@ def test_smooth_isosurfaces_match_reference_and_darken_towards_the_silhouette():
     assert float(np.sqrt((d ** 2).mean())) <= 1.0 and float(np.abs(d).max()) <= 4.0
     hit = flat[..., 3] > 0.99
     assert hit.sum() > 200
-    assert np.array_equal(img[..., 3], flat[..., 3])                      # shading changes colour, not coverage
+    assert np.array_equal(img[..., 3], flat[..., 3])                      # shading changes color, not coverage
     ratio = img[hit, 0] / flat[hit, 0]
     assert ratio.max() <= 1.0 + 1e-12 and ratio.max() > 0.95               # facing the light: nearly unshaded
     h, w = SIZE[1], SIZE[0]

@@ -38,9 +38,9 @@ def test_curvilinear_hexahedra_split_into_five_conforming_tets():
 
 def test_hexahedron_volume_and_both_parities():
     pts = np.array([[0, 0, 0], [2, 0, 0], [2, 3, 0], [0, 3, 0], [0, 0, 5], [2, 0, 5], [2, 3, 5], [0, 3, 5]], float)
-    for colour0 in (True, False):
+    for color0 in (True, False):
         from volviz.unstructured.tetrahedralize import hexahedra_to_tets
-        tets = hexahedra_to_tets(np.arange(8)[None], np.array([colour0]))
+        tets = hexahedra_to_tets(np.arange(8)[None], np.array([color0]))
         m = tetrahedralize(TetMesh(pts, tets, np.zeros(8)))
         assert m.n_cells == 5 and _volumes(m).sum() == pytest.approx(30.0)
 

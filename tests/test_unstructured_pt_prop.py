@@ -27,7 +27,7 @@ def _err(a: np.ndarray, b: np.ndarray) -> tuple[float, float]:
 def scene():
     mesh = syn.box_tets(6)                                          # the unit cube
     pl = pv.Plotter(off_screen=True, window_size=list(SIZE))
-    pl.ren_win.SetMultiSamples(0)         # one depth per pixel (MSAA silhouettes blend colours but not depths)
+    pl.ren_win.SetMultiSamples(0)         # one depth per pixel (MSAA silhouettes blend colors but not depths)
     pl.set_background("black")
     # an opaque plane y = 0.5 through the left half of the cube, and a sphere in front of the cube's right part
     pl.add_mesh(pv.Plane(center=(0.25, 0.5, 0.5), direction=(0, 1, 0), i_size=1.2, j_size=0.5),
@@ -183,15 +183,15 @@ def test_preview_renders_a_smaller_image_cut_at_the_nearest_depth(scene):
     assert h.image.shape == (SIZE[1], SIZE[0], 4)
 
 
-def test_bleed_colour_gives_transparent_edge_pixels_their_neighbours_colour():
-    """Magnified previews interpolate straight alpha: a transparent pixel beside visible ones takes their mean colour
+def test_bleed_color_gives_transparent_edge_pixels_their_neighbours_color():
+    """Magnified previews interpolate straight alpha: a transparent pixel beside visible ones takes their mean color
     (no dark fringe), keeps alpha 0; visible pixels and transparent ones away from any are unchanged."""
-    from volviz.render.image_overlay import bleed_colour
+    from volviz.render.image_overlay import bleed_color
 
     img = np.zeros((4, 5, 4), np.uint8)
     img[1, 1] = [200, 40, 0, 255]
     img[1, 2] = [100, 80, 0, 128]
-    out = bleed_colour(img)
+    out = bleed_color(img)
     assert np.array_equal(out[1, 1], img[1, 1]) and np.array_equal(out[1, 2], img[1, 2])
     assert np.array_equal(out[..., 3], img[..., 3])
     assert np.array_equal(out[0, 0], [200, 40, 0, 0])            # one visible neighbour

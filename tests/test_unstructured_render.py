@@ -180,7 +180,7 @@ def test_shirley_tuchman_classes_and_classic_pt():
 @pytest.mark.parametrize("lookup,degree,scale", [("separable", 2, 1.0), ("separable", 4, 4.0), ("3d", None, 4.0),
                                                  ("auto", None, 8.0)])
 def test_every_lookup_matches_reference(lookup, degree, scale):
-    """Separable (Roettger §9.1: exact opacity, colour polynomial in l) and 3D tables, and the automatic choice by
+    """Separable (Roettger §9.1: exact opacity, color polynomial in l) and 3D tables, and the automatic choice by
     optical depth per cell (2 ... 20 here)."""
     m = syn.box_tets(5, jitter=0.3)
     tf = TF.scaled_extinction(scale)

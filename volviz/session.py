@@ -280,7 +280,7 @@ def session_from_dict(doc: Any, source: str | os.PathLike | None = None) -> Sess
             settings=r.json_value(r.obj(o.get("settings", {}), f"{where}.settings"), f"{where}.settings"),
         )
         try:
-            validate_settings(comp.type, comp.settings, f"{where}.settings")
+            comp.settings = validate_settings(comp.type, comp.settings, f"{where}.settings")
         except SettingsError as exc:
             raise r.fail(*exc.problems[0]) from None
         if comp.id in component_ids:

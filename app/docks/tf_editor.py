@@ -1,5 +1,5 @@
-"""Transfer-function editor dock: extinction curve with draggable control points over the data histogram, colour
-stops with a colour picker, presets (ParaView JSON import/export), fit to data range, undo/redo.
+"""Transfer-function editor dock: extinction curve with draggable control points over the data histogram, color
+stops with a color picker, presets (ParaView JSON import/export), fit to data range, undo/redo.
 
 The editor holds a ``TransferFunction`` (volviz.optics) and never computes optics itself. It emits
 ``changed(tf)`` continuously while the user drags (the window throttles re-rendering) and ``committed(tf)`` when an
@@ -19,7 +19,7 @@ from volviz.optics import TransferFunction
 from volviz_app.docks import set_tooltips
 
 GESTURES = ("Click: add a point · drag a point: move it · right-click: remove it · double-click: "
-            "change its colour")
+            "change its color")
 POINT_RADIUS = 5.0
 MARGIN = 8.0
 COLOR_BAR_HEIGHT = 18.0
@@ -39,7 +39,7 @@ class _SetTransferFunction(QUndoCommand):
 
 
 class TransferFunctionCanvas(QWidget):
-    """Draws histogram, extinction curve and colour bar; lets the user drag, add and remove control points."""
+    """Draws histogram, extinction curve and color bar; lets the user drag, add and remove control points."""
 
     pointsEdited = Signal()      # while dragging
     editFinished = Signal(str)   # description of a finished edit
@@ -232,13 +232,13 @@ class TransferFunctionEditor(QWidget):
         self.hint.setStyleSheet("color: palette(placeholder-text)")
         set_tooltips(
             (self.canvas, GESTURES),
-            (self.presets, "Colour presets: recolour the function over its range (the opacity curve stays)"),
+            (self.presets, "Color presets: recolor the function over its range (the opacity curve stays)"),
             (self.fit_button, "Stretch the function over the data's range"),
             (self.log_box, "Draw the histogram on a logarithmic scale (long-tailed data such as CT)"),
             (self.undo_button, "Undo the last transfer-function edit"),
             (self.redo_button, "Redo the transfer-function edit undone last"),
-            (self.import_button, "Take the colours from a ParaView colour map (JSON)"),
-            (self.export_button, "Save the function as a ParaView colour map (JSON)"),
+            (self.import_button, "Take the colors from a ParaView color map (JSON)"),
+            (self.export_button, "Save the function as a ParaView color map (JSON)"),
         )
         row1 = QHBoxLayout()
         for w in (self.presets, self.fit_button, self.log_box):
@@ -344,14 +344,14 @@ class TransferFunctionEditor(QWidget):
 
     def _pick_color(self, index: int) -> None:
         current = QColor.fromRgbF(*np.clip(self.canvas.colors[index], 0, 1))
-        color = QColorDialog.getColor(current, self, "Control point colour")
+        color = QColorDialog.getColor(current, self, "Control point color")
         if color.isValid():
             self.set_point_color(index, (color.redF(), color.greenF(), color.blueF()))
 
     def set_point_color(self, index: int, rgb: tuple[float, float, float]) -> None:
         colors = self._tf.colors.copy()
         colors[index] = rgb
-        self.edit(TransferFunction(self._tf.scalars, colors, self._tf.extinction, self._tf.name), "Change colour")
+        self.edit(TransferFunction(self._tf.scalars, colors, self._tf.extinction, self._tf.name), "Change color")
 
     def _set_log(self, on: bool) -> None:
         self.canvas.log_histogram = on
@@ -366,7 +366,7 @@ class TransferFunctionEditor(QWidget):
         return list(list_presets())
 
     def apply_preset(self, name: str) -> None:
-        """Colours from a preset, spread over the current range; the extinction curve is kept."""
+        """Colors from a preset, spread over the current range; the extinction curve is kept."""
         from volviz.optics.presets import load_preset
 
         preset = load_preset(name)
@@ -384,27 +384,27 @@ class TransferFunctionEditor(QWidget):
             self.presets.setCurrentIndex(0)
 
     def _ask_import(self) -> None:
-        path, _ = QFileDialog.getOpenFileName(self, "Import ParaView colour map", "", "JSON (*.json)")
+        path, _ = QFileDialog.getOpenFileName(self, "Import ParaView color map", "", "JSON (*.json)")
         if path:
             self.import_paraview(path)
 
     def import_paraview(self, path: str) -> bool:
-        """Colours from the first preset of a ParaView JSON file; a bad file gives a message, not a crash."""
+        """Colors from the first preset of a ParaView JSON file; a bad file gives a message, not a crash."""
         from volviz.optics.presets import read_paraview_presets
 
         try:
             preset = read_paraview_presets(path)[0]
         except ValueError as exc:
-            box = QMessageBox(QMessageBox.Icon.Warning, "Cannot import colour map", str(exc),
+            box = QMessageBox(QMessageBox.Icon.Warning, "Cannot import color map", str(exc),
                               QMessageBox.StandardButton.Ok, self)
             box.open()
             self.error_dialog = box
             return False
-        self.edit(self._recolor(preset), "Import colour map")
+        self.edit(self._recolor(preset), "Import color map")
         return True
 
     def _ask_export(self) -> None:
-        path, _ = QFileDialog.getSaveFileName(self, "Export ParaView colour map", "colormap.json", "JSON (*.json)")
+        path, _ = QFileDialog.getSaveFileName(self, "Export ParaView color map", "colormap.json", "JSON (*.json)")
         if path:
             self.export_paraview(path)
 

@@ -2,7 +2,7 @@
 
 // Semi-transparent isosurfaces (libMini note section 4, volviz.render.gl_iso): one fragment program for every pass;
 // isoPass selects what the fragment writes. Shading as volviz.iso.composite: opacity alpha = the surface opacity, or
-// the iso-spectrum 1 - clamp(mu^a - b, 0, 1) ("Shaded Iso-Surfaces"); head-light colour c (k_a + (1 - k_a) mu).
+// the iso-spectrum 1 - clamp(mu^a - b, 0, 1) ("Shaded Iso-Surfaces"); head-light color c (k_a + (1 - k_a) mu).
 //   0 opaque surface          (c_lit, 1)
 //   1 "over" (2-pass, exact)  (c_lit, alpha), straight: VTK's (SRC_ALPHA, ONE_MINUS_SRC_ALPHA) blending, or depth
 //                             peeling through the //VTK::DepthPeeling tags

@@ -1,7 +1,7 @@
 //VTK::System::Dec
 
 // Semi-transparent isosurfaces (libMini note section 4, volviz.render.gl_iso). Every vertex carries its surface's
-// style (colour, normal-incidence opacity) and iso-spectrum fit (a, b); mu = |n . v| between the unit normal and the
+// style (color, normal-incidence opacity) and iso-spectrum fit (a, b); mu = |n . v| between the unit normal and the
 // view ray is computed per vertex and interpolated (perspective-correct), as the CPU rasteriser of
 // volviz.iso.composite does. Positions and the eye are relative to the meshes' centre (the actor's position).
 in vec4 vertexMC;

@@ -12,7 +12,7 @@
 //
 // Instead of a table, the segment can be evaluated exactly, as the CPU "pt" does: isosurfaces (Roettger sections
 // 8.8-8.10, 8.13: the Heaviside limit of the segment, H(0) = 1/2, several surfaces composited in ray order with their
-// side's colour; smooth shading, section 8.9, with PT_SMOOTH: a headlight through vertex normals, the intensity
+// side's color; smooth shading, section 8.9, with PT_SMOOTH: a headlight through vertex normals, the intensity
 // interpolated linearly in the cell through its barycentric coordinates and taken where the ray crosses the surface)
 // or pre-classification (section 8.14: the TF applied at both ends, kappa and rho linear in between, integrated in
 // closed form). Their data lie in ptTable as rows read by texelFetch.
@@ -50,7 +50,7 @@ uniform vec4 clipPlanes[PT_CLIPS];
 #ifndef PT_KIND
 #define PT_KIND 0
 #endif
-uniform int rowCount;        // 2: isosurfaces (rows: value, opacity; front colour; back colour), 3: TF points
+uniform int rowCount;        // 2: isosurfaces (rows: value, opacity; front color; back color), 3: TF points
 uniform float isoThicken;
 #if PT_KIND == 1
 uniform sampler2DArray ptTable;   // the separable table's layers: bilinear in (s_f, s_b) within a layer
@@ -138,9 +138,9 @@ vec4 isoSegment(float sf, float sb, float hf, float hb)
     float a = h * head.y;
     if (a > 0.0)
     {
-      vec3 colour = texelFetch(ptTable, ivec3(k, ascending ? 1 : 2, 0), 0).rgb;
+      vec3 color = texelFetch(ptTable, ivec3(k, ascending ? 1 : 2, 0), 0).rgb;
       float w = sb != sf ? clamp((v - sf) / (sb - sf), 0.0, 1.0) : 0.5;
-      c += tr * a * colour * (hf + w * (hb - hf));
+      c += tr * a * color * (hf + w * (hb - hf));
       tr *= 1.0 - a;
     }
   }

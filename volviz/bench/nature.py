@@ -1,7 +1,7 @@
 """``volviz bench nature``: a fly-through of a natural scene at 512 x 384 along a fixed camera path (Roettger
 Ch. 10–11).
 
-Scene: the Yukon height field of the libMini demo (1000 x 1000 units, 0.33 per grey level, its colour texture, its
+Scene: the Yukon height field of the libMini demo (1000 x 1000 units, 0.33 per grey level, its color texture, its
 ground-fog map at 0.15 per grey level) with a 513 x 513 x 65 Perlin-noise cloud volume (83.9 million tetrahedra at
 full resolution, Roettger §11.7's size) from height 110 to 235, and the SkyDome texture. Without the data, the
 procedural demo terrain is used (stated in the report).
@@ -65,7 +65,7 @@ NOTES = [
     "leaf carries an optical-depth error ρ_max Δ s ≈ 2.5 Δ, so an opacity error below 1% needs Δ < 0.004 of the "
     "density range — only a field with periods of several hundred units (a few blobs, not clouds) is that linear "
     "over 31 units. The terrain alone needs ~2.5x the triangles for terrain RMSE ~3 (terrain sweep; the Yukon "
-    "texture is high-contrast, so a sub-pixel geometric difference gives a visible colour difference).",
+    "texture is high-contrast, so a sub-pixel geometric difference gives a visible color difference).",
     "The RMSE target alone is met with more geometry (same path, other runs of this command): terrain C, c = 9, "
     "160 (~400,000 triangles) with clouds C, c = 2, 50 gives max RMSE 2.72 at 44,000 cloud tetrahedra per frame "
     "on average (docs/bench/nature_accurate.md, at ~1 fps); with clouds 2, 20 (22,000) frame 0 reaches 4.4; with "
@@ -126,7 +126,7 @@ def build_scene(data: Path, cloud_shape: tuple[int, int, int], terrain_c: tuple[
         fog = noise.fog_map(h, level=30.0, thickness=30.0, seed=2)
         source = "procedural demo terrain (Yukon data not found)"
     scene = NatureScene(hf, tex, sky, big_c=terrain_c[0], small_c=terrain_c[1])
-    scene.add_fog("ground_fog", fog, FogLayer(colour=(0.75, 0.75, 1.0), density=0.05, mode="attenuated"), weight=2.0)
+    scene.add_fog("ground_fog", fog, FogLayer(color=(0.75, 0.75, 1.0), density=0.05, mode="attenuated"), weight=2.0)
     nx, ny, nz = cloud_shape
     sp = 1000.0 / (nx - 1)
     f = noise.cloud_density(cloud_shape, seed=5, coverage=0.3, scale=SCALE, octaves=OCT, sharpness=SHARP,

@@ -5,7 +5,7 @@ RGBA error against the exact reference ``integrate_segment`` at the same random 
 table's domain [TF range]² × [0, l_max] (3D tables also at their own sample points). Writes ``docs/bench/tables.md``
 with the command line, ``docs/bench/tables.png`` (time against RMS error) and optionally ``--json OUT``.
 
-Peers: the thesis's software pre-integration times (Roettger Table 9.4, Pentium 4 2 GHz, 512²: 4.4 s linear colour,
+Peers: the thesis's software pre-integration times (Roettger Table 9.4, Pentium 4 2 GHz, 512²: 4.4 s linear color,
 6.6 s degree 2, 11.0 s degree 4) and VTK's incremental scheme (nearest-index rounding), run here as
 ``incremental-nearest``.
 """
@@ -110,7 +110,7 @@ def run(quick: bool = False, repeats: int = 5, n_points: int = 200_000, l_max: f
         # incremental rebuild after editing one control point near the top of the range
         n, nl = (64, 32) if quick else (128, 64)
         colors = tf.colors.copy()
-        colors[-2] = 1.0 - colors[-2]  # complementary colour: a real edit (unless mid-grey)
+        colors[-2] = 1.0 - colors[-2]  # complementary color: a real edit (unless mid-grey)
         edited = TransferFunction(tf.scalars, colors, tf.extinction, tf.name)
         base = build_table3d(tf, n, nl, l_max)
 
@@ -208,7 +208,7 @@ def write_report(result: dict, out_dir: Path, command: str) -> Path:
     md += [
         "",
         "Notes: the 2D table (Eq. 8.2) is linear in l by construction and its error is that approximation "
-        "(l-bar = l_max/2 here). The separable tables' opacity is exact up to the bilinear rho-hat; their colour "
+        "(l-bar = l_max/2 here). The separable tables' opacity is exact up to the bilinear rho-hat; their color "
         "error falls with the polynomial degree. 'incremental-nearest' is VTK's index rounding; 'incremental-linear' "
         "interpolates the two neighbouring entries instead. Rebuild: one control point near the top of the range "
         "edited and restored (two partial rebuilds) against one full build.",

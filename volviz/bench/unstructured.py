@@ -429,7 +429,7 @@ def _markdown(results: dict[str, Any], path: Path) -> None:
         f"(1-minute load average {results.get('load_average_start', float('nan')):.1f} at the start, "
         f"{results.get('load_average_end', float('nan')):.1f} at the end of this run).",
         "Errors are against the exact float64 reference ray caster on frame 0, in 8-bit units of premultiplied "
-        "colour (VTK images are read back over black, i.e. premultiplied RGB).",
+        "color (VTK images are read back over black, i.e. premultiplied RGB).",
         "VTK gets the same κ and opacity a = ρ·unit_distance with ScalarOpacityUnitDistance = unit_distance = 1.", "",
         "| method | s/frame | sort s | project s | raster s | tets/s | RMSE | max |",
         "|---|---|---|---|---|---|---|---|",
@@ -456,7 +456,7 @@ def _markdown(results: dict[str, Any], path: Path) -> None:
               f"(MPVO + image-space boundary relations + zero-opacity culling). "
               f"Fragments per frame: {pt['fragments']}."]
     lines += ["", "pt rows: 'auto' picks the separable pre-integration (Roettger §9.1: exact opacity 1 - exp(-l ρ̂), "
-              "colour polynomial of degree 2 in l, 256² table) when the largest optical depth of one cell is ≤ 6, "
+              "color polynomial of degree 2 in l, 256² table) when the largest optical depth of one cell is ≤ 6, "
               "as here; pt-3d is the same renderer with the trilinear 3D table (128² x 64, 16 MB). CPU is the "
               "process CPU time of one frame summed over threads (less sensitive to other jobs than wall time)."]
     along = pt.get("path")

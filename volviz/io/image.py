@@ -20,7 +20,7 @@ MAX_PIXELS = 1 << 28
 
 
 def read_image(path: PathLike) -> Image2D:
-    """Read a PNG/JPEG/TIFF/BMP into Image2D: (rows, cols) grey or (rows, cols, 3|4) colour, row 0 at the top."""
+    """Read a PNG/JPEG/TIFF/BMP into Image2D: (rows, cols) grey or (rows, cols, 3|4) color, row 0 at the top."""
     from PIL import Image, UnidentifiedImageError
 
     check_file(path)

@@ -1,4 +1,4 @@
-"""Netpbm grey and colour images: PGM (P2 ASCII, P5 binary) and PPM (P3 ASCII, P6 binary), 8 and 16 bit.
+"""Netpbm grey and color images: PGM (P2 ASCII, P5 binary) and PPM (P3 ASCII, P6 binary), 8 and 16 bit.
 
 Header: magic, width, height, maxval separated by whitespace, ``#`` comments to the end of a line; for P5/P6
 exactly one whitespace byte precedes the raster. ``maxval`` < 256 gives one byte per sample, otherwise two bytes,
@@ -89,7 +89,7 @@ def _read_header(path: PathLike, size: int) -> tuple[bytes, int, int, int, int]:
 
 
 def read_pnm(path: PathLike) -> Image2D:
-    """Read a PGM/PPM image: data (rows, cols) for grey, (rows, cols, 3) for colour; uint8 or native uint16."""
+    """Read a PGM/PPM image: data (rows, cols) for grey, (rows, cols, 3) for color; uint8 or native uint16."""
     size = file_size(path)
     magic, width, height, maxval, offset = _read_header(path, size)
     channels, binary = _MAGICS[magic]

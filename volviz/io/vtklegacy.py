@@ -184,7 +184,7 @@ class _Scan:
             self.need(n * components, b"unsigned_char", left, f"COLOR_SCALARS of {n} x {components}")
         elif kw == b"LOOKUP_TABLE" and len(args) > 1:
             entries = self.counts(args[1:], 1, "LOOKUP_TABLE size")[0]
-            self.need(4 * entries, b"unsigned_char", left, f"LOOKUP_TABLE of {entries} colours")
+            self.need(4 * entries, b"unsigned_char", left, f"LOOKUP_TABLE of {entries} colors")
         elif kw == b"TEXTURE_COORDINATES":
             dim = self.counts(args[1:], 1, "TEXTURE_COORDINATES dimension")[0]
             if not 1 <= dim <= 3:

@@ -14,12 +14,12 @@ transparent fragments i in front of it, each with opacity α_i and premultiplied
 - ``"4pass"``  (order-independent, depth cue): as 3pass, but the sum runs only over fragments with depth ≤ z_b, the
   front-most back face of the transparent surfaces (z_b = ∞ if the pixel has no back face).
 
-Colour channels of the order-independent sums saturate at 1 (as a fixed-point frame buffer does); the alpha channel
+Color channels of the order-independent sums saturate at 1 (as a fixed-point frame buffer does); the alpha channel
 is 1 − Π(1 − α_i)(1 − α_B) for 3pass/4pass, the "over" result for the others.
 
 Shading: ``"spectrum"`` gives transparent fragments the iso-spectrum opacity α(μ) = 1 − clamp(μ^a − b, 0, 1) with
 (a, b) least-squares fitted per surface opacity (``volviz.iso.spectrum``); ``"flat"`` uses the surface opacity as is.
-Colours are lit by a head light, c·(k_a + (1 − k_a)·μ) with μ = |cos θ| between normal and view ray (``lighting``).
+Colors are lit by a head light, c·(k_a + (1 − k_a)·μ) with μ = |cos θ| between normal and view ray (``lighting``).
 """
 from __future__ import annotations
 
@@ -92,7 +92,7 @@ def _back_facing(points: np.ndarray, tris: np.ndarray, normals: np.ndarray, came
 
 def fragments(meshes: Sequence[IsoMesh], camera: Camera, size: tuple[int, int] = (256, 256),
               shading: str = "spectrum", lighting: bool = True) -> Fragments:
-    """Rasterise all surfaces of all volumes once; fragment colours and opacities per the shading model."""
+    """Rasterise all surfaces of all volumes once; fragment colors and opacities per the shading model."""
     if shading not in ("spectrum", "flat"):
         raise ValueError(f"shading must be 'spectrum' or 'flat', got {shading!r}")
     t0 = time.perf_counter()

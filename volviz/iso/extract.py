@@ -1,7 +1,7 @@
 """Isosurface extraction for several iso-values from several (possibly overlapping) volumes (libMini note §4).
 
 Regular volumes go through ``vtkFlyingEdges3D``; curvilinear grids, tetrahedral and other unstructured meshes through
-``vtkContourFilter``. Every iso-value carries its own colour and opacity (an ``IsoStyle``); the result is one
+``vtkContourFilter``. Every iso-value carries its own color and opacity (an ``IsoStyle``); the result is one
 ``IsoMesh`` per (volume, iso-value): points, triangles, unit normals and the style. Normals are oriented along the
 negative scalar gradient (they point out of a blob of high values), the convention the compositor uses to tell front
 from back faces (4-pass mode, libMini note §4 step 3).
@@ -20,7 +20,7 @@ __all__ = ["IsoStyle", "IsoMesh", "extract", "extract_many", "merge_meshes"]
 
 @dataclass(frozen=True)
 class IsoStyle:
-    """Iso-value with colour (RGB in 0..1) and opacity in [0, 1] (1 = opaque, rendered in the opaque pass)."""
+    """Iso-value with color (RGB in 0..1) and opacity in [0, 1] (1 = opaque, rendered in the opaque pass)."""
 
     value: float
     color: tuple[float, float, float] = (1.0, 1.0, 1.0)
@@ -33,7 +33,7 @@ class IsoStyle:
             raise ValueError(f"iso-surface opacity must be in [0, 1], got {self.opacity}")
         c = np.asarray(self.color, dtype=np.float64)
         if c.shape != (3,) or not np.all(np.isfinite(c)) or c.min() < 0.0 or c.max() > 1.0:
-            raise ValueError(f"iso-surface colour must be 3 values in [0, 1], got {self.color}")
+            raise ValueError(f"iso-surface color must be 3 values in [0, 1], got {self.color}")
 
     @property
     def opaque(self) -> bool:

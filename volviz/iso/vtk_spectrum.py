@@ -8,7 +8,7 @@ view axis for parallel projection). Only the alpha is replaced, right after ``//
 (VTK 9.7, llvmpipe), a replacement at ``//VTK::CustomEnd::Impl`` had no effect on a ``vtkOpenGLPolyDataMapper`` and
 none at all through pyvista's ``vtkDataSetMapper``, so use a plain ``vtkOpenGLPolyDataMapper``. The actor must have
 point normals; its property opacity is set to the normal-incidence opacity so VTK draws it in the
-translucent pass (VTK blends straight alpha, SRC_ALPHA / ONE_MINUS_SRC_ALPHA, so the colour follows α).
+translucent pass (VTK blends straight alpha, SRC_ALPHA / ONE_MINUS_SRC_ALPHA, so the color follows α).
 
 The renderer must have at least one light: without lights VTK builds its unlit shader, which declares neither
 ``normalVCVSOutput`` nor ``vertexVC``, and the replacement fails to compile (this was the "does not compile in the Qt
@@ -51,7 +51,7 @@ def apply_spectrum_shader(actor: Any, opacity: float, parallel: bool = False) ->
 
 
 def iso_actor(mesh: Any, parallel: bool = False, spectrum: bool = True) -> Any:
-    """A vtkActor for an ``IsoMesh`` (vtkOpenGLPolyDataMapper, the surface colour, Phong-interpolated normals).
+    """A vtkActor for an ``IsoMesh`` (vtkOpenGLPolyDataMapper, the surface color, Phong-interpolated normals).
 
     Translucent surfaces get the iso-spectrum shader when ``spectrum`` is true, else constant opacity; VTK then
     blends them unsorted (the note's 2-pass mode). The accurate modes are the CPU compositor's

@@ -263,7 +263,7 @@ class TetMesh:
 
 @dataclass
 class Image2D:
-    """A 2D raster: height field, fog map or colour texture (PGM/PPM/DEM). ``data`` is (rows, cols[, channels])."""
+    """A 2D raster: height field, fog map or color texture (PGM/PPM/DEM). ``data`` is (rows, cols[, channels])."""
 
     data: np.ndarray
     spacing: tuple[float, float] = (1.0, 1.0)

@@ -12,13 +12,13 @@ from __future__ import annotations
 
 from typing import Any, Literal, Optional, Union
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
+from pydantic import AliasChoices, BaseModel, ConfigDict, Field, ValidationError, field_validator
 
 __all__ = ["Settings", "TerrainSettings", "FogSettings", "CloudSettings", "SkySettings", "VolumeSettings",
            "MeshSettings", "IsoStyleSettings", "IsosurfaceSettings", "DemoSettings", "RenderOptions",
            "SETTINGS_MODELS", "FogMode", "CloudShadingName", "IsoMode", "IsoShading", "IsoOverlayMode", "Backend",
-           "SortName", "array_key", "settings_model", "validate_settings", "validate_render_options", "typed_settings",
-           "SettingsError"]
+           "SortName", "array_key", "settings_model", "former_names", "validate_settings", "validate_render_options",
+           "typed_settings", "SettingsError"]
 
 FogMode = Literal["emissive", "attenuated", "mip"]
 CloudShadingName = Literal["npr", "physical"]
@@ -31,7 +31,7 @@ TableName = Literal["auto", "3d", "separable-1", "separable-2", "separable-4"]
 
 Vec2 = tuple[float, float]
 Vec3 = tuple[float, float, float]
-Colour = tuple[float, float, float]
+Color = tuple[float, float, float]
 
 
 def _unit(unit: str) -> dict[str, Any]:
@@ -90,7 +90,9 @@ class FogSettings(Settings):
     base_scale: float = Field(1.0, title="Base scale", description="base-map values times this")
     base_offset: float = Field(0.0, title="Base offset", description="added to the base height",
                                json_schema_extra=_unit("m"))
-    colour: Colour = Field((0.75, 0.75, 1.0), title="Colour", json_schema_extra={"colour": True})
+    # "colour": the name sessions were saved with before the public API spelt it "color" (read, saved as "color")
+    color: Color = Field((0.75, 0.75, 1.0), title="Color", json_schema_extra={"color": True},
+                         validation_alias=AliasChoices("color", "colour"))
     density: float = Field(0.05, ge=0, le=1e3, title="Density", description="emission / optical density per unit "
                            "length at emission 1", json_schema_extra=_unit("1/m"))
     mode: FogMode = Field("attenuated", title="Mode", description="emissive (additive), attenuated (the integral as "
@@ -99,11 +101,11 @@ class FogSettings(Settings):
     weight: float = Field(4.0, ge=0, le=1e3, title="LOD weight", description="how much the layer refines the "
                           "terrain mesh under it")
 
-    @field_validator("colour")
+    @field_validator("color")
     @classmethod
-    def _colour_in_range(cls, value: Colour) -> Colour:
+    def _color_in_range(cls, value: Color) -> Color:
         if any(not 0.0 <= v <= 1.0 for v in value):
-            raise ValueError("colour components must be in 0..1")
+            raise ValueError("color components must be in 0..1")
         return value
 
 
@@ -154,10 +156,10 @@ class MeshSettings(VolumeSettings):
 
 
 class IsoStyleSettings(Settings):
-    """One isosurface: its value, colour and opacity."""
+    """One isosurface: its value, color and opacity."""
 
     value: float = Field(title="Iso-value")
-    color: Colour = Field((1.0, 1.0, 1.0), title="Colour", json_schema_extra={"colour": True})
+    color: Color = Field((1.0, 1.0, 1.0), title="Color", json_schema_extra={"color": True})
     opacity: float = Field(0.5, ge=0, le=1, title="Opacity")
 
 
@@ -198,7 +200,7 @@ class RenderOptions(Settings):
     sort: SortName = Field("mpvo", title="Cell sort", description="PT visibility order: mpvo (exact for convex "
                            "meshes, with Guthe's boundary relations otherwise), centroid or power")
     table: TableName = Field("auto", title="Pre-integration table", description="auto (by optical depth), 3d, or "
-                             "separable with a colour polynomial of degree 1, 2 or 4 (Roettger §9.1)")
+                             "separable with a color polynomial of degree 1, 2 or 4 (Roettger §9.1)")
     table_resolution: int = Field(128, ge=16, le=1024, title="Table resolution")
     iso_mode: IsoOverlayMode = Field("vtk", title="Isosurface mode", description="vtk (VTK's own blending) or a "
                                      "transparency mode of the libMini note")
@@ -269,10 +271,22 @@ def typed_settings(component_type: str, settings: dict[str, Any], where: str = "
         raise SettingsError(_problems(exc, where)) from None
 
 
+def former_names(component_type: str) -> dict[str, str]:
+    """The keys older sessions wrote for a component type's fields that have since been renamed, each with the
+    field's name now (the other choices of a field's ``validation_alias``): ``{"colour": "color"}`` for fog."""
+    former = {}
+    for name, info in settings_model(component_type).model_fields.items():
+        if isinstance(info.validation_alias, AliasChoices):
+            former.update({key: name for key in info.validation_alias.choices if isinstance(key, str) and key != name})
+    return former
+
+
 def validate_settings(component_type: str, settings: dict[str, Any], where: str = "settings") -> dict[str, Any]:
-    """``settings`` checked against its model; returned as given (only the keys set), as sessions store them."""
+    """``settings`` checked against its model; returned with only the keys set, as sessions store them, a key
+    written under a field's former name (``former_names``) under its name now, so that a session saves it so."""
     typed_settings(component_type, settings, where)
-    return settings
+    former = former_names(component_type)
+    return {former.get(key, key): value for key, value in settings.items()}
 
 
 def validate_render_options(options: dict[str, Any], where: str = "render.options") -> RenderOptions:

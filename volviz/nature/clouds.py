@@ -30,7 +30,7 @@
 - **Shading** (§11.6): two fields; the table is indexed by one field and the segment length is modulated by the
   other, l' = l · m̄ (m the modulating field over its maximum, averaged over the piece):
   ``"physical"`` (§11.6.1): κ(γ) pre-integrated at ρ = ρ_max, l' = l f / f_max;
-  ``"npr"`` (§11.6.2): κ(f) an inverse colour ramp, ρ(f) linear and zero below a cutoff, l' = l γ / γ_max.
+  ``"npr"`` (§11.6.2): κ(f) an inverse color ramp, ρ(f) linear and zero below a cutoff, l' = l γ / γ_max.
 """
 from __future__ import annotations
 
@@ -141,7 +141,7 @@ class CloudShading:
     @classmethod
     def npr(cls, rho_max: float = 0.08, cutoff: float = 0.04, bright=(1.0, 1.0, 1.0), dark=(0.42, 0.46, 0.56)
             ) -> "CloudShading":
-        """§11.6.2: κ(f) an inverse colour ramp (bright where thin, dark where dense), ρ(f) zero up to ``cutoff``
+        """§11.6.2: κ(f) an inverse color ramp (bright where thin, dark where dense), ρ(f) zero up to ``cutoff``
         then linear to ``rho_max`` at f = 1; γ modulates the segment length."""
         from volviz.optics import TransferFunction
 
@@ -149,11 +149,11 @@ class CloudShading:
         return cls("npr", tf, cutoff)
 
     @classmethod
-    def physical(cls, rho_max: float = 0.08, colour=(1.0, 1.0, 1.0), dark=(0.25, 0.28, 0.35)) -> "CloudShading":
+    def physical(cls, rho_max: float = 0.08, color=(1.0, 1.0, 1.0), dark=(0.25, 0.28, 0.35)) -> "CloudShading":
         """§11.6.1: κ(γ) pre-integrated at the maximum optical density ρ_max; f modulates the length."""
         from volviz.optics import TransferFunction
 
-        tf = TransferFunction([0.0, 1.0], [dark, colour], [rho_max, rho_max], name="clouds-physical")
+        tf = TransferFunction([0.0, 1.0], [dark, color], [rho_max, rho_max], name="clouds-physical")
         return cls("physical", tf, 0.0)
 
 

@@ -20,13 +20,13 @@ height fraction between bottom and top), i.e. the interpolation PCP's front and 
 
 Modes (per layer, ``render_layer``):
 
-- ``"emissive"``: RGB = colour · Σ ½ (e_f + e_b) l (additive, α = 0): the thesis's emission-only model;
-- ``"attenuated"``: the same integral used as optical depth τ: α = 1 − e^{−τ}, RGB = colour · α. For a constant
-  colour this *is* the exact emission–absorption integral whatever the density distribution, since
+- ``"emissive"``: RGB = color · Σ ½ (e_f + e_b) l (additive, α = 0): the thesis's emission-only model;
+- ``"attenuated"``: the same integral used as optical depth τ: α = 1 − e^{−τ}, RGB = color · α. For a constant
+  color this *is* the exact emission–absorption integral whatever the density distribution, since
   ∫ κ ρ e^{−τ(t)} dt = κ (1 − e^{−τ}) for constant κ — order independent, no sorting;
 - ``"mip"`` (§10.4 MIP variant): the maximum of the vertex scalar over the ray's prism entry/exit points (the maximum
   of a linear cell lies on its faces), with scalar 0 at the prism bottom and the layer thickness at the top;
-  RGB = colour · min(gain · max, 1), α = min(gain · max, 1).
+  RGB = color · min(gain · max, 1), α = min(gain · max, 1).
 """
 from __future__ import annotations
 
@@ -46,7 +46,7 @@ from volviz.nature.raster import (PRISM_EDGES, clipped_screen_box, dealt_band, d
 class FogLayer:
     """Optical settings of one prism layer (ground fog or cloud layer)."""
 
-    colour: tuple[float, float, float] = (0.75, 0.75, 1.0)
+    color: tuple[float, float, float] = (0.75, 0.75, 1.0)
     density: float = 0.05          # emission / optical density per unit length at e = 1
     mode: str = "attenuated"       # "emissive" | "attenuated" | "mip"
     mip_gain: float = 0.05         # MIP: intensity per unit of layer thickness
@@ -252,7 +252,7 @@ def render_layer(points: np.ndarray, bottom: np.ndarray, top: np.ndarray, triang
     """
     eb, et = layer_emission(bottom, top, layer, emission)
     emis, mip, drawn = pcp_integrals(points, bottom, top, triangles, eb, et, camera, size, depth)
-    col = np.asarray(layer.colour, dtype=np.float64)
+    col = np.asarray(layer.color, dtype=np.float64)
     out = np.zeros(emis.shape + (4,))
     if layer.mode == "emissive":
         out[..., :3] = emis[..., None] * layer.density * col

@@ -1,12 +1,12 @@
 """Natural scenes: terrain + ground fog / cloud layers + volumetric clouds + sky, on the CPU and in a PyVista plotter.
 
 ``NatureScene`` holds the pieces (terrain C-LOD with its morphed layers, PCP prism layers, cloud C-LOD, sky) and
-renders a frame on the CPU (``render``): the terrain z-buffer and colour (``raster``), the sky behind it, and the
+renders a frame on the CPU (``render``): the terrain z-buffer and color (``raster``), the sky behind it, and the
 volumes as one premultiplied RGBA overlay clipped at the terrain depth. Volumes are composited as layers, farthest
 (from the eye's height) first — exact for layers that do not interleave along a ray (each prism layer is itself order
 independent, see ``fog``; the clouds are sorted by the octree).
 
-``NatureView`` puts a scene into a PyVista plotter: the terrain as a textured mesh (the baked colour map, lighting
+``NatureView`` puts a scene into a PyVista plotter: the terrain as a textured mesh (the baked color map, lighting
 off, so it matches the CPU image), the sky dome, and the volume overlay as a screen-space RGBA image in front (the
 terrain occlusion is already in it). ``update(camera)`` recomputes the terrain LOD mesh and the overlay for a camera.
 
@@ -25,7 +25,7 @@ from volviz.model.settings import TerrainSettings, typed_settings
 from volviz.nature.clouds import CloudLOD, CloudShading, CloudVolume, build_cloud_table, render_cloud_image
 from volviz.nature.fog import FogLayer, render_layer
 from volviz.nature.heightfield import HeightField, grid_from_image, resample_bilinear
-from volviz.nature.raster import bake_colour_map, mip_pyramid, render_sky, render_terrain
+from volviz.nature.raster import bake_color_map, mip_pyramid, render_sky, render_terrain
 from volviz.nature.terrain import TerrainLOD, TerrainMesh, frustum_planes
 
 
@@ -73,7 +73,7 @@ class NatureScene:
         self.cloud_shading: CloudShading | None = None
         self.cloud_table: Any = None
         self.lod: TerrainLOD | None = None
-        self.colour_map: np.ndarray | None = None
+        self.color_map: np.ndarray | None = None
         self._pyramid: Any = None
 
     # ----------------------------------------------------------------------------------------------- building
@@ -118,9 +118,9 @@ class NatureScene:
         if self.terrain is not None and self.lod is None:
             self.lod = TerrainLOD(self.terrain, layers=self._layers, curvature=self._curvature, big_c=self.big_c,
                                   small_c=self.small_c)
-            if self.colour_map is None:
-                self.colour_map = bake_colour_map(self.terrain.normals(), self.texture, self.light)
-                self._pyramid = mip_pyramid(self.colour_map)
+            if self.color_map is None:
+                self.color_map = bake_color_map(self.terrain.normals(), self.texture, self.light)
+                self._pyramid = mip_pyramid(self.color_map)
 
     # ----------------------------------------------------------------------------------------------- rendering
     def terrain_mesh(self, camera: Any, size: tuple[int, int], full: bool = False) -> TerrainMesh | None:
@@ -203,7 +203,7 @@ def demo_scene(seed: int = 0, terrain_size: int = 257, cloud_shape: tuple[int, i
     hf = HeightField(h, (extent / (terrain_size - 1),) * 2)
     scene = NatureScene(hf, None, None, big_c=9.0, small_c=40.0)
     fog = noise.fog_map(h, level=55.0, thickness=25.0, seed=seed + 2)
-    scene.add_fog("ground_fog", fog, FogLayer(colour=(0.85, 0.87, 0.95), density=0.04, mode="attenuated"))
+    scene.add_fog("ground_fog", fog, FogLayer(color=(0.85, 0.87, 0.95), density=0.04, mode="attenuated"))
     nx, ny, nz = cloud_shape
     spacing = extent / (nx - 1)
     f = noise.cloud_density(cloud_shape, seed=seed + 3, coverage=0.25)
@@ -260,7 +260,7 @@ def scene_from_components(components: Sequence[Any], datasets: dict[str, Any]) -
       ``origin`` [x0, y0] (default: the image's),
       ``height_scale`` (1), ``texture_dataset``, ``size`` (2^n + 1), ``C`` (12), ``c`` (60).
     fog: ``dataset`` = thickness map; ``thickness_scale`` (1), ``base_dataset`` + ``base_scale`` + ``base_offset``
-      for a cloud layer between two height fields, ``mode`` (attenuated | emissive | mip), ``density``, ``colour``,
+      for a cloud layer between two height fields, ``mode`` (attenuated | emissive | mip), ``density``, ``color``,
       ``weight`` (curvature weight, 4).
     clouds: ``dataset`` = a RegularVolume of densities, or generated: ``shape`` [nx, ny, nz], ``seed``,
       ``coverage``; ``base_height``, ``thickness``, ``extent``; ``shading`` (npr | physical), ``rho_max``, ``C``, ``c``.
@@ -307,7 +307,7 @@ def scene_from_components(components: Sequence[Any], datasets: dict[str, Any]) -
         base = None
         if base_img is not None:
             base = _image_grid(base_img) * fog.base_scale + fog.base_offset
-        layer = FogLayer(colour=fog.colour, density=fog.density, mode=fog.mode, mip_gain=fog.mip_gain)
+        layer = FogLayer(color=fog.color, density=fog.density, mode=fog.mode, mip_gain=fog.mip_gain)
         scene.add_fog(comp.id, thick, layer, base, fog.weight)
     for comp in by_type.get("clouds", [])[:1]:
         st = typed_settings("clouds", comp.settings, f"component {comp.id!r} settings")
@@ -360,8 +360,8 @@ class NatureView:
         self._mesh = None
         self.last_stats: dict[str, float] = {}
         self.shown_scale = 1          # the preview scale of the overlay shown (``compute``)
-        if scene.terrain is not None and scene.colour_map is not None:
-            img = np.clip(scene.colour_map.transpose(1, 0, 2)[::-1] * 255.0, 0, 255).astype(np.uint8)
+        if scene.terrain is not None and scene.color_map is not None:
+            img = np.clip(scene.color_map.transpose(1, 0, 2)[::-1] * 255.0, 0, 255).astype(np.uint8)
             self._texture = pv.Texture(np.ascontiguousarray(img))
             b = scene.terrain.bounds()
             radius = 3.0 * max(b[1] - b[0], b[3] - b[2])
@@ -405,7 +405,7 @@ class NatureView:
     def _fit_clipping(self) -> None:
         """Make the plotter camera's clipping range hold the sky dome around the eye. A session camera applied before
         any actor existed leaves VTK's default range (0.01, 1000.01), whose far plane cut the dome (radius 3 x the
-        terrain extent) away so the background colour showed instead of the sky."""
+        terrain extent) away so the background color showed instead of the sky."""
         pc = self.plotter.camera
         near, far = (float(v) for v in pc.clipping_range)
         need = 1.05 * self.dome_radius
@@ -513,7 +513,7 @@ class NatureView:
 
 def _magnify(rgba8: np.ndarray, size: tuple[int, int]) -> np.ndarray:
     """A straight-alpha RGBA8 image resampled bilinearly to ``size`` (W, H) pixels over the same view (Pillow:
-    premultiplied while filtering, so no colour bleeds from transparent pixels; pixel centres aligned)."""
+    premultiplied while filtering, so no color bleeds from transparent pixels; pixel centres aligned)."""
     from PIL import Image
 
     img = Image.fromarray(np.ascontiguousarray(rgba8), "RGBA").convert("RGBa")
@@ -522,7 +522,7 @@ def _magnify(rgba8: np.ndarray, size: tuple[int, int]) -> np.ndarray:
 
 def _overlay_rgba(overlay: np.ndarray) -> np.ndarray:
     """A premultiplied RGBA image as 8-bit straight-alpha RGBA, rows bottom-up (VTK's order), for blending in front
-    of the scene. Pure emission (α = 0, colour > 0) is shown with α' = max(α, max colour): C + (1 − α') B instead of
+    of the scene. Pure emission (α = 0, color > 0) is shown with α' = max(α, max color): C + (1 − α') B instead of
     C + B (error ≤ α' B)."""
     alpha = np.maximum(overlay[..., 3], overlay[..., :3].max(axis=-1))
     alpha = np.clip(alpha, 0.0, 1.0)

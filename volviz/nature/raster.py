@@ -1,11 +1,11 @@
-"""CPU rasterisation of the (opaque) terrain: a float64 z-buffer and a lit, textured colour image.
+"""CPU rasterisation of the (opaque) terrain: a float64 z-buffer and a lit, textured color image.
 
 The volumes of a natural scene (fog prisms, clouds) are composited over this depth: a pixel's fog and cloud segments
 end where its ray meets the terrain. Conventions are those of ``volviz.model.camera.Camera``: pixel centres at
 integer (col, row), row 0 at the top, depth = distance along the direction of projection (the ray parameter t).
 
 Triangles are clipped against the near plane in camera space (Sutherland–Hodgman, one plane) and rasterised with
-perspective-correct interpolation (1/z and attribute/z linear in screen space). Shading: a baked colour map
+perspective-correct interpolation (1/z and attribute/z linear in screen space). Shading: a baked color map
 (texture times a static ambient + diffuse light map from the full-resolution normals, Roettger §4.4) sampled with
 trilinear mip-mapping, so lighting does not change with the LOD (only the geometry does) and nothing aliases.
 """
@@ -191,7 +191,7 @@ def _raster(vp, cam, tris, tc, w, h, bands, depth, uvbuf):
 
 
 def mip_pyramid(image: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """A (2^n + 1)-sized (N, N, 3) colour map and its [1 2 1]/4 decimations down to 2 x 2, packed for Numba:
+    """A (2^n + 1)-sized (N, N, 3) color map and its [1 2 1]/4 decimations down to 2 x 2, packed for Numba:
     (flat float32 data, (levels, 2) int64 [offset, size])."""
     levels = [np.asarray(image, dtype=np.float32)]
     while levels[-1].shape[0] > 2:
@@ -274,9 +274,9 @@ def _shade(depth, uvbuf, flat, meta, out):
                     out[y, x, c] = c0[c]
 
 
-def bake_colour_map(normals: np.ndarray, texture: np.ndarray | None = None, light=(0.4, 0.3, 0.85),
+def bake_color_map(normals: np.ndarray, texture: np.ndarray | None = None, light=(0.4, 0.3, 0.85),
                     ambient: float = 0.45, diffuse: float = 0.65, base_color=(0.55, 0.5, 0.42)) -> np.ndarray:
-    """The terrain's static light map times its colour texture on the height-field grid, (N, N, 3) float32
+    """The terrain's static light map times its color texture on the height-field grid, (N, N, 3) float32
     (Roettger §4.4: static ambient + diffuse light map).
     ``normals[i, j]`` x-major; the texture image has row 0 north."""
     from volviz.nature.heightfield import grid_from_image, resample_bilinear
@@ -315,10 +315,10 @@ def dealt_count(nb: int, threads: int) -> int:
 
 
 def render_terrain(points: np.ndarray, triangles: np.ndarray, tcoords: np.ndarray, camera: Any, size: tuple[int, int],
-                   colour_pyramid: tuple[np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
-    """Depth (H, W) float64 (inf where no terrain) and colour (H, W, 3) float32 of a terrain mesh.
+                   color_pyramid: tuple[np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """Depth (H, W) float64 (inf where no terrain) and color (H, W, 3) float32 of a terrain mesh.
 
-    ``tcoords`` (u, v) in [0, 1] address the baked colour map (``bake_colour_map``, packed by ``mip_pyramid``), sampled
+    ``tcoords`` (u, v) in [0, 1] address the baked color map (``bake_color_map``, packed by ``mip_pyramid``), sampled
     trilinearly with the mip level from each pixel's texel footprint, so a minified texture does not alias and the
     image is a smooth function of the geometry (a geometric LOD error shows as a proportional image error).
     """
@@ -333,7 +333,7 @@ def render_terrain(points: np.ndarray, triangles: np.ndarray, tcoords: np.ndarra
     far = camera.clipping_range[1]
     depth[depth > far] = np.inf
     rgb = np.zeros((h, w, 3), dtype=np.float32)
-    _shade(depth, uv, colour_pyramid[0], colour_pyramid[1], rgb)
+    _shade(depth, uv, color_pyramid[0], color_pyramid[1], rgb)
     return depth, rgb
 
 
@@ -364,9 +364,9 @@ def _sky(vp, w, h, tex, zenith, horizon, has_tex, mask, out):
 
 def render_sky(camera: Any, size: tuple[int, int], texture: np.ndarray | None = None,
                zenith=(0.32, 0.5, 0.85), horizon=(0.78, 0.85, 0.95), mask: np.ndarray | None = None) -> np.ndarray:
-    """Sky colour per pixel (H, W, 3) float32: the sky dome at infinity (Roettger §5.1) — a polar texture (u =
+    """Sky color per pixel (H, W, 3) float32: the sky dome at infinity (Roettger §5.1) — a polar texture (u =
     azimuth / 2 pi, top row = zenith, bottom row = horizon) or a zenith/horizon gradient. Below the horizon the
-    horizon colour continues. ``mask`` (H, W) bool: only those pixels are computed (the others stay 0), e.g. where
+    horizon color continues. ``mask`` (H, W) bool: only those pixels are computed (the others stay 0), e.g. where
     no terrain covers the sky."""
     w, h = (int(v) for v in size)
     vp = view_params(camera, (w, h))

@@ -16,7 +16,7 @@ import numpy as np
 
 def sky_dome_mesh(radius: float, centre: Sequence[float] = (0.0, 0.0, 0.0), n_azimuth: int = 64,
                   n_elevation: int = 16, skirt: float = 0.5 * np.pi) -> Any:
-    """A hemisphere (plus a short skirt ``skirt`` radians below the horizon, coloured like the horizon) as
+    """A hemisphere (plus a short skirt ``skirt`` radians below the horizon, colored like the horizon) as
     ``pyvista.PolyData`` with texture coordinates; normals point inwards (seen from inside)."""
     import pyvista as pv
 

@@ -4,7 +4,7 @@
 - ``integrate_segment``: the exact float64 reference for a linear-scalar segment (Eq. 8.1).
 - Tables, each with ``lookup(s_f, s_b, l)``, ``error(...)`` against the reference and ``rebuild(new_tf)``:
   ``build_table3d`` (§8.4; direct or incremental), ``build_table2d`` (§8.5, Eq. 8.2), ``build_separable``
-  (Ch. 9: ρ̂ + colour polynomial), ``build_iso_table`` (§8.8–8.13), ``build_zot`` (conservative zero-opacity test).
+  (Ch. 9: ρ̂ + color polynomial), ``build_iso_table`` (§8.8–8.13), ``build_zot`` (conservative zero-opacity test).
 - ``volviz.optics.metrics``: RMSE / max abs in 8-bit units, PSNR, error heat map.
 """
 from volviz.optics.integrate import integrate_preclassified, integrate_segment

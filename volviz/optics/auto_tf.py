@@ -2,10 +2,10 @@
 
 The opacity ramp runs between robust percentiles of the values (2 % and 99.5 %), computed without the background: a
 histogram bin at either end of the range that holds more than ``BACKGROUND_FRACTION`` of the values (the air around a
-CT scan, the zero outside a simulation's domain) is left out, and so stays transparent. The colour is a cool-warm map
+CT scan, the zero outside a simulation's domain) is left out, and so stays transparent. The color is a cool-warm map
 over the same percentiles. The peak extinction is set so that a ray crossing the data's bounding box reaches an
 optical depth of about ``TARGET_DEPTH`` for the average sample, whatever the data's units and spread: the image is
-neither faint nor a solid block. Values above the upper percentile keep the peak opacity and colour; the function
+neither faint nor a solid block. Values above the upper percentile keep the peak opacity and color; the function
 spans the whole finite range, because volviz draws scalars outside a transfer function's range as transparent.
 """
 from __future__ import annotations
@@ -20,7 +20,7 @@ TARGET_DEPTH = 3.0             # optical depth of the mean sample along a chord 
 MIN_DEPTH, MAX_DEPTH = 1.5, 60.0   # bounds of the peak extinction times the chord length
 MAX_SAMPLES = 2_000_000        # the statistics use an even subsample of larger data
 COOL_WARM = ((0.23, 0.30, 0.75), (0.55, 0.69, 0.94), (0.87, 0.87, 0.87), (0.96, 0.60, 0.48), (0.71, 0.02, 0.15))
-RAMP = (0.0, 0.08, 0.3, 0.65, 1.0)     # extinction at the five colour stops, as a share of the peak
+RAMP = (0.0, 0.08, 0.3, 0.65, 1.0)     # extinction at the five color stops, as a share of the peak
 
 
 def finite_sample(values: np.ndarray) -> np.ndarray:
@@ -86,7 +86,7 @@ def auto_transfer_function(values: np.ndarray, chord: float, name: str = "auto")
 
 
 def _ramp(full_lo: float, full_hi: float, lo: float, hi: float, rho_max: float, name: str) -> TransferFunction:
-    """Cool-warm colour and the extinction ``RAMP`` between ``lo`` and ``hi``, held flat out to the full range."""
+    """Cool-warm color and the extinction ``RAMP`` between ``lo`` and ``hi``, held flat out to the full range."""
     stops = list(np.linspace(lo, hi, len(RAMP)))
     colors = [list(c) for c in COOL_WARM]
     extinction = [r * rho_max for r in RAMP]

@@ -11,7 +11,7 @@ Method (analytic, no quadrature error beyond the special functions):
 1. Split the segment where the scalar crosses a control point of the transfer function, and at the range edges (outside
    the range the medium is transparent). On one piece of length L, ρ and κ are linear in the normalised position
    x ∈ [0, 1]: ρ L = p + 2 q x with p = ρ_a L, q = (ρ_b − ρ_a) L / 2; the optical depth is τ(x) = p x + q x², T = p + q.
-2. Because κ ρ e^{−τ} dt = −κ d(e^{−τ}), integration by parts gives the piece's colour exactly as
+2. Because κ ρ e^{−τ} dt = −κ d(e^{−τ}), integration by parts gives the piece's color exactly as
        C = κ_a (1 − M) + κ_b (M − e^{−T}),      M(p, q) = ∫_0^1 e^{−p x − q x²} dx  (mean transmittance)
    Both weights lie in [0, 1] and add up to 1 − e^{−T}; no division by the scalar difference occurs, so s_f = s_b and
    ∫ρ = 0 need no special case (the weights are simply 0).
@@ -26,9 +26,9 @@ Method (analytic, no quadrature error beyond the special functions):
 Measured accuracy (``tests/test_optics_integrate.py``): M against adaptive quadrature over p, q spanning 0 … 1e6 has
 absolute error < 1e-13 (measured 3e-16 on a 41×41 grid of end densities 0, 1e-6 … 1e6); ``erfcx``/``dawson`` agree
 with SciPy to < 2e-14 relative; whole segments agree with 10^6-step Riemann sums to the sums' own O(h²) error
-(≤ 4e-12 measured) and with closed forms to < 1e-12. Error propagation: an error δ in M changes a piece's colour by
+(≤ 4e-12 measured) and with closed forms to < 1e-12. Error propagation: an error δ in M changes a piece's color by
 |κ_b − κ_a|·δ and its opacity not at all (α uses e^{−T} directly); compositing multiplies by transmittances ≤ 1, so a
-segment crossing P pieces has colour error ≤ P·κ_max·δ plus rounding. With δ ≤ 1e-13 the stated tolerance, ≤ 1e-9
+segment crossing P pieces has color error ≤ P·κ_max·δ plus rounding. With δ ≤ 1e-13 the stated tolerance, ≤ 1e-9
 absolute per RGBA channel for κ ≤ 1, holds for up to 10^4 crossed control points.
 """
 from __future__ import annotations
@@ -151,7 +151,7 @@ def _mean_transmittance(p: float, q: float) -> tuple[float, float]:
 
 @numba.njit(cache=True, nogil=True, inline="always")
 def _linear_piece(col_lo, col_hi, wa, wb, ra, rb, trans, out):
-    """Add the colour of a piece with κ linear from lerp(col_lo, col_hi, wa) to lerp(..., wb) and optical depth
+    """Add the color of a piece with κ linear from lerp(col_lo, col_hi, wa) to lerp(..., wb) and optical depth
     density linear from ``ra`` to ``rb`` (both already times the piece length), seen through ``trans``, to ``out``;
     returns (the piece's transmittance, its optical depth)."""
     p = ra

@@ -12,8 +12,8 @@ face counts half (the value texture filtering converges to); on the diagonal s_f
 slab [s_iso − thicken, s_iso + thicken], counted fully wherever the segment's interval meets it (the §8.8 fix for
 gaps between neighbouring patches; diagonal texels inside the slab are then opaque).
 
-Several coloured isosurfaces go into one texture (§8.10): the crossed surfaces are composited front to back in ray
-order (increasing values for s_f < s_b, decreasing for s_f > s_b), each with its opacity; the colour seen from the
+Several colored isosurfaces go into one texture (§8.10): the crossed surfaces are composited front to back in ray
+order (increasing values for s_f < s_b, decreasing for s_f > s_b), each with its opacity; the color seen from the
 low side (s_f < s_b, looking along the gradient) and from the high side can differ.
 
 Smooth shading (§8.9) blends the shaded front- and back-face triangles with the front-face weight of the front-most
@@ -36,7 +36,7 @@ __all__ = ["IsoSurface", "IsoTable", "build_iso_table", "heaviside_alpha", "iso_
 
 @dataclass(frozen=True)
 class IsoSurface:
-    """One isosurface: value, colour seen from the low side, optional colour from the high side, opacity."""
+    """One isosurface: value, color seen from the low side, optional color from the high side, opacity."""
 
     value: float
     color: tuple[float, float, float] = (1.0, 1.0, 1.0)
@@ -50,7 +50,7 @@ class IsoSurface:
             raise ValueError(f"isosurface opacity must be in [0, 1], got {self.opacity}")
         for c in (self.color, self.back_color if self.back_color is not None else self.color):
             if len(c) != 3 or min(c) < 0 or not np.all(np.isfinite(c)):
-                raise ValueError(f"isosurface colour must be 3 finite values >= 0, got {c}")
+                raise ValueError(f"isosurface color must be 3 finite values >= 0, got {c}")
 
 
 def heaviside_alpha(s_f: Any, s_b: Any, s_iso: float, thicken: float = 0.0) -> np.ndarray:
@@ -103,8 +103,8 @@ class IsoTable(ScalarAxis):
               **kw: Any) -> TableError:
         """Error of the flat texture against ``integrate_segment`` with the thin-peak TF of ``iso_peaks_tf``.
 
-        Meaningful for opaque isosurfaces with one colour per surface (the reference TF cannot express partial
-        opacity independent of the segment, nor side-dependent colours). Defaults: peak width ds/8, area 1e4, l = 1.
+        Meaningful for opaque isosurfaces with one color per surface (the reference TF cannot express partial
+        opacity independent of the segment, nor side-dependent colors). Defaults: peak width ds/8, area 1e4, l = 1.
         """
         width = self.ds / 8 if width is None else width
         tf = iso_peaks_tf(self.isosurfaces, width, area, s_range=(self.s_lo, self.s_hi))
@@ -156,7 +156,7 @@ def iso_peaks_tf(isosurfaces: Sequence[IsoSurface | float], width: float, area: 
     """A TF of thin triangular ρ peaks (base ``width``, ∫ρ ds = ``area``) at the isovalues (§8.13's C δ(s − s_iso)).
 
     A segment crossing one peak gets optical depth area·l/|s_b − s_f|, so α → H·H as area → ∞. Peaks must not
-    overlap. ``s_range`` extends the TF with transparent ends (the colour is the iso colour throughout the peak).
+    overlap. ``s_range`` extends the TF with transparent ends (the color is the iso color throughout the peak).
     """
     isos = sorted((i if isinstance(i, IsoSurface) else IsoSurface(float(i)) for i in isosurfaces),
                   key=lambda i: i.value)

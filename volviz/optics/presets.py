@@ -1,13 +1,13 @@
-"""ParaView colour-map JSON presets: import, export, and the presets shipped in ``resources/presets``.
+"""ParaView color-map JSON presets: import, export, and the presets shipped in ``resources/presets``.
 
 ParaView's preset files hold a list (or one) of objects with ``"Name"``, ``"ColorSpace"``, ``"RGBPoints"``
 (flat x, r, g, b, …) and optionally ``"Points"`` (flat x, opacity, midpoint, sharpness, …). volviz reads them as:
 
-- κ from ``RGBPoints``, linearly interpolated in RGB. Other colour spaces (``"Diverging"``, ``"Lab"``, ``"HSV"``) are
+- κ from ``RGBPoints``, linearly interpolated in RGB. Other color spaces (``"Diverging"``, ``"Lab"``, ``"HSV"``) are
   read as linear RGB between the given points: an approximation that is close when the points are dense (the
   shipped presets are RGB with 33 points).
 - ρ = opacity / unit_distance from ``Points`` (the VTK convention of DESIGN.md; midpoint and sharpness are ignored,
-  i.e. read as 0.5 and 0). Without ``Points`` the opacity is a linear ramp from 0 to 1 over the colour range
+  i.e. read as 0.5 and 0). Without ``Points`` the opacity is a linear ramp from 0 to 1 over the color range
   (ParaView's default for volumes).
 - Both are combined on the union of their control points, which is exact for piecewise-linear inputs.
 
@@ -105,7 +105,7 @@ def tf_from_paraview(obj: Any, unit_distance: float | None = None) -> TransferFu
     colors = np.stack([np.interp(s, cx, cv[:, ch]) for ch in range(3)], axis=1)
     opacity = np.interp(s, ox, ov)
     if np.any(colors < 0) or np.any(opacity < 0):
-        raise ValueError(f"{where}: colours and opacities must be >= 0")
+        raise ValueError(f"{where}: colors and opacities must be >= 0")
     return TransferFunction(s, colors, opacity / unit_distance, name=str(name))
 
 

@@ -1,4 +1,4 @@
-"""Separable pre-integration (Roettger Ch. 9, §9.1; Guthe §1.5): exact opacity from ρ̂, colour as a polynomial in l.
+"""Separable pre-integration (Roettger Ch. 9, §9.1; Guthe §1.5): exact opacity from ρ̂, color as a polynomial in l.
 
 Opacity (§9.1.1, Eqs. 9.1–9.2), exact up to table resolution:
     ρ̂(s_f, s_b) = ∫_0^1 ρ(s_f + t(s_b − s_f)) dt,      α = 1 − exp(−l ρ̂)
@@ -6,7 +6,7 @@ Opacity (§9.1.1, Eqs. 9.1–9.2), exact up to table resolution:
 terms, so there is no cancellation; the diagonal s_f = s_b is ρ(s_f), the limit of the integral-function quotient).
 The exponential is evaluated exactly at lookup (modern hardware does not need the 16-bit α_1D texture).
 
-Colour (§9.1.2): the normalised chromaticity Ĉ_l = C(s_f, s_b, l)/α(s_f, s_b, l) is sampled at l = (i/n)·l_max,
+Color (§9.1.2): the normalised chromaticity Ĉ_l = C(s_f, s_b, l)/α(s_f, s_b, l) is sampled at l = (i/n)·l_max,
 i = 0…n (the digest's ERRATUM: the thesis prints l = i/l_max), and interpolated by a polynomial of degree n = 1, 2 or 4
 in u = l/l_max:  C ≈ α · Σ_i C̃_i(s_f, s_b) u^i.  The sample at l → 0 is the analytic limit
     Ĉ_0 = ∫_0^1 κρ dt / ∫_0^1 ρ dt
@@ -133,7 +133,7 @@ class SeparableTable(ScalarAxis):
         return self.data[..., 1:].reshape(self.n_s, self.n_s, self.degree + 1, 3)
 
     def lookup(self, s_f: Any, s_b: Any, l: Any) -> np.ndarray:
-        """RGBA (..., 4): α = 1 − exp(−l ρ̂) (exact but for bilinear ρ̂), colour = α · clamp(Σ C̃_i u^i)."""
+        """RGBA (..., 4): α = 1 − exp(−l ρ̂) (exact but for bilinear ρ̂), color = α · clamp(Σ C̃_i u^i)."""
         shape, (sf, sb, ll) = _interp.flat_args(s_f, s_b, l)
         vals = np.empty((sf.size, self.data.shape[2]), dtype=np.float64)
         if sf.size:
@@ -195,7 +195,7 @@ class SeparableTable(ScalarAxis):
 
 def build_separable(tf: TransferFunction, n_s: int = 512, l_max: float = 1.0, degree: int = 2, *,
                     s_range: Any = None) -> SeparableTable:
-    """Build the Ch. 9 tables: ρ̂ and the colour polynomial of ``degree`` 1, 2 (recommended) or 4 over [0, l_max]."""
+    """Build the Ch. 9 tables: ρ̂ and the color polynomial of ``degree`` 1, 2 (recommended) or 4 over [0, l_max]."""
     if degree not in _DEGREES:
         raise ValueError(f"degree must be one of {_DEGREES}, got {degree}")
     if int(n_s) != n_s or n_s < 2:

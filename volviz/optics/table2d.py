@@ -5,7 +5,7 @@ RGBA_2D(s_f, s_b) = RGBA(s_f, s_b, l̄). A segment of length l is approximated b
 
     I' = (l/l̄)·RGB_2D + (1 − (l/l̄)·α_2D)·I
 
-"In practice the vertex colours are scaled by the maximum opacity value in the texture to avoid clamping for l > l̄,
+"In practice the vertex colors are scaled by the maximum opacity value in the texture to avoid clamping for l > l̄,
 and the texture entries are multiplied by the reciprocal to compensate." This module stores exactly that: the texture
 ``rgba = RGBA_2D / α_max`` (its α never exceeds 1) and the vertex factor v = min(l·α_max/l̄, 1). The lookup is
 ``v · bilinear(rgba)``; because v ≤ 1 and the texture α ≤ 1, the opacity never exceeds 1 and the transmittance never
@@ -43,11 +43,11 @@ class Table2D(ScalarAxis):
 
     @property
     def vertex_scale(self) -> float:
-        """Factor per unit length for the vertex colour: v = min(l · vertex_scale, 1)."""
+        """Factor per unit length for the vertex color: v = min(l · vertex_scale, 1)."""
         return (self.alpha_max if self.alpha_max > 0 else 1.0) / self.l_bar
 
     def vertex_factor(self, l: Any) -> np.ndarray:
-        """The clamped vertex colour v = min(l·α_max/l̄, 1) (what a GPU would put in the vertex RGBA)."""
+        """The clamped vertex color v = min(l·α_max/l̄, 1) (what a GPU would put in the vertex RGBA)."""
         v = np.clip(np.asarray(l, dtype=np.float64) * self.vertex_scale, 0.0, 1.0)
         return np.where(np.isnan(v), 0.0, v)  # NaN lengths are transparent
 

@@ -1,12 +1,12 @@
 """Piecewise-linear transfer functions: chromaticity κ(s) (RGB) and extinction ρ(s) per unit length.
 
-Optical model (Roettger §7.1 and §8.4, Eq. 8.1; Guthe §1.2): the emitted colour density is κ(s)·ρ(s) (Roettger's
+Optical model (Roettger §7.1 and §8.4, Eq. 8.1; Guthe §1.2): the emitted color density is κ(s)·ρ(s) (Roettger's
 pre-multiplied convention), the opacity of a segment is α = 1 − exp(−∫ρ). Both κ and ρ are linear between control
 points. Scalars outside ``[scalars[0], scalars[-1]]`` and NaN scalars are transparent (κ = 0, ρ = 0).
 
 VTK convention (DESIGN.md, "Opacity conventions differ"): a VTK scalar opacity value ``a`` with the volume property's
 ``ScalarOpacityUnitDistance`` ``u`` is read as the extinction ρ = a / u (per unit length), and written back as
-a = ρ · u. VTK's colour transfer function supplies κ directly.
+a = ρ · u. VTK's color transfer function supplies κ directly.
 """
 from __future__ import annotations
 
@@ -33,7 +33,7 @@ def _as_float_array(value: Any, name: str, ndim: int) -> np.ndarray:
 
 
 class TransferFunction:
-    """Piecewise-linear κ(s) (colour, RGB ≥ 0) and ρ(s) (extinction per unit length ≥ 0) over control points.
+    """Piecewise-linear κ(s) (color, RGB ≥ 0) and ρ(s) (extinction per unit length ≥ 0) over control points.
 
     Parameters
     ----------
@@ -138,7 +138,7 @@ class TransferFunction:
         return rgb, rho
 
     def emission(self, s: Any) -> np.ndarray:
-        """Emitted colour density κ(s)·ρ(s) (..., 3)."""
+        """Emitted color density κ(s)·ρ(s) (..., 3)."""
         rgb, rho = self.evaluate(s)
         return rgb * rho[..., None]
 
@@ -203,7 +203,7 @@ class TransferFunction:
         """From a ``vtkColorTransferFunction`` (κ) and a ``vtkPiecewiseFunction`` (opacity a): ρ = a / unit_distance.
 
         Control points are the union of both functions' nodes, which is exact when both interpolate linearly in RGB
-        (colour space RGB, every node midpoint 0.5 and sharpness 0). Otherwise (HSV/Lab/diverging colour space or
+        (color space RGB, every node midpoint 0.5 and sharpness 0). Otherwise (HSV/Lab/diverging color space or
         non-default midpoints) the functions are additionally sampled at ``samples`` evenly spaced scalars: the result
         is then a piecewise-linear approximation of VTK's curve. VTK clamps outside its range; volviz is transparent
         there (the range is the union of both functions' ranges).
@@ -214,7 +214,7 @@ class TransferFunction:
         n_c = int(ctf.GetSize())
         n_o = int(otf.GetSize())
         if n_c < 1 or n_o < 1:
-            raise ValueError(f"VTK transfer functions must have nodes (colour: {n_c}, opacity: {n_o})")
+            raise ValueError(f"VTK transfer functions must have nodes (color: {n_c}, opacity: {n_o})")
         cnodes = np.zeros((n_c, 6))
         onodes = np.zeros((n_o, 4))
         for i in range(n_c):
@@ -274,6 +274,6 @@ class TransferFunction:
     @classmethod
     def ramp(cls, lo: float = 0.0, hi: float = 1.0, rho_max: float = 1.0, color: Any = (1.0, 1.0, 1.0),
              name: str = "ramp") -> "TransferFunction":
-        """ρ rising linearly from 0 at ``lo`` to ``rho_max`` at ``hi``, constant colour."""
+        """ρ rising linearly from 0 at ``lo`` to ``rho_max`` at ``hi``, constant color."""
         c = np.asarray(color, dtype=np.float64)
         return cls([lo, hi], [c, c], [0.0, rho_max], name=name)

@@ -20,7 +20,7 @@ How a ray is walked (``raycast_kernels.cast_blocks``):
   volume's last sample (size - 1 not a multiple of 2^level), the brick's border values extend to the volume's end.
 - Each segment (s_f, s_b, l) is integrated with the separable table (Roettger §9.1, ``volviz.optics.build_separable``,
   degree 2): the opacity 1 − exp(−l ρ̂(s_f, s_b)) is exact for any l (only ρ̂ is bilinear in the scalars), so the
-  varying step lengths of the levels and the shortened last step in each block need no table axis in l; the colour is
+  varying step lengths of the levels and the shortened last step in each block need no table axis in l; the color is
   a quadratic in l/l_max. Measured table error (``SeparableTable.error``, 256^2 entries over [0, 255], l_max = 4):
   max 1.5e-4 (0.04 of 255) for the embryo walkthrough's TF, 2.4e-4 (0.06 of 255) for the tests' TF (degree 1 or
   128^2 entries measured no faster: the lookups take ~40% of the time, the sampling the rest).
@@ -65,7 +65,7 @@ SUB = 4
 """Edge of the empty-space sub-cells inside a block, in samples of its level (16 / SUB = 4 per axis)."""
 
 T_STOP = 2e-3
-"""Default early-termination transmittance: the colour behind is at most T_STOP·κ_max (0.51 of 255 for κ ≤ 1)."""
+"""Default early-termination transmittance: the color behind is at most T_STOP·κ_max (0.51 of 255 for κ ≤ 1)."""
 
 
 @dataclass
@@ -201,7 +201,7 @@ def zero_opacity_ends(tf: TransferFunction) -> tuple[float, float]:
 
 def segment_table(tf: TransferFunction, s_range: tuple[float, float], l_max: float, n_s: int = 256,
                   degree: int = 2) -> SeparableTable:
-    """The separable table (Roettger §9.1) over ``s_range`` ∪ the TF range, colour polynomial over [0, l_max]."""
+    """The separable table (Roettger §9.1) over ``s_range`` ∪ the TF range, color polynomial over [0, l_max]."""
     lo = min(float(s_range[0]), tf.range[0])
     hi = max(float(s_range[1]), tf.range[1])
     if not hi > lo:

@@ -92,7 +92,7 @@ def _sample_block(data, off, nx, ny, nz, x, y, z):
 @numba.njit(cache=True, nogil=True, inline="always", error_model="numpy")
 def _separable(tab, s_lo, inv_ds, u, degree, kmax, sf, sb, length, seg):
     """Separable pre-integration (Roettger §9.1): α = 1 − exp(−l ρ̂(s_f, s_b)) (exact but for the bilinear ρ̂),
-    colour = α · clamp(Σ C̃_i u^i, 0, κ_max), u = min(l / l_max, 1) (given, with 1 / ds). Writes seg[0:4]; NaN
+    color = α · clamp(Σ C̃_i u^i, 0, κ_max), u = min(l / l_max, 1) (given, with 1 / ds). Writes seg[0:4]; NaN
     scalars give 0."""
     n = tab.shape[0]
     if sf != sf or sb != sb:

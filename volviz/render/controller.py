@@ -189,7 +189,7 @@ class SceneController:
             update_volume_property(prop.GetProperty(), tf, comp.opacity)
         from volviz.render.decorations import update_legend
 
-        update_legend(self.plotter, self.session, self.datasets)   # the scalar bar shows the new colours and range
+        update_legend(self.plotter, self.session, self.datasets)   # the scalar bar shows the new colors and range
 
     def set_visible(self, comp_id: str, visible: bool, nature: bool = True, build: bool = True) -> None:
         """Show or hide a component. A terrain / fog / clouds / sky component rebuilds the natural scene now unless

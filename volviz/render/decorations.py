@@ -1,4 +1,4 @@
-"""What frames the data on screen: a scalar bar (the colour legend of the shown array with its name and range),
+"""What frames the data on screen: a scalar bar (the color legend of the shown array with its name and range),
 the orientation axes and the outline box of the data. Each is a render option of the session (``scalar_bar``,
 ``axes``, ``outline``; on unless set to false), so it is saved with the session and can be switched off."""
 from __future__ import annotations
@@ -50,7 +50,7 @@ def apply_decorations(plotter: Any, session: Session, props: dict[str, Any], dat
     datasets, whose shown array names the scalar bar). Safe to call again after any change: it replaces what it
     added before."""
     plotter.remove_actor(OUTLINE_NAME, render=False)
-    colour = _contrast(session.render.background)
+    color = _contrast(session.render.background)
     if decoration_enabled(session, "outline"):
         from volviz.render.framing import scene_bounds
 
@@ -59,12 +59,12 @@ def apply_decorations(plotter: Any, session: Session, props: dict[str, Any], dat
         if bounds is not None:
             import pyvista as pv
 
-            plotter.add_mesh(pv.Box(bounds).outline(), color=colour, name=OUTLINE_NAME, pickable=False,
+            plotter.add_mesh(pv.Box(bounds).outline(), color=color, name=OUTLINE_NAME, pickable=False,
                              reset_camera=False, render=False, line_width=1)
     axes = getattr(plotter.renderer, "axes_widget", None)
     if decoration_enabled(session, "axes"):
         if axes is None:
-            plotter.add_axes(color=colour, interactive=False)
+            plotter.add_axes(color=color, interactive=False)
         else:
             plotter.renderer.show_axes()
     elif axes is not None:
@@ -80,7 +80,7 @@ def update_legend(plotter: Any, session: Session, datasets: dict[str, Any]) -> N
         _add_scalar_bar(plotter, session, comp, _array_title(comp, datasets), _contrast(session.render.background))
 
 
-def _add_scalar_bar(plotter: Any, session: Session, comp: Any, title: str, colour: tuple[float, float, float]) -> None:
+def _add_scalar_bar(plotter: Any, session: Session, comp: Any, title: str, color: tuple[float, float, float]) -> None:
     import vtk
 
     from volviz.optics import TransferFunction
@@ -109,7 +109,7 @@ def _add_scalar_bar(plotter: Any, session: Session, comp: Any, title: str, colou
     heading_text.SetJustificationToRight()
     heading_text.SetVerticalJustificationToBottom()
     for text in (heading_text, label):
-        text.SetColor(*colour)
+        text.SetColor(*color)
         text.ShadowOff()
         text.ItalicOff()
         text.BoldOff()

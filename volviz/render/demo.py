@@ -13,7 +13,7 @@ def demo_components() -> list[Component]:
                                                           "extent": [1000.0, 1000.0], "C": 9.0, "c": 40.0}),
         Component(id="ground_fog", type="fog", settings={"level": 55.0, "thickness": 25.0, "seed": 2,
                                                          "mode": "attenuated", "density": 0.04,
-                                                         "colour": [0.85, 0.87, 0.95]}),
+                                                         "color": [0.85, 0.87, 0.95]}),
         Component(id="clouds", type="clouds", settings={"shape": [129, 129, 17], "seed": 3, "coverage": 0.25,
                                                         "base_height": 190.0, "rho_max": 0.06}),
         Component(id="sky", type="sky"),

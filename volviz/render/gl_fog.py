@@ -24,12 +24,12 @@ How a frame is drawn:
 - Accumulation and resolve: the prisms draw into the layer's own single-channel float32 target (bound while the
   prism actor draws), with additive blending (emissive, attenuated) or blend equation MAX (mip: the maximum of e at
   the entry/exit points). A second actor right after it, a triangle covering the viewport, restores the scene's
-  framebuffer and blend equation and converts the sum: emissive RGB = colour · density · Σ (α = 0, i.e. added);
-  attenuated τ = density · Σ, α = 1 - e^-τ, RGB = colour · α; mip α = min(gain · max, 1), RGB = colour · α; it is
+  framebuffer and blend equation and converts the sum: emissive RGB = color · density · Σ (α = 0, i.e. added);
+  attenuated τ = density · Σ, α = 1 - e^-τ, RGB = color · α; mip α = min(gain · max, 1), RGB = color · α; it is
   composited premultiplied "over" the scene (ONE, ONE_MINUS_SRC_ALPHA, set and restored by VTK through a 1x1
   premultiplied texture, as ``gl_pt``). Both actors are translucent and share the layer's bounds, so VTK culls or
   draws them together; after them the blend function, blend equation, framebuffer and depth state are VTK's again.
-- Opaque geometry (terrain, sky dome, boxes): the scene's float colour target and depth texture come from the
+- Opaque geometry (terrain, sky dome, boxes): the scene's float color target and depth texture come from the
   ``vtkFramebufferPass`` that ``gl_pt`` installs (shared with GL PT volumes in the same renderer); when the prisms
   draw (translucent pass), that depth texture holds the opaque scene and is not attached to the layer's target, so
   the shader reads it as an ordinary texture.
@@ -216,7 +216,7 @@ class GLFogLayer:
     docstring). Arguments as ``volviz.nature.fog.render_layer``: terrain ``points`` (n, 3) (x, y used), per-vertex
     ``bottom`` and ``top`` heights, ``triangles`` (m, 3), the ``layer``'s optics and ``emission`` = (e_bottom, e_top)
     per vertex (default 1 where the layer has thickness). ``drawn``: the number of prisms uploaded (after
-    zero-emission culling; the CPU's count also leaves out prisms off the screen). ``set_layer`` changes colour,
+    zero-emission culling; the CPU's count also leaves out prisms off the screen). ``set_layer`` changes color,
     density, gain or mode."""
 
     def __init__(self, plotter: Any, points: np.ndarray, bottom: np.ndarray, top: np.ndarray,
@@ -253,7 +253,7 @@ class GLFogLayer:
         else:
             self.set_buffers(buffers)
 
-        GLPTVolume._install_pass(self)         # the shared float colour target and opaque depth texture
+        GLPTVolume._install_pass(self)         # the shared float color target and opaque depth texture
         self._observers = [
             (self.mapper, self.mapper.AddObserver(vtk.vtkCommand.UpdateShaderEvent,
                                                   self._observer(self._on_prisms))),
@@ -381,7 +381,7 @@ class GLFogLayer:
         self._accum.Activate()
         program.SetUniformi("fogAccum", self._accum.GetTextureUnit())
         program.SetUniformi("fogMode", _MODES[self.layer.mode])
-        program.SetUniform3f("fogColour", [float(x) for x in self.layer.colour])
+        program.SetUniform3f("fogColor", [float(x) for x in self.layer.color])
         program.SetUniformf("fogDensity", float(self.layer.density))
         program.SetUniformf("fogGain", float(self.layer.mip_gain))
 

@@ -16,11 +16,11 @@ drawn by one actor per pass, so the per-pixel sums and products are order-indepe
 surfaces (opacity 1) are one opaque actor. All actors share one shader program (``resources/shaders/iso_surface_*``):
 
 - ``"2pass"``: the opaque pass, then the translucent surfaces blended unsorted in draw order, C ← e + (1 − α)·C
-  (VTK's straight-alpha blending of the colour c and α).
+  (VTK's straight-alpha blending of the color c and α).
 - ``"3pass"``: the opaque pass (B); an attenuation pass writing (0, α) under the same blending, C ← (1 − α)·C, so
   C = Π(1 − α_i)·B and the alpha 1 − Π(1 − α_i)(1 − α_B); an emission pass writing (e, 0) with premultiplied
   blending (ONE, ONE_MINUS_SRC_ALPHA; a 1x1 premultiplied actor texture makes VTK set and restore it), C ← C + e.
-  The window's fixed-point colour saturates at 1 as in composite.py.
+  The window's fixed-point color saturates at 1 as in composite.py.
 - ``"4pass"``: as 3pass, with a back-face pass between them: the back faces of the translucent surfaces (triangles
   are wound so that GL's facing is the CPU's, the geometric normal oriented by the vertex normals) are drawn with
   depth writes into volviz's own framebuffer (a float depth texture, cleared per frame; bound and unbound in the
@@ -28,7 +28,7 @@ surfaces (opacity 1) are one opaque actor. All actors share one shader program (
   (``gl_FragCoord.z`` against the texel; the same program computes both, so a back face at z_b itself counts, as the
   CPU's depth ≤ z_b). The scene's depth buffer is never written by the translucent passes.
 - ``"exact"``: VTK's (dual) depth peeling of the renderer, ``peels`` layers at most and occlusion ratio 0, with the
-  same shading: the translucent actor writes the straight colour at the ``//VTK::DepthPeeling`` tags.
+  same shading: the translucent actor writes the straight color at the ``//VTK::DepthPeeling`` tags.
 
 The passes are ordinary actors in the renderer's translucent pass, drawn in the order they were added (the renderer's
 OIT is off while 2/3/4-pass is shown; depth peeling on for exact), and each restores the GL state it changes (blend
@@ -38,7 +38,7 @@ the 2/3/4-pass modes (no OIT) and peeled with the surfaces in exact mode.
 
 Shading, per fragment in GLSL, as composite.py: μ = |n·v| per vertex, interpolated and clamped to [0, 1]; α = the
 surface opacity ("flat") or 1 − clamp(μ^a − b, 0, 1) with the least-squares (a, b) of the surface's opacity
-("spectrum"); colour c·(k_a + (1 − k_a)·μ), k_a = ``volviz.iso.composite.AMBIENT``. The view ray v is built from the
+("spectrum"); color c·(k_a + (1 − k_a)·μ), k_a = ``volviz.iso.composite.AMBIENT``. The view ray v is built from the
 vertex buffer's points (relative to the meshes' centre), so VTK's automatic shift and scale of the vertex buffer is
 turned off: VTK rescales each axis of data more than about 32 units across, which bends v (with it on, μ on the
 Storm scene of ``volviz bench iso`` was off by up to 0.17 and the image by RMSE 1.9 instead of 0.4).
@@ -47,7 +47,7 @@ Measured on llvmpipe (Mesa, VTK 9.7.2) against ``volviz.iso.composite.render`` o
 RGB, two synthetic 24³ volumes with three overlapping translucent surfaces and an opaque one at 256², perspective
 and parallel, spectrum and flat shading (``tests/test_render_gl_iso.py``): RMSE 0.49-0.67 in every mode, 99.9% of
 the pixels within 2.1, at most 2 pixels over 3 (silhouette pixels, up to 111, that GL's edge rule and the CPU
-rasteriser's assign differently). The rest is 8-bit rounding of each blend step in the window's colour buffer. The
+rasteriser's assign differently). The rest is 8-bit rounding of each blend step in the window's color buffer. The
 pixels no surface covers are exactly those of the scene without the surfaces, opaque and translucent props included.
 On the real scenes of ``volviz bench iso`` (Storm, two overlapping Storm volumes, Blunt Fin; 384², docs/bench/iso.md):
 RMSE 0.31-0.59 against the CPU mode, 1 to 13 pixels over 3 (silhouettes); frame time (render + read-back, llvmpipe
@@ -97,7 +97,7 @@ def _oriented_triangles(m: IsoMesh) -> np.ndarray:
 
 def iso_polydata(meshes: Sequence[IsoMesh], centre: np.ndarray, shading: str = "spectrum") -> Any:
     """One vtkPolyData of ``meshes`` in their order: points relative to ``centre`` (float32), triangles wound as
-    ``_oriented_triangles``, and per-vertex attributes ``isoNormal`` (unit normal), ``isoStyle`` (colour, opacity)
+    ``_oriented_triangles``, and per-vertex attributes ``isoNormal`` (unit normal), ``isoStyle`` (color, opacity)
     and ``isoFit`` (the iso-spectrum (a, b) of translucent surfaces with ``shading="spectrum"``, else (0, 0))."""
     import vtk
     from vtk.util.numpy_support import numpy_to_vtk
@@ -139,7 +139,7 @@ def iso_polydata(meshes: Sequence[IsoMesh], centre: np.ndarray, shading: str = "
 class GLIsoSurfaces:
     """The isosurfaces ``meshes`` (of any number of volumes) in a PyVista plotter's renderer, drawn in ``mode`` (one
     of ``volviz.iso.composite.MODES``) with ``shading`` "spectrum" or "flat" (module docstring). ``lighting=False``
-    leaves colours unlit (as composite.py's ``lighting``). ``peels``: depth-peeling layers at most in exact mode."""
+    leaves colors unlit (as composite.py's ``lighting``). ``peels``: depth-peeling layers at most in exact mode."""
 
     def __init__(self, plotter: Any, meshes: Sequence[IsoMesh], mode: str = "3pass", shading: str = "spectrum",
                  lighting: bool = True, peels: int = 64) -> None:

@@ -17,7 +17,7 @@ How a frame is drawn:
   so a cell cut by the near plane (camera inside the mesh) is still drawn. The pixel ray is rebuilt from
   ``gl_FragCoord`` with the camera's affine ray basis (no interpolated varyings), clipped against the cell's planes,
   the near and far planes and the opaque scene's depth at the pixel; the exact (s_f, s_b, l) of that segment look up
-  the 3D table (Roettger §8.4, trilinear) or the separable one (§9.1: exact opacity 1 - exp(-l rho_hat), colour
+  the 3D table (Roettger §8.4, trilinear) or the separable one (§9.1: exact opacity 1 - exp(-l rho_hat), color
   polynomial in l; its layers a 2D texture array, bilinear within a layer), both float32. The fragment shader is
   made for one kind of segment evaluation (``PT_KIND``: 3D table, separable table, isosurfaces, pre-classified; VTK
   recompiles it when the kind changes):
@@ -35,9 +35,9 @@ How a frame is drawn:
 - Opaque geometry: when the cells draw (translucent pass, after the opaque one), the depth buffer of the framebuffer
   being drawn holds the opaque scene (translucent props do not write depth); it is blitted into the volume's own
   depth texture, which the shader reads (texelFetch): each segment ends at the opaque depth of its pixel, so a cell
-  straddling a surface is integrated only up to it. The volume's colour target has no depth attachment, so GL's depth
+  straddling a surface is integrated only up to it. The volume's color target has no depth attachment, so GL's depth
   test never drops a fragment whose exit face lies behind the surface.
-- Multisampling: by default the window's multisampling is switched off while the volume is in it (one colour per
+- Multisampling: by default the window's multisampling is switched off while the volume is in it (one color per
   pixel, as volviz's CPU overlays: the two backends then give the same viewport image), and the renderer draws
   into a float32 scene target (a ``vtkFramebufferPass``, ``_install_pass``, shared with ``volviz.render.gl_fog``'s
   layers, which read its depth texture; the volume itself does not need it and blits its depth from it). With
@@ -55,7 +55,7 @@ Clipping planes and a box crop (``set_clip_planes``) cut each fragment's ray seg
 
 Exact segments instead of a table (as the CPU ``pt``; the same fragment, ray and compositing): ``iso`` draws
 isosurfaces (Roettger §8.8-8.10) by the §8.13 Heaviside limit of each fragment's segment (H(0) = 1/2, the surfaces
-crossed composited in ray order with the colour of the side seen, only cells an isovalue crosses drawn), with
+crossed composited in ray order with the color of the side seen, only cells an isovalue crosses drawn), with
 ``iso_shading="smooth"`` shaded by a headlight through vertex normals (§8.9: the intensity linear in the cell through
 its barycentric coordinates, which are the face planes scaled per cell, taken where the ray crosses the surface);
 ``classification="pre"`` (§8.14) classifies the segment's ends by the TF and integrates kappa and rho linear in
@@ -69,7 +69,7 @@ docs/bench/pt-gl, one run): 1.11 s per frame at 512^2 (the CPU ``pt`` in the sam
 1.17 s with the separable one), 3.4 s at 1024^2 (``pt`` 4.3 s) and 4.7 s at 1920x1080 (``pt`` 6.0 s). What the
 fragment shader costs there (1920x1080, the same frames with parts of the shader replaced; the machine was shared,
 so these varied between runs): the table lookup a fifth to a half of the frame, the ray clipping and the rest of the
-arithmetic most of the remainder; rasterising and blending alone (a constant colour) 0.8 s. Compiled into the
+arithmetic most of the remainder; rasterising and blending alone (a constant color) 0.8 s. Compiled into the
 shader instead of switched or looped on uniforms: the kind of lookup (512^2: 3.7 s per frame with the four kinds
 behind a uniform, 1.4 s compiled) and the number of clipping planes (960x540, the shader without its lookup: 1.45 s
 with a loop over a uniform count of 0, 0.91 s compiled); a half-float table and an early ``discard`` (llvmpipe masks
@@ -263,8 +263,8 @@ class GLPTVolume(PTView):
         self._order_key: Any = None
         self._table: Any = None
         self._table_tex: Any = None
-        self._targets: tuple[Any, ...] | None = None   # colour texture, its FBO, depth texture, its FBO, format
-        self._bound = False                         # the volume's colour target is bound (cells drawn, no resolve yet)
+        self._targets: tuple[Any, ...] | None = None   # color texture, its FBO, depth texture, its FBO, format
+        self._bound = False                         # the volume's color target is bound (cells drawn, no resolve yet)
         self._drawn = False                         # the cells were drawn this frame
         self._table_dirty = True
         self._clip = np.zeros((0, 4))
@@ -307,7 +307,7 @@ class GLPTVolume(PTView):
         self.renderer.SetUseOIT(False)
         self.keep_multisampling = keep_multisampling
         if not keep_multisampling:
-            hold_single_sample(plotter, self)      # one colour per pixel, as the CPU backend's overlays
+            hold_single_sample(plotter, self)      # one color per pixel, as the CPU backend's overlays
             self._install_pass()                   # the renderer's float32 scene target, as the GL fog layers'
         GLPTVolume._on_program.CallDataType = vtk.VTK_OBJECT     # type: ignore[attr-defined]
         self._observers = [
@@ -342,7 +342,7 @@ class GLPTVolume(PTView):
             (self._on_update_shader if caller is self.mapper else self._on_resolve)(program)
 
     def _install_pass(self) -> None:
-        """A float32 colour target around VTK's standard render steps (a ``vtkFramebufferPass``, its depth texture
+        """A float32 color target around VTK's standard render steps (a ``vtkFramebufferPass``, its depth texture
         holding the opaque scene), translucent props drawn in order; shared by the GL layers that use it
         (``volviz.render.gl_fog``; ``self.renderer``, ``self`` counted as a user). GLPTVolume itself draws into its
         own target (module docstring) and works with or without it."""
@@ -442,25 +442,25 @@ class GLPTVolume(PTView):
             return t
         self._release_targets()
         ren_win = self.renderer.GetRenderWindow()
-        colour = vtk.vtkTextureObject()
-        colour.SetContext(ren_win)
-        colour.Create2D(w, h, 4, vtk.VTK_FLOAT, False)
+        color = vtk.vtkTextureObject()
+        color.SetContext(ren_win)
+        color.Create2D(w, h, 4, vtk.VTK_FLOAT, False)
         depth = vtk.vtkTextureObject()
         depth.SetContext(ren_win)
         depth.AllocateDepth(w, h, depth_format)
         fbos = []
-        for tex, attach in ((colour, "colour"), (depth, "depth")):      # read by texelFetch: no filtering
+        for tex, attach in ((color, "color"), (depth, "depth")):      # read by texelFetch: no filtering
             fbo = vtk.vtkOpenGLFramebufferObject()
             fbo.SetContext(ren_win)
             fbo.SaveCurrentBindingsAndBuffers()
             fbo.Bind()
-            if attach == "colour":
+            if attach == "color":
                 fbo.AddColorAttachment(0, tex)
             else:
                 fbo.AddDepthAttachment(tex)
             fbo.RestorePreviousBindingsAndBuffers()
             fbos.append(fbo)
-        self._targets = (colour, fbos[0], depth, fbos[1], depth_format)
+        self._targets = (color, fbos[0], depth, fbos[1], depth_format)
         return self._targets
 
     def _release_targets(self) -> None:
@@ -473,15 +473,15 @@ class GLPTVolume(PTView):
     def _bind_target(self, w: int, h: int) -> Any:
         """Copy the scene's depth at this point of the frame (after the opaque pass: the opaque geometry's; one sample
         of each pixel when the window is multisampled) into the volume's depth texture, then bind and clear the
-        volume's colour target for the cells. Returns the depth texture."""
+        volume's color target for the cells. Returns the depth texture."""
         import vtk
 
         ren_win = self.renderer.GetRenderWindow()
         state = ren_win.GetState()
         scene = [0]
         state.vtkglGetIntegerv(_GL_DRAW_FRAMEBUFFER_BINDING, scene)
-        colour, colour_fbo, depth, depth_fbo, _ = self._make_targets(w, h, self._scene_depth_format(scene[0]))
-        colour_fbo.SaveCurrentBindingsAndBuffers()
+        color, color_fbo, depth, depth_fbo, _ = self._make_targets(w, h, self._scene_depth_format(scene[0]))
+        color_fbo.SaveCurrentBindingsAndBuffers()
         self._bound = True
         state.vtkglBindFramebuffer(_GL_READ_FRAMEBUFFER, scene[0])
         state.vtkglBindFramebuffer(_GL_DRAW_FRAMEBUFFER, depth_fbo.GetFBOIndex())
@@ -490,8 +490,8 @@ class GLPTVolume(PTView):
         state.vtkglDepthMask(True)                  # a depth blit writes through the depth write mask
         vtk.vtkOpenGLFramebufferObject.Blit((0, w, 0, h), (0, w, 0, h), _GL_DEPTH_BUFFER_BIT, _GL_NEAREST)
         state.vtkglDepthMask(bool(mask[0]))
-        colour_fbo.Bind()
-        colour_fbo.ActivateDrawBuffer(0)
+        color_fbo.Bind()
+        color_fbo.ActivateDrawBuffer(0)
         state.vtkglClearColor(0.0, 0.0, 0.0, 0.0)
         state.vtkglClear(_GL_COLOR_BUFFER_BIT)
         return depth
@@ -520,11 +520,11 @@ class GLPTVolume(PTView):
     def _on_resolve(self, program: Any) -> None:
         """The resolve's draw: back to the scene's framebuffer; the volume's image goes over it."""
         self._restore()
-        colour = self._targets[0] if self._targets is not None else None
-        if colour is not None:
-            colour.Activate()
-            program.SetUniformi("ptAccum", colour.GetTextureUnit())
-        program.SetUniformi("ptDrawn", int(self._drawn and colour is not None))
+        color = self._targets[0] if self._targets is not None else None
+        if color is not None:
+            color.Activate()
+            program.SetUniformi("ptAccum", color.GetTextureUnit())
+        program.SetUniformi("ptDrawn", int(self._drawn and color is not None))
 
     def _visible(self) -> np.ndarray:
         """The cells drawn: those with some opacity under the TF (Roettger §9.1), or that an isovalue crosses."""
@@ -574,7 +574,7 @@ class GLPTVolume(PTView):
         import vtk
 
         table = self._table
-        if hasattr(table, "isosurfaces"):                            # rows of texels: value, opacity; colours
+        if hasattr(table, "isosurfaces"):                            # rows of texels: value, opacity; colors
             isos = sorted(table.isosurfaces, key=lambda i: i.value)
             data = np.zeros((1, 3, len(isos), 4), np.float32)
             for k, i in enumerate(isos):
@@ -635,7 +635,7 @@ class GLPTVolume(PTView):
         program.SetUniformi("parallelView", int(cam.parallel))
         if len(self._clip):
             program.SetUniform4fv("clipPlanes", len(self._clip), [float(x) for x in self._clip.ravel()])
-        depth = self._bind_target(w, h)            # the opaque scene's depth, the volume's own colour target
+        depth = self._bind_target(w, h)            # the opaque scene's depth, the volume's own color target
         depth.Activate()
         self._drawn = True
         program.SetUniformi("useDepth", 1)

@@ -22,7 +22,7 @@ parallel projection, with (n, f) the camera's clipping range; ``z = 1`` (no geom
 the typical clipping ratio f/n = 1000 resolves about 1e-4 of the view distance.
 
 Multisampling (PyVista's default, 4 samples) is switched off while any overlay is in the plotter and back on when the
-last one is removed: with MSAA a silhouette pixel of opaque geometry has a blended colour (object and what is behind
+last one is removed: with MSAA a silhouette pixel of opaque geometry has a blended color (object and what is behind
 it) but VTK's depth read-back gives one depth, so the image was cut there by that one depth for the whole pixel: a
 one-pixel edge around opaque objects (max 18 of 255 against 1.6 without MSAA on the PT test scene at 256x192).
 Compositing per sample would need every sample's depth, which ``GetZbufferData`` does not give.
@@ -34,7 +34,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["ImageOverlay", "OverlayView", "bleed_colour", "block_min", "overlay_rgba8", "read_buffers",
+__all__ = ["ImageOverlay", "OverlayView", "bleed_color", "block_min", "overlay_rgba8", "read_buffers",
            "unpremultiply_rgba8", "zbuffer_to_depth"]
 
 _SIBLINGS = "_volviz_pt_overlays"           # plotter attribute: every overlay renderer of the plotter
@@ -67,10 +67,10 @@ def block_min(depth: np.ndarray, size: tuple[int, int]) -> np.ndarray:
     return np.minimum.reduceat(np.minimum.reduceat(depth, rows, axis=0), cols, axis=1)
 
 
-def bleed_colour(rgba8: np.ndarray) -> np.ndarray:
-    """Straight-alpha RGBA8 with each transparent pixel next to visible ones given their mean colour (alpha stays
-    0). Linear interpolation of straight alpha mixes a visible pixel's colour with its transparent neighbour's; with
-    that colour black (``unpremultiply_rgba8``) a magnified image got dark fringes at its edges."""
+def bleed_color(rgba8: np.ndarray) -> np.ndarray:
+    """Straight-alpha RGBA8 with each transparent pixel next to visible ones given their mean color (alpha stays
+    0). Linear interpolation of straight alpha mixes a visible pixel's color with its transparent neighbour's; with
+    that color black (``unpremultiply_rgba8``) a magnified image got dark fringes at its edges."""
     out = np.array(rgba8, dtype=np.uint8, copy=True)
     seen = (out[..., 3] > 0).astype(np.float64)
     col = out[..., :3].astype(np.float64) * seen[..., None]
@@ -89,10 +89,10 @@ def bleed_colour(rgba8: np.ndarray) -> np.ndarray:
 
 def overlay_rgba8(image: np.ndarray, preview: bool = False) -> np.ndarray:
     """Premultiplied float RGBA as ``ImageOverlay.show`` takes it: straight-alpha RGBA8 (``unpremultiply_rgba8``),
-    for a preview (magnified when shown) with its edge colours bled (``bleed_colour``). Made on a worker where
+    for a preview (magnified when shown) with its edge colors bled (``bleed_color``). Made on a worker where
     possible (``PTVolume.compute``): the bleeding takes ~16 ms for a 500 x 350 preview."""
     rgba8 = unpremultiply_rgba8(image)
-    return bleed_colour(rgba8) if preview else rgba8
+    return bleed_color(rgba8) if preview else rgba8
 
 
 def unpremultiply_rgba8(image: np.ndarray) -> np.ndarray:
@@ -121,7 +121,7 @@ def read_buffers(ren_win: Any, w: int, h: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 def hold_single_sample(plotter: Any, holder: Any) -> None:
-    """Multisampling off while ``holder`` is in the plotter (one colour and depth per pixel: the overlays read the
+    """Multisampling off while ``holder`` is in the plotter (one color and depth per pixel: the overlays read the
     depth back, the GL PT pass draws into a single-sample float target; module docstring)."""
     if _MULTISAMPLES not in plotter.__dict__:
         plotter.__dict__[_MULTISAMPLES] = int(plotter.ren_win.GetMultiSamples())
@@ -239,7 +239,7 @@ class OverlayView:
         self.stats: dict[str, Any] = {}
         self.image: np.ndarray | None = None          # last premultiplied image (H, W, 4)
         self.depth: np.ndarray | None = None          # last per-pixel depth limit (H, W)
-        self.scene_rgb: np.ndarray | None = None      # last opaque scene colour (H, W, 3) uint8
+        self.scene_rgb: np.ndarray | None = None      # last opaque scene color (H, W, 3) uint8
         self.camera: Any = None
         self._overlay = ImageOverlay(plotter)
 
@@ -253,9 +253,9 @@ class OverlayView:
         return self.finish(request, *self.compute(request))
 
     def begin(self, scale: int = 1) -> dict[str, Any]:
-        """GUI-thread part 1: the opaque scene's depth and colour, the camera and the image size: the window's, or
+        """GUI-thread part 1: the opaque scene's depth and color, the camera and the image size: the window's, or
         for a preview (``scale`` > 1, e.g. while the camera moves) the window's divided by ``scale``, with the depth
-        limit of each preview pixel the nearest opaque depth under it (``block_min``) and the scene colour at its
+        limit of each preview pixel the nearest opaque depth under it (``block_min``) and the scene color at its
         first pixel."""
         from volviz.model.camera import Camera
 

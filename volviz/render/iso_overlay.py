@@ -10,9 +10,9 @@ scene through the depth buffer exactly as volviz's PT volumes are (``volviz.rend
    included, is the mode's "opaque background" pass);
 3. the mode composites the remaining fragments over a transparent background; the premultiplied image is drawn as
    a full-window overlay with (SRC_ALPHA, ONE_MINUS_SRC_ALPHA), i.e. C = C_iso + (1 − α_iso)·C_scene. For 3/4-pass
-   α_iso = 1 − Π(1 − α_i), so this equals the mode's Π(1 − α_i)·B + Σ e_i with B the scene colour; where the sum
+   α_iso = 1 − Π(1 − α_i), so this equals the mode's Π(1 − α_i)·B + Σ e_i with B the scene color; where the sum
    of emissions exceeds α_iso (straight alpha cannot carry that) the pixel is composited on the CPU over the
-   read-back scene colour and drawn opaque (see ``finish``).
+   read-back scene color and drawn opaque (see ``finish``).
 
 The 8-bit overlay costs at most about 1/255 per channel against the float image (measured in the tests).
 ``begin`` / ``compute`` / ``finish`` split the work as every ``image_overlay.OverlayView`` does: ``compute`` is pure
@@ -121,8 +121,8 @@ class IsoOverlay(OverlayView, IsoModeView):
         return img, st
 
     def finish(self, request: dict[str, Any], img: np.ndarray, st: Any) -> np.ndarray:
-        """Show the image. Straight-alpha blending cannot show a colour above its alpha, which the order-independent
-        sums of 3/4-pass produce; those pixels are composited here over the scene colour read back in ``begin`` and
+        """Show the image. Straight-alpha blending cannot show a color above its alpha, which the order-independent
+        sums of 3/4-pass produce; those pixels are composited here over the scene color read back in ``begin`` and
         drawn opaque (exact for the opaque scene; a PT volume's overlay under such a pixel is not seen through)."""
         shown = img
         over = np.any(img[..., :3] > img[..., 3:4] + 0.5 / 255.0, axis=-1)

@@ -79,7 +79,7 @@ class PTVolume(OverlayView, PTView):
 
     def compute(self, request: dict[str, Any], progress: Any = None) -> tuple[np.ndarray, Any, np.ndarray]:
         """Any-thread part: the volume image for a request of ``begin`` (pure NumPy/Numba, no VTK), its statistics,
-        and the image as VTK will show it (``overlay_rgba8``: straight-alpha 8-bit RGBA, a preview's edge colours
+        and the image as VTK will show it (``overlay_rgba8``: straight-alpha 8-bit RGBA, a preview's edge colors
         bled), made here so that ``finish`` on the GUI thread only hands it over."""
         if progress is not None:
             progress(0.0, "rendering volume")

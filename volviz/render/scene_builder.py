@@ -202,7 +202,7 @@ def ensure_transfer_functions(session: Session, datasets: dict[str, Any]) -> Non
             if comp.dataset is not None and comp.dataset not in datasets:
                 continue  # a hidden component's data is not read: it gets its TF when shown
             if isinstance(datasets.get(comp.dataset), Image2D):
-                continue  # an image shows its own colours (``vtk_scene.add_dataset``)
+                continue  # an image shows its own colors (``vtk_scene.add_dataset``)
             name = comp.id
             while name in session.transfer_functions:
                 name += "'"
@@ -529,7 +529,7 @@ def view_backend(plotter: Any, session: Session, view_kind: str) -> str:
 
 def pt_options(options: dict[str, Any]) -> dict[str, Any]:
     """Render settings -> keywords of ``volviz.unstructured.render``: sort ("mpvo", "centroid", "power"), table
-    ("auto" by optical depth, "3d", or "separable-N" with a colour polynomial of degree N) and its resolution."""
+    ("auto" by optical depth, "3d", or "separable-N" with a color polynomial of degree N) and its resolution."""
     out: dict[str, Any] = {}
     sort = options.get("sort")
     if sort in ("mpvo", "centroid", "power"):

@@ -1,7 +1,7 @@
 """Put volviz datasets into a PyVista plotter with sensible defaults (the VTK side of DESIGN.md's `render` layer).
 
 Each dataset kind gets the visual a user expects on first open: regular volumes and unstructured meshes as volumes with
-a transfer function fitted to the data range, 2D rasters as a height-field surface (or a flat image for colour),
+a transfer function fitted to the data range, 2D rasters as a height-field surface (or a flat image for color),
 time series as their first frame. Nothing here imports Qt: the same code renders offscreen for the CLI and inside
 the app's viewport.
 """
@@ -18,7 +18,7 @@ DEFAULT_COLORS = ((0.23, 0.30, 0.75), (0.87, 0.87, 0.87), (0.71, 0.02, 0.15))  #
 
 
 def default_transfer_function(scalar_range: tuple[float, float], diagonal: float, name: str = "default") -> Any:
-    """A cool-warm colour map with a ramp extinction over the data range: the first look at unknown data.
+    """A cool-warm color map with a ramp extinction over the data range: the first look at unknown data.
 
     The extinction peaks at 8 / diagonal, so a ray through the whole bounding box at the top of the range reaches an
     optical depth of about 8 (opaque) while lower values stay translucent.
@@ -172,7 +172,7 @@ VOLUME_CELL_TYPES = (10, 12, 13, 14)   # VTK tetrahedron, hexahedron, wedge, pyr
 def is_surface(dataset: Any) -> bool:
     """Whether ``dataset`` (the first frame of a time series) has no volume: a curvilinear grid flat in one index
     direction (an ocean surface, a 2D simulation) or a mesh of surface cells only. Such data is drawn as a surface
-    coloured by its array, not as a volume."""
+    colored by its array, not as a volume."""
     if isinstance(dataset, TimeSeries):
         dataset = dataset.frame(0)
     if isinstance(dataset, CurvilinearGrid):
@@ -183,7 +183,7 @@ def is_surface(dataset: Any) -> bool:
 
 
 def _add_surface(plotter: Any, grid: Any, tf: Any, opacity: float, name: Optional[str]) -> Any:
-    """A surface coloured by its active scalars through the transfer function's colours; the cells touching NaN/Inf
+    """A surface colored by its active scalars through the transfer function's colors; the cells touching NaN/Inf
     (land in an ocean field, a solver's failed points) are left out."""
     ctf, _ = tf.to_vtk(1.0)
     ctf.ClampingOn()
@@ -201,7 +201,7 @@ def _add_surface(plotter: Any, grid: Any, tf: Any, opacity: float, name: Optiona
 
 
 def _add_image(plotter: Any, image: Image2D, name: Optional[str]) -> Any:
-    """A 2D raster (a photo, a texture, a grey image) as a flat picture on the z = 0 plane, in its own colours (grey
+    """A 2D raster (a photo, a texture, a grey image) as a flat picture on the z = 0 plane, in its own colors (grey
     levels for one channel). Height maps open as terrain scenes instead
     (``volviz.render.scene_builder.terrain_session``)."""
     grid = image.to_pyvista()

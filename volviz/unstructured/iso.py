@@ -1,12 +1,12 @@
 """Isosurfaces through projected tetrahedra (Roettger §8.8-8.10, §8.13): every ray segment (s_f, s_b) of a cell
 looks up the flat isosurface texture of ``volviz.optics.isosurface`` (independent of the length l), so several
-coloured, semi-transparent isosurfaces are drawn by the same rasteriser and compositing as the volume.
+colored, semi-transparent isosurfaces are drawn by the same rasteriser and compositing as the volume.
 
 - ``iso_lut``: the (n, n) texture as an l-independent "3D table" (two identical l slices) for ``raster.lut_args``;
   bilinear filtering of the discontinuous texture blurs a surface over about one texel of (s_f, s_b), i.e. pixels
   whose segment ends within ds of the isovalue are partly covered (the §8.8 behaviour of texture filtering).
-- ``iso_segment_rgba``: the exact flat colour of segments (the §8.13 Heaviside limit with H(0) = 1/2, surfaces
-  composited in ray order, side-dependent colours), used by the "reference" method.
+- ``iso_segment_rgba``: the exact flat color of segments (the §8.13 Heaviside limit with H(0) = 1/2, surfaces
+  composited in ray order, side-dependent colors), used by the "reference" method.
 - ``iso_visible``: cells whose scalar range meets an isovalue (± thicken); the others cannot show a surface.
 - ``vertex_shade``: smooth shading (§8.9). Every vertex gets a diffuse intensity from its normal (the volume-weighted
   mean of the scalar gradients of its cells) and a headlight; the intensity is interpolated linearly inside each
@@ -87,8 +87,8 @@ def vertex_shade(mesh: TetMesh, light: np.ndarray, ambient: float = 0.3) -> np.n
 def iso_segment_rgba(table: Any, s_f: np.ndarray, s_b: np.ndarray, h_f: np.ndarray | None = None,
                      h_b: np.ndarray | None = None) -> np.ndarray:
     """Exact premultiplied RGBA (k, 4) of segments: the isosurfaces crossed between s_f and s_b, front to back
-    (increasing values when s_f < s_b, decreasing otherwise), each with its opacity and side colour; with shading
-    intensities ``h_f``/``h_b`` at the segment's ends each surface's colour is scaled by the intensity where it is
+    (increasing values when s_f < s_b, decreasing otherwise), each with its opacity and side color; with shading
+    intensities ``h_f``/``h_b`` at the segment's ends each surface's color is scaled by the intensity where it is
     crossed (smooth shading; see the module docstring), else flat."""
     from volviz.optics.isosurface import heaviside_alpha
 
@@ -107,11 +107,11 @@ def iso_segment_rgba(table: Any, s_f: np.ndarray, s_b: np.ndarray, h_f: np.ndarr
         sel = (sb >= sf) if ascending else (sb < sf)
         for iso in (order if ascending else order[::-1]):
             a = heaviside_alpha(sf, sb, iso.value, table.thicken) * sel * iso.opacity
-            colour = np.asarray(iso.color if ascending or iso.back_color is None else iso.back_color)
+            color = np.asarray(iso.color if ascending or iso.back_color is None else iso.back_color)
             if smooth:
                 w = np.where(span != 0.0, np.clip((iso.value - sf) / safe, 0.0, 1.0), 0.5)
-                colour = colour * (hf + w * (hb - hf))[..., None]
-            out[..., :3] += (trans * a)[..., None] * colour
+                color = color * (hf + w * (hb - hf))[..., None]
+            out[..., :3] += (trans * a)[..., None] * color
             out[..., 3] += trans * a
             trans = trans * (1.0 - a)
     return out

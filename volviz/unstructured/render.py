@@ -125,7 +125,7 @@ def render(mesh: TetMesh, tf: Any, camera: Camera, size: tuple[int, int] = (512,
     """Render ``mesh`` with transfer function ``tf`` seen by ``camera`` into a (H, W, 4) premultiplied RGBA image.
 
     ``order`` (a back-to-front cell order, e.g. from a background sort) skips the sort. ``lookup`` picks the
-    pre-integration for "pt": "separable" (Roettger §9.1, n_s x n_s (default 256) with a colour polynomial of
+    pre-integration for "pt": "separable" (Roettger §9.1, n_s x n_s (default 256) with a color polynomial of
     ``degree`` (default 2); exact opacity), "3d" (n_s x n_s x n_l, default n_s = 128, trilinear) or "auto" (by the
     largest optical depth of a cell, see ``auto_lookup``); l_max = the longest edge, over the data and TF range. "pt-st"
     always uses the 3D table. ``table`` overrides it (a ``Table3D`` or a ``SeparableTable``).
@@ -139,7 +139,7 @@ def render(mesh: TetMesh, tf: Any, camera: Camera, size: tuple[int, int] = (512,
     covered: measured RMSE 5, 5% of pixels off by > 4/255 on a 7^3 jittered grid at 48 x 40). "reference" evaluates
     the Heaviside limit per exact segment. ``iso_shading="smooth"`` (exact mode) shades each surface with a
     headlight through vertex normals interpolated linearly inside cells (Roettger §8.9, ``iso.vertex_shade``);
-    "flat" (default) keeps the surfaces' colours.
+    "flat" (default) keeps the surfaces' colors.
     ``classification``: "post" (default; the TF applied to the interpolated scalar, exact inside cells) or "pre"
     (Roettger §8.14, the original projected tetrahedra: the TF applied at each segment's ends only, κ and ρ linear in
     between, ``volviz.optics.integrate_preclassified``), for A/B comparisons: "pt" and "reference" then integrate

@@ -5,13 +5,13 @@ face diagonals of neighbouring hexahedra agree; pyramids become 2. Guthe §4.1: 
 
 Conformity rules used here:
 
-- hexahedra: the 5-split whose central tetrahedron is spanned by the four corners of colour 0 in a 2-colouring of the
-  mesh vertices along hexahedron edges. For a curvilinear grid the colour is ``(i + j + k) % 2`` (the classic
-  alternating parity). Every face diagonal then joins the two colour-0 corners of that face, so both neighbours pick the
+- hexahedra: the 5-split whose central tetrahedron is spanned by the four corners of color 0 in a 2-coloring of the
+  mesh vertices along hexahedron edges. For a curvilinear grid the color is ``(i + j + k) % 2`` (the classic
+  alternating parity). Every face diagonal then joins the two color-0 corners of that face, so both neighbours pick the
   same diagonal. Unstructured hexahedral meshes whose vertex graph is not bipartite are refused with a clear error.
 - prisms and pyramids: every quadrilateral face is split along the diagonal through its smallest vertex in the global
-  order (colour, id) (Dompierre et al. 1999: any global order is consistent between neighbours); on a face shared with
-  a hexahedron this is the hexahedron's colour-0 diagonal, so mixed meshes conform.
+  order (color, id) (Dompierre et al. 1999: any global order is consistent between neighbours); on a face shared with
+  a hexahedron this is the hexahedron's color-0 diagonal, so mixed meshes conform.
 
 Degenerate cells (|6V| <= 1e-12 * (longest edge)^3) are dropped and counted.
 """
@@ -32,7 +32,7 @@ from volviz.model.datasets import (
     UnstructuredMesh,
 )
 
-#: the central tetrahedron and the four corner tetrahedra of a hexahedron (VTK corner order) when the colour-0
+#: the central tetrahedron and the four corner tetrahedra of a hexahedron (VTK corner order) when the color-0
 #: corners are {0, 2, 5, 7}; the other parity uses the complementary corners.
 _HEX5_EVEN = np.array([[0, 2, 5, 7], [1, 0, 2, 5], [3, 0, 2, 7], [4, 0, 5, 7], [6, 2, 5, 7]], dtype=np.int64)
 _HEX5_ODD = np.array([[1, 3, 4, 6], [0, 1, 3, 4], [2, 1, 3, 6], [5, 1, 4, 6], [7, 3, 4, 6]], dtype=np.int64)
@@ -73,7 +73,7 @@ def _orient_and_filter(points: np.ndarray, tets: np.ndarray) -> tuple[np.ndarray
 def hexahedra_to_tets(hexes: np.ndarray, even_corner0: np.ndarray) -> np.ndarray:
     """Split hexahedra (k, 8) in VTK corner order into 5 tetrahedra each (Roettger §11.3.3, alternating parity).
 
-    ``even_corner0[c]`` is True when corner 0 of hexahedron c has colour 0 (then the central tetrahedron is 0,2,5,7).
+    ``even_corner0[c]`` is True when corner 0 of hexahedron c has color 0 (then the central tetrahedron is 0,2,5,7).
     """
     hexes = np.asarray(hexes, dtype=np.int64)
     out = np.empty((len(hexes), 5, 4), dtype=np.int64)
@@ -111,8 +111,8 @@ def pyramids_to_tets(pyramids: np.ndarray, rank: np.ndarray | None = None) -> np
     return np.where(d02[:, None, None], a, b).reshape(-1, 4)
 
 
-def _hex_vertex_colours(hexes: np.ndarray, n_points: int) -> np.ndarray:
-    """2-colour the vertices along hexahedron edges (BFS); raise when the vertex graph is not bipartite."""
+def _hex_vertex_colors(hexes: np.ndarray, n_points: int) -> np.ndarray:
+    """2-color the vertices along hexahedron edges (BFS); raise when the vertex graph is not bipartite."""
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import breadth_first_order
 
@@ -120,18 +120,18 @@ def _hex_vertex_colours(hexes: np.ndarray, n_points: int) -> np.ndarray:
     a = hexes[:, edges[:, 0]].ravel()
     b = hexes[:, edges[:, 1]].ravel()
     graph = coo_matrix((np.ones(2 * len(a)), (np.r_[a, b], np.r_[b, a])), shape=(n_points, n_points)).tocsr()
-    colour = np.full(n_points, -1, dtype=np.int64)
+    color = np.full(n_points, -1, dtype=np.int64)
     for start in np.unique(hexes):
-        if colour[start] >= 0:
+        if color[start] >= 0:
             continue
         order, pred = breadth_first_order(graph, start, directed=False, return_predecessors=True)
-        colour[start] = 0
+        color[start] = 0
         for v in order[1:]:
-            colour[v] = 1 - colour[pred[v]]
-    if np.any(colour[a] == colour[b]):
+            color[v] = 1 - color[pred[v]]
+    if np.any(color[a] == color[b]):
         raise ValueError("hexahedral mesh cannot be split conformingly into 5 tetrahedra: its vertex graph is not "
                          "bipartite (use a tetrahedral mesh or a curvilinear grid)")
-    return colour
+    return color
 
 
 def _curvilinear_hexes(dims: tuple[int, int, int]) -> tuple[np.ndarray, np.ndarray]:
@@ -205,19 +205,19 @@ def _unstructured_tets(points: np.ndarray, cells: list[tuple[int, np.ndarray]]
     n = len(points)
     hexes = [np.asarray(c, dtype=np.int64) for t, c in cells if t == VTK_HEXAHEDRON and len(c)]
     try:
-        colour = _hex_vertex_colours(np.concatenate(hexes), n) if hexes else np.zeros(n, dtype=np.int64)
+        color = _hex_vertex_colors(np.concatenate(hexes), n) if hexes else np.zeros(n, dtype=np.int64)
     except ValueError:   # no conforming 5-split: VTK's ordered triangulation of every cell
         return _vtk_tets(points, cells)
-    # quad diagonals of prisms/pyramids through the smallest (colour, id): on faces shared with a hexahedron that is
-    # the colour-0 diagonal the 5-split uses, so mixed meshes conform too
-    rank = np.maximum(colour, 0) * n + np.arange(n)
+    # quad diagonals of prisms/pyramids through the smallest (color, id): on faces shared with a hexahedron that is
+    # the color-0 diagonal the 5-split uses, so mixed meshes conform too
+    rank = np.maximum(color, 0) * n + np.arange(n)
     for cell_type, conn in cells:
         conn = np.asarray(conn, dtype=np.int64)
         if cell_type == VTK_TETRA:
             parts.append(conn)
             counts["tetra"] = counts.get("tetra", 0) + len(conn)
         elif cell_type == VTK_HEXAHEDRON:
-            parts.append(hexahedra_to_tets(conn, colour[conn[:, 0]] == 0))
+            parts.append(hexahedra_to_tets(conn, color[conn[:, 0]] == 0))
             counts["hexahedron"] = counts.get("hexahedron", 0) + len(conn)
         elif cell_type == VTK_WEDGE:
             parts.append(wedges_to_tets(conn, rank))
