@@ -654,13 +654,19 @@ class MainWindow(CameraBookmarks, QMainWindow):
         """Re-render a PT volume for the current camera and TF: the depth read-back on this thread, the sort, table
         and rasterisation in the background (``_refresh_overlay``), then the image and, with ``estimate``, a fresh
         error estimate. ``scale`` > 1: a preview that many times smaller in each direction. ``settled()`` is called
-        when a render for this request is over."""
+        when a render for this request is over. On the GPU backend only the visibility order is made in the
+        background; until it is done, VTK's renders draw with the newest order there is."""
         controller = self.controller
         volume = controller.pt_volume(comp_id) if controller is not None else None
+        gl = controller.gl_pt_volume(comp_id) if controller is not None else None
         if volume is not None:
             after = (lambda request: self.estimate_error(comp_id, request)) if estimate else None
             self._refresh_overlay(volume, f"pt:{comp_id}", "volume", lambda: controller.pt_volume(comp_id), after,
                                   settled, scale)
+        elif gl is not None:  # the GPU draws with the newest order; the order for this camera is made on a worker
+            gl.reuse_order = True
+            self._refresh_overlay(gl, f"pt-order:{comp_id}", "visibility order",
+                                  lambda: controller.gl_pt_volume(comp_id), None, settled, scale)
         elif settled is not None:
             settled()
 

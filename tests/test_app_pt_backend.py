@@ -1,7 +1,8 @@
 """The render setting Backend in the app (issue #16): a PT volume drawn on the GPU (``volviz.render.gl_pt``, VTK's
 OpenGL with volviz's shaders) shows the image the CPU backend (``volviz.render.pt_prop``) shows, a camera drag
-redraws it with no CPU render, and switching the setting rebuilds the volume on the other backend. Under Xvfb with
-real widgets and real VTK rendering on llvmpipe.
+redraws it with no CPU render and no sort on the GUI thread (the visibility order is made by background jobs, the
+draws in between reuse the newest one), and switching the setting rebuilds the volume on the other backend. Under
+Xvfb with real widgets and real VTK rendering on llvmpipe.
 
 Bound: RMSE <= 1 and max <= 4 of 255 between the two backends' viewport screenshots (the GL PT tests' bound against
 the exact reference; the CPU image passes through an 8-bit straight-alpha overlay, the GPU's through a float
@@ -68,7 +69,8 @@ def test_gpu_backend_matches_the_cpu_follows_a_drag_without_cpu_renders_and_swit
     assert window.statistics.text("backends") == "demo: gpu"
     assert window.statistics.text("gl") == plotter_gl_info(window.plotter).renderer != ""
 
-    # a mouse drag of the camera: VTK draws the volume at every repaint, no CPU render job is submitted
+    # a mouse drag of the camera: VTK draws the volume at every repaint with the newest visibility order, which
+    # background jobs make; no CPU render job is submitted and no render sorts on the GUI thread
     submitted: list[str] = []
     submit = window.jobs.submit
 
@@ -84,18 +86,26 @@ def test_gpu_backend_matches_the_cpu_follows_a_drag_without_cpu_renders_and_swit
     held = Qt.MouseButton.LeftButton
     _mouse(canvas, QEvent.Type.MouseButtonPress, centre, held)
     drawn: list[np.ndarray] = []
+    sorted_here: list[bool] = []
     for k in range(1, 21):
         _mouse(canvas, QEvent.Type.MouseMove, centre + QPoint(5 * k, k), held)
         qtbot.wait(40)
         drawn.append(np.asarray(gpu.camera.position, dtype=float).copy())
+        sorted_here.append(bool(gpu.stats["sorted"]))
     _mouse(canvas, QEvent.Type.MouseButtonRelease, centre + QPoint(100, 20), Qt.MouseButton.NoButton)
     qtbot.wait(300)
+    # the order of the final camera arrives from its job and is drawn: exact again
+    qtbot.waitUntil(lambda: not window._overlay_jobs["pt-order:demo"].running and gpu.stats["order_reused"] is False
+                    and gpu._sorted_key is not None and np.allclose(gpu._sorted_key[0], gpu.camera.position),
+                    timeout=30000)
+    assert not any(sorted_here), "a render during the drag sorted on the GUI thread"
+    assert "visibility order" in submitted
     final = np.asarray(window.plotter.camera.position, dtype=float)
     assert not np.allclose(final, start), "the drag did not move the camera"
     assert len({tuple(p) for p in drawn}) >= 3, "the volume was not redrawn while the camera moved"
     assert np.allclose(gpu.camera.position, final), "the last draw is not of the final camera"
     assert "volume" not in submitted and "error estimate" not in submitted, submitted
-    assert window.overlay_updates == updates
+    assert window.overlay_updates.get("pt:demo") == updates.get("pt:demo")
     after_drag = viewport(window)
     assert np.allclose(gpu.camera.position, final)
 

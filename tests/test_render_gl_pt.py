@@ -200,6 +200,53 @@ def test_prefetched_and_reused_orders():
     assert e[0] <= RMSE and e[1] <= MAX, e
 
 
+def test_order_made_on_a_worker_is_drawn_and_reused_until_the_next_one():
+    """With ``reuse_order`` a render never sorts: it draws the newest order it has. ``begin`` / ``compute`` (on
+    another thread) / ``finish`` make the order for the camera of ``begin``; drawn for that camera it is exact (the
+    image of a volume that sorted for it), and drawn for a camera that moved on it is the newest there is."""
+    import threading
+
+    mesh = syn.cavity_box(6)
+    size = (40, 32)
+    cams = [Camera.orbit(mesh.points, a, 20, 2.5) for a in (30, 75, 120)]
+    exact = [_gl_image(mesh, TF, cam, size) for cam in cams]
+    pl = _plotter(size, cams[0])
+    vol = GLPTVolume(pl, mesh, TF)
+    vol.reuse_order = True
+    pl.screenshot(return_img=True)                  # nothing to reuse yet: sorted here once
+    assert vol.stats["sorted"] and not vol.stats["order_reused"]
+    first = vol.order.copy()
+
+    cams[1].apply_to(pl.renderer.GetActiveCamera())
+    request = vol.begin(scale=2)
+    pl.ren_win.Render()                             # the drag's render: the old order, no sort
+    assert vol.stats["order_reused"] and not vol.stats["sorted"] and np.array_equal(vol.order, first)
+    made: list = []
+    worker = threading.Thread(target=lambda: made.append(vol.compute(request)))
+    worker.start()
+    worker.join()
+    vol.finish(request, *made[0])
+    img = _drawn(pl)
+    assert not vol.stats["order_reused"] and not vol.stats["sorted"] and not np.array_equal(vol.order, first)
+    assert np.array_equal(img, exact[1]), "the worker's order draws another image than a sort in the render"
+    assert vol.begin()["have"] and vol.compute(vol.begin()) == (None,)  # a TF edit's request: nothing to sort
+
+    cams[2].apply_to(pl.renderer.GetActiveCamera())
+    pl.ren_win.Render()                             # moved on before the next order: the newest one, reused
+    assert vol.stats["order_reused"] and not np.array_equal(_drawn(pl), exact[2])
+    request = vol.begin()
+    vol.finish(request, *vol.compute(request))
+    assert np.array_equal(_drawn(pl), exact[2]) and not vol.stats["order_reused"]
+    vol.remove()
+    pl.close()
+
+
+def _drawn(pl: pv.Plotter) -> np.ndarray:
+    """Render now (a screenshot alone shows the last frame) and read the image."""
+    pl.ren_win.Render()
+    return pl.screenshot(return_img=True)
+
+
 def test_opaque_sphere_inside_bluntfin(bluntfin):
     """An opaque sphere inside the fin: each ray's segments end at the sphere's depth (cells straddling it are
     integrated only up to it), then the volume is composited over the sphere. Expected: the reference clipped at the

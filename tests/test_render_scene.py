@@ -136,3 +136,37 @@ def test_movie_export_sorts_the_next_frame_in_the_background() -> None:
         assert np.array_equal(pt.image, plain)
     finally:
         plotter.close()
+
+
+def test_movie_export_sorts_the_next_frame_of_a_gpu_volume_in_the_background() -> None:
+    """The GPU backend's PT volume draws each movie frame with the order sorted while the frame before rendered, and
+    that frame is the one a sort in the render gives."""
+    from volviz.render.controller import SceneController
+    from volviz.render.export import _prefetch_sorts, offscreen_plotter
+    from volviz.render.gl_pt import GLPTVolume
+    from volviz.session import CameraState, Component, RenderSettings, Session
+
+    session = Session(components=[Component(id="demo", type="demo", settings={"cells_per_edge": 5})],
+                      render=RenderSettings(method="pt", size=(64, 48), options={"backend": "gpu"}))
+    plotter = offscreen_plotter((64, 48))
+    try:
+        controller = SceneController(plotter, session, {})
+        controller.build()
+        gl = controller.gl_pt_volume("demo")
+        assert isinstance(gl, GLPTVolume) and controller.pt_volume("demo") is None
+        first = CameraState(position=(2.0, -2.0, 1.5), focal_point=(0.5, 0.5, 0.5), view_up=(0, 0, 1))
+        nxt = CameraState(position=(2.5, -1.5, 1.2), focal_point=(0.5, 0.5, 0.5), view_up=(0, 0, 1))
+        controller.set_camera(nxt)
+        plotter.render()
+        plain = plotter.screenshot(return_img=True)
+        assert gl.stats["sorted"] and not gl.stats["sort_prefetched"]
+        controller.set_camera(first)
+        plotter.render()
+        _prefetch_sorts(controller, nxt, (64, 48))             # while this frame is shown, sort for the next
+        controller.set_camera(nxt)
+        plotter.render()
+        assert gl.stats["sort_prefetched"] is True
+        assert np.array_equal(plotter.screenshot(return_img=True), plain)
+        controller.clear()                                     # the GL resources go before the context
+    finally:
+        plotter.close()

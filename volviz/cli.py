@@ -23,6 +23,7 @@ from volviz.argtypes import MAX_MOVIE_FRAMES, MAX_MOVIE_SECONDS, UsageError, Usa
 BENCHMARKS = {
     "tables": "pre-integration tables: build time and error against the exact ray integral",
     "unstructured": "projected tetrahedra on the Blunt Fin against VTK's unstructured volume mappers",
+    "pt_order": "the GPU PT pass during a drag: the error of drawing with the visibility order of an earlier camera",
     "compression": "the wavelet codec against blosc2, zfp and wavelet + zstd (ratio, PSNR, speed)",
     "nature": "the natural scene (terrain, fog, clouds): frame time and error along a flight",
     "iso": "multiple semi-transparent isosurfaces: compositing modes against the exact order",

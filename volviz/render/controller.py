@@ -517,6 +517,12 @@ class SceneController:
         prop = self.props.get(comp_id)
         return prop if _is_cpu_pt(prop) else None
 
+    def gl_pt_volume(self, comp_id: str) -> Any:
+        """The GPU PT volume of a component (VTK draws it; its visibility order can be made on a worker:
+        ``begin`` / ``compute`` / ``finish``), or None."""
+        prop = self.props.get(comp_id)
+        return prop if _is_pt(prop) and prop.backend == "gpu" else None
+
     def pt_stats(self) -> dict[str, Any]:
         """The last frame statistics of every PT volume (sort / project / raster seconds, fragments, method)."""
         return {comp_id: dict(prop.stats) for comp_id, prop in self.props.items() if _is_pt(prop)}

@@ -289,14 +289,14 @@ def frame_count(fps: float, seconds: float) -> int:
 
 
 def _prefetch_sorts(controller: Any, camera: Any, size: tuple[int, int]) -> None:
-    """Start sorting every visible PT volume for the next frame's camera while this frame renders
+    """Start sorting every visible PT volume (either backend) for the next frame's camera while this frame renders
     (``volviz.unstructured.prefetch``)."""
     from volviz.model.camera import Camera
 
     cam = Camera(camera.position, camera.focal_point, camera.view_up, camera.view_angle, camera.parallel,
                  camera.parallel_scale)
     for comp_id in list(controller.props):
-        pt = controller.pt_volume(comp_id)
+        pt = controller.pt_volume(comp_id) or controller.gl_pt_volume(comp_id)
         if pt is not None and pt.visible:
             pt.prefetch(cam, (int(size[0]), int(size[1])))
 

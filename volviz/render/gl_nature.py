@@ -119,8 +119,8 @@ class CloudPTVolume(GLPTVolume):
     fragment (Eq. 11.9), the given back-to-front order, and ``set_frame`` for the next frame's mesh.
 
     Private members of ``GLPTVolume`` used (what a public API would replace): ``_build_table`` (overridden to return
-    the scene's table), ``_sorted`` / ``_order_key`` (the given order, kept by ``reuse_order``), ``_vis`` (culling
-    of the new mesh), ``gl_pt._cell_attributes`` (the new mesh's vertex attributes)."""
+    the scene's table), ``_sorted`` / ``_sorted_key`` / ``_order_key`` (the given order, kept by ``reuse_order``),
+    ``_vis`` (culling of the new mesh), ``gl_pt._cell_attributes`` (the new mesh's vertex attributes)."""
 
     def __init__(self, plotter: Any, mesh: TetMesh, buffers: CloudBuffers, shading: CloudShading, table: Any
                  ) -> None:
@@ -150,7 +150,7 @@ class CloudPTVolume(GLPTVolume):
         self.actor.SetPosition(*self.topo.origin)
         self.reuse_order = True
         self._sorted = np.arange(self.topo.n_tets, dtype=np.int64)
-        self._order_key = None
+        self._sorted_key = self._order_key = None
 
 
 class GLNatureView(NatureView):

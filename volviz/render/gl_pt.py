@@ -205,6 +205,12 @@ def _shader(name: str, smooth: bool, kind: int = 0, clips: int = 0) -> str:
     return shader_source(name).replace("//VTK::System::Dec\n", "//VTK::System::Dec\n" + head, 1)
 
 
+def _order_key(cam: Camera, size: tuple[int, ...]) -> tuple[Any, ...]:
+    """What a visibility order depends on: the camera and the image size."""
+    return (tuple(cam.position), tuple(cam.focal_point), tuple(cam.view_up), cam.view_angle, cam.parallel,
+            cam.parallel_scale, tuple(size))
+
+
 class GLPTVolume(PTView):
     """A TetMesh drawn by the GPU pre-integrated PT pass in a PyVista plotter's renderer (module docstring).
 
@@ -215,9 +221,11 @@ class GLPTVolume(PTView):
     in closed form. ``sort``/``nonconvex``: as ``visibility_order``. ``stats`` holds the last new index
     buffer's CPU-side seconds (``sort_s``, ``order_s``), the number of cells drawn, and whether a new order was made
     for the camera (``sorted``: here or by ``prefetch``), taken from ``prefetch`` or reused. ``prefetch(camera)``
-    sorts for a known next camera in the background; ``reuse_order = True`` keeps the last order for every camera
-    (e.g. during a mouse drag: the image is then exact per cell but may composite some overlapping cells in the wrong
-    order). ``camera``: the camera of the last draw. The GPU side of the PT view interface
+    sorts for a known next camera in the background; ``reuse_order = True`` never sorts in a render: it draws the
+    newest order it has (e.g. during a mouse drag: the image is then exact per cell but may composite some
+    overlapping cells in the wrong order), and ``begin`` / ``compute`` / ``finish`` make the order for the camera of
+    ``begin`` on a worker while the GPU draws (the app's background jobs, as for the CPU backend's images; the bench
+    states what a reused order costs). ``camera``: the camera of the last draw. The GPU side of the PT view interface
     ``volviz.render.pt_view.PTView``: VTK draws it at every render, so ``update`` has nothing to do.
     ``keep_multisampling``: leave the window's multisampling on (module docstring; default off while the volume is
     shown)."""
@@ -255,6 +263,7 @@ class GLPTVolume(PTView):
         self.order: np.ndarray | None = None       # the drawn cells, back to front
         self.reuse_order = False                    # keep the last order whatever the camera (during interaction)
         self._sorted: np.ndarray | None = None      # the last full visibility order (all cells)
+        self._sorted_key: Any = None                # the camera and size that order was made for
         self._offsets: np.ndarray | None = None     # 0, 3, 6, ...: the index buffer's triangle offsets
         self._cell_arrays: tuple[np.ndarray, np.ndarray] | None = None   # the arrays VTK's cells share
         self._recull = False                        # the TF changed: cull the last order again (no new sort)
@@ -375,27 +384,51 @@ class GLPTVolume(PTView):
         self._apply_kind()
         cam = self.camera = self._camera()
         size = tuple(int(v) for v in self.renderer.GetSize())
-        key = (tuple(cam.position), tuple(cam.focal_point), tuple(cam.view_up), cam.view_angle, cam.parallel,
-               cam.parallel_scale, size)
-        same = key == self._order_key and self._sorted is not None
-        if same and not self._recull:
+        key = _order_key(cam, size)
+        if key == self._order_key and self._sorted is not None and not self._recull:
             return
         t0 = time.perf_counter()
-        reused = not same and self.reuse_order and self._sorted is not None
-        res = None if same or reused or self._prefetcher is None else self._prefetcher.take(cam, size)
+        exact = self._sorted is not None and key == self._sorted_key
+        res = None if exact or self._prefetcher is None else self._prefetcher.take(cam, size)
         prefetched = res is not None
-        if not (same or reused):
-            res = res or visibility_order(self.topo, cam, size, self.sort, self.nonconvex)
-            self._sorted, self._cycles = res.order, int(res.cycles)
+        if not exact and res is None and not (self.reuse_order and self._sorted is not None):
+            res = visibility_order(self.topo, cam, size, self.sort, self.nonconvex)
+        if res is not None:
+            self._sorted, self._cycles, self._sorted_key = res.order, int(res.cycles), key
         self._recull = False
         t1 = time.perf_counter()
         cells = self._sorted[self._vis[self._sorted]]
         self._set_index_buffer(cells)
         self.order, self._order_key = cells, key
         self.stats = {"method": "pt-gl", "sort_s": t1 - t0, "order_s": time.perf_counter() - t1,
-                      "n_visible": int(len(cells)), "cycles": self._cycles, "sorted": not (same or reused),
-                      "sort_prefetched": prefetched,
-                      "order_reused": reused}
+                      "n_visible": int(len(cells)), "cycles": self._cycles, "sorted": res is not None,
+                      "sort_prefetched": prefetched, "order_reused": not exact and res is None}
+
+    def begin(self, scale: int = 1) -> dict[str, Any]:
+        """GUI thread: the order to make next, for the renderer's camera and size now (``scale`` > 1: asked for
+        during an interaction; the order is the same)."""
+        cam = self._camera()
+        size = tuple(int(v) for v in self.renderer.GetSize())
+        key = _order_key(cam, size)
+        return {"camera": cam, "size": size, "key": key, "topo": self.topo, "preview": scale > 1,
+                "have": self._sorted is not None and key == self._sorted_key}
+
+    def compute(self, request: dict[str, Any], progress: Any = None) -> tuple[Any]:
+        """Any thread: the visibility order for ``begin``'s camera (``volviz.unstructured.sort``); None when the
+        volume has it already (e.g. a transfer-function edit asked for a new image)."""
+        from volviz.unstructured.sort import visibility_order
+
+        if request["have"]:
+            return (None,)
+        return (visibility_order(request["topo"], request["camera"], request["size"], self.sort, self.nonconvex),)
+
+    def finish(self, request: dict[str, Any], result: Any) -> None:
+        """GUI thread: draw with ``compute``'s order from the next render on: exact for its camera, and with
+        ``reuse_order`` the newest order for any other (during an interaction the camera has moved on meanwhile)."""
+        if result is None or request["topo"] is not self.topo:
+            return
+        self._sorted, self._cycles, self._sorted_key = result.order, int(result.cycles), request["key"]
+        self._recull = True
 
     def _set_index_buffer(self, cells: np.ndarray) -> None:
         """Draw ``cells`` back to front (4 triangles each) from the next render on: the polydata's cells are 32-bit
