@@ -16,7 +16,7 @@ from PySide6.QtGui import QAction, QKeySequence, QUndoGroup, QUndoStack
 from PySide6.QtWidgets import (QDockWidget, QFileDialog, QLabel, QMainWindow, QMessageBox,
                                QProgressBar, QPushButton, QWidget)
 
-from volviz.jobs import JobOutcome
+from volviz.jobs import JobOutcome, OneInFlight
 from volviz.render.backend import plotter_gl_info
 from volviz.render.controller import iso_summary, no_render
 from volviz.session import CameraKey, Session, SessionError, relative_path
@@ -73,40 +73,6 @@ def default_recovery_dir() -> Path:
 def _histogram_range(hist: Any) -> Optional[tuple[float, float]]:
     """The data range a (counts, edges) histogram spans (None without one)."""
     return None if hist is None else (float(hist[1][0]), float(hist[1][-1]))
-
-
-class OneInFlight:
-    """At most one background job of a kind: a request made while one runs waits, and only the newest waiting one
-    starts when it is done. (Cancelling the running job for every newer request, as a job key does, starves it while
-    requests keep coming: at 30 playback ticks a second no result would ever be shown.)"""
-
-    def __init__(self) -> None:
-        self.running = False
-        self._pending: Optional[Callable[[Callable[[], None]], None]] = None
-        self._waiting: list[Callable[[], None]] = []   # ``settled`` callbacks of requests not started yet
-        self._current: list[Callable[[], None]] = []   # ... of the running job (it answers the requests before it)
-
-    def request(self, start: Callable[[Callable[[], None]], None],
-                settled: Optional[Callable[[], None]] = None) -> None:
-        """``start(next_request)`` submits the job; its completion handler must call ``next_request()`` last.
-        ``settled()`` is called once a job started at or after this request is over (a newer request answers an
-        older one that never started)."""
-        self._pending = start
-        if settled is not None:
-            self._waiting.append(settled)
-        if not self.running:
-            self._next()
-
-    def _next(self) -> None:
-        over, self._current = self._current, []
-        start, self._pending = self._pending, None
-        if start is not None:
-            self._current, self._waiting = self._waiting, []
-        self.running = start is not None
-        for settled in over:
-            settled()
-        if start is not None:
-            start(self._next)
 
 
 def _import_gui_thread_modules() -> None:

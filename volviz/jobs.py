@@ -4,7 +4,9 @@ Long work in volviz (loading, decompression, sorting, table builds, extraction) 
 ``progress(fraction, message)`` callable. Run through a ``JobRunner``, that callable reports progress and raises
 ``Cancelled`` once the job's token is cancelled, so cancellation needs no extra plumbing in the numerics. A job
 submitted with a ``key`` supersedes the running job of the same key: the old one is cancelled and its result is never
-delivered (sorting for the newest camera, not every camera; DESIGN.md "Background work").
+delivered (sorting for the newest camera, not every camera; DESIGN.md "Background work"). ``OneInFlight`` is the
+other policy: one job of a kind at a time, the newest waiting request next, so that every finished result is shown
+while requests keep coming (the app's view refreshes).
 
 This module is Qt-free; the app bridges ``on_progress`` and ``on_done`` to Qt signals.
 """
@@ -197,3 +199,39 @@ class JobRunner:
     def shutdown(self, wait: bool = True) -> None:
         self.cancel_all()
         self._pool.shutdown(wait=wait, cancel_futures=True)
+
+
+class OneInFlight:
+    """At most one background job of a kind: a request made while one runs waits, and only the newest waiting one
+    starts when it is done. (Cancelling the running job for every newer request, as a job key does, starves it while
+    requests keep coming: at 30 playback ticks a second no result would ever be shown.)
+
+    Not thread-safe: requests and completions are made on one thread (the app's GUI thread)."""
+
+    def __init__(self) -> None:
+        self.running = False
+        self._pending: Optional[Callable[[Callable[[], None]], None]] = None
+        self._waiting: list[Callable[[], None]] = []   # ``settled`` callbacks of requests not started yet
+        self._current: list[Callable[[], None]] = []   # ... of the running job (it answers the requests before it)
+
+    def request(self, start: Callable[[Callable[[], None]], None],
+                settled: Optional[Callable[[], None]] = None) -> None:
+        """``start(next_request)`` submits the job; its completion handler must call ``next_request()`` last.
+        ``settled()`` is called once a job started at or after this request is over (a newer request answers an
+        older one that never started)."""
+        self._pending = start
+        if settled is not None:
+            self._waiting.append(settled)
+        if not self.running:
+            self._next()
+
+    def _next(self) -> None:
+        over, self._current = self._current, []
+        start, self._pending = self._pending, None
+        if start is not None:
+            self._current, self._waiting = self._waiting, []
+        self.running = start is not None
+        for settled in over:
+            settled()
+        if start is not None:
+            start(self._next)
