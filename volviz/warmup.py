@@ -42,10 +42,15 @@ def _render(doc: dict, folder: Path, name: str) -> None:
 
 
 def _natural_scene(folder: Path) -> None:
+    from volviz.nature.fog import FogLayer
     from volviz.render.export import render_session
+    from volviz.render.gl_fog import prism_buffers
     from volviz.render.scene_builder import demo_session
 
     render_session(demo_session(), None, SIZE)
+    # the GPU backend's fog prism buffers (its kernels run on the CPU; the GL drawing needs no warm-up)
+    points = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+    prism_buffers(points, points[:, 2], points[:, 2] + 1.0, np.array([[0, 1, 2]]), FogLayer())
 
 
 def _tetrahedral_volume(folder: Path) -> None:

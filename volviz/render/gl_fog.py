@@ -77,23 +77,12 @@ _GL_FUNC_ADD, _GL_MAX = 0x8006, 0x8008
 _GL_BLEND_EQUATION_RGB, _GL_BLEND_EQUATION_ALPHA = 0x8009, 0x883D
 _GL_COLOR_BUFFER_BIT = 0x4000
 _ATTRIBUTES = ("fogSide0", "fogSide1", "fogSide2", "fogBottom", "fogTop", "fogEmBottom", "fogEmTop")
-# the 8 triangles of a prism (vertices 0-2 bottom, 3-5 top), oriented outward per prism in ``prism_buffers``
-_PRISM_TRIANGLES = np.array([[0, 2, 1], [3, 4, 5], [0, 1, 4], [0, 4, 3], [1, 2, 5], [1, 5, 4], [2, 0, 3], [2, 3, 5]])
-
-
-def _affine(xy: np.ndarray, values: np.ndarray) -> np.ndarray:
-    """(m, 3): (gx, gy, c) with gx x + gy y + c = value at each triangle's three vertices (xy (m, 3, 2))."""
-    a = np.concatenate([xy, np.ones(xy.shape[:2] + (1,))], axis=2)
-    return np.linalg.solve(a, values[..., None])[..., 0]
-
-
-def prism_attributes(points: np.ndarray, bottom: np.ndarray, top: np.ndarray, triangles: np.ndarray,
-                     emission_bottom: np.ndarray, emission_top: np.ndarray
-                     ) -> tuple[np.ndarray, np.ndarray, dict[str, np.ndarray]]:
-    """The drawn prisms: (indices of the kept triangles, the layer's centre (3,), per-prism (k, 3) float64 attributes
-    relative to the centre: side planes (nx, ny, d) with nx x + ny y + d >= 0 inside, the affine forms (gx, gy, c) of
-    the bottom and top heights and of the bottom and top emissions). Prisms with all six emissions <= 0 or no
-    thickness are left out, as in the CPU PCP; so are triangles with no area."""
+def _kept_prisms(points: np.ndarray, bottom: np.ndarray, top: np.ndarray, triangles: np.ndarray,
+                 emission_bottom: np.ndarray, emission_top: np.ndarray
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(indices of the kept triangles, the layer's centre (3,), the points' xy relative to it (n, 2), the kept
+    triangles (k, 3), the four per-point values (4, n): bottom and top height relative to the centre, bottom and
+    top emission)."""
     pts = np.asarray(points, dtype=np.float64)
     tris = np.asarray(triangles, dtype=np.int64).reshape(-1, 3)
     zb, zt = np.asarray(bottom, dtype=np.float64), np.asarray(top, dtype=np.float64)
@@ -101,26 +90,29 @@ def prism_attributes(points: np.ndarray, bottom: np.ndarray, top: np.ndarray, tr
     lo = np.array([pts[:, 0].min(), pts[:, 1].min(), min(zb.min(), zt.min())])
     hi = np.array([pts[:, 0].max(), pts[:, 1].max(), max(zb.max(), zt.max())])
     centre = 0.5 * (lo + hi)
-    xy = pts[:, :2] - centre[:2]
+    xy = np.ascontiguousarray(pts[:, :2] - centre[:2])
     t = xy[tris]                                                         # (m, 3, 2)
     area2 = ((t[:, 1, 0] - t[:, 0, 0]) * (t[:, 2, 1] - t[:, 0, 1])
              - (t[:, 1, 1] - t[:, 0, 1]) * (t[:, 2, 0] - t[:, 0, 0]))
     keep = ((eb[tris] > 0).any(axis=1) | (et[tris] > 0).any(axis=1)) & (zt[tris] > zb[tris]).any(axis=1)
     keep &= np.abs(area2) > 0
     idx = np.flatnonzero(keep)
-    t = t[idx]
-    tk = tris[idx]
-    out: dict[str, np.ndarray] = {}
-    for e in range(3):
-        a, b, c = t[:, e], t[:, (e + 1) % 3], t[:, (e + 2) % 3]
-        n = np.stack([-(b[:, 1] - a[:, 1]), b[:, 0] - a[:, 0]], axis=1)
-        n *= np.where(np.einsum("ij,ij->i", n, c - a) < 0, -1.0, 1.0)[:, None]
-        out[f"fogSide{e}"] = np.concatenate([n, -np.einsum("ij,ij->i", n, a)[:, None]], axis=1)
-    out["fogBottom"] = _affine(t, zb[tk] - centre[2])
-    out["fogTop"] = _affine(t, zt[tk] - centre[2])
-    out["fogEmBottom"] = _affine(t, eb[tk])
-    out["fogEmTop"] = _affine(t, et[tk])
-    return idx, centre, out
+    values = np.stack([zb - centre[2], zt - centre[2], eb, et])
+    return idx, centre, xy, np.ascontiguousarray(tris[idx]), values
+
+
+def prism_attributes(points: np.ndarray, bottom: np.ndarray, top: np.ndarray, triangles: np.ndarray,
+                     emission_bottom: np.ndarray, emission_top: np.ndarray
+                     ) -> tuple[np.ndarray, np.ndarray, dict[str, np.ndarray]]:
+    """The drawn prisms: (indices of the kept triangles, the layer's centre (3,), per-prism (k, 3) float64 attributes
+    relative to the centre: side planes (nx, ny, d) with nx x + ny y + d >= 0 inside, the affine forms (gx, gy, c) of
+    the bottom and top heights and of the bottom and top emissions; ``_prism_kernels.prism_forms``). Prisms with all
+    six emissions <= 0 or no thickness are left out, as in the CPU PCP; so are triangles with no area."""
+    from volviz.render._prism_kernels import prism_forms
+
+    idx, centre, xy, kept, values = _kept_prisms(points, bottom, top, triangles, emission_bottom, emission_top)
+    forms, _, _ = prism_forms(xy, kept, values, centre)
+    return idx, centre, {name: forms[:, f] for f, name in enumerate(_ATTRIBUTES)}
 
 
 @dataclass
@@ -139,29 +131,17 @@ class PrismBuffers:
 
 def prism_buffers(points: np.ndarray, bottom: np.ndarray, top: np.ndarray, triangles: np.ndarray, layer: FogLayer,
                   emission: tuple[np.ndarray, np.ndarray] | None = None) -> PrismBuffers:
-    """Any thread, NumPy only: the vertex buffer of the layer's kept prisms (``prism_attributes``; the emission of
-    ``layer``'s mode, ``volviz.nature.fog.layer_emission``). Each prism's 8 triangles are wound outward (front faces
-    culled: only exit faces draw)."""
+    """Any thread (Numba kernels that release the GIL): the vertex buffer of the layer's kept prisms
+    (``prism_attributes``; the emission of ``layer``'s mode, ``volviz.nature.fog.layer_emission``). Each prism's 8
+    triangles are wound outward (front faces culled: only exit faces draw)."""
+    from volviz.render._prism_kernels import expand_buffers, prism_forms
+
     points, bottom, top = (np.asarray(a, dtype=np.float64) for a in (points, bottom, top))
-    triangles = np.asarray(triangles, dtype=np.int64).reshape(-1, 3)
     eb, et = layer_emission(bottom, top, layer, emission)
-    idx, centre, attrs = prism_attributes(points, bottom, top, triangles, eb, et)
-    tk = triangles[idx]
-    xy = points[tk][..., :2]                                              # (k, 3, 2)
-    zb, zt = bottom[tk], top[tk]
-    verts = np.concatenate([np.concatenate([xy, zb[..., None]], axis=2),
-                            np.concatenate([xy, zt[..., None]], axis=2)], axis=1) - centre   # (k, 6, 3)
-    k = len(idx)
-    faces = np.broadcast_to(_PRISM_TRIANGLES, (k, 8, 3)).copy()
-    v = verts[np.arange(k)[:, None, None], faces]                          # (k, 8, 3, 3)
-    normal = np.cross(v[:, :, 1] - v[:, :, 0], v[:, :, 2] - v[:, :, 0])
-    outward = np.einsum("kfj,kfj->kf", normal, v.mean(axis=2) - verts.mean(axis=1)[:, None])
-    flip = outward < 0
-    faces[flip] = faces[flip][:, ::-1]
-    conn = (faces + 6 * np.arange(k)[:, None, None]).reshape(-1)
-    repeated = {name: np.ascontiguousarray(np.repeat(arr, 6, axis=0), np.float32) for name, arr in attrs.items()}
-    return PrismBuffers(np.ascontiguousarray(verts.reshape(-1, 3), np.float32), repeated,
-                        np.ascontiguousarray(conn, np.int64), centre, k)
+    idx, centre, xy, kept, values = _kept_prisms(points, bottom, top, triangles, eb, et)
+    forms, corners, faces = prism_forms(xy, kept, values, centre)
+    verts, attributes, conn = expand_buffers(forms, corners, faces)
+    return PrismBuffers(verts, {name: attributes[f] for f, name in enumerate(_ATTRIBUTES)}, conn, centre, len(idx))
 
 
 def buffers_polydata(points: np.ndarray, attributes: dict[str, np.ndarray],
