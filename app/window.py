@@ -19,6 +19,7 @@ from PySide6.QtWidgets import (QDockWidget, QFileDialog, QLabel, QMainWindow, QM
 from volviz.jobs import JobOutcome, OneInFlight
 from volviz.render.backend import plotter_gl_info
 from volviz.render.controller import iso_summary, no_render
+from volviz.render.error_budget import MOST_ACCURATE_TABLE, error_budget_choice
 from volviz.session import CameraKey, Session, SessionError, relative_path
 from volviz_app.array_choice import ArrayChoice
 from volviz_app.camera_bookmarks import CameraBookmarks
@@ -490,22 +491,18 @@ class MainWindow(CameraBookmarks, QMainWindow):
         self.jobs.submit(volume.error_estimate, request, name="error estimate", key=f"error:{comp_id}",
                          on_done=done)
 
-    MOST_ACCURATE_TABLE = {"table": "separable-4", "table_resolution": 512}
+    MOST_ACCURATE_TABLE = MOST_ACCURATE_TABLE
 
     def _enforce_error_budget(self, rmse: float) -> None:
-        """Measured error above the budget: switch to the most accurate table once, or say that it cannot be met."""
-        options = self.session.render.options
-        budget = float(options.get("error_budget", 1.0))
-        if rmse <= budget:
+        """Measured error above the budget: switch to the most accurate table once, or say that it cannot be met
+        (``volviz.render.error_budget``)."""
+        choice = error_budget_choice(rmse, self.session.render.options)
+        if choice.message is not None:
+            self.status_label.setText(choice.message)
+        if choice.table is None:
             return
-        if all(options.get(k) == v for k, v in self.MOST_ACCURATE_TABLE.items()):
-            self.status_label.setText(f"Measured error {rmse:.2f} exceeds the budget {budget:.2f} even with the "
-                                      "finest table; the exact 'reference' renderer meets any budget")
-            return
-        self.status_label.setText(f"Measured error {rmse:.2f} exceeds the budget {budget:.2f}: switching to the "
-                                  "degree-4 separable table at 512²")
         values = self.render_settings.settings()
-        values["options"].update(self.MOST_ACCURATE_TABLE)
+        values["options"].update(choice.table)
         self.render_settings.load_values(values)
         self._settings_changed(values)
 
