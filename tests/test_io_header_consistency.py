@@ -23,6 +23,16 @@ def test_vti_whole_extent_larger_than_its_piece_is_refused(tmp_path):
     assert vio.read(data_file("volumes/hydrogen.vti")).dimensions == (64, 64, 64)
 
 
+def test_vti_piece_without_the_whole_extent_before_it_is_refused(tmp_path):
+    """A Piece with no ImageData element (and so no WholeExtent) before it is a ReadError, not a TypeError."""
+    data = data_file("volumes/hydrogen.vti").read_bytes()
+    bad = tmp_path / "headless.vti"
+    bad.write_bytes(data.replace(b"<ImageData WholeExtent=", b"<ImageDatum WholeExtent=", 1))
+    with pytest.raises(vio.ReadError, match=r"headless\.vti: VTK XML Piece comes before the ImageData element that "
+                                            r"gives its WholeExtent"):
+        vio.read(bad)
+
+
 def test_vtkhdf_step_without_points_but_with_cells_is_refused(tmp_path):
     bad = tmp_path / "steps.vtkhdf"
     shutil.copy(data_file("series/warping_spheres.vtkhdf"), bad)

@@ -115,6 +115,18 @@ def test_legacy_origin_spacing_and_model_errors(tmp_path, iron):
     refused(write(tmp_path / "c.vtk", mesh), "inconsistent: cell block of type 10 refers to points outside 0..3")
 
 
+def test_legacy_texture_coordinates_are_read(tmp_path):
+    """TEXTURE_COORDINATES is a point attribute, not the X_, Y_ or Z_COORDINATES of a rectilinear grid: read, and
+    its dimension and count checked as an attribute's."""
+    head = (b"# vtk DataFile Version 3.0\nt\nASCII\nDATASET STRUCTURED_POINTS\nDIMENSIONS 2 2 2\nORIGIN 0 0 0\n"
+            b"SPACING 1 1 1\nPOINT_DATA 8\nSCALARS s float 1\nLOOKUP_TABLE default\n0 1 2 3 4 5 6 7\n")
+    volume = vio.read(write(tmp_path / "tc.vtk", head + b"TEXTURE_COORDINATES tc 2 float\n" + b"0 1 " * 8 + b"\n"),
+                      isolate=False)
+    np.testing.assert_array_equal(volume.data.ravel(order="F"), np.arange(8))
+    refused(write(tmp_path / "tc4.vtk", head + b"TEXTURE_COORDINATES tc 4 float\n0\n"),
+            "TEXTURE_COORDINATES of dimension 4")
+
+
 def test_vtk_message_with_bytes_that_are_not_utf8(tmp_path, iron):
     err = refused(write(tmp_path / "u.vtk", iron.replace(b"SCALARS scalars", b"\xff\xfe\xfd scalars")),
                   "vtkDataSetReader failed")

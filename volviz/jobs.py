@@ -96,7 +96,8 @@ def _leave_a_core_free() -> None:
         import numba
     except ImportError:  # pragma: no cover - numba is a dependency
         return
-    numba.set_num_threads(max(1, numba.config.NUMBA_NUM_THREADS - 1))
+    # numba.config sets its settings at import time; its stubs do not declare them
+    numba.set_num_threads(max(1, numba.config.NUMBA_NUM_THREADS - 1))  # type: ignore[attr-defined]
 
 
 #: how much lower than the requester's the scheduling priority of a job thread is (Linux nice increment)

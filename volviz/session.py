@@ -209,7 +209,8 @@ def _kind(value: Any) -> str:
         return repr(value)
     if isinstance(value, str):
         return f"the string {_quote(value)}" if _SAFE_TEXT.match(value) else _quote(value)
-    return {dict: "an object", list: "a list"}.get(type(value), type(value).__name__)
+    kinds: dict[type, str] = {dict: "an object", list: "a list"}
+    return kinds.get(type(value), type(value).__name__)
 
 
 _SAFE_TEXT = re.compile(r"[A-Za-z0-9_.:+/ -]{1,40}\Z")

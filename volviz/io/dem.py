@@ -91,7 +91,7 @@ def _read_profiles(path: PathLike, buf: bytes, h: dict):
     pos, out = 1024, []
     n_profiles = h["profiles"][1]
     for column in range(n_profiles):
-        ints = []
+        ints: list[int] = []
         for _ in range(4):
             m = _INT6.match(buf, pos)
             if m is None:

@@ -15,7 +15,7 @@ from volviz.io._checks import (
     require_bytes,
 )
 from volviz.io.errors import PathLike, ReadError, human_bytes
-from volviz.model import Image2D, RegularVolume
+from volviz.model import Image2D, RegularVolume, vec3
 
 ELEMENT_TYPES = {
     "MET_CHAR": "i1", "MET_UCHAR": "u1", "MET_SHORT": "i2", "MET_USHORT": "u2", "MET_INT": "i4", "MET_UINT": "u4",
@@ -180,6 +180,8 @@ def _read_metaimage(path: PathLike, allow_nonfinite: bool) -> RegularVolume | Im
     check_finite(data_path, values, allow_nonfinite)
     if ndims == 2:
         shape = (dims[1], dims[0]) + ((channels,) if channels > 1 else ())
-        return Image2D(values.reshape(shape), spacing=spacing, origin=origin, source=str(path))
-    return RegularVolume(values.reshape(dims, order="F"), spacing=spacing, origin=origin, name="MetaImage",
+        return Image2D(values.reshape(shape), spacing=(spacing[0], spacing[1]), origin=(origin[0], origin[1]),
+                       source=str(path))
+    return RegularVolume(values.reshape(dims, order="F"), spacing=vec3(spacing, "spacing"),
+                         origin=vec3(origin, "origin"), name="MetaImage",
                          source=str(path))

@@ -233,7 +233,8 @@ def read_plot3d_q(path: PathLike, block: int | None = None, allow_nonfinite: boo
     q = q.astype(q.dtype.newbyteorder("="))
     check_finite(path, q, allow_nonfinite, "q solution")
     q = q.reshape(dims + (5,), order="F")
-    return q, FlowConditions(*(float(v) for v in cond), gamma=gamma), layout
+    fsmach, alpha, re, time = (float(v) for v in cond)
+    return q, FlowConditions(fsmach, alpha, re, time, gamma=gamma), layout
 
 
 def derived_functions(q: np.ndarray, cond: FlowConditions, r_gas: float = 1.0) -> dict[str, np.ndarray]:

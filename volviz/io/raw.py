@@ -5,18 +5,20 @@ match exactly (``header_bytes`` + voxels x sample size); a mismatch means wrong 
 """
 from __future__ import annotations
 
-from typing import Sequence
+from typing import Literal, Sequence
 
 import numpy as np
+from numpy.typing import DTypeLike
 
 from volviz.io._checks import check_dims, check_finite, describe_dims, file_size, read_at
 from volviz.io.errors import PathLike, ReadError, human_bytes
-from volviz.model import Image2D, RegularVolume
+from volviz.model import Image2D, RegularVolume, vec3
 
-_BYTEORDERS = {"little": "<", "<": "<", "big": ">", ">": ">", "native": "=", "=": "=", "msb": ">", "lsb": "<"}
+_BYTEORDERS: dict[str, Literal["<", ">", "="]] = {"little": "<", "<": "<", "big": ">", ">": ">", "native": "=",
+                                                  "=": "=", "msb": ">", "lsb": "<"}
 
 
-def file_dtype(dtype: object, byteorder: str) -> np.dtype:
+def file_dtype(dtype: DTypeLike, byteorder: str) -> np.dtype:
     """The on-disk dtype for a sample type and byte order ("little", "big", "native", "<", ">", "=")."""
     try:
         bo = _BYTEORDERS[str(byteorder).lower()]
@@ -48,7 +50,7 @@ def _size_problem(path: PathLike, dims: Sequence[int], disk: np.dtype, header_by
                               f"({human_bytes(size)}, {abs(size - need)} {more}): wrong dimensions, type or header")
 
 
-def read_raw(path: PathLike, dims: Sequence[int], dtype: object, byteorder: str = "little", header_bytes: int = 0,
+def read_raw(path: PathLike, dims: Sequence[int], dtype: DTypeLike, byteorder: str = "little", header_bytes: int = 0,
              spacing: Sequence[float] = (1.0, 1.0, 1.0), origin: Sequence[float] = (0.0, 0.0, 0.0),
              allow_nonfinite: bool = True, name: str = "scalars") -> RegularVolume | Image2D:
     """Read a headerless volume (dims (nx, ny, nz), x fastest) or image (dims (nx, ny) -> Image2D (ny, nx))."""
@@ -63,13 +65,13 @@ def read_raw(path: PathLike, dims: Sequence[int], dtype: object, byteorder: str 
     n = int(np.prod(dims))
     values = decode_samples(path, read_at(path, header_bytes, n * disk.itemsize), disk, allow_nonfinite)
     if len(dims) == 2:
-        return Image2D(values.reshape(dims[1], dims[0]), spacing=tuple(spacing)[:2], origin=tuple(origin)[:2],
-                       source=str(path))
-    return RegularVolume(values.reshape(dims, order="F"), spacing=tuple(spacing), origin=tuple(origin),
-                         name=name, source=str(path))
+        return Image2D(values.reshape(dims[1], dims[0]), spacing=(spacing[0], spacing[1]),
+                       origin=(origin[0], origin[1]), source=str(path))
+    return RegularVolume(values.reshape(dims, order="F"), spacing=vec3(spacing, "spacing"),
+                         origin=vec3(origin, "origin"), name=name, source=str(path))
 
 
-def read_slice_stack(pattern: str | Sequence[PathLike], dims: Sequence[int], dtype: object,
+def read_slice_stack(pattern: str | Sequence[PathLike], dims: Sequence[int], dtype: DTypeLike,
                      byteorder: str = "little", header_bytes: int = 0,
                      spacing: Sequence[float] = (1.0, 1.0, 1.0), origin: Sequence[float] = (0.0, 0.0, 0.0),
                      allow_nonfinite: bool = True, name: str = "scalars") -> RegularVolume:
@@ -93,5 +95,5 @@ def read_slice_stack(pattern: str | Sequence[PathLike], dims: Sequence[int], dty
     for k, p in enumerate(paths):
         values = decode_samples(p, read_at(p, header_bytes, nx * ny * disk.itemsize), disk, allow_nonfinite)
         volume[:, :, k] = values.reshape((nx, ny), order="F")
-    return RegularVolume(volume, spacing=tuple(spacing), origin=tuple(origin), name=name,
+    return RegularVolume(volume, spacing=vec3(spacing, "spacing"), origin=vec3(origin, "origin"), name=name,
                          source=str(paths[0]))

@@ -9,7 +9,7 @@ import glob
 import os
 import re
 from pathlib import Path
-from typing import Callable, Sequence
+from typing import Any, Callable, Sequence, cast
 
 import numpy as np
 
@@ -33,7 +33,7 @@ def expand_pattern(pattern: str | PathLike | Sequence[PathLike]) -> list[tuple[i
             raise ReadError("<empty list>", "no files given for the series")
         items = [(_number_of(os.fspath(p)), Path(os.fspath(p))) for p in pattern]
         return items
-    text = os.fspath(pattern)
+    text = os.fspath(cast("str | os.PathLike[str]", pattern))  # a sequence other than a list or tuple: TypeError
     if _PRINTF.search(text):
         directory, base = os.path.split(text)
         parts = _PRINTF.split(base)
@@ -92,18 +92,21 @@ def read_series(paths_or_pattern: str | PathLike | Sequence[PathLike],
     """
     items = expand_pattern(paths_or_pattern)
     if reader is None:
-        from volviz.io import read as reader  # type: ignore[no-redef]
+        from volviz.io import read
+
+        reader = read
+    read_frame: Callable[..., Any] = reader  # frames of any kind, checked against frame 0 below
     paths = [p for _, p in items]
     if times is None:
         times = series_times(items)
     if len(times) != len(paths):
         raise ValueError(f"{len(times)} times given for {len(paths)} files")
-    first = reader(paths[0], **options)
+    first = read_frame(paths[0], **options)
     if isinstance(first, TimeSeries):
         raise ReadError(paths[0], "is itself a time series; a series of series is not supported")
 
     def load(index: int):
-        frame = reader(paths[index], **options)
+        frame = read_frame(paths[index], **options)
         if type(frame) is not type(first) or frame.dimensions != first.dimensions:
             raise ReadError(paths[index], f"frame {index} is a {getattr(frame, 'kind', type(frame).__name__)} of "
                                           f"{frame.dimensions}, but frame 0 ({paths[0]}) is a {first.kind} of "

@@ -182,5 +182,6 @@ def _image(path: PathLike, obj, allow_nonfinite: bool) -> RegularVolume:
                            source=str(path), arrays=arrays)
     active = _active_name(pd)
     spec = active if active in arrays and arrays[active].ndim == 3 else default_array(volume)
+    assert spec is not None  # the volume has arrays
     volume.data, volume.name = scalar_of(arrays, spec), spec
     return volume

@@ -6,6 +6,8 @@ array, read past a buffer or loop for ever. VTK's error events are turned into R
 """
 from __future__ import annotations
 
+from typing import Any
+
 from volviz.io.errors import PathLike, ReadError
 from volviz.io.vtkconvert import vtk_to_model
 from volviz.io.vtklegacy import check_legacy_file
@@ -20,7 +22,7 @@ XML_READERS = {
 }
 
 
-def _run(path: PathLike, reader) -> object:
+def _run(path: PathLike, reader) -> Any:
     """Update a VTK reader with its messages captured (kept off the console); ReadError on any error."""
     import vtk
 

@@ -16,6 +16,8 @@ datasets with them; a lie crashes or aborts it. Here only metadata and the small
 """
 from __future__ import annotations
 
+from typing import NoReturn
+
 import numpy as np
 
 from volviz.io.errors import PathLike, ReadError, human_bytes
@@ -52,7 +54,7 @@ class _Structure:
     def __init__(self, path: PathLike, group, size: int, where: str) -> None:
         self.path, self.group, self.size, self.where = path, group, size, where
 
-    def fail(self, problem: str) -> None:
+    def fail(self, problem: str) -> NoReturn:
         raise ReadError(self.path, f"VTKHDF {problem}")
 
     def rows(self, name: str, group=None) -> int:

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import mmap
 import re
+from typing import NoReturn
 
 import numpy as np
 
@@ -59,7 +60,7 @@ class _Scan:
         self.attribute: tuple[bytes, int] | None = None
 
     # -- helpers ----------------------------------------------------------------------------------------------------
-    def fail(self, problem: str) -> None:
+    def fail(self, problem: str) -> NoReturn:
         raise ReadError(self.path, f"VTK legacy {problem}")
 
     def count(self, token: bytes, what: str) -> int:
@@ -112,12 +113,13 @@ class _Scan:
             n = self.counts(args, 1, "POINTS")[0]
             self.need(3 * n, args[1] if len(args) > 1 else b"", left, f"POINTS {n}")
             if self.dataset == b"STRUCTURED_GRID":
-                self.agree("POINTS", n, self.dims and int(np.prod(self.dims, dtype=object)), "DIMENSIONS")
+                self.agree("POINTS", n, None if self.dims is None else int(np.prod(self.dims, dtype=object)),
+                           "DIMENSIONS")
             self.points = n
-        elif kw.endswith(b"_COORDINATES"):
+        elif kw in (b"X_COORDINATES", b"Y_COORDINATES", b"Z_COORDINATES"):
             n = self.counts(args, 1, kw.decode())[0]
             self.need(n, args[1] if len(args) > 1 else b"", left, f"{kw.decode()} {n}")
-            self.agree(kw.decode(), n, self.dims and self.dims[b"XYZ".index(kw[:1])], "DIMENSIONS")
+            self.agree(kw.decode(), n, None if self.dims is None else self.dims[b"XYZ".index(kw[:1])], "DIMENSIONS")
         elif kw in _CELL_LISTS:
             self.cell_list(kw, args, left)
         elif kw in (b"OFFSETS", b"CONNECTIVITY"):
@@ -230,6 +232,7 @@ class _Scan:
         if name in _STRINGS:
             end = self.skip_strings(pos, values)
         elif self.binary:
+            assert size is not None  # None only for the string types
             end = pos + (-(-values // 8) if size == 0 else values * size)
         else:
             end = skip_tokens(self.mm, pos, values)

@@ -24,6 +24,7 @@ import binascii
 import mmap
 import re
 from dataclasses import dataclass
+from typing import NoReturn, overload
 
 import numpy as np
 
@@ -64,7 +65,7 @@ class _Check:
         self.appended_base64 = False
         self.budget = self.size
 
-    def fail(self, problem: str) -> None:
+    def fail(self, problem: str) -> NoReturn:
         raise ReadError(self.path, f"VTK XML {problem}")
 
     # -- attribute values -------------------------------------------------------------------------------------------
@@ -75,6 +76,12 @@ class _Check:
         if len(tokens) != n or not all(re.fullmatch(r"[+-]?\d+", t) for t in tokens):
             self.fail(f"{where} {key} is {describe_bytes(attrs[key])}, not {n} integer{'s' if n > 1 else ''}")
         return [int(t) for t in tokens]
+
+    @overload
+    def count(self, attrs: dict[str, str], key: str, where: str, default: int) -> int: ...
+
+    @overload
+    def count(self, attrs: dict[str, str], key: str, where: str, default: None = None) -> int | None: ...
 
     def count(self, attrs: dict[str, str], key: str, where: str, default: int | None = None) -> int | None:
         values = self.ints(attrs, key, 1, where)
@@ -138,6 +145,8 @@ class _Check:
             if e is None:
                 self.fail("Piece has no Extent")
             w = self.whole
+            if w is None:
+                self.fail(f"Piece comes before the {self.expected} element that gives its WholeExtent")
             if any(e[2 * i] < w[2 * i] or e[2 * i + 1] > w[2 * i + 1] for i in range(3)):
                 self.fail(f"Piece Extent {e} reaches outside the WholeExtent {w}")
             self.piece_extents.append(e)
@@ -148,9 +157,9 @@ class _Check:
         points = self.count(attrs, "NumberOfPoints", "Piece", 0)
         if self.expected == "PolyData":
             lists = {k: self.count(attrs, k, "Piece", 0) for k in POLY_COUNTS}
-            self.piece = _Piece(points, sum(lists.values()), verts_lines_strips_polys=lists)  # type: ignore[arg-type]
+            self.piece = _Piece(points, sum(lists.values()), verts_lines_strips_polys=lists)
         else:
-            self.piece = _Piece(points, self.count(attrs, "NumberOfCells", "Piece", 0))  # type: ignore[arg-type]
+            self.piece = _Piece(points, self.count(attrs, "NumberOfCells", "Piece", 0))
 
     def expected_tuples(self, name: str) -> int | None:
         """How many tuples an array in the current section must have (None: any number)."""
@@ -289,7 +298,7 @@ class _Check:
         if markup_end >= 0:
             tag = _TAG.match(self.mm, markup_end)
             underscore = self.mm.find(b"_", tag.end()) if tag else -1
-            if underscore < 0:
+            if tag is None or underscore < 0:
                 self.fail("AppendedData section without its '_' marker")
             self.appended_start = underscore + 1
             self.appended_base64 = _attrs(tag.group(3)).get("encoding", "raw") == "base64"

@@ -14,9 +14,11 @@ from volviz.model.datasets import (
     TetMesh,
     TimeSeries,
     UnstructuredMesh,
+    vec3,
 )
 
 __all__ = [
     "CELL_SIZES", "VTK_HEXAHEDRON", "VTK_PYRAMID", "VTK_QUAD", "VTK_TETRA", "VTK_TRIANGLE", "VTK_WEDGE",
     "CurvilinearGrid", "Dataset", "Image2D", "RegularVolume", "TetMesh", "TimeSeries", "UnstructuredMesh",
+    "vec3",
 ]

@@ -47,11 +47,13 @@ class RayBasis:
 
 @dataclass
 class Camera:
-    """Position, focal point, view up, vertical view angle, parallel projection and clipping range (VTK semantics)."""
+    """Position, focal point, view up, vertical view angle, parallel projection and clipping range (VTK semantics).
 
-    position: Sequence[float] = (0.0, 0.0, 1.0)
-    focal_point: Sequence[float] = (0.0, 0.0, 0.0)
-    view_up: Sequence[float] = (0.0, 1.0, 0.0)
+    The three vectors may be given as any sequences of three numbers; they are kept as float64 arrays of shape (3,)."""
+
+    position: Sequence[float] | np.ndarray = (0.0, 0.0, 1.0)
+    focal_point: Sequence[float] | np.ndarray = (0.0, 0.0, 0.0)
+    view_up: Sequence[float] | np.ndarray = (0.0, 1.0, 0.0)
     view_angle: float = 30.0
     parallel: bool = False
     parallel_scale: float = 1.0
@@ -73,7 +75,7 @@ class Camera:
     # --- frame -------------------------------------------------------------------------------------------------
     def frame(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Orthonormal (right, up, forward) with forward from the position to the focal point."""
-        f = _unit(self.focal_point - self.position, "direction (position == focal point)")
+        f = _unit(np.subtract(self.focal_point, self.position), "direction (position == focal point)")
         r = _unit(np.cross(f, self.view_up), "view up (parallel to the direction of projection)")
         return r, np.cross(r, f), f
 
@@ -82,7 +84,7 @@ class Camera:
         half = self.parallel_scale if self.parallel else math.tan(math.radians(self.view_angle) / 2.0)
         return half * w / h, half
 
-    def rays(self, size: tuple[int, int], origin: Sequence[float] | None = None) -> RayBasis:
+    def rays(self, size: tuple[int, int], origin: Sequence[float] | np.ndarray | None = None) -> RayBasis:
         """Affine pixel rays for an image of ``size = (W, H)``, positions relative to ``origin`` (default 0)."""
         w, h = (int(v) for v in size)
         if w < 1 or h < 1:

@@ -12,7 +12,7 @@ Conventions (used everywhere in volviz):
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Callable, Sequence, Union
+from typing import Any, Callable, Iterable, Union
 
 import numpy as np
 
@@ -26,11 +26,12 @@ VTK_QUAD = 9
 CELL_SIZES = {VTK_TETRA: 4, VTK_HEXAHEDRON: 8, VTK_WEDGE: 6, VTK_PYRAMID: 5, VTK_TRIANGLE: 3, VTK_QUAD: 4}
 
 
-def _as_vec3(value: Sequence[float], name: str) -> tuple[float, float, float]:
+def vec3(value: Iterable[float], name: str = "vector") -> tuple[float, float, float]:
+    """Three numbers as a tuple of three floats; ValueError naming ``name`` for another count."""
     vec = tuple(float(v) for v in value)
     if len(vec) != 3:
         raise ValueError(f"{name} must have three components, got {len(vec)}")
-    return vec  # type: ignore[return-value]
+    return vec
 
 
 def _range(values: np.ndarray) -> tuple[float, float]:
@@ -56,8 +57,8 @@ class RegularVolume:
             raise ValueError(f"RegularVolume data must be 3D (nx, ny, nz), got shape {self.data.shape}")
         if min(self.data.shape) < 1:
             raise ValueError(f"RegularVolume dimensions must be positive, got {self.data.shape}")
-        self.spacing = _as_vec3(self.spacing, "spacing")
-        self.origin = _as_vec3(self.origin, "origin")
+        self.spacing = vec3(self.spacing, "spacing")
+        self.origin = vec3(self.origin, "origin")
         if min(self.spacing) <= 0 or not all(np.isfinite(self.spacing)):
             raise ValueError(f"RegularVolume spacing must be positive and finite, got {self.spacing}")
         for name, arr in self.arrays.items():

@@ -9,7 +9,7 @@ settings and the render options against the same models, so the schema and the l
 from __future__ import annotations
 
 import json
-from typing import Annotated, Any, Literal, Optional, Union
+from typing import TYPE_CHECKING, Annotated, Any, Literal, Optional, Union
 
 from pydantic import BaseModel, ConfigDict, Field, create_model
 
@@ -40,12 +40,15 @@ class _ComponentDoc(_Strict):
 def _component_doc(kind: str, settings: type[BaseModel]) -> type[_ComponentDoc]:
     """The document model of a component of type ``kind``: the common fields and its settings model."""
     return create_model(f"{kind.capitalize()}Component", __base__=_ComponentDoc,
-                        type=(Literal[kind], ...),  # type: ignore[valid-type]
+                        type=(Literal[kind], ...),  # type: ignore[arg-type]  # a Literal made at run time
                         settings=(settings, Field(default_factory=settings)))
 
 
-ComponentDoc = Annotated[Union[tuple(_component_doc(k, m) for k, m in SETTINGS_MODELS.items())],  # type: ignore
-                         Field(discriminator="type")]
+if TYPE_CHECKING:  # a union of models made at run time: to mypy, their common base
+    ComponentDoc = _ComponentDoc
+else:
+    ComponentDoc = Annotated[Union[tuple(_component_doc(k, m) for k, m in SETTINGS_MODELS.items())],
+                             Field(discriminator="type")]
 
 
 class CameraDoc(_Strict):

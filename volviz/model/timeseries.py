@@ -3,7 +3,7 @@ the linear blend of their point values, so playback is smooth at any display rat
 from __future__ import annotations
 
 from dataclasses import replace
-from typing import Any
+from typing import Any, Union, cast
 
 import numpy as np
 
@@ -34,12 +34,14 @@ def frame_at(series: TimeSeries, t: float, interpolate: bool = True) -> Any:
     i, j, w = bracket(series, t)
     if not interpolate or w == 0.0 or i == j:
         return series.frame(i)
-    a, b = series.frame(i), series.frame(j)
+    a, b = series.frame(i), series.frame(j)  # frames of one kind (read_series checks them against frame 0)
     if isinstance(a, RegularVolume):
-        return replace(a, data=_blend(a.data, b.data, w))
+        return replace(a, data=_blend(a.data, cast(RegularVolume, b).data, w))
     if isinstance(a, TetMesh):
-        return TetMesh(a.points, a.tets, _blend(a.scalars, b.scalars, w), a.name, a.source)
+        return TetMesh(a.points, a.tets, _blend(a.scalars, cast(TetMesh, b).scalars, w), a.name, a.source)
     if isinstance(a, (CurvilinearGrid, UnstructuredMesh)):
-        data = {name: _blend(arr, b.point_data[name], w) for name, arr in a.point_data.items() if name in b.point_data}
+        other = cast(Union[CurvilinearGrid, UnstructuredMesh], b)
+        data = {name: _blend(arr, other.point_data[name], w) for name, arr in a.point_data.items()
+                if name in other.point_data}
         return replace(a, point_data=data)
     raise ValueError(f"cannot interpolate a time series of {a.kind}")

@@ -240,7 +240,7 @@ def _integrate_many(sc, col, ext, msc, mcol, mext, s_f, s_b, length, out):
             _segment(sc, col, ext, s_f[i], s_b[i], length[i], out[i])
 
 
-def _tf_arrays(tf: TransferFunction) -> tuple[np.ndarray, ...]:
+def _tf_arrays(tf: TransferFunction) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Contiguous arrays for the kernels: the TF and its mirror s → −s (for segments with decreasing scalar)."""
     if not isinstance(tf, TransferFunction):
         raise TypeError(f"expected a TransferFunction, got {type(tf).__name__}")

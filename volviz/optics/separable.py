@@ -99,8 +99,8 @@ def segment_averages(tf: TransferFunction, s_f: Any, s_b: Any) -> tuple[np.ndarr
     if sf.size:
         _averages(np.ascontiguousarray(tf.scalars), np.ascontiguousarray(tf.colors),
                   np.ascontiguousarray(tf.extinction), sf, sb, out)
-    out = out.reshape(shape + (7,))
-    return out[..., 0], out[..., 1:4], out[..., 4:7]
+    res = out.reshape(shape + (7,))
+    return res[..., 0], res[..., 1:4], res[..., 4:7]
 
 
 def _vandermonde_inverse(degree: int) -> np.ndarray:

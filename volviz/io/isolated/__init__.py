@@ -296,7 +296,7 @@ class _Read:
                     and all(isinstance(n, str) and len(n) <= MAX_NAME_CHARS for n in names)):
                 raise self.fail("the isolated reader's answer is not a list of names")
             return names
-        header = answer.get("header")
+        header: Any = answer.get("header")  # the child's JSON, checked by array_specs and decode
         try:
             specs = array_specs(header)
             arrays = [_load_array(os.path.join(workdir, f"a{i}.npy"), dtype.itemsize * math.prod(shape))

@@ -120,6 +120,7 @@ class Child:
         for entry in request.get("sys_path", []):
             if isinstance(entry, str) and entry not in sys.path:
                 sys.path.append(entry)
+        arrays: list[np.ndarray] | None = None
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             try:

@@ -57,6 +57,8 @@ class Worker:
         env.pop("VOLVIZ_ISOLATE", None)
         self.proc = subprocess.Popen([sys.executable, "-m", "volviz.io.isolated"], stdin=subprocess.PIPE,
                                      stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env, close_fds=True)
+        assert self.proc.stdin is not None and self.proc.stdout is not None  # pipes, as asked
+        self._stdin, self._stdout = self.proc.stdin, self.proc.stdout
         self._buffer = b""
         self._tail: deque[bytes] = deque()
         self._tail_size = 0
@@ -84,7 +86,7 @@ class Worker:
 
     def _line(self, deadline: float) -> bytes:
         """The next line of the child's stdout, waiting until ``deadline`` (monotonic)."""
-        fd = self.proc.stdout.fileno()
+        fd = self._stdout.fileno()
         while b"\n" not in self._buffer:
             left = deadline - time.monotonic()
             if left <= 0:
@@ -136,8 +138,8 @@ class Worker:
         self._tail.clear()  # what this request makes the child print explains its death, not an earlier request's
         self._tail_size = 0
         try:
-            self.proc.stdin.write(json.dumps(message).encode() + b"\n")
-            self.proc.stdin.flush()
+            self._stdin.write(json.dumps(message).encode() + b"\n")
+            self._stdin.flush()
         except (BrokenPipeError, OSError):
             raise self._died() from None
         try:
@@ -159,14 +161,14 @@ class Worker:
     def close(self) -> None:
         """Ask an idle child to leave (end of its stdin), and make sure it has."""
         try:
-            self.proc.stdin.close()
+            self._stdin.close()
             self.proc.wait(timeout=2)
         except (OSError, subprocess.TimeoutExpired):
             pass
         self.kill()
 
     def _close_pipes(self) -> None:
-        for stream in (self.proc.stdin, self.proc.stdout):
+        for stream in (self._stdin, self._stdout):
             try:
                 stream.close()
             except OSError:
