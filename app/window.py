@@ -11,15 +11,15 @@ import time
 from pathlib import Path
 from typing import Any, Callable, Optional
 
-from PySide6.QtCore import QByteArray, QSettings, QStandardPaths, Qt, QTimer
+from PySide6.QtCore import QByteArray, QSettings, Qt, QTimer
 from PySide6.QtGui import QAction, QKeySequence, QUndoGroup, QUndoStack
-from PySide6.QtWidgets import (QDockWidget, QFileDialog, QLabel, QMainWindow, QMessageBox,
+from PySide6.QtWidgets import (QDockWidget, QLabel, QMainWindow, QMessageBox,
                                QProgressBar, QPushButton, QWidget)
 
 from volviz.jobs import JobOutcome
 from volviz.render.backend import plotter_gl_info
 from volviz.render.controller import iso_summary
-from volviz.session import CameraKey, Session, SessionError, relative_path
+from volviz.session import CameraKey, Session, SessionError
 from volviz_app.array_choice import ArrayChoice
 from volviz_app.camera_bookmarks import CameraBookmarks
 from volviz_app.component_settings import edit_settings
@@ -33,6 +33,7 @@ from volviz_app.errors import hide_temporary_names, open_error
 from volviz_app.export_dialogs import ExportDialogs
 from volviz_app.layout import WindowLayout, scrolled
 from volviz_app.recent import RecentFiles
+from volviz_app.session_files import SessionFiles, default_recovery_dir
 from volviz_app.docks.scene_tree import SceneTree
 from volviz_app.docks.statistics import Statistics
 from volviz_app.docks.tf_editor import TransferFunctionEditor
@@ -46,26 +47,9 @@ from volviz_app.workers import JobBridge
 
 log = logging.getLogger(__name__)
 
-AUTOSAVE_MS = 60_000
 PREVIEW_MS = 40          # live transfer-function preview: at most one re-render per 40 ms while dragging
 RECORD_MS = 250          # camera-path recording samples the camera four times a second
 STAGE_MS = 30            # pause between GUI-thread stages of showing a new scene (other events run in between)
-
-
-def _data_filter() -> str:
-    """The readers' filter plus volviz's own compressed volumes."""
-    from volviz.io import open_dialog_filter
-
-    everything, rest = open_dialog_filter().split(";;", 1)
-    return everything.replace("(", "(*.vvz ", 1) + ";;volviz compressed volume (*.vvz);;" + rest
-
-
-def default_recovery_dir() -> Path:
-    env = os.environ.get("VOLVIZ_RECOVERY_DIR")
-    if env:
-        return Path(env)
-    base = QStandardPaths.writableLocation(QStandardPaths.StandardLocation.AppDataLocation)
-    return Path(base or Path.home() / ".volviz") / "recovery"
 
 
 def _histogram_range(hist: Any) -> Optional[tuple[float, float]]:
@@ -89,7 +73,7 @@ def _import_gui_thread_modules() -> None:
     pyvista.system_supports_plotting()
 
 
-class MainWindow(ViewScheduler, CameraBookmarks, QMainWindow):
+class MainWindow(SessionFiles, ViewScheduler, CameraBookmarks, QMainWindow):
     """volviz main window. ``open_path`` is the single code path behind File > Open and the command line."""
 
     def __init__(self, parent: Optional[QWidget] = None, settings: Optional[QSettings] = None,
@@ -143,9 +127,7 @@ class MainWindow(ViewScheduler, CameraBookmarks, QMainWindow):
 
         self.preview_timer = QTimer(self, singleShot=True, interval=PREVIEW_MS)
         self.preview_timer.timeout.connect(self._apply_pending_tf)
-        self.autosave_timer = QTimer(self, interval=AUTOSAVE_MS)
-        self.autosave_timer.timeout.connect(self.autosave)
-        self.autosave_timer.start()
+        self._connect_session_files()  # the autosave timer
         self.record_timer = QTimer(self, interval=RECORD_MS)
         self.record_timer.timeout.connect(self._record_sample)
         self.nonfinite = NonFiniteStatus(self)  # the status bar's note on non-finite values
@@ -439,11 +421,6 @@ class MainWindow(ViewScheduler, CameraBookmarks, QMainWindow):
             stats["iso"] = iso_summary(iso)
         self.last_stats = stats
         self.statistics.show_stats(stats)
-
-    def set_dirty(self, dirty: bool = True) -> None:
-        self.dirty = dirty
-        name = self.session_path.name if self.session_path else getattr(self, "title", "untitled")
-        self.setWindowTitle(f"volviz — {name}{' *' if dirty else ''}")
 
     # ------------------------------------------------------------------------------------------------ docks
     def _select_component(self, comp_id: str) -> None:
@@ -765,113 +742,7 @@ class MainWindow(ViewScheduler, CameraBookmarks, QMainWindow):
             self.controller.set_camera(None, update=False)
             self._camera_moved()
 
-    # ------------------------------------------------------------------------------------------------ saving
-    def capture_session(self, target: Path) -> Session:
-        """The current state as a session to be saved at ``target`` (paths made relative to it)."""
-        from volviz.session import DatasetRef, resolve_path
-
-        session = self.session
-        refs = []
-        for ref in session.datasets:
-            absolute = resolve_path(self.session_path, ref.path) if self.session_path else Path(ref.path)
-            refs.append(DatasetRef(ref.id, relative_path(target, absolute), dict(ref.options)))
-        layout = dict(session.layout)
-        layout["window_state"] = bytes(self.saveState().toBase64()).decode("ascii")
-        camera = self.controller.camera() if self.controller is not None else session.camera
-        return Session(datasets=refs, components=session.components, transfer_functions=session.transfer_functions,
-                       camera=camera, camera_paths=session.camera_paths, bookmarks=session.bookmarks,
-                       render=session.render, layout=layout, clip=session.clip)
-
-    def save_session(self, path: str | os.PathLike) -> bool:
-        from volviz.session import save
-
-        target = Path(path)
-        try:
-            session = self.capture_session(target)
-            save(session, target)
-        except SessionError as exc:
-            self.show_error("Cannot save session", str(exc))
-            return False
-        self.session, self.session_path = session, target
-        if self.controller is not None:
-            self.controller.session = session
-        self.recent.add(target)
-        self.set_dirty(False)
-        self.clear_recovery()
-        self.status_label.setText(f"Saved {target.name}")
-        return True
-
     # -- autosave and recovery ------------------------------------------------------------------------------------
-    @property
-    def recovery_file(self) -> Path:
-        """This window's own recovery file (``volviz_app.recovery``): other windows never write or delete it."""
-        from volviz_app.recovery import window_file
-
-        if "_own_recovery_file" not in self.__dict__:
-            self.__dict__["_own_recovery_file"] = window_file(self.recovery_dir)
-        return self.__dict__["_own_recovery_file"]
-
-    def autosave(self) -> bool:
-        """Write the current state to the recovery file (only when there are unsaved changes)."""
-        if not self.dirty or self.controller is None:
-            return False
-        from volviz.session import save
-
-        self.recovery_dir.mkdir(parents=True, exist_ok=True)
-        session = self.capture_session(self.recovery_file)
-        session.layout["recovered_from"] = str(self.session_path) if self.session_path else ""
-        try:
-            save(session, self.recovery_file)
-        except SessionError as exc:
-            log.error("autosave failed: %s", exc)
-            return False
-        self.status_label.setText("Autosaved")
-        return True
-
-    def clear_recovery(self) -> None:
-        self.recovery_file.unlink(missing_ok=True)
-
-    def offer_recovery(self) -> bool:
-        """If a crashed window (its process is gone) left a recovery file, claim it as this window's own and ask
-        (without blocking) whether to restore it."""
-        from volviz_app.recovery import claim, orphaned
-
-        if not any(claim(orphan, self.recovery_file) for orphan in orphaned(self.recovery_dir)):
-            return False
-        box = QMessageBox(QMessageBox.Icon.Question, "Recover unsaved work",
-                          "volviz did not shut down cleanly last time. Restore the unsaved work it kept?",
-                          QMessageBox.StandardButton.Yes | QMessageBox.StandardButton.No, self)
-        box.finished.connect(lambda result: self._recovery_answer(box.result()))
-        box.open()
-        self.recovery_dialog = box
-        return True
-
-    def _recovery_answer(self, result: int) -> None:
-        if result == QMessageBox.StandardButton.Yes:
-            self.recover()
-        else:
-            self.clear_recovery()
-
-    def recover(self) -> None:
-        from volviz.session import load
-
-        try:
-            session = load(self.recovery_file)
-        except SessionError as exc:
-            self.show_error("Cannot recover", str(exc))
-            return
-        origin = session.layout.pop("recovered_from", "")
-        if origin:  # keep paths valid relative to the original session file when saved there again
-            from volviz.session import resolve_path
-
-            for ref in session.datasets:
-                ref.path = relative_path(origin, resolve_path(self.recovery_file, ref.path))
-        self._show_session(session, Path(origin) if origin else None, "recovered session", dirty=True)
-
-    def recent_files(self) -> list[str]:
-        """File > Open Recent: the files that opened, newest first (``volviz_app.recent``)."""
-        return self.recent.files()
-
     # ------------------------------------------------------------------------------------------------ export
     def export_screenshot(self, path: str | os.PathLike, size: Optional[tuple[int, int]] = None) -> None:
         """Re-render the current view offscreen at ``size`` (default: the viewport's) and write an image (PNG, JPEG
@@ -932,46 +803,6 @@ class MainWindow(ViewScheduler, CameraBookmarks, QMainWindow):
         self._export_run = run
 
     # ------------------------------------------------------------------------------------------------ dialogs
-    def ask_file(self, title: str, name_filter: str, on_chosen: Any, save: bool = False,
-                 default_name: str = "", multiple: bool = False) -> QFileDialog:
-        """A non-blocking file dialog (kept as ``self.file_dialog``) that starts in the folder used last;
-        ``on_chosen(path)`` runs when accepted."""
-        dialog = QFileDialog(self, title, self.recent.last_folder(), name_filter)
-        dialog.setOption(QFileDialog.Option.DontUseNativeDialog, True)
-        if save:
-            dialog.setAcceptMode(QFileDialog.AcceptMode.AcceptSave)
-            dialog.setFileMode(QFileDialog.FileMode.AnyFile)
-            if default_name:
-                dialog.selectFile(default_name)
-        elif multiple:   # ``on_chosen(paths)`` gets the list
-            dialog.setFileMode(QFileDialog.FileMode.ExistingFiles)
-            dialog.filesSelected.connect(lambda paths: paths and (self.recent.remember_folder(paths[0]),
-                                                                  on_chosen(list(paths))))
-        else:
-            dialog.setFileMode(QFileDialog.FileMode.ExistingFile)
-        dialog.fileSelected.connect(lambda path: path and not multiple and (self.recent.remember_folder(path),
-                                                                            on_chosen(path)))
-        dialog.open()
-        self.file_dialog = dialog
-        return dialog
-
-    def _ask_open_data(self) -> None:
-        self.ask_file("Open data (a PLOT3D grid with its solution: select both)", _data_filter(), self.open_paths,
-                      multiple=True)
-
-    def _ask_open_session(self) -> None:
-        self.ask_file("Open session", "volviz sessions (*.json);;All files (*)", self.open_path)
-
-    def _save_session(self) -> bool:
-        if self.session_path is None:
-            self._ask_save_session_as()
-            return False
-        return self.save_session(self.session_path)
-
-    def _ask_save_session_as(self) -> None:
-        self.ask_file("Save session", "volviz sessions (*.json)", self.save_session, save=True,
-                      default_name="session.json")
-
     def show_error(self, title: str, text: str) -> None:
         """A non-blocking error dialog (the app keeps running); also logged."""
         log.error("%s: %s", title, text)
@@ -1014,20 +845,10 @@ class MainWindow(ViewScheduler, CameraBookmarks, QMainWindow):
             self.jobs.runner.cancel_all()
 
     # ------------------------------------------------------------------------------------------------ closing
-    def ask_unsaved_changes(self) -> QMessageBox.StandardButton:
-        box = QMessageBox(QMessageBox.Icon.Warning, "Unsaved changes", "Save the changes to this session?",
-                          QMessageBox.StandardButton.Save | QMessageBox.StandardButton.Discard
-                          | QMessageBox.StandardButton.Cancel, self)
-        self.unsaved_dialog = box
-        return QMessageBox.StandardButton(box.exec())
-
     def closeEvent(self, event: Any) -> None:
-        if self.dirty:
-            answer = self.ask_unsaved_changes()
-            if answer == QMessageBox.StandardButton.Cancel or (
-                    answer == QMessageBox.StandardButton.Save and not self._save_session()):
-                event.ignore()
-                return
+        if not self._confirm_close():
+            event.ignore()
+            return
         self.clear_recovery()
         self.layout_keeper.save()
         self.autosave_timer.stop()

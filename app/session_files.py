@@ -1,0 +1,215 @@
+"""Session I/O of the main window (a mixin of ``MainWindow``): File > Open Data / Open Session / Save Session /
+Save Session As (non-blocking file dialogs that start in the folder used last), saving, dirty tracking in the window
+title, autosave to a crash-recovery file of the window's own (``volviz_app.recovery``) with the offer to restore one
+left by a crash, File > Open Recent (``volviz_app.recent``), and the question about unsaved changes on closing.
+
+It expects of the window: ``session``, ``session_path``, ``controller``, ``recovery_dir``, ``recent`` (a
+``RecentFiles``), ``status_label``, ``show_error(title, text)``, ``open_path``, ``open_paths`` and
+``_show_session`` (``volviz_app.scene_loading``), ``saveState()`` (``QMainWindow``); ``_connect_session_files()``
+starts the autosave timer (called by the window's ``__init__``)."""
+from __future__ import annotations
+
+import logging
+import os
+from pathlib import Path
+from typing import Any
+
+from PySide6.QtCore import QStandardPaths, QTimer
+from PySide6.QtWidgets import QFileDialog, QMessageBox
+
+from volviz.session import Session, SessionError, relative_path
+
+log = logging.getLogger("volviz_app.window")  # the logger these methods had in window.py
+
+AUTOSAVE_MS = 60_000
+
+
+def _data_filter() -> str:
+    """The readers' filter plus volviz's own compressed volumes."""
+    from volviz.io import open_dialog_filter
+
+    everything, rest = open_dialog_filter().split(";;", 1)
+    return everything.replace("(", "(*.vvz ", 1) + ";;volviz compressed volume (*.vvz);;" + rest
+
+
+def default_recovery_dir() -> Path:
+    env = os.environ.get("VOLVIZ_RECOVERY_DIR")
+    if env:
+        return Path(env)
+    base = QStandardPaths.writableLocation(QStandardPaths.StandardLocation.AppDataLocation)
+    return Path(base or Path.home() / ".volviz") / "recovery"
+
+
+class SessionFiles:
+    """Open, save, autosave, recovery, recent files and dirty tracking of the window (see the module's docstring)."""
+
+    def _connect_session_files(self) -> None:
+        self.autosave_timer = QTimer(self, interval=AUTOSAVE_MS)
+        self.autosave_timer.timeout.connect(self.autosave)
+        self.autosave_timer.start()
+
+    def set_dirty(self, dirty: bool = True) -> None:
+        self.dirty = dirty
+        name = self.session_path.name if self.session_path else getattr(self, "title", "untitled")
+        self.setWindowTitle(f"volviz — {name}{' *' if dirty else ''}")
+
+    def capture_session(self, target: Path) -> Session:
+        """The current state as a session to be saved at ``target`` (paths made relative to it)."""
+        from volviz.session import DatasetRef, resolve_path
+
+        session = self.session
+        refs = []
+        for ref in session.datasets:
+            absolute = resolve_path(self.session_path, ref.path) if self.session_path else Path(ref.path)
+            refs.append(DatasetRef(ref.id, relative_path(target, absolute), dict(ref.options)))
+        layout = dict(session.layout)
+        layout["window_state"] = bytes(self.saveState().toBase64()).decode("ascii")
+        camera = self.controller.camera() if self.controller is not None else session.camera
+        return Session(datasets=refs, components=session.components, transfer_functions=session.transfer_functions,
+                       camera=camera, camera_paths=session.camera_paths, bookmarks=session.bookmarks,
+                       render=session.render, layout=layout, clip=session.clip)
+
+    def save_session(self, path: str | os.PathLike) -> bool:
+        from volviz.session import save
+
+        target = Path(path)
+        try:
+            session = self.capture_session(target)
+            save(session, target)
+        except SessionError as exc:
+            self.show_error("Cannot save session", str(exc))
+            return False
+        self.session, self.session_path = session, target
+        if self.controller is not None:
+            self.controller.session = session
+        self.recent.add(target)
+        self.set_dirty(False)
+        self.clear_recovery()
+        self.status_label.setText(f"Saved {target.name}")
+        return True
+
+    @property
+    def recovery_file(self) -> Path:
+        """This window's own recovery file (``volviz_app.recovery``): other windows never write or delete it."""
+        from volviz_app.recovery import window_file
+
+        if "_own_recovery_file" not in self.__dict__:
+            self.__dict__["_own_recovery_file"] = window_file(self.recovery_dir)
+        return self.__dict__["_own_recovery_file"]
+
+    def autosave(self) -> bool:
+        """Write the current state to the recovery file (only when there are unsaved changes)."""
+        if not self.dirty or self.controller is None:
+            return False
+        from volviz.session import save
+
+        self.recovery_dir.mkdir(parents=True, exist_ok=True)
+        session = self.capture_session(self.recovery_file)
+        session.layout["recovered_from"] = str(self.session_path) if self.session_path else ""
+        try:
+            save(session, self.recovery_file)
+        except SessionError as exc:
+            log.error("autosave failed: %s", exc)
+            return False
+        self.status_label.setText("Autosaved")
+        return True
+
+    def clear_recovery(self) -> None:
+        self.recovery_file.unlink(missing_ok=True)
+
+    def offer_recovery(self) -> bool:
+        """If a crashed window (its process is gone) left a recovery file, claim it as this window's own and ask
+        (without blocking) whether to restore it."""
+        from volviz_app.recovery import claim, orphaned
+
+        if not any(claim(orphan, self.recovery_file) for orphan in orphaned(self.recovery_dir)):
+            return False
+        box = QMessageBox(QMessageBox.Icon.Question, "Recover unsaved work",
+                          "volviz did not shut down cleanly last time. Restore the unsaved work it kept?",
+                          QMessageBox.StandardButton.Yes | QMessageBox.StandardButton.No, self)
+        box.finished.connect(lambda result: self._recovery_answer(box.result()))
+        box.open()
+        self.recovery_dialog = box
+        return True
+
+    def _recovery_answer(self, result: int) -> None:
+        if result == QMessageBox.StandardButton.Yes:
+            self.recover()
+        else:
+            self.clear_recovery()
+
+    def recover(self) -> None:
+        from volviz.session import load
+
+        try:
+            session = load(self.recovery_file)
+        except SessionError as exc:
+            self.show_error("Cannot recover", str(exc))
+            return
+        origin = session.layout.pop("recovered_from", "")
+        if origin:  # keep paths valid relative to the original session file when saved there again
+            from volviz.session import resolve_path
+
+            for ref in session.datasets:
+                ref.path = relative_path(origin, resolve_path(self.recovery_file, ref.path))
+        self._show_session(session, Path(origin) if origin else None, "recovered session", dirty=True)
+
+    def recent_files(self) -> list[str]:
+        """File > Open Recent: the files that opened, newest first (``volviz_app.recent``)."""
+        return self.recent.files()
+
+    def ask_file(self, title: str, name_filter: str, on_chosen: Any, save: bool = False,
+                 default_name: str = "", multiple: bool = False) -> QFileDialog:
+        """A non-blocking file dialog (kept as ``self.file_dialog``) that starts in the folder used last;
+        ``on_chosen(path)`` runs when accepted."""
+        dialog = QFileDialog(self, title, self.recent.last_folder(), name_filter)
+        dialog.setOption(QFileDialog.Option.DontUseNativeDialog, True)
+        if save:
+            dialog.setAcceptMode(QFileDialog.AcceptMode.AcceptSave)
+            dialog.setFileMode(QFileDialog.FileMode.AnyFile)
+            if default_name:
+                dialog.selectFile(default_name)
+        elif multiple:   # ``on_chosen(paths)`` gets the list
+            dialog.setFileMode(QFileDialog.FileMode.ExistingFiles)
+            dialog.filesSelected.connect(lambda paths: paths and (self.recent.remember_folder(paths[0]),
+                                                                  on_chosen(list(paths))))
+        else:
+            dialog.setFileMode(QFileDialog.FileMode.ExistingFile)
+        dialog.fileSelected.connect(lambda path: path and not multiple and (self.recent.remember_folder(path),
+                                                                            on_chosen(path)))
+        dialog.open()
+        self.file_dialog = dialog
+        return dialog
+
+    def _ask_open_data(self) -> None:
+        self.ask_file("Open data (a PLOT3D grid with its solution: select both)", _data_filter(), self.open_paths,
+                      multiple=True)
+
+    def _ask_open_session(self) -> None:
+        self.ask_file("Open session", "volviz sessions (*.json);;All files (*)", self.open_path)
+
+    def _save_session(self) -> bool:
+        if self.session_path is None:
+            self._ask_save_session_as()
+            return False
+        return self.save_session(self.session_path)
+
+    def _ask_save_session_as(self) -> None:
+        self.ask_file("Save session", "volviz sessions (*.json)", self.save_session, save=True,
+                      default_name="session.json")
+
+    def ask_unsaved_changes(self) -> QMessageBox.StandardButton:
+        box = QMessageBox(QMessageBox.Icon.Warning, "Unsaved changes", "Save the changes to this session?",
+                          QMessageBox.StandardButton.Save | QMessageBox.StandardButton.Discard
+                          | QMessageBox.StandardButton.Cancel, self)
+        self.unsaved_dialog = box
+        return QMessageBox.StandardButton(box.exec())
+
+    def _confirm_close(self) -> bool:
+        """Closing with unsaved changes asks whether to save them; False: the window stays open (Cancel, or Save
+        and the session was not saved)."""
+        if not self.dirty:
+            return True
+        answer = self.ask_unsaved_changes()
+        return not (answer == QMessageBox.StandardButton.Cancel or (
+            answer == QMessageBox.StandardButton.Save and not self._save_session()))
