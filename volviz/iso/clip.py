@@ -18,7 +18,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from volviz.iso.extract import IsoMesh
-from volviz.model.datasets import RegularVolume, TetMesh
+from volviz.model.datasets import RegularVolume, TetMesh, vec3
 
 __all__ = ["ClipPlane", "BoxCrop", "ClipSettings", "clip_volume", "clip_isosurface", "clip_isosurfaces",
            "clip_tetmesh", "clip_grid"]
@@ -80,9 +80,9 @@ class BoxCrop:
         for k in range(3):
             e = [0.0, 0.0, 0.0]
             e[k] = 1.0
-            out.append(ClipPlane(self.lo, tuple(e)))
+            out.append(ClipPlane(self.lo, (e[0], e[1], e[2])))
             e[k] = -1.0
-            out.append(ClipPlane(self.hi, tuple(e)))
+            out.append(ClipPlane(self.hi, (e[0], e[1], e[2])))
         return out
 
     def to_dict(self) -> dict[str, Any]:
@@ -154,7 +154,7 @@ def clip_volume(volume: RegularVolume, clip: ClipSettings | Sequence[ClipPlane] 
         grid = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1)
         keep = ClipSettings(cs.planes).inside(grid)
         data = np.where(keep, data.astype(np.float32), np.float32(np.nan))
-    return replace(volume, data=np.ascontiguousarray(data), origin=tuple(float(v) for v in origin))
+    return replace(volume, data=np.ascontiguousarray(data), origin=vec3(origin, "origin"))
 
 
 def _clip_vtk(dataset: Any, planes: list[ClipPlane], poly: bool) -> Any:

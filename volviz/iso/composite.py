@@ -102,7 +102,8 @@ def fragments(meshes: Sequence[IsoMesh], camera: Camera, size: tuple[int, int] =
     n_opaque = int(sum(m.n_triangles for m in meshes if m.style.opacity >= 1.0))
     _, _, fwd = camera.frame()
     n_pts = len(pts)
-    pts, tris, nrm, parent = clip_near_plane(pts, tris, nrm, camera.position, fwd, camera.clipping_range[0])
+    pts, tris, nrm, parent = clip_near_plane(pts, tris, nrm, np.asarray(camera.position), fwd,
+                                             camera.clipping_range[0])
     sid = sid[parent]  # triangles crossing the near plane are cut there, as OpenGL does
     if len(pts) > n_pts:  # normals interpolated along cut edges: unit length again
         nrm[n_pts:] /= np.maximum(np.linalg.norm(nrm[n_pts:], axis=1, keepdims=True), 1e-300)

@@ -9,7 +9,7 @@ from back faces (4-pass mode, libMini note §4 step 3).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Callable, Sequence
+from typing import Any, Callable, Sequence, cast
 
 import numpy as np
 
@@ -44,7 +44,8 @@ class IsoStyle:
 
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> "IsoStyle":
-        return cls(float(d["value"]), tuple(float(v) for v in d.get("color", (1, 1, 1))), float(d.get("opacity", 0.5)))
+        color = cast("tuple[float, float, float]", tuple(float(v) for v in d.get("color", (1, 1, 1))))  # checked below
+        return cls(float(d["value"]), color, float(d.get("opacity", 0.5)))
 
 
 @dataclass
@@ -110,8 +111,8 @@ def _poly_to_arrays(poly: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     tris = faces.reshape(-1, 4)[:, 1:].copy() if faces.size else np.zeros((0, 3), np.int64)
     ok = (tris[:, 0] != tris[:, 1]) & (tris[:, 1] != tris[:, 2]) & (tris[:, 0] != tris[:, 2])
     tris = tris[ok]
-    nrm = out.point_data.get("Normals")
-    nrm = np.zeros_like(pts) if nrm is None else np.asarray(nrm, dtype=np.float64).reshape(-1, 3)
+    normals = out.point_data.get("Normals")
+    nrm = np.zeros_like(pts) if normals is None else np.asarray(normals, dtype=np.float64).reshape(-1, 3)
     return pts, tris, nrm
 
 

@@ -68,6 +68,7 @@ def fit_spectrum(opacity: float, n: int = 2000) -> SpectrumFit:
         r = least_squares(resid, x0=[a0, o], bounds=([1e-4, -1.0], [50.0, 1.0]), method="trf")
         if best is None or r.cost < best.cost:
             best = r
+    assert best is not None  # three starts
     err = resid(best.x)
     return SpectrumFit(o, tau0, float(best.x[0]), float(best.x[1]), float(np.sqrt(np.mean(err ** 2))),
                        float(np.max(np.abs(err))))

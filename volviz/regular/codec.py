@@ -218,7 +218,8 @@ def compress(volume: RegularVolume, path: str | Path, mode: str = "lossless", qu
     choice = TRANSFORM_CHOICES[transform]
     report = progress or (lambda f, m: None)
     data = volume.data
-    shape = tuple(int(s) for s in data.shape)
+    nx, ny, nz = (int(s) for s in data.shape)
+    shape = (nx, ny, nz)
     src = _Source(data)
     peak = _peak(src.kind)
     clip = (float(np.iinfo(src.dtype).min), float(np.iinfo(src.dtype).max)) if src.kind in _INT_TYPES else (
@@ -323,7 +324,7 @@ def _check_meta(meta: dict[str, Any], name: str) -> tuple[tuple[int, int, int], 
         raise VVZError(name, f"unknown sample kind {kind!r}")
     if levels != len(level_shapes(dims)) - 1:
         raise VVZError(name, f"{levels} levels do not match dims {dims}")
-    return dims, levels, coder  # type: ignore[return-value]
+    return dims, levels, coder
 
 
 def transforms(table: np.ndarray, idx: Any, lossless: bool, name: str) -> np.ndarray:
@@ -416,8 +417,8 @@ def decompress(path: str | Path, strict: bool = False, report: list[dict[str, An
                 a = np.empty(shp, np.int32)
                 lo, hi = -(1 << 31), (1 << 31) - 1
             K.run_tiles(K.decode_level, cur, payload, offs, sizes, tfs, valid, steps[lev], ci, a, lo, hi, status)
-            for t in np.nonzero(status != 0)[0]:
-                fail(int(idx[t]), lev, int(t), "inconsistent stream")
+            for bad in np.nonzero(status != 0)[0]:
+                fail(int(idx[bad]), lev, int(bad), "inconsistent stream")
             cur = a
             if progress:
                 progress((levels - lev + 1) / max(levels, 1), f"level {lev}")
@@ -433,8 +434,8 @@ def decompress(path: str | Path, strict: bool = False, report: list[dict[str, An
         data = _to_dtype(cur, meta)
     finally:
         rd.close()
-    return RegularVolume(data=data, spacing=tuple(meta.get("spacing", (1, 1, 1))),  # type: ignore[arg-type]
-                         origin=tuple(meta.get("origin", (0, 0, 0))),  # type: ignore[arg-type]
+    return RegularVolume(data=data, spacing=tuple(meta.get("spacing", (1, 1, 1))),
+                         origin=tuple(meta.get("origin", (0, 0, 0))),
                          name=str(meta.get("name", "scalars")), source=str(path))
 
 

@@ -102,8 +102,8 @@ class BlockPool:
         return (float(lo), float(hi)) if hi >= lo else (0.0, 1.0)
 
 
-def pack_blocks(blocks: Sequence[Any], shape: Sequence[int], origin: Sequence[float],
-                spacing: Sequence[float]) -> BlockPool:
+def pack_blocks(blocks: Sequence[Any], shape: Sequence[int], origin: Sequence[float] | np.ndarray,
+                spacing: Sequence[float] | np.ndarray) -> BlockPool:
     """Pack ``volviz.regular.lod.Block`` s (key ``(level, p)``, float data with overlap) of a volume with ``shape``
     level-0 samples into a pool and its index grid (cells of the finest selected level's node size)."""
     shape3 = tuple(int(v) for v in shape)

@@ -95,7 +95,8 @@ def _table_for(mesh: TetMesh, tf: Any, kind: str, sizes: tuple[int, int], l_max:
     union of the TF range and the data range (so out-of-range parts stay transparent), cached on the mesh for the
     last (kind, TF, sizes)."""
     from volviz.optics import build_table3d
-    from volviz.optics.separable import build_separable
+    from volviz.optics.separable import SeparableTable, build_separable
+    from volviz.optics.table3d import Table3D
 
     r = cell_ranges(mesh)
     ok = ~r.nan
@@ -107,6 +108,7 @@ def _table_for(mesh: TetMesh, tf: Any, kind: str, sizes: tuple[int, int], l_max:
     cached = mesh.__dict__.get(slot)
     if cached is not None and cached[0] == key:
         return cached[1]
+    table: Table3D | SeparableTable
     if kind in ("3d", "pre"):
         table = build_table3d(tf, n_s=sizes[0], n_l=sizes[1], l_max=l_max, s_range=(lo, hi),
                               classification="pre" if kind == "pre" else "post")

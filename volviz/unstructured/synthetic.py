@@ -29,7 +29,7 @@ def box_grid(n: int = 4, field: Callable[[np.ndarray], np.ndarray] = _default_fi
 
 def box_tets(n: int = 4, **kw) -> TetMesh:
     """The tetrahedralised :func:`box_grid` (convex)."""
-    return tetrahedralize(box_grid(n, **kw))  # type: ignore[return-value]
+    return tetrahedralize(box_grid(n, **kw))
 
 
 def carved_box(n: int, remove: Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray],
@@ -47,7 +47,7 @@ def carved_box(n: int, remove: Callable[[np.ndarray, np.ndarray, np.ndarray], np
     hexes = np.stack([idx(0, 0, 0), idx(1, 0, 0), idx(1, 1, 0), idx(0, 1, 0),
                       idx(0, 0, 1), idx(1, 0, 1), idx(1, 1, 1), idx(0, 1, 1)], axis=1)
     um = UnstructuredMesh(pts, [(VTK_HEXAHEDRON, hexes)], {"f": field(pts)})
-    return tetrahedralize(um)  # type: ignore[return-value]
+    return tetrahedralize(um)
 
 
 def cavity_box(n: int = 6) -> TetMesh:
@@ -79,7 +79,8 @@ def pencil_cycle(w: float = 0.2, height: float = 1.0) -> TetMesh:
     so that seen from +z pencil 0 covers 1, 1 covers 2 and 2 covers 0: a visibility cycle."""
     ang = np.deg2rad([90.0, 210.0, 330.0])
     v = np.stack([np.cos(ang), np.sin(ang)], axis=1)
-    pts, tets = [], []
+    corners: list[np.ndarray] = []
+    tets = []
     for i in range(3):
         a, b = v[i], v[(i + 1) % 3]
         d = b - a
@@ -87,7 +88,7 @@ def pencil_cycle(w: float = 0.2, height: float = 1.0) -> TetMesh:
         perp = np.array([-d[1], d[0]]) / np.linalg.norm(d)
         z0, z1 = -height, height                          # z(u) = (2u - 1) height: -h/2 at u=1/4, +h/2 at u=3/4
         p = [np.r_[start + w * perp, z0], np.r_[start - w * perp, z0], np.r_[end, z1 + w], np.r_[end, z1 - w]]
-        pts.extend(p)
+        corners.extend(p)
         tets.append([4 * i, 4 * i + 1, 4 * i + 2, 4 * i + 3])
-    pts = np.asarray(pts)
-    return tetrahedralize(TetMesh(pts, np.asarray(tets), pts[:, 2] * 0 + 0.5))  # type: ignore[return-value]
+    pts = np.asarray(corners)
+    return tetrahedralize(TetMesh(pts, np.asarray(tets), pts[:, 2] * 0 + 0.5))

@@ -18,7 +18,7 @@ Degenerate cells (|6V| <= 1e-12 * (longest edge)^3) are dropped and counted.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Literal, overload
 
 import numpy as np
 
@@ -136,8 +136,8 @@ def _hex_vertex_colors(hexes: np.ndarray, n_points: int) -> np.ndarray:
 
 def _curvilinear_hexes(dims: tuple[int, int, int]) -> tuple[np.ndarray, np.ndarray]:
     nx, ny, nz = dims
-    i, j, k = np.meshgrid(np.arange(nx - 1), np.arange(ny - 1), np.arange(nz - 1), indexing="ij")
-    i, j, k = i.ravel(order="F"), j.ravel(order="F"), k.ravel(order="F")
+    grid = np.meshgrid(np.arange(nx - 1), np.arange(ny - 1), np.arange(nz - 1), indexing="ij")
+    i, j, k = grid[0].ravel(order="F"), grid[1].ravel(order="F"), grid[2].ravel(order="F")
 
     def idx(di: int, dj: int, dk: int) -> np.ndarray:
         return (i + di) + nx * ((j + dj) + ny * (k + dk))
@@ -147,7 +147,8 @@ def _curvilinear_hexes(dims: tuple[int, int, int]) -> tuple[np.ndarray, np.ndarr
     return hexes, (i + j + k) % 2 == 0
 
 
-def _point_scalars(point_data: dict[str, np.ndarray], name: str | None, n: int, order: str) -> tuple[np.ndarray, str]:
+def _point_scalars(point_data: dict[str, np.ndarray], name: str | None, n: int,
+                   order: Literal["C", "F"]) -> tuple[np.ndarray, str]:
     if not point_data:
         raise ValueError("the dataset has no point data to render")
     name = name if name is not None else next(iter(point_data))
@@ -157,6 +158,25 @@ def _point_scalars(point_data: dict[str, np.ndarray], name: str | None, n: int, 
     if arr.size != n:
         raise ValueError(f"point array {name!r} must be scalar (one value per point), got shape {arr.shape}")
     return arr.ravel(order=order).astype(np.float64), name
+
+
+@overload
+def tetrahedralize(source: Any, scalars: str | None = None, report: Literal[False] = False) -> TetMesh: ...
+
+
+@overload
+def tetrahedralize(source: Any, scalars: str | None, report: Literal[True]) -> tuple[TetMesh, TetrahedralizeReport]:
+    ...
+
+
+@overload
+def tetrahedralize(source: Any, scalars: str | None = None, *, report: Literal[True]
+                   ) -> tuple[TetMesh, TetrahedralizeReport]: ...
+
+
+@overload
+def tetrahedralize(source: Any, scalars: str | None = None, report: bool = False
+                   ) -> TetMesh | tuple[TetMesh, TetrahedralizeReport]: ...
 
 
 def tetrahedralize(source: Any, scalars: str | None = None, report: bool = False
