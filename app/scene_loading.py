@@ -1,0 +1,174 @@
+"""Loading a scene in the main window (a mixin of ``MainWindow``): ``open_path``, the one code path behind File >
+Open, Open Recent, drag-and-drop and the command line, the demo scenes, and ``_show_session``, which shows a session:
+its datasets are read and the scene prepared in the background (``SceneController.prepare``) with progress and
+cancel in the status bar, then installed on the GUI thread (``_install_session``: props added, docks filled, one
+render) in short stages, and its first views computed in the background (``volviz_app.view_scheduler``). A newer
+open supersedes an older one; the shown scene stays until the new one is ready, and stays on when it fails.
+
+It expects of the window: ``controller``, ``session``, ``session_path``, ``datasets``, ``dirty``, ``title``,
+``plotter``, ``jobs``, ``_load_serial``, ``_loading_views``, ``_current_job``, ``status_label``, ``_set_busy``,
+``show_error``, ``set_dirty``, ``recent``, the docks (``scene_tree``, ``render_settings``, ``clipping``,
+``timeline``), ``array_choice``, ``decorations``, ``scene_undo_stack``, ``_refresh_bookmark_menu``,
+``_show_first_views``, ``render()`` and ``restoreState`` (``QMainWindow``)."""
+from __future__ import annotations
+
+import logging
+import os
+from pathlib import Path
+from typing import Any, Callable, Optional
+
+from PySide6.QtCore import QByteArray, QTimer
+
+from volviz.jobs import JobOutcome
+from volviz.session import Session
+from volviz_app.errors import open_error
+
+log = logging.getLogger("volviz_app.window")  # the logger these methods had in window.py
+
+STAGE_MS = 30            # pause between GUI-thread stages of showing a new scene (other events run in between)
+
+
+class SceneLoading:
+    """Opening files and showing sessions (see the module's docstring)."""
+
+    def open_demo(self) -> None:
+        from volviz.render.scene_builder import demo_session
+
+        self._show_session(demo_session(), None, "demo scene")
+
+    def open_demo_volume(self) -> None:
+        """The tetrahedral demo volume (an analytic field on a tetrahedralised cube), drawn by volviz's PT."""
+        from volviz.render.scene_builder import demo_volume_session
+
+        self._show_session(demo_volume_session(), None, "demo volume")
+
+    def open_paths(self, paths: list[str]) -> None:
+        """Open what the Open dialog chose: a PLOT3D grid and its solution file together, else the first file."""
+        from volviz.io.plot3d_pairs import grid_and_solution
+
+        pair = grid_and_solution(paths)
+        if pair is not None:
+            self.open_path(pair[0], q=pair[1])
+        elif paths:
+            self.open_path(paths[0])
+
+    def open_path(self, path: str | os.PathLike, q: Optional[str | os.PathLike] = None) -> None:
+        """Open a session file or a data file (the path behind every Open action and the command line); ``q``: the
+        solution file of a PLOT3D grid."""
+        from volviz.render.export import is_session_file
+        from volviz.render.scene_builder import data_session
+        from volviz.session import load
+
+        p = Path(path)
+        try:
+            if not p.exists():
+                raise FileNotFoundError(p)
+            session, session_path = (load(p), p) if is_session_file(p) else (data_session(p, q), None)
+        except Exception as exc:  # the file's fault or ours: a message in the user's terms, the scene stays
+            self.show_error(f"Cannot open {p.name}", open_error(p, exc))
+            return
+        # File > Open Recent lists it once it has opened
+        self._show_session(session, session_path, p.name, path=p, on_shown=lambda: self.recent.add(p))
+
+    def _show_session(self, session: Session, session_path: Optional[Path], title: str,
+                      dirty: bool = False, datasets: Optional[dict[str, Any]] = None, path: Optional[Path] = None,
+                      on_shown: Optional[Callable[[], None]] = None) -> None:
+        """Show ``session``: its datasets are read (unless ``datasets`` are given) and the scene prepared in the
+        background (``SceneController.prepare``: reading, extraction, tetrahedralisation, natural scene), with
+        progress and cancel in the status bar; then the props are added on this thread (``install``) and the
+        view-dependent parts computed in the background. A newer open supersedes an older one; the current scene
+        stays until the new one is ready, and stays on when the new one fails (a message names ``path``, the file
+        opened, and what is wrong with it). ``on_shown()`` runs once the new scene is installed."""
+        from volviz.render.controller import SceneController
+        from volviz.render.scene_builder import load_datasets
+
+        self._load_serial += 1
+        serial = self._load_serial
+        self.jobs.runner.cancel_all()  # the shown scene's background work (error estimates...) would delay this one
+        self._loading_views = False
+        self.status_label.setText(f"Loading {title}…")
+        self._set_busy(True)
+        controller = SceneController(self.plotter, session, {}, on_screen=True)
+
+        def load(progress: Any = None) -> Any:
+            def part(lo: float, hi: float) -> Any:
+                return lambda fraction, message="": progress(lo + (hi - lo) * fraction, message)
+
+            controller.datasets = load_datasets(session, session_path, part(0.0, 0.6), loaded=datasets)
+            return controller.prepare(part(0.6, 1.0))
+
+        def done(outcome: JobOutcome) -> None:
+            if serial != self._load_serial:
+                return
+            if outcome.cancelled:
+                self._set_busy(False)
+                self.status_label.setText(f"Loading {title} cancelled")
+                return
+            if outcome.error is not None:
+                self._set_busy(False)
+                self.status_label.setText(f"Could not load {title}")
+                self.show_error(f"Cannot open {title}", open_error(path, outcome.error, title))
+                return
+            if self._install_session(controller, outcome.result, session_path, title, dirty, serial, path):
+                if datasets is None:  # another file or scene: the old one's settings edits are not undone on it
+                    self.scene_undo_stack.clear()
+                if on_shown:
+                    on_shown()
+
+        self._current_job = self.jobs.submit(load, name=f"load {title}", key="load", on_done=done)
+
+    def _install_session(self, controller: Any, prepared: Any, session_path: Optional[Path], title: str,
+                         dirty: bool, serial: int, path: Optional[Path] = None) -> bool:
+        """GUI thread: replace the shown scene by a prepared one (no numerics here: props added, docks filled, one
+        render), then compute its view-dependent parts in the background; loading ends when they are shown. A scene
+        that cannot be installed is taken out again and the previous one rebuilt (False)."""
+        session = controller.session
+        previous = self.controller
+        camera = previous.camera() if previous is not None else None  # install places the new scene's camera
+        if previous is not None:
+            self.controller.clear()
+        self.plotter.clear()
+        self._current_job = None
+        try:
+            controller.install(prepared, views=False)
+        except Exception as exc:  # a scene that cannot be shown must not take the window down, nor the old scene
+            log.exception("building the scene for %s failed", title)
+            controller.clear()
+            self.controller = None
+            self._set_busy(False)
+            self.status_label.setText(f"Could not show {title}")
+            self.show_error(f"Cannot open {title}", open_error(path, exc, title))
+            if previous is not None:  # the window's state still describes it: show it again, same camera
+                self.session.camera = camera
+                self._show_session(self.session, self.session_path, getattr(self, "title", ""), self.dirty,
+                                   datasets=self.datasets)
+            return False
+        self.session, self.session_path, self.datasets = session, session_path, controller.datasets
+        self.controller = controller
+        if "window_state" in session.layout:
+            self.restoreState(QByteArray.fromBase64(session.layout["window_state"].encode("ascii")))
+        self.scene_tree.populate(session.components, [ref.id for ref in session.datasets], self.array_choice.names)
+        self.render_settings.load(session.render)
+        self.decorations.sync()
+        self.clipping.load(session.clip, controller.installed_bounds)
+        display_time = controller.time  # the session's display time, which set_steps would reset to the first step
+        self.timeline.blockSignals(True)  # the scene already shows the display time: no re-blend, no re-extraction
+        try:
+            self.timeline.set_steps(controller.time_steps())
+            if controller.time_series():
+                self.timeline.set_time(display_time)
+        finally:
+            self.timeline.blockSignals(False)
+        self.volume_time_shown = self.iso_time_shown = None
+        self.isosurface_clip_shown = controller.clip.to_dict()  # cut in ``prepare``
+        self._refresh_bookmark_menu()
+        self.title = title
+        self.error_estimate = None
+        self.last_error_rmse = None
+        self.set_dirty(dirty)
+        # the first render and the first views' GUI-thread parts (a PT volume's depth read-back renders too) in
+        # later turns of the event loop, with room for other events between them: in one turn they held it 160-330
+        # ms for a big PT scene under load
+        QTimer.singleShot(STAGE_MS, lambda: self.controller is controller and self.render())
+        QTimer.singleShot(2 * STAGE_MS, lambda: self._show_first_views(controller, serial, title))
+        return True
