@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from test_app_workflows import viewport, wait_loaded
-from volviz.nature.nature_scene import NatureView
+from volviz.render.nature_view import NatureView
 from volviz.render.gl_nature import GLNatureView
 from volviz_app.window import MainWindow
 

@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from conftest import REPO, data_file, data_root
-from volviz.nature.nature_scene import NatureView, demo_camera, demo_scene, nature_dataset_ids, scene_from_components
+from volviz.nature.nature_scene import demo_camera, demo_scene, nature_dataset_ids, scene_from_components
+from volviz.render.nature_view import NatureView
 from volviz.nature.sky import sky_dome_mesh
 from volviz.model.camera import Camera
 
@@ -178,7 +179,7 @@ def test_preview_keeps_the_terrain_and_magnifies_a_smaller_overlay(demo) -> None
     and magnified to the window; the image stays close to the full-size one."""
     import pyvista as pv
 
-    from volviz.nature.nature_scene import _magnify
+    from volviz.render.nature_view import _magnify
 
     size = (160, 120)
     cam = demo_camera()

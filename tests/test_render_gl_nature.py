@@ -25,7 +25,8 @@ import pyvista as pv
 
 from conftest import data_file
 from volviz.model.camera import Camera
-from volviz.nature.nature_scene import NatureView, demo_scene, scene_from_components
+from volviz.nature.nature_scene import demo_scene, scene_from_components
+from volviz.render.nature_view import NatureView
 from volviz.render.gl_nature import GLNatureView
 
 SIZE = (256, 192)

@@ -196,7 +196,7 @@ class _GLFrames:
     def __init__(self, scene: Any, size: tuple[int, int], reps: int) -> None:
         import pyvista as pv
 
-        from volviz.nature.nature_scene import NatureView
+        from volviz.render.nature_view import NatureView
         from volviz.render.gl_nature import GLNatureView
 
         self.size, self.reps = size, reps

@@ -16,7 +16,7 @@ Google SwiftShader) the GPU's work runs on the same CPU cores, so ``auto`` takes
   at 1920x1080: the CPU path is faster at every size measured. In the app it also renders off the GUI thread and
   draws half-size previews while the camera moves, where the GL pass blocks the GUI thread for a full-size draw.
 - ``"nature"``: the natural scene's fog and cloud layers and C-LOD clouds: ``volviz.render.gl_nature.GLNatureView``
-  (GL prisms and GL PT in the scene's depth buffer) or the CPU ``volviz.nature.nature_scene.NatureView`` (an overlay
+  (GL prisms and GL PT in the scene's depth buffer) or the CPU ``volviz.render.nature_view.NatureView`` (an overlay
   made off the GUI thread). Auto takes the CPU on a software rasteriser: the demo scene on llvmpipe (2 shared cores,
   ~25k cloud tetrahedra, ~60k fog prisms) took 0.61 s per frame on the CPU against 1.47 s on the GL path at
   512x384 (0.57 s of it LOD selection and upload, 0.91 s llvmpipe's draw) and 0.18 / 0.63 s at 64x48.

@@ -1,6 +1,6 @@
 """The natural scene on the GPU backend: terrain C-LOD, sky dome, ground fog / cloud layers and C-LOD clouds all
 drawn by VTK's OpenGL pipeline into the scene's own depth buffer (Roettger Ch. 10-11, digest §8-9); the GPU side of
-``volviz.nature.nature_scene.NatureView``, whose calls it keeps (``update``, ``begin`` / ``compute`` / ``finish``,
+``volviz.render.nature_view.NatureView``, whose calls it keeps (``update``, ``begin`` / ``compute`` / ``finish``,
 ``remove``, ``last_stats``, ``scene`` for the bounds), so the controller and the app only choose the class
 (``volviz.render.backend``, view kind "nature").
 
@@ -43,7 +43,8 @@ import numpy as np
 
 from volviz.model.datasets import TetMesh
 from volviz.nature.clouds import CloudFrame, CloudShading
-from volviz.nature.nature_scene import NatureScene, NatureView
+from volviz.nature.nature_scene import NatureScene
+from volviz.render.nature_view import NatureView
 from volviz.render.gl_fog import GLFogLayer, buffers_polydata, prism_buffers
 from volviz.render.gl_pt import GLPTVolume, _cell_attributes, shader_source
 from volviz.render.image_overlay import hold_single_sample, release_single_sample

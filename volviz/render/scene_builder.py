@@ -17,6 +17,10 @@ from volviz.jobs import ProgressCallback, report
 from volviz.render.backend import backend_setting
 from volviz.session import Component, DatasetRef, RenderSettings, Session, resolve_path
 
+if TYPE_CHECKING:
+    from volviz.render.nature_view import NatureView
+    from volviz.render.gl_nature import GLNatureView
+
 
 class SceneError(Exception):
     """A session that cannot be shown: names the component and the problem."""
@@ -378,12 +382,16 @@ def install_nature(plotter: Any, scene: Any, views: bool = True, backend: str = 
     ``begin`` / ``compute`` / ``finish``)."""
     if scene is None:
         return None
+    view_type: type[GLNatureView] | type[NatureView]
     if backend == "gpu":
-        from volviz.render.gl_nature import GLNatureView as View
-    else:
-        from volviz.nature.nature_scene import NatureView as View
+        from volviz.render.gl_nature import GLNatureView
 
-    view = View(plotter, scene)
+        view_type = GLNatureView
+    else:
+        from volviz.render.nature_view import NatureView
+
+        view_type = NatureView
+    view = view_type(plotter, scene)
     if views:
         view.update()
     return view

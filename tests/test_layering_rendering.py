@@ -1,0 +1,52 @@
+"""Issue #18's layering of VTK's rendering classes: nothing below ``volviz.render`` (model, io, jobs, optics, the four
+method packages, the session) builds actors, mappers, renderers or plotters; VTK's data classes, readers and filters
+are fine there. Read from the source (names imported or used), not from import-linter: it sees ``vtkmodules`` as one
+package and cannot tell ``vtkRenderingCore`` from ``vtkIOXML``."""
+from __future__ import annotations
+
+import ast
+import re
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1] / "volviz"
+BELOW_RENDER = ("model", "io", "jobs", "optics", "unstructured", "regular", "nature", "iso", "session.py")
+RENDERING = re.compile(r"^(vtk\w*(Actor|Mapper|Renderer|RenderWindow|Texture|ShaderProperty|Light)\w*|vtkRendering\w+|"
+                       r"Plotter|BackgroundPlotter|add_mesh|add_actor|add_volume)$")
+#: the departures left (docs/architecture.md): the spectrum shader's actor, VTK's color transfer function
+KNOWN_DEPARTURES = {"iso/vtk_spectrum.py", "optics/transfer_function.py"}
+
+
+def _rendering_names(path: Path) -> set[str]:
+    names: set[str] = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Name):
+            names.add(node.id)
+        elif isinstance(node, ast.Attribute):
+            names.add(node.attr)
+        elif isinstance(node, ast.ImportFrom) and node.module:
+            names.update(node.module.split("."))
+            names.update(a.name for a in node.names)
+        elif isinstance(node, ast.Import):
+            names.update(part for a in node.names for part in a.name.split("."))
+    return {n for n in names if RENDERING.match(n)}
+
+
+def test_only_render_builds_vtk_actors():
+    found = {}
+    for part in BELOW_RENDER:
+        files = [ROOT / part] if part.endswith(".py") else sorted((ROOT / part).rglob("*.py"))
+        for f in files:
+            names = _rendering_names(f)
+            if names:
+                found[f.relative_to(ROOT).as_posix()] = sorted(names)
+    assert set(found) == KNOWN_DEPARTURES, found
+
+
+def test_the_check_sees_a_rendering_class(tmp_path):
+    probe = tmp_path / "probe.py"
+    probe.write_text("def f(plotter):\n    from vtkmodules.vtkRenderingCore import vtkActor\n"
+                     "    return plotter.add_mesh(vtkActor())\n")
+    assert _rendering_names(probe) == {"vtkRenderingCore", "vtkActor", "add_mesh"}
+    probe.write_text("import vtk\nfrom vtkmodules.vtkIOXML import vtkXMLImageDataReader\n"
+                     "r = vtk.vtkXMLUnstructuredGridReader()\n")
+    assert _rendering_names(probe) == set()

@@ -1,0 +1,237 @@
+"""The natural scene in a PyVista plotter, CPU backend (Roettger Ch. 10-11 images made by ``volviz.nature``):
+the terrain's C-LOD mesh as a textured VTK mesh (the baked color map, lighting off, so it matches the CPU image), the
+sky dome around the eye, and the fog and cloud volumes as one screen-space RGBA overlay in front (the terrain
+occlusion is already in it, from the CPU terrain z-buffer). ``NatureView.update(camera)`` recomputes the terrain LOD
+mesh and the overlay for a camera; the app does it in the background (``begin`` / ``compute`` / ``finish``).
+``volviz.render.gl_nature.GLNatureView`` is the GPU backend with the same calls.
+
+``build_nature_components`` builds a view from a session's terrain / fog / clouds / sky components.
+"""
+from __future__ import annotations
+
+from typing import Any, Sequence
+
+import numpy as np
+
+from volviz.nature.nature_scene import NatureScene, scene_from_components
+from volviz.nature.raster import render_terrain
+
+
+class NatureView:
+    """A ``NatureScene`` inside a PyVista plotter: terrain mesh, sky dome and the volume overlay (see module doc).
+    The CPU backend of the natural-scene view; ``volviz.render.gl_nature.GLNatureView`` is the GPU one."""
+
+    backend = "cpu"
+
+    def __init__(self, plotter: Any, scene: NatureScene, size: tuple[int, int] | None = None) -> None:
+        import pyvista as pv
+
+        from volviz.nature.sky import sky_dome_mesh
+
+        self.plotter = plotter
+        self.scene = scene
+        scene.finalize()
+        self.size = size
+        self.terrain_actor = None
+        self.sky_actor = None
+        self._overlay_actor = None
+        self._overlay_image = None
+        self._near = 0.1
+        self._mesh = None
+        self.last_stats: dict[str, float] = {}
+        self.shown_scale = 1          # the preview scale of the overlay shown (``compute``)
+        if scene.terrain is not None and scene.color_map is not None:
+            img = np.clip(scene.color_map.transpose(1, 0, 2)[::-1] * 255.0, 0, 255).astype(np.uint8)
+            self._texture = pv.Texture(np.ascontiguousarray(img))
+            b = scene.terrain.bounds()
+            radius = 3.0 * max(b[1] - b[0], b[3] - b[2])
+            self._near = max(1e-3 * max(b[1] - b[0], b[3] - b[2]), 0.1)
+        else:
+            self._texture = None
+            radius = 3000.0
+        self.dome_radius = self._base_dome_radius = radius
+        dome = sky_dome_mesh(radius, (0.0, 0.0, 0.0))  # moved to the eye by ``update``: the sky is at infinity
+        if scene.sky is not None:
+            sky_img = np.clip(scene.sky * 255.0, 0, 255).astype(np.uint8)
+            self.sky_actor = plotter.add_mesh(dome, texture=pv.Texture(sky_img), lighting=False, name="nature-sky",
+                                              render=False)
+        else:  # the CPU gradient of ``render_sky`` as a polar texture (rows: zenith at the top, horizon at the bottom)
+            zen, hor = np.array([0.32, 0.5, 0.85]), np.array([0.78, 0.85, 0.95])
+            t = np.sqrt(np.linspace(1.0, 0.0, 256))[:, None, None]
+            grad = np.broadcast_to(hor + (zen - hor) * t, (256, 4, 3))
+            sky_img = np.ascontiguousarray(np.clip(grad * 255.0 + 0.5, 0, 255).astype(np.uint8))
+            self.sky_actor = plotter.add_mesh(dome, texture=pv.Texture(sky_img), lighting=False, name="nature-sky",
+                                              render=False)
+
+    def _camera(self) -> Any:
+        from volviz.model.camera import Camera
+
+        self._fit_clipping()
+        return Camera.from_pyvista(self.plotter.camera)
+
+    def _fit_dome(self, eye: Any) -> None:
+        """Grow the sky dome (centred on the eye, see ``begin``) to twice the distance from the eye to the farthest
+        corner of the terrain, so that it never hides the terrain however far the camera backs away (a camera framed
+        on the whole terrain sits more than the dome's base radius away from its far side)."""
+        if self.sky_actor is None or self.scene.terrain is None:
+            return
+        b = self.scene.terrain.bounds()
+        corners = np.array([[x, y, z] for x in b[0:2] for y in b[2:4] for z in b[4:6]], dtype=np.float64)
+        far = float(np.linalg.norm(corners - np.asarray(eye, dtype=np.float64), axis=1).max())
+        scale = max(1.0, 2.0 * far / self._base_dome_radius)
+        self.sky_actor.SetScale(scale, scale, scale)
+        self.dome_radius = self._base_dome_radius * scale
+
+    def _fit_clipping(self) -> None:
+        """Make the plotter camera's clipping range hold the sky dome around the eye. A session camera applied before
+        any actor existed leaves VTK's default range (0.01, 1000.01), whose far plane cut the dome (radius 3 x the
+        terrain extent) away so the background color showed instead of the sky."""
+        pc = self.plotter.camera
+        near, far = (float(v) for v in pc.clipping_range)
+        need = 1.05 * self.dome_radius
+        if far < need or near < 0.5 * self._near:
+            pc.clipping_range = (max(near, self._near), max(far, need))
+
+    def update(self, camera: Any = None) -> dict[str, float]:
+        """Re-triangulate the terrain and re-render the overlay for ``camera`` (default: the plotter's camera), now.
+        An app renders it in the background instead: ``begin`` (GUI thread), ``compute`` (any thread), ``finish``
+        (GUI thread)."""
+        request = self.begin(camera)
+        return self.finish(request, *self.compute(request))
+
+    def begin(self, camera: Any = None, scale: int = 1) -> tuple[Any, tuple[int, int], int]:
+        """GUI thread: the view to compute (``camera`` or the plotter's, the image size and the preview ``scale``,
+        see ``compute``); moves the sky dome to the eye (the sky is at infinity)."""
+        self._fit_dome(camera.position if camera is not None else self.plotter.camera.position)
+        cam = camera or self._camera()
+        if camera is not None:
+            camera.apply_to(self.plotter.camera)
+            self._fit_clipping()  # the VTK side only: ``cam`` keeps the caller's range for the CPU overlay
+        size = self.size or tuple(int(v) for v in self.plotter.window_size)
+        if self.sky_actor is not None:
+            self.sky_actor.SetPosition(*np.asarray(cam.position, dtype=np.float64))
+        return cam, size, max(1, int(scale))
+
+    def compute(self, request: tuple[Any, tuple[int, int], int],
+                progress: Any = None) -> tuple[Any, np.ndarray, dict[str, float]]:
+        """Any thread (one at a time): the C-LOD terrain mesh as VTK poly data (None without terrain), the fog and
+        cloud overlay as 8-bit straight RGBA rows bottom-up, and the statistics. ``progress(fraction, message)`` is
+        called between the stages (a job runner cancels there). A preview (``scale`` > 1, e.g. while the camera
+        moves) renders the fog and clouds at 1/scale of the size in each direction and magnifies them (``_magnify``);
+        the terrain mesh and the clouds' levels of detail are those of the full size (the same frustum), so nothing
+        pops when the full-size view follows."""
+        cam, size, scale = request
+        mesh = self.scene.terrain_mesh(cam, size)
+        if scale > 1:
+            size = (max(1, size[0] // scale), max(1, size[1] // scale))
+        w, h = size
+        stats: dict[str, float] = {}
+        depth = np.full((h, w), np.inf)
+        poly = None
+        if mesh is not None:
+            if progress is not None:
+                progress(0.3, "terrain")
+            poly = mesh.to_pyvista()
+            depth, _ = render_terrain(mesh.points, mesh.triangles, mesh.tcoords, cam, size, self.scene._pyramid)
+            stats["terrain_triangles"] = float(mesh.n_triangles)
+        if progress is not None:
+            progress(0.5, "fog and clouds")
+        overlay = _overlay_rgba(self.scene.render_volumes(cam, size, mesh, depth, stats=stats))
+        if scale > 1:
+            overlay = _magnify(overlay, request[1])
+        return poly, overlay, stats
+
+    def finish(self, request: tuple[Any, tuple[int, int], int], poly: Any, overlay: np.ndarray,
+               stats: dict[str, float]) -> dict[str, float]:
+        """GUI thread: show a ``compute`` result (terrain mesh and overlay image)."""
+        self._show_terrain(poly)
+        self._set_overlay(overlay)
+        self.last_stats = stats
+        self.shown_scale = int(request[2])
+        return stats
+
+    def _show_terrain(self, poly: Any) -> None:
+        """The C-LOD terrain mesh (VTK poly data; None: keep the shown one) as the textured terrain actor."""
+        if poly is not None:
+            if self.terrain_actor is None:
+                self.terrain_actor = self.plotter.add_mesh(poly, texture=self._texture, lighting=False,
+                                                           name="nature-terrain", render=False)
+            else:
+                self.terrain_actor.mapper.SetInputData(poly)
+            self._mesh = poly
+
+    def remove(self) -> None:
+        """Take the view's actors (sky, terrain, overlay) out of the plotter."""
+        for name in ("nature-sky", "nature-terrain", "nature-overlay"):
+            self.plotter.remove_actor(name, render=False)
+        self.terrain_actor = self._overlay_actor = self._overlay_image = None
+
+    def _set_overlay(self, overlay: np.ndarray) -> None:
+        """Show an overlay image of ``_overlay_rgba`` (8-bit straight RGBA, rows bottom-up) in front of the scene."""
+        import vtk
+        from vtk.util.numpy_support import numpy_to_vtk
+
+        h, w = overlay.shape[:2]
+        data = overlay.reshape(-1, 4)
+        if self._overlay_image is None:
+            self._overlay_image = vtk.vtkImageData()
+            mapper = vtk.vtkImageMapper()
+            mapper.SetInputData(self._overlay_image)
+            mapper.SetColorWindow(255.0)
+            mapper.SetColorLevel(127.5)
+            actor = vtk.vtkActor2D()
+            actor.SetMapper(mapper)
+            self.plotter.add_actor(actor, name="nature-overlay", reset_camera=False, render=False)
+            self._overlay_actor = actor
+        img = self._overlay_image
+        img.SetDimensions(w, h, 1)
+        arr = numpy_to_vtk(data, deep=True)
+        arr.SetNumberOfComponents(4)
+        img.GetPointData().SetScalars(arr)
+        img.Modified()
+
+
+def _magnify(rgba8: np.ndarray, size: tuple[int, int]) -> np.ndarray:
+    """A straight-alpha RGBA8 image resampled bilinearly to ``size`` (W, H) pixels over the same view (Pillow:
+    premultiplied while filtering, so no color bleeds from transparent pixels; pixel centres aligned)."""
+    from PIL import Image
+
+    img = Image.fromarray(np.ascontiguousarray(rgba8), "RGBA").convert("RGBa")
+    return np.asarray(img.resize((int(size[0]), int(size[1])), Image.Resampling.BILINEAR).convert("RGBA"))
+
+
+def _overlay_rgba(overlay: np.ndarray) -> np.ndarray:
+    """A premultiplied RGBA image as 8-bit straight-alpha RGBA, rows bottom-up (VTK's order), for blending in front
+    of the scene. Pure emission (α = 0, color > 0) is shown with α' = max(α, max color): C + (1 − α') B instead of
+    C + B (error ≤ α' B)."""
+    alpha = np.maximum(overlay[..., 3], overlay[..., :3].max(axis=-1))
+    alpha = np.clip(alpha, 0.0, 1.0)
+    safe = np.where(alpha > 1e-6, alpha, 1.0)
+    straight = np.clip(overlay[..., :3] / safe[..., None], 0.0, 1.0)
+    rgba = np.concatenate([straight, alpha[..., None]], axis=-1)[::-1]  # VTK rows start at the bottom
+    return np.ascontiguousarray((rgba * 255.0 + 0.5).astype(np.uint8))
+
+
+def build_nature_components(plotter: Any, components: Sequence[Any], datasets: dict[str, Any], camera: Any = None,
+                            size: tuple[int, int] | None = None) -> NatureView:
+    """Add the session's terrain / fog / clouds / sky components to ``plotter`` and render the first overlay for
+    ``camera`` (a ``volviz.model.camera.Camera``, a ``volviz.session.CameraState`` or None for the
+    plotter's). Call ``view.update()`` again after the camera moves."""
+    scene = scene_from_components(components, datasets)
+    view = NatureView(plotter, scene, size)
+    cam = _as_camera(camera, scene) if camera is not None else None
+    view.update(cam)
+    return view
+
+
+def _as_camera(camera: Any, scene: NatureScene) -> Any:
+    from volviz.model.camera import Camera
+
+    if isinstance(camera, Camera):
+        return camera
+    near, far = 5.0, 20000.0
+    if scene.terrain is not None:
+        ex = max(scene.terrain.extent)
+        near, far = max(ex * 1e-3, 0.1), ex * 20.0
+    return Camera(camera.position, camera.focal_point, camera.view_up, camera.view_angle,
+                  clipping_range=(near, far))
