@@ -3,13 +3,11 @@ statistics), menus, status bar with progress and cancel, sessions with autosave 
 everything is a call into volviz."""
 from __future__ import annotations
 
-import copy
 import logging
-import os
 import threading
 import time
 from pathlib import Path
-from typing import Any, Callable, Optional
+from typing import Any, Optional
 
 from PySide6.QtCore import QSettings, Qt, QTimer
 from PySide6.QtGui import QAction, QKeySequence, QUndoGroup, QUndoStack
@@ -29,8 +27,8 @@ from volviz_app.docks.clipping import ClippingDock
 from volviz_app.docks.render_settings import RENDERER_DEFAULTS, RenderSettingsDock
 from volviz_app.gc_guard import GuiThreadCollector
 from volviz_app.help import HelpMenu
-from volviz_app.errors import hide_temporary_names
 from volviz_app.export_dialogs import ExportDialogs
+from volviz_app.export_runs import ExportRuns
 from volviz_app.layout import WindowLayout, scrolled
 from volviz_app.recent import RecentFiles
 from volviz_app.scene_loading import SceneLoading
@@ -73,7 +71,7 @@ def _import_gui_thread_modules() -> None:
     pyvista.system_supports_plotting()
 
 
-class MainWindow(SceneLoading, SessionFiles, ViewScheduler, CameraBookmarks, QMainWindow):
+class MainWindow(SceneLoading, SessionFiles, ViewScheduler, ExportRuns, CameraBookmarks, QMainWindow):
     """volviz main window. ``open_path`` is the single code path behind File > Open and the command line."""
 
     def __init__(self, parent: Optional[QWidget] = None, settings: Optional[QSettings] = None,
@@ -103,9 +101,7 @@ class MainWindow(SceneLoading, SessionFiles, ViewScheduler, CameraBookmarks, QMa
         self._histogram_job: Any = None
         self.histograms_computed = 0       # TF-editor histograms computed in the background and shown
         self.histogram_threads: set[int] = set()       # the threads they were computed on
-        self._export_run: Any = None       # the running screenshot or movie export (``frame_export``)
-        self.export_result: Optional[bool] = None  # of the last export: None while it runs
-        self.export_threads: set[int] = set()      # the threads its background steps ran on
+        self._init_exports()               # the running export and the last one's result
         self._load_serial = 0              # the newest open/rebuild; an older one's late callbacks do nothing
         self._loading_views = False        # the newest scene is installed, its first views are computed
         self._init_view_scheduler()        # its OneInFlight jobs and what they have shown
@@ -600,65 +596,6 @@ class MainWindow(SceneLoading, SessionFiles, ViewScheduler, CameraBookmarks, QMa
             self._camera_moved()
 
     # -- autosave and recovery ------------------------------------------------------------------------------------
-    # ------------------------------------------------------------------------------------------------ export
-    def export_screenshot(self, path: str | os.PathLike, size: Optional[tuple[int, int]] = None) -> None:
-        """Re-render the current view offscreen at ``size`` (default: the viewport's) and write an image (PNG, JPEG
-        or TIFF by the extension), in the background with progress and cancel in the status bar
-        (``volviz_app.frame_export``; a newer export supersedes an older one). ``export_result`` is None while it runs,
-        then True (written) or False."""
-        from volviz.render.export import ImageFile
-
-        size = size or (self.plotter.interactor.width(), self.plotter.interactor.height())
-        self._export(Path(path).name, size, lambda controller: [(None, None)], lambda: ImageFile(path))
-
-    def export_movie(self, path: str | os.PathLike, path_name: Optional[str], through_time: bool,
-                     fps: float = 24.0, size: Optional[tuple[int, int]] = None, orbit: bool = False) -> None:
-        """Render a movie offscreen along the camera path ``path_name`` (or, with ``orbit``, one turn around the
-        current view) and/or through time, in the background like a screenshot (``export_result``): MP4 through
-        imageio-ffmpeg for ``.mp4``, else a PNG sequence in the folder ``path``."""
-        from volviz.render.export import MovieWriter, movie_frames
-
-        self._export(Path(path).name, size or self.session.render.size,
-                     lambda controller: movie_frames(controller, path_name, fps, through_time, orbit=orbit),
-                     lambda: MovieWriter(Path(path), fps))
-
-    def _export(self, name: str, size: tuple[int, int], frames_of: Callable[[Any], list[Any]],
-                open_sink: Callable[[], Any]) -> None:
-        from volviz.render.export import offscreen_scene
-        from volviz_app.frame_export import FrameExport
-
-        if self._export_run is not None:
-            self._export_run.cancel()  # superseded: it ends quietly, the newer export owns the status bar
-        self.export_result = None
-        live = self.controller
-        session = Session(datasets=self.session.datasets, components=copy.deepcopy(self.session.components),
-                          transfer_functions=copy.deepcopy(self.session.transfer_functions),
-                          camera=live.camera() if live else None, render=self.session.render,
-                          clip=self.session.clip, camera_paths=copy.deepcopy(self.session.camera_paths))
-        plotter, controller = offscreen_scene(session, self.datasets, size)
-        t = None
-        if live is not None and live.time_series():
-            t, controller.interpolate_time = live.time, live.interpolate_time
-        self.status_label.setText(f"Exporting {name}…")
-        self._set_busy(True)
-        run: Any = None
-
-        def end(ok: bool, message: str) -> None:
-            self.export_threads |= run.threads
-            if run is not self._export_run:  # superseded
-                return
-            self._export_run = None
-            self.export_result = ok
-            if not self._busy_elsewhere():
-                self._set_busy(False)
-            self.status_label.setText(message)
-            if not ok and not run.cancelled:
-                self.show_error("Cannot export", hide_temporary_names(message))
-
-        self.export_threads = set()
-        run = FrameExport(self, plotter, controller, size, name, frames_of, open_sink, end, t)
-        self._export_run = run
-
     # ------------------------------------------------------------------------------------------------ dialogs
     def show_error(self, title: str, text: str) -> None:
         """A non-blocking error dialog (the app keeps running); also logged."""
