@@ -154,7 +154,8 @@ def describe(path: str, array: Optional[str] = None, q: Optional[str] = None) ->
     from volviz.io import read
 
     with _reading(p, q):
-        dataset = read(p, **({"q": q} if q else {}))
+        options: dict[str, Any] = {"q": q} if q else {}
+        dataset = read(p, **options)
     base = dataset.frame(0) if isinstance(dataset, TimeSeries) else dataset
     desc: dict[str, Any] = {"file": str(p), "kind": dataset.kind, "dimensions": list(dataset.dimensions),
                             "points": dataset.n_points, "cells": dataset.n_cells}

@@ -16,6 +16,8 @@ from typing import Any, Optional, Sequence
 
 import numpy as np
 
+from volviz.model import vec3
+
 DEFAULT_PNG = Path(__file__).resolve().parents[2] / "docs" / "bench" / "compression-animation.png"
 SECTION = "### Rendered walkthrough frames"
 
@@ -27,7 +29,7 @@ def orbit(shape: Sequence[int], frames: int) -> list[tuple[tuple[float, float, f
     for f in range(frames):
         ang = 2 * math.pi * f / 24
         eye = c + 1.6 * float(shape[0]) * np.array([math.cos(ang), math.sin(ang), 0.3])
-        out.append((tuple(map(float, eye)), tuple(map(float, c))))
+        out.append((vec3(eye), vec3(c)))
     return out
 
 

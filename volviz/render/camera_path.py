@@ -13,6 +13,7 @@ from typing import Callable, Optional, Sequence
 
 import numpy as np
 
+from volviz.model import vec3
 from volviz.session import CameraKey, CameraState
 
 
@@ -36,7 +37,7 @@ def interpolate_path(keys: Sequence[CameraKey], t: float) -> CameraState:
 
     def spline(attr: str) -> tuple[float, float, float]:
         p = [np.asarray(getattr(keys[j].camera, attr), dtype=np.float64) for j in idx]
-        return tuple(float(v) for v in _catmull_rom(*p, u))  # type: ignore[return-value]
+        return vec3(_catmull_rom(p[0], p[1], p[2], p[3], u))
 
     a, b = keys[i].camera, keys[i + 1].camera
     up = (1 - u) * np.asarray(a.view_up) + u * np.asarray(b.view_up)
@@ -44,8 +45,8 @@ def interpolate_path(keys: Sequence[CameraKey], t: float) -> CameraState:
     up = up / norm if norm > 0 else np.asarray(a.view_up)
     position, focal = spline("position"), spline("focal_point")
     if np.allclose(position, focal):
-        focal = tuple(np.asarray(position) + (np.asarray(b.focal_point) - np.asarray(b.position)))  # type: ignore
-    return CameraState(position=position, focal_point=focal, view_up=tuple(float(v) for v in up),  # type: ignore
+        focal = vec3(np.asarray(position) + (np.asarray(b.focal_point) - np.asarray(b.position)))
+    return CameraState(position=position, focal_point=focal, view_up=vec3(up),
                        view_angle=(1 - u) * a.view_angle + u * b.view_angle, parallel=a.parallel,
                        parallel_scale=(1 - u) * a.parallel_scale + u * b.parallel_scale)
 
@@ -119,8 +120,7 @@ class FlyNavigator:
             if pos[2] < floor:
                 pos[2] = floor
         focal = pos + f * dist
-        return replace(cam, position=tuple(map(float, pos)), focal_point=tuple(map(float, focal)),
-                       view_up=tuple(map(float, self.world_up)))
+        return replace(cam, position=vec3(pos), focal_point=vec3(focal), view_up=vec3(self.world_up))
 
     def look(self, cam: CameraState, yaw_degrees: float, pitch_degrees: float) -> CameraState:
         """Turn the view direction: yaw about the world up axis, pitch about the camera's right axis."""
@@ -134,7 +134,7 @@ class FlyNavigator:
         pitch = float(np.clip(elevation + pitch, -limit, limit)) - elevation
         f = _rotate(f, r, pitch)
         focal = np.asarray(cam.position) + f * dist
-        return replace(cam, focal_point=tuple(map(float, focal)), view_up=tuple(map(float, self.world_up)))
+        return replace(cam, focal_point=vec3(focal), view_up=vec3(self.world_up))
 
 
 def _rotate(v: np.ndarray, axis: np.ndarray, angle: float) -> np.ndarray:

@@ -13,10 +13,16 @@ the background).
 from __future__ import annotations
 
 from contextlib import contextmanager
-from typing import Any, Iterator, Optional
+from typing import TYPE_CHECKING, Any, Iterator, Optional, TypeGuard
 
 from volviz.model import TimeSeries
 from volviz.session import CameraState, Component, Session
+
+if TYPE_CHECKING:
+    from volviz.render.gl_iso import GLIsoView
+    from volviz.render.iso_overlay import IsoOverlay
+    from volviz.render.lod_volume import LodVolume
+    from volviz.render.pt_view import PTView
 
 
 ISO_MODES = ("vtk", "2pass", "3pass", "4pass", "exact")
@@ -31,13 +37,13 @@ def iso_summary(stats: dict[str, Any]) -> str:
     return f"{stats['method']}: {stats['triangles']:,} triangles{drawn_text}, {stats['volume_s'] * 1000:.0f} ms"
 
 
-def _is_lod(prop: Any) -> bool:
+def _is_lod(prop: Any) -> TypeGuard[LodVolume]:
     from volviz.render.lod_volume import LodVolume
 
     return isinstance(prop, LodVolume)
 
 
-def _is_pt(prop: Any) -> bool:
+def _is_pt(prop: Any) -> TypeGuard[PTView]:
     """A PT volume on either backend (``volviz.render.pt_view``)."""
     from volviz.render.pt_view import is_pt_view
 
@@ -702,11 +708,16 @@ class SceneController:
             view.remove()
             view = self.iso_view = None
         if view is None and mode != "vtk" and self._iso_props():
+            view_type: type[GLIsoView] | type[IsoOverlay]
             if backend == "gpu":
-                from volviz.render.gl_iso import GLIsoView as View
+                from volviz.render.gl_iso import GLIsoView
+
+                view_type = GLIsoView
             else:
-                from volviz.render.iso_overlay import IsoOverlay as View
-            view = self.iso_view = View(self.plotter, mode=mode)
+                from volviz.render.iso_overlay import IsoOverlay
+
+                view_type = IsoOverlay
+            view = self.iso_view = view_type(self.plotter, mode=mode)
         if view is not None:
             view.mode = mode
         self._sync_iso_overlay()

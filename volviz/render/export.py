@@ -410,6 +410,7 @@ class MovieWriter:
 
     def close(self) -> None:
         if self.mp4:
+            assert self.tmp is not None  # named in __init__ for a movie
             try:
                 with _named_errors(self.target, self.tmp):
                     if self.writer is None:
@@ -423,6 +424,7 @@ class MovieWriter:
 
     def abort(self) -> None:
         if self.mp4:
+            assert self.tmp is not None  # named in __init__ for a movie
             try:
                 if self.writer is not None:
                     self.writer.close()

@@ -70,7 +70,7 @@ from volviz.iso.composite import AMBIENT, MODES
 from volviz.iso.extract import IsoMesh
 from volviz.iso.spectrum import fit_spectrum
 from volviz.render.gl_pt import GLPTVolume, shader_source
-from volviz.render.image_overlay import hold_single_sample, release_single_sample
+from volviz.render.image_overlay import hold_single_sample, release_single_sample, window_size
 from volviz.render.iso_overlay import IsoModeView
 
 __all__ = ["GLIsoSurfaces", "GLIsoView", "iso_polydata"]
@@ -102,7 +102,8 @@ def iso_polydata(meshes: Sequence[IsoMesh], centre: np.ndarray, shading: str = "
     import vtk
     from vtk.util.numpy_support import numpy_to_vtk
 
-    pts, tris, cols = [], [], {k: [] for k in _ATTRIBUTES}
+    pts, tris = [], []
+    cols: dict[str, list[np.ndarray]] = {k: [] for k in _ATTRIBUTES}
     base = 0
     for m in meshes:
         st = m.style
@@ -243,7 +244,7 @@ class GLIsoSurfaces:
         import vtk
 
         ren_win = self.renderer.GetRenderWindow()
-        size = tuple(int(v) for v in self.renderer.GetSize())
+        size = window_size(self.renderer)
         state.PushFramebufferBindings()
         self._pushed = True
         if self._fbo is None or self._fbo_size != size:
@@ -390,7 +391,7 @@ class GLIsoView(IsoModeView):
         passes = {"2pass": 1, "3pass": 2, "4pass": 3}.get(self.mode)
         self.stats = {"method": f"iso {self.mode} (gpu)", "triangles": n,
                       "triangles_drawn": None if passes is None else passes * n, "volume_s": self._frame_s,
-                      "size": tuple(int(v) for v in self.plotter.renderer.GetSize())}
+                      "size": window_size(self.plotter.renderer)}
         return self.stats
 
     def remove(self) -> None:

@@ -91,7 +91,7 @@ from typing import Any
 import numpy as np
 
 from volviz.model.datasets import TetMesh
-from volviz.render.image_overlay import hold_single_sample, release_single_sample
+from volviz.render.image_overlay import hold_single_sample, release_single_sample, window_size
 from volviz.render.pt_view import PTView
 from volviz.model.camera import Camera
 from volviz.unstructured.iso import iso_visible
@@ -383,7 +383,7 @@ class GLPTVolume(PTView):
             return
         self._apply_kind()
         cam = self.camera = self._camera()
-        size = tuple(int(v) for v in self.renderer.GetSize())
+        size = window_size(self.renderer)
         key = _order_key(cam, size)
         if key == self._order_key and self._sorted is not None and not self._recull:
             return
@@ -397,6 +397,7 @@ class GLPTVolume(PTView):
             self._sorted, self._cycles, self._sorted_key = res.order, int(res.cycles), key
         self._recull = False
         t1 = time.perf_counter()
+        assert self._sorted is not None  # this order, a prefetched one, a fresh sort or the earlier one reused
         cells = self._sorted[self._vis[self._sorted]]
         self._set_index_buffer(cells)
         self.order, self._order_key = cells, key
@@ -408,7 +409,7 @@ class GLPTVolume(PTView):
         """GUI thread: the order to make next, for the renderer's camera and size now (``scale`` > 1: asked for
         during an interaction; the order is the same)."""
         cam = self._camera()
-        size = tuple(int(v) for v in self.renderer.GetSize())
+        size = window_size(self.renderer)
         key = _order_key(cam, size)
         return {"camera": cam, "size": size, "key": key, "topo": self.topo, "preview": scale > 1,
                 "have": self._sorted is not None and key == self._sorted_key}
@@ -452,7 +453,7 @@ class GLPTVolume(PTView):
         if self._prefetcher is None:
             self._prefetcher = SortPrefetcher(self.mesh, sort=self.sort, nonconvex=self.nonconvex)
         if size is None:
-            size = tuple(int(v) for v in self.renderer.GetSize())
+            size = window_size(self.renderer)
         self._prefetcher.prefetch(camera, size)
 
     def _on_end(self, *_: Any) -> None:
@@ -547,6 +548,7 @@ class GLPTVolume(PTView):
     def _restore(self) -> None:
         """The scene's framebuffer again."""
         if self._bound:
+            assert self._targets is not None  # bound to them
             self._targets[1].RestorePreviousBindingsAndBuffers()
             self._bound = False
 

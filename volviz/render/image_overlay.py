@@ -120,6 +120,12 @@ def read_buffers(ren_win: Any, w: int, h: int) -> tuple[np.ndarray, np.ndarray]:
     return zz, cc
 
 
+def window_size(window: Any) -> tuple[int, int]:
+    """The (width, height) in pixels of a vtkRenderer or vtkRenderWindow."""
+    width, height = window.GetSize()
+    return int(width), int(height)
+
+
 def hold_single_sample(plotter: Any, holder: Any) -> None:
     """Multisampling off while ``holder`` is in the plotter (one color and depth per pixel: the overlays read the
     depth back, the GL PT pass draws into a single-sample float target; module docstring)."""

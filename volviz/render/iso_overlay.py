@@ -120,10 +120,11 @@ class IsoOverlay(OverlayView, IsoModeView):
                              full_triangles=sum(m.n_triangles for m in request["meshes"]), extra={})
         return img, st
 
-    def finish(self, request: dict[str, Any], img: np.ndarray, st: Any) -> np.ndarray:
+    def finish(self, request: dict[str, Any], img: np.ndarray, st: Any, rgba8: np.ndarray | None = None) -> np.ndarray:
         """Show the image. Straight-alpha blending cannot show a color above its alpha, which the order-independent
         sums of 3/4-pass produce; those pixels are composited here over the scene color read back in ``begin`` and
-        drawn opaque (exact for the opaque scene; a PT volume's overlay under such a pixel is not seen through)."""
+        drawn opaque (exact for the opaque scene; a PT volume's overlay under such a pixel is not seen through).
+        ``compute`` makes no ``rgba8``: the parameter is the base class's."""
         shown = img
         over = np.any(img[..., :3] > img[..., 3:4] + 0.5 / 255.0, axis=-1)
         if over.any():

@@ -43,6 +43,7 @@ from typing import Any, Optional
 
 import numpy as np
 
+from volviz.model import vec3
 from volviz.regular.lod import Block, LodCamera, LodTree, Selection
 from volviz.render.vtk_scene import update_volume_property, vtk_volume_property
 from volviz.render.image_overlay import ImageOverlay, unpremultiply_rgba8, zbuffer_to_depth
@@ -54,9 +55,9 @@ __all__ = ["LodVolume", "RENDERERS", "lod_bounds", "lod_camera", "lod_scalar_ran
 
 def lod_camera(vtk_camera: Any, size: tuple[int, int]) -> LodCamera:
     """The LOD selection's pinhole camera for a ``vtkCamera``/``pyvista.Camera`` and an image ``size`` (W, H)."""
-    return LodCamera(eye=tuple(map(float, vtk_camera.GetPosition())),
-                     target=tuple(map(float, vtk_camera.GetFocalPoint())),
-                     up=tuple(map(float, vtk_camera.GetViewUp())), fov_y=float(vtk_camera.GetViewAngle()),
+    return LodCamera(eye=vec3(vtk_camera.GetPosition()),
+                     target=vec3(vtk_camera.GetFocalPoint()),
+                     up=vec3(vtk_camera.GetViewUp()), fov_y=float(vtk_camera.GetViewAngle()),
                      width=int(size[0]), height=int(size[1]))
 
 

@@ -33,7 +33,8 @@ from typing import Any
 import numpy as np
 
 from volviz.model.datasets import TetMesh
-from volviz.render.image_overlay import OverlayView, overlay_rgba8, unpremultiply_rgba8, zbuffer_to_depth
+from volviz.render.image_overlay import (OverlayView, overlay_rgba8, unpremultiply_rgba8, window_size,
+                                         zbuffer_to_depth)
 from volviz.render.pt_view import PTView
 from volviz.model.camera import Camera
 from volviz.unstructured.render import render
@@ -108,7 +109,7 @@ class PTVolume(OverlayView, PTView):
             self._prefetcher = SortPrefetcher(self.mesh, sort=self.render_opts.get("sort", "mpvo"),
                                               nonconvex=self.render_opts.get("nonconvex", "auto"))
         if size is None:
-            size = tuple(int(v) for v in self.plotter.ren_win.GetSize())
+            size = window_size(self.plotter.ren_win)
         self._prefetcher.prefetch(camera, size)
 
     def error_estimate(self, request: dict[str, Any], size: tuple[int, int] = (96, 72),

@@ -5,7 +5,7 @@
 """
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, TypeGuard
 
 from volviz.render.framing import Bounds, points_bounds
 
@@ -43,5 +43,5 @@ class PTView:
         return points_bounds(self.whole_mesh.points)
 
 
-def is_pt_view(prop: Any) -> bool:
+def is_pt_view(prop: Any) -> TypeGuard[PTView]:
     return isinstance(prop, PTView)

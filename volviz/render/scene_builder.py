@@ -9,7 +9,7 @@ import os
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Optional
+from typing import TYPE_CHECKING, Any, Optional
 
 import numpy as np
 
@@ -122,7 +122,7 @@ def vvz_voxels(path: str | os.PathLike) -> int:
     """Number of voxels of a ``.vvz`` file, from its header (nothing is decoded)."""
     from volviz.regular.nodes import NodeDecoder
 
-    return int(np.prod(NodeDecoder(path).dims))
+    return int(np.prod(NodeDecoder(os.fspath(path)).dims))
 
 
 def demo_session() -> Session:
@@ -205,7 +205,7 @@ def ensure_transfer_functions(session: Session, datasets: dict[str, Any]) -> Non
         if comp.transfer_function is None and comp.type in ("volume", "mesh", "demo"):
             if comp.dataset is not None and comp.dataset not in datasets:
                 continue  # a hidden component's data is not read: it gets its TF when shown
-            if isinstance(datasets.get(comp.dataset), Image2D):
+            if comp.dataset is not None and isinstance(datasets.get(comp.dataset), Image2D):
                 continue  # an image shows its own colors (``vtk_scene.add_dataset``)
             name = comp.id
             while name in session.transfer_functions:

@@ -11,7 +11,7 @@ from typing import Any, Optional
 
 import numpy as np
 
-from volviz.model import CurvilinearGrid, Image2D, RegularVolume, TetMesh, TimeSeries, UnstructuredMesh
+from volviz.model import CurvilinearGrid, Image2D, RegularVolume, TetMesh, TimeSeries, UnstructuredMesh, vec3
 from volviz.session import CameraState
 
 DEFAULT_COLORS = ((0.23, 0.30, 0.75), (0.87, 0.87, 0.87), (0.71, 0.02, 0.15))  # cool-warm: low, middle, high
@@ -235,6 +235,6 @@ def apply_camera(plotter: Any, camera: Optional[CameraState]) -> None:
 
 def camera_state(plotter: Any) -> CameraState:
     cam = plotter.camera
-    return CameraState(position=tuple(map(float, cam.position)), focal_point=tuple(map(float, cam.focal_point)),
-                       view_up=tuple(map(float, cam.up)), view_angle=float(cam.view_angle),
+    return CameraState(position=vec3(cam.position), focal_point=vec3(cam.focal_point),
+                       view_up=vec3(cam.up), view_angle=float(cam.view_angle),
                        parallel=bool(cam.parallel_projection), parallel_scale=float(cam.parallel_scale))
