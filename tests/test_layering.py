@@ -1,7 +1,8 @@
 """The layering of ``pyproject.toml``'s import-linter contracts holds: ``volviz`` never imports Qt (nor the app),
 and each package imports only the layers below it (model at the bottom, then io and jobs, optics, the four method
 packages, the session, render, the benches and the CLI). The names of issue #18 hold too: one spelling of color in
-the library, no two classes of the same name in it and the app, no module named ``scene.py``."""
+the library, no two classes of the same name in it and the app, no module named ``scene.py``; ruff and mypy find
+nothing."""
 from __future__ import annotations
 
 import shutil
@@ -26,6 +27,15 @@ def test_ruff_finds_nothing():
     assert ruff is not None, "ruff is a test dependency (pip install -e .[test])"
     done = subprocess.run([ruff, "check", "volviz", "app", "plugins"], cwd=ROOT, capture_output=True, text=True,
                           timeout=300)
+    assert done.returncode == 0, done.stdout[-4000:] + done.stderr[-2000:]
+
+
+def test_mypy_finds_nothing():
+    """The types of pyproject.toml's [tool.mypy] (issue #18: not strict yet, the bodies of unannotated functions
+    checked too)."""
+    mypy = shutil.which("mypy", path=str(Path(sys.executable).parent)) or shutil.which("mypy")
+    assert mypy is not None, "mypy is a test dependency (pip install -e .[test])"
+    done = subprocess.run([mypy, "volviz"], cwd=ROOT, capture_output=True, text=True, timeout=600)
     assert done.returncode == 0, done.stdout[-4000:] + done.stderr[-2000:]
 
 
