@@ -1,0 +1,343 @@
+"""Edits of the shown scene in the main window (a mixin of ``MainWindow``): what the docks' signals do. The scene
+dock selects a component (its transfer function and histogram, computed in the background when missing, go to the TF
+editor), shows or hides it (a component hidden at load is prepared in the background, a natural-scene component
+rebuilds the natural scene in the background), and sets its opacity and settings; the TF editor's edits are
+throttled to one re-render per ``PREVIEW_MS`` (previews while dragging, full size with an error estimate once an
+edit is finished); the clipping dock cuts every prop (isosurfaces and PT meshes in the background); the render
+settings dock changes the renderer (the scene rebuilt with the same camera), the isosurface mode or the error budget.
+
+It expects of the window: ``controller``, ``session``, ``session_path``, ``datasets``, ``jobs``, ``status_label``,
+``tf_editor``, ``scene_tree``, ``array_choice``, ``render()``, ``schedule_render()``, ``set_dirty``,
+``show_error``, ``_show_session`` (``volviz_app.scene_loading``), the refreshes of ``volviz_app.view_scheduler``
+(``refresh_pt``, ``refresh_lod``, ``refresh_nature``, ``refresh_iso_overlay``, ``_enforce_error_budget``) and
+``last_error_rmse``; ``_init_scene_edits()`` makes its state and ``_connect_scene_edits()`` its preview timer (both
+called by the window's ``__init__``; the docks' signals are connected where the docks are built)."""
+from __future__ import annotations
+
+import threading
+from typing import Any, Optional
+
+from PySide6.QtCore import Qt, QTimer
+
+from volviz.jobs import JobOutcome
+from volviz.session import SessionError
+from volviz_app.docks.render_settings import RENDERER_DEFAULTS
+from volviz_app.view_scheduler import MOVING_SCALE
+
+PREVIEW_MS = 40          # live transfer-function preview: at most one re-render per 40 ms while dragging
+
+
+def _histogram_range(hist: Any) -> Optional[tuple[float, float]]:
+    """The data range a (counts, edges) histogram spans (None without one)."""
+    return None if hist is None else (float(hist[1][0]), float(hist[1][-1]))
+
+
+class SceneEdits:
+    """The docks' edits of the shown scene (see the module's docstring)."""
+
+    def _init_scene_edits(self) -> None:
+        self.components_shown = 0          # components hidden at load, prepared in the background and added
+        self._histogram_job: Any = None
+        self.histograms_computed = 0       # TF-editor histograms computed in the background and shown
+        self.histogram_threads: set[int] = set()       # the threads they were computed on
+        self._pending_tf: Optional[tuple[str, Any, bool]] = None  # (component, TF, a finished edit)
+        self.nature_rebuilds = 0           # natural scenes rebuilt in the background (visibility toggles)
+        self.isosurface_clip_shown: Optional[dict[str, Any]] = None  # the clipping the shown isosurfaces are cut by
+
+    def _connect_scene_edits(self) -> None:
+        self.preview_timer = QTimer(self, singleShot=True, interval=PREVIEW_MS)
+        self.preview_timer.timeout.connect(self._apply_pending_tf)
+
+    def _select_component(self, comp_id: str) -> None:
+        if self.controller is None:
+            return
+        self.array_choice.show_component(comp_id)
+        tf = self.controller.transfer_function(comp_id)
+        self.tf_editor.setEnabled(tf is not None)
+        if tf is None:
+            return
+        if comp_id in self.controller.lod_volumes():  # too large to decode whole: the range from node statistics
+            from volviz.render.lod_volume import lod_scalar_range
+
+            self.tf_editor.set_transfer_function(tf, data_range=lod_scalar_range(self.controller.dataset_of(comp_id)))
+            return
+        known = self.controller.histograms.get(comp_id)
+        self.tf_editor.blockSignals(True)  # the scene already shows this TF: no preview re-render
+        try:
+            self.tf_editor.set_transfer_function(tf, data_range=_histogram_range(known), histogram=known)
+        finally:
+            self.tf_editor.blockSignals(False)
+        if known is None:
+            self._compute_histogram(comp_id)
+        elif self._histogram_job is not None:
+            self._histogram_job.cancel()  # an older selection's histogram is no longer wanted
+
+    def _compute_histogram(self, comp_id: str) -> None:
+        """The data histogram of a component that has none yet (hidden at load), for the TF editor: its dataset is
+        read and the histogram computed on a worker (``volviz.model.stats.histogram``) while the editor shows a
+        placeholder; a newer selection supersedes it. ``histograms_computed`` counts the ones shown."""
+        from volviz.model.stats import histogram
+        from volviz.render.scene_builder import load_datasets
+
+        controller, session_path = self.controller, self.session_path
+        self.tf_editor.set_histogram_pending()
+
+        def compute(progress: Any = None) -> Any:
+            load_datasets(controller.session, session_path, loaded=controller.datasets, also=(comp_id,))  # hidden
+            self.histogram_threads.add(threading.get_ident())
+            return histogram(controller.dataset_of(comp_id))
+
+        def done(outcome: JobOutcome) -> None:
+            if outcome.ok and self.controller is controller:
+                controller.histograms[comp_id] = outcome.result
+                if self.scene_tree.current_component() == comp_id:
+                    self.tf_editor.set_histogram(outcome.result, _histogram_range(outcome.result))
+                    self.histograms_computed += 1
+            elif outcome.error is not None:
+                self.tf_editor.set_histogram(None, None)
+                self.show_error(f"Cannot compute the histogram of {comp_id}", str(outcome.error))
+
+        self._histogram_job = self.jobs.submit(compute, name=f"histogram {comp_id}", key="histogram", on_done=done)
+
+    def _tf_changed(self, tf: Any) -> None:
+        comp_id = self.scene_tree.current_component()
+        if comp_id is None or self.controller is None:
+            return
+        # a finished edit renders at full size; a drag under way (the editor's TF not yet committed) as a preview
+        self._pending_tf = (comp_id, tf, tf is self.tf_editor.committed_transfer_function)
+        if not self.preview_timer.isActive():
+            self.preview_timer.start()
+
+    def _tf_committed(self, tf: Any) -> None:
+        self._tf_changed(tf)
+        self.set_dirty()
+
+    def _apply_pending_tf(self) -> None:
+        if self._pending_tf is None or self.controller is None:
+            return
+        comp_id, tf, finished = self._pending_tf
+        self._pending_tf = None
+        volume = self.controller.pt_volume(comp_id)
+        if volume is None:  # VTK mapper: the new color/opacity functions draw at once
+            lod = comp_id in self.controller.lod_volumes()
+            self.controller.set_transfer_function(comp_id, tf, update=not lod)
+            self.render()
+            if lod:  # the block selection depends on the TF (transparent blocks): re-select in the background
+                self.refresh_lod([comp_id])
+            return
+        # volviz PT volume: table build and rasterisation run in the background; the newest edit renders next, while
+        # dragging as a preview (``MOVING_SCALE``), a finished edit at full size with a fresh error estimate
+        self.controller.set_transfer_function(comp_id, tf, update=False)
+        self.refresh_pt(comp_id, estimate=finished, scale=1 if finished else MOVING_SCALE)
+
+    def _set_visibility(self, comp_id: str, visible: bool) -> None:
+        from volviz.render.scene_builder import NATURE_TYPES
+
+        if self.controller is None:
+            return
+        controller = self.controller
+        nature = controller.component(comp_id).type in NATURE_TYPES
+        build = visible and controller.needs_build(comp_id)
+        controller.set_visible(comp_id, visible, nature=False, build=False)
+        self.set_dirty()
+        if nature:
+            self.rebuild_nature(comp_id, visible)
+            return
+        if build:
+            self.show_component(comp_id)
+            return
+        self.render()
+        self.refresh_iso_overlay()
+
+    def show_component(self, comp_id: str) -> None:
+        """A component hidden at load was shown: prepare it in the background (extraction, tetrahedralisation, VTK
+        volume input, histogram; a newer request for it supersedes), add its prop on this thread, then compute its
+        view-dependent parts in the background. ``components_shown`` counts the ones installed."""
+        from volviz.render.scene_builder import load_datasets
+
+        controller, session_path = self.controller, self.session_path
+        self.status_label.setText(f"Preparing {comp_id}…")
+
+        def prepare(progress: Any = None) -> Any:
+            load_datasets(controller.session, session_path, loaded=controller.datasets)  # a component shown anew
+            return controller.prepare_component(comp_id, progress)
+
+        def done(outcome: JobOutcome) -> None:
+            if self.controller is not controller:
+                return
+            if outcome.ok:
+                if not controller.component(comp_id).visible or not controller.needs_build(comp_id):
+                    return  # hidden again meanwhile (or already shown)
+                controller.install_component(comp_id, outcome.result, views=False)
+                self.components_shown += 1
+                self.status_label.setText(f"Showing {comp_id}")
+                self.schedule_render()
+                self.refresh_pt(comp_id)
+                self.refresh_lod([comp_id])
+                self.refresh_iso_overlay()
+            elif outcome.error is not None:
+                self._revert_visibility(comp_id, True)
+                self.show_error(f"Cannot show {comp_id}", str(outcome.error))
+
+        self.jobs.submit(prepare, name=f"show {comp_id}", key=f"show:{comp_id}", on_done=done)
+
+    def _revert_visibility(self, comp_id: str, visible: bool) -> None:
+        """Showing (``visible``) or hiding a component failed: it keeps its previous state, and so does its box."""
+        self.controller.component(comp_id).visible = not visible
+        tree = self.scene_tree.tree
+        tree.blockSignals(True)
+        try:
+            self.scene_tree.item(comp_id).setCheckState(
+                0, Qt.CheckState.Unchecked if visible else Qt.CheckState.Checked)
+        finally:
+            tree.blockSignals(False)
+
+    def rebuild_nature(self, comp_id: str, visible: bool) -> None:
+        """A terrain / fog / clouds / sky component was shown or hidden: rebuild the natural scene in the background
+        (maps, fog prisms, cloud volumes; a newer toggle supersedes an older one), put it in on this thread, then
+        compute its first view in the background; the old one stays on screen meanwhile. A scene that cannot be
+        built (fog without terrain) leaves the component as it was, with a message."""
+        from volviz.render.scene_builder import load_datasets
+
+        controller, session_path = self.controller, self.session_path
+
+        def prepare(progress: Any = None) -> Any:
+            load_datasets(controller.session, session_path, loaded=controller.datasets)  # a component shown anew
+            return controller.prepare_nature(progress)
+
+        def done(outcome: JobOutcome) -> None:
+            if self.controller is not controller:
+                return
+            if outcome.ok:
+                controller.install_nature(outcome.result, views=False)
+                self.nature_rebuilds += 1
+                if controller.nature is None:
+                    self.schedule_render()
+                self.refresh_nature()
+            elif outcome.error is not None:
+                self._revert_visibility(comp_id, visible)
+                self.show_error(f"Cannot {'show' if visible else 'hide'} {comp_id}", str(outcome.error))
+
+        self.jobs.submit(prepare, name="natural scene", key="nature-build", on_done=done)
+
+    def _set_opacity(self, comp_id: str, opacity: float) -> None:
+        if self.controller is None:
+            return
+        controller = self.controller
+        iso = controller.component(comp_id).type == "isosurface"
+        controller.set_opacity(comp_id, opacity, isosurfaces=not iso)
+        self.set_dirty()
+        if iso:  # the surfaces are re-made (opacity, clipping, LOD chains) in the background
+            self._recut_isosurfaces(controller, controller.clip)
+            return
+        self.render()
+        self.refresh_iso_overlay()
+
+    def set_clip(self, clip: dict[str, Any]) -> None:
+        """New scene-wide clipping (from the clipping dock): every prop is cut; isosurfaces and PT volumes are cut
+        in the background (a 535k-triangle isosurface: 0.2 s of clipping and LOD chains), then re-rendered; volumes
+        at a level of detail are ray cast again with the planes in the background."""
+        if self.controller is None:
+            return
+        controller = self.controller
+        try:
+            pt_ids = controller.set_clip(clip, update_pt=False, cut_pt=False, isosurfaces=False)
+        except ValueError as exc:
+            self.show_error("Invalid clipping", str(exc))
+            return
+        self.set_dirty()
+        self.render()
+        self.refresh_iso_overlay()
+        self.refresh_lod()      # ray cast again with the new planes, in the background
+        settings = controller.clip
+        self._recut_isosurfaces(controller, settings)
+        for comp_id in pt_ids:  # the exact cut of a tetrahedral mesh runs in the background, then the re-render
+
+            def done(outcome: JobOutcome, comp_id: str = comp_id) -> None:
+                if outcome.ok and self.controller is controller and controller.clip == settings:
+                    controller.set_pt_mesh(comp_id, outcome.result)
+                    self.render()
+                    self.refresh_pt(comp_id)
+                elif outcome.error is not None:
+                    self.show_error("Cannot clip the volume", str(outcome.error))
+
+            self.jobs.submit(controller.cut_pt_mesh, comp_id, settings, name="clip volume", key=f"clip:{comp_id}",
+                             on_done=done)
+
+    def _recut_isosurfaces(self, controller: Any, settings: Any) -> None:
+        """Cut the isosurfaces' extracted surfaces by new clipping (or for a new opacity) on a worker, with their LOD
+        chains (a newer request supersedes), then swap their actors here; ``isosurfaces_cut()`` tells when the
+        clipping is shown."""
+        from volviz.render.scene_builder import isosurface_parts
+
+        meshes = controller.isosurface_meshes()
+        if not meshes:
+            self.isosurface_clip_shown = settings.to_dict()
+            return
+        comps = {comp_id: controller.component(comp_id) for comp_id in meshes}
+
+        def cut(progress: Any = None) -> dict[str, Any]:
+            return {comp_id: isosurface_parts(comps[comp_id], meshes=m, clip=settings)
+                    for comp_id, m in meshes.items()}
+
+        def done(outcome: JobOutcome) -> None:
+            if outcome.ok and self.controller is controller and controller.clip == settings:
+                controller.show_isosurfaces(outcome.result)
+                self.isosurface_clip_shown = settings.to_dict()
+                self.render()
+                self.refresh_iso_overlay()
+            elif outcome.error is not None:
+                self.show_error("Cannot clip the isosurfaces", str(outcome.error))
+
+        self.jobs.submit(cut, name="clip isosurfaces", key="clip:isosurfaces", on_done=done)
+
+    def isosurfaces_cut(self) -> bool:
+        """Whether the isosurfaces on screen are cut by the current clipping (it is re-cut in the background)."""
+        return self.controller is None or self.isosurface_clip_shown == self.controller.clip.to_dict()
+
+    def apply_component_settings(self, comp_id: str, settings: dict[str, Any]) -> bool:
+        """New settings for a component (the scene tree's form, an undo step): validated through the session schema,
+        then the scene is rebuilt with the same camera and marked dirty; a bad value gives a message naming the field
+        and changes nothing. Undoable edits go through ``volviz_app.component_settings.edit_settings``."""
+        from volviz.session import session_from_dict, session_to_dict
+
+        if self.controller is None:
+            return False
+        try:
+            doc = session_to_dict(self.session)
+            for comp in doc["components"]:
+                if comp["id"] == comp_id:
+                    comp["settings"] = settings
+            candidate = session_from_dict(doc, "scene tree")
+        except (ValueError, SessionError) as exc:
+            self.show_error("Invalid settings", f"{comp_id}: {exc}")
+            return False
+        candidate.camera = self.controller.camera()
+        candidate.layout.pop("window_state", None)  # the docks stay where they are
+        # prepared in the background; the current scene stays until the new one is ready (or shown on an error)
+        self._show_session(candidate, self.session_path, getattr(self, "title", ""), True, datasets=self.datasets)
+        return True
+
+    def _settings_changed(self, values: dict[str, Any]) -> None:
+        current = {**RENDERER_DEFAULTS, **self.session.render.options}  # a missing option is its default
+        rebuild = (values["method"] != self.session.render.method
+                   or any(values["options"].get(k) != current[k] for k in RENDERER_DEFAULTS))
+        budget_changed = values["options"].get("error_budget") != self.session.render.options.get("error_budget")
+        iso_mode = values["options"].get("iso_mode", "vtk")
+        iso_changed = iso_mode != self.session.render.options.get("iso_mode", "vtk")
+        self.session.render.method = values["method"]
+        self.session.render.size = values["size"]
+        self.session.render.options.update(values["options"])
+        self.set_dirty()
+        if iso_changed and not rebuild and self.controller is not None:
+            self.controller.set_iso_mode(iso_mode, update=False)
+            self.render()
+            self.refresh_iso_overlay()
+        if budget_changed and not rebuild and getattr(self, "last_error_rmse", None) is not None:
+            self._enforce_error_budget(self.last_error_rmse)
+            return
+        if rebuild and self.controller is not None:  # another renderer: rebuild the scene with the same camera
+            self.session.camera = self.controller.camera()
+            self.session.layout.pop("window_state", None)
+            self._show_session(self.session, self.session_path, getattr(self, "title", ""), True,
+                               datasets=self.datasets)
