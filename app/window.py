@@ -1,6 +1,19 @@
-"""The main window: a PyVista viewport with docks (transfer function, scene tree, render settings, timeline,
-statistics), menus, status bar with progress and cancel, sessions with autosave and crash recovery. No numerics here:
-everything is a call into volviz."""
+"""The main window: a PyVista viewport with docks, menus and a status bar. No numerics here: everything is a call
+into volviz. ``MainWindow`` is put together from one mixin per responsibility, each in its own module:
+
+- ``window_widgets.WindowWidgets``: the docks, menus and actions, the status bar with progress and cancel;
+- ``scene_loading.SceneLoading``: ``open_path`` and showing a session (prepared in the background, then installed);
+- ``session_files.SessionFiles``: open/save dialogs, saving, dirty tracking, autosave, crash recovery, recent files,
+  the unsaved-changes question on closing;
+- ``view_scheduler.ViewScheduler``: the background refreshes of the views (one job in flight per kind), the error
+  estimate and budget;
+- ``scene_edits.SceneEdits``: what the docks' edits do to the shown scene (TF, visibility, opacity, settings,
+  clipping, render settings);
+- ``export_runs.ExportRuns``: screenshot and movie export in the background;
+- ``camera_bookmarks.CameraBookmarks``: camera bookmarks and camera-path recording.
+
+This module holds the window's shared state (``session``, ``controller``, ``datasets``, ``jobs``, ``plotter``...),
+its construction, ``render``, fly mode, ``show_error`` and closing."""
 from __future__ import annotations
 
 import logging
@@ -9,38 +22,23 @@ from pathlib import Path
 from typing import Any, Optional
 
 from PySide6.QtCore import QSettings, Qt, QTimer
-from PySide6.QtGui import QAction, QKeySequence, QUndoGroup, QUndoStack
-from PySide6.QtWidgets import (QDockWidget, QLabel, QMainWindow, QMessageBox,
-                               QProgressBar, QPushButton, QWidget)
+from PySide6.QtWidgets import QMainWindow, QMessageBox, QWidget
 
 from volviz.render.backend import plotter_gl_info
 from volviz.render.controller import iso_summary
 from volviz.session import CameraKey, Session
-from volviz_app.array_choice import ArrayChoice
 from volviz_app.camera_bookmarks import CameraBookmarks
-from volviz_app.component_settings import edit_settings
 from volviz_app.clip_widget import ClipPlaneWidget
-from volviz_app.decoration_toggles import DecorationToggles
-from volviz_app.docks.clipping import ClippingDock
-from volviz_app.docks.render_settings import RenderSettingsDock
-from volviz_app.gc_guard import GuiThreadCollector
-from volviz_app.help import HelpMenu
-from volviz_app.export_dialogs import ExportDialogs
 from volviz_app.export_runs import ExportRuns
-from volviz_app.layout import WindowLayout, scrolled
-from volviz_app.recent import RecentFiles
+from volviz_app.gc_guard import GuiThreadCollector
+from volviz_app.interaction_renders import SingleRenderDuringInteraction
+from volviz_app.navigation import FlyMode
+from volviz_app.nonfinite_status import NonFiniteStatus
 from volviz_app.scene_edits import SceneEdits
 from volviz_app.scene_loading import SceneLoading
 from volviz_app.session_files import SessionFiles, default_recovery_dir
-from volviz_app.docks.scene_tree import SceneTree
-from volviz_app.docks.statistics import Statistics
-from volviz_app.docks.tf_editor import TransferFunctionEditor
-from volviz_app.docks.timeline import Timeline
-from volviz_app.drop import FileDrop
-from volviz_app.interaction_renders import SingleRenderDuringInteraction
-from volviz_app.navigation import FlyMode
 from volviz_app.view_scheduler import ViewScheduler
-from volviz_app.nonfinite_status import NonFiniteStatus
+from volviz_app.window_widgets import WindowWidgets
 from volviz_app.workers import JobBridge
 
 log = logging.getLogger(__name__)
@@ -64,7 +62,8 @@ def _import_gui_thread_modules() -> None:
     pyvista.system_supports_plotting()
 
 
-class MainWindow(SceneLoading, SessionFiles, ViewScheduler, SceneEdits, ExportRuns, CameraBookmarks, QMainWindow):
+class MainWindow(SceneLoading, SessionFiles, ViewScheduler, SceneEdits, ExportRuns, CameraBookmarks, WindowWidgets,
+                 QMainWindow):
     """volviz main window. ``open_path`` is the single code path behind File > Open and the command line."""
 
     def __init__(self, parent: Optional[QWidget] = None, settings: Optional[QSettings] = None,
@@ -107,136 +106,12 @@ class MainWindow(SceneLoading, SessionFiles, ViewScheduler, SceneEdits, ExportRu
         self.single_render = SingleRenderDuringInteraction(self.plotter)  # one render per move of a drag
         self.clip_widget = ClipPlaneWidget(self.plotter, self.clipping)
         self._connect_view_scheduler()  # interaction observers, fly-mode settle and resize timers
-
         self._connect_scene_edits()  # the TF preview timer
         self._connect_session_files()  # the autosave timer
         self.record_timer = QTimer(self, interval=RECORD_MS)
         self.record_timer.timeout.connect(self._record_sample)
         self.nonfinite = NonFiniteStatus(self)  # the status bar's note on non-finite values
         self.collector.freeze_long_lived()
-
-    # ------------------------------------------------------------------------------------------------ construction
-    def _dock(self, title: str, name: str, widget: QWidget, scroll: bool = True) -> QDockWidget:
-        dock = QDockWidget(title, self)
-        dock.setObjectName(name)
-        dock.setWidget(scrolled(widget) if scroll else widget)
-        return dock
-
-    def _build_docks(self) -> None:
-        self.tf_editor = TransferFunctionEditor()
-        self.scene_tree = SceneTree()
-        self.render_settings = RenderSettingsDock()
-        self.timeline = Timeline()
-        self.statistics = Statistics()
-        self.clipping = ClippingDock()
-        self.tf_dock = self._dock("Transfer function", "tfDock", self.tf_editor)
-        self.scene_dock = self._dock("Scene", "sceneDock", self.scene_tree)
-        self.settings_dock = self._dock("Render settings", "settingsDock", self.render_settings)
-        self.timeline_dock = self._dock("Timeline", "timelineDock", self.timeline, scroll=False)
-        self.stats_dock = self._dock("Statistics", "statsDock", self.statistics)
-        self.clip_dock = self._dock("Clipping", "clipDock", self.clipping)
-        self.docks = [self.tf_dock, self.scene_dock, self.settings_dock, self.timeline_dock, self.stats_dock,
-                      self.clip_dock]
-        self.layout_keeper = WindowLayout(self, self.settings, [self.tf_dock, self.scene_dock, self.settings_dock,
-                                                                self.clip_dock, self.stats_dock], [self.timeline_dock])
-        self.layout_keeper.arrange()
-
-        self.tf_editor.changed.connect(self._tf_changed)
-        self.tf_editor.committed.connect(self._tf_committed)
-        self.scene_tree.componentSelected.connect(self._select_component)
-        self.scene_tree.visibilityChanged.connect(self._set_visibility)
-        self.scene_tree.opacityChanged.connect(self._set_opacity)
-        self.scene_tree.settingsEdited.connect(lambda comp_id, before, after: edit_settings(
-            self, self.scene_undo_stack, comp_id, before, after))
-        self.render_settings.changed.connect(self._settings_changed)
-        self.timeline.timeChanged.connect(self._time_changed)
-        self.timeline.interpolationToggled.connect(self._interpolation_toggled)
-        self.timeline.play_button.toggled.connect(self._playing_changed)
-        self.clipping.changed.connect(self.set_clip)
-
-    def _build_menus(self) -> None:
-        file_menu = self.menuBar().addMenu("&File")
-        self.action_open_data = self._action(file_menu, "Open &Data…", QKeySequence.StandardKey.Open,
-                                             self._ask_open_data)
-        self.action_open_session = self._action(file_menu, "Open &Session…", "Ctrl+Shift+O", self._ask_open_session)
-        self.recent_menu = file_menu.addMenu("Open &Recent")
-        self.action_save_session = self._action(file_menu, "&Save Session", QKeySequence.StandardKey.Save,
-                                                self._save_session)
-        self.action_save_session_as = self._action(file_menu, "Save Session &As…", QKeySequence.StandardKey.SaveAs,
-                                                   self._ask_save_session_as)
-        file_menu.addSeparator()
-        self.action_export_screenshot = self._action(file_menu, "&Export Screenshot…", "Ctrl+E",
-                                                     lambda: self.export_dialogs.ask_screenshot())
-        self.action_export_movie = self._action(file_menu, "Export &Movie…", "Ctrl+Shift+E",
-                                                lambda: self.export_dialogs.ask_movie())
-        self.export_dialogs = ExportDialogs(self)
-        file_menu.addSeparator()
-        self._action(file_menu, "&Quit", QKeySequence.StandardKey.Quit, self.close)
-
-        edit_menu = self.menuBar().addMenu("&Edit")
-        # Edit > Undo / Redo act on the stack edited last (transfer function, clipping, or the scene: arrays shown)
-        self.undo_group = QUndoGroup(self)
-        self.scene_undo_stack = QUndoStack(self)
-        self.array_choice = ArrayChoice(self, self.scene_tree.array, self.scene_undo_stack)
-        for stack in (self.tf_editor.undo_stack, self.clipping.undo_stack, self.scene_undo_stack):
-            self.undo_group.addStack(stack)
-            stack.indexChanged.connect(lambda _index, s=stack: self._activate_undo_stack(s))
-        self.undo_group.setActiveStack(self.tf_editor.undo_stack)
-        undo = self.undo_group.createUndoAction(self, "&Undo")
-        undo.setShortcut(QKeySequence.StandardKey.Undo)
-        redo = self.undo_group.createRedoAction(self, "&Redo")
-        redo.setShortcut(QKeySequence.StandardKey.Redo)
-        edit_menu.addAction(undo)
-        edit_menu.addAction(redo)
-        self.action_undo, self.action_redo = undo, redo
-
-        view_menu = self.menuBar().addMenu("&View")
-        for dock in self.docks:
-            view_menu.addAction(dock.toggleViewAction())
-        view_menu.addSeparator()
-        self._action(view_menu, "Reset &Layout", "", self.layout_keeper.reset)
-        view_menu.addSeparator()
-        self.decorations = DecorationToggles(self, view_menu)
-        view_menu.addSeparator()
-        self.action_fly = self._action(view_menu, "&Fly Mode", "F", self.set_fly_mode)
-        self.action_fly.setCheckable(True)
-        self._action(view_menu, "&Reset Camera", "R", self.reset_camera)
-
-        camera_menu = self.menuBar().addMenu("&Camera")
-        self._action(camera_menu, "Add &Bookmark…", "Ctrl+B", self._ask_bookmark)
-        self.bookmark_menu = camera_menu.addMenu("Go to Bookmark")
-        camera_menu.addSeparator()
-        self.action_record = self._action(camera_menu, "&Record Camera Path", "Ctrl+R", self.set_recording)
-        self.action_record.setCheckable(True)
-        self.help = HelpMenu(self, self.menuBar().addMenu("&Help"), self.plotter.ren_win)
-        self.recent = RecentFiles(self.settings, self.recent_menu, self.open_path)
-        self.file_drop = FileDrop([self, self.plotter.interactor], self.open_path)
-
-    def _activate_undo_stack(self, stack: Any) -> None:
-        import shiboken6
-
-        if shiboken6.isValid(stack) and shiboken6.isValid(self.undo_group):  # not while the window is torn down
-            self.undo_group.setActiveStack(stack)
-
-    def _action(self, menu: Any, text: str, shortcut: Any, slot: Any) -> QAction:
-        action = QAction(text, self)
-        action.setShortcut(QKeySequence(shortcut))
-        action.triggered.connect(slot)
-        menu.addAction(action)
-        return action
-
-    def _build_status_bar(self) -> None:
-        bar = self.statusBar()
-        self.status_label = QLabel("Ready")
-        self.progress_bar = QProgressBar()
-        self.progress_bar.setMaximumWidth(220)
-        self.progress_bar.setRange(0, 1000)
-        self.cancel_button = QPushButton("Cancel")
-        self.cancel_button.clicked.connect(self.cancel_current_job)
-        bar.addWidget(self.status_label, 1)
-        bar.addPermanentWidget(self.progress_bar)
-        bar.addPermanentWidget(self.cancel_button)
-        self._set_busy(False)
 
     # ------------------------------------------------------------------------------------------------ rendering
     def render(self) -> None:
@@ -286,8 +161,7 @@ class MainWindow(SceneLoading, SessionFiles, ViewScheduler, SceneEdits, ExportRu
             self.controller.set_camera(None, update=False)
             self._camera_moved()
 
-    # -- autosave and recovery ------------------------------------------------------------------------------------
-    # ------------------------------------------------------------------------------------------------ dialogs
+    # ------------------------------------------------------------------------------------------------ errors
     def show_error(self, title: str, text: str) -> None:
         """A non-blocking error dialog (the app keeps running); also logged."""
         log.error("%s: %s", title, text)
@@ -297,37 +171,6 @@ class MainWindow(SceneLoading, SessionFiles, ViewScheduler, SceneEdits, ExportRu
         dialog.setWindowModality(Qt.WindowModality.WindowModal)
         dialog.open()
         self.error_dialog = dialog
-
-    # ------------------------------------------------------------------------------------------------ progress
-    def _on_progress(self, job_id: int, fraction: float, message: str) -> None:
-        bar = self.progress_bar
-        # QProgressBar.setValue repaints at once (synchronously); under load that paint and its flush to the X
-        # server held the event loop for most of 80-140 ms gaps. With updates off it only schedules a paint.
-        bar.setUpdatesEnabled(False)
-        bar.setValue(int(round(fraction * 1000)))
-        bar.setUpdatesEnabled(True)
-        if message and bar.isVisible():  # background work after loading (error estimates) keeps "Showing ..."
-            self.status_label.setText(message)
-
-    def _set_busy(self, busy: bool) -> None:
-        was = self.progress_bar.isVisible()
-        busy = busy or self._export_run is not None  # a running export keeps its progress bar and cancel button
-        self.progress_bar.setVisible(busy)
-        self.cancel_button.setVisible(busy)
-        if busy and not was:
-            self.progress_bar.setValue(0)
-
-    def _busy_elsewhere(self) -> bool:
-        """A job other than an export still shows progress (a scene loading, its first views)."""
-        return (self._current_job is not None and not self._current_job.done()) or self._loading_views
-
-    def cancel_current_job(self) -> None:
-        if self._export_run is not None:  # an export runs alongside whatever else: the button stops it first
-            self._export_run.cancel()
-        elif self._current_job is not None and not self._current_job.done():
-            self._current_job.cancel()
-        elif self._loading_views:  # the scene is shown; stop computing its first views
-            self.jobs.runner.cancel_all()
 
     # ------------------------------------------------------------------------------------------------ closing
     def closeEvent(self, event: Any) -> None:

@@ -1,0 +1,191 @@
+"""The main window's widgets (a mixin of ``MainWindow``): the docks (transfer function, scene tree, render
+settings, timeline, statistics, clipping) with their signals connected to the window's handlers
+(``volviz_app.scene_edits``, ``volviz_app.view_scheduler``), the menus and their actions (File, Edit with undo and
+redo over the TF, clipping and scene stacks, View, Camera, Help), and the status bar with its progress bar and
+Cancel button: ``_set_busy`` shows them while a scene loads, its first views are computed or an export runs, and
+``cancel_current_job`` stops the export first, else the loading, else the first views.
+
+It makes the docks (``tf_editor``, ``scene_tree``, ``render_settings``, ``timeline``, ``statistics``,
+``clipping`` and their ``*_dock``), ``layout_keeper``, the undo group, ``array_choice``, ``export_dialogs``,
+``decorations``, ``help``, ``recent``, ``file_drop``, the actions, ``status_label``, ``progress_bar`` and
+``cancel_button``. It expects of the window: ``settings``, ``plotter``, ``jobs``, ``_current_job``,
+``_loading_views``, ``_export_run``, and the handlers its docks and actions call (``open_path``, the ``_ask_*``
+dialogs, ``set_fly_mode``, ``reset_camera``, ``set_recording``, ``set_clip``...). ``_build_docks()``,
+``_build_menus()`` and ``_build_status_bar()`` are called, in this order, by the window's ``__init__``."""
+from __future__ import annotations
+
+from typing import Any
+
+from PySide6.QtGui import QAction, QKeySequence, QUndoGroup, QUndoStack
+from PySide6.QtWidgets import QDockWidget, QLabel, QProgressBar, QPushButton, QWidget
+
+from volviz_app.array_choice import ArrayChoice
+from volviz_app.component_settings import edit_settings
+from volviz_app.decoration_toggles import DecorationToggles
+from volviz_app.docks.clipping import ClippingDock
+from volviz_app.docks.render_settings import RenderSettingsDock
+from volviz_app.docks.scene_tree import SceneTree
+from volviz_app.docks.statistics import Statistics
+from volviz_app.docks.tf_editor import TransferFunctionEditor
+from volviz_app.docks.timeline import Timeline
+from volviz_app.drop import FileDrop
+from volviz_app.export_dialogs import ExportDialogs
+from volviz_app.help import HelpMenu
+from volviz_app.layout import WindowLayout, scrolled
+from volviz_app.recent import RecentFiles
+
+
+class WindowWidgets:
+    """Docks, menus and the status bar of the window (see the module's docstring)."""
+
+    def _dock(self, title: str, name: str, widget: QWidget, scroll: bool = True) -> QDockWidget:
+        dock = QDockWidget(title, self)
+        dock.setObjectName(name)
+        dock.setWidget(scrolled(widget) if scroll else widget)
+        return dock
+
+    def _build_docks(self) -> None:
+        self.tf_editor = TransferFunctionEditor()
+        self.scene_tree = SceneTree()
+        self.render_settings = RenderSettingsDock()
+        self.timeline = Timeline()
+        self.statistics = Statistics()
+        self.clipping = ClippingDock()
+        self.tf_dock = self._dock("Transfer function", "tfDock", self.tf_editor)
+        self.scene_dock = self._dock("Scene", "sceneDock", self.scene_tree)
+        self.settings_dock = self._dock("Render settings", "settingsDock", self.render_settings)
+        self.timeline_dock = self._dock("Timeline", "timelineDock", self.timeline, scroll=False)
+        self.stats_dock = self._dock("Statistics", "statsDock", self.statistics)
+        self.clip_dock = self._dock("Clipping", "clipDock", self.clipping)
+        self.docks = [self.tf_dock, self.scene_dock, self.settings_dock, self.timeline_dock, self.stats_dock,
+                      self.clip_dock]
+        self.layout_keeper = WindowLayout(self, self.settings, [self.tf_dock, self.scene_dock, self.settings_dock,
+                                                                self.clip_dock, self.stats_dock], [self.timeline_dock])
+        self.layout_keeper.arrange()
+
+        self.tf_editor.changed.connect(self._tf_changed)
+        self.tf_editor.committed.connect(self._tf_committed)
+        self.scene_tree.componentSelected.connect(self._select_component)
+        self.scene_tree.visibilityChanged.connect(self._set_visibility)
+        self.scene_tree.opacityChanged.connect(self._set_opacity)
+        self.scene_tree.settingsEdited.connect(lambda comp_id, before, after: edit_settings(
+            self, self.scene_undo_stack, comp_id, before, after))
+        self.render_settings.changed.connect(self._settings_changed)
+        self.timeline.timeChanged.connect(self._time_changed)
+        self.timeline.interpolationToggled.connect(self._interpolation_toggled)
+        self.timeline.play_button.toggled.connect(self._playing_changed)
+        self.clipping.changed.connect(self.set_clip)
+
+    def _build_menus(self) -> None:
+        file_menu = self.menuBar().addMenu("&File")
+        self.action_open_data = self._action(file_menu, "Open &Data…", QKeySequence.StandardKey.Open,
+                                             self._ask_open_data)
+        self.action_open_session = self._action(file_menu, "Open &Session…", "Ctrl+Shift+O", self._ask_open_session)
+        self.recent_menu = file_menu.addMenu("Open &Recent")
+        self.action_save_session = self._action(file_menu, "&Save Session", QKeySequence.StandardKey.Save,
+                                                self._save_session)
+        self.action_save_session_as = self._action(file_menu, "Save Session &As…", QKeySequence.StandardKey.SaveAs,
+                                                   self._ask_save_session_as)
+        file_menu.addSeparator()
+        self.action_export_screenshot = self._action(file_menu, "&Export Screenshot…", "Ctrl+E",
+                                                     lambda: self.export_dialogs.ask_screenshot())
+        self.action_export_movie = self._action(file_menu, "Export &Movie…", "Ctrl+Shift+E",
+                                                lambda: self.export_dialogs.ask_movie())
+        self.export_dialogs = ExportDialogs(self)
+        file_menu.addSeparator()
+        self._action(file_menu, "&Quit", QKeySequence.StandardKey.Quit, self.close)
+
+        edit_menu = self.menuBar().addMenu("&Edit")
+        # Edit > Undo / Redo act on the stack edited last (transfer function, clipping, or the scene: arrays shown)
+        self.undo_group = QUndoGroup(self)
+        self.scene_undo_stack = QUndoStack(self)
+        self.array_choice = ArrayChoice(self, self.scene_tree.array, self.scene_undo_stack)
+        for stack in (self.tf_editor.undo_stack, self.clipping.undo_stack, self.scene_undo_stack):
+            self.undo_group.addStack(stack)
+            stack.indexChanged.connect(lambda _index, s=stack: self._activate_undo_stack(s))
+        self.undo_group.setActiveStack(self.tf_editor.undo_stack)
+        undo = self.undo_group.createUndoAction(self, "&Undo")
+        undo.setShortcut(QKeySequence.StandardKey.Undo)
+        redo = self.undo_group.createRedoAction(self, "&Redo")
+        redo.setShortcut(QKeySequence.StandardKey.Redo)
+        edit_menu.addAction(undo)
+        edit_menu.addAction(redo)
+        self.action_undo, self.action_redo = undo, redo
+
+        view_menu = self.menuBar().addMenu("&View")
+        for dock in self.docks:
+            view_menu.addAction(dock.toggleViewAction())
+        view_menu.addSeparator()
+        self._action(view_menu, "Reset &Layout", "", self.layout_keeper.reset)
+        view_menu.addSeparator()
+        self.decorations = DecorationToggles(self, view_menu)
+        view_menu.addSeparator()
+        self.action_fly = self._action(view_menu, "&Fly Mode", "F", self.set_fly_mode)
+        self.action_fly.setCheckable(True)
+        self._action(view_menu, "&Reset Camera", "R", self.reset_camera)
+
+        camera_menu = self.menuBar().addMenu("&Camera")
+        self._action(camera_menu, "Add &Bookmark…", "Ctrl+B", self._ask_bookmark)
+        self.bookmark_menu = camera_menu.addMenu("Go to Bookmark")
+        camera_menu.addSeparator()
+        self.action_record = self._action(camera_menu, "&Record Camera Path", "Ctrl+R", self.set_recording)
+        self.action_record.setCheckable(True)
+        self.help = HelpMenu(self, self.menuBar().addMenu("&Help"), self.plotter.ren_win)
+        self.recent = RecentFiles(self.settings, self.recent_menu, self.open_path)
+        self.file_drop = FileDrop([self, self.plotter.interactor], self.open_path)
+
+    def _activate_undo_stack(self, stack: Any) -> None:
+        import shiboken6
+
+        if shiboken6.isValid(stack) and shiboken6.isValid(self.undo_group):  # not while the window is torn down
+            self.undo_group.setActiveStack(stack)
+
+    def _action(self, menu: Any, text: str, shortcut: Any, slot: Any) -> QAction:
+        action = QAction(text, self)
+        action.setShortcut(QKeySequence(shortcut))
+        action.triggered.connect(slot)
+        menu.addAction(action)
+        return action
+
+    def _build_status_bar(self) -> None:
+        bar = self.statusBar()
+        self.status_label = QLabel("Ready")
+        self.progress_bar = QProgressBar()
+        self.progress_bar.setMaximumWidth(220)
+        self.progress_bar.setRange(0, 1000)
+        self.cancel_button = QPushButton("Cancel")
+        self.cancel_button.clicked.connect(self.cancel_current_job)
+        bar.addWidget(self.status_label, 1)
+        bar.addPermanentWidget(self.progress_bar)
+        bar.addPermanentWidget(self.cancel_button)
+        self._set_busy(False)
+
+    def _on_progress(self, job_id: int, fraction: float, message: str) -> None:
+        bar = self.progress_bar
+        # QProgressBar.setValue repaints at once (synchronously); under load that paint and its flush to the X
+        # server held the event loop for most of 80-140 ms gaps. With updates off it only schedules a paint.
+        bar.setUpdatesEnabled(False)
+        bar.setValue(int(round(fraction * 1000)))
+        bar.setUpdatesEnabled(True)
+        if message and bar.isVisible():  # background work after loading (error estimates) keeps "Showing ..."
+            self.status_label.setText(message)
+
+    def _set_busy(self, busy: bool) -> None:
+        was = self.progress_bar.isVisible()
+        busy = busy or self._export_run is not None  # a running export keeps its progress bar and cancel button
+        self.progress_bar.setVisible(busy)
+        self.cancel_button.setVisible(busy)
+        if busy and not was:
+            self.progress_bar.setValue(0)
+
+    def _busy_elsewhere(self) -> bool:
+        """A job other than an export still shows progress (a scene loading, its first views)."""
+        return (self._current_job is not None and not self._current_job.done()) or self._loading_views
+
+    def cancel_current_job(self) -> None:
+        if self._export_run is not None:  # an export runs alongside whatever else: the button stops it first
+            self._export_run.cancel()
+        elif self._current_job is not None and not self._current_job.done():
+            self._current_job.cancel()
+        elif self._loading_views:  # the scene is shown; stop computing its first views
+            self.jobs.runner.cancel_all()
