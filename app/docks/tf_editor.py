@@ -1,9 +1,10 @@
 """Transfer-function editor dock: extinction curve with draggable control points over the data histogram, color
 stops with a color picker, presets (ParaView JSON import/export), fit to data range, undo/redo.
 
-The editor holds a ``TransferFunction`` (volviz.optics) and never computes optics itself. It emits
-``changed(tf)`` continuously while the user drags (the window throttles re-rendering) and ``committed(tf)`` when an
-edit is finished; each finished edit is one entry of the undo stack.
+The editor holds a ``TransferFunction`` (volviz.optics) and never computes optics itself; where a point goes when
+one is added, moved or removed is ``volviz.optics.tf_points``. It emits ``changed(tf)`` continuously while the user
+drags (the window throttles re-rendering) and ``committed(tf)`` when an edit is finished; each finished edit is one
+entry of the undo stack.
 """
 from __future__ import annotations
 
@@ -16,6 +17,7 @@ from PySide6.QtWidgets import (QCheckBox, QColorDialog, QComboBox, QFileDialog, 
                                QPushButton, QSizePolicy, QVBoxLayout, QWidget)
 
 from volviz.optics import TransferFunction
+from volviz.optics.tf_points import MIN_POINTS, insert_point, moved_scalar, remove_point
 from volviz_app.docks import set_tooltips
 
 GESTURES = ("Click: add a point · drag a point: move it · right-click: remove it · double-click: "
@@ -138,7 +140,7 @@ class TransferFunctionCanvas(QWidget):
         pos = event.position()
         index = self.point_at(pos)
         if event.button() == Qt.MouseButton.RightButton:
-            if index is not None and len(self.scalars) > 2:
+            if index is not None and len(self.scalars) > MIN_POINTS:
                 self._remove(index)
                 self.editFinished.emit("Remove control point")
             return
@@ -156,10 +158,7 @@ class TransferFunctionCanvas(QWidget):
             return
         s, rho = self.from_screen(event.position())
         i = self.selected
-        eps = 1e-9 * max(abs(self.scalars[-1] - self.scalars[0]), 1.0)
-        if 0 < i < len(self.scalars) - 1:  # interior points keep their order; the end points keep the range
-            s = float(np.clip(s, self.scalars[i - 1] + eps, self.scalars[i + 1] - eps))
-            self.scalars[i] = s
+        self.scalars[i] = moved_scalar(self.scalars, i, s)  # interior points keep their order, the ends the range
         self.extinction[i] = rho
         self.pointsEdited.emit()
         self.update()
@@ -175,18 +174,12 @@ class TransferFunctionCanvas(QWidget):
             self.colorRequested.emit(index)
 
     def _insert(self, s: float, rho: float) -> int:
-        i = int(np.searchsorted(self.scalars, s))
-        i = min(max(i, 1), len(self.scalars) - 1)
-        color = np.array([np.interp(s, self.scalars, self.colors[:, c]) for c in range(3)])
-        self.scalars = np.insert(self.scalars, i, s)
-        self.colors = np.insert(self.colors, i, color, axis=0)
-        self.extinction = np.insert(self.extinction, i, rho)
+        self.scalars, self.colors, self.extinction, i = insert_point(self.scalars, self.colors, self.extinction, s,
+                                                                     rho)
         return i
 
     def _remove(self, index: int) -> None:
-        self.scalars = np.delete(self.scalars, index)
-        self.colors = np.delete(self.colors, index, axis=0)
-        self.extinction = np.delete(self.extinction, index)
+        self.scalars, self.colors, self.extinction = remove_point(self.scalars, self.colors, self.extinction, index)
         self.selected = None
         self.update()
 
