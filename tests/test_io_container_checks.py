@@ -207,3 +207,43 @@ def test_netcdf_unit_text_that_is_not_text_is_refused(tmp_path):
     with pytest.raises(vio.ReadError, match=r"units\.nc: netCDF: malformed netCDF header \(the 'units' attribute "
                                             r"at byte \d+ is not printable text\)"):
         vio.read(bad)
+
+
+EXODUS = "ecosystem/disk_out_ref.ex2"
+
+
+@pytest.mark.parametrize("node", [0, 8500, 19057])
+def test_exodus_connectivity_past_the_nodes_is_refused(tmp_path, node):
+    """A node number outside 1..num_nodes in an element block (a flipped bit in the fuzz campaign: VTK then added a
+    point read from past its array) is refused, naming the block and the node."""
+    from volviz_vtk_readers.containers import netcdf_header
+
+    data = bytearray(data_file(EXODUS).read_bytes())
+    header = netcdf_header(data_file(EXODUS), "Exodus II")
+    assert header is not None and header.dims["num_nodes"] == 8499
+    connect = header.variables["connect1"]
+    at = connect.begin + 4 * 1000                  # the 1001st node number of block 1 (big-endian int32)
+    data[at:at + 4] = struct.pack(">i", node)
+    bad = tmp_path / "bad.ex2"
+    bad.write_bytes(bytes(data))
+    with pytest.raises(vio.ReadError, match=rf"bad\.ex2: Exodus II: element block connectivity 'connect1' refers to "
+                                            rf"node {node}, but the file has nodes 1 to 8499 \(num_nodes\)"):
+        vio.read(bad)
+    assert vio.read(data_file(EXODUS)).n_points == 8499
+
+
+def test_exodus_connectivity_in_a_netcdf4_file_is_checked(tmp_path):
+    """netCDF-4 (HDF5) Exodus files: ``num_nodes`` is a dimension scale, the blocks ``connect<i>`` datasets."""
+    import h5py
+
+    from volviz_vtk_readers.exodus_check import check_exodus_connectivity
+
+    path = tmp_path / "mesh.exo"
+    with h5py.File(path, "w") as f:
+        f.create_dataset("num_nodes", data=np.zeros(4))
+        f.create_dataset("connect1", data=np.array([[1, 2, 3, 4]], dtype=np.int32))
+    check_exodus_connectivity(path)
+    with h5py.File(path, "a") as f:
+        f.create_dataset("connect2", data=np.array([[1, 2, 3, 5]], dtype=np.int64))
+    with pytest.raises(vio.ReadError, match=r"'connect2' refers to node 5, but the file has nodes 1 to 4"):
+        check_exodus_connectivity(path)

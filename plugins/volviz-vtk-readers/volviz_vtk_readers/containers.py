@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import struct
 import warnings
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from volviz.io._checks import check_file, describe_bytes, read_bytes
@@ -87,12 +88,37 @@ class _Cursor:
         return texts
 
 
+@dataclass
+class NetcdfVariable:
+    """A variable of a netCDF classic header: its dimension names, shape (the record dimension's length is the
+    number of records), type code (``_NC_TYPE_SIZE``), the byte offset of its data and whether it is a record
+    variable."""
+
+    name: str
+    dims: tuple[str, ...]
+    shape: tuple[int, ...]
+    nc_type: int
+    begin: int
+    record: bool
+
+
+@dataclass
+class NetcdfHeader:
+    """What ``_netcdf_layout`` read: where the data end, the CF notes (``_cf_notes``), the dimensions' lengths and the
+    variables by name."""
+
+    end: int
+    notes: list[str] = field(default_factory=list)
+    dims: dict[str, int] = field(default_factory=dict)
+    variables: dict[str, NetcdfVariable] = field(default_factory=dict)
+
+
 def _netcdf_end(data: bytes) -> int:
     """The number of bytes the variables of a netCDF classic file reach (``_netcdf_layout``)."""
-    return _netcdf_layout(data)[0]
+    return _netcdf_layout(data).end
 
 
-def _netcdf_layout(data: bytes) -> tuple[int, list[str]]:
+def _netcdf_layout(data: bytes) -> NetcdfHeader:
     """The number of bytes the variables of a netCDF classic file reach, after checking the header's layout against
     itself (EOFError if ``data`` is too short to hold the header; ValueError naming the first inconsistency).
     Names are UTF-8 text without control characters; the CF attributes a reader interprets (``units``, ``axis``,
@@ -105,7 +131,8 @@ def _netcdf_layout(data: bytes) -> tuple[int, list[str]]:
     rounded up to 4 bytes, or 2^32-1 for a variable too large for the field; every ``begin`` lies after the header;
     the fixed-size variables do not overlap; the data ends with the last variable's unpadded values.
 
-    Also returns notes on what a CF reader will misread although the file is valid netCDF (``_cf_notes``)."""
+    Also returns notes on what a CF reader will misread although the file is valid netCDF (``_cf_notes``), the
+    dimensions and the variables."""
     c = _Cursor(data, data[3])
     numrecs = c.count()
     tag, n_dims = c.int32(), c.count()
@@ -120,6 +147,7 @@ def _netcdf_layout(data: bytes) -> tuple[int, list[str]]:
     if tag not in (0, 0x0B):
         raise ValueError(f"variable list tag {tag:#x}")
     variables, references, cf_vars = [], [], []
+    table: dict[str, NetcdfVariable] = {}
     for _ in range(n_vars):
         name = c.name()
         ids = [c.count() for _ in range(c.count())]
@@ -141,6 +169,8 @@ def _netcdf_layout(data: bytes) -> tuple[int, list[str]]:
             raise ValueError(f"variable {name!r} has {exact} bytes by its dimensions but a size field of {vsize}")
         cf_vars[-1] = (name, [dim_names[i] for i in ids], texts)
         variables.append((name, begin, exact, exact + (-exact % 4), record))
+        table[name] = NetcdfVariable(name, tuple(dim_names[i] for i in ids),
+                                     tuple(numrecs if dims[i] == 0 else dims[i] for i in ids), nc_type, begin, record)
     header_end = c.pos
     names = {v[0] for v in variables}
     for name, key, ref in references:
@@ -159,7 +189,7 @@ def _netcdf_layout(data: bytes) -> tuple[int, list[str]]:
     if records and numrecs not in (0, 0xFFFFFFFF, -1):
         record_size = records[0][1] if len(records) == 1 else sum(p for _, _, p in records)
         end = max(end, max(b + e for b, e, _ in records) + (numrecs - 1) * record_size)
-    return end, _cf_notes(cf_vars)
+    return NetcdfHeader(end, _cf_notes(cf_vars), dict(zip(dim_names, dims)), table)
 
 
 def _cf_notes(variables: list[tuple[str, list[str], dict[str, str]]]) -> list[str]:
@@ -198,36 +228,45 @@ def _hdf5_end(path: PathLike, head: bytes) -> int:
     return int.from_bytes(head[at:at + width], "little")
 
 
+def netcdf_header(path: PathLike, what: str, head: bytes | None = None) -> NetcdfHeader | None:
+    """The checked header of the netCDF classic file ``path`` (``_netcdf_layout``; ``head``: its first bytes if read
+    already); None for a header over ``_HEADER_LIMIT`` bytes, which is not parsed. ReadError when the header
+    contradicts itself or the file is shorter than it says."""
+    p = Path(path)
+    size = p.stat().st_size
+    data = read_bytes(p, 65536) if head is None else head
+    while True:
+        try:
+            header = _netcdf_layout(data)
+            break
+        except EOFError:
+            if len(data) >= min(size, _HEADER_LIMIT):
+                if size <= _HEADER_LIMIT:
+                    raise ReadError(p, f"{what}: the netCDF header runs past the end of the file ({size} bytes): "
+                                       "the file is truncated") from None
+                return None
+            data = read_bytes(p, min(size, 4 * len(data)))
+        except (ValueError, struct.error) as exc:
+            raise ReadError(p, f"{what}: malformed netCDF header ({exc})") from None
+    if header.end > size:
+        raise ReadError(p, f"{what}: the netCDF header places data up to byte {header.end}, but the file holds "
+                           f"{size} bytes: the file is truncated")
+    return header
+
+
 def check_container(path: PathLike, what: str, netcdf: bool = True, hdf5: bool = True, adf: bool = False,
                     cf: bool = False) -> Path:
     """Check ``path`` is a regular file in one of the allowed containers and not shorter than its header says. With
     ``cf`` (a file read by CF conventions), a netCDF classic header's ``_cf_notes`` are emitted as ReadWarnings."""
     p = check_file(path)
-    size = p.stat().st_size
     head = read_bytes(p, 65536)
     if netcdf and head[:4] in NETCDF_MAGICS:
-        data = head
-        while True:
-            try:
-                end, notes = _netcdf_layout(data)
-                break
-            except EOFError:
-                if len(data) >= min(size, _HEADER_LIMIT):
-                    if size <= _HEADER_LIMIT:
-                        raise ReadError(p, f"{what}: the netCDF header runs past the end of the file ({size} "
-                                           "bytes): the file is truncated") from None
-                    return p
-                data = read_bytes(p, min(size, 4 * len(data)))
-            except (ValueError, struct.error) as exc:
-                raise ReadError(p, f"{what}: malformed netCDF header ({exc})") from None
-        if end > size:
-            raise ReadError(p, f"{what}: the netCDF header places data up to byte {end}, but the file holds {size} "
-                               "bytes: the file is truncated")
-        for note in notes if cf else []:
+        header = netcdf_header(p, what, head)
+        for note in header.notes if cf and header is not None else []:
             warnings.warn(ReadWarning(f"{p}: {note}"), stacklevel=2)
         return p
     if hdf5 and head.startswith(HDF5_SIGNATURE):
-        end = _hdf5_end(p, head)
+        end, size = _hdf5_end(p, head), p.stat().st_size
         if end > size:
             raise ReadError(p, f"{what}: the HDF5 superblock says the file is {end} bytes, but it holds {size}: the "
                                "file is truncated")

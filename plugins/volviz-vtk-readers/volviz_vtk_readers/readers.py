@@ -28,6 +28,7 @@ from volviz.model import TimeSeries
 
 from volviz_vtk_readers import specs
 from volviz_vtk_readers.containers import check_container
+from volviz_vtk_readers.exodus_check import check_exodus_connectivity
 from volviz_vtk_readers.foamcheck import check_time_folder
 
 
@@ -162,6 +163,7 @@ def _exodus(path: PathLike) -> Any:
     import vtk
 
     check_container(path, "Exodus II")
+    check_exodus_connectivity(path)            # VTK reads past its point array for a node number out of range
     reader = _information(path, _reader("vtkExodusIIReader", path))
     for kind in (vtk.vtkExodusIIReader.NODAL, vtk.vtkExodusIIReader.ELEM_BLOCK):
         for i in range(reader.GetNumberOfObjectArrays(kind)):
