@@ -79,8 +79,8 @@ def _scenes(data: Path) -> dict[str, tuple[list[IsoMesh], Camera, str]]:
 
 def _vtk_blend(meshes: list[IsoMesh], cam: Camera, size: int, reps: int) -> tuple[float, np.ndarray]:
     import pyvista as pv
-    pl = pv.Plotter(off_screen=True, window_size=(size, size))
-    pl.set_background(BG[:3])
+    pl = pv.Plotter(off_screen=True, window_size=[size, size])
+    pl.set_background(BG[:3])  # type: ignore[arg-type]  # pyvista types its functools.wraps wrapper wrongly
     for m in meshes:
         if m.n_triangles:
             pl.add_mesh(m.to_pyvista(), color=m.style.color, opacity=float(m.style.opacity), smooth_shading=True)
@@ -104,15 +104,17 @@ def _gpu_modes(meshes: list[IsoMesh], cam: Camera, size: int, reps: int, cpu: di
     import pyvista as pv
 
     from volviz.render.gl_iso import GLIsoSurfaces
-    pl = pv.Plotter(off_screen=True, window_size=(size, size))
-    pl.ren_win.SetMultiSamples(0)
-    pl.set_background(BG[:3])
+    pl = pv.Plotter(off_screen=True, window_size=[size, size])
+    ren_win = pl.ren_win
+    assert ren_win is not None
+    ren_win.SetMultiSamples(0)
+    pl.set_background(BG[:3])  # type: ignore[arg-type]  # pyvista types its functools.wraps wrapper wrongly
     cam.apply_to(pl.renderer.GetActiveCamera())
     pl.camera_set = True
     iso = GLIsoSurfaces(pl, meshes, mode="2pass")
 
     def frame() -> np.ndarray:
-        pl.ren_win.Render()
+        ren_win.Render()
         return np.asarray(pl.screenshot(return_img=True), dtype=np.float64)[..., :3] / 255.0
     rows = {}
     for mode in MODES:
@@ -158,9 +160,10 @@ def main(argv: list[str] | None = None) -> int:
             rows[mode] = {"seconds": t, "composite_seconds": tc, "triangles_drawn": triangles_drawn(fr, mode),
                           "rmse": rmse(imgs[mode], imgs["exact"]), "max_abs": max_abs(imgs[mode], imgs["exact"])}
         counts = np.diff(fr.ptr)
-        scene = {"note": note, "triangles": fr.n_triangles, "opaque_triangles": fr.n_opaque_triangles,
-                 "fragments": int(len(fr.depth)), "max_depth_complexity": int(counts.max()),
-                 "mean_depth_complexity_covered": float(counts[counts > 0].mean()), "modes": rows}
+        scene: dict[str, Any] = {
+            "note": note, "triangles": fr.n_triangles, "opaque_triangles": fr.n_opaque_triangles,
+            "fragments": int(len(fr.depth)), "max_depth_complexity": int(counts.max()),
+            "mean_depth_complexity_covered": float(counts[counts > 0].mean()), "modes": rows}
         if not args.no_gpu:
             scene["gpu"] = _gpu_modes(meshes, cam, args.size, args.reps, imgs)
         if not args.no_vtk:

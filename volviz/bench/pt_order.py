@@ -64,17 +64,21 @@ def measure(mesh: Any, tf: Any, size: int, lags: list[float], window: int, drag_
     from volviz.unstructured.render import render
 
     azimuths = AZIMUTHS[:frames]
-    pl = pv.Plotter(off_screen=True, window_size=(size, size))
-    pl.set_background("black")
-    pl.ren_win.SetMultiSamples(0)
+    pl = pv.Plotter(off_screen=True, window_size=[size, size])
+    pl.set_background("black")  # type: ignore[arg-type]  # pyvista types its functools.wraps wrapper wrongly
+    ren_win = pl.ren_win
+    assert ren_win is not None
+    ren_win.SetMultiSamples(0)
     vol = GLPTVolume(pl, mesh, tf, lookup="3d")
     pl.camera_set = True
 
     def draw(cam: Any, reuse: bool) -> np.ndarray:
         vol.reuse_order = reuse
         cam.apply_to(pl.renderer.GetActiveCamera())
-        pl.ren_win.Render()
-        return pl.screenshot(return_img=True).astype(np.float64) / 255.0
+        ren_win.Render()
+        shot = pl.screenshot(return_img=True)
+        assert shot is not None
+        return shot.astype(np.float64) / 255.0
 
     draw(_orbit(mesh.points, azimuths[0] - 45.0), False)    # warm-up: shaders, table, vertex buffer
     sorts = []
@@ -94,7 +98,7 @@ def measure(mesh: Any, tf: Any, size: int, lags: list[float], window: int, drag_
         ref = render(mesh, tf, cam, (size, size), "reference")
         ref_s = time.perf_counter() - t0
         own = draw(cam, False)
-        row = {"azimuth": az, "reference_s": ref_s, "own": _err(own, ref), "lags": {}}
+        row: dict[str, Any] = {"azimuth": az, "reference_s": ref_s, "own": _err(own, ref), "lags": {}}
         for lag in all_lags:
             draw(_orbit(mesh.points, az - lag), False)       # the order of the camera lag degrees back
             lagged = draw(cam, True)

@@ -325,14 +325,14 @@ def hdf5_field(path: Path, rng: random.Random) -> Mutation:
     if attrs and choice < 0.25:
         obj, attr = rng.choice(attrs)
 
-        def edit(p: Path) -> None:
+        def edit_attribute(p: Path) -> None:
             with h5py.File(p, "r+") as f:
                 target = f[obj] if obj else f
                 old = np.array(target.attrs[attr])
                 flat = old.reshape(-1).copy()
                 flat[rng.randrange(flat.size)] = _cast(value, flat.dtype)
                 target.attrs[attr] = flat.reshape(old.shape)
-        return Mutation("hdf5-field", f"attribute {obj}/{attr} element set to {value}", None, edit)
+        return Mutation("hdf5-field", f"attribute {obj}/{attr} element set to {value}", None, edit_attribute)
     name = rng.choice([n for n in names if re.search(r"Number|Offset|Types|Steps|Parts|Connectivity", n)] or names)
 
     def edit(p: Path) -> None:
@@ -561,7 +561,7 @@ def _serve_vtk(request: dict) -> dict:
     reader.AddObserver("ErrorEvent", lambda *_: errors.append("error"))
     reader.UpdateInformation()
     steps = reader.GetOutputInformation(0).Get(vtkStreamingDemandDrivenPipeline.TIME_STEPS()) or [None]
-    found = {"n_points": 0, "crc": 0, "problem": ""}
+    found: dict[str, Any] = {"n_points": 0, "crc": 0, "problem": ""}
     for i in frames_to_read(len(steps)):
         reader.UpdateTimeStep(steps[i]) if steps[i] is not None else reader.Update()
         output = reader.GetOutputDataObject(0)
@@ -620,15 +620,17 @@ class BenchWorker:
         if self.proc is None or self.proc.poll() is not None:
             self.proc = self._start()
             self.restarts += 1
+        stdin, stdout = self.proc.stdin, self.proc.stdout
+        assert stdin is not None and stdout is not None                 # _start pipes both
         os.truncate(self.log, 0)
         box: list[str] = []
         t0 = time.perf_counter()
         try:
-            self.proc.stdin.write(json.dumps(request) + "\n")
-            self.proc.stdin.flush()
+            stdin.write(json.dumps(request) + "\n")
+            stdin.flush()
         except OSError:
             pass
-        reader = threading.Thread(target=lambda: box.append(self.proc.stdout.readline()), daemon=True)
+        reader = threading.Thread(target=lambda: box.append(stdout.readline()), daemon=True)
         reader.start()
         reader.join(self.seconds)
         elapsed = time.perf_counter() - t0
@@ -654,6 +656,7 @@ class BenchWorker:
 
     def close(self) -> None:
         if self.proc is not None and self.proc.poll() is None:
+            assert self.proc.stdin is not None                          # _start pipes it
             self.proc.stdin.close()
             self.proc.wait(timeout=30)
         self.proc = None
@@ -735,21 +738,22 @@ def run(data: Path, total: int, seed: int, formats: list[str] | None, minutes: f
             if minutes > 0 and time.perf_counter() - t_start > 60 * minutes:
                 break
             done = n + 1
-            data = src.path.read_bytes()
+            raw = src.path.read_bytes()
             if src.layout == "hdf5" and id(src) not in addresses:
                 addresses[id(src)] = hdf5_object_addresses(src.path)
-            mutation = make_mutation(src, data, recipe, addresses.get(id(src)))
+            mutation = make_mutation(src, raw, recipe, addresses.get(id(src)))
             folder = prepare_folder(src, base, index[id(src)])
             target = mutated_path(src, folder)
-            requests = {"volviz": {"path": str(folder / src.target), "options": src.options},
-                        "vtk": {"path": str(folder / src.target), "options": src.options, "recipe": src.vtk}}
+            requests: dict[str, dict[str, Any]] = {
+                "volviz": {"path": str(folder / src.target), "options": src.options},
+                "vtk": {"path": str(folder / src.target), "options": src.options, "recipe": src.vtk}}
             active = [s for s in sides if s == "volviz" or src.vtk]
             for side in active:
                 if (index[id(src)], side) not in originals:
-                    place(target, data)
+                    place(target, raw)
                     first = sides[side].ask(requests[side])
                     originals[(index[id(src)], side)] = first if first["status"] == "ok" else None
-            place(target, mutation.data if mutation.data is not None else data)
+            place(target, mutation.data if mutation.data is not None else raw)
             if mutation.edit is not None:
                 try:
                     mutation.edit(target)

@@ -136,9 +136,11 @@ def gl_pt_frames(mesh: Any, tf: Any, cams: list[Any], size: tuple[int, int], rep
 
     from volviz.render.gl_pt import GLPTVolume
 
-    pl = pv.Plotter(off_screen=True, window_size=size)
-    pl.set_background("black")
-    pl.ren_win.SetMultiSamples(0)
+    pl = pv.Plotter(off_screen=True, window_size=list(size))
+    pl.set_background("black")  # type: ignore[arg-type]  # pyvista types its functools.wraps wrapper wrongly
+    ren_win = pl.ren_win
+    assert ren_win is not None
+    ren_win.SetMultiSamples(0)
     vol = GLPTVolume(pl, mesh, tf, lookup=lookup)
     cams[0].apply_to(pl.renderer.GetActiveCamera())
     pl.camera_set = True
@@ -148,7 +150,7 @@ def gl_pt_frames(mesh: Any, tf: Any, cams: list[Any], size: tuple[int, int], rep
         for cam in cams[1:] + cams[:1] if len(cams) > 1 else cams * 2:     # each render a new camera
             cam.apply_to(pl.renderer.GetActiveCamera())
             t0, c0 = time.perf_counter(), time.process_time()
-            pl.ren_win.Render()
+            ren_win.Render()
             frame.append(time.perf_counter() - t0)
             cpu.append(time.process_time() - c0)
             sort.append(vol.stats["sort_s"])
@@ -156,12 +158,14 @@ def gl_pt_frames(mesh: Any, tf: Any, cams: list[Any], size: tuple[int, int], rep
             if split:
                 same.append(_timed_render(pl))
                 _one_cell_order(vol)
-                pl.ren_win.Render()
+                ren_win.Render()
                 one.append(_timed_render(pl))
     cams[0].apply_to(pl.renderer.GetActiveCamera())
-    pl.ren_win.Render()
-    img = pl.screenshot(return_img=True).astype(np.float64) / 255.0
-    caps = pl.ren_win.ReportCapabilities() or ""
+    ren_win.Render()
+    shot = pl.screenshot(return_img=True)
+    assert shot is not None
+    img = shot.astype(np.float64) / 255.0
+    caps = ren_win.ReportCapabilities() or ""
     renderer = next((ln.split(":", 1)[1].strip() for ln in caps.splitlines() if "renderer string" in ln), "")
     vol.remove()
     pl.close()
@@ -255,8 +259,8 @@ def main(argv: list[str] | None = None) -> int:
                 runs.append(st)
             imgs.append(img)
             rows.append(sorted(runs, key=lambda s: s.total_s)[len(runs) // 2])
-        res = {k: float(np.median([getattr(s, k) for s in rows])) for k in ("sort_s", "project_s", "raster_s",
-                                                                             "total_s")}
+        res: dict[str, Any] = {k: float(np.median([getattr(s, k) for s in rows]))
+                               for k in ("sort_s", "project_s", "raster_s", "total_s")}
         res["cpu_s"] = float(np.median([s.extra["cpu_s"] for s in rows]))
         res["cycles"] = int(sum(s.cycles for s in rows))
         res["boundary_relations"] = int(np.median([s.boundary_relations for s in rows]))
@@ -291,6 +295,7 @@ def main(argv: list[str] | None = None) -> int:
     results["methods"]["reference"] = {"frame_s": ref_s, "rmse_rgb": 0.0, "max_rgb": 0.0}
     images = {"reference": ref, "pt": pt_imgs[0]}
     if pt3 is not None:
+        assert pt3_imgs is not None
         e3 = _rgb_err(pt3_imgs[0], ref)
         results["methods"]["pt-3d"] = {**pt3, "frame_s": pt3["total_s"], "tets_per_s": rep.n_tets / pt3["total_s"],
                                        "rmse_rgb": e3[0], "max_rgb": e3[1], "rmse_rgba": rmse(pt3_imgs[0], ref),
@@ -324,6 +329,7 @@ def main(argv: list[str] | None = None) -> int:
             times.extend(t)
             if i == 0:
                 img0 = img
+        assert img0 is not None                                        # cams is not empty
         e = _rgb_err(img0, ref)
         frame_s = float(np.median(times))
         results["methods"][name] = {"frame_s": frame_s, "tets_per_s": rep.n_tets / frame_s, "rmse_rgb": e[0],

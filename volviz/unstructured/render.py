@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import asdict, dataclass, field
-from typing import Any
+from typing import Any, Literal, overload
 
 import numpy as np
 
@@ -116,6 +116,33 @@ def _table_for(mesh: TetMesh, tf: Any, kind: str, sizes: tuple[int, int], l_max:
         table = build_separable(tf, n_s=sizes[0], l_max=l_max, degree=sizes[1], s_range=(lo, hi))
     mesh.__dict__[slot] = (key, table)
     return table
+
+
+@overload
+def render(mesh: TetMesh, tf: Any, camera: Camera, size: tuple[int, int] = (512, 512), method: str = "pt", *,
+           sort: str = "mpvo", nonconvex: str = "auto", order: np.ndarray | None = None, lookup: str = "auto",
+           n_s: int | None = None, n_l: int = 64, degree: int | None = None, table: Any = None, t_min: float = 1e-3,
+           depth: np.ndarray | None = None, iso: Any = None, iso_mode: str = "exact", iso_shading: str = "flat",
+           classification: str = "post", return_stats: Literal[False] = False
+           ) -> np.ndarray: ...
+
+
+@overload
+def render(mesh: TetMesh, tf: Any, camera: Camera, size: tuple[int, int] = (512, 512), method: str = "pt", *,
+           sort: str = "mpvo", nonconvex: str = "auto", order: np.ndarray | None = None, lookup: str = "auto",
+           n_s: int | None = None, n_l: int = 64, degree: int | None = None, table: Any = None, t_min: float = 1e-3,
+           depth: np.ndarray | None = None, iso: Any = None, iso_mode: str = "exact", iso_shading: str = "flat",
+           classification: str = "post", return_stats: Literal[True]
+           ) -> tuple[np.ndarray, UnstructuredRenderStats]: ...
+
+
+@overload
+def render(mesh: TetMesh, tf: Any, camera: Camera, size: tuple[int, int] = (512, 512), method: str = "pt", *,
+           sort: str = "mpvo", nonconvex: str = "auto", order: np.ndarray | None = None, lookup: str = "auto",
+           n_s: int | None = None, n_l: int = 64, degree: int | None = None, table: Any = None, t_min: float = 1e-3,
+           depth: np.ndarray | None = None, iso: Any = None, iso_mode: str = "exact", iso_shading: str = "flat",
+           classification: str = "post", return_stats: bool = False
+           ) -> np.ndarray | tuple[np.ndarray, UnstructuredRenderStats]: ...
 
 
 def render(mesh: TetMesh, tf: Any, camera: Camera, size: tuple[int, int] = (512, 512), method: str = "pt", *,
