@@ -25,6 +25,12 @@ def test_fbm_is_deterministic_by_seed() -> None:
     assert v.shape == (9, 10, 11) and v.dtype == np.float32 and np.array_equal(v, noise.fbm3((9, 10, 11), seed=5))
 
 
+def test_fbm_scale_is_one_number_for_every_axis_or_one_per_axis() -> None:
+    assert np.array_equal(noise.fbm2((20, 30), scale=6.0, seed=1), noise.fbm2((20, 30), scale=(6.0, 6.0), seed=1))
+    assert not np.array_equal(noise.fbm2((20, 30), scale=(6.0, 3.0), seed=1), noise.fbm2((20, 30), scale=6.0, seed=1))
+    assert np.array_equal(noise.fbm3((9, 10, 11), scale=4, seed=2), noise.fbm3((9, 10, 11), scale=(4, 4, 4), seed=2))
+
+
 def test_generators_ranges() -> None:
     h = noise.fractal_terrain(65, seed=2, relief=100.0)
     assert h.shape == (65, 65) and h.min() == 0.0 and h.max() == 100.0

@@ -10,7 +10,7 @@ settings forms from these models (field titles, descriptions, bounds, units in `
 """
 from __future__ import annotations
 
-from typing import Any, Literal, Optional, Union
+from typing import Any, Literal, Optional, Union, overload
 
 from pydantic import AliasChoices, BaseModel, ConfigDict, Field, ValidationError, field_validator
 
@@ -262,8 +262,53 @@ def _problems(exc: ValidationError, where: str) -> list[tuple[str, str]]:
     return out
 
 
+@overload
+def typed_settings(component_type: Literal["terrain"], settings: dict[str, Any],
+                   where: str = "settings") -> TerrainSettings: ...
+
+
+@overload
+def typed_settings(component_type: Literal["fog"], settings: dict[str, Any],
+                   where: str = "settings") -> FogSettings: ...
+
+
+@overload
+def typed_settings(component_type: Literal["clouds"], settings: dict[str, Any],
+                   where: str = "settings") -> CloudSettings: ...
+
+
+@overload
+def typed_settings(component_type: Literal["sky"], settings: dict[str, Any],
+                   where: str = "settings") -> SkySettings: ...
+
+
+@overload
+def typed_settings(component_type: Literal["volume"], settings: dict[str, Any],
+                   where: str = "settings") -> VolumeSettings: ...
+
+
+@overload
+def typed_settings(component_type: Literal["mesh"], settings: dict[str, Any],
+                   where: str = "settings") -> MeshSettings: ...
+
+
+@overload
+def typed_settings(component_type: Literal["isosurface"], settings: dict[str, Any],
+                   where: str = "settings") -> IsosurfaceSettings: ...
+
+
+@overload
+def typed_settings(component_type: Literal["demo"], settings: dict[str, Any],
+                   where: str = "settings") -> DemoSettings: ...
+
+
+@overload
+def typed_settings(component_type: str, settings: dict[str, Any], where: str = "settings") -> Settings: ...
+
+
 def typed_settings(component_type: str, settings: dict[str, Any], where: str = "settings") -> Settings:
-    """The model instance of a component's settings (SettingsError naming the field path of each problem)."""
+    """The model instance of a component's settings (SettingsError naming the field path of each problem); typed
+    as the component type's model (``SETTINGS_MODELS``) where the type is a literal, e.g. FogSettings for "fog"."""
     model = settings_model(component_type)
     try:
         return model.model_validate(settings)

@@ -119,7 +119,7 @@ class CloudVolume:
         for arr in (f, gamma):
             a = np.asarray(arr, dtype=np.float64)
             if a.shape != shape:
-                tmp = np.stack([resample_bilinear(a[:, :, k], shape[:2]) for k in range(a.shape[2])], axis=2)
+                tmp = np.stack([resample_bilinear(a[:, :, k], (shape[0], shape[1])) for k in range(a.shape[2])], axis=2)
                 a = np.stack([resample_bilinear(tmp[i], (shape[1], shape[2])) for i in range(shape[0])], axis=0)
             out.append(a.astype(np.float32))
         spacing = tuple(e / (n - 1) for e, n in zip(extent, shape))
@@ -198,8 +198,8 @@ class CloudFrame:
             u = (np.asarray(eye, dtype=np.float64) - p0) / (s[:, None] * np.asarray(vol.spacing))
             key = np.zeros((len(self.leaves), 5))
             for t in range(1, 5):
-                q = local[:, t, 0]
-                cq = np.stack([q >> 2, (q >> 1) & 1, q & 1], 1)
+                qt = local[:, t, 0]
+                cq = np.stack([qt >> 2, (qt >> 1) & 1, qt & 1], 1)
                 front = np.where(cq == 0, u, 1.0 - u).sum(1) < 1.0
                 key[:, t] = np.where(front, 1.0, -1.0)
             local = np.take_along_axis(local, np.argsort(key, axis=1, kind="stable")[:, :, None], axis=1)

@@ -152,5 +152,5 @@ class HeightField:
         if extent is None:
             extent = ((cols - 1) * image.spacing[0], (rows - 1) * image.spacing[1])
         origin = tuple(getattr(image, "origin", (0.0, 0.0)))
-        return cls.from_array(grid_from_image(data), extent, height_scale, origin, size,  # type: ignore[arg-type]
+        return cls.from_array(grid_from_image(data), extent, height_scale, origin, size,
                               source=getattr(image, "source", ""))

@@ -159,7 +159,7 @@ class NatureScene:
                 stats["fog_prisms"] += drawn
                 stats["fog_s"] += time.perf_counter() - t0
             else:
-                assert self.cloud_lod is not None
+                assert self.cloud_lod is not None and self.cloud_shading is not None    # add_clouds sets both
                 frame = self.cloud_lod.update(camera, size, full=full)
                 rgba = render_cloud_image(frame, self.cloud_shading, self.cloud_table, camera, size, depth)
                 stats["cloud_tets"] = float(frame.n_tets)
@@ -316,11 +316,7 @@ def scene_from_components(components: Sequence[Any], datasets: dict[str, Any]) -
             dens = (dens - dens.min()) / max(float(np.ptp(dens)), 1e-12)
         else:
             dens = noise.cloud_density(st.shape, seed=st.seed, coverage=st.coverage)
-        if terrain is not None:
-            ext_default = list(terrain.extent)
-        else:
-            ext_default = [1000.0, 1000.0]
-        ext = st.extent or ext_default
+        ext = st.extent or (terrain.extent if terrain is not None else (1000.0, 1000.0))
         thickness = st.thickness or ext[0] * (dens.shape[2] - 1) / (dens.shape[0] - 1)
         origin = (terrain.origin[0] if terrain else 0.0, terrain.origin[1] if terrain else 0.0, st.base_height)
         spacing = (ext[0] / (dens.shape[0] - 1), ext[1] / (dens.shape[1] - 1), thickness / (dens.shape[2] - 1))

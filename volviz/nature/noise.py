@@ -106,11 +106,16 @@ def perlin3(x: np.ndarray, y: np.ndarray, z: np.ndarray, seed: int = 0) -> np.nd
     return out
 
 
+def _per_axis(scale: float | tuple[float, ...], n: int) -> list[float]:
+    """``scale`` for each of ``n`` axes: one number for all of them, or one per axis."""
+    return [float(v) for v in np.broadcast_to(np.asarray(scale, dtype=np.float64), (n,))]
+
+
 def fbm2(shape: tuple[int, int], scale: float | tuple[float, float] = 8.0, octaves: int = 5, lacunarity: float = 2.0,
          persistence: float = 0.5, seed: int = 0, offset: tuple[float, float] = (0.0, 0.0)) -> np.ndarray:
     """2D fractal Brownian motion on a grid: ``scale`` lattice cells of the base octave across each axis."""
     nx, ny = (int(v) for v in shape)
-    sx, sy = (scale, scale) if np.isscalar(scale) else scale  # type: ignore[misc]
+    sx, sy = _per_axis(scale, 2)
     out = np.empty((nx, ny))
     _fbm2_grid(permutation(seed), _GRAD2, nx, ny, float(sx) / max(nx - 1, 1), float(sy) / max(ny - 1, 1),
                float(offset[0]), float(offset[1]), int(octaves), float(lacunarity), float(persistence), out)
@@ -122,7 +127,7 @@ def fbm3(shape: tuple[int, int, int], scale: float | tuple[float, float, float] 
          offset: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> np.ndarray:
     """3D fractal Brownian motion on a grid (Roettger's cloud and camp-fire generator, [82])."""
     nx, ny, nz = (int(v) for v in shape)
-    sx, sy, sz = (scale,) * 3 if np.isscalar(scale) else scale  # type: ignore[misc]
+    sx, sy, sz = _per_axis(scale, 3)
     out = np.empty((nx, ny, nz), dtype=np.float32)
     _fbm3_grid(permutation(seed), _GRAD3, nx, ny, nz, float(sx) / max(nx - 1, 1), float(sy) / max(ny - 1, 1),
                float(sz) / max(nz - 1, 1), float(offset[0]), float(offset[1]), float(offset[2]), int(octaves),

@@ -38,7 +38,8 @@ def sky_dome_mesh(radius: float, centre: Sequence[float] = (0.0, 0.0, 0.0), n_az
             a, b = i * ne + j, (i + 1) * ne + j
             quads.append([4, a, a + 1, b + 1, b])  # inward-facing winding
     mesh = pv.PolyData(pts, np.asarray(quads, dtype=np.int64).ravel())
-    mesh.active_texture_coordinates = tc.astype(np.float32)
+    # pyvista types the setter's array as float64 only; VTK takes float32 texture coordinates
+    mesh.active_texture_coordinates = tc.astype(np.float32)  # type: ignore[assignment]
     return mesh
 
 
