@@ -66,7 +66,7 @@ from typing import Any
 import numpy as np
 
 from volviz.nature.fog import FogLayer, layer_emission
-from volviz.render.gl_pt import _PASS_MARK, _USERS, GLPTVolume, shader_source
+from volviz.render.gl_pt import _PASS_MARK, _USERS, GLPTVolume, install_scene_pass, shader_source
 from volviz.model.camera import Camera
 
 __all__ = ["GLFogLayer", "PrismBuffers", "add_fog_layer", "buffers_polydata", "prism_attributes",
@@ -233,7 +233,7 @@ class GLFogLayer:
         else:
             self.set_buffers(buffers)
 
-        GLPTVolume._install_pass(self)         # the shared float color target and opaque depth texture
+        install_scene_pass(self.renderer, self)   # the shared float color target and opaque depth texture
         self._observers = [
             (self.mapper, self.mapper.AddObserver(vtk.vtkCommand.UpdateShaderEvent,
                                                   self._observer(self._on_prisms))),

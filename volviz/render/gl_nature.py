@@ -196,7 +196,7 @@ class GLNatureView(NatureView):
             for fog in scene.fogs:
                 bottom = mesh.points[:, 2] if fog.bottom == "terrain" else mesh.layers[fog.bottom]
                 geometry = (mesh.points, bottom, mesh.layers[fog.top], mesh.triangles)
-                prisms[fog.name] = (geometry, prism_buffers(*geometry, fog.layer))
+                prisms[fog.name] = (geometry, prism_buffers(*geometry, layer=fog.layer))
         stats["lod_s"] = time.perf_counter() - t0
         return poly, SimpleNamespace(mesh=mesh, clouds=clouds, prisms=prisms,
                                      eye=np.asarray(cam.position, np.float64)), stats
@@ -210,15 +210,17 @@ class GLNatureView(NatureView):
         scene = self.scene
         for kind, fog in scene.volume_order(frame.eye):    # made in this order: the first frame moves nothing
             if kind == "fog" and fog.name in frame.prisms:
-                geometry, buffers = frame.prisms[fog.name]
+                (points, bottom, top, triangles), buffers = frame.prisms[fog.name]
                 if fog.name in self.layers:
-                    self.layers[fog.name].set_geometry(*geometry, buffers=buffers)
+                    self.layers[fog.name].set_geometry(points, bottom, top, triangles, buffers=buffers)
                 else:
-                    self.layers[fog.name] = GLFogLayer(self.plotter, *geometry, fog.layer, buffers=buffers)
+                    self.layers[fog.name] = GLFogLayer(self.plotter, points, bottom, top, triangles, fog.layer,
+                                                       buffers=buffers)
             elif kind == "clouds" and frame.clouds is not None:
                 if self.clouds is None:
                     assert scene.cloud_shading is not None
-                    self.clouds = CloudPTVolume(self.plotter, *frame.clouds, scene.cloud_shading, scene.cloud_table)
+                    tets, cloud = frame.clouds
+                    self.clouds = CloudPTVolume(self.plotter, tets, cloud, scene.cloud_shading, scene.cloud_table)
                 else:
                     self.clouds.set_frame(*frame.clouds)
         stats["fog_prisms"] = float(sum(layer.drawn for layer in self.layers.values()))
@@ -231,7 +233,7 @@ class GLNatureView(NatureView):
     def _sort_layers(self, eye: np.ndarray) -> None:
         """The layers' actors in the renderer in the CPU's compositing order (``NatureScene.volume_order``)."""
         actors: list[Any] = []
-        for kind, fog in self.scene.volume_order(eye):
+        for kind, fog in self.scene.volume_order([float(v) for v in eye]):
             if kind == "fog" and fog.name in self.layers:
                 actors += [self.layers[fog.name].actor, self.layers[fog.name].resolve_actor]
             elif kind == "clouds" and self.clouds is not None:

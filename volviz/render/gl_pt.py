@@ -205,6 +205,26 @@ def _shader(name: str, smooth: bool, kind: int = 0, clips: int = 0) -> str:
     return shader_source(name).replace("//VTK::System::Dec\n", "//VTK::System::Dec\n" + head, 1)
 
 
+def install_scene_pass(renderer: Any, user: object) -> None:
+    """A float32 color target around VTK's standard render steps (a ``vtkFramebufferPass``, its depth texture
+    holding the opaque scene) on ``renderer``, translucent props drawn in order; shared by the GL layers that use it
+    (``GLPTVolume``, ``volviz.render.gl_fog.GLFogLayer``); ``user`` is counted as one (the last one to leave takes
+    the pass off)."""
+    import vtk
+
+    renderer.SetUseDepthPeeling(False)
+    renderer.SetUseOIT(False)
+    if getattr(renderer, _PASS_MARK, None) is None:
+        fb = vtk.vtkFramebufferPass()
+        fb.SetColorFormat(vtk.vtkTextureObject.Float32)
+        fb.SetDelegatePass(vtk.vtkRenderStepsPass())
+        renderer.SetPass(fb)
+        setattr(renderer, _PASS_MARK, fb)
+    if getattr(renderer, _USERS, None) is None:
+        setattr(renderer, _USERS, [])
+    getattr(renderer, _USERS).append(user)
+
+
 def _order_key(cam: Camera, size: tuple[int, ...]) -> tuple[Any, ...]:
     """What a visibility order depends on: the camera and the image size."""
     return (tuple(cam.position), tuple(cam.focal_point), tuple(cam.view_up), cam.view_angle, cam.parallel,
@@ -351,24 +371,9 @@ class GLPTVolume(PTView):
             (self._on_update_shader if caller is self.mapper else self._on_resolve)(program)
 
     def _install_pass(self) -> None:
-        """A float32 color target around VTK's standard render steps (a ``vtkFramebufferPass``, its depth texture
-        holding the opaque scene), translucent props drawn in order; shared by the GL layers that use it
-        (``volviz.render.gl_fog``; ``self.renderer``, ``self`` counted as a user). GLPTVolume itself draws into its
-        own target (module docstring) and works with or without it."""
-        import vtk
-
-        ren = self.renderer
-        ren.SetUseDepthPeeling(False)
-        ren.SetUseOIT(False)
-        if getattr(ren, _PASS_MARK, None) is None:
-            fb = vtk.vtkFramebufferPass()
-            fb.SetColorFormat(vtk.vtkTextureObject.Float32)
-            fb.SetDelegatePass(vtk.vtkRenderStepsPass())
-            ren.SetPass(fb)
-            setattr(ren, _PASS_MARK, fb)
-        if getattr(ren, _USERS, None) is None:
-            setattr(ren, _USERS, [])
-        getattr(ren, _USERS).append(self)
+        """The renderer's shared float32 scene target (``install_scene_pass``), this volume counted as a user.
+        GLPTVolume itself draws into its own target (module docstring) and works with or without it."""
+        install_scene_pass(self.renderer, self)
 
     # --- per frame -----------------------------------------------------------------------------------------------
     def _camera(self) -> Camera:

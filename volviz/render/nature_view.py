@@ -32,10 +32,11 @@ class NatureView:
         self.scene = scene
         scene.finalize()
         self.size = size
-        self.terrain_actor = None
-        self.sky_actor = None
-        self._overlay_actor = None
-        self._overlay_image = None
+        self.terrain_actor: Any = None
+        self.sky_actor: Any = None
+        self._overlay_actor: Any = None
+        self._overlay_image: Any = None
+        self._texture: Any = None
         self._near = 0.1
         self._mesh = None
         self.last_stats: dict[str, float] = {}
@@ -107,7 +108,8 @@ class NatureView:
         if camera is not None:
             camera.apply_to(self.plotter.camera)
             self._fit_clipping()  # the VTK side only: ``cam`` keeps the caller's range for the CPU overlay
-        size = self.size or tuple(int(v) for v in self.plotter.window_size)
+        w, h = self.size or (int(self.plotter.window_size[0]), int(self.plotter.window_size[1]))
+        size = (w, h)
         if self.sky_actor is not None:
             self.sky_actor.SetPosition(*np.asarray(cam.position, dtype=np.float64))
         return cam, size, max(1, int(scale))
