@@ -1,7 +1,7 @@
 """Multiple semi-transparent isosurfaces from several, possibly overlapping, time-varying volumes (the libMini note,
 Roettger 2007): extraction, order-independent compositing modes, iso-spectrum shading, 4D animation, clipping and
 view-dependent LOD. Entry points for a scene builder: ``IsoSettings``, ``prepare`` (background) and ``render_iso``
-(per view); ``iso_actor`` for a VTK actor per surface."""
+(per view). The VTK actors of the surfaces are made in ``volviz.render`` (``iso_spectrum.iso_actor``)."""
 from volviz.iso.animate import IsoAnimator, IsoFrame, extract_at, playback_times
 from volviz.iso.clip import (BoxCrop, ClipPlane, ClipSettings, clip_isosurface, clip_isosurfaces, clip_tetmesh,
                              clip_volume)
@@ -10,10 +10,9 @@ from volviz.iso.extract import IsoMesh, IsoStyle, extract, extract_many
 from volviz.iso.lod import LodChain, build_lod, lod_mesh, lod_meshes, select_level
 from volviz.iso.component import IsoSettings, PreparedIso, prepare, render_iso
 from volviz.iso.spectrum import SpectrumFit, fit_spectrum, spectrum_alpha
-from volviz.iso.vtk_spectrum import apply_spectrum_shader, iso_actor
 
 __all__ = ["IsoAnimator", "IsoFrame", "extract_at", "playback_times", "BoxCrop", "ClipPlane", "ClipSettings",
            "clip_isosurface", "clip_isosurfaces", "clip_tetmesh", "clip_volume", "MODES", "composite", "fragments",
            "render", "render_modes", "IsoMesh", "IsoStyle", "extract", "extract_many", "LodChain", "build_lod",
            "lod_mesh", "lod_meshes", "select_level", "IsoSettings", "PreparedIso", "prepare", "render_iso",
-           "SpectrumFit", "fit_spectrum", "spectrum_alpha", "apply_spectrum_shader", "iso_actor"]
+           "SpectrumFit", "fit_spectrum", "spectrum_alpha"]

@@ -608,7 +608,7 @@ def add_isosurface_actors(plotter: Any, name: str, parts: IsoParts, spectrum: bo
     restores the light kit before building."""
     import vtk
 
-    from volviz.iso import iso_actor
+    from volviz.render.iso_spectrum import iso_actor
 
     assembly = vtk.vtkPropAssembly()
     translucent = []  # the actors of translucent surfaces (hidden while a CPU mode draws those surfaces)

@@ -7,7 +7,7 @@ from vtkmodules.vtkRenderingCore import vtkActor
 from vtkmodules.vtkRenderingOpenGL2 import vtkOpenGLPolyDataMapper
 
 from volviz.iso.spectrum import spectrum_alpha
-from volviz.iso.vtk_spectrum import apply_spectrum_shader
+from volviz.render.iso_spectrum import apply_spectrum_shader
 
 
 def _sphere_row(shader: bool) -> tuple[np.ndarray, object]:
@@ -50,7 +50,7 @@ def test_iso_actor_renders_translucent_and_opaque_surfaces():
     for style in (IsoStyle(0.0, (0.0, 0.0, 1.0), 0.4), IsoStyle(0.0, (1.0, 0.0, 0.0), 1.0)):
         pts = np.asarray(s.points) * (0.5 if style.opacity == 1.0 else 1.0)
         mesh = IsoMesh(pts, tris, np.asarray(s.point_data["Normals"]), style)
-        from volviz.iso.vtk_spectrum import iso_actor
+        from volviz.render.iso_spectrum import iso_actor
         pl.renderer.AddActor(iso_actor(mesh))
     pl.reset_camera()
     img = pl.screenshot(return_img=True).astype(np.float64)
