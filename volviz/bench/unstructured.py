@@ -57,10 +57,12 @@ def _vtk_render(mesh: Any, tf: Any, cam: Any, size: int, mapper_name: str, reps:
     import vtk
     from vtk.util.numpy_support import vtk_to_numpy
 
+    from volviz.render.vtk_tf import tf_to_vtk
+
     grid = mesh.to_pyvista()
     mapper = getattr(vtk, mapper_name)()
     mapper.SetInputData(grid)
-    ctf, otf = tf.to_vtk(1.0)
+    ctf, otf = tf_to_vtk(tf, 1.0)
     prop = vtk.vtkVolumeProperty()
     prop.SetColor(ctf)
     prop.SetScalarOpacity(otf)

@@ -84,9 +84,10 @@ def _add_scalar_bar(plotter: Any, session: Session, comp: Any, title: str, color
     import vtk
 
     from volviz.optics import TransferFunction
+    from volviz.render.vtk_tf import tf_to_vtk
 
     tf = TransferFunction.from_dict(session.transfer_functions[comp.transfer_function])
-    ctf, _ = tf.to_vtk(1.0)
+    ctf, _ = tf_to_vtk(tf, 1.0)
     ctf.ClampingOn()
     bar = vtk.vtkScalarBarActor()
     bar.SetLookupTable(ctf)

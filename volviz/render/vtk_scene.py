@@ -12,6 +12,7 @@ from typing import Any, Optional
 import numpy as np
 
 from volviz.model import CurvilinearGrid, Image2D, RegularVolume, TetMesh, TimeSeries, UnstructuredMesh, vec3
+from volviz.render.vtk_tf import tf_to_vtk
 from volviz.session import CameraState
 
 DEFAULT_COLORS = ((0.23, 0.30, 0.75), (0.87, 0.87, 0.87), (0.71, 0.02, 0.15))  # cool-warm: low, middle, high
@@ -47,7 +48,7 @@ def update_volume_property(prop: Any, tf: Any, opacity: float = 1.0) -> None:
     """Point a vtkVolumeProperty at ``tf`` (VTK convention: ρ = opacity / unit distance); ``opacity`` scales ρ."""
     tf = tf.scaled_extinction(max(float(opacity), 0.0)) if opacity != 1.0 else tf
     unit = vtk_unit_distance(tf)
-    ctf, otf = tf.to_vtk(unit)
+    ctf, otf = tf_to_vtk(tf, unit)
     prop.SetColor(ctf)
     prop.SetScalarOpacity(otf)
     prop.SetScalarOpacityUnitDistance(unit)
@@ -185,7 +186,7 @@ def is_surface(dataset: Any) -> bool:
 def _add_surface(plotter: Any, grid: Any, tf: Any, opacity: float, name: Optional[str]) -> Any:
     """A surface colored by its active scalars through the transfer function's colors; the cells touching NaN/Inf
     (land in an ocean field, a solver's failed points) are left out."""
-    ctf, _ = tf.to_vtk(1.0)
+    ctf, _ = tf_to_vtk(tf, 1.0)
     ctf.ClampingOn()
     values = np.asarray(grid.active_scalars)
     if values.dtype.kind == "f" and not np.isfinite(values).all():   # cells touching NaN/Inf are not drawn

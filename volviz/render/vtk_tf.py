@@ -1,0 +1,87 @@
+"""A ``volviz.optics.TransferFunction`` to and from VTK's transfer functions (``vtkColorTransferFunction`` for the
+color κ, ``vtkPiecewiseFunction`` for the opacity a = ρ · unit distance, DESIGN.md's convention for VTK's volume
+mappers): what VTK's own mappers, the scalar bar and ParaView-style imports need.
+"""
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from volviz.optics.transfer_function import TransferFunction
+
+__all__ = ["tf_from_vtk", "tf_to_vtk"]
+
+
+def tf_from_vtk(ctf: Any, otf: Any, unit_distance: float, name: str = "",
+                samples: int = 256) -> TransferFunction:
+    """From a ``vtkColorTransferFunction`` (κ) and a ``vtkPiecewiseFunction`` (opacity a): ρ = a / unit_distance.
+
+    Control points are the union of both functions' nodes, which is exact when both interpolate linearly in RGB
+    (color space RGB, every node midpoint 0.5 and sharpness 0). Otherwise (HSV/Lab/diverging color space or
+    non-default midpoints) the functions are additionally sampled at ``samples`` evenly spaced scalars: the result
+    is then a piecewise-linear approximation of VTK's curve. VTK clamps outside its range; volviz is transparent
+    there (the range is the union of both functions' ranges).
+    """
+    unit_distance = float(unit_distance)
+    if not (np.isfinite(unit_distance) and unit_distance > 0):
+        raise ValueError(f"unit_distance must be finite and > 0, got {unit_distance}")
+    n_c = int(ctf.GetSize())
+    n_o = int(otf.GetSize())
+    if n_c < 1 or n_o < 1:
+        raise ValueError(f"VTK transfer functions must have nodes (color: {n_c}, opacity: {n_o})")
+    cnodes = np.zeros((n_c, 6))
+    onodes = np.zeros((n_o, 4))
+    for i in range(n_c):
+        val = [0.0] * 6
+        ctf.GetNodeValue(i, val)
+        cnodes[i] = val
+    for i in range(n_o):
+        val4 = [0.0] * 4
+        otf.GetNodeValue(i, val4)
+        onodes[i] = val4
+    exact = (
+        int(ctf.GetColorSpace()) == 0  # VTK_CTF_RGB
+        and np.allclose(cnodes[:, 4], 0.5, atol=1e-12, rtol=0) and np.allclose(cnodes[:, 5], 0.0, atol=1e-12)
+        and np.allclose(onodes[:, 2], 0.5, atol=1e-12, rtol=0) and np.allclose(onodes[:, 3], 0.0, atol=1e-12)
+    )
+    s = np.unique(np.concatenate([cnodes[:, 0], onodes[:, 0]]))
+    if s.size == 1:
+        raise ValueError("VTK transfer functions span a single scalar; need a range")
+    if exact:
+        colors = np.stack([np.interp(s, cnodes[:, 0], cnodes[:, 1 + ch]) for ch in range(3)], axis=1)
+        opacity = np.interp(s, onodes[:, 0], onodes[:, 1])
+    else:
+        s = np.unique(np.concatenate([s, np.linspace(s[0], s[-1], int(samples))]))
+        c2, o2 = type(ctf)(), type(otf)()
+        c2.DeepCopy(ctf)
+        o2.DeepCopy(otf)
+        c2.ClampingOn()
+        o2.ClampingOn()
+        colors = np.array([c2.GetColor(float(x)) for x in s], dtype=np.float64)
+        opacity = np.array([o2.GetValue(float(x)) for x in s], dtype=np.float64)
+    return TransferFunction(s, np.clip(colors, 0.0, None), np.clip(opacity, 0.0, None) / unit_distance, name=name)
+
+
+def tf_to_vtk(tf: TransferFunction, unit_distance: float) -> tuple[Any, Any]:
+    """``tf`` as ``(vtkColorTransferFunction, vtkPiecewiseFunction)`` with opacity a = ρ · unit_distance.
+
+    Set the same ``unit_distance`` as the volume property's ``ScalarOpacityUnitDistance``. Clamping is turned off
+    on both, so VTK is transparent outside the range like volviz. Opacity values above 1 are kept as they are (VTK
+    clamps them when it uses them), so round-trips are exact.
+    """
+    unit_distance = float(unit_distance)
+    if not (np.isfinite(unit_distance) and unit_distance > 0):
+        raise ValueError(f"unit_distance must be finite and > 0, got {unit_distance}")
+    from vtkmodules.vtkCommonDataModel import vtkPiecewiseFunction
+    from vtkmodules.vtkRenderingCore import vtkColorTransferFunction
+
+    ctf = vtkColorTransferFunction()
+    ctf.SetColorSpaceToRGB()
+    ctf.ClampingOff()
+    otf = vtkPiecewiseFunction()
+    otf.ClampingOff()
+    for s, (r, g, b), rho in zip(tf.scalars, tf.colors, tf.extinction):
+        ctf.AddRGBPoint(float(s), float(r), float(g), float(b))
+        otf.AddPoint(float(s), float(rho) * unit_distance)
+    return ctf, otf
