@@ -32,3 +32,9 @@ def test_the_choice_is_a_copy() -> None:
     choice = error_budget_choice(9.0, {"error_budget": 1.0})
     choice.table["table_resolution"] = 16
     assert MOST_ACCURATE_TABLE == {"table": "separable-4", "table_resolution": 512}
+
+
+def test_a_budget_of_none_is_the_default() -> None:
+    """The settings model's default for ``error_budget`` is None (a session may say ``"error_budget": null``)."""
+    assert error_budget_choice(0.9, {"error_budget": None}) == BudgetChoice()
+    assert error_budget_choice(1.5, {"error_budget": None}).table == MOST_ACCURATE_TABLE

@@ -25,7 +25,8 @@ class BudgetChoice:
 def error_budget_choice(rmse: float, options: Mapping[str, Any]) -> BudgetChoice:
     """What to do about a measured error ``rmse`` under the render ``options`` (their ``error_budget``, ``table``
     and ``table_resolution``)."""
-    budget = float(options.get("error_budget", DEFAULT_BUDGET))
+    given = options.get("error_budget")
+    budget = DEFAULT_BUDGET if given is None else float(given)   # None (the model's default): no budget set
     if rmse <= budget:
         return BudgetChoice()
     if all(options.get(k) == v for k, v in MOST_ACCURATE_TABLE.items()):
