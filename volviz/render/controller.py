@@ -19,8 +19,6 @@ from volviz.model import TimeSeries
 from volviz.session import CameraState, Component, Session
 
 if TYPE_CHECKING:
-    from volviz.render.gl_iso import GLIsoView
-    from volviz.render.iso_overlay import IsoOverlay
     from volviz.render.lod_volume import LodVolume
     from volviz.render.pt_view import PTView
 
@@ -476,7 +474,7 @@ class SceneController:
             if self.nature is not None:
                 requests.append(("nature", self.nature, self.nature.begin()))
             for volume in self.lod_volumes().values():
-                requests.append(("lod", volume, volume.camera()))
+                requests.append(("lod", volume, volume.begin()))
             return requests
         for prop in self.props.values():
             if _is_cpu_pt(prop) and prop.visible:
@@ -487,30 +485,23 @@ class SceneController:
 
     @staticmethod
     def compute_views(requests: list[tuple[str, Any, Any]], progress: Any = None) -> list[Any]:
-        """Any thread: the CPU images and meshes of ``begin_views`` requests (pure NumPy/Numba, no VTK calls)."""
+        """Any thread: the CPU images and meshes of ``begin_views`` requests (pure NumPy/Numba, no VTK calls): each
+        view's ``compute`` (``volviz.render.views.View``)."""
         from volviz.jobs import report
 
         results: list[Any] = []
-        for i, (kind, handle, request) in enumerate(requests):
+        for i, (_, view, request) in enumerate(requests):
             report(progress, i / max(len(requests), 1), f"rendering view {i + 1} of {len(requests)}")
-            if kind == "lod":
-                selection = handle.select(request)
-                results.append((selection, handle.decode(selection)))
-            else:
-                results.append(handle.compute(request))
+            results.append(view.compute(request))
         report(progress, 1.0, "views rendered")
         return results
 
     def finish_views(self, requests: list[tuple[str, Any, Any]], results: list[Any]) -> None:
-        """GUI thread: show the results of ``compute_views`` (hands data to VTK; draws nothing)."""
+        """GUI thread: show the results of ``compute_views`` (each view's ``finish``: hands data to VTK; draws
+        nothing)."""
         with no_render(self.plotter):
-            for (kind, handle, request), result in zip(requests, results):
-                if kind == "nature":
-                    self.finish_nature(handle, request, result)
-                elif kind == "lod":
-                    handle.show(*result)
-                else:
-                    handle.finish(request, *result)
+            for (_, view, request), result in zip(requests, results):
+                view.finish(request, *result)
 
     def lod_volumes(self) -> dict[str, Any]:
         """The visible volumes drawn at a level of detail (``volviz.render.lod_volume.LodVolume``) by component."""
@@ -565,11 +556,9 @@ class SceneController:
         return view
 
     def finish_nature(self, view: Any, request: Any, result: tuple[Any, ...]) -> dict[str, Any]:
-        """GUI thread: show a computed view of the natural scene (``view.compute``); a scene without terrain drops
-        the terrain of the view it replaced."""
-        stats = view.finish(request, *result)  # adds its actors with ``render=False``: the caller draws once
-        if view.terrain_actor is None:
-            self.plotter.remove_actor("nature-terrain", render=False)
+        """GUI thread: show a computed view of the natural scene (``view.compute``; a scene without terrain drops
+        the terrain of the view it replaced)."""
+        stats: dict[str, Any] = view.finish(request, *result)  # adds its actors with ``render=False``
         return stats
 
     def bounds(self) -> tuple[float, float, float, float, float, float]:
@@ -708,16 +697,9 @@ class SceneController:
             view.remove()
             view = self.iso_view = None
         if view is None and mode != "vtk" and self._iso_props():
-            view_type: type[GLIsoView] | type[IsoOverlay]
-            if backend == "gpu":
-                from volviz.render.gl_iso import GLIsoView
+            from volviz.render.views import view_class
 
-                view_type = GLIsoView
-            else:
-                from volviz.render.iso_overlay import IsoOverlay
-
-                view_type = IsoOverlay
-            view = self.iso_view = view_type(self.plotter, mode=mode)
+            view = self.iso_view = view_class("iso", backend)(self.plotter, mode=mode)
         if view is not None:
             view.mode = mode
         self._sync_iso_overlay()

@@ -394,6 +394,16 @@ class GLIsoView(IsoModeView):
                       "size": window_size(self.plotter.renderer)}
         return self.stats
 
+    def begin(self, scale: int = 1) -> None:
+        """The view calls (``volviz.render.views.View``): nothing to make off the GUI thread, VTK draws the passes."""
+        return None
+
+    def compute(self, request: None, progress: Any = None) -> tuple[()]:
+        return ()
+
+    def finish(self, request: None) -> dict[str, Any]:
+        return self.update()
+
     def remove(self) -> None:
         """Take the surfaces out of the renderer (its depth-peeling and OIT settings restored) and give the window
         its multisampling back."""

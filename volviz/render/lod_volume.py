@@ -121,7 +121,10 @@ def _mapper_planes(mapper: Any) -> Optional[np.ndarray]:
 
 
 class LodVolume:
-    """A LOD-rendered compressed volume attached to a plotter (see the module docstring)."""
+    """A LOD-rendered compressed volume attached to a plotter (see the module docstring); the view kind "lod" of
+    ``volviz.render.views`` (CPU only)."""
+
+    backend = "cpu"
 
     def __init__(self, plotter: Any, tree: LodTree, tf: Any, budget: int = 256, mode: str = "tf",
                  opacity: float = 1.0, renderer: str = "volviz", step: Optional[float] = None) -> None:
@@ -342,6 +345,26 @@ class LodVolume:
         self.stats.update({"renderer": "volviz", "prepared": False, "readback_s": t1 - t0, "table_s": t2 - t1,
                            "render_s": t3 - t2, "upload_s": t4 - t3, "draw_s": t4 - t0, "size": (w, h)})
         return img
+
+    def begin(self, scale: int = 1) -> dict[str, Any]:
+        """GUI thread: the selection to make for the plotter's camera now (``volviz.render.views.View``); a preview
+        (``scale`` > 1, while the camera moves) asks for an eighth of the block budget, as the app's coarse pass."""
+        budget = max(1, self.budget // 8) if scale > 1 else self.budget
+        return {"camera": self.camera(), "budget": budget, "preview": scale > 1}
+
+    def compute(self, request: dict[str, Any], progress: Any = None) -> tuple[Selection, list[Block], float, float]:
+        """Any thread: the selection of ``begin``'s request and its decoded new blocks, with their seconds."""
+        t0 = time.perf_counter()
+        selection = self.select(request["camera"], request["budget"])
+        t1 = time.perf_counter()
+        blocks = self.decode(selection)
+        return selection, blocks, t1 - t0, time.perf_counter() - t1
+
+    def finish(self, request: dict[str, Any], selection: Selection, blocks: list[Block], select_s: float = 0.0,
+               decode_s: float = 0.0) -> dict[str, Any]:
+        """GUI thread: draw ``compute``'s selection (``show``); returns the statistics."""
+        self.show(selection, blocks, select_s, decode_s)
+        return self.stats
 
     def update(self) -> dict[str, Any]:
         """Select for the plotter's current camera, decode and draw; returns the statistics."""

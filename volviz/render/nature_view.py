@@ -153,7 +153,9 @@ class NatureView:
         return stats
 
     def _show_terrain(self, poly: Any) -> None:
-        """The C-LOD terrain mesh (VTK poly data; None: keep the shown one) as the textured terrain actor."""
+        """The C-LOD terrain mesh (VTK poly data; None: keep the shown one) as the textured terrain actor. A scene
+        without terrain takes the terrain of the view it replaced (still shown until this first frame) off the
+        plotter."""
         if poly is not None:
             if self.terrain_actor is None:
                 self.terrain_actor = self.plotter.add_mesh(poly, texture=self._texture, lighting=False,
@@ -161,6 +163,8 @@ class NatureView:
             else:
                 self.terrain_actor.mapper.SetInputData(poly)
             self._mesh = poly
+        elif self.terrain_actor is None:
+            self.plotter.remove_actor("nature-terrain", render=False)
 
     def remove(self) -> None:
         """Take the view's actors (sky, terrain, overlay) out of the plotter."""

@@ -9,17 +9,13 @@ import os
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Optional
+from typing import Any, Optional
 
 import numpy as np
 
 from volviz.jobs import ProgressCallback, report
 from volviz.render.backend import backend_setting
 from volviz.session import Component, DatasetRef, RenderSettings, Session, resolve_path
-
-if TYPE_CHECKING:
-    from volviz.render.nature_view import NatureView
-    from volviz.render.gl_nature import GLNatureView
 
 
 class SceneError(Exception):
@@ -382,16 +378,9 @@ def install_nature(plotter: Any, scene: Any, views: bool = True, backend: str = 
     ``begin`` / ``compute`` / ``finish``)."""
     if scene is None:
         return None
-    view_type: type[GLNatureView] | type[NatureView]
-    if backend == "gpu":
-        from volviz.render.gl_nature import GLNatureView
+    from volviz.render.views import view_class
 
-        view_type = GLNatureView
-    else:
-        from volviz.render.nature_view import NatureView
-
-        view_type = NatureView
-    view = view_type(plotter, scene)
+    view = view_class("nature", backend)(plotter, scene)
     if views:
         view.update()
     return view
@@ -510,13 +499,12 @@ def add_pt_component(plotter: Any, session: Session, comp: Component, dataset: A
         tf = tf.scaled_extinction(comp.opacity)
     method = "reference" if session.render.method == "reference" else "pt"
     opts = pt_options(session.render.options) if method == "pt" else {}
+    from volviz.render.views import view_class
+
     if method == "pt" and pt_backend(plotter, session) == "gpu":
-        from volviz.render.gl_pt import GLPTVolume
-
-        return GLPTVolume(plotter, dataset, tf, **{"lookup": "auto", **opts})   # the table the CPU path picks
-    from volviz.render.pt_prop import PTVolume
-
-    handle = PTVolume(plotter, dataset, tf, method=method, scalars=getattr(dataset, "active", None), **opts)
+        return view_class("pt", "gpu")(plotter, dataset, tf, **{"lookup": "auto", **opts})  # the CPU path's table
+    handle = view_class("pt", "cpu")(plotter, dataset, tf, method=method, scalars=getattr(dataset, "active", None),
+                                     **opts)
     if update:
         handle.update()
     return handle
