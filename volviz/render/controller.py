@@ -266,6 +266,8 @@ class SceneController:
                 self.apply_clip(update_pt=False, cut_pt=False, isosurfaces=False)
             if comp.type == "isosurface":
                 self._sync_iso_overlay()
+            elif self.iso_view is not None:
+                self.set_iso_mode(self.iso_mode, update=views)  # a GPU PT volume's pass may rule out exact GL
         return prop
 
     def set_opacity(self, comp_id: str, opacity: float, isosurfaces: bool = True) -> None:
@@ -553,6 +555,9 @@ class SceneController:
         view = install_nature(self.plotter, scene, views, backend)  # adds its actors with ``render=False``
         if view is not None:
             self.props["nature"] = view
+        if self.iso_view is not None:
+            with no_render(self.plotter):
+                self.set_iso_mode(self.iso_mode, update=views)  # the GPU scene's pass may rule out exact GL
         return view
 
     def finish_nature(self, view: Any, request: Any, result: tuple[Any, ...]) -> dict[str, Any]:
@@ -684,7 +689,10 @@ class SceneController:
     def set_iso_mode(self, mode: str, update: bool = True) -> None:
         """Draw the isosurfaces with VTK's blend ("vtk") or a mode of the note on the backend's ``iso_view`` (the CPU
         overlay is rendered now when ``update``; the app renders it in the background: ``iso_overlay.begin`` /
-        ``compute`` / ``finish``)."""
+        ``compute`` / ``finish``). The exact mode is VTK's depth peeling, which does not run under the float scene
+        target of a GPU PT volume or GPU natural scene in the same renderer (``volviz.render.gl_pt``): there the
+        exact mode is drawn by the CPU backend's overlay."""
+        from volviz.render.gl_pt import _PASS_MARK
         from volviz.render.scene_builder import view_backend
 
         if mode not in ISO_MODES:
@@ -692,6 +700,8 @@ class SceneController:
         if mode != "vtk" or "iso_mode" in self.session.render.options:
             self.session.render.options["iso_mode"] = mode
         backend = view_backend(self.plotter, self.session, "iso")
+        if backend == "gpu" and mode == "exact" and getattr(self.plotter.renderer, _PASS_MARK, None) is not None:
+            backend = "cpu"
         view = self.iso_view
         if view is not None and (mode == "vtk" or not self._iso_props() or view.backend != backend):
             view.remove()

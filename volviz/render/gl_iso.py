@@ -54,10 +54,12 @@ RMSE 0.31-0.59 against the CPU mode, 1 to 13 pixels over 3 (silhouettes); frame 
 on 2 shared cores) 10-13 ms for 2-pass, 20-36 ms 3-pass, 37-45 ms 4-pass, 85-124 ms exact, where the CPU compositor
 takes 60-165 ms per frame.
 
-Not handled or not tested: a renderer with its own render pass (``renderer.SetPass``, e.g. the float target of
-``volviz.render.gl_pt``; untested, and exact mode's depth peeling is the renderer's own, which does not run under a
-custom pass); renderers that do not fill their window (the back-face texture is the renderer's size,
-read at ``gl_FragCoord``); multisampled windows (the tests use one sample per pixel, as the CPU compositor does).
+Not handled or not tested: exact mode in a renderer with its own render pass (``renderer.SetPass``, e.g. the float
+target of a GPU PT volume or natural scene, ``volviz.render.gl_pt``): depth peeling is the renderer's own and does
+not run under a custom pass, so the scene controller draws exact mode there with the CPU overlay (2/3/4-pass are
+tested beside a GPU PT volume in ``tests/test_render_gl_iso_view.py``); renderers that do not fill their window (the
+back-face texture is the renderer's size, read at ``gl_FragCoord``); multisampled windows (the tests use one sample
+per pixel, as the CPU compositor does).
 """
 from __future__ import annotations
 
