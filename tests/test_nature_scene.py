@@ -215,3 +215,24 @@ def test_preview_keeps_the_terrain_and_magnifies_a_smaller_overlay(demo) -> None
     assert np.array_equal(big[:, :9, 3], np.full((8, 9), 255))
     assert np.abs(np.diff(big[:, 1:9, 0].astype(int), axis=1) - 20).max() <= 1
     assert np.all(big[..., 1] == 0)
+
+
+def test_terrain_texture_is_mip_mapped_on_a_hardware_driver_only(demo) -> None:
+    """The terrain's color map is mip-mapped, trilinear and isotropic where that is free (a hardware OpenGL driver) or
+    asked for; on a software rasteriser (this machine's llvmpipe) the app draws it unfiltered by default."""
+    import pyvista as pv
+
+    from volviz.render.backend import GLInfo, plotter_gl_info
+    from volviz.render.nature_view import texture_filtering
+
+    plotter = pv.Plotter(off_screen=True, window_size=[64, 48])
+    try:
+        assert plotter_gl_info(plotter).software and not texture_filtering(plotter)
+        plain = NatureView(plotter, demo)._texture
+        assert not plain.GetMipmap() and not plain.GetInterpolate()
+        asked = NatureView(plotter, demo, filter_texture=True)._texture
+        assert asked.GetMipmap() and asked.GetInterpolate() and asked.GetMaximumAnisotropicFiltering() == 1.0
+        plotter.__dict__["_volviz_gl_info"] = GLInfo("NVIDIA Corporation", "NVIDIA H100/PCIe/SSE2", "4.6.0")
+        assert texture_filtering(plotter) and NatureView(plotter, demo)._texture.GetMipmap()
+    finally:
+        plotter.close()

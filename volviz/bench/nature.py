@@ -219,14 +219,14 @@ class _GLFrames:
         self.plotters = [pv.Plotter(off_screen=True, window_size=list(s)) for s in (size, self.SMALL)]
         for pl in self.plotters:
             _window(pl).SetMultiSamples(0)
-        self.views = [GLNatureView(pl, scene) for pl in self.plotters]
+        self.views = [GLNatureView(pl, scene, filter_texture=True) for pl in self.plotters]  # as on a GPU
         self._prisms: dict[str, Any] = {}
         # the app's CPU backend in the same kind of window (VTK's terrain and sky, the CPU's fog and cloud overlay)
         self.cpu_plotter = pv.Plotter(off_screen=True, window_size=list(size))
         _window(self.cpu_plotter).SetMultiSamples(0)
         for pl in self.plotters + [self.cpu_plotter]:
             pl.camera_set = True            # PyVista must not re-frame the cameras the views set
-        self.cpu_view = NatureView(self.cpu_plotter, scene)
+        self.cpu_view = NatureView(self.cpu_plotter, scene, filter_texture=True)
 
     def _render(self, index: int) -> float:
         t0 = time.perf_counter()
@@ -554,7 +554,9 @@ def _write_report(out: Path, result: dict[str, Any], images: list[tuple[np.ndarr
             "GPU takes off the CPU, is its own column. RMSE and max against the same full-resolution reference; "
             "'CPU view RMSE' is the app's CPU backend (``NatureView``: VTK's terrain and sky, the CPU's fog and "
             "cloud overlay) against it, and 'GPU vs CPU view' the two backends' difference: the GPU's error is "
-            "the app's terrain (VTK's texture sampling, not the CPU raster's mip-mapped shading), not its volumes.",
+            "the app's terrain (VTK's texture sampling, not the CPU raster's mip-mapped shading), not its volumes. "
+            "Both views mip-map the terrain texture here, as on a hardware driver (on a software rasteriser the app "
+            "draws it unfiltered: ``volviz.render.nature_view.texture_filtering``).",
             "",
             "| frame | cloud tets | fog prisms | LOD s | upload s | render s | fps | CPU side s "
             "| llvmpipe vertex work s | RMSE | max | CPU view RMSE | GPU vs CPU view |",

@@ -161,8 +161,9 @@ class GLNatureView(NatureView):
 
     backend = "gpu"
 
-    def __init__(self, plotter: Any, scene: NatureScene, size: tuple[int, int] | None = None) -> None:
-        super().__init__(plotter, scene, size)
+    def __init__(self, plotter: Any, scene: NatureScene, size: tuple[int, int] | None = None,
+                 filter_texture: bool | None = None) -> None:
+        super().__init__(plotter, scene, size, filter_texture)
         self.layers: dict[str, GLFogLayer] = {}
         self.clouds: CloudPTVolume | None = None
         hold_single_sample(plotter, self)       # the float targets are single-sample (gl_pt)
