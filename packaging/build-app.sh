@@ -27,7 +27,7 @@ from PIL import Image
 
 rgb = np.asarray(Image.open(sys.argv[1]).convert("RGB"), dtype=float)
 spread = rgb.reshape(-1, 3).std(axis=0).mean()
-print(f"the packaged app showed {sys.argv[2]}: {rgb.shape[1]}x{rgb.shape[0]} window, colour spread {spread:.1f}")
+print(f"the packaged app showed {sys.argv[2]}: {rgb.shape[1]}x{rgb.shape[0]} window, color spread {spread:.1f}")
 sys.exit(0 if spread > 10 else "the packaged app's window is blank")
 PY
 done
