@@ -1,15 +1,15 @@
-"""The view scheduler of the main window (a mixin of ``MainWindow``): the background refreshes of the views that
-depend on the camera, the transfer function, the viewport's size or the display time.
+"""The view scheduler of the main window (a mixin of ``MainWindow``): the background refreshes of the views that depend
+on the camera, the transfer function, the viewport's size or the display time.
 
 Each kind of view keeps one job in flight and the newest request next (``volviz.jobs.OneInFlight``), so that every
-finished render is shown while requests keep coming: the natural scene (``refresh_nature``), the blocks of volumes at
-a level of detail (``refresh_lod``), PT volumes and the isosurfaces' CPU overlay (``refresh_pt``,
-``refresh_iso_overlay`` through ``_refresh_overlay``: ``begin`` on this thread, ``compute`` on a worker, ``finish``
-here), and the blended volumes and re-extracted isosurfaces of time series (``refresh_time_volumes``,
-``refresh_time_isosurfaces``). While the camera moves the images are previews (``MOVING_SCALE``), the full-size
-images follow its end (``_camera_moved``). A new scene's first views end its loading (``_show_first_views``). After
-a PT render the error is measured against the exact reference and the error budget applied
-(``volviz.render.error_budget``).
+finished render is shown while requests keep coming: the natural scene (``refresh_nature``), PT volumes and the
+isosurfaces' CPU overlay (``refresh_pt``, ``refresh_iso_overlay``), all through one path over the view calls of
+``volviz.render.views`` (``_refresh_view``: ``begin`` on this thread, ``compute`` on a worker, ``finish`` here), the
+blocks of volumes at a level of detail in two budgets (``refresh_lod``), and the blended volumes and re-extracted
+isosurfaces of time series (``refresh_time_volumes``, ``refresh_time_isosurfaces``). While the camera moves the
+images are previews (``MOVING_SCALE``), the full-size images follow its end (``_camera_moved``). A new scene's first
+views end its loading (``_show_first_views``). After a PT render the error is measured against the exact reference
+and the error budget applied (``volviz.render.error_budget``).
 
 It expects of the window: ``controller`` (a ``SceneController`` or None), ``plotter``, ``jobs`` (a ``JobBridge``),
 ``session``, ``render()``, ``show_error(title, text)``, ``status_label``, ``render_settings`` and
@@ -190,8 +190,7 @@ class ViewScheduler:
 
     def refresh_nature(self, settled: Optional[Callable[[], None]] = None, scale: int = 1) -> None:
         """Re-compute the natural scene's view-dependent parts (C-LOD terrain, fog and cloud images; issue #5) for
-        the newest camera in the background (``OneInFlight``): the camera is read when the job starts, the VTK data
-        replaced on this thread when it is done."""
+        the newest camera in the background (``_refresh_view``), then draw once the event loop is free."""
         controller = self.controller
         view = controller.nature if controller is not None else None
         if view is None:
@@ -199,24 +198,12 @@ class ViewScheduler:
                 settled()
             return
 
-        def start(next_request: Callable[[], None]) -> None:
-            if self.controller is not controller or controller.nature is not view:
-                next_request()
-                return
-            request = view.begin(scale=scale)
+        def shown(request: Any, stats: Any) -> None:
+            self.last_view_stats = stats
+            self.nature_updates += 1
+            self.schedule_render()
 
-            def done(outcome: JobOutcome) -> None:
-                if outcome.ok and self.controller is controller and controller.nature is view:
-                    self.last_view_stats = controller.finish_nature(view, request, outcome.result)
-                    self.nature_updates += 1
-                    self.schedule_render()
-                elif outcome.error is not None:
-                    self.show_error("Cannot update the natural scene", str(outcome.error))
-                next_request()
-
-            self.jobs.submit(view.compute, request, name="natural scene", on_done=done)
-
-        self._nature_jobs.request(start, settled)
+        self._refresh_view(view, self._nature_jobs, "natural scene", lambda: controller.nature, shown, settled, scale)
 
     def refresh_lod(self, comp_ids: Optional[list[str]] = None,
                     settled: Optional[Callable[[], None]] = None) -> None:
@@ -294,37 +281,51 @@ class ViewScheduler:
 
     def _refresh_overlay(self, handle: Any, key: str, what: str, current: Any, after: Any = None,
                          settled: Optional[Callable[[], None]] = None, scale: int = 1) -> None:
-        """Re-make an overlay image (``OverlayView``: ``begin`` here, ``compute`` on a worker, ``finish`` here) for
-        the current camera. One render per overlay in flight, the newest request next (``OneInFlight``): while the
-        camera or a TF keeps changing, every finished render is shown. (Superseding by a job key cancelled a render
-        for each newer request, but a render cannot stop inside its kernels: each ran to the end on a core and was
-        thrown away, and nothing was shown until the requests stopped.)"""
+        """Re-make an overlay view's image (a PT volume, the isosurfaces' CPU overlay; or a GPU PT volume's
+        visibility order) for the current camera (``_refresh_view``), one in flight per ``key``; a preview is
+        drawn by the next paint, a full-size image at once, then ``after(request)``."""
+
+        def shown(request: Any, result: Any) -> None:
+            self.overlay_updates[key] = self.overlay_updates.get(key, 0) + 1
+            if request.get("preview"):  # while the camera moves: drawn by the next paint, in its own turn
+                self.plotter.update()   # of the event loop, not in the one that also handles the mouse
+            else:
+                self.render()
+            if after is not None:
+                after(request)
+
+        self._refresh_view(handle, self._overlay_jobs.setdefault(key, OneInFlight()), what, current, shown, settled,
+                           scale)
+
+    def _refresh_view(self, view: Any, jobs: OneInFlight, what: str, current: Callable[[], Any],
+                      shown: Callable[[Any, Any], None], settled: Optional[Callable[[], None]] = None,
+                      scale: int = 1) -> None:
+        """Update a view (``volviz.render.views.View``) for the current camera in the background: ``begin`` on this
+        thread when the job starts (the camera and opaque depth of then, not of the request), ``compute`` on a
+        worker, ``finish`` here, then ``shown(request, finish's result)``. One job in flight per ``jobs``, the newest
+        request next (``OneInFlight``): while the camera or a TF keeps changing, every finished update is shown. (A
+        newer request cancelling the older job would throw away work a kernel cannot stop: nothing would be shown
+        until the requests stopped.) A view that ``current()`` no longer returns is left alone."""
         controller = self.controller
 
         def start(next_request: Callable[[], None]) -> None:
-            if self.controller is not controller or current() is not handle:
+            if self.controller is not controller or current() is not view:
                 next_request()
                 return
-            request = handle.begin(scale)  # the camera and opaque depth of now, not of the request
+            request = view.begin(scale=scale)
 
             def done(outcome: JobOutcome) -> None:
-                if outcome.ok and self.controller is controller and current() is handle:
-                    with no_render(self.plotter):  # one render below, not two
-                        handle.finish(request, *outcome.result)
-                    self.overlay_updates[key] = self.overlay_updates.get(key, 0) + 1
-                    if request.get("preview"):  # while the camera moves: drawn by the next paint, in its own turn
-                        self.plotter.update()   # of the event loop, not in the one that also handles the mouse
-                    else:
-                        self.render()
-                    if after is not None:
-                        after(request)
+                if outcome.ok and self.controller is controller and current() is view:
+                    with no_render(self.plotter):  # the caller's ``shown`` draws once
+                        result = view.finish(request, *outcome.result)
+                    shown(request, result)
                 elif outcome.error is not None:
-                    self.show_error(f"Cannot render the {what}", str(outcome.error))
+                    self.show_error(f"Cannot update the {what}", str(outcome.error))
                 next_request()
 
-            self.jobs.submit(handle.compute, request, name=what, on_done=done)
+            self.jobs.submit(view.compute, request, name=what, on_done=done)
 
-        self._overlay_jobs.setdefault(key, OneInFlight()).request(start, settled)
+        jobs.request(start, settled)
 
     def _time_changed(self, t: float) -> None:
         if self.controller is not None and self.controller.time_series():
