@@ -92,22 +92,17 @@ def test_defaults_live_in_the_models():
         model.density = -1.0   # assignments are validated too
 
 
-def test_typed_settings_overloads_give_each_component_type_its_model():
-    """What mypy sees of ``typed_settings("fog", ...)`` is FogSettings: the literal overloads match SETTINGS_MODELS."""
-    import typing
-
+def test_each_component_type_validates_as_its_model():
+    """``typed_settings`` validates by ``SETTINGS_MODELS``; ``validated`` gives a caller the model it names."""
     import volviz.model.settings as M
 
-    if not hasattr(typing, "get_overloads"):
-        pytest.skip("typing.get_overloads needs Python 3.11")
-    typed = {}
-    for overload in typing.get_overloads(M.typed_settings):
-        hints = typing.get_type_hints(overload, vars(M))
-        if typing.get_origin(hints["component_type"]) is typing.Literal:
-            (kind,) = typing.get_args(hints["component_type"])
-            typed[kind] = hints["return"]
-    assert typed == SETTINGS_MODELS
-    assert type(typed_settings("clouds", {})) is M.CloudSettings
+    for kind, model in SETTINGS_MODELS.items():
+        assert type(typed_settings(kind, {})) is model
+    fog = M.validated(FogSettings, {"density": 0.2})
+    assert type(fog) is FogSettings and fog.density == 0.2
+    with pytest.raises(SettingsError) as info:
+        M.validated(M.CloudSettings, {"shape": [2, 129, 17]}, "component 'c' settings")
+    assert info.value.problems == [("component 'c' settings.shape", "Value error, each size must be in 3..1025")]
 
 
 def test_a_session_saved_with_the_former_colour_key_opens_and_saves_color(tmp_path):

@@ -10,7 +10,7 @@ settings forms from these models (field titles, descriptions, bounds, units in `
 """
 from __future__ import annotations
 
-from typing import Any, Literal, Optional, Union, overload
+from typing import Any, Literal, Optional, TypeVar, Union
 
 from pydantic import AliasChoices, BaseModel, ConfigDict, Field, ValidationError, field_validator
 
@@ -18,7 +18,7 @@ __all__ = ["Settings", "TerrainSettings", "FogSettings", "CloudSettings", "SkySe
            "MeshSettings", "IsoStyleSettings", "IsosurfaceSettings", "DemoSettings", "RenderOptions",
            "SETTINGS_MODELS", "FogMode", "CloudShadingName", "IsoMode", "IsoShading", "IsoOverlayMode", "Backend",
            "SortName", "array_key", "settings_model", "former_names", "validate_settings", "validate_render_options",
-           "typed_settings", "SettingsError"]
+           "typed_settings", "validated", "SettingsError"]
 
 FogMode = Literal["emissive", "attenuated", "mip"]
 CloudShadingName = Literal["npr", "physical"]
@@ -262,58 +262,21 @@ def _problems(exc: ValidationError, where: str) -> list[tuple[str, str]]:
     return out
 
 
-@overload
-def typed_settings(component_type: Literal["terrain"], settings: dict[str, Any],
-                   where: str = "settings") -> TerrainSettings: ...
+M = TypeVar("M", bound=Settings)
 
 
-@overload
-def typed_settings(component_type: Literal["fog"], settings: dict[str, Any],
-                   where: str = "settings") -> FogSettings: ...
-
-
-@overload
-def typed_settings(component_type: Literal["clouds"], settings: dict[str, Any],
-                   where: str = "settings") -> CloudSettings: ...
-
-
-@overload
-def typed_settings(component_type: Literal["sky"], settings: dict[str, Any],
-                   where: str = "settings") -> SkySettings: ...
-
-
-@overload
-def typed_settings(component_type: Literal["volume"], settings: dict[str, Any],
-                   where: str = "settings") -> VolumeSettings: ...
-
-
-@overload
-def typed_settings(component_type: Literal["mesh"], settings: dict[str, Any],
-                   where: str = "settings") -> MeshSettings: ...
-
-
-@overload
-def typed_settings(component_type: Literal["isosurface"], settings: dict[str, Any],
-                   where: str = "settings") -> IsosurfaceSettings: ...
-
-
-@overload
-def typed_settings(component_type: Literal["demo"], settings: dict[str, Any],
-                   where: str = "settings") -> DemoSettings: ...
-
-
-@overload
-def typed_settings(component_type: str, settings: dict[str, Any], where: str = "settings") -> Settings: ...
-
-
-def typed_settings(component_type: str, settings: dict[str, Any], where: str = "settings") -> Settings:
-    """The model instance of a component's settings (SettingsError naming the field path of each problem); typed
-    as the component type's model (``SETTINGS_MODELS``) where the type is a literal, e.g. FogSettings for "fog"."""
-    model = settings_model(component_type)
+def validated(model: type[M], settings: dict[str, Any], where: str = "settings") -> M:
+    """``settings`` as an instance of ``model`` (SettingsError naming the field path of each problem)."""
     try:
         return model.model_validate(settings)
     except ValidationError as exc:
         raise SettingsError(_problems(exc, where)) from None
+
+
+def typed_settings(component_type: str, settings: dict[str, Any], where: str = "settings") -> Settings:
+    """The model instance of a component's settings (``validated`` by ``SETTINGS_MODELS[component_type]``); a caller
+    that knows the type asks ``validated(FogSettings, ...)`` for the typed model."""
+    return validated(settings_model(component_type), settings, where)
 
 
 def former_names(component_type: str) -> dict[str, str]:

@@ -20,7 +20,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from volviz.model.settings import TerrainSettings, typed_settings
+from volviz.model.settings import CloudSettings, FogSettings, TerrainSettings, validated
 from volviz.nature.clouds import CloudLOD, CloudShading, CloudVolume, build_cloud_table, render_cloud_image
 from volviz.nature.fog import FogLayer, render_layer
 from volviz.nature.heightfield import HeightField, grid_from_image, resample_bilinear
@@ -277,7 +277,7 @@ def scene_from_components(components: Sequence[Any], datasets: dict[str, Any]) -
     settings = TerrainSettings()
     if "terrain" in by_type:
         comp = by_type["terrain"][0]
-        settings = typed_settings("terrain", comp.settings, f"component {comp.id!r} settings")
+        settings = validated(TerrainSettings, comp.settings, f"component {comp.id!r} settings")
         if comp.dataset is None:
             h = noise.fractal_terrain(settings.size or 257, seed=settings.seed, relief=settings.relief)
             ext = settings.extent or (1000.0, 1000.0)
@@ -295,7 +295,7 @@ def scene_from_components(components: Sequence[Any], datasets: dict[str, Any]) -
         sky = sky_texture(_dataset(by_type["sky"][0], datasets))
     scene = NatureScene(terrain, texture, sky, big_c=settings.C, small_c=settings.c)
     for comp in by_type.get("fog", []):
-        fog = typed_settings("fog", comp.settings, f"component {comp.id!r} settings")
+        fog = validated(FogSettings, comp.settings, f"component {comp.id!r} settings")
         if terrain is None:
             raise ValueError(f"component {comp.id!r}: a fog layer needs a terrain component")
         if comp.dataset is None:
@@ -309,7 +309,7 @@ def scene_from_components(components: Sequence[Any], datasets: dict[str, Any]) -
         layer = FogLayer(color=fog.color, density=fog.density, mode=fog.mode, mip_gain=fog.mip_gain)
         scene.add_fog(comp.id, thick, layer, base, fog.weight)
     for comp in by_type.get("clouds", [])[:1]:
-        st = typed_settings("clouds", comp.settings, f"component {comp.id!r} settings")
+        st = validated(CloudSettings, comp.settings, f"component {comp.id!r} settings")
         if comp.dataset is not None:
             vol = _dataset(comp, datasets)
             dens = np.asarray(vol.data, dtype=np.float64)
