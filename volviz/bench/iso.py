@@ -29,6 +29,7 @@ from typing import Any, Callable
 import numpy as np
 
 from volviz.argtypes import MAX_IMAGE_SIDE, UsageParser, int_in
+from volviz.bench.offscreen import bench_plotter, render_window, screenshot_rgb
 
 from volviz.iso.animate import extract_at
 from volviz.iso.composite import MODES, composite, fragments, triangles_drawn
@@ -91,7 +92,7 @@ def _vtk_blend(meshes: list[IsoMesh], cam: Camera, size: int, reps: int) -> tupl
 
     def frame() -> np.ndarray:
         pl.render()
-        return np.asarray(pl.screenshot(return_img=True), dtype=np.float64)[..., :3] / 255.0
+        return screenshot_rgb(pl)
     t, img = _median(frame, reps)
     pl.close()
     rgba = np.concatenate([img, np.ones(img.shape[:2] + (1,))], axis=-1)
@@ -101,21 +102,17 @@ def _vtk_blend(meshes: list[IsoMesh], cam: Camera, size: int, reps: int) -> tupl
 def _gpu_modes(meshes: list[IsoMesh], cam: Camera, size: int, reps: int, cpu: dict[str, np.ndarray]
                ) -> dict[str, dict[str, float]]:
     """Per mode: GPU frame time (s) and RMSE / max (8-bit units) of the screen against the CPU image ``cpu[mode]``."""
-    import pyvista as pv
 
     from volviz.render.gl_iso import GLIsoSurfaces
-    pl = pv.Plotter(off_screen=True, window_size=[size, size])
-    ren_win = pl.ren_win
-    assert ren_win is not None
-    ren_win.SetMultiSamples(0)
-    pl.set_background(BG[:3])  # type: ignore[arg-type]  # pyvista types its functools.wraps wrapper wrongly
+    pl = bench_plotter((size, size), BG[:3])
+    ren_win = render_window(pl)
     cam.apply_to(pl.renderer.GetActiveCamera())
     pl.camera_set = True
     iso = GLIsoSurfaces(pl, meshes, mode="2pass")
 
     def frame() -> np.ndarray:
         ren_win.Render()
-        return np.asarray(pl.screenshot(return_img=True), dtype=np.float64)[..., :3] / 255.0
+        return screenshot_rgb(pl)
     rows = {}
     for mode in MODES:
         iso.set_mode(mode)

@@ -35,6 +35,7 @@ from typing import Any
 import numpy as np
 
 from volviz.argtypes import UsageParser, float_in, image_size, int_in, joined
+from volviz.bench.offscreen import bench_plotter, render_window, screenshot_rgb
 
 DEFAULT_DATA = Path(os.environ.get("VOLVIZ_DATA", Path(__file__).resolve().parents[2].parent / "shared" / "data"))
 REPO = Path(__file__).resolve().parents[2]
@@ -187,20 +188,6 @@ def _split(scene: Any, cam: Any, size: tuple[int, int]) -> dict[str, float]:
     return out
 
 
-def _window(pl: Any) -> Any:
-    """A PyVista plotter's render window (there is one until the plotter is closed)."""
-    window = pl.ren_win
-    assert window is not None, "the plotter was closed"
-    return window
-
-
-def _screenshot(pl: Any) -> np.ndarray:
-    """The plotter's last frame as RGB in [0, 1]."""
-    img = pl.screenshot(return_img=True)
-    assert img is not None
-    return np.asarray(img, dtype=np.float64) / 255.0
-
-
 class _GLFrames:
     """The GPU backend (``volviz.render.gl_nature.GLNatureView``) on the same frames: a window of the report's size
     for the frame rate and the image, and a 64x48 window, where llvmpipe's fill is negligible, for the CPU side
@@ -210,27 +197,22 @@ class _GLFrames:
     SMALL = (64, 48)
 
     def __init__(self, scene: Any, size: tuple[int, int], reps: int) -> None:
-        import pyvista as pv
-
         from volviz.render.nature_view import NatureView
         from volviz.render.gl_nature import GLNatureView
 
         self.size, self.reps = size, reps
-        self.plotters = [pv.Plotter(off_screen=True, window_size=list(s)) for s in (size, self.SMALL)]
-        for pl in self.plotters:
-            _window(pl).SetMultiSamples(0)
+        self.plotters = [bench_plotter(s) for s in (size, self.SMALL)]
         self.views = [GLNatureView(pl, scene, filter_texture=True) for pl in self.plotters]  # as on a GPU
         self._prisms: dict[str, Any] = {}
         # the app's CPU backend in the same kind of window (VTK's terrain and sky, the CPU's fog and cloud overlay)
-        self.cpu_plotter = pv.Plotter(off_screen=True, window_size=list(size))
-        _window(self.cpu_plotter).SetMultiSamples(0)
+        self.cpu_plotter = bench_plotter(size)
         for pl in self.plotters + [self.cpu_plotter]:
             pl.camera_set = True            # PyVista must not re-frame the cameras the views set
         self.cpu_view = NatureView(self.cpu_plotter, scene, filter_texture=True)
 
     def _render(self, index: int) -> float:
         t0 = time.perf_counter()
-        _window(self.plotters[index]).Render()
+        render_window(self.plotters[index]).Render()
         return time.perf_counter() - t0
 
     def _one_each(self) -> None:
@@ -251,14 +233,14 @@ class _GLFrames:
         big = self.views[0]
         request = big.begin(cam)
         big.finish(request, *big.compute(request))
-        _window(self.plotters[0]).Render()
-        return _screenshot(self.plotters[0])
+        render_window(self.plotters[0]).Render()
+        return screenshot_rgb(self.plotters[0])
 
     def cpu_view_image(self, cam: Any) -> np.ndarray:
         """The app's CPU backend (``NatureView``) for ``cam`` in a window of the image's size (RGB in [0, 1])."""
         self.cpu_view.update(cam)
-        _window(self.cpu_plotter).Render()
-        return _screenshot(self.cpu_plotter)
+        render_window(self.cpu_plotter).Render()
+        return screenshot_rgb(self.cpu_plotter)
 
     def frame(self, cam: Any) -> tuple[dict[str, float], np.ndarray]:
         """Medians over ``reps`` of one frame's parts (``gl_*`` keys) and the large window's image (RGB in [0, 1])."""
@@ -283,7 +265,7 @@ class _GLFrames:
             self._one_each()
             self._render(1)                        # the small index and vertex buffers built and uploaded
             parts["small_one"].append(self._render(1))
-        img = _screenshot(self.plotters[0])
+        img = screenshot_rgb(self.plotters[0])
         med = {k: float(np.median(v)) for k, v in parts.items()}
         draw_work = max(med["small_same"] - med["small_one"], 0.0)
         gl_upload = max(med["small_render"] - med["small_same"], 0.0)

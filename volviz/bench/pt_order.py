@@ -25,6 +25,7 @@ import numpy as np
 from volviz.argtypes import MAX_IMAGE_SIDE, UsageParser, float_in, int_in
 from volviz.io.atomic import atomic_write_text
 from volviz.bench.unstructured import DEFAULT_DATA, bluntfin_tf
+from volviz.bench.offscreen import bench_plotter, render_window, screenshot_rgb
 
 #: the error bound of the GPU pass against the exact reference (issue #16's Blunt Fin test)
 RMSE_BOUND, MAX_BOUND = 1.0, 4.0
@@ -58,17 +59,13 @@ def _err(img: np.ndarray, ref: np.ndarray) -> tuple[float, float]:
 def measure(mesh: Any, tf: Any, size: int, lags: list[float], window: int, drag_speed: float,
             frames: int) -> dict[str, Any]:
     """The errors of each frame drawn with its own order and with lagged ones (module docstring)."""
-    import pyvista as pv
 
     from volviz.render.gl_pt import GLPTVolume
     from volviz.unstructured.render import render
 
     azimuths = AZIMUTHS[:frames]
-    pl = pv.Plotter(off_screen=True, window_size=[size, size])
-    pl.set_background("black")  # type: ignore[arg-type]  # pyvista types its functools.wraps wrapper wrongly
-    ren_win = pl.ren_win
-    assert ren_win is not None
-    ren_win.SetMultiSamples(0)
+    pl = bench_plotter((size, size), "black")
+    ren_win = render_window(pl)
     vol = GLPTVolume(pl, mesh, tf, lookup="3d")
     pl.camera_set = True
 
@@ -76,9 +73,7 @@ def measure(mesh: Any, tf: Any, size: int, lags: list[float], window: int, drag_
         vol.reuse_order = reuse
         cam.apply_to(pl.renderer.GetActiveCamera())
         ren_win.Render()
-        shot = pl.screenshot(return_img=True)
-        assert shot is not None
-        return shot.astype(np.float64) / 255.0
+        return screenshot_rgb(pl)
 
     draw(_orbit(mesh.points, azimuths[0] - 45.0), False)    # warm-up: shaders, table, vertex buffer
     sorts = []

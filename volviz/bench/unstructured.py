@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from volviz.argtypes import MAX_IMAGE_SIDE, UsageParser, int_in
+from volviz.bench.offscreen import bench_plotter, render_window, screenshot_rgb
 
 DEFAULT_DATA = Path(os.environ.get("VOLVIZ_DATA", Path(__file__).resolve().parents[2].parent / "shared" / "data"))
 VTK_MAPPERS = ("vtkProjectedTetrahedraMapper", "vtkUnstructuredGridVolumeRayCastMapper",
@@ -134,15 +135,11 @@ def gl_pt_frames(mesh: Any, tf: Any, cams: list[Any], size: tuple[int, int], rep
     ``ibo_s`` = frame - same - sort - order (VTK's index buffer build and upload; sort and order are the volume's
     own timings), ``draw_work_s`` = same - one_cell (the full draw's vertex and fragment work, which a GPU takes
     off the CPU) and ``cpu_side_proper_s`` = sort + order + ibo_s + one_cell_s."""
-    import pyvista as pv
 
     from volviz.render.gl_pt import GLPTVolume
 
-    pl = pv.Plotter(off_screen=True, window_size=list(size))
-    pl.set_background("black")  # type: ignore[arg-type]  # pyvista types its functools.wraps wrapper wrongly
-    ren_win = pl.ren_win
-    assert ren_win is not None
-    ren_win.SetMultiSamples(0)
+    pl = bench_plotter(size, "black")
+    ren_win = render_window(pl)
     vol = GLPTVolume(pl, mesh, tf, lookup=lookup)
     cams[0].apply_to(pl.renderer.GetActiveCamera())
     pl.camera_set = True
@@ -164,9 +161,7 @@ def gl_pt_frames(mesh: Any, tf: Any, cams: list[Any], size: tuple[int, int], rep
                 one.append(_timed_render(pl))
     cams[0].apply_to(pl.renderer.GetActiveCamera())
     ren_win.Render()
-    shot = pl.screenshot(return_img=True)
-    assert shot is not None
-    img = shot.astype(np.float64) / 255.0
+    img = screenshot_rgb(pl)
     caps = ren_win.ReportCapabilities() or ""
     renderer = next((ln.split(":", 1)[1].strip() for ln in caps.splitlines() if "renderer string" in ln), "")
     vol.remove()
