@@ -65,9 +65,9 @@ def _check_hdf5(path: Path) -> None:
         for name, item in f.items():
             if not _CONNECT.match(name) or not isinstance(item, h5py.Dataset) or item.dtype.kind not in "iu":
                 continue
-            flat = item.size
-            rows = max(1, CHUNK // max(1, int(np.prod(item.shape[1:], dtype=np.int64))))
-            for start in range(0, item.shape[0] if item.ndim else 0, rows):
-                _check_range(path, name, np.asarray(item[start:start + rows]), num_nodes)
-            if item.ndim == 0 and flat:
+            if item.ndim == 0:
                 _check_range(path, name, np.asarray(item[()]).reshape(-1), num_nodes)
+                continue
+            rows = max(1, CHUNK // max(1, int(np.prod(item.shape[1:], dtype=np.int64))))   # whole rows per chunk
+            for start in range(0, item.shape[0], rows):
+                _check_range(path, name, np.asarray(item[start:start + rows]), num_nodes)
