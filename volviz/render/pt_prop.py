@@ -75,7 +75,7 @@ class PTVolume(OverlayView, PTView):
         """GUI-thread part 1: render the opaque scene, read its depth, fix the camera (see the module docstring);
         ``scale`` > 1: a preview image that much smaller (``OverlayView.begin``)."""
         request = super().begin(scale)
-        request["tf"] = self.tf
+        request["tf"], request["mesh"] = self.tf, self.mesh   # what the image is of, whatever is set meanwhile
         return request
 
     def compute(self, request: dict[str, Any], progress: Any = None) -> tuple[np.ndarray, Any, np.ndarray]:
@@ -87,11 +87,12 @@ class PTVolume(OverlayView, PTView):
         opts = dict(self.render_opts)
         pre = self._prefetcher
         res = None
-        if self.method == "pt" and pre is not None and pre.mesh is self.mesh and "order" not in opts:
+        mesh = request["mesh"]
+        if self.method == "pt" and pre is not None and pre.mesh is mesh and "order" not in opts:
             res = pre.take(request["camera"], request["size"])
         if res is not None:
             opts["order"] = res.order
-        img, st = render(self.mesh, request["tf"], request["camera"], request["size"], self.method,
+        img, st = render(mesh, request["tf"], request["camera"], request["size"], self.method,
                          depth=request["depth"], return_stats=True, **opts)
         st.extra["sort_prefetched"] = res is not None
         return img, st, overlay_rgba8(img, request.get("preview", False))
@@ -122,10 +123,11 @@ class PTVolume(OverlayView, PTView):
         w, h = request["size"]
         sw, sh = size
         sh = max(8, int(round(sw * h / max(w, 1))))
-        fast = render(self.mesh, request["tf"], request["camera"], (sw, sh), self.method, **self.render_opts)
+        mesh = request["mesh"]   # both of the same mesh, though a cut may be shown meanwhile
+        fast = render(mesh, request["tf"], request["camera"], (sw, sh), self.method, **self.render_opts)
         if progress is not None:
             progress(0.5, "error estimate: exact reference")
-        exact = render(self.mesh, request["tf"], request["camera"], (sw, sh), "reference")
+        exact = render(mesh, request["tf"], request["camera"], (sw, sh), "reference")
         return {"rmse": float(rmse(fast, exact)), "max": float(max_abs(fast, exact)), "size": (sw, sh)}
 
     def finish(self, request: dict[str, Any], img: np.ndarray, st: Any, rgba8: np.ndarray | None = None) -> np.ndarray:
