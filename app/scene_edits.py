@@ -3,13 +3,14 @@ dock selects a component (its transfer function and histogram, computed in the b
 editor), shows or hides it (a component hidden at load is prepared in the background, a natural-scene component
 rebuilds the natural scene in the background), and sets its opacity and settings; the TF editor's edits are
 throttled to one re-render per ``PREVIEW_MS`` (previews while dragging, full size with an error estimate once an
-edit is finished); the clipping dock cuts every prop (isosurfaces and PT meshes in the background); the render
+edit is finished); the clipping dock cuts every view (what is cut on the CPU, isosurfaces and PT meshes, in the
+background); the render
 settings dock changes the renderer (the scene rebuilt with the same camera), the isosurface mode or the error budget.
 
 It expects of the window: ``controller``, ``session``, ``session_path``, ``datasets``, ``jobs``, ``status_label``,
 ``tf_editor``, ``scene_tree``, ``array_choice``, ``render()``, ``schedule_render()``, ``set_dirty``,
 ``show_error``, ``_show_session`` (``volviz_app.scene_loading``), the refreshes of ``volviz_app.view_scheduler``
-(``refresh_pt``, ``refresh_lod``, ``refresh_nature``, ``refresh_iso_overlay``, ``_enforce_error_budget``) and
+(``refresh_views``, ``refresh_iso_overlay``, ``_enforce_error_budget``) and
 ``last_error_rmse``; ``_init_scene_edits()`` makes its state and ``_connect_scene_edits()`` its preview timer (both
 called by the window's ``__init__``; the docks' signals are connected where the docks are built)."""
 from __future__ import annotations
@@ -42,7 +43,7 @@ class SceneEdits:
         self.histogram_threads: set[int] = set()       # the threads they were computed on
         self._pending_tf: Optional[tuple[str, Any, bool]] = None  # (component, TF, a finished edit)
         self.nature_rebuilds = 0           # natural scenes rebuilt in the background (visibility toggles)
-        self.isosurface_clip_shown: Optional[dict[str, Any]] = None  # the clipping the shown isosurfaces are cut by
+        self.cuts_pending: set[str] = set()  # components whose cut for the current clipping or opacity is not shown
 
     def _connect_scene_edits(self) -> None:
         self.preview_timer = QTimer(self, singleShot=True, interval=PREVIEW_MS)
@@ -117,18 +118,12 @@ class SceneEdits:
             return
         comp_id, tf, finished = self._pending_tf
         self._pending_tf = None
-        volume = self.controller.pt_volume(comp_id)
-        if volume is None:  # VTK mapper: the new color/opacity functions draw at once
-            lod = comp_id in self.controller.lod_volumes()
-            self.controller.set_transfer_function(comp_id, tf, update=not lod)
-            self.render()
-            if lod:  # the block selection depends on the TF (transparent blocks): re-select in the background
-                self.refresh_lod([comp_id])
-            return
-        # volviz PT volume: table build and rasterisation run in the background; the newest edit renders next, while
-        # dragging as a preview (``MOVING_SCALE``), a finished edit at full size with a fresh error estimate
         self.controller.set_transfer_function(comp_id, tf, update=False)
-        self.refresh_pt(comp_id, estimate=finished, scale=1 if finished else MOVING_SCALE)
+        # what the view re-makes for the TF (a CPU PT image, a GPU PT volume's culling, a LOD block selection) runs
+        # in the background; the newest edit next, while dragging as a preview (``MOVING_SCALE``), a finished edit at
+        # full size with a fresh error estimate. VTK's own mappers draw the new functions at once.
+        if not self.refresh_views([comp_id], estimate=finished, scale=1 if finished else MOVING_SCALE):
+            self.render()
 
     def _set_visibility(self, comp_id: str, visible: bool) -> None:
         from volviz.render.scene_builder import NATURE_TYPES
@@ -147,7 +142,7 @@ class SceneEdits:
             self.show_component(comp_id)
             return
         self.render()
-        self.refresh_iso_overlay()
+        self.refresh_views([comp_id, "iso-overlay"])
 
     def show_component(self, comp_id: str) -> None:
         """A component hidden at load was shown: prepare it in the background (extraction, tetrahedralisation, VTK
@@ -172,9 +167,7 @@ class SceneEdits:
                 self.components_shown += 1
                 self.status_label.setText(f"Showing {comp_id}")
                 self.schedule_render()
-                self.refresh_pt(comp_id)
-                self.refresh_lod([comp_id])
-                self.refresh_iso_overlay()
+                self.refresh_views([comp_id, "iso-overlay"])
             elif outcome.error is not None:
                 self._revert_visibility(comp_id, True)
                 self.show_error(f"Cannot show {comp_id}", str(outcome.error))
@@ -224,76 +217,56 @@ class SceneEdits:
         if self.controller is None:
             return
         controller = self.controller
-        iso = controller.component(comp_id).type == "isosurface"
-        controller.set_opacity(comp_id, opacity, isosurfaces=not iso)
+        stale = controller.set_opacity(comp_id, opacity, update=False)
         self.set_dirty()
-        if iso:  # the surfaces are re-made (opacity, clipping, LOD chains) in the background
-            self._recut_isosurfaces(controller, controller.clip)
-            return
         self.render()
-        self.refresh_iso_overlay()
+        if stale:  # surfaces scaled by the opacity: cut again in the background
+            self._cut_in_background(controller, controller.clip, stale)
+        self.refresh_views([comp_id, "iso-overlay"])
 
     def set_clip(self, clip: dict[str, Any]) -> None:
-        """New scene-wide clipping (from the clipping dock): every prop is cut; isosurfaces and PT volumes are cut
-        in the background (a 535k-triangle isosurface: 0.2 s of clipping and LOD chains), then re-rendered; volumes
-        at a level of detail are ray cast again with the planes in the background."""
+        """New scene-wide clipping (from the clipping dock): every view is given it; what is cut on the CPU
+        (isosurfaces: a 535k-triangle isosurface takes 0.2 s of clipping and LOD chains; CPU PT meshes) is cut in
+        the background, then re-rendered; the other camera views (volumes at a level of detail ray cast with the
+        planes, the iso overlay) are refreshed in the background."""
         if self.controller is None:
             return
         controller = self.controller
         try:
-            pt_ids = controller.set_clip(clip, update_pt=False, cut_pt=False, isosurfaces=False)
+            pending = controller.set_clip(clip, update=False)
         except ValueError as exc:
             self.show_error("Invalid clipping", str(exc))
             return
         self.set_dirty()
         self.render()
-        self.refresh_iso_overlay()
-        self.refresh_lod()      # ray cast again with the new planes, in the background
-        settings = controller.clip
-        self._recut_isosurfaces(controller, settings)
-        for comp_id in pt_ids:  # the exact cut of a tetrahedral mesh runs in the background, then the re-render
+        self.refresh_views([key for key, view in controller.camera_views().items()
+                            if view.kind != "nature" and key.split(":", 1)[-1] not in pending])
+        self.cuts_pending.intersection_update(pending)  # the others show this clipping already (an undo, say)
+        self._cut_in_background(controller, controller.clip, pending)
+
+    def _cut_in_background(self, controller: Any, settings: Any, comp_ids: list[str]) -> None:
+        """Cut the views of ``comp_ids`` by ``settings`` (``SceneController.cut``: a PT volume's tetrahedra, an
+        isosurface component's surfaces with their LOD chains) on a worker (a newer request for a component
+        supersedes), then show each cut here and refresh its camera views; ``clipping_shown()`` tells when all
+        are shown."""
+        self.cuts_pending.update(comp_ids)
+        for comp_id in comp_ids:
 
             def done(outcome: JobOutcome, comp_id: str = comp_id) -> None:
                 if outcome.ok and self.controller is controller and controller.clip == settings:
-                    controller.set_pt_mesh(comp_id, outcome.result)
+                    controller.show_cut(comp_id, outcome.result)
+                    self.cuts_pending.discard(comp_id)
                     self.render()
-                    self.refresh_pt(comp_id)
+                    self.refresh_views([comp_id, "iso-overlay"])
                 elif outcome.error is not None:
-                    self.show_error("Cannot clip the volume", str(outcome.error))
+                    self.show_error("Cannot clip", f"{comp_id}: {outcome.error}")
 
-            self.jobs.submit(controller.cut_pt_mesh, comp_id, settings, name="clip volume", key=f"clip:{comp_id}",
+            self.jobs.submit(controller.cut, comp_id, settings, name=f"clip {comp_id}", key=f"clip:{comp_id}",
                              on_done=done)
 
-    def _recut_isosurfaces(self, controller: Any, settings: Any) -> None:
-        """Cut the isosurfaces' extracted surfaces by new clipping (or for a new opacity) on a worker, with their LOD
-        chains (a newer request supersedes), then swap their actors here; ``isosurfaces_cut()`` tells when the
-        clipping is shown."""
-        from volviz.render.scene_builder import isosurface_parts
-
-        meshes = controller.isosurface_meshes()
-        if not meshes:
-            self.isosurface_clip_shown = settings.to_dict()
-            return
-        comps = {comp_id: controller.component(comp_id) for comp_id in meshes}
-
-        def cut(progress: Any = None) -> dict[str, Any]:
-            return {comp_id: isosurface_parts(comps[comp_id], meshes=m, clip=settings)
-                    for comp_id, m in meshes.items()}
-
-        def done(outcome: JobOutcome) -> None:
-            if outcome.ok and self.controller is controller and controller.clip == settings:
-                controller.show_isosurfaces(outcome.result)
-                self.isosurface_clip_shown = settings.to_dict()
-                self.render()
-                self.refresh_iso_overlay()
-            elif outcome.error is not None:
-                self.show_error("Cannot clip the isosurfaces", str(outcome.error))
-
-        self.jobs.submit(cut, name="clip isosurfaces", key="clip:isosurfaces", on_done=done)
-
-    def isosurfaces_cut(self) -> bool:
-        """Whether the isosurfaces on screen are cut by the current clipping (it is re-cut in the background)."""
-        return self.controller is None or self.isosurface_clip_shown == self.controller.clip.to_dict()
+    def clipping_shown(self) -> bool:
+        """Whether every view on screen is cut by the current clipping and opacity (cuts run in the background)."""
+        return self.controller is None or not self.cuts_pending
 
     def apply_component_settings(self, comp_id: str, settings: dict[str, Any]) -> bool:
         """New settings for a component (the scene tree's form, an undo step): validated through the session schema,

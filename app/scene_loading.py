@@ -160,7 +160,7 @@ class SceneLoading:
         finally:
             self.timeline.blockSignals(False)
         self.volume_time_shown = self.iso_time_shown = None
-        self.isosurface_clip_shown = controller.clip.to_dict()  # cut in ``prepare``
+        self.cuts_pending = set()  # cut in ``prepare``
         self._refresh_bookmark_menu()
         self.title = title
         self.error_estimate = None

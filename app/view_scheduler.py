@@ -1,25 +1,25 @@
 """The view scheduler of the main window (a mixin of ``MainWindow``): the background refreshes of the views that depend
 on the camera, the transfer function, the viewport's size or the display time.
 
-Each kind of view keeps one job in flight and the newest request next (``volviz.jobs.OneInFlight``), so that every
-finished render is shown while requests keep coming: the natural scene (``refresh_nature``), PT volumes and the
-isosurfaces' CPU overlay (``refresh_pt``, ``refresh_iso_overlay``), all through one path over the view calls of
-``volviz.render.views`` (``_refresh_view``: ``begin`` on this thread, ``compute`` on a worker, ``finish`` here), the
-blocks of volumes at a level of detail in two budgets (``refresh_lod``), and the blended volumes and re-extracted
-isosurfaces of time series (``refresh_time_volumes``, ``refresh_time_isosurfaces``). While the camera moves the
-images are previews (``MOVING_SCALE``), the full-size images follow its end (``_camera_moved``). A new scene's first
-views end its loading (``_show_first_views``). After a PT render the error is measured against the exact reference
-and the error budget applied (``volviz.render.error_budget``).
+Every view that re-makes something for a camera (``SceneController.camera_views``: the natural scene, volumes at a
+level of detail, PT volumes on either backend, the isosurfaces' CPU overlay) is refreshed through one path over the
+view calls of ``volviz.render.views`` (``refresh_views``: ``begin`` on this thread, ``compute`` on a worker,
+``finish`` here), one job in flight per view and the newest request next (``volviz.jobs.OneInFlight``), so that every
+finished update is shown while requests keep coming. While the camera moves the images are previews
+(``MOVING_SCALE``), the full-size images follow its end (``_camera_moved``); a view that asks for it
+(``coarse_first``: the LOD volumes' block selection) first shows a coarse update. A new scene's first views end its
+loading (``_show_first_views``). After a CPU PT render the error is measured against the exact reference and the
+error budget applied (``volviz.render.error_budget``). The blended volumes and re-extracted isosurfaces of time
+series follow the display time (``refresh_time_volumes``, ``refresh_time_isosurfaces``).
 
 It expects of the window: ``controller`` (a ``SceneController`` or None), ``plotter``, ``jobs`` (a ``JobBridge``),
-``session``, ``render()``, ``show_error(title, text)``, ``status_label``, ``render_settings`` and
+``session``, ``render()``, ``show_statistics()``, ``show_error(title, text)``, ``status_label``, ``render_settings`` and
 ``_settings_changed(values)`` (the budget's switch of table), ``timeline``, ``nonfinite``, ``collector``,
 ``_set_busy(busy)``, ``_load_serial`` and ``_loading_views``. ``_init_view_scheduler()`` makes its state and
 ``_connect_view_scheduler()`` its timers and the viewport's interaction observers (both called by the window's
 ``__init__``)."""
 from __future__ import annotations
 
-import time
 from typing import Any, Callable, Optional
 
 from PySide6.QtCore import QTimer
@@ -37,16 +37,14 @@ class ViewScheduler:
     """The window's background view refreshes (see the module's docstring)."""
 
     def _init_view_scheduler(self) -> None:
-        self._overlay_jobs: dict[str, OneInFlight] = {}  # per overlay (a PT volume, the iso overlay): its renders
-        self.overlay_updates: dict[str, int] = {}  # per overlay: the renders shown so far
+        self._view_jobs: dict[str, OneInFlight] = {}  # per camera view (by its key): its updates
+        self.view_updates: dict[str, int] = {}  # per camera view: the updates shown so far
+        self.view_requests: dict[str, Any] = {}  # per camera view: the request of the update shown last
+        self.view_results: dict[str, Any] = {}   # per camera view: what its ``finish`` returned last
         self._moving_scheduled = False     # a refresh for the camera the mouse is moving is queued
         self._iso_jobs = OneInFlight()     # isosurface extraction for the display time
-        self._nature_jobs = OneInFlight()  # the natural scene's view-dependent parts for the camera
         self._volume_jobs = OneInFlight()  # blended volumes of time series for the display time
         self.volume_time_shown: Optional[tuple[float, bool]] = None  # (time, interpolated) of the shown volumes
-        self.nature_updates = 0            # background updates of the natural scene shown so far
-        self._lod_jobs: dict[str, OneInFlight] = {}  # block selection of volumes at a level of detail
-        self.lod_shown: dict[str, int] = {}  # the block budget of the selection each LOD volume shows
         self.iso_time_shown: Optional[tuple[float, bool]] = None  # (time, interpolated) of the shown isosurfaces
 
     def _connect_view_scheduler(self) -> None:
@@ -65,32 +63,18 @@ class ViewScheduler:
         self.plotter.iren.add_observer("ConfigureEvent", lambda *args: self.resize_timer.start())
 
     def _show_first_views(self, controller: Any, serial: int, title: str) -> None:
-        """Compute the new scene's view-dependent parts in the background (natural scene, LOD blocks, PT volumes,
-        the isosurfaces' CPU mode); the loading ends when all are shown (or failed, or were cancelled)."""
-        waiting = [1]
+        """Compute the new scene's camera views in the background (natural scene, LOD blocks, PT volumes, the
+        isosurfaces' CPU mode); the loading ends when all are shown (or failed, or were cancelled)."""
 
         def settled() -> None:
-            waiting[0] -= 1
-            if waiting[0] == 0 and serial == self._load_serial and self.controller is controller:
+            if serial == self._load_serial and self.controller is controller:
                 self._loading_views = False
                 self._set_busy(False)
                 self.status_label.setText(f"Showing {title}")
                 self.nonfinite.report(title)  # NaN / Inf counts, once, when they arrive
 
         self._loading_views = True
-        if controller.nature is not None:
-            waiting[0] += 1
-            self.refresh_nature(settled=settled)
-        lods = list(controller.lod_volumes())
-        waiting[0] += len(lods)
-        self.refresh_lod(lods, settled=settled)
-        for comp_id in controller.pt_stats():
-            waiting[0] += 1
-            self.refresh_pt(comp_id, settled=settled)
-        if controller.iso_overlay is not None:
-            waiting[0] += 1
-            self.refresh_iso_overlay(settled=settled)
-        settled()
+        self.refresh_views(settled=settled)
 
     def estimate_error(self, comp_id: str, request: Optional[dict[str, Any]] = None) -> None:
         """Measure the PT volume's error against the exact reference for the current view, in the background; the
@@ -142,19 +126,14 @@ class ViewScheduler:
             QTimer.singleShot(0, self._camera_moving)
 
     def _camera_moving(self) -> None:
-        """While the mouse moves the camera, the images of our own renderers follow it: the natural scene's fog and
-        clouds (with the terrain's C-LOD mesh), PT volumes and the isosurface overlay are re-made in the background,
-        one render of each in flight and the newest camera next (``OneInFlight``), so each shows every render it
-        finishes. VTK draws its own props at once. The images are previews at 1 / ``MOVING_SCALE`` of the window's
-        size in each direction (a quarter of the pixels, magnified smoothly); the full-size images, the error
-        estimate and the LOD re-selection follow at the end of the interaction (``_camera_moved``)."""
+        """While the mouse moves the camera, the camera views follow it (``refresh_views`` with ``moving``): re-made
+        in the background, one update of each in flight and the newest camera next (``OneInFlight``), so each shows
+        every update it finishes. VTK draws its own props at once. Images are previews at 1 / ``MOVING_SCALE`` of the
+        window's size in each direction (a quarter of the pixels, magnified smoothly); the full-size images, the
+        error estimate and the LOD re-selection follow at the end of the interaction (``_camera_moved``)."""
         self._moving_scheduled = False
-        if self.controller is None:
-            return
-        self.refresh_nature(scale=MOVING_SCALE)
-        for comp_id in self.controller.pt_stats():
-            self.refresh_pt(comp_id, estimate=False, scale=MOVING_SCALE)
-        self.refresh_iso_overlay(scale=MOVING_SCALE)
+        if self.controller is not None:
+            self.refresh_views(scale=MOVING_SCALE, estimate=False, moving=True)
 
     def _fly_moved(self) -> None:
         """A fly-mode step moved the camera: previews follow it as during a mouse drag (``_camera_moving``), and
@@ -163,169 +142,103 @@ class ViewScheduler:
         self.fly_settle_timer.start()
 
     def _camera_moved(self) -> None:
-        """After the camera moved: refresh what depends on it (terrain LOD, fog and cloud images, PT volumes), then
-        draw and re-measure the error estimate for the new view."""
+        """After the camera moved: draw, and refresh every camera view for the new camera (full size, with the error
+        estimate)."""
         if self.controller is None:
             return
-        self.refresh_nature()
-        self.refresh_lod()
-        self.last_view_stats = self.controller.update_views(pt=False, nature=False, lod=False)
         self.render()
-        for comp_id in self.controller.pt_stats():
-            self.refresh_pt(comp_id)
-        self.refresh_iso_overlay()
+        self.refresh_views()
 
     def _viewport_resized(self) -> None:
+        """The images of the camera views have the viewport's size, and the block selection depends on it: refresh
+        the views whose last update was made for another size."""
         if self.controller is None:
             return
-        self.refresh_nature()  # its overlay image has the viewport's size
-        self.refresh_lod()     # the block selection depends on the viewport's size
         size = tuple(int(v) for v in self.plotter.ren_win.GetSize())
-        for comp_id, stats in self.controller.pt_stats().items():
-            if stats and tuple(stats.get("size", size)) != size:
-                self.refresh_pt(comp_id)
-        overlay = self.controller.iso_overlay
-        if overlay is not None and tuple(overlay.stats.get("size", size)) != size:
-            self.refresh_iso_overlay()
+        stale = [key for key, view in self.controller.camera_views().items()
+                 if tuple(getattr(view, "stats", {}).get("size", ())) != size]
+        if stale:
+            self.refresh_views(stale)
 
     def refresh_nature(self, settled: Optional[Callable[[], None]] = None, scale: int = 1) -> None:
-        """Re-compute the natural scene's view-dependent parts (C-LOD terrain, fog and cloud images; issue #5) for
-        the newest camera in the background (``_refresh_view``), then draw once the event loop is free."""
-        controller = self.controller
-        view = controller.nature if controller is not None else None
-        if view is None:
-            if settled is not None:
-                settled()
-            return
-
-        def shown(request: Any, stats: Any) -> None:
-            self.last_view_stats = stats
-            self.nature_updates += 1
-            self.schedule_render()
-
-        self._refresh_view(view, self._nature_jobs, "natural scene", lambda: controller.nature, shown, settled, scale)
-
-    def refresh_lod(self, comp_ids: Optional[list[str]] = None,
-                    settled: Optional[Callable[[], None]] = None) -> None:
-        """Re-select the blocks of volumes at a level of detail for the current camera and TF in the background:
-        first a coarse selection (an eighth of the block budget) that shows quickly, then the full budget (the
-        refinement once the camera stopped); selection and decoding on a worker, the drawing on this thread."""
-        controller = self.controller
-        if controller is None:
-            return
-        for comp_id, volume in controller.lod_volumes().items():
-            if comp_ids is not None and comp_id not in comp_ids:
-                continue
-            jobs = self._lod_jobs.setdefault(comp_id, OneInFlight())
-            budgets = list(dict.fromkeys((max(1, volume.budget // 8), volume.budget)))
-            for budget in budgets:  # ``settled()`` once per volume, when its full budget is shown
-                jobs.request(self._lod_step(controller, comp_id, volume, budget),
-                             settled if budget == budgets[-1] else None)
-
-    def _lod_step(self, controller: Any, comp_id: str, volume: Any, budget: int) -> Callable[..., None]:
-        def start(next_request: Callable[[], None]) -> None:
-            if self.controller is not controller or controller.props.get(comp_id) is not volume:
-                next_request()
-                return
-            camera = volume.camera()
-
-            def select(progress: Any = None) -> tuple[Any, list[Any], float, float]:
-                t0 = time.perf_counter()
-                selection = volume.select(camera, budget)
-                t1 = time.perf_counter()
-                return selection, volume.decode(selection), t1 - t0, time.perf_counter() - t1
-
-            def done(outcome: JobOutcome) -> None:
-                if outcome.ok and self.controller is controller and controller.props.get(comp_id) is volume:
-                    volume.show(*outcome.result)
-                    self.lod_shown[comp_id] = budget
-                    self.schedule_render()
-                elif outcome.error is not None:
-                    self.show_error("Cannot select the volume's level of detail", str(outcome.error))
-                next_request()
-
-            self.jobs.submit(select, name="level of detail", on_done=done)
-
-        return start
-
-    def refresh_pt(self, comp_id: str, settled: Optional[Callable[[], None]] = None, estimate: bool = True,
-                   scale: int = 1) -> None:
-        """Re-render a PT volume for the current camera and TF: the depth read-back on this thread, the sort, table
-        and rasterisation in the background (``_refresh_overlay``), then the image and, with ``estimate``, a fresh
-        error estimate. ``scale`` > 1: a preview that many times smaller in each direction. ``settled()`` is called
-        when a render for this request is over. On the GPU backend only the visibility order is made in the
-        background; until it is done, VTK's renders draw with the newest order there is."""
-        controller = self.controller
-        volume = controller.pt_volume(comp_id) if controller is not None else None
-        gl = controller.gl_pt_volume(comp_id) if controller is not None else None
-        if volume is not None:
-            after = (lambda request: self.estimate_error(comp_id, request)) if estimate else None
-            self._refresh_overlay(volume, f"pt:{comp_id}", "volume", lambda: controller.pt_volume(comp_id), after,
-                                  settled, scale)
-        elif gl is not None:  # the GPU draws with the newest order; the order for this camera is made on a worker
-            gl.reuse_order = True
-            self._refresh_overlay(gl, f"pt-order:{comp_id}", "visibility order",
-                                  lambda: controller.gl_pt_volume(comp_id), None, settled, scale)
-        elif settled is not None:
-            settled()
+        """Re-compute the natural scene's view-dependent parts (C-LOD terrain, fog and clouds) for the newest camera
+        in the background (``refresh_views``)."""
+        self.refresh_views(["nature"], settled=settled, scale=scale)
 
     def refresh_iso_overlay(self, settled: Optional[Callable[[], None]] = None, scale: int = 1) -> None:
-        """Re-render the isosurfaces' CPU transparency mode (when one is on) in the background, like a PT volume."""
+        """Re-render the isosurfaces' CPU transparency mode (when one is on) in the background (``refresh_views``)."""
+        self.refresh_views(["iso-overlay"], settled=settled, scale=scale)
+
+    def refresh_views(self, keys: Optional[list[str]] = None, settled: Optional[Callable[[], None]] = None,
+                      scale: int = 1, estimate: bool = True, moving: bool = False) -> int:
+        """Update the camera views (``SceneController.camera_views``; only those whose key or component id is in
+        ``keys`` when given) for the current camera in the background (``_refresh_view``). ``scale`` > 1: previews
+        that many times smaller in each direction; ``moving``: the camera is moving (a view whose VTK props need
+        nothing new for a moving camera, ``while_moving = False``, is left alone); ``estimate``: measure a CPU PT
+        image's error afterwards. ``settled()`` is called once every chosen view's update is over. Returns the number
+        of views chosen."""
         controller = self.controller
-        overlay = controller.iso_overlay if controller is not None else None
-        if overlay is not None:
-            self._refresh_overlay(overlay, "iso-overlay", "isosurfaces", lambda: controller.iso_overlay,
-                                  settled=settled, scale=scale)
-        elif settled is not None:
-            settled()
+        views = controller.camera_views() if controller is not None else {}
+        chosen = [(key, view) for key, view in views.items()
+                  if (keys is None or key in keys or key.split(":", 1)[-1] in keys)
+                  and not (moving and not getattr(view, "while_moving", True))]
+        waiting = [len(chosen) + 1]
 
-    def _refresh_overlay(self, handle: Any, key: str, what: str, current: Any, after: Any = None,
-                         settled: Optional[Callable[[], None]] = None, scale: int = 1) -> None:
-        """Re-make an overlay view's image (a PT volume, the isosurfaces' CPU overlay; or a GPU PT volume's
-        visibility order) for the current camera (``_refresh_view``), one in flight per ``key``; a preview is
-        drawn by the next paint, a full-size image at once, then ``after(request)``."""
+        def one_settled() -> None:
+            waiting[0] -= 1
+            if waiting[0] == 0 and settled is not None:
+                settled()
 
-        def shown(request: Any, result: Any) -> None:
-            self.overlay_updates[key] = self.overlay_updates.get(key, 0) + 1
-            if request.get("preview"):  # while the camera moves: drawn by the next paint, in its own turn
-                self.plotter.update()   # of the event loop, not in the one that also handles the mouse
-            else:
-                self.render()
-            if after is not None:
-                after(request)
+        for key, view in chosen:
+            self._refresh_view(key, view, one_settled, scale, estimate)
+        one_settled()
+        return len(chosen)
 
-        self._refresh_view(handle, self._overlay_jobs.setdefault(key, OneInFlight()), what, current, shown, settled,
-                           scale)
-
-    def _refresh_view(self, view: Any, jobs: OneInFlight, what: str, current: Callable[[], Any],
-                      shown: Callable[[Any, Any], None], settled: Optional[Callable[[], None]] = None,
-                      scale: int = 1) -> None:
+    def _refresh_view(self, key: str, view: Any, settled: Callable[[], None], scale: int, estimate: bool) -> None:
         """Update a view (``volviz.render.views.View``) for the current camera in the background: ``begin`` on this
         thread when the job starts (the camera and opaque depth of then, not of the request), ``compute`` on a
-        worker, ``finish`` here, then ``shown(request, finish's result)``. One job in flight per ``jobs``, the newest
-        request next (``OneInFlight``): while the camera or a TF keeps changing, every finished update is shown. (A
-        newer request cancelling the older job would throw away work a kernel cannot stop: nothing would be shown
-        until the requests stopped.) A view that ``current()`` no longer returns is left alone."""
+        worker, ``finish`` here; it is drawn by the next paint, in its own turn of the event loop (not in the one
+        that also handles the mouse), and a full-size update's statistics go to the statistics dock. One job in
+        flight per view, the newest request next (``OneInFlight``): while the camera or a TF keeps changing, every
+        finished update is shown. (A newer request cancelling the older job would throw away work a kernel cannot
+        stop: nothing would be shown until the requests stopped.) A view that the controller no longer shows under
+        ``key`` is left alone. A view with ``coarse_first`` shows a coarse update (``begin(scale=2)``) before a
+        full-size one."""
         controller = self.controller
+        jobs = self._view_jobs.setdefault(key, OneInFlight())
+        what = view.job[1]
+        comp_id = key.split(":", 1)[-1]
 
-        def start(next_request: Callable[[], None]) -> None:
-            if self.controller is not controller or current() is not view:
-                next_request()
-                return
-            request = view.begin(scale=scale)
+        def step(scale: int) -> Callable[[Callable[[], None]], None]:
+            def start(next_request: Callable[[], None]) -> None:
+                if self.controller is not controller or controller.camera_views().get(key) is not view:
+                    next_request()
+                    return
+                request = view.begin(scale=scale)
 
-            def done(outcome: JobOutcome) -> None:
-                if outcome.ok and self.controller is controller and current() is view:
-                    with no_render(self.plotter):  # the caller's ``shown`` draws once
-                        result = view.finish(request, *outcome.result)
-                    shown(request, result)
-                elif outcome.error is not None:
-                    self.show_error(f"Cannot update the {what}", str(outcome.error))
-                next_request()
+                def done(outcome: JobOutcome) -> None:
+                    if outcome.ok and self.controller is controller and controller.camera_views().get(key) is view:
+                        with no_render(self.plotter):  # drawn once, below
+                            result = view.finish(request, *outcome.result)
+                        self.view_updates[key] = self.view_updates.get(key, 0) + 1
+                        self.view_requests[key], self.view_results[key] = request, result
+                        preview = bool(request.get("preview")) if isinstance(request, dict) else False
+                        self.schedule_render()
+                        if not preview:
+                            self.show_statistics()
+                        if estimate and not preview and hasattr(view, "error_estimate"):
+                            self.estimate_error(comp_id, request)
+                    elif outcome.error is not None:
+                        self.show_error(f"Cannot update the {what}", str(outcome.error))
+                    next_request()
 
-            self.jobs.submit(view.compute, request, name=what, on_done=done)
+                self.jobs.submit(view.compute, request, name=what, on_done=done)
 
-        jobs.request(start, settled)
+            return start
+
+        if scale == 1 and getattr(view, "coarse_first", False):
+            jobs.request(step(2))
+        jobs.request(step(scale), settled)
 
     def _time_changed(self, t: float) -> None:
         if self.controller is not None and self.controller.time_series():

@@ -117,8 +117,14 @@ class MainWindow(SceneLoading, SessionFiles, ViewScheduler, SceneEdits, ExportRu
     def render(self) -> None:
         start = time.perf_counter()
         self.plotter.render()
-        elapsed = time.perf_counter() - start
-        stats: dict[str, Any] = {"frame_seconds": elapsed, "method": self.session.render.method,
+        self.show_statistics(time.perf_counter() - start)
+
+    def show_statistics(self, elapsed: Optional[float] = None) -> None:
+        """The statistics dock for the last frame (``elapsed``: its render's seconds; default the last render's)."""
+        if elapsed is None:
+            elapsed = self.last_stats.get("render_seconds", 0.0) if getattr(self, "last_stats", None) else 0.0
+        stats: dict[str, Any] = {"frame_seconds": elapsed, "render_seconds": elapsed,
+                                 "method": self.session.render.method,
                                  "cells": sum(getattr(d, "n_cells", 0) for d in self.datasets.values()),
                                  "gl": plotter_gl_info(self.plotter).renderer}
         pt = self.controller.pt_stats() if self.controller is not None else {}

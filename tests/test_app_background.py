@@ -8,6 +8,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+import pytest
 from PySide6.QtCore import QEvent, QPoint, Qt, QTimer
 
 from conftest import blob_vvz, data_file
@@ -103,21 +104,21 @@ def test_camera_move_updates_the_natural_scene_in_the_background(qtbot, make_win
     window.open_demo()  # the app's default scene: terrain, fog, clouds and sky
     wait_loaded(qtbot, window)
     view = window.controller.nature
-    qtbot.waitUntil(lambda: not window._nature_jobs.running, timeout=60000)
-    mesh, overlay, updates = view._mesh, overlay_pixels(view), window.nature_updates
+    qtbot.waitUntil(lambda: not window._view_jobs["nature"].running, timeout=60000)
+    mesh, overlay, updates = view._mesh, overlay_pixels(view), window.view_updates.get("nature", 0)
     window.plotter.camera.azimuth = 40.0
     window.plotter.camera.elevation = 10.0
     window._camera_moved()  # what the end of a mouse interaction triggers: it draws the new view at once
     assert view._mesh is mesh and np.array_equal(overlay_pixels(view), overlay), \
         "the natural scene was updated on the GUI thread"
     gaps = LoopGaps()
-    qtbot.waitUntil(lambda: window.nature_updates > updates, timeout=60000)
+    qtbot.waitUntil(lambda: window.view_updates.get("nature", 0) > updates, timeout=60000)
     gaps.stop()
     gaps.assert_responsive("after a camera move", 5)
     assert view._mesh is not mesh and view._mesh.n_cells > 0  # the terrain re-triangulated for the new view
     changed = overlay_pixels(view)
     assert changed.shape == overlay.shape and np.abs(changed.astype(int) - overlay).max() > 0
-    assert window.last_view_stats["terrain_triangles"] == view._mesh.n_cells
+    assert window.view_results["nature"]["terrain_triangles"] == view._mesh.n_cells
 
 
 def test_lod_volume_selects_in_the_background_coarse_first(qtbot, make_window, tmp_path: Path) -> None:
@@ -133,7 +134,8 @@ def test_lod_volume_selects_in_the_background_coarse_first(qtbot, make_window, t
     window.open_path(session)
     wait_loaded(qtbot, window)
     volume = window.controller.lod_volumes()["blob"]
-    qtbot.waitUntil(lambda: not window._lod_jobs.get("blob") or not window._lod_jobs["blob"].running, timeout=60000)
+    qtbot.waitUntil(lambda: not window._view_jobs.get("lod:blob") or not window._view_jobs["lod:blob"].running,
+                    timeout=60000)
     far = list(volume.selection.nodes)
     shown: list[int] = []
     show = volume.show
@@ -141,7 +143,8 @@ def test_lod_volume_selects_in_the_background_coarse_first(qtbot, make_window, t
     window.plotter.camera.position = (24.0, -40.0, 24.0)  # close to the volume: finer blocks
     window._camera_moved()
     assert list(volume.selection.nodes) == far and not shown, "the blocks were selected on the GUI thread"
-    qtbot.waitUntil(lambda: window.lod_shown.get("blob") == 16 and len(shown) == 2, timeout=60000)
+    qtbot.waitUntil(lambda: window.view_requests.get("lod:blob", {}).get("budget") == 16 and len(shown) == 2,
+                    timeout=60000)
     assert shown[0] <= 2 < shown[1] <= 16  # a coarse selection (budget / 8) first, then the full budget
     assert list(volume.selection.nodes) == list(volume.select(volume.camera()).nodes)  # as if selected right here
     assert volume.stats["blocks"] == shown[1]
@@ -149,7 +152,7 @@ def test_lod_volume_selects_in_the_background_coarse_first(qtbot, make_window, t
     # a clipping plane (keep x >= 24, the volume's middle) is ray cast on a worker, not on the GUI thread
     shown.clear()
     window.set_clip({"planes": [{"point": [24.0, 0.0, 0.0], "normal": [1.0, 0.0, 0.0]}]})
-    qtbot.waitUntil(lambda: len(shown) == 2 and not window._lod_jobs["blob"].running, timeout=60000)
+    qtbot.waitUntil(lambda: len(shown) == 2 and not window._view_jobs["lod:blob"].running, timeout=60000)
     assert volume.stats["prepared"] is True, "the clipped view was ray cast on the GUI thread"
     cut = volume.image
     assert 0.0 < cut[..., 3].sum() < 0.9 * whole[..., 3].sum()     # part of the volume is cut away
@@ -200,7 +203,7 @@ def test_nature_visibility_toggles_rebuild_in_the_background(qtbot, make_window)
     view = window.controller.nature
     assert [f.name for f in view.scene.fogs] == ["ground_fog"]
     before = overlay_pixels(view)
-    rebuilds, updates = window.nature_rebuilds, window.nature_updates
+    rebuilds, updates = window.nature_rebuilds, window.view_updates.get("nature", 0)
     gaps = LoopGaps()
     window.scene_tree.item("ground_fog").setCheckState(0, Qt.CheckState.Unchecked)  # what a click in the tree does
     assert window.controller.nature is view and window.nature_rebuilds == rebuilds, \
@@ -210,13 +213,14 @@ def test_nature_visibility_toggles_rebuild_in_the_background(qtbot, make_window)
                     and window.controller.nature.last_stats != {}, timeout=60000)
     gaps.stop()
     new = window.controller.nature
-    assert window.nature_updates > updates and new.scene.fogs == [] and new.scene.terrain is not None
+    assert window.view_updates.get("nature", 0) > updates and new.scene.fogs == [] and new.scene.terrain is not None
     after = overlay_pixels(new)
     assert after.shape == before.shape and np.abs(after.astype(int) - before).max() > 0  # the fog is gone
     gaps.assert_responsive("during a rebuild", 5)
 
     window.scene_tree.item("ground_fog").setCheckState(0, Qt.CheckState.Checked)
-    qtbot.waitUntil(lambda: window.controller.nature is not new and not window._nature_jobs.running, timeout=60000)
+    qtbot.waitUntil(lambda: window.controller.nature is not new and not window._view_jobs["nature"].running,
+                    timeout=60000)
     qtbot.waitUntil(lambda: [f.name for f in window.controller.nature.scene.fogs] == ["ground_fog"], timeout=60000)
     # fog without terrain cannot be built: a message, and the terrain stays shown and checked
     shown = window.controller.nature
@@ -283,8 +287,8 @@ def test_pt_volume_follows_a_mouse_drag_of_the_camera(qtbot, make_window) -> Non
     window.open_demo_volume()
     wait_loaded(qtbot, window)
     volume = window.controller.pt_volume("demo")
-    qtbot.waitUntil(lambda: volume.image is not None and not window._overlay_jobs["pt:demo"].running, timeout=60000)
-    before = window.overlay_updates.get("pt:demo", 0)
+    qtbot.waitUntil(lambda: volume.image is not None and not window._view_jobs["pt:demo"].running, timeout=60000)
+    before = window.view_updates.get("pt:demo", 0)
     shown_before = np.asarray(volume.camera.position).copy()
     canvas = window.plotter.interactor
     centre = QPoint(canvas.width() // 2, canvas.height() // 2)
@@ -296,7 +300,7 @@ def test_pt_volume_follows_a_mouse_drag_of_the_camera(qtbot, make_window) -> Non
         _mouse(canvas, QEvent.Type.MouseMove, centre + QPoint(4 * k, k), held)
         seen.append(np.asarray(window.plotter.camera.position, dtype=float).copy())
         qtbot.wait(25)
-    qtbot.waitUntil(lambda: window.overlay_updates.get("pt:demo", 0) >= before + 2, timeout=60000)
+    qtbot.waitUntil(lambda: window.view_updates.get("pt:demo", 0) >= before + 2, timeout=60000)
     gaps.stop()
     during = np.asarray(volume.camera.position)
     assert not np.allclose(during, shown_before), "the volume image did not follow the drag"
@@ -307,7 +311,7 @@ def test_pt_volume_follows_a_mouse_drag_of_the_camera(qtbot, make_window) -> Non
     _mouse(canvas, QEvent.Type.MouseButtonRelease, centre + QPoint(160, 40), Qt.MouseButton.NoButton)
     final = np.asarray(window.plotter.camera.position, dtype=float).copy()
     # the last preview may already be of the final camera: wait for the full-size image the release asks for
-    qtbot.waitUntil(lambda: volume.image.shape[:2] == (h, w) and not window._overlay_jobs["pt:demo"].running,
+    qtbot.waitUntil(lambda: volume.image.shape[:2] == (h, w) and not window._view_jobs["pt:demo"].running,
                     timeout=60000)
     assert np.allclose(volume.camera.position, final) and volume.image[..., 3].max() > 0
 
@@ -323,11 +327,11 @@ def test_pt_volume_keeps_showing_renders_while_flying(qtbot, make_window) -> Non
     window.open_demo_volume()
     wait_loaded(qtbot, window)
     volume = window.controller.pt_volume("demo")
-    jobs = window._overlay_jobs
+    jobs = window._view_jobs
     qtbot.waitUntil(lambda: volume.image is not None and not jobs["pt:demo"].running, timeout=60000)
     window.set_fly_mode(True)
     canvas = window.plotter.interactor
-    before = window.overlay_updates.get("pt:demo", 0)
+    before = window.view_updates.get("pt:demo", 0)
     started = [0]
     compute = volume.compute
 
@@ -342,14 +346,14 @@ def test_pt_volume_keeps_showing_renders_while_flying(qtbot, make_window) -> Non
         QApplication.sendEvent(canvas, QKeyEvent(QEvent.Type.KeyPress, Qt.Key.Key_W, Qt.KeyboardModifier.NoModifier))
         presses += 1
         qtbot.wait(30)
-    shown_while_flying = window.overlay_updates.get("pt:demo", 0) - before
+    shown_while_flying = window.view_updates.get("pt:demo", 0) - before
     w, h = (int(v) for v in window.plotter.ren_win.GetSize())
     assert volume.image.shape[:2] == (h // 2, w // 2), "previews while flying: a quarter of the pixels"
     final = np.asarray(window.plotter.camera.position, dtype=float).copy()
     # the keys have stopped: the full-size image of the final camera follows
     qtbot.waitUntil(lambda: volume.image.shape[:2] == (h, w) and not jobs["pt:demo"].running, timeout=60000)
     assert shown_while_flying >= 2, f"{shown_while_flying} renders shown during {presses} key presses"
-    assert window.overlay_updates["pt:demo"] - before == started[0], "a finished render was thrown away"
+    assert window.view_updates["pt:demo"] - before == started[0], "a finished render was thrown away"
     assert started[0] < presses
     assert np.allclose(volume.camera.position, final)
 
@@ -363,8 +367,8 @@ def test_natural_scene_follows_a_mouse_drag_with_previews(qtbot, make_window) ->
     window.open_demo()
     wait_loaded(qtbot, window)
     view = window.controller.nature
-    qtbot.waitUntil(lambda: not window._nature_jobs.running, timeout=60000)
-    updates, mesh = window.nature_updates, view._mesh
+    qtbot.waitUntil(lambda: not window._view_jobs["nature"].running, timeout=60000)
+    updates, mesh = window.view_updates.get("nature", 0), view._mesh
     canvas = window.plotter.interactor
     centre = QPoint(canvas.width() // 2, canvas.height() // 2)
     held = Qt.MouseButton.LeftButton
@@ -372,12 +376,12 @@ def test_natural_scene_follows_a_mouse_drag_with_previews(qtbot, make_window) ->
     for k in range(1, 21):
         _mouse(canvas, QEvent.Type.MouseMove, centre + QPoint(3 * k, 0), held)
         qtbot.wait(25)
-    qtbot.waitUntil(lambda: window.nature_updates > updates, timeout=60000)
+    qtbot.waitUntil(lambda: window.view_updates.get("nature", 0) > updates, timeout=60000)
     assert view.shown_scale == 2 and view._mesh is not mesh
     w, h = (int(v) for v in window.plotter.window_size)
     assert view._overlay_image.GetDimensions()[:2] == (w, h)  # magnified to the window
     _mouse(canvas, QEvent.Type.MouseButtonRelease, centre + QPoint(60, 0), Qt.MouseButton.NoButton)
-    qtbot.waitUntil(lambda: view.shown_scale == 1 and not window._nature_jobs.running, timeout=60000)
+    qtbot.waitUntil(lambda: view.shown_scale == 1 and not window._view_jobs["nature"].running, timeout=60000)
 
 
 def test_dragging_a_transfer_function_point_previews_the_pt_volume(qtbot, make_window) -> None:
@@ -389,7 +393,7 @@ def test_dragging_a_transfer_function_point_previews_the_pt_volume(qtbot, make_w
     window.open_demo_volume()
     wait_loaded(qtbot, window)
     volume = window.controller.pt_volume("demo")
-    qtbot.waitUntil(lambda: volume.image is not None and not window._overlay_jobs["pt:demo"].running, timeout=60000)
+    qtbot.waitUntil(lambda: volume.image is not None and not window._view_jobs["pt:demo"].running, timeout=60000)
     w, h = (int(v) for v in window.plotter.ren_win.GetSize())
     full_before = volume.image.copy()
     editor = window.tf_editor
@@ -400,19 +404,40 @@ def test_dragging_a_transfer_function_point_previews_the_pt_volume(qtbot, make_w
     start = QPoint(int(p.x()), int(p.y()))
     end = QPoint(start.x(), canvas._plot_rect().bottom() - 2)
     held = Qt.MouseButton.LeftButton
-    updates = window.overlay_updates.get("pt:demo", 0)
+    updates = window.view_updates.get("pt:demo", 0)
     _mouse(canvas, QEvent.Type.MouseButtonPress, start, held)
     for k in range(1, 11):
         _mouse(canvas, QEvent.Type.MouseMove, start + (end - start) * (k / 10), held)
         qtbot.wait(30)
-    qtbot.waitUntil(lambda: window.overlay_updates.get("pt:demo", 0) > updates and volume.tf is editor.transfer_function
-                    and not window._overlay_jobs["pt:demo"].running, timeout=60000)
+    qtbot.waitUntil(lambda: window.view_updates.get("pt:demo", 0) > updates and volume.tf is editor.transfer_function
+                    and not window._view_jobs["pt:demo"].running, timeout=60000)
     assert volume.image.shape[:2] == (h // 2, w // 2), "a preview while dragging"
     assert editor.undo_stack.count() == 0  # the edit is not finished yet
     live = editor.transfer_function
     assert volume.tf is live and live.extinction[index] < tf0.extinction[index]
     _mouse(canvas, QEvent.Type.MouseButtonRelease, end, Qt.MouseButton.NoButton)
-    qtbot.waitUntil(lambda: volume.image.shape[:2] == (h, w) and not window._overlay_jobs["pt:demo"].running,
+    qtbot.waitUntil(lambda: volume.image.shape[:2] == (h, w) and not window._view_jobs["pt:demo"].running,
                     timeout=60000)
     assert editor.undo_stack.count() == 1 and volume.tf is editor.committed_transfer_function
     assert volume.image[..., 3].sum() < full_before[..., 3].sum()  # thinner with the lowered point
+
+
+def test_pt_volume_opacity_renders_in_the_background(qtbot, make_window) -> None:
+    """The scene tree's opacity slider on a PT volume scales its extinction; the image is re-rendered by the view
+    scheduler on a worker (it used to render on the GUI thread), and the new image is thinner."""
+    window = make_window()
+    window.open_demo_volume()
+    wait_loaded(qtbot, window)
+    volume = window.controller.pt_volume("demo")
+    qtbot.waitUntil(lambda: volume.image is not None and not window._view_jobs["pt:demo"].running, timeout=60000)
+    image, updates = volume.image, window.view_updates.get("pt:demo", 0)
+    alpha = image[..., 3].sum()
+    window.scene_tree.tree.setCurrentItem(window.scene_tree.item("demo"))
+    window.scene_tree.opacity.setValue(30)
+    assert window.controller.component("demo").opacity == pytest.approx(0.3)
+    assert volume.image is image, "the volume was rendered on the GUI thread"
+    qtbot.waitUntil(lambda: window.view_updates.get("pt:demo", 0) > updates
+                    and not window._view_jobs["pt:demo"].running, timeout=60000)
+    assert volume.tf.extinction.max() == pytest.approx(
+        0.3 * window.controller.transfer_function("demo").extinction.max())
+    assert 0.0 < volume.image[..., 3].sum() < 0.9 * alpha

@@ -49,10 +49,10 @@ def viewport(window: MainWindow) -> np.ndarray:
     from PySide6.QtWidgets import QApplication
 
     deadline = time.monotonic() + 30.0
-    while not window.isosurfaces_cut() and time.monotonic() < deadline:
+    while not window.clipping_shown() and time.monotonic() < deadline:
         QApplication.processEvents()
         time.sleep(0.005)
-    assert window.isosurfaces_cut(), "the isosurfaces were not re-cut for the new clipping"
+    assert window.clipping_shown(), "the isosurfaces were not re-cut for the new clipping"
     window.plotter.render()
     return np.asarray(window.plotter.screenshot(None, return_img=True)).astype(np.float64)
 
@@ -76,7 +76,7 @@ def test_clip_plane_cuts_the_view_undo_and_survives_save_and_reopen(qtbot, make_
     shown = window.controller.props["iso"].volviz_shown
     dock.add_button.click()                              # a plane through the centre, normal +x: keeps x >= 11.5
     assert len(window.session.clip["planes"]) == 1 and window.dirty
-    assert window.controller.props["iso"].volviz_shown is shown and not window.isosurfaces_cut(), \
+    assert window.controller.props["iso"].volviz_shown is shown and not window.clipping_shown(), \
         "the isosurfaces were cut on the GUI thread"
     cut = viewport(window)
     assert np.abs(cut[left] - background).max() <= 3     # the left half is gone

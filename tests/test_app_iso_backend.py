@@ -65,7 +65,7 @@ def test_isosurfaces_on_the_gpu_backend_match_the_cpu_without_overlay_jobs(qtbot
     qtbot.wait(200)
     wait_loaded(qtbot, window)
     # no CPU overlay job was asked for (``_refresh_overlay`` keeps one queue per overlay) or finished
-    assert "iso-overlay" not in window._overlay_jobs and "iso-overlay" not in window.overlay_updates
+    assert "iso-overlay" not in window._view_jobs and "iso-overlay" not in window.view_updates
     gpu = viewport(window)
     _check(gpu, _cpu_expected(window, view.meshes), "gpu vs cpu compositor")
     window.render()

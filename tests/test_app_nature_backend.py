@@ -37,11 +37,11 @@ def _set_backend(qtbot, window: MainWindow, backend: str) -> Any:
     """Choose ``backend`` in the render settings dock as a user does; returns the natural scene's view once its
     first frame is shown."""
     old = window.controller
-    shown = window.nature_updates
+    shown = window.view_updates.get("nature", 0)
     window.render_settings.backend.setCurrentText(backend)
     qtbot.waitUntil(lambda: window.controller is not old, timeout=60000)
     wait_loaded(qtbot, window)
-    qtbot.waitUntil(lambda: window.nature_updates > shown and not window._nature_jobs.running, timeout=60000)
+    qtbot.waitUntil(lambda: window.view_updates.get("nature", 0) > shown and not window._view_jobs["nature"].running, timeout=60000)
     return window.controller.nature
 
 
@@ -62,7 +62,7 @@ def test_demo_scene_on_the_gpu_backend_matches_the_cpu_without_overlay_jobs(qtbo
         return submit(fn, *args, name=name, **kwargs)
 
     window.jobs.submit = recorded          # the real submit, recorded
-    overlays = dict(window.overlay_updates)
+    overlays = {key: n for key, n in window.view_updates.items() if key != "nature"}  # the CPU images
     gpu = _set_backend(qtbot, window, "gpu")
     assert isinstance(gpu, GLNatureView) and window.session.render.options["backend"] == "gpu"
     assert gpu.clouds is not None and gpu.layers and gpu.last_stats["cloud_tets"] > 0
@@ -70,7 +70,7 @@ def test_demo_scene_on_the_gpu_backend_matches_the_cpu_without_overlay_jobs(qtbo
     nature_jobs = [fn for name, fn in submitted if name == "natural scene"]
     assert nature_jobs and all(getattr(fn, "__self__", gpu) is gpu or fn.__name__ == "prepare" for fn in nature_jobs)
     assert "nature-overlay" not in window.plotter.actors and gpu._overlay_image is None
-    assert window.overlay_updates == overlays
+    assert {key: n for key, n in window.view_updates.items() if key != "nature"} == overlays
     window.jobs.submit = submit
     gpu_image = viewport(window)
     _check(gpu_image, cpu_image, "gpu vs cpu")

@@ -41,7 +41,7 @@ def _set_backend(qtbot, window: MainWindow, backend: str) -> Any:
     if isinstance(volume, PTVolume):
         w, h = (int(v) for v in window.plotter.ren_win.GetSize())
         qtbot.waitUntil(lambda: volume.image is not None and volume.image.shape[:2] == (h, w)
-                        and not window._overlay_jobs["pt:demo"].running, timeout=60000)
+                        and not window._view_jobs["pt:demo"].running, timeout=60000)
     return volume
 
 
@@ -79,7 +79,7 @@ def test_gpu_backend_matches_the_cpu_follows_a_drag_without_cpu_renders_and_swit
         return submit(fn, *args, name=name, **kwargs)
 
     window.jobs.submit = recorded  # the real submit, recorded
-    updates = dict(window.overlay_updates)
+    updates = dict(window.view_updates)
     start = np.asarray(gpu.camera.position, dtype=float).copy()
     canvas = window.plotter.interactor
     centre = QPoint(canvas.width() // 2, canvas.height() // 2)
@@ -95,7 +95,7 @@ def test_gpu_backend_matches_the_cpu_follows_a_drag_without_cpu_renders_and_swit
     _mouse(canvas, QEvent.Type.MouseButtonRelease, centre + QPoint(100, 20), Qt.MouseButton.NoButton)
     qtbot.wait(300)
     # the order of the final camera arrives from its job and is drawn: exact again
-    qtbot.waitUntil(lambda: not window._overlay_jobs["pt-order:demo"].running and gpu.stats["order_reused"] is False
+    qtbot.waitUntil(lambda: not window._view_jobs["pt-order:demo"].running and gpu.stats["order_reused"] is False
                     and gpu._sorted_key is not None and np.allclose(gpu._sorted_key[0], gpu.camera.position),
                     timeout=30000)
     assert not any(sorted_here), "a render during the drag sorted on the GUI thread"
@@ -105,7 +105,7 @@ def test_gpu_backend_matches_the_cpu_follows_a_drag_without_cpu_renders_and_swit
     assert len({tuple(p) for p in drawn}) >= 3, "the volume was not redrawn while the camera moved"
     assert np.allclose(gpu.camera.position, final), "the last draw is not of the final camera"
     assert "volume" not in submitted and "error estimate" not in submitted, submitted
-    assert window.overlay_updates.get("pt:demo") == updates.get("pt:demo")
+    assert window.view_updates.get("pt:demo") == updates.get("pt:demo")
     after_drag = viewport(window)
     assert np.allclose(gpu.camera.position, final)
 

@@ -132,16 +132,16 @@ def test_reset_camera_brings_a_pt_volume_back(qtbot, make_window) -> None:
     first = data_share(window)
     assert first > 0.05      # the faint fin framed left of the scalar bar (far away below: under 0.01)
 
-    shown = window.overlay_updates.get("pt:data", 0)
+    shown = window.view_updates.get("pt:data", 0)
     _move_far_away(window)
-    qtbot.waitUntil(lambda: window.overlay_updates.get("pt:data", 0) > shown, timeout=30000)
+    qtbot.waitUntil(lambda: window.view_updates.get("pt:data", 0) > shown, timeout=30000)
     assert data_share(window) < 0.01
 
     action = _reset_camera_action(window)
     assert action.shortcut().toString() == "R"
-    shown = window.overlay_updates.get("pt:data", 0)
+    shown = window.view_updates.get("pt:data", 0)
     action.trigger()
-    qtbot.waitUntil(lambda: window.overlay_updates.get("pt:data", 0) > shown, timeout=30000)
+    qtbot.waitUntil(lambda: window.view_updates.get("pt:data", 0) > shown, timeout=30000)
     assert _inside(window.plotter.camera.focal_point, scene_bounds(window.controller.props))
     assert data_share(window) > 0.5 * first
 
@@ -156,15 +156,15 @@ def test_reset_camera_brings_the_demo_scene_back(qtbot, make_window) -> None:
     size = float(np.linalg.norm(np.subtract(bounds[1::2], bounds[0::2])))
     before = viewport(window)
 
-    updates = window.nature_updates
+    updates = window.view_updates.get("nature", 0)
     _move_far_away(window)
-    qtbot.waitUntil(lambda: window.nature_updates > updates, timeout=60000)
+    qtbot.waitUntil(lambda: window.view_updates.get("nature", 0) > updates, timeout=60000)
     away = viewport(window)
     assert not _inside(window.plotter.camera.focal_point, bounds)
 
-    updates = window.nature_updates
+    updates = window.view_updates.get("nature", 0)
     _reset_camera_action(window).trigger()
-    qtbot.waitUntil(lambda: window.nature_updates > updates, timeout=60000)
+    qtbot.waitUntil(lambda: window.view_updates.get("nature", 0) > updates, timeout=60000)
     camera = window.plotter.camera
     assert _inside(camera.focal_point, bounds)
     assert np.linalg.norm(np.subtract(camera.position, camera.focal_point)) < 2.0 * size

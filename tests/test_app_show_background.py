@@ -49,7 +49,7 @@ def test_natural_scene_adds_its_actors_without_rendering(qtbot, make_window) -> 
     window = make_window()
     window.open_demo()
     wait_loaded(qtbot, window)
-    qtbot.waitUntil(lambda: not window._nature_jobs.running, timeout=60000)
+    qtbot.waitUntil(lambda: not window._view_jobs["nature"].running, timeout=60000)
     controller = window.controller
     scene = controller.prepare_nature()
     renders = []

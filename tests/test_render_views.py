@@ -57,3 +57,94 @@ def test_a_lod_volume_through_the_view_calls_shows_what_update_shows(tmp_path):
         finally:
             pl.close()
     np.testing.assert_array_equal(images[0], images[1])
+
+
+@pytest.mark.parametrize("kind", sorted(__import__("volviz.render.views", fromlist=["x"]).COMPONENT_VIEWS))
+def test_each_component_view_offers_the_component_calls(kind):
+    from volviz.render.views import component_view_classes
+
+    for cls in component_view_classes(kind):
+        assert cls.kind == kind and isinstance(cls.camera_dependent, bool)
+        for name in ("set_tf", "set_clip", "update", "bounds", "remove"):
+            assert callable(getattr(cls, name, None)), f"{cls.__name__} has no {name}"
+        assert "opacity" in inspect.signature(cls.set_tf).parameters, f"{cls.__name__}.set_tf(tf, opacity)"
+        assert isinstance(getattr(cls, "visible", None), property) or "visible" in cls.__annotations__
+
+
+@pytest.mark.parametrize("backend", ["cpu", "gpu"])
+def test_every_kind_of_component_answers_the_same_calls_through_the_controller(tmp_path, backend):
+    """A volume VTK draws, a PT volume, a volume at a level of detail and isosurfaces in one scene: the controller
+    gives each the same calls (TF, opacity, visibility, clipping, bounds) and each does its own thing with them."""
+    import pyvista as pv
+
+    from conftest import blob_vvz
+    from volviz.iso.clip import ClipPlane, ClipSettings
+    from volviz.regular.lod import LodTree
+    from volviz.render.controller import SceneController
+    from volviz.render.views import ComponentView
+    from volviz.session import CameraState, Component, DatasetRef, Session
+
+    from volviz.model import RegularVolume
+
+    g = np.linspace(-1.0, 1.0, 20)
+    x, y, z = np.meshgrid(g, g, g, indexing="ij")
+    datasets = {"ball": RegularVolume((x * x + y * y + z * z).astype(np.float32), origin=(30.0, 0.0, 0.0)),
+                "blob": LodTree(blob_vvz(tmp_path / "blob.vvz", 24), cache_bytes=8 << 20)}
+    session = Session(datasets=[DatasetRef("ball", "/unused"), DatasetRef("blob", "/unused")],
+                      components=[Component("vol", "volume", "ball"),
+                                  Component("iso", "isosurface", "ball",
+                                            settings={"styles": [{"value": 0.5, "color": [1, 0.5, 0.2],
+                                                                  "opacity": 0.5}]}),
+                                  Component("demo", "demo", settings={"cells_per_edge": 6}),
+                                  Component("blob", "volume", "blob", settings={"budget": 16})],
+                      camera=CameraState((15.0, -80.0, 20.0), (15.0, 0.0, 0.0), (0.0, 0.0, 1.0)))
+    session.render.options.update(backend=backend, scalar_bar=False, axes=False, outline=False)
+    pl = pv.Plotter(off_screen=True, window_size=[96, 72])
+    try:
+        c = SceneController(pl, session, datasets)
+        c.build()
+        kinds = {comp_id: view.kind for comp_id, view in c.views.items()}
+        assert kinds == {"vol": "vtk", "iso": "isosurfaces", "demo": "pt", "blob": "lod"}
+        assert all(isinstance(view, ComponentView) for view in c.views.values())
+        assert c.views["demo"].backend == backend
+        assert set(c.camera_views()) == {"lod:blob", ("pt-order:demo" if backend == "gpu" else "pt:demo")}
+        whole = c.bounds()
+
+        # transfer functions: each view draws the new one (VTK's property, the PT table, the LOD volume's TF)
+        for comp_id in ("vol", "demo", "blob"):
+            tf = c.transfer_function(comp_id).scaled_extinction(2.0)
+            c.set_transfer_function(comp_id, tf)
+        assert c.views["demo"].tf.extinction[-1] == pytest.approx(c.transfer_function("demo").extinction[-1])
+        assert c.views["blob"].tf is not None and c.views["blob"].tf.extinction[-1] == pytest.approx(
+            c.transfer_function("blob").extinction[-1])
+
+        # opacity: a volume's extinction is scaled, the isosurfaces are cut again with the new opacity
+        shown = c.views["iso"].parts
+        c.set_opacity("iso", 0.5)
+        assert c.views["iso"].parts is not shown
+        assert c.views["iso"].parts.shown[0].style.opacity == pytest.approx(0.25)
+        c.set_opacity("demo", 0.5)
+        assert c.views["demo"].tf.extinction[-1] == pytest.approx(0.5 * c.transfer_function("demo").extinction[-1])
+
+        # visibility
+        for comp_id in ("vol", "iso", "demo", "blob"):
+            c.set_visible(comp_id, False)
+            assert not c.views[comp_id].visible
+            c.set_visible(comp_id, True)
+            assert c.views[comp_id].visible
+        assert c.camera_views() and c.lod_volumes()
+
+        # clipping: VTK's props, the GPU PT pass and the LOD volume clip at once; the CPU PT mesh and the isosurfaces
+        # are cut (here, now); the scene's bounds stay the uncut extents
+        half = ClipSettings([ClipPlane((0.0, 0.0, 0.0), (1.0, 0.0, 0.0))])  # keeps x >= 0
+        cut = c.set_clip(half)
+        assert sorted(cut) == (["demo", "iso"] if backend == "cpu" else ["iso"])
+        assert c.views["vol"].prop.GetMapper().GetNumberOfClippingPlanes() == 1
+        assert c.views["blob"].volume.GetMapper().GetNumberOfClippingPlanes() == 1
+        assert c.views["iso"].parts.clip == half.to_dict()
+        if backend == "cpu":
+            assert c.views["demo"].mesh.n_cells < c.views["demo"].whole_mesh.n_cells
+        assert c.bounds() == pytest.approx(whole)
+        c.clear()
+    finally:
+        pl.close()

@@ -201,7 +201,7 @@ def test_bleed_color_gives_transparent_edge_pixels_their_neighbours_color():
 
 
 def test_a_request_is_of_the_mesh_shown_at_begin_though_a_cut_is_shown_meanwhile(scene):
-    """The app shows a clipping's cut while a render or an error estimate of the uncut mesh may still
+    """The app shows a clipping's cut (``show_cut``) while a render or an error estimate of the uncut mesh may still
     run on a worker: both stay of the mesh of their ``begin``. (An estimate that rendered the uncut mesh fast and
     the cut one exactly measured RMSE 51 and switched the table for nothing.)"""
     from volviz.iso.clip import ClipPlane, ClipSettings
@@ -210,9 +210,7 @@ def test_a_request_is_of_the_mesh_shown_at_begin_though_a_cut_is_shown_meanwhile
     request = h.begin()
     whole = h.mesh
     lo, hi = whole.points.min(axis=0), whole.points.max(axis=0)
-    from volviz.render.scene_builder import cut_tetmesh
-
-    h.mesh = cut_tetmesh(whole, ClipSettings([ClipPlane(tuple((lo + hi) / 2), (1.0, 0.0, 0.0))]))
+    h.show_cut(h.cut(ClipSettings([ClipPlane(tuple((lo + hi) / 2), (1.0, 0.0, 0.0))])), True)
     try:
         assert h.mesh is not whole and h.mesh.n_cells < whole.n_cells
         estimate = h.error_estimate(request)
@@ -226,5 +224,5 @@ def test_a_request_is_of_the_mesh_shown_at_begin_though_a_cut_is_shown_meanwhile
         expected = render(whole, TF, request["camera"], request["size"], "pt", depth=request["depth"])
         assert np.array_equal(img, expected)
     finally:
-        h.mesh = whole
+        h.show_cut(whole, True)
         h.update()

@@ -1,7 +1,9 @@
 """A live scene in one plotter: what the app's docks change and what export renders, through one code path.
 
-``SceneController`` owns the mapping from session components to VTK props. Transfer-function edits, visibility,
-opacity and display time update the props in place (no rebuild), so live previews stay cheap. The scene-wide clipping
+``SceneController`` owns one view per shown component (``views``: ``volviz.render.views.ComponentView``, made by
+``volviz.render.scene_builder.install_component``; the natural scene's view under ``"nature"``) and talks to every
+kind through the same calls. Transfer-function edits, visibility, opacity, clipping and display time update the views
+in place (no rebuild), so live previews stay cheap. The scene-wide clipping
 (``session.clip``, ``set_clip``) cuts every prop alike (``volviz.render.clipping``); the isosurfaces' transparency
 mode (``session.render.options["iso_mode"]``: "vtk" = VTK's own 2-pass blend, or one of the modes "2pass", "3pass",
 "4pass", "exact" of the libMini note §4) is chosen per scene. A note mode is drawn by the ``iso_view`` of the backend
@@ -13,14 +15,10 @@ the background).
 from __future__ import annotations
 
 from contextlib import contextmanager
-from typing import TYPE_CHECKING, Any, Iterator, Optional, TypeGuard
+from typing import Any, Iterator, Optional
 
 from volviz.model import TimeSeries
 from volviz.session import CameraState, Component, Session
-
-if TYPE_CHECKING:
-    from volviz.render.lod_volume import LodVolume
-    from volviz.render.pt_view import PTView
 
 
 ISO_MODES = ("vtk", "2pass", "3pass", "4pass", "exact")
@@ -33,24 +31,6 @@ def iso_summary(stats: dict[str, Any]) -> str:
     drawn = stats.get("triangles_drawn")
     drawn_text = "" if drawn is None else f", {drawn:,} drawn"
     return f"{stats['method']}: {stats['triangles']:,} triangles{drawn_text}, {stats['volume_s'] * 1000:.0f} ms"
-
-
-def _is_lod(prop: Any) -> TypeGuard[LodVolume]:
-    from volviz.render.lod_volume import LodVolume
-
-    return isinstance(prop, LodVolume)
-
-
-def _is_pt(prop: Any) -> TypeGuard[PTView]:
-    """A PT volume on either backend (``volviz.render.pt_view``)."""
-    from volviz.render.pt_view import is_pt_view
-
-    return is_pt_view(prop)
-
-
-def _is_cpu_pt(prop: Any) -> bool:
-    """A PT volume whose images volviz renders (``begin`` / ``compute`` / ``finish``); the GPU's VTK draws."""
-    return _is_pt(prop) and prop.backend == "cpu"
 
 
 @contextmanager
@@ -78,12 +58,20 @@ class SceneController:
         self.on_screen = on_screen  # the Qt viewport (kept for callers; both draw the iso-spectrum shader)
         self.session = session
         self.datasets = datasets
-        self.props: dict[str, Any] = {}
+        self.views: dict[str, Any] = {}  # comp id -> its view (``ComponentView``); "nature" -> the natural scene's
         self.iso_view: Any = None         # GLIsoView or IsoOverlay while a mode of the note is on
-        self._vtk_inputs: dict[str, Any] = {}  # uncut inputs of clipped VTK tetrahedral volumes
         self.histograms: dict[str, Any] = {}   # comp id -> (counts, edges) of its data, from ``prepare``
         self.time = 0.0
         self.interpolate_time = True
+
+    @property
+    def props(self) -> dict[str, Any]:
+        """What each view shows by id: volviz's own views themselves (PT, LOD, the natural scene), the VTK prop of
+        the others (a vtkVolume, an actor, an isosurface component's prop assembly)."""
+        return {comp_id: getattr(view, "prop", view) for comp_id, view in self.views.items()}
+
+    def _views_of(self, kind: str) -> dict[str, Any]:
+        return {comp_id: view for comp_id, view in self.views.items() if getattr(view, "kind", "") == kind}
 
     # -- building ---------------------------------------------------------------------------------------------------
     def build(self) -> None:
@@ -112,34 +100,31 @@ class SceneController:
 
         ensure_lights(self.plotter)
         with no_render(self.plotter):  # the caller draws once afterwards
-            self.props = install_scene(self.plotter, self.session, self.datasets, prepared, spectrum=True,
+            self.views = install_scene(self.plotter, self.session, self.datasets, prepared, spectrum=True,
                                        views=views)
             self.plotter.camera_set = True  # install_scene chose the view; PyVista must not re-frame the props
             self.installed_bounds = self.bounds()  # (what the clipping dock starts from)
             self.decorate()
-            if any(_is_pt(p) for p in self.props.values()):
+            if self._views_of("pt"):
                 # VTK fits the clipping range to its own props only: a previous scene's near plane cut through a PT
                 # mesh (a 700k-tetrahedron first frame took minutes instead of 0.3 s)
                 self.plotter.renderer.ResetCameraClippingRange(self.installed_bounds)
-            self._vtk_inputs = {}
             self.histograms = dict(prepared.histograms)
             self.time = prepared.time if prepared.time is not None else 0.0
-            for comp_id, cut in prepared.cut.items():  # PT meshes were cut in ``prepare`` (the GPU clips itself)
-                if _is_cpu_pt(self.props.get(comp_id)):
-                    self.set_pt_mesh(comp_id, cut)
+            for comp_id, cut in prepared.cut.items():  # meshes cut in ``prepare`` (a GPU PT volume clips itself)
+                self._show_prepared_cut(comp_id, cut)
             if self.clip.all_planes():
-                self.apply_clip(update_pt=False, cut_pt=False, isosurfaces=False)
+                self.apply_clip(update=False)
             self.set_iso_mode(self.iso_mode, update=views)
 
     def clear(self) -> None:
         """Remove everything this controller added, including PT overlay renderers, which ``plotter.clear()`` keeps."""
-        for comp_id, prop in self.props.items():
-            if _is_pt(prop) or comp_id == "nature":
-                prop.remove()
+        for view in self.views.values():
+            view.remove()
         if self.iso_view is not None:
             self.iso_view.remove()
             self.iso_view = None
-        self.props = {}
+        self.views = {}
         self.plotter.clear()
 
     def decorate(self) -> None:
@@ -172,25 +157,18 @@ class SceneController:
         return component_transfer_function(self.session, self.component(comp_id))
 
     def set_transfer_function(self, comp_id: str, tf: Any, update: bool = True) -> None:
-        """Store ``tf`` in the session and apply it; a PT volume re-renders only when ``update`` (the app instead
-        renders it in the background: ``pt_volume(comp_id)``, then ``begin`` / ``compute`` / ``finish``)."""
-        from volviz.render.vtk_scene import update_volume_property
-
+        """Store ``tf`` in the session and give it to the component's view; a view that re-makes something for a new
+        TF (a CPU PT volume's image, a LOD volume's block selection) does so now only when ``update`` (the app does it
+        in the background: ``camera_views``, then ``begin`` / ``compute`` / ``finish``)."""
         comp = self.component(comp_id)
         name = comp.transfer_function or comp.id
         self.session.transfer_functions[name] = tf.to_dict()
         comp.transfer_function = name
-        prop = self.props.get(comp_id)
-        if _is_pt(prop):
-            prop.set_tf(tf.scaled_extinction(comp.opacity) if comp.opacity != 1.0 else tf)
+        view = self.views.get(comp_id)
+        if view is not None:
+            view.set_tf(tf, comp.opacity)
             if update:
-                prop.update()
-        elif _is_lod(prop):
-            prop.set_transfer_function(tf)
-            if update:
-                prop.update()             # the selection depends on the TF (transparent blocks, Eq. 2.7)
-        elif prop is not None and prop.IsA("vtkVolume"):
-            update_volume_property(prop.GetProperty(), tf, comp.opacity)
+                view.update()
         from volviz.render.decorations import update_legend
 
         update_legend(self.plotter, self.session, self.datasets)   # the scalar bar shows the new colors and range
@@ -210,30 +188,24 @@ class SceneController:
 
         comp = self.component(comp_id)
         comp.visible = bool(visible)
-        if comp.type in NATURE_TYPES:
+        if comp.type in NATURE_TYPES:  # the natural scene is one view of all its components
             if nature:
                 self.rebuild_nature()
             return
-        prop = self.props.get(comp_id)
-        if prop is None and visible:  # hidden at build time: add it now
+        view = self.views.get(comp_id)
+        if view is None and visible:  # hidden at build time: add it now
             if build:
                 self.install_component(comp_id, self.prepare_component(comp_id), views=True)
             return
-        if comp.type == "isosurface":
-            self._sync_iso_overlay()
-            return
-        if _is_pt(prop):
-            prop.visible = bool(visible)
-        elif _is_lod(prop):
-            prop.volume.SetVisibility(bool(visible))
-        elif prop is not None:
-            prop.SetVisibility(bool(visible))
+        if view is not None:
+            view.visible = bool(visible)
+        self._sync_iso_overlay()
 
     def needs_build(self, comp_id: str) -> bool:
-        """Whether showing the component needs ``prepare_component`` / ``install_component`` (it has no prop yet)."""
+        """Whether showing the component needs ``prepare_component`` / ``install_component`` (it has no view yet)."""
         from volviz.render.scene_builder import NATURE_TYPES
 
-        return self.component(comp_id).type not in NATURE_TYPES and self.props.get(comp_id) is None
+        return self.component(comp_id).type not in NATURE_TYPES and self.views.get(comp_id) is None
 
     def prepare_component(self, comp_id: str, progress: Any = None) -> Any:
         """Any thread: the heavy part of showing a non-nature component that was hidden at build time
@@ -250,50 +222,43 @@ class SceneController:
         return prepared
 
     def install_component(self, comp_id: str, prepared: Any, views: bool = True) -> Any:
-        """GUI thread: add the prop of a ``prepare_component`` result without rendering (a PT volume's image and a
+        """GUI thread: add the view of a ``prepare_component`` result without rendering (a PT volume's image and a
         LOD volume's blocks are drawn now when ``views``; the app updates them in the background)."""
         from volviz.render.scene_builder import install_component
 
         comp = self.component(comp_id)
         with no_render(self.plotter):
-            prop = install_component(self.plotter, self.session, comp, self.datasets, prepared, spectrum=True,
+            view = install_component(self.plotter, self.session, comp, self.datasets, prepared, spectrum=True,
                                      views=views)
-            self.props[comp_id] = prop
+            self.views[comp_id] = view
             self.histograms.update(prepared.histograms)
             if comp_id in prepared.cut:
-                self.set_pt_mesh(comp_id, prepared.cut[comp_id])
-            if comp.type != "isosurface" and self.clip.all_planes():
-                self.apply_clip(update_pt=False, cut_pt=False, isosurfaces=False)
-            if comp.type == "isosurface":
-                self._sync_iso_overlay()
-            elif self.iso_view is not None:
-                self.set_iso_mode(self.iso_mode, update=views)  # a GPU PT volume's pass may rule out exact GL
-        return prop
+                self._show_prepared_cut(comp_id, prepared.cut[comp_id])
+            if self.clip.all_planes():
+                self.apply_clip(update=False)
+            self.set_iso_mode(self.iso_mode, update=views)  # new surfaces, or a GPU PT pass that rules out exact GL
+        return getattr(view, "prop", view)
 
-    def set_opacity(self, comp_id: str, opacity: float, isosurfaces: bool = True) -> None:
-        """Set a component's opacity. An isosurface component's surfaces are re-made here when ``isosurfaces`` (the
-        app re-makes them in the background: ``isosurface_meshes``, ``isosurface_parts``, ``show_isosurfaces``)."""
+    def _show_prepared_cut(self, comp_id: str, cut: Any) -> None:
+        view = self.views.get(comp_id)
+        if view is not None and not view.set_clip(self.clip):
+            view.show_cut(cut, self.component(comp_id).visible)
+
+    def set_opacity(self, comp_id: str, opacity: float, update: bool = True) -> list[str]:
+        """Set a component's opacity (its view's ``set_tf``). What that re-makes (a PT image, a cut of the
+        isosurfaces) is made now when ``update``; otherwise returns the ids whose cut is stale, which the app makes in
+        the background (``cut`` on a worker, then ``show_cut``; images through ``camera_views``)."""
         comp = self.component(comp_id)
         comp.opacity = float(min(max(opacity, 0.0), 1.0))
-        prop = self.props.get(comp_id)
-        if prop is None:
-            return
-        if comp.type == "isosurface":
-            if isosurfaces:
-                self._readd_isosurfaces(comp_id)
-        elif _is_pt(prop):
-            tf = self.transfer_function(comp_id)
-            prop.set_tf(tf.scaled_extinction(comp.opacity) if comp.opacity != 1.0 else tf)
-            prop.update()
-        elif _is_lod(prop):
-            prop.opacity = comp.opacity
-            prop.set_transfer_function(self.transfer_function(comp_id))
-        elif prop.IsA("vtkVolume"):
-            from volviz.render.vtk_scene import update_volume_property
-
-            update_volume_property(prop.GetProperty(), self.transfer_function(comp_id), comp.opacity)
-        else:
-            prop.GetProperty().SetOpacity(comp.opacity)
+        view = self.views.get(comp_id)
+        if view is None:
+            return []
+        view.set_tf(self.transfer_function(comp_id), comp.opacity)
+        if update:
+            view.update()
+        self._sync_iso_overlay()
+        stale = getattr(view, "stale", None)
+        return [comp_id] if stale is not None and stale() else []
 
     # -- time -------------------------------------------------------------------------------------------------------
     def time_series(self) -> dict[str, TimeSeries]:
@@ -326,26 +291,21 @@ class SceneController:
         if interpolate is not None:
             self.interpolate_time = bool(interpolate)
         self.time = float(t)
-        for comp_id, series in self.time_series().items():
-            prop = self.props.get(comp_id)
-            if prop is None:
-                continue
+        for comp_id in self.time_isosurfaces():  # re-extract at the new time (the 4D blend happens in prepare)
             comp = self.component(comp_id)
-            if comp.type == "isosurface":  # re-extract at the new time (the 4D blend happens in prepare)
-                comp.settings = {**comp.settings, "interpolate": self.interpolate_time}
-                if isosurfaces:
-                    self.show_isosurfaces({comp_id: self.extract_isosurfaces(comp_id, self.time)})
-            elif prop.IsA("vtkVolume") and volumes:
-                self.show_volumes({comp_id: self.blend_volume(comp_id, self.time)})
+            comp.settings = {**comp.settings, "interpolate": self.interpolate_time}
+            if isosurfaces:
+                self.show_isosurfaces({comp_id: self.extract_isosurfaces(comp_id, self.time)})
+        if volumes:
+            self.show_volumes({comp_id: self.blend_volume(comp_id, self.time) for comp_id in self.time_volumes()})
         self._sync_iso_overlay()
         if update and self.iso_overlay is not None:
             self.iso_overlay.update()
 
     def time_volumes(self) -> list[str]:
         """The VTK volumes shown from a time series (what a display-time change re-blends)."""
-        return [comp_id for comp_id in self.time_series()
-                if self.component(comp_id).type != "isosurface" and self.props.get(comp_id) is not None
-                and self.props[comp_id].IsA("vtkVolume")]
+        views = self._views_of("vtk")
+        return [comp_id for comp_id in self.time_series() if comp_id in views and views[comp_id].prop.IsA("vtkVolume")]
 
     def blend_volume(self, comp_id: str, t: float, interpolate: Optional[bool] = None, progress: Any = None) -> Any:
         """Any thread: the VTK input of a time-series volume at display time ``t`` (the 4D blend of the neighbouring
@@ -357,22 +317,15 @@ class SceneController:
 
     def show_volumes(self, inputs: dict[str, Any]) -> None:
         """GUI thread: give time-series volumes new inputs (``comp_id → blend_volume(...)``), cut by the clipping."""
-        from volviz.render.clipping import clip_vtk_prop
-
         for comp_id, data in inputs.items():
-            prop = self.props.get(comp_id)
-            if prop is None or data is None:
-                continue
-            self._vtk_inputs.pop(comp_id, None)
-            prop.GetMapper().SetInputData(data)
-            if self.clip.all_planes():
-                self._vtk_inputs[comp_id] = clip_vtk_prop(prop, self.clip)
+            view = self.views.get(comp_id)
+            if view is not None and data is not None:
+                view.set_input(data, self.clip)
 
     def time_isosurfaces(self) -> list[str]:
         """The isosurface components shown from a time series (what a display-time change re-extracts)."""
-        series = self.time_series()
-        return [comp_id for comp_id in series
-                if self.props.get(comp_id) is not None and self.component(comp_id).type == "isosurface"]
+        views = self._views_of("isosurfaces")
+        return [comp_id for comp_id in self.time_series() if comp_id in views]
 
     def extract_isosurfaces(self, comp_id: str, t: float, interpolate: Optional[bool] = None,
                             progress: Any = None) -> list[Any]:
@@ -405,20 +358,18 @@ class SceneController:
         ``extract_isosurfaces``, or better the ``isosurface_parts``, whose clipping and LOD chains were made off this
         thread and are redone here only when the clipping or opacity changed since); the overlay's meshes follow
         (not re-rendered)."""
-        from volviz.render.scene_builder import IsoParts, add_isosurface_actors, isosurface_parts
+        from volviz.render.scene_builder import IsoParts
 
         with no_render(self.plotter):  # no render per added actor: the caller draws once afterwards
             for comp_id, surfaces in meshes.items():
-                prop = self.props.get(comp_id)
-                if prop is None:
+                view = self.views.get(comp_id)
+                if view is None:
                     continue
                 comp = self.component(comp_id)
                 parts = surfaces if isinstance(surfaces, IsoParts) else None
                 if parts is None or parts.clip != self.clip.to_dict() or parts.opacity != comp.opacity:
-                    parts = isosurface_parts(comp, meshes=list(parts.meshes if parts else surfaces),
-                                             clip=self.session.clip)
-                self.plotter.remove_actor(prop, render=False)
-                self.props[comp_id] = add_isosurface_actors(self.plotter, comp_id, parts)
+                    parts = view.cut(self.clip, meshes=list(parts.meshes if parts else surfaces))
+                view.show(parts)
         self._sync_iso_overlay()
 
     # -- camera -----------------------------------------------------------------------------------------------------
@@ -445,45 +396,52 @@ class SceneController:
     # -- view-dependent parts (terrain LOD, fog and cloud images) ---------------------------------------------------
     @property
     def nature(self) -> Any:
-        return self.props.get("nature")
+        return self.views.get("nature")
+
+    def camera_views(self) -> dict[str, Any]:
+        """The shown views that re-make something for a new camera (``volviz.render.views.View``: ``begin`` /
+        ``compute`` / ``finish``), by the key of their updates (``view.job[0]``, with the component's id): the natural
+        scene, volumes at a level of detail, PT volumes (a CPU volume's image, a GPU volume's visibility order) and
+        the isosurfaces' CPU overlay, in this order (the later ones read the opaque scene's depth)."""
+        out: dict[str, Any] = {}
+        if self.nature is not None:
+            out[self.nature.job[0]] = self.nature
+        for kind in ("lod", "pt"):
+            for comp_id, view in self._views_of(kind).items():
+                if self.component(comp_id).visible:   # (a CPU image is not drawn before its first update)
+                    out[f"{view.job[0]}:{comp_id}"] = view
+        if self.iso_overlay is not None:
+            out[self.iso_overlay.job[0]] = self.iso_overlay
+        return out
 
     def update_views(self, pt: bool = True, nature: bool = True, lod: bool = True) -> dict[str, Any]:
-        """Re-run what depends on the camera (C-LOD terrain, fog and clouds unless ``nature`` is false, PT volumes
-        unless ``pt`` is false, volumes at a level of detail unless ``lod`` is false, for callers that do those in
-        the background: ``nature.begin`` / ``compute`` / ``finish``, ``lod_volumes`` ``select`` / ``decode`` /
-        ``show``); returns their statistics."""
+        """Re-make what depends on the camera now (``update`` of each of ``camera_views``; the natural scene unless
+        ``nature`` is false, PT volumes and the isosurface view unless ``pt`` is false, volumes at a level of detail
+        unless ``lod`` is false: for callers that do those in the background); returns their statistics."""
+        skip = {kind for kind, on in (("nature", nature), ("pt", pt), ("iso", pt), ("lod", lod)) if not on}
         stats: dict[str, Any] = {}
-        if nature and self.nature is not None:
-            stats.update(self.nature.update())
-        for comp_id, prop in self.props.items():
-            if pt and _is_pt(prop) and prop.visible:
-                prop.update()
-                stats[comp_id] = dict(prop.stats)
-            elif lod and _is_lod(prop) and prop.volume.GetVisibility():
-                stats[comp_id] = dict(prop.update())
-        if pt and self.iso_view is not None:
-            self.iso_view.update()
-            stats["iso"] = dict(self.iso_view.stats)
+        views = {key.split(":", 1)[-1]: view for key, view in self.camera_views().items() if view.kind != "iso"}
+        if self.iso_view is not None:
+            views["iso"] = self.iso_view  # the CPU overlay's image, or only the GPU passes' statistics
+        for key, view in views.items():
+            if view.kind in skip:
+                continue
+            result = view.update()
+            if view.kind == "nature":
+                stats.update(result)
+            else:
+                stats[key] = dict(view.stats)
         return stats
 
     def begin_views(self, stage: int) -> list[tuple[str, Any, Any]]:
         """GUI thread: the requests of the view-dependent parts for the current camera, in two stages because the
         PT volumes and the isosurfaces' CPU mode read the opaque scene's depth: stage 0 the natural scene and the
-        volumes at a level of detail, stage 1 (after stage 0 is finished) the PT volumes and the iso overlay. Then
-        ``compute_views`` (any thread) and ``finish_views`` (GUI thread); ``update_views`` does all three here."""
-        requests: list[tuple[str, Any, Any]] = []
-        if stage == 0:
-            if self.nature is not None:
-                requests.append(("nature", self.nature, self.nature.begin()))
-            for volume in self.lod_volumes().values():
-                requests.append(("lod", volume, volume.begin()))
-            return requests
-        for prop in self.props.values():
-            if _is_cpu_pt(prop) and prop.visible:
-                requests.append(("overlay", prop, prop.begin()))
-        if self.iso_overlay is not None:
-            requests.append(("overlay", self.iso_overlay, self.iso_overlay.begin()))
-        return requests
+        volumes at a level of detail, stage 1 (after stage 0 is finished) the CPU images of PT volumes and the iso
+        overlay (a GPU PT volume sorts in VTK's render). Then ``compute_views`` (any thread) and ``finish_views``
+        (GUI thread); ``update_views`` does all three here."""
+        first = ("nature", "lod")
+        return [(key, view, view.begin()) for key, view in self.camera_views().items()
+                if (view.kind in first) == (stage == 0) and (stage == 0 or view.backend == "cpu")]
 
     @staticmethod
     def compute_views(requests: list[tuple[str, Any, Any]], progress: Any = None) -> list[Any]:
@@ -507,28 +465,27 @@ class SceneController:
 
     def lod_volumes(self) -> dict[str, Any]:
         """The visible volumes drawn at a level of detail (``volviz.render.lod_volume.LodVolume``) by component."""
-        return {comp_id: prop for comp_id, prop in self.props.items()
-                if _is_lod(prop) and prop.volume.GetVisibility()}
+        return {comp_id: view for comp_id, view in self._views_of("lod").items() if view.visible}
 
     def pt_volume(self, comp_id: str) -> Any:
         """The PT volume of a component whose images volviz renders (the CPU backend: ``begin`` / ``compute`` /
         ``finish``), or None when VTK draws it (the GPU backend, or VTK's own mappers)."""
-        prop = self.props.get(comp_id)
-        return prop if _is_cpu_pt(prop) else None
+        view = self._views_of("pt").get(comp_id)
+        return view if view is not None and view.backend == "cpu" else None
 
     def gl_pt_volume(self, comp_id: str) -> Any:
         """The GPU PT volume of a component (VTK draws it; its visibility order can be made on a worker:
         ``begin`` / ``compute`` / ``finish``), or None."""
-        prop = self.props.get(comp_id)
-        return prop if _is_pt(prop) and prop.backend == "gpu" else None
+        view = self._views_of("pt").get(comp_id)
+        return view if view is not None and view.backend == "gpu" else None
 
     def pt_stats(self) -> dict[str, Any]:
         """The last frame statistics of every PT volume (sort / project / raster seconds, fragments, method)."""
-        return {comp_id: dict(prop.stats) for comp_id, prop in self.props.items() if _is_pt(prop)}
+        return {comp_id: dict(view.stats) for comp_id, view in self._views_of("pt").items()}
 
     def pt_backends(self) -> dict[str, str]:
         """The backend ("gpu" or "cpu") of every PT volume (``volviz.render.backend``)."""
-        return {comp_id: prop.backend for comp_id, prop in self.props.items() if _is_pt(prop)}
+        return {comp_id: view.backend for comp_id, view in self._views_of("pt").items()}
 
     def rebuild_nature(self) -> None:
         """Rebuild the natural scene for the visible nature components now (``prepare_nature``, ``install_nature``)."""
@@ -545,7 +502,7 @@ class SceneController:
         the old terrain and overlay stay on screen until the new view's first ``finish_nature`` replaces them."""
         from volviz.render.scene_builder import install_nature, view_backend
 
-        old = self.props.pop("nature", None)
+        old = self.views.pop("nature", None)
         backend = view_backend(self.plotter, self.session, "nature")
         if old is not None and "gpu" in (old.backend, backend):
             old.remove()   # the GL layers go with their view (float targets, observers)
@@ -554,7 +511,7 @@ class SceneController:
             self.plotter.remove_actor(name, render=False)
         view = install_nature(self.plotter, scene, views, backend)  # adds its actors with ``render=False``
         if view is not None:
-            self.props["nature"] = view
+            self.views["nature"] = view
         if self.iso_view is not None:
             with no_render(self.plotter):
                 self.set_iso_mode(self.iso_mode, update=views)  # the GPU scene's pass may rule out exact GL
@@ -570,19 +527,11 @@ class SceneController:
         """(xmin, xmax, ymin, ymax, zmin, zmax) of everything the visible components show, including what VTK does
         not see (PT volumes, isosurfaces drawn by a CPU mode, the natural scene's terrain and clouds; not the sky
         dome around the eye); uncut extents."""
-        from volviz.render.framing import points_bounds, prop_bounds, union
+        from volviz.render.framing import union
 
-        boxes = []
-        for comp_id, prop in self.shown_props().items():
-            if _is_pt(prop):
-                boxes.append(prop.bounds())
-            elif comp_id in self._iso_props():
-                boxes += [points_bounds(m.points) for m in prop.volviz_meshes if len(m.points)]
-            else:
-                box = prop_bounds(prop)
-                if box is not None:
-                    boxes.append(box)
-        return union(boxes) or (-1.0, 1.0, -1.0, 1.0, -1.0, 1.0)
+        visible = {c.id for c in self.session.components if c.visible}
+        boxes = [view.bounds() for comp_id, view in self.views.items() if comp_id == "nature" or comp_id in visible]
+        return union([box for box in boxes if box is not None]) or (-1.0, 1.0, -1.0, 1.0, -1.0, 1.0)
 
     # -- clipping (scene-wide) --------------------------------------------------------------------------------------
     @property
@@ -591,79 +540,46 @@ class SceneController:
 
         return clip_settings(self.session.clip)
 
-    def set_clip(self, clip: Any, update_pt: bool = True, cut_pt: bool = True,
-                 isosurfaces: bool = True) -> list[str]:
-        """Store new clipping (``session.clip`` JSON or ClipSettings) and cut every prop; returns the ids of the PT
-        volumes drawn from a cut mesh (CPU backend; a GPU volume clips per fragment, at once). Their meshes are cut here
-        when ``cut_pt`` and re-rendered when ``update_pt``; the app instead cuts them in the background (``cut_pt_mesh``
-        on a worker, then ``set_pt_mesh``) and re-renders.
-        Isosurfaces are re-cut here when ``isosurfaces``; the app instead cuts them in the background
-        (``isosurface_meshes``, ``volviz.render.scene_builder.isosurface_parts`` on a worker, ``show_isosurfaces``)."""
+    def set_clip(self, clip: Any, update: bool = True) -> list[str]:
+        """Store new clipping (``session.clip`` JSON or ClipSettings) and give it to every view (``apply_clip``);
+        returns the ids of the views drawn from a cut made on the CPU (a CPU PT volume's mesh, an isosurface
+        component's surfaces), which are cut and re-made here when ``update``; the app instead cuts them in the
+        background (``cut`` on a worker, then ``show_cut``) and re-renders."""
         from volviz.iso.clip import ClipSettings
 
         self.session.clip = clip.to_dict() if isinstance(clip, ClipSettings) else self.clip.from_dict(clip).to_dict()
-        return self.apply_clip(update_pt, cut_pt, isosurfaces)
+        return self.apply_clip(update)
 
-    def isosurface_meshes(self) -> dict[str, list[Any]]:
-        """The extracted (uncut) surfaces of every shown isosurface component, for re-cutting them elsewhere."""
-        return {comp_id: list(prop.volviz_meshes) for comp_id, prop in self._iso_props().items()}
-
-    def apply_clip(self, update_pt: bool = True, cut_pt: bool = True, isosurfaces: bool = True) -> list[str]:
-        """Cut every prop by the session's clipping (isosurfaces only when ``isosurfaces``: ``install`` gets them
-        cut by ``prepare``); returns the ids of the PT volumes drawn from a cut mesh (the CPU backend; see
-        ``set_clip``)."""
-        from volviz.render.clipping import clip_vtk_prop
-
+    def apply_clip(self, update: bool = True) -> list[str]:
+        """Give the session's clipping to every view (``set_clip``: VTK's mapper planes, a GPU PT volume's
+        per-fragment planes at once); returns the ids of those drawn from a CPU cut, which are cut now when
+        ``update`` (see ``set_clip``)."""
         clip = self.clip
-        pt_ids = []
-        for comp_id, prop in list(self.props.items()):
-            if comp_id == "nature":
+        pending = []
+        for comp_id, view in self.views.items():
+            if comp_id == "nature" or view.set_clip(clip):
                 continue
-            comp = self.component(comp_id)
-            if comp.type == "isosurface":
-                if isosurfaces:
-                    self._readd_isosurfaces(comp_id)
-            elif _is_pt(prop):
-                if prop.set_clip(clip):        # the GPU clips per fragment; the CPU draws a cut mesh
-                    continue
-                pt_ids.append(comp_id)
-                if cut_pt:
-                    self.set_pt_mesh(comp_id, self.cut_pt_mesh(comp_id))
-                    if update_pt and prop.visible:
-                        prop.update()
-            elif _is_lod(prop):
-                clip_vtk_prop(prop.volume, clip)       # mapper clipping planes, blocks untouched
-            elif hasattr(prop, "GetMapper"):
-                self._vtk_inputs[comp_id] = clip_vtk_prop(prop, clip, self._vtk_inputs.get(comp_id))
+            pending.append(comp_id)
+            if update:
+                self.show_cut(comp_id, self.cut(comp_id, clip))
+                if view.camera_dependent and view.visible:
+                    view.update()
         self._sync_iso_overlay()
         self.plotter.render()
-        return pt_ids
+        return pending
 
-    def cut_pt_mesh(self, comp_id: str, clip: Any = None, progress: Any = None) -> Any:
-        """Any thread: the PT volume's uncut mesh cut by ``clip`` (default: the session's), exactly
-        (``volviz.iso.clip.clip_tetmesh``), with its topology built; None when the clipping removes all of it."""
-        from volviz.render.scene_builder import cut_tetmesh
+    def cut(self, comp_id: str, clip: Any = None, progress: Any = None) -> Any:
+        """Any thread: the component's data cut by ``clip`` (default: the session's) as its view draws it (the
+        view's ``cut``: the exact cut of a PT volume's tetrahedra, ``volviz.iso.clip.clip_tetmesh``; the isosurfaces'
+        triangles, ``clip_isosurfaces``, scaled by the opacity, with their LOD chains)."""
+        return self.views[comp_id].cut(self.clip if clip is None else clip)
 
-        return cut_tetmesh(self.props[comp_id].whole_mesh, self.clip if clip is None else clip)
-
-    def set_pt_mesh(self, comp_id: str, mesh: Any) -> None:
-        """Show a cut mesh of ``cut_pt_mesh`` (None: nothing left, the volume is hidden); re-render it afterwards."""
-        prop = self.props[comp_id]
-        if mesh is None:
-            prop.visible = False
-            return
-        prop.mesh = mesh
-        prop.visible = self.component(comp_id).visible
-
-    def _readd_isosurfaces(self, comp_id: str) -> None:
-        """New actors for an isosurface component's already extracted surfaces (after a clip or opacity change)."""
-        from volviz.render.scene_builder import add_isosurfaces
-
-        prop = self.props[comp_id]
-        self.plotter.remove_actor(prop, render=False)
-        self.props[comp_id] = add_isosurfaces(self.plotter, self.component(comp_id), None, clip=self.session.clip,
-                                              meshes=prop.volviz_meshes)
-        self._sync_iso_overlay()
+    def show_cut(self, comp_id: str, cut: Any) -> None:
+        """GUI thread: show a ``cut`` (not rendered; a CPU PT volume's image is re-made afterwards)."""
+        view = self.views.get(comp_id)
+        if view is not None:
+            view.show_cut(cut, self.component(comp_id).visible)
+            self._sync_iso_overlay()
 
     # -- isosurface transparency mode (per scene) -------------------------------------------------------------------
     @property
@@ -719,8 +635,7 @@ class SceneController:
             self.plotter.render()
 
     def _iso_props(self) -> dict[str, Any]:
-        return {comp_id: prop for comp_id, prop in self.props.items()
-                if comp_id != "nature" and self.component(comp_id).type == "isosurface"}
+        return {comp_id: view.prop for comp_id, view in self._views_of("isosurfaces").items()}
 
     def _sync_iso_overlay(self) -> None:
         """In a mode of the note the iso view (either backend) draws the visible components' translucent surfaces;

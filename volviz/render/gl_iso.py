@@ -338,6 +338,7 @@ class GLIsoView(IsoModeView):
     ``triangles_drawn`` (per frame: once per pass for 2/3/4-pass; None for exact, whose number of peeled layers VTK
     does not report), ``volume_s`` (the renderer's last frame, the passes and the rest of the scene) and ``size``."""
 
+    kind = "iso"
     backend = "gpu"
 
     def __init__(self, plotter: Any, meshes: Sequence[IsoMesh] = (), mode: str = "3pass",

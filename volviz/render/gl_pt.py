@@ -251,6 +251,7 @@ class GLPTVolume(PTView):
     shown)."""
 
     backend = "gpu"
+    job = ("pt-order", "visibility order")   # the app's key for its updates, and what its worker makes
 
     def __init__(self, plotter: Any, mesh: TetMesh, tf: Any, *, lookup: str = "3d", n_s: int | None = None,
                  n_l: int = 64, degree: int | None = None, sort: str = "mpvo", nonconvex: str = "auto",
@@ -412,7 +413,9 @@ class GLPTVolume(PTView):
 
     def begin(self, scale: int = 1) -> dict[str, Any]:
         """GUI thread: the order to make next, for the renderer's camera and size now (``scale`` > 1: asked for
-        during an interaction; the order is the same)."""
+        during an interaction; the order is the same). A caller that makes the orders on a worker from now on
+        (``compute``) keeps them off the GUI thread: renders reuse the newest order (``reuse_order``)."""
+        self.reuse_order = True
         cam = self._camera()
         size = window_size(self.renderer)
         key = _order_key(cam, size)
@@ -701,10 +704,10 @@ class GLPTVolume(PTView):
             program.SetUniform3f("kappaMax", [float(x) for x in table.kappa_max])
 
     # --- public --------------------------------------------------------------------------------------------------
-    def set_tf(self, tf: Any) -> None:
-        """A new transfer function: the table texture is rebuilt at the next render and the zero-opacity culling
-        follows it (a new index buffer from the same visibility order: the sort does not depend on the TF; the
-        vertex buffer stays)."""
+    def _use_tf(self, tf: Any) -> None:
+        """A new transfer function (``set_tf``): the table texture is rebuilt at the next render and the
+        zero-opacity culling follows it (a new index buffer from the same visibility order: the sort does not depend
+        on the TF; the vertex buffer stays)."""
         self.tf = tf
         self._vis = self._visible()
         self._table_dirty = True

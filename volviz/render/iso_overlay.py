@@ -71,7 +71,9 @@ class IsoModeView:
 class IsoOverlay(OverlayView, IsoModeView):
     """The isosurfaces of a scene drawn by one of the CPU transparency modes as a depth-composited overlay."""
 
+    kind = "iso"
     backend = "cpu"
+    job = ("iso-overlay", "isosurfaces")  # the app's key for its updates, and what its worker makes
 
     def __init__(self, plotter: Any, meshes: Sequence[IsoMesh] = (), mode: str = "3pass",
                  shading: str = "spectrum") -> None:

@@ -166,6 +166,41 @@ class LodVolume:
         if self._overlay is not None:
             self._overlay.renderer.SetDraw(bool(self.volume.GetVisibility()) and self.image is not None)
 
+    kind = "lod"
+    job = ("lod", "level of detail")  # the app's key for its updates, and what its worker makes
+    coarse_first = True  # a settled camera first shows a coarse selection (``begin(scale=2)``), then the full one
+    while_moving = False  # VTK draws the selected blocks for any camera: nothing to re-make while it moves
+    camera_dependent = True
+
+    @property
+    def prop(self) -> LodVolume:
+        return self
+
+    @property
+    def visible(self) -> bool:
+        return bool(self.volume.GetVisibility())
+
+    @visible.setter
+    def visible(self, on: bool) -> None:
+        self.volume.SetVisibility(bool(on))
+
+    def set_tf(self, tf: Any, opacity: float = 1.0) -> None:
+        """A new TF and opacity (``volviz.render.views.ComponentView``): the current selection is drawn again; the
+        caller re-selects (``update``, or ``begin`` / ``compute`` / ``finish``: the selection depends on the TF)."""
+        self.opacity = float(opacity)
+        self.set_transfer_function(tf)
+
+    def set_clip(self, clip: Any) -> bool:
+        """The mapper's clipping planes, which the ray caster reads at the next selection's draw (True: nothing for
+        the caller to cut)."""
+        from volviz.render.clipping import clip_vtk_prop
+
+        clip_vtk_prop(self.volume, clip)
+        return True
+
+    def bounds(self) -> tuple[float, float, float, float, float, float]:
+        return lod_bounds(self.tree)
+
     def set_transfer_function(self, tf: Any) -> None:
         """A new TF (and the current ``opacity``); with our renderer the current selection is drawn again."""
         self.tf = tf

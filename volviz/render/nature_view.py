@@ -21,7 +21,16 @@ class NatureView:
     """A ``NatureScene`` inside a PyVista plotter: terrain mesh, sky dome and the volume overlay (see module doc).
     The CPU backend of the natural-scene view; ``volviz.render.gl_nature.GLNatureView`` is the GPU one."""
 
+    kind = "nature"
     backend = "cpu"
+    job = ("nature", "natural scene")  # the app's key for its updates, and what its worker makes
+    camera_dependent = True
+
+    def bounds(self) -> Any:
+        """The terrain's and the clouds' box (``volviz.render.framing.nature_bounds``; not the sky dome's)."""
+        from volviz.render.framing import nature_bounds
+
+        return nature_bounds(self.scene)
 
     def __init__(self, plotter: Any, scene: NatureScene, size: tuple[int, int] | None = None,
                  filter_texture: bool | None = None) -> None:

@@ -47,6 +47,7 @@ class PTVolume(OverlayView, PTView):
     interface ``volviz.render.pt_view.PTView``; ``mesh`` is what is drawn (a cut of ``whole_mesh`` under clipping)."""
 
     backend = "cpu"
+    job = ("pt", "volume")   # the app's key for its updates, and what its worker makes (an image)
 
     def __init__(self, plotter: Any, mesh: Any, tf: Any, method: str = "pt", **render_opts: Any) -> None:
         scalars = render_opts.pop("scalars", None)
@@ -136,13 +137,13 @@ class PTVolume(OverlayView, PTView):
         self.stats.update(method=self.method, sort_prefetched=bool(st.extra.get("sort_prefetched", False)))
         return img
 
-    def set_tf(self, tf: Any) -> None:
+    def _use_tf(self, tf: Any) -> None:
         """A new transfer function for the next image (``update``, or ``begin`` / ``compute`` / ``finish``)."""
         self.tf = tf
 
     def set_clip(self, clip: Any) -> bool:
         """Clipping is not done here: the caller shows an exact cut of ``whole_mesh`` as ``mesh``
-        (``volviz.render.scene_builder.cut_tetmesh``, ``SceneController.set_pt_mesh``); returns False
+        (``cut``, ``show_cut``); returns False
         (``PTView.set_clip``)."""
         return False
 

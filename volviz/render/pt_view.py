@@ -13,22 +13,48 @@ __all__ = ["PTView", "is_pt_view"]
 
 
 class PTView:
-    """What both PT volumes offer. Attributes: ``backend`` ("gpu" or "cpu"), ``mesh`` (the TetMesh drawn),
-    ``whole_mesh`` (uncut), ``tf``, ``stats`` (the last frame's: ``method``, ``sort_s``, ...), ``visible``."""
+    """What both PT volumes offer (the calls of ``volviz.render.views.View`` and ``ComponentView``). Attributes:
+    ``backend`` ("gpu" or "cpu"), ``mesh`` (the TetMesh drawn), ``whole_mesh`` (uncut), ``tf``, ``stats`` (the last
+    frame's: ``method``, ``sort_s``, ...), ``visible``."""
 
+    kind = "pt"
+    camera_dependent = True
     backend = ""
+    mesh: Any
     whole_mesh: Any
     stats: dict[str, Any]
     visible: bool
 
-    def set_tf(self, tf: Any) -> None:
-        """Draw with a new transfer function from the next frame on."""
+    @property
+    def prop(self) -> PTView:
+        return self
+
+    def set_tf(self, tf: Any, opacity: float = 1.0) -> None:
+        """Draw with a new transfer function from the next frame on; ``opacity`` scales its extinction."""
+        self._use_tf(tf.scaled_extinction(opacity) if opacity != 1.0 else tf)
+
+    def _use_tf(self, tf: Any) -> None:
         raise NotImplementedError
 
     def set_clip(self, clip: Any) -> bool:
         """Clip by ``volviz.iso.clip.ClipSettings``. True: done; False: this view clips only by drawing a cut mesh,
-        which the caller makes (``volviz.render.scene_builder.cut_tetmesh``) and sets as ``mesh``."""
+        which the caller makes (``cut`` on any thread) and shows (``show_cut``)."""
         raise NotImplementedError
+
+    def cut(self, clip: Any, progress: Any = None) -> Any:
+        """Any thread: the uncut mesh cut by ``clip`` exactly (``volviz.iso.clip.clip_tetmesh``), with its topology
+        built; None when the clipping removes all of it."""
+        from volviz.render.scene_builder import cut_tetmesh
+
+        return cut_tetmesh(self.whole_mesh, clip)
+
+    def show_cut(self, mesh: Any, visible: bool = True) -> None:
+        """Draw a ``cut`` from the next frame on (None: nothing left, the volume is hidden); re-render it after."""
+        if mesh is None:
+            self.visible = False
+            return
+        self.mesh = mesh
+        self.visible = visible
 
     def update(self) -> Any:
         """Make the view current for the plotter's camera and scene now."""

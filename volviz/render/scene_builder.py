@@ -388,11 +388,11 @@ def install_nature(plotter: Any, scene: Any, views: bool = True, backend: str = 
 
 def install_scene(plotter: Any, session: Session, datasets: dict[str, Any], prepared: PreparedScene,
                   spectrum: bool = True, views: bool = True) -> dict[str, Any]:
-    """GUI thread: add the props of a ``prepare_scene`` result to ``plotter``; returns the VTK prop of each
-    component by id, and under ``"nature"`` the NatureView that draws the terrain, fog, clouds and sky components
-    together. The view-dependent parts (PT volume images, LOD block selections, the natural scene's terrain and
-    overlay) are drawn now when ``views``; otherwise they stay empty until the caller updates them (the app does
-    that in the background)."""
+    """GUI thread: add the props of a ``prepare_scene`` result to ``plotter``; returns the view of each component by
+    id (``install_component``), and under ``"nature"`` the NatureView that draws the terrain, fog, clouds and sky
+    components together. The view-dependent parts (PT volume images, LOD block selections, the natural scene's
+    terrain and overlay) are drawn now when ``views``; otherwise they stay empty until the caller updates them (the
+    app does that in the background)."""
     from volviz.render.vtk_scene import apply_camera
 
     props: dict[str, Any] = {}
@@ -411,10 +411,10 @@ def install_scene(plotter: Any, session: Session, datasets: dict[str, Any], prep
     plotter.set_background(session.render.background)
     if session.camera is None:  # framed on every component before the view-dependent parts are drawn
         from volviz.render.decorations import legend_margin
-        from volviz.render.framing import frame_bounds, nature_bounds, points_bounds, prop_bounds, union
+        from volviz.render.framing import frame_bounds, nature_bounds, points_bounds, union
         from volviz.render.lod_volume import lod_bounds
 
-        boxes = [prop_bounds(p) for p in props.values()] + [points_bounds(m.points) for _, m in pt_components]
+        boxes = [view.bounds() for view in props.values()] + [points_bounds(m.points) for _, m in pt_components]
         boxes += [lod_bounds(d) for _, d in lod_components]
         if prepared.nature is not None:
             boxes.append(nature_bounds(prepared.nature))
@@ -431,18 +431,22 @@ def install_scene(plotter: Any, session: Session, datasets: dict[str, Any], prep
 
 def install_component(plotter: Any, session: Session, comp: Component, datasets: dict[str, Any],
                       prepared: PreparedScene, spectrum: bool = True, views: bool = True) -> Any:
-    """GUI thread: add the prop of one non-nature component from its ``prepare_component`` result; a PT volume's
-    image and a LOD volume's blocks are drawn now when ``views`` (else the caller updates them in the background)."""
+    """GUI thread: add one non-nature component from its ``prepare_component`` result; returns its view
+    (``volviz.render.views.ComponentView``: a PT volume, a LOD volume, its isosurfaces, or a VTK prop's view). A PT
+    volume's image and a LOD volume's blocks are drawn now when ``views`` (else the caller updates them in the
+    background)."""
+    from volviz.render.component_views import IsoSurfacesView, VtkPropView
+
     dataset = component_dataset(comp, datasets)
     if comp.type == "isosurface":
-        return add_isosurface_actors(plotter, comp.id, prepared.parts[comp.id], spectrum=spectrum)
+        return IsoSurfacesView(plotter, comp, prepared.parts[comp.id], spectrum=spectrum)
     if is_lod(dataset):
         return add_lod_component(plotter, session, comp, dataset, update=views)
     if uses_pt(session, dataset):
         return add_pt_component(plotter, session, comp, prepared.parts[comp.id], update=views)
     tf = component_transfer_function(session, comp)
-    return add_volume_prop(plotter, dataset, prepared.parts.get(comp.id), tf, comp.opacity, comp.id,
-                           backend_setting(session.render.options))
+    return VtkPropView(add_volume_prop(plotter, dataset, prepared.parts.get(comp.id), tf, comp.opacity, comp.id,
+                                       backend_setting(session.render.options)))
 
 
 def build_scene(plotter: Any, session: Session, datasets: dict[str, Any], spectrum: bool = True) -> dict[str, Any]:

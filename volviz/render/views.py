@@ -7,15 +7,24 @@ to make for the plotter's camera now; ``scale`` > 1 asks for a preview while the
 on any thread (the CPU work: an image, a mesh, a visibility order, blocks), ``finish(request, *result)`` on the GUI
 thread (hand it to VTK; the caller renders once), and ``remove()``. A GPU view's ``compute`` does only the part the
 CPU must do (the GL PT pass: the visibility order; the GL natural scene: LOD selection and vertex buffers); VTK draws
-it at every render. ``SceneController`` updates all of them through these calls (``begin_views``, ``compute_views``,
-``finish_views``), and the app runs ``compute`` in its background jobs.
+it at every render. ``SceneController`` updates all of them through these calls (``camera_views``, ``begin_views``,
+``compute_views``, ``finish_views``), and the app runs ``compute`` in its background jobs. ``job`` is the key of a
+view's updates and what its worker makes ("visibility order", "volume", ...); a view may ask for a coarse update
+first (``coarse_first``) or for none while the camera moves (``while_moving = False``).
+
+Every shown component has a view (``ComponentView``) the controller talks to through the same calls, whatever its
+kind: ``set_tf(tf, opacity)``, ``visible``, ``set_clip(clip)`` (True: clipped at once; False: drawn from a cut the
+caller makes, ``cut(clip)`` on any thread and ``show_cut(cut, visible)`` on the GUI thread), ``update()``,
+``bounds()``, ``stats`` and ``remove()``; ``prop`` is what it adds to VTK. The PT and LOD views are also camera
+views (``camera_dependent``); a component that VTK draws with its own props has a view of
+``volviz.render.component_views``.
 """
 from __future__ import annotations
 
 import importlib
 from typing import Any, Protocol, runtime_checkable
 
-__all__ = ["VIEWS", "View", "view_class"]
+__all__ = ["COMPONENT_VIEWS", "ComponentView", "VIEWS", "View", "component_view_classes", "view_class"]
 
 #: (view kind, backend) -> "module:class"
 VIEWS: dict[tuple[str, str], str] = {
@@ -44,12 +53,54 @@ class View(Protocol):
     def remove(self) -> None: ...
 
 
+#: the classes of the views of components, by kind ("module:class"; PT by backend)
+COMPONENT_VIEWS: dict[str, tuple[str, ...]] = {
+    "pt": (VIEWS[("pt", "gpu")], VIEWS[("pt", "cpu")]),
+    "lod": (VIEWS[("lod", "cpu")],),
+    "vtk": ("volviz.render.component_views:VtkPropView",),
+    "isosurfaces": ("volviz.render.component_views:IsoSurfacesView",),
+}
+
+
+@runtime_checkable
+class ComponentView(Protocol):
+    """What the view of every shown component offers (module docstring)."""
+
+    kind: str
+    camera_dependent: bool
+    visible: bool
+    stats: dict[str, Any]
+
+    @property
+    def prop(self) -> Any: ...
+
+    def set_tf(self, tf: Any, opacity: float = 1.0) -> None: ...
+
+    def set_clip(self, clip: Any) -> bool: ...
+
+    def update(self) -> Any: ...
+
+    def bounds(self) -> Any: ...
+
+    def remove(self) -> None: ...
+
+
+def _load(spec: str) -> type:
+    module, name = spec.split(":")
+    cls: type = getattr(importlib.import_module(module), name)
+    return cls
+
+
 def view_class(kind: str, backend: str) -> type:
     """The view class drawing ``kind`` on ``backend``; ValueError naming what exists otherwise."""
     try:
-        module, name = VIEWS[(kind, backend)].split(":")
+        spec = VIEWS[(kind, backend)]
     except KeyError:
         raise ValueError(f"no {backend!r} view for {kind!r}; views: "
                          f"{', '.join(f'{k}/{b}' for k, b in VIEWS)}") from None
-    cls: type = getattr(importlib.import_module(module), name)
-    return cls
+    return _load(spec)
+
+
+def component_view_classes(kind: str) -> list[type]:
+    """The view classes of components of ``kind`` (``COMPONENT_VIEWS``)."""
+    return [_load(spec) for spec in COMPONENT_VIEWS[kind]]

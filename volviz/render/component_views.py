@@ -1,0 +1,144 @@
+"""The views of the components that VTK draws with its own props, behind the calls ``SceneController`` makes of every
+component's view (``volviz.render.views.ComponentView``): a volume drawn by VTK's ray casters (or its projected
+tetrahedra for the render method "vtk"), a surface, and the surfaces of an isosurface component (libMini note §3-4:
+extracted once, cut exactly by the scene's clipping and scaled by the component's opacity on the CPU, drawn by VTK;
+a transparency mode of the note draws their translucent part through the scene-wide iso view).
+
+volviz's own views (``volviz.render.pt_view.PTView``, ``volviz.render.lod_volume.LodVolume``) answer the same calls
+themselves.
+"""
+from __future__ import annotations
+
+from typing import Any, Optional
+
+from volviz.render.framing import Bounds, points_bounds, prop_bounds, union
+
+__all__ = ["IsoSurfacesView", "VtkPropView"]
+
+
+class VtkPropView:
+    """A component VTK draws with its own mapper (``prop``: a vtkVolume or an actor). Clipping: the mapper's clipping
+    planes, or an exact cut of a tetrahedral input kept uncut here (``volviz.render.clipping.clip_vtk_prop``)."""
+
+    kind = "vtk"
+    camera_dependent = False  # VTK draws it for any camera
+
+    def __init__(self, prop: Any) -> None:
+        self.prop = prop
+        self._uncut: Any = None
+        self.stats: dict[str, Any] = {}
+
+    @property
+    def backend(self) -> str:
+        mapper = self.prop.GetMapper() if hasattr(self.prop, "GetMapper") else None
+        return "cpu" if mapper is not None and mapper.IsA("vtkFixedPointVolumeRayCastMapper") else "gpu"
+
+    @property
+    def visible(self) -> bool:
+        return bool(self.prop.GetVisibility())
+
+    @visible.setter
+    def visible(self, on: bool) -> None:
+        self.prop.SetVisibility(bool(on))
+
+    def set_tf(self, tf: Any, opacity: float = 1.0) -> None:
+        """A volume's color and opacity functions, or a surface's opacity."""
+        if self.prop.IsA("vtkVolume"):
+            if tf is None:
+                return
+            from volviz.render.vtk_scene import update_volume_property
+
+            update_volume_property(self.prop.GetProperty(), tf, opacity)
+        else:
+            self.prop.GetProperty().SetOpacity(float(opacity))
+
+    def set_clip(self, clip: Any) -> bool:
+        """Clip by ``volviz.iso.clip.ClipSettings`` at once (True: nothing for the caller to cut)."""
+        from volviz.render.clipping import clip_vtk_prop
+
+        self._uncut = clip_vtk_prop(self.prop, clip, self._uncut)
+        return True
+
+    def set_input(self, data: Any, clip: Any) -> None:
+        """A new mapper input (a time series' volume at a new display time), cut by ``clip``."""
+        self._uncut = None
+        self.prop.GetMapper().SetInputData(data)
+        if clip.all_planes():
+            self.set_clip(clip)
+
+    def update(self) -> dict[str, Any]:
+        """Nothing to re-make: VTK draws it at every render."""
+        return {}
+
+    def bounds(self) -> Optional[Bounds]:
+        return prop_bounds(self.prop)
+
+    def remove(self) -> None:
+        """The plotter's ``clear`` removes the prop."""
+
+
+class IsoSurfacesView(VtkPropView):
+    """The surfaces of an isosurface component (``volviz.render.scene_builder.IsoParts``) as VTK actors (``prop``: a
+    vtkPropAssembly, ``add_isosurface_actors``). A new clipping or opacity is a new cut of the extracted surfaces:
+    ``cut(clip)`` on any thread, ``show_cut(parts)`` here (or ``update`` does both now)."""
+
+    kind = "isosurfaces"
+    camera_dependent = False  # the transparency modes draw them through the scene-wide iso view
+
+    def __init__(self, plotter: Any, comp: Any, parts: Any, spectrum: bool = True) -> None:
+        from volviz.render.clipping import clip_settings
+
+        super().__init__(None)
+        self.plotter, self.comp, self.spectrum = plotter, comp, spectrum
+        self.parts = parts
+        self.clip = clip_settings(parts.clip)
+        self.show(parts)
+
+    @property
+    def meshes(self) -> list[Any]:
+        """The extracted, uncut surfaces."""
+        return list(self.parts.meshes)
+
+    def set_tf(self, tf: Any, opacity: float = 1.0) -> None:
+        """The surfaces keep their own colors; an opacity other than the shown cut's makes it stale (``update``)."""
+
+    def set_clip(self, clip: Any) -> bool:
+        """Keep ``clip`` for the next cut; True when the shown cut already is of it and of the current opacity."""
+        self.clip = clip
+        return not self.stale()
+
+    def stale(self) -> bool:
+        return self.parts.clip != self.clip.to_dict() or self.parts.opacity != float(self.comp.opacity)
+
+    def cut(self, clip: Any = None, meshes: Optional[list[Any]] = None, progress: Any = None) -> Any:
+        """Any thread: the surfaces (``meshes``, default the extracted ones) cut by ``clip`` (default: the last
+        ``set_clip``), scaled by the component's opacity, with their LOD chains."""
+        from volviz.render.scene_builder import isosurface_parts
+
+        return isosurface_parts(self.comp, meshes=self.meshes if meshes is None else list(meshes),
+                                clip=self.clip if clip is None else clip)
+
+    def show_cut(self, parts: Any, visible: bool = True) -> None:
+        """GUI thread: show a ``cut`` (new actors, not rendered)."""
+        self.show(parts)
+        self.visible = visible
+
+    def show(self, parts: Any) -> None:
+        from volviz.render.scene_builder import add_isosurface_actors
+
+        if self.prop is not None:
+            self.plotter.remove_actor(self.prop, render=False)
+        self.parts = parts
+        self.prop = add_isosurface_actors(self.plotter, self.comp.id, parts, spectrum=self.spectrum)
+
+    def update(self) -> dict[str, Any]:
+        """Cut again now when the clipping or the opacity changed."""
+        if self.stale():
+            self.show_cut(self.cut(), self.visible)
+        return {}
+
+    def bounds(self) -> Optional[Bounds]:
+        return union([points_bounds(m.points) for m in self.parts.meshes if len(m.points)])
+
+    def remove(self) -> None:
+        self.plotter.remove_actor(self.prop, render=False)
