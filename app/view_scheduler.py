@@ -33,14 +33,23 @@ RESIZE_MS = 200          # overlays re-render once the viewport stopped resizing
 FLY_SETTLE_MS = 300      # fly mode: full-size images once no key moved the camera for 300 ms
 
 
+def _shown(request: Any, result: Any) -> dict[str, Any]:
+    """What to keep of a shown update: its request's numbers and flags (a LOD volume's block ``budget``,
+    ``preview``) and the statistics its ``finish`` returned, not its images, depths or meshes."""
+    kept = {k: v for k, v in (request.items() if isinstance(request, dict) else ())
+            if isinstance(v, (bool, int, float, str))}
+    if isinstance(result, dict):
+        kept.update(result)
+    return kept
+
+
 class ViewScheduler:
     """The window's background view refreshes (see the module's docstring)."""
 
     def _init_view_scheduler(self) -> None:
         self._view_jobs: dict[str, OneInFlight] = {}  # per camera view (by its key): its updates
         self.view_updates: dict[str, int] = {}  # per camera view: the updates shown so far
-        self.view_requests: dict[str, Any] = {}  # per camera view: the request of the update shown last
-        self.view_results: dict[str, Any] = {}   # per camera view: what its ``finish`` returned last
+        self.view_shown: dict[str, dict[str, Any]] = {}  # per camera view: the last shown update (``_shown``)
         self._moving_scheduled = False     # a refresh for the camera the mouse is moving is queued
         self._iso_jobs = OneInFlight()     # isosurface extraction for the display time
         self._volume_jobs = OneInFlight()  # blended volumes of time series for the display time
@@ -221,7 +230,7 @@ class ViewScheduler:
                         with no_render(self.plotter):  # drawn once, below
                             result = view.finish(request, *outcome.result)
                         self.view_updates[key] = self.view_updates.get(key, 0) + 1
-                        self.view_requests[key], self.view_results[key] = request, result
+                        self.view_shown[key] = _shown(request, result)
                         preview = bool(request.get("preview")) if isinstance(request, dict) else False
                         self.schedule_render()
                         if not preview:

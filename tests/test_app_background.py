@@ -118,7 +118,7 @@ def test_camera_move_updates_the_natural_scene_in_the_background(qtbot, make_win
     assert view._mesh is not mesh and view._mesh.n_cells > 0  # the terrain re-triangulated for the new view
     changed = overlay_pixels(view)
     assert changed.shape == overlay.shape and np.abs(changed.astype(int) - overlay).max() > 0
-    assert window.view_results["nature"]["terrain_triangles"] == view._mesh.n_cells
+    assert window.view_shown["nature"]["terrain_triangles"] == view._mesh.n_cells
 
 
 def test_lod_volume_selects_in_the_background_coarse_first(qtbot, make_window, tmp_path: Path) -> None:
@@ -143,7 +143,7 @@ def test_lod_volume_selects_in_the_background_coarse_first(qtbot, make_window, t
     window.plotter.camera.position = (24.0, -40.0, 24.0)  # close to the volume: finer blocks
     window._camera_moved()
     assert list(volume.selection.nodes) == far and not shown, "the blocks were selected on the GUI thread"
-    qtbot.waitUntil(lambda: window.view_requests.get("lod:blob", {}).get("budget") == 16 and len(shown) == 2,
+    qtbot.waitUntil(lambda: window.view_shown.get("lod:blob", {}).get("budget") == 16 and len(shown) == 2,
                     timeout=60000)
     assert shown[0] <= 2 < shown[1] <= 16  # a coarse selection (budget / 8) first, then the full budget
     assert list(volume.selection.nodes) == list(volume.select(volume.camera()).nodes)  # as if selected right here
