@@ -150,7 +150,10 @@ def test_dask_cluster_encoding_is_bit_identical(tmp_path):
     from volviz.regular.cli import compress_main
 
     vols = _moving_series(20, shape=(20, 16, 18))  # IBBPBBPPB: I at 0, 9, 18 -> three parts
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None) as cluster:
+    # in-process workers watch this process's memory, which is the whole test run's: without memory_limit=0 they
+    # pause once it passes 80 % of their share of the machine, and the encoding waits for them for ever
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None,
+                      memory_limit=0) as cluster:
         for kw in ({}, {"mode": "quality", "quality": 70}):
             A.compress_series(vols, tmp_path / "seq.vvs", **kw)
             A.compress_series(vols, tmp_path / "dask.vvs", scheduler=cluster.scheduler_address, **kw)
