@@ -220,9 +220,10 @@ class SceneEdits:
         stale = controller.set_opacity(comp_id, opacity, update=False)
         self.set_dirty()
         self.render()
-        if stale:  # surfaces scaled by the opacity: cut again in the background
+        if stale:  # surfaces scaled by the opacity: cut again in the background, then their views are refreshed
             self._cut_in_background(controller, controller.clip, stale)
-        self.refresh_views([comp_id, "iso-overlay"])
+        else:
+            self.refresh_views([comp_id, "iso-overlay"])
 
     def set_clip(self, clip: dict[str, Any]) -> None:
         """New scene-wide clipping (from the clipping dock): every view is given it; what is cut on the CPU
