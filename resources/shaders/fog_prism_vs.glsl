@@ -1,35 +1,17 @@
 //VTK::System::Dec
 
-// Ground fog / cloud layer prisms (Roettger section 10.3, PCP): each prism is 6 vertices of a static buffer; every
-// vertex carries its prism's three vertical side planes, the affine bottom and top heights and the affine bottom and
-// top emissions (all relative to the layer's centre). They are the same at the 6 vertices: flat varyings.
+// Ground fog / cloud layer prisms (Roettger section 10.3, PCP): the vertices of the layer's terrain triangles. Each
+// carries its xy (relative to the layer's centre) in vertexMC and its bottom and top heights (relative to the centre)
+// and bottom and top emissions in fogValue; fog_prism_gs.glsl makes each triangle's prism.
 in vec4 vertexMC;
-in vec3 fogSide0;
-in vec3 fogSide1;
-in vec3 fogSide2;
-in vec3 fogBottom;
-in vec3 fogTop;
-in vec3 fogEmBottom;
-in vec3 fogEmTop;
+in vec4 fogValue;
 
-uniform mat4 MCDCMatrix;
-
-flat out vec3 side0;
-flat out vec3 side1;
-flat out vec3 side2;
-flat out vec3 zBottom;
-flat out vec3 zTop;
-flat out vec3 eBottom;
-flat out vec3 eTop;
+out vec2 vertexXY;
+out vec4 vertexValue;
 
 void main()
 {
-  side0 = fogSide0;
-  side1 = fogSide1;
-  side2 = fogSide2;
-  zBottom = fogBottom;
-  zTop = fogTop;
-  eBottom = fogEmBottom;
-  eTop = fogEmTop;
-  gl_Position = MCDCMatrix * vertexMC;
+  vertexXY = vertexMC.xy;
+  vertexValue = fogValue;
+  gl_Position = vertexMC;
 }

@@ -218,13 +218,10 @@ class _GLFrames:
     def _one_each(self) -> None:
         """Cut every prism layer to its first prism and the clouds to their first tetrahedron (until the next frame)."""
         from volviz.bench.unstructured import _one_cell_order
-        from volviz.render.gl_fog import PrismBuffers
 
         view = self.views[1]
         for name, layer in view.layers.items():
-            b = self._prisms[name][1]
-            layer.set_buffers(PrismBuffers(b.points[:6], {k: v[:6] for k, v in b.attributes.items()},
-                                           b.connectivity[:24], b.centre, min(b.drawn, 1)))
+            layer.set_buffers(self._prisms[name][1].first_prism())
         if view.clouds is not None:
             _one_cell_order(view.clouds)
 

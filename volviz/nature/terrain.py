@@ -59,10 +59,8 @@ class TerrainMesh:
     def to_pyvista(self, normals: np.ndarray | None = None):
         import pyvista as pv
 
-        faces = np.hstack([np.full((len(self.triangles), 1), 3, dtype=np.int64), self.triangles]).ravel()
-        mesh = pv.PolyData(self.points, faces)
-        # pyvista types the setter's array as float64 only; VTK takes float32 texture coordinates
-        mesh.active_texture_coordinates = self.tcoords.astype(np.float32)  # type: ignore[assignment]
+        mesh = pv.PolyData.from_regular_faces(self.points, self.triangles)
+        mesh.active_texture_coordinates = self.tcoords.astype(np.float32)
         if normals is not None:
             mesh.point_data["Normals"] = normals
             mesh.point_data.active_normals_name = "Normals"

@@ -7,12 +7,15 @@ PCP, Roettger §10.3 (the three-pass recipe) and §10.4 (the near-plane cap, the
 
 How a frame is drawn:
 
-- Uploaded once: a static vertex buffer with 6 vertices per prism (its bottom and top triangles) and 8 triangles, each
-  vertex carrying its prism's three vertical side planes, the affine bottom and top heights zb(x, y), zt(x, y) and
-  the affine bottom and top emissions E_b(x, y), E_t(x, y), all relative to the layer's centre (float32 keeps its
-  precision for layers far from the origin). The emission at a point is E_b + u (E_t - E_b), u the height fraction
-  between bottom and top: the CPU's Σ λ_i [(1 - u) e_bottom,i + u e_top,i]. Prisms whose six emissions are all zero
-  (or with no thickness) are culled (§10.3: "zero-emission cells were discarded").
+- Uploaded per geometry: the layer's terrain triangles, each vertex with its xy and its bottom and top heights and
+  emissions (4 floats, ``prism_buffers``); a geometry shader (``resources/shaders/fog_prism_gs.glsl``) makes each
+  triangle's prism on the GPU: its three vertical side planes, the affine bottom and top heights zb(x, y),
+  zt(x, y) and the affine bottom and top emissions E_b(x, y), E_t(x, y), all relative to the layer's centre (float32
+  keeps its precision for layers far from the origin), and its 8 triangles wound outward. The emission at a point is
+  E_b + u (E_t - E_b), u the height fraction between bottom and top: the CPU's Σ λ_i [(1 - u) e_bottom,i +
+  u e_top,i]. Prisms whose six emissions are all zero (or with no thickness or no area) emit nothing (§10.3:
+  "zero-emission cells were discarded"). A C-LOD frame hands VTK only the terrain's vertices (7 floats each) and
+  triangles.
 - Per fragment (``resources/shaders/fog_prism_fs.glsl`` with ``ray_pixel.glsl``): only back (exit) faces are
   rasterised, so every pixel of a prism's footprint gets one fragment, also for a prism cut by the near plane. The
   pixel ray is rebuilt from ``gl_FragCoord`` with the camera's affine ray basis (as ``gl_pt``), intersected with the
@@ -42,16 +45,17 @@ prism face, or touching a prism's edge in MIP mode, where the integral jumps and
 rasteriser's fixed-point edge functions decide differently; up to 32); the emissive mode against the exact emissive
 integral (dense ray marching) for fields linear along rays, top-down view at 128^2: RMSE 0.25-0.30, max 1.26-1.42.
 
-Timings, measured on llvmpipe, 2 cores (shared with other work; llvmpipe ran about one core), attenuated mode, frame
-time with the layer minus without it, against the CPU ``render_layer`` (Numba) for the same image:
+Timings, measured on llvmpipe, 2 cores (shared with other work), attenuated mode, the oblique camera of the tests:
+frame time with the layer minus without it, against the CPU ``render_layer`` (Numba) for the same layer with no
+opaque depth:
 
-    terrain (prisms)       64x48 window   256^2           1024^2
-    33^2 (1,428)           1.4 ms         9.6 ms / 6.4    57 ms / 115
-    129^2 (17,336)         26 ms          94 ms / 45      564 ms / 462      (GPU / CPU)
+    terrain (prisms)       64x48 window    256^2            1024^2
+    33^2 (1,428)           2.5 ms / 0.8    8.8 ms / 4.8     39 ms / 70
+    129^2 (17,336)         32 ms / 7.3     58 ms / 42       331 ms / 512      (GPU / CPU)
 
-The per-frame CPU-side cost is the 64x48 column (few pixels to shade): llvmpipe's vertex work for 8 triangles per
-prism, of which the Python callbacks (camera, ray basis, uniforms, target) take 0.6-1.8 ms; building the buffers
-takes 13 ms / 98 ms once. On a real GPU the prisms' vertex and fragment work leaves the CPU.
+In the 64x48 window (few pixels to shade) the time is llvmpipe's vertex and geometry work for the prisms, which a GPU
+takes off the CPU; the Python callbacks (camera, ray basis, uniforms, target) take 0.6-1.8 ms. The per-point buffer
+(``prism_buffers``) takes 0.6 ms for the 129^2 terrain.
 
 Not handled: a renderer that does not fill its window (the ray basis and the target assume the renderer's size with
 the origin at the framebuffer's corner), parallel projection (natural scenes are perspective), depth peeling for
@@ -69,79 +73,77 @@ from volviz.nature.fog import FogLayer, layer_emission
 from volviz.render.gl_pt import _PASS_MARK, _USERS, GLPTVolume, install_scene_pass, shader_source
 from volviz.model.camera import Camera
 
-__all__ = ["GLFogLayer", "PrismBuffers", "add_fog_layer", "buffers_polydata", "prism_attributes",
-           "prism_buffers"]
+__all__ = ["GLFogLayer", "PrismBuffers", "add_fog_layer", "buffers_polydata", "layer_values", "prism_buffers"]
 
 _MODES = {"emissive": 0, "attenuated": 1, "mip": 2}
 _GL_FUNC_ADD, _GL_MAX = 0x8006, 0x8008
 _GL_BLEND_EQUATION_RGB, _GL_BLEND_EQUATION_ALPHA = 0x8009, 0x883D
 _GL_COLOR_BUFFER_BIT = 0x4000
-_ATTRIBUTES = ("fogSide0", "fogSide1", "fogSide2", "fogBottom", "fogTop", "fogEmBottom", "fogEmTop")
-def _kept_prisms(points: np.ndarray, bottom: np.ndarray, top: np.ndarray, triangles: np.ndarray,
-                 emission_bottom: np.ndarray, emission_top: np.ndarray
-                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """(indices of the kept triangles, the layer's centre (3,), the points' xy relative to it (n, 2), the kept
-    triangles (k, 3), the four per-point values (4, n): bottom and top height relative to the centre, bottom and
-    top emission)."""
+_ATTRIBUTES = ("fogValue",)
+def layer_values(points: np.ndarray, bottom: np.ndarray, top: np.ndarray, emission_bottom: np.ndarray,
+                 emission_top: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The layer's centre (3,) (of the bounding box of its points between bottom and top), the points relative to it
+    as float32 (n + 2, 3) (x, y; z the bottom height; then the box's two corners, in no triangle, so that VTK's
+    bounds hold the whole layer), the four per-point values as float32 (n + 2, 4) (bottom and top height relative
+    to the centre, bottom and top emission; 0 at the corners) and the box relative to the centre (3, 2)."""
     pts = np.asarray(points, dtype=np.float64)
-    tris = np.asarray(triangles, dtype=np.int64).reshape(-1, 3)
     zb, zt = np.asarray(bottom, dtype=np.float64), np.asarray(top, dtype=np.float64)
-    eb, et = np.asarray(emission_bottom, dtype=np.float64), np.asarray(emission_top, dtype=np.float64)
     lo = np.array([pts[:, 0].min(), pts[:, 1].min(), min(zb.min(), zt.min())])
     hi = np.array([pts[:, 0].max(), pts[:, 1].max(), max(zb.max(), zt.max())])
     centre = 0.5 * (lo + hi)
-    xy = np.ascontiguousarray(pts[:, :2] - centre[:2])
-    t = xy[tris]                                                         # (m, 3, 2)
-    area2 = ((t[:, 1, 0] - t[:, 0, 0]) * (t[:, 2, 1] - t[:, 0, 1])
-             - (t[:, 1, 1] - t[:, 0, 1]) * (t[:, 2, 0] - t[:, 0, 0]))
-    keep = ((eb[tris] > 0).any(axis=1) | (et[tris] > 0).any(axis=1)) & (zt[tris] > zb[tris]).any(axis=1)
-    keep &= np.abs(area2) > 0
-    idx = np.flatnonzero(keep)
-    values = np.stack([zb - centre[2], zt - centre[2], eb, et])
-    return idx, centre, xy, np.ascontiguousarray(tris[idx]), values
-
-
-def prism_attributes(points: np.ndarray, bottom: np.ndarray, top: np.ndarray, triangles: np.ndarray,
-                     emission_bottom: np.ndarray, emission_top: np.ndarray
-                     ) -> tuple[np.ndarray, np.ndarray, dict[str, np.ndarray]]:
-    """The drawn prisms: (indices of the kept triangles, the layer's centre (3,), per-prism (k, 3) float64 attributes
-    relative to the centre: side planes (nx, ny, d) with nx x + ny y + d >= 0 inside, the affine forms (gx, gy, c) of
-    the bottom and top heights and of the bottom and top emissions; ``_prism_kernels.prism_forms``). Prisms with all
-    six emissions <= 0 or no thickness are left out, as in the CPU PCP; so are triangles with no area."""
-    from volviz.render._prism_kernels import prism_forms
-
-    idx, centre, xy, kept, values = _kept_prisms(points, bottom, top, triangles, emission_bottom, emission_top)
-    forms, _, _ = prism_forms(xy, kept, values, centre)
-    return idx, centre, {name: forms[:, f] for f, name in enumerate(_ATTRIBUTES)}
+    n = len(pts)
+    rel = np.empty((n + 2, 3), np.float32)       # the last two: the box's corners, for VTK's bounds and culling
+    rel[:n, :2] = pts[:, :2] - centre[:2]
+    rel[:n, 2] = zb - centre[2]
+    rel[n:] = [lo - centre, hi - centre]
+    values = np.zeros((n + 2, 4), np.float32)
+    values[:n, 0] = rel[:n, 2]
+    values[:n, 1] = zt - centre[2]
+    values[:n, 2] = emission_bottom
+    values[:n, 3] = emission_top
+    return centre, rel, values, np.stack([lo - centre, hi - centre], axis=1)
 
 
 @dataclass
 class PrismBuffers:
-    """A layer's prism vertex buffer as NumPy arrays (``prism_buffers``), made on any thread and handed to VTK without
-    a copy (``GLFogLayer.set_buffers``): ``points`` (6k, 3) float32 relative to ``centre``, ``attributes`` (name ->
-    (6k, 3) float32, each prism's forms at its 6 vertices), ``connectivity`` (24k,) int64 (8 outward triangles per
-    prism), ``drawn`` = k prisms."""
+    """A layer's vertex buffer as NumPy arrays (``prism_buffers``), made on any thread and handed to VTK without a
+    copy (``GLFogLayer.set_buffers``): the terrain triangles' ``points`` (n, 3) float32 relative to ``centre``, their
+    ``attributes`` (``fogValue``: (n, 4) float32, bottom and top height and emission), ``connectivity`` (3m,) int64
+    (the triangles; the geometry shader makes each one's prism), ``bounds`` (3, 2) relative to the centre, ``drawn``
+    = the prisms kept (with area, thickness and some emission)."""
 
     points: np.ndarray
     attributes: dict[str, np.ndarray]
     connectivity: np.ndarray
     centre: np.ndarray
     drawn: int
+    bounds: np.ndarray
+
+    def first_prism(self) -> "PrismBuffers":
+        """The same buffers drawing only the first kept prism (or none): a draw with the prisms' own work removed."""
+        from volviz.render._prism_kernels import kept_triangles
+
+        tris = self.connectivity.reshape(-1, 3)
+        kept = np.flatnonzero(kept_triangles(self.points, self.attributes["fogValue"], tris))[:1]
+        return PrismBuffers(self.points, self.attributes, np.ascontiguousarray(tris[kept].reshape(-1)), self.centre,
+                            len(kept), self.bounds)
 
 
 def prism_buffers(points: np.ndarray, bottom: np.ndarray, top: np.ndarray, triangles: np.ndarray, layer: FogLayer,
                   emission: tuple[np.ndarray, np.ndarray] | None = None) -> PrismBuffers:
-    """Any thread (Numba kernels that release the GIL): the vertex buffer of the layer's kept prisms
-    (``prism_attributes``; the emission of ``layer``'s mode, ``volviz.nature.fog.layer_emission``). Each prism's 8
-    triangles are wound outward (front faces culled: only exit faces draw)."""
-    from volviz.render._prism_kernels import expand_buffers, prism_forms
+    """Any thread: the vertex buffer of the layer's prisms, one per terrain triangle: per point its xy and the bottom
+    and top heights and emissions of ``layer``'s mode (``volviz.nature.fog.layer_emission``); the prisms themselves
+    (side planes, affine forms, 8 triangles wound outward) are made per triangle by the geometry shader
+    (``fog_prism_gs.glsl``), which also drops those with no area, no thickness or all six emissions <= 0, as the CPU
+    PCP does. ``drawn`` counts those kept (``_prism_kernels.kept_triangles``)."""
+    from volviz.render._prism_kernels import kept_triangles
 
     points, bottom, top = (np.asarray(a, dtype=np.float64) for a in (points, bottom, top))
     eb, et = layer_emission(bottom, top, layer, emission)
-    idx, centre, xy, kept, values = _kept_prisms(points, bottom, top, triangles, eb, et)
-    forms, corners, faces = prism_forms(xy, kept, values, centre)
-    verts, attributes, conn = expand_buffers(forms, corners, faces)
-    return PrismBuffers(verts, {name: attributes[f] for f, name in enumerate(_ATTRIBUTES)}, conn, centre, len(idx))
+    centre, rel, values, bounds = layer_values(points, bottom, top, eb, et)
+    tris = np.ascontiguousarray(np.asarray(triangles, dtype=np.int64).reshape(-1, 3))
+    drawn = int(np.count_nonzero(kept_triangles(rel, values, tris)))
+    return PrismBuffers(rel, {"fogValue": values}, tris.reshape(-1), centre, drawn, bounds)
 
 
 def buffers_polydata(points: np.ndarray, attributes: dict[str, np.ndarray],
@@ -218,9 +220,12 @@ class GLFogLayer:
 
         self.mapper = vtk.vtkOpenGLPolyDataMapper()
         self.mapper.ScalarVisibilityOff()
+        # the geometry shader places the prisms' corners from vertexMC's xy and fogValue's heights in one frame
+        self.mapper.SetVBOShiftScaleMethod(vtk.vtkPolyDataMapper.DISABLE_SHIFT_SCALE)
         for name in _ATTRIBUTES:
             self.mapper.MapDataArrayToVertexAttribute(name, name, vtk.vtkDataObject.FIELD_ASSOCIATION_POINTS, -1)
-        self.actor = self._translucent_actor(self.mapper, "fog_prism_vs.glsl", "fog_prism_fs.glsl")
+        self.actor = self._translucent_actor(self.mapper, "fog_prism_vs.glsl", "fog_prism_fs.glsl",
+                                             "fog_prism_gs.glsl")
         self.actor.GetProperty().FrontfaceCullingOn()
         self.resolve_mapper = vtk.vtkOpenGLPolyDataMapper()
         self.resolve_mapper.ScalarVisibilityOff()
@@ -246,12 +251,14 @@ class GLFogLayer:
 
     # --- set-up --------------------------------------------------------------------------------------------------
     @staticmethod
-    def _translucent_actor(mapper: Any, vs: str, fs: str) -> Any:
+    def _translucent_actor(mapper: Any, vs: str, fs: str, gs: str | None = None) -> Any:
         import vtk
 
         sp = vtk.vtkShaderProperty()
         sp.SetVertexShaderCode(shader_source(vs))
         sp.SetFragmentShaderCode(shader_source(fs))
+        if gs is not None:
+            sp.SetGeometryShaderCode(shader_source(gs))
         actor = vtk.vtkActor()
         actor.SetMapper(mapper)
         actor.SetShaderProperty(sp)
@@ -271,7 +278,7 @@ class GLFogLayer:
         return on_update_shader
 
     def _upload(self) -> None:
-        """The static prism buffer and the resolve triangle for the current layer (its mode picks the emission)."""
+        """The layer's vertex buffer and the resolve triangle for the current layer (its mode picks the emission)."""
         self.set_buffers(prism_buffers(*self._geometry, self.layer, self._emission))
 
     def set_buffers(self, buffers: PrismBuffers) -> None:
@@ -283,8 +290,7 @@ class GLFogLayer:
         centre = self.centre = buffers.centre
         self.mapper.SetInputData(pd)
         self.actor.SetPosition(*centre)
-        bounds = np.array(pd.GetBounds(), np.float64).reshape(3, 2) if self.drawn else np.zeros((3, 2))
-        self.resolve_mapper.SetInputData(_resolve_polydata(bounds))
+        self.resolve_mapper.SetInputData(_resolve_polydata(buffers.bounds if self.drawn else np.zeros((3, 2))))
         self.resolve_actor.SetPosition(*centre)
         on = self.drawn > 0 and getattr(self, "_visible", True)
         self.actor.SetVisibility(on)
@@ -390,7 +396,7 @@ class GLFogLayer:
                      ) -> None:
         """New prisms (arguments as the constructor's), e.g. the next frame's C-LOD terrain triangles: the vertex
         buffer is built (unless ``buffers``, ``prism_buffers`` of the same arguments, were made elsewhere) and
-        uploaded again (``drawn`` prisms, 6 vertices and 31 floats each); the target stays."""
+        uploaded again (the triangles' vertices, 7 floats each); the target stays."""
         self._geometry = (np.asarray(points, dtype=np.float64), np.asarray(bottom, dtype=np.float64),
                           np.asarray(top, dtype=np.float64), np.asarray(triangles, dtype=np.int64))
         self._emission = emission

@@ -17,8 +17,9 @@ drawn by VTK's OpenGL pipeline into the scene's own depth buffer (Roettger Ch. 1
   are re-added to the renderer in that order when it changes.
 
 ``compute`` (any thread) does the LOD work and builds the vertex buffers as NumPy arrays: the terrain's C-LOD mesh,
-the clouds' refinement, morphing and leaf list, the tetrahedra's topology, cell attributes and modulation forms
-(``cloud_buffers``) and each layer's prisms (``gl_fog.prism_buffers``); ``finish`` (GUI thread) only hands them to
+the clouds' refinement, morphing and leaf list, the tetrahedra's face planes, cell attributes and modulation forms
+(``cloud_buffers``, one Numba pass) and each layer's per-point heights and emissions (``gl_fog.prism_buffers``; the
+prisms are made by a geometry shader); ``finish`` (GUI thread) only hands them to
 VTK, sharing the arrays (``gl_fog.buffers_polydata``), and VTK uploads them and draws everything at the next render,
 at the window's full size (a preview ``scale`` is ignored). No image is made on the CPU. (The first frame's cloud
 volume also builds gl_pt's own buffer once, in its constructor.)
@@ -46,11 +47,11 @@ from volviz.nature.clouds import CloudFrame, CloudShading
 from volviz.nature.nature_scene import NatureScene
 from volviz.render.nature_view import NatureView
 from volviz.render.gl_fog import GLFogLayer, buffers_polydata, prism_buffers
-from volviz.render.gl_pt import GLPTVolume, _cell_attributes, shader_source
+from volviz.render.gl_pt import GLPTVolume, shader_source
 from volviz.render.image_overlay import hold_single_sample, release_single_sample
-from volviz.unstructured.topology import topology, visible_cells
+from volviz.unstructured.topology import topology, visible_ranges
 
-__all__ = ["CloudBuffers", "CloudPTVolume", "GLNatureView", "cloud_buffers", "cloud_tetrahedra", "modulation_forms"]
+__all__ = ["CloudBuffers", "CloudPTVolume", "GLNatureView", "cloud_buffers", "cloud_tetrahedra"]
 
 BYTES_PER_TET = 4 * 31 * 4 + 12 * 4         # vertex buffer (4 vertices x 31 float32) + index buffer (12 uint32)
 
@@ -82,17 +83,6 @@ def cloud_tetrahedra(frame: CloudFrame, shading: CloudShading, eye: Any) -> tupl
     return mesh, other / max(m_max, 1e-12)
 
 
-def modulation_forms(mesh: TetMesh, modulation: np.ndarray) -> np.ndarray:
-    """Per tetrahedron (m, 4) float32 (g, c): the affine form g . x + c of the per-point ``modulation`` with x
-    relative to the mesh's centre (``topology(mesh).origin``, where GLPTVolume places its actor)."""
-    topo = topology(mesh)
-    p = topo.points[topo.tets]
-    v = np.asarray(modulation, np.float64)[topo.tets]
-    g = np.linalg.solve(p[:, 1:] - p[:, :1], (v[:, 1:] - v[:, :1])[..., None])[..., 0]
-    c = v[:, 0] - np.einsum("ij,ij->i", g, p[:, 0])
-    return np.ascontiguousarray(np.concatenate([g, c[:, None]], axis=1), np.float32)
-
-
 @dataclass
 class CloudBuffers:
     """A frame's cloud vertex buffer as NumPy arrays (``cloud_buffers``, any thread): ``points`` (4m, 3) float32
@@ -105,14 +95,17 @@ class CloudBuffers:
 
 
 def cloud_buffers(mesh: TetMesh, modulation: np.ndarray, shading: CloudShading) -> CloudBuffers:
-    """Any thread, NumPy only: the vertex buffer of ``CloudPTVolume`` for ``mesh`` and its per-point ``modulation``
-    (gl_pt's static buffer, 4 vertices per tetrahedron, with the modulation forms added) and the TF's culling."""
+    """Any thread (Numba, releasing the GIL): the vertex buffer of ``CloudPTVolume`` for ``mesh`` (finite scalars)
+    and its per-point ``modulation`` (gl_pt's buffer, 4 vertices per tetrahedron with its cell attributes, and the
+    modulation form; ``_cloud_buffer_kernels.cloud_vertex_buffer``) and the TF's culling from the cells' ranges."""
+    from volviz.render._cloud_buffer_kernels import cloud_vertex_buffer
+
     topo = topology(mesh)
-    attributes = _cell_attributes(mesh)
-    attributes["ptModulate"] = modulation_forms(mesh, modulation)
-    return CloudBuffers(np.ascontiguousarray(topo.points[topo.tets].reshape(-1, 3), np.float32),
-                        {k: np.repeat(v, 4, axis=0) for k, v in attributes.items()},
-                        visible_cells(mesh, shading.tf.scalars, shading.tf.extinction))
+    pos, attr, ranges = cloud_vertex_buffer(topo.points, topo.tets, topo.face_n, topo.face_d,
+                                    np.asarray(mesh.scalars, np.float64), np.asarray(modulation, np.float64))
+    names = [f"ptPlane{f}" for f in range(4)] + ["ptScalar", "ptRange", "ptModulate"]
+    visible = visible_ranges(ranges[:, 0], ranges[:, 1], shading.tf.scalars, shading.tf.extinction)
+    return CloudBuffers(pos, {name: attr[k] for k, name in enumerate(names)}, visible)
 
 
 class CloudPTVolume(GLPTVolume):
@@ -121,7 +114,7 @@ class CloudPTVolume(GLPTVolume):
 
     Private members of ``GLPTVolume`` used (what a public API would replace): ``_build_table`` (overridden to return
     the scene's table), ``_sorted`` / ``_sorted_key`` / ``_order_key`` (the given order, kept by ``reuse_order``),
-    ``_vis`` (culling of the new mesh), ``gl_pt._cell_attributes`` (the new mesh's vertex attributes)."""
+    ``_vis`` (culling of the new mesh)."""
 
     def __init__(self, plotter: Any, mesh: TetMesh, buffers: CloudBuffers, shading: CloudShading, table: Any
                  ) -> None:

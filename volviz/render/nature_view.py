@@ -33,9 +33,10 @@ class NatureView:
         return nature_bounds(self.scene)
 
     def __init__(self, plotter: Any, scene: NatureScene, size: tuple[int, int] | None = None,
-                 filter_texture: bool | None = None) -> None:
+                 filter_texture: bool | None = None, full: bool = False) -> None:
         """``filter_texture``: mip-map the terrain's color map (``_filtered_texture``); None: on a hardware OpenGL
-        driver, not on a software rasteriser, where it costs more than it is worth (``texture_filtering``)."""
+        driver, not on a software rasteriser, where it costs more than it is worth (``texture_filtering``).
+        ``full``: the reference view, every terrain triangle, prism and non-empty cloud cell (no LOD)."""
         import pyvista as pv
 
         from volviz.nature.sky import sky_dome_mesh
@@ -44,6 +45,7 @@ class NatureView:
         self.scene = scene
         scene.finalize()
         self.size = size
+        self.full = bool(full)
         self.terrain_actor: Any = None
         self.sky_actor: Any = None
         self._overlay_actor: Any = None
@@ -137,7 +139,7 @@ class NatureView:
         the terrain mesh and the clouds' levels of detail are those of the full size (the same frustum), so nothing
         pops when the full-size view follows."""
         cam, size, scale = request
-        mesh = self.scene.terrain_mesh(cam, size)
+        mesh = self.scene.terrain_mesh(cam, size, full=self.full)
         if scale > 1:
             size = (max(1, size[0] // scale), max(1, size[1] // scale))
         w, h = size
@@ -152,7 +154,7 @@ class NatureView:
             stats["terrain_triangles"] = float(mesh.n_triangles)
         if progress is not None:
             progress(0.5, "fog and clouds")
-        overlay = _overlay_rgba(self.scene.render_volumes(cam, size, mesh, depth, stats=stats))
+        overlay = _overlay_rgba(self.scene.render_volumes(cam, size, mesh, depth, full=self.full, stats=stats))
         if scale > 1:
             overlay = _magnify(overlay, request[1])
         return poly, overlay, stats

@@ -8,6 +8,7 @@ arrays are replaced.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 from numba import njit, prange
@@ -20,13 +21,12 @@ FACES = np.array([[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]], dtype=np.int64)
 
 @dataclass
 class Topology:
-    """Geometry and adjacency of a TetMesh, relative to ``origin``."""
+    """Geometry and adjacency of a TetMesh, relative to ``origin``. The adjacency (``neighbor``, ``boundary``) is
+    made when first used: a mesh drawn in a given order (the clouds' leaves) never needs it."""
 
     origin: np.ndarray          # (3,) float64, subtracted from every point
     points: np.ndarray          # (n, 3) float64, relative to origin
     tets: np.ndarray            # (m, 4) int64
-    neighbor: np.ndarray        # (m, 4) int64: tetrahedron across face f, -1 on the boundary
-    boundary: np.ndarray        # (b, 2) int64: (tet, face) of every boundary face
     face_n: np.ndarray          # (m, 4, 3) float64 unit outward normals
     face_d: np.ndarray          # (m, 4) float64: n . x = d on the face plane, n . x <= d inside
     centroid: np.ndarray        # (m, 3)
@@ -37,6 +37,18 @@ class Topology:
     @property
     def n_tets(self) -> int:
         return int(len(self.tets))
+
+    @cached_property
+    def neighbor(self) -> np.ndarray:
+        """(m, 4) int64: the tetrahedron across face f, -1 on the boundary (ValueError for a face shared by more
+        than two tetrahedra)."""
+        return _face_adjacency(self.tets)
+
+    @cached_property
+    def boundary(self) -> np.ndarray:
+        """(b, 2) int64: (tet, face) of every boundary face."""
+        bt, bf = np.nonzero(self.neighbor < 0)
+        return np.stack([bt, bf], axis=1).astype(np.int64)
 
 
 @dataclass
@@ -128,7 +140,9 @@ def build_topology(mesh: TetMesh) -> Topology:
     """Compute the adjacency and geometry of ``mesh`` (see :func:`topology` for the cached version)."""
     if mesh.n_cells == 0:
         raise ValueError("TetMesh has no tetrahedra")
-    used = mesh.points[np.unique(mesh.tets)]
+    in_cells = np.zeros(len(mesh.points), dtype=bool)
+    in_cells[mesh.tets.ravel()] = True
+    used = mesh.points[in_cells]
     if not np.all(np.isfinite(used)):
         raise ValueError("TetMesh has non-finite point coordinates")
     origin = 0.5 * (used.min(axis=0) + used.max(axis=0))
@@ -141,10 +155,7 @@ def build_topology(mesh: TetMesh) -> Topology:
     circ_center = np.empty((m, 3))
     circ_r2 = np.empty(m)
     max_edge = _geometry(pts, tets, FACES, n, d, centroid, circ_center, circ_r2)
-    neighbor = _face_adjacency(tets)
-    bt, bf = np.nonzero(neighbor < 0)
-    return Topology(origin, pts, tets, neighbor, np.stack([bt, bf], axis=1).astype(np.int64), n, d, centroid,
-                    circ_center, circ_r2, float(max_edge))
+    return Topology(origin, pts, tets, n, d, centroid, circ_center, circ_r2, float(max_edge))
 
 
 def topology(mesh: TetMesh) -> Topology:
@@ -174,18 +185,25 @@ def cell_ranges(mesh: TetMesh) -> CellRanges:
 
 
 def visible_cells(mesh: TetMesh, control_scalars: np.ndarray, control_rho: np.ndarray) -> np.ndarray:
-    """Boolean mask of cells whose scalar range meets a part of the TF with rho > 0 (exact for piecewise-linear rho).
+    """Boolean mask of cells whose scalar range meets a part of the TF with rho > 0 (exact for piecewise-linear rho,
+    ``visible_ranges``). Cells with a NaN vertex scalar are invisible."""
+    r = cell_ranges(mesh)
+    return visible_ranges(r.smin, r.smax, control_scalars, control_rho) & ~r.nan
+
+
+def visible_ranges(smin: np.ndarray, smax: np.ndarray, control_scalars: np.ndarray, control_rho: np.ndarray
+                   ) -> np.ndarray:
+    """Boolean mask of the cells with scalar ranges [smin, smax] that meet a part of the TF with rho > 0.
 
     rho is positive on the open piece between control points i, i+1 iff rho_i > 0 or rho_{i+1} > 0; outside
-    [first, last] it is zero. Cells with a NaN vertex scalar are invisible.
+    [first, last] it is zero.
     """
-    r = cell_ranges(mesh)
     x = np.asarray(control_scalars, dtype=np.float64)
     rho = np.asarray(control_rho, dtype=np.float64)
-    vis = np.zeros(len(r.smin), dtype=bool)
+    vis = np.zeros(len(smin), dtype=bool)
     for i in range(len(x) - 1):
         if rho[i] > 0 or rho[i + 1] > 0:
-            vis |= (r.smax >= x[i]) & (r.smin <= x[i + 1])
+            vis |= (smax >= x[i]) & (smin <= x[i + 1])
     if len(x) == 1 and rho[0] > 0:
-        vis |= (r.smin <= x[0]) & (r.smax >= x[0])
-    return vis & ~r.nan
+        vis |= (smin <= x[0]) & (smax >= x[0])
+    return vis
