@@ -1,50 +1,75 @@
 """The clouds' GPU vertex buffer (``volviz.render.gl_nature.cloud_buffers``, its Numba kernel
-``volviz.render._cloud_buffer_kernels``; Roettger §11.3-11.6 drawn by the GPU PT pass) against the NumPy
-formulation of the same quantities: gl_pt's cell attributes (face planes, scalar form, scalar range), the modulation
+``volviz.render._cloud_buffer_kernels.leaf_vertex_buffer``; Roettger §11.3-11.6 drawn by the GPU PT pass) against the
+NumPy formulation of the same quantities: the frame's tetrahedral mesh in back-to-front order
+(``CloudFrame.to_tetmesh``), gl_pt's cell attributes of it (face planes, scalar form, scalar range), the modulation
 form solved per cell with ``numpy.linalg.solve``, each repeated at the cell's 4 vertices, and the TF's culling of
 ``volviz.unstructured.topology.visible_cells``."""
 from __future__ import annotations
 
 import numpy as np
-from scipy.spatial import Delaunay
+import pytest
 
-from volviz.model.datasets import TetMesh
-from volviz.nature.clouds import CloudShading
-from volviz.render.gl_nature import cloud_buffers
+from volviz.model.camera import Camera
+from volviz.nature import noise
+from volviz.nature.clouds import CloudLOD, CloudShading, CloudVolume
+from volviz.render.gl_nature import cloud_buffers, modulation_scale
 from volviz.render.gl_pt import _cell_attributes
 from volviz.unstructured.topology import topology, visible_cells
 
-
-def _mesh(n: int = 300, seed: int = 2) -> tuple[TetMesh, np.ndarray]:
-    rng = np.random.default_rng(seed)
-    pts = rng.uniform(0.0, 50.0, (n, 3)) + [1e4, 2e4, 110.0]        # far from the origin, as the cloud deck
-    tets = Delaunay(pts).simplices
-    tets[::2] = tets[::2][:, [0, 1, 3, 2]]                            # both orientations
-    return TetMesh(pts, tets, rng.uniform(0.0, 1.0, n)), rng.uniform(0.2, 1.0, n)
+EYES = [(-8.1, -12.4, 14.3), (30.0, 9.0, 3.0), (6.0, 5.0, 4.5)]     # outside, beside, inside the volume
 
 
-def test_buffer_matches_the_numpy_attributes_at_every_vertex():
-    mesh, modulation = _mesh()
-    b = cloud_buffers(mesh, modulation, CloudShading.npr())
+def _frame(eye, shading):
+    shape = (17, 17, 9)
+    f = noise.cloud_density(shape, seed=2, coverage=0.4)
+    g = noise.cloud_light(f, (1.5, 1.5, 1.5))
+    vol = CloudVolume(f, g, (1.5, 1.5, 1.5), (1e4, -2e4, 110.0))   # far from the origin, as a cloud deck
+    lod = CloudLOD(vol, big_c=2.5, small_c=4.0, cutoff=shading.cutoff)
+    eye = np.asarray(eye) * 1.5 + vol.origin
+    cam = Camera(eye, np.asarray(vol.origin) + [12.0, 12.0, 6.0], (0, 0, 1), 50, clipping_range=(0.5, 200))
+    return lod.update(cam, (48, 36)), vol, eye
+
+
+@pytest.mark.parametrize("eye", EYES)
+@pytest.mark.parametrize("table_field", ["f", "gamma"])
+def test_buffer_matches_the_numpy_attributes_at_every_vertex(eye, table_field):
+    shading = CloudShading.npr() if table_field == "f" else CloudShading.physical()
+    frame, vol, eye = _frame(eye, shading)
+    assert frame.n_tets > 50 and len(np.unique(frame.leaves[:, 0])) > 1        # leaves of several levels
+    m_scale = modulation_scale(vol, shading)
+    b = cloud_buffers(frame, shading, eye, m_scale)
+    mesh, other = frame.to_tetmesh(shading.table_field, eye=eye)
     topo = topology(mesh)
-    np.testing.assert_array_equal(b.points, topo.points[topo.tets].reshape(-1, 3).astype(np.float32))
+    assert b.n_tets == mesh.n_cells
+    np.testing.assert_allclose(b.points.astype(np.float64) + b.centre,
+                               (topo.points + topo.origin)[topo.tets].reshape(-1, 3), rtol=0, atol=1e-3)
     expected = _cell_attributes(mesh)
     p = topo.points[topo.tets]
-    v = modulation[topo.tets]
+    v = (other / m_scale)[topo.tets]
     g = np.linalg.solve(p[:, 1:] - p[:, :1], (v[:, 1:] - v[:, :1])[..., None])[..., 0]
-    expected["ptModulate"] = np.concatenate([g, (v[:, 0] - np.einsum("ij,ij->i", g, p[:, 0]))[:, None]], axis=1)
+    c = v[:, 0] - np.einsum("ij,ij->i", g, p[:, 0] + topo.origin - b.centre)   # the form relative to b.centre
+    expected["ptModulate"] = np.concatenate([g, c[:, None]], axis=1)
+    s = mesh.scalars[topo.tets]
+    gs = expected["ptScalar"][:, :3].astype(np.float64)
+    expected["ptScalar"] = np.concatenate([gs, (s[:, 0] - np.einsum("ij,ij->i", gs, p[:, 0] + topo.origin
+                                                                     - b.centre))[:, None]], axis=1)
+    for f in range(4):                                   # planes n . x = d relative to b.centre
+        n = expected[f"ptPlane{f}"][:, :3].astype(np.float64)
+        d = expected[f"ptPlane{f}"][:, 3] + np.einsum("ij,j->i", n, topo.origin - b.centre)
+        expected[f"ptPlane{f}"] = np.concatenate([n, d[:, None]], axis=1)
     assert set(b.attributes) == set(expected)
     for name, cell in expected.items():
         got = b.attributes[name]
         assert got.shape == (4 * len(cell), 4) and got.dtype == np.float32
-        scale = np.abs(cell).max()
-        np.testing.assert_allclose(got, np.repeat(cell, 4, axis=0), rtol=1e-5, atol=1e-6 * scale, err_msg=name)
+        scale = max(np.abs(cell).max(), 1e-12)
+        np.testing.assert_allclose(got, np.repeat(cell, 4, axis=0), rtol=1e-5, atol=1e-5 * scale, err_msg=name)
 
 
 def test_culling_matches_visible_cells():
-    mesh, modulation = _mesh(seed=4)
-    shading = CloudShading.npr(cutoff=0.5)                   # a TF that is zero below 0.5
-    b = cloud_buffers(mesh, modulation, shading)
+    shading = CloudShading.npr(cutoff=0.3)
+    frame, vol, eye = _frame(EYES[0], shading)
+    b = cloud_buffers(frame, shading, eye, modulation_scale(vol, shading))
+    mesh, _ = frame.to_tetmesh(shading.table_field, eye=eye)
     expected = visible_cells(mesh, shading.tf.scalars, shading.tf.extinction)
     assert 0 < expected.sum() < len(expected)
     np.testing.assert_array_equal(b.visible, expected)

@@ -8,26 +8,27 @@ drawn by VTK's OpenGL pipeline into the scene's own depth buffer (Roettger Ch. 1
 - Prism layers (ground fog, cloud layers between two height fields; §10.3-10.4): one ``volviz.render.gl_fog.
   GLFogLayer`` each, on the frame's C-LOD terrain triangles and morphed layer heights (``GLFogLayer.set_geometry``
   every frame: the prisms follow the terrain's LOD as on the CPU), reading the opaque depth of the terrain and sky.
-- Clouds (§11.3-11.6): the frame's C-LOD leaves as 5 tetrahedra each (``CloudFrame.to_tetmesh``, back to front)
-  with the morphed table field, drawn by ``CloudPTVolume``, a ``volviz.render.gl_pt.GLPTVolume`` whose fragments
+- Clouds (§11.3-11.6): the frame's C-LOD leaves as 5 tetrahedra each (split and ordered back to front as
+  ``CloudFrame.to_tetmesh`` does, written straight into the vertex buffer by ``cloud_buffers``) with the morphed
+  table field, drawn by ``CloudPTVolume``, a ``volviz.render.gl_pt.GLPTVolume`` whose fragments
   scale the segment length by the second field as the CPU clouds do (Eq. 11.9, l' = l m̄ with m the modulating field
   over its maximum at the middle of the segment; NPR §11.6.2: the table is indexed by f, γ modulates), looked up in
   the scene's own cloud table (the CPU's, 64 x 64 x 128 over the root cube's diagonal).
 - The layers are composited in ``NatureScene.volume_order`` (farthest layer first), the CPU's order: their actors
   are re-added to the renderer in that order when it changes.
 
-``compute`` (any thread) does the LOD work and builds the vertex buffers as NumPy arrays: the terrain's C-LOD mesh,
-the clouds' refinement, morphing and leaf list, the tetrahedra's face planes, cell attributes and modulation forms
-(``cloud_buffers``, one Numba pass) and each layer's per-point heights and emissions (``gl_fog.prism_buffers``; the
-prisms are made by a geometry shader); ``finish`` (GUI thread) only hands them to
-VTK, sharing the arrays (``gl_fog.buffers_polydata``), and VTK uploads them and draws everything at the next render,
-at the window's full size (a preview ``scale`` is ignored). No image is made on the CPU. (The first frame's cloud
-volume also builds gl_pt's own buffer once, in its constructor.)
+``compute`` (any thread) does the LOD work and builds the vertex buffers as NumPy arrays, in two threads (the
+Numba kernels release the GIL): the terrain's C-LOD mesh and each layer's per-point heights and emissions
+(``gl_fog.prism_buffers``; the prisms are made by a geometry shader) on one, the clouds' refinement, morphing, leaf
+list and per-tetrahedron face planes, table-field and modulation forms (``cloud_buffers``, one Numba pass over the
+leaves) on the other; ``finish`` (GUI thread) only hands them to VTK, sharing the arrays
+(``gl_fog.buffers_polydata``), and VTK uploads them and draws everything at the next render, at the window's full
+size (a preview ``scale`` is ignored). No image is made on the CPU.
 
 What ``GLPTVolume`` lacks for the clouds (``CloudPTVolume`` works around it through its private members, listed
 there): a per-cell length modulation attribute, a caller-given back-to-front order (the leaves' BSP order; MPVO would
 sample the non-conforming leaf mesh's boundaries), a caller-given table (its own is built per mesh over the mesh's
-longest edge), and a public way to replace the mesh. Per frame the cloud vertex buffer is rebuilt and uploaded:
+longest edge), and a public way to replace the mesh by a frame's buffers. Per frame the cloud vertex buffer is rebuilt and uploaded:
 4 vertices x 31 float32 per tetrahedron (496 bytes) plus 12 indices (48 bytes), ``stats["cloud_upload_bytes"]``.
 
 Errors against the CPU ``NatureView`` of the same camera and LOD (8-bit screen units), measured on llvmpipe in
@@ -36,6 +37,7 @@ Errors against the CPU ``NatureView`` of the same camera and LOD (8-bit screen u
 from __future__ import annotations
 
 import time
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from types import SimpleNamespace
 from typing import Any
@@ -43,15 +45,15 @@ from typing import Any
 import numpy as np
 
 from volviz.model.datasets import TetMesh
-from volviz.nature.clouds import CloudFrame, CloudShading
+from volviz.nature.clouds import CloudFrame, CloudShading, CloudVolume
 from volviz.nature.nature_scene import NatureScene
 from volviz.render.nature_view import NatureView
 from volviz.render.gl_fog import GLFogLayer, buffers_polydata, prism_buffers
-from volviz.render.gl_pt import GLPTVolume, shader_source
+from volviz.render.gl_pt import GLPTVolume, _resolve_polydata, shader_source
 from volviz.render.image_overlay import hold_single_sample, release_single_sample
-from volviz.unstructured.topology import topology, visible_ranges
+from volviz.unstructured.topology import visible_ranges
 
-__all__ = ["CloudBuffers", "CloudPTVolume", "GLNatureView", "cloud_buffers", "cloud_tetrahedra"]
+__all__ = ["CloudBuffers", "CloudPTVolume", "GLNatureView", "cloud_buffers", "modulation_scale"]
 
 BYTES_PER_TET = 4 * 31 * 4 + 12 * 4         # vertex buffer (4 vertices x 31 float32) + index buffer (12 uint32)
 
@@ -74,76 +76,101 @@ def _patched(name: str, patches: tuple[tuple[str, str], ...]) -> str:
     return text
 
 
-def cloud_tetrahedra(frame: CloudFrame, shading: CloudShading, eye: Any) -> tuple[TetMesh, np.ndarray]:
-    """The frame's leaves as tetrahedra in back-to-front order for ``eye`` with the morphed table field, and the
-    modulating field per point over its maximum (the CPU's ``m_scale``): γ / γ_max for NPR, f / f_max otherwise."""
-    vol = frame.lod.volume
-    mesh, other = frame.to_tetmesh(shading.table_field, eye=eye)
-    m_max = float(vol.gamma.max() if shading.table_field == "f" else vol.f.max())
-    return mesh, other / max(m_max, 1e-12)
+def modulation_scale(volume: CloudVolume, shading: CloudShading) -> float:
+    """The modulating field's maximum (the CPU's ``m_scale``): γ_max for NPR (table field f), f_max otherwise."""
+    return max(float(volume.gamma.max() if shading.table_field == "f" else volume.f.max()), 1e-12)
 
 
 @dataclass
 class CloudBuffers:
     """A frame's cloud vertex buffer as NumPy arrays (``cloud_buffers``, any thread): ``points`` (4m, 3) float32
-    relative to the mesh's centre, ``attributes`` (gl_pt's cell attributes and ``ptModulate``, (4m, 4) float32, each
-    tetrahedron's at its 4 vertices), ``visible`` (m,) the cells with some opacity under the cloud TF."""
+    relative to ``centre`` (the cloud volume's), ``attributes`` (gl_pt's cell attributes and ``ptModulate``, (4m, 4)
+    float32, each tetrahedron's at its 4 vertices), ``visible`` (m,) the tetrahedra with some opacity under the cloud
+    TF; the tetrahedra are in back-to-front order. ``bounds`` (3, 2): the volume's box relative to the centre."""
 
     points: np.ndarray
     attributes: dict[str, np.ndarray]
     visible: np.ndarray
+    centre: np.ndarray
+    bounds: np.ndarray
+
+    @property
+    def n_tets(self) -> int:
+        return int(len(self.visible))
 
 
-def cloud_buffers(mesh: TetMesh, modulation: np.ndarray, shading: CloudShading) -> CloudBuffers:
-    """Any thread (Numba, releasing the GIL): the vertex buffer of ``CloudPTVolume`` for ``mesh`` (finite scalars)
-    and its per-point ``modulation`` (gl_pt's buffer, 4 vertices per tetrahedron with its cell attributes, and the
-    modulation form; ``_cloud_buffer_kernels.cloud_vertex_buffer``) and the TF's culling from the cells' ranges."""
-    from volviz.render._cloud_buffer_kernels import cloud_vertex_buffer
+def cloud_buffers(frame: CloudFrame, shading: CloudShading, eye: Any, m_scale: float) -> CloudBuffers:
+    """Any thread (Numba, releasing the GIL): the vertex buffer of ``CloudPTVolume`` for a frame's leaves, 5
+    tetrahedra each in back-to-front order for ``eye`` with the morphed table field and the modulating field over
+    ``m_scale`` (``modulation_scale``), as ``CloudFrame.to_tetmesh`` splits and orders them
+    (``_cloud_buffer_kernels.leaf_vertex_buffer``), and the TF's culling from the tetrahedra's ranges."""
+    from volviz.render._cloud_buffer_kernels import leaf_vertex_buffer
 
-    topo = topology(mesh)
-    pos, attr, ranges = cloud_vertex_buffer(topo.points, topo.tets, topo.face_n, topo.face_d,
-                                    np.asarray(mesh.scalars, np.float64), np.asarray(modulation, np.float64))
+    vol = frame.lod.volume
+    vf, vg = frame.lod.morphed
+    table, other = (vf, vg) if shading.table_field == "f" else (vg, vf)
+    origin = np.asarray(vol.origin, np.float64)
+    spacing = np.asarray(vol.spacing, np.float64)
+    centre = origin + 0.5 * (np.asarray(vol.shape, np.float64) - 1.0) * spacing
+    pos, attr, ranges = leaf_vertex_buffer(np.ascontiguousarray(frame.leaves, np.int64), int(vol.root),
+                                           np.asarray(vol.shape, np.int64), origin, spacing, centre,
+                                           table.reshape(-1), other.reshape(-1), float(m_scale),
+                                           np.asarray(eye, np.float64).reshape(3))
     names = [f"ptPlane{f}" for f in range(4)] + ["ptScalar", "ptRange", "ptModulate"]
     visible = visible_ranges(ranges[:, 0], ranges[:, 1], shading.tf.scalars, shading.tf.extinction)
-    return CloudBuffers(pos, {name: attr[k] for k, name in enumerate(names)}, visible)
+    half = 0.5 * (np.asarray(vol.shape, np.float64) - 1.0) * spacing
+    return CloudBuffers(pos, {name: attr[k] for k, name in enumerate(names)}, visible, centre,
+                        np.stack([-half, half], axis=1))
+
+
+@dataclass
+class _FrameGeometry:
+    """What ``GLPTVolume``'s draw reads of its ``topo`` for a frame drawn in a given order: the actor's origin (the
+    ray basis is taken relative to it) and the number of tetrahedra."""
+
+    origin: np.ndarray
+    n_tets: int
 
 
 class CloudPTVolume(GLPTVolume):
     """C-LOD cloud tetrahedra on the GPU PT pass (module docstring): the shading's table, the length modulated per
-    fragment (Eq. 11.9), the given back-to-front order, and ``set_frame`` for the next frame's mesh.
+    fragment (Eq. 11.9), the given back-to-front order, and ``set_frame`` for the next frame's buffers.
 
     Private members of ``GLPTVolume`` used (what a public API would replace): ``_build_table`` (overridden to return
     the scene's table), ``_sorted`` / ``_sorted_key`` / ``_order_key`` (the given order, kept by ``reuse_order``),
-    ``_vis`` (culling of the new mesh)."""
+    ``_vis`` (culling of the new frame), ``topo`` (``_FrameGeometry``: a frame has no mesh topology)."""
 
-    def __init__(self, plotter: Any, mesh: TetMesh, buffers: CloudBuffers, shading: CloudShading, table: Any
-                 ) -> None:
+    def __init__(self, plotter: Any, buffers: CloudBuffers, shading: CloudShading, table: Any) -> None:
         import vtk
 
         self._cloud_table = table
-        super().__init__(plotter, mesh, shading.tf, lookup="3d")
+        # GLPTVolume is made on one tetrahedron (its own buffer is replaced by the frame's at once)
+        one = TetMesh(np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]),
+                      np.array([[0, 1, 2, 3]]), np.zeros(4))
+        super().__init__(plotter, one, shading.tf, lookup="3d")
         sp = self.actor.GetShaderProperty()
         sp.SetVertexShaderCode(_patched("pt_tet_vs.glsl", _VS_PATCH))
         sp.SetFragmentShaderCode(_patched("pt_tet_fs.glsl", _FS_PATCH))
         self.mapper.MapDataArrayToVertexAttribute("ptModulate", "ptModulate",
                                                   vtk.vtkDataObject.FIELD_ASSOCIATION_POINTS, -1)
         self.stats = {"method": "pt-gl clouds"}
-        self.set_frame(mesh, buffers)
+        self.set_frame(buffers)
 
     def _build_table(self) -> Any:
         return self._cloud_table
 
-    def set_frame(self, mesh: TetMesh, buffers: CloudBuffers) -> None:
+    def set_frame(self, buffers: CloudBuffers) -> None:
         """The next frame's tetrahedra (back to front) as ``cloud_buffers`` made them: a new vertex buffer (shared
-        with VTK, uploaded at the next render), the mesh's own order for every camera, the same table."""
-        self.mesh = self.whole_mesh = mesh
-        self.topo = topology(mesh)
+        with VTK, uploaded at the next render), their own order for every camera, the same table."""
+        self.topo = _FrameGeometry(np.asarray(buffers.centre, np.float64), buffers.n_tets)  # type: ignore[assignment]
         self._vis = buffers.visible
         self.polydata = buffers_polydata(buffers.points, buffers.attributes)
         self.mapper.SetInputData(self.polydata)
-        self.actor.SetPosition(*self.topo.origin)
+        self.actor.SetPosition(*buffers.centre)
+        self.resolve_mapper.SetInputData(_resolve_polydata(buffers.bounds))    # VTK culls the resolve by these
+        self.resolve_actor.SetPosition(*buffers.centre)
         self.reuse_order = True
-        self._sorted = np.arange(self.topo.n_tets, dtype=np.int64)
+        self._sorted = np.arange(buffers.n_tets, dtype=np.int64)
         self._sorted_key = self._order_key = None
 
 
@@ -159,41 +186,51 @@ class GLNatureView(NatureView):
         super().__init__(plotter, scene, size, filter_texture)
         self.layers: dict[str, GLFogLayer] = {}
         self.clouds: CloudPTVolume | None = None
+        self._m_scale: float | None = None
         hold_single_sample(plotter, self)       # the float targets are single-sample (gl_pt)
 
     def compute(self, request: tuple[Any, tuple[int, int], int],
                 progress: Any = None) -> tuple[Any, Any, dict[str, float]]:
         """Any thread: the LOD work of a frame (no image): the terrain's C-LOD mesh as VTK poly data and as the
-        ``TerrainMesh`` the prisms stand on, the clouds' tetrahedra with their vertex buffer (``cloud_buffers``), each
-        prism layer's vertex buffer (``prism_buffers``), statistics (``lod_s``: seconds spent here)."""
+        ``TerrainMesh`` the prisms stand on with each prism layer's vertex buffer (``prism_buffers``), on a second
+        thread meanwhile the clouds' refinement, morphing and vertex buffer (``cloud_buffers``; both parts run
+        Numba kernels that release the GIL), statistics (``lod_s``: seconds spent here)."""
         cam, size, _ = request
         t0 = time.perf_counter()
         scene = self.scene
-        mesh = scene.terrain_mesh(cam, size)
         stats: dict[str, float] = {}
-        poly = None
+        with ThreadPoolExecutor(max_workers=1) as pool:
+            terrain = pool.submit(self._terrain_part, cam, size)
+            clouds = None
+            if scene.cloud_lod is not None:
+                if progress is not None:
+                    progress(0.3, "clouds")
+                assert scene.cloud_shading is not None
+                frame = scene.cloud_lod.update(cam, size)
+                if self._m_scale is None:
+                    self._m_scale = modulation_scale(scene.cloud_lod.volume, scene.cloud_shading)
+                clouds = cloud_buffers(frame, scene.cloud_shading, cam.position, self._m_scale)
+                stats["cloud_tets"] = float(frame.n_tets)
+                stats["cloud_upload_bytes"] = float(frame.n_tets * BYTES_PER_TET)
+            mesh, poly, prisms = terrain.result()
         if mesh is not None:
-            poly = mesh.to_pyvista()
             stats["terrain_triangles"] = float(mesh.n_triangles)
-        clouds = None
-        if scene.cloud_lod is not None:
-            if progress is not None:
-                progress(0.5, "clouds")
-            assert scene.cloud_shading is not None
-            frame = scene.cloud_lod.update(cam, size)
-            tets, modulation = cloud_tetrahedra(frame, scene.cloud_shading, cam.position)
-            clouds = (tets, cloud_buffers(tets, modulation, scene.cloud_shading))
-            stats["cloud_tets"] = float(frame.n_tets)
-            stats["cloud_upload_bytes"] = float(frame.n_tets * BYTES_PER_TET)
-        prisms = {}
-        if mesh is not None:
-            for fog in scene.fogs:
-                bottom = mesh.points[:, 2] if fog.bottom == "terrain" else mesh.layers[fog.bottom]
-                geometry = (mesh.points, bottom, mesh.layers[fog.top], mesh.triangles)
-                prisms[fog.name] = (geometry, prism_buffers(*geometry, layer=fog.layer))
         stats["lod_s"] = time.perf_counter() - t0
         return poly, SimpleNamespace(mesh=mesh, clouds=clouds, prisms=prisms,
                                      eye=np.asarray(cam.position, np.float64)), stats
+
+    def _terrain_part(self, cam: Any, size: tuple[int, int]) -> tuple[Any, Any, dict[str, Any]]:
+        """The terrain's C-LOD mesh, as VTK poly data, and each prism layer's (geometry, ``prism_buffers``)."""
+        scene = self.scene
+        mesh = scene.terrain_mesh(cam, size)
+        if mesh is None:
+            return None, None, {}
+        prisms = {}
+        for fog in scene.fogs:
+            bottom = mesh.points[:, 2] if fog.bottom == "terrain" else mesh.layers[fog.bottom]
+            geometry = (mesh.points, bottom, mesh.layers[fog.top], mesh.triangles)
+            prisms[fog.name] = (geometry, prism_buffers(*geometry, layer=fog.layer))
+        return mesh, mesh.to_pyvista(), prisms
 
     def finish(self, request: tuple[Any, tuple[int, int], int], poly: Any, frame: Any,
                stats: dict[str, float]) -> dict[str, float]:
@@ -213,10 +250,9 @@ class GLNatureView(NatureView):
             elif kind == "clouds" and frame.clouds is not None:
                 if self.clouds is None:
                     assert scene.cloud_shading is not None
-                    tets, cloud = frame.clouds
-                    self.clouds = CloudPTVolume(self.plotter, tets, cloud, scene.cloud_shading, scene.cloud_table)
+                    self.clouds = CloudPTVolume(self.plotter, frame.clouds, scene.cloud_shading, scene.cloud_table)
                 else:
-                    self.clouds.set_frame(*frame.clouds)
+                    self.clouds.set_frame(frame.clouds)
         stats["fog_prisms"] = float(sum(layer.drawn for layer in self.layers.values()))
         self._sort_layers(frame.eye)
         stats["upload_s"] = time.perf_counter() - t0

@@ -444,7 +444,7 @@ class GLPTVolume(PTView):
         numpy arrays shared with VTK (kept referenced here), VTK builds and uploads the index buffer from them."""
         from vtk.util.numpy_support import numpy_to_vtk
 
-        if len(self.topo.tets) * 4 >= 2 ** 31:
+        if self.topo.n_tets * 4 >= 2 ** 31:
             raise ValueError("too many tetrahedra for 32-bit vertex indices")
         offsets, conn = _triangles(cells, self._offsets)
         self._offsets = offsets.base if offsets.base is not None else offsets
