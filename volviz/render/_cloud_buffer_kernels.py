@@ -7,13 +7,13 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
+from volviz.unstructured.topology import FACES, face_plane
+
 N_ATTRIBUTES = 7     # ptPlane0..3, ptScalar, ptRange, ptModulate (gl_pt's cell attributes and the clouds' one)
 
 #: the 5 tetrahedra of a leaf cube by corner (q = 4 i + 2 j + k), for even and odd leaves (``CloudFrame.to_tetmesh``)
 EVEN = np.array([[0, 6, 5, 3], [4, 0, 6, 5], [2, 0, 6, 3], [1, 0, 5, 3], [7, 6, 5, 3]], dtype=np.int64)
 ODD = np.array([[4, 2, 1, 7], [0, 4, 2, 1], [6, 4, 2, 7], [5, 4, 1, 7], [3, 2, 1, 7]], dtype=np.int64)
-#: face f of a tetrahedron: the face opposite vertex f (``volviz.unstructured.topology.FACES``)
-FACES = np.array([[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]], dtype=np.int64)
 
 
 @njit(cache=True, nogil=True)
@@ -130,15 +130,7 @@ def _leaf(leaves: np.ndarray, leaf: int, root: int, ny: int, nz: int, origin: np
             sv[2], sv[3] = sv[3], sv[2]
             mv[2], mv[3] = mv[3], mv[2]
         for f in range(4):
-            i0, i1, i2 = FACES[f, 0], FACES[f, 1], FACES[f, 2]
-            ux, uy, uz = p[i1, 0] - p[i0, 0], p[i1, 1] - p[i0, 1], p[i1, 2] - p[i0, 2]
-            wx, wy, wz = p[i2, 0] - p[i0, 0], p[i2, 1] - p[i0, 1], p[i2, 2] - p[i0, 2]
-            nx, ny_, nz_ = uy * wz - uz * wy, uz * wx - ux * wz, ux * wy - uy * wx
-            nn = np.sqrt(nx * nx + ny_ * ny_ + nz_ * nz_)
-            if nn > 0:
-                nx, ny_, nz_ = nx / nn, ny_ / nn, nz_ / nn
-            cell[f, 0], cell[f, 1], cell[f, 2] = nx, ny_, nz_
-            cell[f, 3] = nx * p[i0, 0] + ny_ * p[i0, 1] + nz_ * p[i0, 2]
+            cell[f, 0], cell[f, 1], cell[f, 2], cell[f, 3] = face_plane(p, FACES[f, 0], FACES[f, 1], FACES[f, 2])
         _affine(p, sv, cell[4], e, em, g)
         cell[5, 0] = min(min(sv[0], sv[1]), min(sv[2], sv[3]))
         cell[5, 1] = max(max(sv[0], sv[1]), max(sv[2], sv[3]))

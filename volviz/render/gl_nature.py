@@ -28,8 +28,9 @@ size (a preview ``scale`` is ignored). No image is made on the CPU.
 What ``GLPTVolume`` lacks for the clouds (``CloudPTVolume`` works around it through its private members, listed
 there): a per-cell length modulation attribute, a caller-given back-to-front order (the leaves' BSP order; MPVO would
 sample the non-conforming leaf mesh's boundaries), a caller-given table (its own is built per mesh over the mesh's
-longest edge), and a public way to replace the mesh by a frame's buffers. Per frame the cloud vertex buffer is rebuilt and uploaded:
-4 vertices x 31 float32 per tetrahedron (496 bytes) plus 12 indices (48 bytes), ``stats["cloud_upload_bytes"]``.
+longest edge), and a public way to replace the mesh by a frame's buffers. Per frame the cloud vertex buffer is
+rebuilt and uploaded: 4 vertices x 31 float32 per tetrahedron (496 bytes) plus 12 indices (48 bytes),
+``stats["cloud_upload_bytes"]``.
 
 Errors against the CPU ``NatureView`` of the same camera and LOD (8-bit screen units), measured on llvmpipe in
 ``tests/test_render_gl_nature.py``: see the bounds there.

@@ -75,6 +75,19 @@ def _face_adjacency(tets: np.ndarray) -> np.ndarray:
     return neighbor.reshape(m, 4)
 
 
+@njit(cache=True, nogil=True)
+def face_plane(p: np.ndarray, i0: int, i1: int, i2: int) -> tuple[float, float, float, float]:
+    """The plane (nx, ny, nz, d) of the face (i0, i1, i2) of the corners ``p`` (4, 3): unit normal (p1 - p0) x
+    (p2 - p0) (zero for a degenerate face) and n . x = d on it; outward for ``FACES`` of a positive tetrahedron."""
+    ux, uy, uz = p[i1, 0] - p[i0, 0], p[i1, 1] - p[i0, 1], p[i1, 2] - p[i0, 2]
+    wx, wy, wz = p[i2, 0] - p[i0, 0], p[i2, 1] - p[i0, 1], p[i2, 2] - p[i0, 2]
+    nx, ny, nz = uy * wz - uz * wy, uz * wx - ux * wz, ux * wy - uy * wx
+    nn = np.sqrt(nx * nx + ny * ny + nz * nz)
+    if nn > 0:
+        nx, ny, nz = nx / nn, ny / nn, nz / nn
+    return nx, ny, nz, nx * p[i0, 0] + ny * p[i0, 1] + nz * p[i0, 2]
+
+
 @njit(cache=True, nogil=True, parallel=True)
 def _geometry(pts: np.ndarray, tets: np.ndarray, faces: np.ndarray, n: np.ndarray, d: np.ndarray,
               centroid: np.ndarray, circ_center: np.ndarray, circ_r2: np.ndarray) -> float:
@@ -101,15 +114,7 @@ def _geometry(pts: np.ndarray, tets: np.ndarray, faces: np.ndarray, n: np.ndarra
                 e[1, a], e[2, a] = e[2, a], e[1, a]
             vol = -vol
         for f in range(4):
-            i0, i1, i2 = faces[f, 0], faces[f, 1], faces[f, 2]
-            ux, uy, uz = p[i1, 0] - p[i0, 0], p[i1, 1] - p[i0, 1], p[i1, 2] - p[i0, 2]
-            wx, wy, wz = p[i2, 0] - p[i0, 0], p[i2, 1] - p[i0, 1], p[i2, 2] - p[i0, 2]
-            nx, ny, nz = uy * wz - uz * wy, uz * wx - ux * wz, ux * wy - uy * wx
-            nn = np.sqrt(nx * nx + ny * ny + nz * nz)
-            if nn > 0:
-                nx, ny, nz = nx / nn, ny / nn, nz / nn
-            n[c, f, 0], n[c, f, 1], n[c, f, 2] = nx, ny, nz
-            d[c, f] = nx * p[i0, 0] + ny * p[i0, 1] + nz * p[i0, 2]
+            n[c, f, 0], n[c, f, 1], n[c, f, 2], d[c, f] = face_plane(p, faces[f, 0], faces[f, 1], faces[f, 2])
         for a in range(3):
             centroid[c, a] = 0.25 * (p[0, a] + p[1, a] + p[2, a] + p[3, a])
         r0 = 0.5 * (e[0, 0] ** 2 + e[0, 1] ** 2 + e[0, 2] ** 2)
