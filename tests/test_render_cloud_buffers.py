@@ -2,7 +2,7 @@
 ``volviz.render._cloud_buffer_kernels.leaf_vertex_buffer``; Roettger §11.3-11.6 drawn by the GPU PT pass) against the
 NumPy formulation of the same quantities: the frame's tetrahedral mesh in back-to-front order
 (``CloudFrame.to_tetmesh``), gl_pt's cell attributes of it (face planes, scalar form, scalar range), the modulation
-form solved per cell with ``numpy.linalg.solve``, each repeated at the cell's 4 vertices, and the TF's culling of
+form solved per cell with ``numpy.linalg.solve``, the positions at the cell's 4 vertices, and the TF's culling of
 ``volviz.unstructured.topology.visible_cells``."""
 from __future__ import annotations
 
@@ -32,7 +32,7 @@ def _frame(eye, shading):
 
 @pytest.mark.parametrize("eye", EYES)
 @pytest.mark.parametrize("table_field", ["f", "gamma"])
-def test_buffer_matches_the_numpy_attributes_at_every_vertex(eye, table_field):
+def test_buffers_match_the_numpy_cell_attributes(eye, table_field):
     shading = CloudShading.npr() if table_field == "f" else CloudShading.physical()
     frame, vol, eye = _frame(eye, shading)
     assert frame.n_tets > 50 and len(np.unique(frame.leaves[:, 0])) > 1        # leaves of several levels
@@ -57,12 +57,12 @@ def test_buffer_matches_the_numpy_attributes_at_every_vertex(eye, table_field):
         n = expected[f"ptPlane{f}"][:, :3].astype(np.float64)
         d = expected[f"ptPlane{f}"][:, 3] + np.einsum("ij,j->i", n, topo.origin - b.centre)
         expected[f"ptPlane{f}"] = np.concatenate([n, d[:, None]], axis=1)
-    assert set(b.attributes) == set(expected)
-    for name, cell in expected.items():
-        got = b.attributes[name]
-        assert got.shape == (4 * len(cell), 4) and got.dtype == np.float32
+    names = [f"ptPlane{f}" for f in range(4)] + ["ptScalar", "ptRange", "ptModulate"]
+    assert b.cells.shape == (mesh.n_cells, 7, 4) and b.cells.dtype == np.float32
+    for k, name in enumerate(names):
+        cell = expected[name]
         scale = max(np.abs(cell).max(), 1e-12)
-        np.testing.assert_allclose(got, np.repeat(cell, 4, axis=0), rtol=1e-5, atol=1e-5 * scale, err_msg=name)
+        np.testing.assert_allclose(b.cells[:, k], cell, rtol=1e-5, atol=1e-5 * scale, err_msg=name)
 
 
 def test_culling_matches_visible_cells():

@@ -39,6 +39,9 @@ def _shot(cls, scene, cam) -> tuple[np.ndarray, dict, object]:
     view = cls(pl, scene)
     stats = view.update(cam)
     img = pl.screenshot(return_img=True).astype(np.float64)
+    if getattr(view, "clouds", None) is not None:   # what the GPU holds: positions and the cell buffer texture
+        stats = dict(stats, cell_buffer_bytes=view.clouds._cell_buffer.GetSize(),
+                     vertices=view.clouds.polydata.GetNumberOfPoints())
     actors = set(pl.actors)
     view.remove()
     pl.close()
@@ -71,7 +74,10 @@ def test_demo_scene_gpu_matches_cpu(demo, eye, focus) -> None:
     cam = Camera(eye, focus, (0.0, 0.0, 1.0), 60.0, clipping_range=(5.0, 10000.0))
     st_cpu, st_gpu = _compare(demo, cam, 0.75, "demo")
     assert st_gpu["cloud_tets"] == st_cpu["cloud_tets"] > 0      # the same LOD
-    assert st_gpu["cloud_upload_bytes"] == 544 * st_gpu["cloud_tets"]
+    tets = st_gpu["cloud_tets"]
+    # uploaded per tetrahedron: 4 positions (48 bytes), 7 RGBA float texels of cell data (112), 12 indices (48)
+    assert st_gpu["cell_buffer_bytes"] == 112 * tets and st_gpu["vertices"] == 4 * tets
+    assert st_gpu["cloud_upload_bytes"] == 208 * tets
     assert st_gpu["fog_prisms"] > 0
 
 

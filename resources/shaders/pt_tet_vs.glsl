@@ -24,12 +24,7 @@ flat out vec4 cellBary;
 
 uniform mat4 MCDCMatrix;
 
-flat out vec4 cellPlane0;
-flat out vec4 cellPlane1;
-flat out vec4 cellPlane2;
-flat out vec4 cellPlane3;
-flat out vec4 cellScalar;
-flat out vec4 cellRange;
+//VOLVIZ::include pt_cell_out.glsl
 
 void main()
 {

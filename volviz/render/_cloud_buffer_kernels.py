@@ -1,7 +1,8 @@
-"""Numba kernel of ``volviz.render.gl_nature.cloud_buffers``: the GPU PT pass's vertex buffer for a frame's cloud
-leaves (Roettger §11.3-11.6 drawn by ``volviz.render.gl_pt``), written in one parallel pass over the leaves: each
-leaf's 5 tetrahedra (``CloudFrame.to_tetmesh``'s split and back-to-front order within the leaf) with their corners,
-face planes and the affine forms of the table field and the modulating field, without building a tetrahedral mesh."""
+"""Numba kernel of ``volviz.render.gl_nature.cloud_buffers``: the GPU PT pass's vertex positions and per-tetrahedron
+cell data for a frame's cloud leaves (Roettger §11.3-11.6 drawn by ``volviz.render.gl_pt``), written in one parallel
+pass over the leaves: each leaf's 5 tetrahedra (``CloudFrame.to_tetmesh``'s split and back-to-front order within the
+leaf) with their corners, face planes and the affine forms of the table field and the modulating field, without
+building a tetrahedral mesh."""
 from __future__ import annotations
 
 import numpy as np
@@ -48,15 +49,15 @@ def leaf_vertex_buffer(leaves: np.ndarray, root: int, shape: np.ndarray, origin:
     """For the frame's ``leaves`` (L, 4: level, a, b, c; back to front) of a cloud volume (``shape`` points, octree
     ``root`` size, grid ``origin`` and ``spacing``) with the morphed ``table`` and ``other`` fields (flat, C order):
     per tetrahedron, 5 per leaf in back-to-front order for ``eye`` (the corner tetrahedra behind the central one, the
-    central one, those in front), the vertex positions relative to ``centre`` (20L, 3) float32; the attributes
-    (7, 20L, 4) float32 at each vertex: the four unit outward face planes (n, d) (vertices 2 and 3 swapped where the
-    tetrahedron is negatively oriented), the table field's affine form (g, c), its (min, max, 0, 0), and the affine
-    form of ``other`` / ``m_scale`` (the length modulation, Eq. 11.9); and the table field's (min, max) per
-    tetrahedron as float64 (5L, 2), for the TF's culling."""
+    central one, those in front), the vertex positions relative to ``centre`` (20L, 3) float32 (tetrahedron t's at
+    4 t ... 4 t + 3); the cell data (5L, 7, 4) float32 per tetrahedron: the four unit outward face planes (n, d)
+    (vertices 2 and 3 swapped where the tetrahedron is negatively oriented), the table field's affine form (g, c),
+    its (min, max, 0, 0), and the affine form of ``other`` / ``m_scale`` (the length modulation, Eq. 11.9); and the
+    table field's (min, max) per tetrahedron as float64 (5L, 2), for the TF's culling."""
     n_leaves = leaves.shape[0]
     m = 5 * n_leaves
     pos = np.empty((4 * m, 3), dtype=np.float32)
-    attr = np.empty((N_ATTRIBUTES, 4 * m, 4), dtype=np.float32)
+    cells = np.empty((m, N_ATTRIBUTES, 4), dtype=np.float32)
     ranges = np.empty((m, 2))
     ny, nz = shape[1], shape[2]
     chunks = min(n_leaves, 64)
@@ -73,15 +74,15 @@ def leaf_vertex_buffer(leaves: np.ndarray, root: int, shape: np.ndarray, origin:
         g = np.empty(3)
         for leaf in range(chunk * n_leaves // chunks, (chunk + 1) * n_leaves // chunks):
             _leaf(leaves, leaf, root, ny, nz, origin, spacing, centre, table, other, m_scale, eye, u, front, order,
-                  p, sv, mv, cell, e, em, g, pos, attr, ranges)
-    return pos, attr, ranges
+                  p, sv, mv, cell, e, em, g, pos, cells, ranges)
+    return pos, cells, ranges
 
 
 @njit(cache=True, nogil=True)
 def _leaf(leaves: np.ndarray, leaf: int, root: int, ny: int, nz: int, origin: np.ndarray, spacing: np.ndarray,
           centre: np.ndarray, table: np.ndarray, other: np.ndarray, m_scale: float, eye: np.ndarray, u: np.ndarray,
           front: np.ndarray, order: np.ndarray, p: np.ndarray, sv: np.ndarray, mv: np.ndarray, cell: np.ndarray,
-          e: np.ndarray, em: np.ndarray, g: np.ndarray, pos: np.ndarray, attr: np.ndarray, ranges: np.ndarray
+          e: np.ndarray, em: np.ndarray, g: np.ndarray, pos: np.ndarray, cells: np.ndarray, ranges: np.ndarray
           ) -> None:
     """One leaf of ``leaf_vertex_buffer``: its 5 tetrahedra at 5 * leaf ... (the arrays after ``eye`` are scratch)."""
     s = root >> leaves[leaf, 0]
@@ -141,6 +142,6 @@ def _leaf(leaves: np.ndarray, leaf: int, root: int, ny: int, nz: int, origin: np
         for v in range(4):
             for ax in range(3):
                 pos[4 * tet + v, ax] = p[v, ax]
-            for kk in range(N_ATTRIBUTES):
-                for ax in range(4):
-                    attr[kk, 4 * tet + v, ax] = cell[kk, ax]
+        for kk in range(N_ATTRIBUTES):
+            for ax in range(4):
+                cells[tet, kk, ax] = cell[kk, ax]

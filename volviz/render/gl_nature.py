@@ -28,9 +28,10 @@ size (a preview ``scale`` is ignored). No image is made on the CPU.
 What ``GLPTVolume`` lacks for the clouds (``CloudPTVolume`` works around it through its private members, listed
 there): a per-cell length modulation attribute, a caller-given back-to-front order (the leaves' BSP order; MPVO would
 sample the non-conforming leaf mesh's boundaries), a caller-given table (its own is built per mesh over the mesh's
-longest edge), and a public way to replace the mesh by a frame's buffers. Per frame the cloud vertex buffer is
-rebuilt and uploaded: 4 vertices x 31 float32 per tetrahedron (496 bytes) plus 12 indices (48 bytes),
-``stats["cloud_upload_bytes"]``.
+longest edge), and a public way to replace the mesh by a frame's buffers. Per frame the clouds' buffers are rebuilt
+and uploaded whole: the vertex positions (4 x 3 float32 per tetrahedron), the cell data as a buffer texture (7 RGBA
+float32 texels per tetrahedron, fetched by ``gl_VertexID / 4`` in ``cloud_tet_vs.glsl`` rather than repeated at the
+4 vertices as gl_pt's static buffer does) and 12 indices: 208 bytes per tetrahedron, ``stats["cloud_upload_bytes"]``.
 
 Errors against the CPU ``NatureView`` of the same camera and LOD (8-bit screen units), measured on llvmpipe in
 ``tests/test_render_gl_nature.py``: see the bounds there.
@@ -56,13 +57,11 @@ from volviz.unstructured.topology import visible_ranges
 
 __all__ = ["CloudBuffers", "CloudPTVolume", "GLNatureView", "cloud_buffers", "modulation_scale"]
 
-BYTES_PER_TET = 4 * 31 * 4 + 12 * 4         # vertex buffer (4 vertices x 31 float32) + index buffer (12 uint32)
+#: bytes uploaded per tetrahedron: 4 vertex positions (3 float32), 7 RGBA float32 texels of cell data, 12 indices
+BYTES_PER_TET = 4 * 3 * 4 + 7 * 16 + 12 * 4
 
-# (anchor in gl_pt's shader, text added after it): the modulation attribute passed through as a flat varying, and the
-# length scaled by the modulating field at the middle of the clipped segment
-_VS_PATCH = (("in vec4 ptRange;", "\nin vec4 ptModulate;"),
-             ("flat out vec4 cellRange;", "\nflat out vec4 cellModulate;"),
-             ("cellRange = ptRange;", "\n  cellModulate = ptModulate;"))
+# (anchor in gl_pt's fragment shader, text added after it): the modulation's flat varying, and the length scaled by
+# the modulating field at the middle of the clipped segment
 _FS_PATCH = (("flat in vec4 cellRange;", "\nflat in vec4 cellModulate;"),
              ("float len = (t1 - t0) * length(d);",
               "\n  len *= max(dot(cellModulate.xyz, o + 0.5 * (t0 + t1) * d) + cellModulate.w, 0.0);"))
@@ -84,13 +83,14 @@ def modulation_scale(volume: CloudVolume, shading: CloudShading) -> float:
 
 @dataclass
 class CloudBuffers:
-    """A frame's cloud vertex buffer as NumPy arrays (``cloud_buffers``, any thread): ``points`` (4m, 3) float32
-    relative to ``centre`` (the cloud volume's), ``attributes`` (gl_pt's cell attributes and ``ptModulate``, (4m, 4)
-    float32, each tetrahedron's at its 4 vertices), ``visible`` (m,) the tetrahedra with some opacity under the cloud
-    TF; the tetrahedra are in back-to-front order. ``bounds`` (3, 2): the volume's box relative to the centre."""
+    """A frame's cloud buffers as NumPy arrays (``cloud_buffers``, any thread): ``points`` (4m, 3) float32 vertex
+    positions relative to ``centre`` (the cloud volume's), ``cells`` (m, 7, 4) float32 per-tetrahedron data (gl_pt's
+    cell attributes and the modulation form: ``cloud_tet_vs.glsl`` fetches them from a buffer texture), ``visible``
+    (m,) the tetrahedra with some opacity under the cloud TF; the tetrahedra are in back-to-front order. ``bounds``
+    (3, 2): the volume's box relative to the centre."""
 
     points: np.ndarray
-    attributes: dict[str, np.ndarray]
+    cells: np.ndarray
     visible: np.ndarray
     centre: np.ndarray
     bounds: np.ndarray
@@ -101,9 +101,9 @@ class CloudBuffers:
 
 
 def cloud_buffers(frame: CloudFrame, shading: CloudShading, eye: Any, m_scale: float) -> CloudBuffers:
-    """Any thread (Numba, releasing the GIL): the vertex buffer of ``CloudPTVolume`` for a frame's leaves, 5
-    tetrahedra each in back-to-front order for ``eye`` with the morphed table field and the modulating field over
-    ``m_scale`` (``modulation_scale``), as ``CloudFrame.to_tetmesh`` splits and orders them
+    """Any thread (Numba, releasing the GIL): the buffers of ``CloudPTVolume`` for a frame's leaves, 5 tetrahedra
+    each in back-to-front order for ``eye`` with the morphed table field and the modulating field over ``m_scale``
+    (``modulation_scale``), as ``CloudFrame.to_tetmesh`` splits and orders them
     (``_cloud_buffer_kernels.leaf_vertex_buffer``), and the TF's culling from the tetrahedra's ranges."""
     from volviz.render._cloud_buffer_kernels import leaf_vertex_buffer
 
@@ -113,15 +113,13 @@ def cloud_buffers(frame: CloudFrame, shading: CloudShading, eye: Any, m_scale: f
     origin = np.asarray(vol.origin, np.float64)
     spacing = np.asarray(vol.spacing, np.float64)
     centre = origin + 0.5 * (np.asarray(vol.shape, np.float64) - 1.0) * spacing
-    pos, attr, ranges = leaf_vertex_buffer(np.ascontiguousarray(frame.leaves, np.int64), int(vol.root),
-                                           np.asarray(vol.shape, np.int64), origin, spacing, centre,
-                                           table.reshape(-1), other.reshape(-1), float(m_scale),
-                                           np.asarray(eye, np.float64).reshape(3))
-    names = [f"ptPlane{f}" for f in range(4)] + ["ptScalar", "ptRange", "ptModulate"]
+    pos, cells, ranges = leaf_vertex_buffer(np.ascontiguousarray(frame.leaves, np.int64), int(vol.root),
+                                            np.asarray(vol.shape, np.int64), origin, spacing, centre,
+                                            table.reshape(-1), other.reshape(-1), float(m_scale),
+                                            np.asarray(eye, np.float64).reshape(3))
     visible = visible_ranges(ranges[:, 0], ranges[:, 1], shading.tf.scalars, shading.tf.extinction)
     half = 0.5 * (np.asarray(vol.shape, np.float64) - 1.0) * spacing
-    return CloudBuffers(pos, {name: attr[k] for k, name in enumerate(names)}, visible, centre,
-                        np.stack([-half, half], axis=1))
+    return CloudBuffers(pos, cells, visible, centre, np.stack([-half, half], axis=1))
 
 
 @dataclass
@@ -135,25 +133,28 @@ class _FrameGeometry:
 
 class CloudPTVolume(GLPTVolume):
     """C-LOD cloud tetrahedra on the GPU PT pass (module docstring): the shading's table, the length modulated per
-    fragment (Eq. 11.9), the given back-to-front order, and ``set_frame`` for the next frame's buffers.
+    fragment (Eq. 11.9), the given back-to-front order, and ``set_frame`` for the next frame's buffers: a vertex
+    buffer of positions only and the cell data in a buffer texture (``cloud_tet_vs.glsl``), uploaded at the next
+    render.
 
     Private members of ``GLPTVolume`` used (what a public API would replace): ``_build_table`` (overridden to return
     the scene's table), ``_sorted`` / ``_sorted_key`` / ``_order_key`` (the given order, kept by ``reuse_order``),
-    ``_vis`` (culling of the new frame), ``topo`` (``_FrameGeometry``: a frame has no mesh topology)."""
+    ``_vis`` (culling of the new frame), ``topo`` (``_FrameGeometry``: a frame has no mesh topology),
+    ``_on_update_shader`` / ``_on_end`` (extended to bind the cell texture)."""
 
     def __init__(self, plotter: Any, buffers: CloudBuffers, shading: CloudShading, table: Any) -> None:
-        import vtk
-
         self._cloud_table = table
+        self._cells: Any = None               # the frame's cell data as a VTK array, until uploaded
+        self._cell_buffer: Any = None         # its GL buffer and buffer texture
+        self._cell_texture: Any = None
         # GLPTVolume is made on one tetrahedron (its own buffer is replaced by the frame's at once)
         one = TetMesh(np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]),
                       np.array([[0, 1, 2, 3]]), np.zeros(4))
         super().__init__(plotter, one, shading.tf, lookup="3d")
+        self.mapper.RemoveAllVertexAttributeMappings()
         sp = self.actor.GetShaderProperty()
-        sp.SetVertexShaderCode(_patched("pt_tet_vs.glsl", _VS_PATCH))
+        sp.SetVertexShaderCode(shader_source("cloud_tet_vs.glsl"))
         sp.SetFragmentShaderCode(_patched("pt_tet_fs.glsl", _FS_PATCH))
-        self.mapper.MapDataArrayToVertexAttribute("ptModulate", "ptModulate",
-                                                  vtk.vtkDataObject.FIELD_ASSOCIATION_POINTS, -1)
         self.stats = {"method": "pt-gl clouds"}
         self.set_frame(buffers)
 
@@ -161,18 +162,61 @@ class CloudPTVolume(GLPTVolume):
         return self._cloud_table
 
     def set_frame(self, buffers: CloudBuffers) -> None:
-        """The next frame's tetrahedra (back to front) as ``cloud_buffers`` made them: a new vertex buffer (shared
-        with VTK, uploaded at the next render), their own order for every camera, the same table."""
+        """The next frame's tetrahedra (back to front) as ``cloud_buffers`` made them: new vertex positions (shared
+        with VTK) and cell data (uploaded to the buffer texture at the next render), their own order for every camera,
+        the same table."""
+        from vtk.util.numpy_support import numpy_to_vtk
+
         self.topo = _FrameGeometry(np.asarray(buffers.centre, np.float64), buffers.n_tets)  # type: ignore[assignment]
         self._vis = buffers.visible
-        self.polydata = buffers_polydata(buffers.points, buffers.attributes)
+        self.polydata = buffers_polydata(buffers.points, {})
         self.mapper.SetInputData(self.polydata)
+        cells = buffers.cells.reshape(-1, 4) if buffers.n_tets else np.zeros((1, 4), np.float32)
+        self._cells = numpy_to_vtk(np.ascontiguousarray(cells), deep=False)
+        self._cells_ref = cells               # numpy_to_vtk(deep=False) needs the array kept alive
         self.actor.SetPosition(*buffers.centre)
         self.resolve_mapper.SetInputData(_resolve_polydata(buffers.bounds))    # VTK culls the resolve by these
         self.resolve_actor.SetPosition(*buffers.centre)
         self.reuse_order = True
         self._sorted = np.arange(buffers.n_tets, dtype=np.int64)
         self._sorted_key = self._order_key = None
+
+    def _on_update_shader(self, program: Any) -> None:
+        """gl_pt's uniforms and textures, and the frame's cell data as the buffer texture ``cloudCells`` (uploaded
+        when the frame changed)."""
+        import vtk
+
+        super()._on_update_shader(program)
+        if program is None:
+            return
+        ren_win = self.renderer.GetRenderWindow()
+        if self._cells is not None:
+            if self._cell_buffer is None:
+                self._cell_buffer = vtk.vtkOpenGLVertexBufferObject()
+                self._cell_buffer.SetDataType(vtk.VTK_FLOAT)
+                self._cell_buffer.SetCoordShiftAndScaleMethod(0)     # the raw floats, no shift or scale
+                self._cell_texture = vtk.vtkTextureObject()
+                self._cell_texture.SetContext(ren_win)
+            self._cell_buffer.UploadDataArray(self._cells)
+            self._cell_texture.CreateTextureBuffer(self._cells.GetNumberOfTuples(), 4, vtk.VTK_FLOAT,
+                                                   self._cell_buffer)
+            self._cells = None
+        self._cell_texture.Activate()
+        program.SetUniformi("cloudCells", self._cell_texture.GetTextureUnit())
+
+    def _on_end(self, *args: Any) -> None:
+        super()._on_end(*args)
+        if self._cell_texture is not None:
+            self._cell_texture.Deactivate()
+
+    def remove(self) -> None:
+        """GLPTVolume's ``remove`` and the cell texture's GL resources."""
+        ren_win = self.renderer.GetRenderWindow()
+        if ren_win is not None and self._cell_texture is not None:
+            self._cell_texture.ReleaseGraphicsResources(ren_win)
+            self._cell_buffer.ReleaseGraphicsResources()
+        self._cell_texture = self._cell_buffer = None
+        super().remove()
 
 
 class GLNatureView(NatureView):
