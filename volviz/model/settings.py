@@ -5,8 +5,9 @@ loader validates a component's ``settings`` object against it (``validate_settin
 type or a value out of range is refused with the field's path, and the defaults live in one place (the model)
 instead of in the ``.get(key, default)`` calls of the code that uses them. ``RenderOptions`` does the same for
 ``render.options``. Every option with a fixed set of values is a ``Literal`` defined once below; the app builds its
-settings forms from these models (field titles, descriptions, bounds, units in ``json_schema_extra``), and
-``volviz schema`` exports them as part of the session's JSON schema (``volviz.model.session_schema``).
+settings forms from these models (field titles, descriptions, bounds, units in ``json_schema_extra``; a field that
+applies only to some datasets is marked ``APPLIES_TO``, ``volviz.model.applicability``), and ``volviz schema``
+exports them as part of the session's JSON schema (``volviz.model.session_schema``).
 """
 from __future__ import annotations
 
@@ -17,8 +18,8 @@ from pydantic import AliasChoices, BaseModel, ConfigDict, Field, ValidationError
 __all__ = ["Settings", "TerrainSettings", "FogSettings", "CloudSettings", "SkySettings", "VolumeSettings",
            "MeshSettings", "IsoStyleSettings", "IsosurfaceSettings", "DemoSettings", "RenderOptions",
            "SETTINGS_MODELS", "FogMode", "CloudShadingName", "IsoMode", "IsoShading", "IsoOverlayMode", "Backend",
-           "SortName", "array_key", "settings_model", "former_names", "validate_settings", "validate_render_options",
-           "typed_settings", "validated", "SettingsError"]
+           "SortName", "APPLIES_TO", "array_key", "settings_model", "former_names", "validate_settings",
+           "validate_render_options", "typed_settings", "validated", "SettingsError"]
 
 FogMode = Literal["emissive", "attenuated", "mip"]
 CloudShadingName = Literal["npr", "physical"]
@@ -34,8 +35,17 @@ Vec3 = tuple[float, float, float]
 Color = tuple[float, float, float]
 
 
+#: the ``json_schema_extra`` key of a field that applies only to some datasets: the dataset trait (or list of traits)
+#: it needs (``volviz.model.applicability``)
+APPLIES_TO = "applies_to"
+
+
 def _unit(unit: str) -> dict[str, Any]:
     return {"unit": unit}
+
+
+def _applies_to(trait: str) -> dict[str, Any]:
+    return {APPLIES_TO: trait}
 
 
 class SettingsError(ValueError):
@@ -145,10 +155,10 @@ class VolumeSettings(Settings):
 
     array: Optional[str] = Field(None, title="Array", description="the shown array (NAME, NAME:component, "
                                  "NAME:magnitude); default: the dataset's first", json_schema_extra={"array": True})
-    budget: int = Field(256, ge=1, le=1 << 20, title="Block budget", description="compressed .vvz volumes: bricks "
-                        "decoded per view")
+    budget: int = Field(256, ge=1, le=1 << 20, title="Block budget", description="compressed .vvz volumes drawn at "
+                        "a level of detail: blocks decoded per view", json_schema_extra=_applies_to("lod_volume"))
     interpolate: bool = Field(True, title="Interpolate in time", description="time series: blend the two nearest "
-                              "steps")
+                              "steps", json_schema_extra=_applies_to("time_series"))
 
 
 class MeshSettings(VolumeSettings):
@@ -173,7 +183,8 @@ class IsosurfaceSettings(Settings):
                                  description="planes and box of this component (volviz.iso.clip)")
     lod: bool = Field(False, title="Level of detail")
     triangles_per_pixel2: float = Field(0.25, gt=0, le=100, title="Triangles per pixel²", description="LOD target")
-    interpolate: bool = Field(True, title="Interpolate in time")
+    interpolate: bool = Field(True, title="Interpolate in time", description="time series: blend the two nearest "
+                              "steps", json_schema_extra=_applies_to("time_series"))
     scalars: Optional[str] = Field(None, title="Array", json_schema_extra={"array": True})
 
 

@@ -18,6 +18,7 @@ from contextlib import contextmanager
 from typing import Any, Iterator, Optional
 
 from volviz.model import TimeSeries
+from volviz.model.applicability import DatasetTraits
 from volviz.session import CameraState, Component, Session
 
 
@@ -149,6 +150,17 @@ class SceneController:
         from volviz.render.scene_builder import component_dataset
 
         return component_dataset(self.component(comp_id), self.datasets)
+
+    def dataset_traits(self, comp_id: str) -> Optional[DatasetTraits]:
+        """What the component's dataset is, for the settings that apply to some datasets only
+        (``volviz.model.applicability``): no traits for a component without a dataset, None while its dataset is
+        not read (a component hidden at load)."""
+        from volviz.render.scene_builder import dataset_traits
+
+        comp = self.component(comp_id)
+        if comp.dataset is None:
+            return DatasetTraits()
+        return dataset_traits(self.datasets[comp.dataset]) if comp.dataset in self.datasets else None
 
     # -- transfer functions, visibility, opacity --------------------------------------------------------------------
     def transfer_function(self, comp_id: str) -> Any:

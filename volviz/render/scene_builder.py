@@ -14,6 +14,7 @@ from typing import Any, Optional
 import numpy as np
 
 from volviz.jobs import ProgressCallback, report
+from volviz.model.applicability import DatasetTraits
 from volviz.render.backend import backend_setting
 from volviz.session import Component, DatasetRef, RenderSettings, Session, resolve_path
 
@@ -458,6 +459,14 @@ def is_lod(dataset: Any) -> bool:
     from volviz.regular.lod import LodTree
 
     return isinstance(dataset, LodTree)
+
+
+def dataset_traits(dataset: Any) -> DatasetTraits:
+    """What a loaded dataset (as ``read_any`` gives it) is, for the settings that apply to some datasets only
+    (``volviz.model.applicability``): a time series, a compressed volume drawn at a level of detail."""
+    from volviz.model import TimeSeries
+
+    return DatasetTraits(time_series=isinstance(dataset, TimeSeries), lod_volume=is_lod(dataset))
 
 
 def add_lod_component(plotter: Any, session: Session, comp: Component, dataset: Any, update: bool = True) -> Any:
