@@ -91,6 +91,7 @@ class SceneEdits:
         def done(outcome: JobOutcome) -> None:
             if outcome.ok and self.controller is controller:
                 controller.histograms[comp_id] = outcome.result
+                self.scene_tree.dataset_read(comp_id)
                 if self.scene_tree.current_component() == comp_id:
                     self.tf_editor.set_histogram(outcome.result, _histogram_range(outcome.result))
                     self.histograms_computed += 1
@@ -164,6 +165,7 @@ class SceneEdits:
                 if not controller.component(comp_id).visible or not controller.needs_build(comp_id):
                     return  # hidden again meanwhile (or already shown)
                 controller.install_component(comp_id, outcome.result, views=False)
+                self.scene_tree.dataset_read(comp_id)
                 self.components_shown += 1
                 self.status_label.setText(f"Showing {comp_id}")
                 self.schedule_render()

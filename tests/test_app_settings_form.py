@@ -2,7 +2,9 @@
 builds, edits that rebuild the scene and Edit > Undo that takes them back, fields set back to their default."""
 from __future__ import annotations
 
+import json
 import typing
+from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
@@ -191,3 +193,72 @@ def test_opening_another_scene_forgets_the_settings_edits_of_the_old_one(qtbot, 
     wait_loaded(qtbot, window)
     assert not window.scene_undo_stack.canUndo()
     assert _settings(window, "ground_fog")["density"] == pytest.approx(0.04)
+
+
+def _row_labels(form: SettingsForm) -> list[str]:
+    """The texts of the form's row labels, as the dock shows them."""
+    from PySide6.QtWidgets import QFormLayout
+
+    layout = form.layout()
+    items = [layout.itemAt(i, QFormLayout.ItemRole.LabelRole) for i in range(layout.rowCount())]
+    return [item.widget().text() for item in items if item is not None and item.widget() is not None]
+
+
+def test_form_shows_only_the_settings_that_apply_to_the_dataset(qtbot, make_window, tmp_path: Path) -> None:
+    """A tetrahedral volume has no block budget and nothing to interpolate in time; a time series can interpolate,
+    a compressed volume drawn at a level of detail has a block budget. A setting the session gives that does not
+    apply stays in its settings through edits of the others. A component hidden at load (its dataset not read) shows
+    every field until it is shown."""
+    from conftest import blob_vvz
+    from test_app_background import write_pvm_series
+    from volviz.model.demo import demo_tet_mesh
+
+    demo_tet_mesh(4).to_pyvista().save(tmp_path / "tets.vtu")
+    demo_tet_mesh(3).to_pyvista().save(tmp_path / "later.vtu")
+    write_pvm_series(tmp_path, 3, 16)
+    blob_vvz(tmp_path / "blob.vvz", 32)
+    session_file = tmp_path / "applies.json"
+    session_file.write_text(json.dumps({
+        "format": "volviz-session", "version": 1,
+        "datasets": [{"id": "tets", "path": str(tmp_path / "tets.vtu")},
+                     {"id": "series", "path": str(tmp_path / "blob.pvm-t%02d")},
+                     {"id": "blob", "path": str(tmp_path / "blob.vvz"), "options": {"lod": True}},
+                     {"id": "later", "path": str(tmp_path / "later.vtu")}],
+        "components": [
+            {"id": "tets", "type": "volume", "dataset": "tets", "settings": {"budget": 64}},
+            {"id": "series", "type": "volume", "dataset": "series"},
+            {"id": "blob", "type": "volume", "dataset": "blob", "settings": {"budget": 16}},
+            {"id": "iso", "type": "isosurface", "dataset": "tets",
+             "settings": {"styles": [{"value": 0.3, "opacity": 0.5}], "interpolate": False}},
+            {"id": "later", "type": "volume", "dataset": "later", "visible": False}]}))
+    window = make_window()
+    window.open_path(session_file)
+    wait_loaded(qtbot, window)
+    assert window.error_dialog is None
+
+    tets = _select(window, "tets")
+    assert "Block budget" not in _row_labels(tets) and "Interpolate in time" not in _row_labels(tets)
+    assert set(tets.rows) == set() and tets.settings == {"budget": 64}   # not shown, still set
+    series = _select(window, "series")
+    assert "Interpolate in time" in _row_labels(series) and "Block budget" not in _row_labels(series)
+    assert list(series.rows) == ["interpolate"]
+    blob = _select(window, "blob")
+    assert "Block budget" in _row_labels(blob) and "Interpolate in time" not in _row_labels(blob)
+    assert list(blob.rows) == ["budget"] and blob.editor("budget").value() == 16
+    iso = _select(window, "iso")
+    assert "Interpolate in time" not in _row_labels(iso)
+    assert {"Transparency mode", "Level of detail", "Triangles per pixel²"} <= set(_row_labels(iso))
+
+    iso.editor("shading").setCurrentText("flat")                      # an edit of a shown field
+    wait_loaded(qtbot, window)
+    assert _settings(window, "iso")["shading"] == "flat"
+    assert _settings(window, "iso")["interpolate"] is False             # the hidden one kept
+    assert "Interpolate in time" not in _row_labels(_select(window, "iso"))
+    assert _settings(window, "tets") == {"budget": 64}
+
+    assert list(_select(window, "later").rows) == ["budget", "interpolate"]   # not read: not known
+    shown = window.components_shown
+    window.scene_tree.item("later").setCheckState(0, Qt.CheckState.Checked)
+    qtbot.waitUntil(lambda: window.components_shown > shown, timeout=60000)
+    assert window.scene_tree.current_component() == "later" and not window.scene_tree.form.rows
+    assert "Block budget" not in _row_labels(window.scene_tree.form)

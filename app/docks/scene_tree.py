@@ -1,5 +1,6 @@
 """Scene tree dock: the session's components with visibility check boxes, an opacity slider, the array shown and
-the selected component's settings as a form (``volviz_app.settings_form``)."""
+the selected component's settings as a form (``volviz_app.settings_form``) of the fields that apply to its dataset
+(``volviz.model.applicability``)."""
 from __future__ import annotations
 
 from typing import Any, Callable, Optional, Sequence
@@ -8,6 +9,8 @@ from PySide6.QtCore import Qt, Signal
 from PySide6.QtWidgets import (QComboBox, QGroupBox, QHBoxLayout, QLabel, QSlider, QTreeWidget, QTreeWidgetItem,
                                QVBoxLayout, QWidget)
 
+from volviz.model.applicability import DatasetTraits, applicable_fields
+from volviz.model.settings import settings_model
 from volviz_app.settings_form import SettingsForm
 
 KIND_LABELS = {"volume": "Volume", "mesh": "Mesh", "isosurface": "Isosurface", "terrain": "Terrain",
@@ -63,17 +66,22 @@ class SceneTree(QWidget):
         self._components: dict[str, Any] = {}
         self._datasets: Sequence[str] = ()
         self._arrays: Callable[[str], list[str]] = lambda comp_id: []
+        self._traits: Callable[[str], Optional[DatasetTraits]] = lambda comp_id: None
 
     def populate(self, components: list[Any], datasets: Sequence[str] = (),
-                 arrays: Optional[Callable[[str], list[str]]] = None) -> None:
+                 arrays: Optional[Callable[[str], list[str]]] = None,
+                 traits: Optional[Callable[[str], Optional[DatasetTraits]]] = None) -> None:
         """List ``components``; their forms offer ``datasets`` (ids) for dataset fields and ``arrays(component id)``
-        for array fields. The selected component stays selected if it is still there (else the first is)."""
+        for array fields, and show the fields that apply to ``traits(component id)`` (what its dataset is; None or
+        no ``traits``: every field). The selected component stays selected if it is still there (else the first
+        is)."""
         selected = self.current_component()
         self._filling = True
         self.tree.clear()
         self._components = {comp.id: comp for comp in components}
         self._datasets = list(datasets)
         self._arrays = arrays or (lambda comp_id: [])
+        self._traits = traits or (lambda comp_id: None)
         for comp in components:
             item = QTreeWidgetItem([comp.id, KIND_LABELS.get(comp.type, comp.type)])
             item.setData(0, Qt.ItemDataRole.UserRole, comp.id)
@@ -116,7 +124,8 @@ class SceneTree(QWidget):
         self.componentSelected.emit(comp_id)
 
     def _show_form(self, comp_id: Optional[str]) -> None:
-        """Swap in the settings form of ``comp_id`` (none for None)."""
+        """Swap in the settings form of ``comp_id`` (none for None): the fields that apply to its dataset, less
+        ``FORM_SKIPS``; the values of the others stay in its settings."""
         if self.form is not None:
             self.settings_layout.removeWidget(self.form)
             self.form.setParent(None)  # gone from the dock now, deleted once its signal handlers returned
@@ -126,10 +135,21 @@ class SceneTree(QWidget):
         self.settings_box.setTitle(f"Settings of {comp_id}" if comp is not None else "Settings")
         if comp is None:
             return
-        self.form = SettingsForm(comp.type, comp.settings, self._datasets, lambda: self._arrays(comp.id),
-                                 FORM_SKIPS)
+        applicable = applicable_fields(comp.type, self._traits(comp.id))
+        skip = [name for name in settings_model(comp.type).model_fields if name in FORM_SKIPS or name not in applicable]
+        self.form = SettingsForm(comp.type, comp.settings, self._datasets, lambda: self._arrays(comp.id), skip)
         self.form.committed.connect(lambda before, after: self.settingsEdited.emit(comp.id, before, after))
         self.settings_layout.addWidget(self.form)
+
+    def dataset_read(self, comp_id: str) -> None:
+        """The dataset of ``comp_id`` was read (it was not when the form was made): its form, if shown, is made again
+        when other fields now apply."""
+        if self.form is None or self.current_component() != comp_id:
+            return
+        comp = self._components[comp_id]
+        shown = [name for name in applicable_fields(comp.type, self._traits(comp_id)) if name not in FORM_SKIPS]
+        if shown != list(self.form.rows):
+            self._show_form(comp_id)
 
     def _opacity_moved(self, value: int) -> None:
         item = self.tree.currentItem()
