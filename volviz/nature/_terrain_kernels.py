@@ -186,14 +186,15 @@ def _outside(planes: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> bool:
 @njit(cache=True, nogil=True)
 def emit_fans(n: int, sx: float, sy: float, x0: float, y0: float, state: np.ndarray, nodes: np.ndarray,
               sizes: np.ndarray, count: int, morphed: np.ndarray, planes: np.ndarray,
-              vmap: np.ndarray, stamp: int, vstamp: np.ndarray, verts: np.ndarray, tris: np.ndarray) -> tuple[int, int]:
+              vmap: np.ndarray, stamp: int, verts: np.ndarray, tris: np.ndarray) -> tuple[int, int]:
     """Triangle fans around the centre of every leaf, skipping the edge midpoints whose same-size neighbour does not
     exist (the T-vertex rule of §3.5.3). Leaves whose box misses the frustum ``planes`` are skipped (emission only);
     the box's height range is that of the fan's own morphed vertices over every field (``morphed`` (F, n, n)), which
     bounds its planar triangles exactly. (The unmorphed height range of the node does not: a morphed vertex averages
     ancestors' vertices outside the node, so visible fans near the image border were culled — holes that appeared
     and vanished from frame to frame.)
-    Vertices are numbered on first use (``verts`` gets their grid indices). Returns (n_vertices, n_triangles)."""
+    Vertices are numbered on first use (``vmap`` (n, n, 2): the stamp of the frame that numbered a grid point and
+    its number; ``verts`` gets their grid indices). Returns (n_vertices, n_triangles)."""
     nv = 0
     nt = 0
     ring_i = np.empty(8, dtype=np.int64)
@@ -256,27 +257,27 @@ def emit_fans(n: int, sx: float, sy: float, x0: float, y0: float, state: np.ndar
             hi[2] = zh
             if _outside(planes, lo, hi):
                 continue
-        if vstamp[ci, cj] != stamp:
-            vstamp[ci, cj] = stamp
-            vmap[ci, cj] = nv
+        if vmap[ci, cj, 0] != stamp:
+            vmap[ci, cj, 0] = stamp
+            vmap[ci, cj, 1] = nv
             verts[nv, 0] = ci
             verts[nv, 1] = cj
             nv += 1
-        c_id = vmap[ci, cj]
+        c_id = vmap[ci, cj, 1]
         for a in range(r):
             i = ring_i[a]
             j = ring_j[a]
-            if vstamp[i, j] != stamp:
-                vstamp[i, j] = stamp
-                vmap[i, j] = nv
+            if vmap[i, j, 0] != stamp:
+                vmap[i, j, 0] = stamp
+                vmap[i, j, 1] = nv
                 verts[nv, 0] = i
                 verts[nv, 1] = j
                 nv += 1
         for a in range(r):
             b = (a + 1) % r
             tris[nt, 0] = c_id
-            tris[nt, 1] = vmap[ring_i[a], ring_j[a]]
-            tris[nt, 2] = vmap[ring_i[b], ring_j[b]]
+            tris[nt, 1] = vmap[ring_i[a], ring_j[a], 1]
+            tris[nt, 2] = vmap[ring_i[b], ring_j[b], 1]
             nt += 1
     return nv, nt
 

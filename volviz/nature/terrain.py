@@ -124,8 +124,7 @@ class TerrainLOD:
         self._nodes = np.zeros((cap, 2), dtype=np.int64)
         self._sizes = np.zeros(cap, dtype=np.int64)
         self._morphed = np.zeros_like(self.fields)
-        self._vmap = np.zeros((n, n), dtype=np.int64)
-        self._vstamp = np.zeros((n, n), dtype=np.int64)
+        self._vmap = np.zeros((n, n, 2), dtype=np.int64)       # per grid point: (stamp of its frame, vertex id)
         self._stamp = 0
 
     def set_resolution(self, small_c: float) -> None:
@@ -150,7 +149,7 @@ class TerrainLOD:
         verts = np.empty((n_leaves * 9 + 8, 2), dtype=np.int64)
         tris = np.empty((n_leaves * 8 + 8, 3), dtype=np.int64)
         nv, nt = K.emit_fans(n, hf.spacing[0], hf.spacing[1], hf.origin[0], hf.origin[1], self._state, self._nodes,
-                             self._sizes, count, self._morphed, pl, self._vmap, self._stamp, self._vstamp,
+                             self._sizes, count, self._morphed, pl, self._vmap, self._stamp,
                              verts, tris)
         verts = verts[:nv]
         vals = np.empty((nv, self.fields.shape[0]))
