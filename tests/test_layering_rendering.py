@@ -49,3 +49,30 @@ def test_the_check_sees_a_rendering_class(tmp_path):
     probe.write_text("import vtk\nfrom vtkmodules.vtkIOXML import vtkXMLImageDataReader\n"
                      "r = vtk.vtkXMLUnstructuredGridReader()\n")
     assert _rendering_names(probe) == set()
+
+
+def _imports_vtk(path: Path) -> bool:
+    """Whether ``path`` imports VTK itself (``import vtk``, ``vtk.*``, ``vtkmodules.*``), not through the facade."""
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Import) and any(a.name.split(".")[0] in ("vtk", "vtkmodules") for a in node.names):
+            return True
+        if isinstance(node, ast.ImportFrom) and node.module and node.module.split(".")[0] in ("vtk", "vtkmodules"):
+            return True
+    return False
+
+
+def test_render_reaches_vtk_through_its_facade_only():
+    """Issue #18: ``volviz.render.vtk_facade`` is the one module of ``volviz.render`` that imports VTK, and a module
+    elsewhere in volviz that imports VTK itself (readers, filters) uses none of its rendering classes."""
+    direct = {f.relative_to(ROOT).as_posix() for f in sorted(ROOT.rglob("*.py")) if _imports_vtk(f)}
+    assert {f for f in direct if f.startswith("render/")} == {"render/vtk_facade.py"}
+    assert {f: sorted(_rendering_names(ROOT / f)) for f in direct - {"render/vtk_facade.py"}
+            if _rendering_names(ROOT / f)} == {}
+
+
+def test_the_facade_check_sees_a_direct_import(tmp_path):
+    probe = tmp_path / "probe.py"
+    probe.write_text("def f():\n    from vtkmodules.vtkRenderingCore import vtkActor\n    return vtkActor()\n")
+    assert _imports_vtk(probe)
+    probe.write_text("def f():\n    from volviz.render.vtk_facade import vtk\n    return vtk.vtkActor()\n")
+    assert not _imports_vtk(probe)

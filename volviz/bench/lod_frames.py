@@ -54,7 +54,7 @@ def _references(plotter: Any, tree: Any, volume: np.ndarray, tf: Any, views: lis
     """Per view: the exact reference (8-bit-scaled RGB over black) and VTK's full volume as one block; plus the
     reference's convergence (its step halved, on the first measured view) and its cost."""
     import pyvista as pv
-    import vtk
+    from volviz.render.vtk_facade import vtk
 
     from volviz.regular.raycast import render_reference
     from volviz.render.vtk_scene import vtk_volume_property

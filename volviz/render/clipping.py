@@ -34,9 +34,9 @@ def clip_settings(clip: dict[str, Any] | ClipSettings | None) -> ClipSettings:
 
 
 def vtk_plane(plane: ClipPlane) -> Any:
-    from vtkmodules.vtkCommonDataModel import vtkPlane
+    from volviz.render.vtk_facade import vtk
 
-    p = vtkPlane()
+    p = vtk.vtkPlane()
     p.SetOrigin(*plane.point)
     p.SetNormal(*plane.normal)  # VTK's mappers keep the side the normal points to, as ClipPlane does
     return p

@@ -32,7 +32,7 @@ class OpaqueObstacles:
         self._locator: Any = None
 
     def _surfaces(self) -> list[Any]:
-        import vtk
+        from volviz.render.vtk_facade import vtk
 
         names = {id(a) for name, a in getattr(self.renderer, "actors", {}).items() if name in NOT_OBSTACLES}
         out = []
@@ -57,7 +57,7 @@ class OpaqueObstacles:
         return out
 
     def _build(self) -> Any:
-        import vtk
+        from volviz.render.vtk_facade import vtk
 
         surfaces = self._surfaces()
         key = tuple((id(a), a.GetMTime(), d.GetMTime()) for a, d in surfaces)
@@ -75,8 +75,8 @@ class OpaqueObstacles:
         return self._locator
 
     def __call__(self, start: np.ndarray, end: np.ndarray) -> Optional[float]:
-        import vtk
-        from vtkmodules.util.numpy_support import vtk_to_numpy
+        from volviz.render.vtk_facade import vtk
+        from volviz.render.vtk_facade import vtk_to_numpy
 
         built = self._build()
         if built is None:

@@ -81,7 +81,7 @@ def update_legend(plotter: Any, session: Session, datasets: dict[str, Any]) -> N
 
 
 def _add_scalar_bar(plotter: Any, session: Session, comp: Any, title: str, color: tuple[float, float, float]) -> None:
-    import vtk
+    from volviz.render.vtk_facade import vtk
 
     from volviz.optics import TransferFunction
     from volviz.render.vtk_tf import tf_to_vtk

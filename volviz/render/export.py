@@ -89,9 +89,9 @@ def offscreen_plotter(size: tuple[int, int]) -> Any:
     import pyvista as pv
 
     if not os.environ.get("DISPLAY"):  # VTK tries X first and warns before it falls back to EGL: not the user's concern
-        from vtkmodules.vtkCommonCore import vtkLogger
+        from volviz.render.vtk_facade import vtk
 
-        vtkLogger.SetStderrVerbosity(vtkLogger.VERBOSITY_ERROR)
+        vtk.vtkLogger.SetStderrVerbosity(vtk.vtkLogger.VERBOSITY_ERROR)
 
     return pv.Plotter(off_screen=True, window_size=[int(size[0]), int(size[1])])
 

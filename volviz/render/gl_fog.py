@@ -70,10 +70,10 @@ from typing import Any
 import numpy as np
 
 from volviz.nature.fog import FogLayer, layer_emission
-from volviz.render.gl_pt import _PASS_MARK, _USERS, GLPTVolume, install_scene_pass, shader_source
+from volviz.render.gl_pt import _PASS_MARK, _USERS, install_scene_pass, shader_source
 from volviz.model.camera import Camera
 
-__all__ = ["GLFogLayer", "PrismBuffers", "add_fog_layer", "buffers_polydata", "layer_values", "prism_buffers"]
+__all__ = ["GLFogLayer", "PrismBuffers", "add_fog_layer", "layer_values", "prism_buffers"]
 
 _MODES = {"emissive": 0, "attenuated": 1, "mip": 2}
 _GL_FUNC_ADD, _GL_MAX = 0x8006, 0x8008
@@ -146,43 +146,14 @@ def prism_buffers(points: np.ndarray, bottom: np.ndarray, top: np.ndarray, trian
     return PrismBuffers(rel, {"fogValue": values}, tris.reshape(-1), centre, drawn, bounds)
 
 
-def buffers_polydata(points: np.ndarray, attributes: dict[str, np.ndarray],
-                     connectivity: np.ndarray | None = None) -> Any:
-    """A vtkPolyData sharing NumPy vertex buffers (no copy; the VTK arrays keep them referenced): float32 ``points``
-    (n, 3), named float32 per-vertex ``attributes``, triangles ``connectivity`` (3 indices each; None: no cells yet,
-    as the GL PT pass, whose order sets them)."""
-    import vtk
-    from vtk.util.numpy_support import numpy_to_vtk
-
-    pd = vtk.vtkPolyData()
-    vp = vtk.vtkPoints()
-    vp.SetData(numpy_to_vtk(points, deep=False))
-    pd.SetPoints(vp)
-    for name, arr in attributes.items():
-        va = numpy_to_vtk(arr, deep=False)
-        va.SetName(name)
-        pd.GetPointData().AddArray(va)
-    cells = vtk.vtkCellArray()
-    if connectivity is not None:
-        cells.SetData(numpy_to_vtk(np.arange(0, len(connectivity) + 1, 3, dtype=np.int64), deep=True),
-                      numpy_to_vtk(connectivity, deep=False))
-    pd.SetPolys(cells)
-    return pd
-
-
 def _resolve_polydata(bounds: np.ndarray) -> Any:
     """The resolve's geometry: the 8 corners of ``bounds`` (3, 2) (for VTK's culling) and one triangle whose
     ``fogCorner`` attribute covers the viewport in normalised device coordinates."""
-    import vtk
-    from vtk.util.numpy_support import numpy_to_vtk
+    from volviz.render.vtk_facade import box_corners_polydata, numpy_to_vtk, vtk
 
-    corners = np.array([[bounds[0, i & 1], bounds[1, (i >> 1) & 1], bounds[2, (i >> 2) & 1]] for i in range(8)])
+    pd = box_corners_polydata(bounds)
     ndc = np.zeros((8, 2), np.float32)
     ndc[:3] = [[-1.0, -1.0], [3.0, -1.0], [-1.0, 3.0]]
-    pd = vtk.vtkPolyData()
-    vp = vtk.vtkPoints()
-    vp.SetData(numpy_to_vtk(np.ascontiguousarray(corners, np.float32), deep=True))
-    pd.SetPoints(vp)
     va = numpy_to_vtk(ndc, deep=True)
     va.SetName("fogCorner")
     pd.GetPointData().AddArray(va)
@@ -204,7 +175,7 @@ class GLFogLayer:
     def __init__(self, plotter: Any, points: np.ndarray, bottom: np.ndarray, top: np.ndarray,
                  triangles: np.ndarray, layer: FogLayer, emission: tuple[np.ndarray, np.ndarray] | None = None,
                  buffers: PrismBuffers | None = None) -> None:
-        import vtk
+        from volviz.render.vtk_facade import shader_observer, vtk
 
         self.plotter = plotter
         self.renderer = plotter.renderer
@@ -241,9 +212,9 @@ class GLFogLayer:
         install_scene_pass(self.renderer, self)   # the shared float color target and opaque depth texture
         self._observers = [
             (self.mapper, self.mapper.AddObserver(vtk.vtkCommand.UpdateShaderEvent,
-                                                  self._observer(self._on_prisms))),
+                                                  shader_observer(self._on_prisms))),
             (self.resolve_mapper, self.resolve_mapper.AddObserver(vtk.vtkCommand.UpdateShaderEvent,
-                                                                  self._observer(self._on_resolve))),
+                                                                  shader_observer(self._on_resolve))),
             (self.renderer, self.renderer.AddObserver(vtk.vtkCommand.EndEvent, self._on_end)),
         ]
         self.renderer.AddActor(self.actor)
@@ -252,7 +223,7 @@ class GLFogLayer:
     # --- set-up --------------------------------------------------------------------------------------------------
     @staticmethod
     def _translucent_actor(mapper: Any, vs: str, fs: str, gs: str | None = None) -> Any:
-        import vtk
+        from volviz.render.vtk_facade import premultiplied_texture, vtk
 
         sp = vtk.vtkShaderProperty()
         sp.SetVertexShaderCode(shader_source(vs))
@@ -263,19 +234,8 @@ class GLFogLayer:
         actor.SetMapper(mapper)
         actor.SetShaderProperty(sp)
         actor.ForceTranslucentOn()
-        actor.SetTexture(GLPTVolume._premultiplied_texture())
+        actor.SetTexture(premultiplied_texture())
         return actor
-
-    @staticmethod
-    def _observer(fn: Any) -> Any:
-        import vtk
-
-        def on_update_shader(caller: Any, event: str, program: Any = None) -> None:
-            if program is not None:
-                fn(program)
-
-        on_update_shader.CallDataType = vtk.VTK_OBJECT      # type: ignore[attr-defined]
-        return on_update_shader
 
     def _upload(self) -> None:
         """The layer's vertex buffer and the resolve triangle for the current layer (its mode picks the emission)."""
@@ -285,7 +245,9 @@ class GLFogLayer:
         """GUI thread: show a ``prism_buffers`` result (made for this layer's optics, e.g. on a worker for the next
         frame's C-LOD triangles): the prisms' and the resolve's poly data to the mappers, uploaded at the next
         render."""
-        pd = buffers_polydata(buffers.points, buffers.attributes, buffers.connectivity)
+        from volviz.render.vtk_facade import shared_polydata
+
+        pd = shared_polydata(buffers.points, buffers.attributes, buffers.connectivity)
         self.drawn = buffers.drawn
         centre = self.centre = buffers.centre
         self.mapper.SetInputData(pd)
@@ -299,7 +261,7 @@ class GLFogLayer:
     # --- per frame -----------------------------------------------------------------------------------------------
     def _target(self, w: int, h: int) -> Any:
         """The layer's (w, h) single-channel float32 target (made again when the renderer's size changes)."""
-        import vtk
+        from volviz.render.vtk_facade import vtk
 
         ren_win = self.renderer.GetRenderWindow()
         if self._accum is None or (self._accum.GetWidth(), self._accum.GetHeight()) != (w, h):

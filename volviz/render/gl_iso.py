@@ -71,7 +71,7 @@ import numpy as np
 from volviz.iso.composite import AMBIENT, MODES
 from volviz.iso.extract import IsoMesh
 from volviz.iso.spectrum import fit_spectrum
-from volviz.render.gl_pt import GLPTVolume, shader_source
+from volviz.render.gl_pt import shader_source
 from volviz.render.image_overlay import hold_single_sample, release_single_sample, window_size
 from volviz.render.iso_overlay import IsoModeView
 
@@ -101,8 +101,8 @@ def iso_polydata(meshes: Sequence[IsoMesh], centre: np.ndarray, shading: str = "
     """One vtkPolyData of ``meshes`` in their order: points relative to ``centre`` (float32), triangles wound as
     ``_oriented_triangles``, and per-vertex attributes ``isoNormal`` (unit normal), ``isoStyle`` (color, opacity)
     and ``isoFit`` (the iso-spectrum (a, b) of translucent surfaces with ``shading="spectrum"``, else (0, 0))."""
-    import vtk
-    from vtk.util.numpy_support import numpy_to_vtk
+    from volviz.render.vtk_facade import vtk
+    from volviz.render.vtk_facade import numpy_to_vtk
 
     pts, tris = [], []
     cols: dict[str, list[np.ndarray]] = {k: [] for k in _ATTRIBUTES}
@@ -146,7 +146,7 @@ class GLIsoSurfaces:
 
     def __init__(self, plotter: Any, meshes: Sequence[IsoMesh], mode: str = "3pass", shading: str = "spectrum",
                  lighting: bool = True, peels: int = 64) -> None:
-        import vtk
+        from volviz.render.vtk_facade import vtk
 
         if shading not in ("spectrum", "flat"):
             raise ValueError(f"shading must be 'spectrum' or 'flat', got {shading!r}")
@@ -182,7 +182,7 @@ class GLIsoSurfaces:
 
     # --- set-up --------------------------------------------------------------------------------------------------
     def _add(self, kind: int, pd: Any) -> None:
-        import vtk
+        from volviz.render.vtk_facade import premultiplied_texture, vtk
 
         mapper = vtk.vtkOpenGLPolyDataMapper()
         mapper.SetInputData(pd)
@@ -204,7 +204,7 @@ class GLIsoSurfaces:
         else:
             actor.ForceTranslucentOn()
         if kind == _EMIT:
-            actor.SetTexture(GLPTVolume._premultiplied_texture())   # (ONE, ONE_MINUS_SRC_ALPHA), restored by VTK
+            actor.SetTexture(premultiplied_texture())   # (ONE, ONE_MINUS_SRC_ALPHA), restored by VTK
 
         def on_update_shader(caller: Any, event: str, program: Any = None) -> None:
             self._on_update_shader(kind, program)
@@ -243,7 +243,7 @@ class GLIsoSurfaces:
     def _bind_back_target(self, state: Any) -> None:
         """Bind (making it at the renderer's size when needed) the framebuffer with a float depth texture into which
         the back faces are drawn with depth writes on; its depth is cleared to the far plane."""
-        import vtk
+        from volviz.render.vtk_facade import vtk
 
         ren_win = self.renderer.GetRenderWindow()
         size = window_size(self.renderer)
@@ -343,7 +343,7 @@ class GLIsoView(IsoModeView):
 
     def __init__(self, plotter: Any, meshes: Sequence[IsoMesh] = (), mode: str = "3pass",
                  shading: str = "spectrum") -> None:
-        import vtk
+        from volviz.render.vtk_facade import vtk
 
         self.plotter = plotter
         self.meshes: list[IsoMesh] = []

@@ -22,7 +22,7 @@ Numba kernels release the GIL): the terrain's C-LOD mesh and each layer's per-po
 (``gl_fog.prism_buffers``; the prisms are made by a geometry shader) on one, the clouds' refinement, morphing, leaf
 list and per-tetrahedron face planes, table-field and modulation forms (``cloud_buffers``, one Numba pass over the
 leaves) on the other; ``finish`` (GUI thread) only hands them to VTK, sharing the arrays
-(``gl_fog.buffers_polydata``), and VTK uploads them and draws everything at the next render, at the window's full
+(``vtk_facade.shared_polydata``), and VTK uploads them and draws everything at the next render, at the window's full
 size (a preview ``scale`` is ignored). No image is made on the CPU.
 
 What ``GLPTVolume`` lacks for the clouds (``CloudPTVolume`` works around it through its private members, listed
@@ -50,7 +50,7 @@ from volviz.model.datasets import TetMesh
 from volviz.nature.clouds import CloudFrame, CloudShading, CloudVolume
 from volviz.nature.nature_scene import NatureScene
 from volviz.render.nature_view import NatureView
-from volviz.render.gl_fog import GLFogLayer, buffers_polydata, prism_buffers
+from volviz.render.gl_fog import GLFogLayer, prism_buffers
 from volviz.render.gl_pt import GLPTVolume, _resolve_polydata, shader_source
 from volviz.render.image_overlay import hold_single_sample, release_single_sample
 from volviz.unstructured.topology import visible_ranges
@@ -165,11 +165,11 @@ class CloudPTVolume(GLPTVolume):
         """The next frame's tetrahedra (back to front) as ``cloud_buffers`` made them: new vertex positions (shared
         with VTK) and cell data (uploaded to the buffer texture at the next render), their own order for every camera,
         the same table."""
-        from vtk.util.numpy_support import numpy_to_vtk
+        from volviz.render.vtk_facade import numpy_to_vtk, shared_polydata
 
         self.topo = _FrameGeometry(np.asarray(buffers.centre, np.float64), buffers.n_tets)  # type: ignore[assignment]
         self._vis = buffers.visible
-        self.polydata = buffers_polydata(buffers.points, {})
+        self.polydata = shared_polydata(buffers.points, {})
         self.mapper.SetInputData(self.polydata)
         cells = buffers.cells.reshape(-1, 4) if buffers.n_tets else np.zeros((1, 4), np.float32)
         self._cells = numpy_to_vtk(np.ascontiguousarray(cells), deep=False)
@@ -184,7 +184,7 @@ class CloudPTVolume(GLPTVolume):
     def _on_update_shader(self, program: Any) -> None:
         """gl_pt's uniforms and textures, and the frame's cell data as the buffer texture ``cloudCells`` (uploaded
         when the frame changed)."""
-        import vtk
+        from volviz.render.vtk_facade import vtk
 
         super()._on_update_shader(program)
         if program is None:

@@ -154,8 +154,8 @@ def _cell_attributes(mesh: TetMesh, smooth: bool = False) -> dict[str, np.ndarra
 def _polydata(mesh: TetMesh, smooth: bool = False) -> Any:
     """The static vertex buffer as vtkPolyData: 4 points per tetrahedron (relative to the centre) with the cell
     attributes repeated at each, and no cells yet (the order sets them)."""
-    import vtk
-    from vtk.util.numpy_support import numpy_to_vtk
+    from volviz.render.vtk_facade import vtk
+    from volviz.render.vtk_facade import numpy_to_vtk
 
     topo = topology(mesh)
     pd = vtk.vtkPolyData()
@@ -173,13 +173,9 @@ def _polydata(mesh: TetMesh, smooth: bool = False) -> Any:
 def _resolve_polydata(bounds: np.ndarray) -> Any:
     """The resolve's geometry: the 8 corners of ``bounds`` (3, 2), so that VTK culls it with the cells, and the
     triangle (0, 1, 2), which ``pt_resolve_vs.glsl`` places over the viewport by ``gl_VertexID``."""
-    import vtk
-    from vtk.util.numpy_support import numpy_to_vtk
+    from volviz.render.vtk_facade import box_corners_polydata, numpy_to_vtk, vtk
 
-    corners = np.array([[bounds[0, i & 1], bounds[1, (i >> 1) & 1], bounds[2, (i >> 2) & 1]] for i in range(8)])
-    pd = vtk.vtkPolyData()
-    pd.SetPoints(vtk.vtkPoints())
-    pd.GetPoints().SetData(numpy_to_vtk(np.ascontiguousarray(corners, np.float32), deep=True))
+    pd = box_corners_polydata(bounds)
     offsets, conn = (numpy_to_vtk(np.array(v, np.int64), deep=True) for v in ([0, 3], [0, 1, 2]))
     pd.SetPolys(vtk.vtkCellArray())
     pd.GetPolys().SetData(offsets, conn)
@@ -210,7 +206,7 @@ def install_scene_pass(renderer: Any, user: object) -> None:
     holding the opaque scene) on ``renderer``, translucent props drawn in order; shared by the GL layers that use it
     (``GLPTVolume``, ``volviz.render.gl_fog.GLFogLayer``); ``user`` is counted as one (the last one to leave takes
     the pass off)."""
-    import vtk
+    from volviz.render.vtk_facade import vtk
 
     renderer.SetUseDepthPeeling(False)
     renderer.SetUseOIT(False)
@@ -257,7 +253,7 @@ class GLPTVolume(PTView):
                  n_l: int = 64, degree: int | None = None, sort: str = "mpvo", nonconvex: str = "auto",
                  iso: Any = None, iso_shading: str = "flat", classification: str = "post",
                  keep_multisampling: bool = False) -> None:
-        import vtk
+        from volviz.render.vtk_facade import premultiplied_texture, vtk
 
         if not isinstance(mesh, TetMesh):
             raise TypeError(f"GLPTVolume needs a TetMesh, got {type(mesh).__name__}")
@@ -318,7 +314,7 @@ class GLPTVolume(PTView):
         self.actor.SetPosition(*self.topo.origin)
         self.actor.ForceTranslucentOn()
         self.actor.GetProperty().FrontfaceCullingOn()
-        self.actor.SetTexture(self._premultiplied_texture())
+        self.actor.SetTexture(premultiplied_texture())
         self.resolve_mapper = vtk.vtkOpenGLPolyDataMapper()
         self.resolve_mapper.ScalarVisibilityOff()
         pts = self.topo.points
@@ -331,7 +327,7 @@ class GLPTVolume(PTView):
         self.resolve_actor.SetShaderProperty(rsp)
         self.resolve_actor.SetPosition(*self.topo.origin)
         self.resolve_actor.ForceTranslucentOn()
-        self.resolve_actor.SetTexture(self._premultiplied_texture())
+        self.resolve_actor.SetTexture(premultiplied_texture())
 
         self.renderer.SetUseDepthPeeling(False)    # translucent props drawn in order: the cells, then the resolve
         self.renderer.SetUseOIT(False)
@@ -351,21 +347,6 @@ class GLPTVolume(PTView):
         self.renderer.AddActor(self.resolve_actor)
 
     # --- set-up --------------------------------------------------------------------------------------------------
-    @staticmethod
-    def _premultiplied_texture() -> Any:
-        """A 1x1 white texture with PremultipliedAlphaOn: VTK then blends the actor with (ONE, ONE_MINUS_SRC_ALPHA)
-        and restores its blend state after it."""
-        import vtk
-
-        img = vtk.vtkImageData()
-        img.SetDimensions(1, 1, 1)
-        img.AllocateScalars(vtk.VTK_UNSIGNED_CHAR, 4)
-        img.GetPointData().GetScalars().SetTuple4(0, 255, 255, 255, 255)
-        tex = vtk.vtkTexture()
-        tex.SetInputData(img)
-        tex.PremultipliedAlphaOn()
-        return tex
-
     def _on_program(self, caller: Any, event: str, program: Any = None) -> None:
         """UpdateShaderEvent of either mapper (its program being bound): the cells' or the resolve's set-up."""
         if program is not None:
@@ -442,7 +423,7 @@ class GLPTVolume(PTView):
     def _set_index_buffer(self, cells: np.ndarray) -> None:
         """Draw ``cells`` back to front (4 triangles each) from the next render on: the polydata's cells are 32-bit
         numpy arrays shared with VTK (kept referenced here), VTK builds and uploads the index buffer from them."""
-        from vtk.util.numpy_support import numpy_to_vtk
+        from volviz.render.vtk_facade import numpy_to_vtk
 
         if self.topo.n_tets * 4 >= 2 ** 31:
             raise ValueError("too many tetrahedra for 32-bit vertex indices")
@@ -477,7 +458,7 @@ class GLPTVolume(PTView):
         """The volume's (w, h) float32 RGBA target and its copy of the opaque depth (``depth_format``: the scene's
         depth attachment's, as a depth blit needs), each attached to a framebuffer object of its own (made again when
         the size changes)."""
-        import vtk
+        from volviz.render.vtk_facade import vtk
 
         t = self._targets
         if t is not None and (t[0].GetWidth(), t[0].GetHeight()) == (w, h) and t[4] == depth_format:
@@ -516,7 +497,7 @@ class GLPTVolume(PTView):
         """Copy the scene's depth at this point of the frame (after the opaque pass: the opaque geometry's; one sample
         of each pixel when the window is multisampled) into the volume's depth texture, then bind and clear the
         volume's color target for the cells. Returns the depth texture."""
-        import vtk
+        from volviz.render.vtk_facade import vtk
 
         ren_win = self.renderer.GetRenderWindow()
         state = ren_win.GetState()
@@ -541,7 +522,7 @@ class GLPTVolume(PTView):
     def _scene_depth_format(self, fbo_index: int) -> int:
         """The vtkTextureObject depth format matching the depth attachment of the framebuffer being drawn (the window's
         render framebuffer or a render pass's): GL blits depth only between equal formats."""
-        import vtk
+        from volviz.render.vtk_facade import vtk
 
         fb = getattr(self.renderer, _PASS_MARK, None)
         if fb is not None:
@@ -614,7 +595,7 @@ class GLPTVolume(PTView):
         return _table_for(self.mesh, tf, "separable", (self.n_s or 256, int(degree or 2)), l_max)
 
     def _upload_table(self, ren_win: Any) -> None:
-        import vtk
+        from volviz.render.vtk_facade import vtk
 
         table = self._table
         if hasattr(table, "isosurfaces"):                            # rows of texels: value, opacity; colors

@@ -108,8 +108,8 @@ def unpremultiply_rgba8(image: np.ndarray) -> np.ndarray:
 
 def read_buffers(ren_win: Any, w: int, h: int) -> tuple[np.ndarray, np.ndarray]:
     """(z (H, W) float64, rgb (H, W, 3) uint8) of the render window, row 0 at the top."""
-    import vtk
-    from vtk.util.numpy_support import vtk_to_numpy
+    from volviz.render.vtk_facade import vtk
+    from volviz.render.vtk_facade import vtk_to_numpy
 
     z = vtk.vtkFloatArray()
     ren_win.GetZbufferData(0, 0, w - 1, h - 1, z)
@@ -148,7 +148,7 @@ class ImageOverlay:
     """One full-window image over a plotter's scene (see the module docstring). Starts hidden."""
 
     def __init__(self, plotter: Any) -> None:
-        import vtk
+        from volviz.render.vtk_facade import vtk
 
         self.plotter = plotter
         ren_win = plotter.ren_win
@@ -188,7 +188,7 @@ class ImageOverlay:
         or the plotter's rendering is suppressed. The image fills the window whatever its size; ``smooth``: an image
         smaller than the window (a preview, ``overlay_rgba8``) is magnified with linear interpolation instead of pixel
         blocks."""
-        from vtk.util.numpy_support import numpy_to_vtk
+        from volviz.render.vtk_facade import numpy_to_vtk
 
         h, w = rgba8.shape[:2]
         padded = np.pad(np.asarray(rgba8, np.uint8)[::-1], ((1, 1), (1, 1), (0, 0)), mode="edge")  # VTK: bottom up

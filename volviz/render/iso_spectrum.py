@@ -57,12 +57,12 @@ def iso_actor(mesh: Any, parallel: bool = False, spectrum: bool = True) -> Any:
     blends them unsorted (the note's 2-pass mode). The accurate modes are the CPU compositor's
     (``volviz.iso.composite``); opaque surfaces are plain opaque actors.
     """
-    from vtkmodules.vtkRenderingCore import vtkActor
-    from vtkmodules.vtkRenderingOpenGL2 import vtkOpenGLPolyDataMapper
-    mapper = vtkOpenGLPolyDataMapper()
+    from volviz.render.vtk_facade import vtk
+
+    mapper = vtk.vtkOpenGLPolyDataMapper()
     mapper.SetInputData(mesh.to_pyvista())
     mapper.ScalarVisibilityOff()
-    actor = vtkActor()
+    actor = vtk.vtkActor()
     actor.SetMapper(mapper)
     prop = actor.GetProperty()
     prop.SetColor(*(float(c) for c in mesh.style.color))

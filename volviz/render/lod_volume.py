@@ -75,8 +75,8 @@ def lod_bounds(tree: LodTree) -> tuple[float, float, float, float, float, float]
 
 def _image(block: Block) -> Any:
     """A vtkImageData of one block (samples at origin + spacing * index, x fastest)."""
-    import vtk
-    from vtk.util.numpy_support import numpy_to_vtk
+    from volviz.render.vtk_facade import vtk
+    from volviz.render.vtk_facade import numpy_to_vtk
 
     img = vtk.vtkImageData()
     img.SetDimensions(*block.data.shape)
@@ -130,7 +130,7 @@ class LodVolume:
                  opacity: float = 1.0, renderer: str = "volviz", step: Optional[float] = None) -> None:
         """``renderer``: "volviz" (our ray caster) or "vtk" (vtkMultiBlockVolumeMapper); ``step``: the ray
         caster's sample distance in voxels of each block's level (default ``volviz.regular.raycast.STEP``)."""
-        import vtk
+        from volviz.render.vtk_facade import vtk
 
         if renderer not in RENDERERS:
             raise ValueError(f"LOD renderer must be one of {RENDERERS}, got {renderer!r}")
@@ -299,7 +299,7 @@ class LodVolume:
         self.selection = selection
         self.stats = self.show_stats(selection, blocks, select_s, decode_s)
         if self.renderer == "vtk":
-            import vtk
+            from volviz.render.vtk_facade import vtk
 
             mb = vtk.vtkMultiBlockDataSet()
             mb.SetNumberOfBlocks(len(selection.nodes))

@@ -607,7 +607,7 @@ def add_isosurface_actors(plotter: Any, name: str, parts: IsoParts, spectrum: bo
     The shader needs the renderer's lights: a renderer without lights (``pyvista.Plotter.clear`` removes them)
     compiles VTK's unlit shader, which declares no normals (``normalVCVSOutput`` undeclared); the scene controller
     restores the light kit before building."""
-    import vtk
+    from volviz.render.vtk_facade import vtk
 
     from volviz.render.iso_spectrum import iso_actor
 

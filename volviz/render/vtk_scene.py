@@ -55,7 +55,7 @@ def update_volume_property(prop: Any, tf: Any, opacity: float = 1.0) -> None:
 
 
 def vtk_volume_property(tf: Any, opacity: float = 1.0) -> Any:
-    import vtk
+    from volviz.render.vtk_facade import vtk
 
     prop = vtk.vtkVolumeProperty()
     update_volume_property(prop, tf, opacity)
@@ -99,7 +99,7 @@ def default_transfer_function_for(dataset: Any, name: str = "default") -> Any:
 
 def volume_input(dataset: Any) -> Any:
     """The VTK data object a volume mapper draws for ``dataset`` (tetrahedralised for non-image grids)."""
-    import vtk
+    from volviz.render.vtk_facade import vtk
 
     grid = transparent_nonfinite(volume_grid(dataset))
     if isinstance(dataset, RegularVolume):
@@ -152,7 +152,7 @@ def volume_prop(plotter: Any, data: Any, regular: bool, tf: Any, opacity: float,
     """Add a ``vtkVolume`` drawing the VTK dataset ``data`` with ``tf`` to ``plotter``: regular volumes through
     vtkSmartVolumeMapper (its CPU ray caster where ``backend`` picks "cpu": by default on a software OpenGL, see
     ``volviz.render.backend``), others through vtkProjectedTetrahedraMapper. Returns the volume."""
-    import vtk
+    from volviz.render.vtk_facade import vtk
 
     from volviz.render.backend import choose_backend, plotter_gl_info
 

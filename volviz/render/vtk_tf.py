@@ -73,13 +73,12 @@ def tf_to_vtk(tf: TransferFunction, unit_distance: float) -> tuple[Any, Any]:
     unit_distance = float(unit_distance)
     if not (np.isfinite(unit_distance) and unit_distance > 0):
         raise ValueError(f"unit_distance must be finite and > 0, got {unit_distance}")
-    from vtkmodules.vtkCommonDataModel import vtkPiecewiseFunction
-    from vtkmodules.vtkRenderingCore import vtkColorTransferFunction
+    from volviz.render.vtk_facade import vtk
 
-    ctf = vtkColorTransferFunction()
+    ctf = vtk.vtkColorTransferFunction()
     ctf.SetColorSpaceToRGB()
     ctf.ClampingOff()
-    otf = vtkPiecewiseFunction()
+    otf = vtk.vtkPiecewiseFunction()
     otf.ClampingOff()
     for s, (r, g, b), rho in zip(tf.scalars, tf.colors, tf.extinction):
         ctf.AddRGBPoint(float(s), float(r), float(g), float(b))
