@@ -1,5 +1,9 @@
 """A live scene in one plotter: what the app's docks change and what export renders, through one code path.
 
+Each edit of the session's state through it (a component's visibility, opacity or transfer function, the clipping,
+the isosurfaces' mode) is announced to the subscribers of ``changes`` (``volviz.model.events``), e.g. the app's
+window, which marks the session edited and shows the new state in its docks.
+
 ``SceneController`` owns one view per shown component (``views``: ``volviz.render.views.ComponentView``, made by
 ``volviz.render.scene_builder.install_component``; the natural scene's view under ``"nature"``) and talks to every
 kind through the same calls. Transfer-function edits, visibility, opacity, clipping and display time update the views
@@ -19,6 +23,7 @@ from typing import Any, Iterator, Optional
 
 from volviz.model import TimeSeries
 from volviz.model.applicability import DatasetTraits
+from volviz.model.events import ChangeNotifier, SceneChange
 from volviz.session import CameraState, Component, Session
 
 
@@ -64,6 +69,7 @@ class SceneController:
         self.histograms: dict[str, Any] = {}   # comp id -> (counts, edges) of its data, from ``prepare``
         self.time = 0.0
         self.interpolate_time = True
+        self.changes = ChangeNotifier()   # a SceneChange after each edit of the session's state (``model.events``)
 
     @property
     def props(self) -> dict[str, Any]:
@@ -184,6 +190,7 @@ class SceneController:
         from volviz.render.decorations import update_legend
 
         update_legend(self.plotter, self.session, self.datasets)   # the scalar bar shows the new colors and range
+        self.changes.notify(SceneChange("transfer_function", comp_id))
 
     def set_visible(self, comp_id: str, visible: bool, nature: bool = True, build: bool = True) -> None:
         """Show or hide a component. A terrain / fog / clouds / sky component rebuilds the natural scene now unless
@@ -194,6 +201,7 @@ class SceneController:
             self._set_visible(comp_id, visible, nature, build)
         finally:
             self.decorate()        # the outline and the scalar bar follow what is shown
+        self.changes.notify(SceneChange("visible", comp_id))
 
     def _set_visible(self, comp_id: str, visible: bool, nature: bool, build: bool) -> None:
         from volviz.render.scene_builder import NATURE_TYPES
@@ -263,14 +271,16 @@ class SceneController:
         comp = self.component(comp_id)
         comp.opacity = float(min(max(opacity, 0.0), 1.0))
         view = self.views.get(comp_id)
-        if view is None:
-            return []
-        view.set_tf(self.transfer_function(comp_id), comp.opacity)
-        if update:
-            view.update()
-        self._sync_iso_overlay()
-        stale = getattr(view, "stale", None)
-        return [comp_id] if stale is not None and stale() else []
+        stale: list[str] = []
+        if view is not None:
+            view.set_tf(self.transfer_function(comp_id), comp.opacity)
+            if update:
+                view.update()
+            self._sync_iso_overlay()
+            is_stale = getattr(view, "stale", None)
+            stale = [comp_id] if is_stale is not None and is_stale() else []
+        self.changes.notify(SceneChange("opacity", comp_id))
+        return stale
 
     # -- time -------------------------------------------------------------------------------------------------------
     def time_series(self) -> dict[str, TimeSeries]:
@@ -560,7 +570,9 @@ class SceneController:
         from volviz.iso.clip import ClipSettings
 
         self.session.clip = clip.to_dict() if isinstance(clip, ClipSettings) else self.clip.from_dict(clip).to_dict()
-        return self.apply_clip(update)
+        pending = self.apply_clip(update)
+        self.changes.notify(SceneChange("clip"))
+        return pending
 
     def apply_clip(self, update: bool = True) -> list[str]:
         """Give the session's clipping to every view (``set_clip``: VTK's mapper planes, a GPU PT volume's
@@ -625,6 +637,7 @@ class SceneController:
 
         if mode not in ISO_MODES:
             raise ValueError(f"unknown isosurface mode {mode!r}; choose from {ISO_MODES}")
+        changed = mode != self.iso_mode
         if mode != "vtk" or "iso_mode" in self.session.render.options:
             self.session.render.options["iso_mode"] = mode
         backend = view_backend(self.plotter, self.session, "iso")
@@ -645,6 +658,8 @@ class SceneController:
             self.iso_overlay.update()
         else:
             self.plotter.render()
+        if changed:
+            self.changes.notify(SceneChange("iso_mode"))
 
     def _iso_props(self) -> dict[str, Any]:
         return {comp_id: view.prop for comp_id, view in self._views_of("isosurfaces").items()}
