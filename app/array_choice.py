@@ -13,7 +13,7 @@ from PySide6.QtCore import Qt
 from PySide6.QtGui import QUndoStack
 from PySide6.QtWidgets import QComboBox
 
-from volviz_app.component_settings import edit_settings
+from .component_settings import edit_settings
 
 
 class ArrayChoice:

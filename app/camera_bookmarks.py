@@ -5,14 +5,20 @@ from __future__ import annotations
 import time
 from typing import Optional
 
+from PySide6.QtCore import QTimer
 from PySide6.QtWidgets import QInputDialog
 
 from volviz.session import CameraKey
+from .window_base import WindowBase
 
 
-class CameraBookmarks:
+class CameraBookmarks(WindowBase):
     """Named camera views (Camera > Bookmarks) and recorded camera paths (Camera > Record Path), kept in the
     session."""
+
+    _recording: Optional[list[CameraKey]]  # the keys of the path being recorded (None: not recording)
+    _record_start: float                   # when the recording started (``time.perf_counter``)
+    record_timer: QTimer                   # samples the camera while recording (made by the window's ``__init__``)
 
     def add_bookmark(self, name: str) -> None:
         if self.controller is None:

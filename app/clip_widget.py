@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from typing import Any, Optional
 
-from volviz_app.docks.clipping import ClippingDock, plane_offset
+from .docks.clipping import ClippingDock, plane_offset
 
 
 class ClipPlaneWidget:
@@ -27,7 +27,8 @@ class ClipPlaneWidget:
         """The box widget on the crop box while box crop is on and widgets are shown."""
         box = self.dock.clip["box"]
         if not (self.dock.show_widget.isChecked() and box is not None):
-            self.box_widget = _drop(self.box_widget, self.plotter.widgets.box_widgets)
+            _drop(self.box_widget, self.plotter.widgets.box_widgets)
+            self.box_widget = None
             return
         bounds = [v for pair in zip(box["lo"], box["hi"]) for v in pair]
         self._placing = True
@@ -73,7 +74,8 @@ class ClipPlaneWidget:
 
     def _remove(self) -> None:
         if self.widget is not None:
-            self.widget = _drop(self.widget, self.plotter.widgets.plane_widgets)
+            _drop(self.widget, self.plotter.widgets.plane_widgets)
+            self.widget = None
             self.plotter.render()
 
 
@@ -83,4 +85,3 @@ def _drop(widget: Any, registry: list[Any]) -> None:
         widget.Off()
         if widget in registry:
             registry.remove(widget)
-    return None

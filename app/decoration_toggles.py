@@ -14,8 +14,8 @@ TOGGLES = (("scalar_bar", "Scalar &Bar", "The color legend of the shown array, w
 
 
 class DecorationToggles:
-    """The three actions in ``menu``; ``window`` provides ``session``, ``controller``, ``set_dirty`` and ``render``.
-    ``actions`` maps each render option to its action."""
+    """The three actions in ``menu``; ``window`` provides ``session``, ``controller``, ``set_dirty`` and
+    ``render_scene``. ``actions`` maps each render option to its action."""
 
     def __init__(self, window: Any, menu: QMenu) -> None:
         self.window = window
@@ -48,4 +48,4 @@ class DecorationToggles:
         window.set_dirty()
         if window.controller is not None:
             window.controller.decorate()
-            window.render()
+            window.render_scene()

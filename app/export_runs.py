@@ -15,10 +15,11 @@ from pathlib import Path
 from typing import Any, Callable, Optional
 
 from volviz.session import Session
-from volviz_app.errors import hide_temporary_names
+from .errors import hide_temporary_names
+from .window_base import WindowBase
 
 
-class ExportRuns:
+class ExportRuns(WindowBase):
     """Screenshot and movie export (see the module's docstring)."""
 
     def _init_exports(self) -> None:
@@ -50,7 +51,7 @@ class ExportRuns:
     def _export(self, name: str, size: tuple[int, int], frames_of: Callable[[Any], list[Any]],
                 open_sink: Callable[[], Any]) -> None:
         from volviz.render.export import offscreen_scene
-        from volviz_app.frame_export import FrameExport
+        from .frame_export import FrameExport
 
         if self._export_run is not None:
             self._export_run.cancel()  # superseded: it ends quietly, the newer export owns the status bar

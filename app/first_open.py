@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Optional
 
-from volviz_app.smoke import pump_events
+from .smoke import pump_events
 
 WINDOW_SIZE = (1366, 768)
 TIMEOUT_S = 300.0
@@ -146,7 +146,7 @@ def open_one(app: Any, path: Path, root: Path, out: Path, workdir: Path) -> Firs
     """Open ``path`` in a fresh window, time it to the first complete image, grab the window into ``out``."""
     from PySide6.QtCore import QSettings
 
-    from volviz_app.window import MainWindow
+    from .window import MainWindow
 
     record = FirstOpen(path, path.relative_to(root).as_posix())
     settings = QSettings(str(workdir / f"{path.name}.ini"), QSettings.Format.IniFormat)

@@ -22,15 +22,16 @@ def menu_shortcuts(window: QMainWindow) -> list[tuple[str, str, str]]:
     def walk(menu: QMenu, path: str) -> None:
         for action in menu.actions():
             sub = action.menu()
-            if sub is not None:
+            if isinstance(sub, QMenu):
                 walk(sub, f"{path} > {_plain(action.text())}")
             elif not action.isSeparator() and not action.shortcut().isEmpty():
                 keys = action.shortcut().toString(QKeySequence.SequenceFormat.NativeText)
                 rows.append((keys, path, _plain(action.text()) or action.toolTip()))
 
     for top in window.menuBar().actions():
-        if top.menu() is not None:
-            walk(top.menu(), _plain(top.text()))
+        menu = top.menu()
+        if isinstance(menu, QMenu):
+            walk(menu, _plain(top.text()))
     return rows
 
 
@@ -38,7 +39,7 @@ def fly_shortcuts() -> list[tuple[str, str, str]]:
     """Fly mode's keys (``volviz_app.navigation.MOVES``), one row per motion."""
     from PySide6.QtCore import Qt
 
-    from volviz_app.navigation import MOVES
+    from .navigation import MOVES
 
     names = {(1, 0, 0): "move forward", (-1, 0, 0): "move back", (0, 1, 0): "move right", (0, -1, 0): "move left",
              (0, 0, 1): "rise", (0, 0, -1): "sink"}

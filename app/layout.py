@@ -128,5 +128,7 @@ class WindowLayout(QObject):
     def viewport_fraction(self, viewport: Optional[Any] = None) -> float:
         """The share of the window's area the central widget (the viewport) gets."""
         central = viewport or self.window.centralWidget()
+        if central is None:  # no viewport yet
+            return 0.0
         area = max(self.window.width() * self.window.height(), 1)
         return central.width() * central.height() / area

@@ -17,9 +17,10 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
 
     from PySide6.QtWidgets import QApplication
 
-    from volviz_app.window import MainWindow
+    from .window import MainWindow
 
-    app = QApplication.instance() or QApplication(sys.argv[:1])
+    existing = QApplication.instance()  # reused when it is a QApplication (a QCoreApplication shows no windows)
+    app = existing if isinstance(existing, QApplication) else QApplication(sys.argv[:1])
     app.setApplicationName("volviz")
     app.setOrganizationName("volviz")
     app.setWindowIcon(_icon())
@@ -29,7 +30,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
 
         from PySide6.QtCore import QSettings
 
-        from volviz_app.smoke import screenshot
+        from .smoke import screenshot
 
         scratch = Path(tempfile.mkdtemp(prefix="volviz-app-check-"))
         window = MainWindow(settings=QSettings(str(scratch / "settings.ini"), QSettings.Format.IniFormat),

@@ -5,10 +5,11 @@ from __future__ import annotations
 from typing import Any, Callable, Optional
 
 from PySide6.QtCore import QEvent, QObject, Qt
+from PySide6.QtGui import QKeyEvent, QMouseEvent
 
 from volviz.render.camera_path import FlyNavigator
 
-MOVES = {
+MOVES: dict[int, tuple[int, int, int]] = {  # by key code (``QKeyEvent.key()``; a ``Qt.Key`` is an int)
     Qt.Key.Key_W: (1, 0, 0), Qt.Key.Key_Up: (1, 0, 0),
     Qt.Key.Key_S: (-1, 0, 0), Qt.Key.Key_Down: (-1, 0, 0),
     Qt.Key.Key_D: (0, 1, 0), Qt.Key.Key_Right: (0, 1, 0),
@@ -62,7 +63,7 @@ class FlyMode(QObject):
         if not self.enabled:
             return False
         kind = event.type()
-        if kind == QEvent.Type.KeyPress:
+        if kind == QEvent.Type.KeyPress and isinstance(event, QKeyEvent):
             key = event.key()
             if key in MOVES:
                 f, r, u = MOVES[key]
@@ -77,10 +78,10 @@ class FlyMode(QObject):
             return True  # no VTK key bindings while flying
         if kind == QEvent.Type.KeyRelease:
             return True
-        if kind == QEvent.Type.MouseButtonPress:
+        if kind == QEvent.Type.MouseButtonPress and isinstance(event, QMouseEvent):
             self._last_mouse = event.position()
             return True
-        if kind == QEvent.Type.MouseMove and self._last_mouse is not None:
+        if kind == QEvent.Type.MouseMove and self._last_mouse is not None and isinstance(event, QMouseEvent):
             pos = event.position()
             dx, dy = pos.x() - self._last_mouse.x(), pos.y() - self._last_mouse.y()
             self._last_mouse = pos

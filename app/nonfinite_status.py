@@ -9,7 +9,7 @@ from __future__ import annotations
 from typing import Any
 
 from volviz.jobs import JobOutcome
-from volviz_app.read_notes import READ_NOTES, short_note
+from .read_notes import READ_NOTES, short_note
 
 
 def nonfinite_note(datasets: dict[str, Any]) -> str:

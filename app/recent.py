@@ -27,9 +27,8 @@ class RecentFiles:
     def files(self) -> list[str]:
         """The recent files that still exist, newest first."""
         value = self.settings.value(RECENT_KEY, [])
-        if isinstance(value, str):
-            value = [value]
-        return [str(v) for v in (value or []) if os.path.exists(str(v))]
+        entries = [value] if isinstance(value, str) else value if isinstance(value, (list, tuple)) else []
+        return [str(v) for v in entries if os.path.exists(str(v))]
 
     def add(self, path: str | os.PathLike) -> None:
         """``path`` opened: it goes to the top of the list, and its folder is where the next dialog starts."""

@@ -8,7 +8,7 @@ background); the render
 settings dock changes the renderer (the scene rebuilt with the same camera), the isosurface mode or the error budget.
 
 It expects of the window: ``controller``, ``session``, ``session_path``, ``datasets``, ``jobs``, ``status_label``,
-``tf_editor``, ``scene_tree``, ``array_choice``, ``render()``, ``schedule_render()``, ``set_dirty``,
+``tf_editor``, ``scene_tree``, ``array_choice``, ``render_scene()``, ``schedule_render()``, ``set_dirty``,
 ``show_error``, ``_show_session`` (``volviz_app.scene_loading``), the refreshes of ``volviz_app.view_scheduler``
 (``refresh_views``, ``refresh_iso_overlay``, ``_enforce_error_budget``) and
 ``last_error_rmse``; ``_init_scene_edits()`` makes its state and ``_connect_scene_edits()`` its preview timer (both
@@ -16,14 +16,18 @@ called by the window's ``__init__``; the docks' signals are connected where the 
 from __future__ import annotations
 
 import threading
-from typing import Any, Optional
+from typing import TYPE_CHECKING, Any, Optional
 
 from PySide6.QtCore import Qt, QTimer
 
 from volviz.jobs import JobOutcome
 from volviz.session import SessionError
-from volviz_app.docks.render_settings import RENDERER_DEFAULTS
-from volviz_app.view_scheduler import MOVING_SCALE
+from .docks.render_settings import RENDERER_DEFAULTS
+from .view_scheduler import MOVING_SCALE
+from .window_base import WindowBase
+
+if TYPE_CHECKING:
+    from volviz.render.controller import SceneController
 
 PREVIEW_MS = 40          # live transfer-function preview: at most one re-render per 40 ms while dragging
 
@@ -33,7 +37,7 @@ def _histogram_range(hist: Any) -> Optional[tuple[float, float]]:
     return None if hist is None else (float(hist[1][0]), float(hist[1][-1]))
 
 
-class SceneEdits:
+class SceneEdits(WindowBase):
     """The docks' edits of the shown scene (see the module's docstring)."""
 
     def _init_scene_edits(self) -> None:
@@ -81,6 +85,8 @@ class SceneEdits:
         from volviz.render.scene_builder import load_datasets
 
         controller, session_path = self.controller, self.session_path
+        if controller is None:
+            return
         self.tf_editor.set_histogram_pending()
 
         def compute(progress: Any = None) -> Any:
@@ -124,7 +130,7 @@ class SceneEdits:
         # in the background; the newest edit next, while dragging as a preview (``MOVING_SCALE``), a finished edit at
         # full size with a fresh error estimate. VTK's own mappers draw the new functions at once.
         if not self.refresh_views([comp_id], estimate=finished, scale=1 if finished else MOVING_SCALE):
-            self.render()
+            self.render_scene()
 
     def _set_visibility(self, comp_id: str, visible: bool) -> None:
         from volviz.render.scene_builder import NATURE_TYPES
@@ -142,7 +148,7 @@ class SceneEdits:
         if build:
             self.show_component(comp_id)
             return
-        self.render()
+        self.render_scene()
         self.refresh_views([comp_id, "iso-overlay"])
 
     def show_component(self, comp_id: str) -> None:
@@ -152,6 +158,8 @@ class SceneEdits:
         from volviz.render.scene_builder import load_datasets
 
         controller, session_path = self.controller, self.session_path
+        if controller is None:
+            return
         self.status_label.setText(f"Preparing {comp_id}…")
 
         def prepare(progress: Any = None) -> Any:
@@ -171,14 +179,14 @@ class SceneEdits:
                 self.schedule_render()
                 self.refresh_views([comp_id, "iso-overlay"])
             elif outcome.error is not None:
-                self._revert_visibility(comp_id, True)
+                self._revert_visibility(controller, comp_id, True)
                 self.show_error(f"Cannot show {comp_id}", str(outcome.error))
 
         self.jobs.submit(prepare, name=f"show {comp_id}", key=f"show:{comp_id}", on_done=done)
 
-    def _revert_visibility(self, comp_id: str, visible: bool) -> None:
+    def _revert_visibility(self, controller: SceneController, comp_id: str, visible: bool) -> None:
         """Showing (``visible``) or hiding a component failed: it keeps its previous state, and so does its box."""
-        self.controller.component(comp_id).visible = not visible
+        controller.component(comp_id).visible = not visible
         tree = self.scene_tree.tree
         tree.blockSignals(True)
         try:
@@ -195,6 +203,8 @@ class SceneEdits:
         from volviz.render.scene_builder import load_datasets
 
         controller, session_path = self.controller, self.session_path
+        if controller is None:
+            return
 
         def prepare(progress: Any = None) -> Any:
             load_datasets(controller.session, session_path, loaded=controller.datasets)  # a component shown anew
@@ -210,7 +220,7 @@ class SceneEdits:
                     self.schedule_render()
                 self.refresh_nature()
             elif outcome.error is not None:
-                self._revert_visibility(comp_id, visible)
+                self._revert_visibility(controller, comp_id, visible)
                 self.show_error(f"Cannot {'show' if visible else 'hide'} {comp_id}", str(outcome.error))
 
         self.jobs.submit(prepare, name="natural scene", key="nature-build", on_done=done)
@@ -221,7 +231,7 @@ class SceneEdits:
         controller = self.controller
         stale = controller.set_opacity(comp_id, opacity, update=False)
         self.set_dirty()
-        self.render()
+        self.render_scene()
         if stale:  # surfaces scaled by the opacity: cut again in the background, then their views are refreshed
             self._cut_in_background(controller, controller.clip, stale)
         else:
@@ -241,13 +251,13 @@ class SceneEdits:
             self.show_error("Invalid clipping", str(exc))
             return
         self.set_dirty()
-        self.render()
+        self.render_scene()
         self.refresh_views([key for key, view in controller.camera_views().items()
                             if view.kind != "nature" and key.split(":", 1)[-1] not in pending])
         self.cuts_pending.intersection_update(pending)  # the others show this clipping already (an undo, say)
         self._cut_in_background(controller, controller.clip, pending)
 
-    def _cut_in_background(self, controller: Any, settings: Any, comp_ids: list[str]) -> None:
+    def _cut_in_background(self, controller: SceneController, settings: Any, comp_ids: list[str]) -> None:
         """Cut the views of ``comp_ids`` by ``settings`` (``SceneController.cut``: a PT volume's tetrahedra, an
         isosurface component's surfaces with their LOD chains) on a worker (a newer request for a component
         supersedes), then show each cut here and refresh its camera views; ``clipping_shown()`` tells when all
@@ -259,7 +269,7 @@ class SceneEdits:
                 if outcome.ok and self.controller is controller and controller.clip == settings:
                     controller.show_cut(comp_id, outcome.result)
                     self.cuts_pending.discard(comp_id)
-                    self.render()
+                    self.render_scene()
                     self.refresh_views([comp_id, "iso-overlay"])
                 elif outcome.error is not None:
                     self.show_error("Cannot clip", f"{comp_id}: {outcome.error}")
@@ -307,9 +317,9 @@ class SceneEdits:
         self.set_dirty()
         if iso_changed and not rebuild and self.controller is not None:
             self.controller.set_iso_mode(iso_mode, update=False)
-            self.render()
+            self.render_scene()
             self.refresh_iso_overlay()
-        if budget_changed and not rebuild and getattr(self, "last_error_rmse", None) is not None:
+        if budget_changed and not rebuild and self.last_error_rmse is not None:
             self._enforce_error_budget(self.last_error_rmse)
             return
         if rebuild and self.controller is not None:  # another renderer: rebuild the scene with the same camera

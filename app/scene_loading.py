@@ -9,26 +9,30 @@ It expects of the window: ``controller``, ``session``, ``session_path``, ``datas
 ``plotter``, ``jobs``, ``_load_serial``, ``_loading_views``, ``_current_job``, ``status_label``, ``_set_busy``,
 ``show_error``, ``set_dirty``, ``recent``, the docks (``scene_tree``, ``render_settings``, ``clipping``,
 ``timeline``), ``array_choice``, ``decorations``, ``scene_undo_stack``, ``_refresh_bookmark_menu``,
-``_show_first_views``, ``render()`` and ``restoreState`` (``QMainWindow``)."""
+``_show_first_views``, ``render_scene()`` and ``restoreState`` (``QMainWindow``)."""
 from __future__ import annotations
 
 import logging
 import os
 from pathlib import Path
-from typing import Any, Callable, Optional
+from typing import TYPE_CHECKING, Any, Callable, Optional
 
 from PySide6.QtCore import QByteArray, QTimer
 
 from volviz.jobs import JobOutcome
 from volviz.session import Session
-from volviz_app.errors import open_error
+from .errors import open_error
+from .window_base import WindowBase
+
+if TYPE_CHECKING:
+    from volviz.render.controller import SceneController
 
 log = logging.getLogger("volviz_app.window")  # the logger these methods had in window.py
 
 STAGE_MS = 30            # pause between GUI-thread stages of showing a new scene (other events run in between)
 
 
-class SceneLoading:
+class SceneLoading(WindowBase):
     """Opening files and showing sessions (see the module's docstring)."""
 
     def open_demo(self) -> None:
@@ -117,7 +121,7 @@ class SceneLoading:
 
         self._current_job = self.jobs.submit(load, name=f"load {title}", key="load", on_done=done)
 
-    def _install_session(self, controller: Any, prepared: Any, session_path: Optional[Path], title: str,
+    def _install_session(self, controller: SceneController, prepared: Any, session_path: Optional[Path], title: str,
                          dirty: bool, serial: int, path: Optional[Path] = None) -> bool:
         """GUI thread: replace the shown scene by a prepared one (no numerics here: props added, docks filled, one
         render), then compute its view-dependent parts in the background; loading ends when they are shown. A scene
@@ -126,7 +130,7 @@ class SceneLoading:
         previous = self.controller
         camera = previous.camera() if previous is not None else None  # install places the new scene's camera
         if previous is not None:
-            self.controller.clear()
+            previous.clear()
         self.plotter.clear()
         self._current_job = None
         try:
@@ -167,9 +171,14 @@ class SceneLoading:
         self.error_estimate = None
         self.last_error_rmse = None
         self.set_dirty(dirty)
+
+        def first_render() -> None:
+            if self.controller is controller:
+                self.render_scene()
+
         # the first render and the first views' GUI-thread parts (a PT volume's depth read-back renders too) in
         # later turns of the event loop, with room for other events between them: in one turn they held it 160-330
         # ms for a big PT scene under load
-        QTimer.singleShot(STAGE_MS, lambda: self.controller is controller and self.render())
+        QTimer.singleShot(STAGE_MS, first_render)
         QTimer.singleShot(2 * STAGE_MS, lambda: self._show_first_views(controller, serial, title))
         return True

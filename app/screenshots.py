@@ -53,7 +53,7 @@ def main(argv: list[str] | None = None) -> int:
 
     from PySide6.QtWidgets import QApplication
 
-    from volviz_app.window import MainWindow
+    from .window import MainWindow
 
     app = QApplication.instance() or QApplication([])
     window = MainWindow()

@@ -18,6 +18,7 @@ from PySide6.QtCore import QStandardPaths, QTimer
 from PySide6.QtWidgets import QFileDialog, QMessageBox
 
 from volviz.session import Session, SessionError, relative_path
+from .window_base import WindowBase
 
 log = logging.getLogger("volviz_app.window")  # the logger these methods had in window.py
 
@@ -40,7 +41,7 @@ def default_recovery_dir() -> Path:
     return Path(base or Path.home() / ".volviz") / "recovery"
 
 
-class SessionFiles:
+class SessionFiles(WindowBase):
     """Open, save, autosave, recovery, recent files and dirty tracking of the window (see the module's docstring)."""
 
     def _connect_session_files(self) -> None:
@@ -63,7 +64,7 @@ class SessionFiles:
             absolute = resolve_path(self.session_path, ref.path) if self.session_path else Path(ref.path)
             refs.append(DatasetRef(ref.id, relative_path(target, absolute), dict(ref.options)))
         layout = dict(session.layout)
-        layout["window_state"] = bytes(self.saveState().toBase64()).decode("ascii")
+        layout["window_state"] = self.saveState().toBase64().toStdString()
         camera = self.controller.camera() if self.controller is not None else session.camera
         return Session(datasets=refs, components=session.components, transfer_functions=session.transfer_functions,
                        camera=camera, camera_paths=session.camera_paths, bookmarks=session.bookmarks,
@@ -91,7 +92,7 @@ class SessionFiles:
     @property
     def recovery_file(self) -> Path:
         """This window's own recovery file (``volviz_app.recovery``): other windows never write or delete it."""
-        from volviz_app.recovery import window_file
+        from .recovery import window_file
 
         if "_own_recovery_file" not in self.__dict__:
             self.__dict__["_own_recovery_file"] = window_file(self.recovery_dir)
@@ -120,7 +121,7 @@ class SessionFiles:
     def offer_recovery(self) -> bool:
         """If a crashed window (its process is gone) left a recovery file, claim it as this window's own and ask
         (without blocking) whether to restore it."""
-        from volviz_app.recovery import claim, orphaned
+        from .recovery import claim, orphaned
 
         if not any(claim(orphan, self.recovery_file) for orphan in orphaned(self.recovery_dir)):
             return False
@@ -171,12 +172,22 @@ class SessionFiles:
                 dialog.selectFile(default_name)
         elif multiple:   # ``on_chosen(paths)`` gets the list
             dialog.setFileMode(QFileDialog.FileMode.ExistingFiles)
-            dialog.filesSelected.connect(lambda paths: paths and (self.recent.remember_folder(paths[0]),
-                                                                  on_chosen(list(paths))))
+
+            def files_selected(paths: list[str]) -> None:
+                if paths:
+                    self.recent.remember_folder(paths[0])
+                    on_chosen(list(paths))
+
+            dialog.filesSelected.connect(files_selected)
         else:
             dialog.setFileMode(QFileDialog.FileMode.ExistingFile)
-        dialog.fileSelected.connect(lambda path: path and not multiple and (self.recent.remember_folder(path),
-                                                                            on_chosen(path)))
+
+        def file_selected(path: str) -> None:
+            if path and not multiple:
+                self.recent.remember_folder(path)
+                on_chosen(path)
+
+        dialog.fileSelected.connect(file_selected)
         dialog.open()
         self.file_dialog = dialog
         return dialog

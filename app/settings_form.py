@@ -16,7 +16,7 @@ from __future__ import annotations
 import copy
 import json
 import typing
-from typing import Any, Callable, Literal, Optional, Sequence
+from typing import Any, Callable, Generic, Literal, Optional, Sequence, TypeVar, Union
 
 from pydantic.fields import FieldInfo
 from PySide6.QtCore import Signal
@@ -33,6 +33,9 @@ DECIMALS = 6                      # digits after the point a float spin box keep
 FLOAT_LIMIT = 1e9                 # the range of a float field without bounds
 INT_LIMIT = 2 ** 31 - 1           # the range of an int field without bounds (QSpinBox holds a C int)
 CLIP_NOTE = "Edited in the Clipping dock"
+
+_W = TypeVar("_W", bound=QWidget, covariant=True)  # an editor's widget
+_Cell = TypeVar("_Cell", bound=QWidget)
 
 
 def field_bounds(info: FieldInfo) -> tuple[Optional[float], Optional[float]]:
@@ -93,21 +96,32 @@ class FloatBox(QDoubleSpinBox):
         return text.rstrip("0").rstrip(point) if point in text else text
 
 
-def _number_box(annotation: Any, info: Optional[FieldInfo] = None) -> QAbstractSpinBox:
+def _number_box(annotation: Any, info: Optional[FieldInfo] = None) -> Union[QSpinBox, FloatBox]:
     """A spin box for an int or float with the field's bounds (the whole range where it has none) and unit."""
+    if annotation is not int:
+        return _float_box(info)
     lower, upper = field_bounds(info) if info is not None else (None, None)
-    if annotation is int:
-        box: Any = QSpinBox()
-        box.setKeyboardTracking(False)
-        box.setRange(int(lower) if lower is not None else -INT_LIMIT, int(upper) if upper is not None else INT_LIMIT)
-    else:
-        box = FloatBox()
-        box.setRange(float(lower) if lower is not None else -FLOAT_LIMIT,
-                     float(upper) if upper is not None else FLOAT_LIMIT)
+    box = QSpinBox()
+    box.setKeyboardTracking(False)
+    box.setRange(int(lower) if lower is not None else -INT_LIMIT, int(upper) if upper is not None else INT_LIMIT)
+    _show_unit(box, info)
+    return box
+
+
+def _float_box(info: Optional[FieldInfo] = None) -> FloatBox:
+    """A spin box for a float with the field's bounds (the whole range where it has none) and unit."""
+    lower, upper = field_bounds(info) if info is not None else (None, None)
+    box = FloatBox()
+    box.setRange(float(lower) if lower is not None else -FLOAT_LIMIT,
+                 float(upper) if upper is not None else FLOAT_LIMIT)
+    _show_unit(box, info)
+    return box
+
+
+def _show_unit(box: Union[QSpinBox, FloatBox], info: Optional[FieldInfo]) -> None:
     unit = _hints(info).get("unit") if info is not None else None
     if unit:
         box.setSuffix(f" {unit}")
-    return box
 
 
 class ColorButton(QPushButton):
@@ -139,11 +153,11 @@ class ColorButton(QPushButton):
         self.chosen.emit()
 
 
-class _Editor:
+class _Editor(Generic[_W]):
     """The editor of one field: ``widget``, ``value()`` (as the session stores it) and ``show(value)`` (no report);
     ``edited`` is called when the user committed a value."""
 
-    def __init__(self, widget: QWidget, edited: Callable[[], None]) -> None:
+    def __init__(self, widget: _W, edited: Callable[[], None]) -> None:
         self.widget, self.edited = widget, edited
 
     def value(self) -> Any:
@@ -153,7 +167,7 @@ class _Editor:
         raise NotImplementedError
 
 
-class _CheckBox(_Editor):
+class _CheckBox(_Editor[QCheckBox]):
     def __init__(self, edited: Callable[[], None]) -> None:
         super().__init__(QCheckBox(), edited)
         self.widget.toggled.connect(lambda _on: self.edited())
@@ -167,7 +181,7 @@ class _CheckBox(_Editor):
         self.widget.blockSignals(False)
 
 
-class _Choice(_Editor):
+class _Choice(_Editor[QComboBox]):
     """A combo box of fixed choices (a ``Literal``) or of names (datasets, arrays): None is no entry chosen."""
 
     def __init__(self, choices: Sequence[str], edited: Callable[[], None]) -> None:
@@ -186,7 +200,7 @@ class _Choice(_Editor):
         self.widget.blockSignals(False)
 
 
-class _Number(_Editor):
+class _Number(_Editor[Union[QSpinBox, FloatBox]]):
     def __init__(self, annotation: Any, info: FieldInfo, edited: Callable[[], None]) -> None:
         super().__init__(_number_box(annotation, info), edited)
         self.kind = annotation
@@ -197,11 +211,11 @@ class _Number(_Editor):
 
     def show(self, value: Any) -> None:
         self.widget.blockSignals(True)
-        self.widget.setValue(self.widget.minimum() if value is None else value)
+        self.widget.setValue(self.kind(self.widget.minimum()) if value is None else value)
         self.widget.blockSignals(False)
 
 
-class _Vector(_Editor):
+class _Vector(_Editor[QWidget]):
     """A row of spin boxes for a fixed-length tuple (extent, origin, grid shape)."""
 
     def __init__(self, kinds: Sequence[Any], info: FieldInfo, edited: Callable[[], None]) -> None:
@@ -209,7 +223,8 @@ class _Vector(_Editor):
         row = QHBoxLayout(self.widget)
         row.setContentsMargins(0, 0, 0, 0)
         unit = _hints(info).get("unit")
-        self.kinds, self.boxes = list(kinds), []
+        self.kinds = list(kinds)
+        self.boxes: list[Union[QSpinBox, FloatBox]] = []
         for kind in self.kinds:
             box = _number_box(kind)
             if unit:
@@ -228,7 +243,7 @@ class _Vector(_Editor):
             box.blockSignals(False)
 
 
-class _Color(_Editor):
+class _Color(_Editor[ColorButton]):
     def __init__(self, edited: Callable[[], None]) -> None:
         super().__init__(ColorButton(), edited)
         self.widget.chosen.connect(self.edited)
@@ -240,7 +255,7 @@ class _Color(_Editor):
         self.widget.set_rgb(value if value is not None else (1.0, 1.0, 1.0))
 
 
-class _ReadOnly(_Editor):
+class _ReadOnly(_Editor[QLabel]):
     """A nested object without a model (the isosurfaces' clipping): shown as JSON, edited elsewhere."""
 
     def __init__(self, note: str) -> None:
@@ -285,8 +300,15 @@ class StylesTable(QWidget):
 
     def styles(self) -> list[dict[str, Any]]:
         """The surfaces as the session stores them."""
-        return [{"value": self.table.cellWidget(row, 0).value(), "color": list(self.table.cellWidget(row, 1).rgb),
-                 "opacity": self.table.cellWidget(row, 2).value()} for row in range(self.table.rowCount())]
+        return [{"value": self._cell(row, 0, FloatBox).value(), "color": list(self._cell(row, 1, ColorButton).rgb),
+                 "opacity": self._cell(row, 2, FloatBox).value()} for row in range(self.table.rowCount())]
+
+    def _cell(self, row: int, column: int, kind: type[_Cell]) -> _Cell:
+        """The editor in a cell of the table (``_append`` put it there)."""
+        widget = self.table.cellWidget(row, column)
+        if not isinstance(widget, kind):
+            raise TypeError(f"the cell ({row}, {column}) of the surfaces table holds no {kind.__name__}")
+        return widget
 
     def set_styles(self, styles: Sequence[dict[str, Any]]) -> None:
         """Show ``styles`` (a missing color or opacity as the model's default), reporting nothing."""
@@ -299,11 +321,11 @@ class StylesTable(QWidget):
         fields = IsoStyleSettings.model_fields
         row = self.table.rowCount() if row is None else row
         self.table.insertRow(row)
-        value = _number_box(float, fields["value"])
+        value = _float_box(fields["value"])
         value.setValue(float(style.get("value", 0.0)))
         color = ColorButton()
         color.set_rgb(style.get("color", _default(fields["color"])))
-        opacity = _number_box(float, fields["opacity"])
+        opacity = _float_box(fields["opacity"])
         opacity.setValue(float(style.get("opacity", _default(fields["opacity"]))))
         for column, widget in enumerate((value, color, opacity)):
             widget.setToolTip(fields[("value", "color", "opacity")[column]].title or "")
@@ -330,7 +352,7 @@ class StylesTable(QWidget):
             self.edited.emit()
 
 
-class _Styles(_Editor):
+class _Styles(_Editor[StylesTable]):
     def __init__(self, edited: Callable[[], None]) -> None:
         super().__init__(StylesTable(), edited)
         self.widget.edited.connect(self.edited)
@@ -345,7 +367,7 @@ class _Styles(_Editor):
 class _Row:
     """One field of the form: its label (a check box "set" for a field with a default), editor and problem text."""
 
-    def __init__(self, name: str, info: FieldInfo, editor: _Editor) -> None:
+    def __init__(self, name: str, info: FieldInfo, editor: _Editor[QWidget]) -> None:
         self.name, self.info, self.editor = name, info, editor
         self.default = _default(info)
         title = info.title or name
@@ -420,7 +442,7 @@ class SettingsForm(QWidget):
         layout.addRow(self.message)
 
     def _editor(self, name: str, info: FieldInfo, datasets: Sequence[str],
-                arrays: Callable[[], Sequence[str]]) -> _Editor:
+                arrays: Callable[[], Sequence[str]]) -> _Editor[QWidget]:
         edited = lambda: self._edited(name)  # noqa: E731
         hints, annotation = _hints(info), _without_none(info.annotation)
         origin = typing.get_origin(annotation)
@@ -484,7 +506,7 @@ class SettingsForm(QWidget):
 
     def _show_problems(self, problems: list[tuple[str, str]]) -> None:
         by_row: dict[str, list[str]] = {}
-        rest = []
+        rest: list[str] = []
         for path, message in problems:
             field = path.removeprefix("settings").lstrip(".").split(".")[0].split("[")[0]
             (by_row.setdefault(field, []) if field in self.rows else rest).append(f"{path}: {message}")

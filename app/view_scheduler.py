@@ -13,11 +13,11 @@ error budget applied (``volviz.render.error_budget``). The blended volumes and r
 series follow the display time (``refresh_time_volumes``, ``refresh_time_isosurfaces``).
 
 It expects of the window: ``controller`` (a ``SceneController`` or None), ``plotter``, ``jobs`` (a ``JobBridge``),
-``session``, ``render()``, ``show_statistics()``, ``show_error(title, text)``, ``status_label``, ``render_settings`` and
-``_settings_changed(values)`` (the budget's switch of table), ``timeline``, ``nonfinite``, ``collector``,
-``_set_busy(busy)``, ``_load_serial`` and ``_loading_views``. ``_init_view_scheduler()`` makes its state and
-``_connect_view_scheduler()`` its timers and the viewport's interaction observers (both called by the window's
-``__init__``)."""
+``session``, ``render_scene()``, ``show_statistics()``, ``show_error(title, text)``, ``status_label``,
+``render_settings`` and ``_settings_changed(values)`` (the budget's switch of table), ``timeline``, ``nonfinite``,
+``collector``, ``_set_busy(busy)``, ``_load_serial`` and ``_loading_views``. ``_init_view_scheduler()`` makes its
+state and ``_connect_view_scheduler()`` its timers and the viewport's interaction observers (both called by the
+window's ``__init__``)."""
 from __future__ import annotations
 
 from typing import Any, Callable, Optional
@@ -25,8 +25,9 @@ from typing import Any, Callable, Optional
 from PySide6.QtCore import QTimer
 
 from volviz.jobs import JobOutcome, OneInFlight
-from volviz.render.controller import no_render
+from volviz.render.controller import SceneController, no_render
 from volviz.render.error_budget import MOST_ACCURATE_TABLE, error_budget_choice
+from .window_base import WindowBase
 
 MOVING_SCALE = 2         # previews while the camera moves or a TF point is dragged: 1/2 x 1/2 of the window
 RESIZE_MS = 200          # overlays re-render once the viewport stopped resizing for 200 ms
@@ -43,7 +44,7 @@ def _shown(request: Any, result: Any) -> dict[str, Any]:
     return kept
 
 
-class ViewScheduler:
+class ViewScheduler(WindowBase):
     """The window's background view refreshes (see the module's docstring)."""
 
     def _init_view_scheduler(self) -> None:
@@ -53,8 +54,10 @@ class ViewScheduler:
         self._moving_scheduled = False     # a refresh for the camera the mouse is moving is queued
         self._iso_jobs = OneInFlight()     # isosurface extraction for the display time
         self._volume_jobs = OneInFlight()  # blended volumes of time series for the display time
-        self.volume_time_shown: Optional[tuple[float, bool]] = None  # (time, interpolated) of the shown volumes
-        self.iso_time_shown: Optional[tuple[float, bool]] = None  # (time, interpolated) of the shown isosurfaces
+        self.volume_time_shown = None      # (time, interpolated) of the shown volumes
+        self.iso_time_shown = None         # (time, interpolated) of the shown isosurfaces
+        self.error_estimate = None         # the last CPU PT error estimate, as the statistics dock shows it
+        self.last_error_rmse = None        # and its RMSE, which the error budget is checked against
 
     def _connect_view_scheduler(self) -> None:
         """The viewport's interaction observers, the fly-mode settle timer and the resize timer."""
@@ -64,14 +67,18 @@ class ViewScheduler:
         self.plotter.iren.add_observer("StartInteractionEvent", lambda *args: setattr(self.collector, "interacting",
                                                                                       True))
         self.plotter.iren.add_observer("InteractionEvent", lambda *args: self._schedule_camera_moving())
-        self.plotter.iren.add_observer("EndInteractionEvent", lambda *args: (
-            setattr(self.collector, "interacting", False), QTimer.singleShot(0, self._camera_moved)))
+
+        def interaction_ended(*args: Any) -> None:
+            self.collector.interacting = False
+            QTimer.singleShot(0, self._camera_moved)
+
+        self.plotter.iren.add_observer("EndInteractionEvent", interaction_ended)
         # a resized viewport makes the overlay images (PT volumes, CPU-mode isosurfaces) the wrong size: redo them
         self.resize_timer = QTimer(self, singleShot=True, interval=RESIZE_MS)
         self.resize_timer.timeout.connect(self._viewport_resized)
         self.plotter.iren.add_observer("ConfigureEvent", lambda *args: self.resize_timer.start())
 
-    def _show_first_views(self, controller: Any, serial: int, title: str) -> None:
+    def _show_first_views(self, controller: SceneController, serial: int, title: str) -> None:
         """Compute the new scene's camera views in the background (natural scene, LOD blocks, PT volumes, the
         isosurfaces' CPU mode); the loading ends when all are shown (or failed, or were cancelled)."""
 
@@ -100,7 +107,7 @@ class ViewScheduler:
                 self.error_estimate = (f"RMSE {e['rmse']:.2f}, max {e['max']:.1f} of 255 vs exact "
                                        f"({e['size'][0]}x{e['size'][1]})")
                 self.last_error_rmse = e["rmse"]
-                self.render()
+                self.render_scene()
                 self._enforce_error_budget(e["rmse"])
 
         self.jobs.submit(volume.error_estimate, request, name="error estimate", key=f"error:{comp_id}",
@@ -123,8 +130,8 @@ class ViewScheduler:
 
     def schedule_render(self) -> None:
         """Draw once control returns to the event loop: a repaint of the viewport, which renders (Qt merges the
-        repaints asked for in one pass). One render per frame instead of two: ``render`` renders, then the widget's
-        paint renders again (pyvistaqt), each 10-70 ms on llvmpipe."""
+        repaints asked for in one pass). One render per frame instead of two: ``render_scene`` renders, then the
+        widget's paint renders again (pyvistaqt), each 10-70 ms on llvmpipe."""
         self.plotter.interactor.update()
 
     def _schedule_camera_moving(self) -> None:
@@ -155,13 +162,13 @@ class ViewScheduler:
         estimate)."""
         if self.controller is None:
             return
-        self.render()
+        self.render_scene()
         self.refresh_views()
 
     def _viewport_resized(self) -> None:
         """The images of the camera views have the viewport's size, and the block selection depends on it: refresh
         the views whose last update was made for another size."""
-        if self.controller is None:
+        if self.controller is None or self.plotter.ren_win is None:  # no scene, or the window has closed
             return
         size = tuple(int(v) for v in self.plotter.ren_win.GetSize())
         stale = [key for key, view in self.controller.camera_views().items()
@@ -214,19 +221,24 @@ class ViewScheduler:
         ``key`` is left alone. A view with ``coarse_first`` shows a coarse update (``begin(scale=2)``) before a
         full-size one."""
         controller = self.controller
+        if controller is None:
+            return
         jobs = self._view_jobs.setdefault(key, OneInFlight())
         what = view.job[1]
         comp_id = key.split(":", 1)[-1]
 
+        def still_shown() -> bool:
+            return self.controller is controller and controller.camera_views().get(key) is view
+
         def step(scale: int) -> Callable[[Callable[[], None]], None]:
             def start(next_request: Callable[[], None]) -> None:
-                if self.controller is not controller or controller.camera_views().get(key) is not view:
+                if not still_shown():
                     next_request()
                     return
                 request = view.begin(scale=scale)
 
                 def done(outcome: JobOutcome) -> None:
-                    if outcome.ok and self.controller is controller and controller.camera_views().get(key) is view:
+                    if outcome.ok and still_shown():
                         with no_render(self.plotter):  # drawn once, below
                             result = view.finish(request, *outcome.result)
                         self.view_updates[key] = self.view_updates.get(key, 0) + 1
@@ -256,6 +268,8 @@ class ViewScheduler:
     def _playing_changed(self, playing: bool) -> None:
         """During playback VTK draws at its interactive rate, as while the mouse moves the camera (its ray casters
         then cast fewer rays); at the pause the still rate, and one full-quality frame."""
+        if self.plotter.ren_win is None:  # the window has closed
+            return
         iren = self.plotter.iren.interactor if hasattr(self.plotter.iren, "interactor") else self.plotter.iren
         rate = iren.GetDesiredUpdateRate() if playing else iren.GetStillUpdateRate()
         self.plotter.ren_win.SetDesiredUpdateRate(rate)
@@ -268,6 +282,8 @@ class ViewScheduler:
 
     def _show_time(self, t: float, interpolate: Optional[bool]) -> None:
         controller = self.controller
+        if controller is None:
+            return
         controller.set_time(t, interpolate=interpolate, update=False, isosurfaces=False, volumes=False)
         self.refresh_time_volumes()
         self.refresh_time_isosurfaces()

@@ -12,8 +12,8 @@ into volviz. ``MainWindow`` is put together from one mixin per responsibility, e
 - ``export_runs.ExportRuns``: screenshot and movie export in the background;
 - ``camera_bookmarks.CameraBookmarks``: camera bookmarks and camera-path recording.
 
-This module holds the window's shared state (``session``, ``controller``, ``datasets``, ``jobs``, ``plotter``...),
-its construction, ``render``, fly mode, ``show_error`` and closing."""
+This module sets the window's shared state (``session``, ``controller``, ``jobs``, ``plotter``..., typed in
+``window_base.WindowBase``), and holds its construction, ``render_scene``, fly mode, ``show_error`` and closing."""
 from __future__ import annotations
 
 import logging
@@ -26,20 +26,20 @@ from PySide6.QtWidgets import QMainWindow, QMessageBox, QWidget
 
 from volviz.render.backend import plotter_gl_info
 from volviz.render.controller import iso_summary
-from volviz.session import CameraKey, Session
-from volviz_app.camera_bookmarks import CameraBookmarks
-from volviz_app.clip_widget import ClipPlaneWidget
-from volviz_app.export_runs import ExportRuns
-from volviz_app.gc_guard import GuiThreadCollector
-from volviz_app.interaction_renders import SingleRenderDuringInteraction
-from volviz_app.navigation import FlyMode
-from volviz_app.nonfinite_status import NonFiniteStatus
-from volviz_app.scene_edits import SceneEdits
-from volviz_app.scene_loading import SceneLoading
-from volviz_app.session_files import SessionFiles, default_recovery_dir
-from volviz_app.view_scheduler import ViewScheduler
-from volviz_app.window_widgets import WindowWidgets
-from volviz_app.workers import JobBridge
+from volviz.session import Session
+from .camera_bookmarks import CameraBookmarks
+from .clip_widget import ClipPlaneWidget
+from .export_runs import ExportRuns
+from .gc_guard import GuiThreadCollector
+from .interaction_renders import SingleRenderDuringInteraction
+from .navigation import FlyMode
+from .nonfinite_status import NonFiniteStatus
+from .scene_edits import SceneEdits
+from .scene_loading import SceneLoading
+from .session_files import SessionFiles, default_recovery_dir
+from .view_scheduler import ViewScheduler
+from .window_widgets import WindowWidgets
+from .workers import JobBridge
 
 log = logging.getLogger(__name__)
 
@@ -80,21 +80,21 @@ class MainWindow(SceneLoading, SessionFiles, ViewScheduler, SceneEdits, ExportRu
         self.setCentralWidget(self.plotter.interactor)
         self.jobs = JobBridge(self)
         self.jobs.progress.connect(self._on_progress)
-        self.session: Session = Session()
-        self.session_path: Optional[Path] = None
-        self.datasets: dict[str, Any] = {}
-        self.controller: Optional[Any] = None
-        self.error_dialog: Optional[QMessageBox] = None
-        self.recovery_dialog: Optional[QMessageBox] = None
+        self.session = Session()
+        self.session_path = None
+        self.datasets = {}
+        self.controller = None
+        self.error_dialog = None
+        self.recovery_dialog = None
         self.dirty = False
-        self.last_stats: dict[str, Any] = {}
+        self.last_stats = {}
         self._current_job = None
         self._init_scene_edits()           # histograms, the pending TF preview, what the edits have shown
         self._init_exports()               # the running export and the last one's result
         self._load_serial = 0              # the newest open/rebuild; an older one's late callbacks do nothing
         self._loading_views = False        # the newest scene is installed, its first views are computed
         self._init_view_scheduler()        # its OneInFlight jobs and what they have shown
-        self._recording: Optional[list[CameraKey]] = None
+        self._recording = None
         self._record_start = 0.0
 
         self._build_docks()
@@ -114,7 +114,7 @@ class MainWindow(SceneLoading, SessionFiles, ViewScheduler, SceneEdits, ExportRu
         self.collector.freeze_long_lived()
 
     # ------------------------------------------------------------------------------------------------ rendering
-    def render(self) -> None:
+    def render_scene(self) -> None:
         start = time.perf_counter()
         self.plotter.render()
         self.show_statistics(time.perf_counter() - start)
@@ -128,7 +128,7 @@ class MainWindow(SceneLoading, SessionFiles, ViewScheduler, SceneEdits, ExportRu
                                  "cells": sum(getattr(d, "n_cells", 0) for d in self.datasets.values()),
                                  "gl": plotter_gl_info(self.plotter).renderer}
         pt = self.controller.pt_stats() if self.controller is not None else {}
-        if pt:  # volviz's own renderer: the split of its last frame
+        if pt and self.controller is not None:  # volviz's own renderer: the split of its last frame
             last = list(pt.values())
             stats.update(frame_seconds=sum(s.get("total_s", 0.0) for s in last) + elapsed,
                          sort_seconds=sum(s.get("sort_s", 0.0) for s in last),

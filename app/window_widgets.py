@@ -19,23 +19,24 @@ from typing import Any
 from PySide6.QtGui import QAction, QKeySequence, QUndoGroup, QUndoStack
 from PySide6.QtWidgets import QDockWidget, QLabel, QProgressBar, QPushButton, QWidget
 
-from volviz_app.array_choice import ArrayChoice
-from volviz_app.component_settings import edit_settings
-from volviz_app.decoration_toggles import DecorationToggles
-from volviz_app.docks.clipping import ClippingDock
-from volviz_app.docks.render_settings import RenderSettingsDock
-from volviz_app.docks.scene_tree import SceneTree
-from volviz_app.docks.statistics import Statistics
-from volviz_app.docks.tf_editor import TransferFunctionEditor
-from volviz_app.docks.timeline import Timeline
-from volviz_app.drop import FileDrop
-from volviz_app.export_dialogs import ExportDialogs
-from volviz_app.help import HelpMenu
-from volviz_app.layout import WindowLayout, scrolled
-from volviz_app.recent import RecentFiles
+from .array_choice import ArrayChoice
+from .component_settings import edit_settings
+from .decoration_toggles import DecorationToggles
+from .docks.clipping import ClippingDock
+from .docks.render_settings import RenderSettingsDock
+from .docks.scene_tree import SceneTree
+from .docks.statistics import Statistics
+from .docks.tf_editor import TransferFunctionEditor
+from .docks.timeline import Timeline
+from .drop import FileDrop
+from .export_dialogs import ExportDialogs
+from .help import HelpMenu
+from .layout import WindowLayout, scrolled
+from .recent import RecentFiles
+from .window_base import WindowBase
 
 
-class WindowWidgets:
+class WindowWidgets(WindowBase):
     """Docks, menus and the status bar of the window (see the module's docstring)."""
 
     def _dock(self, title: str, name: str, widget: QWidget, scroll: bool = True) -> QDockWidget:
@@ -91,7 +92,7 @@ class WindowWidgets:
                                                      lambda: self.export_dialogs.ask_screenshot())
         self.action_export_movie = self._action(file_menu, "Export &Movie…", "Ctrl+Shift+E",
                                                 lambda: self.export_dialogs.ask_movie())
-        self.export_dialogs = ExportDialogs(self)
+        self.export_dialogs: ExportDialogs = ExportDialogs(self)
         file_menu.addSeparator()
         self._action(file_menu, "&Quit", QKeySequence.StandardKey.Quit, self.close)
 

@@ -68,7 +68,7 @@ def test_isosurfaces_on_the_gpu_backend_match_the_cpu_without_overlay_jobs(qtbot
     assert "iso-overlay" not in window._view_jobs and "iso-overlay" not in window.view_updates
     gpu = viewport(window)
     _check(gpu, _cpu_expected(window, view.meshes), "gpu vs cpu compositor")
-    window.render()
+    window.render_scene()
     n = sum(m.n_triangles for m in view.meshes)
     assert window.last_stats["iso"].startswith(f"iso 3pass (gpu): {n:,} triangles, {2 * n:,} drawn, ")
 

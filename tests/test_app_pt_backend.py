@@ -65,7 +65,7 @@ def test_gpu_backend_matches_the_cpu_follows_a_drag_without_cpu_renders_and_swit
     assert np.abs(gpu_image - hidden).max() > 50, "the GPU volume is not on screen"
     e = _difference(gpu_image, cpu_image)
     assert e[0] <= RMSE and e[1] <= MAX, f"GPU vs CPU backend in the viewport: RMSE {e[0]:.3f}, max {e[1]:.0f}"
-    window.render()
+    window.render_scene()
     assert window.statistics.text("backends") == "demo: gpu"
     assert window.statistics.text("gl") == plotter_gl_info(window.plotter).renderer != ""
 
@@ -115,7 +115,7 @@ def test_gpu_backend_matches_the_cpu_follows_a_drag_without_cpu_renders_and_swit
     assert isinstance(cpu, PTVolume) and np.allclose(cpu.camera.position, final)
     e = _difference(viewport(window), after_drag)
     assert e[0] <= RMSE and e[1] <= MAX, f"after switching gpu -> cpu: RMSE {e[0]:.3f}, max {e[1]:.0f}"
-    window.render()
+    window.render_scene()
     assert window.statistics.text("backends") == "demo: cpu"
 
 
@@ -127,7 +127,7 @@ def test_closing_the_window_frees_the_gpu_volume_before_its_context(qtbot, make_
     window.open_demo_volume()
     wait_loaded(qtbot, window)
     assert isinstance(_set_backend(qtbot, window, "gpu"), GLPTVolume)
-    window.render()
+    window.render_scene()
     renderer = window.plotter.renderer
     assert getattr(renderer, _PASS_MARK) is not None
     window.dirty = False

@@ -15,7 +15,7 @@ from PySide6.QtGui import QUndoCommand, QUndoStack
 from PySide6.QtWidgets import (QCheckBox, QDoubleSpinBox, QFormLayout, QGroupBox, QHBoxLayout, QListWidget,
                                QPushButton, QVBoxLayout, QWidget)
 
-from volviz_app.docks import set_tooltips
+from . import set_tooltips
 
 NO_CLIP: dict[str, Any] = {"planes": [], "box": None}
 LIMIT = 1e9
@@ -131,7 +131,7 @@ class ClippingDock(QWidget):
         self.remove_button.clicked.connect(self.remove_plane)
         self.flip_button.clicked.connect(self.flip_plane)
         self.plane_list.currentRowChanged.connect(self._show_plane)
-        self.plane_list.currentRowChanged.connect(lambda row: self._loading or self.refreshed.emit())
+        self.plane_list.currentRowChanged.connect(self._selection_changed)
         for b in self.normal + [self.offset]:
             b.valueChanged.connect(self._plane_edited)
         self.box_enabled.toggled.connect(self._box_edited)
@@ -234,6 +234,10 @@ class ClippingDock(QWidget):
         self.remove_button.setEnabled(has)
         self.flip_button.setEnabled(has)
         self._loading = loading
+
+    def _selection_changed(self, row: int) -> None:
+        if not self._loading:
+            self.refreshed.emit()
 
     def _plane_edited(self, *args: Any) -> None:
         row = self.plane_list.currentRow()

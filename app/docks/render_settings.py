@@ -82,8 +82,8 @@ class RenderSettingsDock(QWidget):
         form.addRow("Export height", self.height_box)
         for combo in (self.method, self.backend, self.table_kind, self.table_resolution, self.sort, self.iso_mode):
             combo.currentTextChanged.connect(self._emit)
-        for box in (self.error_budget, self.width_box, self.height_box):
-            box.valueChanged.connect(self._emit)
+        for spin_box in (self.error_budget, self.width_box, self.height_box):
+            spin_box.valueChanged.connect(self._emit)
         self._loading = False
 
     def settings(self) -> dict[str, Any]:

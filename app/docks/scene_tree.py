@@ -11,7 +11,7 @@ from PySide6.QtWidgets import (QComboBox, QGroupBox, QHBoxLayout, QLabel, QSlide
 
 from volviz.model.applicability import DatasetTraits, applicable_fields
 from volviz.model.settings import settings_model
-from volviz_app.settings_form import SettingsForm
+from ..settings_form import SettingsForm
 
 KIND_LABELS = {"volume": "Volume", "mesh": "Mesh", "isosurface": "Isosurface", "terrain": "Terrain",
                "fog": "Ground fog", "clouds": "Clouds", "sky": "Sky", "demo": "Demo volume"}
@@ -90,16 +90,16 @@ class SceneTree(QWidget):
             item.setCheckState(0, Qt.CheckState.Checked if comp.visible else Qt.CheckState.Unchecked)
             self.tree.addTopLevelItem(item)
         self._filling = False
-        if self.tree.topLevelItemCount():
-            self.tree.setCurrentItem(self.item(selected) if selected in self._components else
-                                     self.tree.topLevelItem(0))
+        first = self.tree.topLevelItem(0)  # None: no components
+        if first is not None:
+            self.tree.setCurrentItem(self.item(selected) if selected in self._components else first)
         else:
             self._show_form(None)
 
     def item(self, comp_id: str) -> QTreeWidgetItem:
         for i in range(self.tree.topLevelItemCount()):
             item = self.tree.topLevelItem(i)
-            if item.data(0, Qt.ItemDataRole.UserRole) == comp_id:
+            if item is not None and item.data(0, Qt.ItemDataRole.UserRole) == comp_id:
                 return item
         raise KeyError(comp_id)
 

@@ -18,7 +18,7 @@ from PySide6.QtWidgets import (QCheckBox, QColorDialog, QComboBox, QFileDialog, 
 
 from volviz.optics import TransferFunction
 from volviz.optics.tf_points import MIN_POINTS, insert_point, moved_scalar, remove_point
-from volviz_app.docks import set_tooltips
+from . import set_tooltips
 
 GESTURES = ("Click: add a point · drag a point: move it · right-click: remove it · double-click: "
             "change its color")
@@ -105,7 +105,7 @@ class TransferFunctionCanvas(QWidget):
         if self.histogram_pending:
             painter.setPen(QColor(140, 140, 150))
             painter.drawText(r, Qt.AlignmentFlag.AlignCenter, "computing histogram…")
-        elif self.histogram is not None and self.histogram.size:
+        elif self.histogram is not None and self.histogram_edges is not None and self.histogram.size:
             counts = np.log1p(self.histogram) if self.log_histogram else self.histogram.astype(np.float64)
             top = counts.max() or 1.0
             painter.setPen(Qt.PenStyle.NoPen)

@@ -50,11 +50,11 @@ class Timeline(QWidget):
         self.setSizePolicy(QSizePolicy.Policy.Preferred, QSizePolicy.Policy.Fixed)
         row = QHBoxLayout(self)  # one row: the timeline takes little of the window's height
         row.setContentsMargins(6, 2, 6, 2)
-        for w in (self.back_button, self.play_button, self.forward_button):
-            row.addWidget(w)
+        for button in (self.back_button, self.play_button, self.forward_button):
+            row.addWidget(button)
         row.addWidget(self.slider, 1)
-        for w in (self.label, self.speed, self.loop, self.interpolate):
-            row.addWidget(w)
+        for widget in (self.label, self.speed, self.loop, self.interpolate):
+            row.addWidget(widget)
         self.timer = QTimer(self)
         self.timer.setInterval(33)
         self.timer.timeout.connect(self._tick)

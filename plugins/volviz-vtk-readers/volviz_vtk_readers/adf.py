@@ -51,7 +51,7 @@ import re
 from collections import defaultdict
 from math import prod
 from pathlib import Path
-from typing import NamedTuple, NoReturn
+from typing import BinaryIO, Literal, NamedTuple, NoReturn, Union
 
 from volviz.io._checks import check_file
 from volviz.io.errors import PathLike, ReadError, human_bytes
@@ -124,19 +124,18 @@ class _File:
     """The file's bytes: all in memory up to IN_MEMORY bytes, else read where asked."""
 
     def __init__(self, path: Path, size: int) -> None:
-        self.data = path.read_bytes() if size <= IN_MEMORY else None
-        self.handle = open(path, "rb") if self.data is None else None
-        self.size = len(self.data) if self.data is not None else size
+        self.source: Union[bytes, BinaryIO] = path.read_bytes() if size <= IN_MEMORY else open(path, "rb")
+        self.size = len(self.source) if isinstance(self.source, bytes) else size
 
     def at(self, offset: int, count: int) -> bytes:
-        if self.data is not None:
-            return self.data[offset:offset + count]
-        self.handle.seek(offset)
-        return self.handle.read(count)
+        if isinstance(self.source, bytes):
+            return self.source[offset:offset + count]
+        self.source.seek(offset)
+        return self.source.read(count)
 
     def close(self) -> None:
-        if self.handle is not None:
-            self.handle.close()
+        if not isinstance(self.source, bytes):
+            self.source.close()
 
 
 class _Walk:
@@ -144,7 +143,9 @@ class _Walk:
 
     def __init__(self, path: Path, file: _File) -> None:
         self.path, self.file, self.size = path, file, file.size
-        self.binary, self.order, self.sizes = False, "big", {}
+        self.binary = False
+        self.order: Literal["little", "big"] = "big"
+        self.sizes: dict[str, int] = {}
         self.nodes: dict[str, _Node] = {}
 
     def fail(self, problem: str) -> NoReturn:

@@ -153,7 +153,6 @@ def _netcdf_layout(data: bytes) -> NetcdfHeader:
         ids = [c.count() for _ in range(c.count())]
         texts = c.attributes()
         references += [(name, key, ref) for key in _REFERENCES for ref in texts.get(key, "").split()]
-        cf_vars.append((name, ids, texts))
         nc_type = c.int32()
         vsize, begin = c.count(), c.offset()
         if any(i >= len(dims) for i in ids):
@@ -167,7 +166,7 @@ def _netcdf_layout(data: bytes) -> NetcdfHeader:
             exact *= dims[i]
         if vsize not in (exact, exact + (-exact % 4)) and not (vsize == 0xFFFFFFFF and exact > 0xFFFFFFFB):
             raise ValueError(f"variable {name!r} has {exact} bytes by its dimensions but a size field of {vsize}")
-        cf_vars[-1] = (name, [dim_names[i] for i in ids], texts)
+        cf_vars.append((name, [dim_names[i] for i in ids], texts))
         variables.append((name, begin, exact, exact + (-exact % 4), record))
         table[name] = NetcdfVariable(name, tuple(dim_names[i] for i in ids),
                                      tuple(numrecs if dims[i] == 0 else dims[i] for i in ids), nc_type, begin, record)

@@ -6,6 +6,7 @@ Importing this module imports neither VTK nor the loaders: volviz reads it to kn
 from __future__ import annotations
 
 import re
+from typing import Any
 
 from volviz.io.registry import ReaderSpec
 
@@ -69,9 +70,9 @@ _R = "volviz_vtk_readers.readers:"
 _BLOCKS = ("blocks", "time_index", "allow_nonfinite")
 
 
-def _spec(*args, **kwargs) -> ReaderSpec:
+def _spec(name: str, description: str, patterns: tuple[str, ...], loader: str, **kwargs: Any) -> ReaderSpec:
     """Every loader here runs a VTK C++ reader, which a malformed file can crash: ``read`` runs it isolated."""
-    return ReaderSpec(*args, isolated=True, **kwargs)
+    return ReaderSpec(name, description, patterns, loader, isolated=True, **kwargs)
 
 
 SPECS: list[ReaderSpec] = [  # netCDF before Exodus: a netCDF file known by content alone opens as netCDF

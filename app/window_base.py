@@ -1,0 +1,158 @@
+"""The typed view that ``MainWindow``'s mixins have of the window they are mixed into.
+
+Each mixin (``scene_loading.SceneLoading``, ``session_files.SessionFiles``, ``view_scheduler.ViewScheduler``,
+``scene_edits.SceneEdits``, ``export_runs.ExportRuns``, ``camera_bookmarks.CameraBookmarks``,
+``window_widgets.WindowWidgets``) derives from ``WindowBase``, which declares, once and with their types:
+
+- the window's shared state: what more than one part of the window reads or writes (``session``, ``controller``,
+  ``jobs``, ``plotter``, the docks, ``status_label``...), whichever of ``MainWindow.__init__`` or a mixin sets it;
+- the signatures of the methods a mixin calls on another mixin or on ``MainWindow`` (``render_scene``,
+  ``show_error``, ``set_dirty``, ``refresh_views``, the handlers the docks and actions are connected to...).
+
+A mixin's own state, which only its methods use, stays declared where the mixin sets it. The methods are declared
+under ``TYPE_CHECKING`` only: at run time ``WindowBase`` holds nothing but annotations, so the real definitions (in
+the mixins, in ``MainWindow``, or ``QMainWindow``'s) are what the window runs, whatever their place in its MRO. mypy
+checks every real definition against its declaration here as an override. For the type checker ``WindowBase`` is a
+``QMainWindow`` (the mixins pass ``self`` as the parent of widgets and timers, call ``menuBar()``, ``saveState()``...);
+at run time it is a plain class, so that ``MainWindow`` keeps a single Qt base (PySide6 does not allow two).
+
+A base class rather than a ``Protocol`` for ``self``: mypy takes a mixin's ``self`` annotated with a protocol, but
+that protocol would have to list everything the mixin's methods touch, its own state and methods included, and every
+method would repeat the annotation; the base class needs only what is shared, and no annotation on ``self``."""
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Callable, Optional
+
+if TYPE_CHECKING:
+    from PySide6.QtCore import QSettings
+    from PySide6.QtGui import QAction, QUndoStack
+    from PySide6.QtWidgets import QLabel, QMainWindow, QMenu, QMessageBox, QProgressBar, QPushButton
+    from pyvistaqt import QtInteractor
+
+    from volviz.jobs import Job
+    from volviz.render.controller import SceneController
+    from volviz.session import Session
+    from .array_choice import ArrayChoice
+    from .decoration_toggles import DecorationToggles
+    from .docks.clipping import ClippingDock
+    from .docks.render_settings import RenderSettingsDock
+    from .docks.scene_tree import SceneTree
+    from .docks.statistics import Statistics
+    from .docks.tf_editor import TransferFunctionEditor
+    from .docks.timeline import Timeline
+    from .frame_export import FrameExport
+    from .gc_guard import GuiThreadCollector
+    from .layout import WindowLayout
+    from .nonfinite_status import NonFiniteStatus
+    from .recent import RecentFiles
+    from .workers import JobBridge
+
+    _QtWindow = QMainWindow
+else:
+    _QtWindow = object
+
+
+class WindowBase(_QtWindow):
+    """The main window's shared state and the methods its parts call on each other (see the module's docstring)."""
+
+    # -- set by MainWindow.__init__
+    settings: QSettings
+    recovery_dir: Path
+    collector: GuiThreadCollector
+    plotter: QtInteractor
+    jobs: JobBridge
+    nonfinite: NonFiniteStatus
+    error_dialog: Optional[QMessageBox]
+    recovery_dialog: Optional[QMessageBox]
+    last_stats: dict[str, Any]
+    # -- the shown scene (set by MainWindow.__init__, replaced by SceneLoading and SessionFiles)
+    session: Session
+    session_path: Optional[Path]
+    datasets: dict[str, Any]
+    controller: Optional[SceneController]
+    title: str                         # what the window title names when there is no session file
+    dirty: bool
+    # -- loading (SceneLoading) and the progress it shows (WindowWidgets)
+    _current_job: Optional[Job]
+    _load_serial: int
+    _loading_views: bool
+    # -- the shown views (ViewScheduler, reset by SceneLoading for a new scene)
+    volume_time_shown: Optional[tuple[float, bool]]
+    iso_time_shown: Optional[tuple[float, bool]]
+    error_estimate: Optional[str]
+    last_error_rmse: Optional[float]
+    cuts_pending: set[str]             # SceneEdits
+    _export_run: Optional[FrameExport]  # ExportRuns
+    # -- widgets (WindowWidgets)
+    tf_editor: TransferFunctionEditor
+    scene_tree: SceneTree
+    render_settings: RenderSettingsDock
+    timeline: Timeline
+    statistics: Statistics
+    clipping: ClippingDock
+    layout_keeper: WindowLayout
+    scene_undo_stack: QUndoStack
+    array_choice: ArrayChoice
+    decorations: DecorationToggles
+    recent: RecentFiles
+    bookmark_menu: QMenu
+    action_fly: QAction
+    action_record: QAction
+    status_label: QLabel
+    progress_bar: QProgressBar
+    cancel_button: QPushButton
+
+    if TYPE_CHECKING:
+        # -- MainWindow
+        def render_scene(self) -> None: ...
+        def show_statistics(self, elapsed: Optional[float] = None) -> None: ...
+        def show_error(self, title: str, text: str) -> None: ...
+        def set_fly_mode(self, enabled: bool) -> None: ...
+        def reset_camera(self) -> None: ...
+
+        # -- SceneLoading
+        def open_path(self, path: str | os.PathLike, q: Optional[str | os.PathLike] = None) -> None: ...
+        def open_paths(self, paths: list[str]) -> None: ...
+        def _show_session(self, session: Session, session_path: Optional[Path], title: str,
+                          dirty: bool = False, datasets: Optional[dict[str, Any]] = None, path: Optional[Path] = None,
+                          on_shown: Optional[Callable[[], None]] = None) -> None: ...
+
+        # -- SessionFiles
+        def set_dirty(self, dirty: bool = True) -> None: ...
+        def _ask_open_data(self) -> None: ...
+        def _ask_open_session(self) -> None: ...
+        def _save_session(self) -> bool: ...
+        def _ask_save_session_as(self) -> None: ...
+
+        # -- ViewScheduler
+        def schedule_render(self) -> None: ...
+        def refresh_views(self, keys: Optional[list[str]] = None, settled: Optional[Callable[[], None]] = None,
+                          scale: int = 1, estimate: bool = True, moving: bool = False) -> int: ...
+        def refresh_nature(self, settled: Optional[Callable[[], None]] = None, scale: int = 1) -> None: ...
+        def refresh_iso_overlay(self, settled: Optional[Callable[[], None]] = None, scale: int = 1) -> None: ...
+        def _show_first_views(self, controller: SceneController, serial: int, title: str) -> None: ...
+        def _enforce_error_budget(self, rmse: float) -> None: ...
+        def _camera_moved(self) -> None: ...
+        def _time_changed(self, t: float) -> None: ...
+        def _playing_changed(self, playing: bool) -> None: ...
+        def _interpolation_toggled(self, on: bool) -> None: ...
+
+        # -- SceneEdits
+        def set_clip(self, clip: dict[str, Any]) -> None: ...
+        def _select_component(self, comp_id: str) -> None: ...
+        def _set_visibility(self, comp_id: str, visible: bool) -> None: ...
+        def _set_opacity(self, comp_id: str, opacity: float) -> None: ...
+        def _settings_changed(self, values: dict[str, Any]) -> None: ...
+        def _tf_changed(self, tf: Any) -> None: ...
+        def _tf_committed(self, tf: Any) -> None: ...
+
+        # -- CameraBookmarks
+        def set_recording(self, recording: bool) -> Optional[str]: ...
+        def _ask_bookmark(self) -> None: ...
+        def _refresh_bookmark_menu(self) -> None: ...
+
+        # -- WindowWidgets
+        def _set_busy(self, busy: bool) -> None: ...
+        def _busy_elsewhere(self) -> bool: ...
