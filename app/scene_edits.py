@@ -18,7 +18,7 @@ from __future__ import annotations
 import threading
 from typing import TYPE_CHECKING, Any, Optional
 
-from PySide6.QtCore import Qt, QTimer
+from PySide6.QtCore import QTimer
 
 from volviz.jobs import JobOutcome
 from volviz.session import SessionError
@@ -27,6 +27,7 @@ from .view_scheduler import MOVING_SCALE
 from .window_base import WindowBase
 
 if TYPE_CHECKING:
+    from volviz.model.events import SceneChange
     from volviz.render.controller import SceneController
 
 PREVIEW_MS = 40          # live transfer-function preview: at most one re-render per 40 ms while dragging
@@ -118,7 +119,6 @@ class SceneEdits(WindowBase):
 
     def _tf_committed(self, tf: Any) -> None:
         self._tf_changed(tf)
-        self.set_dirty()
 
     def _apply_pending_tf(self) -> None:
         if self._pending_tf is None or self.controller is None:
@@ -141,7 +141,6 @@ class SceneEdits(WindowBase):
         nature = controller.component(comp_id).type in NATURE_TYPES
         build = visible and controller.needs_build(comp_id)
         controller.set_visible(comp_id, visible, nature=False, build=False)
-        self.set_dirty()
         if nature:
             self.rebuild_nature(comp_id, visible)
             return
@@ -185,15 +184,18 @@ class SceneEdits(WindowBase):
         self.jobs.submit(prepare, name=f"show {comp_id}", key=f"show:{comp_id}", on_done=done)
 
     def _revert_visibility(self, controller: SceneController, comp_id: str, visible: bool) -> None:
-        """Showing (``visible``) or hiding a component failed: it keeps its previous state, and so does its box."""
-        controller.component(comp_id).visible = not visible
-        tree = self.scene_tree.tree
-        tree.blockSignals(True)
-        try:
-            self.scene_tree.item(comp_id).setCheckState(
-                0, Qt.CheckState.Unchecked if visible else Qt.CheckState.Checked)
-        finally:
-            tree.blockSignals(False)
+        """Showing (``visible``) or hiding a component failed: it keeps its previous state (its box follows through
+        ``_scene_changed``)."""
+        controller.set_visible(comp_id, not visible, nature=False, build=False)
+
+    def _scene_changed(self, change: SceneChange) -> None:
+        """The shown scene's controller changed the session's state (``SceneController.changes``, wherever the edit
+        came from: a dock, an undo step, a failed show reverted): the session is marked edited, and the scene dock
+        shows a component's visibility and opacity as they now are."""
+        self.set_dirty()
+        if change.what in ("visible", "opacity") and change.component is not None and self.controller is not None:
+            comp = self.controller.component(change.component)
+            self.scene_tree.show_state(comp.id, comp.visible, comp.opacity)
 
     def rebuild_nature(self, comp_id: str, visible: bool) -> None:
         """A terrain / fog / clouds / sky component was shown or hidden: rebuild the natural scene in the background
@@ -230,7 +232,6 @@ class SceneEdits(WindowBase):
             return
         controller = self.controller
         stale = controller.set_opacity(comp_id, opacity, update=False)
-        self.set_dirty()
         self.render_scene()
         if stale:  # surfaces scaled by the opacity: cut again in the background, then their views are refreshed
             self._cut_in_background(controller, controller.clip, stale)
@@ -250,7 +251,6 @@ class SceneEdits(WindowBase):
         except ValueError as exc:
             self.show_error("Invalid clipping", str(exc))
             return
-        self.set_dirty()
         self.render_scene()
         self.refresh_views([key for key, view in controller.camera_views().items()
                             if view.kind != "nature" and key.split(":", 1)[-1] not in pending])

@@ -149,6 +149,7 @@ class SceneLoading(WindowBase):
             return False
         self.session, self.session_path, self.datasets = session, session_path, controller.datasets
         self.controller = controller
+        controller.changes.subscribe(self._scene_changed)   # the window follows the scene's state from now on
         if "window_state" in session.layout:
             self.restoreState(QByteArray.fromBase64(session.layout["window_state"].encode("ascii")))
         self.scene_tree.populate(session.components, [ref.id for ref in session.datasets], self.array_choice.names,

@@ -151,6 +151,19 @@ class SceneTree(QWidget):
         if shown != list(self.form.rows):
             self._show_form(comp_id)
 
+    def show_state(self, comp_id: str, visible: bool, opacity: float) -> None:
+        """Show a component's visibility and opacity as the scene holds them (after a change made anywhere: the dock,
+        an undo, a failed show), without emitting the dock's signals."""
+        item = self.item(comp_id)
+        self._filling = True
+        try:
+            item.setCheckState(0, Qt.CheckState.Checked if visible else Qt.CheckState.Unchecked)
+            item.setData(0, Qt.ItemDataRole.UserRole + 1, float(opacity))
+            if self.tree.currentItem() is item:
+                self.opacity.setValue(int(round(float(opacity) * 100)))
+        finally:
+            self._filling = False
+
     def _opacity_moved(self, value: int) -> None:
         item = self.tree.currentItem()
         if self._filling or item is None:
