@@ -160,6 +160,7 @@ class SceneLoading(WindowBase):
         display_time = controller.time  # the session's display time, which set_steps would reset to the first step
         self.timeline.blockSignals(True)  # the scene already shows the display time: no re-blend, no re-extraction
         try:
+            self.timeline.interpolate.setChecked(controller.interpolate_time)   # the session's switch
             self.timeline.set_steps(controller.time_steps())
             if controller.time_series():
                 self.timeline.set_time(display_time)

@@ -205,8 +205,8 @@ def _row_labels(form: SettingsForm) -> list[str]:
 
 
 def test_form_shows_only_the_settings_that_apply_to_the_dataset(qtbot, make_window, tmp_path: Path) -> None:
-    """A tetrahedral volume has no block budget and nothing to interpolate in time; a time series can interpolate,
-    a compressed volume drawn at a level of detail has a block budget. A setting the session gives that does not
+    """A tetrahedral volume has no block budget; a compressed volume drawn at a level of detail has one; a time
+    series' interpolation is the Timeline dock's switch for the whole scene, not a row of the form. A setting the session gives that does not
     apply stays in its settings through edits of the others. A component hidden at load (its dataset not read) shows
     every field until it is shown."""
     from conftest import blob_vvz
@@ -239,9 +239,9 @@ def test_form_shows_only_the_settings_that_apply_to_the_dataset(qtbot, make_wind
     tets = _select(window, "tets")
     assert "Block budget" not in _row_labels(tets) and "Interpolate in time" not in _row_labels(tets)
     assert set(tets.rows) == set() and tets.settings == {"budget": 64}   # not shown, still set
-    series = _select(window, "series")
-    assert "Interpolate in time" in _row_labels(series) and "Block budget" not in _row_labels(series)
-    assert list(series.rows) == ["interpolate"]
+    series = _select(window, "series")       # its interpolation is the Timeline dock's switch, not a form row
+    assert "Interpolate in time" not in _row_labels(series) and "Block budget" not in _row_labels(series)
+    assert list(series.rows) == []
     blob = _select(window, "blob")
     assert "Block budget" in _row_labels(blob) and "Interpolate in time" not in _row_labels(blob)
     assert list(blob.rows) == ["budget"] and blob.editor("budget").value() == 16
@@ -256,7 +256,7 @@ def test_form_shows_only_the_settings_that_apply_to_the_dataset(qtbot, make_wind
     assert "Interpolate in time" not in _row_labels(_select(window, "iso"))
     assert _settings(window, "tets") == {"budget": 64}
 
-    assert list(_select(window, "later").rows) == ["budget", "interpolate"]   # not read: not known
+    assert list(_select(window, "later").rows) == ["budget"]   # not read: not known
     shown = window.components_shown
     window.scene_tree.item("later").setCheckState(0, Qt.CheckState.Checked)
     qtbot.waitUntil(lambda: window.components_shown > shown, timeout=60000)

@@ -170,3 +170,15 @@ def test_movie_export_sorts_the_next_frame_of_a_gpu_volume_in_the_background() -
         controller.clear()                                     # the GL resources go before the context
     finally:
         plotter.close()
+
+
+def test_the_session_keeps_the_scenes_interpolation_switch():
+    """4D interpolation is one switch for the scene, kept in the components' ``interpolate`` settings: on unless a
+    component turns it off."""
+    from volviz.render.controller import session_interpolates
+    from volviz.session import Component, Session
+
+    assert session_interpolates(Session(components=[Component("a", "volume"), Component("b", "isosurface")]))
+    assert session_interpolates(Session(components=[Component("a", "volume", settings={"interpolate": True})]))
+    assert not session_interpolates(Session(components=[Component("a", "volume"),
+                                                        Component("b", "volume", settings={"interpolate": False})]))

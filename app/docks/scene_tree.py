@@ -17,8 +17,9 @@ KIND_LABELS = {"volume": "Volume", "mesh": "Mesh", "isosurface": "Isosurface", "
                "fog": "Ground fog", "clouds": "Clouds", "sky": "Sky", "demo": "Demo volume"}
 
 
-#: settings the form leaves to another editor of the dock: the array combo box (``volviz_app.array_choice``)
-FORM_SKIPS = ("array",)
+#: settings the form leaves to other editors: the array combo box (``volviz_app.array_choice``) and the Timeline
+#: dock's Interpolate switch, one for the whole scene (``volviz.render.controller.session_interpolates``)
+FORM_SKIPS = ("array", "interpolate")
 
 
 class SceneTree(QWidget):

@@ -58,6 +58,13 @@ def ensure_lights(plotter: Any) -> None:
         plotter.enable_lightkit()
 
 
+def session_interpolates(session: Session) -> bool:
+    """Whether the scene blends neighbouring time steps (4D interpolation): one switch for the whole scene, kept in
+    each component's ``interpolate`` setting (``SceneController.set_time`` writes it to every time series); off
+    when a component's setting turns it off."""
+    return all(comp.settings.get("interpolate", True) is not False for comp in session.components)
+
+
 class SceneController:
     def __init__(self, plotter: Any, session: Session, datasets: dict[str, Any], on_screen: bool = False):
         self.plotter = plotter
@@ -68,7 +75,7 @@ class SceneController:
         self.iso_view: Any = None         # GLIsoView or IsoOverlay while a mode of the note is on
         self.histograms: dict[str, Any] = {}   # comp id -> (counts, edges) of its data, from ``prepare``
         self.time = 0.0
-        self.interpolate_time = True
+        self.interpolate_time = session_interpolates(session)
         self.changes = ChangeNotifier()   # a SceneChange after each edit of the session's state (``model.events``)
 
     @property
@@ -312,10 +319,11 @@ class SceneController:
         ``blend_volume`` on a worker → ``show_volumes``)."""
         if interpolate is not None:
             self.interpolate_time = bool(interpolate)
+            for comp_id in self.time_series():     # the session keeps the switch (``session_interpolates``)
+                comp = self.component(comp_id)
+                comp.settings = {**comp.settings, "interpolate": self.interpolate_time}
         self.time = float(t)
         for comp_id in self.time_isosurfaces():  # re-extract at the new time (the 4D blend happens in prepare)
-            comp = self.component(comp_id)
-            comp.settings = {**comp.settings, "interpolate": self.interpolate_time}
             if isosurfaces:
                 self.show_isosurfaces({comp_id: self.extract_isosurfaces(comp_id, self.time)})
         if volumes:
