@@ -6,7 +6,8 @@ import json
 import numpy as np
 import pytest
 
-from volviz.iso.clip import BoxCrop, ClipPlane, ClipSettings, clip_isosurface, clip_tetmesh, clip_volume
+from volviz.iso.clip import clip_isosurface, clip_tetmesh, clip_volume
+from volviz.model.clip import BoxCrop, ClipPlane, ClipSettings
 from volviz.iso.extract import extract
 from volviz.model.datasets import RegularVolume
 from volviz.unstructured.synthetic import box_tets

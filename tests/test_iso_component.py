@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from conftest import data_file
-from volviz.iso.clip import BoxCrop, ClipPlane, ClipSettings
+from volviz.model.clip import BoxCrop, ClipPlane, ClipSettings
 from volviz.iso.composite import render
 from volviz.iso.extract import IsoStyle
 from volviz.iso.component import IsoSettings, prepare, render_iso

@@ -5,7 +5,7 @@ import json
 
 import pytest
 
-from volviz.iso.clip import ClipSettings
+from volviz.model.clip import ClipSettings
 from volviz.session import SessionError, dumps, loads
 
 OLD = {"format": "volviz-session", "version": 1, "components": [{"id": "demo", "type": "demo"}]}

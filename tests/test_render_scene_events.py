@@ -28,7 +28,7 @@ def test_a_change_kind_is_checked_and_subscribers_are_called_in_order():
 def test_the_controller_announces_each_edit_after_applying_it():
     import pyvista as pv
 
-    from volviz.iso.clip import ClipPlane, ClipSettings
+    from volviz.model.clip import ClipPlane, ClipSettings
     from volviz.model import RegularVolume
     from volviz.render.controller import SceneController
     from volviz.session import CameraState, Component, DatasetRef, Session

@@ -78,7 +78,7 @@ def test_every_kind_of_component_answers_the_same_calls_through_the_controller(t
     import pyvista as pv
 
     from conftest import blob_vvz
-    from volviz.iso.clip import ClipPlane, ClipSettings
+    from volviz.model.clip import ClipPlane, ClipSettings
     from volviz.regular.lod import LodTree
     from volviz.render.controller import SceneController
     from volviz.render.views import ComponentView

@@ -204,7 +204,7 @@ def test_a_request_is_of_the_mesh_shown_at_begin_though_a_cut_is_shown_meanwhile
     """The app shows a clipping's cut (``show_cut``) while a render or an error estimate of the uncut mesh may still
     run on a worker: both stay of the mesh of their ``begin``. (An estimate that rendered the uncut mesh fast and
     the cut one exactly measured RMSE 51 and switched the table for nothing.)"""
-    from volviz.iso.clip import ClipPlane, ClipSettings
+    from volviz.model.clip import ClipPlane, ClipSettings
 
     pl, mesh, h = scene
     request = h.begin()

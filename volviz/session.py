@@ -363,7 +363,7 @@ def _option_scalar(r: _Reader, value: Any, where: str) -> Any:
 
 
 def _read_clip(r: _Reader, value: Any) -> dict[str, Any]:
-    """Scene-wide clipping (``volviz.iso.clip.ClipSettings`` as JSON): any number of planes ``{"point", "normal"}``
+    """Scene-wide clipping (``volviz.model.clip.ClipSettings`` as JSON): any number of planes ``{"point", "normal"}``
     keeping ``(x - point)·normal >= 0``, and an optional box ``{"lo", "hi"}``. Sessions written before clipping
     existed have no ``clip`` field and load with no clipping."""
     d = r.obj(value, "clip")

@@ -15,7 +15,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any, Callable, Optional, Sequence
 
-from volviz.iso.clip import ClipSettings, clip_isosurfaces, clip_volume
+from volviz.iso.clip import clip_isosurfaces, clip_volume
+from volviz.model.clip import ClipSettings
 from volviz.iso.composite import MODES, IsoRenderStats, render
 from volviz.iso.extract import IsoMesh, IsoStyle, extract
 from volviz.iso.lod import LodChain, build_lod, lod_meshes

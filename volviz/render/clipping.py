@@ -1,6 +1,6 @@
 """Scene-wide clipping planes and box crop (libMini note, Fig. 6) applied to every kind of prop a scene shows, so
 volumes, isosurfaces and unstructured meshes are cut alike. The settings are ``session.clip`` (JSON of
-``volviz.iso.clip.ClipSettings``: a plane keeps ``(x − point)·normal ≥ 0``, the box keeps ``lo ≤ x ≤ hi``).
+``volviz.model.clip.ClipSettings``: a plane keeps ``(x − point)·normal ≥ 0``, the box keeps ``lo ≤ x ≤ hi``).
 
 How each prop honours them:
 
@@ -18,7 +18,8 @@ from __future__ import annotations
 import logging
 from typing import Any
 
-from volviz.iso.clip import ClipPlane, ClipSettings, clip_grid
+from volviz.iso.clip import clip_grid
+from volviz.model.clip import ClipPlane, ClipSettings
 
 log = logging.getLogger(__name__)
 

@@ -53,7 +53,7 @@ class VtkPropView:
             self.prop.GetProperty().SetOpacity(float(opacity))
 
     def set_clip(self, clip: Any) -> bool:
-        """Clip by ``volviz.iso.clip.ClipSettings`` at once (True: nothing for the caller to cut)."""
+        """Clip by ``volviz.model.clip.ClipSettings`` at once (True: nothing for the caller to cut)."""
         from volviz.render.clipping import clip_vtk_prop
 
         self._uncut = clip_vtk_prop(self.prop, clip, self._uncut)

@@ -575,7 +575,7 @@ class SceneController:
         returns the ids of the views drawn from a cut made on the CPU (a CPU PT volume's mesh, an isosurface
         component's surfaces), which are cut and re-made here when ``update``; the app instead cuts them in the
         background (``cut`` on a worker, then ``show_cut``) and re-renders."""
-        from volviz.iso.clip import ClipSettings
+        from volviz.model.clip import ClipSettings
 
         self.session.clip = clip.to_dict() if isinstance(clip, ClipSettings) else self.clip.from_dict(clip).to_dict()
         pending = self.apply_clip(update)

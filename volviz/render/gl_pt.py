@@ -714,7 +714,7 @@ class GLPTVolume(PTView):
         self._clip = np.array(rows, np.float64).reshape(-1, 4)
 
     def set_clip(self, clip: Any) -> bool:
-        """Clip by ``volviz.iso.clip.ClipSettings`` (its planes and box) per fragment (``set_clip_planes``); returns
+        """Clip by ``volviz.model.clip.ClipSettings`` (its planes and box) per fragment (``set_clip_planes``); returns
         True (``PTView.set_clip``: nothing for the caller to cut)."""
         self.set_clip_planes([(p.normal, p.point) for p in clip.all_planes()])
         return True

@@ -37,7 +37,7 @@ class PTView:
         raise NotImplementedError
 
     def set_clip(self, clip: Any) -> bool:
-        """Clip by ``volviz.iso.clip.ClipSettings``. True: done; False: this view clips only by drawing a cut mesh,
+        """Clip by ``volviz.model.clip.ClipSettings``. True: done; False: this view clips only by drawing a cut mesh,
         which the caller makes (``cut`` on any thread) and shows (``show_cut``)."""
         raise NotImplementedError
 
