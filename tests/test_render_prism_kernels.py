@@ -40,7 +40,8 @@ def test_buffers_hold_the_points_values_and_box_relative_to_the_centre():
     # the box's two corners close the points (in no triangle) so that VTK's bounds hold the layer's tops
     np.testing.assert_allclose(b.points[n:], np.stack([lo - b.centre, hi - b.centre]), atol=1e-3)
     np.testing.assert_allclose(b.bounds, np.stack([lo - b.centre, hi - b.centre], axis=1), atol=1e-9)
-    np.testing.assert_array_equal(b.connectivity, tris.reshape(-1))
+    thick = (top[tris] > bottom[tris]).any(axis=1)                        # all emit: the thick ones are kept
+    np.testing.assert_array_equal(b.connectivity, tris[thick].reshape(-1))
     assert b.connectivity.max() < n
 
 
@@ -54,11 +55,13 @@ def test_prisms_are_kept_with_area_thickness_and_emission():
     assert buffers.drawn == int(thick.sum())
     kept = kept_triangles(buffers.points, buffers.attributes["fogValue"], tris)
     np.testing.assert_array_equal(kept, thick)
+    np.testing.assert_array_equal(buffers.connectivity, tris[thick].reshape(-1))    # only the kept prisms drawn
     emission = (np.where(np.arange(len(bottom)) % 3 == 0, 1.0, 0.0), np.zeros(len(bottom)))
     some = prism_buffers(points, bottom, top, tris, layer, emission)
     assert some.drawn == int((thick & (emission[0][tris] > 0).any(axis=1)).sum())
     none = prism_buffers(points, bottom, top, tris, layer, (np.zeros(len(bottom)), np.zeros(len(bottom))))
     assert none.drawn == 0
+    assert none.connectivity.shape == (0,)
     first = buffers.first_prism()
     assert first.drawn == 1 and np.array_equal(first.connectivity, tris[np.flatnonzero(thick)[0]])
 
@@ -68,5 +71,5 @@ def test_triangles_without_area_are_left_out():
     tris = np.array([[0, 1, 2], [0, 1, 3]])
     z = np.zeros(4)
     b = prism_buffers(points, z, z + 1.0, tris, FogLayer(mode="emissive"), (np.ones(4), np.ones(4)))
-    assert b.drawn == 1
+    assert b.drawn == 1 and np.array_equal(b.connectivity, [0, 1, 3])
     np.testing.assert_array_equal(kept_triangles(b.points, b.attributes["fogValue"], tris), [False, True])

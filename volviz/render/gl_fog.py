@@ -120,13 +120,9 @@ class PrismBuffers:
     bounds: np.ndarray
 
     def first_prism(self) -> "PrismBuffers":
-        """The same buffers drawing only the first kept prism (or none): a draw with the prisms' own work removed."""
-        from volviz.render._prism_kernels import kept_triangles
-
-        tris = self.connectivity.reshape(-1, 3)
-        kept = np.flatnonzero(kept_triangles(self.points, self.attributes["fogValue"], tris))[:1]
-        return PrismBuffers(self.points, self.attributes, np.ascontiguousarray(tris[kept].reshape(-1)), self.centre,
-                            len(kept), self.bounds)
+        """The same buffers drawing only the first prism (or none): a draw with the prisms' own work removed."""
+        return PrismBuffers(self.points, self.attributes, self.connectivity[:3].copy(), self.centre,
+                            min(self.drawn, 1), self.bounds)
 
 
 def prism_buffers(points: np.ndarray, bottom: np.ndarray, top: np.ndarray, triangles: np.ndarray, layer: FogLayer,
@@ -134,16 +130,17 @@ def prism_buffers(points: np.ndarray, bottom: np.ndarray, top: np.ndarray, trian
     """Any thread: the vertex buffer of the layer's prisms, one per terrain triangle: per point its xy and the bottom
     and top heights and emissions of ``layer``'s mode (``volviz.nature.fog.layer_emission``); the prisms themselves
     (side planes, affine forms, 8 triangles wound outward) are made per triangle by the geometry shader
-    (``fog_prism_gs.glsl``), which also drops those with no area, no thickness or all six emissions <= 0, as the CPU
-    PCP does. ``drawn`` counts those kept (``_prism_kernels.kept_triangles``)."""
+    (``fog_prism_gs.glsl``). Triangles whose prism has no area, no thickness or all six emissions <= 0 are left out
+    here (``_prism_kernels.kept_triangles``, the shader's own test, which it also applies), as the CPU PCP leaves
+    them out: ``drawn`` prisms, 3 indices each in ``connectivity``."""
     from volviz.render._prism_kernels import kept_triangles
 
     points, bottom, top = (np.asarray(a, dtype=np.float64) for a in (points, bottom, top))
     eb, et = layer_emission(bottom, top, layer, emission)
     centre, rel, values, bounds = layer_values(points, bottom, top, eb, et)
     tris = np.ascontiguousarray(np.asarray(triangles, dtype=np.int64).reshape(-1, 3))
-    drawn = int(np.count_nonzero(kept_triangles(rel, values, tris)))
-    return PrismBuffers(rel, {"fogValue": values}, tris.reshape(-1), centre, drawn, bounds)
+    kept = np.ascontiguousarray(tris[kept_triangles(rel, values, tris)])
+    return PrismBuffers(rel, {"fogValue": values}, kept.reshape(-1), centre, len(kept), bounds)
 
 
 def _resolve_polydata(bounds: np.ndarray) -> Any:
