@@ -7,7 +7,7 @@ live in (N, N) matrices at the node centres (Roettger's "quadtree matrix").
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 
 @njit(cache=True, nogil=True)
@@ -134,41 +134,53 @@ def _blend(fields: np.ndarray, out: np.ndarray, vi: int, vj: int, ai: int, aj: i
         out[f, vi, vj] = (1.0 - w) * 0.5 * (out[f, ai, aj] + out[f, bi, bj]) + w * fields[f, vi, vj]
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, parallel=True)
 def morph(fields: np.ndarray, n: int, state: np.ndarray, weight: np.ndarray, nodes: np.ndarray, sizes: np.ndarray,
           count: int, out: np.ndarray) -> None:
     """Geomorphing: every vertex a refinement introduces is the midpoint of an edge (a, b) of the coarser fan and
     gets ``(1 - w) (out[a] + out[b]) / 2 + w * true`` with w the refining node's factor (edge points shared with the
-    neighbour use the minimum of both factors). Coarse to fine, so ``out[a]``, ``out[b]`` are already morphed."""
+    neighbour use the minimum of both factors). Coarse to fine, so ``out[a]``, ``out[b]`` are already morphed: level
+    by level (``nodes`` lists them coarse to fine), the nodes of a level in parallel; a node reads only vertices of
+    coarser levels, and two neighbours that both write their shared edge's points write the same values."""
     m = (n - 1) // 2
     last = n - 1
     for f in range(fields.shape[0]):
         for (i, j) in ((0, 0), (last, 0), (0, last), (last, last), (m, m), (m, 0), (last, m), (m, last), (0, m)):
             out[f, i, j] = fields[f, i, j]
-    for k in range(count):
-        ci = nodes[k, 0]
-        cj = nodes[k, 1]
-        if state[ci, cj] != 2:
-            continue
-        d = sizes[k]
-        h = d // 2
-        q = h // 2
-        w = weight[ci, cj]
-        for si in (-1, 1):
-            for sj in (-1, 1):  # children centres on the centre-corner diagonals
-                _blend(fields, out, ci + si * q, cj + sj * q, ci, cj, ci + si * h, cj + sj * h, w)
-        for s in (-1, 1):  # inner child-edge midpoints on the centre-to-edge-midpoint spokes
-            _blend(fields, out, ci + s * q, cj, ci, cj, ci + s * h, cj, w)
-            _blend(fields, out, ci, cj + s * q, ci, cj, ci, cj + s * h, w)
-        for s in (-1, 1):  # outer child-edge midpoints on this node's border, shared with the neighbour
-            ni = ci + s * d
-            wn = w if (ni < 0 or ni > last) else min(w, weight[ni, cj])
-            for t in (-1, 1):
-                _blend(fields, out, ci + s * h, cj + t * q, ci + s * h, cj, ci + s * h, cj + t * h, wn)
-            nj = cj + s * d
-            wn = w if (nj < 0 or nj > last) else min(w, weight[ci, nj])
-            for t in (-1, 1):
-                _blend(fields, out, ci + t * q, cj + s * h, ci, cj + s * h, ci + t * h, cj + s * h, wn)
+    start = 0
+    while start < count:
+        stop = start
+        while stop < count and sizes[stop] == sizes[start]:
+            stop += 1
+        for k in prange(start, stop):
+            _morph_node(fields, last, state, weight, nodes[k, 0], nodes[k, 1], sizes[k], out)
+        start = stop
+
+
+@njit(cache=True, nogil=True)
+def _morph_node(fields: np.ndarray, last: int, state: np.ndarray, weight: np.ndarray, ci: int, cj: int, d: int,
+                out: np.ndarray) -> None:
+    """``morph`` of the vertices node (ci, cj) of size ``d`` introduces, if it is refined."""
+    if state[ci, cj] != 2:
+        return
+    h = d // 2
+    q = h // 2
+    w = weight[ci, cj]
+    for si in (-1, 1):
+        for sj in (-1, 1):  # children centres on the centre-corner diagonals
+            _blend(fields, out, ci + si * q, cj + sj * q, ci, cj, ci + si * h, cj + sj * h, w)
+    for s in (-1, 1):  # inner child-edge midpoints on the centre-to-edge-midpoint spokes
+        _blend(fields, out, ci + s * q, cj, ci, cj, ci + s * h, cj, w)
+        _blend(fields, out, ci, cj + s * q, ci, cj, ci, cj + s * h, w)
+    for s in (-1, 1):  # outer child-edge midpoints on this node's border, shared with the neighbour
+        ni = ci + s * d
+        wn = w if (ni < 0 or ni > last) else min(w, weight[ni, cj])
+        for t in (-1, 1):
+            _blend(fields, out, ci + s * h, cj + t * q, ci + s * h, cj, ci + s * h, cj + t * h, wn)
+        nj = cj + s * d
+        wn = w if (nj < 0 or nj > last) else min(w, weight[ci, nj])
+        for t in (-1, 1):
+            _blend(fields, out, ci + t * q, cj + s * h, ci, cj + s * h, ci + t * h, cj + s * h, wn)
 
 
 @njit(cache=True, nogil=True)
