@@ -154,3 +154,26 @@ def test_resampling_and_yukon_map() -> None:
     assert non_conforming_edges(mesh, hf.size) == 0
     assert 1000 < mesh.n_triangles < 2 * 1024 * 1024 / 10
     assert mesh.tcoords.min() >= 0 and mesh.tcoords.max() <= 1
+
+
+def test_parallel_geomorphing_matches_the_node_by_node_order():
+    """``morph`` blends the nodes of a level in parallel: every vertex of the mesh gets the value the coarse-to-fine
+    node order gives (``_morph_node`` applied node by node), exactly."""
+    from volviz.nature import _terrain_kernels as K
+    from volviz.nature import noise
+
+    h = noise.fractal_terrain(257, seed=1, relief=84.0)
+    lod = TerrainLOD(HeightField(h, (2.0, 2.0)), layers={"fog": h + 5.0}, big_c=9.0, small_c=60.0)
+    for eye in ([100.0, 50.0, 200.0], [400.0, 300.0, 120.0]):
+        mesh = lod.update(eye)
+        count = int(mesh.stats["nodes"])
+        serial = np.zeros_like(lod._morphed)
+        m, last = (lod.n - 1) // 2, lod.n - 1
+        for i, j in ((0, 0), (last, 0), (0, last), (last, last), (m, m), (m, 0), (last, m), (m, last), (0, m)):
+            serial[:, i, j] = lod.fields[:, i, j]
+        for k in range(count):
+            K._morph_node(lod.fields, last, lod._state, lod._weight, lod._nodes[k, 0], lod._nodes[k, 1],
+                          lod._sizes[k], serial)
+        gi, gj = mesh.grid_index[:, 0], mesh.grid_index[:, 1]
+        assert mesh.n_triangles > 100_000 and (lod._weight[lod._state == 2] < 1.0).any()   # morphing under way
+        np.testing.assert_array_equal(lod._morphed[:, gi, gj], serial[:, gi, gj])
