@@ -55,8 +55,7 @@ def camera_path(points: np.ndarray, n: int) -> list[Any]:
 
 
 def _vtk_render(mesh: Any, tf: Any, cam: Any, size: int, mapper_name: str, reps: int) -> tuple[np.ndarray, list[float]]:
-    from volviz.render.vtk_facade import vtk
-    from volviz.render.vtk_facade import vtk_to_numpy
+    from volviz.render.vtk_facade import vtk_to_numpy, vtk
 
     from volviz.render.vtk_tf import tf_to_vtk
 

@@ -75,8 +75,7 @@ class OpaqueObstacles:
         return self._locator
 
     def __call__(self, start: np.ndarray, end: np.ndarray) -> Optional[float]:
-        from volviz.render.vtk_facade import vtk
-        from volviz.render.vtk_facade import vtk_to_numpy
+        from volviz.render.vtk_facade import vtk_to_numpy, vtk
 
         built = self._build()
         if built is None:

@@ -101,8 +101,7 @@ def iso_polydata(meshes: Sequence[IsoMesh], centre: np.ndarray, shading: str = "
     """One vtkPolyData of ``meshes`` in their order: points relative to ``centre`` (float32), triangles wound as
     ``_oriented_triangles``, and per-vertex attributes ``isoNormal`` (unit normal), ``isoStyle`` (color, opacity)
     and ``isoFit`` (the iso-spectrum (a, b) of translucent surfaces with ``shading="spectrum"``, else (0, 0))."""
-    from volviz.render.vtk_facade import vtk
-    from volviz.render.vtk_facade import numpy_to_vtk
+    from volviz.render.vtk_facade import numpy_to_vtk, vtk
 
     pts, tris = [], []
     cols: dict[str, list[np.ndarray]] = {k: [] for k in _ATTRIBUTES}
@@ -182,7 +181,7 @@ class GLIsoSurfaces:
 
     # --- set-up --------------------------------------------------------------------------------------------------
     def _add(self, kind: int, pd: Any) -> None:
-        from volviz.render.vtk_facade import premultiplied_texture, vtk
+        from volviz.render.vtk_facade import premultiplied_texture, shader_observer, vtk
 
         mapper = vtk.vtkOpenGLPolyDataMapper()
         mapper.SetInputData(pd)
@@ -205,11 +204,7 @@ class GLIsoSurfaces:
             actor.ForceTranslucentOn()
         if kind == _EMIT:
             actor.SetTexture(premultiplied_texture())   # (ONE, ONE_MINUS_SRC_ALPHA), restored by VTK
-
-        def on_update_shader(caller: Any, event: str, program: Any = None) -> None:
-            self._on_update_shader(kind, program)
-
-        on_update_shader.CallDataType = vtk.VTK_OBJECT      # type: ignore[attr-defined]
+        on_update_shader = shader_observer(lambda program: self._on_update_shader(kind, program))
         self._observers.append((mapper, mapper.AddObserver(vtk.vtkCommand.UpdateShaderEvent, on_update_shader)))
         self.actors[kind] = actor
         self.renderer.AddActor(actor)

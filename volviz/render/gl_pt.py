@@ -154,8 +154,7 @@ def _cell_attributes(mesh: TetMesh, smooth: bool = False) -> dict[str, np.ndarra
 def _polydata(mesh: TetMesh, smooth: bool = False) -> Any:
     """The static vertex buffer as vtkPolyData: 4 points per tetrahedron (relative to the centre) with the cell
     attributes repeated at each, and no cells yet (the order sets them)."""
-    from volviz.render.vtk_facade import vtk
-    from volviz.render.vtk_facade import numpy_to_vtk
+    from volviz.render.vtk_facade import numpy_to_vtk, vtk
 
     topo = topology(mesh)
     pd = vtk.vtkPolyData()

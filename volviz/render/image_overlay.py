@@ -108,8 +108,7 @@ def unpremultiply_rgba8(image: np.ndarray) -> np.ndarray:
 
 def read_buffers(ren_win: Any, w: int, h: int) -> tuple[np.ndarray, np.ndarray]:
     """(z (H, W) float64, rgb (H, W, 3) uint8) of the render window, row 0 at the top."""
-    from volviz.render.vtk_facade import vtk
-    from volviz.render.vtk_facade import vtk_to_numpy
+    from volviz.render.vtk_facade import vtk_to_numpy, vtk
 
     z = vtk.vtkFloatArray()
     ren_win.GetZbufferData(0, 0, w - 1, h - 1, z)

@@ -75,8 +75,7 @@ def lod_bounds(tree: LodTree) -> tuple[float, float, float, float, float, float]
 
 def _image(block: Block) -> Any:
     """A vtkImageData of one block (samples at origin + spacing * index, x fastest)."""
-    from volviz.render.vtk_facade import vtk
-    from volviz.render.vtk_facade import numpy_to_vtk
+    from volviz.render.vtk_facade import numpy_to_vtk, vtk
 
     img = vtk.vtkImageData()
     img.SetDimensions(*block.data.shape)

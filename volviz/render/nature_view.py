@@ -190,8 +190,7 @@ class NatureView:
 
     def _set_overlay(self, overlay: np.ndarray) -> None:
         """Show an overlay image of ``_overlay_rgba`` (8-bit straight RGBA, rows bottom-up) in front of the scene."""
-        from volviz.render.vtk_facade import vtk
-        from volviz.render.vtk_facade import numpy_to_vtk
+        from volviz.render.vtk_facade import numpy_to_vtk, vtk
 
         h, w = overlay.shape[:2]
         data = overlay.reshape(-1, 4)
