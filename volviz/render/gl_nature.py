@@ -21,7 +21,7 @@ drawn by VTK's OpenGL pipeline into the scene's own depth buffer (Roettger Ch. 1
 Numba kernels release the GIL): the terrain's C-LOD mesh and each layer's per-point heights and emissions
 (``gl_fog.prism_buffers``; the prisms are made by a geometry shader) on one, the clouds' refinement, morphing, leaf
 list and per-tetrahedron face planes, table-field and modulation forms (``cloud_buffers``, one Numba pass over the
-leaves) on the other; ``finish`` (GUI thread) only hands them to VTK, sharing the arrays
+leaves) on the other, each with half the caller's Numba threads (``volviz.numba_threads``); ``finish`` (GUI thread) only hands them to VTK, sharing the arrays
 (``vtk_facade.shared_polydata``), and VTK uploads them and draws everything at the next render, at the window's full
 size (a preview ``scale`` is ignored). No image is made on the CPU.
 
@@ -49,6 +49,7 @@ import numpy as np
 from volviz.model.datasets import TetMesh
 from volviz.nature.clouds import CloudFrame, CloudShading, CloudVolume
 from volviz.nature.nature_scene import NatureScene
+from volviz.numba_threads import numba_threads, share
 from volviz.render.nature_view import NatureView
 from volviz.render.gl_fog import GLFogLayer, prism_buffers
 from volviz.render.gl_pt import GLPTVolume, _resolve_polydata, shader_source
@@ -244,8 +245,9 @@ class GLNatureView(NatureView):
         t0 = time.perf_counter()
         scene = self.scene
         stats: dict[str, float] = {}
-        with ThreadPoolExecutor(max_workers=1) as pool:
-            terrain = pool.submit(self._terrain_part, cam, size)
+        each = share(2)
+        with ThreadPoolExecutor(max_workers=1) as pool, numba_threads(each):
+            terrain = pool.submit(self._terrain_part, cam, size, each)
             clouds = None
             if scene.cloud_lod is not None:
                 if progress is not None:
@@ -264,8 +266,13 @@ class GLNatureView(NatureView):
         return poly, SimpleNamespace(mesh=mesh, clouds=clouds, prisms=prisms,
                                      eye=np.asarray(cam.position, np.float64)), stats
 
-    def _terrain_part(self, cam: Any, size: tuple[int, int]) -> tuple[Any, Any, dict[str, Any]]:
-        """The terrain's C-LOD mesh, as VTK poly data, and each prism layer's (geometry, ``prism_buffers``)."""
+    def _terrain_part(self, cam: Any, size: tuple[int, int], threads: int) -> tuple[Any, Any, dict[str, Any]]:
+        """The terrain's C-LOD mesh, as VTK poly data, and each prism layer's (geometry, ``prism_buffers``), its
+        kernels on ``threads`` Numba threads."""
+        with numba_threads(threads):
+            return self._terrain_buffers(cam, size)
+
+    def _terrain_buffers(self, cam: Any, size: tuple[int, int]) -> tuple[Any, Any, dict[str, Any]]:
         scene = self.scene
         mesh = scene.terrain_mesh(cam, size)
         if mesh is None:
