@@ -128,25 +128,25 @@ def refine(d2: np.ndarray, height: np.ndarray, n: int, sx: float, sy: float, x0:
     return end, blocked
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _blend(fields: np.ndarray, out: np.ndarray, vi: int, vj: int, ai: int, aj: int, bi: int, bj: int, w: float) -> None:
-    for f in range(fields.shape[0]):
-        out[f, vi, vj] = (1.0 - w) * 0.5 * (out[f, ai, aj] + out[f, bi, bj]) + w * fields[f, vi, vj]
+    for f in range(fields.shape[2]):
+        out[vi, vj, f] = (1.0 - w) * 0.5 * (out[ai, aj, f] + out[bi, bj, f]) + w * fields[vi, vj, f]
 
 
 @njit(cache=True, nogil=True, parallel=True)
 def morph(fields: np.ndarray, n: int, state: np.ndarray, weight: np.ndarray, nodes: np.ndarray, sizes: np.ndarray,
           count: int, out: np.ndarray) -> None:
-    """Geomorphing: every vertex a refinement introduces is the midpoint of an edge (a, b) of the coarser fan and
+    """Geomorphing of the (n, n, F) ``fields`` (a point's F values side by side) into ``out``: every vertex a refinement introduces is the midpoint of an edge (a, b) of the coarser fan and
     gets ``(1 - w) (out[a] + out[b]) / 2 + w * true`` with w the refining node's factor (edge points shared with the
     neighbour use the minimum of both factors). Coarse to fine, so ``out[a]``, ``out[b]`` are already morphed: level
     by level (``nodes`` lists them coarse to fine), the nodes of a level in parallel; a node reads only vertices of
     coarser levels, and two neighbours that both write their shared edge's points write the same values."""
     m = (n - 1) // 2
     last = n - 1
-    for f in range(fields.shape[0]):
-        for (i, j) in ((0, 0), (last, 0), (0, last), (last, last), (m, m), (m, 0), (last, m), (m, last), (0, m)):
-            out[f, i, j] = fields[f, i, j]
+    for (i, j) in ((0, 0), (last, 0), (0, last), (last, last), (m, m), (m, 0), (last, m), (m, last), (0, m)):
+        for f in range(fields.shape[2]):
+            out[i, j, f] = fields[i, j, f]
     start = 0
     while start < count:
         stop = start
@@ -157,7 +157,7 @@ def morph(fields: np.ndarray, n: int, state: np.ndarray, weight: np.ndarray, nod
         start = stop
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _morph_node(fields: np.ndarray, last: int, state: np.ndarray, weight: np.ndarray, ci: int, cj: int, d: int,
                 out: np.ndarray) -> None:
     """``morph`` of the vertices node (ci, cj) of size ``d`` introduces, if it is refined."""
@@ -198,19 +198,20 @@ def _outside(planes: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> bool:
 @njit(cache=True, nogil=True)
 def emit_fans(n: int, sx: float, sy: float, x0: float, y0: float, state: np.ndarray, nodes: np.ndarray,
               sizes: np.ndarray, count: int, morphed: np.ndarray, planes: np.ndarray,
-              vmap: np.ndarray, stamp: int, verts: np.ndarray, tris: np.ndarray) -> tuple[int, int]:
+              vmap: np.ndarray, stamp: int, verts: np.ndarray, vals: np.ndarray, tris: np.ndarray) -> tuple[int, int]:
     """Triangle fans around the centre of every leaf, skipping the edge midpoints whose same-size neighbour does not
     exist (the T-vertex rule of §3.5.3). Leaves whose box misses the frustum ``planes`` are skipped (emission only);
-    the box's height range is that of the fan's own morphed vertices over every field (``morphed`` (F, n, n)), which
+    the box's height range is that of the fan's own morphed vertices over every field (``morphed`` (n, n, F)), which
     bounds its planar triangles exactly. (The unmorphed height range of the node does not: a morphed vertex averages
     ancestors' vertices outside the node, so visible fans near the image border were culled — holes that appeared
     and vanished from frame to frame.)
     Vertices are numbered on first use (``vmap`` (n, n, 2): the stamp of the frame that numbered a grid point and
-    its number; ``verts`` gets their grid indices). Returns (n_vertices, n_triangles)."""
+    its number; ``verts`` gets their grid indices, ``vals`` their F morphed values). Returns (n_vertices,
+    n_triangles)."""
     nv = 0
     nt = 0
-    ring_i = np.empty(8, dtype=np.int64)
-    ring_j = np.empty(8, dtype=np.int64)
+    ring_i = np.empty(9, dtype=np.int64)          # the ring, then the centre
+    ring_j = np.empty(9, dtype=np.int64)
     lo = np.empty(3)
     hi = np.empty(3)
     last = n - 1
@@ -258,25 +259,20 @@ def emit_fans(n: int, sx: float, sy: float, x0: float, y0: float, state: np.ndar
             hi[1] = y0 + (cj + h) * sy
             zl = np.inf
             zh = -np.inf
-            for f in range(morphed.shape[0]):
-                zl = min(zl, morphed[f, ci, cj])
-                zh = max(zh, morphed[f, ci, cj])
+            for f in range(morphed.shape[2]):
+                zl = min(zl, morphed[ci, cj, f])
+                zh = max(zh, morphed[ci, cj, f])
                 for a in range(r):
-                    v = morphed[f, ring_i[a], ring_j[a]]
+                    v = morphed[ring_i[a], ring_j[a], f]
                     zl = min(zl, v)
                     zh = max(zh, v)
             lo[2] = zl
             hi[2] = zh
             if _outside(planes, lo, hi):
                 continue
-        if vmap[ci, cj, 0] != stamp:
-            vmap[ci, cj, 0] = stamp
-            vmap[ci, cj, 1] = nv
-            verts[nv, 0] = ci
-            verts[nv, 1] = cj
-            nv += 1
-        c_id = vmap[ci, cj, 1]
-        for a in range(r):
+        ring_i[r] = ci
+        ring_j[r] = cj
+        for a in range(r + 1):
             i = ring_i[a]
             j = ring_j[a]
             if vmap[i, j, 0] != stamp:
@@ -284,7 +280,10 @@ def emit_fans(n: int, sx: float, sy: float, x0: float, y0: float, state: np.ndar
                 vmap[i, j, 1] = nv
                 verts[nv, 0] = i
                 verts[nv, 1] = j
+                for f in range(morphed.shape[2]):
+                    vals[nv, f] = morphed[i, j, f]
                 nv += 1
+        c_id = vmap[ci, cj, 1]
         for a in range(r):
             b = (a + 1) % r
             tris[nt, 0] = c_id
@@ -292,10 +291,3 @@ def emit_fans(n: int, sx: float, sy: float, x0: float, y0: float, state: np.ndar
             tris[nt, 2] = vmap[ring_i[b], ring_j[b], 1]
             nt += 1
     return nv, nt
-
-
-@njit(cache=True, nogil=True)
-def gather(out: np.ndarray, verts: np.ndarray, nv: int, dest: np.ndarray) -> None:
-    for v in range(nv):
-        for f in range(out.shape[0]):
-            dest[v, f] = out[f, verts[v, 0], verts[v, 1]]

@@ -102,7 +102,7 @@ class TerrainLOD:
         for name, arr in zip(["terrain"] + self.layer_names, stack):
             if arr.shape != (n, n) or not np.all(np.isfinite(arr)):
                 raise ValueError(f"layer {name!r} must be a finite ({n}, {n}) array, got {arr.shape}")
-        self.fields = np.ascontiguousarray(np.stack(stack))
+        self.fields = np.ascontiguousarray(np.stack(stack, axis=-1))     # (n, n, F): a point's values side by side
         self.big_c = float(big_c)
         self.small_c = float(small_c)
         self.geomorph = bool(geomorph)
@@ -124,7 +124,7 @@ class TerrainLOD:
         self._nodes = np.zeros((cap, 2), dtype=np.int64)
         self._sizes = np.zeros(cap, dtype=np.int64)
         self._morphed = np.zeros_like(self.fields)
-        self._vmap = np.zeros((n, n, 2), dtype=np.int64)       # per grid point: (stamp of its frame, vertex id)
+        self._vmap = np.zeros((n, n, 2), dtype=np.int32)       # per grid point: (stamp of its frame, vertex id)
         self._stamp = 0
 
     def set_resolution(self, small_c: float) -> None:
@@ -147,13 +147,13 @@ class TerrainLOD:
         pl = np.zeros((0, 4)) if planes is None else np.ascontiguousarray(planes, dtype=np.float64)
         n_leaves = int(np.count_nonzero(self._state == 1))
         verts = np.empty((n_leaves * 9 + 8, 2), dtype=np.int64)
-        tris = np.empty((n_leaves * 8 + 8, 3), dtype=np.int64)
+        vals = np.empty((n_leaves * 9 + 8, self.fields.shape[2]))
+        tris = np.empty((n_leaves * 8 + 8, 3), dtype=np.int32)     # 32-bit: VTK indexes them fastest
         nv, nt = K.emit_fans(n, hf.spacing[0], hf.spacing[1], hf.origin[0], hf.origin[1], self._state, self._nodes,
                              self._sizes, count, self._morphed, pl, self._vmap, self._stamp,
-                             verts, tris)
+                             verts, vals, tris)
         verts = verts[:nv]
-        vals = np.empty((nv, self.fields.shape[0]))
-        K.gather(self._morphed, verts, nv, vals)
+        vals = vals[:nv]
         pts = np.empty((nv, 3))
         pts[:, 0] = hf.origin[0] + verts[:, 0] * hf.spacing[0]
         pts[:, 1] = hf.origin[1] + verts[:, 1] * hf.spacing[1]
