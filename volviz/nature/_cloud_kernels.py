@@ -23,7 +23,7 @@ def _corner(i: int, j: int, k: int) -> int:
     return (i << 2) | (j << 1) | k
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def coarse_value(cv: np.ndarray, ii: int, jj: int, kk: int, p: int) -> float:
     """Value at lattice point (ii, jj, kk) in {0, 1, 2}^3 of the node's own linear 5-tet interpolation of its
     corner values cv[8] (index i<<2 | j<<1 | k): edge midpoint = mean of the edge's ends, face centre = mean of the

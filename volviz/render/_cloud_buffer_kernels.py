@@ -17,13 +17,13 @@ EVEN = np.array([[0, 6, 5, 3], [4, 0, 6, 5], [2, 0, 6, 3], [1, 0, 5, 3], [7, 6, 
 ODD = np.array([[4, 2, 1, 7], [0, 4, 2, 1], [6, 4, 2, 7], [5, 4, 1, 7], [3, 2, 1, 7]], dtype=np.int64)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _det3(e: np.ndarray) -> float:
     return (e[0, 0] * (e[1, 1] * e[2, 2] - e[1, 2] * e[2, 1]) - e[0, 1] * (e[1, 0] * e[2, 2] - e[1, 2] * e[2, 0])
             + e[0, 2] * (e[1, 0] * e[2, 1] - e[1, 1] * e[2, 0]))
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _affine(p: np.ndarray, v: np.ndarray, out: np.ndarray, e: np.ndarray, m: np.ndarray, g: np.ndarray) -> None:
     """(gx, gy, gz, c) with g . x + c = v[i] at the 4 corners ``p`` (4, 3) (Cramer's rule; g = 0 if flat); ``e``,
     ``m`` (3, 3) and ``g`` (3,) are scratch."""
@@ -78,7 +78,7 @@ def leaf_vertex_buffer(leaves: np.ndarray, root: int, shape: np.ndarray, origin:
     return pos, cells, ranges
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def _leaf(leaves: np.ndarray, leaf: int, root: int, ny: int, nz: int, origin: np.ndarray, spacing: np.ndarray,
           centre: np.ndarray, table: np.ndarray, other: np.ndarray, m_scale: float, eye: np.ndarray, u: np.ndarray,
           front: np.ndarray, order: np.ndarray, p: np.ndarray, sv: np.ndarray, mv: np.ndarray, cell: np.ndarray,

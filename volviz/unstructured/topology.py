@@ -75,7 +75,7 @@ def _face_adjacency(tets: np.ndarray) -> np.ndarray:
     return neighbor.reshape(m, 4)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def face_plane(p: np.ndarray, i0: int, i1: int, i2: int) -> tuple[float, float, float, float]:
     """The plane (nx, ny, nz, d) of the face (i0, i1, i2) of the corners ``p`` (4, 3): unit normal (p1 - p0) x
     (p2 - p0) (zero for a degenerate face) and n . x = d on it; outward for ``FACES`` of a positive tetrahedron."""
