@@ -1,5 +1,5 @@
 """The GPU fog prisms' per-point vertex buffer (``volviz.render.gl_fog.prism_buffers``, PCP, Roettger §10.3) and the
-kernel that counts the prisms the geometry shader keeps (``volviz.render._prism_kernels.kept_triangles``) against
+kernel that lists the prisms the geometry shader keeps (``volviz.render._prism_kernels.kept_connectivity``) against
 NumPy formulations: values relative to the layer's centre, the box's corners for VTK's bounds, and a prism kept only
 with area, thickness and some emission. The prisms' forms themselves are made by the geometry shader; its images
 are checked against the CPU PCP in ``tests/test_render_gl_fog.py``."""
@@ -9,7 +9,7 @@ import numpy as np
 from scipy.spatial import Delaunay
 
 from volviz.nature.fog import FogLayer
-from volviz.render._prism_kernels import kept_triangles
+from volviz.render._prism_kernels import kept_connectivity
 from volviz.render.gl_fog import prism_buffers
 
 
@@ -53,8 +53,8 @@ def test_prisms_are_kept_with_area_thickness_and_emission():
     thick = (top[tris] > bottom[tris]).any(axis=1)
     assert 0 < thick.sum() < len(tris)
     assert buffers.drawn == int(thick.sum())
-    kept = kept_triangles(buffers.points, buffers.attributes["fogValue"], tris)
-    np.testing.assert_array_equal(kept, thick)
+    kept = kept_connectivity(buffers.points, buffers.attributes["fogValue"], tris)
+    np.testing.assert_array_equal(kept, tris[thick].reshape(-1))
     np.testing.assert_array_equal(buffers.connectivity, tris[thick].reshape(-1))    # only the kept prisms drawn
     emission = (np.where(np.arange(len(bottom)) % 3 == 0, 1.0, 0.0), np.zeros(len(bottom)))
     some = prism_buffers(points, bottom, top, tris, layer, emission)
@@ -72,4 +72,4 @@ def test_triangles_without_area_are_left_out():
     z = np.zeros(4)
     b = prism_buffers(points, z, z + 1.0, tris, FogLayer(mode="emissive"), (np.ones(4), np.ones(4)))
     assert b.drawn == 1 and np.array_equal(b.connectivity, [0, 1, 3])
-    np.testing.assert_array_equal(kept_triangles(b.points, b.attributes["fogValue"], tris), [False, True])
+    np.testing.assert_array_equal(kept_connectivity(b.points, b.attributes["fogValue"], tris), [0, 1, 3])

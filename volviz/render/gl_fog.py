@@ -86,21 +86,12 @@ def layer_values(points: np.ndarray, bottom: np.ndarray, top: np.ndarray, emissi
     as float32 (n + 2, 3) (x, y; z the bottom height; then the box's two corners, in no triangle, so that VTK's
     bounds hold the whole layer), the four per-point values as float32 (n + 2, 4) (bottom and top height relative
     to the centre, bottom and top emission; 0 at the corners) and the box relative to the centre (3, 2)."""
-    pts = np.asarray(points, dtype=np.float64)
-    zb, zt = np.asarray(bottom, dtype=np.float64), np.asarray(top, dtype=np.float64)
-    lo = np.array([pts[:, 0].min(), pts[:, 1].min(), min(zb.min(), zt.min())])
-    hi = np.array([pts[:, 0].max(), pts[:, 1].max(), max(zb.max(), zt.max())])
+    from volviz.render._prism_kernels import layer_buffer
+
+    pts = np.ascontiguousarray(points, dtype=np.float64)
+    zb, zt, eb, et = (np.ascontiguousarray(a, dtype=np.float64) for a in (bottom, top, emission_bottom, emission_top))
+    lo, hi, rel, values = layer_buffer(pts, zb, zt, eb, et)
     centre = 0.5 * (lo + hi)
-    n = len(pts)
-    rel = np.empty((n + 2, 3), np.float32)       # the last two: the box's corners, for VTK's bounds and culling
-    rel[:n, :2] = pts[:, :2] - centre[:2]
-    rel[:n, 2] = zb - centre[2]
-    rel[n:] = [lo - centre, hi - centre]
-    values = np.zeros((n + 2, 4), np.float32)
-    values[:n, 0] = rel[:n, 2]
-    values[:n, 1] = zt - centre[2]
-    values[:n, 2] = emission_bottom
-    values[:n, 3] = emission_top
     return centre, rel, values, np.stack([lo - centre, hi - centre], axis=1)
 
 
@@ -108,7 +99,7 @@ def layer_values(points: np.ndarray, bottom: np.ndarray, top: np.ndarray, emissi
 class PrismBuffers:
     """A layer's vertex buffer as NumPy arrays (``prism_buffers``), made on any thread and handed to VTK without a
     copy (``GLFogLayer.set_buffers``): the terrain triangles' ``points`` (n, 3) float32 relative to ``centre``, their
-    ``attributes`` (``fogValue``: (n, 4) float32, bottom and top height and emission), ``connectivity`` (3m,) int64
+    ``attributes`` (``fogValue``: (n, 4) float32, bottom and top height and emission), ``connectivity`` (3m,) int32
     (the triangles; the geometry shader makes each one's prism), ``bounds`` (3, 2) relative to the centre, ``drawn``
     = the prisms kept (with area, thickness and some emission)."""
 
@@ -131,16 +122,18 @@ def prism_buffers(points: np.ndarray, bottom: np.ndarray, top: np.ndarray, trian
     and top heights and emissions of ``layer``'s mode (``volviz.nature.fog.layer_emission``); the prisms themselves
     (side planes, affine forms, 8 triangles wound outward) are made per triangle by the geometry shader
     (``fog_prism_gs.glsl``). Triangles whose prism has no area, no thickness or all six emissions <= 0 are left out
-    here (``_prism_kernels.kept_triangles``, the shader's own test, which it also applies), as the CPU PCP leaves
+    here (``_prism_kernels.kept_connectivity``, the shader's own test, which it also applies), as the CPU PCP leaves
     them out: ``drawn`` prisms, 3 indices each in ``connectivity``."""
-    from volviz.render._prism_kernels import kept_triangles
+    from volviz.render._prism_kernels import kept_connectivity
 
     points, bottom, top = (np.asarray(a, dtype=np.float64) for a in (points, bottom, top))
     eb, et = layer_emission(bottom, top, layer, emission)
     centre, rel, values, bounds = layer_values(points, bottom, top, eb, et)
-    tris = np.ascontiguousarray(np.asarray(triangles, dtype=np.int64).reshape(-1, 3))
-    kept = np.ascontiguousarray(tris[kept_triangles(rel, values, tris)])
-    return PrismBuffers(rel, {"fogValue": values}, kept.reshape(-1), centre, len(kept), bounds)
+    tris = np.ascontiguousarray(triangles).reshape(-1, 3)
+    if tris.dtype.kind not in "iu":
+        tris = tris.astype(np.int64)
+    kept = kept_connectivity(rel, values, tris)
+    return PrismBuffers(rel, {"fogValue": values}, kept, centre, len(kept) // 3, bounds)
 
 
 def _resolve_polydata(bounds: np.ndarray) -> Any:

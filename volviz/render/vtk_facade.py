@@ -54,7 +54,8 @@ def shared_polydata(points: np.ndarray, attributes: dict[str, np.ndarray],
                     connectivity: np.ndarray | None = None) -> Any:
     """A vtkPolyData sharing NumPy vertex buffers (no copy; the VTK arrays keep them referenced): float32 ``points``
     (n, 3), named per-vertex ``attributes``, triangles ``connectivity`` (3 indices each; None: no cells yet, e.g.
-    when a visibility order sets them later)."""
+    when a visibility order sets them later). 32-bit ``connectivity`` keeps VTK's cells in 32-bit storage, from which
+    VTK builds the index buffer several times faster than from 64-bit cells."""
     pd = vtk.vtkPolyData()
     vp = vtk.vtkPoints()
     vp.SetData(numpy_to_vtk(points, deep=False))
@@ -65,7 +66,7 @@ def shared_polydata(points: np.ndarray, attributes: dict[str, np.ndarray],
         pd.GetPointData().AddArray(va)
     cells = vtk.vtkCellArray()
     if connectivity is not None:
-        cells.SetData(numpy_to_vtk(np.arange(0, len(connectivity) + 1, 3, dtype=np.int64), deep=True),
+        cells.SetData(numpy_to_vtk(np.arange(0, len(connectivity) + 1, 3, dtype=connectivity.dtype), deep=True),
                       numpy_to_vtk(connectivity, deep=False))
     pd.SetPolys(cells)
     return pd
