@@ -177,3 +177,26 @@ def test_parallel_geomorphing_matches_the_node_by_node_order():
         gi, gj = mesh.grid_index[:, 0], mesh.grid_index[:, 1]
         assert mesh.n_triangles > 100_000 and (lod._weight[lod._state == 2] < 1.0).any()   # morphing under way
         np.testing.assert_array_equal(lod._morphed[gi, gj], serial[gi, gj])
+
+
+def test_culled_geomorphing_gives_every_kept_vertex_its_full_value():
+    """With frustum planes, nodes whose column misses the frustum are not morphed; every vertex of the culled mesh
+    still gets exactly the value of the morph over all nodes, and the skipped part is real (points outside the
+    frustum keep no value)."""
+    from volviz.model.camera import Camera
+    from volviz.nature import noise
+
+    h = noise.fractal_terrain(257, seed=1, relief=84.0)
+    hf = HeightField(h, (2.0, 2.0))
+    cam = Camera((100.0, 80.0, 150.0), (300.0, 250.0, 20.0), (0, 0, 1), 40.0, clipping_range=(1.0, 2000.0))
+    planes = frustum_planes(cam, (64, 48), margin=0.05)
+    culled_lod, full_lod = (TerrainLOD(hf, layers={"fog": h + 5.0}, big_c=9.0, small_c=60.0) for _ in range(2))
+    culled = culled_lod.update(cam.position, planes)
+    full_lod.update(cam.position)
+    gi, gj = culled.grid_index[:, 0], culled.grid_index[:, 1]
+    assert culled.n_triangles > 10_000 and (culled_lod._weight[culled_lod._state == 2] < 1.0).any()
+    np.testing.assert_array_equal(culled_lod._morphed[gi, gj], full_lod._morphed[gi, gj])
+    np.testing.assert_array_equal(culled.points[:, 2], full_lod._morphed[gi, gj, 0])
+    refined_vertices = full_lod._morphed != 0.0
+    skipped = refined_vertices & (culled_lod._morphed == 0.0)
+    assert skipped[..., 0].sum() > 1000

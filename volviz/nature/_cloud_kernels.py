@@ -178,10 +178,23 @@ def _ep(state, eprime, off, lv, na, nb, nc, a, b, c, inside_default):
 
 
 @njit(cache=True, nogil=True)
-def morph(f, g, root, roots, off, state, eprime, nodes, count, vf, vg):
+def _box_outside(planes, x0, y0, z0, x1, y1, z1):
+    for q in range(planes.shape[0]):
+        x = x1 if planes[q, 0] >= 0 else x0
+        y = y1 if planes[q, 1] >= 0 else y0
+        z = z1 if planes[q, 2] >= 0 else z0
+        if planes[q, 0] * x + planes[q, 1] * y + planes[q, 2] * z + planes[q, 3] < 0.0:
+            return True
+    return False
+
+
+@njit(cache=True, nogil=True)
+def morph(f, g, root, roots, off, state, eprime, nodes, count, vf, vg, origin, spacing, planes):
     """Volumetric morphing (§11.4) with the corrected Eq. (11.8): S' = (1 − w) coarse + w S, w = the minimum e' of
     all same-level nodes sharing the vertex (unrefined = 0). Coarse values come from the refining node's own 5-tet
-    interpolation of its (already morphed) corners; coarse to fine."""
+    interpolation of its (already morphed) corners; coarse to fine. Nodes whose box misses the frustum ``planes``
+    (``emit``'s test; none: every node) are left out: every corner of a leaf ``emit`` lists is a point its parent
+    introduces, and the boxes of a listed leaf's ancestors contain its box, so they pass the test too."""
     nx, ny, nz = f.shape
     for a in range(0, nx, root):
         for b in range(0, ny, root):
@@ -198,8 +211,13 @@ def morph(f, g, root, roots, off, state, eprime, nodes, count, vf, vg):
         idx = off[lv] + (a * nb + b) * nc + c
         if state[idx] != 2:
             continue
-        w0 = eprime[idx]
         s = root >> lv
+        if planes.shape[0] > 0:
+            ex, ey, ez = spacing[0] * s, spacing[1] * s, spacing[2] * s
+            bx0, by0, bz0 = origin[0] + a * ex, origin[1] + b * ey, origin[2] + c * ez
+            if _box_outside(planes, bx0, by0, bz0, bx0 + ex, by0 + ey, bz0 + ez):
+                continue
+        w0 = eprime[idx]
         h = s // 2
         x0, y0, z0 = a * s, b * s, c * s
         p = (a + b + c) % 2
@@ -234,17 +252,6 @@ def morph(f, g, root, roots, off, state, eprime, nodes, count, vf, vg):
                     xi, yi, zi = x0 + ii * h, y0 + jj * h, z0 + kk * h
                     vf[xi, yi, zi] = (1.0 - w) * coarse_value(cf, ii, jj, kk, p) + w * f[xi, yi, zi]
                     vg[xi, yi, zi] = (1.0 - w) * coarse_value(cg, ii, jj, kk, p) + w * g[xi, yi, zi]
-
-
-@njit(cache=True, nogil=True)
-def _box_outside(planes, x0, y0, z0, x1, y1, z1):
-    for q in range(planes.shape[0]):
-        x = x1 if planes[q, 0] >= 0 else x0
-        y = y1 if planes[q, 1] >= 0 else y0
-        z = z1 if planes[q, 2] >= 0 else z0
-        if planes[q, 0] * x + planes[q, 1] * y + planes[q, 2] * z + planes[q, 3] < 0.0:
-            return True
-    return False
 
 
 @njit(cache=True, nogil=True)

@@ -134,14 +134,32 @@ def _blend(fields: np.ndarray, out: np.ndarray, vi: int, vj: int, ai: int, aj: i
         out[vi, vj, f] = (1.0 - w) * 0.5 * (out[ai, aj, f] + out[bi, bj, f]) + w * fields[vi, vj, f]
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _outside(planes: np.ndarray, x0: float, y0: float, z0: float, x1: float, y1: float, z1: float) -> bool:
+    """Whether the box [x0, x1] x [y0, y1] x [z0, z1] lies wholly on the negative side of one of the ``planes``."""
+    for p in range(planes.shape[0]):
+        # the box corner furthest along the plane normal
+        x = x1 if planes[p, 0] >= 0 else x0
+        y = y1 if planes[p, 1] >= 0 else y0
+        z = z1 if planes[p, 2] >= 0 else z0
+        if planes[p, 0] * x + planes[p, 1] * y + planes[p, 2] * z + planes[p, 3] < 0.0:
+            return True
+    return False
+
+
 @njit(cache=True, nogil=True, parallel=True)
 def morph(fields: np.ndarray, n: int, state: np.ndarray, weight: np.ndarray, nodes: np.ndarray, sizes: np.ndarray,
-          count: int, out: np.ndarray) -> None:
-    """Geomorphing of the (n, n, F) ``fields`` (a point's F values side by side) into ``out``: every vertex a refinement introduces is the midpoint of an edge (a, b) of the coarser fan and
-    gets ``(1 - w) (out[a] + out[b]) / 2 + w * true`` with w the refining node's factor (edge points shared with the
-    neighbour use the minimum of both factors). Coarse to fine, so ``out[a]``, ``out[b]`` are already morphed: level
-    by level (``nodes`` lists them coarse to fine), the nodes of a level in parallel; a node reads only vertices of
-    coarser levels, and two neighbours that both write their shared edge's points write the same values."""
+          count: int, out: np.ndarray, sx: float, sy: float, x0: float, y0: float, planes: np.ndarray,
+          z_range: np.ndarray) -> None:
+    """Geomorphing of the (n, n, F) ``fields`` (a point's F values side by side) into ``out``: every vertex a
+    refinement introduces is the midpoint of an edge (a, b) of the coarser fan and gets ``(1 - w) (out[a] + out[b])
+    / 2 + w * true`` with w the refining node's factor (edge points shared with the neighbour use the minimum of both
+    factors). Coarse to fine, so ``out[a]``, ``out[b]`` are already morphed: level by level (``nodes`` lists them
+    coarse to fine), the nodes of a level in parallel; a node reads only vertices of coarser levels, and two
+    neighbours that both write their shared edge's points write the same values.
+    Nodes whose column (their square, heights over ``z_range`` = every field's (min, max), which bounds every morphed
+    value) misses the frustum ``planes`` are left out (none: every node): every vertex of a fan ``emit_fans`` keeps is
+    introduced by an ancestor of its leaf, whose column contains the leaf's box."""
     m = (n - 1) // 2
     last = n - 1
     for (i, j) in ((0, 0), (last, 0), (0, last), (last, last), (m, m), (m, 0), (last, m), (m, last), (0, m)):
@@ -153,7 +171,11 @@ def morph(fields: np.ndarray, n: int, state: np.ndarray, weight: np.ndarray, nod
         while stop < count and sizes[stop] == sizes[start]:
             stop += 1
         for k in prange(start, stop):
-            _morph_node(fields, last, state, weight, nodes[k, 0], nodes[k, 1], sizes[k], out)
+            ci, cj, h = nodes[k, 0], nodes[k, 1], sizes[k] // 2
+            if planes.shape[0] > 0 and _outside(planes, x0 + (ci - h) * sx, y0 + (cj - h) * sy, z_range[0],
+                                                x0 + (ci + h) * sx, y0 + (cj + h) * sy, z_range[1]):
+                continue
+            _morph_node(fields, last, state, weight, ci, cj, sizes[k], out)
         start = stop
 
 
@@ -184,18 +206,6 @@ def _morph_node(fields: np.ndarray, last: int, state: np.ndarray, weight: np.nda
 
 
 @njit(cache=True, nogil=True)
-def _outside(planes: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> bool:
-    for p in range(planes.shape[0]):
-        # the box corner furthest along the plane normal
-        x = hi[0] if planes[p, 0] >= 0 else lo[0]
-        y = hi[1] if planes[p, 1] >= 0 else lo[1]
-        z = hi[2] if planes[p, 2] >= 0 else lo[2]
-        if planes[p, 0] * x + planes[p, 1] * y + planes[p, 2] * z + planes[p, 3] < 0.0:
-            return True
-    return False
-
-
-@njit(cache=True, nogil=True)
 def emit_fans(n: int, sx: float, sy: float, x0: float, y0: float, state: np.ndarray, nodes: np.ndarray,
               sizes: np.ndarray, count: int, morphed: np.ndarray, planes: np.ndarray,
               vmap: np.ndarray, stamp: int, verts: np.ndarray, vals: np.ndarray, tris: np.ndarray) -> tuple[int, int]:
@@ -212,8 +222,6 @@ def emit_fans(n: int, sx: float, sy: float, x0: float, y0: float, state: np.ndar
     nt = 0
     ring_i = np.empty(9, dtype=np.int64)          # the ring, then the centre
     ring_j = np.empty(9, dtype=np.int64)
-    lo = np.empty(3)
-    hi = np.empty(3)
     last = n - 1
     for k in range(count):
         ci = nodes[k, 0]
@@ -253,10 +261,6 @@ def emit_fans(n: int, sx: float, sy: float, x0: float, y0: float, state: np.ndar
             ring_j[r] = cj
             r += 1
         if planes.shape[0] > 0:
-            lo[0] = x0 + (ci - h) * sx
-            hi[0] = x0 + (ci + h) * sx
-            lo[1] = y0 + (cj - h) * sy
-            hi[1] = y0 + (cj + h) * sy
             zl = np.inf
             zh = -np.inf
             for f in range(morphed.shape[2]):
@@ -266,9 +270,7 @@ def emit_fans(n: int, sx: float, sy: float, x0: float, y0: float, state: np.ndar
                     v = morphed[ring_i[a], ring_j[a], f]
                     zl = min(zl, v)
                     zh = max(zh, v)
-            lo[2] = zl
-            hi[2] = zh
-            if _outside(planes, lo, hi):
+            if _outside(planes, x0 + (ci - h) * sx, y0 + (cj - h) * sy, zl, x0 + (ci + h) * sx, y0 + (cj + h) * sy, zh):
                 continue
         ring_i[r] = ci
         ring_j[r] = cj

@@ -278,7 +278,9 @@ class CloudLOD:
 
     def update(self, camera: Any, size: tuple[int, int] | None = None, cull: bool = True, full: bool = False
                ) -> CloudFrame:
-        """Refine, morph and list the visible leaves for ``camera`` (``full``: every cell, the reference)."""
+        """Refine, morph and list the visible leaves for ``camera`` (``full``: every cell, the reference). With
+        ``cull`` and a ``size``, only the leaves in the view frustum are listed and only their values are morphed
+        (``morphed`` holds stale values elsewhere)."""
         from volviz.nature.terrain import frustum_planes
 
         t0 = time.perf_counter()
@@ -286,6 +288,7 @@ class CloudLOD:
         vol = self.volume
         origin = np.asarray(vol.origin, dtype=np.float64)
         spacing = np.asarray(vol.spacing, dtype=np.float64)
+        planes = frustum_planes(camera, size) if (cull and size is not None) else np.zeros((0, 4))
         # reset the previous frame's nodes only
         prev = self._nodes[: self._count]
         if len(prev):
@@ -310,10 +313,9 @@ class CloudLOD:
                 self._eprime.fill(0.0)
                 self._nodes = np.zeros((2 * len(self._nodes), 4), dtype=np.int64)
             K.morph(vol.f, vol.gamma, vol.root, self.roots, self.off, self._state, self._eprime, self._nodes, count,
-                    self._vf, self._vg)
+                    self._vf, self._vg, origin, spacing, planes)
         self._count = count
         t1 = time.perf_counter()
-        planes = frustum_planes(camera, size) if (cull and size is not None) else np.zeros((0, 4))
         order = self._root_order(eye)
         while True:
             n = K.emit(self.fmax, self.cutoff, vol.root, self.levels, self.roots, self.off, origin, spacing, eye,

@@ -103,6 +103,7 @@ class TerrainLOD:
             if arr.shape != (n, n) or not np.all(np.isfinite(arr)):
                 raise ValueError(f"layer {name!r} must be a finite ({n}, {n}) array, got {arr.shape}")
         self.fields = np.ascontiguousarray(np.stack(stack, axis=-1))     # (n, n, F): a point's values side by side
+        self._z_range = np.array([self.fields.min(), self.fields.max()])  # bounds every morphed value
         self.big_c = float(big_c)
         self.small_c = float(small_c)
         self.geomorph = bool(geomorph)
@@ -132,7 +133,8 @@ class TerrainLOD:
         self.small_c = float(small_c)
 
     def update(self, eye: Sequence[float], planes: np.ndarray | None = None) -> TerrainMesh:
-        """Triangulate for an eye position; ``planes`` (p, 4) culls leaves outside the frustum (emission only)."""
+        """Triangulate for an eye position; ``planes`` (p, 4) culls the leaves outside the frustum (refinement is
+        unchanged; only the culled leaves' own vertices are not morphed)."""
         t0 = time.perf_counter()
         n = self.n
         self._state.fill(0)
@@ -142,9 +144,10 @@ class TerrainLOD:
         count, blocked = K.refine(self.d2, hf.heights, n, hf.spacing[0], hf.spacing[1], hf.origin[0], hf.origin[1],
                                   eye_a, self.big_c, self.small_c, self.geomorph, self._state, self._weight,
                                   self._nodes, self._sizes)
-        K.morph(self.fields, n, self._state, self._weight, self._nodes, self._sizes, count, self._morphed)
-        self._stamp += 1
         pl = np.zeros((0, 4)) if planes is None else np.ascontiguousarray(planes, dtype=np.float64)
+        K.morph(self.fields, n, self._state, self._weight, self._nodes, self._sizes, count, self._morphed,
+                hf.spacing[0], hf.spacing[1], hf.origin[0], hf.origin[1], pl, self._z_range)
+        self._stamp += 1
         n_leaves = int(np.count_nonzero(self._state == 1))
         verts = np.empty((n_leaves * 9 + 8, 2), dtype=np.int64)
         vals = np.empty((n_leaves * 9 + 8, self.fields.shape[2]))
