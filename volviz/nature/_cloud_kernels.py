@@ -15,6 +15,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
+from volviz.nature._frustum_kernels import box_outside
 from volviz.nature.raster import CUBE_EDGES, clipped_screen_box, dealt_band, dealt_count
 
 
@@ -178,17 +179,6 @@ def _ep(state, eprime, off, lv, na, nb, nc, a, b, c, inside_default):
 
 
 @njit(cache=True, nogil=True)
-def _box_outside(planes, x0, y0, z0, x1, y1, z1):
-    for q in range(planes.shape[0]):
-        x = x1 if planes[q, 0] >= 0 else x0
-        y = y1 if planes[q, 1] >= 0 else y0
-        z = z1 if planes[q, 2] >= 0 else z0
-        if planes[q, 0] * x + planes[q, 1] * y + planes[q, 2] * z + planes[q, 3] < 0.0:
-            return True
-    return False
-
-
-@njit(cache=True, nogil=True)
 def morph(f, g, root, roots, off, state, eprime, nodes, count, vf, vg, origin, spacing, planes):
     """Volumetric morphing (§11.4) with the corrected Eq. (11.8): S' = (1 − w) coarse + w S, w = the minimum e' of
     all same-level nodes sharing the vertex (unrefined = 0). Coarse values come from the refining node's own 5-tet
@@ -215,7 +205,7 @@ def morph(f, g, root, roots, off, state, eprime, nodes, count, vf, vg, origin, s
         if planes.shape[0] > 0:
             ex, ey, ez = spacing[0] * s, spacing[1] * s, spacing[2] * s
             bx0, by0, bz0 = origin[0] + a * ex, origin[1] + b * ey, origin[2] + c * ez
-            if _box_outside(planes, bx0, by0, bz0, bx0 + ex, by0 + ey, bz0 + ez):
+            if box_outside(planes, bx0, by0, bz0, bx0 + ex, by0 + ey, bz0 + ez):
                 continue
         w0 = eprime[idx]
         h = s // 2
@@ -273,7 +263,7 @@ def emit(fmax, cutoff, root, levels, roots, off, origin, spacing, eye, planes, s
             s = root >> lv
             ex, ey, ez = spacing[0] * s, spacing[1] * s, spacing[2] * s
             bx0, by0, bz0 = origin[0] + a * ex, origin[1] + b * ey, origin[2] + c * ez
-            if planes.shape[0] > 0 and _box_outside(planes, bx0, by0, bz0, bx0 + ex, by0 + ey, bz0 + ez):
+            if planes.shape[0] > 0 and box_outside(planes, bx0, by0, bz0, bx0 + ex, by0 + ey, bz0 + ez):
                 continue
             refined = False
             if lv < levels:

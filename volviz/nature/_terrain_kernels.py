@@ -9,6 +9,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
+from volviz.nature._frustum_kernels import box_outside
+
 
 @njit(cache=True, nogil=True)
 def local_d2(g: np.ndarray, n: int, unit: float, out: np.ndarray, weight: float) -> None:
@@ -134,19 +136,6 @@ def _blend(fields: np.ndarray, out: np.ndarray, vi: int, vj: int, ai: int, aj: i
         out[vi, vj, f] = (1.0 - w) * 0.5 * (out[ai, aj, f] + out[bi, bj, f]) + w * fields[vi, vj, f]
 
 
-@njit(cache=True, nogil=True, inline="always")
-def _outside(planes: np.ndarray, x0: float, y0: float, z0: float, x1: float, y1: float, z1: float) -> bool:
-    """Whether the box [x0, x1] x [y0, y1] x [z0, z1] lies wholly on the negative side of one of the ``planes``."""
-    for p in range(planes.shape[0]):
-        # the box corner furthest along the plane normal
-        x = x1 if planes[p, 0] >= 0 else x0
-        y = y1 if planes[p, 1] >= 0 else y0
-        z = z1 if planes[p, 2] >= 0 else z0
-        if planes[p, 0] * x + planes[p, 1] * y + planes[p, 2] * z + planes[p, 3] < 0.0:
-            return True
-    return False
-
-
 @njit(cache=True, nogil=True, parallel=True)
 def morph(fields: np.ndarray, n: int, state: np.ndarray, weight: np.ndarray, nodes: np.ndarray, sizes: np.ndarray,
           count: int, out: np.ndarray, sx: float, sy: float, x0: float, y0: float, planes: np.ndarray,
@@ -172,8 +161,8 @@ def morph(fields: np.ndarray, n: int, state: np.ndarray, weight: np.ndarray, nod
             stop += 1
         for k in prange(start, stop):
             ci, cj, h = nodes[k, 0], nodes[k, 1], sizes[k] // 2
-            if planes.shape[0] > 0 and _outside(planes, x0 + (ci - h) * sx, y0 + (cj - h) * sy, z_range[0],
-                                                x0 + (ci + h) * sx, y0 + (cj + h) * sy, z_range[1]):
+            if planes.shape[0] > 0 and box_outside(planes, x0 + (ci - h) * sx, y0 + (cj - h) * sy, z_range[0],
+                                                   x0 + (ci + h) * sx, y0 + (cj + h) * sy, z_range[1]):
                 continue
             _morph_node(fields, last, state, weight, ci, cj, sizes[k], out)
         start = stop
@@ -270,7 +259,8 @@ def emit_fans(n: int, sx: float, sy: float, x0: float, y0: float, state: np.ndar
                     v = morphed[ring_i[a], ring_j[a], f]
                     zl = min(zl, v)
                     zh = max(zh, v)
-            if _outside(planes, x0 + (ci - h) * sx, y0 + (cj - h) * sy, zl, x0 + (ci + h) * sx, y0 + (cj + h) * sy, zh):
+            if box_outside(planes, x0 + (ci - h) * sx, y0 + (cj - h) * sy, zl,
+                           x0 + (ci + h) * sx, y0 + (cj + h) * sy, zh):
                 continue
         ring_i[r] = ci
         ring_j[r] = cj
