@@ -39,9 +39,10 @@ def _shot(cls, scene, cam) -> tuple[np.ndarray, dict, object]:
     view = cls(pl, scene)
     stats = view.update(cam)
     img = pl.screenshot(return_img=True).astype(np.float64)
-    if getattr(view, "clouds", None) is not None:   # what the GPU holds: positions and the cell buffer texture
-        stats = dict(stats, cell_buffer_bytes=view.clouds._cell_buffer.GetSize(),
-                     vertices=view.clouds.polydata.GetNumberOfPoints())
+    if getattr(view, "clouds", None) is not None:   # what the GPU holds: a point and 5 texels per leaf
+        stats = dict(stats, leaf_buffer_bytes=view.clouds._leaf_buffer.GetSize(),
+                     vertices=view.clouds.polydata.GetNumberOfPoints(),
+                     indices=view.clouds.polydata.GetVerts().GetNumberOfConnectivityIds())
     actors = set(pl.actors)
     view.remove()
     pl.close()
@@ -74,10 +75,12 @@ def test_demo_scene_gpu_matches_cpu(demo, eye, focus) -> None:
     cam = Camera(eye, focus, (0.0, 0.0, 1.0), 60.0, clipping_range=(5.0, 10000.0))
     st_cpu, st_gpu = _compare(demo, cam, 0.75, "demo")
     assert st_gpu["cloud_tets"] == st_cpu["cloud_tets"] > 0      # the same LOD
-    tets = st_gpu["cloud_tets"]
-    # uploaded per tetrahedron: 4 positions (48 bytes), 7 RGBA float texels of cell data (112), 12 indices (48)
-    assert st_gpu["cell_buffer_bytes"] == 112 * tets and st_gpu["vertices"] == 4 * tets
-    assert st_gpu["cloud_upload_bytes"] == 208 * tets
+    leaves = st_gpu["cloud_tets"] // 5
+    # uploaded per leaf of 5 tetrahedra: its lowest corner (12 bytes), 5 RGBA float texels (80), 1 index (4); the
+    # volume's box as 2 more points
+    assert st_gpu["leaf_buffer_bytes"] == 80 * leaves and st_gpu["vertices"] == leaves + 2
+    assert 0 < st_gpu["indices"] <= leaves
+    assert st_gpu["cloud_upload_bytes"] == 96 * leaves
     assert st_gpu["fog_prisms"] > 0
 
 

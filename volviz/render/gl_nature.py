@@ -8,9 +8,10 @@ drawn by VTK's OpenGL pipeline into the scene's own depth buffer (Roettger Ch. 1
 - Prism layers (ground fog, cloud layers between two height fields; §10.3-10.4): one ``volviz.render.gl_fog.
   GLFogLayer`` each, on the frame's C-LOD terrain triangles and morphed layer heights (``GLFogLayer.set_geometry``
   every frame: the prisms follow the terrain's LOD as on the CPU), reading the opaque depth of the terrain and sky.
-- Clouds (§11.3-11.6): the frame's C-LOD leaves as 5 tetrahedra each (split and ordered back to front as
-  ``CloudFrame.to_tetmesh`` does, written straight into the vertex buffer by ``cloud_buffers``) with the morphed
-  table field, drawn by ``CloudPTVolume``, a ``volviz.render.gl_pt.GLPTVolume`` whose fragments
+- Clouds (§11.3-11.6): the frame's C-LOD leaves in their back-to-front order, one point each with its place and
+  corner values (``cloud_buffers``); a geometry shader makes each leaf's 5 tetrahedra (split and ordered back to
+  front as ``CloudFrame.to_tetmesh`` does) with the morphed table field, drawn by ``CloudPTVolume``, a
+  ``volviz.render.gl_pt.GLPTVolume`` whose fragments
   scale the segment length by the second field as the CPU clouds do (Eq. 11.9, l' = l m̄ with m the modulating field
   over its maximum at the middle of the segment; NPR §11.6.2: the table is indexed by f, γ modulates), looked up in
   the scene's own cloud table (the CPU's, 64 x 64 x 128 over the root cube's diagonal).
@@ -18,20 +19,22 @@ drawn by VTK's OpenGL pipeline into the scene's own depth buffer (Roettger Ch. 1
   are re-added to the renderer in that order when it changes.
 
 ``compute`` (any thread) does the LOD work and builds the vertex buffers as NumPy arrays, in two threads (the
-Numba kernels release the GIL): the terrain's C-LOD mesh and each layer's per-point heights and emissions
-(``gl_fog.prism_buffers``; the prisms are made by a geometry shader) on one, the clouds' refinement, morphing, leaf
-list and per-tetrahedron face planes, table-field and modulation forms (``cloud_buffers``, one Numba pass over the
-leaves) on the other, each with half the caller's Numba threads (``volviz.numba_threads``); ``finish`` (GUI thread) only hands them to VTK, sharing the arrays
+Numba kernels release the GIL), each with half the caller's Numba threads (``volviz.numba_threads``): the terrain's
+C-LOD mesh and each layer's per-point heights and emissions (``gl_fog.prism_buffers``; the prisms are made by a
+geometry shader) on one, the clouds' refinement, morphing, leaf list and per-leaf texels (``cloud_buffers``, one
+Numba pass over the leaves) on the other; ``finish`` (GUI thread) only hands them to VTK, sharing the arrays
 (``vtk_facade.shared_polydata``), and VTK uploads them and draws everything at the next render, at the window's full
 size (a preview ``scale`` is ignored). No image is made on the CPU.
 
 What ``GLPTVolume`` lacks for the clouds (``CloudPTVolume`` works around it through its private members, listed
 there): a per-cell length modulation attribute, a caller-given back-to-front order (the leaves' BSP order; MPVO would
 sample the non-conforming leaf mesh's boundaries), a caller-given table (its own is built per mesh over the mesh's
-longest edge), and a public way to replace the mesh by a frame's buffers. Per frame the clouds' buffers are rebuilt
-and uploaded whole: the vertex positions (4 x 3 float32 per tetrahedron), the cell data as a buffer texture (7 RGBA
-float32 texels per tetrahedron, fetched by ``gl_VertexID / 4`` in ``cloud_tet_vs.glsl`` rather than repeated at the
-4 vertices as gl_pt's static buffer does) and 12 indices: 208 bytes per tetrahedron, ``stats["cloud_upload_bytes"]``.
+longest edge), cells made on the GPU, and a public way to replace the mesh by a frame's buffers. Per frame the
+clouds' buffers are rebuilt and uploaded whole, 96 bytes per leaf of 5 tetrahedra (``BYTES_PER_LEAF``,
+``stats["cloud_upload_bytes"]``): a point (3 float32), 5 RGBA float32 texels in a buffer texture (``cloud_leaf_gs.
+glsl``: the leaf's lowest grid point and edge, the table field and the modulating field at its 8 corners) and one
+index. (Made on the CPU, the tetrahedra took 208 bytes each: 4 positions, 7 texels of face planes and affine forms,
+12 indices; VTK's index buffer for 12 indices per tetrahedron was most of the upload.)
 
 Errors against the CPU ``NatureView`` of the same camera and LOD (8-bit screen units), measured on llvmpipe in
 ``tests/test_render_gl_nature.py``: see the bounds there.
@@ -58,8 +61,8 @@ from volviz.unstructured.topology import visible_ranges
 
 __all__ = ["CloudBuffers", "CloudPTVolume", "GLNatureView", "cloud_buffers", "modulation_scale"]
 
-#: bytes uploaded per tetrahedron: 4 vertex positions (3 float32), 7 RGBA float32 texels of cell data, 12 indices
-BYTES_PER_TET = 4 * 3 * 4 + 7 * 16 + 12 * 4
+#: bytes uploaded per leaf (5 tetrahedra): its lowest corner (3 float32), 5 RGBA float32 texels, 1 index
+BYTES_PER_LEAF = 3 * 4 + 5 * 16 + 4
 
 # (anchor in gl_pt's fragment shader, text added after it): the modulation's flat varying, and the length scaled by
 # the modulating field at the middle of the clipped segment
@@ -84,29 +87,32 @@ def modulation_scale(volume: CloudVolume, shading: CloudShading) -> float:
 
 @dataclass
 class CloudBuffers:
-    """A frame's cloud buffers as NumPy arrays (``cloud_buffers``, any thread): ``points`` (4m, 3) float32 vertex
-    positions relative to ``centre`` (the cloud volume's), ``cells`` (m, 7, 4) float32 per-tetrahedron data (gl_pt's
-    cell attributes and the modulation form: ``cloud_tet_vs.glsl`` fetches them from a buffer texture), ``visible``
-    (m,) the tetrahedra with some opacity under the cloud TF; the tetrahedra are in back-to-front order. ``bounds``
-    (3, 2): the volume's box relative to the centre."""
+    """A frame's cloud buffers as NumPy arrays (``cloud_buffers``, any thread): ``points`` (L + 2, 3) float32, the
+    leaves' lowest corners relative to ``centre`` (the cloud volume's) and the volume's box (for VTK's bounds),
+    ``texels`` (L, 5, 4) float32 per leaf (``_cloud_buffer_kernels.N_TEXELS``: ``cloud_leaf_gs.glsl`` makes the
+    leaf's tetrahedra from them), ``visible`` (L,) the leaves with some opacity under the cloud TF; the leaves are in
+    back-to-front order. ``bounds`` (3, 2): the volume's box relative to the centre; ``origin`` and ``spacing``: the
+    grid's, the origin relative to the centre."""
 
     points: np.ndarray
-    cells: np.ndarray
+    texels: np.ndarray
     visible: np.ndarray
     centre: np.ndarray
     bounds: np.ndarray
+    origin: np.ndarray
+    spacing: np.ndarray
 
     @property
-    def n_tets(self) -> int:
+    def n_leaves(self) -> int:
         return int(len(self.visible))
 
 
-def cloud_buffers(frame: CloudFrame, shading: CloudShading, eye: Any, m_scale: float) -> CloudBuffers:
-    """Any thread (Numba, releasing the GIL): the buffers of ``CloudPTVolume`` for a frame's leaves, 5 tetrahedra
-    each in back-to-front order for ``eye`` with the morphed table field and the modulating field over ``m_scale``
-    (``modulation_scale``), as ``CloudFrame.to_tetmesh`` splits and orders them
-    (``_cloud_buffer_kernels.leaf_vertex_buffer``), and the TF's culling from the tetrahedra's ranges."""
-    from volviz.render._cloud_buffer_kernels import leaf_vertex_buffer
+def cloud_buffers(frame: CloudFrame, shading: CloudShading, m_scale: float) -> CloudBuffers:
+    """Any thread (Numba, releasing the GIL): the buffers of ``CloudPTVolume`` for a frame's leaves in their
+    back-to-front order: each leaf's place and its corners' morphed table field and modulating field over
+    ``m_scale`` (``modulation_scale``; ``_cloud_buffer_kernels.leaf_buffer``), and the TF's culling from each leaf's
+    range of the table field (a leaf is kept if one of its tetrahedra has some opacity)."""
+    from volviz.render._cloud_buffer_kernels import leaf_buffer
 
     vol = frame.lod.volume
     vf, vg = frame.lod.morphed
@@ -114,47 +120,53 @@ def cloud_buffers(frame: CloudFrame, shading: CloudShading, eye: Any, m_scale: f
     origin = np.asarray(vol.origin, np.float64)
     spacing = np.asarray(vol.spacing, np.float64)
     centre = origin + 0.5 * (np.asarray(vol.shape, np.float64) - 1.0) * spacing
-    pos, cells, ranges = leaf_vertex_buffer(np.ascontiguousarray(frame.leaves, np.int64), int(vol.root),
-                                            np.asarray(vol.shape, np.int64), origin, spacing, centre,
-                                            table.reshape(-1), other.reshape(-1), float(m_scale),
-                                            np.asarray(eye, np.float64).reshape(3))
-    visible = visible_ranges(ranges[:, 0], ranges[:, 1], shading.tf.scalars, shading.tf.extinction)
+    pos, texels, ranges = leaf_buffer(np.ascontiguousarray(frame.leaves, np.int64), int(vol.root),
+                                      np.asarray(vol.shape, np.int64), origin, spacing, centre, table.reshape(-1),
+                                      other.reshape(-1), float(m_scale))
     half = 0.5 * (np.asarray(vol.shape, np.float64) - 1.0) * spacing
-    return CloudBuffers(pos, cells, visible, centre, np.stack([-half, half], axis=1))
+    pos[-2:] = [-half, half]
+    visible = visible_ranges(ranges[:, 0], ranges[:, 1], shading.tf.scalars, shading.tf.extinction)
+    return CloudBuffers(pos, texels, visible, centre, np.stack([-half, half], axis=1), origin - centre, spacing)
 
 
 @dataclass
 class _FrameGeometry:
     """What ``GLPTVolume``'s draw reads of its ``topo`` for a frame drawn in a given order: the actor's origin (the
-    ray basis is taken relative to it) and the number of tetrahedra."""
+    ray basis is taken relative to it) and the number of cells it orders (here the leaves)."""
 
     origin: np.ndarray
     n_tets: int
 
 
 class CloudPTVolume(GLPTVolume):
-    """C-LOD cloud tetrahedra on the GPU PT pass (module docstring): the shading's table, the length modulated per
-    fragment (Eq. 11.9), the given back-to-front order, and ``set_frame`` for the next frame's buffers: a vertex
-    buffer of positions only and the cell data in a buffer texture (``cloud_tet_vs.glsl``), uploaded at the next
-    render.
+    """C-LOD cloud leaves on the GPU PT pass (module docstring): the shading's table, the length modulated per
+    fragment (Eq. 11.9), the given back-to-front order of the leaves, and ``set_frame`` for the next frame's buffers:
+    one point per leaf, drawn in that order, whose texels (a buffer texture) the geometry shader makes the leaf's 5
+    tetrahedra from (``cloud_leaf_gs.glsl``), uploaded at the next render.
 
     Private members of ``GLPTVolume`` used (what a public API would replace): ``_build_table`` (overridden to return
-    the scene's table), ``_sorted`` / ``_sorted_key`` / ``_order_key`` (the given order, kept by ``reuse_order``),
-    ``_vis`` (culling of the new frame), ``topo`` (``_FrameGeometry``: a frame has no mesh topology),
-    ``_on_update_shader`` / ``_on_end`` (extended to bind the cell texture)."""
+    the scene's table), ``_set_index_buffer`` (overridden: one index per leaf), ``_sorted`` / ``_sorted_key`` /
+    ``_order_key`` (the given order, kept by ``reuse_order``), ``_vis`` (culling of the new frame), ``topo``
+    (``_FrameGeometry``: a frame has no mesh topology), ``_on_update_shader`` / ``_on_end`` (extended to bind the
+    leaf texture and set the grid and eye uniforms)."""
 
     def __init__(self, plotter: Any, buffers: CloudBuffers, shading: CloudShading, table: Any) -> None:
+        from volviz.render.vtk_facade import vtk
+
         self._cloud_table = table
-        self._cells: Any = None               # the frame's cell data as a VTK array, until uploaded
-        self._cell_buffer: Any = None         # its GL buffer and buffer texture
-        self._cell_texture: Any = None
+        self._texels: Any = None              # the frame's leaf texels as a VTK array, until uploaded
+        self._leaf_buffer: Any = None         # their GL buffer and buffer texture
+        self._leaf_texture: Any = None
         # GLPTVolume is made on one tetrahedron (its own buffer is replaced by the frame's at once)
         one = TetMesh(np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]),
                       np.array([[0, 1, 2, 3]]), np.zeros(4))
         super().__init__(plotter, one, shading.tf, lookup="3d")
         self.mapper.RemoveAllVertexAttributeMappings()
+        # the geometry shader makes positions in model coordinates: VTK must not shift and scale the vertex buffer
+        self.mapper.SetVBOShiftScaleMethod(vtk.vtkPolyDataMapper.DISABLE_SHIFT_SCALE)
         sp = self.actor.GetShaderProperty()
-        sp.SetVertexShaderCode(shader_source("cloud_tet_vs.glsl"))
+        sp.SetVertexShaderCode(shader_source("cloud_leaf_vs.glsl"))
+        sp.SetGeometryShaderCode(shader_source("cloud_leaf_gs.glsl"))
         sp.SetFragmentShaderCode(_patched("pt_tet_fs.glsl", _FS_PATCH))
         self.stats = {"method": "pt-gl clouds"}
         self.set_frame(buffers)
@@ -163,60 +175,79 @@ class CloudPTVolume(GLPTVolume):
         return self._cloud_table
 
     def set_frame(self, buffers: CloudBuffers) -> None:
-        """The next frame's tetrahedra (back to front) as ``cloud_buffers`` made them: new vertex positions (shared
-        with VTK) and cell data (uploaded to the buffer texture at the next render), their own order for every camera,
-        the same table."""
+        """The next frame's leaves (back to front) as ``cloud_buffers`` made them: new points (shared with VTK) and
+        texels (uploaded to the buffer texture at the next render), their own order for every camera, the same
+        table."""
         from volviz.render.vtk_facade import numpy_to_vtk, shared_polydata
 
-        self.topo = _FrameGeometry(np.asarray(buffers.centre, np.float64), buffers.n_tets)  # type: ignore[assignment]
+        self.topo = _FrameGeometry(np.asarray(buffers.centre, np.float64), buffers.n_leaves)  # type: ignore[assignment]
         self._vis = buffers.visible
+        self._grid = (np.asarray(buffers.origin, np.float64), np.asarray(buffers.spacing, np.float64))
         self.polydata = shared_polydata(buffers.points, {})
         self.mapper.SetInputData(self.polydata)
-        cells = buffers.cells.reshape(-1, 4) if buffers.n_tets else np.zeros((1, 4), np.float32)
-        self._cells = numpy_to_vtk(np.ascontiguousarray(cells), deep=False)
-        self._cells_ref = cells               # numpy_to_vtk(deep=False) needs the array kept alive
+        texels = buffers.texels.reshape(-1, 4) if buffers.n_leaves else np.zeros((1, 4), np.float32)
+        self._texels = numpy_to_vtk(np.ascontiguousarray(texels), deep=False)
+        self._texels_ref = texels             # numpy_to_vtk(deep=False) needs the array kept alive
         self.actor.SetPosition(*buffers.centre)
         self.resolve_mapper.SetInputData(_resolve_polydata(buffers.bounds))    # VTK culls the resolve by these
         self.resolve_actor.SetPosition(*buffers.centre)
         self.reuse_order = True
-        self._sorted = np.arange(buffers.n_tets, dtype=np.int64)
+        self._sorted = np.arange(buffers.n_leaves, dtype=np.int64)
         self._sorted_key = self._order_key = None
 
+    def _set_index_buffer(self, cells: np.ndarray) -> None:
+        """Draw the leaves ``cells`` in this order from the next render on: one point each (32-bit indices shared
+        with VTK, kept referenced here)."""
+        from volviz.render.vtk_facade import numpy_to_vtk, vtk
+
+        conn = np.ascontiguousarray(cells, dtype=np.int32)
+        offsets = np.arange(len(conn) + 1, dtype=np.int32)
+        self._cell_arrays = (offsets, conn)
+        verts = vtk.vtkCellArray()
+        verts.SetData(numpy_to_vtk(offsets, deep=False), numpy_to_vtk(conn, deep=False))
+        self.polydata.SetVerts(verts)
+        self.polydata.Modified()
+
     def _on_update_shader(self, program: Any) -> None:
-        """gl_pt's uniforms and textures, and the frame's cell data as the buffer texture ``cloudCells`` (uploaded
-        when the frame changed)."""
+        """gl_pt's uniforms and textures, the frame's leaf texels as the buffer texture ``cloudLeaves`` (uploaded
+        when the frame changed), and the grid and the eye in model coordinates for the geometry shader."""
         from volviz.render.vtk_facade import vtk
 
         super()._on_update_shader(program)
         if program is None:
             return
         ren_win = self.renderer.GetRenderWindow()
-        if self._cells is not None:
-            if self._cell_buffer is None:
-                self._cell_buffer = vtk.vtkOpenGLVertexBufferObject()
-                self._cell_buffer.SetDataType(vtk.VTK_FLOAT)
-                self._cell_buffer.SetCoordShiftAndScaleMethod(0)     # the raw floats, no shift or scale
-                self._cell_texture = vtk.vtkTextureObject()
-                self._cell_texture.SetContext(ren_win)
-            self._cell_buffer.UploadDataArray(self._cells)
-            self._cell_texture.CreateTextureBuffer(self._cells.GetNumberOfTuples(), 4, vtk.VTK_FLOAT,
-                                                   self._cell_buffer)
-            self._cells = None
-        self._cell_texture.Activate()
-        program.SetUniformi("cloudCells", self._cell_texture.GetTextureUnit())
+        if self._texels is not None:
+            if self._leaf_buffer is None:
+                self._leaf_buffer = vtk.vtkOpenGLVertexBufferObject()
+                self._leaf_buffer.SetDataType(vtk.VTK_FLOAT)
+                self._leaf_buffer.SetCoordShiftAndScaleMethod(0)     # the raw floats, no shift or scale
+                self._leaf_texture = vtk.vtkTextureObject()
+                self._leaf_texture.SetContext(ren_win)
+            self._leaf_buffer.UploadDataArray(self._texels)
+            self._leaf_texture.CreateTextureBuffer(self._texels.GetNumberOfTuples(), 4, vtk.VTK_FLOAT,
+                                                   self._leaf_buffer)
+            self._texels = None
+        self._leaf_texture.Activate()
+        program.SetUniformi("cloudLeaves", self._leaf_texture.GetTextureUnit())
+        origin, spacing = self._grid
+        eye = np.asarray(self.renderer.GetActiveCamera().GetPosition(), np.float64) - self.topo.origin
+        program.SetUniform3f("cloudOrigin", [float(v) for v in origin])
+        program.SetUniform3f("cloudSpacing", [float(v) for v in spacing])
+        program.SetUniform3f("cloudEye", [float(v) for v in eye])
 
     def _on_end(self, *args: Any) -> None:
         super()._on_end(*args)
-        if self._cell_texture is not None:
-            self._cell_texture.Deactivate()
+        if self._leaf_texture is not None:
+            self._leaf_texture.Deactivate()
 
     def remove(self) -> None:
         """GLPTVolume's ``remove`` and the cell texture's GL resources."""
         ren_win = self.renderer.GetRenderWindow()
-        if ren_win is not None and self._cell_texture is not None:
-            self._cell_texture.ReleaseGraphicsResources(ren_win)
-            self._cell_buffer.ReleaseGraphicsResources()
-        self._cell_texture = self._cell_buffer = None
+        if ren_win is not None and self._leaf_texture is not None:
+            self._leaf_texture.ReleaseGraphicsResources(ren_win)
+            self._leaf_buffer.ReleaseGraphicsResources()
+        self._leaf_texture = self._leaf_buffer = None
         super().remove()
 
 
@@ -256,9 +287,9 @@ class GLNatureView(NatureView):
                 frame = scene.cloud_lod.update(cam, size)
                 if self._m_scale is None:
                     self._m_scale = modulation_scale(scene.cloud_lod.volume, scene.cloud_shading)
-                clouds = cloud_buffers(frame, scene.cloud_shading, cam.position, self._m_scale)
+                clouds = cloud_buffers(frame, scene.cloud_shading, self._m_scale)
                 stats["cloud_tets"] = float(frame.n_tets)
-                stats["cloud_upload_bytes"] = float(frame.n_tets * BYTES_PER_TET)
+                stats["cloud_upload_bytes"] = float(clouds.n_leaves * BYTES_PER_LEAF)
             mesh, poly, prisms = terrain.result()
         if mesh is not None:
             stats["terrain_triangles"] = float(mesh.n_triangles)
