@@ -4,7 +4,7 @@ same float32 arithmetic, and the layer's per-point buffer in one pass."""
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -24,43 +24,67 @@ def _keeps(points: np.ndarray, values: np.ndarray, a: int, b: int, c: int) -> bo
     return det != 0.0 and thick and emits
 
 
-@njit(cache=True, nogil=True)
+#: chunks of the points or triangles that the kernels deal out to their threads
+CHUNKS = 64
+
+
+@njit(cache=True, nogil=True, parallel=True)
 def kept_connectivity(points: np.ndarray, values: np.ndarray, tris: np.ndarray) -> np.ndarray:
     """The indices of the triangles ``tris`` (m, 3) that make a prism (``_keeps``), in their order, (3 k,) int32:
-    the layer's index buffer."""
+    the layer's index buffer (counted, then written, per chunk of triangles in parallel)."""
     m = tris.shape[0]
-    out = np.empty(3 * m, dtype=np.int32)
-    k = 0
-    for i in range(m):
-        a, b, c = tris[i, 0], tris[i, 1], tris[i, 2]
-        if _keeps(points, values, a, b, c):
-            out[k] = a
-            out[k + 1] = b
-            out[k + 2] = c
-            k += 3
-    return out[:k].copy()
+    start = np.zeros(CHUNKS + 1, dtype=np.int64)
+    for chunk in prange(CHUNKS):
+        c = 0
+        for i in range(chunk * m // CHUNKS, (chunk + 1) * m // CHUNKS):
+            if _keeps(points, values, tris[i, 0], tris[i, 1], tris[i, 2]):
+                c += 1
+        start[chunk + 1] = c
+    for chunk in range(CHUNKS):
+        start[chunk + 1] += start[chunk]
+    out = np.empty(3 * start[CHUNKS], dtype=np.int32)
+    for chunk in prange(CHUNKS):
+        k = 3 * start[chunk]
+        for i in range(chunk * m // CHUNKS, (chunk + 1) * m // CHUNKS):
+            a, b, c = tris[i, 0], tris[i, 1], tris[i, 2]
+            if _keeps(points, values, a, b, c):
+                out[k] = a
+                out[k + 1] = b
+                out[k + 2] = c
+                k += 3
+    return out
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, parallel=True)
 def layer_buffer(points: np.ndarray, bottom: np.ndarray, top: np.ndarray, emission_bottom: np.ndarray,
                  emission_top: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """One pass of ``gl_fog.layer_values`` (its docstring): the box (lo, hi) of the points between bottom and top,
-    the float32 points relative to the box's centre with the box's two corners appended, (n + 2, 3), and the
-    float32 per-point values (n + 2, 4)."""
+    """One pass of ``gl_fog.layer_values`` (its docstring; the box per chunk of points, then the buffers, in
+    parallel): the box (lo, hi) of the points between bottom and top, the float32 points relative to the box's
+    centre with the box's two corners appended, (n + 2, 3), and the float32 per-point values (n + 2, 4)."""
     n = points.shape[0]
-    lo = np.full(3, np.inf)
-    hi = np.full(3, -np.inf)
-    for i in range(n):
-        lo[0] = min(lo[0], points[i, 0])
-        hi[0] = max(hi[0], points[i, 0])
-        lo[1] = min(lo[1], points[i, 1])
-        hi[1] = max(hi[1], points[i, 1])
-        lo[2] = min(lo[2], min(bottom[i], top[i]))
-        hi[2] = max(hi[2], max(bottom[i], top[i]))
+    box = np.empty((CHUNKS, 6))
+    for chunk in prange(CHUNKS):
+        lo0 = lo1 = lo2 = np.inf
+        hi0 = hi1 = hi2 = -np.inf
+        for i in range(chunk * n // CHUNKS, (chunk + 1) * n // CHUNKS):
+            lo0 = min(lo0, points[i, 0])
+            hi0 = max(hi0, points[i, 0])
+            lo1 = min(lo1, points[i, 1])
+            hi1 = max(hi1, points[i, 1])
+            lo2 = min(lo2, min(bottom[i], top[i]))
+            hi2 = max(hi2, max(bottom[i], top[i]))
+        box[chunk, 0], box[chunk, 1], box[chunk, 2] = lo0, lo1, lo2
+        box[chunk, 3], box[chunk, 4], box[chunk, 5] = hi0, hi1, hi2
+    lo = np.zeros(3)
+    hi = np.zeros(3)
+    if n > 0:                                  # no points: an empty box at the origin
+        for a in range(3):
+            lo[a] = box[:, a].min()
+            hi[a] = box[:, 3 + a].max()
     centre = 0.5 * (lo + hi)
     rel = np.empty((n + 2, 3), np.float32)
     values = np.zeros((n + 2, 4), np.float32)
-    for i in range(n):
+    for i in prange(n):
         rel[i, 0] = points[i, 0] - centre[0]
         rel[i, 1] = points[i, 1] - centre[1]
         zb = np.float32(bottom[i] - centre[2])
