@@ -194,92 +194,143 @@ def _morph_node(fields: np.ndarray, last: int, state: np.ndarray, weight: np.nda
             _blend(fields, out, ci + t * q, cj + s * h, ci, cj + s * h, ci + t * h, cj + s * h, wn)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
+def _ring(ci: int, cj: int, d: int, last: int, state: np.ndarray, ring_i: np.ndarray, ring_j: np.ndarray) -> int:
+    """The fan ring of leaf (ci, cj) of size ``d``, counter-clockwise seen from above (x east, y north): its corners
+    and the edge midpoints whose same-size neighbour exists (or that lie on the grid's border), the T-vertex rule of
+    §3.5.3. Returns the ring's length (4 to 8)."""
+    h = d // 2
+    r = 0
+    ring_i[r] = ci - h
+    ring_j[r] = cj - h
+    r += 1
+    if cj - d < 0 or state[ci, cj - d] != 0:
+        ring_i[r] = ci
+        ring_j[r] = cj - h
+        r += 1
+    ring_i[r] = ci + h
+    ring_j[r] = cj - h
+    r += 1
+    if ci + d > last or state[ci + d, cj] != 0:
+        ring_i[r] = ci + h
+        ring_j[r] = cj
+        r += 1
+    ring_i[r] = ci + h
+    ring_j[r] = cj + h
+    r += 1
+    if cj + d > last or state[ci, cj + d] != 0:
+        ring_i[r] = ci
+        ring_j[r] = cj + h
+        r += 1
+    ring_i[r] = ci - h
+    ring_j[r] = cj + h
+    r += 1
+    if ci - d < 0 or state[ci - d, cj] != 0:
+        ring_i[r] = ci - h
+        ring_j[r] = cj
+        r += 1
+    return r
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _fan_outside(ci: int, cj: int, h: int, r: int, ring_i: np.ndarray, ring_j: np.ndarray, morphed: np.ndarray,
+                 planes: np.ndarray, sx: float, sy: float, x0: float, y0: float) -> bool:
+    """Whether the fan's box (its square, heights over its own morphed vertices in every field) misses the
+    frustum ``planes``."""
+    zl = np.inf
+    zh = -np.inf
+    for f in range(morphed.shape[2]):
+        zl = min(zl, morphed[ci, cj, f])
+        zh = max(zh, morphed[ci, cj, f])
+        for a in range(r):
+            v = morphed[ring_i[a], ring_j[a], f]
+            zl = min(zl, v)
+            zh = max(zh, v)
+    return box_outside(planes, x0 + (ci - h) * sx, y0 + (cj - h) * sy, zl, x0 + (ci + h) * sx, y0 + (cj + h) * sy, zh)
+
+
+#: chunks of the node list that ``emit_fans`` deals out to its threads
+FAN_CHUNKS = 64
+
+
+@njit(cache=True, nogil=True, parallel=True)
 def emit_fans(n: int, sx: float, sy: float, x0: float, y0: float, state: np.ndarray, nodes: np.ndarray,
               sizes: np.ndarray, count: int, morphed: np.ndarray, planes: np.ndarray,
               vmap: np.ndarray, stamp: int, verts: np.ndarray, vals: np.ndarray, tris: np.ndarray) -> tuple[int, int]:
-    """Triangle fans around the centre of every leaf, skipping the edge midpoints whose same-size neighbour does not
-    exist (the T-vertex rule of §3.5.3). Leaves whose box misses the frustum ``planes`` are skipped (emission only);
-    the box's height range is that of the fan's own morphed vertices over every field (``morphed`` (n, n, F)), which
-    bounds its planar triangles exactly. (The unmorphed height range of the node does not: a morphed vertex averages
-    ancestors' vertices outside the node, so visible fans near the image border were culled — holes that appeared
-    and vanished from frame to frame.)
-    Vertices are numbered on first use (``vmap`` (n, n, 2): the stamp of the frame that numbered a grid point and
-    its number; ``verts`` gets their grid indices, ``vals`` their F morphed values). Returns (n_vertices,
-    n_triangles)."""
-    nv = 0
-    nt = 0
-    ring_i = np.empty(9, dtype=np.int64)          # the ring, then the centre
-    ring_j = np.empty(9, dtype=np.int64)
+    """Triangle fans around the centre of every leaf (``_ring``: the T-vertex rule of §3.5.3). Leaves whose box
+    misses the frustum ``planes`` are skipped (emission only); the box's height range is that of the fan's own morphed
+    vertices over every field (``morphed`` (n, n, F)), which bounds its planar triangles exactly. (The unmorphed height
+    range of the node does not: a morphed vertex averages ancestors' vertices outside the node, so visible fans near
+    the image border were culled — holes that appeared and vanished from frame to frame.)
+    In parallel, in three passes: the kept fans are found and their vertices marked per chunk of the node list
+    (``vmap`` (n, n, 2): the stamp of the frame that marked a grid point, and its number), the marked points numbered
+    in row-major order (``verts`` gets their grid indices, ``vals`` their F morphed values), the fans' triangles
+    written at their chunk's offset in node order; the result does not depend on the number of threads. Returns
+    (n_vertices, n_triangles)."""
     last = n - 1
-    for k in range(count):
-        ci = nodes[k, 0]
-        cj = nodes[k, 1]
-        if state[ci, cj] != 1:
-            continue
-        d = sizes[k]
-        h = d // 2
-        r = 0
-        # counter-clockwise seen from above (x east, y north)
-        ring_i[r] = ci - h
-        ring_j[r] = cj - h
-        r += 1
-        if cj - d < 0 or state[ci, cj - d] != 0:
-            ring_i[r] = ci
-            ring_j[r] = cj - h
-            r += 1
-        ring_i[r] = ci + h
-        ring_j[r] = cj - h
-        r += 1
-        if ci + d > last or state[ci + d, cj] != 0:
-            ring_i[r] = ci + h
-            ring_j[r] = cj
-            r += 1
-        ring_i[r] = ci + h
-        ring_j[r] = cj + h
-        r += 1
-        if cj + d > last or state[ci, cj + d] != 0:
-            ring_i[r] = ci
-            ring_j[r] = cj + h
-            r += 1
-        ring_i[r] = ci - h
-        ring_j[r] = cj + h
-        r += 1
-        if ci - d < 0 or state[ci - d, cj] != 0:
-            ring_i[r] = ci - h
-            ring_j[r] = cj
-            r += 1
-        if planes.shape[0] > 0:
-            zl = np.inf
-            zh = -np.inf
-            for f in range(morphed.shape[2]):
-                zl = min(zl, morphed[ci, cj, f])
-                zh = max(zh, morphed[ci, cj, f])
-                for a in range(r):
-                    v = morphed[ring_i[a], ring_j[a], f]
-                    zl = min(zl, v)
-                    zh = max(zh, v)
-            if box_outside(planes, x0 + (ci - h) * sx, y0 + (cj - h) * sy, zl,
-                           x0 + (ci + h) * sx, y0 + (cj + h) * sy, zh):
+    kept = np.zeros(count, dtype=np.bool_)
+    chunk_tris = np.zeros(FAN_CHUNKS + 1, dtype=np.int64)
+    marked_row = np.zeros(n, dtype=np.bool_)
+    for chunk in prange(FAN_CHUNKS):
+        ring_i = np.empty(8, dtype=np.int64)
+        ring_j = np.empty(8, dtype=np.int64)
+        t = 0
+        for k in range(chunk * count // FAN_CHUNKS, (chunk + 1) * count // FAN_CHUNKS):
+            ci = nodes[k, 0]
+            cj = nodes[k, 1]
+            if state[ci, cj] != 1:
                 continue
-        ring_i[r] = ci
-        ring_j[r] = cj
-        for a in range(r + 1):
-            i = ring_i[a]
-            j = ring_j[a]
-            if vmap[i, j, 0] != stamp:
-                vmap[i, j, 0] = stamp
-                vmap[i, j, 1] = nv
-                verts[nv, 0] = i
-                verts[nv, 1] = j
-                for f in range(morphed.shape[2]):
-                    vals[nv, f] = morphed[i, j, f]
-                nv += 1
-        c_id = vmap[ci, cj, 1]
-        for a in range(r):
-            b = (a + 1) % r
-            tris[nt, 0] = c_id
-            tris[nt, 1] = vmap[ring_i[a], ring_j[a], 1]
-            tris[nt, 2] = vmap[ring_i[b], ring_j[b], 1]
-            nt += 1
-    return nv, nt
+            h = sizes[k] // 2
+            r = _ring(ci, cj, sizes[k], last, state, ring_i, ring_j)
+            if planes.shape[0] > 0 and _fan_outside(ci, cj, h, r, ring_i, ring_j, morphed, planes, sx, sy, x0, y0):
+                continue
+            kept[k] = True
+            t += r
+            # every thread that marks a point writes the same stamp
+            vmap[ci, cj, 0] = stamp
+            marked_row[ci] = True
+            for a in range(r):
+                vmap[ring_i[a], ring_j[a], 0] = stamp
+                marked_row[ring_i[a]] = True
+        chunk_tris[chunk + 1] = t
+    for chunk in range(FAN_CHUNKS):
+        chunk_tris[chunk + 1] += chunk_tris[chunk]
+    row_start = np.zeros(n + 1, dtype=np.int64)
+    for i in prange(n):
+        if marked_row[i]:
+            c = 0
+            for j in range(n):
+                if vmap[i, j, 0] == stamp:
+                    c += 1
+            row_start[i + 1] = c
+    for i in range(n):
+        row_start[i + 1] += row_start[i]
+    for i in prange(n):
+        if marked_row[i]:
+            v = row_start[i]
+            for j in range(n):
+                if vmap[i, j, 0] == stamp:
+                    vmap[i, j, 1] = v
+                    verts[v, 0] = i
+                    verts[v, 1] = j
+                    for f in range(morphed.shape[2]):
+                        vals[v, f] = morphed[i, j, f]
+                    v += 1
+    for chunk in prange(FAN_CHUNKS):
+        ring_i = np.empty(8, dtype=np.int64)
+        ring_j = np.empty(8, dtype=np.int64)
+        t = chunk_tris[chunk]
+        for k in range(chunk * count // FAN_CHUNKS, (chunk + 1) * count // FAN_CHUNKS):
+            if not kept[k]:
+                continue
+            ci = nodes[k, 0]
+            cj = nodes[k, 1]
+            r = _ring(ci, cj, sizes[k], last, state, ring_i, ring_j)
+            c_id = vmap[ci, cj, 1]
+            for a in range(r):
+                b = (a + 1) % r
+                tris[t, 0] = c_id
+                tris[t, 1] = vmap[ring_i[a], ring_j[a], 1]
+                tris[t, 2] = vmap[ring_i[b], ring_j[b], 1]
+                t += 1
+    return row_start[n], chunk_tris[FAN_CHUNKS]

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
-from typing import Any, Sequence
+from typing import Any, Callable, Sequence
 
 import numpy as np
 
@@ -122,13 +122,16 @@ class NatureScene:
                 self._pyramid = mip_pyramid(self.color_map)
 
     # ----------------------------------------------------------------------------------------------- rendering
-    def terrain_mesh(self, camera: Any, size: tuple[int, int], full: bool = False) -> TerrainMesh | None:
+    def terrain_mesh(self, camera: Any, size: tuple[int, int], full: bool = False,
+                     emit_threads: Callable[[], int] | None = None) -> TerrainMesh | None:
+        """The terrain's C-LOD mesh for ``camera`` in a window of ``size`` (``full``: every triangle), culled to the
+        view frustum with a margin; ``emit_threads`` as ``TerrainLOD.update``'s."""
         self.finalize()
         if self.lod is None:
             return None
         if full:
             return self.lod.full_mesh()
-        return self.lod.update(camera.position, frustum_planes(camera, size, margin=0.05))
+        return self.lod.update(camera.position, frustum_planes(camera, size, margin=0.05), emit_threads)
 
     def volume_order(self, eye: Sequence[float]) -> list[tuple[str, Any]]:
         """The volume layers in compositing order for an eye position: ("fog", _Fog) per prism layer and

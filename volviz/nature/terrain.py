@@ -26,12 +26,14 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
-from typing import Sequence
+from typing import Callable, Sequence
 
+import numba
 import numpy as np
 
 from volviz.nature import _terrain_kernels as K
 from volviz.nature.heightfield import HeightField
+from volviz.numba_threads import numba_threads
 
 
 def propagation_factor(big_c: float) -> float:
@@ -132,9 +134,11 @@ class TerrainLOD:
         """The global resolution c (the triangle-count knob of Eq. 3.2)."""
         self.small_c = float(small_c)
 
-    def update(self, eye: Sequence[float], planes: np.ndarray | None = None) -> TerrainMesh:
+    def update(self, eye: Sequence[float], planes: np.ndarray | None = None,
+               emit_threads: Callable[[], int] | None = None) -> TerrainMesh:
         """Triangulate for an eye position; ``planes`` (p, 4) culls the leaves outside the frustum (refinement is
-        unchanged; only the culled leaves' own vertices are not morphed)."""
+        unchanged; only the culled leaves' own vertices are not morphed). ``emit_threads``: asked for the Numba
+        thread count of the fan emission when it starts (e.g. more once other work of the frame is done)."""
         t0 = time.perf_counter()
         n = self.n
         self._state.fill(0)
@@ -152,9 +156,10 @@ class TerrainLOD:
         verts = np.empty((n_leaves * 9 + 8, 2), dtype=np.int64)
         vals = np.empty((n_leaves * 9 + 8, self.fields.shape[2]))
         tris = np.empty((n_leaves * 8 + 8, 3), dtype=np.int32)     # 32-bit: VTK indexes them fastest
-        nv, nt = K.emit_fans(n, hf.spacing[0], hf.spacing[1], hf.origin[0], hf.origin[1], self._state, self._nodes,
-                             self._sizes, count, self._morphed, pl, self._vmap, self._stamp,
-                             verts, vals, tris)
+        with numba_threads(emit_threads() if emit_threads is not None else numba.get_num_threads()):
+            nv, nt = K.emit_fans(n, hf.spacing[0], hf.spacing[1], hf.origin[0], hf.origin[1], self._state,
+                                 self._nodes, self._sizes, count, self._morphed, pl, self._vmap, self._stamp,
+                                 verts, vals, tris)
         verts = verts[:nv]
         vals = vals[:nv]
         pts = np.empty((nv, 3))
@@ -162,10 +167,10 @@ class TerrainLOD:
         pts[:, 1] = hf.origin[1] + verts[:, 1] * hf.spacing[1]
         pts[:, 2] = vals[:, 0]
         layers = {name: vals[:, i + 1].copy() for i, name in enumerate(self.layer_names)}
-        tc = verts.astype(np.float64) / (n - 1)
+        tc = verts / float(n - 1)
         stats = {"nodes": float(count), "leaves": float(n_leaves), "triangles": float(nt), "vertices": float(nv),
                  "guard_blocked": float(blocked), "seconds": time.perf_counter() - t0}
-        return TerrainMesh(pts, tris[:nt].copy(), verts, layers, tc, stats)
+        return TerrainMesh(pts, tris[:nt], verts, layers, tc, stats)
 
     def full_mesh(self) -> TerrainMesh:
         """The full-resolution grid (the reference): every node refined, no morphing (w = 1)."""

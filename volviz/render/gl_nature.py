@@ -41,11 +41,12 @@ Errors against the CPU ``NatureView`` of the same camera and LOD (8-bit screen u
 """
 from __future__ import annotations
 
+import threading
 import time
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import ThreadPoolExecutor, wait
 from dataclasses import dataclass
 from types import SimpleNamespace
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
@@ -264,6 +265,9 @@ class GLNatureView(NatureView):
         self.layers: dict[str, GLFogLayer] = {}
         self.clouds: CloudPTVolume | None = None
         self._m_scale: float | None = None
+        # the terrain half of ``compute``: one thread kept for the view's life (a new thread each frame would also
+        # make Numba's OpenMP start a new team of threads for it each frame)
+        self._terrain_worker = ThreadPoolExecutor(max_workers=1, thread_name_prefix="volviz-terrain-lod")
         hold_single_sample(plotter, self)       # the float targets are single-sample (gl_pt)
 
     def compute(self, request: tuple[Any, tuple[int, int], int],
@@ -271,25 +275,38 @@ class GLNatureView(NatureView):
         """Any thread: the LOD work of a frame (no image): the terrain's C-LOD mesh as VTK poly data and as the
         ``TerrainMesh`` the prisms stand on with each prism layer's vertex buffer (``prism_buffers``), on a second
         thread meanwhile the clouds' refinement, morphing and vertex buffer (``cloud_buffers``; both parts run
-        Numba kernels that release the GIL), statistics (``lod_s``: seconds spent here)."""
+        Numba kernels that release the GIL), statistics (``lod_s``: seconds spent here). Each part's kernels get
+        half the caller's Numba threads; the terrain's fan emission and prism buffers get all of them once the
+        clouds are done."""
         cam, size, _ = request
         t0 = time.perf_counter()
         scene = self.scene
         stats: dict[str, float] = {}
-        each = share(2)
-        with ThreadPoolExecutor(max_workers=1) as pool, numba_threads(each):
-            terrain = pool.submit(self._terrain_part, cam, size, each)
+        each, whole = share(2), share(1)
+        clouds_done = threading.Event()
+
+        def threads() -> int:
+            return whole if clouds_done.is_set() else each
+
+        with numba_threads(each):
+            terrain = self._terrain_worker.submit(self._terrain_part, cam, size, threads)
             clouds = None
-            if scene.cloud_lod is not None:
-                if progress is not None:
-                    progress(0.3, "clouds")
-                assert scene.cloud_shading is not None
-                frame = scene.cloud_lod.update(cam, size)
-                if self._m_scale is None:
-                    self._m_scale = modulation_scale(scene.cloud_lod.volume, scene.cloud_shading)
-                clouds = cloud_buffers(frame, scene.cloud_shading, self._m_scale)
-                stats["cloud_tets"] = float(frame.n_tets)
-                stats["cloud_upload_bytes"] = float(clouds.n_leaves * BYTES_PER_LEAF)
+            try:
+                if scene.cloud_lod is not None:
+                    if progress is not None:
+                        progress(0.3, "clouds")
+                    assert scene.cloud_shading is not None
+                    frame = scene.cloud_lod.update(cam, size)
+                    if self._m_scale is None:
+                        self._m_scale = modulation_scale(scene.cloud_lod.volume, scene.cloud_shading)
+                    clouds = cloud_buffers(frame, scene.cloud_shading, self._m_scale)
+                    stats["cloud_tets"] = float(frame.n_tets)
+                    stats["cloud_upload_bytes"] = float(clouds.n_leaves * BYTES_PER_LEAF)
+            except BaseException:
+                clouds_done.set()
+                wait([terrain])                    # no terrain work left behind
+                raise
+            clouds_done.set()
             mesh, poly, prisms = terrain.result()
         if mesh is not None:
             stats["terrain_triangles"] = float(mesh.n_triangles)
@@ -297,23 +314,27 @@ class GLNatureView(NatureView):
         return poly, SimpleNamespace(mesh=mesh, clouds=clouds, prisms=prisms,
                                      eye=np.asarray(cam.position, np.float64)), stats
 
-    def _terrain_part(self, cam: Any, size: tuple[int, int], threads: int) -> tuple[Any, Any, dict[str, Any]]:
-        """The terrain's C-LOD mesh, as VTK poly data, and each prism layer's (geometry, ``prism_buffers``), its
-        kernels on ``threads`` Numba threads."""
-        with numba_threads(threads):
-            return self._terrain_buffers(cam, size)
-
-    def _terrain_buffers(self, cam: Any, size: tuple[int, int]) -> tuple[Any, Any, dict[str, Any]]:
+    def _terrain_part(self, cam: Any, size: tuple[int, int], threads: Callable[[], int]
+                      ) -> tuple[Any, Any, dict[str, Any]]:
+        """The terrain's C-LOD mesh, as VTK poly data, and each prism layer's (geometry, ``prism_buffers``), their
+        kernels on ``threads()`` Numba threads (asked for when each stage starts)."""
         scene = self.scene
-        mesh = scene.terrain_mesh(cam, size)
+        with numba_threads(threads()):
+            mesh = scene.terrain_mesh(cam, size, emit_threads=threads)
         if mesh is None:
             return None, None, {}
+        with numba_threads(threads()):
+            return mesh, mesh.to_pyvista(), self._prism_layers(mesh)
+
+    def _prism_layers(self, mesh: Any) -> dict[str, Any]:
+        """Each prism layer's (geometry, ``prism_buffers``) on the terrain ``mesh``, by name."""
+        scene = self.scene
         prisms = {}
         for fog in scene.fogs:
             bottom = mesh.points[:, 2] if fog.bottom == "terrain" else mesh.layers[fog.bottom]
             geometry = (mesh.points, bottom, mesh.layers[fog.top], mesh.triangles)
             prisms[fog.name] = (geometry, prism_buffers(*geometry, layer=fog.layer))
-        return mesh, mesh.to_pyvista(), prisms
+        return prisms
 
     def finish(self, request: tuple[Any, tuple[int, int], int], poly: Any, frame: Any,
                stats: dict[str, float]) -> dict[str, float]:
@@ -373,5 +394,6 @@ class GLNatureView(NatureView):
         if self.clouds is not None:
             self.clouds.remove()
             self.clouds = None
+        self._terrain_worker.shutdown(wait=True)
         release_single_sample(self.plotter, self)
         super().remove()
