@@ -132,3 +132,24 @@ def test_layers_follow_the_cpu_compositing_order(demo) -> None:
         assert [k for k, _ in demo.volume_order(eye)][0] == first
     view.remove()
     pl.close()
+
+
+@pytest.mark.parametrize("cls", [NatureView, GLNatureView], ids=["cpu", "gpu"])
+def test_a_first_frame_of_sky_only_then_the_terrain(demo, cls) -> None:
+    """A view whose first frame has no terrain triangle in view (the camera looks up) shows the sky; the terrain
+    appears when the camera turns to it (PyVista refuses an empty mesh, and an empty layer has no box)."""
+    up = Camera((500.0, 500.0, 330.0), (500.0, 500.0, 3000.0), (0.0, 1.0, 0.0), 60.0, clipping_range=(5.0, 10000.0))
+    pl = pv.Plotter(off_screen=True, window_size=SIZE)
+    view = cls(pl, demo)
+    stats = view.update(up)
+    sky = pl.screenshot(return_img=True).astype(np.float64)
+    assert stats["terrain_triangles"] == 0 and view.terrain_actor is None
+    assert np.isfinite(sky).all() and sky.std() > 1.0
+    down = Camera((500.0, -150.0, 330.0), (500.0, 600.0, 80.0), (0.0, 0.0, 1.0), 60.0, clipping_range=(5.0, 10000.0))
+    stats = view.update(down)
+    pl.ren_win.Render()
+    ground = pl.screenshot(return_img=True).astype(np.float64)
+    assert stats["terrain_triangles"] > 1000 and view.terrain_actor is not None
+    assert np.abs(ground - sky).mean() > 10.0
+    view.remove()
+    pl.close()

@@ -171,8 +171,11 @@ class NatureView:
     def _show_terrain(self, poly: Any) -> None:
         """The C-LOD terrain mesh (VTK poly data; None: keep the shown one) as the textured terrain actor. A scene
         without terrain takes the terrain of the view it replaced (still shown until this first frame) off the
-        plotter."""
+        plotter. While no triangle is in view (e.g. the camera looks at the sky) before the first one, no actor is
+        made (PyVista refuses empty meshes)."""
         if poly is not None:
+            if self.terrain_actor is None and poly.n_points == 0:
+                return
             if self.terrain_actor is None:
                 self.terrain_actor = self.plotter.add_mesh(poly, texture=self._texture, lighting=False,
                                                            name="nature-terrain", render=False)
