@@ -200,3 +200,30 @@ def test_culled_geomorphing_gives_every_kept_vertex_its_full_value():
     refined_vertices = full_lod._morphed != 0.0
     skipped = refined_vertices & (culled_lod._morphed == 0.0)
     assert skipped[..., 0].sum() > 1000
+
+
+def test_fan_emission_is_the_same_on_any_number_of_threads():
+    """The parallel fan emission numbers the vertices row by row and writes the fans in node order: one thread and
+    all threads give the same mesh, array for array."""
+    import numba
+
+    from volviz.model.camera import Camera
+    from volviz.nature import noise
+    from volviz.numba_threads import numba_threads
+
+    h = noise.fractal_terrain(257, seed=3, relief=84.0)
+    hf = HeightField(h, (2.0, 2.0))
+    cam = Camera((80.0, 60.0, 120.0), (300.0, 250.0, 20.0), (0, 0, 1), 50.0, clipping_range=(1.0, 2000.0))
+    planes = frustum_planes(cam, (64, 48), margin=0.05)
+    meshes = []
+    for threads in (1, numba.config.NUMBA_NUM_THREADS):
+        lod = TerrainLOD(hf, layers={"fog": h + 5.0}, big_c=9.0, small_c=60.0)
+        with numba_threads(threads):
+            meshes.append(lod.update(cam.position, planes))
+    one, many = meshes
+    assert one.n_triangles > 10_000
+    for a, b in ((one.points, many.points), (one.triangles, many.triangles), (one.grid_index, many.grid_index),
+                 (one.layers["fog"], many.layers["fog"])):
+        np.testing.assert_array_equal(a, b)
+    gi = one.grid_index
+    assert np.all(np.diff(gi[:, 0] * hf.size + gi[:, 1]) > 0)        # row-major, each grid point once
