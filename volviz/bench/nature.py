@@ -77,11 +77,18 @@ NOTES = [
     "max 2.32. The GPU backend against the app's own full-resolution reference needs clouds 2, 100 with terrain "
     "9, 160 for RMSE <= 3 on every frame (docs/bench/nature_accurate.md: max 2.88 at 86,000 tetrahedra per frame; "
     "clouds 2, 50 gives 3.11 on frame 0, terrain 9, 100 with clouds 2, 100 gives 3.37).",
-    "GPU backend's CPU side: at the default LOD the LOD work, upload and submission take 0.03 s a frame (target "
-    "0.05 met there); at the setting that meets RMSE <= 3, 0.11 s (NOT met): the terrain's C-LOD over ~480,000 "
-    "triangles (refinement, morphing, fans: 0.045-0.06 s) runs on one thread while the clouds' refinement, "
-    "morphing and vertex buffer for ~90,000 tetrahedra run on the other, then VTK uploads ~45 MB of vertex "
-    "buffers (the clouds' 496 bytes per tetrahedron are most of it).",
+    "GPU backend's CPU side at the setting that meets RMSE <= 3 (docs/bench/nature_accurate.md): ~0.05 s a frame "
+    "on 2 cores (0.095 s before this round). What brought it down, each measured along this path: the terrain and "
+    "cloud halves each get half the Numba threads (two threads that each launched kernels on every core "
+    "oversubscribed the machine: LOD 0.07 -> 0.05 s); the terrain's fields side by side per grid point and the "
+    "blend helpers inlined (morphing 20 -> 11 ms); morphing skips nodes whose box misses the frustum (terrain "
+    "11 -> 6 ms, clouds 10 -> 4.5 ms); the prism layer's buffers in one Numba pass (9 -> 5 ms); the clouds' "
+    "tetrahedra made by a geometry shader from one point and 5 texels per leaf (96 bytes per leaf of 5 tetrahedra "
+    "instead of 208 per tetrahedron; VTK's index buffer for 12 indices per tetrahedron was most of the upload); "
+    "32-bit triangle indices (VTK builds index buffers from 32-bit cells fastest); the fan emission and prism "
+    "buffers on both cores once the clouds are done. Left: the terrain's C-LOD (refinement, morphing, fans over "
+    "~400,000 triangles) is the critical path, and VTK builds the terrain's and prisms' index buffers (~6-7 ns per "
+    "index) at every upload.",
     "Frame rate: everything is CPU work in Numba (terrain z-buffer and mip-mapped shading, per-pixel PCP prisms, "
     "per-pixel pre-integrated cloud tetrahedra) on 2 cores; the load average of the run is in the header (under "
     "load 3-6 the frame rate was 2-3 fps). The clouds (per pixel and leaf: ray/cube clip, <= 3 pieces, a trilinear "
