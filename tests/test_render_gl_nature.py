@@ -153,3 +153,17 @@ def test_a_first_frame_of_sky_only_then_the_terrain(demo, cls) -> None:
     assert np.abs(ground - sky).mean() > 10.0
     view.remove()
     pl.close()
+
+
+def test_a_frame_computed_after_the_view_was_removed(demo) -> None:
+    """The app may remove a view while a frame for it is computed on a worker: the frame still comes out (its
+    terrain half then runs on a thread of its own)."""
+    cam = Camera((500.0, -150.0, 330.0), (500.0, 600.0, 80.0), (0.0, 0.0, 1.0), 60.0, clipping_range=(5.0, 10000.0))
+    pl = pv.Plotter(off_screen=True, window_size=SIZE)
+    view = GLNatureView(pl, demo)
+    request = view.begin(cam)
+    view.remove()
+    poly, frame, stats = view.compute(request)
+    assert poly.n_points > 0 and frame.mesh.n_triangles == stats["terrain_triangles"] > 1000
+    assert frame.clouds is not None and frame.clouds.n_leaves > 0 and frame.prisms
+    pl.close()

@@ -268,6 +268,7 @@ class GLNatureView(NatureView):
         # the terrain half of ``compute``: one thread kept for the view's life (a new thread each frame would also
         # make Numba's OpenMP start a new team of threads for it each frame)
         self._terrain_worker = ThreadPoolExecutor(max_workers=1, thread_name_prefix="volviz-terrain-lod")
+
         hold_single_sample(plotter, self)       # the float targets are single-sample (gl_pt)
 
     def compute(self, request: tuple[Any, tuple[int, int], int],
@@ -289,7 +290,10 @@ class GLNatureView(NatureView):
             return whole if clouds_done.is_set() else each
 
         with numba_threads(each):
-            terrain = self._terrain_worker.submit(self._terrain_part, cam, size, threads)
+            try:
+                terrain = self._terrain_worker.submit(self._terrain_part, cam, size, threads)
+            except RuntimeError:                   # removed meanwhile (its worker is shut down): a one-off thread
+                terrain = ThreadPoolExecutor(max_workers=1).submit(self._terrain_part, cam, size, threads)
             clouds = None
             try:
                 if scene.cloud_lod is not None:
@@ -394,6 +398,6 @@ class GLNatureView(NatureView):
         if self.clouds is not None:
             self.clouds.remove()
             self.clouds = None
-        self._terrain_worker.shutdown(wait=True)
+        self._terrain_worker.shutdown(wait=False)       # a frame in flight on it finishes on its own
         release_single_sample(self.plotter, self)
         super().remove()
