@@ -18,8 +18,9 @@ Google SwiftShader) the GPU's work runs on the same CPU cores, so ``auto`` takes
 - ``"nature"``: the natural scene's fog and cloud layers and C-LOD clouds: ``volviz.render.gl_nature.GLNatureView``
   (GL prisms and GL PT in the scene's depth buffer) or the CPU ``volviz.render.nature_view.NatureView`` (an overlay
   made off the GUI thread). Auto takes the CPU on a software rasteriser: the demo scene on llvmpipe (2 shared cores,
-  ~25k cloud tetrahedra, ~60k fog prisms) took 0.61 s per frame on the CPU against 1.47 s on the GL path at
-  512x384 (0.57 s of it LOD selection and upload, 0.91 s llvmpipe's draw) and 0.18 / 0.63 s at 64x48.
+  ~25k cloud tetrahedra, ~60k fog prisms, median of 5 frames) takes 0.18 s per frame on the CPU against 0.22 s on
+  the GL path at 512x384 (0.01 s of it LOD selection and handing the buffers to VTK, the rest llvmpipe's draw) and
+  0.04 / 0.13 s at 64x48 (llvmpipe runs the prisms' and tetrahedra's geometry shaders on the CPU cores).
 - ``"iso"``: the isosurfaces' transparency modes of the libMini note §4 (2-pass, 3-pass, 4-pass, exact):
   ``volviz.render.gl_iso.GLIsoView`` (the passes as VTK actors, drawn at every render) or the CPU
   ``volviz.render.iso_overlay.IsoOverlay`` (fragment lists composited off the GUI thread, pasted over the scene).
