@@ -31,14 +31,15 @@ CHUNKS = 64
 @njit(cache=True, nogil=True, parallel=True)
 def kept_connectivity(points: np.ndarray, values: np.ndarray, tris: np.ndarray) -> np.ndarray:
     """The indices of the triangles ``tris`` (m, 3) that make a prism (``_keeps``), in their order, (3 k,) int32:
-    the layer's index buffer (counted, then written, per chunk of triangles in parallel)."""
+    the layer's index buffer (tested and counted, then written at each chunk's offset, per chunk in parallel)."""
     m = tris.shape[0]
+    keep = np.empty(m, dtype=np.bool_)
     start = np.zeros(CHUNKS + 1, dtype=np.int64)
     for chunk in prange(CHUNKS):
         c = 0
         for i in range(chunk * m // CHUNKS, (chunk + 1) * m // CHUNKS):
-            if _keeps(points, values, tris[i, 0], tris[i, 1], tris[i, 2]):
-                c += 1
+            keep[i] = _keeps(points, values, tris[i, 0], tris[i, 1], tris[i, 2])
+            c += keep[i]
         start[chunk + 1] = c
     for chunk in range(CHUNKS):
         start[chunk + 1] += start[chunk]
@@ -46,11 +47,10 @@ def kept_connectivity(points: np.ndarray, values: np.ndarray, tris: np.ndarray) 
     for chunk in prange(CHUNKS):
         k = 3 * start[chunk]
         for i in range(chunk * m // CHUNKS, (chunk + 1) * m // CHUNKS):
-            a, b, c = tris[i, 0], tris[i, 1], tris[i, 2]
-            if _keeps(points, values, a, b, c):
-                out[k] = a
-                out[k + 1] = b
-                out[k + 2] = c
+            if keep[i]:
+                out[k] = tris[i, 0]
+                out[k + 1] = tris[i, 1]
+                out[k + 2] = tris[i, 2]
                 k += 3
     return out
 
