@@ -143,6 +143,27 @@ def test_hard_cases(case, lookup):
     assert e[0] <= RMSE and e[1] <= MAX, e
 
 
+def test_volume_whose_first_corners_are_out_of_view():
+    """A narrow view of the top of a box of cells: the face through the mesh bounds' corners 0, 1, 2 (z = 0) is far
+    out of the frustum. The resolve actor carries the whole box in its bounds (``vtk_facade.box_corners_polydata``),
+    so VTK's frustum culling keeps it with the cells; with only that face in its bounds it was culled, the volume
+    never reached the screen and the props drawn after it went into the volume's target. Bounds as the hard cases."""
+    mesh = syn.box_tets(4, jitter=0.2)
+    cam = Camera((0.5, -3.0, 0.95), (0.5, 0.5, 0.95), (0, 0, 1), 4.0, clipping_range=(0.5, 10.0))
+    size = (40, 32)
+    ref = render(mesh, TF, cam, size, "reference")
+    assert ref[..., 3].max() > 0.05
+    pl = _plotter(size, cam)
+    vol = GLPTVolume(pl, mesh, TF)
+    img = pl.screenshot(return_img=True)
+    lo, hi = np.asarray(vol.actor.GetBounds()).reshape(3, 2).T, np.asarray(vol.resolve_actor.GetBounds()).reshape(3, 2).T
+    vol.remove()
+    pl.close()
+    assert np.allclose(lo, hi)                       # the resolve's bounds are the cells'
+    e = _err(img, ref[..., :3])
+    assert e[0] <= RMSE and e[1] <= MAX, e
+
+
 def test_clipping_plane_cuts_segments():
     """A clipping plane through the middle of a box, keeping the half toward the camera: each ray's segment ends at
     the plane, so the image equals the reference with the plane's depth along each pixel ray as its far limit. A box

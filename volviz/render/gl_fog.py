@@ -137,20 +137,17 @@ def prism_buffers(points: np.ndarray, bottom: np.ndarray, top: np.ndarray, trian
 
 
 def _resolve_polydata(bounds: np.ndarray) -> Any:
-    """The resolve's geometry: the 8 corners of ``bounds`` (3, 2) (for VTK's culling) and one triangle whose
-    ``fogCorner`` attribute covers the viewport in normalised device coordinates."""
-    from volviz.render.vtk_facade import box_corners_polydata, numpy_to_vtk, vtk
+    """The resolve's geometry: the 8 corners of ``bounds`` (3, 2) in the actor's bounds (for VTK's culling) and one
+    triangle whose ``fogCorner`` attribute covers the viewport in normalised device coordinates (the other corners'
+    is (0, 0): the bounds' zero-area triangle stays one)."""
+    from volviz.render.vtk_facade import box_corners_polydata, numpy_to_vtk
 
-    pd = box_corners_polydata(bounds)
+    pd = box_corners_polydata(bounds, [(0, 1, 2)])
     ndc = np.zeros((8, 2), np.float32)
     ndc[:3] = [[-1.0, -1.0], [3.0, -1.0], [-1.0, 3.0]]
     va = numpy_to_vtk(ndc, deep=True)
     va.SetName("fogCorner")
     pd.GetPointData().AddArray(va)
-    cells = vtk.vtkCellArray()
-    cells.SetData(numpy_to_vtk(np.array([0, 3], np.int64), deep=True), numpy_to_vtk(np.array([0, 1, 2], np.int64),
-                                                                                      deep=True))
-    pd.SetPolys(cells)
     return pd
 
 

@@ -170,15 +170,12 @@ def _polydata(mesh: TetMesh, smooth: bool = False) -> Any:
 
 
 def _resolve_polydata(bounds: np.ndarray) -> Any:
-    """The resolve's geometry: the 8 corners of ``bounds`` (3, 2), so that VTK culls it with the cells, and the
-    triangle (0, 1, 2), which ``pt_resolve_vs.glsl`` places over the viewport by ``gl_VertexID``."""
-    from volviz.render.vtk_facade import box_corners_polydata, numpy_to_vtk, vtk
+    """The resolve's geometry: the 8 corners of ``bounds`` (3, 2) in the actor's bounds, so that VTK culls it with
+    the cells, and the triangle (0, 1, 2), which ``pt_resolve_vs.glsl`` places over the viewport by ``gl_VertexID``
+    (vertex 7 of the bounds' zero-area triangle lands on vertex 0)."""
+    from volviz.render.vtk_facade import box_corners_polydata
 
-    pd = box_corners_polydata(bounds)
-    offsets, conn = (numpy_to_vtk(np.array(v, np.int64), deep=True) for v in ([0, 3], [0, 1, 2]))
-    pd.SetPolys(vtk.vtkCellArray())
-    pd.GetPolys().SetData(offsets, conn)
-    return pd
+    return box_corners_polydata(bounds, [(0, 1, 2)])
 
 
 def _triangles(cells: np.ndarray, offsets: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:

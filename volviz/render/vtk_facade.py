@@ -12,11 +12,12 @@ Besides the VTK module and NumPy's bridge to it, it holds the VTK idioms the GL 
   (ONE, ONE_MINUS_SRC_ALPHA) and restore its own blend state after it;
 - ``shared_polydata(points, attributes, connectivity)``: poly data whose points, point arrays and triangles share
   NumPy buffers without a copy (a vertex buffer made on a worker thread, handed to VTK on the GUI thread);
-- ``box_corners_polydata(bounds)``: the 8 corners of a box as points (what VTK culls a full-screen pass by).
+- ``box_corners_polydata(bounds, triangles)``: the 8 corners of a box and a zero-area triangle spanning it, with
+  any triangles given (what VTK culls a full-screen pass by, and a bounds holder that draws nothing).
 """
 from __future__ import annotations
 
-from typing import Any, Callable
+from typing import Any, Callable, Sequence
 
 import numpy as np
 import vtk
@@ -72,12 +73,20 @@ def shared_polydata(points: np.ndarray, attributes: dict[str, np.ndarray],
     return pd
 
 
-def box_corners_polydata(bounds: np.ndarray) -> Any:
-    """Poly data with the 8 corners of ``bounds`` (3, 2) as float32 points and no cells yet."""
+def box_corners_polydata(bounds: np.ndarray, triangles: Sequence[tuple[int, int, int]] = ()) -> Any:
+    """Poly data with the 8 corners of ``bounds`` (3, 2) as float32 points (corner i at x = bounds[0][i & 1],
+    y = bounds[1][(i >> 1) & 1], z = bounds[2][(i >> 2) & 1]), the ``triangles`` given, and the zero-area triangle
+    (0, 7, 7) between opposite corners. VTK's mappers take their bounds (frustum culling, the camera's clipping range)
+    from the points the cells use, so that triangle makes them the whole box; a zero-area triangle gives GL no
+    fragment (as long as the vertex shader places vertex 7 on vertex 0 or on the same point twice)."""
     b = np.asarray(bounds, np.float64).reshape(3, 2)
     corners = np.array([[b[0, i & 1], b[1, (i >> 1) & 1], b[2, (i >> 2) & 1]] for i in range(8)], np.float32)
     pd = vtk.vtkPolyData()
     vp = vtk.vtkPoints()
     vp.SetData(numpy_to_vtk(corners, deep=True))
     pd.SetPoints(vp)
+    tris = np.array([*triangles, (0, 7, 7)], np.int64).reshape(-1)
+    cells = vtk.vtkCellArray()
+    cells.SetData(numpy_to_vtk(np.arange(0, len(tris) + 1, 3, dtype=np.int64), deep=True), numpy_to_vtk(tris, deep=True))
+    pd.SetPolys(cells)
     return pd
