@@ -159,7 +159,6 @@ def test_opaque_actor_in_the_same_renderer(meshes, mode):
     bx, by, _ = np.rint(PERSPECTIVE.project(ball, SIZE)).astype(int)
     with_iso = _shot(pl)
     iso.remove()
-    pl.renderer.SetUseDepthPeeling(mode == "exact")    # exact mode peels the renderer's other translucent props too
     slab_only = _shot(pl)
     pl.close()
     cover = _cpu(meshes, PERSPECTIVE, "exact")
@@ -187,10 +186,15 @@ def test_remove_restores_the_renderer_and_rejects_unknown_modes(meshes):
     ren.SetMaximumNumberOfPeels(4)
     blank = _shot(pl)
     iso = GLIsoSurfaces(pl, meshes, mode="exact", peels=32)
-    assert ren.GetUseDepthPeeling() and ren.GetMaximumNumberOfPeels() == 32
+    layer = iso._peel_layer.renderer            # exact: a peeling renderer drawn after the plotter's, same layer
+    assert layer.GetUseDepthPeeling() and layer.GetMaximumNumberOfPeels() == 32 and layer.GetOcclusionRatio() == 0
+    assert layer.GetLayer() == ren.GetLayer() and layer.GetPreserveColorBuffer() and layer.GetPreserveDepthBuffer()
+    assert ren.GetUseOIT() and not ren.GetUseDepthPeeling() and ren.GetMaximumNumberOfPeels() == 4   # untouched
+    assert pl.ren_win.GetRenderers().IsItemPresent(layer)
     _shot(pl)
     iso.set_mode("4pass")
     assert not ren.GetUseDepthPeeling() and not ren.GetUseOIT()
+    assert iso._peel_layer is None and not pl.ren_win.GetRenderers().IsItemPresent(layer)
     with pytest.raises(ValueError, match="unknown transparency mode"):
         iso.set_mode("5pass")
     with pytest.raises(ValueError, match="shading"):
@@ -201,3 +205,40 @@ def test_remove_restores_the_renderer_and_rejects_unknown_modes(meshes):
     assert ren.GetActors().GetNumberOfItems() == 0
     assert np.array_equal(_shot(pl), blank)
     pl.close()
+
+
+def test_exact_mode_under_a_render_pass(meshes):
+    """Exact mode in a renderer running the float32 scene target of the GPU PT volumes and fog layers (a
+    ``vtkFramebufferPass``, under which VTK does not peel): the peeling layer gives the same image as without the
+    pass, within the bounds against the CPU compositor; resetting the camera's clipping range in the plotter's
+    renderer still holds the surfaces (the layer leaves a box of their bounds there)."""
+    from volviz.render.gl_pt import _PASS_MARK, install_scene_pass
+
+    images = []
+    for with_pass in (False, True):
+        pl = _plotter(PERSPECTIVE)
+        if with_pass:
+            install_scene_pass(pl.renderer, "test")
+            assert getattr(pl.renderer, _PASS_MARK) is pl.renderer.GetPass()
+        iso = GLIsoSurfaces(pl, meshes, mode="exact")
+        images.append(_shot(pl))
+        iso.remove()
+        pl.renderer.SetPass(None)
+        pl.close()
+    clear = [m for m in meshes if not m.style.opaque]
+    pl = _plotter(PERSPECTIVE)
+    pl.add_mesh(pv.Sphere(radius=0.05), color="white")   # all the renderer itself draws
+    iso = GLIsoSurfaces(pl, clear, mode="exact")         # translucent only: nothing of them drawn by the renderer
+    pl.renderer.ResetCameraClippingRange()
+    near, far = pl.renderer.GetActiveCamera().GetClippingRange()
+    iso.remove()
+    pl.close()
+    depth = (np.concatenate([m.points for m in clear]) - PERSPECTIVE.position) @ PERSPECTIVE.frame()[2]
+    assert 0 < near <= depth.min() and far >= depth.max()
+    cpu = _cpu(meshes, PERSPECTIVE, "exact")
+    d = np.abs(images[1] - cpu)
+    px = d.max(axis=-1)
+    rmse, p999, over3 = float(np.sqrt((d ** 2).mean())), float(np.percentile(px, 99.9)), int((px > 3.0).sum())
+    print(f"exact under a vtkFramebufferPass: RMSE {rmse:.3f} p99.9 {p999:.2f} pixels>3 {over3}")
+    assert np.array_equal(images[0], images[1])
+    assert rmse <= RMSE and p999 <= P999 and over3 <= OVER3_PIXELS

@@ -23,6 +23,7 @@ from volviz.model.datasets import RegularVolume, TimeSeries
 from volviz.render.controller import SceneController
 from volviz.render.gl_iso import GLIsoView
 from volviz.render.iso_overlay import IsoOverlay
+from volviz.render.pt_prop import PTVolume
 from volviz.session import CameraState, DatasetRef, Session
 from volviz.model.camera import Camera
 
@@ -119,7 +120,7 @@ def test_mode_changes_vtk_mode_and_the_cpu_backend() -> None:
     view = c.iso_view
     assert isinstance(view, GLIsoView) and view.mode == "4pass"
     c.set_iso_mode("exact")
-    assert c.iso_view is view and view.surfaces.mode == "exact" and p.renderer.GetUseDepthPeeling()
+    assert c.iso_view is view and view.surfaces.mode == "exact" and view.surfaces._peel_layer is not None
     gpu = _check(c, p, "exact", "exact after 4pass")
     c.set_iso_mode("vtk")
     assert c.iso_view is None and view.surfaces is None and not p.renderer.GetUseDepthPeeling()
@@ -136,23 +137,47 @@ def test_mode_changes_vtk_mode_and_the_cpu_backend() -> None:
     c.clear()
 
 
-def test_exact_mode_beside_a_gpu_pt_volume_is_drawn_by_the_cpu_overlay() -> None:
-    """The exact mode is VTK's depth peeling, which does not run under the float scene target of a GPU PT volume in
-    the same renderer (measured: 2,348 pixels off by more than 3, up to 50, against the scene without the volume);
-    there the CPU overlay draws it, within the bounds of the CPU compositor, and 3-pass stays on the GPU."""
+CAMERA_BESIDE = CameraState((-2.0, -16.0, 0.0), (3.5, 3.5, 2.0), (0.0, 0.0, 1.0))
+
+
+def _pt_and_iso(mode: str, backend: str, volume: bool = True) -> np.ndarray:
+    """The ball's surfaces in ``mode`` beside the demo PT volume (2 units across, at the lower left of the view, apart
+    from the surfaces on the screen), both drawn by ``backend``; ``volume=False``: the surfaces alone."""
     from volviz.render.gl_pt import GLPTVolume
     from volviz.session import Component
 
-    for mode, expected in (("exact", IsoOverlay), ("3pass", GLIsoView)):
-        s = Session(datasets=[DatasetRef("b", "/unused")],
-                    components=[iso_component(), Component(id="demo", type="demo", settings={"cells_per_edge": 4})],
-                    camera=CameraState((11.5, -40.0, 11.5), (11.5, 11.5, 11.5), (0.0, 0.0, 1.0)))
-        s.render.background = BG
-        s.render.options.update(PLAIN, backend="gpu", iso_mode=mode)
-        p = plotter()
-        c = SceneController(p, s, {"b": ball()})
-        c.build()
-        assert isinstance(c.props["demo"], GLPTVolume) and isinstance(c.iso_view, expected), (mode, c.iso_view)
-        c.props["demo"].visible = False
-        _check(c, p, mode, "beside a GPU PT volume")
-        c.clear()
+    demo = [Component(id="demo", type="demo", settings={"cells_per_edge": 4})] if volume else []
+    s = Session(datasets=[DatasetRef("b", "/unused")], components=[iso_component(), *demo], camera=CAMERA_BESIDE)
+    s.render.background = BG
+    s.render.options.update(PLAIN, backend=backend, iso_mode=mode)
+    p = plotter()
+    c = SceneController(p, s, {"b": ball()})
+    c.build()
+    c.update_views()
+    kinds = (GLPTVolume, GLIsoView) if backend == "gpu" else (PTVolume, IsoOverlay)
+    assert not volume or isinstance(c.props["demo"], kinds[0])
+    assert isinstance(c.iso_view, kinds[1]), (mode, c.iso_view)
+    img = _screen(p)
+    c.clear()
+    return img
+
+
+@pytest.mark.parametrize("mode", MODES)
+def test_every_mode_beside_a_gpu_pt_volume_matches_the_cpu_backend(mode: str) -> None:
+    """Every mode, exact included (VTK's depth peeling in a ``PeelLayer`` over the float32 scene target the GPU PT
+    volume installs, under which the renderer itself does not peel), beside a GPU PT volume: the whole viewport
+    against the CPU backend's (the CPU PT image and the CPU compositor's overlay over it). Measured: RMSE 0.26-0.53,
+    99.9th percentile at most 2, 1 pixel over 3 (a silhouette pixel); the bounds of this file. The volume is in the
+    picture (its pixels differ from the surfaces alone). Where the volume and the surfaces overlap on the screen the
+    backends differ in 3/4-pass (the CPU overlay draws pixels whose emissions exceed their opacity opaque over the
+    scene read back without the volume's image), so the view keeps them apart."""
+    gpu, cpu = _pt_and_iso(mode, "gpu"), _pt_and_iso(mode, "cpu")
+    diff = gpu - cpu
+    px = np.abs(diff).max(axis=2)
+    rmse, p999, over3 = float(np.sqrt((diff ** 2).mean())), float(np.percentile(px, 99.9)), int((px > 3).sum())
+    print(f"beside a GPU PT volume {mode}: RMSE {rmse:.3f} max {px.max():.1f} p99.9 {p999:.2f} pixels>3 {over3}")
+    assert rmse <= RMSE and p999 <= P999 and over3 <= OVER3_PIXELS
+    alone = _pt_and_iso(mode, "gpu", volume=False)
+    shown = np.abs(gpu - alone).max(axis=2) > 20
+    print(f"pixels of the volume: {int(shown.sum())}")
+    assert shown.sum() > 100                                          # the volume is in the picture

@@ -637,10 +637,7 @@ class SceneController:
     def set_iso_mode(self, mode: str, update: bool = True) -> None:
         """Draw the isosurfaces with VTK's blend ("vtk") or a mode of the note on the backend's ``iso_view`` (the CPU
         overlay is rendered now when ``update``; the app renders it in the background: ``iso_overlay.begin`` /
-        ``compute`` / ``finish``). The exact mode is VTK's depth peeling, which does not run under the float scene
-        target of a GPU PT volume or GPU natural scene in the same renderer (``volviz.render.gl_pt``): there the
-        exact mode is drawn by the CPU backend's overlay."""
-        from volviz.render.gl_pt import _PASS_MARK
+        ``compute`` / ``finish``)."""
         from volviz.render.scene_builder import view_backend
 
         if mode not in ISO_MODES:
@@ -649,8 +646,6 @@ class SceneController:
         if mode != "vtk" or "iso_mode" in self.session.render.options:
             self.session.render.options["iso_mode"] = mode
         backend = view_backend(self.plotter, self.session, "iso")
-        if backend == "gpu" and mode == "exact" and getattr(self.plotter.renderer, _PASS_MARK, None) is not None:
-            backend = "cpu"
         view = self.iso_view
         if view is not None and (mode == "vtk" or not self._iso_props() or view.backend != backend):
             view.remove()

@@ -27,14 +27,18 @@ surfaces (opacity 1) are one opaque actor. All actors share one shader program (
   mappers' ``UpdateShaderEvent`` observers), and the emission shader discards fragments behind that z_b
   (``gl_FragCoord.z`` against the texel; the same program computes both, so a back face at z_b itself counts, as the
   CPU's depth ≤ z_b). The scene's depth buffer is never written by the translucent passes.
-- ``"exact"``: VTK's (dual) depth peeling of the renderer, ``peels`` layers at most and occlusion ratio 0, with the
-  same shading: the translucent actor writes the straight color at the ``//VTK::DepthPeeling`` tags.
+- ``"exact"``: VTK's (dual) depth peeling, ``peels`` layers at most and occlusion ratio 0, with the same shading
+  (the translucent actor writes the straight color at the ``//VTK::DepthPeeling`` tags), by a ``PeelLayer``
+  (``volviz.render.peel_layer``): a renderer drawn right after the plotter's, keeping its image and depth, so the
+  surfaces are peeled over the finished scene whatever render pass the plotter's renderer runs (the float32 scene
+  target of a GPU PT volume or natural scene, ``volviz.render.gl_pt``, under which VTK does not peel).
 
-The passes are ordinary actors in the renderer's translucent pass, drawn in the order they were added (the renderer's
-OIT is off while 2/3/4-pass is shown; depth peeling on for exact), and each restores the GL state it changes (blend
+The 2/3/4 passes are ordinary actors in the renderer's translucent pass, drawn in the order they were added (the
+renderer's OIT and depth peeling are off while they are shown), and each restores the GL state it changes (blend
 function, depth mask, framebuffer binding), so other props of the renderer render normally; the renderer's OIT and
-depth-peeling settings are restored by ``remove``. Other translucent props of the renderer are blended unsorted in
-the 2/3/4-pass modes (no OIT) and peeled with the surfaces in exact mode.
+depth-peeling settings are restored by ``remove`` (and left as they were in exact mode). Other translucent props of
+the renderer are blended unsorted in the 2/3/4-pass modes (no OIT); in exact mode they are drawn by the renderer as
+before and the surfaces composited over them, as the CPU overlay composites its image over the rendered scene.
 
 Shading, per fragment in GLSL, as composite.py: μ = |n·v| per vertex, interpolated and clamped to [0, 1]; α = the
 surface opacity ("flat") or 1 − clamp(μ^a − b, 0, 1) with the least-squares (a, b) of the surface's opacity
@@ -54,12 +58,10 @@ RMSE 0.31-0.59 against the CPU mode, 1 to 13 pixels over 3 (silhouettes); frame 
 on 2 shared cores) 10-13 ms for 2-pass, 20-36 ms 3-pass, 37-45 ms 4-pass, 85-124 ms exact, where the CPU compositor
 takes 60-165 ms per frame.
 
-Not handled or not tested: exact mode in a renderer with its own render pass (``renderer.SetPass``, e.g. the float
-target of a GPU PT volume or natural scene, ``volviz.render.gl_pt``): depth peeling is the renderer's own and does
-not run under a custom pass, so the scene controller draws exact mode there with the CPU overlay (2/3/4-pass are
-tested beside a GPU PT volume in ``tests/test_render_gl_iso_view.py``); renderers that do not fill their window (the
-back-face texture is the renderer's size, read at ``gl_FragCoord``); multisampled windows (the tests use one sample
-per pixel, as the CPU compositor does).
+Exact mode under the float32 scene target gives the same image as without it (tested), and all four modes are tested
+beside a GPU PT volume in ``tests/test_render_gl_iso_view.py``. Not handled or not tested: renderers that do not
+fill their window (the back-face texture is the renderer's size, read at ``gl_FragCoord``); multisampled windows
+(the tests use one sample per pixel, as the CPU compositor does).
 """
 from __future__ import annotations
 
@@ -74,10 +76,11 @@ from volviz.iso.spectrum import fit_spectrum
 from volviz.render.gl_pt import shader_source
 from volviz.render.image_overlay import hold_single_sample, release_single_sample, window_size
 from volviz.render.iso_overlay import IsoModeView
+from volviz.render.peel_layer import PeelLayer
 
 __all__ = ["GLIsoSurfaces", "GLIsoView", "iso_polydata"]
 
-_OPAQUE, _OVER, _ATTENUATE, _BACK, _EMIT = range(5)
+_OPAQUE, _OVER, _ATTENUATE, _BACK, _EMIT, _PEEL = range(6)
 _ATTRIBUTES = ("isoNormal", "isoStyle", "isoFit")
 _GL_DEPTH_BUFFER_BIT = 0x0100
 
@@ -171,16 +174,19 @@ class GLIsoSurfaces:
         self._observers: list[tuple[Any, int]] = []
         if opaque:
             self._add(_OPAQUE, iso_polydata(opaque, self.centre, shading))
+        self._peel_layer: PeelLayer | None = None
+        self._translucent: Any = None
         if clear:
-            pd = iso_polydata(clear, self.centre, shading)
+            self._translucent = iso_polydata(clear, self.centre, shading)
             for kind in (_OVER, _ATTENUATE, _BACK, _EMIT):
-                self._add(kind, pd)
+                self._add(kind, self._translucent)
         self._observers.append((ren, ren.AddObserver(vtk.vtkCommand.EndEvent, self._on_end)))
         self.mode = ""
         self.set_mode(mode)
 
     # --- set-up --------------------------------------------------------------------------------------------------
-    def _add(self, kind: int, pd: Any) -> None:
+    def _add(self, kind: int, pd: Any, renderer: Any = None) -> Any:
+        """An actor of ``pd`` drawing the pass ``kind``, added to ``renderer`` (default: the plotter's)."""
         from volviz.render.vtk_facade import premultiplied_texture, shader_observer, vtk
 
         mapper = vtk.vtkOpenGLPolyDataMapper()
@@ -207,7 +213,8 @@ class GLIsoSurfaces:
         on_update_shader = shader_observer(lambda program: self._on_update_shader(kind, program))
         self._observers.append((mapper, mapper.AddObserver(vtk.vtkCommand.UpdateShaderEvent, on_update_shader)))
         self.actors[kind] = actor
-        self.renderer.AddActor(actor)
+        (renderer or self.renderer).AddActor(actor)
+        return actor
 
     # --- per draw ------------------------------------------------------------------------------------------------
     def _on_update_shader(self, kind: int, program: Any) -> None:
@@ -222,7 +229,7 @@ class GLIsoSurfaces:
         program.SetUniform3f("isoEye", [float(v) for v in eye - self.centre])
         program.SetUniform3f("isoForward", [float(v) for v in fwd])
         program.SetUniformi("isoParallel", int(bool(cam.GetParallelProjection())))
-        program.SetUniformi("isoPass", kind)
+        program.SetUniformi("isoPass", _OVER if kind == _PEEL else kind)
         program.SetUniformf("isoAmbient", float(self.ambient))
         program.SetUniformi("isoClipZ", int(kind == _EMIT and self.mode == "4pass"))
         state = self.renderer.GetState()
@@ -289,16 +296,30 @@ class GLIsoSurfaces:
         self.mode = mode
         shown = {"2pass": (_OVER,), "exact": (_OVER,), "3pass": (_ATTENUATE, _EMIT),
                  "4pass": (_ATTENUATE, _BACK, _EMIT)}[mode]
+        shown = () if mode == "exact" else shown        # exact: the peeling layer's own actor
         for kind, actor in self.actors.items():
-            actor.SetVisibility(kind == _OPAQUE or kind in shown)
+            actor.SetVisibility(kind in (_OPAQUE, _PEEL) or kind in shown)
         ren = self.renderer
         if mode == "exact":
-            ren.SetUseDepthPeeling(True)
-            ren.SetMaximumNumberOfPeels(self.peels)
-            ren.SetOcclusionRatio(0.0)
+            peel, oit = self._saved[:2]
+            ren.SetUseDepthPeeling(peel)                 # the renderer's own translucent props as before
+            ren.SetUseOIT(oit)
+            if self._peel_layer is None and self._translucent is not None:
+                self._peel_layer = PeelLayer(ren, self.peels)
+                self._peel_layer.add(self._add(_PEEL, self._translucent, self._peel_layer.renderer))
         else:
             ren.SetUseDepthPeeling(False)
             ren.SetUseOIT(False)
+            self._remove_peel_layer()
+
+    def _remove_peel_layer(self) -> None:
+        if self._peel_layer is not None:
+            self._peel_layer.remove()
+            self._peel_layer = None
+            mapper = self.actors.pop(_PEEL).GetMapper()
+            for obj, tag in [o for o in self._observers if o[0] is mapper]:
+                obj.RemoveObserver(tag)
+                self._observers.remove((obj, tag))
 
     def remove(self) -> None:
         """Take the surfaces out of the renderer and restore its depth-peeling and OIT settings (call before closing
@@ -306,6 +327,7 @@ class GLIsoSurfaces:
         for obj, tag in self._observers:
             obj.RemoveObserver(tag)
         self._observers = []
+        self._remove_peel_layer()
         for actor in self.actors.values():
             self.renderer.RemoveActor(actor)
         self.actors = {}
@@ -331,7 +353,7 @@ class GLIsoView(IsoModeView):
     view exists (the back-face target of 4-pass and the CPU compositor it is measured against have one sample per
     pixel). ``stats``: ``method`` ("iso <mode> (gpu)"), ``triangles`` (translucent triangles uploaded),
     ``triangles_drawn`` (per frame: once per pass for 2/3/4-pass; None for exact, whose number of peeled layers VTK
-    does not report), ``volume_s`` (the renderer's last frame, the passes and the rest of the scene) and ``size``."""
+    does not report), ``volume_s`` (the window's last frame: the passes and the rest of the scene) and ``size``."""
 
     kind = "iso"
     backend = "gpu"
@@ -351,9 +373,9 @@ class GLIsoView(IsoModeView):
         self._frame_s = 0.0
         self.mode = mode
         hold_single_sample(plotter, self)
-        ren = plotter.renderer
-        self._observers = [(ren, ren.AddObserver(vtk.vtkCommand.StartEvent, self._on_start)),
-                           (ren, ren.AddObserver(vtk.vtkCommand.EndEvent, self._on_end))]
+        win = plotter.ren_win              # the window's frame: the exact mode's peeling layer draws after the renderer
+        self._observers = [(win, win.AddObserver(vtk.vtkCommand.StartEvent, self._on_start)),
+                           (win, win.AddObserver(vtk.vtkCommand.EndEvent, self._on_end))]
         self.set_surfaces(list(meshes), [None] * len(meshes), shading)
 
     def _mode_changed(self, mode: str) -> None:
