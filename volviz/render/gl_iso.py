@@ -55,8 +55,8 @@ rasteriser's assign differently). The rest is 8-bit rounding of each blend step 
 pixels no surface covers are exactly those of the scene without the surfaces, opaque and translucent props included.
 On the real scenes of ``volviz bench iso`` (Storm, two overlapping Storm volumes, Blunt Fin; 384², docs/bench/iso.md):
 RMSE 0.31-0.59 against the CPU mode, 1 to 13 pixels over 3 (silhouettes); frame time (render + read-back, llvmpipe
-on 2 shared cores) 10-13 ms for 2-pass, 20-36 ms 3-pass, 37-45 ms 4-pass, 85-124 ms exact, where the CPU compositor
-takes 60-165 ms per frame.
+on 2 cores, load 0.7) 4-6 ms for 2-pass, 8-12 ms 3-pass, 9-16 ms 4-pass, 30-58 ms exact, where the CPU compositor
+takes 11-30 ms per frame in the same run.
 
 Exact mode under the float32 scene target gives the same image as without it (tested), and all four modes are tested
 beside a GPU PT volume in ``tests/test_render_gl_iso_view.py``. Not handled or not tested: renderers that do not
