@@ -363,14 +363,19 @@ def test_pt_volume_transfer_function_edits_render_in_the_background(qtbot, make_
     window.open_demo_volume()
     wait_loaded(qtbot, window)
     assert window.controller.pt_volume("demo") is not None
+    qtbot.waitUntil(lambda: window.view_updates.get("pt:demo", 0) >= 1, timeout=30000)   # its first image is shown
     before = viewport(window)
+    background = np.asarray(window.session.render.background) * 255.0
+    assert (np.abs(before[..., :3] - background).max(axis=2) > 30).mean() > 0.05          # the volume is drawn
     tf = window.tf_editor.transfer_function
     window.tf_editor.edit(tf.scaled_extinction(0.05), "Thin out")  # as a finished drag would
-    qtbot.waitUntil(lambda: window.jobs.runner.active == 0 and window._pending_tf is None, timeout=30000)
-    qtbot.wait(200)
-    after = viewport(window)
-    h, w = min(before.shape[0], after.shape[0]), min(before.shape[1], after.shape[1])  # docks may shift by a few px
-    assert np.abs(after[:h, :w] - before[:h, :w]).mean() > 0.5
+
+    def changed() -> bool:          # the image for the new TF is made in the background and then shown
+        after = viewport(window)
+        h, w = min(before.shape[0], after.shape[0]), min(before.shape[1], after.shape[1])  # docks may shift a few px
+        return bool(np.abs(after[:h, :w] - before[:h, :w]).mean() > 0.5)
+
+    qtbot.waitUntil(changed, timeout=30000)
     assert window.controller.pt_volume("demo").tf == tf.scaled_extinction(0.05)
 
 
