@@ -71,8 +71,10 @@ class FrameExport:
         self._release(abort=True)
 
     def _release(self, abort: bool) -> None:
-        """Close the offscreen plotter and let go of the output; ``abort``: remove what was written of it."""
-        self.plotter.close()
+        """Close the offscreen scene and let go of the output; ``abort``: remove what was written of it."""
+        from volviz.render.export import close_scene
+
+        close_scene(self.plotter, self.controller)
         sink, self.sink = self.sink, None
         if sink is not None and abort:
             try:

@@ -147,3 +147,24 @@ def test_warmup_leaves_every_kernel_it_uses_in_the_disk_cache() -> None:
         assert all(name in result.stdout for name in ("natural scene", "tetrahedral volume", "compressed volume",
                                                       "time series")), result.stdout
     assert "compiled: 0 []" in runs[1].stdout, runs[1].stdout
+
+
+def test_gpu_render_ends_cleanly(tmp_path: Path) -> None:
+    """A session on the GPU backend (a GPU PT volume and its float32 render pass, isosurfaces in exact mode through
+    the peeling layer) rendered offscreen: the views are taken out before the plotter closes, so VTK reports no GL
+    resource left behind (it printed "FrameBufferObject should have been deleted" on every GPU export)."""
+    storm = data_file("storm/Storm.pvm-t01").parent
+    session = tmp_path / "gpu.json"
+    session.write_text(json.dumps({
+        "format": "volviz-session", "version": 1,
+        "datasets": [{"id": "storm", "path": str(storm / "Storm.pvm-t%02d")}],
+        "components": [{"id": "iso", "type": "isosurface", "dataset": "storm",
+                        "settings": {"styles": [{"value": 30, "color": [0.3, 0.5, 1.0], "opacity": 0.4}]}},
+                       {"id": "demo", "type": "demo", "settings": {"cells_per_edge": 6}}],
+        "camera": {"position": [90, -60, 60], "focal_point": [12, 12, 10], "view_up": [0, 0, 1]},
+        "render": {"options": {"time": 3.0, "backend": "gpu", "iso_mode": "exact"}}}))
+    out = tmp_path / "gpu.png"
+    result = run_cli("render", str(session), "-o", str(out), "--size", "160x120")
+    assert result.returncode == 0, result.stderr
+    assert iio.imread(out)[..., :3].std() > 5.0
+    assert "ERR|" not in result.stderr and "should have been deleted" not in result.stderr, result.stderr

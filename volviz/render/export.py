@@ -144,11 +144,20 @@ def write_png(image: np.ndarray, path: str | os.PathLike) -> None:
 def offscreen_scene(session: Session, datasets: dict[str, Any], size: tuple[int, int]) -> tuple[Any, Any]:
     """An offscreen plotter of ``size`` and a ``SceneController`` of ``session`` over it, not built yet: ``build()``
     here, or (the app) ``prepare`` on a worker, ``install(views=False)``, then ``begin_views`` / ``compute_views`` /
-    ``finish_views``, and ``snapshot``. The caller closes the plotter."""
+    ``finish_views``, and ``snapshot``. The caller ends it with ``close_scene``."""
     from volviz.render.controller import SceneController
 
     plotter = offscreen_plotter(size)
     return plotter, SceneController(plotter, session, datasets)
+
+
+def close_scene(plotter: Any, controller: Any) -> None:
+    """Take the controller's views out (the GPU passes free their GL resources while the plotter's context lives)
+    and close the plotter: an offscreen scene's end, however its rendering ended."""
+    try:
+        controller.clear()
+    finally:
+        plotter.close()
 
 
 def snapshot(plotter: Any, size: tuple[int, int]) -> np.ndarray:
@@ -175,7 +184,7 @@ def render_session(session: Session, session_file: Optional[str | os.PathLike], 
         controller.build()
         image = snapshot(plotter, size)
     finally:
-        plotter.close()
+        close_scene(plotter, controller)
     report(progress, 1.0, "rendered")
     return np.asarray(image)
 
@@ -337,7 +346,7 @@ def render_movie(session: Session, session_file: Optional[str | os.PathLike], ou
             raise
         writer.close()
     finally:
-        plotter.close()
+        close_scene(plotter, controller)
     return target
 
 
