@@ -375,7 +375,7 @@ class GLNatureView(NatureView):
             if kind == "fog" and fog.name in self.layers:
                 actors += [self.layers[fog.name].actor, self.layers[fog.name].resolve_actor]
             elif kind == "clouds" and self.clouds is not None:
-                actors.append(self.clouds.actor)
+                actors += [self.clouds.actor, self.clouds.resolve_actor]
         props = self.plotter.renderer.GetViewProps()
         shown = [props.GetItemAsObject(i) for i in range(props.GetNumberOfItems())]
         position = {id(p): i for i, p in enumerate(shown)}
