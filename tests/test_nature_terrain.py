@@ -45,11 +45,15 @@ def test_no_t_junctions_for_many_eyes(big_c: float) -> None:
 
 
 def test_full_refinement_is_the_full_grid() -> None:
-    hf = rough_field(33)
+    hf = HeightField(rough_field(33).heights, (2.5, 0.75), origin=(-10.0, 300.0))
     mesh = TerrainLOD(hf).full_mesh()
     assert mesh.n_triangles == 2 * 32 * 32
     assert len(mesh.points) == 33 * 33
-    np.testing.assert_array_equal(mesh.points[:, 2], hf.heights[mesh.grid_index[:, 0], mesh.grid_index[:, 1]])
+    gi = mesh.grid_index
+    np.testing.assert_array_equal(mesh.points[:, 2], hf.heights[gi[:, 0], gi[:, 1]])
+    np.testing.assert_array_equal(mesh.points[:, 0], -10.0 + gi[:, 0] * 2.5)      # the grid point's place
+    np.testing.assert_array_equal(mesh.points[:, 1], 300.0 + gi[:, 1] * 0.75)
+    np.testing.assert_array_equal(mesh.tcoords, gi / 32.0)
     assert non_conforming_edges(mesh, 33) == 0
 
 

@@ -334,3 +334,23 @@ def emit_fans(n: int, sx: float, sy: float, x0: float, y0: float, state: np.ndar
                 tris[t, 2] = vmap[ring_i[b], ring_j[b], 1]
                 t += 1
     return row_start[n], chunk_tris[FAN_CHUNKS]
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def mesh_arrays(verts: np.ndarray, vals: np.ndarray, x0: float, y0: float, sx: float, sy: float, n: int
+                ) -> tuple[np.ndarray, np.ndarray]:
+    """The emitted vertices' positions (x0 + i sx, y0 + j sy, morphed height) and texture coordinates
+    (i / (n - 1), j / (n - 1)), from their grid indices ``verts`` (nv, 2) and morphed fields ``vals`` (nv, F; the
+    height first), in one parallel pass."""
+    nv = verts.shape[0]
+    pts = np.empty((nv, 3))
+    tc = np.empty((nv, 2))
+    last = float(n - 1)
+    for v in prange(nv):
+        i, j = verts[v, 0], verts[v, 1]
+        pts[v, 0] = x0 + i * sx
+        pts[v, 1] = y0 + j * sy
+        pts[v, 2] = vals[v, 0]
+        tc[v, 0] = i / last
+        tc[v, 1] = j / last
+    return pts, tc

@@ -160,14 +160,10 @@ class TerrainLOD:
             nv, nt = K.emit_fans(n, hf.spacing[0], hf.spacing[1], hf.origin[0], hf.origin[1], self._state,
                                  self._nodes, self._sizes, count, self._morphed, pl, self._vmap, self._stamp,
                                  verts, vals, tris)
-        verts = verts[:nv]
-        vals = vals[:nv]
-        pts = np.empty((nv, 3))
-        pts[:, 0] = hf.origin[0] + verts[:, 0] * hf.spacing[0]
-        pts[:, 1] = hf.origin[1] + verts[:, 1] * hf.spacing[1]
-        pts[:, 2] = vals[:, 0]
+            verts = verts[:nv]
+            vals = vals[:nv]
+            pts, tc = K.mesh_arrays(verts, vals, hf.origin[0], hf.origin[1], hf.spacing[0], hf.spacing[1], n)
         layers = {name: vals[:, i + 1].copy() for i, name in enumerate(self.layer_names)}
-        tc = verts / float(n - 1)
         stats = {"nodes": float(count), "leaves": float(n_leaves), "triangles": float(nt), "vertices": float(nv),
                  "guard_blocked": float(blocked), "seconds": time.perf_counter() - t0}
         return TerrainMesh(pts, tris[:nt], verts, layers, tc, stats)
