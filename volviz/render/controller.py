@@ -114,8 +114,10 @@ class SceneController:
 
         ensure_lights(self.plotter)
         with no_render(self.plotter):  # the caller draws once afterwards
+            # the views are drawn last, over the whole opaque scene (the outline box of ``decorate`` included, as
+            # every later update sees it)
             self.views = install_scene(self.plotter, self.session, self.datasets, prepared, spectrum=True,
-                                       views=views)
+                                       views=False)
             self.plotter.camera_set = True  # install_scene chose the view; PyVista must not re-frame the props
             self.installed_bounds = self.bounds()  # (what the clipping dock starts from)
             self.decorate()
@@ -129,7 +131,9 @@ class SceneController:
                 self._show_prepared_cut(comp_id, cut)
             if self.clip.all_planes():
                 self.apply_clip(update=False)
-            self.set_iso_mode(self.iso_mode, update=views)
+            self.set_iso_mode(self.iso_mode, update=False)
+            if views:
+                self.update_views()
 
     def clear(self) -> None:
         """Remove everything this controller added, including PT overlay renderers, which ``plotter.clear()`` keeps."""
