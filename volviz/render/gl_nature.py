@@ -268,8 +268,7 @@ class GLNatureView(NatureView):
         # the terrain half of ``compute``: one thread kept for the view's life (a new thread each frame would also
         # make Numba's OpenMP start a new team of threads for it each frame)
         self._terrain_worker = ThreadPoolExecutor(max_workers=1, thread_name_prefix="volviz-terrain-lod")
-
-        hold_single_sample(plotter, self)       # the float targets are single-sample (gl_pt)
+        self._single_sample = False             # held once a fog layer or the clouds draw (``finish``)
 
     def compute(self, request: tuple[Any, tuple[int, int], int],
                 progress: Any = None) -> tuple[Any, Any, dict[str, float]]:
@@ -361,6 +360,11 @@ class GLNatureView(NatureView):
                     self.clouds = CloudPTVolume(self.plotter, frame.clouds, scene.cloud_shading, scene.cloud_table)
                 else:
                     self.clouds.set_frame(frame.clouds)
+        if (self.layers or self.clouds is not None) and not self._single_sample:
+            # the float scene target and the volumes' targets are single-sample (gl_pt); a scene of terrain and sky
+            # alone keeps the window's multisampling, as the CPU backend does without an overlay
+            hold_single_sample(self.plotter, self)
+            self._single_sample = True
         stats["fog_prisms"] = float(sum(layer.drawn for layer in self.layers.values()))
         self._sort_layers(frame.eye)
         stats["upload_s"] = time.perf_counter() - t0
@@ -399,5 +403,7 @@ class GLNatureView(NatureView):
             self.clouds.remove()
             self.clouds = None
         self._terrain_worker.shutdown(wait=False)       # a frame in flight on it finishes on its own
-        release_single_sample(self.plotter, self)
+        if self._single_sample:
+            release_single_sample(self.plotter, self)
+            self._single_sample = False
         super().remove()
