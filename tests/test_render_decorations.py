@@ -58,3 +58,25 @@ def test_decorations_switch_off_and_follow_the_transfer_function():
         assert scalar_bar_actor(plotter).GetLookupTable().GetRange() == pytest.approx((0.0, 1e-6))
     finally:
         plotter.close()
+
+
+def test_scalar_bar_labels_a_symmetric_range_with_zero():
+    """A field of either sign (warping_spheres: -6.98328 .. 6.98321): the middle label is 0, not -3.3e-05 (VTK's own
+    labels printed "-3.34e-05", which ran off the right edge of a small window); the labels span the range; ranges
+    of one sign, or narrow and far from zero, keep their values."""
+    from volviz.render.decorations import label_values
+
+    assert label_values(-6.98, 6.98).tolist() == [-6.98, -3.49, 0.0, 3.49, 6.98]
+    assert label_values(-6.98328, 6.98321)[2] == 0.0
+    assert label_values(-1.0, 3.0).tolist() == [-1.0, 0.0, 1.0, 2.0, 3.0]
+    assert label_values(0.0, 1e-6).tolist() == pytest.approx([0.0, 2.5e-7, 5e-7, 7.5e-7, 1e-6])
+    assert label_values(1000.0, 1000.004).tolist() == pytest.approx([1000.0, 1000.001, 1000.002, 1000.003, 1000.004])
+    plotter, controller = _scene(data_file("series/warping_spheres.vtkhdf"))
+    try:
+        bar = scalar_bar_actor(plotter)
+        lo, hi = bar.GetLookupTable().GetRange()
+        assert lo < 0 < hi and bar.GetUseCustomLabels()
+        labels = [bar.GetCustomLabels().GetValue(i) for i in range(bar.GetCustomLabels().GetNumberOfTuples())]
+        assert labels[0] == lo and labels[-1] == hi and labels[2] == 0.0
+    finally:
+        plotter.close()

@@ -80,8 +80,18 @@ def update_legend(plotter: Any, session: Session, datasets: dict[str, Any]) -> N
         _add_scalar_bar(plotter, session, comp, _array_title(comp, datasets), _contrast(session.render.background))
 
 
+def label_values(lo: float, hi: float, count: int = 5) -> np.ndarray:
+    """The scalar bar's ``count`` evenly spaced label values from ``lo`` to ``hi``; a value within a thousandth of
+    the range of zero is written as 0 (below the labels' 3 significant digits, and a thousandth of the bar's height
+    from where it is drawn): the middle of a nearly symmetric range (-6.98328 .. 6.98321) is -3.3e-05, which VTK's
+    own labels print in full."""
+    values = np.linspace(float(lo), float(hi), int(count))
+    values[np.abs(values) < 1e-3 * abs(float(hi) - float(lo))] = 0.0
+    return values
+
+
 def _add_scalar_bar(plotter: Any, session: Session, comp: Any, title: str, color: tuple[float, float, float]) -> None:
-    from volviz.render.vtk_facade import vtk
+    from volviz.render.vtk_facade import numpy_to_vtk, vtk
 
     from volviz.optics import TransferFunction
     from volviz.render.vtk_tf import tf_to_vtk
@@ -91,7 +101,8 @@ def _add_scalar_bar(plotter: Any, session: Session, comp: Any, title: str, color
     ctf.ClampingOn()
     bar = vtk.vtkScalarBarActor()
     bar.SetLookupTable(ctf)
-    bar.SetNumberOfLabels(5)
+    bar.SetCustomLabels(numpy_to_vtk(label_values(*ctf.GetRange()), deep=True))
+    bar.UseCustomLabelsOn()
     bar.SetLabelFormat("%-#6.3g")
     bar.SetOrientationToVertical()          # at the right edge, as ParaView places it
     bar.SetPosition(0.84, 0.12)
