@@ -42,6 +42,23 @@ def test_time_series_interpolation() -> None:
     assert frame_at(series, 2.0).data.dtype == np.uint8  # exactly on a step: the step itself
 
 
+def test_a_moving_mesh_is_interpolated_in_its_positions_too() -> None:
+    """Steps of one topology whose points move (a deforming surface): between steps the points are blended as the
+    values are, in float64 (coordinates near 1e6 keep their precision); a step with other cells keeps the earlier
+    step's points (no blend across a remeshing)."""
+    from volviz.model.datasets import UnstructuredMesh
+
+    tri = [(5, np.array([[0, 1, 2]]))]
+    p0 = np.array([[1e6, 0.0, 0.0], [1e6 + 1.0, 0.0, 0.0], [1e6, 1.0, 0.0]])
+    steps = [UnstructuredMesh(p0 + [0.0, 0.0, z], tri, {"v": np.full(3, z, np.float32)}) for z in (0.0, 2.0)]
+    mid = frame_at(TimeSeries([0.0, 1.0], steps), 0.25)
+    assert mid.points.dtype == np.float64 and np.array_equal(mid.points, p0 + [0.0, 0.0, 0.5])
+    assert np.array_equal(mid.point_data["v"], np.full(3, 0.5, np.float32))
+    other = UnstructuredMesh(p0 + [0.0, 0.0, 2.0], [(5, np.array([[0, 2, 1]]))], {"v": np.full(3, 2.0, np.float32)})
+    kept = frame_at(TimeSeries([0.0, 1.0], [steps[0], other]), 0.25)
+    assert np.array_equal(kept.points, p0) and np.array_equal(kept.point_data["v"], np.full(3, 0.5, np.float32))
+
+
 def test_height_field_bilinear_height() -> None:
     from volviz.nature.heightfield import HeightField
 

@@ -213,3 +213,41 @@ def test_first_offscreen_image_of_a_pt_volume_sees_the_outline_box() -> None:
     rmse, worst = float(np.sqrt((d ** 2).mean())), float(np.abs(d).max())
     print(f"notch_disp.vtu GPU vs CPU: RMSE {rmse:.3f} max {worst:.0f}")
     assert rmse <= 0.5 and int((np.abs(d).max(axis=2) > 3).sum()) <= 2
+
+
+def test_a_time_series_of_surfaces_follows_the_display_time() -> None:
+    """A deforming surface over 100 steps (warping_spheres.vtkhdf, points and values change): a display-time change
+    gives the surface actor the frame at that time (it kept the first step: the timeline played a still picture), a
+    scene opened at a later display time shows that time, and between steps the points move with the values."""
+    from volviz.model.timeseries import frame_at
+    from volviz.render.export import close_scene, offscreen_scene, snapshot
+    from volviz.render.scene_builder import data_session, load_datasets
+
+    session = data_session(data_file("series/warping_spheres.vtkhdf"))
+    datasets = load_datasets(session, None)
+    series = datasets[session.components[0].dataset]
+    plotter, controller = offscreen_scene(session, datasets, (160, 120))
+    try:
+        controller.build()
+        assert controller.time_volumes() == ["data"]
+        start = snapshot(plotter, (160, 120)).astype(float)
+        controller.set_time(1.53)
+        later = snapshot(plotter, (160, 120)).astype(float)
+        shown = controller.views["data"].prop.GetMapper().GetInput()
+        expected = frame_at(series, 1.53)
+        assert shown.GetNumberOfPoints() == len(expected.points)
+        drawn = np.array([shown.GetPoint(i) for i in range(shown.GetNumberOfPoints())])
+        assert np.allclose(np.sort(drawn, axis=0), np.sort(expected.points, axis=0), atol=1e-5)
+        assert np.abs(later - start).mean() > 1.0
+        camera = controller.camera()
+    finally:
+        close_scene(plotter, controller)
+    session.render.options["time"] = 1.53
+    session.camera = camera                              # (framed on the first step's bounds, as above)
+    plotter, controller = offscreen_scene(session, datasets, (160, 120))
+    try:
+        controller.build()
+        opened_later = snapshot(plotter, (160, 120)).astype(float)
+    finally:
+        close_scene(plotter, controller)
+    assert np.array_equal(opened_later, later)

@@ -1,5 +1,6 @@
 """Continuous display time over a time series (the libMini note's 4D interpolation): the data between two steps is
-the linear blend of their point values, so playback is smooth at any display rate."""
+the linear blend of their point values (and of the point positions of a mesh that moves with one topology), so
+playback is smooth at any display rate."""
 from __future__ import annotations
 
 from dataclasses import replace
@@ -29,8 +30,22 @@ def _blend(a: np.ndarray, b: np.ndarray, w: float) -> np.ndarray:
     return ((1.0 - w) * a.astype(np.float32) + w * b.astype(np.float32)).astype(np.float32)
 
 
+def _moved_points(a: Any, b: Any, w: float) -> np.ndarray:
+    """The points between two steps of a mesh: blended (float64) when the steps share one topology (the same cells,
+    or the same grid) and the points moved, else the earlier step's."""
+    if a.points.shape != b.points.shape or np.array_equal(a.points, b.points):
+        return a.points
+    if isinstance(a, TetMesh) and not np.array_equal(a.tets, b.tets):
+        return a.points
+    if isinstance(a, UnstructuredMesh) and (len(a.cells) != len(b.cells) or any(
+            ta != tb or not np.array_equal(ca, cb) for (ta, ca), (tb, cb) in zip(a.cells, b.cells))):
+        return a.points
+    return (1.0 - w) * np.asarray(a.points, np.float64) + w * np.asarray(b.points, np.float64)
+
+
 def frame_at(series: TimeSeries, t: float, interpolate: bool = True) -> Any:
-    """The dataset shown at display time ``t``: the nearest earlier step, or the blend of its two neighbours."""
+    """The dataset shown at display time ``t``: the nearest earlier step, or the blend of its two neighbours (their
+    point values, and the point positions of a mesh that moves with one topology)."""
     i, j, w = bracket(series, t)
     if not interpolate or w == 0.0 or i == j:
         return series.frame(i)
@@ -38,10 +53,11 @@ def frame_at(series: TimeSeries, t: float, interpolate: bool = True) -> Any:
     if isinstance(a, RegularVolume):
         return replace(a, data=_blend(a.data, cast(RegularVolume, b).data, w))
     if isinstance(a, TetMesh):
-        return TetMesh(a.points, a.tets, _blend(a.scalars, cast(TetMesh, b).scalars, w), a.name, a.source)
+        tb = cast(TetMesh, b)
+        return TetMesh(_moved_points(a, tb, w), a.tets, _blend(a.scalars, tb.scalars, w), a.name, a.source)
     if isinstance(a, (CurvilinearGrid, UnstructuredMesh)):
         other = cast(Union[CurvilinearGrid, UnstructuredMesh], b)
         data = {name: _blend(arr, other.point_data[name], w) for name, arr in a.point_data.items()
                 if name in other.point_data}
-        return replace(a, point_data=data)
+        return replace(a, points=_moved_points(a, other, w), point_data=data)
     raise ValueError(f"cannot interpolate a time series of {a.kind}")

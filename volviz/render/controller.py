@@ -337,24 +337,36 @@ class SceneController:
             self.iso_overlay.update()
 
     def time_volumes(self) -> list[str]:
-        """The VTK volumes shown from a time series (what a display-time change re-blends)."""
+        """The VTK volumes and surfaces shown from a time series (what a display-time change re-blends)."""
+        from volviz.render.vtk_scene import is_surface
+
         views = self._views_of("vtk")
-        return [comp_id for comp_id in self.time_series() if comp_id in views and views[comp_id].prop.IsA("vtkVolume")]
+        series = self.time_series()
+        return [comp_id for comp_id in series if comp_id in views
+                and (views[comp_id].prop.IsA("vtkVolume") or (views[comp_id].prop.IsA("vtkActor")
+                                                              and is_surface(series[comp_id])))]
 
     def blend_volume(self, comp_id: str, t: float, interpolate: Optional[bool] = None, progress: Any = None) -> Any:
-        """Any thread: the VTK input of a time-series volume at display time ``t`` (the 4D blend of the neighbouring
-        steps when interpolating, libMini note "4D Visualization"); ``show_volumes`` puts it on screen."""
-        from volviz.render.scene_builder import prepared_volume_input
+        """Any thread: the VTK input of a time-series volume or surface at display time ``t`` (the 4D blend of the
+        neighbouring steps when interpolating, libMini note "4D Visualization"; ``scene_builder.time_input``);
+        ``show_volumes`` puts it on screen."""
+        from volviz.render.scene_builder import time_input
 
         interpolate = self.interpolate_time if interpolate is None else bool(interpolate)
-        return prepared_volume_input(self.time_series()[comp_id], float(t), interpolate)
+        return time_input(self.time_series()[comp_id], float(t), interpolate)
 
     def show_volumes(self, inputs: dict[str, Any]) -> None:
-        """GUI thread: give time-series volumes new inputs (``comp_id → blend_volume(...)``), cut by the clipping."""
+        """GUI thread: give time-series volumes and surfaces new inputs (``comp_id → blend_volume(...)``), cut by the
+        clipping; the outline box follows data that moves."""
+        changed = False
         for comp_id, data in inputs.items():
             view = self.views.get(comp_id)
             if view is not None and data is not None:
+                before = view.bounds()
                 view.set_input(data, self.clip)
+                changed = changed or view.bounds() != before
+        if changed:
+            self.decorate()
 
     def time_isosurfaces(self) -> list[str]:
         """The isosurface components shown from a time series (what a display-time change re-extracts)."""

@@ -297,7 +297,8 @@ def prepare_component(session: Session, comp: Component, datasets: dict[str, Any
         if clip.all_planes():
             prepared.cut[comp.id] = cut_tetmesh(mesh, clip)
     else:
-        prepared.parts[comp.id] = prepared_volume_input(dataset, t, interpolate)
+        prepared.parts[comp.id] = (time_input(dataset, dataset.times[0] if t is None else t, interpolate) if series
+                                   else prepared_volume_input(dataset))
 
 
 def pt_mesh(dataset: Any) -> Any:
@@ -343,15 +344,35 @@ def prepared_volume_input(dataset: Any, t: Optional[float] = None, interpolate: 
     return volume_input(dataset)
 
 
+def time_input(dataset: Any, t: float, interpolate: bool = True) -> Any:
+    """Any thread: what a VTK prop of a time series draws at display time ``t``: a volume's mapper input
+    (``prepared_volume_input``, blended) or a surface's (``vtk_scene.surface_input`` of the frame at ``t``: points
+    and values blended between steps of one topology); None for what does not follow the time (a 2D image)."""
+    from volviz.model import Image2D, TimeSeries
+    from volviz.model.timeseries import frame_at
+    from volviz.render.vtk_scene import is_surface, surface_input
+
+    first = dataset.frame(0) if isinstance(dataset, TimeSeries) else dataset
+    if isinstance(first, Image2D):
+        return None
+    if is_surface(first):
+        frame = frame_at(dataset, float(t), interpolate) if isinstance(dataset, TimeSeries) else dataset
+        return surface_input(frame)
+    return prepared_volume_input(dataset, t, interpolate)
+
+
 def add_volume_prop(plotter: Any, dataset: Any, data: Any, tf: Any, opacity: float, name: str,
                     backend: str = "auto") -> Any:
-    """GUI thread: a vtkVolume drawing ``data`` (from ``prepared_volume_input``; None: ``add_dataset`` instead);
+    """GUI thread: a vtkVolume drawing ``data`` (from ``prepared_volume_input``), the surface of a time series at
+    its display time (``data`` from ``time_input``), or (``data`` None) ``add_dataset``'s default visual;
     ``backend``: the render option (``volviz.render.backend``), which picks VTK's GPU or CPU ray caster."""
     from volviz.model import RegularVolume, TimeSeries
-    from volviz.render.vtk_scene import add_dataset, volume_prop
+    from volviz.render.vtk_scene import add_dataset, add_surface, is_surface, volume_prop
 
     if data is None:
         return add_dataset(plotter, dataset, tf=tf, opacity=opacity, name=name)
+    if is_surface(dataset):        # a time series' surface at the display time (``time_input``)
+        return add_surface(plotter, data, tf, opacity, name)
     regular = isinstance(dataset.frame(0) if isinstance(dataset, TimeSeries) else dataset, RegularVolume)
     return volume_prop(plotter, data, regular, tf, opacity, name, backend)
 

@@ -143,7 +143,7 @@ def add_dataset(plotter: Any, dataset: Any, tf: Any = None, opacity: float = 1.0
     if tf is None:
         tf = default_transfer_function_for(dataset)
     if is_surface(dataset):
-        return _add_surface(plotter, grid, tf, opacity, name)
+        return add_surface(plotter, grid, tf, opacity, name)
     return volume_prop(plotter, volume_input(dataset), isinstance(dataset, RegularVolume), tf, opacity, name)
 
 
@@ -183,16 +183,27 @@ def is_surface(dataset: Any) -> bool:
     return False
 
 
-def _add_surface(plotter: Any, grid: Any, tf: Any, opacity: float, name: Optional[str]) -> Any:
-    """A surface colored by its active scalars through the transfer function's colors; the cells touching NaN/Inf
-    (land in an ocean field, a solver's failed points) are left out."""
-    ctf, _ = tf_to_vtk(tf, 1.0)
-    ctf.ClampingOn()
+def surface_input(dataset: Any) -> Any:
+    """The PyVista surface drawn for a dataset of surface cells (``is_surface``; or its ``volume_grid``), its active
+    scalars kept active: the cells touching NaN/Inf (land in an ocean field, a solver's failed points) are left
+    out."""
+    grid = volume_grid(dataset)
+    name = grid.active_scalars_name
     values = np.asarray(grid.active_scalars)
     if values.dtype.kind == "f" and not np.isfinite(values).all():   # cells touching NaN/Inf are not drawn
         grid = grid.extract_points(np.flatnonzero(np.isfinite(values)), adjacent_cells=False)
     surface = grid.extract_surface(algorithm="dataset_surface") if hasattr(grid, "extract_surface") else grid
-    actor = plotter.add_mesh(surface, scalars=grid.active_scalars_name, opacity=opacity, name=name,
+    if name is not None and name in surface.array_names:
+        surface.set_active_scalars(name)
+    return surface
+
+
+def add_surface(plotter: Any, dataset: Any, tf: Any, opacity: float, name: Optional[str]) -> Any:
+    """A surface (``surface_input``) colored by its active scalars through the transfer function's colors."""
+    ctf, _ = tf_to_vtk(tf, 1.0)
+    ctf.ClampingOn()
+    surface = surface_input(dataset)
+    actor = plotter.add_mesh(surface, scalars=surface.active_scalars_name, opacity=opacity, name=name,
                              nan_opacity=0.0, show_scalar_bar=False, reset_camera=False, render=False)
     mapper = actor.GetMapper()
     mapper.SetLookupTable(ctf)
