@@ -87,6 +87,7 @@ def box_corners_polydata(bounds: np.ndarray, triangles: Sequence[tuple[int, int,
     pd.SetPoints(vp)
     tris = np.array([*triangles, (0, 7, 7)], np.int64).reshape(-1)
     cells = vtk.vtkCellArray()
-    cells.SetData(numpy_to_vtk(np.arange(0, len(tris) + 1, 3, dtype=np.int64), deep=True), numpy_to_vtk(tris, deep=True))
+    offsets = np.arange(0, len(tris) + 1, 3, dtype=np.int64)
+    cells.SetData(numpy_to_vtk(offsets, deep=True), numpy_to_vtk(tris, deep=True))
     pd.SetPolys(cells)
     return pd
