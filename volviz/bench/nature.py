@@ -77,8 +77,11 @@ NOTES = [
     "max 2.32. The GPU backend against the app's own full-resolution reference needs clouds 2, 100 with terrain "
     "9, 160 for RMSE <= 3 on every frame (docs/bench/nature_accurate.md: max 2.88 at 86,000 tetrahedra per frame; "
     "clouds 2, 50 gives 3.11 on frame 0, terrain 9, 100 with clouds 2, 100 gives 3.37).",
-    "GPU backend's CPU side at the setting that meets RMSE <= 3 (docs/bench/nature_accurate.md): ~0.05 s a frame "
-    "on 2 cores (0.095 s before this round). What brought it down, each measured along this path: the terrain and "
+    "GPU backend's CPU side at the setting that meets RMSE <= 3 (docs/bench/nature_accurate.md): ~0.043 s a frame "
+    "on 2 cores (0.095 s two rounds before). The buffer upload in it is timed inside the draw (each mapper's buffer "
+    "update, ~4 ms for terrain, prisms and clouds); it was the first draw minus a second one, two ~0.3 s llvmpipe "
+    "draws whose difference ranged 0-34 ms from frame to frame (and held llvmpipe's own first-use work). What "
+    "brought it down, each measured along this path: the terrain and "
     "cloud halves each get half the Numba threads (two threads that each launched kernels on every core "
     "oversubscribed the machine: LOD 0.07 -> 0.05 s); the terrain's fields side by side per grid point and the "
     "blend helpers inlined (morphing 20 -> 11 ms); morphing skips nodes whose box misses the frustum (terrain "
@@ -87,8 +90,8 @@ NOTES = [
     "instead of 208 per tetrahedron; VTK's index buffer for 12 indices per tetrahedron was most of the upload); "
     "32-bit triangle indices (VTK builds index buffers from 32-bit cells fastest); the fan emission and prism "
     "buffers on both cores once the clouds are done. Left: the terrain's C-LOD (refinement, morphing, fans over "
-    "~400,000 triangles) is the critical path, and VTK builds the terrain's and prisms' index buffers (~6-7 ns per "
-    "index) at every upload.",
+    "~400,000 triangles) is the critical path, and VTK builds the terrain's and prisms' index buffers (2-4 ns per "
+    "index, timed inside the draw) at every upload.",
     "Frame rate: everything is CPU work in Numba (terrain z-buffer and mip-mapped shading, per-pixel PCP prisms, "
     "per-pixel pre-integrated cloud tetrahedra) on 2 cores; the load average of the run is in the header (under "
     "load 3-6 the frame rate was 2-3 fps). The clouds (per pixel and leaf: ray/cube clip, <= 3 pieces, a trilinear "
@@ -205,6 +208,44 @@ def _split(scene: Any, cam: Any, size: tuple[int, int]) -> dict[str, float]:
     return out
 
 
+class _BufferUploadTimer:
+    """Seconds VTK spends building and uploading the buffers of the mappers it watches, per render: the time from a
+    mapper's ``EndEvent`` (its input is up to date) to its first ``UpdateShaderEvent`` (the draw begins), which is
+    ``vtkOpenGLPolyDataMapper``'s buffer update (index buffers from the cells, vertex buffers of changed arrays).
+    Measured on the CPU, without the driver's vertex work that follows."""
+
+    def __init__(self) -> None:
+        self.seconds = 0.0
+        self._watched: dict[int, Any] = {}
+        self._since: dict[int, float] = {}
+
+    def watch(self, mappers: list[Any]) -> None:
+        from volviz.render.vtk_facade import vtk
+
+        for mapper in mappers:
+            key = id(mapper)
+            if key in self._watched:
+                continue
+            self._watched[key] = mapper
+
+            def ended(*_: Any, key: int = key) -> None:
+                self._since[key] = time.perf_counter()
+
+            def drawing(*_: Any, key: int = key) -> None:
+                start = self._since.pop(key, None)
+                if start is not None:
+                    self.seconds += time.perf_counter() - start
+
+            mapper.AddObserver(vtk.vtkCommand.EndEvent, ended)
+            mapper.AddObserver(vtk.vtkCommand.UpdateShaderEvent, drawing)
+
+    def take(self) -> float:
+        """The seconds counted since the last ``take``."""
+        out, self.seconds = self.seconds, 0.0
+        self._since.clear()
+        return out
+
+
 class _GLFrames:
     """The GPU backend (``volviz.render.gl_nature.GLNatureView``) on the same frames: a window of the report's size
     for the frame rate and the image, and a 64x48 window, where llvmpipe's fill is negligible, for the CPU side
@@ -231,11 +272,26 @@ class _GLFrames:
         self.ref_plotter = bench_plotter(size)
         self.ref_plotter.camera_set = True
         self.ref_view = NatureView(self.ref_plotter, scene, filter_texture=True, full=True)
+        self._uploads = _BufferUploadTimer()
 
     def _render(self, index: int) -> float:
         t0 = time.perf_counter()
         render_window(self.plotters[index]).Render()
         return time.perf_counter() - t0
+
+    def _watch_small(self) -> None:
+        """The buffer-upload timer on the small window's terrain, prism and cloud mappers."""
+        view = self.views[1]
+        mappers = [layer.mapper for layer in view.layers.values()]
+        if view.terrain_actor is not None:
+            mapper = view.terrain_actor.GetMapper()
+            if mapper.IsA("vtkDataSetMapper"):             # PyVista's: the poly data mapper inside draws
+                mapper = mapper.GetPolyDataMapper()
+            if mapper is not None:
+                mappers.append(mapper)
+        if view.clouds is not None:
+            mappers.append(view.clouds.mapper)
+        self._uploads.watch(mappers)
 
     def _one_each(self) -> None:
         """Cut every prism layer to its first prism, the clouds to their first leaf and the terrain to its first
@@ -282,7 +338,7 @@ class _GLFrames:
     def frame(self, cam: Any) -> tuple[dict[str, float], np.ndarray]:
         """Medians over ``reps`` of one frame's parts (``gl_*`` keys) and the large window's image (RGB in [0, 1])."""
         parts: dict[str, list[float]] = {k: [] for k in ("lod", "upload", "render", "small_upload", "small_render",
-                                                         "small_same", "small_one")}
+                                                         "vbo_upload", "small_same", "small_one")}
         img = np.zeros(0)
         stats: dict[str, float] = {}
         for _ in range(self.reps):
@@ -297,7 +353,10 @@ class _GLFrames:
             parts["render"].append(self._render(0))
             parts["small_upload"].append(small.finish(request, *result)["upload_s"])
             self._prisms = result[1].prisms        # (geometry, PrismBuffers) by layer name
+            self._watch_small()
+            self._uploads.take()
             parts["small_render"].append(self._render(1))
+            parts["vbo_upload"].append(self._uploads.take())
             parts["small_same"].append(self._render(1))
             self._one_each()
             self._render(1)                        # the small index and vertex buffers built and uploaded
@@ -305,7 +364,7 @@ class _GLFrames:
         img = screenshot_rgb(self.plotters[0])
         med = {k: float(np.median(v)) for k, v in parts.items()}
         draw_work = max(med["small_same"] - med["small_one"], 0.0)
-        gl_upload = max(med["small_render"] - med["small_same"], 0.0)
+        gl_upload = med["vbo_upload"]
         out = {"gl_frame_s": med["lod"] + med["upload"] + med["render"],
                "gl_lod_s": med["lod"], "gl_upload_s": med["upload"], "gl_render_s": med["render"],
                "gl_cpu_side_s": med["lod"] + med["small_upload"] + gl_upload + med["small_one"],
@@ -615,8 +674,9 @@ def _write_report(out: Path, result: dict[str, Any], images: list[tuple[np.ndarr
             "frames, one LOD computation each (terrain C-LOD, cloud refinement and morphing, the prism and cloud "
             "vertex buffers: LOD s) handed to VTK (upload s) and drawn (render s) in a window of the image's size; "
             "fps = 1 / their sum. CPU side = the same frame's per-frame CPU cost drawn in a 64 x 48 window, where "
-            "fill is negligible: LOD s + handing the buffers to VTK + VTK's buffer upload (the first draw minus the "
-            "same draw again) + a draw submission (the draw with every prism layer cut to one prism, the clouds "
+            "fill is negligible: LOD s + handing the buffers to VTK + VTK's buffer upload (timed inside the first draw "
+            "of the new buffers: from each mapper's input update to its draw, i.e. VTK building index buffers and "
+            "uploading vertex buffers, without the driver's vertex work) + a draw submission (the draw with every prism layer cut to one prism, the clouds "
             "to one leaf (5 tetrahedra) and the terrain to one triangle: callbacks, uniforms, VTK's traversal, the "
             "driver's calls, the sky); llvmpipe's own vertex work for the prisms, tetrahedra and terrain triangles "
             "(the full draw minus the cut one), which a GPU takes off the CPU, is its own column. RMSE and max "
