@@ -441,3 +441,25 @@ def test_pt_volume_opacity_renders_in_the_background(qtbot, make_window) -> None
     assert volume.tf.extinction.max() == pytest.approx(
         0.3 * window.controller.transfer_function("demo").extinction.max())
     assert 0.0 < volume.image[..., 3].sum() < 0.9 * alpha
+
+
+def test_a_surface_time_series_plays_in_the_app(qtbot, make_window) -> None:
+    """A deforming surface (warping_spheres.vtkhdf) opened in the app: moving the timeline gives the surface the
+    frame at that time, blended in the background like a volume's, and the viewport changes (it showed the first
+    step whatever the time)."""
+    from volviz.model.timeseries import frame_at
+
+    window = make_window()
+    window.open_path(data_file("series/warping_spheres.vtkhdf"))
+    wait_loaded(qtbot, window)
+    actor = window.controller.props["data"]
+    series = window.controller.time_series()["data"]
+    window.plotter.render()
+    before = np.asarray(window.plotter.screenshot(None, return_img=True)).astype(float)
+    window.timeline.set_time(1.53)
+    qtbot.waitUntil(lambda: window.volume_time_shown == (1.53, True), timeout=30000)
+    shown = actor.GetMapper().GetInput()
+    assert shown.GetNumberOfPoints() == len(frame_at(series, 1.53).points)
+    window.plotter.render()
+    after = np.asarray(window.plotter.screenshot(None, return_img=True)).astype(float)
+    assert np.abs(after - before).mean() > 0.5
