@@ -294,9 +294,8 @@ class GLIsoSurfaces:
         if mode not in MODES:
             raise ValueError(f"unknown transparency mode {mode!r}; choose from {MODES}")
         self.mode = mode
-        shown = {"2pass": (_OVER,), "exact": (_OVER,), "3pass": (_ATTENUATE, _EMIT),
-                 "4pass": (_ATTENUATE, _BACK, _EMIT)}[mode]
-        shown = () if mode == "exact" else shown        # exact: the peeling layer's own actor
+        shown = {"2pass": (_OVER,), "exact": (),        # exact: the peeling layer's own actor, made below
+                 "3pass": (_ATTENUATE, _EMIT), "4pass": (_ATTENUATE, _BACK, _EMIT)}[mode]
         for kind, actor in self.actors.items():
             actor.SetVisibility(kind in (_OPAQUE, _PEEL) or kind in shown)
         ren = self.renderer
