@@ -366,7 +366,9 @@ class SceneController:
                 view.set_input(data, self.clip)
                 changed = changed or view.bounds() != before
         if changed:
-            self.decorate()
+            from volviz.render.decorations import update_outline
+
+            update_outline(self.plotter, self.session, self.shown_props())
 
     def time_isosurfaces(self) -> list[str]:
         """The isosurface components shown from a time series (what a display-time change re-extracts)."""

@@ -49,18 +49,8 @@ def apply_decorations(plotter: Any, session: Session, props: dict[str, Any], dat
     render options say (``props``: the components' props, whose bounds the outline draws; ``datasets``: the loaded
     datasets, whose shown array names the scalar bar). Safe to call again after any change: it replaces what it
     added before."""
-    plotter.remove_actor(OUTLINE_NAME, render=False)
+    update_outline(plotter, session, props)
     color = _contrast(session.render.background)
-    if decoration_enabled(session, "outline"):
-        from volviz.render.framing import scene_bounds
-
-        data = {k: p for k, p in props.items() if k != "nature"}   # a landscape needs no box around it
-        bounds = scene_bounds(data)
-        if bounds is not None:
-            import pyvista as pv
-
-            plotter.add_mesh(pv.Box(bounds).outline(), color=color, name=OUTLINE_NAME, pickable=False,
-                             reset_camera=False, render=False, line_width=1)
     axes = getattr(plotter.renderer, "axes_widget", None)
     if decoration_enabled(session, "axes"):
         if axes is None:
@@ -70,6 +60,21 @@ def apply_decorations(plotter: Any, session: Session, props: dict[str, Any], dat
     elif axes is not None:
         plotter.renderer.hide_axes()
     update_legend(plotter, session, datasets)
+
+
+def update_outline(plotter: Any, session: Session, props: dict[str, Any]) -> None:
+    """Redraw only the outline box around ``props`` (data that moved: the scalar bar and axes stay as they are)."""
+    plotter.remove_actor(OUTLINE_NAME, render=False)
+    if decoration_enabled(session, "outline"):
+        from volviz.render.framing import scene_bounds
+
+        data = {k: p for k, p in props.items() if k != "nature"}   # a landscape needs no box around it
+        bounds = scene_bounds(data)
+        if bounds is not None:
+            import pyvista as pv
+
+            plotter.add_mesh(pv.Box(bounds).outline(), color=_contrast(session.render.background),
+                             name=OUTLINE_NAME, pickable=False, reset_camera=False, render=False, line_width=1)
 
 
 def update_legend(plotter: Any, session: Session, datasets: dict[str, Any]) -> None:

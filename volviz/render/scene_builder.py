@@ -297,8 +297,7 @@ def prepare_component(session: Session, comp: Component, datasets: dict[str, Any
         if clip.all_planes():
             prepared.cut[comp.id] = cut_tetmesh(mesh, clip)
     else:
-        prepared.parts[comp.id] = (time_input(dataset, dataset.times[0] if t is None else t, interpolate) if series
-                                   else prepared_volume_input(dataset))
+        prepared.parts[comp.id] = time_input(dataset, t, interpolate) if series else prepared_volume_input(dataset)
 
 
 def pt_mesh(dataset: Any) -> Any:
@@ -344,21 +343,21 @@ def prepared_volume_input(dataset: Any, t: Optional[float] = None, interpolate: 
     return volume_input(dataset)
 
 
-def time_input(dataset: Any, t: float, interpolate: bool = True) -> Any:
-    """Any thread: what a VTK prop of a time series draws at display time ``t``: a volume's mapper input
-    (``prepared_volume_input``, blended) or a surface's (``vtk_scene.surface_input`` of the frame at ``t``: points
-    and values blended between steps of one topology); None for what does not follow the time (a 2D image)."""
-    from volviz.model import Image2D, TimeSeries
+def time_input(series: Any, t: Optional[float] = None, interpolate: bool = True) -> Any:
+    """Any thread: what a VTK prop of a time series draws at display time ``t`` (default: the first step): a
+    volume's mapper input (``prepared_volume_input``, blended) or a surface's (``vtk_scene.surface_input`` of the
+    frame at ``t``: points and values blended between steps of one topology); None for what does not follow the
+    time (a 2D image)."""
+    from volviz.model import Image2D
     from volviz.model.timeseries import frame_at
     from volviz.render.vtk_scene import is_surface, surface_input
 
-    first = dataset.frame(0) if isinstance(dataset, TimeSeries) else dataset
-    if isinstance(first, Image2D):
+    t = float(series.times[0] if t is None else t)
+    if isinstance(series.frame(0), Image2D):
         return None
-    if is_surface(first):
-        frame = frame_at(dataset, float(t), interpolate) if isinstance(dataset, TimeSeries) else dataset
-        return surface_input(frame)
-    return prepared_volume_input(dataset, t, interpolate)
+    if is_surface(series):
+        return surface_input(frame_at(series, t, interpolate))
+    return prepared_volume_input(series, t, interpolate)
 
 
 def add_volume_prop(plotter: Any, dataset: Any, data: Any, tf: Any, opacity: float, name: str,

@@ -143,7 +143,7 @@ def add_dataset(plotter: Any, dataset: Any, tf: Any = None, opacity: float = 1.0
     if tf is None:
         tf = default_transfer_function_for(dataset)
     if is_surface(dataset):
-        return add_surface(plotter, grid, tf, opacity, name)
+        return add_surface(plotter, surface_input(grid), tf, opacity, name)
     return volume_prop(plotter, volume_input(dataset), isinstance(dataset, RegularVolume), tf, opacity, name)
 
 
@@ -198,11 +198,10 @@ def surface_input(dataset: Any) -> Any:
     return surface
 
 
-def add_surface(plotter: Any, dataset: Any, tf: Any, opacity: float, name: Optional[str]) -> Any:
-    """A surface (``surface_input``) colored by its active scalars through the transfer function's colors."""
+def add_surface(plotter: Any, surface: Any, tf: Any, opacity: float, name: Optional[str]) -> Any:
+    """A surface made by ``surface_input``, colored by its active scalars through the transfer function's colors."""
     ctf, _ = tf_to_vtk(tf, 1.0)
     ctf.ClampingOn()
-    surface = surface_input(dataset)
     actor = plotter.add_mesh(surface, scalars=surface.active_scalars_name, opacity=opacity, name=name,
                              nan_opacity=0.0, show_scalar_bar=False, reset_camera=False, render=False)
     mapper = actor.GetMapper()
