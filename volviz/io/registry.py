@@ -50,7 +50,11 @@ class ReaderSpec:
     a ``"module:function"`` returning them (computed once, for readers whose list comes from a library).
     ``sniff``: ``f(first_bytes) -> bool`` (or ``"module:function"``) telling whether the content is this format.
     ``loader``: ``"module:function"`` taking ``(path, **options)`` and returning a ``volviz.model`` dataset.
-    ``folder_markers``: paths relative to a folder whose presence means this reader opens the folder itself.
+    ``folder_markers``: paths relative to a folder (or globs: any matching file) whose presence means this reader
+    opens the folder itself. ``sniffs_folders``: a folder also opens with this reader when one of its first few
+    files (by name) passes the sniffer (DICOM series: folders of files often without an extension).
+    ``reads_siblings``: the loader reads a file together with the files beside it that belong with it (the slices
+    of a DICOM series), so numbered files of this format are not grouped into a time series.
     ``select_options``: options that pick this reader whatever the file is called (``dims`` for raw volumes).
     ``sniff_opens``: False when the loader needs the file's extension, so a file recognised only by content is
     refused with a hint to rename it. ``claims_name``: False for extensions other formats share (``.dat``, ``.inp``):
@@ -67,6 +71,8 @@ class ReaderSpec:
     loader: str
     sniff: Union[Sniffer, str, None] = None
     folder_markers: tuple[str, ...] = ()
+    sniffs_folders: bool = False
+    reads_siblings: bool = False
     select_options: tuple[str, ...] = ()
     sniff_opens: bool = True
     claims_name: bool = True
@@ -79,7 +85,7 @@ class ReaderSpec:
 
     @property
     def opens_folders(self) -> bool:
-        return bool(self.folder_markers)
+        return bool(self.folder_markers) or self.sniffs_folders
 
     def globs(self) -> tuple[str, ...]:
         """The file-name patterns (resolved and cached on first use when given as ``"module:function"``)."""
@@ -101,10 +107,34 @@ class ReaderSpec:
         return bool(sniff(head))
 
     def opens_folder(self, folder: Path) -> bool:
-        return any((folder / marker).exists() for marker in self.folder_markers)
+        for marker in self.folder_markers:
+            found = (next(folder.glob(marker), None) is not None if any(c in marker for c in "*?[")
+                     else (folder / marker).exists())
+            if found:
+                return True
+        return self.sniffs_folders and any(self.accepts(_head_or_empty(f)) for f in _first_files(folder))
 
     def load_function(self) -> Callable[..., Any]:
         return _resolve(self.loader)
+
+
+FOLDER_SNIFF_FILES = 8  # files of a folder a ``sniffs_folders`` spec looks into
+
+
+def _first_files(folder: Path) -> list[Path]:
+    """The first regular files of ``folder`` by name (at most ``FOLDER_SNIFF_FILES``; hidden files skipped)."""
+    try:
+        names = sorted(e.name for e in os.scandir(folder) if not e.name.startswith(".") and e.is_file())
+    except OSError:
+        return []
+    return [folder / n for n in names[:FOLDER_SNIFF_FILES]]
+
+
+def _head_or_empty(path: Path) -> bytes:
+    try:
+        return read_bytes(path, HEAD_BYTES)
+    except ReadError:
+        return b""
 
 
 def _resolve(target: str) -> Callable[..., Any]:
@@ -262,8 +292,12 @@ def _folder_spec(p: Path) -> ReaderSpec:
         if spec.opens_folder(p):
             return spec
     folders = [s for s in reader_specs() if s.opens_folders]
-    known = "; ".join(f"{s.description} (holding {' or '.join(s.folder_markers)})" for s in folders)
+    known = "; ".join(f"{s.description} (holding {' or '.join(_folder_signs(s))})" for s in folders)
     raise ReadError(p, "is a directory, not a file" + (f", and not a folder volviz opens: {known}" if known else ""))
+
+
+def _folder_signs(spec: ReaderSpec) -> tuple[str, ...]:
+    return spec.folder_markers + ((f"{spec.description} files",) if spec.sniffs_folders else ())
 
 
 def _is_dir(path: PathLike) -> bool:

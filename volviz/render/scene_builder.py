@@ -28,8 +28,11 @@ MIN_SERIES_FILES = 3
 
 def series_pattern(path: str | os.PathLike) -> Optional[str]:
     """``Storm.pvm-t%02d`` for ``Storm.pvm-t01`` when at least three numbered siblings exist (opened as one time
-    series, as ParaView groups numbered files); None otherwise."""
+    series, as ParaView groups numbered files); None otherwise, and for folders and for files whose reader reads
+    them with their siblings (``ReaderSpec.reads_siblings``: the slices of a DICOM series)."""
     p = Path(path)
+    if not p.is_file() or _reads_siblings(p):
+        return None
     match = re.search(r"(\d+)(?!.*\d)", p.name)
     if match is None:
         return None
@@ -44,6 +47,16 @@ def series_pattern(path: str | os.PathLike) -> Optional[str]:
     widths = {len(rx.match(name).group(1)) for name in siblings}  # type: ignore[union-attr]
     number = f"%0{len(digits)}d" if len(widths) == 1 and digits.startswith("0") else "%d"
     return str(p.parent.resolve() / f"{head}{number}{tail}")
+
+
+def _reads_siblings(path: Path) -> bool:
+    from volviz.io import ReadError
+    from volviz.io.registry import spec_of
+
+    try:
+        return spec_of(path).reads_siblings
+    except ReadError:
+        return False
 
 
 def data_session(path: str | os.PathLike, q: Optional[str | os.PathLike] = None) -> Session:
