@@ -1,0 +1,133 @@
+"""NRRD (.nrrd, or a detached .nhdr header with its data file) through pynrrd: raw, text, gzip and bzip2 data.
+
+- Placement: ``space directions`` and ``space origin`` (else ``spacings``, else unit voxels) in the file's ``space``;
+  LPS and LAS files (what ITK, 3D Slicer and DICOM tools write) are turned into RAS, then
+  ``placement.aligned_volume`` aligns the grid.
+- An axis without a space direction (``none``) is not spatial: its ``kind`` ``time`` makes a ``TimeSeries`` (one
+  volume per sample); any other kind (vector, RGB-color, list ...) makes the components of one array.
+- The header is read first and the data size it claims is checked against the file before any data is read.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from volviz.io._checks import check_file, file_size, require_bytes
+from volviz.io.errors import PathLike, ReadError, human_bytes
+from volviz.io.metaimage import DEFLATE_MAX_RATIO
+from volviz.model import RegularVolume, TimeSeries
+
+from volviz_imaging.placement import LPS_TO_RAS, aligned_volume
+
+_TO_RAS = {"right-anterior-superior": np.eye(4), "ras": np.eye(4),
+           "left-anterior-superior": np.diag([-1.0, 1.0, 1.0, 1.0]), "las": np.diag([-1.0, 1.0, 1.0, 1.0]),
+           "left-posterior-superior": LPS_TO_RAS, "lps": LPS_TO_RAS}
+_COMPRESSED = {"gzip": DEFLATE_MAX_RATIO, "gz": DEFLATE_MAX_RATIO, "bzip2": 50_000, "bz2": 50_000}
+_TYPE_SIZES = {"int8": 1, "uint8": 1, "int16": 2, "uint16": 2, "int32": 4, "uint32": 4, "int64": 8, "uint64": 8,
+               "float": 4, "double": 8, "block": 1}
+
+
+def _header(p: Path) -> dict[str, Any]:
+    import nrrd
+
+    try:
+        with open(p, "rb") as fh:
+            return dict(nrrd.read_header(fh))
+    except (nrrd.NRRDError, ValueError, UnicodeDecodeError, KeyError, IndexError, TypeError) as exc:
+        raise ReadError(p, f"not a NRRD header pynrrd can read ({exc})") from None
+
+
+def _data_file(p: Path, header: dict[str, Any]) -> Path:
+    name = header.get("data file") or header.get("datafile")
+    if not name:
+        return p
+    if not isinstance(name, str) or " " in name.strip() or "%" in name or name.upper().startswith("LIST"):
+        raise ReadError(p, "its 'data file' is a list or pattern of files, which volviz does not read; use one file")
+    data = p.parent / name
+    if not data.is_file():
+        raise ReadError(p, f"its data file {name!r} is not beside it (looked for {data})")
+    return data
+
+
+def _check_size(p: Path, header: dict[str, Any]) -> None:
+    sizes = [int(n) for n in header.get("sizes", [])]
+    if not sizes or any(n < 1 for n in sizes):
+        raise ReadError(p, f"NRRD sizes {sizes} must all be positive")
+    item = _TYPE_SIZES.get(str(header.get("type", "")).replace("_t", ""), 8)
+    needed = int(np.prod(sizes, dtype=object)) * item
+    data = _data_file(p, header)
+    size = file_size(data)
+    what = f"NRRD {'x'.join(map(str, sizes))} {header.get('type')} data"
+    encoding = str(header.get("encoding", "raw")).lower()
+    if encoding in _COMPRESSED:
+        if needed > _COMPRESSED[encoding] * size + 64:
+            raise ReadError(p, f"{what} ({human_bytes(needed)}) is more than its {size} {encoding} bytes can "
+                               "inflate to: the header is wrong")
+    elif encoding == "raw" and data != p:
+        require_bytes(data, needed, size, what)
+
+
+def _affine(header: dict[str, Any], spatial: list[int]) -> np.ndarray:
+    affine = np.eye(4)
+    directions = header.get("space directions")
+    if directions is not None:
+        rows = np.asarray(directions, dtype=np.float64)
+        vectors = rows[spatial][:, :3]
+        affine[: vectors.shape[1], : len(spatial)] = vectors.T
+    else:
+        spacings = np.asarray(header.get("spacings", [1.0] * len(header["sizes"])), dtype=np.float64)
+        steps = np.where(np.isfinite(spacings[spatial]) & (spacings[spatial] > 0), spacings[spatial], 1.0)
+        affine[:3, :3] = np.diag(steps)
+    origin = header.get("space origin")
+    if origin is not None:
+        origin = np.asarray(origin, dtype=np.float64)
+        if np.all(np.isfinite(origin)):
+            affine[: len(origin), 3] = origin[:3]
+    space = str(header.get("space", "")).lower().removesuffix("-time")
+    return _TO_RAS.get(space, np.eye(4)) @ affine
+
+
+def _axes(p: Path, header: dict[str, Any]) -> tuple[list[int], int | None, str]:
+    """(the spatial axes, the non-spatial axis or None, its kind)."""
+    sizes = [int(n) for n in header["sizes"]]
+    directions = header.get("space directions")
+    kinds = [str(k).lower() for k in header.get("kinds", ["domain"] * len(sizes))]
+    if directions is not None:
+        rows = np.asarray(directions, dtype=np.float64)
+        spatial = [i for i in range(len(sizes)) if np.all(np.isfinite(rows[i]))]
+    else:
+        spatial = [i for i in range(len(sizes)) if kinds[i] in ("domain", "space", "time") or len(sizes) <= 3]
+        spatial = spatial[:3]
+    other = [i for i in range(len(sizes)) if i not in spatial]
+    if len(spatial) > 3 or len(other) > 1 or (len(spatial) < 2 and len(sizes) > 1):
+        raise ReadError(p, f"a NRRD of {len(sizes)} axes ({', '.join(kinds)}): volviz reads 2 or 3 space axes with "
+                           "at most one axis of components or time")
+    return spatial, (other[0] if other else None), (kinds[other[0]] if other else "")
+
+
+def read_nrrd(path: PathLike, allow_nonfinite: bool = True) -> RegularVolume | TimeSeries:
+    """A NRRD file as a volume, with its non-spatial axis as components or time steps (see the module)."""
+    import nrrd
+
+    p = check_file(path)
+    header = _header(p)
+    _check_size(p, header)
+    spatial, other, kind = _axes(p, header)
+    try:
+        data, _ = nrrd.read(str(p), index_order="F")
+    except (nrrd.NRRDError, ValueError, OSError, EOFError, TypeError) as exc:
+        raise ReadError(p, f"its data could not be read ({exc})") from None
+    order = spatial + ([other] if other is not None else [])
+    data = np.transpose(data, order)
+    while data.ndim < (4 if other is not None else 3):  # a 2D image: one slice
+        data = np.expand_dims(data, len(spatial))
+        spatial = spatial + [-1]
+    affine = _affine(header, [a for a in spatial if a >= 0])
+    name = Path(p).name.rsplit(".", 1)[0]
+    if other is not None and kind == "time":
+        frames: list[Any] = [aligned_volume(p, data[..., t], affine, name, allow_nonfinite=allow_nonfinite,
+                                            warn=t == 0) for t in range(data.shape[-1])]
+        return TimeSeries(np.arange(len(frames), dtype=np.float64), frames, source=str(p))
+    return aligned_volume(p, data, affine, name, allow_nonfinite=allow_nonfinite)

@@ -1,0 +1,385 @@
+"""The imaging plugin (plugins/volviz-imaging) through ``volviz.io.read``: NIfTI (also gzip, .hdr/.img pairs, 4D, 5D
+vectors), FreeSurfer MGH, NRRD (LPS space directions, gzip, detached headers, vector and time axes) and DICOM series,
+each file written here by the format's own library (nibabel, pynrrd, pydicom) with a known voxel-to-world transform
+that permutes and flips the axes. Every voxel volviz shows is checked against the file's voxel at the same RAS world
+point (the placement and the value scaling both); and bad files."""
+from __future__ import annotations
+
+import gzip
+import warnings
+from pathlib import Path
+
+import nibabel as nib
+import nrrd
+import numpy as np
+import pydicom
+import pytest
+from pydicom.dataset import FileMetaDataset
+from pydicom.uid import ExplicitVRLittleEndian, generate_uid
+
+import volviz.io as vio
+from volviz.io.errors import ReadError, ReadWarning
+from volviz.io.registry import spec_of
+from volviz.model import RegularVolume, TimeSeries
+from volviz.render.scene_builder import data_session, series_pattern
+
+# voxel (i, j, k) -> RAS: i along -y (0.5 mm), j along +z (2 mm), k along -x (3 mm): a permutation with two flips
+AFFINE = np.array([[0.0, 0.0, -3.0, 40.0],
+                   [-0.5, 0.0, 0.0, 12.0],
+                   [0.0, 2.0, 0.0, -7.0],
+                   [0.0, 0.0, 0.0, 1.0]])
+SHAPE = (6, 5, 4)
+
+
+def _stored(shape=SHAPE, seed=0) -> np.ndarray:
+    return np.random.default_rng(seed).integers(-300, 300, size=shape).astype(np.int16)
+
+
+def _assert_placed(volume: RegularVolume, values: np.ndarray, affine: np.ndarray) -> None:
+    """Every voxel of ``volume`` (origin + index x spacing in RAS) holds the file's voxel at that world point."""
+    assert isinstance(volume, RegularVolume)
+    assert sorted(volume.dimensions) == sorted(values.shape[:3])
+    inverse = np.linalg.inv(affine)
+    idx = np.indices(volume.dimensions).reshape(3, -1).T
+    world = np.asarray(volume.origin) + idx * np.asarray(volume.spacing)
+    voxel = world @ inverse[:3, :3].T + inverse[:3, 3]
+    np.testing.assert_allclose(voxel, np.rint(voxel), atol=1e-6)  # every shown point is a voxel of the file
+    ijk = np.rint(voxel).astype(int)
+    expected = values[ijk[:, 0], ijk[:, 1], ijk[:, 2]]
+    np.testing.assert_array_equal(volume.data.reshape(-1, *volume.data.shape[3:]), expected)
+
+
+# -- NIfTI / Analyze / MGH ---------------------------------------------------------------------------------------------
+def _nifti(path: Path, data: np.ndarray, affine=AFFINE, slope=None, inter=None, cls=nib.Nifti1Image) -> Path:
+    img = cls(data, affine)
+    if slope is not None:
+        img.header.set_slope_inter(slope, inter)
+    nib.save(img, str(path))
+    return path
+
+
+def test_nifti_voxels_are_placed_in_ras_through_the_files_scaling(tmp_path):
+    stored = _stored()
+    path = _nifti(tmp_path / "ct.nii", stored, slope=2.0, inter=-1024.0)
+    volume = vio.read(path)
+    assert spec_of(path).name == "nifti" and volume.name == "ct"
+    assert volume.spacing == (3.0, 0.5, 2.0) and volume.origin == (31.0, 9.5, -7.0)
+    _assert_placed(volume, stored * 2.0 - 1024.0, AFFINE)
+
+
+@pytest.mark.parametrize("name", ["ct.nii.gz", "ct.hdr", "ct.img"])
+def test_nifti_gzip_and_pairs_read_the_same_volume(tmp_path, name):
+    stored = _stored(seed=1)
+    target = tmp_path / name
+    _nifti(target if name != "ct.img" else tmp_path / "ct.hdr", stored, cls=nib.Nifti1Pair if "nii" not in name
+           else nib.Nifti1Image)
+    _assert_placed(vio.read(target), stored, AFFINE)
+
+
+def test_analyze_and_nifti2_and_mgh(tmp_path):
+    stored = _stored(seed=2)
+    for name, cls in (("a.hdr", nib.AnalyzeImage), ("b.nii", nib.Nifti2Image), ("c.mgz", nib.MGHImage)):
+        affine = AFFINE if cls is not nib.AnalyzeImage else np.diag([2.0, 3.0, 4.0, 1.0])
+        data = stored.astype(np.int32) if cls is nib.MGHImage else stored
+        path = _nifti(tmp_path / name, data, affine, cls=cls)
+        volume = vio.read(path)
+        written = nib.load(str(path))  # Analyze keeps only the voxel sizes and its own origin convention
+        _assert_placed(volume, stored, written.affine)
+
+
+def test_nifti_4d_is_a_time_series_in_seconds_read_step_by_step(tmp_path):
+    stored = _stored(SHAPE + (3,), seed=3)
+    img = nib.Nifti1Image(stored, AFFINE)
+    img.header.set_xyzt_units("mm", "msec")
+    img.header["pixdim"][4] = 2500.0
+    nib.save(img, str(tmp_path / "bold.nii.gz"))
+    series = vio.read(tmp_path / "bold.nii.gz")
+    assert isinstance(series, TimeSeries) and series.frames[1] is None  # later steps are read when shown
+    np.testing.assert_allclose(series.times, [0.0, 2.5, 5.0])
+    for t in range(3):
+        _assert_placed(series.frame(t), stored[..., t], AFFINE)
+    _assert_placed(vio.read(tmp_path / "bold.nii.gz", time_index=2), stored[..., 2], AFFINE)
+    with pytest.raises(ReadError, match="time_index 3 is out of range: the file has 3"):
+        vio.read(tmp_path / "bold.nii.gz", time_index=3)
+
+
+def test_nifti_5d_vectors_are_one_array_of_components(tmp_path):
+    stored = _stored(SHAPE + (1, 3), seed=4).astype(np.float32)
+    path = _nifti(tmp_path / "warp.nii", stored)
+    volume = vio.read(path)
+    assert list(volume.arrays) == ["warp"] and volume.arrays["warp"].shape[3] == 3
+    for c in range(3):
+        shown = RegularVolume(volume.arrays["warp"][..., c], volume.spacing, volume.origin)
+        _assert_placed(shown, stored[..., 0, c], AFFINE)
+    np.testing.assert_allclose(volume.data, np.linalg.norm(volume.arrays["warp"], axis=-1), rtol=1e-6)
+
+
+def test_an_oblique_scan_is_shown_on_its_nearest_axes_with_a_warning(tmp_path):
+    angle = np.radians(10.0)
+    rot = np.array([[np.cos(angle), -np.sin(angle), 0.0], [np.sin(angle), np.cos(angle), 0.0], [0.0, 0.0, 1.0]])
+    affine = np.eye(4)
+    affine[:3, :3] = rot @ np.diag([2.0, 2.0, 2.0])
+    path = _nifti(tmp_path / "oblique.nii", _stored(seed=5), affine)
+    with pytest.warns(ReadWarning, match=r"scanned obliquely \(10.0 degrees"):
+        volume = vio.read(path, isolate=False)
+    assert volume.spacing == pytest.approx((2.0, 2.0, 2.0))
+
+
+def test_bad_nifti_files_say_what_is_wrong(tmp_path):
+    good = _nifti(tmp_path / "good.nii", _stored())
+    cut = tmp_path / "cut.nii"
+    cut.write_bytes(good.read_bytes()[:500])
+    with pytest.raises(ReadError, match=r"cut.nii.*needs 240 bytes .* holds only .*truncated"):
+        vio.read(cut)
+    header = bytearray(good.read_bytes()[:352])
+    header[42:48] = np.array([30000, 30000, 30000], "<i2").tobytes()  # dim[1..3]: 54 GB of int16 claimed
+    bomb = tmp_path / "bomb.nii.gz"
+    bomb.write_bytes(gzip.compress(bytes(header) + b"\0" * 64))
+    with pytest.raises(ReadError, match="more than its .* compressed bytes can inflate to"):
+        vio.read(bomb)
+    _nifti(tmp_path / "pair.hdr", _stored(), cls=nib.Nifti1Pair)
+    (tmp_path / "pair.img").unlink()
+    with pytest.raises(ReadError, match=r"pair.hdr: its data file pair.img is not beside it"):
+        vio.read(tmp_path / "pair.hdr")
+    junk = tmp_path / "junk.nii"
+    junk.write_bytes(b"\x07" * 400)
+    with pytest.raises(ReadError, match="junk.nii"):
+        vio.read(junk)
+
+
+# -- NRRD --------------------------------------------------------------------------------------------------------------
+LPS = np.diag([-1.0, -1.0, 1.0, 1.0])
+
+
+def _nrrd_header(affine_lps: np.ndarray, **extra) -> dict:
+    return {"space": "left-posterior-superior", "space directions": affine_lps[:3, :3].T,
+            "space origin": affine_lps[:3, 3], **extra}
+
+
+@pytest.mark.parametrize("encoding", ["raw", "gzip"])
+def test_nrrd_in_lps_lands_where_the_same_nifti_does(tmp_path, encoding):
+    stored = _stored(seed=6)
+    affine_lps = LPS @ AFFINE   # the same voxels at the same world points, written in LPS
+    nrrd.write(str(tmp_path / "head.nrrd"), stored, _nrrd_header(affine_lps, encoding=encoding), index_order="F")
+    volume = vio.read(tmp_path / "head.nrrd")
+    _assert_placed(volume, stored, AFFINE)
+    same = vio.read(_nifti(tmp_path / "head.nii", stored))
+    assert (volume.origin, volume.spacing) == (same.origin, same.spacing)
+    np.testing.assert_array_equal(volume.data, same.data)
+
+
+def test_nrrd_detached_header_vector_and_time_axes(tmp_path):
+    stored = _stored(seed=7)
+    nrrd.write(str(tmp_path / "d.nhdr"), stored, _nrrd_header(LPS @ AFFINE), detached_header=True,
+               index_order="F")
+    _assert_placed(vio.read(tmp_path / "d.nhdr"), stored, AFFINE)
+
+    vectors = _stored((3,) + SHAPE, seed=8).astype(np.float32)
+    directions = np.vstack([np.full(3, np.nan), (LPS @ AFFINE)[:3, :3].T])
+    origin = (LPS @ AFFINE)[:3, 3]
+    nrrd.write(str(tmp_path / "v.nrrd"), vectors, {"space": "LPS", "space directions": directions,
+                                                  "space origin": origin,
+                                                  "kinds": ["vector", "domain", "domain", "domain"]},
+               index_order="F")
+    volume = vio.read(tmp_path / "v.nrrd")
+    assert volume.arrays[volume.name.split(":")[0]].shape[3] == 3
+    for c in range(3):
+        arr = next(iter(volume.arrays.values()))[..., c]
+        _assert_placed(RegularVolume(arr, volume.spacing, volume.origin), vectors[c], AFFINE)
+
+    steps = _stored(SHAPE + (2,), seed=9)
+    directions = np.vstack([(LPS @ AFFINE)[:3, :3].T, np.full(3, np.nan)])
+    nrrd.write(str(tmp_path / "t.nrrd"), steps, {"space": "LPS", "space directions": directions,
+                                                "space origin": origin,
+                                                "kinds": ["domain", "domain", "domain", "time"]}, index_order="F")
+    series = vio.read(tmp_path / "t.nrrd")
+    assert isinstance(series, TimeSeries) and len(series) == 2
+    for t in range(2):
+        _assert_placed(series.frame(t), steps[..., t], AFFINE)
+
+
+def test_bad_nrrd_files_say_what_is_wrong(tmp_path):
+    nrrd.write(str(tmp_path / "d.nhdr"), _stored(), _nrrd_header(LPS @ AFFINE, encoding="raw"),
+               detached_header=True, index_order="F")
+    data = next(p for p in tmp_path.iterdir() if p.suffix != ".nhdr")
+    data.write_bytes(data.read_bytes()[:100])
+    with pytest.raises(ReadError, match=r"needs 240 bytes .* holds only 100 bytes"):
+        vio.read(tmp_path / "d.nhdr")
+    data.unlink()
+    with pytest.raises(ReadError, match="its data file .* is not beside it"):
+        vio.read(tmp_path / "d.nhdr")
+    bad = tmp_path / "bad.nrrd"
+    bad.write_bytes(b"NRRD0004\ntype: short\ndimension: 3\nsizes: 4 4\nencoding: raw\n\n" + b"\0" * 64)
+    with pytest.raises(ReadError, match="bad.nrrd"):
+        vio.read(bad)
+
+
+# -- DICOM -------------------------------------------------------------------------------------------------------------
+def dicom_series(folder: Path, values: np.ndarray, iop, origin, spacing, gap, names, series_uid=None,
+                  slope=1.0, intercept=-1024.0, times=None, number=1, positions=None):
+    """``values`` (slices, rows, cols) stored as CT slices of one series: slice s at origin + (s mod ``positions``)
+    x gap x normal."""
+    folder.mkdir(exist_ok=True)
+    row, col = np.asarray(iop[:3], float), np.asarray(iop[3:], float)
+    normal = np.cross(row, col)
+    series_uid = series_uid or generate_uid()
+    for s, name in enumerate(names):
+        meta = FileMetaDataset()
+        meta.MediaStorageSOPClassUID = "1.2.840.10008.5.1.4.1.1.2"
+        meta.MediaStorageSOPInstanceUID = generate_uid()
+        meta.TransferSyntaxUID = ExplicitVRLittleEndian
+        ds = pydicom.Dataset()
+        ds.file_meta = meta
+        ds.SOPClassUID, ds.SOPInstanceUID = meta.MediaStorageSOPClassUID, meta.MediaStorageSOPInstanceUID
+        ds.SeriesInstanceUID, ds.SeriesNumber, ds.SeriesDescription = series_uid, number, f"series {number}"
+        ds.Modality = "CT"
+        ds.InstanceNumber = len(names) - s          # the reverse of the stacking order
+        ds.ImageOrientationPatient = [float(v) for v in iop]
+        place = s % (positions or len(names))
+        ds.ImagePositionPatient = [float(v) for v in np.asarray(origin) + place * gap * normal]
+        ds.PixelSpacing = [float(spacing[0]), float(spacing[1])]
+        ds.RescaleSlope, ds.RescaleIntercept = slope, intercept
+        if times is not None:
+            ds.TriggerTime = times[s]
+        ds.Rows, ds.Columns = values.shape[1:]
+        ds.SamplesPerPixel, ds.PhotometricInterpretation = 1, "MONOCHROME2"
+        ds.BitsAllocated, ds.BitsStored, ds.HighBit, ds.PixelRepresentation = 16, 16, 15, 1
+        ds.PixelData = values[s].astype("<i2").tobytes()
+        ds.save_as(folder / name, enforce_file_format=True)
+    return series_uid
+
+
+def _dicom_affine_ras(iop, origin, spacing, gap) -> np.ndarray:
+    """voxel (column, row, slice) -> RAS, from DICOM's definition (PS3.3 C.7.6.2.1.1) and LPS -> RAS."""
+    row, col = np.asarray(iop[:3], float), np.asarray(iop[3:], float)
+    affine = np.eye(4)
+    affine[:3, 0], affine[:3, 1] = row * spacing[1], col * spacing[0]
+    affine[:3, 2], affine[:3, 3] = np.cross(row, col) * gap, origin
+    return LPS @ affine
+
+
+SAGITTAL = (0.0, 1.0, 0.0, 0.0, 0.0, -1.0)   # along a row: +y (posterior); down a column: -z (inferior)
+
+
+def test_a_dicom_series_is_stacked_in_patient_space_in_hounsfield_units(tmp_path):
+    stored = _stored((5, 6, 4), seed=10)      # 5 slices of 6 rows x 4 columns
+    names = [f"IM{n:04d}.dcm" for n in (3, 1, 4, 0, 2)]  # file names in no order
+    dicom_series(tmp_path / "ct", stored, SAGITTAL, (10.0, -20.0, 30.0), (0.7, 0.6), 2.5, names)
+    expected = np.transpose(stored, (2, 1, 0)) * 1.0 - 1024.0   # (column, row, slice)
+    affine = _dicom_affine_ras(SAGITTAL, (10.0, -20.0, 30.0), (0.7, 0.6), 2.5)
+    for target in (tmp_path / "ct", tmp_path / "ct" / names[2]):  # the folder, or any one slice of it
+        volume = vio.read(target)
+        assert volume.name == "CT (HU)" and volume.dimensions == (5, 4, 6)
+        _assert_placed(volume, expected, affine)
+    assert series_pattern(tmp_path / "ct" / names[2]) is None      # numbered slices are not a time series
+    assert data_session(tmp_path / "ct" / names[2]).datasets[0].path.endswith(names[2])
+
+
+def test_a_dicom_folder_of_files_without_extension_and_with_two_series(tmp_path):
+    folder = tmp_path / "study"
+    small, large = _stored((2, 4, 4), seed=11), _stored((3, 4, 4), seed=12)
+    axial = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0)
+    dicom_series(folder, small, axial, (0, 0, 0), (1, 1), 1.0, ["1", "2"], number=1)
+    uid = dicom_series(folder, large, axial, (0, 0, 0), (1, 1), 1.0, ["3", "4", "5"], number=2)
+    assert spec_of(folder).name == "dicom"
+    with pytest.warns(ReadWarning, match="holds 2 series; showing series 2 'series 2' \\(3 files"):
+        volume = vio.read(folder, isolate=False)
+    _assert_placed(volume, np.transpose(large, (2, 1, 0)) - 1024.0, _dicom_affine_ras(axial, (0, 0, 0), (1, 1), 1))
+    assert vio.read(folder, series="1").dimensions == (4, 4, 2)
+    assert vio.read(folder, series=uid).dimensions == (4, 4, 3)
+    with pytest.raises(ReadError, match="no series 'nope'; the series here are: 1 'series 1' \\(2 files"):
+        vio.read(folder, series="nope")
+
+
+def test_a_dicom_series_repeating_each_position_is_a_time_series(tmp_path):
+    stored = _stored((3, 4, 4), seed=13)
+    phases = np.concatenate([stored, stored + 100])
+    axial = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0)
+    names = [f"f{n}.dcm" for n in range(6)]
+    dicom_series(tmp_path / "cine", phases, axial, (0, 0, 0), (1, 1), 2.0, names,
+                  times=[0.0, 0.0, 0.0, 40.0, 40.0, 40.0], positions=3)
+    series = vio.read(tmp_path / "cine")
+    assert isinstance(series, TimeSeries) and list(series.times) == [0.0, 40.0]
+    affine = _dicom_affine_ras(axial, (0, 0, 0), (1, 1), 2.0)
+    _assert_placed(series.frame(1), np.transpose(stored + 100, (2, 1, 0)) - 1024.0, affine)
+
+
+def test_uneven_dicom_slices_are_reported_and_bad_ones_named(tmp_path):
+    axial = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0)
+    folder = tmp_path / "uneven"
+    dicom_series(folder, _stored((3, 4, 4), seed=14), axial, (0, 0, 0), (1, 1), 1.0, ["a.dcm", "b.dcm", "c.dcm"])
+    moved = pydicom.dcmread(folder / "c.dcm")
+    moved.ImagePositionPatient = [0.0, 0.0, 5.0]
+    moved.save_as(folder / "c.dcm")
+    with pytest.warns(ReadWarning, match="not evenly spaced \\(gaps 1 to 4 mm\\)"):
+        vio.read(folder, isolate=False)
+    cut = pydicom.dcmread(folder / "b.dcm")
+    cut.PixelData = cut.PixelData[:10]
+    cut.save_as(folder / "b.dcm")
+    with pytest.raises(ReadError, match=r"b.dcm: its pixel data \(Explicit VR Little Endian\) could not be decoded"):
+        vio.read(folder)
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    (empty / "notes.dcm").write_text("not dicom")
+    with pytest.raises(ReadError, match="holds no DICOM image"):
+        vio.read(empty)
+
+
+def test_imaging_files_render_legibly_on_first_open(tmp_path):
+    """A NIfTI head opens with the default visual: an image that is not the bare background."""
+    from volviz.render.export import render_session
+
+    z, y, x = np.mgrid[-1:1:24j, -1:1:28j, -1:1:20j]
+    ball = (np.sqrt(x * x + y * y + z * z) < 0.8) * 800.0 + 40.0
+    path = _nifti(tmp_path / "ball.nii.gz", ball.astype(np.int16), np.diag([1.0, 1.2, 0.9, 1.0]))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ReadWarning)
+        img = np.asarray(render_session(data_session(path), None, (160, 120)))
+    background = img[0, 0].astype(int)
+    changed = np.abs(img[..., :3].astype(int) - background[:3]).max(axis=-1) > 24
+    assert 0.1 < changed.mean() < 0.9
+
+
+# -- malformed files: mutated copies read consistently or raise ReadError ----------------------------------------------
+def _fuzz_files(folder: Path) -> dict[str, Path]:
+    stored = _stored(seed=20)
+    files = {"nii": _nifti(folder / "f.nii", stored, slope=2.0, inter=1.0),
+             "nii.gz": _nifti(folder / "f.nii.gz", stored)}
+    nrrd.write(str(folder / "f.nrrd"), stored, _nrrd_header(LPS @ AFFINE, encoding="raw"), index_order="F")
+    nrrd.write(str(folder / "g.nrrd"), stored, _nrrd_header(LPS @ AFFINE, encoding="gzip"), index_order="F")
+    files.update({"nrrd": folder / "f.nrrd", "nrrd-gzip": folder / "g.nrrd"})
+    dicom_series(folder / "dcm", _stored((1, 6, 5), seed=21), (1.0, 0.0, 0.0, 0.0, 1.0, 0.0), (0, 0, 0), (1, 1),
+                 1.0, ["one.dcm"])
+    files["dcm"] = folder / "dcm" / "one.dcm"
+    return files
+
+
+@pytest.mark.parametrize("kind", ["nii", "nii.gz", "nrrd", "nrrd-gzip", "dcm"])
+def test_mutated_imaging_files_read_consistently_or_raise_read_error(tmp_path, kind):
+    """Bit flips (mostly in the header: its first 400 bytes) and truncations at 16 places of each format, through
+    the isolated reader: the same grid size, finite spacing and origin -- or a ReadError naming the file; a truncated
+    file is never read as a volume."""
+    import random
+
+    from volviz.bench import robustness as rb
+
+    path = _fuzz_files(tmp_path)[kind]
+    data = path.read_bytes()
+    original = rb.fingerprint_volviz(vio.read(path))
+    rng = random.Random(kind)
+    mutations = [rb.flip_bits(data, rng, min(400, len(data))) for _ in range(16)]
+    mutations += [rb.truncate(data, at) for at in sorted(rng.sample(range(1, len(data)), 16))]
+    outcomes = []
+    for mutation in mutations:
+        path.write_bytes(mutation.data)
+        try:
+            found = rb.fingerprint_volviz(vio.read(path))
+        except ReadError as exc:
+            assert str(path) in str(exc), f"{mutation.detail}: {exc}"
+            outcomes.append("refused")
+            continue
+        assert found["problem"] == "", f"{mutation.detail}: {found['problem']}"
+        assert found["n_points"] == original["n_points"], f"{mutation.detail}: another size was accepted"
+        assert mutation.kind != "truncate", f"{mutation.detail}: read although truncated"
+        outcomes.append("read")
+    assert outcomes.count("refused") >= 16  # every truncation at least
