@@ -160,9 +160,10 @@ class SessionFiles(WindowBase):
         return self.recent.files()
 
     def ask_file(self, title: str, name_filter: str, on_chosen: Any, save: bool = False,
-                 default_name: str = "", multiple: bool = False) -> QFileDialog:
+                 default_name: str = "", multiple: bool = False, folder: bool = False) -> QFileDialog:
         """A non-blocking file dialog (kept as ``self.file_dialog``) that starts in the folder used last;
-        ``on_chosen(path)`` runs when accepted."""
+        ``on_chosen(path)`` runs when accepted. ``folder``: it chooses a folder, and the next dialog starts in the
+        folder that holds it (among its siblings)."""
         dialog = QFileDialog(self, title, self.recent.last_folder(), name_filter)
         dialog.setOption(QFileDialog.Option.DontUseNativeDialog, True)
         if save:
@@ -179,12 +180,15 @@ class SessionFiles(WindowBase):
                     on_chosen(list(paths))
 
             dialog.filesSelected.connect(files_selected)
+        elif folder:
+            dialog.setFileMode(QFileDialog.FileMode.Directory)
+            dialog.setOption(QFileDialog.Option.ShowDirsOnly, True)
         else:
             dialog.setFileMode(QFileDialog.FileMode.ExistingFile)
 
         def file_selected(path: str) -> None:
             if path and not multiple:
-                self.recent.remember_folder(path)
+                self.recent.remember_folder(Path(path).parent if folder else path)
                 on_chosen(path)
 
         dialog.fileSelected.connect(file_selected)
@@ -195,6 +199,9 @@ class SessionFiles(WindowBase):
     def _ask_open_data(self) -> None:
         self.ask_file("Open data (a PLOT3D grid with its solution: select both)", _data_filter(), self.open_paths,
                       multiple=True)
+
+    def _ask_open_folder(self) -> None:
+        self.ask_file("Open a folder (a DICOM series, an OpenFOAM case)", "", self.open_path, folder=True)
 
     def _ask_open_session(self) -> None:
         self.ask_file("Open session", "volviz sessions (*.json);;All files (*)", self.open_path)

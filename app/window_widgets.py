@@ -81,6 +81,7 @@ class WindowWidgets(WindowBase):
         file_menu = self.menuBar().addMenu("&File")
         self.action_open_data = self._action(file_menu, "Open &Data…", QKeySequence.StandardKey.Open,
                                              self._ask_open_data)
+        self.action_open_folder = self._action(file_menu, "Open &Folder…", "Ctrl+Alt+O", self._ask_open_folder)
         self.action_open_session = self._action(file_menu, "Open &Session…", "Ctrl+Shift+O", self._ask_open_session)
         self.recent_menu = file_menu.addMenu("Open &Recent")
         self.action_save_session = self._action(file_menu, "&Save Session", QKeySequence.StandardKey.Save,

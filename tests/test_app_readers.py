@@ -231,3 +231,30 @@ def test_a_read_warning_reaches_the_status_bar_each_time_the_file_opens(qtbot, m
     window.open_path(data_file("volumes/neghip.slc"))
     wait_loaded(qtbot, window)
     assert window.status_label.text() == "Showing neghip.slc" and window.status_label.toolTip() == ""
+
+
+def test_a_dicom_series_opens_through_file_open_folder(qtbot, make_window, tmp_path) -> None:
+    """File > Open Folder… (a folder dialog) opens a folder of DICOM slices as one CT volume in Hounsfield units."""
+    from PySide6.QtWidgets import QFileDialog
+
+    from test_io_imaging import dicom_series
+
+    z, y, x = np.mgrid[-1:1:20j, -1:1:24j, -1:1:24j]
+    r = np.sqrt(x * x + y * y + z * z)
+    stored = np.where(r < 0.5, 2024, np.where(r < 0.8, 1064, 24)).astype(np.int16)   # bone in tissue in air
+    folder = tmp_path / "CT head"
+    dicom_series(folder, stored, (1.0, 0.0, 0.0, 0.0, 1.0, 0.0), (0.0, 0.0, 0.0), (0.8, 0.8), 1.0,
+                 [f"IM{n:04d}" for n in range(len(stored))])
+    window = small_window(make_window)
+    window.action_open_folder.trigger()
+    dialog = window.file_dialog
+    assert dialog.isVisible() and dialog.fileMode() == QFileDialog.FileMode.Directory
+    dialog.setDirectory(str(tmp_path))
+    dialog.selectFile(str(folder))
+    dialog.accept()
+    wait_loaded(qtbot, window)
+    assert window.error_dialog is None, window.error_dialog.text()
+    assert "CT head" in window.windowTitle()
+    assert drawn_as(window, "data") == "volume" and legend(window) == "CT (HU)"
+    assert window.datasets["data"].scalar_range() == (-1000.0, 1000.0)
+    assert data_share(window) > 0.02      # the bone ball (the auto transfer function hides air and tissue)
