@@ -1,4 +1,5 @@
-"""Ordinary raster images (PNG, JPEG, TIFF, BMP) -> Image2D (e.g. the sky/clouds.jpeg photo).
+"""Ordinary raster images (PNG, JPEG, TIFF, BMP) -> Image2D (e.g. the sky/clouds.jpeg photo); multi-page TIFF
+stacks (microscopy) -> a volume through ``volviz.io.tiffstack``.
 
 The header is read first (Pillow); images of more than ``MAX_PIXELS`` pixels are refused before decoding (a small
 compressed file can describe a gigantic image). PNG, TIFF and BMP are decoded by Pillow; JPEG by VTK's
@@ -11,19 +12,25 @@ from __future__ import annotations
 
 import numpy as np
 
-from volviz.io._checks import check_file, open_file
+from volviz.io._checks import check_file, open_file, read_bytes
 from volviz.io.errors import PathLike, ReadError
-from volviz.model import Image2D
+from volviz.io.tiffstack import is_tiff, read_tiff_stack
+from volviz.model import Image2D, RegularVolume, TimeSeries
 
 EXTENSIONS = (".png", ".jpg", ".jpeg", ".tif", ".tiff", ".bmp")
 MAX_PIXELS = 1 << 28
 
 
-def read_image(path: PathLike) -> Image2D:
-    """Read a PNG/JPEG/TIFF/BMP into Image2D: (rows, cols) grey or (rows, cols, 3|4) color, row 0 at the top."""
+def read_image(path: PathLike) -> Image2D | RegularVolume | TimeSeries:
+    """Read a PNG/JPEG/TIFF/BMP into Image2D: (rows, cols) grey or (rows, cols, 3|4) color, row 0 at the top; a
+    TIFF whose pages make a stack becomes a volume (``volviz.io.tiffstack``)."""
     from PIL import Image, UnidentifiedImageError
 
     check_file(path)
+    if is_tiff(read_bytes(path, 4)):
+        stack = read_tiff_stack(path)
+        if stack is not None:
+            return stack
     with open_file(path) as fh:
         try:
             with Image.open(fh) as im:

@@ -1,0 +1,188 @@
+"""Multi-page TIFF stacks (microscopy z-stacks: ImageJ hyperstacks, OME-TIFF, plain page sequences) -> a volume,
+through tifffile. ``volviz.io.image.read_image`` asks here first for every TIFF; a file whose pages do not make a
+stack (one page, an RGB photo) goes on to the 2D image path.
+
+- Axes, from tifffile's series: Y and X are the image; a depth axis (Z, else ImageJ's / tifffile's generic I or Q)
+  of more than one page makes the volume's z; channels (C) and samples (S: RGB) become the components of one array
+  (by magnitude or one channel in the array selector); a time axis (T) makes a ``TimeSeries``. Other axes of more
+  than one entry are refused with their names.
+- Voxel size: OME-XML's PhysicalSizeX/Y/Z; else the X/YResolution tags (pixels per unit) and ImageJ's ``spacing``
+  for z; 1 where the file says nothing. Sizes are in the file's unit (ImageJ's ``unit``, OME's
+  PhysicalSizeXUnit, e.g. micrometres); no conversion.
+- Orientation: x along the image's columns, y up the image (row 0, the top row, at the largest y, as the 2D image
+  is shown), z from the first page to the last.
+- Before pixels are read, the stack's size is checked against the file: an uncompressed stack must fit in it, a
+  compressed one must not claim more than ``MAX_RATIO`` times the file's bytes.
+"""
+from __future__ import annotations
+
+import contextlib
+import logging
+from typing import Any, Iterator
+
+import numpy as np
+
+from volviz.io._checks import check_finite, file_size
+from volviz.io.errors import PathLike, ReadError, human_bytes
+from volviz.model import RegularVolume, TimeSeries
+from volviz.model.arrays import default_array, scalar_of
+
+TIFF_MAGIC = (b"II*\x00", b"MM\x00*", b"II+\x00", b"MM\x00+")
+MAX_RATIO = 4096       # what LZW / deflate / packbits can inflate to, per byte of the file, with room
+_DEPTH = ("Z", "I", "Q")
+_COMPONENTS = ("C", "S")
+
+
+def is_tiff(head: bytes) -> bool:
+    return head[:4] in TIFF_MAGIC
+
+
+def _layout(path: PathLike, axes: str, shape: tuple[int, ...]) -> dict[str, int] | None:
+    """Where the time, depth and component axes are (-1: none), or None when the pages make no stack."""
+    sizes = dict(zip(axes, shape))
+    if "Y" not in sizes or "X" not in sizes:
+        return None
+    depth = [a for a in _DEPTH if sizes.get(a, 1) > 1]
+    if not depth:
+        return None
+    components = [a for a in _COMPONENTS if sizes.get(a, 1) > 1]
+    other = [a for a in axes if a not in "TYX" + "".join(_DEPTH + _COMPONENTS) and sizes[a] > 1]
+    if len(depth) > 1 or len(components) > 1 or other:
+        extra = depth[1:] + components[1:] + other
+        raise ReadError(path, f"a TIFF stack with axes {axes} {'x'.join(map(str, shape))}: volviz reads one depth "
+                              f"axis, one channel axis and a time axis; the axes {', '.join(extra)} are more")
+    return {"T": axes.find("T") if sizes.get("T", 1) > 1 else -1, "Z": axes.index(depth[0]),
+            "C": axes.index(components[0]) if components else -1}
+
+
+def _resolution(page: Any, tag: str) -> float | None:
+    """Microns (or the file's unit) per pixel from a resolution tag in pixels per unit."""
+    entry = page.tags.get(tag)
+    if entry is None:
+        return None
+    value = entry.value
+    try:
+        per_unit = value[0] / value[1] if isinstance(value, tuple) else float(value)
+    except (TypeError, ValueError, ZeroDivisionError):
+        return None
+    return 1.0 / per_unit if np.isfinite(per_unit) and per_unit > 0 else None
+
+
+def _positive(value: Any) -> float | None:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        return None
+    return v if np.isfinite(v) and v > 0 else None
+
+
+def _spacing(tif: Any) -> tuple[float, float, float]:
+    page = tif.pages[0]
+    sx, sy = _resolution(page, "XResolution"), _resolution(page, "YResolution")
+    sz = _positive((tif.imagej_metadata or {}).get("spacing")) if tif.is_imagej else None
+    if tif.is_ome:
+        import tifffile
+
+        try:
+            pixels = tifffile.xml2dict(tif.ome_metadata)["OME"]["Image"]
+            pixels = (pixels[0] if isinstance(pixels, list) else pixels)["Pixels"]
+            sx = _positive(pixels.get("PhysicalSizeX")) or sx
+            sy = _positive(pixels.get("PhysicalSizeY")) or sy
+            sz = _positive(pixels.get("PhysicalSizeZ")) or sz
+        except (KeyError, TypeError, IndexError, ValueError):
+            pass
+    return sx or 1.0, sy or sx or 1.0, sz or 1.0
+
+
+def _check_size(path: PathLike, series: Any, tif: Any) -> None:
+    needed = int(np.prod(series.shape, dtype=object)) * np.dtype(series.dtype).itemsize
+    size = file_size(path)
+    compressed = int(getattr(tif.pages[0], "compression", 1)) != 1
+    limit = MAX_RATIO * size if compressed else size
+    if needed > limit:
+        raise ReadError(path, f"its pages claim a {'x'.join(map(str, series.shape))} {series.dtype} stack "
+                              f"({human_bytes(needed)}), more than its {size} "
+                              f"{'compressed ' if compressed else ''}bytes can hold: the file is damaged")
+
+
+def _volume(path: PathLike, stack: np.ndarray, spacing: tuple[float, float, float], name: str,
+            allow_nonfinite: bool) -> RegularVolume:
+    """(z, y, x[, c]) pages, row 0 at the top -> a volume (x, y up, z[, c])."""
+    data = np.moveaxis(stack, (0, 1, 2), (2, 1, 0))[:, ::-1]
+    check_finite(path, data, allow_nonfinite)
+    if data.ndim == 3:
+        return RegularVolume(data, spacing=spacing, name=name, source=str(path))
+    volume = RegularVolume(np.zeros(data.shape[:3], np.uint8), spacing=spacing, name=name, source=str(path),
+                           arrays={name: data})
+    spec = default_array(volume)
+    assert spec is not None
+    volume.data, volume.name = scalar_of(volume.arrays, spec), spec
+    return volume
+
+
+class _Complaints(logging.Handler):
+    """What tifffile logs about a file while it reads it (an invalid page offset, corrupted ImageJ metadata)."""
+
+    def __init__(self) -> None:
+        super().__init__(logging.WARNING)
+        self.messages: list[str] = []
+
+    def emit(self, record: logging.LogRecord) -> None:
+        self.messages.append(record.getMessage())
+
+
+@contextlib.contextmanager
+def _complaints() -> Iterator[_Complaints]:
+    logger = logging.getLogger("tifffile")
+    handler, propagate = _Complaints(), logger.propagate
+    logger.addHandler(handler)
+    logger.propagate = False
+    try:
+        yield handler
+    finally:
+        logger.removeHandler(handler)
+        logger.propagate = propagate
+
+
+def read_tiff_stack(path: PathLike, allow_nonfinite: bool = True) -> RegularVolume | TimeSeries | None:
+    """The TIFF's stack as a volume (or a time series of them), or None when its pages make no stack. A file
+    tifffile finds damaged (it logs a warning: a page beyond the end, corrupted ImageJ metadata) is refused, whatever
+    its first page holds."""
+    import tifffile
+
+    with _complaints() as complaints:
+        result = _read(path, allow_nonfinite, tifffile)
+    if complaints.messages:
+        found = complaints.messages[0].split("> ", 1)[-1]
+        raise ReadError(path, f"is a damaged TIFF ({found}; {len(complaints.messages)} problem(s) found)")
+    return result
+
+
+def _read(path: PathLike, allow_nonfinite: bool, tifffile: Any) -> RegularVolume | TimeSeries | None:
+    try:
+        with tifffile.TiffFile(str(path)) as tif:
+            if not tif.series:
+                return None
+            series = tif.series[0]
+            layout = _layout(path, series.axes, tuple(series.shape))
+            if layout is None:
+                return None
+            _check_size(path, series, tif)
+            spacing = _spacing(tif)
+            interval = _positive((tif.imagej_metadata or {}).get("finterval")) if tif.is_imagej else None
+            data = series.asarray()
+    except ReadError:
+        raise
+    except (tifffile.TiffFileError, ValueError, OSError, EOFError, KeyError, IndexError, TypeError,
+            MemoryError) as exc:
+        raise ReadError(path, f"not a readable TIFF stack ({type(exc).__name__}: {str(exc)[:200]})") from None
+    axes = series.axes
+    order = [layout["T"]] if layout["T"] >= 0 else []
+    order += [layout["Z"], axes.index("Y"), axes.index("X")] + ([layout["C"]] if layout["C"] >= 0 else [])
+    rest = [i for i in range(data.ndim) if i not in order]       # axes of one entry
+    data = np.transpose(data, rest + order).reshape([data.shape[i] for i in order])
+    name = "intensity"
+    if layout["T"] < 0:
+        return _volume(path, data, spacing, name, allow_nonfinite)
+    frames: list[Any] = [_volume(path, data[t], spacing, name, allow_nonfinite) for t in range(len(data))]
+    return TimeSeries(np.arange(len(frames)) * (interval or 1.0), frames, source=str(path))
