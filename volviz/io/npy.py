@@ -1,0 +1,65 @@
+"""NumPy ``.npy`` arrays (what ``numpy.save`` writes), read by NumPy without pickles (``allow_pickle=False``).
+
+The array's index order is the volume's x, y, z, as ``pyvista.wrap`` takes a 3D array (``a[i, j, k]`` at
+``(i, j, k)``, unit spacing): a (nx, ny, nz) array is a volume; a 4D array whose last axis has 2 to 4 entries is a
+volume of vectors / channels (one array, by magnitude or component); any other 4D array is a time series along its
+first axis (t, x, y, z); a 2D array is an image (rows, columns). Numbers only: booleans become 0 / 1, complex and
+record arrays are refused. NumPy maps the data after reading the header, and refuses a file shorter than the header
+says.
+"""
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from volviz.io._checks import check_file, check_finite
+from volviz.io.errors import PathLike, ReadError
+from volviz.model import Image2D, RegularVolume, TimeSeries
+from volviz.model.arrays import default_array, scalar_of
+
+MAGIC = b"\x93NUMPY"
+
+
+def is_npy(head: bytes) -> bool:
+    return head.startswith(MAGIC)
+
+
+def _volume(path: PathLike, data: np.ndarray, name: str, allow_nonfinite: bool) -> RegularVolume:
+    check_finite(path, data, allow_nonfinite)
+    if data.ndim == 3:
+        return RegularVolume(data, name=name, source=str(path))
+    volume = RegularVolume(np.zeros(data.shape[:3], np.uint8), name=name, source=str(path), arrays={name: data})
+    spec = default_array(volume)
+    assert spec is not None
+    volume.data, volume.name = scalar_of(volume.arrays, spec), spec
+    return volume
+
+
+def read_npy(path: PathLike, allow_nonfinite: bool = True) -> RegularVolume | TimeSeries | Image2D:
+    """A ``.npy`` array as a volume, a volume of vectors, a time series or an image (see the module)."""
+    p = check_file(path)
+    try:  # reads the header only; the data is mapped, and a file shorter than its header says is refused here
+        data: Any = np.load(p, mmap_mode="r", allow_pickle=False)
+    except (ValueError, OSError, EOFError) as exc:
+        raise ReadError(p, f"not a NumPy .npy file NumPy can read, or shorter than its header says "
+                           f"({str(exc)[:200]})") from None
+    if not isinstance(data, np.ndarray):
+        raise ReadError(p, "is an .npz archive of several arrays, not one .npy array")
+    shape, dtype = data.shape, data.dtype
+    if dtype.hasobject or dtype.names is not None or dtype.kind not in "biuf":
+        raise ReadError(p, f"holds {dtype} values; volviz reads arrays of numbers (integers, floats, booleans)")
+    if len(shape) not in (2, 3, 4) or min(shape, default=0) < 1:
+        raise ReadError(p, f"holds an array of shape {shape}; volviz reads 2D images, 3D volumes, and 4D arrays "
+                           "(x, y, z, channels) or (time, x, y, z)")
+    data = np.asarray(data, dtype=np.uint8 if dtype.kind == "b" else None)
+    if not data.dtype.isnative:
+        data = data.astype(data.dtype.newbyteorder("="))
+    name = p.stem
+    if data.ndim == 2:
+        check_finite(p, data, allow_nonfinite)
+        return Image2D(np.ascontiguousarray(data), source=str(p))
+    if data.ndim == 3 or 2 <= data.shape[3] <= 4:
+        return _volume(p, np.ascontiguousarray(data), name, allow_nonfinite)
+    frames: list[Any] = [_volume(p, np.ascontiguousarray(data[t]), name, allow_nonfinite) for t in range(len(data))]
+    return TimeSeries(np.arange(len(frames), dtype=np.float64), frames, source=str(p))
