@@ -383,3 +383,31 @@ def test_mutated_imaging_files_read_consistently_or_raise_read_error(tmp_path, k
         assert mutation.kind != "truncate", f"{mutation.detail}: read although truncated"
         outcomes.append("read")
     assert outcomes.count("refused") >= 16  # every truncation at least
+
+
+# -- MRC / CCP4 --------------------------------------------------------------------------------------------------------
+def test_an_mrc_map_in_its_axis_order_is_laid_out_x_y_z_in_angstrom(tmp_path):
+    import mrcfile
+
+    sections = _stored((4, 5, 6), seed=30).astype(np.float32)        # (sections, rows, columns)
+    with mrcfile.new(tmp_path / "map.mrc") as mrc:
+        mrc.set_data(sections)
+        mrc.voxel_size = (1.5, 2.0, 2.5)
+        mrc.header.origin = (10.0, 20.0, 30.0)
+    volume = vio.read(tmp_path / "map.mrc")
+    assert volume.name == "density" and volume.spacing == (1.5, 2.0, 2.5) and volume.origin == (10.0, 20.0, 30.0)
+    np.testing.assert_array_equal(volume.data, np.transpose(sections, (2, 1, 0)))   # columns are x
+
+    with mrcfile.new(tmp_path / "ccp4.map") as mrc:   # a CCP4 map storing z in columns, x in rows, y in sections
+        mrc.set_data(sections)
+        mrc.header.mapc, mrc.header.mapr, mrc.header.maps = 3, 1, 2
+        mrc.header.nxstart, mrc.header.nystart, mrc.header.nzstart = 2, 0, 0
+        mrc.voxel_size = 1.0
+    volume = vio.read(tmp_path / "ccp4.map")
+    np.testing.assert_array_equal(volume.data, np.transpose(sections, (1, 0, 2)))  # rows x, sections y, columns z
+    assert volume.origin == (2.0, 0.0, 0.0)                       # the start indices times the voxel size
+
+    good = (tmp_path / "map.mrc").read_bytes()
+    (tmp_path / "cut.mrc").write_bytes(good[: len(good) - 40])
+    with pytest.raises(ReadError, match="cut.mrc: not an MRC / CCP4 map mrcfile can read"):
+        vio.read(tmp_path / "cut.mrc")

@@ -45,6 +45,11 @@ def is_mgh(head: bytes) -> bool:
     return version == 1 and all(d > 0 for d in dims) and dtype in (0, 1, 3, 4)
 
 
+def is_mrc(head: bytes) -> bool:
+    """An MRC2014 / CCP4 map: ``MAP `` at byte 208 (gzip-compressed or not)."""
+    return inflated_head(head)[208:212] == b"MAP "
+
+
 def is_nrrd(head: bytes) -> bool:
     return head.startswith(b"NRRD000")
 
@@ -75,6 +80,9 @@ SPECS: list[ReaderSpec] = [
           arrays="the voxel values; several frames as a time series", options=("time_index", "allow_nonfinite")),
     _spec("nrrd", "NRRD", ("*.nrrd", "*.nhdr"), "nrrd_files:read_nrrd", sniff=is_nrrd,
           arrays="the voxel values; a vector / color axis as components, a time axis as a time series",
+          options=("allow_nonfinite",)),
+    _spec("mrc", "MRC / CCP4 map", ("*.mrc", "*.mrcs", "*.map", "*.ccp4", "*.rec", "*.mrc.gz", "*.map.gz"),
+          "mrc:read_mrc", sniff=is_mrc, arrays="the density, in the map's axis order laid out x, y, z (Angstrom)",
           options=("allow_nonfinite",)),
     _spec("dicom", "DICOM series", ("*.dcm", "*.dicom", "*.ima"), "dicom:read_dicom", sniff=is_dicom,
           folder_markers=("DICOMDIR", "*.dcm", "*.DCM"), sniffs_folders=True,
