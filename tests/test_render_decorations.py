@@ -80,3 +80,35 @@ def test_scalar_bar_labels_a_symmetric_range_with_zero():
         assert labels[0] == lo and labels[-1] == hi and labels[2] == 0.0
     finally:
         plotter.close()
+
+
+def test_scalar_bar_labels_are_short_enough_for_a_small_export(tmp_path):
+    """Labels in fixed point with the decimals the label step needs ("-1000", not VTK's "-1.00e+03"), scientific
+    only where that is shorter; at 320 x 240 the labels of a CT range (-1000 .. 1000 HU) stay inside the image: its
+    last columns are background (with "%-#6.3g" the label "1.00e+03" ran over the right edge)."""
+    from volviz.render.decorations import label_format, label_values
+
+    def shown(lo, hi):
+        fmt = label_format(lo, hi)
+        return [fmt % v for v in label_values(lo, hi)]
+
+    assert shown(-1000.0, 1000.0) == ["-1000", "-500", "0", "500", "1000"]
+    assert shown(0.0, 1162.0) == ["0", "290", "581", "872", "1162"]
+    assert shown(-6.98, 6.98) == ["-7.0", "-3.5", "0.0", "3.5", "7.0"]
+    assert shown(0.0, 1.0) == ["0.00", "0.25", "0.50", "0.75", "1.00"]
+    assert shown(0.0, 1e-6) == ["0.00e+00", "2.50e-07", "5.00e-07", "7.50e-07", "1.00e-06"]
+    assert len(set(shown(1000.0, 1000.004))) == 5          # labels of a narrow range far from zero differ
+    assert shown(5.0, 5.0) == ["5"] * 5
+
+    ct = np.linspace(-1000.0, 1000.0, 16 * 16 * 16).reshape(16, 16, 16)
+    np.save(tmp_path / "ct.npy", ct)
+    plotter, controller = _scene(tmp_path / "ct.npy", axes=False, outline=False)
+    try:
+        assert scalar_bar_actor(plotter).GetLabelFormat() == "%.0f"
+        image = np.asarray(plotter.screenshot(None, return_img=True)).astype(int)
+        edge = image[:, -3:]
+        assert (np.abs(edge - image[0, 0]).sum(axis=-1) > 60).sum() == 0    # nothing drawn over the right edge
+        labels = image[:, int(0.86 * 320):]
+        assert (np.abs(labels - image[0, 0]).sum(axis=-1) > 60).mean() > 0.01   # the labels are drawn
+    finally:
+        plotter.close()

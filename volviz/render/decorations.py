@@ -95,6 +95,22 @@ def label_values(lo: float, hi: float, count: int = 5) -> np.ndarray:
     return values
 
 
+def label_format(lo: float, hi: float, count: int = 5) -> str:
+    """The printf format of the scalar bar's labels (``label_values``): fixed-point with the decimals that show the
+    label step to 2 significant digits ("-1000", "0.25"), or scientific notation with the digits that tell the labels
+    apart ("2.50e-07") when that is shorter. VTK's "%-#6.3g" printed "1.00e+03" for 1000, which ran off the right
+    edge of exports narrower than ~350 pixels, and "1.16e+03" for 1162."""
+    step = abs(float(hi) - float(lo)) / max(int(count) - 1, 1)
+    if not (np.isfinite(step) and step > 0):
+        return "%.3g"
+    values = label_values(lo, hi, count)
+    decimals = max(0, 1 - int(np.floor(np.log10(step))))
+    biggest = float(np.abs(values).max())
+    digits = min(max(2 + int(np.ceil(np.log10(max(biggest / step, 1.0)))), 3), 10)
+    candidates = [f"%.{decimals}f", f"%.{digits - 1}e"]
+    return min(candidates, key=lambda fmt: max(len(fmt % v) for v in values))
+
+
 def _add_scalar_bar(plotter: Any, session: Session, comp: Any, title: str, color: tuple[float, float, float]) -> None:
     from volviz.render.vtk_facade import numpy_to_vtk, vtk
 
@@ -108,7 +124,7 @@ def _add_scalar_bar(plotter: Any, session: Session, comp: Any, title: str, color
     bar.SetLookupTable(ctf)
     bar.SetCustomLabels(numpy_to_vtk(label_values(*ctf.GetRange()), deep=True))
     bar.UseCustomLabelsOn()
-    bar.SetLabelFormat("%-#6.3g")
+    bar.SetLabelFormat(label_format(*ctf.GetRange()))
     bar.SetOrientationToVertical()          # at the right edge, as ParaView places it
     bar.SetPosition(0.84, 0.12)
     bar.SetWidth(0.12)
