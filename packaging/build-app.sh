@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Build the one-folder app with PyInstaller (dist/volviz/volviz-app) and check that it starts and renders the demo
-# scene: the built app opens it under Xvfb, saves its window as PNG and quits; the PNG must show the scene.
+# scene, a VTK file and a NIfTI file: the built app opens each under Xvfb, saves its window as PNG and quits; the PNG
+# must show the scene.
 # Run after packaging/setup-debian.sh:  bash packaging/build-app.sh [DIST_DIR]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -15,8 +16,12 @@ echo "built $app ($(du -sh "$dist/volviz" | cut -f1))"
 .venv/bin/python -c "import pyvista as pv, numpy as np; g = pv.ImageData(dimensions=(24, 24, 24)); \
 x = np.linspace(-1, 1, 24); X, Y, Z = np.meshgrid(x, x, x, indexing='ij'); \
 g.point_data['density'] = np.exp(-4 * (X**2 + Y**2 + Z**2)).ravel(order='F'); g.save('$work/blob.vti')"
+# and the same blob as NIfTI (the volviz-imaging plugin: nibabel, found through its entry point)
+.venv/bin/python -c "import nibabel as nib, numpy as np; x = np.linspace(-1, 1, 24); \
+X, Y, Z = np.meshgrid(x, x, x, indexing='ij'); \
+nib.save(nib.Nifti1Image((1000 * np.exp(-4 * (X**2 + Y**2 + Z**2))).astype(np.int16), np.eye(4)), '$work/blob.nii.gz')"
 # the checks run from another folder, with no virtual environment on PATH: only what was packaged is used
-for target in demo "$work/blob.vti"; do
+for target in demo "$work/blob.vti" "$work/blob.nii.gz"; do
     (cd "$work" && env -u VIRTUAL_ENV PATH=/usr/bin:/bin xvfb-run -a -s "-screen 0 1280x900x24" \
         "$app" --screenshot "$work/check.png" $([ "$target" = demo ] || echo "$target"))
     .venv/bin/python - "$work/check.png" "$target" <<'PY'
