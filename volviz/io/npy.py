@@ -16,7 +16,7 @@ import numpy as np
 from volviz.io._checks import check_file, check_finite
 from volviz.io.errors import PathLike, ReadError
 from volviz.model import Image2D, RegularVolume, TimeSeries
-from volviz.model.arrays import default_array, scalar_of
+from volviz.model.arrays import volume_of
 
 MAGIC = b"\x93NUMPY"
 
@@ -27,13 +27,7 @@ def is_npy(head: bytes) -> bool:
 
 def _volume(path: PathLike, data: np.ndarray, name: str, allow_nonfinite: bool) -> RegularVolume:
     check_finite(path, data, allow_nonfinite)
-    if data.ndim == 3:
-        return RegularVolume(data, name=name, source=str(path))
-    volume = RegularVolume(np.zeros(data.shape[:3], np.uint8), name=name, source=str(path), arrays={name: data})
-    spec = default_array(volume)
-    assert spec is not None
-    volume.data, volume.name = scalar_of(volume.arrays, spec), spec
-    return volume
+    return volume_of(data, name, source=str(path))
 
 
 def read_npy(path: PathLike, allow_nonfinite: bool = True) -> RegularVolume | TimeSeries | Image2D:

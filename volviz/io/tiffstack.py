@@ -25,7 +25,7 @@ import numpy as np
 from volviz.io._checks import check_finite, file_size
 from volviz.io.errors import PathLike, ReadError, human_bytes
 from volviz.model import RegularVolume, TimeSeries
-from volviz.model.arrays import default_array, scalar_of
+from volviz.model.arrays import volume_of
 
 TIFF_MAGIC = (b"II*\x00", b"MM\x00*", b"II+\x00", b"MM\x00+")
 MAX_RATIO = 4096       # what LZW / deflate / packbits can inflate to, per byte of the file, with room
@@ -110,14 +110,7 @@ def _volume(path: PathLike, stack: np.ndarray, spacing: tuple[float, float, floa
     """(z, y, x[, c]) pages, row 0 at the top -> a volume (x, y up, z[, c])."""
     data = np.moveaxis(stack, (0, 1, 2), (2, 1, 0))[:, ::-1]
     check_finite(path, data, allow_nonfinite)
-    if data.ndim == 3:
-        return RegularVolume(data, spacing=spacing, name=name, source=str(path))
-    volume = RegularVolume(np.zeros(data.shape[:3], np.uint8), spacing=spacing, name=name, source=str(path),
-                           arrays={name: data})
-    spec = default_array(volume)
-    assert spec is not None
-    volume.data, volume.name = scalar_of(volume.arrays, spec), spec
-    return volume
+    return volume_of(data, name, spacing, source=str(path))
 
 
 class _Complaints(logging.Handler):

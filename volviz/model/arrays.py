@@ -159,6 +159,23 @@ def scalar_of(arrays: dict[str, np.ndarray], spec: str) -> np.ndarray:
     return _reduce(values, parsed, 1 if values.ndim == 3 else int(values.shape[3]), 3)
 
 
+def volume_of(data: np.ndarray, name: str, spacing: tuple[float, float, float] = (1.0, 1.0, 1.0),
+              origin: tuple[float, float, float] = (0.0, 0.0, 0.0), source: str = "") -> RegularVolume:
+    """A regular volume of one point array ``data`` named ``name``: (nx, ny, nz) values, or (nx, ny, nz, c) with
+    ``c`` > 1 components, then shown by its default array (``default_array``: the magnitude) and offered per
+    component by the array selector."""
+    if data.ndim == 4 and data.shape[3] == 1:
+        data = data[..., 0]
+    if data.ndim == 3:
+        return RegularVolume(data, spacing=spacing, origin=origin, name=name, source=source)
+    volume = RegularVolume(np.zeros(data.shape[:3], np.uint8), spacing=spacing, origin=origin, name=name,
+                           source=source, arrays={name: data})
+    spec = default_array(volume)
+    assert spec is not None  # the volume has an array
+    volume.data, volume.name = scalar_of(volume.arrays, spec), spec
+    return volume
+
+
 def _cell_to_point(dataset: Any, name: str, scalar: np.ndarray) -> np.ndarray:
     """A cell scalar averaged onto the points by VTK's cell-to-point filter (as ParaView shows cell data)."""
     grid = dataset.to_pyvista() if not isinstance(dataset, CurvilinearGrid) else CurvilinearGrid(

@@ -17,7 +17,7 @@ import numpy as np
 from volviz.io._checks import check_finite
 from volviz.io.errors import PathLike, ReadError, ReadWarning
 from volviz.model import RegularVolume
-from volviz.model.arrays import default_array, scalar_of
+from volviz.model.arrays import volume_of
 
 __all__ = ["LPS_TO_RAS", "aligned_volume", "lps_to_ras", "oblique_degrees"]
 
@@ -70,13 +70,4 @@ def aligned_volume(path: PathLike, data: np.ndarray, affine: np.ndarray, name: s
     if not data.dtype.isnative:
         data = data.astype(data.dtype.newbyteorder("="))
     check_finite(path, data, allow_nonfinite)
-    if data.ndim == 3:
-        return RegularVolume(data, spacing=spacing, origin=origin, name=name, source=str(path))
-    if data.shape[3] == 1:
-        return RegularVolume(data[..., 0], spacing=spacing, origin=origin, name=name, source=str(path))
-    volume = RegularVolume(np.zeros(data.shape[:3], np.uint8), spacing=spacing, origin=origin, name=name,
-                           source=str(path), arrays={name: data})
-    spec = default_array(volume)
-    assert spec is not None
-    volume.data, volume.name = scalar_of(volume.arrays, spec), spec
-    return volume
+    return volume_of(data, name, spacing, origin, source=str(path))
