@@ -71,7 +71,12 @@ def _read_step(path: PathLike, step: int | None, allow_nonfinite: bool):
 
 
 def read_vtkhdf(path: PathLike, allow_nonfinite: bool = True):
-    """Read a VTKHDF file: a model dataset, or a TimeSeries (lazy frames) when the file is transient."""
+    """Read a VTKHDF file: a model dataset, or a TimeSeries (lazy frames) when the file is transient. An HDF5 file
+    without a /VTKHDF group (a .hdf of arrays) is read by ``volviz.io.hdf5arrays``."""
+    from volviz.io.hdf5arrays import has_vtkhdf_group, read_hdf5
+
+    if read_bytes(path, 8) == HDF5_SIGNATURE and not has_vtkhdf_group(path):
+        return read_hdf5(path, allow_nonfinite=allow_nonfinite)
     _kind, times = _inspect(path)
     if times is None:
         return _read_step(path, None, allow_nonfinite)

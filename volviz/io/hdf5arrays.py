@@ -1,0 +1,154 @@
+"""Plain HDF5 files (.h5, .hdf5, NeXus .nxs, ...) holding arrays: tomography reconstructions, simulation fields,
+ilastik and other lab tools' volumes, through h5py. A file with a ``/VTKHDF`` group is read by ``volviz.io.vtkhdf``.
+
+- Which array: ``dataset="/entry/data/data"`` (its path in the file); by default the largest numeric 3D or 4D
+  dataset, the others named in a warning (and every one in the error when none fits).
+- Layout: HDF5 stores arrays in C order, and volviz reads a (nz, ny, nx) dataset with x fastest, as XDMF describes
+  such arrays to ParaView and as image stacks (slice, row, column) are stored; a 4D dataset whose last axis has 2 to
+  4 entries is (z, y, x, channels), any other 4D one (t, z, y, x), a time series. A file with only 2D datasets
+  gives the largest as an image.
+- Voxel size: the dataset's ``element_size_um`` attribute (ilastik, z y x) or ``spacing`` / ``voxel_size`` (in
+  the dataset's axis order); 1 where it has none.
+- The dataset's storage is checked against the file before it is read (an uncompressed dataset must fit in the file,
+  a compressed one may not claim more than ``MAX_RATIO`` times its stored bytes). The HDF5 library is native code:
+  the reader runs isolated (``volviz.io.isolated``).
+"""
+from __future__ import annotations
+
+import warnings
+from typing import Any
+
+import numpy as np
+
+from volviz.io._checks import check_file, check_finite, file_size, read_bytes
+from volviz.io.errors import PathLike, ReadError, ReadWarning, human_bytes
+from volviz.model import Image2D, RegularVolume, TimeSeries
+from volviz.model.arrays import volume_of
+
+HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
+MAX_DATASETS = 10_000    # datasets of a file looked at
+MAX_RATIO = 1032         # what deflate can inflate to; other filters are held by the reader process's memory limit
+_SPACING_ATTRS = ("element_size_um", "spacing", "voxel_size")
+
+
+def has_vtkhdf_group(path: PathLike) -> bool:
+    import h5py
+
+    try:
+        with h5py.File(path, "r") as f:
+            return "VTKHDF" in f and isinstance(f["VTKHDF"], h5py.Group)
+    except (OSError, RuntimeError, ValueError, KeyError, TypeError):
+        return False
+
+
+def _arrays(f: Any) -> list[tuple[str, tuple[int, ...]]]:
+    """(path, shape) of every numeric dataset of 2 to 4 dimensions of more than one entry each."""
+    import h5py
+
+    found: list[tuple[str, tuple[int, ...]]] = []
+    seen = 0
+
+    def visit(name: str, obj: Any) -> None:
+        nonlocal seen
+        seen += 1
+        if seen > MAX_DATASETS or not isinstance(obj, h5py.Dataset):
+            return
+        shape = tuple(int(n) for n in obj.shape or ())
+        if 2 <= len(shape) <= 4 and min(shape) > 1 and obj.dtype.kind in "biuf" and obj.dtype.names is None:
+            found.append(("/" + name, shape))
+
+    f.visititems(visit)
+    return found
+
+
+def _describe(found: list[tuple[str, tuple[int, ...]]]) -> str:
+    shown = [f"{name} ({'x'.join(map(str, shape))})" for name, shape in found[:10]]
+    return ", ".join(shown) + (f" and {len(found) - 10} more" if len(found) > 10 else "")
+
+
+def _pick(path: PathLike, f: Any, dataset: str | None) -> str:
+    found = _arrays(f)
+    if dataset is not None:
+        name = "/" + dataset.lstrip("/")
+        if name not in f or not any(n == name for n, _ in found):
+            raise ReadError(path, f"has no numeric 2D to 4D dataset {name!r}; its arrays are: "
+                                  f"{_describe(found) or 'none'}")
+        return name
+    volumes = [item for item in found if len(item[1]) >= 3] or found
+    if not volumes:
+        raise ReadError(path, "holds no numeric dataset of 2 to 4 dimensions (an image, a volume, channels or time "
+                              "steps)")
+    chosen = max(volumes, key=lambda item: int(np.prod(item[1], dtype=object)))
+    others = [item for item in volumes if item != chosen]
+    if others:
+        warnings.warn(f"{path}: holds {len(volumes)} arrays; showing the largest, {_describe([chosen])}. Others: "
+                      f"{_describe(others)} (dataset=... picks one)", ReadWarning, stacklevel=4)
+    return chosen[0]
+
+
+def _check_storage(path: PathLike, ds: Any) -> None:
+    needed = int(np.prod(ds.shape, dtype=object)) * ds.dtype.itemsize
+    size = file_size(path)
+    limit = size if ds.compression is None and not ds.chunks else MAX_RATIO * size
+    if needed > limit:
+        raise ReadError(path, f"its dataset {ds.name} claims {'x'.join(map(str, ds.shape))} {ds.dtype} values "
+                              f"({human_bytes(needed)}), more than the file's {size} bytes can hold")
+
+
+def _spacing(path: PathLike, ds: Any) -> tuple[float, float, float]:
+    """(x, y, z) from the first voxel-size attribute in the dataset's (z, y, x) order; 1 where it has none."""
+    for key in _SPACING_ATTRS:
+        if key in ds.attrs:
+            try:
+                values = np.asarray(ds.attrs[key], dtype=np.float64).ravel()
+            except (TypeError, ValueError):
+                continue
+            if values.size >= 3 and np.all(np.isfinite(values[-3:])) and np.all(values[-3:] > 0):
+                sz, sy, sx = (float(v) for v in values[-3:])
+                return sx, sy, sz
+            warnings.warn(f"{path}: the {key} attribute of {ds.name} ({values.tolist()}) is not three positive "
+                          "sizes; unit voxels are used", ReadWarning, stacklevel=4)
+    return 1.0, 1.0, 1.0
+
+
+def _volume(path: PathLike, data: np.ndarray, spacing: tuple[float, float, float], name: str,
+            allow_nonfinite: bool) -> RegularVolume:
+    """(z, y, x[, c]) -> a volume (x, y, z[, c])."""
+    data = np.ascontiguousarray(np.moveaxis(data, (0, 1, 2), (2, 1, 0)))
+    if data.dtype.kind == "b":
+        data = data.astype(np.uint8)
+    check_finite(path, data, allow_nonfinite)
+    return volume_of(data, name, spacing, source=str(path))
+
+
+def read_hdf5(path: PathLike, dataset: str | None = None,
+              allow_nonfinite: bool = True) -> RegularVolume | TimeSeries | Image2D | Any:
+    """An HDF5 file's array as a volume, a time series or an image (see the module); VTKHDF files as VTK data."""
+    import h5py
+
+    p = check_file(path)
+    if read_bytes(p, 8) != HDF5_SIGNATURE:
+        raise ReadError(p, "not an HDF5 file (no HDF5 signature at its start)")
+    if has_vtkhdf_group(p) and dataset is None:
+        from volviz.io.vtkhdf import read_vtkhdf
+
+        return read_vtkhdf(p, allow_nonfinite)
+    try:
+        with h5py.File(p, "r") as f:
+            name = _pick(p, f, dataset)
+            ds = f[name]
+            _check_storage(p, ds)
+            spacing = _spacing(p, ds)
+            data = ds[()]
+    except ReadError:
+        raise
+    except (OSError, RuntimeError, KeyError, ValueError, TypeError, IndexError, MemoryError) as exc:
+        raise ReadError(p, f"the HDF5 library could not read it ({type(exc).__name__}: {str(exc)[:200]})") from None
+    label = name.rsplit("/", 1)[-1] or "data"
+    if data.ndim == 2:
+        check_finite(p, data, allow_nonfinite)
+        return Image2D(np.ascontiguousarray(data), source=str(p))
+    if data.ndim == 3 or 2 <= data.shape[3] <= 4:
+        return _volume(p, data, spacing, label, allow_nonfinite)
+    frames: list[Any] = [_volume(p, data[t], spacing, label, allow_nonfinite) for t in range(len(data))]
+    return TimeSeries(np.arange(len(frames), dtype=np.float64), frames, source=str(p))
