@@ -1,5 +1,5 @@
-"""NumPy ``.npy`` arrays through ``volviz.io.read`` (``volviz.io.npy``): the index order is x, y, z as pyvista.wrap
-takes it; channels, time series and images; and files that are not arrays of numbers."""
+"""NumPy ``.npy`` arrays through ``volviz.io.read`` (``volviz.io.npy``): read (z, y, x) like HDF5 arrays and TIFF
+stacks (x fastest, VTK's image layout); channels, time series and images; and files that are not arrays of numbers."""
 from __future__ import annotations
 
 import numpy as np
@@ -9,31 +9,33 @@ import volviz.io as vio
 from volviz.io.errors import ReadError
 from volviz.model import Image2D, RegularVolume, TimeSeries
 
-ARRAY = np.random.default_rng(0).normal(size=(5, 4, 3)).astype(np.float32)
+ARRAY = np.random.default_rng(0).normal(size=(5, 4, 3)).astype(np.float32)     # (z, y, x)
+SHOWN = np.transpose(ARRAY, (2, 1, 0))                                           # (x, y, z)
 
 
-def test_a_3d_array_is_a_volume_indexed_x_y_z_like_pyvista(tmp_path):
-    import pyvista as pv
+def test_a_3d_array_is_a_volume_read_z_y_x_as_an_hdf5_array_is(tmp_path):
+    import h5py
 
     np.save(tmp_path / "density.npy", ARRAY)
     volume = vio.read(tmp_path / "density.npy")
-    assert isinstance(volume, RegularVolume) and volume.name == "density" and volume.dimensions == (5, 4, 3)
-    np.testing.assert_array_equal(volume.data, ARRAY)
-    grid = pv.wrap(ARRAY)
-    assert tuple(grid.dimensions) == volume.dimensions       # the same layout as pyvista's
-    np.testing.assert_array_equal(np.asarray(grid.point_data[grid.array_names[0]]), ARRAY.ravel(order="F"))
+    assert isinstance(volume, RegularVolume) and volume.name == "density" and volume.dimensions == (3, 4, 5)
+    np.testing.assert_array_equal(volume.data, SHOWN)
+    assert volume.data[2, 1, 0] == ARRAY[0, 1, 2]          # a[k, j, i] at (i, j, k): x fastest in memory
+    with h5py.File(tmp_path / "density.h5", "w") as f:
+        f["density"] = ARRAY
+    np.testing.assert_array_equal(vio.read(tmp_path / "density.h5").data, volume.data)   # the same volume
 
 
 def test_channels_time_series_images_and_booleans(tmp_path):
     np.save(tmp_path / "v.npy", np.stack([ARRAY, -ARRAY, 2 * ARRAY], axis=-1))
     vectors = vio.read(tmp_path / "v.npy")
-    assert vectors.arrays["v"].shape == (5, 4, 3, 3)
-    np.testing.assert_allclose(vectors.data, np.sqrt(6.0) * np.abs(ARRAY), rtol=1e-6)
-    deep = np.concatenate([ARRAY, ARRAY], axis=2)               # z 6: a last axis too long for channels
+    assert vectors.arrays["v"].shape == (3, 4, 5, 3)
+    np.testing.assert_allclose(vectors.data, np.sqrt(6.0) * np.abs(SHOWN), rtol=1e-6)
+    deep = np.concatenate([ARRAY, ARRAY], axis=2)               # x 6: a last axis too long for channels
     np.save(tmp_path / "t.npy", np.stack([deep + t for t in range(3)]))
     series = vio.read(tmp_path / "t.npy")
     assert isinstance(series, TimeSeries) and len(series) == 3
-    np.testing.assert_array_equal(series.frame(2).data, deep + 2)
+    np.testing.assert_array_equal(series.frame(2).data, np.transpose(deep + 2, (2, 1, 0)))
     np.save(tmp_path / "i.npy", ARRAY[..., 0])
     assert isinstance(vio.read(tmp_path / "i.npy"), Image2D)
     np.save(tmp_path / "mask.npy", ARRAY > 0)

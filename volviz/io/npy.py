@@ -1,11 +1,11 @@
 """NumPy ``.npy`` arrays (what ``numpy.save`` writes), read by NumPy without pickles (``allow_pickle=False``).
 
-The array's index order is the volume's x, y, z, as ``pyvista.wrap`` takes a 3D array (``a[i, j, k]`` at
-``(i, j, k)``, unit spacing): a (nx, ny, nz) array is a volume; a 4D array whose last axis has 2 to 4 entries is a
-volume of vectors / channels (one array, by magnitude or component); any other 4D array is a time series along its
-first axis (t, x, y, z); a 2D array is an image (rows, columns). Numbers only: booleans become 0 / 1, complex and
-record arrays are refused. NumPy maps the data after reading the header, and refuses a file shorter than the header
-says.
+A 3D array is read (z, y, x), x fastest in memory, as every volviz reader of Python-made arrays reads them (HDF5,
+TIFF stacks) and as scikit-image, tifffile and napari index volumes (and as VTK lays out image data): ``a[k, j, i]``
+is at ``(i, j, k)``, unit spacing. A 4D array whose last axis has 2 to 4 entries is (z, y, x, channels), one array by
+magnitude or component; any other 4D array is (t, z, y, x), a time series; a 2D array is an image (rows, columns).
+Numbers only: booleans become 0 / 1, complex and record arrays are refused. NumPy maps the data after reading the
+header, and refuses a file shorter than the header says.
 """
 from __future__ import annotations
 
@@ -26,6 +26,8 @@ def is_npy(head: bytes) -> bool:
 
 
 def _volume(path: PathLike, data: np.ndarray, name: str, allow_nonfinite: bool) -> RegularVolume:
+    """(z, y, x[, c]) -> a volume (x, y, z[, c])."""
+    data = np.ascontiguousarray(np.moveaxis(data, (0, 1, 2), (2, 1, 0)))
     check_finite(path, data, allow_nonfinite)
     return volume_of(data, name, source=str(path))
 
@@ -44,8 +46,8 @@ def read_npy(path: PathLike, allow_nonfinite: bool = True) -> RegularVolume | Ti
     if dtype.hasobject or dtype.names is not None or dtype.kind not in "biuf":
         raise ReadError(p, f"holds {dtype} values; volviz reads arrays of numbers (integers, floats, booleans)")
     if len(shape) not in (2, 3, 4) or min(shape, default=0) < 1:
-        raise ReadError(p, f"holds an array of shape {shape}; volviz reads 2D images, 3D volumes, and 4D arrays "
-                           "(x, y, z, channels) or (time, x, y, z)")
+        raise ReadError(p, f"holds an array of shape {shape}; volviz reads 2D images, 3D volumes (z, y, x), and 4D "
+                           "arrays (z, y, x, channels) or (time, z, y, x)")
     data = np.asarray(data, dtype=np.uint8 if dtype.kind == "b" else None)
     if not data.dtype.isnative:
         data = data.astype(data.dtype.newbyteorder("="))
@@ -54,6 +56,6 @@ def read_npy(path: PathLike, allow_nonfinite: bool = True) -> RegularVolume | Ti
         check_finite(p, data, allow_nonfinite)
         return Image2D(np.ascontiguousarray(data), source=str(p))
     if data.ndim == 3 or 2 <= data.shape[3] <= 4:
-        return _volume(p, np.ascontiguousarray(data), name, allow_nonfinite)
-    frames: list[Any] = [_volume(p, np.ascontiguousarray(data[t]), name, allow_nonfinite) for t in range(len(data))]
+        return _volume(p, data, name, allow_nonfinite)
+    frames: list[Any] = [_volume(p, data[t], name, allow_nonfinite) for t in range(len(data))]
     return TimeSeries(np.arange(len(frames), dtype=np.float64), frames, source=str(p))

@@ -203,7 +203,7 @@ BUILTIN_READERS: list[ReaderSpec] = [
                "volviz.io.image:read_image", arrays="grey levels or RGB; TIFF stacks: a volume, channels as components",
                isolated=True),
     ReaderSpec("npy", "NumPy array", ("*.npy",), "volviz.io.npy:read_npy", sniff="volviz.io.npy:is_npy",
-               arrays="the array: (x, y, z) volume, (x, y, z, channels), (t, x, y, z) or a 2D image",
+               arrays="the array: (z, y, x) volume, (z, y, x, channels), (t, z, y, x) or a 2D image",
                options=("allow_nonfinite",)),
     ReaderSpec("raw", "Raw volume", (), "volviz.io.raw:read_raw", select_options=("dims",), listed=False,
                arrays="one scalar volume", options=("dims", "dtype", "byteorder", "header_bytes")),
