@@ -411,3 +411,105 @@ def test_an_mrc_map_in_its_axis_order_is_laid_out_x_y_z_in_angstrom(tmp_path):
     (tmp_path / "cut.mrc").write_bytes(good[: len(good) - 40])
     with pytest.raises(ReadError, match="cut.mrc: not an MRC / CCP4 map mrcfile can read"):
         vio.read(tmp_path / "cut.mrc")
+
+
+# -- OME-Zarr / Zarr ---------------------------------------------------------------------------------------------------
+def _ome_zarr(path, levels, axes, transforms, zarr_format=2):
+    """An OME-Zarr image written with zarr-python: one array per level, NGFF multiscales metadata (0.4 on Zarr v2,
+    0.5 under ``attributes.ome`` on Zarr v3)."""
+    import zarr
+
+    group = zarr.open_group(str(path), mode="w", zarr_format=zarr_format)
+    datasets = []
+    for i, (data, transform) in enumerate(zip(levels, transforms)):
+        array = group.create_array(str(i), shape=data.shape, dtype=data.dtype, chunks=tuple(max(1, n // 2)
+                                                                                        for n in data.shape))
+        array[:] = data
+        datasets.append({"path": str(i), "coordinateTransformations": transform})
+    multiscales = [{"version": "0.4" if zarr_format == 2 else "0.5", "axes": axes, "datasets": datasets}]
+    if zarr_format == 2:
+        group.attrs["multiscales"] = multiscales
+    else:
+        group.attrs["ome"] = {"version": "0.5", "multiscales": multiscales}
+    return path
+
+
+ZYX = [{"name": "z", "type": "space", "unit": "micrometer"}, {"name": "y", "type": "space", "unit": "micrometer"},
+       {"name": "x", "type": "space", "unit": "micrometer"}]
+
+
+@pytest.mark.parametrize("zarr_format", [2, 3])
+def test_an_ome_zarr_image_at_its_scale_and_translation(tmp_path, zarr_format):
+    stack = _stored((4, 6, 8), seed=40)                       # (z, y, x)
+    path = _ome_zarr(tmp_path / "cells.ome.zarr", [stack, stack[:, ::2, ::2]], ZYX,
+                     [[{"type": "scale", "scale": [2.0, 0.5, 0.25]}, {"type": "translation",
+                                                                    "translation": [10.0, 0.0, 5.0]}],
+                      [{"type": "scale", "scale": [2.0, 1.0, 0.5]}]], zarr_format)
+    assert spec_of(path).name == "zarr"
+    volume = vio.read(path)
+    assert volume.spacing == (0.25, 0.5, 2.0) and volume.origin == (5.0, 0.0, 10.0) and volume.name == "cells"
+    np.testing.assert_array_equal(volume.data, np.transpose(stack, (2, 1, 0)))
+    coarse = vio.read(path, level=1)
+    assert coarse.spacing == (0.5, 1.0, 2.0)
+    np.testing.assert_array_equal(coarse.data, np.transpose(stack[:, ::2, ::2], (2, 1, 0)))
+
+
+def test_the_finest_ome_zarr_level_that_fits_and_channels_over_time(tmp_path, monkeypatch):
+    from volviz_imaging import omezarr
+
+    stack = _stored((2, 3, 4, 6, 8), seed=41)                  # (t, c, z, y, x)
+    axes = [{"name": "t", "type": "time"}, {"name": "c", "type": "channel"}] + ZYX
+    path = _ome_zarr(tmp_path / "movie.ome.zarr", [stack, stack[..., ::2, ::2]], axes,
+                     [[{"type": "scale", "scale": [1.5, 1.0, 1.0, 1.0, 1.0]}],
+                      [{"type": "scale", "scale": [1.5, 1.0, 1.0, 2.0, 2.0]}]])
+    series = vio.read(path)
+    assert isinstance(series, TimeSeries) and list(series.times) == [0.0, 1.5]
+    frame = series.frame(1)
+    assert frame.arrays["movie"].shape == (8, 6, 4, 3)
+    np.testing.assert_array_equal(frame.arrays["movie"], np.transpose(stack[1], (3, 2, 1, 0)))
+    monkeypatch.setattr(omezarr, "MAX_VOXELS", 3 * 4 * 6 * 8 - 1)    # level 0 no longer fits one step
+    with pytest.warns(ReadWarning, match="showing level 1"):
+        smaller = vio.read(path, isolate=False)
+    assert smaller.frame(0).dimensions == (4, 3, 4)
+
+
+def test_a_plain_zarr_array_reads_z_y_x(tmp_path):
+    import zarr
+
+    stack = _stored((3, 4, 5), seed=42)
+    zarr.create_array(str(tmp_path / "plain.zarr"), data=stack)
+    volume = vio.read(tmp_path / "plain.zarr")
+    np.testing.assert_array_equal(volume.data, np.transpose(stack, (2, 1, 0)))
+
+
+def test_a_zarr_codec_that_would_unpickle_is_refused_before_anything_is_decoded(tmp_path):
+    """A Zarr v2 array may name any numcodecs codec; numcodecs' "pickle" would unpickle the chunk. The chunk here
+    would write a marker file when unpickled: it must not exist afterwards."""
+    import json
+    import pickle
+
+    class Marker:
+        def __reduce__(self):
+            return (Path.write_text, (tmp_path / "PWNED", "unpickled"))
+
+    folder = tmp_path / "evil.zarr"
+    folder.mkdir()
+    (folder / ".zarray").write_text(json.dumps({
+        "zarr_format": 2, "shape": [2, 2, 2], "chunks": [2, 2, 2], "dtype": "<f4", "fill_value": 0, "order": "C",
+        "compressor": None, "filters": [{"id": "pickle", "protocol": 5}], "dimension_separator": "."}))
+    (folder / "0.0.0").write_bytes(pickle.dumps(Marker()))
+    with pytest.raises(ReadError, match="evil.zarr: its Zarr array uses the codec\\(s\\) pickle, which volviz does "
+                                        "not run"):
+        vio.read(folder)
+    assert not (tmp_path / "PWNED").exists()
+
+
+def test_a_damaged_zarr_chunk_is_a_read_error(tmp_path):
+    import zarr
+
+    stack = _stored((4, 4, 4), seed=43).astype(np.float32)
+    zarr.create_array(str(tmp_path / "d.zarr"), data=stack, chunks=(2, 2, 2), zarr_format=2)
+    chunk = next(p for p in (tmp_path / "d.zarr").iterdir() if not p.name.startswith("."))
+    chunk.write_bytes(chunk.read_bytes()[:7])
+    with pytest.raises(ReadError, match="d.zarr: a chunk could not be read"):
+        vio.read(tmp_path / "d.zarr")
