@@ -70,7 +70,7 @@ def test_help_of_the_installed_command() -> None:
     (["render", "demo-volume", "-o", "x.gif"], "unknown image format .gif"),
     (["render", "demo-volume", "-o", "x.mp4"], "give --orbit, --time or --path"),
     (["render", "demo-volume", "-o", "x.png", "--orbit"], "a movie is written to"),
-    (["render", "demo-volume", "-o", "x.png", "--array", "T"], "--array and --q apply to data files"),
+    (["render", "demo-volume", "-o", "x.png", "--array", "T"], "--array, --q and --option apply to data files"),
     (["render", "missing.slc", "-o", "x.png"], "missing.slc: no such file"),
     (["render", "demo-volume", "-o", "x.png", "--bogus"], "unrecognized arguments: --bogus"),
     (["info", "missing.slc", "--array", ""], "--array"),
@@ -257,3 +257,27 @@ def test_image_sizes_beyond_what_renders_here_are_refused() -> None:
     for size in [(8193, 16), (0, 10), (2 ** 40, 2 ** 40)]:
         with pytest.raises(ExportError, match="cannot be rendered"):
             check_image_size(size)
+
+
+def test_reader_options_on_the_command_line(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """``--option KEY=VALUE`` reaches the file's reader (``info`` and ``render``; kept in a rendered session's
+    dataset); an option the reader does not take is a one-line usage error naming the ones it takes."""
+    import h5py
+
+    with h5py.File(tmp_path / "scan.h5", "w") as f:
+        f["big"] = np.arange(6 * 5 * 4, dtype=np.float32).reshape(6, 5, 4)
+        f["small"] = np.arange(8, dtype=np.float32).reshape(2, 2, 2)
+    assert main(["info", "--json", str(tmp_path / "scan.h5")]) == 0
+    assert json.loads(capsys.readouterr().out)["dimensions"] == [4, 5, 6]          # the largest by default
+    assert main(["info", "--json", str(tmp_path / "scan.h5"), "--option", "dataset=/small"]) == 0
+    assert json.loads(capsys.readouterr().out)["dimensions"] == [2, 2, 2]
+    assert main(["render", str(tmp_path / "scan.h5"), "--option", "dataset=small", "-o", str(tmp_path / "s.png"),
+                 "--size", "64x48"]) == 0
+    with Image.open(tmp_path / "s.png") as image:
+        assert image.size == (64, 48)
+    capsys.readouterr()
+    assert main(["info", str(tmp_path / "scan.h5"), "--option", "datset=small"]) == 2
+    assert ("--option: the hdf5 reader does not take option(s) datset; it takes dataset, allow_nonfinite"
+            in one_line_error(capsys))
+    assert main(["info", str(tmp_path / "scan.h5"), "--option", "nonsense"]) == 2
+    assert "'nonsense' is not KEY=VALUE (e.g. dataset=/entry/data/data)" in one_line_error(capsys)

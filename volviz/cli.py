@@ -45,10 +45,26 @@ def _array_spec(text: str) -> str:
         raise argparse.ArgumentTypeError(str(exc)) from None
 
 
+def _reader_option(text: str) -> tuple[str, Any]:
+    """``KEY=VALUE`` -> (key, value): an integer, a number, true / false, or the text."""
+    key, sep, value = text.partition("=")
+    if not sep or not key.strip().isidentifier():
+        raise argparse.ArgumentTypeError(f"{text!r} is not KEY=VALUE (e.g. dataset=/entry/data/data)")
+    for kind in (int, float):
+        try:
+            return key.strip(), kind(value)
+        except ValueError:
+            pass
+    return key.strip(), {"true": True, "false": False}.get(value.strip().lower(), value)
+
+
 def _data_options(command: argparse.ArgumentParser) -> None:
     command.add_argument("--array", type=_array_spec, metavar="NAME[:c]",
                          help="the array to show: NAME, NAME:0.. (one component) or NAME:magnitude")
     command.add_argument("--q", metavar="FILE", help="the PLOT3D solution (q) file of a PLOT3D grid file")
+    command.add_argument("--option", type=_reader_option, action="append", default=[], metavar="KEY=VALUE",
+                         help="an option of the file's reader (repeatable), e.g. dataset=/entry/data/data (HDF5), "
+                              "variable=V (MATLAB), series=3 (DICOM), level=0 (OME-Zarr), time_index=2")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -107,14 +123,17 @@ def build_parser() -> argparse.ArgumentParser:
 
 @contextmanager
 def _reading(path: str | os.PathLike, q: Optional[str]) -> Iterator[None]:
-    """Reading ``path`` (with the PLOT3D solution file ``q``) inside: a missing ``q`` is a usage error, and a solution
-    file given alone says what to do instead of failing to read."""
+    """Reading ``path`` (with the PLOT3D solution file ``q``) inside: a missing ``q`` and an option the reader does not
+    take are usage errors, and a solution file given alone says what to do instead of failing to read."""
     from volviz.io import ReadError
+    from volviz.io.registry import ReaderOptionError
 
     if q is not None and not Path(q).is_file():
         raise UsageError(f"--q {q}: no such file")
     try:
         yield
+    except ReaderOptionError as exc:
+        raise UsageError(f"--option: {exc}") from None
     except ReadError:
         hint = None if q else plot3d_solution_hint(path)
         if hint:
@@ -134,13 +153,14 @@ def plot3d_solution_hint(path: str | os.PathLike) -> Optional[str]:
     return (f"{p} is a PLOT3D solution (q) file: open its grid file and give this one with --q, e.g. {example}")
 
 
-def describe(path: str, array: Optional[str] = None, q: Optional[str] = None) -> dict[str, Any]:
+def describe(path: str, array: Optional[str] = None, q: Optional[str] = None,
+             reader_options: Optional[dict[str, Any]] = None) -> dict[str, Any]:
     """Kind, dimensions, counts, arrays (association, components, range, non-finite values), time steps and series
     membership of a data file (or the header of a .vvz compressed volume / .vvs compressed series)."""
     p = Path(path)
     if p.suffix.lower() in (".vvz", ".vvs"):
-        if array is not None or q is not None:
-            raise UsageError("--array and --q apply to data files, not to compressed volumes")
+        if array is not None or q is not None or reader_options:
+            raise UsageError("--array, --q and --option apply to data files, not to compressed volumes")
         if p.suffix.lower() == ".vvz":
             from volviz.regular.codec import info as vvz_info
 
@@ -154,7 +174,7 @@ def describe(path: str, array: Optional[str] = None, q: Optional[str] = None) ->
     from volviz.io import read
 
     with _reading(p, q):
-        options: dict[str, Any] = {"q": q} if q else {}
+        options: dict[str, Any] = {**(reader_options or {}), **({"q": q} if q else {})}
         dataset = read(p, **options)
     base = dataset.frame(0) if isinstance(dataset, TimeSeries) else dataset
     desc: dict[str, Any] = {"file": str(p), "kind": dataset.kind, "dimensions": list(dataset.dimensions),
@@ -252,7 +272,7 @@ def run(argv: Optional[Sequence[str]] = None) -> int:
     if args.command == "info":
         if args.file is None and not args.gl:
             raise UsageError("info needs a file, or --gl (see volviz info --help)")
-        desc = describe(args.file, args.array, args.q) if args.file is not None else {}
+        desc = describe(args.file, args.array, args.q, dict(args.option)) if args.file is not None else {}
         if args.gl:
             desc.update(describe_gl())
         if args.json:
@@ -301,12 +321,13 @@ def _render(args: argparse.Namespace) -> int:
                          f"{args.fps * args.duration:.0f} frames; at most {MAX_MOVIE_FRAMES}")
     target = Path(args.target)
     data_file = str(args.target) not in ("demo", "demo-volume") and not is_session_file(target)
-    if not data_file and (args.array is not None or args.q is not None):
-        raise UsageError("--array and --q apply to data files (a session names the array of each component)")
+    if not data_file and (args.array is not None or args.q is not None or args.option):
+        raise UsageError("--array, --q and --option apply to data files (a session names the array of each "
+                         "component and the options of each dataset)")
     if data_file and not target.exists():
         raise UsageError(f"{target}: no such file (give a session, a data file, 'demo' or 'demo-volume')")
     check_output(args.output, movie)
-    session, session_file = open_target(args.target, args.array, args.q)
+    session, session_file = open_target(args.target, args.array, args.q, dict(args.option))
     size = args.size or session.render.size
     check_image_size(size)
     datasets: dict[str, Any] = {}

@@ -390,7 +390,9 @@ def loader_call(kind: str, loader: str, options: dict) -> tuple[Callable[..., An
         opts.pop("allow_nonfinite")
     unknown = [k for k in opts if k not in params and not accepts_kwargs]
     if unknown:
-        raise ReaderOptionError(f"the {kind} reader does not take option(s) {', '.join(unknown)}")
+        taken = [name for name in list(params)[1:] if params[name].kind is not inspect.Parameter.VAR_KEYWORD]
+        raise ReaderOptionError(f"the {kind} reader does not take option(s) {', '.join(unknown)}; it takes "
+                                f"{', '.join(taken) or 'none'}")
     return f, opts
 
 

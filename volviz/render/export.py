@@ -189,11 +189,12 @@ def render_session(session: Session, session_file: Optional[str | os.PathLike], 
     return np.asarray(image)
 
 
-def open_target(target: str | os.PathLike, array: Optional[str] = None,
-                q: Optional[str | os.PathLike] = None) -> tuple[Session, Optional[Path]]:
+def open_target(target: str | os.PathLike, array: Optional[str] = None, q: Optional[str | os.PathLike] = None,
+                reader_options: Optional[dict[str, Any]] = None) -> tuple[Session, Optional[Path]]:
     """The session a command-line target names, and its file: ``demo``, ``demo-volume``, a session file, or a data
-    file shown with the array spec ``array`` (``volviz.model.arrays``) and the PLOT3D solution file ``q``. A member
-    of a numbered series opens the whole series at that member's time step (``data_session``)."""
+    file shown with the array spec ``array`` (``volviz.model.arrays``), the PLOT3D solution file ``q`` and the
+    options of its reader (``dataset=`` of an HDF5 file ...), kept in the session's dataset. A member of a numbered
+    series opens the whole series at that member's time step (``data_session``)."""
     from volviz.model.settings import array_key
     from volviz.render.scene_builder import data_session, demo_session, demo_volume_session
     from volviz.session import load
@@ -204,6 +205,7 @@ def open_target(target: str | os.PathLike, array: Optional[str] = None,
     if is_session_file(path):
         return load(path), path
     session = data_session(path, q)
+    session.datasets[0].options.update(reader_options or {})
     comp = session.components[0]
     if array is not None:
         comp.settings[array_key(comp.type)] = str(array)

@@ -315,7 +315,9 @@ class _Read:
             advice = answer.get("advice") if isinstance(answer.get("advice"), str) else None
             return ReadError(self.shown if path in (self.path, "") else path, problem, advice)
         if kind == "options":
-            return TypeError(str(answer.get("message")))
+            from volviz.io.registry import ReaderOptionError
+
+            return ReaderOptionError(str(answer.get("message")))
         if kind == "memory":
             return self.fail(f"{engine(self.spec)} needs more memory than the limit of {human_bytes(memory)} "
                              f"(VOLVIZ_READ_MEMORY): the file is damaged (a size that does not fit it) or too large")
