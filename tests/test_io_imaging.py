@@ -267,6 +267,13 @@ def test_a_dicom_series_is_stacked_in_patient_space_in_hounsfield_units(tmp_path
     dicom_series(tmp_path / "ct", stored, SAGITTAL, (10.0, -20.0, 30.0), (0.7, 0.6), 2.5, names)
     expected = np.transpose(stored, (2, 1, 0)) * 1.0 - 1024.0   # (column, row, slice)
     affine = _dicom_affine_ras(SAGITTAL, (10.0, -20.0, 30.0), (0.7, 0.6), 2.5)
+    with warnings.catch_warnings():  # nibabel's DICOM wrappers call themselves experimental; their affine is not
+        warnings.simplefilter("ignore")
+        from nibabel.nicom.dicomwrappers import wrapper_from_file
+
+        nib_lps = wrapper_from_file(str(tmp_path / "ct" / names[0])).affine      # voxel (row, column) -> LPS
+    in_plane = LPS @ affine                                        # this test's own reading of PS3.3 C.7.6.2.1.1
+    np.testing.assert_allclose(in_plane[:3, [1, 0, 3]], nib_lps[:3, [0, 1, 3]], atol=1e-9)
     for target in (tmp_path / "ct", tmp_path / "ct" / names[2]):  # the folder, or any one slice of it
         volume = vio.read(target)
         assert volume.name == "CT (HU)" and volume.dimensions == (5, 4, 6)
