@@ -277,7 +277,7 @@ def test_reader_options_on_the_command_line(tmp_path: Path, capsys: pytest.Captu
         assert image.size == (64, 48)
     capsys.readouterr()
     assert main(["info", str(tmp_path / "scan.h5"), "--option", "datset=small"]) == 2
-    assert ("--option: the hdf5 reader does not take option(s) datset; it takes dataset, allow_nonfinite"
+    assert ("--option: the hdf5 reader does not take option(s) datset; it takes dataset, order, allow_nonfinite"
             in one_line_error(capsys))
     assert main(["info", str(tmp_path / "scan.h5"), "--option", "nonsense"]) == 2
     assert "'nonsense' is not KEY=VALUE (e.g. dataset=/entry/data/data)" in one_line_error(capsys)

@@ -98,3 +98,10 @@ def test_damaged_and_empty_files(tmp_path):
         assert volume.dimensions == (40, 40, 40)
         outcomes.append("read")
     assert "refused" in outcomes
+
+
+def test_order_xyz_reads_a_fortran_style_dataset_and_its_spacing(tmp_path):
+    path = _file(tmp_path / "sim.h5", u=(STACK, {"spacing": [0.5, 1.0, 2.0]}, {}))
+    volume = vio.read(path, order="xyz")
+    assert volume.dimensions == (4, 5, 6) and volume.spacing == (0.5, 1.0, 2.0)
+    np.testing.assert_array_equal(volume.data, STACK)

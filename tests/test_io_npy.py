@@ -58,3 +58,18 @@ def test_files_that_are_not_arrays_of_numbers(tmp_path):
     np.save(tmp_path / "5d.npy", np.zeros((2, 2, 2, 2, 2)))
     with pytest.raises(ReadError, match=r"5d.npy: holds an array of shape \(2, 2, 2, 2, 2\)"):
         vio.read(tmp_path / "5d.npy")
+
+
+def test_order_xyz_reads_an_array_indexed_x_y_z(tmp_path):
+    """``order="xyz"``: a[i, j, k] at (i, j, k), as pyvista.wrap takes an array; an unknown order is refused."""
+    import pyvista as pv
+
+    np.save(tmp_path / "f.npy", ARRAY)
+    volume = vio.read(tmp_path / "f.npy", order="xyz")
+    assert volume.dimensions == (5, 4, 3)
+    np.testing.assert_array_equal(volume.data, ARRAY)
+    grid = pv.wrap(ARRAY)
+    assert tuple(grid.dimensions) == volume.dimensions
+    np.testing.assert_array_equal(np.asarray(grid.point_data[grid.array_names[0]]), volume.data.ravel(order="F"))
+    with pytest.raises(ReadError, match="f.npy: order='yxz' is not one of zyx, xyz"):
+        vio.read(tmp_path / "f.npy", order="yxz")

@@ -5,7 +5,8 @@ ilastik and other lab tools' volumes, through h5py. A file with a ``/VTKHDF`` gr
   dataset, the others named in a warning (and every one in the error when none fits).
 - Layout: HDF5 stores arrays in C order, and volviz reads a (nz, ny, nx) dataset with x fastest, as XDMF describes
   such arrays to ParaView and as image stacks (slice, row, column) are stored; a 4D dataset whose last axis has 2 to
-  4 entries is (z, y, x, channels), any other 4D one (t, z, y, x), a time series. A file with only 2D datasets
+  4 entries is (z, y, x, channels), any other 4D one (t, z, y, x), a time series (``order="xyz"``: x, y, z instead,
+  ``volviz.io.axis_order``). A file with only 2D datasets
   gives the largest as an image.
 - Voxel size: the dataset's ``element_size_um`` attribute (ilastik, z y x) or ``spacing`` / ``voxel_size`` (in
   the dataset's axis order); 1 where it has none.
@@ -21,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from volviz.io._checks import check_file, check_finite, file_size, read_bytes
+from volviz.io.axis_order import check_order, to_xyz
 from volviz.io.errors import PathLike, ReadError, ReadWarning, human_bytes
 from volviz.model import Image2D, RegularVolume, TimeSeries
 from volviz.model.arrays import volume_of
@@ -95,8 +97,8 @@ def _check_storage(path: PathLike, ds: Any) -> None:
                               f"({human_bytes(needed)}), more than the file's {size} bytes can hold")
 
 
-def _spacing(path: PathLike, ds: Any) -> tuple[float, float, float]:
-    """(x, y, z) from the first voxel-size attribute in the dataset's (z, y, x) order; 1 where it has none."""
+def _spacing(path: PathLike, ds: Any, order: str) -> tuple[float, float, float]:
+    """(x, y, z) from the first voxel-size attribute in the dataset's axis order; 1 where it has none."""
     for key in _SPACING_ATTRS:
         if key in ds.attrs:
             try:
@@ -104,29 +106,31 @@ def _spacing(path: PathLike, ds: Any) -> tuple[float, float, float]:
             except (TypeError, ValueError):
                 continue
             if values.size >= 3 and np.all(np.isfinite(values[-3:])) and np.all(values[-3:] > 0):
-                sz, sy, sx = (float(v) for v in values[-3:])
-                return sx, sy, sz
+                a, b, c = (float(v) for v in values[-3:])
+                return (c, b, a) if order == "zyx" else (a, b, c)
             warnings.warn(f"{path}: the {key} attribute of {ds.name} ({values.tolist()}) is not three positive "
                           "sizes; unit voxels are used", ReadWarning, stacklevel=4)
     return 1.0, 1.0, 1.0
 
 
-def _volume(path: PathLike, data: np.ndarray, spacing: tuple[float, float, float], name: str,
+def _volume(path: PathLike, data: np.ndarray, spacing: tuple[float, float, float], name: str, order: str,
             allow_nonfinite: bool) -> RegularVolume:
-    """(z, y, x[, c]) -> a volume (x, y, z[, c])."""
-    data = np.ascontiguousarray(np.moveaxis(data, (0, 1, 2), (2, 1, 0)))
+    """(z, y, x[, c]) (or in ``order``) -> a volume (x, y, z[, c])."""
+    data = to_xyz(data, order)
     if data.dtype.kind == "b":
         data = data.astype(np.uint8)
     check_finite(path, data, allow_nonfinite)
     return volume_of(data, name, spacing, source=str(path))
 
 
-def read_hdf5(path: PathLike, dataset: str | None = None,
+def read_hdf5(path: PathLike, dataset: str | None = None, order: str = "zyx",
               allow_nonfinite: bool = True) -> RegularVolume | TimeSeries | Image2D | Any:
-    """An HDF5 file's array as a volume, a time series or an image (see the module); VTKHDF files as VTK data."""
+    """An HDF5 file's array as a volume, a time series or an image (see the module; ``order``:
+    ``volviz.io.axis_order``); VTKHDF files as VTK data."""
     import h5py
 
     p = check_file(path)
+    check_order(p, order)
     if read_bytes(p, 8) != HDF5_SIGNATURE:
         raise ReadError(p, "not an HDF5 file (no HDF5 signature at its start)")
     if has_vtkhdf_group(p) and dataset is None:
@@ -138,7 +142,7 @@ def read_hdf5(path: PathLike, dataset: str | None = None,
             name = _pick(p, f, dataset)
             ds = f[name]
             _check_storage(p, ds)
-            spacing = _spacing(p, ds)
+            spacing = _spacing(p, ds, order)
             data = ds[()]
     except ReadError:
         raise
@@ -149,6 +153,6 @@ def read_hdf5(path: PathLike, dataset: str | None = None,
         check_finite(p, data, allow_nonfinite)
         return Image2D(np.ascontiguousarray(data), source=str(p))
     if data.ndim == 3 or 2 <= data.shape[3] <= 4:
-        return _volume(p, data, spacing, label, allow_nonfinite)
-    frames: list[Any] = [_volume(p, data[t], spacing, label, allow_nonfinite) for t in range(len(data))]
+        return _volume(p, data, spacing, label, order, allow_nonfinite)
+    frames: list[Any] = [_volume(p, data[t], spacing, label, order, allow_nonfinite) for t in range(len(data))]
     return TimeSeries(np.arange(len(frames), dtype=np.float64), frames, source=str(p))

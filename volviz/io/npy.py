@@ -2,7 +2,8 @@
 
 A 3D array is read (z, y, x), x fastest in memory, as every volviz reader of Python-made arrays reads them (HDF5,
 TIFF stacks) and as scikit-image, tifffile and napari index volumes (and as VTK lays out image data): ``a[k, j, i]``
-is at ``(i, j, k)``, unit spacing. A 4D array whose last axis has 2 to 4 entries is (z, y, x, channels), one array by
+is at ``(i, j, k)``, unit spacing (``order="xyz"`` reads a[i, j, k] there instead: ``volviz.io.axis_order``). A 4D
+array whose last axis has 2 to 4 entries is (z, y, x, channels), one array by
 magnitude or component; any other 4D array is (t, z, y, x), a time series; a 2D array is an image (rows, columns).
 Numbers only: booleans become 0 / 1, complex and record arrays are refused. NumPy maps the data after reading the
 header, and refuses a file shorter than the header says.
@@ -14,6 +15,7 @@ from typing import Any
 import numpy as np
 
 from volviz.io._checks import check_file, check_finite
+from volviz.io.axis_order import check_order, to_xyz
 from volviz.io.errors import PathLike, ReadError
 from volviz.model import Image2D, RegularVolume, TimeSeries
 from volviz.model.arrays import volume_of
@@ -25,16 +27,19 @@ def is_npy(head: bytes) -> bool:
     return head.startswith(MAGIC)
 
 
-def _volume(path: PathLike, data: np.ndarray, name: str, allow_nonfinite: bool) -> RegularVolume:
-    """(z, y, x[, c]) -> a volume (x, y, z[, c])."""
-    data = np.ascontiguousarray(np.moveaxis(data, (0, 1, 2), (2, 1, 0)))
+def _volume(path: PathLike, data: np.ndarray, name: str, order: str, allow_nonfinite: bool) -> RegularVolume:
+    """(z, y, x[, c]) (or in ``order``) -> a volume (x, y, z[, c])."""
+    data = to_xyz(data, order)
     check_finite(path, data, allow_nonfinite)
     return volume_of(data, name, source=str(path))
 
 
-def read_npy(path: PathLike, allow_nonfinite: bool = True) -> RegularVolume | TimeSeries | Image2D:
-    """A ``.npy`` array as a volume, a volume of vectors, a time series or an image (see the module)."""
+def read_npy(path: PathLike, order: str = "zyx",
+             allow_nonfinite: bool = True) -> RegularVolume | TimeSeries | Image2D:
+    """A ``.npy`` array as a volume, a volume of vectors, a time series or an image (see the module; ``order``:
+    ``volviz.io.axis_order``)."""
     p = check_file(path)
+    check_order(p, order)
     try:  # reads the header only; the data is mapped, and a file shorter than its header says is refused here
         data: Any = np.load(p, mmap_mode="r", allow_pickle=False)
     except (ValueError, OSError, EOFError) as exc:
@@ -56,6 +61,6 @@ def read_npy(path: PathLike, allow_nonfinite: bool = True) -> RegularVolume | Ti
         check_finite(p, data, allow_nonfinite)
         return Image2D(np.ascontiguousarray(data), source=str(p))
     if data.ndim == 3 or 2 <= data.shape[3] <= 4:
-        return _volume(p, data, name, allow_nonfinite)
-    frames: list[Any] = [_volume(p, data[t], name, allow_nonfinite) for t in range(len(data))]
+        return _volume(p, data, name, order, allow_nonfinite)
+    frames: list[Any] = [_volume(p, data[t], name, order, allow_nonfinite) for t in range(len(data))]
     return TimeSeries(np.arange(len(frames), dtype=np.float64), frames, source=str(p))
