@@ -10,6 +10,7 @@ header, and refuses a file shorter than the header says.
 """
 from __future__ import annotations
 
+from tokenize import TokenError
 from typing import Any
 
 import numpy as np
@@ -42,7 +43,8 @@ def read_npy(path: PathLike, order: str = "zyx",
     check_order(p, order)
     try:  # reads the header only; the data is mapped, and a file shorter than its header says is refused here
         data: Any = np.load(p, mmap_mode="r", allow_pickle=False)
-    except (ValueError, OSError, EOFError) as exc:
+    except (ValueError, OSError, EOFError, SyntaxError, TokenError, TypeError, OverflowError, MemoryError) as exc:
+        # a damaged header reaches NumPy's literal parser: SyntaxError / TokenError, not only ValueError
         raise ReadError(p, f"not a NumPy .npy file NumPy can read, or shorter than its header says "
                            f"({str(exc)[:200]})") from None
     if not isinstance(data, np.ndarray):
