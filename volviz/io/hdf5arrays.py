@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from volviz.io._checks import check_file, check_finite, file_size, read_bytes
+from volviz.io.array_choice import choose_array
 from volviz.io.axis_order import check_order, to_xyz
 from volviz.io.errors import PathLike, ReadError, ReadWarning, human_bytes
 from volviz.model import Image2D, RegularVolume, TimeSeries
@@ -63,29 +64,10 @@ def _arrays(f: Any) -> list[tuple[str, tuple[int, ...]]]:
     return found
 
 
-def _describe(found: list[tuple[str, tuple[int, ...]]]) -> str:
-    shown = [f"{name} ({'x'.join(map(str, shape))})" for name, shape in found[:10]]
-    return ", ".join(shown) + (f" and {len(found) - 10} more" if len(found) > 10 else "")
-
-
 def _pick(path: PathLike, f: Any, dataset: str | None) -> str:
-    found = _arrays(f)
-    if dataset is not None:
-        name = "/" + dataset.lstrip("/")
-        if name not in f or not any(n == name for n, _ in found):
-            raise ReadError(path, f"has no numeric 2D to 4D dataset {name!r}; its arrays are: "
-                                  f"{_describe(found) or 'none'}")
-        return name
-    volumes = [item for item in found if len(item[1]) >= 3] or found
-    if not volumes:
-        raise ReadError(path, "holds no numeric dataset of 2 to 4 dimensions (an image, a volume, channels or time "
-                              "steps)")
-    chosen = max(volumes, key=lambda item: int(np.prod(item[1], dtype=object)))
-    others = [item for item in volumes if item != chosen]
-    if others:
-        warnings.warn(f"{path}: holds {len(volumes)} arrays; showing the largest, {_describe([chosen])}. Others: "
-                      f"{_describe(others)} (dataset=... picks one)", ReadWarning, stacklevel=4)
-    return chosen[0]
+    wanted = None if dataset is None else "/" + dataset.lstrip("/")
+    return choose_array(path, _arrays(f), wanted, "dataset", "holds no numeric dataset of 2 to 4 dimensions (an "
+                        "image, a volume, channels or time steps)")
 
 
 def _check_storage(path: PathLike, ds: Any) -> None:

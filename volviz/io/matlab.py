@@ -11,13 +11,13 @@
 """
 from __future__ import annotations
 
-import warnings
 from typing import Any
 
 import numpy as np
 
 from volviz.io._checks import check_file, check_finite, read_bytes
-from volviz.io.errors import PathLike, ReadError, ReadWarning
+from volviz.io.array_choice import choose_array
+from volviz.io.errors import PathLike, ReadError
 from volviz.model import Image2D, RegularVolume, TimeSeries
 from volviz.model.arrays import volume_of
 
@@ -30,26 +30,10 @@ def is_mat(head: bytes) -> bool:
     return head.startswith((b"MATLAB 5.0 MAT-file", b"MATLAB 7.3 MAT-file"))
 
 
-def _choose(path: PathLike, found: list[tuple[str, tuple[int, ...]]], variable: str | None,
-            others: list[str]) -> tuple[str, tuple[int, ...]]:
+def _choose(path: PathLike, found: list[tuple[str, tuple[int, ...]]], variable: str | None, others: list[str]) -> str:
     """The variable to show among ``found`` (name, MATLAB shape) numeric arrays of 2 to 4 dimensions."""
-    listing = ", ".join(f"{n} ({'x'.join(map(str, s))})" for n, s in found) or "none"
-    if variable is not None:
-        hit = [item for item in found if item[0] == variable]
-        if not hit:
-            raise ReadError(path, f"has no numeric 2D to 4D variable {variable!r}; its arrays are: {listing}")
-        return hit[0]
-    volumes = [item for item in found if len(item[1]) >= 3] or found
-    if not volumes:
-        raise ReadError(path, "holds no numeric 2D to 4D array" + (f" (only {', '.join(others)})" if others else ""))
-    chosen = max(volumes, key=lambda item: int(np.prod(item[1], dtype=object)))
-    rest = [item for item in volumes if item != chosen]
-    if rest:
-        warnings.warn(f"{path}: holds {len(volumes)} arrays; showing the largest, {chosen[0]} "
-                      f"({'x'.join(map(str, chosen[1]))}). Others: "
-                      + ", ".join(f"{n} ({'x'.join(map(str, s))})" for n, s in rest) + " (variable=... picks one)",
-                      ReadWarning, stacklevel=4)
-    return chosen
+    return choose_array(path, found, variable, "variable",
+                        "holds no numeric 2D to 4D array" + (f" (only {', '.join(others)})" if others else ""))
 
 
 def _v5(path: PathLike, variable: str | None) -> tuple[str, np.ndarray]:
@@ -64,7 +48,7 @@ def _v5(path: PathLike, variable: str | None) -> tuple[str, np.ndarray]:
                 found.append((name, shape))
             else:
                 others.append(f"{name} ({kind})")
-        name, _ = _choose(path, found, variable, others)
+        name = _choose(path, found, variable, others)
         values = scipy.io.loadmat(str(path), variable_names=[name], squeeze_me=False, mat_dtype=False)[name]
     except ReadError:
         raise
@@ -88,7 +72,7 @@ def _v73(path: PathLike, variable: str | None) -> tuple[str, np.ndarray]:
                     found.append((name, shape))
                 elif not name.startswith("#"):
                     others.append(f"{name} ({kind or 'group'})")
-            name, _ = _choose(path, found, variable, others)
+            name = _choose(path, found, variable, others)
             values = f[name][()]
     except ReadError:
         raise
