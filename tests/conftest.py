@@ -76,3 +76,33 @@ def make_window(qtbot, tmp_path: Path):
         win.dirty = False  # no "save changes?" prompt at teardown
         win.close()
     gc.collect()  # free the closed windows here, on the GUI thread
+
+
+def read_mutations(path: Path, mutations, truncated_reads_same: bool) -> int:
+    """Write each mutation (``volviz.bench.robustness.Mutation``) of a file to ``path`` and read it with
+    ``volviz.io.read``; assert the fuzz property: a ReadError naming the file, or a dataset of the original's size
+    with finite spacing and origin. A truncated file is refused, or (``truncated_reads_same``) read with exactly the
+    original's data. Returns how many were refused."""
+    import warnings
+
+    import volviz.io as vio
+    from volviz.bench import robustness as rb
+
+    original = rb.fingerprint_volviz(vio.read(path))
+    refused = 0
+    for mutation in mutations:
+        path.write_bytes(mutation.data)
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                found = rb.fingerprint_volviz(vio.read(path))
+        except vio.ReadError as exc:
+            assert str(path) in str(exc), f"{mutation.detail}: {exc}"
+            refused += 1
+            continue
+        assert found["problem"] == "", f"{mutation.detail}: {found['problem']}"
+        assert found["n_points"] == original["n_points"], f"{mutation.detail}: another size was accepted"
+        if mutation.kind == "truncate":
+            assert truncated_reads_same, f"{mutation.detail}: read although truncated"
+            assert found["crc"] == original["crc"], f"{mutation.detail}: a truncated file read with other data"
+    return refused
