@@ -14,6 +14,13 @@ import numpy as np
 from volviz.io.errors import NonFiniteWarning, PathLike, ReadError, human_bytes
 
 
+HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"   # at the start of an HDF5 file (at 512 after a user block: MAT v7.3)
+
+
+def is_hdf5(head: bytes) -> bool:
+    return head.startswith(HDF5_SIGNATURE)
+
+
 def check_file(path: PathLike) -> Path:
     """Return ``path`` as a Path after checking it names an existing, regular, readable file."""
     try:

@@ -21,14 +21,13 @@ from typing import Any
 
 import numpy as np
 
-from volviz.io._checks import check_file, check_finite, file_size, read_bytes
+from volviz.io._checks import HDF5_SIGNATURE, check_file, check_finite, file_size, read_bytes
 from volviz.io.array_choice import choose_array
 from volviz.io.axis_order import check_order, to_xyz
 from volviz.io.errors import PathLike, ReadError, ReadWarning, human_bytes
 from volviz.model import Image2D, RegularVolume, TimeSeries
 from volviz.model.arrays import volume_of
 
-HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 MAX_DATASETS = 10_000    # datasets of a file looked at
 MAX_RATIO = 1032         # what deflate can inflate to; other filters are held by the reader process's memory limit
 _SPACING_ATTRS = ("element_size_um", "spacing", "voxel_size")

@@ -15,13 +15,12 @@ from typing import Any
 
 import numpy as np
 
-from volviz.io._checks import check_file, check_finite, read_bytes
+from volviz.io._checks import HDF5_SIGNATURE, check_file, check_finite, read_bytes
 from volviz.io.array_choice import choose_array
 from volviz.io.errors import PathLike, ReadError
 from volviz.model import Image2D, RegularVolume, TimeSeries
 from volviz.model.arrays import volume_of
 
-HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 _NUMERIC = ("double", "single", "int8", "uint8", "int16", "uint16", "int32", "uint32", "int64", "uint64", "logical")
 
 

@@ -9,13 +9,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from volviz.io._checks import check_finite, describe_bytes, file_size, read_bytes
+from volviz.io._checks import HDF5_SIGNATURE, check_finite, describe_bytes, file_size, read_bytes
 from volviz.io.errors import PathLike, ReadError
 from volviz.io.vtkconvert import vtk_to_model
 from volviz.io.vtkhdfcheck import check_structure
 from volviz.model import TimeSeries
 
-HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 
 
 def _inspect(path: PathLike) -> tuple[str, np.ndarray | None]:

@@ -8,10 +8,9 @@ files are checked by ``volviz_vtk_readers.adf``; without h5py this check is skip
 """
 from __future__ import annotations
 
-from volviz.io._checks import check_file, file_size, read_bytes
+from volviz.io._checks import HDF5_SIGNATURE, check_file, file_size, read_bytes
 from volviz.io.errors import PathLike, ReadError
 
-HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 
 
 def check_cgns_hdf5(path: PathLike) -> None:

@@ -13,10 +13,9 @@ import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from volviz.io._checks import check_file, describe_bytes, read_bytes
+from volviz.io._checks import HDF5_SIGNATURE, check_file, describe_bytes, read_bytes
 from volviz.io.errors import PathLike, ReadError, ReadWarning
 
-HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 NETCDF_MAGICS = (b"CDF\x01", b"CDF\x02", b"CDF\x05")
 _NC_TYPE_SIZE = {1: 1, 2: 1, 3: 2, 4: 4, 5: 4, 6: 8, 7: 1, 8: 2, 9: 4, 10: 8, 11: 8}
 _HEADER_LIMIT = 64 << 20  # a netCDF header larger than this is not parsed (only its magic is checked)
