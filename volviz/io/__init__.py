@@ -10,6 +10,7 @@ Readers (each returns a ``volviz.model`` dataset, convertible with ``.to_pyvista
 - raw volumes (explicit dims/type/order)  -> RegularVolume (``read_raw``), slice stacks (``read_slice_stack``)
 - VTK legacy .vtk, XML .vti .vtu .vts .vtr .vtp -> RegularVolume / CurvilinearGrid / UnstructuredMesh
 - VTKHDF (static or transient)            -> the matching dataset, or TimeSeries with lazy frames
+- ParaView collections .pvd               -> TimeSeries at the file's times (a step's parts merged)
 - PGM/PPM P2/P3/P5/P6, 8/16 bit           -> Image2D
 - USGS DEM (ASCII)                        -> Image2D of heights in metres
 - PNG/JPEG/TIFF/BMP (Pillow)              -> Image2D

@@ -45,11 +45,14 @@ def _moved_points(a: Any, b: Any, w: float) -> np.ndarray:
 
 def frame_at(series: TimeSeries, t: float, interpolate: bool = True) -> Any:
     """The dataset shown at display time ``t``: the nearest earlier step, or the blend of its two neighbours (their
-    point values, and the point positions of a mesh that moves with one topology)."""
+    point values, and the point positions of a mesh that moves with one topology). Between two steps of different
+    sizes (an adaptively refined mesh, a regridded volume) there is no blend: the earlier step is shown."""
     i, j, w = bracket(series, t)
     if not interpolate or w == 0.0 or i == j:
         return series.frame(i)
     a, b = series.frame(i), series.frame(j)  # frames of one kind (read_series checks them against frame 0)
+    if type(a) is not type(b) or a.dimensions != b.dimensions:
+        return a
     if isinstance(a, RegularVolume):
         return replace(a, data=_blend(a.data, cast(RegularVolume, b).data, w))
     if isinstance(a, TetMesh):
