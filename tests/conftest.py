@@ -106,3 +106,36 @@ def read_mutations(path: Path, mutations, truncated_reads_same: bool) -> int:
             assert truncated_reads_same, f"{mutation.detail}: read although truncated"
             assert found["crc"] == original["crc"], f"{mutation.detail}: a truncated file read with other data"
     return refused
+
+
+def xml_mutations(data: bytes, seed: str, flips: int, cuts: int, per_kind: int) -> list:
+    """Bit flips, truncations and XML attribute mutations (``volviz.bench.robustness``) of a text file's bytes."""
+    import random
+
+    from volviz.bench import robustness as rb
+
+    rng = random.Random(seed)
+    mutations = [rb.flip_bits(data, rng, len(data)) for _ in range(flips)]
+    mutations += [rb.truncate(data, at) for at in sorted(rng.sample(range(1, len(data)), cuts))]
+    return mutations + [m for kind in ("xml-swap", "xml-flip", "xml-enlarge") for _ in range(per_kind)
+                        if (m := rb.xml_mutation(data, rng, kind)) is not None]
+
+
+def read_every_frame(path: Path, mutations, names: tuple[str, ...]) -> tuple[int, list]:
+    """Write each mutation to ``path`` and read it with every frame of a time series; a ReadError must name one of
+    ``names``. Returns how many were refused and ``(mutation, dataset, frames)`` of those read."""
+    import volviz.io as vio
+    from volviz.model import TimeSeries
+
+    refused, read = 0, []
+    for mutation in mutations:
+        path.write_bytes(mutation.data)
+        try:
+            found = vio.read(path)
+            frames = [found.frame(i) for i in range(len(found))] if isinstance(found, TimeSeries) else [found]
+        except vio.ReadError as exc:
+            assert any(name in str(exc) for name in names), f"{mutation.detail}: {exc}"
+            refused += 1
+            continue
+        read.append((mutation, found, frames))
+    return refused, read

@@ -4,14 +4,13 @@ files that are not there."""
 from __future__ import annotations
 
 import math
-import random
 
 import numpy as np
 import pytest
 import pyvista as pv
+from conftest import read_every_frame, xml_mutations
 
 import volviz.io as vio
-from volviz.bench import robustness as rb
 from volviz.io.errors import ReadError
 from volviz.model import TimeSeries
 from volviz.model.timeseries import frame_at
@@ -131,22 +130,9 @@ def test_mutated_collections_are_read_consistently_or_refused(tmp_path):
     """Bit flips, truncations and XML attribute mutations of a collection: each is read with finite, increasing
     times and frames made of its members, or refused with a ReadError naming a file; nothing else escapes."""
     path = _series(tmp_path)
-    data = path.read_bytes()
-    rng = random.Random("pvd")
-    mutations = [rb.flip_bits(data, rng, len(data)) for _ in range(24)]
-    mutations += [rb.truncate(data, at) for at in sorted(rng.sample(range(1, len(data)), 12))]
-    mutations += [m for kind in ("xml-swap", "xml-flip", "xml-enlarge") for _ in range(8)
-                  if (m := rb.xml_mutation(data, rng, kind)) is not None]
-    refused = 0
-    for mutation in mutations:
-        path.write_bytes(mutation.data)
-        try:
-            found = vio.read(path)
-        except ReadError as exc:
-            assert ".pvd" in str(exc) or ".vtu" in str(exc), f"{mutation.detail}: {exc}"
-            refused += 1
-            continue
-        frames = [found.frame(i) for i in range(len(found))] if isinstance(found, TimeSeries) else [found]
+    mutations = xml_mutations(path.read_bytes(), "pvd", flips=24, cuts=12, per_kind=8)
+    refused, read = read_every_frame(path, mutations, (".pvd", ".vtu"))
+    for mutation, found, frames in read:
         if isinstance(found, TimeSeries):
             assert all(math.isfinite(t) for t in found.times) and np.all(np.diff(found.times) > 0)
         assert all(f.n_points % 64 == 0 and np.isfinite(f.point_data["u"]).all() for f in frames), mutation.detail

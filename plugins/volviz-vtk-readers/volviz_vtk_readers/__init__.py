@@ -23,6 +23,9 @@ dispatches to the loaders in ``volviz_vtk_readers.readers``. What each format gi
 - Fluent (.cas with its .dat beside it, or the .dat): every cell zone merged with every cell field.
 - VTK multiblock (.vtm .vtpd): every block merged (what ParaView shows on open); ``blocks=`` picks some.
 - VTK parallel XML (.pvtu .pvti .pvts .pvtr .pvtp): the pieces joined into one data set by VTK's reader.
+- XDMF (.xdmf .xmf, versions 2 and 3; FEniCS / dolfinx, meshio, HPC codes): the temporal collections when the file
+  has any (dolfinx writes the bare mesh as a grid of its own beside them), else every grid; blocks on one mesh are
+  fields of it (one data set with every block's arrays), as in ``volviz_vtk_readers.xdmf``.
 
 Files with several time steps become a ``volviz.model.TimeSeries``; ``list_blocks(path)`` lists block names.
 """

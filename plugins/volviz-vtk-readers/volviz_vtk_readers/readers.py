@@ -26,7 +26,7 @@ from volviz.io.vtkconvert import vtk_to_model
 from volviz.io.vtkfiles import _run
 from volviz.model import TimeSeries
 
-from volviz_vtk_readers import specs
+from volviz_vtk_readers import specs, xdmf
 from volviz_vtk_readers.containers import check_container
 from volviz_vtk_readers.exodus_check import check_exodus_connectivity
 from volviz_vtk_readers.foamcheck import check_time_folder
@@ -358,6 +358,32 @@ def read_netcdf_cf(path: PathLike, dimensions: str | None = None, spherical: boo
     return _in_time(path, reader, read_netcdf_cf, options, time_index, _convert(path, None, allow_nonfinite))
 
 
+# -- XDMF --------------------------------------------------------------------------------------------------------------
+def _xdmf(path: PathLike) -> Any:
+    _check_sniffed(path, xdmf.is_xdmf, "XDMF")
+    return _information(path, _reader("vtkXdmfReader", path))
+
+
+def read_xdmf(path: PathLike, blocks: Sequence[str] | str | None = None, time_index: int | None = None,
+              allow_nonfinite: bool = True):
+    """XDMF 2/3: the temporal collections (or every grid, or ``blocks``); blocks on one mesh as one data set with
+    all their fields (``volviz_vtk_readers.xdmf``)."""
+    found = xdmf.outline(path)
+    xdmf.check_heavy_data(path, found)
+    temporal = found.temporal if blocks is None else []
+    reader = _xdmf(path)
+
+    def convert(obj: Any) -> Any:
+        leaves = list(_leaves(_select_leaves(path, obj, blocks)))
+        if not leaves:
+            raise ReadError(path, "holds no grid with points")
+        joined = xdmf.fields_on_shared_meshes(xdmf.shown_leaves(leaves, temporal))
+        return vtk_to_model(path, joined, allow_nonfinite=allow_nonfinite)
+
+    return _in_time(path, reader, read_xdmf, {"blocks": blocks, "allow_nonfinite": allow_nonfinite}, time_index,
+                    convert)
+
+
 # -- AVS UCD -----------------------------------------------------------------------------------------------------------
 def read_avs_ucd(path: PathLike, allow_nonfinite: bool = True):
     """AVS UCD (.inp, ASCII or binary): the mesh with every node and cell component."""
@@ -372,12 +398,14 @@ def read_avs_ucd(path: PathLike, allow_nonfinite: bool = True):
 
 # -- block listing -----------------------------------------------------------------------------------------------------
 _TREE_READERS: dict[str, Callable[[PathLike], Any]] = {
-    "cgns": _cgns, "ensight": _ensight, "tecplot": _tecplot, "fluent": _fluent, "vtk-multiblock": _vtk_multiblock}
+    "cgns": _cgns, "ensight": _ensight, "tecplot": _tecplot, "fluent": _fluent, "vtk-multiblock": _vtk_multiblock,
+    "xdmf": _xdmf}
 
 
 def list_blocks(path: PathLike) -> list[str]:
     """The names ``blocks=`` takes for this file: Exodus element blocks, OpenFOAM ``internalMesh`` and
-    ``patch/...`` names, CGNS ``Base/Zone``, EnSight parts, Tecplot and Fluent zones, .vtm/.vtpd blocks.
+    ``patch/...`` names, CGNS ``Base/Zone``, EnSight parts, Tecplot and Fluent zones, .vtm/.vtpd blocks, XDMF
+    grids.
     Formats without blocks give ``[]``."""
     from volviz.io.registry import spec_of
 

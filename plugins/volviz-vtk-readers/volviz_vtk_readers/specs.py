@@ -11,6 +11,7 @@ from typing import Any
 from volviz.io.registry import ReaderSpec
 
 from volviz_vtk_readers.containers import is_cgns, is_netcdf
+from volviz_vtk_readers.xdmf import is_xdmf
 
 _TECPLOT_KEYWORD = re.compile(rb"\s*(TITLE|VARIABLES|ZONE|FILETYPE|DATASETAUXDATA|TEXT|GEOMETRY)\b", re.I)
 _XML_TYPE = re.compile(rb'<VTKFile[^>]*\btype="([A-Za-z]+)"')
@@ -98,6 +99,9 @@ SPECS: list[ReaderSpec] = [  # netCDF before Exodus: a netCDF file known by cont
     _spec("vtk-multiblock", "VTK multiblock", ("*.vtm", "*.vtmb", "*.vtpd"), _R + "read_vtk_multiblock",
           sniff=is_vtk_multiblock, sniff_opens=False, arrays="every point and cell array of every block",
           options=("blocks", "allow_nonfinite")),
+    _spec("xdmf", "XDMF", ("*.xdmf", "*.xmf"), _R + "read_xdmf", sniff=is_xdmf,
+          arrays="every attribute of the temporal collections (or of every grid); fields on one mesh together",
+          options=_BLOCKS),
     _spec("vtk-parallel", "VTK parallel XML", ("*.pvtu", "*.pvti", "*.pvts", "*.pvtr", "*.pvtp"),
           _R + "read_vtk_parallel", sniff=is_vtk_parallel, sniff_opens=False,
           arrays="every point and cell array, pieces joined", options=("allow_nonfinite",)),
