@@ -508,3 +508,51 @@ def test_a_damaged_zarr_chunk_is_a_read_error(tmp_path):
     chunk.write_bytes(chunk.read_bytes()[:7])
     with pytest.raises(ReadError, match="d.zarr: a chunk could not be read"):
         vio.read(tmp_path / "d.zarr")
+
+
+# -- MINC --------------------------------------------------------------------------------------------------------------
+def _minc(name: str) -> Path:
+    from nibabel.testing import data_path   # MINC files shipped with nibabel (nibabel writes no MINC)
+
+    return Path(data_path) / name
+
+
+@pytest.mark.parametrize("name", ["minc1_1_scale.mnc", "minc2_1_scale.mnc", "small.mnc", "minc2_baddim.mnc"])
+def test_minc_1_and_2_voxels_are_placed_in_world_space_through_the_files_scaling(name):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")            # minc2_baddim.mnc: "Invalid spacing declaration"
+        img = nib.load(_minc(name))
+        volume = vio.read(_minc(name))
+    values = img.get_fdata()
+    assert np.ptp(values) > 0
+    _assert_placed(volume, values.astype(volume.data.dtype), img.affine)
+
+
+@pytest.mark.parametrize("name", ["minc1_4d.mnc", "minc2_4d.mnc", "minc2-4d-d.mnc"])
+def test_a_minc_time_dimension_is_a_time_series(name):
+    img = nib.load(_minc(name))
+    series = vio.read(_minc(name))
+    assert isinstance(series, TimeSeries) and len(series) == img.shape[0]
+    np.testing.assert_allclose(np.diff(series.times), img.header.get_zooms()[0])
+    values = img.get_fdata()
+    for t in range(len(series)):
+        _assert_placed(series.frame(t), values[t].astype(series.frame(t).data.dtype), img.affine)
+    one = vio.read(_minc(name), time_index=1)
+    np.testing.assert_array_equal(one.data, series.frame(1).data)
+
+
+def test_mutated_minc_files_read_consistently_or_raise_read_error(tmp_path):
+    import random
+
+    from volviz.bench import robustness as rb
+
+    from conftest import read_mutations
+
+    for name in ("minc1_1_scale.mnc", "minc2_1_scale.mnc"):
+        path = tmp_path / name
+        data = _minc(name).read_bytes()
+        path.write_bytes(data)
+        rng = random.Random(name)
+        mutations = [rb.flip_bits(data, rng, min(2048, len(data))) for _ in range(16)]
+        mutations += [rb.truncate(data, at) for at in sorted(rng.sample(range(1, len(data)), 12))]
+        assert read_mutations(path, mutations, truncated_reads_same=False) >= 12

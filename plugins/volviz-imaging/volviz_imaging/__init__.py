@@ -5,6 +5,8 @@ the loaders here, each run in volviz's isolated reader process (``volviz.io.isol
 
 - NIfTI-1 / NIfTI-2 (.nii, .nii.gz, .hdr + .img), Analyze 7.5 and FreeSurfer MGH (.mgh, .mgz): nibabel
   (``volviz_imaging.nifti``); 4D files are time series.
+- MINC 1 and 2 (.mnc; BrainWeb, the MNI templates): nibabel (``volviz_imaging.minc``); a time dimension is a time
+  series.
 - NRRD (.nrrd, .nhdr + data file; raw, text, gzip, bzip2): pynrrd (``volviz_imaging.nrrd_files``).
 - DICOM series (a folder, or any slice of the series, or a multi-frame file): pydicom (``volviz_imaging.dicom``).
 - MRC / CCP4 density maps (.mrc, .map, .ccp4, .rec): mrcfile (``volviz_imaging.mrc``), in Angstrom.

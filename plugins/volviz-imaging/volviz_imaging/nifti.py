@@ -14,7 +14,7 @@ through nibabel.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
@@ -28,7 +28,8 @@ from volviz_imaging.placement import aligned_volume
 _TIME_UNITS = {"msec": 1e-3, "usec": 1e-6, "sec": 1.0}
 
 
-def _load(path: PathLike) -> Any:
+def load_image(path: PathLike, what: str = "NIfTI, Analyze or MGH") -> Any:
+    """nibabel's image of the file (its header read, no voxel yet); ReadError naming the file otherwise."""
     import nibabel as nib
     from nibabel.filebasedimages import ImageFileError
 
@@ -39,7 +40,7 @@ def _load(path: PathLike) -> Any:
         raise ReadError(p, f"its data file {Path(exc.filename or '').name or '(unknown)'} is not beside it (an "
                            "Analyze / NIfTI pair needs both the .hdr and the .img)") from None
     except (ImageFileError, nib.spatialimages.HeaderDataError, ValueError, OSError, EOFError) as exc:
-        raise ReadError(p, f"not a NIfTI, Analyze or MGH image nibabel can read ({exc})") from None
+        raise ReadError(p, f"not a {what} image nibabel can read ({exc})") from None
 
 
 def _name(path: PathLike) -> str:
@@ -70,11 +71,11 @@ def _check_size(path: PathLike, img: Any) -> None:
         require_bytes(data, needed, size - offset, what)
 
 
-def _time_step(img: Any) -> float:
-    """The time between volumes in seconds when the file says so, else 1 (steps)."""
+def time_step(img: Any, axis: int = 3) -> float:
+    """The time between volumes (``axis`` of the image) in seconds when the file says so, else 1 (steps)."""
     header = img.header
     try:
-        step = float(header.get_zooms()[3])
+        step = float(header.get_zooms()[axis])
         unit = header.get_xyzt_units()[1] if hasattr(header, "get_xyzt_units") else "unknown"
     except (IndexError, TypeError, ValueError):
         return 1.0
@@ -83,7 +84,7 @@ def _time_step(img: Any) -> float:
     return step * _TIME_UNITS.get(unit, 1.0)
 
 
-def _voxels(path: PathLike, img: Any, index: tuple) -> np.ndarray:
+def voxels(path: PathLike, img: Any, index: tuple) -> np.ndarray:
     """The scaled voxels at ``index`` (nibabel's proxy applies scl_slope / scl_inter), RGB records as components."""
     try:
         data = np.asanyarray(img.dataobj[index])
@@ -97,7 +98,7 @@ def _voxels(path: PathLike, img: Any, index: tuple) -> np.ndarray:
 def read_nifti(path: PathLike, time_index: int | None = None,
                allow_nonfinite: bool = True) -> RegularVolume | TimeSeries:
     """A NIfTI / Analyze / MGH file as a volume, or its 4th dimension as a time series (see the module)."""
-    img = _load(path)
+    img = load_image(path)
     shape = tuple(int(n) for n in img.shape)
     if len(shape) < 3:
         shape = shape + (1,) * (3 - len(shape))
@@ -112,16 +113,22 @@ def read_nifti(path: PathLike, time_index: int | None = None,
 
     def volume(t: int | None) -> RegularVolume:
         if len(img.shape) < 3:
-            data = _voxels(path, img, (Ellipsis,)).reshape(shape[:3])
+            data = voxels(path, img, (Ellipsis,)).reshape(shape[:3])
         elif len(shape) == 5:
-            data = _voxels(path, img, (Ellipsis, 0, slice(None)))
+            data = voxels(path, img, (Ellipsis, 0, slice(None)))
         elif len(shape) == 4:
-            data = _voxels(path, img, (Ellipsis, t or 0))
+            data = voxels(path, img, (Ellipsis, t or 0))
         else:
-            data = _voxels(path, img, (Ellipsis,))
+            data = voxels(path, img, (Ellipsis,))
         return aligned_volume(path, data, affine, name, allow_nonfinite=allow_nonfinite, warn=not t)
 
-    n_steps = shape[3] if len(shape) == 4 else 1
+    return volume_or_series(path, volume, shape[3] if len(shape) == 4 else 1, time_step(img), time_index)
+
+
+def volume_or_series(path: PathLike, volume: Callable[[int | None], RegularVolume], n_steps: int, step: float,
+                     time_index: int | None) -> RegularVolume | TimeSeries:
+    """Step ``time_index`` of an image of ``n_steps`` volumes, ``step`` seconds apart; without it the one volume,
+    or a TimeSeries whose later steps are read when shown (``volume(t)`` reads step t)."""
     if time_index is not None:
         if not 0 <= time_index < n_steps:
             raise ReadError(path, f"time_index {time_index} is out of range: the file has {n_steps} time step(s)")
@@ -129,4 +136,4 @@ def read_nifti(path: PathLike, time_index: int | None = None,
     if n_steps == 1:
         return volume(0)
     frames: list[Any] = [volume(0)] + [None] * (n_steps - 1)
-    return TimeSeries(np.arange(n_steps) * _time_step(img), frames, loader=volume, source=str(path))
+    return TimeSeries(np.arange(n_steps) * step, frames, loader=volume, source=str(path))

@@ -50,6 +50,14 @@ def is_mrc(head: bytes) -> bool:
     return inflated_head(head)[208:212] == b"MAP "
 
 
+def is_minc(head: bytes) -> bool:
+    """MINC 1 is a netCDF classic file (``CDF\x01`` / ``CDF\x02``) holding ``image`` variables; MINC 2 an HDF5 file
+    with the ``minc-2.0`` group (its name lies in the first kilobytes of the superblock's heap)."""
+    if head[:4] in (b"CDF\x01", b"CDF\x02"):
+        return b"image" in head and b"space" in head
+    return head.startswith(b"\x89HDF\r\n\x1a\n") and b"minc-2.0" in head
+
+
 def is_nrrd(head: bytes) -> bool:
     return head.startswith(b"NRRD000")
 
@@ -78,6 +86,9 @@ SPECS: list[ReaderSpec] = [
           options=("time_index", "allow_nonfinite")),
     _spec("mgh", "FreeSurfer MGH", ("*.mgh", "*.mgz"), "nifti:read_nifti", sniff=is_mgh,
           arrays="the voxel values; several frames as a time series", options=("time_index", "allow_nonfinite")),
+    _spec("minc", "MINC", ("*.mnc",), "minc:read_minc", sniff=is_minc,
+          arrays="the voxel values through the file's scaling; a time dimension as a time series",
+          options=("time_index", "allow_nonfinite")),
     _spec("nrrd", "NRRD", ("*.nrrd", "*.nhdr"), "nrrd_files:read_nrrd", sniff=is_nrrd,
           arrays="the voxel values; a vector / color axis as components, a time axis as a time series",
           options=("allow_nonfinite",)),
