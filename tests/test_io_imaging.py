@@ -556,3 +556,98 @@ def test_mutated_minc_files_read_consistently_or_raise_read_error(tmp_path):
         mutations = [rb.flip_bits(data, rng, min(2048, len(data))) for _ in range(16)]
         mutations += [rb.truncate(data, at) for at in sorted(rng.sample(range(1, len(data)), 12))]
         assert read_mutations(path, mutations, truncated_reads_same=False) >= 12
+
+
+# -- Gaussian cube -----------------------------------------------------------------------------------------------------
+BOHR = 0.529177210903
+
+
+def _cube_file(path: Path, values: np.ndarray, origin, axes, angstrom=False, orbitals=None) -> Path:
+    """A cube file as Gaussian's cubegen writes it: values (n1, n2, n3[, orbitals]), six per line, a new line for
+    every (i1, i2) row."""
+    atoms = [(8, 8.0, 0.0, 0.0, 0.0), (1, 1.0, 1.4, 0.0, 1.1)]
+    n_atoms = -len(atoms) if orbitals else len(atoms)
+    sign = -1 if angstrom else 1
+    lines = ["cube file written by the test", "total density",
+             f"{n_atoms:5d} {origin[0]:12.6f} {origin[1]:12.6f} {origin[2]:12.6f}"]
+    lines += [f"{sign * n if a == 0 else n:5d} " + " ".join(f"{v:12.6f}" for v in axes[a])
+              for a, n in enumerate(values.shape[:3])]
+    lines += [f"{z:5d} {q:12.6f} {x:12.6f} {y:12.6f} {w:12.6f}" for z, q, x, y, w in atoms]
+    if orbitals:
+        lines.append(f"{len(orbitals):5d} " + " ".join(f"{o:5d}" for o in orbitals))
+    flat = values.reshape(values.shape[0] * values.shape[1], -1)
+    for row in flat:
+        lines += [" ".join(f"{v:13.5E}" for v in row[k:k + 6]) for k in range(0, len(row), 6)]
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def _cube_affine(origin, axes, unit) -> np.ndarray:
+    affine = np.eye(4)
+    affine[:3, :3] = np.asarray(axes, dtype=np.float64).T * unit
+    affine[:3, 3] = np.asarray(origin, dtype=np.float64) * unit
+    return affine
+
+
+def _as_written(values: np.ndarray) -> np.ndarray:
+    """The values a cube file holds: five decimals of mantissa."""
+    return np.vectorize(lambda v: float(f"{v:.5E}"))(values).astype(np.float32)
+
+
+def test_a_cube_file_is_placed_in_angstrom(tmp_path):
+    values = _as_written(np.random.default_rng(7).normal(size=(5, 4, 7)))
+    origin, axes = (-3.0, -2.0, -4.5), ((0.0, 0.0, 0.25), (0.5, 0.0, 0.0), (0.0, -0.3, 0.0))   # permuted, flipped
+    volume = vio.read(_cube_file(tmp_path / "water.cube", values, origin, axes))
+    assert volume.name == "density"
+    _assert_placed(volume, values.astype(np.float32), _cube_affine(origin, axes, BOHR))
+    in_angstrom = vio.read(_cube_file(tmp_path / "a.cube", values, origin, axes, angstrom=True))
+    _assert_placed(in_angstrom, values.astype(np.float32), _cube_affine(origin, axes, 1.0))
+
+
+def test_an_orbital_cube_shows_one_orbital_and_names_the_others(tmp_path):
+    values = _as_written(np.random.default_rng(8).normal(size=(3, 4, 5, 2)))
+    axes = ((0.2, 0, 0), (0, 0.2, 0), (0, 0, 0.2))
+    path = _cube_file(tmp_path / "mo.cube", values, (0, 0, 0), axes, orbitals=[12, 13])
+    with pytest.warns(ReadWarning, match="holds 2 orbitals; showing orbital 12. Others: 13"):
+        first = vio.read(path)
+    assert first.name == "orbital 12"
+    np.testing.assert_array_equal(first.data, values[..., 0])
+    second = vio.read(path, orbital=13)
+    np.testing.assert_array_equal(second.data, values[..., 1])
+    with pytest.raises(ReadError, match="mo.cube: holds no orbital 7; its orbitals are 12, 13"):
+        vio.read(path, orbital=7)
+
+
+def test_skewed_and_damaged_cube_files(tmp_path):
+    values = np.random.default_rng(9).normal(size=(4, 4, 4))
+    skewed = ((0.2, 0.02, 0), (0, 0.2, 0), (0, 0, 0.2))
+    with pytest.warns(ReadWarning, match="degrees from the nearest world axes"):
+        vio.read(_cube_file(tmp_path / "skew.cube", values, (0, 0, 0), skewed))
+    path = _cube_file(tmp_path / "bad.cube", values, (0, 0, 0), ((0.2, 0, 0), (0, 0.2, 0), (0, 0, 0.2)))
+    text = path.read_text()
+    for broken, problem in [
+            (text.replace("    4     0.200000", "  400     0.200000", 1),
+             "its header announces 400 x 4 x 4 points.* more than its 896 bytes"),
+            (text.rsplit("\n", 3)[0] + "\n", "holds 56 readable values where its header announces 64"),
+            (text.replace("E", "Q", 3), "holds text that is not a number among its values"),
+            ("\n".join(text.split("\n")[:4]), "is shorter than a cube file's header"),
+            (text.replace("    2 ", "  two ", 1), "atom count is text, not an integer")]:
+        path.write_text(broken)
+        with pytest.raises(ReadError, match=f"bad.cube: {problem}"):
+            vio.read(path)
+
+
+def test_mutated_cube_files_read_consistently_or_raise_read_error(tmp_path):
+    import random
+
+    from volviz.bench import robustness as rb
+
+    from conftest import read_mutations
+
+    values = np.random.default_rng(10).normal(size=(4, 5, 6))
+    path = _cube_file(tmp_path / "f.cube", values, (0, 0, 0), ((0.2, 0, 0), (0, 0.2, 0), (0, 0, 0.2)))
+    data = path.read_bytes()
+    rng = random.Random("cube")
+    mutations = [rb.flip_bits(data, rng, 500) for _ in range(16)]
+    mutations += [rb.truncate(data, at) for at in sorted(rng.sample(range(1, len(data) - 1), 12))]
+    assert read_mutations(path, mutations, truncated_reads_same=True) >= 12

@@ -10,6 +10,7 @@ the loaders here, each run in volviz's isolated reader process (``volviz.io.isol
 - NRRD (.nrrd, .nhdr + data file; raw, text, gzip, bzip2): pynrrd (``volviz_imaging.nrrd_files``).
 - DICOM series (a folder, or any slice of the series, or a multi-frame file): pydicom (``volviz_imaging.dicom``).
 - MRC / CCP4 density maps (.mrc, .map, .ccp4, .rec): mrcfile (``volviz_imaging.mrc``), in Angstrom.
+- Gaussian cube files (.cube): electron densities, orbitals and potentials, in Angstrom (``volviz_imaging.cube``).
 - OME-Zarr images and Zarr arrays (folders): zarr-python (``volviz_imaging.omezarr``), codecs checked first.
 
 Every medical volume is placed in RAS millimetres on the world axes nearest to its own

@@ -95,6 +95,9 @@ SPECS: list[ReaderSpec] = [
     _spec("mrc", "MRC / CCP4 map", ("*.mrc", "*.mrcs", "*.map", "*.ccp4", "*.rec", "*.mrc.gz", "*.map.gz"),
           "mrc:read_mrc", sniff=is_mrc, arrays="the density, in the map's axis order laid out x, y, z (Angstrom)",
           options=("allow_nonfinite",)),
+    _spec("cube", "Gaussian cube", ("*.cube", "*.cub"), "cube:read_cube",
+          arrays="the density, orbital or potential on the grid (Angstrom); orbital= picks an orbital",
+          options=("orbital", "allow_nonfinite")),
     _spec("zarr", "OME-Zarr / Zarr", ("*.zarr",), "omezarr:read_zarr",
           folder_markers=(".zattrs", "zarr.json", ".zarray", ".zgroup"),
           arrays="an OME-Zarr image's level of at most 256 M voxels (level= picks one), channels, time; a Zarr array "
