@@ -189,3 +189,22 @@ def test_demo_scene_bounds_are_its_terrain_and_clouds_not_the_sky_dome():
         assert controller.bounds()[:4] == pytest.approx((0.0, 1000.0, 0.0, 1000.0))    # the dome is 3 km wide
     finally:
         plotter.close()
+
+
+def test_signed_data_around_zero_gets_the_diverging_view():
+    """Seismic-like amplitudes: zero transparent and white, both signs alike in opacity, blue below and red above,
+    the peak held beyond the robust range on both sides; the mean sample still reaches the target depth."""
+    values = np.random.default_rng(5).laplace(0.0, 100.0, 200_000)
+    tf = auto_transfer_function(values, chord=4.0)
+    lo, hi = robust_range(values)
+    reach = max(-lo, hi)
+    rho = _rho(tf, np.array([0.0, -0.5 * reach, 0.5 * reach, -reach, reach, values.min(), values.max()]))
+    assert rho[0] == 0.0 and rho[1] == pytest.approx(rho[2]) and rho[3] == pytest.approx(rho[4])
+    assert rho[3] > rho[1] > 0
+    assert rho[5] == pytest.approx(rho[3]) and rho[6] == pytest.approx(rho[4])
+    colors = tf.evaluate(np.array([-reach, 0.0, reach]))[0]
+    assert colors[0][2] > colors[0][0] and colors[2][0] > colors[2][2]            # blue below, red above
+    np.testing.assert_allclose(colors[1], (0.87, 0.87, 0.87), atol=1e-6)
+    assert float(np.mean(_rho(tf, values))) * 4.0 == pytest.approx(TARGET_DEPTH, rel=0.02)
+    one_sided = auto_transfer_function(np.random.default_rng(6).uniform(-10.0, 100.0, 50_000), chord=4.0)
+    assert _rho(one_sided, np.array([-9.0]))[0] == 0.0 < _rho(one_sided, np.array([95.0]))[0]   # mostly positive

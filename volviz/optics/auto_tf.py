@@ -7,6 +7,11 @@ over the same percentiles. The peak extinction is set so that a ray crossing the
 optical depth of about ``TARGET_DEPTH`` for the average sample, whatever the data's units and spread: the image is
 neither faint nor a solid block. Values above the upper percentile keep the peak opacity and color; the function
 spans the whole finite range, because volviz draws scalars outside a transfer function's range as transparent.
+
+Signed data around zero (seismic amplitudes, a velocity component, vorticity, an orbital's two signs: robust
+percentiles of opposite signs, the smaller at least ``SIGNED_BALANCE`` of the larger) gets the diverging view
+instead: zero transparent and white, the ramp rising towards both signs alike, blue for negative and red for
+positive values. The one-sided ramp would show only the positive half.
 """
 from __future__ import annotations
 
@@ -21,6 +26,7 @@ MIN_DEPTH, MAX_DEPTH = 1.5, 60.0   # bounds of the peak extinction times the cho
 MAX_SAMPLES = 2_000_000        # the statistics use an even subsample of larger data
 COOL_WARM = ((0.23, 0.30, 0.75), (0.55, 0.69, 0.94), (0.87, 0.87, 0.87), (0.96, 0.60, 0.48), (0.71, 0.02, 0.15))
 RAMP = (0.0, 0.08, 0.3, 0.65, 1.0)     # extinction at the five color stops, as a share of the peak
+SIGNED_BALANCE = 0.25          # signed data: the smaller of |low| and |high| percentile over the larger, at least
 
 
 def finite_sample(values: np.ndarray) -> np.ndarray:
@@ -78,11 +84,32 @@ def auto_transfer_function(values: np.ndarray, chord: float, name: str = "auto")
         pad = max(abs(full_lo) * 1e-3, 1e-6)
         return _ramp(full_lo - pad, full_hi + pad, full_lo - pad, full_hi + pad, MIN_DEPTH / chord, name)
     lo, hi = robust_range(sample)
-    shape = np.interp(sample, np.linspace(lo, hi, len(RAMP)), RAMP)
+    signed = is_signed(lo, hi)
+    reach = max(-lo, hi)
+    shape = (np.interp(np.abs(sample), np.linspace(0.0, reach, len(RAMP)), RAMP) if signed
+             else np.interp(sample, np.linspace(lo, hi, len(RAMP)), RAMP))
     mean = float(shape.mean())
     depth = TARGET_DEPTH / mean if mean > 0 else MAX_DEPTH
     rho_max = float(np.clip(depth, MIN_DEPTH, MAX_DEPTH)) / chord
+    if signed:
+        return _diverging(full_lo, full_hi, reach, rho_max, name)
     return _ramp(full_lo, full_hi, lo, hi, rho_max, name)
+
+
+def is_signed(lo: float, hi: float) -> bool:
+    """Whether robust percentiles ``lo`` < 0 < ``hi`` are balanced enough for the diverging view."""
+    return lo < 0.0 < hi and min(-lo, hi) >= SIGNED_BALANCE * max(-lo, hi)
+
+
+def _diverging(full_lo: float, full_hi: float, reach: float, rho_max: float, name: str) -> TransferFunction:
+    """The ramp mirrored about zero out to ``±reach``: cool colors below zero, warm above, held flat beyond."""
+    n = len(RAMP)
+    fractions = np.linspace(-1.0, 1.0, 2 * n - 1)
+    stops = list(fractions * reach)
+    colors = [list(np.interp(f, np.linspace(-1.0, 1.0, n), np.asarray(COOL_WARM)[:, c]) for c in range(3))
+              for f in fractions]
+    extinction = [float(np.interp(abs(f), np.linspace(0.0, 1.0, n), RAMP)) * rho_max for f in fractions]
+    return _held_flat(full_lo, full_hi, stops, colors, extinction, name, hold_low=True)
 
 
 def _ramp(full_lo: float, full_hi: float, lo: float, hi: float, rho_max: float, name: str) -> TransferFunction:
@@ -90,10 +117,17 @@ def _ramp(full_lo: float, full_hi: float, lo: float, hi: float, rho_max: float, 
     stops = list(np.linspace(lo, hi, len(RAMP)))
     colors = [list(c) for c in COOL_WARM]
     extinction = [r * rho_max for r in RAMP]
+    return _held_flat(full_lo, full_hi, stops, colors, extinction, name)
+
+
+def _held_flat(full_lo: float, full_hi: float, stops: list, colors: list, extinction: list, name: str,
+               hold_low: bool = False) -> TransferFunction:
+    """The function over ``stops`` extended to the full range: its last stop held above; below, transparent or
+    (``hold_low``) its first stop held."""
     if full_lo < stops[0]:
         stops.insert(0, full_lo)
         colors.insert(0, colors[0])
-        extinction.insert(0, 0.0)
+        extinction.insert(0, extinction[0] if hold_low else 0.0)
     if full_hi > stops[-1]:
         stops.append(full_hi)
         colors.append(colors[-1])
