@@ -126,6 +126,9 @@ def _describe(window: Any, record: FirstOpen) -> None:
     if window.error_dialog is not None:
         text = " ".join(window.error_dialog.text().split())
         record.notes.append("error dialog: " + (text if len(text) <= NOTE_CHARS else text[:NOTE_CHARS] + " …"))
+    if window.raw_dialog is not None:
+        record.notes.append(f"headerless data: the layout dialog opens with the guess "
+                            f"{window.raw_dialog.describe(window.raw_dialog.layout())}")
     if window.controller is None:
         return
     steps = ((lambda w: _format(w, record.path), "format"), (_kind, "kind"), (_dimensions, "dimensions"),
@@ -161,9 +164,9 @@ def open_one(app: Any, path: Path, root: Path, out: Path, workdir: Path) -> Firs
 
     start = time.perf_counter()
     window.open_path(path)
-    done = pump_events(app, lambda: window.error_dialog is not None or (
+    done = pump_events(app, lambda: window.error_dialog is not None or window.raw_dialog is not None or (
         window.controller is not None and not window.progress_bar.isVisible()), TIMEOUT_S)
-    if window.error_dialog is None and done:
+    if window.error_dialog is None and window.raw_dialog is None and done:
         window.plotter.render()
     record.seconds = time.perf_counter() - start
     if not done:
@@ -175,8 +178,9 @@ def open_one(app: Any, path: Path, root: Path, out: Path, workdir: Path) -> Firs
     save_small_png(shot)
     record.screenshot = shot.name
     window.dirty = False
-    if window.error_dialog is not None:
-        window.error_dialog.close()
+    for dialog in (window.error_dialog, window.raw_dialog):
+        if dialog is not None:
+            dialog.close()
     window.close()
     window.deleteLater()
     pump_events(app, lambda: False, 0.1)

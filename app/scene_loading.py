@@ -17,7 +17,7 @@ import os
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, Optional
 
-from PySide6.QtCore import QByteArray, QTimer
+from PySide6.QtCore import QByteArray, Qt, QTimer
 
 from volviz.jobs import JobOutcome
 from volviz.session import Session
@@ -34,6 +34,8 @@ STAGE_MS = 30            # pause between GUI-thread stages of showing a new scen
 
 class SceneLoading(WindowBase):
     """Opening files and showing sessions (see the module's docstring)."""
+
+    raw_dialog: Optional[Any] = None     # the layout dialog of the last headerless data opened
 
     def open_demo(self) -> None:
         from volviz.render.scene_builder import demo_session
@@ -67,12 +69,29 @@ class SceneLoading(WindowBase):
         try:
             if not p.exists():
                 raise FileNotFoundError(p)
+            if q is None and self._ask_raw_layout(p):
+                return
             session, session_path = (load(p), p) if is_session_file(p) else (data_session(p, q), None)
         except Exception as exc:  # the file's fault or ours: a message in the user's terms, the scene stays
             self.show_error(f"Cannot open {p.name}", open_error(p, exc))
             return
         # File > Open Recent lists it once it has opened
         self._show_session(session, session_path, p.name, path=p, on_shown=lambda: self.recent.add(p))
+
+    def _ask_raw_layout(self, path: Path) -> bool:
+        """For headerless data (``volviz.io.raw_layout.headerless_data``), the dialog that asks its layout (kept as
+        ``raw_dialog``; Open opens the header it writes). True when the dialog was shown."""
+        from volviz.io.raw_layout import headerless_data
+
+        from .raw_import import RawImportDialog
+
+        files = headerless_data(path)
+        if not files:
+            return False
+        self.raw_dialog = RawImportDialog(files, self.open_path, self)
+        self.raw_dialog.setWindowModality(Qt.WindowModality.WindowModal)
+        self.raw_dialog.open()
+        return True
 
     def _show_session(self, session: Session, session_path: Optional[Path], title: str,
                       dirty: bool = False, datasets: Optional[dict[str, Any]] = None, path: Optional[Path] = None,

@@ -29,11 +29,11 @@ def screenshot(app: Any, window: Any, target: str | None, out: Path) -> int:
         window.open_path(target)
     else:
         window.open_demo()
-    shown = pump_events(app, lambda: window.error_dialog is not None or (
+    shown = pump_events(app, lambda: window.error_dialog is not None or window.raw_dialog is not None or (
         window.controller is not None and not window.progress_bar.isVisible()), TIMEOUT_S)
     pump_events(app, lambda: False, 0.5)
     window.plotter.render()
-    window.grab().save(str(out))
+    (window.raw_dialog or window).grab().save(str(out))    # headerless data: the dialog asking its layout
     window.dirty = False
     failed = window.error_dialog is not None or not shown
     if failed:

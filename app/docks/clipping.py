@@ -12,9 +12,10 @@ from typing import Any, Optional, Sequence
 
 from PySide6.QtCore import Signal
 from PySide6.QtGui import QUndoCommand, QUndoStack
-from PySide6.QtWidgets import (QCheckBox, QDoubleSpinBox, QFormLayout, QGroupBox, QHBoxLayout, QListWidget,
+from PySide6.QtWidgets import (QCheckBox, QDoubleSpinBox, QFormLayout, QGroupBox, QListWidget,
                                QPushButton, QVBoxLayout, QWidget)
 
+from ..widget_row import widget_row
 from . import set_tooltips
 
 NO_CLIP: dict[str, Any] = {"planes": [], "box": None}
@@ -28,15 +29,6 @@ def _spin(decimals: int = 4) -> QDoubleSpinBox:
     box.setKeyboardTracking(False)  # typed values apply on Enter / focus out, not per keystroke
     box.setMinimumWidth(64)         # not as wide as the longest value of the range: three fit in a narrow dock
     return box
-
-
-def _row(boxes: Sequence[QWidget]) -> QWidget:
-    w = QWidget()
-    lay = QHBoxLayout(w)
-    lay.setContentsMargins(0, 0, 0, 0)
-    for b in boxes:
-        lay.addWidget(b)
-    return w
 
 
 def plane_offset(plane: dict[str, Any]) -> tuple[tuple[float, float, float], float]:
@@ -112,19 +104,19 @@ class ClippingDock(QWidget):
         planes = QGroupBox("Clipping planes (keep x·n ≥ offset)")
         form = QFormLayout(planes)
         form.addRow(self.plane_list)
-        form.addRow(_row([self.add_button, self.remove_button, self.flip_button]))
-        form.addRow("Normal", _row(self.normal))
+        form.addRow(widget_row([self.add_button, self.remove_button, self.flip_button]))
+        form.addRow("Normal", widget_row(self.normal))
         form.addRow("Offset", self.offset)
         form.addRow(self.show_widget)
         box = QGroupBox("Box")
         box_form = QFormLayout(box)
         box_form.addRow(self.box_enabled)
-        box_form.addRow("Min", _row(self.box_lo))
-        box_form.addRow("Max", _row(self.box_hi))
+        box_form.addRow("Min", widget_row(self.box_lo))
+        box_form.addRow("Max", widget_row(self.box_hi))
         layout = QVBoxLayout(self)
         layout.addWidget(planes)
         layout.addWidget(box)
-        layout.addWidget(_row([self.undo_button, self.redo_button]))
+        layout.addWidget(widget_row([self.undo_button, self.redo_button]))
         layout.addStretch(1)
 
         self.add_button.clicked.connect(self.add_plane)

@@ -1,5 +1,6 @@
 """MetaImage (ITK/VTK): a text header ``Key = Value`` per line, ending with ``ElementDataFile``; data in a
-separate file (.mhd + .raw) or after the header (``ElementDataFile = LOCAL``, .mha). Optional zlib compression
+separate file (.mhd + .raw), after the header (``ElementDataFile = LOCAL``, .mha), or in one file per slice
+(``ElementDataFile = LIST`` followed by their names, or a pattern ``quarter.%d 1 93 1``). Optional zlib compression
 (``CompressedData = True``). 2D images become Image2D (rows = DimSize[1]), 3D images RegularVolume.
 """
 from __future__ import annotations
@@ -73,6 +74,29 @@ def _floats(path: PathLike, fields: dict[str, str], keys: tuple[str, ...], n: in
     return (default,) * n
 
 
+def _slice_files(path: PathLike, data_name: str, rest: bytes, nz: int) -> list[Path]:
+    """The slice files of ``ElementDataFile = LIST`` (one name per line after it) or of a printf pattern
+    ``name.%03d first last step``, relative to the header's folder; as many as there are slices."""
+    folder = Path(path).parent
+    if data_name.upper().startswith("LIST"):
+        names = [ln.strip() for ln in rest.decode("utf-8", "replace").splitlines() if ln.strip()][:nz]
+    else:
+        parts = data_name.split()
+        if len(parts) != 4:
+            raise ReadError(path, f"MetaImage ElementDataFile pattern {data_name!r} is not 'name%d first last step'")
+        first, last, step = (parse_int(path, t, "MetaImage ElementDataFile pattern") for t in parts[1:])
+        if step == 0 or (last - first) // step + 1 != nz:
+            raise ReadError(path, f"MetaImage ElementDataFile pattern {data_name!r} names "
+                                  f"{max((last - first) // step + 1, 0) if step else 0} slices, DimSize {nz}")
+        try:
+            names = [parts[0] % i for i in range(first, last + (1 if step > 0 else -1), step)]
+        except (TypeError, ValueError):
+            raise ReadError(path, f"MetaImage ElementDataFile pattern {parts[0]!r} is not a printf pattern") from None
+    if len(names) != nz:
+        raise ReadError(path, f"MetaImage ElementDataFile LIST names {len(names)} slice files, DimSize {nz}")
+    return [folder / name for name in names]
+
+
 def read_metaimage(path: PathLike, allow_nonfinite: bool = True) -> RegularVolume | Image2D:
     """Read .mhd (+ data file) or .mha into RegularVolume (3D) or Image2D (2D, any number of channels).
 
@@ -122,9 +146,16 @@ def _read_metaimage(path: PathLike, allow_nonfinite: bool) -> RegularVolume | Im
     data_name = fields["elementdatafile"]
     if data_name.upper() == "LOCAL":
         data_path, data_size, offset = Path(path), size, header_end
-    elif data_name.upper() == "LIST" or "%" in data_name or len(data_name.split()) > 1:
-        raise ReadError(path, "MetaImage ElementDataFile names a list or pattern of slice files, which is not "
-                              "supported; use one data file")
+    elif data_name.upper().startswith("LIST") or "%" in data_name:
+        if ndims != 3 or compressed or not binary:
+            raise ReadError(path, "MetaImage slice files (ElementDataFile LIST or a pattern) are read for 3D "
+                                  "uncompressed binary data only")
+        from volviz.io.raw import read_slice_stack
+
+        slices = _slice_files(path, data_name, head[header_end:], dims[2])
+        header_size = parse_int(path, fields.get("headersize", "0"), "MetaImage HeaderSize")
+        return read_slice_stack(slices, dims, disk.newbyteorder("="), "big" if msb else "little",
+                                max(header_size, 0), spacing, origin, allow_nonfinite, name="MetaImage")
     else:
         data_path = Path(path).parent / data_name
         if not data_path.exists():

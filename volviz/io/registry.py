@@ -362,13 +362,15 @@ def spec_of(path: PathLike, options: dict | None = None) -> ReaderSpec:
             raise ReadError(p, f"is the raw data of {headers[0]}",
                             f"open {headers[0]}, the header that describes it")
         raise ReadError(p, "is raw data without a header: volviz needs its dimensions and sample type",
-                        "write a MetaImage header (.mhd) naming them next to it and open that (in Python: "
-                        "volviz.io.read_raw)")
+                        "write a MetaImage header (.mhd) naming them next to it and open that; volviz-app guesses "
+                        "the layout from the data and writes that header for you (in Python: "
+                        "volviz.io.raw_layout.guess_layouts, volviz.io.read_raw)")
     if re.search(r"\.\d+$", p.name):
         raise ReadError(p, "looks like one slice of a stack of numbered slices without a header: volviz needs the "
                            "slices' size and sample type",
                         "write a MetaImage header (.mhd) whose ElementDataFile lists the slices (or a pattern) and "
-                        "open that (in Python: volviz.io.read_slice_stack)")
+                        "open that; volviz-app guesses the layout from the data and writes that header for you (in "
+                        "Python: volviz.io.raw_layout.guess_layouts, volviz.io.read_slice_stack)")
     raise ReadError(p, f"unknown data format (extension {ext or 'none'!r}, content: {describe_bytes(head)}); "
                        "supported: " + _described(s for s in specs if s.listed))
 
