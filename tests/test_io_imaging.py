@@ -651,3 +651,32 @@ def test_mutated_cube_files_read_consistently_or_raise_read_error(tmp_path):
     mutations = [rb.flip_bits(data, rng, 500) for _ in range(16)]
     mutations += [rb.truncate(data, at) for at in sorted(rng.sample(range(1, len(data) - 1), 12))]
     assert read_mutations(path, mutations, truncated_reads_same=True) >= 12
+
+
+@pytest.mark.parametrize("syntax", ["JPEGLosslessProcess14_1", "JPEGLSLossless", "JPEG2000Lossless"])
+def test_compressed_dicom_series_read_the_same_voxels(tmp_path, syntax):
+    """A series compressed by GDCM into the transfer syntaxes of clinical exports (JPEG Lossless, JPEG-LS,
+    JPEG 2000) reads voxel for voxel as the uncompressed series."""
+    import gdcm
+
+    values = _stored((4, 12, 10), seed=3)
+    names = [f"s{i}.dcm" for i in range(4)]
+    dicom_series(tmp_path / "plain", values, (1.0, 0.0, 0.0, 0.0, 1.0, 0.0), (0, 0, 0), (0.5, 0.5), 2.0, names)
+    (tmp_path / "packed").mkdir()
+    for name in names:
+        reader = gdcm.ImageReader()
+        reader.SetFileName(str(tmp_path / "plain" / name))
+        assert reader.Read()
+        change = gdcm.ImageChangeTransferSyntax()
+        change.SetTransferSyntax(gdcm.TransferSyntax(getattr(gdcm.TransferSyntax, syntax)))
+        change.SetInput(reader.GetImage())
+        assert change.Change()
+        writer = gdcm.ImageWriter()
+        writer.SetFileName(str(tmp_path / "packed" / name))
+        writer.SetFile(reader.GetFile())
+        writer.SetImage(change.GetOutput())
+        assert writer.Write()
+    assert pydicom.dcmread(tmp_path / "packed" / names[0]).file_meta.TransferSyntaxUID.is_compressed
+    plain, packed = vio.read(tmp_path / "plain"), vio.read(tmp_path / "packed")
+    np.testing.assert_array_equal(packed.data, plain.data)
+    assert packed.spacing == plain.spacing and packed.origin == plain.origin

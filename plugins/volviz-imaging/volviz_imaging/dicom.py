@@ -12,8 +12,10 @@
 - A folder whose slices repeat each position the same number of times (cardiac phases, dynamic series) becomes a
   ``TimeSeries`` of volumes, ordered by TriggerTime / AcquisitionTime / InstanceNumber within a position.
 - Values through the modality LUT (RescaleSlope / RescaleIntercept: CT in Hounsfield units); RGB slices give one
-  array of three components. Compressed pixel data is decoded by pydicom's decoders (RLE always, JPEG and JPEG 2000
-  through Pillow); a transfer syntax no installed decoder handles is named in the error.
+  array of three components. Compressed pixel data is decoded by pydicom's decoders: RLE natively, and through GDCM
+  (python-gdcm) JPEG Lossless (Process 14, the usual PACS export), JPEG-LS, JPEG 2000 and JPEG baseline; 12-bit JPEG
+  Extended needs pylibjpeg-libjpeg (GPL, not installed). A transfer syntax no installed decoder handles is named in
+  the error.
 """
 from __future__ import annotations
 
