@@ -16,6 +16,7 @@ Readers (each returns a ``volviz.model`` dataset, convertible with ``.to_pyvista
 - PNG/JPEG/TIFF/BMP (Pillow)              -> Image2D
 - anything meshio reads                   -> UnstructuredMesh
 - a numbered series (list, glob, ``%d``)  -> TimeSeries with lazy frames (``read_series``)
+- a folder no reader opens itself         -> its collection file or largest numbered series (``folders``)
 
 More formats come from reader plugins (entry-point group ``volviz.readers``, see ``volviz.io.registry``); the
 optional ``volviz-vtk-readers`` plugin in ``plugins/`` adds Exodus II, OpenFOAM, CGNS, EnSight, netCDF CF, Tecplot,
@@ -27,9 +28,11 @@ Float data holding NaN/Inf is kept (renderers draw it transparent) with a ``NonF
 from __future__ import annotations
 
 import functools
+import os
 from typing import Any
 
 from volviz.io.errors import NonFiniteWarning, PathLike, ReadError, ReadWarning
+from volviz.io.folders import folder_target
 from volviz.io.raw import read_raw, read_slice_stack
 from volviz.io.registry import (ReaderSpec, call_reader, format_of, is_pattern, open_dialog_filter, reader_specs,
                                 supported_formats)
@@ -50,7 +53,13 @@ def read(path: PathLike, isolate: bool | None = None, **options: Any):
         if isolate is None:
             return read_series(path, **options)
         return read_series(path, reader=functools.partial(read, isolate=isolate), **options)
-    kind = format_of(path, options)
+    try:
+        kind = format_of(path, options)
+    except ReadError:
+        target = folder_target(path) if os.path.isdir(path) else None
+        if target is None:
+            raise
+        return read(target, isolate, **options)      # a folder of output: its collection file or numbered series
     return call_reader(kind, path, options, isolate)
 
 

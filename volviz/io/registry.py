@@ -307,7 +307,9 @@ def _folder_spec(p: Path) -> ReaderSpec:
             return spec
     folders = [s for s in reader_specs() if s.opens_folders]
     known = "; ".join(f"{s.description} (holding {' or '.join(_folder_signs(s))})" for s in folders)
-    raise ReadError(p, "is a directory, not a file" + (f", and not a folder volviz opens: {known}" if known else ""))
+    raise ReadError(p, "is a directory, not a file" + (f", and not a folder volviz opens: {known}" if known else "")
+                    + "; nor does it hold one collection file (.pvd, .xdmf, .vtm, .foam, .case) or a numbered series of "
+                      "data files")
 
 
 def _folder_signs(spec: ReaderSpec) -> tuple[str, ...]:

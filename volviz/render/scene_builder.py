@@ -13,6 +13,7 @@ from typing import Any, Optional
 
 import numpy as np
 
+from volviz.io.folders import MIN_SERIES_FILES, numbered_pattern
 from volviz.jobs import ProgressCallback, report
 from volviz.model.applicability import DatasetTraits
 from volviz.render.backend import backend_setting
@@ -23,7 +24,6 @@ class SceneError(Exception):
     """A session that cannot be shown: names the component and the problem."""
 
 
-MIN_SERIES_FILES = 3
 
 
 def series_pattern(path: str | os.PathLike) -> Optional[str]:
@@ -36,7 +36,7 @@ def series_pattern(path: str | os.PathLike) -> Optional[str]:
     match = re.search(r"(\d+)(?!.*\d)", p.name)
     if match is None:
         return None
-    head, digits, tail = p.name[:match.start()], match.group(1), p.name[match.end():]
+    head, tail = p.name[:match.start()], p.name[match.end():]
     rx = re.compile(re.escape(head) + r"(\d+)" + re.escape(tail) + r"\Z")
     try:
         siblings = [name for name in os.listdir(p.parent) if rx.match(name)]
@@ -44,9 +44,28 @@ def series_pattern(path: str | os.PathLike) -> Optional[str]:
         return None
     if len(siblings) < MIN_SERIES_FILES:
         return None
-    widths = {len(rx.match(name).group(1)) for name in siblings}  # type: ignore[union-attr]
-    number = f"%0{len(digits)}d" if len(widths) == 1 and digits.startswith("0") else "%d"
-    return str(p.parent.resolve() / f"{head}{number}{tail}")
+    numbers = [rx.match(name).group(1) for name in siblings]  # type: ignore[union-attr]
+    return str(p.parent.resolve() / numbered_pattern(head, numbers, tail))
+
+
+def _shown_in_folder(path: str | os.PathLike) -> str | os.PathLike:
+    """A folder that no reader opens itself shows its collection file, or the first file of its largest numbered
+    series (``volviz.io.folders``); anything else is shown as it is."""
+    from volviz.io import ReadError
+    from volviz.io.folders import folder_target
+    from volviz.io.registry import spec_of
+    from volviz.io.series import expand_pattern
+
+    if not Path(path).is_dir():
+        return path
+    try:
+        spec_of(path)
+        return path
+    except ReadError:
+        target = folder_target(path)
+    if target is None:
+        return path                           # reading it says why it does not open
+    return expand_pattern(target)[0][1] if "%" in Path(target).name else target
 
 
 def _reads_siblings(path: Path) -> bool:
@@ -67,6 +86,7 @@ def data_session(path: str | os.PathLike, q: Optional[str | os.PathLike] = None)
     when there is none)."""
     from volviz.io.plot3d_pairs import grid_of_solution, is_plot3d_solution
 
+    path = _shown_in_folder(path)
     if is_height_map(path):
         return terrain_session(path)
     if q is None and Path(path).is_file() and is_plot3d_solution(path):
