@@ -178,6 +178,8 @@ BUILTIN_READERS: list[ReaderSpec] = [
     ReaderSpec("slc", "SLC volume", ("*.slc",), "volviz.io.slc:read_slc", sniff=_sniff_slc, arrays="one scalar volume"),
     ReaderSpec("metaimage", "MetaImage", ("*.mhd", "*.mha"), "volviz.io.metaimage:read_metaimage",
                sniff=_sniff_metaimage, arrays="one scalar volume or image", options=("allow_nonfinite",)),
+    ReaderSpec("bov", "VisIt brick of values", ("*.bov",), "volviz.io.bov:read_bov", sniff="volviz.io.bov:is_bov",
+               arrays="one array (its components as one array) named by VARIABLE", options=("allow_nonfinite",)),
     ReaderSpec("vtk", "VTK legacy", ("*.vtk",), "volviz.io.vtkfiles:read_vtk_file",
                sniff=lambda head: head.startswith(b"# vtk DataFile"), sniff_opens=False,
                arrays="every point and cell array", options=("allow_nonfinite",), isolated=True),
@@ -308,8 +310,8 @@ def _folder_spec(p: Path) -> ReaderSpec:
     folders = [s for s in reader_specs() if s.opens_folders]
     known = "; ".join(f"{s.description} (holding {' or '.join(_folder_signs(s))})" for s in folders)
     raise ReadError(p, "is a directory, not a file" + (f", and not a folder volviz opens: {known}" if known else "")
-                    + "; nor does it hold one collection file (.pvd, .xdmf, .vtm, .foam, .case) or a numbered series of "
-                      "data files")
+                    + "; nor does it hold one collection file (.pvd, .xdmf, .vtm, .foam, .case) or a numbered "
+                      "series of data files")
 
 
 def _folder_signs(spec: ReaderSpec) -> tuple[str, ...]:
