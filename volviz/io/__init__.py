@@ -7,6 +7,7 @@ Readers (each returns a ``volviz.model`` dataset, convertible with ``.to_pyvista
 - PVM v1/v2/v3, 8/16 bit (DDS refused)    -> RegularVolume
 - SLC (raw or run-length coded)           -> RegularVolume
 - MetaImage .mhd/.raw, .mha               -> RegularVolume (3D) or Image2D (2D)
+- VisIt brick of values .bov             -> RegularVolume (zonal values at the cell centres)
 - raw volumes (explicit dims/type/order)  -> RegularVolume (``read_raw``), slice stacks (``read_slice_stack``)
 - VTK legacy .vtk, XML .vti .vtu .vts .vtr .vtp -> RegularVolume / CurvilinearGrid / UnstructuredMesh
 - VTKHDF (static or transient)            -> the matching dataset, or TimeSeries with lazy frames

@@ -1,0 +1,69 @@
+"""VisIt's Brick of Values (``volviz.io.bov``): zonal and nodal bricks placed in their brick, byte order,
+components, offsets, and headers or data files that do not fit."""
+from __future__ import annotations
+
+import random
+
+import numpy as np
+import pytest
+from conftest import read_mutations
+
+import volviz.io as vio
+from volviz.bench import robustness as rb
+from volviz.io.errors import ReadError
+from volviz.model import RegularVolume
+
+VALUES = np.random.default_rng(0).normal(size=(6, 5, 4))          # [x, y, z]
+
+
+def _brick(folder, header: str, data: bytes, name="brick.bov"):
+    (folder / "brick.values").write_bytes(data)
+    path = folder / name
+    path.write_text(header)
+    return path
+
+
+HEADER = ("TIME: 2.5\nDATA_FILE: brick.values\nDATA_SIZE: 6 5 4\nDATA_FORMAT: FLOAT\nVARIABLE: density\n"
+          "DATA_ENDIAN: LITTLE\nCENTERING: zonal\nBRICK_ORIGIN: -3 0 10\nBRICK_SIZE: 6 10 2\n")
+
+
+def test_a_zonal_brick_is_placed_at_its_cell_centres(tmp_path):
+    volume = vio.read(_brick(tmp_path, HEADER, VALUES.astype("<f4").tobytes(order="F")))
+    assert isinstance(volume, RegularVolume) and volume.name == "density" and volume.dimensions == (6, 5, 4)
+    np.testing.assert_array_equal(volume.data, VALUES.astype(np.float32))
+    assert volume.spacing == (1.0, 2.0, 0.5) and volume.origin == (-2.5, 1.0, 10.25)
+    nodal = HEADER.replace("zonal", "nodal").replace("LITTLE", "BIG").replace("FLOAT", "DOUBLE")
+    volume = vio.read(_brick(tmp_path, nodal, VALUES.astype(">f8").tobytes(order="F")))
+    np.testing.assert_array_equal(volume.data, VALUES)
+    np.testing.assert_allclose(volume.spacing, (6 / 5, 10 / 4, 2 / 3))
+    assert volume.origin == (-3.0, 0.0, 10.0)
+
+
+def test_components_and_byte_offset(tmp_path):
+    vectors = np.stack([VALUES, -VALUES, 2 * VALUES], axis=0)          # components fastest on disk
+    header = HEADER + "DATA_COMPONENTS: 3\nBYTE_OFFSET: 16\n"
+    volume = vio.read(_brick(tmp_path, header, bytes(16) + vectors.astype("<f4").tobytes(order="F")))
+    assert volume.arrays["density"].shape == (6, 5, 4, 3)
+    np.testing.assert_array_equal(volume.arrays["density"][..., 2], (2 * VALUES).astype(np.float32))
+
+
+@pytest.mark.parametrize("edit, problem", [
+    (lambda h: h.replace("6 5 4", "6 5 5"), "need 480 bytes .* the file holds 480|need 600 bytes"),
+    (lambda h: h.replace("FLOAT", "QUAD"), "BOV DATA_FORMAT 'QUAD' is not one of"),
+    (lambda h: h.replace("brick.values", "gone.values"), "its data file gone.values is missing"),
+    (lambda h: h.replace("DATA_SIZE: 6 5 4\n", ""), "is not a BOV header"),
+    (lambda h: h.replace("BRICK_SIZE: 6 10 2", "BRICK_SIZE: 6 -10 2"), "BRICK_SIZE .* is not positive"),
+])
+def test_headers_that_do_not_fit_are_refused_naming_the_file(tmp_path, edit, problem):
+    path = _brick(tmp_path, edit(HEADER), VALUES.astype("<f4").tobytes(order="F"))
+    with pytest.raises(ReadError, match=problem):
+        vio.read(path)
+
+
+def test_mutated_headers_read_consistently_or_raise_read_error(tmp_path):
+    path = _brick(tmp_path, HEADER, VALUES.astype("<f4").tobytes(order="F"))
+    data = path.read_bytes()
+    rng = random.Random("bov")
+    mutations = [rb.flip_bits(data, rng, len(data)) for _ in range(24)]
+    mutations += [rb.truncate(data, at) for at in sorted(rng.sample(range(1, len(data)), 12))]
+    assert read_mutations(path, mutations, truncated_reads_same=True) >= 12
