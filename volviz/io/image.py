@@ -1,5 +1,6 @@
 """Ordinary raster images (PNG, JPEG, TIFF, BMP) -> Image2D (e.g. the sky/clouds.jpeg photo); multi-page TIFF
-stacks (microscopy) -> a volume through ``volviz.io.tiffstack``.
+stacks (microscopy) -> a volume through ``volviz.io.tiffstack``; single-band GeoTIFFs -> heights in metres through
+``volviz.io.elevation``; TIFFs of 32-bit samples as stored.
 
 The header is read first (Pillow); images of more than ``MAX_PIXELS`` pixels are refused before decoding (a small
 compressed file can describe a gigantic image). PNG, TIFF and BMP are decoded by Pillow; JPEG by VTK's
@@ -31,6 +32,11 @@ def read_image(path: PathLike) -> Image2D | RegularVolume | TimeSeries:
         stack = read_tiff_stack(path)
         if stack is not None:
             return stack
+        from volviz.io.elevation import geotiff_tags, read_geotiff_dem
+
+        tags = geotiff_tags(path)
+        if tags is not None:
+            return read_geotiff_dem(path, tags)
     with open_file(path) as fh:
         try:
             with Image.open(fh) as im:
@@ -41,6 +47,8 @@ def read_image(path: PathLike) -> Image2D | RegularVolume | TimeSeries:
                     raise ReadError(path, f"image claims {width}x{height} pixels, more than the limit of {MAX_PIXELS}")
                 if im.format == "JPEG" and im.mode in ("L", "RGB"):
                     data = _jpeg_pixels(path)
+                elif im.mode in ("F", "I") and im.format == "TIFF":   # 32-bit samples: as stored, not as color
+                    data = _tiff_page(path)
                 else:
                     if im.mode not in ("L", "I;16", "I;16B", "RGB", "RGBA"):
                         im = im.convert("RGBA" if "A" in im.getbands() else "RGB")
@@ -51,6 +59,17 @@ def read_image(path: PathLike) -> Image2D | RegularVolume | TimeSeries:
             raise ReadError(path, f"not a readable image ({type(exc).__name__}: {str(exc)[:200]})") from None
     maxval = 65535 if data.dtype == np.uint16 else 255
     return Image2D(data, maxval=maxval, source=str(path))
+
+
+def _tiff_page(path: PathLike) -> np.ndarray:
+    """The first page of a TIFF of 32-bit samples (float heights, counts) as stored, by tifffile."""
+    import tifffile
+
+    try:
+        with tifffile.TiffFile(str(path)) as tif:
+            return tif.pages.first.asarray()
+    except (tifffile.TiffFileError, ValueError, OSError, EOFError) as exc:
+        raise ReadError(path, f"its samples could not be read ({exc})") from None
 
 
 def _jpeg_pixels(path: PathLike) -> np.ndarray:

@@ -202,6 +202,8 @@ BUILTIN_READERS: list[ReaderSpec] = [
                options=("variable", "allow_nonfinite"), isolated=True),
     ReaderSpec("pnm", "PGM/PPM image", ("*.pgm", "*.ppm", "*.pnm"), "volviz.io.pnm:read_pnm",
                sniff="volviz.io.pnm:is_pnm", arrays="grey levels or RGB"),
+    ReaderSpec("hgt", "SRTM height tile", ("*.hgt",), "volviz.io.elevation:read_hgt",
+               arrays="heights in metres (voids at the lowest height)"),
     ReaderSpec("dem", "USGS DEM", ("*.dem",), "volviz.io.dem:read_dem", arrays="heights in metres",
                options=("vtk_compatible",)),
     ReaderSpec("image", "Raster image", ("*.png", "*.jpg", "*.jpeg", "*.tif", "*.tiff", "*.bmp"),

@@ -119,15 +119,20 @@ RELIEF = 0.1        # a grey-level height map opened directly rises to at most 1
 
 
 def is_height_map(path: str | os.PathLike) -> bool:
-    """Whether opening ``path`` should show a terrain: a USGS DEM, or a grey PGM (not part of a numbered series)."""
+    """Whether opening ``path`` should show a terrain: a USGS DEM, a grey PGM (not part of a numbered series), an
+    SRTM tile or a single-band GeoTIFF (``volviz.io.elevation``)."""
+    from volviz.io.elevation import is_elevation_model
+
     p = Path(path)
-    return p.suffix.lower() in HEIGHT_MAP_SUFFIXES and p.is_file() and series_pattern(p) is None
+    if p.suffix.lower() in HEIGHT_MAP_SUFFIXES and p.is_file() and series_pattern(p) is None:
+        return True
+    return is_elevation_model(p)
 
 
 def terrain_session(path: str | os.PathLike) -> Session:
-    """A height map (DEM in metres, PGM in grey levels) as a natural scene: its C-LOD terrain under a sky, moved
-    to the origin; a PGM's grey levels are scaled so that its relief is at most ``RELIEF`` of its width (a DEM keeps
-    its true heights)."""
+    """A height map (DEM, GeoTIFF or SRTM tile in metres, PGM in grey levels) as a natural scene: its C-LOD terrain
+    under a sky, moved to the origin; a PGM's grey levels are scaled so that its relief is at most ``RELIEF`` of its
+    width (the others keep their true heights)."""
     from volviz.io import read
 
     image = read(path)
