@@ -380,6 +380,11 @@ SECRET = b"TOP-SECRET-PASSPHRASE"
                                                                    b"ElementDataFile = LOCAL\n"),
     ("c.mha", b"NDims = 3\nDimSize = 1 1 1\nElementType = " + SECRET + b"\nElementDataFile = LOCAL\n"),
     ("d.mha", b"NDims = 3\nDimSize = 1 1 1\nElementType = MET_UCHAR\nElementDataFile = " + SECRET + b"%d\n"),
+    ("a.bov", b"DATA_FILE: a.bov\nDATA_SIZE: 1 1 1\nDATA_FORMAT: " + SECRET + b"\n"),
+    ("b.bov", b"DATA_FILE: b.bov\nDATA_SIZE: 1 " + SECRET + b" 1\nDATA_FORMAT: FLOAT\n"),
+    ("a.pvd", b'<VTKFile type="Collection"><Collection><DataSet timestep="' + SECRET + b'" file="."/>'
+              b"</Collection></VTKFile>"),
+    ("a.cube", b"c\nc\n" + SECRET + b" 0 0 0\n1 1 0 0\n1 0 1 0\n1 0 0 1\n"),
     ("noext", SECRET + b"\x00\x01"), ("a.unknownext", SECRET),
 ])
 def test_messages_do_not_quote_the_file(tmp_path, name, content):

@@ -73,7 +73,7 @@ def test_the_written_header_opens_the_data_and_lists_or_patterns_read_the_same(t
                                                                                 "ElementDataFile = slice.%d 1 10 1"))
     np.testing.assert_array_equal(vio.read(pattern).data, field)
     pattern.write_text(pattern.read_text().replace("1 10 1", "1 9 1"))
-    with pytest.raises(ReadError, match="pattern.mhd: MetaImage ElementDataFile pattern .* names 9 slices, DimSize 10"):
+    with pytest.raises(ReadError, match="pattern.mhd: MetaImage ElementDataFile pattern names 9 slices, DimSize 10"):
         vio.read(pattern)
 
 

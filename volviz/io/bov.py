@@ -68,14 +68,14 @@ def read_bov(path: PathLike, allow_nonfinite: bool = True) -> RegularVolume:
     dims = check_dims(p, [parse_int(p, v, "BOV DATA_SIZE") for v in sizes], "BOV DATA_SIZE")
     kind = fields["DATA_FORMAT"].upper()
     if kind not in FORMATS:
-        raise ReadError(p, f"BOV DATA_FORMAT {kind!r} is not one of {', '.join(FORMATS)}")
+        raise ReadError(p, f"BOV DATA_FORMAT is not one of {', '.join(FORMATS)}")
     components = parse_int(p, fields.get("DATA_COMPONENTS", "1"), "BOV DATA_COMPONENTS")
     offset = parse_int(p, fields.get("BYTE_OFFSET", "0"), "BOV BYTE_OFFSET")
     if components < 1 or offset < 0:
         raise ReadError(p, f"BOV DATA_COMPONENTS {components} / BYTE_OFFSET {offset} out of range")
     endian = fields.get("DATA_ENDIAN", "LITTLE").upper()
     if endian not in ("LITTLE", "BIG"):
-        raise ReadError(p, f"BOV DATA_ENDIAN {endian!r} is neither LITTLE nor BIG")
+        raise ReadError(p, "BOV DATA_ENDIAN is neither LITTLE nor BIG")
     disk = file_dtype(FORMATS[kind], endian.lower())
     data_path = Path(fields["DATA_FILE"])
     data_path = data_path if data_path.is_absolute() else p.parent / data_path

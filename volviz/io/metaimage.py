@@ -83,15 +83,15 @@ def _slice_files(path: PathLike, data_name: str, rest: bytes, nz: int) -> list[P
     else:
         parts = data_name.split()
         if len(parts) != 4:
-            raise ReadError(path, f"MetaImage ElementDataFile pattern {data_name!r} is not 'name%d first last step'")
+            raise ReadError(path, "MetaImage ElementDataFile pattern is not 'name%d first last step'")
         first, last, step = (parse_int(path, t, "MetaImage ElementDataFile pattern") for t in parts[1:])
         if step == 0 or (last - first) // step + 1 != nz:
-            raise ReadError(path, f"MetaImage ElementDataFile pattern {data_name!r} names "
+            raise ReadError(path, f"MetaImage ElementDataFile pattern names "
                                   f"{max((last - first) // step + 1, 0) if step else 0} slices, DimSize {nz}")
         try:
             names = [parts[0] % i for i in range(first, last + (1 if step > 0 else -1), step)]
         except (TypeError, ValueError):
-            raise ReadError(path, f"MetaImage ElementDataFile pattern {parts[0]!r} is not a printf pattern") from None
+            raise ReadError(path, "MetaImage ElementDataFile pattern's file name is not a printf pattern") from None
     if len(names) != nz:
         raise ReadError(path, f"MetaImage ElementDataFile LIST names {len(names)} slice files, DimSize {nz}")
     return [folder / name for name in names]

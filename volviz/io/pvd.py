@@ -42,9 +42,9 @@ def _number(path: Path, index: int, element: ET.Element, name: str, default: flo
     try:
         value = float(text)
     except ValueError:
-        raise ReadError(path, f"DataSet {index + 1}: {name}={text[:40]!r} is not a number") from None
+        raise ReadError(path, f"DataSet {index + 1}: its {name} is {describe_bytes(text)}, not a number") from None
     if not math.isfinite(value):
-        raise ReadError(path, f"DataSet {index + 1}: {name}={text[:40]!r} is not finite")
+        raise ReadError(path, f"DataSet {index + 1}: its {name} is not finite")
     return value
 
 

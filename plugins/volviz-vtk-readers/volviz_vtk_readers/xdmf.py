@@ -50,9 +50,9 @@ def _dimensions(p: Path, text: str | None) -> tuple[int, ...] | None:
     try:
         dims = tuple(int(v) for v in text.split())
     except ValueError:
-        raise ReadError(p, f"a DataItem's Dimensions={text[:40]!r} are not whole numbers") from None
+        raise ReadError(p, "a DataItem's Dimensions are not whole numbers") from None
     if not dims or min(dims) < 0:
-        raise ReadError(p, f"a DataItem's Dimensions={text[:40]!r} are not sizes")
+        raise ReadError(p, "a DataItem's Dimensions are not sizes")
     return dims
 
 
