@@ -8,17 +8,22 @@
 // invocation order). Per tetrahedron, as gl_pt's cell attributes: the four unit outward face planes (vertices 2 and 3
 // swapped where it is negatively oriented), the table field's affine form and range over the cell, and the
 // modulating field's affine form (Eq. 11.9), as flat outputs for pt_tet_fs.glsl; its 4 faces as triangles, of which
-// front-face culling keeps the back (exit) faces. The leaf's texels (5 per leaf in cloudLeaves): its lowest grid
-// point and edge (i, j, k, s), the table field at its 8 corners (q = 4 i + 2 j + k) and the modulating field over
-// its scale there. A corner's position comes from its grid point alone, so neighbouring leaves share bit-equal
-// vertices (no cracks).
+// front-face culling keeps the back (exit) faces. The leaf's place and its morphed corner values come from
+// cloud_leaf_vs.glsl; a leaf whose table field over its corners meets no part of the transfer function with
+// extinction (cloudVisible: its closed intervals, volviz.unstructured.topology.visible_ranges) makes nothing. A
+// corner's position comes from its grid point alone, so neighbouring leaves share bit-equal vertices (no cracks).
 layout(points, invocations = 5) in;
 layout(triangle_strip, max_vertices = 12) out;
 
-flat in int leafId[];
+flat in ivec4 leafPlace[];
+flat in vec4 leafTableLow[];
+flat in vec4 leafTableHigh[];
+flat in vec4 leafModulateLow[];
+flat in vec4 leafModulateHigh[];
 
 uniform mat4 MCDCMatrix;
-uniform samplerBuffer cloudLeaves;
+uniform vec2 cloudVisible[8];      // the table field's intervals where the TF has extinction
+uniform int cloudVisibleCount;
 uniform vec3 cloudOrigin;     // the grid's origin in model coordinates (relative to the actor's position)
 uniform vec3 cloudSpacing;
 uniform vec3 cloudEye;        // the camera's position in model coordinates
@@ -63,14 +68,29 @@ vec4 affineForm(vec3 p[4], vec4 v, vec3 e1, vec3 e2, vec3 e3, float det)
 
 void main()
 {
-  int base = leafId[0] * 5;
-  vec4 place = texelFetch(cloudLeaves, base);
-  vec4 tLow = texelFetch(cloudLeaves, base + 1);
-  vec4 tHigh = texelFetch(cloudLeaves, base + 2);
-  vec4 mLow = texelFetch(cloudLeaves, base + 3);
-  vec4 mHigh = texelFetch(cloudLeaves, base + 4);
-  ivec3 g0 = ivec3(place.xyz);
-  int s = int(place.w);
+  int s = leafPlace[0].w;
+  if (s == 0)
+  {
+    return;
+  }
+  vec4 tLow = leafTableLow[0];
+  vec4 tHigh = leafTableHigh[0];
+  vec4 mLow = leafModulateLow[0];
+  vec4 mHigh = leafModulateHigh[0];
+  vec4 extremes = max(tLow, tHigh);
+  float high = max(max(extremes.x, extremes.y), max(extremes.z, extremes.w));
+  extremes = min(tLow, tHigh);
+  float low = min(min(extremes.x, extremes.y), min(extremes.z, extremes.w));
+  bool shown = false;
+  for (int i = 0; i < 8; ++i)
+  {
+    shown = shown || (i < cloudVisibleCount && high >= cloudVisible[i].x && low <= cloudVisible[i].y);
+  }
+  if (!shown)
+  {
+    return;
+  }
+  ivec3 g0 = leafPlace[0].xyz;
   ivec3 cell = g0 / s;
   bool odd = ((cell.x + cell.y + cell.z) & 1) == 1;
   // the leaf's tetrahedra back to front for the eye: corner tetrahedron t is in front of the central one when the

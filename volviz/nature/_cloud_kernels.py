@@ -246,11 +246,13 @@ def morph(f, g, root, roots, off, state, eprime, nodes, count, vf, vg, origin, s
 
 @njit(cache=True, nogil=True)
 def emit(fmax, cutoff, root, levels, roots, off, origin, spacing, eye, planes, state, root_order, vf, full,
-         out, stack):
+         out, stack, corner_test=True):
     """Back-to-front octree traversal (§11.5): roots in a BSP order of the root grid, children far-to-near at every
-    level; per node frustum culling and the zero-opacity test (fmax <= cutoff; for leaves the max of the morphed
-    corner densities). Leaves go to ``out`` (lv, a, b, c) in visibility order. ``full`` refines every node (the
-    full-resolution reference). Returns the number of leaves, or -1 if ``out`` is too small."""
+    level; per node frustum culling and the zero-opacity test (fmax <= cutoff; for leaves with ``corner_test`` also
+    the max of the morphed corner densities in ``vf``; without it the leaves whose morphed corners are all
+    transparent are listed too, for a caller that morphs them itself). Leaves go to ``out`` (lv, a, b, c) in
+    visibility order. ``full`` refines every node (the full-resolution reference). Returns the number of leaves, or
+    -1 if ``out`` is too small."""
     n = 0
     cap = out.shape[0]
     for r in range(root_order.shape[0]):
@@ -286,12 +288,13 @@ def emit(fmax, cutoff, root, levels, roots, off, origin, spacing, eye, planes, s
                     stack[top, 3] = 2 * c + (q & 1)
                     top += 1
                 continue
-            m = -np.inf
-            x0, y0, z0 = a * s, b * s, c * s
-            for q in range(8):
-                m = max(m, vf[x0 + (q >> 2) * s, y0 + ((q >> 1) & 1) * s, z0 + (q & 1) * s])
-            if m <= cutoff:
-                continue
+            if corner_test:
+                m = -np.inf
+                x0, y0, z0 = a * s, b * s, c * s
+                for q in range(8):
+                    m = max(m, vf[x0 + (q >> 2) * s, y0 + ((q >> 1) & 1) * s, z0 + (q & 1) * s])
+                if m <= cutoff:
+                    continue
             if n >= cap:
                 return -1
             out[n, 0], out[n, 1], out[n, 2], out[n, 3] = lv, a, b, c

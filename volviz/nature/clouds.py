@@ -276,11 +276,28 @@ class CloudLOD:
                 orders.append(list(range(0, k)) + list(range(n - 1, k, -1)) + [k])
         return np.array([(i, j, k) for i in orders[0] for j in orders[1] for k in orders[2]], dtype=np.int64)
 
-    def update(self, camera: Any, size: tuple[int, int] | None = None, cull: bool = True, full: bool = False
-               ) -> CloudFrame:
+    def refinement_thresholds(self) -> np.ndarray:
+        """Per stored node (``off`` order) the distance below which Eq. (11.1) refines it, as float32: e = num / d
+        with num = s C max(c Δ, 1) (s the node's longest edge), so e > 1 iff d < num; 0 for transparent nodes
+        (fmax <= cutoff, never refined). ``decide``'s test in closed form, for a renderer that computes the morph
+        weights e' (Eq. 11.6) itself from the eye; cached until C, c or the cutoff change."""
+        key = (self.big_c, self.small_c, self.cutoff)
+        if getattr(self, "_thresholds_key", None) != key:
+            vol = self.volume
+            edge = np.concatenate([np.full(int(self.off[lv + 1] - self.off[lv]),
+                                           (vol.root >> lv) * max(vol.spacing)) for lv in range(self.levels)])
+            num = edge * self.big_c * np.maximum(self.small_c * self.delta, 1.0)
+            self._thresholds = np.where(self.fmax > self.cutoff, num, 0.0).astype(np.float32)
+            self._thresholds_key = key
+        return self._thresholds
+
+    def update(self, camera: Any, size: tuple[int, int] | None = None, cull: bool = True, full: bool = False,
+               morph: bool = True) -> CloudFrame:
         """Refine, morph and list the visible leaves for ``camera`` (``full``: every cell, the reference). With
         ``cull`` and a ``size``, only the leaves in the view frustum are listed and only their values are morphed
-        (``morphed`` holds stale values elsewhere)."""
+        (``morphed`` holds stale values elsewhere). Without ``morph`` the fields are left unmorphed and the leaves
+        whose morphed corners are all transparent are listed too: for a renderer that morphs the leaves itself
+        (``resources/shaders/cloud_leaf_vs.glsl``)."""
         from volviz.nature.terrain import frustum_planes
 
         t0 = time.perf_counter()
@@ -312,14 +329,15 @@ class CloudLOD:
                 self._state.fill(0)
                 self._eprime.fill(0.0)
                 self._nodes = np.zeros((2 * len(self._nodes), 4), dtype=np.int64)
-            K.morph(vol.f, vol.gamma, vol.root, self.roots, self.off, self._state, self._eprime, self._nodes, count,
-                    self._vf, self._vg, origin, spacing, planes)
+            if morph:
+                K.morph(vol.f, vol.gamma, vol.root, self.roots, self.off, self._state, self._eprime, self._nodes,
+                        count, self._vf, self._vg, origin, spacing, planes)
         self._count = count
         t1 = time.perf_counter()
         order = self._root_order(eye)
         while True:
             n = K.emit(self.fmax, self.cutoff, vol.root, self.levels, self.roots, self.off, origin, spacing, eye,
-                       planes, self._state, order, self._vf, full, self._leaves, self._stack)
+                       planes, self._state, order, self._vf, full, self._leaves, self._stack, morph or full)
             if n >= 0:
                 break
             self._leaves = np.zeros((2 * len(self._leaves), 4), dtype=np.int64)

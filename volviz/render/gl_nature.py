@@ -8,10 +8,11 @@ drawn by VTK's OpenGL pipeline into the scene's own depth buffer (Roettger Ch. 1
 - Prism layers (ground fog, cloud layers between two height fields; §10.3-10.4): one ``volviz.render.gl_fog.
   GLFogLayer`` each, on the frame's C-LOD terrain triangles and morphed layer heights (``GLFogLayer.set_geometry``
   every frame: the prisms follow the terrain's LOD as on the CPU), reading the opaque depth of the terrain and sky.
-- Clouds (§11.3-11.6): the frame's C-LOD leaves in their back-to-front order, one point each with its place and
-  corner values (``cloud_buffers``); a geometry shader makes each leaf's 5 tetrahedra (split and ordered back to
-  front as ``CloudFrame.to_tetmesh`` does) with the morphed table field, drawn by ``CloudPTVolume``, a
-  ``volviz.render.gl_pt.GLPTVolume`` whose fragments
+- Clouds (§11.3-11.6): the frame's C-LOD leaves in their back-to-front order, one point each; the GPU morphs them
+  (``cloud_leaf_vs.glsl``: the weights of Eq. 11.6 from the eye and the corrected Eq. 11.8 along each leaf's
+  ancestors, from the grid's fields and the octree's refinement thresholds uploaded once) and a geometry shader
+  makes each leaf's 5 tetrahedra (split and ordered back to front as ``CloudFrame.to_tetmesh`` does), drawn by
+  ``CloudPTVolume``, a ``volviz.render.gl_pt.GLPTVolume`` whose fragments
   scale the segment length by the second field as the CPU clouds do (Eq. 11.9, l' = l m̄ with m the modulating field
   over its maximum at the middle of the segment; NPR §11.6.2: the table is indexed by f, γ modulates), looked up in
   the scene's own cloud table (the CPU's, 64 x 64 x 128 over the root cube's diagonal).
@@ -21,20 +22,22 @@ drawn by VTK's OpenGL pipeline into the scene's own depth buffer (Roettger Ch. 1
 ``compute`` (any thread) does the LOD work and builds the vertex buffers as NumPy arrays, in two threads (the
 Numba kernels release the GIL), each with half the caller's Numba threads (``volviz.numba_threads``): the terrain's
 C-LOD mesh and each layer's per-point heights and emissions (``gl_fog.prism_buffers``; the prisms are made by a
-geometry shader) on one, the clouds' refinement, morphing, leaf list and per-leaf texels (``cloud_buffers``, one
-Numba pass over the leaves) on the other; ``finish`` (GUI thread) only hands them to VTK, sharing the arrays
-(``vtk_facade.shared_polydata``), and VTK uploads them and draws everything at the next render, at the window's full
-size (a preview ``scale`` is ignored). No image is made on the CPU.
+geometry shader) on one, the clouds' refinement and leaf list (no morph: the GPU's) on the other; ``finish`` (GUI
+thread) only hands them to VTK, sharing the arrays (``vtk_facade.shared_polydata``), and VTK uploads them and draws
+everything at the next render, at the window's full size (a preview ``scale`` is ignored). No image is made on the
+CPU.
+
+Per frame the clouds upload only what their LOD mesh gained (``volviz.render.cloud_slots``): the texels of the
+leaves new to it (16 bytes each: their octree address, into the next free slots, one region) and the draw order
+(4 bytes per leaf), ``stats["cloud_upload_bytes"]``; every few frames a compaction re-sends the whole slot array.
+A leaf that stays keeps its texel while it morphs: its corner values are made on the GPU for each eye (a
+geomorphed leaf's values move with every step of the eye, so values made on the CPU would change for most leaves
+every frame).
 
 What ``GLPTVolume`` lacks for the clouds (``CloudPTVolume`` works around it through its private members, listed
 there): a per-cell length modulation attribute, a caller-given back-to-front order (the leaves' BSP order; MPVO would
 sample the non-conforming leaf mesh's boundaries), a caller-given table (its own is built per mesh over the mesh's
-longest edge), cells made on the GPU, and a public way to replace the mesh by a frame's buffers. Per frame the
-clouds' buffers are rebuilt and uploaded whole, 96 bytes per leaf of 5 tetrahedra (``BYTES_PER_LEAF``,
-``stats["cloud_upload_bytes"]``): a point (3 float32), 5 RGBA float32 texels in a buffer texture (``cloud_leaf_gs.
-glsl``: the leaf's lowest grid point and edge, the table field and the modulating field at its 8 corners) and one
-index. (Made on the CPU, the tetrahedra took 208 bytes each: 4 positions, 7 texels of face planes and affine forms,
-12 indices; VTK's index buffer for 12 indices per tetrahedron was most of the upload.)
+longest edge), cells made on the GPU, and a public way to replace the mesh by a frame's buffers.
 
 Errors against the CPU ``NatureView`` of the same camera and LOD (8-bit screen units), measured on llvmpipe in
 ``tests/test_render_gl_nature.py``: see the bounds there.
@@ -51,25 +54,27 @@ from typing import Any, Callable
 import numpy as np
 
 from volviz.model.datasets import TetMesh
-from volviz.nature.clouds import CloudFrame, CloudShading, CloudVolume
+from volviz.nature.clouds import CloudFrame, CloudLOD, CloudShading, CloudVolume
 from volviz.nature.nature_scene import NatureScene
 from volviz.numba_threads import numba_threads, share
 from volviz.render.nature_view import NatureView
 from volviz.render.gl_fog import GLFogLayer, prism_buffers
 from volviz.render.gl_pt import GLPTVolume, _resolve_polydata, shader_source
 from volviz.render.image_overlay import hold_single_sample, release_single_sample
-from volviz.unstructured.topology import visible_ranges
 
-__all__ = ["CloudBuffers", "CloudPTVolume", "GLNatureView", "cloud_buffers", "modulation_scale"]
-
-#: bytes uploaded per leaf (5 tetrahedra): its lowest corner (3 float32), 5 RGBA float32 texels, 1 index
-BYTES_PER_LEAF = 3 * 4 + 5 * 16 + 4
+__all__ = ["CloudLeaves", "CloudPTVolume", "GLNatureView", "cloud_field_texels", "cloud_leaves",
+           "modulation_scale"]
 
 # (anchor in gl_pt's fragment shader, text added after it): the modulation's flat varying, and the length scaled by
 # the modulating field at the middle of the clipped segment
 _FS_PATCH = (("flat in vec4 cellRange;", "\nflat in vec4 cellModulate;"),
              ("float len = (t1 - t0) * length(d);",
               "\n  len *= max(dot(cellModulate.xyz, o + 0.5 * (t0 + t1) * d) + cellModulate.w, 0.0);"))
+
+#: the most intervals of the table field with extinction the geometry shader tests a leaf against (``cloudVisible``)
+_VISIBLE_INTERVALS = 8
+#: the most octree levels the vertex shader's morph walks (``cloudOffsets``)
+_MAX_LEVELS = 16
 
 
 def _patched(name: str, patches: tuple[tuple[str, str], ...]) -> str:
@@ -86,18 +91,24 @@ def modulation_scale(volume: CloudVolume, shading: CloudShading) -> float:
     return max(float(volume.gamma.max() if shading.table_field == "f" else volume.f.max()), 1e-12)
 
 
-@dataclass
-class CloudBuffers:
-    """A frame's cloud buffers as NumPy arrays (``cloud_buffers``, any thread): ``points`` (L + 2, 3) float32, the
-    leaves' lowest corners relative to ``centre`` (the cloud volume's) and the volume's box (for VTK's bounds),
-    ``texels`` (L, 5, 4) float32 per leaf (``_cloud_buffer_kernels.N_TEXELS``: ``cloud_leaf_gs.glsl`` makes the
-    leaf's tetrahedra from them), ``visible`` (L,) the leaves with some opacity under the cloud TF; the leaves are in
-    back-to-front order. ``bounds`` (3, 2): the volume's box relative to the centre; ``origin`` and ``spacing``: the
-    grid's, the origin relative to the centre."""
+def cloud_field_texels(volume: CloudVolume, shading: CloudShading) -> np.ndarray:
+    """Per grid point (C order of the (nx, ny, nz) grid) the table field and the modulating field over its maximum
+    (``modulation_scale``), (n, 2) float32: what ``cloud_leaf_vs.glsl`` morphs the leaves' corners from."""
+    table, other = (volume.f, volume.gamma) if shading.table_field == "f" else (volume.gamma, volume.f)
+    out = np.empty((table.size, 2), np.float32)
+    out[:, 0] = table.reshape(-1)
+    out[:, 1] = other.reshape(-1).astype(np.float64) / modulation_scale(volume, shading)
+    return out
 
-    points: np.ndarray
-    texels: np.ndarray
-    visible: np.ndarray
+
+@dataclass
+class CloudLeaves:
+    """A frame's cloud leaves for ``CloudPTVolume`` (``cloud_leaves``, any thread): ``leaves`` (n, 4) int64 (level,
+    a, b, c) in back-to-front order and their ``keys`` (``cloud_slots.leaf_keys``); ``bounds`` (3, 2) the volume's
+    box relative to ``centre`` (the volume's); ``origin`` (relative to the centre) and ``spacing``: the grid's."""
+
+    leaves: np.ndarray
+    keys: np.ndarray
     centre: np.ndarray
     bounds: np.ndarray
     origin: np.ndarray
@@ -105,35 +116,49 @@ class CloudBuffers:
 
     @property
     def n_leaves(self) -> int:
-        return int(len(self.visible))
+        return int(len(self.leaves))
 
 
-def cloud_buffers(frame: CloudFrame, shading: CloudShading, m_scale: float) -> CloudBuffers:
-    """Any thread (Numba, releasing the GIL): the buffers of ``CloudPTVolume`` for a frame's leaves in their
-    back-to-front order: each leaf's place and its corners' morphed table field and modulating field over
-    ``m_scale`` (``modulation_scale``; ``_cloud_buffer_kernels.leaf_buffer``), and the TF's culling from each leaf's
-    range of the table field (a leaf is kept if one of its tetrahedra has some opacity)."""
-    from volviz.render._cloud_buffer_kernels import leaf_buffer
+def cloud_leaves(frame: CloudFrame) -> CloudLeaves:
+    """Any thread: a frame's leaves (``CloudLOD.update(..., morph=False)``: the GPU morphs them) with their keys."""
+    from volviz.render.cloud_slots import leaf_keys
 
-    vol = frame.lod.volume
-    vf, vg = frame.lod.morphed
-    table, other = (vf, vg) if shading.table_field == "f" else (vg, vf)
+    lod = frame.lod
+    vol = lod.volume
     origin = np.asarray(vol.origin, np.float64)
     spacing = np.asarray(vol.spacing, np.float64)
-    centre = origin + 0.5 * (np.asarray(vol.shape, np.float64) - 1.0) * spacing
-    pos, texels, ranges = leaf_buffer(np.ascontiguousarray(frame.leaves, np.int64), int(vol.root),
-                                      np.asarray(vol.shape, np.int64), origin, spacing, centre, table.reshape(-1),
-                                      other.reshape(-1), float(m_scale))
     half = 0.5 * (np.asarray(vol.shape, np.float64) - 1.0) * spacing
-    pos[-2:] = [-half, half]
-    visible = visible_ranges(ranges[:, 0], ranges[:, 1], shading.tf.scalars, shading.tf.extinction)
-    return CloudBuffers(pos, texels, visible, centre, np.stack([-half, half], axis=1), origin - centre, spacing)
+    centre = origin + half
+    leaves = np.ascontiguousarray(frame.leaves, np.int64)
+    return CloudLeaves(leaves, leaf_keys(leaves, lod.roots), centre, np.stack([-half, half], axis=1),
+                       origin - centre, spacing)
+
+
+def _visible_intervals(tf: Any) -> list[tuple[float, float]]:
+    """The closed intervals of the table field where the TF has extinction (``visible_ranges``'s pieces merged),
+    at most ``_VISIBLE_INTERVALS``: past that, the neighbours nearest each other are joined (a superset: leaves in
+    the gaps are drawn and add nothing)."""
+    x = np.asarray(tf.scalars, np.float64)
+    rho = np.asarray(tf.extinction, np.float64)
+    pieces = [[x[i], x[i + 1]] for i in range(len(x) - 1) if rho[i] > 0 or rho[i + 1] > 0]
+    if len(x) == 1 and rho[0] > 0:
+        pieces = [[x[0], x[0]]]
+    merged: list[list[float]] = []
+    for lo, hi in pieces:
+        if merged and lo <= merged[-1][1]:
+            merged[-1][1] = max(merged[-1][1], hi)
+        else:
+            merged.append([lo, hi])
+    while len(merged) > _VISIBLE_INTERVALS:
+        gap = int(np.argmin([merged[i + 1][0] - merged[i][1] for i in range(len(merged) - 1)]))
+        merged[gap:gap + 2] = [[merged[gap][0], merged[gap + 1][1]]]
+    return [(float(lo), float(hi)) for lo, hi in merged]
 
 
 @dataclass
 class _FrameGeometry:
     """What ``GLPTVolume``'s draw reads of its ``topo`` for a frame drawn in a given order: the actor's origin (the
-    ray basis is taken relative to it) and the number of cells it orders (here the leaves)."""
+    ray basis is taken relative to it) and the number of cells it orders (here the leaf slots)."""
 
     origin: np.ndarray
     n_tets: int
@@ -141,23 +166,35 @@ class _FrameGeometry:
 
 class CloudPTVolume(GLPTVolume):
     """C-LOD cloud leaves on the GPU PT pass (module docstring): the shading's table, the length modulated per
-    fragment (Eq. 11.9), the given back-to-front order of the leaves, and ``set_frame`` for the next frame's buffers:
-    one point per leaf, drawn in that order, whose texels (a buffer texture) the geometry shader makes the leaf's 5
-    tetrahedra from (``cloud_leaf_gs.glsl``), uploaded at the next render.
+    fragment (Eq. 11.9), the given back-to-front order of the leaves, and ``set_frame`` for the next frame's leaves.
+    The leaves live in slots of a texel array on the GPU (``volviz.render.cloud_slots``: only the leaves a frame
+    adds are uploaded); one point per slot, drawn in the frame's order; the vertex shader morphs each leaf from the
+    grid's fields and the octree's refinement thresholds (two textures uploaded once) for the eye, and the geometry
+    shader makes its 5 tetrahedra (``cloud_leaf_vs.glsl``, ``cloud_leaf_gs.glsl``).
 
     Private members of ``GLPTVolume`` used (what a public API would replace): ``_build_table`` (overridden to return
-    the scene's table), ``_set_index_buffer`` (overridden: one index per leaf), ``_sorted`` / ``_sorted_key`` /
-    ``_order_key`` (the given order, kept by ``reuse_order``), ``_vis`` (culling of the new frame), ``topo``
-    (``_FrameGeometry``: a frame has no mesh topology), ``_on_update_shader`` / ``_on_end`` (extended to bind the
-    leaf texture and set the grid and eye uniforms)."""
+    the scene's table), ``_set_index_buffer`` (overridden: one index per leaf), ``_visible`` (overridden: the
+    geometry shader culls), ``_sorted`` / ``_sorted_key`` / ``_order_key`` (the given order, kept by
+    ``reuse_order``), ``_vis``, ``topo`` (``_FrameGeometry``: a frame has no mesh topology), ``_on_update_shader``
+    / ``_on_end`` (extended to bind the cloud textures and set the grid, octree and eye uniforms)."""
 
-    def __init__(self, plotter: Any, buffers: CloudBuffers, shading: CloudShading, table: Any) -> None:
+    def __init__(self, plotter: Any, leaves: CloudLeaves, lod: CloudLOD, shading: CloudShading, table: Any
+                 ) -> None:
+        from volviz.render.cloud_slots import LeafSlots
         from volviz.render.vtk_facade import vtk
 
+        if lod.levels > _MAX_LEVELS:
+            raise ValueError(f"cloud octree of {lod.levels} levels; the GPU morph walks at most {_MAX_LEVELS}")
         self._cloud_table = table
-        self._texels: Any = None              # the frame's leaf texels as a VTK array, until uploaded
-        self._leaf_buffer: Any = None         # their GL buffer and buffer texture
-        self._leaf_texture: Any = None
+        self.lod = lod
+        self.slots = LeafSlots()
+        self.last_update: Any = None           # the last frame's ``SlotUpdate``
+        self._pending: list[Any] = []          # slot updates not yet on the GPU, in order
+        self._fields: np.ndarray | None = cloud_field_texels(lod.volume, shading)   # until uploaded
+        self._thresholds: np.ndarray | None = None
+        self._thresholds_sent: np.ndarray | None = None
+        self._textures: dict[str, Any] = {}    # uniform name -> vtkTextureObject (2D-emulated texel arrays)
+        self._capacity = 0
         # GLPTVolume is made on one tetrahedron (its own buffer is replaced by the frame's at once)
         one = TetMesh(np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]),
                       np.array([[0, 1, 2, 3]]), np.zeros(4))
@@ -170,34 +207,45 @@ class CloudPTVolume(GLPTVolume):
         sp.SetGeometryShaderCode(shader_source("cloud_leaf_gs.glsl"))
         sp.SetFragmentShaderCode(_patched("pt_tet_fs.glsl", _FS_PATCH))
         self.stats = {"method": "pt-gl clouds"}
-        self.set_frame(buffers)
+        self.set_frame(leaves)
 
     def _build_table(self) -> Any:
         return self._cloud_table
 
-    def set_frame(self, buffers: CloudBuffers) -> None:
-        """The next frame's leaves (back to front) as ``cloud_buffers`` made them: new points (shared with VTK) and
-        texels (uploaded to the buffer texture at the next render), their own order for every camera, the same
-        table."""
-        from volviz.render.vtk_facade import numpy_to_vtk, shared_polydata
+    def _visible(self) -> np.ndarray:
+        """Every slot: the geometry shader drops the leaves the TF hides (their morphed values are made there)."""
+        return np.ones(max(self._capacity, 1), dtype=bool)
 
-        self.topo = _FrameGeometry(np.asarray(buffers.centre, np.float64), buffers.n_leaves)  # type: ignore[assignment]
-        self._vis = buffers.visible
-        self._grid = (np.asarray(buffers.origin, np.float64), np.asarray(buffers.spacing, np.float64))
-        self.polydata = shared_polydata(buffers.points, {})
-        self.mapper.SetInputData(self.polydata)
-        texels = buffers.texels.reshape(-1, 4) if buffers.n_leaves else np.zeros((1, 4), np.float32)
-        self._texels = numpy_to_vtk(np.ascontiguousarray(texels), deep=False)
-        self._texels_ref = texels             # numpy_to_vtk(deep=False) needs the array kept alive
-        self.actor.SetPosition(*buffers.centre)
-        self.resolve_mapper.SetInputData(_resolve_polydata(buffers.bounds))    # VTK culls the resolve by these
-        self.resolve_actor.SetPosition(*buffers.centre)
+    def set_frame(self, leaves: CloudLeaves) -> None:
+        """GUI thread: the next frame's leaves (back to front): their slots (the new ones' texels uploaded at the
+        next render, ``last_update``), drawn in this order for every camera, with the same table."""
+        from volviz.render.cloud_slots import RESERVED
+        from volviz.render.vtk_facade import shared_polydata
+
+        update = self.slots.place(leaves.leaves, leaves.keys)
+        self._pending = [update] if update.whole else self._pending + [update]
+        self._thresholds = self.lod.refinement_thresholds()
+        self._grid = (np.asarray(leaves.origin, np.float64), np.asarray(leaves.spacing, np.float64))
+        if update.capacity != self._capacity:
+            # one point per slot; the reserved two at the box's corners give VTK the volume's bounds
+            points = np.zeros((update.capacity, 3), np.float32)
+            points[:RESERVED] = leaves.bounds.T
+            self.polydata = shared_polydata(points, {})
+            self.mapper.SetInputData(self.polydata)
+            self._capacity = update.capacity
+            self._vis = self._visible()
+        self.topo = _FrameGeometry(np.asarray(leaves.centre, np.float64), self._capacity)  # type: ignore[assignment]
+        self.actor.SetPosition(*leaves.centre)
+        if self.last_update is None:
+            self.resolve_mapper.SetInputData(_resolve_polydata(leaves.bounds))   # VTK culls the resolve by these
+        self.resolve_actor.SetPosition(*leaves.centre)
+        self.last_update = update
         self.reuse_order = True
-        self._sorted = np.arange(buffers.n_leaves, dtype=np.int64)
+        self._sorted = update.order.astype(np.int64)
         self._sorted_key = self._order_key = None
 
     def _set_index_buffer(self, cells: np.ndarray) -> None:
-        """Draw the leaves ``cells`` in this order from the next render on: one point each (32-bit indices shared
+        """Draw the slots ``cells`` in this order from the next render on: one point each (32-bit indices shared
         with VTK, kept referenced here)."""
         from volviz.render.vtk_facade import numpy_to_vtk, vtk
 
@@ -209,46 +257,80 @@ class CloudPTVolume(GLPTVolume):
         self.polydata.SetVerts(verts)
         self.polydata.Modified()
 
-    def _on_update_shader(self, program: Any) -> None:
-        """gl_pt's uniforms and textures, the frame's leaf texels as the buffer texture ``cloudLeaves`` (uploaded
-        when the frame changed), and the grid and the eye in model coordinates for the geometry shader."""
+    def _texture(self, name: str, texels: np.ndarray, ren_win: Any) -> None:
+        """(Re)make the 2D-emulated texel array ``name`` from ``texels`` (n, components) float32."""
         from volviz.render.vtk_facade import vtk
 
+        old = self._textures.pop(name, None)
+        if old is not None:
+            old.ReleaseGraphicsResources(ren_win)
+        tex = vtk.vtkTextureObject()
+        tex.SetContext(ren_win)
+        data = np.ascontiguousarray(texels, np.float32)
+        if not tex.EmulateTextureBufferWith2DTexturesFromRaw(len(data), data.shape[1], vtk.VTK_FLOAT, data):
+            raise RuntimeError(f"OpenGL refused the clouds' {name} texture of {len(data)} texels")
+        self._textures[name] = tex
+
+    def _upload(self, ren_win: Any) -> None:
+        """What changed since the last render: the grid's fields (once), the refinement thresholds (when C, c or
+        the cutoff changed) and the slot updates in order (a region each, or the whole array after a compaction)."""
+        from volviz.render.vtk_facade import vtk
+
+        if self._fields is not None:
+            self._texture("cloudFields", self._fields, ren_win)
+            self._fields = None
+        if self._thresholds is not self._thresholds_sent:
+            self._texture("cloudNodes", self._thresholds.reshape(-1, 1), ren_win)
+            self._thresholds_sent = self._thresholds
+        for update in self._pending:
+            if update.whole:
+                self._texture("cloudSlots", update.texels, ren_win)
+            elif len(update.texels):
+                if not self._textures["cloudSlots"].UpdateTextureBuffer2DRegion(
+                        update.start, len(update.texels), 4, vtk.VTK_FLOAT, update.texels):
+                    raise RuntimeError("OpenGL refused the clouds' slot update")
+        self._pending = []
+
+    def _on_update_shader(self, program: Any) -> None:
+        """gl_pt's uniforms and textures, the cloud textures (uploaded as they changed), and the grid, octree, eye
+        and TF intervals for the vertex and geometry shaders."""
         super()._on_update_shader(program)
         if program is None:
             return
-        ren_win = self.renderer.GetRenderWindow()
-        if self._texels is not None:
-            if self._leaf_buffer is None:
-                self._leaf_buffer = vtk.vtkOpenGLVertexBufferObject()
-                self._leaf_buffer.SetDataType(vtk.VTK_FLOAT)
-                self._leaf_buffer.SetCoordShiftAndScaleMethod(0)     # the raw floats, no shift or scale
-                self._leaf_texture = vtk.vtkTextureObject()
-                self._leaf_texture.SetContext(ren_win)
-            self._leaf_buffer.UploadDataArray(self._texels)
-            self._leaf_texture.CreateTextureBuffer(self._texels.GetNumberOfTuples(), 4, vtk.VTK_FLOAT,
-                                                   self._leaf_buffer)
-            self._texels = None
-        self._leaf_texture.Activate()
-        program.SetUniformi("cloudLeaves", self._leaf_texture.GetTextureUnit())
+        self._upload(self.renderer.GetRenderWindow())
+        for name, tex in self._textures.items():
+            tex.Activate()
+            program.SetUniformi(name, tex.GetTextureUnit())
+            program.SetUniformi(name + "Width", int(tex.GetWidth()))
+        lod = self.lod
         origin, spacing = self._grid
         eye = np.asarray(self.renderer.GetActiveCamera().GetPosition(), np.float64) - self.topo.origin
         program.SetUniform3f("cloudOrigin", [float(v) for v in origin])
         program.SetUniform3f("cloudSpacing", [float(v) for v in spacing])
         program.SetUniform3f("cloudEye", [float(v) for v in eye])
+        program.SetUniform1iv("cloudShape", 3, [int(v) for v in lod.volume.shape])
+        program.SetUniform1iv("cloudRoots", 3, [int(v) for v in lod.roots])
+        program.SetUniformi("cloudRoot", int(lod.volume.root))
+        offsets = [int(v) for v in lod.off[:lod.levels]] + [0] * (_MAX_LEVELS - lod.levels)
+        program.SetUniform1iv("cloudOffsets", _MAX_LEVELS, offsets)
+        program.SetUniformi("cloudGeomorph", int(lod.geomorph))
+        intervals = _visible_intervals(self.tf)
+        flat = [v for pair in intervals for v in pair] + [0.0] * (2 * (_VISIBLE_INTERVALS - len(intervals)))
+        program.SetUniform2fv("cloudVisible", _VISIBLE_INTERVALS, flat)
+        program.SetUniformi("cloudVisibleCount", len(intervals))
 
     def _on_end(self, *args: Any) -> None:
         super()._on_end(*args)
-        if self._leaf_texture is not None:
-            self._leaf_texture.Deactivate()
+        for tex in self._textures.values():
+            tex.Deactivate()
 
     def remove(self) -> None:
-        """GLPTVolume's ``remove`` and the cell texture's GL resources."""
+        """GLPTVolume's ``remove`` and the cloud textures' GL resources."""
         ren_win = self.renderer.GetRenderWindow()
-        if ren_win is not None and self._leaf_texture is not None:
-            self._leaf_texture.ReleaseGraphicsResources(ren_win)
-            self._leaf_buffer.ReleaseGraphicsResources()
-        self._leaf_texture = self._leaf_buffer = None
+        if ren_win is not None:
+            for tex in self._textures.values():
+                tex.ReleaseGraphicsResources(ren_win)
+        self._textures = {}
         super().remove()
 
 
@@ -264,7 +346,6 @@ class GLNatureView(NatureView):
         super().__init__(plotter, scene, size, filter_texture)
         self.layers: dict[str, GLFogLayer] = {}
         self.clouds: CloudPTVolume | None = None
-        self._m_scale: float | None = None
         # the terrain half of ``compute``: one thread kept for the view's life (a new thread each frame would also
         # make Numba's OpenMP start a new team of threads for it each frame)
         self._terrain_worker = ThreadPoolExecutor(max_workers=1, thread_name_prefix="volviz-terrain-lod")
@@ -274,7 +355,7 @@ class GLNatureView(NatureView):
                 progress: Any = None) -> tuple[Any, Any, dict[str, float]]:
         """Any thread: the LOD work of a frame (no image): the terrain's C-LOD mesh as VTK poly data and as the
         ``TerrainMesh`` the prisms stand on with each prism layer's vertex buffer (``prism_buffers``), on a second
-        thread meanwhile the clouds' refinement, morphing and vertex buffer (``cloud_buffers``; both parts run
+        thread meanwhile the clouds' refinement and leaf list (``cloud_leaves``; both parts run
         Numba kernels that release the GIL), statistics (``lod_s``: seconds spent here). Each part's kernels get
         half the caller's Numba threads; the terrain's fan emission and prism buffers get all of them once the
         clouds are done."""
@@ -299,12 +380,9 @@ class GLNatureView(NatureView):
                     if progress is not None:
                         progress(0.3, "clouds")
                     assert scene.cloud_shading is not None
-                    frame = scene.cloud_lod.update(cam, size)
-                    if self._m_scale is None:
-                        self._m_scale = modulation_scale(scene.cloud_lod.volume, scene.cloud_shading)
-                    clouds = cloud_buffers(frame, scene.cloud_shading, self._m_scale)
+                    frame = scene.cloud_lod.update(cam, size, morph=False)
+                    clouds = cloud_leaves(frame)
                     stats["cloud_tets"] = float(frame.n_tets)
-                    stats["cloud_upload_bytes"] = float(clouds.n_leaves * BYTES_PER_LEAF)
             except BaseException:
                 clouds_done.set()
                 wait([terrain])                    # no terrain work left behind
@@ -356,10 +434,15 @@ class GLNatureView(NatureView):
                                                        buffers=buffers)
             elif kind == "clouds" and frame.clouds is not None:
                 if self.clouds is None:
-                    assert scene.cloud_shading is not None
-                    self.clouds = CloudPTVolume(self.plotter, frame.clouds, scene.cloud_shading, scene.cloud_table)
+                    assert scene.cloud_shading is not None and scene.cloud_lod is not None
+                    self.clouds = CloudPTVolume(self.plotter, frame.clouds, scene.cloud_lod, scene.cloud_shading,
+                                                scene.cloud_table)
                 else:
                     self.clouds.set_frame(frame.clouds)
+                update = self.clouds.last_update
+                stats["cloud_leaves_added"] = float(update.added)
+                stats["cloud_upload_bytes"] = float(update.upload_bytes)
+                stats["cloud_upload_whole"] = float(update.whole)
         if (self.layers or self.clouds is not None) and not self._single_sample:
             # the float scene target and the volumes' targets are single-sample (gl_pt); a scene of terrain and sky
             # alone keeps the window's multisampling, as the CPU backend does without an overlay
