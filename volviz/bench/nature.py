@@ -27,6 +27,7 @@ Writes docs/bench/nature.md and nature_frames.png (LOD frames, references and x8
 """
 from __future__ import annotations
 
+import copy
 import json
 import os
 import shlex
@@ -77,8 +78,9 @@ NOTES = [
     "max 2.32. The GPU backend against the app's own full-resolution reference needs clouds 2, 100 with terrain "
     "9, 160 for RMSE <= 3 on every frame (docs/bench/nature_accurate.md: max 2.88 at 86,000 tetrahedra per frame; "
     "clouds 2, 50 gives 3.11 on frame 0, terrain 9, 100 with clouds 2, 100 gives 3.37).",
-    "GPU backend's CPU side at the setting that meets RMSE <= 3 (docs/bench/nature_accurate.md): ~0.043 s a frame "
-    "on 2 cores (0.095 s two rounds before). The buffer upload in it is timed inside the draw (each mapper's buffer "
+    "GPU backend's CPU side at the setting that meets RMSE <= 3 (docs/bench/nature_accurate.md): ~0.037 s a frame "
+    "on 2 cores (0.043 s before the clouds were morphed on the GPU, 0.095 s three rounds before). The buffer "
+    "upload in it is timed inside the draw (each mapper's buffer "
     "update, ~4 ms for terrain, prisms and clouds); it was the first draw minus a second one, two ~0.3 s llvmpipe "
     "draws whose difference ranged 0-34 ms from frame to frame (and held llvmpipe's own first-use work). What "
     "brought it down, each measured along this path: the terrain and "
@@ -86,8 +88,10 @@ NOTES = [
     "oversubscribed the machine: LOD 0.07 -> 0.05 s); the terrain's fields side by side per grid point and the "
     "blend helpers inlined (morphing 20 -> 11 ms); morphing skips nodes whose box misses the frustum (terrain "
     "11 -> 6 ms, clouds 10 -> 4.5 ms); the prism layer's buffers in one Numba pass (9 -> 5 ms); the clouds' "
-    "tetrahedra made by a geometry shader from one point and 5 texels per leaf (96 bytes per leaf of 5 tetrahedra "
-    "instead of 208 per tetrahedron; VTK's index buffer for 12 indices per tetrahedron was most of the upload); "
+    "tetrahedra made by a geometry shader from one point per leaf (VTK's index buffer for 12 indices per "
+    "tetrahedron was most of the upload); the clouds morphed on the GPU from leaves kept in slots (no CPU morph "
+    "or per-leaf buffer: a frame sends the texels of the leaves it adds and the draw order, ~0.07 MB instead of "
+    "~1.6 MB along the path); "
     "32-bit triangle indices (VTK builds index buffers from 32-bit cells fastest); the fan emission and prism "
     "buffers on both cores once the clouds are done. Left: the terrain's C-LOD (refinement, morphing, fans over "
     "~400,000 triangles) is the critical path, and VTK builds the terrain's and prisms' index buffers (2-4 ns per "
@@ -298,8 +302,6 @@ class _GLFrames:
         triangle (until the next frame)."""
         import pyvista as pv
 
-        from volviz.bench.unstructured import _one_cell_order
-
         view = self.views[1]
         if view.terrain_actor is not None and view._mesh is not None:
             one = pv.PolyData.from_regular_faces(view._mesh.points, view._mesh.regular_faces[:1])
@@ -308,7 +310,9 @@ class _GLFrames:
         for name, layer in view.layers.items():
             layer.set_buffers(self._prisms[name][1].first_prism())
         if view.clouds is not None:
-            _one_cell_order(view.clouds)
+            from volviz.render.cloud_slots import RESERVED
+
+            view.clouds._set_index_buffer(view.clouds.order[:RESERVED + 1])   # the reserved slots and one leaf
 
     def image(self, cam: Any) -> np.ndarray:
         """One frame of the GPU backend for ``cam`` in the large window (RGB in [0, 1]), untimed."""
@@ -341,8 +345,13 @@ class _GLFrames:
                                                          "vbo_upload", "small_same", "small_one")}
         img = np.zeros(0)
         stats: dict[str, float] = {}
+        # every run is the same step from the previous frame: the clouds' slots as that frame left them
+        slots = [copy.deepcopy(v.clouds.slots) if v.clouds is not None else None for v in self.views]
         for _ in range(self.reps):
             big, small = self.views
+            for view, kept in zip(self.views, slots):
+                if view.clouds is not None and kept is not None:
+                    view.clouds.slots = copy.deepcopy(kept)
             request = big.begin(cam)
             small.begin(cam)                       # the small window's camera and sky dome
             t0 = time.perf_counter()
@@ -370,7 +379,9 @@ class _GLFrames:
                "gl_cpu_side_s": med["lod"] + med["small_upload"] + gl_upload + med["small_one"],
                "gl_cpu_side_total_s": med["lod"] + med["small_upload"] + med["small_render"],
                "gl_vbo_upload_s": gl_upload, "gl_submit_s": med["small_one"], "gl_draw_work_s": draw_work,
-               "gl_cloud_tets": int(stats.get("cloud_tets", 0)), "gl_fog_prisms": int(stats.get("fog_prisms", 0))}
+               "gl_cloud_tets": int(stats.get("cloud_tets", 0)), "gl_fog_prisms": int(stats.get("fog_prisms", 0)),
+               "gl_cloud_leaves_added": int(stats.get("cloud_leaves_added", 0)),
+               "gl_cloud_upload_bytes": int(stats.get("cloud_upload_bytes", 0))}
         out["gl_fps"] = 1.0 / max(out["gl_frame_s"], 1e-9)
         return out, img
 
@@ -392,17 +403,21 @@ def _rows(a: np.ndarray) -> np.ndarray:
 
 
 def _changed_part(frames: list[Any]) -> dict[str, Any]:
-    """Per step of a dense path, how much of the GPU backend's LOD buffers is new: the cloud leaves (their texels:
-    place and corner values), terrain triangles (their 3 morphed vertices) and fog prisms (their 3 vertices' heights
-    and emissions) of a frame that the previous frame does not have bit for bit (wherever they were in it): the part
-    an upload of only what changed would send."""
+    """Per step of a dense path, how much of the GPU backend's LOD buffers is new. Clouds: the leaves new to the
+    LOD mesh and the bytes their slots upload (``volviz.render.cloud_slots``: [added, leaves, bytes, whole]; the
+    GPU morphs the leaves, so a leaf that stays uploads nothing). Terrain triangles (their 3 morphed vertices) and
+    fog prisms (their 3 vertices' heights and emissions): those the previous frame does not have bit for bit
+    (wherever they were in it), the part an upload of only what changed would send."""
+    from volviz.render.cloud_slots import LeafSlots
+
     out: dict[str, Any] = {"clouds": [], "terrain": [], "fog": []}
+    slots = LeafSlots()
+    if frames and frames[0].clouds is not None:
+        slots.place(frames[0].clouds.leaves, frames[0].clouds.keys)
     for prev, cur in zip(frames[:-1], frames[1:]):
-        if cur.clouds is not None and prev.clouds is not None:
-            def leaves(b: Any) -> np.ndarray:
-                return _rows(b.texels.reshape(b.n_leaves, -1))
-            new = ~np.isin(leaves(cur.clouds), leaves(prev.clouds))
-            out["clouds"].append([int(new.sum()), int(len(new))])
+        if cur.clouds is not None:
+            update = slots.place(cur.clouds.leaves, cur.clouds.keys)
+            out["clouds"].append([update.added, cur.clouds.n_leaves, update.upload_bytes, int(update.whole)])
         if cur.mesh is not None and prev.mesh is not None:
             new = ~np.isin(_rows(cur.mesh.points[cur.mesh.triangles]), _rows(prev.mesh.points[prev.mesh.triangles]))
             out["terrain"].append([int(new.sum()), int(len(new))])
@@ -415,6 +430,40 @@ def _changed_part(frames: list[Any]) -> dict[str, Any]:
                     return _rows(np.concatenate([b.points[tris], b.attributes["fogValue"][tris]], axis=2))
                 new = ~np.isin(prisms(b), prisms(pb))
                 out["fog"].append([int(new.sum()), int(len(new))])
+    return out
+
+
+#: camera steps (world units a frame) of the clouds' upload measurement: the popping path's, a slow and a fast
+#: fly-through over the 1000-unit scene (15 and 60 units a second at 30 fps), and a jump
+UPLOAD_STEPS = (0.04, 0.5, 2.0, 8.0)
+
+
+def _cloud_uploads(scene: Any, size: tuple[int, int], frames: int = 13) -> list[dict[str, float]]:
+    """Per camera step of ``UPLOAD_STEPS``, along the path from parameter 0.55 (the popping path's start): the
+    leaves the GPU clouds draw, those new to their LOD mesh and the bytes a frame uploads (the slots of the new
+    leaves and the draw order, ``volviz.render.cloud_slots``; compactions re-send the whole slot array), means over
+    ``frames - 1`` steps, against 96 bytes a leaf (a leaf's place and its 16 morphed corner values)."""
+    from volviz.render.cloud_slots import LeafSlots
+    from volviz.render.gl_nature import cloud_leaves
+
+    if scene.cloud_lod is None:
+        return []
+    length = sum(float(np.linalg.norm(np.subtract(KEYS[i + 1][0], KEYS[i][0]))) for i in range(len(KEYS) - 1))
+    out = []
+    for step in UPLOAD_STEPS:
+        slots = LeafSlots()
+        steps = []
+        for k, cam in enumerate(path_cameras(frames, 0.55, 0.55 + step * (frames - 1) / length)):
+            leaves = cloud_leaves(scene.cloud_lod.update(cam, size, morph=False))
+            update = slots.place(leaves.leaves, leaves.keys)
+            if k:
+                steps.append((leaves.n_leaves, update.added, update.upload_bytes, update.whole))
+        n, added, sent, whole = (np.mean([s[i] for s in steps]) for i in range(4))
+        out.append({"step_units": step, "leaves": float(n), "added": float(added), "upload_mb": float(sent) / 1e6,
+                    "compactions": int(round(whole * len(steps))), "steps": len(steps),
+                    "whole_leaf_mb": float(n) * 96 / 1e6})
+        print(f"cloud uploads at {step} units a step: {added:.0f} of {n:.0f} leaves new, {sent / 1e6:.3f} MB",
+              flush=True)
     return out
 
 
@@ -542,6 +591,7 @@ def main(argv: list[str] | None = None) -> int:
         d_app = d_ref
         if gl is not None:
             popping["changed"] = _changed_part([gl.lod_frame(c) for c in dense])
+            popping["cloud_uploads"] = _cloud_uploads(scene, size)
             app_refs = [_rgba(gl.reference_image(c)) for c in dense]
             d_app = np.array([rmse(a, b) for a, b in zip(app_refs[1:], app_refs[:-1])])
             popping["gl_ref_steps"] = d_app.tolist()
@@ -671,8 +721,10 @@ def _write_report(out: Path, result: dict[str, Any], images: list[tuple[np.ndarr
         lines += [
             "",
             f"GPU backend (``volviz.render.gl_nature.GLNatureView``, VTK's OpenGL on {s['gl']['renderer']}): the same "
-            "frames, one LOD computation each (terrain C-LOD, cloud refinement and morphing, the prism and cloud "
-            "vertex buffers: LOD s) handed to VTK (upload s) and drawn (render s) in a window of the image's size; "
+            "frames, one LOD computation each (terrain C-LOD, cloud refinement and leaf list — the GPU morphs the "
+            "leaves —, the prism vertex buffers: LOD s) handed to VTK (upload s; for the clouds the slots of the "
+            "leaves new to the mesh, each run the same step from the previous frame) and drawn (render s) in a "
+            "window of the image's size; "
             "fps = 1 / their sum. CPU side = the same frame's per-frame CPU cost drawn in a 64 x 48 window, where "
             "fill is negligible: LOD s + handing the buffers to VTK + VTK's buffer upload (timed inside the first "
             "draw of the new buffers: from each mapper's input update to its draw, i.e. VTK building index buffers "
@@ -769,13 +821,30 @@ def _write_report(out: Path, result: dict[str, Any], images: list[tuple[np.ndarr
             new, total = (float(np.mean([s[i] for s in steps])) for i in (0, 1))
             return f"{new:,.0f} of {total:,.0f} ({100.0 * new / max(total, 1.0):.0f} %)"
         clouds = changed["clouds"]
-        mb = (float(np.mean([s[0] for s in clouds])) * 80 / 1e6, float(np.mean([s[1] for s in clouds])) * 80 / 1e6
-              ) if clouds else (0.0, 0.0)
-        lines += ["", "The changed part of the GPU backend's LOD buffers along the same dense path (mean per step; "
-                      "what the previous frame does not hold bit for bit): cloud leaves " + share("clouds") +
-                  f" ({mb[0]:.2f} of {mb[1]:.2f} MB of leaf texels), terrain triangles " +
-                  share("terrain") + ", fog prisms " + share("fog") + ". Every frame uploads its buffers whole "
-                  "(VTK's Python API has no sub-range upload)."]
+        sent = float(np.mean([s[2] for s in clouds])) / 1e6 if clouds else 0.0
+        whole = sum(s[3] for s in clouds)
+        every = float(np.mean([s[1] for s in clouds])) * 96 / 1e6 if clouds else 0.0
+        lines += ["", "The changed part of the GPU backend's LOD buffers along the same dense path (mean per step). "
+                      "Clouds: leaves new to the LOD mesh " + share("clouds") + f"; uploaded {sent:.3f} MB a step "
+                      "(their 16-byte slot texels as one region, and the 4-byte draw order of every leaf; "
+                      f"{whole} of {len(clouds)} steps re-sent the whole slot array after a compaction), against "
+                      f"{every:.3f} MB for 96 bytes a leaf (its place and 16 morphed corner values, which move "
+                      "with every step of the eye in a geomorphing region): the GPU morphs the leaves, so a leaf "
+                      "that stays sends nothing. Terrain triangles " + share("terrain") + ", fog prisms " +
+                  share("fog") + " (what the previous frame does not hold bit for bit): uploaded whole every "
+                  "frame."]
+    uploads = pop.get("cloud_uploads") if pop else None
+    if uploads:
+        lines += ["", "The clouds' upload per frame at other speeds along the path from the same start (means over "
+                      f"{uploads[0]['steps']} steps; the GPU backend's LOD work without images): leaves drawn, new to "
+                      "the LOD mesh, MB uploaded (slots of the new leaves + draw order; compactions re-send the "
+                      "slot array), and the MB of 96 bytes a leaf for comparison.", "",
+                  "| step (units) | leaves | new leaves | MB uploaded | compactions | MB at 96 B a leaf |",
+                  "|---|---|---|---|---|---|"]
+        for u in uploads:
+            lines.append(f"| {u['step_units']:g} | {u['leaves']:,.0f} | {u['added']:,.0f} "
+                         f"({100.0 * u['added'] / max(u['leaves'], 1.0):.1f} %) | {u['upload_mb']:.3f} | "
+                         f"{u['compactions']} of {u['steps']} | {u['whole_leaf_mb']:.3f} |")
     if result.get("terrain_sweep"):
         lines += [
             "",
