@@ -78,7 +78,7 @@ NOTES = [
     "max 2.32. The GPU backend against the app's own full-resolution reference needs clouds 2, 100 with terrain "
     "9, 160 for RMSE <= 3 on every frame (docs/bench/nature_accurate.md: max 2.88 at 86,000 tetrahedra per frame; "
     "clouds 2, 50 gives 3.11 on frame 0, terrain 9, 100 with clouds 2, 100 gives 3.37).",
-    "GPU backend's CPU side at the setting that meets RMSE <= 3 (docs/bench/nature_accurate.md): ~0.037 s a frame "
+    "GPU backend's CPU side at the setting that meets RMSE <= 3 (docs/bench/nature_accurate.md): ~0.038 s a frame "
     "on 2 cores (0.043 s before the clouds were morphed on the GPU, 0.095 s three rounds before). The buffer "
     "upload in it is timed inside the draw (each mapper's buffer "
     "update, ~4 ms for terrain, prisms and clouds); it was the first draw minus a second one, two ~0.3 s llvmpipe "
