@@ -309,7 +309,7 @@ class _GLFrames:
             view.terrain_actor.mapper.SetInputData(one)
         for name, layer in view.layers.items():
             layer.set_buffers(self._prisms[name][1].first_prism())
-        if view.clouds is not None:
+        if view.clouds is not None and view.clouds.order is not None:
             from volviz.render.cloud_slots import RESERVED
 
             view.clouds._set_index_buffer(view.clouds.order[:RESERVED + 1])   # the reserved slots and one leaf

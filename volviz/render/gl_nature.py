@@ -279,7 +279,7 @@ class CloudPTVolume(GLPTVolume):
         if self._fields is not None:
             self._texture("cloudFields", self._fields, ren_win)
             self._fields = None
-        if self._thresholds is not self._thresholds_sent:
+        if self._thresholds is not None and self._thresholds is not self._thresholds_sent:
             self._texture("cloudNodes", self._thresholds.reshape(-1, 1), ren_win)
             self._thresholds_sent = self._thresholds
         for update in self._pending:
