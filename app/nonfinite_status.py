@@ -33,7 +33,8 @@ def nonfinite_note(datasets: dict[str, Any]) -> str:
 
 class NonFiniteStatus:
     """Appends the read warnings and ``nonfinite_note`` of the shown scene's datasets to ``window.status_label``
-    (``window`` provides ``controller``, ``datasets``, ``jobs`` and ``status_label``). ``note`` is the last note
+    (``window`` provides ``controller``, ``datasets``, ``jobs``, ``status_label`` and ``file_choices``, which is
+    given the files' choices of what to show). ``note`` is the last note
     shown, ``warnings`` the read warnings of the scene shown."""
 
     def __init__(self, window: Any) -> None:
@@ -48,8 +49,10 @@ class NonFiniteStatus:
         controller, datasets = window.controller, dict(window.datasets)
         READ_NOTES.install()  # again, should a ``warnings.catch_warnings`` block have restored the handler
         paths = [ref.path for ref in controller.session.datasets] if controller is not None else []
-        self.warnings = READ_NOTES.take(paths)
-        read = "; ".join(short_note(n) for n in self.warnings)
+        self.warnings, choices = READ_NOTES.take_all(paths)
+        window.file_choices.set_choices(choices)
+        hint = [window.file_choices.hint()] if window.file_choices.choices else []
+        read = "; ".join(hint + [short_note(n) for n in self.warnings])
         self.note = read
         window.status_label.setToolTip("\n\n".join(self.warnings))
         if read:

@@ -11,15 +11,16 @@ import warnings
 from pathlib import Path
 from typing import Any, Iterable
 
-from volviz.io import ReadWarning
+from volviz.io import ChoiceWarning, ReadWarning
 
 
 class ReadNotes:
-    """ReadWarning messages raised since the last ``take``."""
+    """ReadWarning messages raised since the last ``take``, and the ``ChoiceWarning``s among them."""
 
     def __init__(self) -> None:
         self._lock = threading.Lock()
         self._notes: list[str] = []
+        self._choices: list[ChoiceWarning] = []
 
     def install(self) -> None:
         """Hook ``warnings.showwarning`` (once; again after a ``warnings.catch_warnings`` block restored it) and show
@@ -33,6 +34,8 @@ class ReadNotes:
             if issubclass(category, ReadWarning):
                 with self._lock:
                     self._notes.append(str(message))
+                    if isinstance(message, ChoiceWarning):
+                        self._choices.append(message)
             previous(message, category, filename, lineno, file, line)
 
         show.read_notes = self  # type: ignore[attr-defined]
@@ -42,10 +45,19 @@ class ReadNotes:
     def take(self, paths: Iterable[str] = ()) -> list[str]:
         """The notes kept so far that name one of the files ``paths`` (by file name), without repeats; all are
         forgotten (those of a scene that was replaced before it was shown included)."""
+        return self.take_all(paths)[0]
+
+    def take_all(self, paths: Iterable[str] = ()) -> tuple[list[str], list[ChoiceWarning]]:
+        """``take``'s notes and the ``ChoiceWarning``s among them (of the same files, in the order raised)."""
         with self._lock:
             notes, self._notes = self._notes, []
+            choices, self._choices = self._choices, []
         names = {Path(p).name for p in paths}
-        return [n for n in dict.fromkeys(notes) if any(name and name in n for name in names)]
+
+        def named(note: str) -> bool:
+            return any(name and name in note for name in names)
+
+        return [n for n in dict.fromkeys(notes) if named(n)], [c for c in choices if named(str(c))]
 
 
 READ_NOTES = ReadNotes()

@@ -42,6 +42,7 @@ if TYPE_CHECKING:
     from .docks.scene_tree import SceneTree
     from .docks.statistics import Statistics
     from .docks.tf_editor import TransferFunctionEditor
+    from .file_choices import FileChoices
     from .docks.timeline import Timeline
     from .frame_export import FrameExport
     from .gc_guard import GuiThreadCollector
@@ -65,6 +66,7 @@ class WindowBase(_QtWindow):
     plotter: QtInteractor
     jobs: JobBridge
     nonfinite: NonFiniteStatus
+    file_choices: FileChoices
     error_dialog: Optional[QMessageBox]
     recovery_dialog: Optional[QMessageBox]
     last_stats: dict[str, Any]

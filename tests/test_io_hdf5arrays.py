@@ -13,7 +13,7 @@ import pytest
 
 import volviz.io as vio
 from conftest import data_file
-from volviz.io.errors import ReadError, ReadWarning
+from volviz.io.errors import ChoiceWarning, ReadError, ReadWarning
 from volviz.model import Image2D, RegularVolume, TimeSeries
 
 STACK = np.random.default_rng(0).normal(size=(4, 5, 6)).astype(np.float32)      # (z, y, x)
@@ -37,6 +37,14 @@ def test_the_largest_volume_laid_out_z_y_x_with_its_voxel_size(tmp_path):
     assert isinstance(volume, RegularVolume) and volume.name == "data" and volume.dimensions == (6, 5, 4)
     assert volume.spacing == (0.5, 2.0, 3.0)
     np.testing.assert_array_equal(volume.data, np.transpose(STACK, (2, 1, 0)))   # x fastest in the file
+    # the choices as data for the app's chooser (also through the isolated reader), again when one was asked for
+    for isolate, asked in ((False, None), (True, None), (True, "/small")):
+        with pytest.warns(ChoiceWarning) as caught:
+            vio.read(path, isolate=isolate, **({"dataset": asked} if asked else {}))
+        choice = next(w.message for w in caught if isinstance(w.message, ChoiceWarning))
+        assert (choice.option, choice.chosen) == ("dataset", asked or "/entry/data/data")
+        assert choice.choices == ["/entry/data/data", "/small"] and choice.path == str(path)
+        assert choice.labels == ["/entry/data/data (4x5x6)", "/small (2x2x2)"]
     assert vio.read(path, dataset="small").dimensions == (2, 2, 2)
     assert isinstance(vio.read(path, dataset="/flat"), Image2D)
     with pytest.raises(ReadError, match=r"scan.nxs: has no numeric 2D to 4D dataset '/nope'; its arrays are: "

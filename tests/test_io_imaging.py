@@ -18,7 +18,7 @@ from pydicom.dataset import FileMetaDataset
 from pydicom.uid import ExplicitVRLittleEndian, generate_uid
 
 import volviz.io as vio
-from volviz.io.errors import ReadError, ReadWarning
+from volviz.io.errors import ChoiceWarning, ReadError, ReadWarning
 from volviz.io.registry import spec_of
 from volviz.model import RegularVolume, TimeSeries
 from volviz.render.scene_builder import data_session, series_pattern
@@ -289,9 +289,19 @@ def test_a_dicom_folder_of_files_without_extension_and_with_two_series(tmp_path)
     dicom_series(folder, small, axial, (0, 0, 0), (1, 1), 1.0, ["1", "2"], number=1)
     uid = dicom_series(folder, large, axial, (0, 0, 0), (1, 1), 1.0, ["3", "4", "5"], number=2)
     assert spec_of(folder).name == "dicom"
-    with pytest.warns(ReadWarning, match="holds 2 series; showing series 2 'series 2' \\(3 files"):
+    with pytest.warns(ReadWarning, match="holds 2 series; showing the one with the most files, 2 'series 2' "
+                                         "\\(3 files") as caught:
         volume = vio.read(folder, isolate=False)
     _assert_placed(volume, np.transpose(large, (2, 1, 0)) - 1024.0, _dicom_affine_ras(axial, (0, 0, 0), (1, 1), 1))
+    # the choices as data, for the app's chooser, also through the isolated reader; the series UIDs pick them
+    for isolate in (False, True):
+        with pytest.warns(ChoiceWarning) as caught:
+            vio.read(folder, isolate=isolate)
+        choice = next(w.message for w in caught if isinstance(w.message, ChoiceWarning))
+        assert choice.option == "series" and choice.chosen == uid and choice.choices[0] == uid
+        assert len(choice.choices) == 2 and choice.labels[1].startswith("1 'series 1' (2 files")
+    with pytest.warns(ChoiceWarning, match="showing the one as asked, 1 'series 1'"):
+        assert vio.read(folder, series=choice.choices[1]).dimensions == (4, 4, 2)
     assert vio.read(folder, series="1").dimensions == (4, 4, 2)
     assert vio.read(folder, series=uid).dimensions == (4, 4, 3)
     with pytest.raises(ReadError, match="no series 'nope'; the series here are: 1 'series 1' \\(2 files"):

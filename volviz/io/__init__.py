@@ -32,7 +32,7 @@ import functools
 import os
 from typing import Any
 
-from volviz.io.errors import NonFiniteWarning, PathLike, ReadError, ReadWarning
+from volviz.io.errors import ChoiceWarning, NonFiniteWarning, PathLike, ReadError, ReadWarning
 from volviz.io.folders import folder_target
 from volviz.io.raw import read_raw, read_slice_stack
 from volviz.io.registry import (ReaderSpec, call_reader, format_of, is_pattern, open_dialog_filter, reader_specs,
@@ -79,7 +79,7 @@ def __getattr__(name: str):
 
 
 __all__ = [
-    "NonFiniteWarning", "ReadError", "ReadWarning", "ReaderSpec", "reader_specs", "expand_pattern",
+    "ChoiceWarning", "NonFiniteWarning", "ReadError", "ReadWarning", "ReaderSpec", "reader_specs", "expand_pattern",
     "open_dialog_filter", "read", "read_dem", "read_image", "read_meshio", "read_metaimage", "read_plot3d",
     "read_pnm", "read_pvm", "read_raw", "read_series", "read_slc", "read_slice_stack", "read_vtk_file", "read_vtkhdf",
     "supported_formats",

@@ -1,4 +1,5 @@
-"""The one exception every volviz reader raises for bad input, and the warning for kept non-finite values."""
+"""The one exception every volviz reader raises for bad input, the warnings of a doubtful or partial read, and the
+warning for kept non-finite values."""
 from __future__ import annotations
 
 import os
@@ -28,6 +29,46 @@ class ReadError(Exception):
 class ReadWarning(UserWarning):
     """A file was read, but something in it will likely be shown other than its author meant (a coordinate the reader
     takes for data, an orientation that is ignored): the message names the file and the doubt."""
+
+
+#: the most choices a ``ChoiceWarning`` carries, and the longest choice (characters)
+MAX_CHOICES = 1000
+MAX_CHOICE_CHARS = 256
+
+
+class ChoiceWarning(ReadWarning):
+    """A file holds several things to show (arrays of an HDF5 or MATLAB file, series of a DICOM folder) and the reader
+    showed one: ``path`` the file, ``option`` the reader option that picks another, ``chosen`` its value for the one
+    shown and ``choices`` the values it takes (the shown one among them), as strings, with a ``labels`` entry each
+    to show a person; the message says the same in words."""
+
+    def __init__(self, message: str, path: PathLike = "", option: str = "", chosen: str = "",
+                 choices: list[str] | tuple[str, ...] = (), labels: list[str] | tuple[str, ...] = ()) -> None:
+        super().__init__(message)
+        self.path = os.fspath(path)
+        self.option = str(option)
+        self.chosen = str(chosen)
+        self.choices = [str(c)[:MAX_CHOICE_CHARS] for c in list(choices)[:MAX_CHOICES]]
+        labels = [str(t)[:MAX_CHOICE_CHARS] for t in list(labels)[:MAX_CHOICES]]
+        self.labels = labels if len(labels) == len(self.choices) else list(self.choices)
+
+    def fields(self) -> dict[str, object]:
+        """The structured part, as plain data (what the isolated reader sends beside the message)."""
+        return {"path": self.path, "option": self.option, "chosen": self.chosen, "choices": list(self.choices),
+                "labels": list(self.labels)}
+
+    @classmethod
+    def from_fields(cls, message: str, fields: object) -> "ChoiceWarning | None":
+        """The warning again from ``fields`` (as ``fields`` made them; None when they are not of that form)."""
+        if not isinstance(fields, dict):
+            return None
+        path, option, chosen, choices, labels = (fields.get(k) for k in ("path", "option", "chosen", "choices",
+                                                                          "labels"))
+        if not (isinstance(path, str) and isinstance(option, str) and option.isidentifier()
+                and isinstance(chosen, str) and isinstance(choices, list) and isinstance(labels, list)
+                and all(isinstance(c, str) for c in choices + labels)):
+            return None
+        return cls(message, path, option, chosen, choices, labels)
 
 
 class NonFiniteWarning(UserWarning):

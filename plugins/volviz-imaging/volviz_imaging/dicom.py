@@ -31,7 +31,7 @@ from typing import Any, Iterator
 import numpy as np
 
 from volviz.io._checks import read_bytes
-from volviz.io.errors import PathLike, ReadError, ReadWarning
+from volviz.io.errors import ChoiceWarning, PathLike, ReadError, ReadWarning
 from volviz.model import RegularVolume, TimeSeries
 
 from volviz_imaging.placement import aligned_volume, lps_to_ras
@@ -176,17 +176,20 @@ def _pick_series(path: Path, slices: list[_Slice], chosen: Path | None, series: 
         if not hits:
             raise ReadError(path, f"no series {series!r}; the series here are: "
                                   + "; ".join(label(k) for k in groups))
-        return groups[hits[0]]
-    if chosen is not None:
+        key, how = hits[0], "as asked"
+    elif chosen is not None:
         mine = next((s for s in slices if s.path == chosen), None)
         if mine is None:
             raise ReadError(chosen, "is not a DICOM image (no pixel data, or not a DICOM file pydicom can read)")
-        return groups[_series_key(mine)]
-    key = max(groups, key=lambda k: len(groups[k]))
+        key, how = _series_key(mine), "of the file opened"
+    else:
+        key, how = max(groups, key=lambda k: len(groups[k])), "with the most files"
     if len(groups) > 1:
-        warnings.warn(f"{path}: holds {len(groups)} series; showing series {label(key)}. Others: "
-                      + "; ".join(label(k) for k in groups if k != key) + " (open one of their files, or pass "
-                      "series=...)", ReadWarning, stacklevel=3)
+        keys = sorted(groups, key=lambda k: -len(groups[k]))
+        warnings.warn(ChoiceWarning(f"{path}: holds {len(groups)} series; showing the one {how}, {label(key)}. "
+                                    "Others: " + "; ".join(label(k) for k in keys if k != key)
+                                    + " (open one of their files, or pass series=...)", path, "series", key, keys,
+                                    [label(k) for k in keys]), stacklevel=3)
     return groups[key]
 
 

@@ -33,7 +33,7 @@ from typing import Any
 
 import numpy as np
 
-from volviz.io.errors import NonFiniteWarning, PathLike, ReadError, ReadWarning, human_bytes
+from volviz.io.errors import ChoiceWarning, NonFiniteWarning, PathLike, ReadError, ReadWarning, human_bytes
 from volviz.io.isolated.codec import CodecError, array_specs, decode
 from volviz.io.isolated.worker import ChildDied, ChildTimedOut, Pool
 
@@ -42,8 +42,8 @@ WORKDIR_PREFIX = "volviz-read-"
 MAP_BYTES = 1 << 20  # arrays from this size on are mapped, smaller ones copied (each mapping costs a page and a slot)
 _FALSE = ("0", "false", "no", "off")
 _SIZE = re.compile(r"\s*(\d+(?:\.\d+)?)\s*([kmgt]?)i?b?\s*", re.I)
-_WARNINGS = {c.__name__: c for c in (NonFiniteWarning, ReadWarning, UserWarning, RuntimeWarning, DeprecationWarning,
-                                     FutureWarning, ResourceWarning)}
+_WARNINGS = {c.__name__: c for c in (NonFiniteWarning, ReadWarning, ChoiceWarning, UserWarning, RuntimeWarning,
+                                     DeprecationWarning, FutureWarning, ResourceWarning)}
 
 
 def isolation_enabled(isolate: bool | None = None) -> bool:
@@ -218,8 +218,14 @@ def _load_array(path: str, nbytes: int) -> np.ndarray:
 
 
 def _reemit(caught: Any) -> None:
+    """The child's warnings again in this process: [category, message], a ``ChoiceWarning`` with its choices."""
     for item in caught if isinstance(caught, list) else []:
-        if isinstance(item, list) and len(item) == 2 and all(isinstance(t, str) for t in item):
+        if not (isinstance(item, list) and len(item) in (2, 3) and all(isinstance(t, str) for t in item[:2])):
+            continue
+        choice = ChoiceWarning.from_fields(item[1], item[2]) if len(item) == 3 and item[0] == "ChoiceWarning" else None
+        if choice is not None:
+            warnings.warn(choice, stacklevel=4)
+        else:
             warnings.warn(item[1], _WARNINGS.get(item[0], UserWarning), stacklevel=4)
 
 

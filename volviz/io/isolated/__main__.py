@@ -44,6 +44,16 @@ def _die_with_parent() -> None:
     threading.Thread(target=watch, name="volviz-reader-watchdog", daemon=True).start()
 
 
+
+def _warning(message: Warning | str) -> list:
+    """A caught warning for the parent: [category, message], and a ``ChoiceWarning``'s choices as a third item."""
+    from volviz.io.errors import ChoiceWarning
+
+    item: list = [type(message).__name__ if isinstance(message, Warning) else "UserWarning", str(message)[:2000]]
+    if isinstance(message, ChoiceWarning):
+        item.append(message.fields())
+    return item
+
 class _MemoryLimit:
     """RLIMIT_AS lowered to the present address space plus ``budget`` for the duration of one read."""
 
@@ -146,7 +156,7 @@ class Child:
                 answer = {"ok": False, "error": "exception", "type": type(exc).__name__, "message": str(exc)[:2000]}
             finally:
                 dataset = arrays = None
-        answer["warnings"] = [[w.category.__name__, str(w.message)[:2000]] for w in caught[:50]]
+        answer["warnings"] = [_warning(w.message) for w in caught[:50]]
         return answer
 
 
