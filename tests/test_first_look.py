@@ -208,3 +208,40 @@ def test_signed_data_around_zero_gets_the_diverging_view():
     assert float(np.mean(_rho(tf, values))) * 4.0 == pytest.approx(TARGET_DEPTH, rel=0.02)
     one_sided = auto_transfer_function(np.random.default_rng(6).uniform(-10.0, 100.0, 50_000), chord=4.0)
     assert _rho(one_sided, np.array([-9.0]))[0] == 0.0 < _rho(one_sided, np.array([95.0]))[0]   # mostly positive
+
+
+def test_surfaces_of_geometry_alone_are_drawn_plain_without_a_scale(tmp_path):
+    """An STL (no arrays) and a PLY whose only arrays are its vertex normals (nx, ny, nz as meshio reads them) are
+    drawn in one plain colour with no scalar bar (there is no scale to explain; the PLY was colored by nx under a
+    bar titled "nx"); a surface with a data array beside its normals shows that array, with its bar."""
+    import pyvista as pv
+
+    from volviz.model.arrays import default_array, is_geometry_array
+    from volviz.render.decorations import scalar_bar_title
+    from volviz.render.export import close_scene, offscreen_scene, snapshot
+    from volviz.render.scene_builder import data_session, load_datasets
+
+    sphere = pv.Sphere(theta_resolution=24, phi_resolution=24)
+    sphere.save(tmp_path / "geometry.stl")
+    sphere.save(tmp_path / "normals.ply")
+    sphere["height"] = sphere.points[:, 2]
+    sphere.save(tmp_path / "data.vtp")
+    assert is_geometry_array("Normals") and is_geometry_array("nx") and not is_geometry_array("height")
+    for name, title in (("geometry.stl", None), ("normals.ply", None), ("data.vtp", "height")):
+        session = data_session(tmp_path / name)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            datasets = load_datasets(session, None)
+        assert (default_array(datasets["data"]) is None) == (title is None), name
+        plotter, controller = offscreen_scene(session, datasets, (160, 120))
+        try:
+            controller.build()
+            image = np.asarray(snapshot(plotter, (160, 120))).astype(int)
+            assert scalar_bar_title(plotter) == title, name
+        finally:
+            close_scene(plotter, controller)
+        middle = image[45:75, 42:74]                     # the sphere (the axes and the box are elsewhere)
+        assert (np.abs(middle - image[0, 0]).sum(axis=2) > 40).mean() > 0.9, name
+        # shading alone varies a plain surface's brightness, not its hue; data adds a colour ramp (blue to red)
+        spread = float(np.ptp(middle[..., 0] - middle[..., 2]))
+        assert (spread < 40) == (title is None), (name, spread)

@@ -137,10 +137,22 @@ def list_arrays(dataset: Any) -> list[ArrayInfo]:
     return infos
 
 
+#: names of arrays that describe the geometry rather than data on it (vertex normals as PLY and VTK name them,
+#: texture coordinates), compared in lower case without spaces and underscores
+GEOMETRY_ARRAYS = frozenset({"nx", "ny", "nz", "normals", "tcoords", "texturecoordinates"})
+
+
+def is_geometry_array(name: str) -> bool:
+    """Whether ``name`` is a geometry attribute (``GEOMETRY_ARRAYS``): never shown by default, a surface with only
+    these is drawn in a plain colour."""
+    return name.lower().replace(" ", "").replace("_", "") in GEOMETRY_ARRAYS
+
+
 def default_array(dataset: Any) -> str | None:
     """The spec a first open shows: the dataset's active array when it varies, else the first point array that
-    varies, else the first cell array that varies, else the first array (vectors by their magnitude)."""
-    infos = list_arrays(dataset)
+    varies, else the first cell array that varies, else the first array (vectors by their magnitude); geometry
+    attributes (``is_geometry_array``) are not candidates, and None when nothing else is there."""
+    infos = [i for i in list_arrays(dataset) if not is_geometry_array(i.name)]
     if not infos:
         return None
     active = getattr(_base(dataset), "active", None) or getattr(_base(dataset), "name", None)

@@ -81,7 +81,7 @@ def update_legend(plotter: Any, session: Session, datasets: dict[str, Any]) -> N
     """Redraw only the scalar bar (after a transfer-function edit: the outline and axes stay as they are)."""
     _remove_scalar_bar(plotter)
     comp = _legend_component(session) if decoration_enabled(session, "scalar_bar") else None
-    if comp is not None:
+    if comp is not None and _shows_array(comp, datasets):
         _add_scalar_bar(plotter, session, comp, _array_title(comp, datasets), _contrast(session.render.background))
 
 
@@ -149,6 +149,23 @@ def _add_scalar_bar(plotter: Any, session: Session, comp: Any, title: str, color
         text.SetFontSize(12)
     plotter.add_actor(bar, name=SCALAR_BAR_NAME, reset_camera=False, render=False, pickable=False)
     plotter.add_actor(heading, name=SCALAR_BAR_TITLE_NAME, reset_camera=False, render=False, pickable=False)
+
+
+def _shows_array(comp: Any, datasets: dict[str, Any]) -> bool:
+    """Whether the component colours by an array (its setting, else its dataset's default): a surface of geometry
+    alone (an STL, a PLY of normals) is drawn in a plain colour, with no scale to explain."""
+    if comp.settings.get(array_key(comp.type)) or comp.type != "volume":
+        return True
+    from volviz.model.arrays import default_array
+    from volviz.render.vtk_scene import is_surface
+
+    dataset = datasets.get(comp.dataset)
+    if dataset is None or not is_surface(dataset):
+        return True
+    try:
+        return default_array(dataset) is not None
+    except (TypeError, ValueError, AttributeError):
+        return True
 
 
 def _array_title(comp: Any, datasets: dict[str, Any]) -> str:

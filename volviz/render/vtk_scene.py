@@ -185,16 +185,21 @@ def is_surface(dataset: Any) -> bool:
 
 def surface_input(dataset: Any) -> Any:
     """The PyVista surface drawn for a dataset of surface cells (``is_surface``; or its ``volume_grid``), its active
-    scalars kept active: the cells touching NaN/Inf (land in an ocean field, a solver's failed points) are left
-    out."""
+    scalars kept active unless they are a geometry attribute (``volviz.model.arrays.is_geometry_array``): the cells
+    touching NaN/Inf (land in an ocean field, a solver's failed points) are left out."""
+    from volviz.model.arrays import is_geometry_array
+
     grid = volume_grid(dataset)
     name = grid.active_scalars_name
     values = np.asarray(grid.active_scalars)
     if values.dtype.kind == "f" and not np.isfinite(values).all():   # cells touching NaN/Inf are not drawn
         grid = grid.extract_points(np.flatnonzero(np.isfinite(values)), adjacent_cells=False)
     surface = grid.extract_surface(algorithm="dataset_surface") if hasattr(grid, "extract_surface") else grid
-    if name is not None and name in surface.array_names:
+    if name is not None and name in surface.array_names and not is_geometry_array(name):
         surface.set_active_scalars(name)
+    else:                          # geometry alone (normals, texture coordinates): a plain colour
+        surface.point_data.active_scalars_name = None
+        surface.cell_data.active_scalars_name = None
     return surface
 
 
