@@ -240,8 +240,11 @@ def test_surfaces_of_geometry_alone_are_drawn_plain_without_a_scale(tmp_path):
             assert scalar_bar_title(plotter) == title, name
         finally:
             close_scene(plotter, controller)
-        middle = image[45:75, 42:74]                     # the sphere (the axes and the box are elsewhere)
-        assert (np.abs(middle - image[0, 0]).sum(axis=2) > 40).mean() > 0.9, name
+        drawn = np.abs(image - image[0, 0]).sum(axis=2) > 40
+        drawn[90:, :40] = False                          # the orientation axes
+        rows, cols = (int(v.mean()) for v in np.nonzero(drawn))
+        middle = image[rows - 8:rows + 8, cols - 8:cols + 8]         # the sphere's middle (the box lines are thin)
+        assert (np.abs(middle - image[0, 0]).sum(axis=2) > 40).mean() > 0.8, name
         # shading alone varies a plain surface's brightness, not its hue; data adds a colour ramp (blue to red)
         spread = float(np.ptp(middle[..., 0] - middle[..., 2]))
         assert (spread < 40) == (title is None), (name, spread)

@@ -435,7 +435,7 @@ class SceneController:
             from volviz.render.decorations import legend_margin
             from volviz.render.framing import frame_scene
 
-            frame_scene(self.plotter, self.shown_props(), right_margin=legend_margin(self.session))
+            frame_scene(self.plotter, self.shown_props(), right_margin=legend_margin(self.session, self.datasets))
         else:
             apply_camera(self.plotter, camera)
         if update:

@@ -24,9 +24,11 @@ def decoration_enabled(session: Session, name: str) -> bool:
 LEGEND_MARGIN = 0.2        # the share of the viewport's width at its right that framing keeps for the scalar bar
 
 
-def legend_margin(session: Session) -> float:
-    """How much of the viewport's width, at its right, the scalar bar takes (0 when none is shown)."""
-    shown = decoration_enabled(session, "scalar_bar") and _legend_component(session) is not None
+def legend_margin(session: Session, datasets: Optional[dict[str, Any]] = None) -> float:
+    """How much of the viewport's width, at its right, the scalar bar takes (0 when none is shown; with the loaded
+    ``datasets``, also when the component it would explain colours by no array)."""
+    comp = _legend_component(session) if decoration_enabled(session, "scalar_bar") else None
+    shown = comp is not None and (datasets is None or _shows_array(comp, datasets))
     return LEGEND_MARGIN if shown else 0.0
 
 

@@ -477,7 +477,8 @@ def install_scene(plotter: Any, session: Session, datasets: dict[str, Any], prep
         boxes += [lod_bounds(d) for _, d in lod_components]
         if prepared.nature is not None:
             boxes.append(nature_bounds(prepared.nature))
-        frame_bounds(plotter, union([b for b in boxes if b is not None]), right_margin=legend_margin(session))
+        frame_bounds(plotter, union([b for b in boxes if b is not None]),
+                     right_margin=legend_margin(session, datasets))
     else:
         apply_camera(plotter, session.camera)
     nature = install_nature(plotter, prepared.nature, views, view_backend(plotter, session, "nature"))
