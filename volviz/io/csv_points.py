@@ -1,0 +1,137 @@
+"""Point tables (``.csv``, ``.tsv``): a header row naming the columns, then a row of numbers per point — what
+ParaView opens with its CSV reader and "Table To Points", and what a logger, a particle tracker or a spreadsheet
+writes. The columns named x, y and z (any case; ParaView's own exports name them ``Points:0``, ``Points:1``,
+``Points:2``) place the points, or the columns the options ``x=``, ``y=``, ``z=`` name; a table without a z column
+lies in the z = 0 plane. Every other numeric column is an array on the points; columns of text are left out (named in
+a warning). Comma, semicolon, tab or blank separated; ``#`` starts a comment. Rows whose coordinates are missing are
+left out with a warning. The points are vertices of an ``UnstructuredMesh``, drawn as points coloured by an array.
+"""
+from __future__ import annotations
+
+import re
+import warnings
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from volviz.io._checks import check_file, check_finite
+from volviz.io.errors import PathLike, ReadError, ReadWarning
+from volviz.model import UnstructuredMesh
+
+VTK_VERTEX = 1
+#: the largest table read (bytes of text)
+MAX_BYTES = 2 << 30
+#: header names taken for each coordinate, in lower case without blanks
+COORDINATE_NAMES = ({"x", "points:0", "coordsx", "coordinatex", "posx", "positionx"},
+                    {"y", "points:1", "coordsy", "coordinatey", "posy", "positiony"},
+                    {"z", "points:2", "coordsz", "coordinatez", "posz", "positionz"})
+SAMPLE_ROWS = 200
+
+
+def _separator(line: str) -> str | None:
+    """The column separator of a header line: tab, semicolon, comma, else blanks (None)."""
+    for sep in ("\t", ";", ","):
+        if sep in line:
+            return sep
+    return None
+
+
+def _fields(line: str, sep: str | None) -> list[str]:
+    return [f.strip().strip('"').strip("'").strip() for f in (line.split(sep) if sep else line.split())]
+
+
+def _number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def _key(name: str) -> str:
+    return re.sub(r"[\s_]+", "", name.lower())
+
+
+def _coordinate_columns(p: Path, names: list[str], asked: tuple[str | None, ...]) -> list[int | None]:
+    """The columns of x, y, z (None: no z, the plane z = 0); a ReadError naming the columns when x or y is missing."""
+    out: list[int | None] = []
+    for axis, (wanted, known) in enumerate(zip(asked, COORDINATE_NAMES)):
+        label = "xyz"[axis]
+        if wanted is not None:
+            if wanted not in names:
+                raise ReadError(p, f"has no column {wanted!r} (asked for as {label}); its columns are: "
+                                   + ", ".join(names))
+            out.append(names.index(wanted))
+            continue
+        found = [i for i, n in enumerate(names) if _key(n) in known]
+        if not found and axis < 2:
+            raise ReadError(p, f"has no column named {label} for the points' {label} coordinate; its columns are: "
+                               + ", ".join(names[:30]) + (" ..." if len(names) > 30 else ""),
+                            "name the coordinate columns with the options x=, y= (and z=)")
+        out.append(found[0] if found else None)
+    return out
+
+
+def read_csv_points(path: PathLike, x: str | None = None, y: str | None = None, z: str | None = None,
+                    allow_nonfinite: bool = True) -> UnstructuredMesh:
+    """The table's rows as points with the other numeric columns as point arrays (see the module docstring)."""
+    p = check_file(path)
+    if p.stat().st_size > MAX_BYTES:
+        raise ReadError(p, f"is a table of {p.stat().st_size / 1e9:.1f} GB; volviz reads point tables of at most "
+                           f"{MAX_BYTES / 1e9:.1f} GB", "convert it to a binary format (VTK .vtp, HDF5)")
+    with open(p, "rb") as f:
+        head = f.read(1 << 16)
+    if b"\0" in head:
+        raise ReadError(p, "is not a text table (it holds zero bytes)")
+    lines = head.decode("utf-8", errors="replace").splitlines()
+    header_at = next((i for i, line in enumerate(lines) if line.strip() and not line.lstrip().startswith("#")), None)
+    if header_at is None:
+        raise ReadError(p, "holds no rows")
+    sep = _separator(lines[header_at])
+    names = _fields(lines[header_at], sep)
+    if all(_number(n) for n in names):
+        raise ReadError(p, "has no header row naming its columns (its first row is numbers)",
+                        "add a first row naming the columns, with x, y and z for the coordinates")
+    if len(set(names)) != len(names) or any(not n for n in names):
+        raise ReadError(p, "has empty or repeated column names in its header row: " + ", ".join(names[:30]))
+    columns = _coordinate_columns(p, names, (x, y, z))
+    sample = [_fields(line, sep) for line in lines[header_at + 1:header_at + 1 + SAMPLE_ROWS]
+              if line.strip() and not line.lstrip().startswith("#")]
+    if not sample:
+        raise ReadError(p, "has a header row but no rows of values")
+    numeric = [i for i in range(len(names)) if all(i < len(row) and (_number(row[i]) or not row[i]) for row in sample)]
+    for axis, col in enumerate(columns):
+        if col is not None and col not in numeric:
+            raise ReadError(p, f"its {'xyz'[axis]} column {names[col]!r} holds text, not numbers")
+    text = [names[i] for i in range(len(names)) if i not in numeric]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")     # genfromtxt's per-row conversion warnings: counted below instead
+        try:
+            table = np.genfromtxt(p, delimiter=sep, skip_header=header_at + 1, usecols=numeric, comments="#",
+                                  dtype=np.float64, invalid_raise=False, ndmin=2, encoding="utf-8")
+        except (ValueError, UnicodeDecodeError) as exc:
+            raise ReadError(p, f"has rows that cannot be read as numbers ({str(exc)[:200]})") from None
+    if table.size == 0:
+        raise ReadError(p, "has no rows of numbers under its header")
+    at = {col: k for k, col in enumerate(numeric)}
+    coords = [table[:, at[c]] if c is not None else np.zeros(len(table)) for c in columns]
+    points = np.stack(coords, axis=1)
+    placed = np.isfinite(points).all(axis=1)
+    if not placed.all():
+        warnings.warn(f"{p}: {int((~placed).sum()):,} of {len(points):,} rows have no coordinates (missing or not "
+                      "numbers) and are left out", ReadWarning, stacklevel=2)
+        points, table = points[placed], table[placed]
+    if not len(points):
+        raise ReadError(p, "has no row with all its coordinates")
+    if text:
+        warnings.warn(f"{p}: columns of text left out: {', '.join(text[:20])}", ReadWarning, stacklevel=2)
+    arrays: dict[str, Any] = {}
+    for col in numeric:
+        if col in columns:
+            continue
+        values = table[:, at[col]]
+        check_finite(p, values, allow_nonfinite)
+        arrays[names[col]] = values
+    cells = [(VTK_VERTEX, np.arange(len(points), dtype=np.int64).reshape(-1, 1))]
+    return UnstructuredMesh(points, cells, point_data=arrays, source=str(p))
