@@ -210,13 +210,14 @@ def test_signed_data_around_zero_gets_the_diverging_view():
     assert _rho(one_sided, np.array([-9.0]))[0] == 0.0 < _rho(one_sided, np.array([95.0]))[0]   # mostly positive
 
 
-def test_surfaces_of_geometry_alone_are_drawn_plain_without_a_scale(tmp_path):
+def test_surfaces_of_geometry_alone_are_drawn_plain_or_in_their_colours_without_a_scale(tmp_path):
     """An STL (no arrays) and a PLY whose only arrays are its vertex normals (nx, ny, nz as meshio reads them) are
     drawn in one plain colour with no scalar bar (there is no scale to explain; the PLY was colored by nx under a
-    bar titled "nx"); a surface with a data array beside its normals shows that array, with its bar."""
+    bar titled "nx"); a PLY with vertex colours in those colours; a surface with a data array beside its normals
+    shows that array, with its bar."""
     import pyvista as pv
 
-    from volviz.model.arrays import default_array, is_geometry_array
+    from volviz.model.arrays import default_array, is_appearance_array
     from volviz.render.decorations import scalar_bar_title
     from volviz.render.export import close_scene, offscreen_scene, snapshot
     from volviz.render.scene_builder import data_session, load_datasets
@@ -224,10 +225,13 @@ def test_surfaces_of_geometry_alone_are_drawn_plain_without_a_scale(tmp_path):
     sphere = pv.Sphere(theta_resolution=24, phi_resolution=24)
     sphere.save(tmp_path / "geometry.stl")
     sphere.save(tmp_path / "normals.ply")
+    painted = sphere.copy()
+    painted["RGB"] = np.tile(np.array([[30, 200, 40]], np.uint8), (painted.n_points, 1))
+    painted.save(tmp_path / "painted.ply", texture="RGB")      # uchar red, green, blue: meshio reads them signed
     sphere["height"] = sphere.points[:, 2]
     sphere.save(tmp_path / "data.vtp")
-    assert is_geometry_array("Normals") and is_geometry_array("nx") and not is_geometry_array("height")
-    for name, title in (("geometry.stl", None), ("normals.ply", None), ("data.vtp", "height")):
+    assert is_appearance_array("Normals") and is_appearance_array("nx") and not is_appearance_array("height")
+    for name, title in (("geometry.stl", None), ("normals.ply", None), ("painted.ply", None), ("data.vtp", "height")):
         session = data_session(tmp_path / name)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
@@ -245,6 +249,9 @@ def test_surfaces_of_geometry_alone_are_drawn_plain_without_a_scale(tmp_path):
         rows, cols = (int(v.mean()) for v in np.nonzero(drawn))
         middle = image[rows - 8:rows + 8, cols - 8:cols + 8]         # the sphere's middle (the box lines are thin)
         assert (np.abs(middle - image[0, 0]).sum(axis=2) > 40).mean() > 0.8, name
-        # shading alone varies a plain surface's brightness, not its hue; data adds a colour ramp (blue to red)
+        # shading alone varies a plain surface's brightness, not its hue; data adds a colour ramp (blue to red); a
+        # painted surface shows its own green
         spread = float(np.ptp(middle[..., 0] - middle[..., 2]))
         assert (spread < 40) == (title is None), (name, spread)
+        green = (middle[..., 1] > 1.5 * np.maximum(middle[..., 0], middle[..., 2])).mean()
+        assert (green > 0.6) == (name == "painted.ply") and (green > 0.6 or green < 0.05), (name, green)

@@ -137,22 +137,54 @@ def list_arrays(dataset: Any) -> list[ArrayInfo]:
     return infos
 
 
-#: names of arrays that describe the geometry rather than data on it (vertex normals as PLY and VTK name them,
-#: texture coordinates), compared in lower case without spaces and underscores
-GEOMETRY_ARRAYS = frozenset({"nx", "ny", "nz", "normals", "tcoords", "texturecoordinates"})
+#: names of arrays that describe how a surface looks rather than data on it: vertex normals (as PLY and VTK name
+#: them), texture coordinates and vertex colours; compared in lower case without spaces and underscores
+APPEARANCE_ARRAYS = frozenset({"nx", "ny", "nz", "normals", "tcoords", "texturecoordinates", "red", "green", "blue",
+                               "alpha", "rgb", "rgba", "colors", "colours"})
 
 
-def is_geometry_array(name: str) -> bool:
-    """Whether ``name`` is a geometry attribute (``GEOMETRY_ARRAYS``): never shown by default, a surface with only
-    these is drawn in a plain colour."""
-    return name.lower().replace(" ", "").replace("_", "") in GEOMETRY_ARRAYS
+def _plain_name(name: str) -> str:
+    return name.lower().replace(" ", "").replace("_", "")
+
+
+def is_appearance_array(name: str) -> bool:
+    """Whether ``name`` is an appearance attribute (``APPEARANCE_ARRAYS``): never shown through a transfer function
+    by default; a surface with only these is drawn in its vertex colours, else in a plain colour."""
+    return _plain_name(name) in APPEARANCE_ARRAYS
+
+
+def vertex_colours(dataset: Any) -> np.ndarray | None:
+    """The point colours of a mesh or grid as (n, 3) or (n, 4) uint8: its red, green, blue (and alpha) arrays, or one
+    RGB / RGBA / colors array of 3 or 4 components; integers as bytes (meshio reads PLY's unsigned bytes as signed
+    ones), floats in [0, 1] scaled to 255. None when it has none."""
+    d = _base(dataset)
+    point_data = getattr(d, "point_data", None) or {}
+    named = {_plain_name(k): v for k, v in point_data.items()}
+    if all(k in named for k in ("red", "green", "blue")):
+        parts = [named[k] for k in ("red", "green", "blue", "alpha") if k in named]
+        if any(np.ndim(p) != 1 for p in parts):
+            return None
+        values = np.stack(parts, axis=1)
+    else:
+        found = [v for k, v in named.items() if k in ("rgb", "rgba", "colors", "colours")
+                 and np.ndim(v) == 2 and np.shape(v)[1] in (3, 4)]
+        if not found:
+            return None
+        values = found[0]
+    values = np.asarray(values)
+    if values.dtype.kind in "iu":
+        return (values.astype(np.int64) % 256).astype(np.uint8)
+    if values.dtype.kind == "f" and np.isfinite(values).all():
+        scale = 255.0 if values.max(initial=0.0) <= 1.0 else 1.0
+        return np.clip(np.rint(values * scale), 0, 255).astype(np.uint8)
+    return None
 
 
 def default_array(dataset: Any) -> str | None:
     """The spec a first open shows: the dataset's active array when it varies, else the first point array that
-    varies, else the first cell array that varies, else the first array (vectors by their magnitude); geometry
-    attributes (``is_geometry_array``) are not candidates, and None when nothing else is there."""
-    infos = [i for i in list_arrays(dataset) if not is_geometry_array(i.name)]
+    varies, else the first cell array that varies, else the first array (vectors by their magnitude); appearance
+    attributes (``is_appearance_array``) are not candidates, and None when nothing else is there."""
+    infos = [i for i in list_arrays(dataset) if not is_appearance_array(i.name)]
     if not infos:
         return None
     active = getattr(_base(dataset), "active", None) or getattr(_base(dataset), "name", None)

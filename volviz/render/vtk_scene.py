@@ -183,28 +183,42 @@ def is_surface(dataset: Any) -> bool:
     return False
 
 
+#: the point array of a surface's own colours (``surface_input``), drawn as they are by ``add_surface``
+VERTEX_COLOURS = "volviz vertex colours"
+
+
 def surface_input(dataset: Any) -> Any:
     """The PyVista surface drawn for a dataset of surface cells (``is_surface``; or its ``volume_grid``), its active
-    scalars kept active unless they are a geometry attribute (``volviz.model.arrays.is_geometry_array``): the cells
-    touching NaN/Inf (land in an ocean field, a solver's failed points) are left out."""
-    from volviz.model.arrays import is_geometry_array
+    scalars kept active unless they are an appearance attribute (``volviz.model.arrays.is_appearance_array``): then
+    its vertex colours (``VERTEX_COLOURS``), if it has any, else none. The cells touching NaN/Inf (land in an ocean
+    field, a solver's failed points) are left out."""
+    from volviz.model.arrays import is_appearance_array, vertex_colours
 
     grid = volume_grid(dataset)
     name = grid.active_scalars_name
+    if name is not None and is_appearance_array(name):
+        name = None
+        colours = vertex_colours(dataset)
+        if colours is not None and len(colours) == grid.n_points:
+            grid.point_data[VERTEX_COLOURS] = colours
     values = np.asarray(grid.active_scalars)
     if values.dtype.kind == "f" and not np.isfinite(values).all():   # cells touching NaN/Inf are not drawn
         grid = grid.extract_points(np.flatnonzero(np.isfinite(values)), adjacent_cells=False)
     surface = grid.extract_surface(algorithm="dataset_surface") if hasattr(grid, "extract_surface") else grid
-    if name is not None and name in surface.array_names and not is_geometry_array(name):
+    if name is not None and name in surface.array_names:
         surface.set_active_scalars(name)
-    else:                          # geometry alone (normals, texture coordinates): a plain colour
+    else:                          # appearance alone (normals, texture coordinates, colours): no scalars
         surface.point_data.active_scalars_name = None
         surface.cell_data.active_scalars_name = None
     return surface
 
 
 def add_surface(plotter: Any, surface: Any, tf: Any, opacity: float, name: Optional[str]) -> Any:
-    """A surface made by ``surface_input``, colored by its active scalars through the transfer function's colors."""
+    """A surface made by ``surface_input``, colored by its active scalars through the transfer function's colors, or
+    in its own vertex colours when it shows no array."""
+    if surface.active_scalars_name is None and VERTEX_COLOURS in surface.point_data:
+        return plotter.add_mesh(surface, scalars=VERTEX_COLOURS, rgb=True, opacity=opacity, name=name,
+                                show_scalar_bar=False, reset_camera=False, render=False)
     ctf, _ = tf_to_vtk(tf, 1.0)
     ctf.ClampingOn()
     actor = plotter.add_mesh(surface, scalars=surface.active_scalars_name, opacity=opacity, name=name,
