@@ -149,17 +149,16 @@ def _plain_name(name: str) -> str:
 
 def is_appearance_array(name: str) -> bool:
     """Whether ``name`` is an appearance attribute (``APPEARANCE_ARRAYS``): never shown through a transfer function
-    by default; a surface with only these is drawn in its vertex colours, else in a plain colour."""
+    by default on a mesh; a surface with only these is drawn in its vertex colours, else in a plain colour."""
     return _plain_name(name) in APPEARANCE_ARRAYS
 
 
 def vertex_colours(dataset: Any) -> np.ndarray | None:
-    """The point colours of a mesh or grid as (n, 3) or (n, 4) uint8: its red, green, blue (and alpha) arrays, or one
+    """The point colours of a surface (a mesh, or the PyVista data set drawn for it) as (n, 3) or (n, 4) uint8: its red, green, blue (and alpha) arrays, or one
     RGB / RGBA / colors array of 3 or 4 components; integers as bytes (meshio reads PLY's unsigned bytes as signed
     ones), floats in [0, 1] scaled to 255. None when it has none."""
-    d = _base(dataset)
-    point_data = getattr(d, "point_data", None) or {}
-    named = {_plain_name(k): v for k, v in point_data.items()}
+    point_data = getattr(_base(dataset), "point_data", None) or {}
+    named = {_plain_name(k): np.asarray(v) for k, v in point_data.items()}
     if all(k in named for k in ("red", "green", "blue")):
         parts = [named[k] for k in ("red", "green", "blue", "alpha") if k in named]
         if any(np.ndim(p) != 1 for p in parts):
@@ -182,9 +181,12 @@ def vertex_colours(dataset: Any) -> np.ndarray | None:
 
 def default_array(dataset: Any) -> str | None:
     """The spec a first open shows: the dataset's active array when it varies, else the first point array that
-    varies, else the first cell array that varies, else the first array (vectors by their magnitude); appearance
-    attributes (``is_appearance_array``) are not candidates, and None when nothing else is there."""
-    infos = [i for i in list_arrays(dataset) if not is_appearance_array(i.name)]
+    varies, else the first cell array that varies, else the first array (vectors by their magnitude). On meshes,
+    appearance attributes (``is_appearance_array``) are not candidates, and None when nothing else is there (on a
+    volume an "rgb" array is data: a colour microscopy stack)."""
+    infos = list_arrays(dataset)
+    if isinstance(_base(dataset), UnstructuredMesh):
+        infos = [i for i in infos if not is_appearance_array(i.name)]
     if not infos:
         return None
     active = getattr(_base(dataset), "active", None) or getattr(_base(dataset), "name", None)
