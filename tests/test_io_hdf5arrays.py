@@ -113,3 +113,28 @@ def test_order_xyz_reads_a_fortran_style_dataset_and_its_spacing(tmp_path):
     volume = vio.read(path, order="xyz")
     assert volume.dimensions == (4, 5, 6) and volume.spacing == (0.5, 1.0, 2.0)
     np.testing.assert_array_equal(volume.data, STACK)
+
+
+def test_the_heavy_data_of_an_xdmf_file_points_to_it(tmp_path):
+    """An .h5 that an .xdmf beside it names as its heavy data (meshio, dolfinx) is read, with a warning that the
+    .xdmf shows its arrays as meant; an .xdmf that names another file, or a dataset asked for by name, says nothing."""
+    import warnings
+
+    import h5py
+
+    with h5py.File(tmp_path / "mesh.h5", "w") as f:
+        f["data0"] = np.zeros((10, 3))
+        f["data1"] = np.zeros((4, 4, 4))
+    (tmp_path / "other.xdmf").write_text('<Xdmf><DataItem Format="HDF">results.h5:/data0</DataItem></Xdmf>')
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        vio.read(tmp_path / "mesh.h5", isolate=False)
+    assert not [w for w in caught if "heavy data" in str(w.message)]
+    (tmp_path / "mesh.xdmf").write_text('<Xdmf Version="3.0"><Domain><Grid><Geometry><DataItem Format="HDF">'
+                                        'mesh.h5:/data0</DataItem></Geometry></Grid></Domain></Xdmf>')
+    with pytest.warns(ReadWarning, match=r"mesh.h5: is the heavy data of mesh.xdmf beside it, .* open mesh.xdmf"):
+        vio.read(tmp_path / "mesh.h5")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        vio.read(tmp_path / "mesh.h5", dataset="/data1", isolate=False)
+    assert not [w for w in caught if "heavy data" in str(w.message)]

@@ -104,6 +104,29 @@ def _volume(path: PathLike, data: np.ndarray, spacing: tuple[float, float, float
     return volume_of(data, name, spacing, source=str(path))
 
 
+#: the most XDMF files beside an HDF5 file looked at, and the bytes read of each
+MAX_XDMF_SIBLINGS = 20
+XDMF_HEAD_BYTES = 1 << 20
+
+
+def _warn_if_heavy_data(p: Any) -> None:
+    """A ReadWarning when an XDMF file beside ``p`` names it as its heavy data (meshio, dolfinx, FEniCS and many
+    solvers write a .xdmf describing the mesh and a .h5 holding its arrays): the .xdmf is what shows the data as the
+    solver meant (the .h5 alone is a list of arrays: points, cell connectivity, fields)."""
+    import re
+
+    for sibling in sorted(p.parent.glob("*.xmf"))[:MAX_XDMF_SIBLINGS] + sorted(
+            p.parent.glob("*.xdmf"))[:MAX_XDMF_SIBLINGS]:
+        try:
+            head = read_bytes(sibling, XDMF_HEAD_BYTES).decode("utf-8", errors="replace")
+        except OSError:
+            continue
+        if re.search(r"(^|[\s/\\>\"])" + re.escape(p.name) + r"\s*:", head):
+            warnings.warn(f"{p}: is the heavy data of {sibling.name} beside it, which describes the mesh and fields "
+                          f"its arrays hold; open {sibling.name} to see them as meant", ReadWarning, stacklevel=3)
+            return
+
+
 def read_hdf5(path: PathLike, dataset: str | None = None, order: str = "zyx",
               allow_nonfinite: bool = True) -> RegularVolume | TimeSeries | Image2D | Any:
     """An HDF5 file's array as a volume, a time series or an image (see the module; ``order``:
@@ -118,6 +141,8 @@ def read_hdf5(path: PathLike, dataset: str | None = None, order: str = "zyx",
         from volviz.io.vtkhdf import read_vtkhdf
 
         return read_vtkhdf(p, allow_nonfinite)
+    if dataset is None:
+        _warn_if_heavy_data(p)
     try:
         with h5py.File(p, "r") as f:
             name = _pick(p, f, dataset)
