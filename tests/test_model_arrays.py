@@ -95,25 +95,25 @@ def test_real_files_offer_every_array():
     assert default_array(notch) == "Nodal Displacement:magnitude"     # the vector-only mesh of the issue
 
 
-def test_vertex_colours_of_meshes():
+def test_vertex_colors_of_meshes():
     """A mesh's own colours as bytes: red/green/blue arrays (signed bytes as meshio reads PLY's unsigned ones, or
     floats in [0, 1]) or one RGB(A) array; none for a mesh of data arrays, and never a default array."""
     from volviz.model import UnstructuredMesh
-    from volviz.model.arrays import default_array, vertex_colours
+    from volviz.model.arrays import default_array, vertex_colors
 
     points = np.zeros((3, 3))
     cells = [(1, np.arange(3).reshape(-1, 1))]
     signed = {"red": np.array([-1, 0, 127], np.int8), "green": np.array([-128, 5, 6], np.int8),
               "blue": np.array([1, 2, 3], np.int8)}
     mesh = UnstructuredMesh(points, cells, point_data=dict(signed))
-    np.testing.assert_array_equal(vertex_colours(mesh), [[255, 128, 1], [0, 5, 2], [127, 6, 3]])
+    np.testing.assert_array_equal(vertex_colors(mesh), [[255, 128, 1], [0, 5, 2], [127, 6, 3]])
     assert default_array(mesh) is None
     unit = UnstructuredMesh(points, cells, point_data={"Red": np.array([0.0, 0.5, 1.0]),
                                                        "Green": np.zeros(3), "Blue": np.ones(3),
                                                        "Alpha": np.ones(3)})
-    np.testing.assert_array_equal(vertex_colours(unit), [[0, 0, 255, 255], [128, 0, 255, 255], [255, 0, 255, 255]])
+    np.testing.assert_array_equal(vertex_colors(unit), [[0, 0, 255, 255], [128, 0, 255, 255], [255, 0, 255, 255]])
     rgb = UnstructuredMesh(points, cells, point_data={"RGB": np.array([[1, 2, 3]] * 3, np.uint8),
                                                       "t": np.array([1.0, 2.0, 3.0])})
-    np.testing.assert_array_equal(vertex_colours(rgb), [[1, 2, 3]] * 3)
+    np.testing.assert_array_equal(vertex_colors(rgb), [[1, 2, 3]] * 3)
     assert default_array(rgb) == "t"
-    assert vertex_colours(UnstructuredMesh(points, cells, point_data={"t": np.ones(3)})) is None
+    assert vertex_colors(UnstructuredMesh(points, cells, point_data={"t": np.ones(3)})) is None

@@ -153,10 +153,11 @@ def is_appearance_array(name: str) -> bool:
     return _plain_name(name) in APPEARANCE_ARRAYS
 
 
-def vertex_colours(dataset: Any) -> np.ndarray | None:
-    """The point colours of a surface (a mesh, or the PyVista data set drawn for it) as (n, 3) or (n, 4) uint8: its red, green, blue (and alpha) arrays, or one
-    RGB / RGBA / colors array of 3 or 4 components; integers as bytes (meshio reads PLY's unsigned bytes as signed
-    ones), floats in [0, 1] scaled to 255. None when it has none."""
+def vertex_colors(dataset: Any) -> np.ndarray | None:
+    """The point colors of a surface (a mesh, or the PyVista data set drawn for it) as (n, 3) or (n, 4)
+    uint8: its red, green, blue (and alpha) arrays, or one RGB / RGBA / colors array of 3 or 4 components; integers
+    as bytes (meshio reads PLY's unsigned bytes as signed ones), floats in [0, 1] scaled to 255. None when it has
+    none."""
     point_data = getattr(_base(dataset), "point_data", None) or {}
     named = {_plain_name(k): np.asarray(v) for k, v in point_data.items()}
     if all(k in named for k in ("red", "green", "blue")):

@@ -184,23 +184,23 @@ def is_surface(dataset: Any) -> bool:
 
 
 #: the point array of a surface's own colours (``surface_input``), drawn as they are by ``add_surface``
-VERTEX_COLOURS = "volviz vertex colours"
+VERTEX_COLORS = "volviz vertex colours"
 
 
 def surface_input(dataset: Any) -> Any:
     """The PyVista surface drawn for a dataset of surface cells (``is_surface``; or its ``volume_grid``), its active
     scalars kept active unless they are an appearance attribute (``volviz.model.arrays.is_appearance_array``): then
-    its vertex colours (``VERTEX_COLOURS``), if it has any, else none. The cells touching NaN/Inf (land in an ocean
+    its vertex colours (``VERTEX_COLORS``), if it has any, else none. The cells touching NaN/Inf (land in an ocean
     field, a solver's failed points) are left out."""
-    from volviz.model.arrays import is_appearance_array, vertex_colours
+    from volviz.model.arrays import is_appearance_array, vertex_colors
 
     grid = volume_grid(dataset)
     name = grid.active_scalars_name
     if name is not None and is_appearance_array(name):
         name = None
-        colours = vertex_colours(dataset)
-        if colours is not None and len(colours) == grid.n_points:
-            grid.point_data[VERTEX_COLOURS] = colours
+        colors = vertex_colors(dataset)
+        if colors is not None and len(colors) == grid.n_points:
+            grid.point_data[VERTEX_COLORS] = colors
     values = np.asarray(grid.active_scalars)
     if values.dtype.kind == "f" and not np.isfinite(values).all():   # cells touching NaN/Inf are not drawn
         grid = grid.extract_points(np.flatnonzero(np.isfinite(values)), adjacent_cells=False)
@@ -216,8 +216,8 @@ def surface_input(dataset: Any) -> Any:
 def add_surface(plotter: Any, surface: Any, tf: Any, opacity: float, name: Optional[str]) -> Any:
     """A surface made by ``surface_input``, colored by its active scalars through the transfer function's colors, or
     in its own vertex colours when it shows no array."""
-    if surface.active_scalars_name is None and VERTEX_COLOURS in surface.point_data:
-        return plotter.add_mesh(surface, scalars=VERTEX_COLOURS, rgb=True, opacity=opacity, name=name,
+    if surface.active_scalars_name is None and VERTEX_COLORS in surface.point_data:
+        return plotter.add_mesh(surface, scalars=VERTEX_COLORS, rgb=True, opacity=opacity, name=name,
                                 show_scalar_bar=False, reset_camera=False, render=False)
     ctf, _ = tf_to_vtk(tf, 1.0)
     ctf.ClampingOn()
