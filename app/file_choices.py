@@ -1,5 +1,6 @@
 """File > Show Another Array or Series…: for a file that holds several things to show (the datasets of an HDF5 file,
-the variables of a MATLAB file, the series of a DICOM folder), the reader shows one and says which others there are
+the variables of a MATLAB file, the series of a DICOM folder, the orbitals of a cube file, the levels of an OME-Zarr
+image), the reader shows one and says which others there are
 (``volviz.io.ChoiceWarning``, kept by ``read_notes`` while the scene loads); this dialog lists them, the shown one
 selected, and shows the one picked: the dataset's reader option is set in the session (saved with it) and the scene
 is loaded again (framed anew: the new choice may have other bounds). The component settings that named an array
@@ -31,7 +32,6 @@ class FileChoiceDialog(QDialog):
         self.list = QListWidget()
         for value, label in zip(choice.choices, choice.labels):
             item = QListWidgetItem(label)
-            item.setData(Qt.ItemDataRole.UserRole, value)
             self.list.addItem(item)
             if value == choice.chosen:
                 self.list.setCurrentItem(item)
@@ -43,13 +43,15 @@ class FileChoiceDialog(QDialog):
         layout.addWidget(buttons)
         self.resize(520, 320)
 
-    def picked(self) -> Optional[str]:
-        item = self.list.currentItem()
-        return None if item is None else str(item.data(Qt.ItemDataRole.UserRole))
+    def picked(self) -> Optional[str | int]:
+        """The value of the item selected (a string or an integer, as the reader option takes it)."""
+        row = self.list.currentRow()
+        return self.choice.choices[row] if 0 <= row < len(self.choice.choices) else None
 
 
 def _things(option: str) -> str:
-    return {"series": "series", "variable": "variables", "dataset": "datasets"}.get(option, "arrays")
+    return {"series": "series", "variable": "variables", "dataset": "datasets", "orbital": "orbitals",
+            "level": "levels"}.get(option, "arrays")
 
 
 class FileChoices:
@@ -87,7 +89,7 @@ class FileChoices:
         self.dialog.accepted.connect(lambda dialog=self.dialog: self.show(dialog.choice, dialog.picked()))
         self.dialog.open()
 
-    def show(self, choice: ChoiceWarning, value: Optional[str]) -> bool:
+    def show(self, choice: ChoiceWarning, value: Optional[str | int]) -> bool:
         """Show ``value`` of ``choice``'s option (its file's dataset in the session); False when nothing changes."""
         from volviz.model.settings import array_key
 

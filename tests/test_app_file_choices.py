@@ -68,3 +68,29 @@ def test_a_file_with_one_volume_has_nothing_to_choose(qtbot, make_window, tmp_pa
     wait_loaded(qtbot, window)
     qtbot.wait(200)
     assert not window.file_choices.action.isEnabled() and window.file_choices.choices == []
+
+
+def test_pick_another_orbital_of_a_cube_file(qtbot, make_window, tmp_path) -> None:
+    """An option that takes integers (a cube file's orbital numbers) goes to the reader as an integer."""
+    from test_io_imaging import _as_written, _cube_file
+
+    window = make_window()
+    window.resize(720, 540)
+    values = _as_written(np.random.default_rng(8).normal(size=(3, 4, 5, 2)))
+    path = _cube_file(tmp_path / "mo.cube", values, (0, 0, 0), ((0.2, 0, 0), (0, 0.2, 0), (0, 0, 0.2)),
+                      orbitals=[12, 13])
+    window.open_path(path)
+    wait_loaded(qtbot, window)
+    qtbot.waitUntil(lambda: window.file_choices.action.isEnabled(), timeout=30000)
+    assert window.datasets["data"].name == "orbital 12"
+    assert "2 orbitals: Ctrl+Alt+A shows another" in window.status_label.text()
+    window.file_choices.action.trigger()
+    dialog = window.file_choices.dialog
+    assert [dialog.list.item(i).text() for i in range(dialog.list.count())] == ["orbital 12", "orbital 13"]
+    dialog.list.setCurrentRow(1)
+    qtbot.mouseClick(dialog.findChild(QDialogButtonBox).button(QDialogButtonBox.StandardButton.Ok),
+                     Qt.MouseButton.LeftButton)
+    qtbot.waitUntil(lambda: window.datasets.get("data") is not None
+                    and window.datasets["data"].name == "orbital 13", timeout=60000)
+    assert window.session.datasets[0].options == {"orbital": 13}
+    np.testing.assert_array_equal(window.datasets["data"].data, values[..., 1])

@@ -473,9 +473,12 @@ def test_the_finest_ome_zarr_level_that_fits_and_channels_over_time(tmp_path, mo
     assert frame.arrays["movie"].shape == (8, 6, 4, 3)
     np.testing.assert_array_equal(frame.arrays["movie"], np.transpose(stack[1], (3, 2, 1, 0)))
     monkeypatch.setattr(omezarr, "MAX_VOXELS", 3 * 4 * 6 * 8 - 1)    # level 0 no longer fits one step
-    with pytest.warns(ReadWarning, match="showing level 1"):
+    with pytest.warns(ReadWarning, match="showing level 1") as caught:
         smaller = vio.read(path, isolate=False)
     assert smaller.frame(0).dimensions == (4, 3, 4)
+    choice = next(w.message for w in caught if isinstance(w.message, ChoiceWarning))
+    assert (choice.option, choice.chosen, choice.choices) == ("level", 1, [0, 1])
+    assert choice.labels[0].startswith("level 0 (") and choice.labels[0].endswith("— finest")
 
 
 def test_a_plain_zarr_array_reads_z_y_x(tmp_path):
@@ -618,11 +621,15 @@ def test_an_orbital_cube_shows_one_orbital_and_names_the_others(tmp_path):
     values = _as_written(np.random.default_rng(8).normal(size=(3, 4, 5, 2)))
     axes = ((0.2, 0, 0), (0, 0.2, 0), (0, 0, 0.2))
     path = _cube_file(tmp_path / "mo.cube", values, (0, 0, 0), axes, orbitals=[12, 13])
-    with pytest.warns(ReadWarning, match="holds 2 orbitals; showing orbital 12. Others: 13"):
+    with pytest.warns(ReadWarning, match="holds 2 orbitals; showing the first, orbital 12. Others: 13") as caught:
         first = vio.read(path)
     assert first.name == "orbital 12"
     np.testing.assert_array_equal(first.data, values[..., 0])
-    second = vio.read(path, orbital=13)
+    choice = next(w.message for w in caught if isinstance(w.message, ChoiceWarning))   # for the app's chooser
+    assert (choice.option, choice.chosen, choice.choices) == ("orbital", 12, [12, 13])  # integers, as it takes them
+    assert choice.labels == ["orbital 12", "orbital 13"]
+    with pytest.warns(ChoiceWarning, match="showing as asked, orbital 13"):
+        second = vio.read(path, orbital=choice.choices[1])
     np.testing.assert_array_equal(second.data, values[..., 1])
     with pytest.raises(ReadError, match="mo.cube: holds no orbital 7; its orbitals are 12, 13"):
         vio.read(path, orbital=7)

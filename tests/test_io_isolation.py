@@ -131,8 +131,8 @@ def test_reader_messages_and_warnings_come_back_from_the_child(tmp_path) -> None
 
 
 def test_a_childs_choices_come_back_only_in_their_form() -> None:
-    """A ``ChoiceWarning``'s choices cross from the child as plain data; anything else of that name comes back as
-    its message alone (a ReadWarning without choices: nothing for the app's chooser)."""
+    """A ``ChoiceWarning``'s choices cross from the child as plain data (strings or integers); anything else of that
+    name comes back as its message alone (a ReadWarning without choices: nothing for the app's chooser)."""
     import warnings
 
     from volviz.io.isolated import _reemit
@@ -140,7 +140,8 @@ def test_a_childs_choices_come_back_only_in_their_form() -> None:
     good = {"path": "/d/scan.h5", "option": "dataset", "chosen": "/a", "choices": ["/a", "/b"],
             "labels": ["/a (2x2x2)", "/b (3x3x3)"]}
     for fields, choices in ((good, ["/a", "/b"]), (dict(good, option="not an identifier"), []),
-                            (dict(good, choices=["/a", 3]), []), ("not a dict", [])):
+                            (dict(good, choices=["/a", 3.5]), []), (dict(good, chosen=True), []),
+                            ("not a dict", [])):
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             _reemit([["ChoiceWarning", "scan.h5: holds 2 arrays", fields]])

@@ -3,7 +3,7 @@ warning for kept non-finite values."""
 from __future__ import annotations
 
 import os
-from typing import Union
+from typing import Sequence, Union
 
 PathLike = Union[str, "os.PathLike[str]"]
 
@@ -37,20 +37,21 @@ MAX_CHOICE_CHARS = 256
 
 
 class ChoiceWarning(ReadWarning):
-    """A file holds several things to show (arrays of an HDF5 or MATLAB file, series of a DICOM folder) and the reader
-    showed one: ``path`` the file, ``option`` the reader option that picks another, ``chosen`` its value for the one
-    shown and ``choices`` the values it takes (the shown one among them), as strings, with a ``labels`` entry each
-    to show a person; the message says the same in words."""
+    """A file holds several things to show (arrays of an HDF5 or MATLAB file, series of a DICOM folder, orbitals of a
+    cube file, levels of an OME-Zarr image) and the reader showed one: ``path`` the file, ``option`` the reader
+    option that picks another, ``chosen`` its value for the one shown and ``choices`` the values it takes (the shown
+    one among them; strings or integers, as the option takes them), with a ``labels`` entry each to show a person;
+    the message says the same in words."""
 
-    def __init__(self, message: str, path: PathLike = "", option: str = "", chosen: str = "",
-                 choices: list[str] | tuple[str, ...] = (), labels: list[str] | tuple[str, ...] = ()) -> None:
+    def __init__(self, message: str, path: PathLike = "", option: str = "", chosen: str | int = "",
+                 choices: Sequence[str | int] = (), labels: Sequence[str] = ()) -> None:
         super().__init__(message)
         self.path = os.fspath(path)
         self.option = str(option)
-        self.chosen = str(chosen)
-        self.choices = [str(c)[:MAX_CHOICE_CHARS] for c in list(choices)[:MAX_CHOICES]]
-        labels = [str(t)[:MAX_CHOICE_CHARS] for t in list(labels)[:MAX_CHOICES]]
-        self.labels = labels if len(labels) == len(self.choices) else list(self.choices)
+        self.chosen = _choice(chosen)
+        self.choices = [_choice(c) for c in list(choices)[:MAX_CHOICES]]
+        texts = [str(t)[:MAX_CHOICE_CHARS] for t in list(labels)[:MAX_CHOICES]]
+        self.labels = texts if len(texts) == len(self.choices) else [str(c) for c in self.choices]
 
     def fields(self) -> dict[str, object]:
         """The structured part, as plain data (what the isolated reader sends beside the message)."""
@@ -65,10 +66,19 @@ class ChoiceWarning(ReadWarning):
         path, option, chosen, choices, labels = (fields.get(k) for k in ("path", "option", "chosen", "choices",
                                                                           "labels"))
         if not (isinstance(path, str) and isinstance(option, str) and option.isidentifier()
-                and isinstance(chosen, str) and isinstance(choices, list) and isinstance(labels, list)
-                and all(isinstance(c, str) for c in choices + labels)):
+                and isinstance(chosen, (str, int)) and _is_choice(chosen) and isinstance(choices, list)
+                and isinstance(labels, list) and all(_is_choice(c) for c in choices)
+                and all(isinstance(t, str) for t in labels)):
             return None
         return cls(message, path, option, chosen, choices, labels)
+
+
+def _is_choice(value: object) -> bool:
+    return isinstance(value, str) or (isinstance(value, int) and not isinstance(value, bool))
+
+
+def _choice(value: str | int) -> str | int:
+    return value if isinstance(value, int) and not isinstance(value, bool) else str(value)[:MAX_CHOICE_CHARS]
 
 
 class NonFiniteWarning(UserWarning):

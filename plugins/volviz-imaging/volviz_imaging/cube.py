@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from volviz.io._checks import check_file, parse_float, parse_int, read_bytes
-from volviz.io.errors import PathLike, ReadError, ReadWarning, human_bytes
+from volviz.io.errors import ChoiceWarning, PathLike, ReadError, human_bytes
 from volviz.model import RegularVolume
 
 from volviz_imaging.placement import aligned_volume
@@ -105,11 +105,14 @@ def read_cube(path: PathLike, orbital: int | None = None, allow_nonfinite: bool 
 
 def _chosen_orbital(p: Path, orbitals: list[int], orbital: int | None) -> int:
     """The index (in the file's list) of the orbital to show; a warning names the others."""
-    if orbital is not None:
-        if orbital not in orbitals:
-            raise ReadError(p, f"holds no orbital {orbital}; its orbitals are {', '.join(map(str, orbitals))}")
-        return orbitals.index(orbital)
+    if orbital is not None and orbital not in orbitals:
+        raise ReadError(p, f"holds no orbital {orbital}; its orbitals are {', '.join(map(str, orbitals))}")
+    chosen = orbitals.index(orbital) if orbital is not None else 0
     if len(orbitals) > 1:
-        warnings.warn(f"{p}: holds {len(orbitals)} orbitals; showing orbital {orbitals[0]}. Others: "
-                      f"{', '.join(map(str, orbitals[1:]))} (orbital=N picks one)", ReadWarning, stacklevel=3)
-    return 0
+        how = "as asked" if orbital is not None else "the first"
+        warnings.warn(ChoiceWarning(f"{p}: holds {len(orbitals)} orbitals; showing {how}, orbital "
+                                    f"{orbitals[chosen]}. Others: "
+                                    f"{', '.join(str(n) for n in orbitals if n != orbitals[chosen])} (orbital=N "
+                                    "picks one)", p, "orbital", orbitals[chosen], orbitals,
+                                    [f"orbital {n}" for n in orbitals]), stacklevel=3)
+    return chosen

@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from volviz.io.errors import PathLike, ReadError, ReadWarning
+from volviz.io.errors import ChoiceWarning, PathLike, ReadError
 from volviz.model import RegularVolume, TimeSeries
 from volviz.model.arrays import volume_of
 
@@ -149,10 +149,14 @@ def read_zarr(path: PathLike, level: int | str | None = None,
         names = [str(a.get("name", "")).lower() for a in axes]
         per_step = [_voxels(a) // max(a.shape[names.index("t")] if "t" in names else 1, 1) for a in arrays]
         index = next((i for i, v in enumerate(per_step) if v <= MAX_VOXELS), len(arrays) - 1)
-        if index > 0:
-            warnings.warn(f"{root}: showing level {index} ({'x'.join(map(str, arrays[index].shape))}); the finer "
-                          f"levels hold more than {MAX_VOXELS} voxels per step (level=0 reads the finest)",
-                          ReadWarning, stacklevel=2)
+    if len(arrays) > 1:
+        shapes = ["x".join(map(str, a.shape)) for a in arrays]
+        said = (f"showing level {index} ({shapes[index]}); the finer levels hold more than {MAX_VOXELS} voxels per "
+                "step (level=0 reads the finest)" if level is None and index > 0
+                else f"showing level {index} ({shapes[index]}) of {len(arrays)} (level=N picks another)")
+        warnings.warn(ChoiceWarning(f"{root}: {said}", root, "level", index, list(range(len(arrays))),
+                                    [f"level {i} ({shape})" + (" — finest" if i == 0 else "")
+                                     for i, shape in enumerate(shapes)]), stacklevel=2)
     array = arrays[index]
     n = len(array.shape)
     if len(axes) != n:
