@@ -172,7 +172,7 @@ class SceneLoading(WindowBase):
         if "window_state" in session.layout:
             self.restoreState(QByteArray.fromBase64(session.layout["window_state"].encode("ascii")))
         self.scene_tree.populate(session.components, [ref.id for ref in session.datasets], self.array_choice.names,
-                                 controller.dataset_traits)
+                                 controller.dataset_traits, controller.drawn_as)
         self.render_settings.load(session.render)
         self.decorations.sync()
         self.clipping.load(session.clip, controller.installed_bounds)

@@ -15,6 +15,7 @@ from ..settings_form import SettingsForm
 
 KIND_LABELS = {"volume": "Volume", "mesh": "Mesh", "isosurface": "Isosurface", "terrain": "Terrain",
                "fog": "Ground fog", "clouds": "Clouds", "sky": "Sky", "demo": "Demo volume"}
+DRAWN_AS_LABELS = {"surface": "Surface", "points": "Points"}
 
 
 #: settings the form leaves to other editors: the array combo box (``volviz_app.array_choice``) and the Timeline
@@ -68,14 +69,16 @@ class SceneTree(QWidget):
         self._datasets: Sequence[str] = ()
         self._arrays: Callable[[str], list[str]] = lambda comp_id: []
         self._traits: Callable[[str], Optional[DatasetTraits]] = lambda comp_id: None
+        self._drawn_as: Callable[[str], Optional[str]] = lambda comp_id: None
 
     def populate(self, components: list[Any], datasets: Sequence[str] = (),
                  arrays: Optional[Callable[[str], list[str]]] = None,
-                 traits: Optional[Callable[[str], Optional[DatasetTraits]]] = None) -> None:
+                 traits: Optional[Callable[[str], Optional[DatasetTraits]]] = None,
+                 drawn_as: Optional[Callable[[str], Optional[str]]] = None) -> None:
         """List ``components``; their forms offer ``datasets`` (ids) for dataset fields and ``arrays(component id)``
         for array fields, and show the fields that apply to ``traits(component id)`` (what its dataset is; None or
-        no ``traits``: every field). The selected component stays selected if it is still there (else the first
-        is)."""
+        no ``traits``: every field); ``drawn_as(component id)`` ("surface", "points") refines the Kind column. The
+        selected component stays selected if it is still there (else the first is)."""
         selected = self.current_component()
         self._filling = True
         self.tree.clear()
@@ -83,8 +86,9 @@ class SceneTree(QWidget):
         self._datasets = list(datasets)
         self._arrays = arrays or (lambda comp_id: [])
         self._traits = traits or (lambda comp_id: None)
+        self._drawn_as = drawn_as or (lambda comp_id: None)
         for comp in components:
-            item = QTreeWidgetItem([comp.id, KIND_LABELS.get(comp.type, comp.type)])
+            item = QTreeWidgetItem([comp.id, self._kind_label(comp)])
             item.setData(0, Qt.ItemDataRole.UserRole, comp.id)
             item.setData(0, Qt.ItemDataRole.UserRole + 1, comp.opacity)
             item.setFlags(item.flags() | Qt.ItemFlag.ItemIsUserCheckable)
@@ -96,6 +100,11 @@ class SceneTree(QWidget):
             self.tree.setCurrentItem(self.item(selected) if selected in self._components else first)
         else:
             self._show_form(None)
+
+    def _kind_label(self, comp: Any) -> str:
+        """The Kind column: the component's type, or how it draws its dataset where that says more (a surface, a
+        set of points)."""
+        return DRAWN_AS_LABELS.get(self._drawn_as(comp.id) or "", KIND_LABELS.get(comp.type, comp.type))
 
     def item(self, comp_id: str) -> QTreeWidgetItem:
         for i in range(self.tree.topLevelItemCount()):

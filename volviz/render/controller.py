@@ -179,6 +179,16 @@ class SceneController:
             return DatasetTraits()
         return dataset_traits(self.datasets[comp.dataset]) if comp.dataset in self.datasets else None
 
+    def drawn_as(self, comp_id: str) -> Optional[str]:
+        """How a volume component draws its dataset (``scene_builder.drawn_as``); None for other components and
+        while the dataset is not read."""
+        from volviz.render.scene_builder import drawn_as
+
+        comp = self.component(comp_id)
+        if comp.type != "volume" or comp.dataset not in self.datasets:
+            return None
+        return drawn_as(self.datasets[comp.dataset])
+
     # -- transfer functions, visibility, opacity --------------------------------------------------------------------
     def transfer_function(self, comp_id: str) -> Any:
         from volviz.render.scene_builder import component_transfer_function

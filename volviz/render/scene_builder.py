@@ -528,6 +528,21 @@ def dataset_traits(dataset: Any) -> DatasetTraits:
     return DatasetTraits(time_series=isinstance(dataset, TimeSeries), lod_volume=is_lod(dataset))
 
 
+def drawn_as(dataset: Any) -> str:
+    """How a volume component draws a loaded dataset: ``"points"`` (a mesh of vertices only, e.g. a point table),
+    ``"surface"`` (surface cells, a flat grid: ``vtk_scene.is_surface``) or ``"volume"``."""
+    from volviz.model import TimeSeries, UnstructuredMesh
+    from volviz.render.vtk_scene import is_surface
+
+    if is_lod(dataset):
+        return "volume"
+    first = dataset.frame(0) if isinstance(dataset, TimeSeries) else dataset
+    if not is_surface(first):
+        return "volume"
+    points = isinstance(first, UnstructuredMesh) and all(int(t) == 1 for t, _ in first.cells)
+    return "points" if points else "surface"
+
+
 def add_lod_component(plotter: Any, session: Session, comp: Component, dataset: Any, update: bool = True) -> Any:
     """A compressed volume at a view-dependent level of detail (``volviz.render.lod_volume``); the component
     setting ``budget`` is the number of blocks per view (default 256). Its blocks are selected now when ``update``
