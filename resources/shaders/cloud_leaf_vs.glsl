@@ -154,12 +154,12 @@ void main()
     ivec3 octant = (leaf >> (level - l - 1)) & 1;
     ivec3 toward = 2 * octant - 1;
     // e' of this node's 7 neighbours toward the child's octant (mask m: the axes it is displaced along)
-    float near[8];
-    near[0] = chain;
+    float beside[8];
+    beside[0] = chain;
     for (int m = 1; m < 8; ++m)
     {
       ivec3 n = node + bits(m) * toward;
-      near[m] = inside(l, n) ? weight(l, n) : chain;
+      beside[m] = inside(l, n) ? weight(l, n) : chain;
     }
     int parity = (node.x + node.y + node.z) & 1;
     int halfSize = size >> 1;
@@ -179,7 +179,7 @@ void main()
       {
         if ((m & boundary) == m)
         {
-          w = min(w, near[m]);
+          w = min(w, beside[m]);
         }
       }
       child[c] = (1.0 - w) * coarse(corner, p, parity) + w * field(node * size + p * halfSize);
