@@ -43,6 +43,7 @@ if TYPE_CHECKING:
     from .docks.statistics import Statistics
     from .docks.tf_editor import TransferFunctionEditor
     from .file_choices import FileChoices
+    from .reload_data import ReloadData
     from .docks.timeline import Timeline
     from .frame_export import FrameExport
     from .gc_guard import GuiThreadCollector
@@ -67,6 +68,7 @@ class WindowBase(_QtWindow):
     jobs: JobBridge
     nonfinite: NonFiniteStatus
     file_choices: FileChoices
+    reload_data: ReloadData
     error_dialog: Optional[QMessageBox]
     recovery_dialog: Optional[QMessageBox]
     last_stats: dict[str, Any]

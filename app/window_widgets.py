@@ -21,6 +21,7 @@ from PySide6.QtWidgets import QDockWidget, QLabel, QProgressBar, QPushButton, QW
 
 from .array_choice import ArrayChoice
 from .file_choices import FileChoices
+from .reload_data import ReloadData
 from .component_settings import edit_settings
 from .decoration_toggles import DecorationToggles
 from .docks.clipping import ClippingDock
@@ -86,6 +87,7 @@ class WindowWidgets(WindowBase):
         self.action_open_session = self._action(file_menu, "Open &Session…", "Ctrl+Shift+O", self._ask_open_session)
         self.recent_menu = file_menu.addMenu("Open &Recent")
         self.file_choices = FileChoices(self, file_menu)
+        self.reload_data = ReloadData(self, file_menu)
         self.action_save_session = self._action(file_menu, "&Save Session", QKeySequence.StandardKey.Save,
                                                 self._save_session)
         self.action_save_session_as = self._action(file_menu, "Save Session &As…", QKeySequence.StandardKey.SaveAs,
