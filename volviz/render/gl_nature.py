@@ -135,24 +135,16 @@ def cloud_leaves(frame: CloudFrame) -> CloudLeaves:
 
 
 def _visible_intervals(tf: Any) -> list[tuple[float, float]]:
-    """The closed intervals of the table field where the TF has extinction (``visible_ranges``'s pieces merged),
-    at most ``_VISIBLE_INTERVALS``: past that, the neighbours nearest each other are joined (a superset: leaves in
-    the gaps are drawn and add nothing)."""
-    x = np.asarray(tf.scalars, np.float64)
-    rho = np.asarray(tf.extinction, np.float64)
-    pieces = [[x[i], x[i + 1]] for i in range(len(x) - 1) if rho[i] > 0 or rho[i + 1] > 0]
-    if len(x) == 1 and rho[0] > 0:
-        pieces = [[x[0], x[0]]]
-    merged: list[list[float]] = []
-    for lo, hi in pieces:
-        if merged and lo <= merged[-1][1]:
-            merged[-1][1] = max(merged[-1][1], hi)
-        else:
-            merged.append([lo, hi])
+    """The table field's intervals where the TF has extinction (``visible_intervals``), at most
+    ``_VISIBLE_INTERVALS``: past that, the neighbours nearest each other are joined (a superset: leaves in the gaps
+    are drawn and add nothing)."""
+    from volviz.unstructured.topology import visible_intervals
+
+    merged = visible_intervals(tf.scalars, tf.extinction)
     while len(merged) > _VISIBLE_INTERVALS:
         gap = int(np.argmin([merged[i + 1][0] - merged[i][1] for i in range(len(merged) - 1)]))
-        merged[gap:gap + 2] = [[merged[gap][0], merged[gap + 1][1]]]
-    return [(float(lo), float(hi)) for lo, hi in merged]
+        merged[gap:gap + 2] = [(merged[gap][0], merged[gap + 1][1])]
+    return merged
 
 
 @dataclass

@@ -196,19 +196,31 @@ def visible_cells(mesh: TetMesh, control_scalars: np.ndarray, control_rho: np.nd
     return visible_ranges(r.smin, r.smax, control_scalars, control_rho) & ~r.nan
 
 
-def visible_ranges(smin: np.ndarray, smax: np.ndarray, control_scalars: np.ndarray, control_rho: np.ndarray
-                   ) -> np.ndarray:
-    """Boolean mask of the cells with scalar ranges [smin, smax] that meet a part of the TF with rho > 0.
+def visible_intervals(control_scalars: np.ndarray, control_rho: np.ndarray) -> list[tuple[float, float]]:
+    """The closed scalar intervals where the TF has rho > 0, overlapping and touching ones merged, in order.
 
     rho is positive on the open piece between control points i, i+1 iff rho_i > 0 or rho_{i+1} > 0; outside
     [first, last] it is zero.
     """
     x = np.asarray(control_scalars, dtype=np.float64)
     rho = np.asarray(control_rho, dtype=np.float64)
-    vis = np.zeros(len(smin), dtype=bool)
-    for i in range(len(x) - 1):
-        if rho[i] > 0 or rho[i + 1] > 0:
-            vis |= (smax >= x[i]) & (smin <= x[i + 1])
+    pieces = sorted((float(x[i]), float(x[i + 1])) for i in range(len(x) - 1) if rho[i] > 0 or rho[i + 1] > 0)
     if len(x) == 1 and rho[0] > 0:
-        vis |= (smin <= x[0]) & (smax >= x[0])
+        pieces = [(float(x[0]), float(x[0]))]
+    merged: list[tuple[float, float]] = []
+    for lo, hi in pieces:
+        if merged and lo <= merged[-1][1]:
+            merged[-1] = (merged[-1][0], max(merged[-1][1], hi))
+        else:
+            merged.append((lo, hi))
+    return merged
+
+
+def visible_ranges(smin: np.ndarray, smax: np.ndarray, control_scalars: np.ndarray, control_rho: np.ndarray
+                   ) -> np.ndarray:
+    """Boolean mask of the cells with scalar ranges [smin, smax] that meet a part of the TF with rho > 0
+    (``visible_intervals``)."""
+    vis = np.zeros(len(smin), dtype=bool)
+    for lo, hi in visible_intervals(control_scalars, control_rho):
+        vis |= (smax >= lo) & (smin <= hi)
     return vis
