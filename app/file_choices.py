@@ -92,14 +92,18 @@ class FileChoices:
     def show(self, choice: ChoiceWarning, value: Optional[str | int]) -> bool:
         """Show ``value`` of ``choice``'s option (its file's dataset in the session); False when nothing changes."""
         from volviz.model.settings import array_key
+        from volviz.session import resolve_path
 
         window = self.window
         if value is None or value == choice.chosen or value not in choice.choices:
             return False
         session = copy.deepcopy(window.session)
-        base = window.session_path.parent if window.session_path is not None else Path.cwd()
         target = Path(choice.path).resolve()
-        refs = [ref for ref in session.datasets if (base / ref.path).resolve() == target]
+
+        def where(ref: Any) -> Path:       # as load_datasets reads it
+            return resolve_path(window.session_path, ref.path) if window.session_path else Path(ref.path).resolve()
+
+        refs = [ref for ref in session.datasets if where(ref) == target]
         if not refs:
             return False
         for ref in refs:
