@@ -42,6 +42,10 @@ class JobBridge(QObject):
             self._handlers[job.job_id] = on_done
         return job
 
+    def busy(self) -> bool:
+        """Whether a job whose result the window waits for is still running or queued."""
+        return bool(self._handlers)
+
     def _dispatch(self, outcome: JobOutcome) -> None:
         handler = self._handlers.pop(outcome.job_id, None)
         if handler is not None:

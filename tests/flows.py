@@ -1,0 +1,76 @@
+"""Helpers of the flow tests: drive the real window with real input events and compare the picture the user is left
+with against ``volviz render`` of the same session at the same camera and size."""
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import imageio.v3 as iio
+import numpy as np
+from PySide6.QtCore import QEvent, QPoint, QPointF, Qt
+from PySide6.QtGui import QMouseEvent
+from PySide6.QtWidgets import QApplication
+
+from volviz.optics.metrics import max_abs, rmse
+
+
+def wait_loaded(qtbot, window, timeout: int = 60000) -> None:
+    """Until the scene and its first views are shown."""
+    qtbot.waitUntil(lambda: not window.progress_bar.isVisible() and window.controller is not None, timeout=timeout)
+
+
+def wait_settled(qtbot, window, timeout: int = 60000) -> None:
+    """Until no background job is running and the window is not busy: the view is at its final quality."""
+    qtbot.waitUntil(lambda: not window.progress_bar.isVisible() and not window.jobs.busy(), timeout=timeout)
+    qtbot.wait(100)
+
+
+def screen(window) -> np.ndarray:
+    """The viewport's frame as the user sees it (the render window's pixels after one draw), RGB float."""
+    window.plotter.render()
+    return np.asarray(window.plotter.screenshot(None, return_img=True))[..., :3].astype(np.float64)
+
+
+def _mouse(widget, kind: QEvent.Type, pos: QPointF, buttons: Qt.MouseButton,
+           button: Qt.MouseButton = Qt.MouseButton.LeftButton) -> None:
+    event = QMouseEvent(kind, pos, widget.mapToGlobal(pos), button, buttons, Qt.KeyboardModifier.NoModifier)
+    QApplication.sendEvent(widget, event)
+
+
+def drag(qtbot, widget, start: QPoint, end: QPoint, steps: int = 8, button=Qt.MouseButton.LeftButton) -> None:
+    """A real press-move-release sequence on ``widget`` delivered through Qt's event system."""
+    a, b = QPointF(start), QPointF(end)
+    _mouse(widget, QEvent.Type.MouseButtonPress, a, button, button)
+    for k in range(1, steps + 1):
+        _mouse(widget, QEvent.Type.MouseMove, a + (b - a) * (k / steps), button, button)
+        qtbot.wait(30)
+    _mouse(widget, QEvent.Type.MouseButtonRelease, b, Qt.MouseButton.NoButton, button)
+
+
+def drag_viewport(qtbot, window, dx: int, dy: int = 0) -> None:
+    """Orbit the camera by dragging across the middle of the viewport."""
+    canvas = window.plotter.interactor
+    c = QPoint(canvas.width() // 2, canvas.height() // 2)
+    drag(qtbot, canvas, c, c + QPoint(dx, dy))
+
+
+def render_saved(session: Path, size: tuple[int, int], out: Path) -> np.ndarray:
+    """``volviz render SESSION -o OUT --size WxH`` in its own process (no Qt): the reference the screen is held to."""
+    proc = subprocess.run([sys.executable, "-m", "volviz.cli", "render", str(session), "-o", str(out),
+                           "--size", f"{size[0]}x{size[1]}"], capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    return np.asarray(iio.imread(out))[..., :3].astype(np.float64)
+
+
+def compare_with_render(window, tmp_path: Path, name: str = "flow") -> dict[str, float]:
+    """Save the window's session, render it offscreen at the viewport's size and camera, and return the error of the
+    on-screen frame against it (8-bit units: rmse, max; and the fraction of pixels off by more than 24)."""
+    session = tmp_path / f"{name}.json"
+    assert window.save_session(session)
+    shown = screen(window)
+    size = (shown.shape[1], shown.shape[0])
+    ref = render_saved(session, size, tmp_path / f"{name}.png")
+    assert ref.shape == shown.shape
+    return {"rmse": rmse(shown / 255.0, ref / 255.0), "max": max_abs(shown / 255.0, ref / 255.0),
+            "off": float((np.abs(shown - ref).max(axis=2) > 24).mean())}
