@@ -25,10 +25,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, get_args
 
-import numpy as np
-
 from volviz.io._checks import path_kind
 from volviz.io.atomic import OutputPathError, atomic_write_bytes
+from volviz.io.jsonbounds import nesting_depth, outside_strings
 from volviz.model.settings import Backend, SettingsError, validate_render_options, validate_settings
 
 FORMAT = "volviz-session"
@@ -468,31 +467,22 @@ def loads(text: str, source: str | os.PathLike | None = None) -> Session:
     return session_from_dict(migrate(doc, src), src)
 
 
-_STRING = re.compile(rb'"[^"]*"')
 _NUMBER_CHARS = bytes.maketrans(b"-+0123456789.eE", b"#" * 15)
-_NOT_BRACKETS = bytes(c for c in range(256) if c not in b"[]{}")
-_DEPTH_STEP = np.zeros(256, np.int8)
-_DEPTH_STEP[[ord("["), ord("{")]] = 1
-_DEPTH_STEP[[ord("]"), ord("}")]] = -1
 
 
 def _check_structure(data: bytes, source: str | None) -> None:
     """Bound value count, number length and nesting depth before ``json`` sees the text, with C-speed scans of the
     bytes between strings (no Python work per value): a hostile file is refused without deep recursion, slow
     big-number conversion or a huge allocation."""
-    if b"\\" in data:  # drop escaped backslashes and quotes, so that every remaining quote opens or closes a string
-        data = data.replace(b"\\\\", b"").replace(b'\\"', b"")
-    outside = _STRING.sub(b"", data)
+    outside = outside_strings(data)
     values = outside.count(b",") + outside.count(b"[") + outside.count(b"{") + 1
     if values > MAX_VALUES:
         raise SessionError(source, f"holds about {values} values; a session holds at most {MAX_VALUES}")
     if b"#" * (MAX_NUMBER_CHARS + 1) in outside.translate(_NUMBER_CHARS, b"#"):
         raise SessionError(source, f"holds a number longer than {MAX_NUMBER_CHARS} characters")
-    brackets = np.frombuffer(outside.translate(None, _NOT_BRACKETS), np.uint8)
-    if brackets.size:
-        depth = int(np.cumsum(_DEPTH_STEP[brackets], dtype=np.int32).max())
-        if depth > MAX_DEPTH:
-            raise SessionError(source, f"nests lists and objects {depth} deep; at most {MAX_DEPTH} are allowed")
+    depth = nesting_depth(outside)
+    if depth > MAX_DEPTH:
+        raise SessionError(source, f"nests lists and objects {depth} deep; at most {MAX_DEPTH} are allowed")
 
 
 def _check_sizes(doc: Any, source: str | None) -> None:

@@ -8,7 +8,7 @@ Layout (all integers little-endian)::
         10 hdr_size   u16  (64)
         12 flags      u32  (0)
         16 meta_off   u64  metadata: UTF-8 JSON object (see codec.py for the keys)
-        24 meta_len   u64  (<= 16 MiB)
+        24 meta_len   u64  (<= 1 MiB, nesting <= 4)
         32 table_off  u64  brick table: table_count records of 32 bytes
         40 table_count u64
         48 meta_crc   u32  CRC32 of the metadata bytes
@@ -27,13 +27,17 @@ Layout (all integers little-endian)::
     zero-detail inverse of that transform (5/3: linear interpolation, S-transform: constant 2x2x2 blocks).
 
 Reading never executes or unpickles anything: the metadata is JSON, the table a fixed numpy record layout, and every
-size and offset is checked against the file size before anything is allocated. Each brick carries its own CRC32, so
+size and offset is checked against the file size before anything is allocated; the metadata's length and nesting
+are bounded before it is parsed, and its fields (dtype from an allow-list, dims, sizes) are checked against each other
+and against the brick table, whose payloads must tile the payload area exactly (:func:`check_meta`,
+:func:`check_table`). Each brick carries its own CRC32, so
 a damaged brick is found, named and skipped while the others decode. Writing is atomic (temporary file in the target
 directory, fsync, rename).
 """
 from __future__ import annotations
 
 import json
+import math
 import os
 import struct
 import zlib
@@ -43,13 +47,20 @@ from typing import Any, BinaryIO
 import numpy as np
 
 from volviz.io._checks import describe_bytes
+from volviz.io.jsonbounds import nesting_depth, outside_strings
 from volviz.io.atomic import check_output_path, remove_stale_temporaries, temp_name
 from volviz.io.errors import ReadError
 
 MAGIC = b"VVZ\x00\r\n\x1a\n"
 VERSION = 2
 HEADER_SIZE = 64
-MAX_META = 16 << 20
+MAX_META = 1 << 20           # bytes of the metadata JSON (a written one is under 1 KB)
+MAX_META_DEPTH = 4          # nesting of its lists and objects (a written one nests 2 deep)
+#: the sample types the codec writes, and the "kind" it records beside each (codec._Source)
+DTYPE_KINDS = {"uint8": "uint8", "int8": "int8", "uint16": "uint16", "int16": "int16", "bool": "int-quantised",
+               "uint32": "int-quantised", "int32": "int-quantised", "uint64": "int-quantised",
+               "int64": "int-quantised", "float16": "float", "float32": "float", "float64": "float"}
+MAX_DIM = 1 << 20
 _HDR = struct.Struct("<8sHHIQQQQIII")
 BRICK_DTYPE = np.dtype([("level", "<u1"), ("kind", "<u1"), ("transform", "<u2"), ("tile", "<u4"), ("offset", "<u8"),
                         ("size", "<u8"), ("crc", "<u4"), ("res1", "<u4")])
@@ -160,15 +171,125 @@ def parse_header(head: bytes, file_size: int, name: str = "<vvz>") -> dict[str, 
                        "compress the volume again")
     if hdr_size != HEADER_SIZE:
         raise VVZError(name, f"bad header size {hdr_size}")
-    if meta_len > MAX_META or meta_off < HEADER_SIZE or meta_off + meta_len > file_size:
+    if meta_len > MAX_META:
+        raise VVZError(name, f"header field meta_len is {meta_len} bytes; .vvz metadata is at most {MAX_META}")
+    if meta_off < HEADER_SIZE or meta_off + meta_len > file_size:
         raise VVZError(name, f"metadata block ({meta_len} bytes at {meta_off}) lies outside the file "
                        f"({file_size} bytes): truncated or damaged")
+    if table_count == 0:
+        raise VVZError(name, "header field table_count is 0; a .vvz holds at least its root brick")
     if table_count > file_size // BRICK_DTYPE.itemsize or table_off < HEADER_SIZE or \
             table_off + table_count * BRICK_DTYPE.itemsize > file_size:
         raise VVZError(name, f"brick table ({table_count} records at {table_off}) lies outside the file "
                        f"({file_size} bytes): truncated or damaged")
     return dict(version=version, flags=flags, meta_off=meta_off, meta_len=meta_len, table_off=table_off,
                 table_count=table_count, meta_crc=meta_crc, table_crc=table_crc)
+
+
+def parse_meta(data: bytes, name: str = "<vvz>") -> dict[str, Any]:
+    """The metadata JSON object, its nesting bounded before ``json`` recurses into it. Raises :class:`VVZError`."""
+    depth = nesting_depth(outside_strings(data))
+    if depth > MAX_META_DEPTH:
+        raise VVZError(name, f"metadata nests lists and objects {depth} deep; .vvz metadata nests at most "
+                       f"{MAX_META_DEPTH}")
+    try:
+        meta = json.loads(data.decode("utf-8"), parse_constant=_no_constant)
+    except (UnicodeDecodeError, ValueError) as exc:  # JSONDecodeError is a ValueError
+        raise VVZError(name, f"metadata is not valid JSON ({exc})") from None
+    if not isinstance(meta, dict) or meta.get("format") != "volviz-vvz":
+        raise VVZError(name, "metadata is not a volviz-vvz object")
+    return meta
+
+
+def _no_constant(word: str) -> None:
+    raise ValueError(f"{word} is not a number")
+
+
+def _field(meta: dict[str, Any], key: str, name: str, kind: type | tuple[type, ...], what: str,
+           ok: Any = lambda v: True, default: Any = ...) -> Any:
+    """``meta[key]`` if it is of type ``kind`` (never a bool for numbers) and ``ok``; else a VVZError naming the
+    field, its value and what it should be."""
+    if key not in meta and default is not ...:
+        return default
+    value = meta.get(key)
+    typed = isinstance(value, kind) and not (isinstance(value, bool) and bool not in (kind if isinstance(
+        kind, tuple) else (kind,)))
+    if not typed or not ok(value):
+        shown = repr(value) if len(repr(value)) <= 60 else repr(value)[:57] + "..."
+        raise VVZError(name, f"metadata field {key!r} is {shown if key in meta else 'missing'}; expected {what}")
+    return value
+
+
+def _finite(v: Any) -> bool:
+    try:
+        return math.isfinite(v)
+    except OverflowError:  # an integer too large for a float
+        return False
+
+
+def check_meta(meta: dict[str, Any], payload_bytes: int, name: str = "<vvz>") -> None:
+    """The metadata fields the decoder trusts, checked against each other and against the file: dims, dtype (from
+    :data:`DTYPE_KINDS`) and the kind the codec records with it, the original and payload sizes, levels, tile,
+    delta, value range, spacing, origin and name. Raises :class:`VVZError` naming the field and both values."""
+    dims = _field(meta, "dims", name, list, f"3 integers from 1 to {MAX_DIM}", lambda v: len(v) == 3 and all(
+        isinstance(d, int) and not isinstance(d, bool) and 1 <= d <= MAX_DIM for d in v))
+    dtype = _field(meta, "dtype", name, str, "one of " + ", ".join(DTYPE_KINDS), lambda v: v in DTYPE_KINDS)
+    kind = _field(meta, "kind", name, str, "a sample kind")
+    if kind != DTYPE_KINDS[dtype]:
+        raise VVZError(name, f"metadata field 'kind' is {kind!r} but 'dtype' is {dtype!r} (the codec writes kind "
+                       f"{DTYPE_KINDS[dtype]!r} for {dtype})")
+    expected = int(np.prod(dims, dtype=np.int64)) * np.dtype(dtype).itemsize
+    _field(meta, "original_bytes", name, int, f"{expected} (dims {dims} of {dtype})", lambda v: v == expected)
+    _field(meta, "payload_bytes", name, int, f"{payload_bytes} (the bytes between the header and the metadata)",
+           lambda v: v == payload_bytes)
+    _field(meta, "levels", name, int, "an integer from 0 to 20", lambda v: 0 <= v <= 20)
+    _field(meta, "tile", name, int, "a positive integer", lambda v: v > 0)
+    _field(meta, "coder", name, str, "a coder name")
+    _field(meta, "coder_version", name, int, "a positive integer", lambda v: v > 0, default=1)
+    _field(meta, "delta", name, (int, float), "a finite number >= 0", lambda v: _finite(v) and v >= 0)
+    if kind in ("float", "int-quantised"):
+        lo = _field(meta, "float_lo", name, (int, float), "a finite number", _finite)
+        _field(meta, "float_hi", name, (int, float), f"a finite number >= float_lo ({lo})",
+               lambda v: _finite(v) and v >= lo)
+    _field(meta, "spacing", name, list, "3 finite numbers > 0", lambda v: len(v) == 3 and all(
+        isinstance(x, (int, float)) and not isinstance(x, bool) and _finite(x) and x > 0 for x in v), default=None)
+    _field(meta, "origin", name, list, "3 finite numbers", lambda v: len(v) == 3 and all(
+        isinstance(x, (int, float)) and not isinstance(x, bool) and _finite(x) for x in v), default=None)
+    _field(meta, "name", name, str, "a name of at most 1024 characters", lambda v: len(v) <= 1024, default=None)
+
+
+def check_table(table: np.ndarray, meta_off: int, name: str = "<vvz>") -> None:
+    """The brick table as the writer makes it: kinds 0 or 1; payloads back to back from the header to the metadata
+    in table order (so no size or offset can be changed unnoticed); a stripped node (size 0) has offset and crc 0.
+    Raises :class:`VVZError` naming the brick, the field and both values."""
+    def brick(i: int) -> str:
+        return f"brick {i} (level {int(table[i]['level'])}, tile {int(table[i]['tile'])})"
+
+    bad = np.nonzero(table["kind"] > KIND_NODE)[0]
+    if bad.size:
+        raise VVZError(name, f"{brick(int(bad[0]))} field kind is {int(table[bad[0]]['kind'])}; expected "
+                       f"{KIND_ROOT} (root) or {KIND_NODE} (node)")
+    sizes = table["size"].astype(np.uint64)
+    if sizes.max() > np.uint64(meta_off):
+        i = int(np.argmax(sizes))
+        raise VVZError(name, f"{brick(i)} field size is {int(sizes[i])} bytes, but the payload area holds "
+                       f"{meta_off - HEADER_SIZE}")
+    stripped = sizes == 0
+    bad = np.nonzero(stripped & ((table["offset"] != 0) | (table["crc"] != 0)))[0]
+    if bad.size:
+        i = int(bad[0])
+        raise VVZError(name, f"{brick(i)} field size is 0 (a stripped node) but its offset is "
+                       f"{int(table[i]['offset'])} and crc {int(table[i]['crc'])}; a stripped node has both 0")
+    starts = HEADER_SIZE + np.concatenate(([0], np.cumsum(sizes, dtype=np.uint64)[:-1]))
+    bad = np.nonzero(~stripped & (table["offset"].astype(np.uint64) != starts))[0]
+    if bad.size:
+        i = int(bad[0])
+        raise VVZError(name, f"{brick(i)} field offset is {int(table[i]['offset'])}, but the bricks before it end "
+                       f"at {int(starts[i])}")
+    total = int(sizes.sum(dtype=np.uint64))
+    if total != meta_off - HEADER_SIZE:
+        raise VVZError(name, f"brick table sizes add up to {total} bytes, but the payload area holds "
+                       f"{meta_off - HEADER_SIZE} (from byte {HEADER_SIZE} to the metadata at {meta_off})")
 
 
 class Reader:
@@ -192,22 +313,11 @@ class Reader:
             raise VVZError(name, "metadata checksum mismatch (damaged metadata)")
         if crc32(table_bytes) != h["table_crc"]:
             raise VVZError(name, "brick table checksum mismatch (damaged table)")
-        try:
-            meta = json.loads(meta_bytes.decode("utf-8"))
-        except (UnicodeDecodeError, json.JSONDecodeError) as exc:
-            raise VVZError(name, f"metadata is not valid JSON ({exc})") from exc
-        if not isinstance(meta, dict) or meta.get("format") != "volviz-vvz":
-            raise VVZError(name, "metadata is not a volviz-vvz object")
         self.header = h
-        self.meta: dict[str, Any] = meta
+        self.meta: dict[str, Any] = parse_meta(meta_bytes, name)
         self.table = np.frombuffer(table_bytes, BRICK_DTYPE)
-        end = self.table["offset"].astype(np.uint64) + self.table["size"].astype(np.uint64)
-        bad = np.nonzero((self.table["size"] > 0) & ((self.table["offset"] < HEADER_SIZE) |
-                                                      (end > np.uint64(h["meta_off"]))))[0]
-        if bad.size:
-            b = self.table[bad[0]]
-            raise VVZError(name, f"brick {int(bad[0])} (level {int(b['level'])}, tile {int(b['tile'])}) points "
-                           f"outside the payload area: truncated or damaged")
+        check_table(self.table, h["meta_off"], name)
+        check_meta(self.meta, h["meta_off"] - HEADER_SIZE, name)
         self._map: np.ndarray | None = None
 
     @property
