@@ -1,5 +1,6 @@
 """Plain HDF5 files (.h5, .hdf5, NeXus .nxs, ...) holding arrays: tomography reconstructions, simulation fields,
-ilastik and other lab tools' volumes, through h5py. A file with a ``/VTKHDF`` group is read by ``volviz.io.vtkhdf``.
+ilastik and other lab tools' volumes, through h5py. Formats on HDF5 (VTKHDF, Fluent CFF, CGNS, Exodus,
+netCDF-4, MAT v7.3: ``volviz.io.hdf5kind``) go to their own readers unless ``dataset=`` names an array.
 
 - Which array: ``dataset="/entry/data/data"`` (its path in the file); by default the largest numeric 3D or 4D
   dataset, the others named in a warning (and every one in the error when none fits).
@@ -25,6 +26,7 @@ from volviz.io._checks import HDF5_SIGNATURE, check_file, check_finite, file_siz
 from volviz.io.array_choice import choose_array
 from volviz.io.axis_order import check_order, to_xyz
 from volviz.io.errors import PathLike, ReadError, ReadWarning, human_bytes
+from volviz.io.hdf5kind import hdf5_kind, read_as_kind
 from volviz.model import Image2D, RegularVolume, TimeSeries
 from volviz.model.arrays import volume_of
 
@@ -135,12 +137,11 @@ def read_hdf5(path: PathLike, dataset: str | None = None, order: str = "zyx",
 
     p = check_file(path)
     check_order(p, order)
+    kind = hdf5_kind(p) if dataset is None else None
+    if kind is not None:  # a format on HDF5 (Fluent CFF, CGNS, Exodus, netCDF-4, VTKHDF, MAT v7.3): its own reader
+        return read_as_kind(p, kind, allow_nonfinite)
     if read_bytes(p, 8) != HDF5_SIGNATURE:
         raise ReadError(p, "not an HDF5 file (no HDF5 signature at its start)")
-    if has_vtkhdf_group(p) and dataset is None:
-        from volviz.io.vtkhdf import read_vtkhdf
-
-        return read_vtkhdf(p, allow_nonfinite)
     if dataset is None:
         _warn_if_heavy_data(p)
     try:

@@ -21,6 +21,8 @@ dispatches to the loaders in ``volviz_vtk_readers.readers``. What each format gi
 - Tecplot ASCII (.dat .plt .tec with a Tecplot header): every zone merged. Binary Tecplot is refused with a hint.
 - AVS UCD (.inp .ucd, ASCII or binary; told from Abaqus .inp by content): the mesh with every component.
 - Fluent (.cas with its .dat beside it, or the .dat): every cell zone merged with every cell field.
+- Fluent CFF (.cas.h5 with its .dat.h5 beside it, or the .dat.h5; HDF5): the same through vtkFLUENTCFFReader
+  (``volviz_vtk_readers.fluentcff``); an .h5 of this kind under any name is sent there by ``volviz.io.hdf5kind``.
 - VTK multiblock (.vtm .vtpd): every block merged (what ParaView shows on open); ``blocks=`` picks some.
 - VTK parallel XML (.pvtu .pvti .pvts .pvtr .pvtp): the pieces joined into one data set by VTK's reader.
 - XDMF (.xdmf .xmf, versions 2 and 3; FEniCS / dolfinx, meshio, HPC codes): the temporal collections when the file

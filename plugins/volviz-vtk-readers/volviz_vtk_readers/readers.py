@@ -397,9 +397,15 @@ def read_avs_ucd(path: PathLike, allow_nonfinite: bool = True):
 
 
 # -- block listing -----------------------------------------------------------------------------------------------------
+def _fluent_cff(path: PathLike) -> Any:
+    from volviz_vtk_readers.fluentcff import fluent_cff_reader
+
+    return fluent_cff_reader(path)
+
+
 _TREE_READERS: dict[str, Callable[[PathLike], Any]] = {
-    "cgns": _cgns, "ensight": _ensight, "tecplot": _tecplot, "fluent": _fluent, "vtk-multiblock": _vtk_multiblock,
-    "xdmf": _xdmf}
+    "cgns": _cgns, "ensight": _ensight, "tecplot": _tecplot, "fluent": _fluent, "fluent-cff": _fluent_cff,
+    "vtk-multiblock": _vtk_multiblock, "xdmf": _xdmf}
 
 
 def list_blocks(path: PathLike) -> list[str]:

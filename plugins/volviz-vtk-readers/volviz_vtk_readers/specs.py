@@ -8,6 +8,7 @@ from __future__ import annotations
 import re
 from typing import Any
 
+from volviz.io._checks import is_hdf5
 from volviz.io.registry import ReaderSpec
 
 from volviz_vtk_readers.containers import is_cgns, is_netcdf
@@ -96,6 +97,9 @@ SPECS: list[ReaderSpec] = [  # netCDF before Exodus: a netCDF file known by cont
           arrays="every node and cell component", options=("allow_nonfinite",)),
     _spec("fluent", "Fluent case", ("*.cas", "*.dat"), _R + "read_fluent", sniff=is_fluent, claims_name=False,
           arrays="every cell field of the case's .dat file", options=("blocks", "allow_nonfinite")),
+    _spec("fluent-cff", "Fluent CFF case (HDF5)", ("*.cas.h5", "*.dat.h5"),
+          "volviz_vtk_readers.fluentcff:read_fluent_cff", sniff=is_hdf5,
+          arrays="every cell field (SV_*) of the case's .dat.h5", options=("blocks", "allow_nonfinite")),
     _spec("vtk-multiblock", "VTK multiblock", ("*.vtm", "*.vtmb", "*.vtpd"), _R + "read_vtk_multiblock",
           sniff=is_vtk_multiblock, sniff_opens=False, arrays="every point and cell array of every block",
           options=("blocks", "allow_nonfinite")),
