@@ -15,7 +15,7 @@ from volviz.io._checks import (
     check_dims, check_finite, describe_bytes, describe_dims, file_size, parse_float, parse_int, read_at, read_bytes,
     require_bytes,
 )
-from volviz.io.errors import PathLike, ReadError, human_bytes
+from volviz.io.errors import PathLike, ReadError, ReadWarning, human_bytes
 from volviz.model import Image2D, RegularVolume, vec3
 
 ELEMENT_TYPES = {
@@ -97,6 +97,37 @@ def _slice_files(path: PathLike, data_name: str, rest: bytes, nz: int) -> list[P
     return [folder / name for name in names]
 
 
+def _inflate(data_path: Path, offset: int, stored: int, n_bytes: int, declared: int | None, what: str) -> bytes:
+    """The ``n_bytes`` a zlib stream at ``offset`` (running to the end of the file, ``stored`` bytes) inflates to.
+
+    The inflated size is what must agree with the dimensions: a ``CompressedDataSize`` (``declared``) that differs
+    from the stream's length is stale (tools rewrite the data and keep the header), and is a ReadWarning when the
+    stream inflates in full; it names the cause (a file shorter than it says) when the stream falls short."""
+    if stored <= 0:
+        raise ReadError(data_path, "MetaImage compressed data is empty")
+    if n_bytes > DEFLATE_MAX_RATIO * stored + 64:
+        raise ReadError(data_path, f"{what} needs {n_bytes} bytes ({human_bytes(n_bytes)}), more than its "
+                                   f"{stored} compressed bytes can inflate to (zlib expands at most "
+                                   f"{DEFLATE_MAX_RATIO}:1)")
+    packed = bytes(read_at(data_path, offset, stored))
+    try:
+        inflater = zlib.decompressobj()
+        raw = inflater.decompress(packed, n_bytes + 1)
+    except zlib.error as exc:
+        raise ReadError(data_path, f"MetaImage zlib data is corrupt ({exc})") from None
+    if len(raw) != n_bytes:
+        if declared is not None:
+            require_bytes(data_path, declared, stored, "MetaImage CompressedDataSize")
+        raise ReadError(data_path, f"{what} inflates to {len(raw)}{'+' if len(raw) > n_bytes else ''} bytes, "
+                                   f"the header needs {n_bytes} ({human_bytes(n_bytes)})")
+    used = stored - len(inflater.unused_data) - len(inflater.unconsumed_tail)
+    if declared is not None and declared != used:
+        warnings.warn(ReadWarning(f"{data_path}: the header's CompressedDataSize ({declared}) is not the length of "
+                                  f"its zlib stream ({used} bytes), which inflates to exactly the {n_bytes} bytes "
+                                  "the dimensions need: the stream is read, the stale size ignored"), stacklevel=4)
+    return raw
+
+
 def read_metaimage(path: PathLike, allow_nonfinite: bool = True) -> RegularVolume | Image2D:
     """Read .mhd (+ data file) or .mha into RegularVolume (3D) or Image2D (2D, any number of channels).
 
@@ -176,26 +207,10 @@ def _read_metaimage(path: PathLike, allow_nonfinite: bool) -> RegularVolume | Im
         except ValueError:
             raise ReadError(data_path, "MetaImage text data holds a value that is not a number") from None
     elif compressed:
-        stored = data_size - offset
-        if "compresseddatasize" in fields:
-            stored = parse_int(path, fields["compresseddatasize"], "MetaImage CompressedDataSize")
-            require_bytes(data_path, stored, data_size - offset, "MetaImage CompressedDataSize")
-        if stored <= 0:
-            raise ReadError(data_path, "MetaImage compressed data is empty")
-        if n_bytes > DEFLATE_MAX_RATIO * stored + 64:
-            raise ReadError(data_path, f"{what} needs {n_bytes} bytes ({human_bytes(n_bytes)}), more than its "
-                                       f"{stored} compressed bytes can inflate to (zlib expands at most "
-                                       f"{DEFLATE_MAX_RATIO}:1)")
-        packed = read_at(data_path, offset, stored)
-        try:
-            inflater = zlib.decompressobj()
-            raw = inflater.decompress(bytes(packed), n_bytes + 1)
-        except zlib.error as exc:
-            raise ReadError(data_path, f"MetaImage zlib data is corrupt ({exc})") from None
-        if len(raw) != n_bytes:
-            raise ReadError(data_path, f"{what} inflates to {len(raw)}{'+' if len(raw) > n_bytes else ''} bytes, "
-                                       f"the header needs {n_bytes} ({human_bytes(n_bytes)})")
-        values = np.frombuffer(raw, dtype=disk).astype(disk.newbyteorder("="))
+        declared = (parse_int(path, fields["compresseddatasize"], "MetaImage CompressedDataSize")
+                    if "compresseddatasize" in fields else None)
+        values = np.frombuffer(_inflate(data_path, offset, data_size - offset, n_bytes, declared, what),
+                               dtype=disk).astype(disk.newbyteorder("="))
     else:
         if header_size == -1:
             offset = data_size - n_bytes
