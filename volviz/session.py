@@ -16,6 +16,7 @@ values instead of quoting them (only short identifiers are quoted).
 from __future__ import annotations
 
 import copy
+import errno
 import json
 import math
 import os
@@ -456,6 +457,7 @@ def relative_path(session_file: str | os.PathLike, dataset_path: str | os.PathLi
 def loads(text: str, source: str | os.PathLike | None = None) -> Session:
     """Parse and validate a session document held in memory (see :func:`load` for files)."""
     src = None if source is None else str(source)
+    text = text.removeprefix("\ufeff")  # a UTF-8 byte-order mark decoded as text
     _check_structure(text.encode("utf-8", "surrogatepass"), src)
     try:
         doc = json.loads(text, parse_constant=lambda name: _reject_constant(name, src))
@@ -519,12 +521,13 @@ def load(path: str | os.PathLike) -> Session:
     p = Path(path)
     data = _read_regular(p)
     try:
-        text = data.decode("utf-8")
+        text = data.decode("utf-8-sig")  # a byte-order mark, as some Windows editors write, is dropped
     except UnicodeDecodeError:
         raise SessionError(p, "is not UTF-8 text (binary data)") from None
     session = loads(text, p)
     for i, ref in enumerate(session.datasets):
         _check_dataset_path(p, ref.path, f"datasets[{i}].path")
+        _check_dataset_options(p, ref, f"datasets[{i}].options")
     return session
 
 
@@ -561,11 +564,30 @@ def _check_dataset_path(session_file: Path, stored: str, where: str) -> None:
     try:
         path = resolve_path(session_file, stored)
         mode = os.stat(path).st_mode
-    except (OSError, ValueError, RuntimeError):  # missing (reported when read), a pattern, or unresolvable
+    except RuntimeError:  # Path.resolve: "Symlink loop from ..."
+        raise SessionError(session_file, f"{stored} is a loop of symbolic links, not a data file", where) from None
+    except OSError as exc:
+        if exc.errno == errno.ELOOP:
+            raise SessionError(session_file, f"{stored} is a loop of symbolic links, not a data file", where) from None
+        return  # missing: reported when read
+    except ValueError:  # a pattern or an unresolvable name
         return
     if stat.S_ISREG(mode) or (stat.S_ISDIR(mode) and _read_as_folder(path)):
         return
     raise SessionError(session_file, f"is {path_kind(mode)}, not a data file", where)
+
+
+def _check_dataset_options(session_file: Path, ref: DatasetRef, where: str) -> None:
+    """The options of a dataset that exists, checked against its reader (``volviz.io.option_check``): an unknown
+    option, a missing one or a value of another type is refused here, naming the field."""
+    from volviz.io.option_check import OptionProblem, check_reader_options
+
+    try:
+        check_reader_options(resolve_path(session_file, ref.path), ref.options)
+    except OptionProblem as exc:
+        raise SessionError(session_file, exc.problem, f"{where}.{exc.option}" if exc.option else where) from None
+    except (OSError, RuntimeError, ValueError):  # a path that cannot be resolved: reported by the path check
+        return
 
 
 def _read_as_folder(folder: Path) -> bool:
