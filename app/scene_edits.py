@@ -293,6 +293,7 @@ class SceneEdits(WindowBase):
             doc = session_to_dict(self.session)
             for comp in doc["components"]:
                 if comp["id"] == comp_id:
+                    _refit_on_new_array(doc, comp, settings)
                     comp["settings"] = settings
             candidate = session_from_dict(doc, "scene tree")
         except (ValueError, SessionError) as exc:
@@ -327,3 +328,19 @@ class SceneEdits(WindowBase):
             self.session.layout.pop("window_state", None)
             self._show_session(self.session, self.session_path, getattr(self, "title", ""), True,
                                datasets=self.datasets)
+
+
+def _refit_on_new_array(doc: dict[str, Any], comp: dict[str, Any], settings: dict[str, Any]) -> None:
+    """A component that shows another array gets the first-look transfer function of that array (placed from its
+    histogram when the scene is prepared), as on a first open: the old one's scalar range belongs to the old array
+    (Blunt Fin: Density's 0.19 .. 4.98 kept over MachNumber's 0 .. 3.39). The old function is dropped from the
+    session unless another component uses it."""
+    from volviz.model.settings import array_key
+
+    key = array_key(comp["type"])
+    old_tf = comp.get("transfer_function")
+    if settings.get(key) == comp.get("settings", {}).get(key) or old_tf is None:
+        return
+    comp["transfer_function"] = None
+    if not any(c.get("transfer_function") == old_tf for c in doc["components"]):
+        doc["transfer_functions"].pop(old_tf, None)

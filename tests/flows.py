@@ -74,3 +74,28 @@ def compare_with_render(window, tmp_path: Path, name: str = "flow") -> dict[str,
     assert ref.shape == shown.shape
     return {"rmse": rmse(shown / 255.0, ref / 255.0), "max": max_abs(shown / 255.0, ref / 255.0),
             "off": float((np.abs(shown - ref).max(axis=2) > 24).mean())}
+
+
+def pick_combo_item(qtbot, combo, data: str) -> None:
+    """Open ``combo``'s popup with a click and click the item whose data is ``data`` (as a user picks)."""
+    from PySide6.QtCore import Qt as _Qt
+
+    index = combo.findData(data)
+    assert index >= 0, f"{data!r} is not offered: {[combo.itemData(i) for i in range(combo.count())]}"
+    qtbot.mouseClick(combo, _Qt.MouseButton.LeftButton)
+    view = combo.view()
+    qtbot.waitUntil(view.isVisible)
+    view.scrollTo(view.model().index(index, 0))  # as the user scrolls a long list
+    qtbot.wait(50)
+    rect = view.visualRect(view.model().index(index, 0))
+    qtbot.mouseMove(view.viewport(), rect.center())  # the popup selects the item under the pointer
+    qtbot.wait(50)
+    qtbot.mouseClick(view.viewport(), _Qt.MouseButton.LeftButton, pos=rect.center())
+
+
+def scalar_bar_ranges(window) -> list[tuple[float, float]]:
+    """The value ranges the viewport's scalar bars show."""
+    from volviz.render.decorations import scalar_bar_actor
+
+    bar = scalar_bar_actor(window.plotter)
+    return [] if bar is None else [tuple(float(v) for v in bar.GetLookupTable().GetRange())]
