@@ -16,6 +16,8 @@ from __future__ import annotations
 
 import argparse
 import json
+import re
+import socket
 import sys
 import time
 from typing import Any, Sequence
@@ -45,8 +47,23 @@ def _progress_bar(stream: Any = None) -> Any:
     return report
 
 
+def _raw_input(args: argparse.Namespace) -> None:
+    """``--raw`` input checked before it is memory-mapped: a regular file (a FIFO or device would block the map, as
+    ``volviz info`` refuses them: ``volviz.io._checks.check_file``) holding exactly NX*NY*NZ samples."""
+    from volviz.io._checks import file_size
+
+    nx, ny, nz = args.raw
+    dtype = np.dtype(args.dtype)
+    size = file_size(args.input)  # ReadError (a user error) for a missing file, a folder, FIFO or device
+    need = nx * ny * nz * dtype.itemsize
+    if need != size:
+        raise SystemExit(f"--raw {nx} {ny} {nz} --dtype {dtype.name} needs {need} bytes, but {args.input} holds "
+                         f"{size} bytes ({'fewer' if size < need else 'more'}): give its dimensions and --dtype")
+
+
 def _load(args: argparse.Namespace) -> RegularVolume:
     if args.raw:
+        _raw_input(args)
         nx, ny, nz = args.raw
         dtype = np.dtype(args.dtype)
         data = np.memmap(args.input, dtype=dtype, mode="r", shape=(nx, ny, nz), order="F")
@@ -132,6 +149,7 @@ def _series_main(args: argparse.Namespace) -> int:
             compression_backend("dask")
         except BackendMissing as exc:
             raise SystemExit(f"--scheduler: {exc}") from None
+        _check_scheduler(args.scheduler)
     series = read(args.input)
     if not isinstance(series, TimeSeries):
         raise SystemExit(f"{args.input}: not a time series (use a numbered pattern such as Storm.pvm-t%02d)")
@@ -144,6 +162,46 @@ def _series_main(args: argparse.Namespace) -> int:
         with open(args.json, "w") as f:
             json.dump(result, f, indent=1)
     return 0
+
+
+SCHEDULER_TIMEOUT = 5.0  # seconds a scheduler has to accept a connection (dask's own client waits 30 s)
+_ADDRESS = re.compile(r"(?:tcp://)?(?P<host>\[[^\]]+\]|[^:/\[\]]+):(?P<port>\d{1,5})/?\Z")
+
+
+def _check_scheduler(address: str, timeout: float = SCHEDULER_TIMEOUT) -> None:
+    """Fail fast, as a usage error and before anything is read or written, unless a dask scheduler answers at
+    ``address`` (``tcp://HOST:PORT`` or ``HOST:PORT``; other transports are left to the backend). A scheduler sends
+    its handshake as soon as a client connects, a message that starts with its length (u64, distributed's TCP
+    framing); a host that accepts the connection but says nothing, or something else, is no scheduler."""
+    scheme = address.split("://", 1)[0] if "://" in address else "tcp"
+    if scheme != "tcp":  # inproc://, tls://, ucx://: the backend connects itself
+        return
+    m = _ADDRESS.match(address)
+    if m is None:
+        raise SystemExit(f"--scheduler {address!r}: not an address of the form tcp://HOST:PORT")
+    host, port = m["host"].strip("[]"), int(m["port"])
+    head = b""
+    try:
+        with socket.create_connection((host, port), timeout=timeout) as conn:
+            deadline = time.monotonic() + timeout
+            while len(head) < 8 and time.monotonic() < deadline:
+                conn.settimeout(max(deadline - time.monotonic(), 0.01))
+                chunk = conn.recv(8 - len(head))
+                if not chunk:
+                    break
+                head += chunk
+    except TimeoutError:
+        pass
+    except OSError as exc:
+        raise SystemExit(f"--scheduler {address}: no scheduler reachable at {host}:{port} "
+                         f"({exc.strerror or type(exc).__name__})") from None
+    if len(head) < 8:
+        raise SystemExit(f"--scheduler {address}: {host}:{port} accepted the connection but sent no scheduler "
+                         f"handshake within {timeout:g} s (got {len(head)} bytes)")
+    size = int.from_bytes(head, "little")
+    if not 0 < size < 1 << 26:
+        raise SystemExit(f"--scheduler {address}: {host}:{port} answers, but not as a dask scheduler (its first "
+                         f"message claims {size} bytes)")
 
 
 def _print_info(meta: dict[str, Any]) -> None:
