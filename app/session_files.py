@@ -22,7 +22,8 @@ from .window_base import WindowBase
 
 log = logging.getLogger("volviz_app.window")  # the logger these methods had in window.py
 
-AUTOSAVE_MS = 60_000
+AUTOSAVE_MS = 60_000     # the recovery file is rewritten at least this often while there are unsaved changes
+EDIT_AUTOSAVE_MS = 1_500  # and this long after every edit, so a crash loses at most the last moments
 
 
 def _data_filter() -> str:
@@ -48,9 +49,13 @@ class SessionFiles(WindowBase):
         self.autosave_timer = QTimer(self, interval=AUTOSAVE_MS)
         self.autosave_timer.timeout.connect(self.autosave)
         self.autosave_timer.start()
+        self.edit_autosave_timer = QTimer(self, singleShot=True, interval=EDIT_AUTOSAVE_MS)
+        self.edit_autosave_timer.timeout.connect(self.autosave)
 
     def set_dirty(self, dirty: bool = True) -> None:
         self.dirty = dirty
+        if dirty and hasattr(self, "edit_autosave_timer"):
+            self.edit_autosave_timer.start()  # (re)started by each edit: one write after a burst of edits
         name = self.session_path.name if self.session_path else getattr(self, "title", "untitled")
         self.setWindowTitle(f"volviz — {name}{' *' if dirty else ''}")
 
@@ -197,14 +202,49 @@ class SessionFiles(WindowBase):
         return dialog
 
     def _ask_open_data(self) -> None:
-        self.ask_file("Open data (a PLOT3D grid with its solution: select both)", _data_filter(), self.open_paths,
-                      multiple=True)
+        self.keeping_unsaved_work(lambda: self.ask_file("Open data (a PLOT3D grid with its solution: select both)",
+                                                        _data_filter(), self.open_paths, multiple=True))
 
     def _ask_open_folder(self) -> None:
-        self.ask_file("Open a folder (a DICOM series, an OpenFOAM case)", "", self.open_path, folder=True)
+        self.keeping_unsaved_work(lambda: self.ask_file("Open a folder (a DICOM series, an OpenFOAM case)", "",
+                                                        self.open_path, folder=True))
 
     def _ask_open_session(self) -> None:
-        self.ask_file("Open session", "volviz sessions (*.json);;All files (*)", self.open_path)
+        self.keeping_unsaved_work(lambda: self.ask_file("Open session", "volviz sessions (*.json);;All files (*)",
+                                                        self.open_path))
+
+    def open_path_asking(self, path: str | os.PathLike) -> None:
+        """``open_path`` for what replaces the scene at the user's word (File > Open Recent, a drop): unsaved
+        changes are asked about first (``keeping_unsaved_work``)."""
+        self.keeping_unsaved_work(lambda: self.open_path(path))
+
+    def keeping_unsaved_work(self, then: Any) -> None:
+        """Run ``then()`` (which replaces the scene) now if nothing is unsaved; else ask, without blocking, Save /
+        Discard / Cancel (kept as ``unsaved_dialog``): Save saves (asking for a file when the session has none) and
+        then goes on, Discard goes on, Cancel keeps everything as it is."""
+        if not self.dirty:
+            then()
+            return
+        box = QMessageBox(QMessageBox.Icon.Warning, "Unsaved changes",
+                          "The scene has unsaved changes. Save them before opening another?",
+                          QMessageBox.StandardButton.Save | QMessageBox.StandardButton.Discard
+                          | QMessageBox.StandardButton.Cancel, self)
+
+        def answered(_: int) -> None:
+            answer = box.standardButton(box.clickedButton()) if box.clickedButton() else None
+            if answer == QMessageBox.StandardButton.Discard:
+                then()
+            elif answer == QMessageBox.StandardButton.Save:
+                if self.session_path is not None:
+                    if self.save_session(self.session_path):
+                        then()
+                else:
+                    self.ask_file("Save session", "volviz sessions (*.json)",
+                                  lambda p: self.save_session(p) and then(), save=True, default_name="session.json")
+
+        box.finished.connect(answered)
+        box.open()
+        self.unsaved_dialog = box
 
     def _save_session(self) -> bool:
         if self.session_path is None:

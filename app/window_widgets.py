@@ -137,8 +137,8 @@ class WindowWidgets(WindowBase):
         self.action_record = self._action(camera_menu, "&Record Camera Path", "Ctrl+R", self.set_recording)
         self.action_record.setCheckable(True)
         self.help = HelpMenu(self, self.menuBar().addMenu("&Help"), self.plotter.ren_win)
-        self.recent = RecentFiles(self.settings, self.recent_menu, self.open_path)
-        self.file_drop = FileDrop([self, self.plotter.interactor], self.open_path)
+        self.recent = RecentFiles(self.settings, self.recent_menu, self.open_path_asking)
+        self.file_drop = FileDrop([self, self.plotter.interactor], self.open_path_asking)
 
     def _activate_undo_stack(self, stack: Any) -> None:
         import shiboken6
