@@ -6,7 +6,8 @@ is at ``(i, j, k)``, unit spacing (``order="xyz"`` reads a[i, j, k] there instea
 array whose last axis has 2 to 4 entries is (z, y, x, channels), one array by
 magnitude or component; any other 4D array is (t, z, y, x), a time series; a 2D array is an image (rows, columns).
 Numbers only: booleans become 0 / 1, complex and record arrays are refused. NumPy maps the data after reading the
-header, and refuses a file shorter than the header says.
+header, and refuses a file shorter than the header says; a file longer than its header says is refused too (at least
+one slice more) or warned about (``volviz.io.trailing``).
 """
 from __future__ import annotations
 
@@ -18,6 +19,7 @@ import numpy as np
 from volviz.io._checks import check_file, check_finite
 from volviz.io.axis_order import check_order, to_xyz
 from volviz.io.errors import PathLike, ReadError
+from volviz.io.trailing import check_trailing
 from volviz.model import Image2D, RegularVolume, TimeSeries
 from volviz.model.arrays import volume_of
 
@@ -50,6 +52,11 @@ def read_npy(path: PathLike, order: str = "zyx",
     if not isinstance(data, np.ndarray):
         raise ReadError(p, "is an .npz archive of several arrays, not one .npy array")
     shape, dtype = data.shape, data.dtype
+    if isinstance(data, np.memmap) and data.size:  # the header's shape against the bytes after the header
+        fortran = data.flags.f_contiguous and not data.flags.c_contiguous
+        slowest = shape[-1] if fortran else shape[0]
+        check_trailing(p, f"shape {shape} of {dtype}", data.nbytes, p.stat().st_size - data.offset - data.nbytes,
+                       data.nbytes // max(slowest, 1))
     if dtype.hasobject or dtype.names is not None or dtype.kind not in "biuf":
         raise ReadError(p, f"holds {dtype} values; volviz reads arrays of numbers (integers, floats, booleans)")
     if len(shape) not in (2, 3, 4) or min(shape, default=0) < 1:

@@ -8,18 +8,21 @@ radio astronomy (RA, Dec, frequency or velocity), integral-field optical cubes, 
 - Axes: FITS lists NAXIS1 (x, fastest) first; the volume is laid out x, y, z in that order, one unit per pixel and
   per channel (a cube's spectral axis shares no unit with its sky axes), the sky pixel's aspect kept from
   |CDELT2 / CDELT1|. The array is named after BUNIT when the header has it.
-- astropy checks each header; a data unit shorter than its header says is refused before it is read.
+- astropy checks each header; a data unit shorter than its header says is refused before it is read, and so is a
+  file holding a slice or more beyond its last HDU (fewer extra bytes: a ``ReadWarning``, ``volviz.io.trailing``).
 """
 from __future__ import annotations
 
 import math
 import warnings
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from volviz.io._checks import check_file, check_finite, describe_bytes, read_bytes
 from volviz.io.errors import PathLike, ReadError, ReadWarning
+from volviz.io.trailing import check_trailing
 from volviz.model import Image2D, RegularVolume
 
 from volviz_astronomy.specs import is_fits
@@ -38,7 +41,72 @@ def _open(path: PathLike) -> Any:
         return hdus
     except (OSError, ValueError, TypeError, IndexError, KeyError, fits.verify.VerifyError,
             fits.verify.VerifyWarning) as exc:
+        _not_an_extension(path)
         raise ReadError(path, f"astropy cannot read it as FITS ({str(exc).strip()[:200]})") from None
+
+
+def _fields(hdu: Any) -> str:
+    """The header fields that give an HDU's data size, as "NAXIS1 16, NAXIS2 14, NAXIS3 8 of BITPIX -32"."""
+    axes = ", ".join(f"NAXIS{i} {n}" for i, n in enumerate(_shape(hdu)[::-1], 1))
+    return f"{axes} of BITPIX {hdu.header.get('BITPIX')}"
+
+
+def _slice_bytes(hdu: Any) -> int:
+    shape = _shape(hdu)
+    return abs(int(hdu.header.get("BITPIX", 8))) // 8 * math.prod(shape[1:]) if shape else 2880
+
+
+def _check_after_last_hdu(path: Path, hdus: Any) -> None:
+    """Bytes after the last HDU's data unit: refused when they make a slice or more, else a ReadWarning."""
+    from astropy.io import fits
+
+    last = hdus[-1]
+    info = hdus.fileinfo(len(hdus) - 1)
+    start, span = int(info["datLoc"]), int(info["datSpan"])
+    if type(last) in (fits.PrimaryHDU, fits.ImageHDU):  # plain images: the padding after the samples is zeros
+        data_bytes = _expected_bytes(last)
+        check_trailing(path, _fields(last), data_bytes, _extra_bytes(path, start + data_bytes), _slice_bytes(last))
+    else:  # tables, tile-compressed images: their data unit as astropy measured it
+        check_trailing(path, f"a {type(last).__name__} data unit of {span} bytes", span,
+                       path.stat().st_size - start - span, 2880)
+
+
+def _extra_bytes(path: Path, data_end: int) -> int:
+    """The bytes after the last HDU's data (ending at ``data_end``) that are not its zero padding to the 2880-byte
+    block: a data unit that a wrong NAXISn cut short leaves its rest there."""
+    pad = -data_end % 2880
+    with open(path, "rb") as handle:
+        handle.seek(data_end)
+        padding = np.frombuffer(handle.read(pad), np.uint8)
+    after = path.stat().st_size - data_end - pad
+    if after > 0:
+        return after + pad
+    nonzero = np.flatnonzero(padding)
+    return int(nonzero[-1]) + 1 if nonzero.size else 0
+
+
+def _not_an_extension(path: PathLike) -> None:
+    """When the HDUs after the primary one do not parse: if the primary header parses and the bytes after its data
+    unit do not start an extension (``XTENSION=``), its header claims less data than the file holds; say so."""
+    from astropy.io import fits
+
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            with fits.open(path, memmap=False, lazy_load_hdus=True) as hdus:
+                first = hdus[0]  # hdus.fileinfo(0) would parse the HDUs after it
+                start, span = int(first._data_offset), int(first._data_size)
+                fields, data_bytes, end = _fields(first), _expected_bytes(first), start + span
+    except Exception:  # noqa: BLE001 - the primary HDU does not parse either: astropy's message stands
+        return
+    size = Path(path).stat().st_size
+    with open(path, "rb") as handle:
+        handle.seek(end)
+        following = handle.read(8)
+    if end < size and following != b"XTENSION":
+        raise ReadError(path, f"its header gives {fields}: {data_bytes} bytes of data, but {size - start - data_bytes} "
+                              "bytes follow them that are no FITS extension (no XTENSION header): the header claims "
+                              "less data than the file holds")
 
 
 def _shape(hdu: Any) -> tuple[int, ...]:
@@ -88,6 +156,8 @@ def read_fits(path: PathLike, hdu: int | str | None = None,
         if "ZNAXIS" not in header and p.suffix.lower() != ".gz" and start + _expected_bytes(chosen) > p.stat().st_size:
             raise ReadError(p, f"its data unit ({' x '.join(map(str, _shape(chosen)[::-1]))} samples of BITPIX "
                                f"{header.get('BITPIX')}) runs past the end of the file: it is truncated")
+        if p.suffix.lower() != ".gz":  # bytes after the last HDU: a header that claims less than the file holds
+            _check_after_last_hdu(p, hdus)
         try:
             data = np.array(chosen.data)
         except (OSError, ValueError, TypeError, IndexError) as exc:

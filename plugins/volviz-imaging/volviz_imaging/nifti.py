@@ -9,7 +9,8 @@ through nibabel.
   time unit; step numbers when it has none), each read when it is shown; ``time_index=i`` reads one step. A 5D file
   of one time step (NIfTI's vector intents: displacement fields, RGB) gives one array with its components.
 - Before any voxel is read, the header's data size is checked against the file (an uncompressed file that is too
-  short, a compressed one that could not inflate to it).
+  short, a compressed one that could not inflate to it; an uncompressed NIfTI / Analyze file that holds a slice or
+  more beyond its header's dims is refused, fewer extra bytes are a ``ReadWarning``: ``volviz.io.trailing``).
 """
 from __future__ import annotations
 
@@ -20,6 +21,7 @@ import numpy as np
 
 from volviz.io._checks import check_file, file_size, require_bytes
 from volviz.io.errors import PathLike, ReadError, human_bytes
+from volviz.io.trailing import check_trailing
 from volviz.io.metaimage import DEFLATE_MAX_RATIO
 from volviz.model import RegularVolume, TimeSeries
 
@@ -69,6 +71,10 @@ def _check_size(path: PathLike, img: Any) -> None:
                                   f"compressed bytes can inflate to: the header is wrong")
     else:
         require_bytes(data, needed, size - offset, what)
+        if type(img).__name__ != "MGHImage":  # MGH keeps scan parameters and tags after its voxels
+            dims = ", ".join(f"dim[{i + 1}] {n}" for i, n in enumerate(img.shape))
+            check_trailing(path, f"{dims} of {dtype.name}", needed, size - offset - needed,
+                           needed // max(int(img.shape[-1]), 1))
 
 
 def time_step(img: Any, axis: int = 3) -> float:
