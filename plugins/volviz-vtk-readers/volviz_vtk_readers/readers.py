@@ -30,6 +30,7 @@ from volviz_vtk_readers import specs, xdmf
 from volviz_vtk_readers.containers import check_container
 from volviz_vtk_readers.exodus_check import check_exodus_connectivity
 from volviz_vtk_readers.foamcheck import check_time_folder
+from volviz_vtk_readers.tecplotcheck import check_tecplot_zones
 
 
 class _Pass:
@@ -282,12 +283,17 @@ def _tecplot(path: PathLike) -> Any:
     if read_bytes(p, 5) == b"#!TDV":
         raise ReadError(p, "is a binary Tecplot file (#!TDV); VTK reads Tecplot ASCII only: export it as ASCII "
                            "(e.g. Tecplot's preplot -a or 'Write Data File' ASCII)")
+    check_tecplot_zones(p)  # VTK's reader loops or returns an empty mesh on a zone cut short
     return _information(path, _reader("vtkTecplotReader", path))
 
 
 def read_tecplot(path: PathLike, blocks: Sequence[str] | str | None = None, allow_nonfinite: bool = True):
     """Tecplot ASCII: every zone (or ``blocks``) with every variable, merged."""
-    return _convert(path, blocks, allow_nonfinite)(_run(path, _tecplot(path)))  # every variable is read
+    output = _run(path, _tecplot(path))  # every variable is read
+    if output is None or output.GetNumberOfPoints() == 0:
+        raise ReadError(path, "VTK's Tecplot reader found no zone with points in it",
+                        "check the file's ZONE headers and values")
+    return _convert(path, blocks, allow_nonfinite)(output)
 
 
 def _fluent(path: PathLike) -> Any:
