@@ -5,7 +5,10 @@
 - A file is written to a temporary beside it, fsynced and renamed over the target: a reader never sees a half-written
   file, and the old file survives a failed write.
 - Temporaries are named ``.NAME.volviz-tmp-PID-RANDOM``. A save killed between write and rename leaves one behind;
-  the next save into that folder removes every such temporary whose process is gone (:func:`remove_stale_temporaries`).
+  the next save into that folder removes every such temporary whose process is gone, and the next save of the same
+  target also those unchanged for :data:`STALE_AGE_S` (:func:`remove_stale_temporaries`).
+- Two processes writing the same target each write their own temporary (unique name) and rename it: the target is
+  always one complete file of one of them, never a mix.
 - A directory store is replaced by :func:`replace_directory` so that a kill at any moment leaves one complete store
   (:func:`recover_directory` finishes or undoes an interrupted replacement).
 """
@@ -16,6 +19,7 @@ import re
 import secrets
 import shutil
 import stat
+import time
 from pathlib import Path
 
 from volviz.io._checks import path_kind
@@ -82,16 +86,31 @@ def process_alive(pid: int) -> bool:
     return pid > 0
 
 
-def _stale(folder: Path, name: str | None, role: str) -> list[Path]:
-    """Leftovers of ``role`` in ``folder`` (of target ``name`` only, when given) whose writing process is gone."""
+#: seconds a temporary of the target being written may stay unchanged before it counts as abandoned even though a
+#: process of its id runs (ids are reused after a kill, and a folder may be shared with another machine)
+STALE_AGE_S = 30 * 60
+
+
+def _abandoned(path: Path, now: float) -> bool:
+    try:
+        return now - os.lstat(path).st_mtime > STALE_AGE_S
+    except OSError:
+        return False
+
+
+def _stale(folder: Path, name: str | None, role: str, target: str | None = None) -> list[Path]:
+    """Leftovers of ``role`` in ``folder`` (of target ``name`` only, when given) whose writing process is gone, and
+    those of target ``target`` unchanged for :data:`STALE_AGE_S` whatever their process id."""
     try:
         entries = os.listdir(folder)
     except OSError:
         return []
     found = []
+    now = time.time()
     for entry in entries:
         m = _TEMP.match(entry)
-        if m and m["role"] == role and (name is None or m["name"] == name) and not process_alive(int(m["pid"])):
+        if m and m["role"] == role and (name is None or m["name"] == name) and (
+                not process_alive(int(m["pid"])) or (m["name"] == target and _abandoned(folder / entry, now))):
             found.append(folder / entry)
     return found
 
@@ -106,10 +125,12 @@ def _remove(path: Path) -> None:
         pass
 
 
-def remove_stale_temporaries(folder: str | os.PathLike) -> list[Path]:
+def remove_stale_temporaries(folder: str | os.PathLike, target: str | os.PathLike | None = None) -> list[Path]:
     """Remove the temporaries (files and store folders) that interrupted saves left in ``folder``: every
-    ``.NAME.volviz-tmp-PID-RANDOM`` whose process ``PID`` is no longer running. Returns what was removed."""
-    removed = _stale(Path(folder), None, "tmp")
+    ``.NAME.volviz-tmp-PID-RANDOM`` whose process ``PID`` is no longer running, and those of the file ``target``
+    about to be written that were not changed for :data:`STALE_AGE_S` (their id may belong to another process now).
+    Returns what was removed."""
+    removed = _stale(Path(folder), None, "tmp", None if target is None else Path(target).name)
     for path in removed:
         _remove(path)
     return removed
@@ -131,7 +152,7 @@ def atomic_write_bytes(path: str | os.PathLike, data: bytes) -> None:
     Refuses targets that are not regular files (:func:`check_output_path`) and first removes stale temporaries of
     earlier interrupted saves in the folder."""
     target = check_output_path(path)
-    remove_stale_temporaries(target.parent)
+    remove_stale_temporaries(target.parent, target)
     tmp = temp_name(target)
     fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)  # 0o666 & ~umask, as open() would
     try:
@@ -177,7 +198,7 @@ def new_temp_dir(path: str | os.PathLike) -> Path:
     empty sibling folder to write the new store into (hand it to :func:`replace_directory` when complete)."""
     target = check_output_path(path, directory=True)
     recover_directory(target)
-    remove_stale_temporaries(target.parent)
+    remove_stale_temporaries(target.parent, target)
     tmp = temp_name(target)
     tmp.mkdir()
     return tmp

@@ -91,7 +91,7 @@ class Writer:
 
     def __init__(self, path: str | os.PathLike) -> None:
         self.path = check_output_path(path)  # a regular file or nothing: never a device, FIFO or symlink
-        remove_stale_temporaries(self.path.parent)  # of earlier writes that were killed before their rename
+        remove_stale_temporaries(self.path.parent, self.path)  # of writes killed before their rename
         self._tmp = temp_name(self.path)
         self._f: BinaryIO = open(self._tmp, "x+b")
         self._f.write(b"\0" * HEADER_SIZE)
