@@ -75,8 +75,27 @@ class SceneLoading(WindowBase):
         except Exception as exc:  # the file's fault or ours: a message in the user's terms, the scene stays
             self.show_error(f"Cannot open {p.name}", open_error(p, exc))
             return
+        if session_path is not None and self._ask_missing_data(session, session_path, path=p):
+            return
         # File > Open Recent lists it once it has opened
         self._show_session(session, session_path, p.name, path=p, on_shown=lambda: self.recent.add(p))
+
+    def _ask_missing_data(self, session: Session, session_path: Path, path: Path) -> bool:
+        """A session whose data files are not where it says: those in the remembered folders are used; for the
+        others the dialog that names them and locates them (kept as ``missing_dialog``), which shows the session
+        once all are found. True when the dialog was shown (the shown scene stays meanwhile)."""
+        from .missing_data import MissingDataDialog, still_missing
+
+        missing = still_missing(session, session_path, self.settings)
+        if not missing:
+            return False
+
+        def complete(found: Session) -> None:
+            self._show_session(found, session_path, path.name, path=path, on_shown=lambda: self.recent.add(path))
+
+        self.missing_dialog = MissingDataDialog(session, session_path, missing, self.settings, complete, self)
+        self.missing_dialog.open()
+        return True
 
     def _ask_raw_layout(self, path: Path) -> bool:
         """For headerless data (``volviz.io.raw_layout.headerless_data``), the dialog that asks its layout (kept as

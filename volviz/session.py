@@ -614,3 +614,82 @@ def save(session: Session, path: str | os.PathLike) -> None:
         raise SessionError(p, f"cannot be written: {exc.problem}") from None
     except OSError as exc:
         raise SessionError(p, f"cannot be written: {exc.strerror or exc}") from None
+
+
+# ------------------------------------------------------------------------------------------------- missing data
+@dataclass(frozen=True)
+class MissingFile:
+    """A dataset of a session whose file is not where the session says: its ``dataset`` id, the path as ``stored``
+    and the ``expected`` absolute path it was looked for at."""
+
+    dataset: str
+    stored: str
+    expected: Path
+
+
+_UNSET_VARIABLE = re.compile(r"\$(\w+)|\$\{(\w+)\}")
+LOCATE_ENTRIES = 50_000  # folder entries a search for missing files looks at, at most (a home folder is not walked)
+
+
+def missing_files(session: Session, session_file: str | os.PathLike | None,
+                  ids: set[str] | None = None) -> list[MissingFile]:
+    """The datasets (those in ``ids``, else all) whose files do not exist, in the session's order."""
+    missing = []
+    for ref in session.datasets:
+        if ids is not None and ref.id not in ids:
+            continue
+        expected = resolve_path(session_file, ref.path) if session_file else Path(os.path.expandvars(ref.path))
+        if not expected.exists():
+            missing.append(MissingFile(ref.id, ref.path, expected))
+    return missing
+
+
+def unset_variables(missing: list[MissingFile]) -> list[str]:
+    """The environment variables the missing files' stored paths use that are not set (``$VOLVIZ_DATA``)."""
+    names = {a or b for f in missing for a, b in _UNSET_VARIABLE.findall(f.stored)}
+    return sorted(n for n in names if not os.environ.get(n))
+
+
+def missing_message(missing: list[MissingFile]) -> str:
+    """One line naming each missing file and what to do."""
+    unset = unset_variables(missing)
+    files = "; ".join(f"{f.dataset}: {f.stored}" + ("" if str(f.expected) == f.stored or unset_variables([f])
+                                                     else f" (looked for {f.expected})") for f in missing)
+    hint = (f"set {', '.join(unset)} to the folder that holds them" if unset
+            else "put the files back, or open the session in volviz-app and locate the folder that holds them")
+    return f"{len(missing)} data file{'s' if len(missing) > 1 else ''} not found: {files}; {hint}"
+
+
+def _tails(stored: str) -> list[Path]:
+    """The stored path's endings, longest first, after any environment variable or absolute prefix:
+    ``$VOLVIZ_DATA/yukon/Yukon.map.pgm`` -> ``yukon/Yukon.map.pgm``, ``Yukon.map.pgm``."""
+    text = _UNSET_VARIABLE.sub("", stored).replace("\\", "/")
+    parts = [p for p in text.split("/") if p not in ("", ".", "..", "~")]
+    return [Path(*parts[i:]) for i in range(len(parts))]
+
+
+def locate_missing(missing: list[MissingFile], folders: list[Path],
+                   max_entries: int = LOCATE_ENTRIES) -> dict[str, Path]:
+    """Where the ``missing`` files are under ``folders``: first the stored path's endings directly under each folder
+    (``yukon/Yukon.map.pgm``), then the file's name anywhere below it (at most ``max_entries`` entries looked at
+    in all). Returns dataset id -> the file found."""
+    found: dict[str, Path] = {}
+    for f in missing:
+        for folder in folders:
+            hit = next((folder / t for t in _tails(f.stored) if (folder / t).is_file()), None)
+            if hit is not None:
+                found[f.dataset] = hit.resolve()
+                break
+    wanted = {Path(f.stored).name: f.dataset for f in missing if f.dataset not in found}
+    seen = 0
+    for folder in folders:
+        if not wanted:
+            break
+        for root, dirs, files in os.walk(folder):
+            dirs.sort()
+            seen += len(dirs) + len(files)
+            for name in sorted(set(files) & set(wanted)):
+                found[wanted.pop(name)] = (Path(root) / name).resolve()
+            if seen > max_entries or not wanted:
+                break
+    return found

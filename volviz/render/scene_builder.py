@@ -17,7 +17,8 @@ from volviz.io.folders import MIN_SERIES_FILES, numbered_pattern
 from volviz.jobs import ProgressCallback, report
 from volviz.model.applicability import DatasetTraits
 from volviz.render.backend import backend_setting
-from volviz.session import Component, DatasetRef, RenderSettings, Session, resolve_path
+from volviz.session import (Component, DatasetRef, RenderSettings, Session, SessionError, missing_files, missing_message,
+                            resolve_path)
 
 
 class SceneError(Exception):
@@ -188,6 +189,9 @@ def load_datasets(session: Session, session_file: Optional[str | os.PathLike],
     used |= nature_dataset_ids([c for c in session.components if c.visible and c.type in NATURE_TYPES])
     loaded = {} if loaded is None else loaded
     refs = [ref for ref in session.datasets if ref.id in used and ref.id not in loaded]
+    missing = missing_files(session, session_file, {ref.id for ref in refs})
+    if missing:  # each one named at once, before any is read
+        raise SessionError(session_file, missing_message(missing), field="datasets")
     for i, ref in enumerate(refs):
         report(progress, i / max(len(refs), 1), f"reading {Path(ref.path).name}")
         path = resolve_path(session_file, ref.path) if session_file else Path(ref.path)
