@@ -153,6 +153,28 @@ def is_appearance_array(name: str) -> bool:
     return _plain_name(name) in APPEARANCE_ARRAYS
 
 
+#: names of arrays that keep the books of a pipeline rather than measure anything: cell and point ids (original,
+#: global, pedigree), block / object / process / file ids, ghost levels, validity masks; compared like
+#: ``APPEARANCE_ARRAYS``
+BOOKKEEPING_ARRAYS = frozenset({
+    "vtkoriginalcellids", "vtkoriginalpointids", "vtkoriginalindices", "originalcellids", "originalpointids",
+    "objectid", "globalnodeid", "globalelementid", "globalids", "globalpointids", "globalcellids",
+    "pedigreeelementid", "pedigreenodeid", "pedigreeids", "vtkghosttype", "vtkghostlevels", "vtkcompositeindex",
+    "elementblockids", "blockid", "blockids", "vtkblockcolors", "vtkprocessid", "processid", "fileid", "cellid",
+    "pointid", "sourceelementid", "sourceelementside", "vtkvalidpointmask", "vtkinsidedness", "vtkpedigreeids"})
+
+
+#: VTK cell types of solid cells (tetrahedron, voxel, hexahedron, wedge, pyramid, prisms, their quadratic forms,
+#: polyhedron): a mesh holding any is drawn as a volume, which needs an array
+_SOLID_CELL_TYPES = frozenset({10, 11, 12, 13, 14, 15, 16, 24, 25, 26, 27, 29, 32, 33, 42})
+
+
+def is_bookkeeping_array(name: str) -> bool:
+    """Whether ``name`` is a bookkeeping array (``BOOKKEEPING_ARRAYS``): ids, ghost levels, masks; never the default
+    array while another exists, and on a mesh not at all (a mesh with nothing else is drawn plain)."""
+    return _plain_name(name) in BOOKKEEPING_ARRAYS
+
+
 def vertex_colors(dataset: Any) -> np.ndarray | None:
     """The point colors of a surface (a mesh, or the PyVista data set drawn for it) as (n, 3) or (n, 4)
     uint8: its red, green, blue (and alpha) arrays, or one RGB / RGBA / colors array of 3 or 4 components; integers
@@ -182,12 +204,19 @@ def vertex_colors(dataset: Any) -> np.ndarray | None:
 
 def default_array(dataset: Any) -> str | None:
     """The spec a first open shows: the dataset's active array when it varies, else the first point array that
-    varies, else the first cell array that varies, else the first array (vectors by their magnitude). On meshes,
-    appearance attributes (``is_appearance_array``) are not candidates, and None when nothing else is there (on a
-    volume an "rgb" array is data: a colour microscopy stack)."""
+    varies, else the first cell array that varies, else the first array (vectors by their magnitude). Bookkeeping
+    arrays (``is_bookkeeping_array``: ids, ghost levels) are candidates only where nothing else is: never on a
+    surface mesh; on meshes appearance attributes (``is_appearance_array``) are not candidates either, and None when
+    nothing else is there, a surface then drawn plain (on a volume an "rgb" array is data: a colour microscopy stack;
+    a mesh of solid cells keeps its ids while the unstructured volume renderer needs a field to draw)."""
     infos = list_arrays(dataset)
-    if isinstance(_base(dataset), UnstructuredMesh):
+    base = _base(dataset)
+    mesh = isinstance(base, UnstructuredMesh)
+    if mesh:
         infos = [i for i in infos if not is_appearance_array(i.name)]
+    surface = mesh and not any(int(t) in _SOLID_CELL_TYPES and len(c) for t, c in base.cells)
+    if surface or any(not is_bookkeeping_array(i.name) for i in infos):
+        infos = [i for i in infos if not is_bookkeeping_array(i.name)]
     if not infos:
         return None
     active = getattr(_base(dataset), "active", None) or getattr(_base(dataset), "name", None)
