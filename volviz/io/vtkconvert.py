@@ -42,6 +42,51 @@ def _active_name(attributes) -> str | None:
     return scalars.GetName() if scalars is not None and scalars.GetName() else None
 
 
+def _attribute_sets(leaf) -> tuple:
+    return ("point", leaf.GetPointData(), leaf.GetNumberOfPoints()), ("cell", leaf.GetCellData(),
+                                                                         leaf.GetNumberOfCells())
+
+
+def _with_partial_arrays(path: PathLike, leaves: list) -> list:
+    """The blocks with every array that only some of them carry (an Exodus element variable defined on some element
+    blocks) added to the others as NaN, as doubles in every block: vtkAppendFilter keeps only the arrays all its
+    inputs share, and ParaView shows a partial array with NaN (no colour) where a block lacks it. A ReadWarning names
+    them. Arrays whose component counts differ between blocks stay left out."""
+    import vtk
+    from vtkmodules.util.numpy_support import numpy_to_vtk, vtk_to_numpy
+
+    found: dict[tuple[str, str], list[int]] = {}
+    for leaf in leaves:
+        for where, attributes, _ in _attribute_sets(leaf):
+            for i in range(attributes.GetNumberOfArrays()):
+                arr = attributes.GetArray(i)
+                if arr is not None and arr.GetName():
+                    found.setdefault((where, arr.GetName()), []).append(arr.GetNumberOfComponents())
+    partial = {key: comps[0] for key, comps in found.items() if len(comps) < len(leaves) and len(set(comps)) == 1}
+    if not partial:
+        return leaves
+    out = []
+    for leaf in leaves:
+        copy = leaf.NewInstance()
+        copy.ShallowCopy(leaf)
+        for where, attributes, n in _attribute_sets(copy):
+            for (kind, name), comps in partial.items():
+                if kind != where:
+                    continue
+                arr = attributes.GetArray(name)
+                values = (vtk_to_numpy(arr).astype(np.float64) if arr is not None
+                          else np.full((n, comps) if comps > 1 else n, np.nan))
+                doubles = numpy_to_vtk(np.ascontiguousarray(values), deep=True, array_type=vtk.VTK_DOUBLE)
+                doubles.SetName(name)
+                attributes.RemoveArray(name)
+                attributes.AddArray(doubles)
+        out.append(copy)
+    names = ", ".join(f"{name} ({kind})" for kind, name in sorted(partial))
+    warnings.warn(ReadWarning(f"{path}: {names}: defined on some of its {len(leaves)} blocks only; NaN (not drawn) "
+                              "on the others"), stacklevel=4)
+    return out
+
+
 def merge_composite(path: PathLike, obj):
     """A composite data set (multiblock / partitioned) as one data set; ReadError if it holds nothing."""
     import vtk
@@ -60,6 +105,7 @@ def merge_composite(path: PathLike, obj):
         raise ReadError(path, "holds no data set with points")
     if len(leaves) == 1:
         return leaves[0]
+    leaves = _with_partial_arrays(path, leaves)
     append = vtk.vtkAppendFilter()
     append.SetMergePoints(False)
     for leaf in leaves:
