@@ -1,7 +1,7 @@
 """zlib-compressed MetaImage (.mhd + .zraw) whose CompressedDataSize is stale: the inflated size is what must agree
-with the dimensions (the whole stream; VTK's vtkMetaImageReader, which inflates only the bytes the field names, agrees where the field
-is right, and gives a garbled tail or nothing where it is stale); the stale field is a ReadWarning, and a stream that
-really falls short is still refused."""
+with the dimensions (the whole stream; VTK's vtkMetaImageReader, which inflates only the bytes the field names,
+agrees where the field is right, and gives a garbled tail or nothing where it is stale); the stale field is a
+ReadWarning, and a stream that really falls short is still refused."""
 from __future__ import annotations
 
 import warnings

@@ -1,10 +1,13 @@
-"""Point tables (``.csv``, ``.tsv``): a header row naming the columns, then a row of numbers per point — what
-ParaView opens with its CSV reader and "Table To Points", and what a logger, a particle tracker or a spreadsheet
-writes. The columns named x, y and z (any case; ParaView's own exports name them ``Points:0``, ``Points:1``,
-``Points:2``) place the points, or the columns the options ``x=``, ``y=``, ``z=`` name; a table without a z column
-lies in the z = 0 plane. Every other numeric column is an array on the points; columns of text are left out (named in
-a warning). Comma, semicolon, tab or blank separated; ``#`` starts a comment. Rows whose coordinates are missing are
-left out with a warning. The points are vertices of an ``UnstructuredMesh``, drawn as points coloured by an array.
+"""Point tables (``.csv``, ``.tsv``; ``.xyz``, ``.pts``, ``.txt`` known by content, ``is_point_text``): a header
+row naming the columns, then a row of numbers per point -- what ParaView opens with its CSV reader and "Table To
+Points", and what a logger, a particle tracker or a spreadsheet writes. Text point clouds may have no header (the
+first three columns are then x, y, z, the others ``column 4`` ... or red, green, blue, as scanners and surveys write
+them; a Leica .pts point count before the rows is skipped); .csv and .tsv tables need theirs. The columns named x, y
+and z (any case; ParaView's own exports name them ``Points:0``, ``Points:1``, ``Points:2``) place the points, or the
+columns the options ``x=``, ``y=``, ``z=`` name; a table without a z column lies in the z = 0 plane. Every other
+numeric column is an array on the points; columns of text are left out (named in a warning). Comma, semicolon, tab
+or blank separated; ``#`` starts a comment. Rows whose coordinates are missing are left out with a warning. The
+points are vertices of an ``UnstructuredMesh``, drawn as points coloured by an array.
 """
 from __future__ import annotations
 
@@ -27,6 +30,7 @@ COORDINATE_NAMES = ({"x", "points:0", "coordsx", "coordinatex", "posx", "positio
                     {"y", "points:1", "coordsy", "coordinatey", "posy", "positiony"},
                     {"z", "points:2", "coordsz", "coordinatez", "posz", "positionz"})
 SAMPLE_ROWS = 200
+HEAD_SNIFF = 4096  # the bytes the registry gives a sniffer
 
 
 def _separator(line: str) -> str | None:
@@ -91,9 +95,75 @@ def _numbers(p: Path, sep: str | None, skip: int, columns: list[int]) -> np.ndar
             raise ReadError(p, f"has rows that cannot be read as numbers ({str(exc)[:200]})") from None
 
 
+def _rows(lines: list[str]) -> list[str]:
+    return [line for line in lines if line.strip() and not line.lstrip().startswith("#")]
+
+
+def _count_line(lines: list[str], at: int) -> int:
+    """1 when the row at ``at`` is a lone point count before rows of 3 or more numbers (Leica .pts), else 0."""
+    rest = _rows(lines[at + 1:at + 3])
+    row = lines[at].split()
+    if len(row) == 1 and row[0].isdigit() and rest:
+        following = _fields(rest[0], _separator(rest[0]))
+        return int(len(following) >= 3 and all(_number(f) for f in following))
+    return 0
+
+
+def _headerless_names(lines: list[str], at: int, sep: str | None) -> list[str]:
+    """Names for the columns of a table without a header row: x, y, z, then ``column 4`` ...; the last three extra
+    columns are red, green, blue when they hold whole numbers 0 to 255 in every sampled row (scanners' x y z r g b
+    and x y z intensity r g b), a lone column before them ``intensity``."""
+    n = len(_fields(lines[at], sep))
+    names = ["x", "y", "z"] + [f"column {i}" for i in range(4, n + 1)]
+    sample = [_fields(line, sep) for line in _rows(lines[at:at + SAMPLE_ROWS])]
+    if n >= 6 and all(len(row) == n for row in sample):
+        try:
+            colours = np.array([[float(v) for v in row[-3:]] for row in sample])
+        except ValueError:
+            return names
+        if np.all(colours == np.round(colours)) and colours.min() >= 0 and colours.max() <= 255:
+            names[-3:] = ["red", "green", "blue"]
+            if n == 7:
+                names[3] = "intensity"
+    return names
+
+
+def is_point_text(head: bytes) -> bool:
+    """Text whose first rows (after ``#`` comments and a lone point count) hold the same number, 3 or more, of
+    numbers each: a header-less point table (.xyz, .pts, .txt), or one whose header row names x and y columns."""
+    if b"\0" in head:
+        return False
+    lines = head.decode("utf-8", errors="replace").splitlines()
+    rows = _rows(lines[:-1] if len(head) >= HEAD_SNIFF else lines)[:20]  # the last line may be cut
+    if len(rows) > 1 and _count_line(rows, 0):
+        rows = rows[1:]
+    if not rows:
+        return False
+    sep = _separator(rows[0])
+    first = _fields(rows[0], sep)
+    keys = {_key(f) for f in first}
+    if keys & COORDINATE_NAMES[0] and keys & COORDINATE_NAMES[1] and len(rows) > 1:
+        rows = rows[1:]
+    counts = {len(_fields(row, sep)) for row in rows}
+    return len(counts) == 1 and counts.pop() >= 3 and all(_number(f) for row in rows for f in _fields(row, sep))
+
+
 def read_csv_points(path: PathLike, x: str | None = None, y: str | None = None, z: str | None = None,
                     allow_nonfinite: bool = True) -> UnstructuredMesh:
-    """The table's rows as points with the other numeric columns as point arrays (see the module docstring)."""
+    """The table's rows as points with the other numeric columns as point arrays (see the module docstring); a
+    .csv / .tsv table needs its header row (ParaView's CSV reader takes the first row for names)."""
+    return _read_points(path, (x, y, z), allow_nonfinite, headerless=False)
+
+
+def read_text_points(path: PathLike, x: str | None = None, y: str | None = None, z: str | None = None,
+                     allow_nonfinite: bool = True) -> UnstructuredMesh:
+    """A text point cloud (.xyz, .pts, .txt, or known by content): like ``read_csv_points``, with or without a
+    header row."""
+    return _read_points(path, (x, y, z), allow_nonfinite, headerless=True)
+
+
+def _read_points(path: PathLike, asked: tuple[str | None, str | None, str | None], allow_nonfinite: bool,
+                 headerless: bool) -> UnstructuredMesh:
     p = check_file(path)
     if p.stat().st_size > MAX_BYTES:
         raise ReadError(p, f"is a table of {p.stat().st_size / 1e9:.1f} GB; volviz reads point tables of at most "
@@ -106,15 +176,20 @@ def read_csv_points(path: PathLike, x: str | None = None, y: str | None = None, 
     header_at = next((i for i, line in enumerate(lines) if line.strip() and not line.lstrip().startswith("#")), None)
     if header_at is None:
         raise ReadError(p, "holds no rows")
+    header_at += _count_line(lines, header_at)
     sep = _separator(lines[header_at])
     names = _fields(lines[header_at], sep)
+    skip = header_at + 1
     if all(_number(n) for n in names):
-        raise ReadError(p, "has no header row naming its columns (its first row is numbers)",
-                        "add a first row naming the columns, with x, y and z for the coordinates")
+        if not headerless or len(names) < 3:
+            raise ReadError(p, "has no header row naming its columns (its first row is numbers" + (
+                f", {len(names)} of them, not the 3 or more of x y z columns)" if headerless else ")"),
+                "add a first row naming the columns, with x, y and z for the coordinates")
+        names, skip = _headerless_names(lines, header_at, sep), header_at
     if len(set(names)) != len(names) or any(not n for n in names):
         raise ReadError(p, "has empty or repeated column names in its header row: " + ", ".join(names[:30]))
-    columns = _coordinate_columns(p, names, (x, y, z))
-    sample = [_fields(line, sep) for line in lines[header_at + 1:header_at + 1 + SAMPLE_ROWS]
+    columns = _coordinate_columns(p, names, asked)
+    sample = [_fields(line, sep) for line in lines[skip:skip + SAMPLE_ROWS]
               if line.strip() and not line.lstrip().startswith("#")]
     if not sample:
         raise ReadError(p, "has a header row but no rows of values")
@@ -123,7 +198,7 @@ def read_csv_points(path: PathLike, x: str | None = None, y: str | None = None, 
         if col is not None and col not in numeric:
             raise ReadError(p, f"its {'xyz'[axis]} column {names[col]!r} holds text, not numbers")
     text = [names[i] for i in range(len(names)) if i not in numeric]
-    table = _numbers(p, sep, header_at + 1, numeric)
+    table = _numbers(p, sep, skip, numeric)
     if table.size == 0:
         raise ReadError(p, "has no rows of numbers under its header")
     at = {col: k for k, col in enumerate(numeric)}

@@ -6,7 +6,8 @@ Each zone header (``ZONE`` up to its first line of numbers) gives the counts (Te
 data"): ordered zones ``I x J x K`` points and ``max(I-1, 1) x max(J-1, 1) x max(K-1, 1)`` cells, finite-element zones
 ``N`` nodes and ``E`` elements of ``ET`` / ``ZONETYPE``; ``DATAPACKING`` (``F``) POINT or BLOCK; ``VARLOCATION``
 cell-centred variables (one value per cell, BLOCK only); and an FE zone's connectivity (E x nodes per element) after
-the values. A zone without numbers is refused whatever its header. The numbers up to the next record (a line starting with a letter) are counted, ``n*value`` counting n.
+the values. A zone without numbers is refused whatever its header. The numbers up to the next record (a line starting
+with a letter) are counted, ``n*value`` counting n.
 Zones with shared variables or connectivity, polygonal/polyhedral zones, or anything this check does not know, are
 left to VTK.
 """
