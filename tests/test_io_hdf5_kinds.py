@@ -49,6 +49,9 @@ def test_a_fluent_cff_case_and_its_data_file_read_as_vtk_reads_them():
         for name in ("SV_T", "SV_P", "SV_BF_V"):
             np.testing.assert_array_equal(mesh.cell_data[name], vtk_to_numpy(cd.GetArray(name)))
     assert float(mesh.cell_data["SV_T"].min()) == pytest.approx(283.148, abs=1e-3)
+    from volviz_vtk_readers import list_blocks
+
+    assert list_blocks(case) == ["block0"]  # its one cell zone, found by VTK's reader though the name says .h5
 
 
 def test_fluent_cff_files_apart_or_misnamed_are_refused_or_read_as_the_mesh_with_a_warning(tmp_path):

@@ -422,6 +422,11 @@ def list_blocks(path: PathLike) -> list[str]:
     from volviz.io.registry import spec_of
 
     kind = spec_of(path).name
+    if kind in ("hdf5", "vtkhdf"):  # a format on HDF5 under a generic name (.h5): the reader it goes to
+        from volviz.io.hdf5kind import KINDS, hdf5_kind
+
+        found = hdf5_kind(path)
+        kind = KINDS[found][0] if found is not None else kind
     if kind == "exodus":
         return _exodus_blocks(_exodus(path))
     if kind == "openfoam":
