@@ -22,7 +22,10 @@ _VTK_POLYHEDRON = 42
 _QUADRATIC = (21, 22, 23, 24, 25, 26, 27, 28, 29, 30, 31, 32, 33)
 
 
-def _arrays(path: PathLike, attributes, n: int, allow_nonfinite: bool, where: str) -> dict[str, np.ndarray]:
+def _arrays(path: PathLike, attributes, n: int, allow_nonfinite: bool, where: str,
+            filled: dict[str, np.ndarray] | None = None) -> dict[str, np.ndarray]:
+    """The numeric arrays of ``n`` tuples, checked for NaN/Inf except where ``filled`` (name -> mask) says the merge
+    put NaN for a block without the array (``_with_partial_arrays``)."""
     from vtkmodules.util.numpy_support import vtk_to_numpy
 
     out: dict[str, np.ndarray] = {}
@@ -32,7 +35,9 @@ def _arrays(path: PathLike, attributes, n: int, allow_nonfinite: bool, where: st
             continue
         name = arr.GetName() or f"{where}{i}"
         values = np.array(vtk_to_numpy(arr))
-        check_finite(path, values, allow_nonfinite, f"{where} array {name!r}")
+        mask = (filled or {}).get(name)
+        check_finite(path, values[~mask] if mask is not None and len(mask) == n else values, allow_nonfinite,
+                     f"{where} array {name!r}")
         out[name] = values
     return out
 
@@ -47,7 +52,22 @@ def _attribute_sets(leaf) -> tuple:
                                                                          leaf.GetNumberOfCells())
 
 
-def _with_partial_arrays(path: PathLike, leaves: list) -> list:
+_FILLED = "volviz filled "  # field data of a merged data set: where a partial array was filled, per element
+
+
+def _filled(obj, where: str) -> dict[str, np.ndarray]:
+    """The masks ``merge_composite`` left in ``obj``'s field data: array name -> True where it put NaN."""
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+
+    fd, out = obj.GetFieldData(), {}
+    for i in range(fd.GetNumberOfArrays()):
+        name = fd.GetArrayName(i) or ""
+        if name.startswith(_FILLED + where + ":"):
+            out[name.split(":", 1)[1]] = vtk_to_numpy(fd.GetArray(i)).astype(bool)
+    return out
+
+
+def _with_partial_arrays(path: PathLike, leaves: list) -> tuple[list, dict[tuple[str, str], np.ndarray]]:
     """The blocks with every array that only some of them carry (an Exodus element variable defined on some element
     blocks) added to the others as NaN, as doubles in every block: vtkAppendFilter keeps only the arrays all its
     inputs share, and ParaView shows a partial array with NaN (no colour) where a block lacks it. A ReadWarning names
@@ -64,8 +84,9 @@ def _with_partial_arrays(path: PathLike, leaves: list) -> list:
                     found.setdefault((where, arr.GetName()), []).append(arr.GetNumberOfComponents())
     partial = {key: comps[0] for key, comps in found.items() if len(comps) < len(leaves) and len(set(comps)) == 1}
     if not partial:
-        return leaves
-    out = []
+        return leaves, {}
+    out: list = []
+    masks: dict[tuple[str, str], list[np.ndarray]] = {key: [] for key in partial}
     for leaf in leaves:
         copy = leaf.NewInstance()
         copy.ShallowCopy(leaf)
@@ -74,6 +95,7 @@ def _with_partial_arrays(path: PathLike, leaves: list) -> list:
                 if kind != where:
                     continue
                 arr = attributes.GetArray(name)
+                masks[(kind, name)].append(np.full(n, arr is None))
                 values = (vtk_to_numpy(arr).astype(np.float64) if arr is not None
                           else np.full((n, comps) if comps > 1 else n, np.nan))
                 doubles = numpy_to_vtk(np.ascontiguousarray(values), deep=True, array_type=vtk.VTK_DOUBLE)
@@ -84,12 +106,14 @@ def _with_partial_arrays(path: PathLike, leaves: list) -> list:
     names = ", ".join(f"{name} ({kind})" for kind, name in sorted(partial))
     warnings.warn(ReadWarning(f"{path}: {names}: defined on some of its {len(leaves)} blocks only; NaN (not drawn) "
                               "on the others"), stacklevel=4)
-    return out
+    return out, {key: np.concatenate(parts) for key, parts in masks.items()}
 
 
 def merge_composite(path: PathLike, obj):
-    """A composite data set (multiblock / partitioned) as one data set; ReadError if it holds nothing."""
+    """A composite data set (multiblock / partitioned) as one data set; ReadError if it holds nothing. Arrays only
+    some blocks carry are kept, NaN elsewhere, with masks of the filled places in the field data (``_filled``)."""
     import vtk
+    from vtkmodules.util.numpy_support import numpy_to_vtk
 
     if not obj.IsA("vtkCompositeDataSet"):
         return obj
@@ -105,7 +129,7 @@ def merge_composite(path: PathLike, obj):
         raise ReadError(path, "holds no data set with points")
     if len(leaves) == 1:
         return leaves[0]
-    leaves = _with_partial_arrays(path, leaves)
+    leaves, masks = _with_partial_arrays(path, leaves)
     append = vtk.vtkAppendFilter()
     append.SetMergePoints(False)
     for leaf in leaves:
@@ -113,6 +137,10 @@ def merge_composite(path: PathLike, obj):
     append.Update()
     out = vtk.vtkUnstructuredGrid()
     out.ShallowCopy(append.GetOutput())
+    for (where, name), mask in masks.items():
+        flags = numpy_to_vtk(mask.astype(np.uint8), deep=True)
+        flags.SetName(f"{_FILLED}{where}:{name}")
+        out.GetFieldData().AddArray(flags)
     return out
 
 
@@ -193,8 +221,9 @@ def _unstructured(path: PathLike, obj, allow_nonfinite: bool) -> UnstructuredMes
         order.append(idx)
     perm = np.concatenate(order) if order else np.empty(0, np.int64)
     pd, cd = obj.GetPointData(), obj.GetCellData()
-    point_data = _arrays(path, pd, obj.GetNumberOfPoints(), allow_nonfinite, "point")
-    cell_data = {k: v[perm] for k, v in _arrays(path, cd, obj.GetNumberOfCells(), allow_nonfinite, "cell").items()}
+    point_data = _arrays(path, pd, obj.GetNumberOfPoints(), allow_nonfinite, "point", _filled(obj, "point"))
+    cell_data = {k: v[perm] for k, v in _arrays(path, cd, obj.GetNumberOfCells(), allow_nonfinite, "cell",
+                                                _filled(obj, "cell")).items()}
     active = _active_name(pd)
     return UnstructuredMesh(points, cells, point_data, cell_data,
                             active=active if active in point_data else None, source=str(path))
