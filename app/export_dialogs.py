@@ -1,15 +1,21 @@
 """File > Export Screenshot and File > Export Movie: the dialogs, and the checks made before anything renders.
 
-A screenshot has the viewport's aspect ratio by default (the render settings' export width, the height that keeps the
-viewport's shape); its format follows the file's extension (PNG, JPEG, TIFF), and any other extension is refused with
-a message before rendering (``volviz.render.export.check_output``). A movie is an orbit of the current view (no
-recorded path needed), a recorded camera path, or a run through the time series."""
+A screenshot is made at exactly the size asked (issue #28: 512x384 set gave 512x365): the screenshot dialog
+(``ScreenshotDialog``) starts at the render settings' export size, takes any size up to ``MAX_IMAGE_SIDE`` a side
+whatever the window's shape, or the window's size times a scale factor, and a transparent background (alpha 0 where
+nothing is drawn). Its format follows the file's extension (PNG, JPEG, TIFF), and any other extension, a size this
+machine cannot render, or transparency in a JPEG is refused with a message before rendering
+(``volviz.render.export``). A movie is an orbit of the current view (no recorded path needed), a recorded camera
+path, or a run through the time series."""
 from __future__ import annotations
 
 import os
 from typing import Any, Optional
 
-from PySide6.QtWidgets import QInputDialog
+from PySide6.QtWidgets import (QCheckBox, QDialog, QDialogButtonBox, QDoubleSpinBox, QFormLayout, QHBoxLayout,
+                               QInputDialog, QLabel, QSpinBox, QWidget)
+
+from volviz.argtypes import MAX_IMAGE_SIDE
 
 IMAGE_FILTER = ("Images (*.png *.jpg *.jpeg *.tif *.tiff);;PNG image (*.png);;JPEG image (*.jpg *.jpeg);;"
                 "TIFF image (*.tif *.tiff)")
@@ -18,10 +24,64 @@ ORBIT = "Orbit around the current view"
 THROUGH_TIME = "Through time"
 
 
-def aspect_size(viewport: tuple[int, int], width: int) -> tuple[int, int]:
-    """An image ``width`` pixels wide with the viewport's aspect ratio (at least 1 pixel high)."""
-    vw, vh = max(int(viewport[0]), 1), max(int(viewport[1]), 1)
-    return int(width), max(int(round(width * vh / vw)), 1)
+def scaled_size(viewport: tuple[int, int], scale: float) -> tuple[int, int]:
+    """The viewport's size times ``scale``, each side 1 .. ``MAX_IMAGE_SIDE``."""
+    w, h = (min(max(int(round(int(side) * scale)), 1), MAX_IMAGE_SIDE) for side in viewport[:2])
+    return w, h
+
+
+class ScreenshotDialog(QDialog):
+    """The screenshot's size (``width`` and ``height``, or ``of_window`` times ``scale``) and ``transparent``
+    background; ``chosen()`` reads them."""
+
+    def __init__(self, parent: QWidget, size: tuple[int, int], viewport: tuple[int, int]) -> None:
+        super().__init__(parent)
+        self.setWindowTitle("Export screenshot")
+        self.viewport = (int(viewport[0]), int(viewport[1]))
+        self.width_box, self.height_box = QSpinBox(), QSpinBox()
+        for box, value in ((self.width_box, size[0]), (self.height_box, size[1])):
+            box.setRange(1, MAX_IMAGE_SIDE)
+            box.setSuffix(" px")
+            box.setValue(int(value))
+        self.of_window = QCheckBox(f"The window's size ({self.viewport[0]}x{self.viewport[1]}) times")
+        self.scale = QDoubleSpinBox()
+        self.scale.setRange(0.25, 8.0)
+        self.scale.setSingleStep(0.5)
+        self.scale.setValue(2.0)
+        self.scale.setSuffix("x")
+        self.transparent = QCheckBox("Transparent background (PNG, TIFF)")
+        size_row = QHBoxLayout()
+        size_row.addWidget(self.width_box)
+        size_row.addWidget(QLabel("x"))
+        size_row.addWidget(self.height_box)
+        window_row = QHBoxLayout()
+        window_row.addWidget(self.of_window)
+        window_row.addWidget(self.scale)
+        buttons = QDialogButtonBox(QDialogButtonBox.StandardButton.Ok | QDialogButtonBox.StandardButton.Cancel)
+        buttons.accepted.connect(self.accept)
+        buttons.rejected.connect(self.reject)
+        self.ok_button = buttons.button(QDialogButtonBox.StandardButton.Ok)
+        form = QFormLayout(self)
+        form.addRow("Size:", size_row)
+        form.addRow("", window_row)
+        form.addRow("", QLabel(f"Any size up to {MAX_IMAGE_SIDE} pixels a side, whatever the window's shape."))
+        form.addRow("", self.transparent)
+        form.addRow(buttons)
+        self.of_window.toggled.connect(self._follow_window)
+        self.scale.valueChanged.connect(lambda _: self._follow_window(self.of_window.isChecked()))
+
+    def _follow_window(self, on: bool) -> None:
+        """With ``of_window`` the size boxes show the window's size times the scale, and are not edited."""
+        self.width_box.setEnabled(not on)
+        self.height_box.setEnabled(not on)
+        if on:
+            w, h = scaled_size(self.viewport, self.scale.value())
+            self.width_box.setValue(w)
+            self.height_box.setValue(h)
+
+    def chosen(self) -> tuple[tuple[int, int], bool]:
+        """(the size in pixels, transparent background)."""
+        return (self.width_box.value(), self.height_box.value()), self.transparent.isChecked()
 
 
 class ExportDialogs:
@@ -31,33 +91,56 @@ class ExportDialogs:
     def __init__(self, window: Any) -> None:
         self.window = window
         self.movie_dialog: Optional[QInputDialog] = None
+        self.screenshot_dialog: Optional[ScreenshotDialog] = None
 
-    def refused(self, path: str | os.PathLike, movie: bool = False) -> bool:
-        """Check what ``path`` would receive; a refusal is shown as a message (True: refused)."""
+    def refused(self, path: str | os.PathLike, movie: bool = False, size: Optional[tuple[int, int]] = None,
+                transparent: bool = False) -> bool:
+        """Check what ``path`` would receive (an image of ``size``, with alpha when ``transparent``); a refusal is
+        shown as a message (True: refused)."""
         from volviz.io.atomic import OutputPathError
-        from volviz.render.export import ExportError, check_output
+        from volviz.render.export import ExportError, check_image_size, check_output, check_transparency
 
         try:
             check_output(path, movie=movie)
+            if size is not None:
+                check_image_size(size)
+            if transparent:
+                check_transparency(path)
         except (ExportError, OutputPathError) as exc:
-            self.window.show_error("Cannot export", f"{exc}\n\nChoose another name or folder.")
+            self.window.show_error("Cannot export", f"{exc}\n\nChoose another name, format or size.")
             return True
         return False
 
     def screenshot_size(self) -> tuple[int, int]:
-        """The render settings' export width at the viewport's aspect ratio."""
-        viewport = self.window.plotter.interactor
-        return aspect_size((viewport.width(), viewport.height()), self.window.session.render.size[0])
+        """The render settings' export size, exactly."""
+        width, height = self.window.session.render.size
+        return int(width), int(height)
 
-    def screenshot(self, path: str | os.PathLike) -> bool:
-        """Export the current view to ``path`` at ``screenshot_size`` (False: the name was refused)."""
-        if self.refused(path):
+    def screenshot(self, path: str | os.PathLike, size: Optional[tuple[int, int]] = None,
+                   transparent: bool = False) -> bool:
+        """Export the current view to ``path`` at exactly ``size`` (default ``screenshot_size``), without the
+        background when ``transparent`` (False: refused, with a message)."""
+        size = size or self.screenshot_size()
+        if self.refused(path, size=size, transparent=transparent):
             return False
-        self.window.export_screenshot(path, self.screenshot_size())
+        self.window.export_screenshot(path, size, transparent)
         return True
 
-    def ask_screenshot(self) -> None:
-        self.window.ask_file("Export screenshot", IMAGE_FILTER, self.screenshot, save=True, default_name="volviz.png")
+    def ask_screenshot(self) -> ScreenshotDialog:
+        """The size and background (non-blocking ``ScreenshotDialog``), then where to write the image."""
+        viewport = self.window.plotter.window_size
+        dialog = ScreenshotDialog(self.window, self.screenshot_size(), (viewport[0], viewport[1]))
+
+        def chosen() -> None:
+            size, transparent = dialog.chosen()
+            self.window.ask_file("Export screenshot", IMAGE_FILTER,
+                                 lambda path: self.screenshot(path, size, transparent), save=True,
+                                 default_name="volviz.png")
+
+        dialog.accepted.connect(chosen)
+        dialog.open()
+        self.screenshot_dialog = dialog
+        return dialog
 
     def movie_choices(self) -> list[str]:
         controller = self.window.controller

@@ -27,15 +27,16 @@ class ExportRuns(WindowBase):
         self.export_result: Optional[bool] = None  # of the last export: None while it runs
         self.export_threads: set[int] = set()      # the threads its background steps ran on
 
-    def export_screenshot(self, path: str | os.PathLike, size: Optional[tuple[int, int]] = None) -> None:
-        """Re-render the current view offscreen at ``size`` (default: the viewport's) and write an image (PNG, JPEG
-        or TIFF by the extension), in the background with progress and cancel in the status bar
-        (``volviz_app.frame_export``; a newer export supersedes an older one). ``export_result`` is None while it runs,
-        then True (written) or False."""
+    def export_screenshot(self, path: str | os.PathLike, size: Optional[tuple[int, int]] = None,
+                          transparent: bool = False) -> None:
+        """Re-render the current view offscreen at exactly ``size`` (default: the viewport's) and write an image (PNG,
+        JPEG or TIFF by the extension; ``transparent``: alpha 0 where nothing is drawn), in the background with
+        progress and cancel in the status bar (``volviz_app.frame_export``; a newer export supersedes an older one).
+        ``export_result`` is None while it runs, then True (written) or False."""
         from volviz.render.export import ImageFile
 
         size = size or (self.plotter.interactor.width(), self.plotter.interactor.height())
-        self._export(Path(path).name, size, lambda controller: [(None, None)], lambda: ImageFile(path))
+        self._export(Path(path).name, size, lambda controller: [(None, None)], lambda: ImageFile(path), transparent)
 
     def export_movie(self, path: str | os.PathLike, path_name: Optional[str], through_time: bool,
                      fps: float = 24.0, size: Optional[tuple[int, int]] = None, orbit: bool = False) -> None:
@@ -49,7 +50,7 @@ class ExportRuns(WindowBase):
                      lambda: MovieWriter(Path(path), fps))
 
     def _export(self, name: str, size: tuple[int, int], frames_of: Callable[[Any], list[Any]],
-                open_sink: Callable[[], Any]) -> None:
+                open_sink: Callable[[], Any], transparent: bool = False) -> None:
         from volviz.render.export import offscreen_scene
         from .frame_export import FrameExport
 
@@ -82,5 +83,5 @@ class ExportRuns(WindowBase):
                 self.show_error("Cannot export", hide_temporary_names(message))
 
         self.export_threads = set()
-        run = FrameExport(self, plotter, controller, size, name, frames_of, open_sink, end, t)
+        run = FrameExport(self, plotter, controller, size, name, frames_of, open_sink, end, t, transparent)
         self._export_run = run

@@ -29,13 +29,15 @@ Frame = tuple[Optional[Any], Optional[float]]  # (camera or None: keep, display 
 class FrameExport:
     """One running export. ``window`` provides ``jobs`` (a ``JobBridge``); ``frames_of(controller)`` lists the
     frames once the scene is installed; ``open_sink()`` (on a worker) returns an object with ``append(image)``,
-    ``close()`` and ``abort()``; ``on_end(ok, message)`` runs once at the end."""
+    ``close()`` and ``abort()``; ``on_end(ok, message)`` runs once at the end. ``transparent``: the frames keep
+    alpha, without the background (``volviz.render.export.snapshot``)."""
 
     def __init__(self, window: Any, plotter: Any, controller: Any, size: tuple[int, int], name: str,
                  frames_of: Callable[[Any], list[Frame]], open_sink: Callable[[], Any],
-                 on_end: Callable[[bool, str], None], t: Optional[float] = None) -> None:
+                 on_end: Callable[[bool, str], None], t: Optional[float] = None, transparent: bool = False) -> None:
         self.window, self.plotter, self.controller = window, plotter, controller
         self.size, self.name = (int(size[0]), int(size[1])), name
+        self.transparent = bool(transparent)
         self.frames_of, self.open_sink, self.on_end = frames_of, open_sink, on_end
         self.frames: list[Frame] = []
         self.sink: Any = None
@@ -146,8 +148,11 @@ class FrameExport:
         self.sink = self.open_sink()
 
     def _frame(self, i: int) -> None:
+        from volviz.render.export import size_window
+
         camera, t = self.frames[i]
         c = self.controller
+        size_window(self.plotter, self.size)  # the views begin at the frame's size (the GL warm-up render is 8x8)
         if camera is not None:
             c.set_camera(camera, update=False)
         if t is not None and t != c.time:
@@ -188,7 +193,7 @@ class FrameExport:
                    message="rendering the views", frame=i)
 
     def _render(self, i: int) -> None:
-        image = self._snapshot(self.size)
+        image = self._snapshot(self.size, self.transparent)
         sink = self.sink
 
         def written(_: Any) -> None:
@@ -204,7 +209,7 @@ class FrameExport:
         frames = f"{len(self.frames)} frames, " if len(self.frames) > 1 else ""
         self._end(True, f"Exported {self.name} ({frames}{self.size[0]}x{self.size[1]})")
 
-    def _snapshot(self, size: tuple[int, int]) -> Any:
+    def _snapshot(self, size: tuple[int, int], transparent: bool = False) -> Any:
         from volviz.render.export import snapshot
 
-        return snapshot(self.plotter, size)
+        return snapshot(self.plotter, size, transparent)

@@ -160,21 +160,70 @@ def close_scene(plotter: Any, controller: Any) -> None:
         plotter.close()
 
 
-def snapshot(plotter: Any, size: tuple[int, int]) -> np.ndarray:
-    """Render the offscreen plotter (VTK side, the thread that owns it) once at ``size`` and return the (H, W, 3) uint8
-    image. (``screenshot(window_size=...)`` renders twice: once after resizing and again after sizing back.)"""
+def size_window(plotter: Any, size: tuple[int, int]) -> None:
+    """Give the offscreen plotter's window ``size`` without rendering. The view-dependent CPU images (the natural
+    scene's fog and cloud overlay) are computed at the window's size when they begin: begun at another size, they
+    cover only part of the frame (issue #28: an export's first frame showed no clouds or fog)."""
     width, height = int(size[0]), int(size[1])
     if list(plotter.window_size) != [width, height]:
-        plotter.render_window.SetSize(width, height)  # no render here: the one render is below
+        plotter.render_window.SetSize(width, height)
+
+
+def snapshot(plotter: Any, size: tuple[int, int], transparent: bool = False) -> np.ndarray:
+    """Render the offscreen plotter (VTK side, the thread that owns it) once at ``size`` and return the (H, W, 3) uint8
+    image, or with ``transparent`` the (H, W, 4) straight-alpha image without the background, from two renders
+    (``separate_background``). (``screenshot(window_size=...)`` renders twice: once after resizing and again after
+    sizing back.)"""
+    size_window(plotter, size)  # no render here: the one render is below
+    if not transparent:
+        return _render_image(plotter)
+    renderer = plotter.renderer
+    kept = renderer.GetBackground()
+    try:
+        renderer.SetBackground(0.0, 0.0, 0.0)
+        on_black = _render_image(plotter)
+        renderer.SetBackground(1.0, 1.0, 1.0)
+        on_white = _render_image(plotter)
+    finally:
+        renderer.SetBackground(*kept)
+    return separate_background(on_black, on_white)
+
+
+def _render_image(plotter: Any) -> np.ndarray:
     if not plotter._first_time:  # the first image pyvista renders itself (and places a camera that was never set)
         plotter.render()
-    return np.asarray(plotter.screenshot(None, return_img=True))
+    return np.asarray(plotter.screenshot(None, return_img=True))[..., :3]
+
+
+def separate_background(on_black: np.ndarray, on_white: np.ndarray) -> np.ndarray:
+    """The straight-alpha (H, W, 4) uint8 image of a scene rendered over a black and over a white background: every
+    blend (volumes, antialiased lines and text, multisampling) is linear in the background, so 1 - alpha is the
+    difference of the two and the color premultiplied by alpha is the image on black. Composited over any color it
+    is the render over that color within one 8-bit step (rounding). (VTK's own alpha channel disagreed with its color
+    on antialiased lines: the outline box came out half transparent, issue #28.)"""
+    black = np.asarray(on_black, dtype=np.float64)[..., :3]
+    white = np.asarray(on_white, dtype=np.float64)[..., :3]
+    alpha = np.clip(255.0 - (white - black).mean(axis=2), 0.0, 255.0)
+    alpha8 = np.rint(alpha)
+    color = np.where(alpha8[..., None] > 0.0, black * 255.0 / np.maximum(alpha8, 1.0)[..., None], 0.0)
+    out = np.empty(black.shape[:2] + (4,), dtype=np.uint8)
+    out[..., :3] = np.clip(np.rint(color), 0, 255)
+    out[..., 3] = alpha8
+    return out
+
+
+def check_transparency(path: str | os.PathLike) -> None:
+    """ExportError when the image ``path`` names cannot keep a transparent background (JPEG has no alpha)."""
+    if output_kind(path) == "JPEG":
+        raise ExportError(f"{Path(path)}: JPEG has no transparency; use .png or .tif/.tiff for a transparent "
+                          "background")
 
 
 def render_session(session: Session, session_file: Optional[str | os.PathLike], size: tuple[int, int],
                    progress: Optional[ProgressCallback] = None,
-                   datasets: Optional[dict[str, Any]] = None) -> np.ndarray:
-    """Render a session offscreen (its datasets read now unless given); returns the (H, W, 3) uint8 image."""
+                   datasets: Optional[dict[str, Any]] = None, transparent: bool = False) -> np.ndarray:
+    """Render a session offscreen (its datasets read now unless given); returns the (H, W, 3) uint8 image, or with
+    ``transparent`` the (H, W, 4) straight-alpha one without the background (``snapshot``)."""
     from volviz.render.scene_builder import load_datasets
 
     datasets = load_datasets(session, session_file, progress, loaded=datasets)
@@ -182,7 +231,7 @@ def render_session(session: Session, session_file: Optional[str | os.PathLike], 
     plotter, controller = offscreen_scene(session, datasets, size)
     try:
         controller.build()
-        image = snapshot(plotter, size)
+        image = snapshot(plotter, size, transparent)
     finally:
         close_scene(plotter, controller)
     report(progress, 1.0, "rendered")
@@ -214,12 +263,15 @@ def open_target(target: str | os.PathLike, array: Optional[str] = None, q: Optio
 
 def render_to_file(session: Session, session_file: Optional[str | os.PathLike], out: str | os.PathLike,
                    size: tuple[int, int], progress: Optional[ProgressCallback] = None,
-                   datasets: Optional[dict[str, Any]] = None) -> Path:
-    """Render a session to the image ``out`` in the format its extension names; the output and the size are checked
-    before anything renders (ExportError)."""
+                   datasets: Optional[dict[str, Any]] = None, transparent: bool = False) -> Path:
+    """Render a session to the image ``out`` in the format its extension names (``transparent``: without the
+    background, where the format keeps alpha); the output and the size are checked before anything renders
+    (ExportError)."""
     check_output(out)
     check_image_size(size)
-    image = render_session(session, session_file, size, progress, datasets)
+    if transparent:
+        check_transparency(out)
+    image = render_session(session, session_file, size, progress, datasets, transparent)
     write_image(image, out)
     return Path(out)
 
