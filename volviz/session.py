@@ -639,9 +639,25 @@ def missing_files(session: Session, session_file: str | os.PathLike | None,
         if ids is not None and ref.id not in ids:
             continue
         expected = resolve_path(session_file, ref.path) if session_file else Path(os.path.expandvars(ref.path))
-        if not expected.exists():
+        if not _present(expected):
             missing.append(MissingFile(ref.id, ref.path, expected))
     return missing
+
+
+def _present(path: Path) -> bool:
+    """Whether a dataset path names something there: a file or folder, or a numbered series' pattern
+    (``quarter.%d``, ``Storm.pvm-t*``) that some file matches."""
+    if path.exists():
+        return True
+    if not re.search(r"%0?\d*d|[*?\[]", path.name):
+        return False
+    from volviz.io.errors import ReadError
+    from volviz.io.series import expand_pattern
+
+    try:
+        return any(p.exists() for _, p in expand_pattern(str(path)))
+    except (ReadError, OSError):
+        return False
 
 
 def unset_variables(missing: list[MissingFile]) -> list[str]:
