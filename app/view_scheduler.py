@@ -30,6 +30,7 @@ from volviz.render.error_budget import MOST_ACCURATE_TABLE, error_budget_choice
 from .window_base import WindowBase
 
 MOVING_SCALE = 2         # previews while the camera moves or a TF point is dragged: 1/2 x 1/2 of the window
+FLY_SCALE = 4            # previews while flying: 1/4 x 1/4 (a flight near the ground fills the window with fog)
 RESIZE_MS = 200          # overlays re-render once the viewport stopped resizing for 200 ms
 FLY_SETTLE_MS = 300      # fly mode: full-size images once no key moved the camera for 300 ms
 
@@ -152,9 +153,11 @@ class ViewScheduler(WindowBase):
             self.refresh_views(scale=MOVING_SCALE, estimate=False, moving=True)
 
     def _fly_moved(self) -> None:
-        """A fly-mode step moved the camera: previews follow it as during a mouse drag (``_camera_moving``), and
-        the full-size images once the keys have stopped for ``FLY_SETTLE_MS``."""
-        self._camera_moving()
+        """A fly-mode step moved the camera: previews follow it as during a mouse drag (``_camera_moving``, at
+        ``FLY_SCALE``), and the full-size images once the keys have stopped for ``FLY_SETTLE_MS``."""
+        self._moving_scheduled = False
+        if self.controller is not None:
+            self.refresh_views(scale=FLY_SCALE, estimate=False, moving=True)
         self.fly_settle_timer.start()
 
     def _camera_moved(self) -> None:

@@ -144,18 +144,21 @@ class MainWindow(SceneLoading, SessionFiles, ViewScheduler, SceneEdits, ExportRu
 
     # ------------------------------------------------------------------------------------------------ navigation
     def set_fly_mode(self, enabled: bool) -> None:
-        bounds = self.plotter.bounds
-        size = max(bounds[1] - bounds[0], bounds[3] - bounds[2], bounds[5] - bounds[4], 1e-9)
-        self.fly.set_enabled(enabled, size)
+        from volviz.render.collision import OpaqueObstacles, fly_bounds, fly_clearance
+
         nature = self.controller.nature if self.controller is not None else None
         terrain = getattr(getattr(nature, "scene", None), "terrain", None)
+        # the scene's size: a terrain's extent (the sky dome around it is 6 times wider, and its size made the flight
+        # cross the whole terrain in a second), else the bounds of what is drawn
+        bounds = terrain.bounds() if terrain is not None else self.plotter.bounds
+        size = max(bounds[1] - bounds[0], bounds[3] - bounds[2], bounds[5] - bounds[4], 1e-9)
+        self.fly.set_enabled(enabled, size)
         # collision-free flight: the eye stays a clearance (the render option fly_clearance, a share of the scene
         # size, 1 % by default) above the terrain and short of opaque geometry
-        from volviz.render.collision import OpaqueObstacles, fly_clearance
-
         self.fly.set_ground(terrain.height_at if terrain is not None else None,
                             clearance=fly_clearance(self.session.render.options) * size,
                             obstacle=OpaqueObstacles(self.plotter.renderer))
+        self.fly.set_bounds(fly_bounds(bounds, self.plotter.camera.position, terrain))
         self.action_fly.setChecked(enabled)
         self.status_label.setText("Fly mode: W/A/S/D or arrows move, Q/E sink/rise, drag to look, +/- speed"
                                   if enabled else "Orbit mode")

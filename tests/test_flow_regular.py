@@ -1,4 +1,4 @@
-"""Flows on regular volumes, driven in the real window and held to ``volviz render`` of the saved session (issue #28)."""
+"""Flows on regular volumes in the real window, held to ``volviz render`` of the saved session (issue #28)."""
 from __future__ import annotations
 
 from conftest import data_file

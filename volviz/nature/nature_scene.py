@@ -123,15 +123,15 @@ class NatureScene:
 
     # ----------------------------------------------------------------------------------------------- rendering
     def terrain_mesh(self, camera: Any, size: tuple[int, int], full: bool = False,
-                     emit_threads: Callable[[], int] | None = None) -> TerrainMesh | None:
+                     emit_threads: Callable[[], int] | None = None, detail: float = 1.0) -> TerrainMesh | None:
         """The terrain's C-LOD mesh for ``camera`` in a window of ``size`` (``full``: every triangle), culled to the
-        view frustum with a margin; ``emit_threads`` as ``TerrainLOD.update``'s."""
+        view frustum with a margin; ``emit_threads`` and ``detail`` (< 1: coarser) as ``TerrainLOD.update``'s."""
         self.finalize()
         if self.lod is None:
             return None
         if full:
             return self.lod.full_mesh()
-        return self.lod.update(camera.position, frustum_planes(camera, size, margin=0.05), emit_threads)
+        return self.lod.update(camera.position, frustum_planes(camera, size, margin=0.05), emit_threads, detail)
 
     def volume_order(self, eye: Sequence[float]) -> list[tuple[str, Any]]:
         """The volume layers in compositing order for an eye position: ("fog", _Fog) per prism layer and

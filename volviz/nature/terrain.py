@@ -135,10 +135,12 @@ class TerrainLOD:
         self.small_c = float(small_c)
 
     def update(self, eye: Sequence[float], planes: np.ndarray | None = None,
-               emit_threads: Callable[[], int] | None = None) -> TerrainMesh:
+               emit_threads: Callable[[], int] | None = None, detail: float = 1.0) -> TerrainMesh:
         """Triangulate for an eye position; ``planes`` (p, 4) culls the leaves outside the frustum (refinement is
         unchanged; only the culled leaves' own vertices are not morphed). ``emit_threads``: asked for the Numba
-        thread count of the fan emission when it starts (e.g. more once other work of the frame is done)."""
+        thread count of the fan emission when it starts (e.g. more once other work of the frame is done).
+        ``detail`` < 1 scales the minimum global resolution C (Eq. 3.2) down for a coarser mesh: about detail²
+        of the triangles, for frames drawn while the camera moves."""
         t0 = time.perf_counter()
         n = self.n
         self._state.fill(0)
@@ -146,8 +148,8 @@ class TerrainLOD:
         eye_a = np.asarray(eye, dtype=np.float64).reshape(3)
         hf = self.terrain
         count, blocked = K.refine(self.d2, hf.heights, n, hf.spacing[0], hf.spacing[1], hf.origin[0], hf.origin[1],
-                                  eye_a, self.big_c, self.small_c, self.geomorph, self._state, self._weight,
-                                  self._nodes, self._sizes)
+                                  eye_a, self.big_c * float(detail), self.small_c, self.geomorph, self._state,
+                                  self._weight, self._nodes, self._sizes)
         pl = np.zeros((0, 4)) if planes is None else np.ascontiguousarray(planes, dtype=np.float64)
         K.morph(self.fields, n, self._state, self._weight, self._nodes, self._sizes, count, self._morphed,
                 hf.spacing[0], hf.spacing[1], hf.origin[0], hf.origin[1], pl, self._z_range)

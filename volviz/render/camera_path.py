@@ -80,7 +80,7 @@ class FlyNavigator:
     pitch about the right axis, pitch limited short of the poles). ``ground(x, y)`` (optional) gives the terrain height
     under a point; the camera is kept ``clearance`` above it. ``obstacle(start, end)`` (optional) gives the distance
     from ``start`` at which the segment to ``end`` first meets opaque geometry (None: free); the camera stops
-    ``clearance`` short of it."""
+    ``clearance`` short of it. ``bounds`` (optional) is the box the eye stays in."""
 
     def __init__(self, speed: float = 1.0, ground: Optional[Callable[[float, float], float]] = None,
                  clearance: float = 0.0, world_up: Sequence[float] = (0.0, 0.0, 1.0),
@@ -90,6 +90,7 @@ class FlyNavigator:
         self.clearance = float(clearance)
         self.obstacle = obstacle
         self.world_up = np.asarray(world_up, dtype=np.float64) / np.linalg.norm(world_up)
+        self.bounds: Optional[tuple[float, ...]] = None   # (xmin, xmax, ymin, ymax, zmin, zmax) the eye stays in
 
     def _axes(self, cam: CameraState) -> tuple[np.ndarray, np.ndarray, float]:
         pos, focal = np.asarray(cam.position), np.asarray(cam.focal_point)
@@ -115,6 +116,9 @@ class FlyNavigator:
             if hit is not None:
                 delta = direction * max(0.0, min(travel, float(hit) - self.clearance))
         pos = start + delta
+        if self.bounds is not None:
+            b = self.bounds
+            pos = np.clip(pos, [b[0], b[2], b[4]], [b[1], b[3], b[5]])
         if self.ground is not None:
             floor = float(self.ground(pos[0], pos[1])) + self.clearance
             if pos[2] < floor:

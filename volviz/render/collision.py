@@ -23,6 +23,25 @@ def fly_clearance(options: dict[str, Any]) -> float:
     return float(value)
 
 
+def fly_bounds(scene_bounds: Any, eye: Any, terrain: Any = None) -> tuple[float, ...]:
+    """The box a flying eye stays in: around a terrain, half its extent beyond each side and up to its extent above
+    its highest point (the sky dome's bounds are 6 times wider); else the scene's bounds grown by their size on
+    every side. The box holds the ``eye`` where the flight starts, so the first step never jumps."""
+    if terrain is not None:
+        x0, y0 = (float(v) for v in terrain.origin[:2])
+        ex, ey = (float(v) for v in terrain.extent[:2])
+        box = [x0 - ex / 2, x0 + 1.5 * ex, y0 - ey / 2, y0 + 1.5 * ey, float(np.min(terrain.heights)),
+               float(np.max(terrain.heights)) + max(ex, ey)]
+    else:
+        b = np.asarray(scene_bounds, dtype=np.float64)
+        size = max(float(np.max(b[1::2] - b[0::2])), 1e-9)
+        box = [b[0] - size, b[1] + size, b[2] - size, b[3] + size, b[4] - size, b[5] + size]
+    for axis, value in enumerate(float(v) for v in eye):
+        box[2 * axis] = min(box[2 * axis], value)
+        box[2 * axis + 1] = max(box[2 * axis + 1], value)
+    return tuple(float(v) for v in box)
+
+
 class OpaqueObstacles:
     """``obstacles(start, end)``: the distance from ``start`` to the first opaque surface on the segment, or None."""
 

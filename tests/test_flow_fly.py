@@ -1,0 +1,60 @@
+"""Flying through the natural scene with a held key, in the real window (issue #28): the flight follows the clock
+(the window never queues a render per key event), frames drawn while flying are previews over a coarse terrain, the
+eye stays above the terrain and inside it, and the picture the user is left with is ``volviz render``'s."""
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+from PySide6.QtCore import QEvent, Qt
+from PySide6.QtGui import QKeyEvent
+from PySide6.QtWidgets import QApplication
+
+from flows import compare_with_render, wait_loaded, wait_settled
+from loop_latency import LoopGaps
+
+YUKON = Path(__file__).resolve().parents[1] / "resources" / "sessions" / "yukon.json"
+
+
+def _key(widget, kind: QEvent.Type, key: Qt.Key, repeat: bool) -> None:
+    QApplication.sendEvent(widget, QKeyEvent(kind, key, Qt.KeyboardModifier.NoModifier, "w", repeat))
+
+
+def test_hold_w_over_yukon(qtbot, make_window, tmp_path: Path) -> None:
+    window = make_window()
+    window.resize(1366, 768)
+    window.open_path(YUKON)
+    wait_loaded(qtbot, window, timeout=180000)
+    wait_settled(qtbot, window, timeout=180000)
+    window.action_fly.trigger()                                 # View > Fly Mode
+    assert window.fly.enabled
+    terrain = window.controller.nature.scene.terrain
+    x0, x1, y0, y1, z0, z1 = window.fly.navigator.bounds
+    view = window.controller.nature
+    start = window.plotter.camera.position
+    canvas = window.plotter.interactor
+    samples, scales = [], set()
+    gaps = LoopGaps()
+    gaps.restart()
+    began = time.monotonic()
+    _key(canvas, QEvent.Type.KeyPress, Qt.Key.Key_W, False)
+    while time.monotonic() - began < 5.0:   # held: the keyboard's auto-repeat, as X sends it
+        qtbot.wait(40)
+        _key(canvas, QEvent.Type.KeyPress, Qt.Key.Key_W, True)
+        samples.append(window.plotter.camera.position)
+        scales.add(view.shown_scale)
+    _key(canvas, QEvent.Type.KeyRelease, Qt.Key.Key_W, False)
+    gaps.stop()
+    print(f"flight: {window.fly.steps} camera steps in 5 s, {gaps.summary()}")
+    assert window.fly.steps >= 20            # the timer flew on while the key was held
+    assert 4 in scales                       # frames drawn while flying were previews
+    end = window.plotter.camera.position
+    assert end[1] > start[1] + 100           # forward: the view looks along +y
+    for x, y, z in samples:                  # above the ground, inside the terrain's box
+        assert x0 <= x <= x1 and y0 <= y <= y1 and z <= z1
+        assert z >= terrain.height_at(x, y) - 1e-6
+    wait_settled(qtbot, window, timeout=180000)
+    qtbot.waitUntil(lambda: view.shown_scale == 1, timeout=180000)   # the full-size frame follows the stop
+    wait_settled(qtbot, window, timeout=180000)
+    err = compare_with_render(window, tmp_path)
+    assert err["rmse"] < 2.0 and err["off"] < 0.01, err
