@@ -26,12 +26,18 @@ AUTOSAVE_MS = 60_000     # the recovery file is rewritten at least this often wh
 EDIT_AUTOSAVE_MS = 1_500  # and this long after every edit, so a crash loses at most the last moments
 
 
+PLOT3D_SOLUTIONS = "*.q *q.bin *q*.bin *q.dat *.sol"   # the solution files picked beside a PLOT3D grid
+
+
 def _data_filter() -> str:
-    """The readers' filter plus volviz's own compressed volumes."""
+    """The readers' filter plus volviz's own compressed volumes and the PLOT3D solution files the dialog asks for
+    beside a grid (the grid's patterns, ``*xyz*.bin``, hid ``bluntfinq.bin``)."""
     from volviz.io import open_dialog_filter
 
     everything, rest = open_dialog_filter().split(";;", 1)
-    return everything.replace("(", "(*.vvz ", 1) + ";;volviz compressed volume (*.vvz);;" + rest
+    rest = rest.replace("PLOT3D grid (+ q solution) (", f"PLOT3D grid (+ q solution) ({PLOT3D_SOLUTIONS} ", 1)
+    return (everything.replace("(", f"(*.vvz {PLOT3D_SOLUTIONS} ", 1) + ";;volviz compressed volume (*.vvz);;"
+            + rest)
 
 
 def default_recovery_dir() -> Path:

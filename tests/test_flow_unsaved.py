@@ -76,3 +76,4 @@ def test_recovery_file_follows_each_edit_within_seconds(qtbot, make_window) -> N
     qtbot.waitUntil(window.recovery_file.exists, timeout=10000)
     kept = json.loads(window.recovery_file.read_text())
     assert len(kept["clip"]["planes"]) == 1       # the plane added a moment ago is in what a crash leaves
+
