@@ -19,7 +19,8 @@ __all__ = ["Settings", "TerrainSettings", "FogSettings", "CloudSettings", "SkySe
            "MeshSettings", "IsoStyleSettings", "IsosurfaceSettings", "DemoSettings", "RenderOptions",
            "SETTINGS_MODELS", "FogMode", "CloudShadingName", "IsoMode", "IsoShading", "IsoOverlayMode", "Backend",
            "SortName", "APPLIES_TO", "array_key", "settings_model", "former_names", "validate_settings",
-           "validate_render_options", "typed_settings", "validated", "SettingsError"]
+           "validate_render_options", "typed_settings", "validated", "SettingsError",
+           "ScalarBarStyle"]
 
 FogMode = Literal["emissive", "attenuated", "mip"]
 CloudShadingName = Literal["npr", "physical"]
@@ -159,6 +160,8 @@ class VolumeSettings(Settings):
                         "a level of detail: blocks decoded per view", json_schema_extra=_applies_to("lod_volume"))
     interpolate: bool = Field(True, title="Interpolate in time", description="time series: blend the two nearest "
                               "steps", json_schema_extra=_applies_to("time_series"))
+    log_scale: bool = Field(False, title="Log color scale", description="color and opacity of log10 of the value "
+                            "(values <= 0 take the color of the smallest positive value)")
 
 
 class MeshSettings(VolumeSettings):
@@ -202,6 +205,27 @@ SETTINGS_MODELS: dict[str, type[Settings]] = {
 }
 
 
+#: a printf format of one number: flags, width, precision, one of f e g (and capitals); text around it, no other %
+LABEL_FORMAT = r"^[^%]{0,16}%[-+ #0]{0,4}[0-9]{0,2}(\.[0-9]{1,2})?[feEgG][^%]{0,16}$"
+
+
+class ScalarBarStyle(Settings):
+    """What the scalar bar shows when it is edited (View > Edit Scalar Bar): each unset field follows the data."""
+
+    title: Optional[str] = Field(None, max_length=200, title="Title", description="default: the shown array's name")
+    range: Optional[Vec2] = Field(None, title="Range", description="a fixed range of the bar; default: the transfer "
+                                  "function's")
+    format: Optional[str] = Field(None, pattern=LABEL_FORMAT, title="Number format", description="printf format of "
+                                  "the labels, e.g. %.3g; default: chosen from the range")
+
+    @field_validator("range")
+    @classmethod
+    def _increasing(cls, value: Optional[Vec2]) -> Optional[Vec2]:
+        if value is not None and not value[0] < value[1]:
+            raise ValueError("the range's low end must be below its high end")
+        return value
+
+
 class RenderOptions(Settings):
     """``render.options`` of a session: how every view is drawn."""
 
@@ -221,6 +245,7 @@ class RenderOptions(Settings):
     fly_clearance: float = Field(0.01, ge=0, le=0.5, title="Fly clearance", description="fly mode keeps this share "
                                  "of the scene's size from opaque geometry")
     scalar_bar: bool = Field(True, title="Scalar bar")
+    scalar_bar_style: ScalarBarStyle = Field(default_factory=ScalarBarStyle, title="Scalar bar style")
     axes: bool = Field(True, title="Axes")
     outline: bool = Field(True, title="Outline box")
 

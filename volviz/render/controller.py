@@ -195,6 +195,12 @@ class SceneController:
 
         return component_transfer_function(self.session, self.component(comp_id))
 
+    def _drawn(self, comp: Component, tf: Any) -> Any:
+        """``tf`` as the component is drawn with it (through log10 with its setting ``log_scale``)."""
+        from volviz.render.drawn_tf import drawn_tf
+
+        return tf if comp.dataset not in self.datasets else drawn_tf(comp, tf, self.dataset_of(comp.id))
+
     def set_transfer_function(self, comp_id: str, tf: Any, update: bool = True) -> None:
         """Store ``tf`` in the session and give it to the component's view; a view that re-makes something for a new
         TF (a CPU PT volume's image, a LOD volume's block selection) does so now only when ``update`` (the app does it
@@ -205,7 +211,7 @@ class SceneController:
         comp.transfer_function = name
         view = self.views.get(comp_id)
         if view is not None:
-            view.set_tf(tf, comp.opacity)
+            view.set_tf(self._drawn(comp, tf), comp.opacity)
             if update:
                 view.update()
         from volviz.render.decorations import update_legend
@@ -294,7 +300,7 @@ class SceneController:
         view = self.views.get(comp_id)
         stale: list[str] = []
         if view is not None:
-            view.set_tf(self.transfer_function(comp_id), comp.opacity)
+            view.set_tf(self._drawn(comp, self.transfer_function(comp_id)), comp.opacity)
             if update:
                 view.update()
             self._sync_iso_overlay()

@@ -7,7 +7,7 @@ from typing import Any, Optional
 
 import numpy as np
 
-from volviz.model.settings import array_key
+from volviz.model.settings import ScalarBarStyle, array_key, validated
 from volviz.session import Session
 
 DECORATIONS = ("scalar_bar", "axes", "outline")
@@ -84,7 +84,7 @@ def update_legend(plotter: Any, session: Session, datasets: dict[str, Any]) -> N
     _remove_scalar_bar(plotter)
     comp = _legend_component(session) if decoration_enabled(session, "scalar_bar") else None
     if comp is not None and _shows_array(comp, datasets):
-        _add_scalar_bar(plotter, session, comp, _array_title(comp, datasets), _contrast(session.render.background))
+        _add_scalar_bar(plotter, session, comp, datasets, _contrast(session.render.background))
 
 
 def label_values(lo: float, hi: float, count: int = 5) -> np.ndarray:
@@ -113,20 +113,64 @@ def label_format(lo: float, hi: float, count: int = 5) -> str:
     return min(candidates, key=lambda fmt: max(len(fmt % v) for v in values))
 
 
-def _add_scalar_bar(plotter: Any, session: Session, comp: Any, title: str, color: tuple[float, float, float]) -> None:
-    from volviz.render.vtk_facade import numpy_to_vtk, vtk
+def scalar_bar_style(session: Session) -> ScalarBarStyle:
+    """The session's edits of the scalar bar (title, range, number format; each unset follows the data)."""
+    return validated(ScalarBarStyle, session.render.options.get("scalar_bar_style") or {},
+                     "render.options.scalar_bar_style")
 
+
+def _bar_scale(session: Session, comp: Any, datasets: dict[str, Any]) -> tuple[Any, np.ndarray, str, bool]:
+    """The scalar bar's colour function, label values, label format and whether it is logarithmic: the component's
+    transfer function (through log10 with ``log_scale``: log ticks from the smallest positive value) over the edited
+    range, else over the function's own."""
     from volviz.optics import TransferFunction
+    from volviz.optics.log_scale import log_mapped, log_ticks
+    from volviz.render.drawn_tf import log_floor, uses_log_scale
+    from volviz.render.vtk_facade import vtk
     from volviz.render.vtk_tf import tf_to_vtk
 
+    style = scalar_bar_style(session)
     tf = TransferFunction.from_dict(session.transfer_functions[comp.transfer_function])
-    ctf, _ = tf_to_vtk(tf, 1.0)
+    lo, hi = style.range or tf.range
+    log = False
+    if uses_log_scale(comp):
+        from volviz.render.scene_builder import SceneError, component_dataset
+
+        try:
+            floor = log_floor(tf, component_dataset(comp, datasets))
+        except (SceneError, KeyError):
+            floor = log_floor(tf, None)
+        tf = log_mapped(tf, floor)
+        lo, log = max(lo, floor), hi > max(lo, floor) > 0
+    if not log and style.range is None:
+        ctf, _ = tf_to_vtk(tf, 1.0)
+    else:   # sampled: a range of its own, or a log scale (VTK interpolates a log table between its nodes in log10)
+        values = np.geomspace(lo, hi, 256) if log else np.linspace(lo, hi, 256)
+        colors, _ = tf.evaluate(np.clip(values, *tf.range))
+        ctf = vtk.vtkColorTransferFunction()
+        ctf.SetColorSpaceToRGB()
+        for v, (r, g, b) in zip(values, colors):
+            ctf.AddRGBPoint(float(v), float(r), float(g), float(b))
+        if log:
+            ctf.SetScaleToLog10()
     ctf.ClampingOn()
+    labels = log_ticks(lo, hi) if log else label_values(lo, hi)
+    return ctf, labels, style.format or ("%.3g" if log else label_format(lo, hi)), log
+
+
+def _add_scalar_bar(plotter: Any, session: Session, comp: Any, datasets: dict[str, Any],
+                    color: tuple[float, float, float]) -> None:
+    from volviz.render.vtk_facade import numpy_to_vtk, vtk
+
+    ctf, labels, fmt, log = _bar_scale(session, comp, datasets)
+    title = scalar_bar_style(session).title
+    if title is None:
+        title = _array_title(comp, datasets) + (" (log)" if log else "")
     bar = vtk.vtkScalarBarActor()
     bar.SetLookupTable(ctf)
-    bar.SetCustomLabels(numpy_to_vtk(label_values(*ctf.GetRange()), deep=True))
+    bar.SetCustomLabels(numpy_to_vtk(labels, deep=True))
     bar.UseCustomLabelsOn()
-    bar.SetLabelFormat(label_format(*ctf.GetRange()))
+    bar.SetLabelFormat(fmt)
     bar.SetOrientationToVertical()          # at the right edge, as ParaView places it
     bar.SetPosition(0.84, 0.12)
     bar.SetWidth(0.12)

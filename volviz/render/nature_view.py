@@ -74,15 +74,17 @@ class NatureView:
         dome = sky_dome_mesh(radius, (0.0, 0.0, 0.0))  # moved to the eye by ``update``: the sky is at infinity
         if scene.sky is not None:
             sky_img = np.clip(scene.sky * 255.0, 0, 255).astype(np.uint8)
-            self.sky_actor = plotter.add_mesh(dome, texture=pv.Texture(sky_img), lighting=False, name="nature-sky",
-                                              render=False)
         else:  # the CPU gradient of ``render_sky`` as a polar texture (rows: zenith at the top, horizon at the bottom)
             zen, hor = np.array([0.32, 0.5, 0.85]), np.array([0.78, 0.85, 0.95])
             t = np.sqrt(np.linspace(1.0, 0.0, 256))[:, None, None]
             grad = np.broadcast_to(hor + (zen - hor) * t, (256, 4, 3))
             sky_img = np.ascontiguousarray(np.clip(grad * 255.0 + 0.5, 0, 255).astype(np.uint8))
-            self.sky_actor = plotter.add_mesh(dome, texture=pv.Texture(sky_img), lighting=False, name="nature-sky",
-                                              render=False)
+        sky = pv.Texture(sky_img)
+        # clamped, not repeated: at the horizon row (v = 0) a repeating texture blended in the zenith's colour, a
+        # darker line across the whole sky
+        sky.repeat = False
+        sky.edge_clamp = True
+        self.sky_actor = plotter.add_mesh(dome, texture=sky, lighting=False, name="nature-sky", render=False)
 
     def _camera(self) -> Any:
         from volviz.model.camera import Camera

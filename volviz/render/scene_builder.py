@@ -254,6 +254,13 @@ def ensure_transfer_functions(session: Session, datasets: dict[str, Any]) -> Non
             comp.transfer_function = name
 
 
+def drawn_transfer_function(session: Session, comp: Component, dataset: Any) -> Any:
+    """The component's transfer function as drawn (through log10 with the setting ``log_scale``)."""
+    from volviz.render.drawn_tf import drawn_tf
+
+    return drawn_tf(comp, component_transfer_function(session, comp), dataset)
+
+
 def component_transfer_function(session: Session, comp: Component) -> Any:
     from volviz.optics import TransferFunction
 
@@ -508,7 +515,7 @@ def install_component(plotter: Any, session: Session, comp: Component, datasets:
         return add_lod_component(plotter, session, comp, dataset, update=views)
     if uses_pt(session, dataset):
         return add_pt_component(plotter, session, comp, prepared.parts[comp.id], update=views)
-    tf = component_transfer_function(session, comp)
+    tf = drawn_transfer_function(session, comp, dataset)
     return VtkPropView(add_volume_prop(plotter, dataset, prepared.parts.get(comp.id), tf, comp.opacity, comp.id,
                                        backend_setting(session.render.options)))
 
@@ -558,7 +565,7 @@ def add_lod_component(plotter: Any, session: Session, comp: Component, dataset: 
         plotter.view_isometric()
         plotter.renderer.ResetCamera(lo[0], hi[0], lo[1], hi[1], lo[2], hi[2])
         plotter.camera_set = True
-    lod = LodVolume(plotter, dataset, component_transfer_function(session, comp),
+    lod = LodVolume(plotter, dataset, drawn_transfer_function(session, comp, dataset),
                     budget=int(comp.settings.get("budget", 256)), opacity=comp.opacity)
     if update:
         lod.update()
@@ -585,7 +592,7 @@ def add_pt_component(plotter: Any, session: Session, comp: Component, dataset: A
     (``volviz.render.gl_pt``) or the CPU (``volviz.render.pt_prop``) as the render option ``backend`` picks for this
     plotter's OpenGL (``volviz.render.backend``; the exact "reference" method is CPU only). A CPU volume's image is
     rendered now when ``update`` (the app renders it in the background: ``begin`` / ``compute`` / ``finish``)."""
-    tf = component_transfer_function(session, comp)
+    tf = drawn_transfer_function(session, comp, dataset)
     if comp.opacity != 1.0:
         tf = tf.scaled_extinction(comp.opacity)
     method = "reference" if session.render.method == "reference" else "pt"
