@@ -1,4 +1,4 @@
-"""The log colour scale (``volviz.optics.log_scale``) and the edited scalar bar (render option
+"""The log color scale (``volviz.optics.log_scale``) and the edited scalar bar (render option
 ``scalar_bar_style``): issue #28's missing tools, without a window."""
 from __future__ import annotations
 
@@ -18,14 +18,14 @@ def test_log_mapping_interpolates_in_log10_and_clamps_at_the_floor():
     tf = log_mapped(_tf(), 1.0)
     assert tf.range == (0.0, 100.0)
     colors, extinction = tf.evaluate(np.array([1.0, 10.0, 100.0]))
-    # log10(1) = 0 is below the first positive knot: the colour of the floor (the knot at 0 clamped to 1 is the 0's)
+    # log10(1) = 0 is below the first positive knot: the color of the floor (the knot at 0 clamped to 1 is the 0's)
     np.testing.assert_allclose(colors[1:], [[0, 1, 0], [1, 0, 0]], atol=1e-12)
     np.testing.assert_allclose(extinction[1:], [2.0, 4.0], atol=1e-12)
-    # halfway in log10 between 10 and 100 (31.6) is halfway in colour; linear mapping would give 0.24 there
+    # halfway in log10 between 10 and 100 (31.6) is halfway in color; linear mapping would give 0.24 there
     c, e = tf.evaluate(np.array([10 ** 1.5]))
     np.testing.assert_allclose(c[0], [0.5, 0.5, 0.0], atol=5e-3)
     np.testing.assert_allclose(e, [3.0], atol=1e-2)
-    # values at or below 0 take the floor's colour and opacity
+    # values at or below 0 take the floor's color and opacity
     c0, e0 = tf.evaluate(np.array([0.0, 0.5]))
     c1, e1 = tf.evaluate(np.array([1.0]))
     np.testing.assert_allclose(c0, np.vstack([c1, c1]), atol=1e-12)
@@ -65,7 +65,7 @@ def test_scalar_bar_styles_are_render_options(style):
 
 @pytest.mark.parametrize("style, message", [({"format": "%s"}, "format"), ({"format": "%d%n"}, "format"),
                                             ({"format": "%.3g %g"}, "format"), ({"range": [5, 1]}, "range"),
-                                            ({"colour": 1}, "unknown setting")])
+                                            ({"color": 1}, "unknown setting")])
 def test_bad_scalar_bar_styles_are_refused(style, message):
     with pytest.raises(SettingsError, match=f"render.options.scalar_bar_style.*{message}"):
         validate_render_options({"scalar_bar_style": style})

@@ -1,11 +1,11 @@
-"""A log colour scale: a transfer function applied to log10 of the scalar (the component setting ``log_scale``).
+"""A log color scale: a transfer function applied to log10 of the scalar (the component setting ``log_scale``).
 
-The control points keep their data values; colour and extinction are interpolated between them in log10 of the
+The control points keep their data values; color and extinction are interpolated between them in log10 of the
 value, as ParaView's "log scale" does. Renderers interpolate transfer functions linearly in the value, so the mapping
-is handed to them as a function resampled at ``LOG_SAMPLES`` geometrically spaced values and its own knots (piecewise linear between
-neighbours a factor (hi/lo)^(1/LOG_SAMPLES) apart: within 0.4 % of the log curve's colour step over three decades).
+is handed to them as a function resampled at ``LOG_SAMPLES`` geometrically spaced values and at its own knots
+(piecewise linear between neighbours a factor (hi/lo)^(1/LOG_SAMPLES) apart).
 Log10 has no value at or below 0: those scalars, and control points there, are clamped to the smallest positive
-value (``floor``, the data's), and take its colour and opacity.
+value (``floor``, the data's), and take its color and opacity.
 """
 from __future__ import annotations
 
@@ -30,7 +30,7 @@ def positive_floor(values: np.ndarray, lo: float, hi: float) -> float:
 
 def log_mapped(tf: TransferFunction, floor: float, samples: int = LOG_SAMPLES) -> TransferFunction:
     """``tf`` applied to log10 of the scalar, as a transfer function of the scalar itself (see the module's
-    docstring): defined over the same range, values from the range's low end up to ``floor`` take the colour at
+    docstring): defined over the same range, values from the range's low end up to ``floor`` take the color at
     ``floor``. A range that ends at or below ``floor`` has nothing to map logarithmically: ``tf`` is returned."""
     lo, hi = tf.range
     floor = max(float(floor), float(lo))
@@ -42,7 +42,7 @@ def log_mapped(tf: TransferFunction, floor: float, samples: int = LOG_SAMPLES) -
     logs = np.log10(values)
     colors = np.stack([np.interp(logs, knots, tf.colors[:, ch]) for ch in range(3)], axis=1)
     extinction = np.interp(logs, knots, tf.extinction)
-    if lo < floor:  # the clamped part: constant at the floor's colour
+    if lo < floor:  # the clamped part: constant at the floor's color
         values = np.concatenate([[lo], values])
         colors = np.concatenate([colors[:1], colors])
         extinction = np.concatenate([extinction[:1], extinction])

@@ -26,7 +26,7 @@ LEGEND_MARGIN = 0.2        # the share of the viewport's width at its right that
 
 def legend_margin(session: Session, datasets: Optional[dict[str, Any]] = None) -> float:
     """How much of the viewport's width, at its right, the scalar bar takes (0 when none is shown; with the loaded
-    ``datasets``, also when the component it would explain colours by no array)."""
+    ``datasets``, also when the component it would explain colors by no array)."""
     comp = _legend_component(session) if decoration_enabled(session, "scalar_bar") else None
     shown = comp is not None and (datasets is None or _shows_array(comp, datasets))
     return LEGEND_MARGIN if shown else 0.0
@@ -120,7 +120,7 @@ def scalar_bar_style(session: Session) -> ScalarBarStyle:
 
 
 def _bar_scale(session: Session, comp: Any, datasets: dict[str, Any]) -> tuple[Any, np.ndarray, str, bool]:
-    """The scalar bar's colour function, label values, label format and whether it is logarithmic: the component's
+    """The scalar bar's color function, label values, label format and whether it is logarithmic: the component's
     transfer function (through log10 with ``log_scale``: log ticks from the smallest positive value) over the edited
     range, else over the function's own."""
     from volviz.optics import TransferFunction
@@ -198,8 +198,8 @@ def _add_scalar_bar(plotter: Any, session: Session, comp: Any, datasets: dict[st
 
 
 def _shows_array(comp: Any, datasets: dict[str, Any]) -> bool:
-    """Whether the component colours by an array (its setting, else its dataset's default): a surface of geometry
-    alone (an STL, a PLY of normals) is drawn in a plain colour, with no scale to explain."""
+    """Whether the component colors by an array (its setting, else its dataset's default): a surface of geometry
+    alone (an STL, a PLY of normals) is drawn in a plain color, with no scale to explain."""
     if comp.settings.get(array_key(comp.type)) or comp.type != "volume":
         return True
     from volviz.model.arrays import default_array

@@ -21,7 +21,7 @@ def uses_log_scale(comp: Component) -> bool:
 
 def log_floor(tf: Any, dataset: Any) -> float:
     """The smallest positive value the log scale of ``tf`` over ``dataset``'s shown array maps (values at or below
-    it take its colour): the TF's low end when positive, else the data's smallest positive value (cached per
+    it take its color): the TF's low end when positive, else the data's smallest positive value (cached per
     dataset: one pass over the values)."""
     lo, hi = tf.range
     if lo > 0:
