@@ -34,7 +34,9 @@ from .drop import FileDrop
 from .export_dialogs import ExportDialogs
 from .help import HelpMenu
 from .layout import WindowLayout, scrolled
+from .probe import ProbeTool
 from .recent import RecentFiles
+from .scalar_bar_editor import ScalarBarEditor
 from .window_base import WindowBase
 
 
@@ -125,6 +127,7 @@ class WindowWidgets(WindowBase):
         self._action(view_menu, "Reset &Layout", "", self.layout_keeper.reset)
         view_menu.addSeparator()
         self.decorations = DecorationToggles(self, view_menu)
+        self.scalar_bar_editor = ScalarBarEditor(self, view_menu)
         view_menu.addSeparator()
         self.action_fly = self._action(view_menu, "&Fly Mode", "F", self.set_fly_mode)
         self.action_fly.setCheckable(True)
@@ -162,6 +165,7 @@ class WindowWidgets(WindowBase):
         self.cancel_button = QPushButton("Cancel")
         self.cancel_button.clicked.connect(self.cancel_current_job)
         bar.addWidget(self.status_label, 1)
+        self.probe = ProbeTool(self)   # the value under the cursor, left of the progress bar
         bar.addPermanentWidget(self.progress_bar)
         bar.addPermanentWidget(self.cancel_button)
         self._set_busy(False)

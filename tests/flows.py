@@ -99,3 +99,20 @@ def scalar_bar_ranges(window) -> list[tuple[float, float]]:
 
     bar = scalar_bar_actor(window.plotter)
     return [] if bar is None else [tuple(float(v) for v in bar.GetLookupTable().GetRange())]
+
+
+def hover(qtbot, widget, pos: QPoint) -> None:
+    """The mouse moved (no button held) to ``pos`` over ``widget``, as a real move event."""
+    _mouse(widget, QEvent.Type.MouseMove, QPointF(pos), Qt.MouseButton.NoButton, Qt.MouseButton.NoButton)
+    qtbot.wait(50)
+
+
+def click(qtbot, widget, pos: QPoint, double: bool = False) -> None:
+    """A left click (press and release at ``pos``; ``double``: then a double click) as real events on ``widget``."""
+    left = Qt.MouseButton.LeftButton
+    _mouse(widget, QEvent.Type.MouseButtonPress, QPointF(pos), left, left)
+    _mouse(widget, QEvent.Type.MouseButtonRelease, QPointF(pos), Qt.MouseButton.NoButton, left)
+    if double:
+        _mouse(widget, QEvent.Type.MouseButtonDblClick, QPointF(pos), left, left)
+        _mouse(widget, QEvent.Type.MouseButtonRelease, QPointF(pos), Qt.MouseButton.NoButton, left)
+    qtbot.wait(50)

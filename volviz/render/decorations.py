@@ -254,3 +254,24 @@ def scalar_bar_title(plotter: Any) -> Optional[str]:
     """The scalar bar's title (the shown array's name), None without a scalar bar."""
     heading = plotter.renderer.actors.get(SCALAR_BAR_TITLE_NAME)
     return None if heading is None else str(heading.GetInput())
+
+
+def scalar_bar_hit(plotter: Any, x: float, y: float) -> bool:
+    """Whether display pixel (x, y) (VTK's: rows from the bottom) is on the scalar bar or its title."""
+    renderer = plotter.renderer
+    for name in (SCALAR_BAR_NAME, SCALAR_BAR_TITLE_NAME):
+        actor = renderer.actors.get(name)
+        if actor is None:
+            continue
+        box = [0.0] * 4
+        if name == SCALAR_BAR_NAME:
+            lo = actor.GetPositionCoordinate().GetComputedDisplayValue(renderer)
+            hi = actor.GetPosition2Coordinate().GetComputedDisplayValue(renderer)
+            box = [lo[0], hi[0], lo[1], hi[1]]
+        else:
+            bounds = [0.0] * 4
+            actor.GetBoundingBox(renderer, bounds)
+            box = bounds
+        if box[0] <= x <= box[1] and box[2] <= y <= box[3]:
+            return True
+    return False
