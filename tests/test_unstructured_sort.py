@@ -104,8 +104,10 @@ def test_camera_inside_nonconvex_mesh_samples_only_what_is_in_front():
     finally:
         sort_mod._boundary_box = saved
     assert len(src) > 0 and set(zip(src, dst)) == set(zip(src_all, dst_all))
-    res = visibility_order(m, cam, SIZE, "mpvo")
+    res = visibility_order(m, cam, SIZE, "mpvo", nonconvex="sample")
     assert res.boundary_relations == len(src) and order_violations(m, cam, SIZE, res.order, 1e-9) == 0
+    res = visibility_order(m, cam, SIZE, "mpvo")                     # object space: the default
+    assert res.boundary_relations > 0 and order_violations(m, cam, SIZE, res.order, 1e-9) == 0
     # one tetrahedron wholly behind the eye: empty; one crossing the near plane: the box of its front part
     pts = np.array([[0.4, 0.0, 0.4], [0.6, 0.0, 0.4], [0.5, -0.1, 0.6], [0.5, 0.05, 0.5],
                     [0.45, 0.62, 0.45], [0.55, 0.62, 0.45], [0.5, 0.62, 0.55], [0.5, 0.11, 0.5]])

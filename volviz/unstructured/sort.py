@@ -8,12 +8,14 @@ Roettger §8.1 and Guthe §4.3 (§3.1 of the thesis):
 - ``"mpvo"``: Williams' MPVO as a topological sort (Kahn) of the face-adjacency graph, each shared face directed by the
   side of its plane the eye lies on. Correct for convex, connected, acyclic meshes.
 - Non-convex or disconnected meshes (``"mpvo"`` adds them automatically unless the mesh is convex): the missing
-  relations between boundary faces are *sampled at the pixel centres of the image being rendered*, the image-space
-  variant of XMPVO (Cook, Max, Silva, Williams 2004, "SXMPVO"). Every boundary face is ray-cast at every pixel centre it
-  covers; along each pixel ray, a boundary face where the ray re-enters the mesh (cell B) after the ray has left it
-  (cell A) yields the relation "B before A". Together with the MPVO relations, every pair of cells met consecutively
-  along any pixel ray is ordered, which is exactly what a rasteriser that samples those pixel centres needs: the order
-  is correct for that image (it is not a total depth order for rays between pixel centres, which are never drawn).
+  relations between boundary faces, where a ray leaves the mesh (cell A) and re-enters it later (cell B): "B before
+  A". By default they come from object space (``volviz.unstructured.boundary_pairs``: the overlapping exit/entry
+  pairs of the boundary faces off the convex hull, found through a grid sized by the number of those faces), so the
+  cost does not depend on the window size (issue #29) and the order is right for every ray of the view.
+  ``nonconvex="sample"`` keeps the previous image-space variant of XMPVO (Cook, Max, Silva, Williams 2004, "SXMPVO"):
+  every boundary face ray-cast at every pixel centre of the image it covers, each entry face after an exit face along
+  a pixel ray giving a relation; exact for that image's pixel centres, at a cost that grows with the window
+  (Blunt Fin: 32 ms at 512², 262 ms at 1920x1080); the tests use it as the witness of the object-space relations.
 - Visibility cycles (real ones, or ones created by combining relations that hold on different rays) stall Kahn's
   algorithm. They are broken by emitting the farthest remaining cell (by centroid depth); ``SortResult.cycles`` counts
   the breaks.
@@ -28,9 +30,11 @@ from numba import njit, prange
 
 from volviz.model.datasets import TetMesh
 from volviz.model.camera import Camera
+from volviz.unstructured.boundary_pairs import inner_boundary, object_relations
 from volviz.unstructured.topology import FACES, Topology, topology
 
 METHODS = ("mpvo", "centroid", "power")
+NONCONVEX = ("auto", "object", "sample", "none")
 
 
 @dataclass
@@ -328,30 +332,9 @@ def _csr(src: np.ndarray, dst: np.ndarray, m: int) -> tuple[np.ndarray, np.ndarr
     return np.cumsum(ptr), np.ascontiguousarray(dst[order])
 
 
-def is_convex(topo: Topology, rel_tol: float = 1e-9) -> bool:
+def is_convex(topo: Topology) -> bool:
     """True when every boundary face lies on the convex hull of the mesh (convex and connected: MPVO is exact)."""
-    cached = topo.__dict__.get("_convex")
-    if cached is not None:
-        return cached
-    from scipy.spatial import ConvexHull, QhullError
-
-    bf = topo.boundary
-    verts = np.unique(topo.tets[bf[:, 0][:, None], FACES[bf[:, 1]]])
-    try:
-        hull_pts = topo.points[verts][ConvexHull(topo.points[verts]).vertices]
-    except QhullError:          # all points in one plane (or fewer than 4): no volume, so no order can be wrong
-        topo.__dict__["_convex"] = True
-        return True
-    scale = float(np.abs(topo.points).max()) or 1.0
-    n = topo.face_n[bf[:, 0], bf[:, 1]]
-    d = topo.face_d[bf[:, 0], bf[:, 1]]
-    convex = True
-    for s in range(0, len(n), 4096):
-        if np.any((n[s:s + 4096] @ hull_pts.T - d[s:s + 4096, None]).max(axis=1) > rel_tol * scale):
-            convex = False
-            break
-    topo.__dict__["_convex"] = convex
-    return convex
+    return len(inner_boundary(topo)) == 0
 
 
 def _view(cam: Camera, topo: Topology) -> tuple[np.ndarray, np.ndarray]:
@@ -363,8 +346,10 @@ def visibility_order(mesh: TetMesh | Topology, camera: Camera, size: tuple[int, 
                      method: str = "mpvo", nonconvex: str = "auto") -> SortResult:
     """Back-to-front order of all cells of ``mesh`` for ``camera``.
 
-    ``nonconvex``: "auto" (sample boundary relations unless the mesh is convex), "sample" (always) or "none" (plain
-    MPVO). ``size`` is the image the order is for (boundary relations are sampled at its pixel centres).
+    ``nonconvex``: "auto" (boundary relations in object space, ``boundary_pairs``, unless the mesh is convex),
+    "object" (always), "sample" (always, sampled at the pixel centres of an image of ``size``: the previous method,
+    whose cost grows with the window; kept as the tests' witness) or "none" (plain MPVO). ``size``: the image the
+    order is for (with "auto"/"object" only its aspect matters).
     """
     if method not in METHODS:
         raise ValueError(f"unknown sort method {method!r}; choose one of {METHODS}")
@@ -380,11 +365,12 @@ def visibility_order(mesh: TetMesh | Topology, camera: Camera, size: tuple[int, 
                             _power_keys(topo.circ_center, topo.circ_r2, eye, fwd, camera.parallel)))
         return SortResult(order.astype(np.int64), method, seconds=time.perf_counter() - t0)
     m = topo.n_tets
-    if nonconvex not in ("auto", "sample", "none"):
-        raise ValueError(f"nonconvex must be 'auto', 'sample' or 'none', got {nonconvex!r}")
-    sample = nonconvex == "sample" or (nonconvex == "auto" and not is_convex(topo))
-    if sample:
+    if nonconvex not in NONCONVEX:
+        raise ValueError(f"nonconvex must be one of {NONCONVEX}, got {nonconvex!r}")
+    if nonconvex == "sample":
         src, dst = boundary_relations(topo, camera, size)
+    elif nonconvex == "object" or (nonconvex == "auto" and not is_convex(topo)):
+        src, dst = object_relations(topo, camera, size)
     else:
         src, dst = np.empty(0, np.int64), np.empty(0, np.int64)
     ptr, dsts = _csr(src, dst, m)
