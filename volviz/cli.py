@@ -29,6 +29,8 @@ BENCHMARKS = {
     "iso": "multiple semi-transparent isosurfaces: compositing modes against the exact order",
     "isolation": "crash-isolated reading: isolated against in-process read time on every shared dataset",
     "robustness": "fuzz campaign: mutated shared files through volviz's readers and VTK's, side by side",
+    "first_open": "volviz render of every shared file: time to the first image, drawn share, transfer-function "
+                  "legibility",
 }
 #: commands whose arguments go, unread here, to their own parser (``volviz.regular.cli``, ``volviz.bench.NAME``)
 PASSED_ON = ("bench", "compress")

@@ -164,11 +164,6 @@ BOOKKEEPING_ARRAYS = frozenset({
     "pointid", "sourceelementid", "sourceelementside", "vtkvalidpointmask", "vtkinsidedness", "vtkpedigreeids"})
 
 
-#: VTK cell types of solid cells (tetrahedron, voxel, hexahedron, wedge, pyramid, prisms, their quadratic forms,
-#: polyhedron): a mesh holding any is drawn as a volume, which needs an array
-_SOLID_CELL_TYPES = frozenset({10, 11, 12, 13, 14, 15, 16, 24, 25, 26, 27, 29, 32, 33, 42})
-
-
 def is_bookkeeping_array(name: str) -> bool:
     """Whether ``name`` is a bookkeeping array (``BOOKKEEPING_ARRAYS``): ids, ghost levels, masks; never the default
     array while another exists, and on a mesh not at all (a mesh with nothing else is drawn plain)."""
@@ -205,17 +200,16 @@ def vertex_colors(dataset: Any) -> np.ndarray | None:
 def default_array(dataset: Any) -> str | None:
     """The spec a first open shows: the dataset's active array when it varies, else the first point array that
     varies, else the first cell array that varies, else the first array (vectors by their magnitude). Bookkeeping
-    arrays (``is_bookkeeping_array``: ids, ghost levels) are candidates only where nothing else is: never on a
-    surface mesh; on meshes appearance attributes (``is_appearance_array``) are not candidates either, and None when
-    nothing else is there, a surface then drawn plain (on a volume an "rgb" array is data: a colour microscopy stack;
-    a mesh of solid cells keeps its ids while the unstructured volume renderer needs a field to draw)."""
+    arrays (``is_bookkeeping_array``: ids, ghost levels) are candidates only where nothing else is, and never on a
+    mesh; on meshes appearance attributes (``is_appearance_array``) are not candidates either: None when nothing
+    else is there, the mesh then drawn as plain geometry (``volviz.model.representation``; on a volume an "rgb"
+    array is data: a colour microscopy stack)."""
     infos = list_arrays(dataset)
     base = _base(dataset)
     mesh = isinstance(base, UnstructuredMesh)
     if mesh:
         infos = [i for i in infos if not is_appearance_array(i.name)]
-    surface = mesh and not any(int(t) in _SOLID_CELL_TYPES and len(c) for t, c in base.cells)
-    if surface or any(not is_bookkeeping_array(i.name) for i in infos):
+    if mesh or any(not is_bookkeeping_array(i.name) for i in infos):
         infos = [i for i in infos if not is_bookkeeping_array(i.name)]
     if not infos:
         return None

@@ -8,6 +8,14 @@ optical depth of about ``TARGET_DEPTH`` for the average sample, whatever the dat
 neither faint nor a solid block. Values above the upper percentile keep the peak opacity and color; the function
 spans the whole finite range, because volviz draws scalars outside a transfer function's range as transparent.
 
+A background need not sit in one end bin: CT air is noisy, a flow's free stream is a narrow spike inside the range.
+The dominant mode of the histogram is found and followed down both of its flanks to the valleys around it, the
+valley-seeking mode separation of Prewitt & Mendelsohn (1966, "The analysis of cell images", Ann. N.Y. Acad. Sci.
+128) on a lightly smoothed histogram. When that mode is narrow (at most ``MODE_WIDTH`` of the range) and holds more
+than ``BACKGROUND_FRACTION`` of the values it is the background: at the low end of the range the ramp starts above
+it; elsewhere (a free stream, the bright side of an inverted image) the function is centred on it, transparent there
+and rising with the distance from it on either side, cool below and warm above, as the signed view is about zero.
+
 Signed data around zero (seismic amplitudes, a velocity component, vorticity, an orbital's two signs: robust
 percentiles of opposite signs, the smaller at least ``SIGNED_BALANCE`` of the larger) gets the diverging view
 instead: zero transparent and white, the ramp rising towards both signs alike, blue for negative and red for
@@ -26,6 +34,8 @@ MIN_DEPTH, MAX_DEPTH = 1.5, 60.0   # bounds of the peak extinction times the cho
 MAX_SAMPLES = 2_000_000        # the statistics use an even subsample of larger data
 COOL_WARM = ((0.23, 0.30, 0.75), (0.55, 0.69, 0.94), (0.87, 0.87, 0.87), (0.96, 0.60, 0.48), (0.71, 0.02, 0.15))
 RAMP = (0.0, 0.08, 0.3, 0.65, 1.0)     # extinction at the five color stops, as a share of the peak
+MODE_WIDTH = 0.125             # a background mode spans at most this share of the value range
+SMOOTHING = 5                  # bins of the box filter the mode's flanks are followed on
 SIGNED_BALANCE = 0.25          # signed data: the smaller of |low| and |high| percentile over the larger, at least
 
 
@@ -83,6 +93,14 @@ def auto_transfer_function(values: np.ndarray, chord: float, name: str = "auto")
     if full_hi <= full_lo:   # constant data: a faint uniform fog around the one value
         pad = max(abs(full_lo) * 1e-3, 1e-6)
         return _ramp(full_lo - pad, full_hi + pad, full_lo - pad, full_hi + pad, MIN_DEPTH / chord, name)
+    mode = background_mode(sample)
+    if mode is not None and mode[0] > full_lo:     # a background inside the range or at its top: centred on it
+        return _around(sample, full_lo, full_hi, mode, chord, name)
+    if mode is not None:                           # at the bottom: the ramp starts above it
+        fg = sample[sample > mode[1]]
+        sample_lo, sample_hi = (float(v) for v in np.percentile(fg, [LOW_PERCENTILE, HIGH_PERCENTILE]))
+        if sample_hi > sample_lo and fg.size:
+            return _scaled_ramp(sample, full_lo, full_hi, sample_lo, sample_hi, chord, name)
     lo, hi = robust_range(sample)
     signed = is_signed(lo, hi)
     reach = max(-lo, hi)
@@ -94,6 +112,66 @@ def auto_transfer_function(values: np.ndarray, chord: float, name: str = "auto")
     if signed:
         return _diverging(full_lo, full_hi, reach, rho_max, name)
     return _ramp(full_lo, full_hi, lo, hi, rho_max, name)
+
+
+def background_mode(values: np.ndarray, bins: int = 256) -> tuple[float, float, float] | None:
+    """(low edge, high edge, centre) of the background mode of ``values`` (see the module docstring), or None when
+    the dominant mode is wide or holds at most ``BACKGROUND_FRACTION`` of the values."""
+    lo, hi = float(values.min()), float(values.max())
+    if hi <= lo:
+        return None
+    counts, edges = np.histogram(values, bins=bins, range=(lo, hi))
+    smooth = np.convolve(counts, np.ones(SMOOTHING) / SMOOTHING, mode="same")
+    peak = int(np.argmax(counts))
+    a = b = peak
+    while a > 0 and counts[a - 1] > 0 and smooth[a - 1] <= smooth[a]:
+        a -= 1
+    while b < bins - 1 and counts[b + 1] > 0 and smooth[b + 1] <= smooth[b]:
+        b += 1
+    if b + 1 - a > MODE_WIDTH * bins or counts[a:b + 1].sum() <= BACKGROUND_FRACTION * values.size:
+        return None
+    return float(edges[a]), float(edges[b + 1]), float(0.5 * (edges[peak] + edges[peak + 1]))
+
+
+def _scaled_ramp(sample: np.ndarray, full_lo: float, full_hi: float, lo: float, hi: float, chord: float,
+                 name: str) -> TransferFunction:
+    """``_ramp`` between ``lo`` and ``hi`` with the peak extinction that gives the mean sample ``TARGET_DEPTH``."""
+    shape = np.interp(sample, np.linspace(lo, hi, len(RAMP)), RAMP, left=0.0)
+    return _ramp(full_lo, full_hi, lo, hi, _peak(float(shape.mean()), chord), name)
+
+
+def _peak(mean: float, chord: float) -> float:
+    depth = TARGET_DEPTH / mean if mean > 0 else MAX_DEPTH
+    return float(np.clip(depth, MIN_DEPTH, MAX_DEPTH)) / chord
+
+
+def _around(sample: np.ndarray, full_lo: float, full_hi: float, mode: tuple[float, float, float], chord: float,
+            name: str) -> TransferFunction:
+    """Transparent over the background mode ``mode`` (low, high, centre), rising with the distance from its edges
+    to the robust extremes of the values below and above it: cool below, warm above."""
+    low_edge, high_edge, _ = mode
+    below, above = sample[sample < low_edge], sample[sample > high_edge]
+    down = low_edge - float(np.percentile(below, LOW_PERCENTILE)) if below.size else 0.0
+    up = float(np.percentile(above, HIGH_PERCENTILE)) - high_edge if above.size else 0.0
+    n = len(RAMP)
+    stops: list[float] = []
+    colors: list[list[float]] = []
+    extinction: list[float] = []
+    cool, warm = np.asarray(COOL_WARM[:3][::-1]), np.asarray(COOL_WARM[2:])
+    for base, reach, side, palette in ((low_edge, down, -1.0, cool), (high_edge, up, 1.0, warm)):
+        if reach <= 0:
+            continue
+        for f in np.linspace(0.0, 1.0, n):
+            stops.append(base + side * f * reach)
+            colors.append([float(np.interp(f, np.linspace(0.0, 1.0, 3), palette[:, c])) for c in range(3)])
+            extinction.append(float(np.interp(f, np.linspace(0.0, 1.0, n), RAMP)))
+    order = np.argsort(stops, kind="stable")
+    stops = [stops[i] for i in order]
+    colors = [colors[i] for i in order]
+    extinction = [extinction[i] for i in order]
+    shape = np.interp(sample, stops, extinction)
+    rho_max = _peak(float(shape.mean()), chord)
+    return _held_flat(full_lo, full_hi, stops, colors, [e * rho_max for e in extinction], name, hold_low=True)
 
 
 def is_signed(lo: float, hi: float) -> bool:

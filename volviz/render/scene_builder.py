@@ -308,6 +308,9 @@ def prepare_scene(session: Session, datasets: dict[str, Any], t: Optional[float]
     time ``t``, the natural scene's maps and volumes, data histograms). Touches no plotter; ``install_scene`` adds
     the props on the GUI thread."""
     ensure_transfer_functions(session, datasets)
+    from volviz.render.first_look import first_look
+
+    t = first_look(session, datasets, t)   # a series constant at its first step: from where it varies
     prepared = PreparedScene(time=t)
     shown = [c for c in session.components if c.visible and c.type not in NATURE_TYPES]
     for i, comp in enumerate(shown):
@@ -541,17 +544,11 @@ def dataset_traits(dataset: Any) -> DatasetTraits:
 
 def drawn_as(dataset: Any) -> str:
     """How a volume component draws a loaded dataset: ``"points"`` (a mesh of vertices only, e.g. a point table),
-    ``"surface"`` (surface cells, a flat grid: ``vtk_scene.is_surface``) or ``"volume"``."""
-    from volviz.model import TimeSeries, UnstructuredMesh
-    from volviz.render.vtk_scene import is_surface
+    ``"surface"`` (surface cells, a flat grid, no field or a constant one: ``volviz.model.representation``) or
+    ``"volume"``."""
+    from volviz.model.representation import representation
 
-    if is_lod(dataset):
-        return "volume"
-    first = dataset.frame(0) if isinstance(dataset, TimeSeries) else dataset
-    if not is_surface(first):
-        return "volume"
-    points = isinstance(first, UnstructuredMesh) and all(int(t) == 1 for t, _ in first.cells)
-    return "points" if points else "surface"
+    return "volume" if is_lod(dataset) else representation(dataset).kind
 
 
 def add_lod_component(plotter: Any, session: Session, comp: Component, dataset: Any, update: bool = True) -> Any:

@@ -15,6 +15,7 @@ from volviz.model import CurvilinearGrid, Image2D, RegularVolume, TetMesh, TimeS
 from volviz.render.vtk_tf import tf_to_vtk
 from volviz.session import CameraState
 
+PLAIN_COLOR = (0.80, 0.80, 0.78)    # geometry without a field: a neutral light grey, shaded by the lights
 DEFAULT_COLORS = ((0.23, 0.30, 0.75), (0.87, 0.87, 0.87), (0.71, 0.02, 0.15))  # cool-warm: low, middle, high
 
 
@@ -138,8 +139,8 @@ def add_dataset(plotter: Any, dataset: Any, tf: Any = None, opacity: float = 1.0
         return _add_image(plotter, dataset, name)
 
     grid = volume_grid(dataset)
-    if grid.active_scalars is None:
-        return plotter.add_mesh(grid, opacity=opacity, name=name)
+    if grid.active_scalars is None or shows_no_field(dataset):
+        return add_surface(plotter, surface_input(dataset, plain=True), tf, opacity, name)
     if tf is None:
         tf = default_transfer_function_for(dataset)
     if is_surface(dataset):
@@ -172,41 +173,43 @@ def volume_prop(plotter: Any, data: Any, regular: bool, tf: Any, opacity: float,
     return volume
 
 
-VOLUME_CELL_TYPES = (10, 12, 13, 14)   # VTK tetrahedron, hexahedron, wedge, pyramid
-
-
 def is_surface(dataset: Any) -> bool:
-    """Whether ``dataset`` (the first frame of a time series) has no volume: a curvilinear grid flat in one index
-    direction (an ocean surface, a 2D simulation) or a mesh of surface cells only. Such data is drawn as a surface
-    colored by its array, not as a volume."""
-    if isinstance(dataset, TimeSeries):
-        dataset = dataset.frame(0)
-    if isinstance(dataset, CurvilinearGrid):
-        return min(dataset.dimensions) < 2
-    if isinstance(dataset, UnstructuredMesh):
-        return not any(int(t) in VOLUME_CELL_TYPES and len(c) for t, c in dataset.cells)
-    return False
+    """Whether ``dataset`` (a time series: at its first step where the field varies) is not drawn as a volume: a
+    mesh of surface cells or vertices, a grid one layer thick, geometry without a field or a constant field (the
+    one rule of ``volviz.model.representation``). Such data is drawn as a surface colored by its field, or plain."""
+    from volviz.model.representation import VOLUME, representation
+
+    return representation(dataset).kind != VOLUME
+
+
+def shows_no_field(dataset: Any) -> bool:
+    """Whether ``dataset`` (a volviz dataset) is geometry alone, drawn in a plain color without a scalar bar (a mesh
+    with only block ids, an STL)."""
+    from volviz.model.representation import representation
+
+    known = isinstance(dataset, (TimeSeries, CurvilinearGrid, UnstructuredMesh))
+    return known and representation(dataset).field is None
 
 
 #: the point array of a surface's own colours (``surface_input``), drawn as they are by ``add_surface``
 VERTEX_COLORS = "volviz vertex colours"
 
 
-def surface_input(dataset: Any) -> Any:
+def surface_input(dataset: Any, plain: bool = False) -> Any:
     """The PyVista surface drawn for a dataset of surface cells (``is_surface``; or its ``volume_grid``), its active
-    scalars kept active unless they are an appearance attribute (``volviz.model.arrays.is_appearance_array``): then
-    its vertex colours (``VERTEX_COLORS``), if it has any, else none. The cells touching NaN/Inf (land in an ocean
-    field, a solver's failed points) are left out."""
+    scalars kept active unless they are an appearance attribute (``volviz.model.arrays.is_appearance_array``) or
+    the dataset is drawn ``plain`` (geometry alone): then its vertex colours (``VERTEX_COLORS``), if it has any, else
+    none. The cells touching NaN/Inf (land in an ocean field, a solver's failed points) are left out."""
     from volviz.model.arrays import is_appearance_array, vertex_colors
 
     grid = volume_grid(dataset)
     name = grid.active_scalars_name
-    if name is not None and is_appearance_array(name):
+    if name is not None and (plain or is_appearance_array(name)):
         name = None
         colors = vertex_colors(dataset)
         if colors is not None and len(colors) == grid.n_points:
             grid.point_data[VERTEX_COLORS] = colors
-    values = np.asarray(grid.active_scalars)
+    values = np.asarray(grid.active_scalars) if name is not None else np.zeros(0)
     if values.dtype.kind == "f" and not np.isfinite(values).all():   # cells touching NaN/Inf are not drawn
         grid = grid.extract_points(np.flatnonzero(np.isfinite(values)), adjacent_cells=False)
     surface = grid.extract_surface(algorithm="dataset_surface") if hasattr(grid, "extract_surface") else grid
@@ -223,6 +226,9 @@ def add_surface(plotter: Any, surface: Any, tf: Any, opacity: float, name: Optio
     in its own vertex colours when it shows no array."""
     if surface.active_scalars_name is None and VERTEX_COLORS in surface.point_data:
         return plotter.add_mesh(surface, scalars=VERTEX_COLORS, rgb=True, opacity=opacity, name=name,
+                                show_scalar_bar=False, reset_camera=False, render=False)
+    if surface.active_scalars_name is None or tf is None:      # geometry alone: one neutral color
+        return plotter.add_mesh(surface, scalars=None, color=PLAIN_COLOR, opacity=opacity, name=name,
                                 show_scalar_bar=False, reset_camera=False, render=False)
     ctf, _ = tf_to_vtk(tf, 1.0)
     ctf.ClampingOn()

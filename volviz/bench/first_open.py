@@ -1,0 +1,323 @@
+"""Benchmark: the first image of every shared dataset as ``volviz render FILE -o x.png`` makes it (issue #30).
+
+For each file a user would open in the data folder (one member of each numbered series, the OpenFOAM case as its
+folder) it measures, in a fresh process each, the wall time of ``volviz render FILE -o x.png`` (1024x768) and the
+share of the image's pixels that differ from the background. For every dataset drawn as a volume it also measures
+the legibility of the automatic transfer function (``volviz.optics.auto_tf``), in this process:
+
+- *visible footprint*: of the pixels the data covers (the same view rendered with an opaque transfer function),
+  the share whose colour differs visibly from the background (CIE76 colour difference above ``VISIBLE_DE``);
+- *mode contrast*: the colour difference between the two main modes of the data's histogram, each seen as a slab
+  of its value as thick as the mean chord of the data's box over the background (``mode_contrast``).
+
+Writes the section between ``BEGIN`` and ``END`` of ``docs/first-open.md`` (the app's table above it is kept), or
+only prints with ``--no-write``. ``--profile N`` adds where the time of the N slowest files goes (cProfile of an
+in-process render, by volviz module).
+"""
+from __future__ import annotations
+
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import time
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Optional
+
+import numpy as np
+
+from volviz.argtypes import UsageParser
+
+DEFAULT_DATA = Path(os.environ.get("VOLVIZ_DATA", Path(__file__).resolve().parents[2].parent / "shared" / "data"))
+REPORT = Path(__file__).resolve().parents[2] / "docs" / "first-open.md"
+BEGIN, END = "<!-- volviz bench first_open: begin -->", "<!-- volviz bench first_open: end -->"
+COMMAND = "VOLVIZ_DATA=../shared/data .venv/bin/volviz bench first_open --profile 3"
+SIZE = (1024, 768)
+METRIC_SIZE = (320, 240)       # the legibility measures render smaller (they compare shares, not details)
+VISIBLE_DE = 10.0              # CIE76 difference a viewer sees at a glance (2.3 is just noticeable)
+DRAWN_DIFFERENCE = 24          # summed |RGB| difference from the background of a drawn pixel
+TARGET_S = 5.0
+MAX_MB = 100
+
+
+def opened_files(root: Path) -> list[Path]:
+    """The files under ``root`` a user opens: every data file, one member (the first) of each numbered series, a
+    folder that a reader opens whole (an OpenFOAM case) as itself; no README, no sidecar a header names."""
+    from volviz.io import ReadError
+    from volviz.io.registry import spec_of
+    from volviz.render.scene_builder import series_pattern
+
+    found: list[Path] = []
+    seen: set[str] = set()
+    for folder, dirs, files in os.walk(root):
+        dirs.sort()
+        here = Path(folder)
+        if here != root and (here / "case.foam").exists():
+            try:
+                spec_of(here)
+                found.append(here)
+                dirs.clear()
+                continue
+            except ReadError:
+                pass
+        for name in sorted(files, key=_natural):
+            path = here / name
+            sidecar = path.suffix.lower() == ".h5" and path.with_suffix(".xdmf").exists()   # XDMF heavy data
+            if name.lower() == "readme.md" or path.suffix.lower() == ".raw" or name.endswith(".dat.h5") or sidecar:
+                continue
+            pattern = series_pattern(path)
+            if pattern is not None:
+                if pattern in seen:
+                    continue
+                seen.add(pattern)
+            found.append(path)
+    return found
+
+
+def _natural(name: str) -> list[Any]:
+    return [int(part) if part.isdigit() else part for part in re.split(r"(\d+)", name)]
+
+
+def drawn_fraction(image: np.ndarray) -> float:
+    """The share of ``image``'s pixels that differ from its background (its top-left pixel)."""
+    image = np.asarray(image)[..., :3].astype(np.int32)
+    return float((np.abs(image - image[0, 0]).sum(axis=2) > DRAWN_DIFFERENCE).mean())
+
+
+def to_lab(rgb: np.ndarray) -> np.ndarray:
+    """sRGB in [0, 1] (..., 3) to CIE L*a*b* (D65)."""
+    rgb = np.asarray(rgb, dtype=np.float64)
+    linear = np.where(rgb <= 0.04045, rgb / 12.92, ((rgb + 0.055) / 1.055) ** 2.4)
+    xyz = linear @ np.array([[0.4124, 0.2126, 0.0193], [0.3576, 0.7152, 0.1192], [0.1805, 0.0722, 0.9505]])
+    xyz = xyz / np.array([0.95047, 1.0, 1.08883])
+    f = np.where(xyz > 0.008856, np.cbrt(xyz), 7.787 * xyz + 16.0 / 116.0)
+    return np.stack([116.0 * f[..., 1] - 16.0, 500.0 * (f[..., 0] - f[..., 1]), 200.0 * (f[..., 1] - f[..., 2])],
+                    axis=-1)
+
+
+def color_difference(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """CIE76 colour difference of sRGB colours in [0, 1]."""
+    return np.linalg.norm(to_lab(a) - to_lab(b), axis=-1)
+
+
+def main_modes(values: np.ndarray, bins: int = 128) -> tuple[float, float]:
+    """The values of the two main modes of ``values``' histogram: its tallest bin, and the tallest local maximum at
+    least 1/8 of the range away from it (the second tallest bin when the histogram has one hump)."""
+    counts, edges = np.histogram(values, bins=bins)
+    centres = 0.5 * (edges[1:] + edges[:-1])
+    first = int(np.argmax(counts))
+    padded = np.concatenate([[-1], counts, [-1]])
+    peaks = [i for i in range(bins) if padded[i + 1] >= padded[i] and padded[i + 1] >= padded[i + 2]
+             and abs(i - first) >= bins // 8 and counts[i] > 0]
+    if not peaks:
+        peaks = [i for i in np.argsort(counts)[::-1] if i != first][:1]
+    second = max(peaks, key=lambda i: counts[i])
+    return float(centres[first]), float(centres[second])
+
+
+def slab_color(tf: Any, value: float, chord: float, background: np.ndarray) -> np.ndarray:
+    """The colour of a slab of ``value`` ``chord`` thick seen through ``tf`` over ``background`` (emission and
+    absorption with the transfer function's color and extinction)."""
+    colors, extinction = tf.evaluate(np.array([value]))
+    color = np.clip(np.asarray(colors, dtype=np.float64).reshape(-1, 3)[0], 0.0, 1.0)
+    alpha = 1.0 - float(np.exp(-float(np.asarray(extinction).reshape(-1)[0]) * chord))
+    return alpha * color + (1.0 - alpha) * np.asarray(background, dtype=np.float64)
+
+
+def mode_contrast(values: np.ndarray, tf: Any, chord: float, background: np.ndarray) -> float:
+    """CIE76 difference between the slabs (``slab_color``) of the two main modes (``main_modes``) of ``values``."""
+    a, b = main_modes(values)
+    return float(color_difference(slab_color(tf, a, chord, background), slab_color(tf, b, chord, background)))
+
+
+@dataclass
+class FirstImage:
+    """One file's first image: time, drawn share, how it is drawn, and the legibility measures of a volume."""
+
+    name: str
+    megabytes: float
+    seconds: Optional[float] = None
+    drawn: Optional[float] = None
+    kind: str = ""
+    visible: Optional[float] = None
+    contrast: Optional[float] = None
+    note: str = ""
+    profile: list[str] = field(default_factory=list)
+
+
+def render_timed(path: Path, out: Path) -> tuple[float, int, str]:
+    """Wall seconds, exit status and last stderr line of ``volviz render PATH -o OUT`` in a fresh process."""
+    start = time.perf_counter()
+    done = subprocess.run([str(Path(sys.executable).parent / "volviz"), "render", str(path), "-o", str(out), "--size",
+                           f"{SIZE[0]}x{SIZE[1]}"], capture_output=True, text=True, timeout=600)
+    seconds = time.perf_counter() - start
+    lines = [line for line in done.stderr.splitlines() if line.strip()]
+    return seconds, done.returncode, lines[-1] if lines else ""
+
+
+def legibility(path: Path) -> Optional[tuple[str, Optional[float], Optional[float]]]:
+    """How ``path`` is drawn, and for a volume its visible footprint and mode contrast (see the module docstring)."""
+    from volviz.model.stats import scalar_values
+    from volviz.optics import TransferFunction
+    from volviz.optics.auto_tf import mean_chord
+    from volviz.render.export import open_target, render_session
+    from volviz.render.scene_builder import (component_dataset, component_transfer_function, drawn_as,
+                                            ensure_transfer_functions, load_datasets)
+    from volviz.render.vtk_scene import volume_grid
+
+    session, _ = open_target(path)
+    comp = session.components[0]
+    if comp.type != "volume" or comp.dataset is None:
+        return comp.type, None, None
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        datasets = load_datasets(session, None)
+        kind = drawn_as(datasets[comp.dataset])
+        if kind != "volume":
+            return kind, None, None
+        ensure_transfer_functions(session, datasets)
+        session.render.options["axes"] = False
+        image = render_session(session, None, METRIC_SIZE, datasets=datasets)
+        tf = component_transfer_function(session, comp)
+        tf_name = str(comp.transfer_function)
+        dataset = component_dataset(comp, datasets)
+        chord = mean_chord(volume_grid(dataset).bounds)
+        lo, hi = tf.range
+        opaque = TransferFunction([lo, hi], [(1.0, 1.0, 1.0)] * 2, [60.0 / chord] * 2, name=tf_name)
+        session.transfer_functions[tf_name] = opaque.to_dict()
+        mask_image = render_session(session, None, METRIC_SIZE, datasets=datasets)
+    background = np.asarray(session.render.background, dtype=np.float64)
+    footprint = np.abs(mask_image.astype(np.int32) - mask_image[0, 0]).sum(axis=2) > DRAWN_DIFFERENCE
+    footprint[:, int(0.8 * METRIC_SIZE[0]):] = False          # the scalar bar
+    seen = color_difference(image / 255.0, background) > VISIBLE_DE
+    visible = float((seen & footprint).sum() / max(int(footprint.sum()), 1))
+    values = np.asarray(scalar_values(dataset), dtype=np.float64).reshape(-1)
+    values = values[np.isfinite(values)]
+    return kind, visible, mode_contrast(values, tf, chord, background)
+
+
+def where_time_goes(path: Path, top: int = 6) -> list[str]:
+    """The volviz functions (and VTK's render) that took the most cumulative time of an in-process render of
+    ``path`` after imports: cProfile, top ``top`` by own module, as 'module.function s'."""
+    import cProfile
+    import pstats
+
+    from volviz.render.export import open_target, render_session
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        session, _ = open_target(path)
+        profiler = cProfile.Profile()
+        profiler.enable()
+        render_session(session, None, SIZE)
+        profiler.disable()
+    stats = pstats.Stats(profiler)
+    rows = []
+    for (filename, _, function), entry in stats.stats.items():  # type: ignore[attr-defined]
+        cumulative = entry[3]
+        if "/volviz/" in filename and not function.startswith("<"):
+            module = filename.split("/volviz/")[-1].removesuffix(".py").replace("/", ".")
+            rows.append((cumulative, f"{module}.{function}"))
+    rows.sort(reverse=True)
+    total = sum(entry[2] for entry in stats.stats.values())  # type: ignore[attr-defined]
+    picked = [f"`{name}` {seconds:.2f} s" for seconds, name in rows[1:top + 1]]
+    return [f"in-process render {total:.2f} s of own time"] + picked
+
+
+def measure(root: Path, names: Optional[list[str]] = None) -> list[FirstImage]:
+    """Every file of ``opened_files`` (or those named in ``names``, relative to ``root``) measured."""
+    records = []
+    with tempfile.TemporaryDirectory() as work:
+        for path in opened_files(root):
+            name = path.relative_to(root).as_posix()
+            if names and name not in names:
+                continue
+            size = sum(p.stat().st_size for p in path.rglob("*") if p.is_file()) if path.is_dir() else \
+                path.stat().st_size
+            record = FirstImage(name, size / 1e6)
+            if record.megabytes < MAX_MB:
+                out = Path(work) / "x.png"
+                seconds, status, last = render_timed(path, out)
+                if status == 0:
+                    from PIL import Image
+
+                    record.seconds = seconds
+                    record.drawn = drawn_fraction(np.asarray(Image.open(out).convert("RGB")))
+                else:
+                    record.note = last.removeprefix("volviz: error: ")
+            if not record.note:
+                try:
+                    shown = legibility(path)
+                except Exception as exc:  # a measure that cannot be made is said, the row kept
+                    record.note = f"legibility: {type(exc).__name__}: {exc}"
+                else:
+                    if shown is not None:
+                        record.kind, record.visible, record.contrast = shown
+            print(f"{name}: {record.seconds} s drawn {record.drawn} {record.kind} visible {record.visible} "
+                  f"contrast {record.contrast} {record.note}", flush=True)
+            records.append(record)
+    return records
+
+
+def _number(value: Optional[float], fmt: str) -> str:
+    return "" if value is None else format(value, fmt)
+
+
+def markdown(records: list[FirstImage], profiles: dict[str, list[str]]) -> str:
+    """The section of ``docs/first-open.md`` this benchmark writes."""
+    import platform
+
+    lines = [BEGIN, "", "## `volviz render`: time to the first image, and legibility of the automatic transfer "
+             "function", "", "Regenerate (about 3 minutes):", "", "```", COMMAND, "```", "",
+             f"Each file is rendered by `volviz render FILE -o x.png` ({SIZE[0]}x{SIZE[1]}) in a fresh process: "
+             "*first image* is that command's wall time (start-up, imports, reading, the transfer function, the "
+             f"render, the PNG); target under {TARGET_S:g} s for files under {MAX_MB} MB. *Drawn* is the share of "
+             "the image's pixels that differ from the background. For volumes, *visible* is the share of the data's "
+             "footprint (the same view with an opaque transfer function) whose colour differs from the background "
+             f"by more than ΔE {VISIBLE_DE:g} (CIE76), and *contrast* the ΔE between the two main modes of the "
+             "histogram, each seen as a slab one mean chord thick (`volviz.bench.first_open`). Measured on "
+             f"{platform.machine()} with {os.cpu_count()} cores, Mesa llvmpipe, while other work ran.", "",
+             "| file | MB | drawn as | first image | drawn | visible | contrast (ΔE) | notes |",
+             "|---|---|---|---|---|---|---|---|"]
+    for r in records:
+        lines.append(f"| `{r.name}` | {r.megabytes:.1f} | {r.kind} | {_number(r.seconds, '.1f')}"
+                     f"{' s' if r.seconds is not None else ''} | {_number(r.drawn, '.0%')} | "
+                     f"{_number(r.visible, '.0%')} | {_number(r.contrast, '.0f')} | {r.note.replace('|', '/')} |")
+    if profiles:
+        lines += ["", "Where the time goes for the slowest files (cProfile of the same render in one process, "
+                  "cumulative seconds of the largest volviz calls):", ""]
+        for name, rows in profiles.items():
+            lines.append(f"- `{name}`: " + "; ".join(rows))
+    return "\n".join(lines + ["", END]) + "\n"
+
+
+def write_section(text: str, report: Path = REPORT) -> None:
+    """Replace the section between ``BEGIN`` and ``END`` of ``report`` by ``text`` (appended when absent)."""
+    from volviz.io.atomic import atomic_write_text
+
+    old = report.read_text() if report.exists() else ""
+    if BEGIN in old and END in old:
+        new = old[:old.index(BEGIN)] + text.rstrip("\n") + old[old.index(END) + len(END):]
+    else:
+        new = old.rstrip("\n") + "\n\n" + text
+    atomic_write_text(report, new)
+
+
+def main(argv: Optional[list[str]] = None) -> int:
+    parser = UsageParser(prog="volviz bench first_open", description=__doc__.split("\n")[0])
+    parser.add_argument("--data", type=Path, default=DEFAULT_DATA, help="the data folder (default $VOLVIZ_DATA)")
+    parser.add_argument("--only", nargs="*", default=None, help="only these files (relative to the data folder)")
+    parser.add_argument("--profile", type=int, default=0, help="say where the time goes for the N slowest files")
+    parser.add_argument("--no-write", action="store_true", help="print only; leave docs/first-open.md alone")
+    args = parser.parse_args(argv)
+    records = measure(args.data.resolve(), args.only)
+    slowest = sorted((r for r in records if r.seconds is not None), key=lambda r: -float(r.seconds or 0))
+    profiles = {r.name: where_time_goes(args.data.resolve() / r.name) for r in slowest[:max(args.profile, 0)]}
+    text = markdown(records, profiles)
+    print(text)
+    if not args.no_write:
+        write_section(text)
+    return 0
