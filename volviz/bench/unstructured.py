@@ -85,6 +85,7 @@ def _vtk_render(mesh: Any, tf: Any, cam: Any, size: int, mapper_name: str, reps:
     for _ in range(reps):
         t0 = time.perf_counter()
         win.Render()
+        finish(win)
         times.append(time.perf_counter() - t0)
     w2i = vtk.vtkWindowToImageFilter()
     w2i.SetInput(win)
@@ -94,6 +95,12 @@ def _vtk_render(mesh: Any, tf: Any, cam: Any, size: int, mapper_name: str, reps:
     arr = vtk_to_numpy(w2i.GetOutput().GetPointData().GetScalars()).reshape(size, size, 3)[::-1]
     win.Finalize()
     return arr.astype(np.float64) / 255.0, times
+
+
+def finish(window: Any) -> None:
+    """Wait until the GPU has completed the frame (``vtkOpenGLRenderWindow.WaitForCompletion``, a glFinish), so that
+    a timed ``Render()`` ends with the GPU's completion and not with the command submission (issue #29)."""
+    window.WaitForCompletion()
 
 
 def _rgb_err(a: np.ndarray, b: np.ndarray) -> tuple[float, float]:
@@ -149,6 +156,7 @@ def gl_pt_frames(mesh: Any, tf: Any, cams: list[Any], size: tuple[int, int], rep
             cam.apply_to(pl.renderer.GetActiveCamera())
             t0, c0 = time.perf_counter(), time.process_time()
             ren_win.Render()
+            finish(ren_win)
             frame.append(time.perf_counter() - t0)
             cpu.append(time.process_time() - c0)
             sort.append(vol.stats["sort_s"])
@@ -180,6 +188,7 @@ def _timed_render(pl: Any) -> float:
     """The process CPU seconds of one render."""
     c0 = time.process_time()
     pl.ren_win.Render()
+    finish(pl.ren_win)
     return time.process_time() - c0
 
 
@@ -206,6 +215,10 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--scan", type=_size_list, default=[],
                    help="also time pt, pt-gl and vtkProjectedTetrahedraMapper at these window sizes "
                         "(comma list of N or WxH, e.g. 256,512,1024,1920x1080; 2 cameras, 1 frame each)")
+    p.add_argument("--sort-sizes", type=_size_list, default=_size_list("256,512,1024,1920x1080,3840x2160"),
+                   help="window sizes of the sort-seconds table (comma list of N or WxH; empty: no table)")
+    p.add_argument("--cpu-sizes", type=_size_list, default=_size_list("512,1920x1080,3840x2160"),
+                   help="window sizes at which pt-gl's CPU side is taken apart, beside 64² (2 cameras, 1 frame each)")
     p.add_argument("--out", default=str(Path(__file__).resolve().parents[2] / "docs" / "bench"))
     p.add_argument("--json", default=None, help="also write the results as JSON")
     args = p.parse_args(argv)
@@ -310,6 +323,10 @@ def main(argv: list[str] | None = None) -> int:
                                        "cpu_side_proper_s": gl64["cpu_side_proper_s"]}
         images["pt-gl"] = gl_img
         print(f"pt-gl: {results['methods']['pt-gl']}", flush=True)
+        if args.cpu_sizes:
+            results["cpu_side"] = cpu_side_scan(mesh, tf, cams[:2], [(64, 64), *args.cpu_sizes], args.gl_lookup)
+    if args.sort_sizes:
+        results["sort_scan"] = sort_scan(mesh, cams[:2] if len(cams) > 1 else cams * 2, args.sort_sizes, args.reps)
 
     results["methods"]["pt"]["path"] = along
     covered = int((pt_imgs[0][..., 3] > 0).sum())
@@ -355,6 +372,46 @@ def main(argv: list[str] | None = None) -> int:
     if args.json:
         Path(args.json).write_text(json.dumps(results, indent=2))
     return 0
+
+
+#: the sort rows of the window-size table: (label, method, nonconvex)
+SORT_ROWS = (("mpvo (object-space boundary relations)", "mpvo", "auto"),
+             ("mpvo (boundary relations sampled at the pixel centres, before #29)", "mpvo", "sample"),
+             ("centroid", "centroid", "auto"), ("power", "power", "auto"))
+
+
+def sort_scan(mesh: Any, cams: list[Any], sizes: list[tuple[int, int]], reps: int) -> list[dict[str, Any]]:
+    """Seconds of ``visibility_order`` against window size for each of ``SORT_ROWS``: the median over ``cams`` x
+    ``reps`` calls after a warm-up call (each call for a camera other than the previous one)."""
+    from volviz.unstructured.sort import visibility_order
+    from volviz.unstructured.topology import topology
+
+    topo = topology(mesh)
+    rows = []
+    for label, method, nonconvex in SORT_ROWS:
+        row: dict[str, Any] = {"label": label, "seconds": {}}
+        visibility_order(topo, cams[-1], sizes[0], method, nonconvex)
+        for w, h in sizes:
+            times = [visibility_order(topo, cam, (w, h), method, nonconvex).seconds
+                     for _ in range(reps) for cam in cams]
+            row["seconds"][f"{w}x{h}"] = float(np.median(times))
+        rows.append(row)
+        print(f"sort scan: {row}", flush=True)
+    return rows
+
+
+def cpu_side_scan(mesh: Any, tf: Any, cams: list[Any], sizes: list[tuple[int, int]], lookup: str
+                  ) -> list[dict[str, Any]]:
+    """The CPU side of a pt-gl frame for a new camera at each window size (``gl_pt_frames`` with ``split``: sort,
+    order, index buffer upload, draw submission; one pass over ``cams``)."""
+    rows = []
+    for w, h in sizes:
+        res, _ = gl_pt_frames(mesh, tf, cams, (w, h), 1, lookup, split=True)
+        row = {"size": [w, h], **{k: res[k] for k in ("frame_s", "cpu_s", "sort_s", "order_s", "ibo_s",
+                                                       "one_cell_s", "draw_work_s", "cpu_side_proper_s")}}
+        rows.append(row)
+        print(f"cpu side {w}x{h}: {row}", flush=True)
+    return rows
 
 
 def _size_scan(mesh: Any, tf: Any, cams: list[Any], sizes: list[tuple[int, int]], gl_lookup: str, sort: str,
@@ -500,6 +557,8 @@ def _markdown(results: dict[str, Any], path: Path) -> None:
                   + (f". vtkProjectedTetrahedraMapper: {v64:.3f} s per 64² frame (target ≤ 1/5: {v64 / 5:.3f} s; "
                      f"pt-gl's total {gl['cpu_side_s'] / v64:.2f}x, proper {gl['cpu_side_proper_s'] / v64:.2f}x of "
                      "it)." if v64 else ".")]
+    lines += _cpu_side_lines(results.get("cpu_side"), results["n_tets"])
+    lines += _sort_scan_lines(results.get("sort_scan"), results["n_tets"])
     scan = results.get("scan")
     if scan:
         lines += ["", "Seconds per frame against window size (median of 2 cameras, one frame each):", "",
@@ -522,6 +581,38 @@ def _markdown(results: dict[str, Any], path: Path) -> None:
               "sorting ≥ 2 M tetrahedra/s.", "",
               "![time vs error](unstructured_time_error.png)", "", "![side by side](unstructured_side_by_side.png)", ""]
     path.write_text("\n".join(lines))
+
+
+def _cpu_side_lines(rows: list[dict[str, Any]] | None, n_tets: int) -> list[str]:
+    if not rows:
+        return []
+    lines = ["", "The CPU side of a pt-gl frame for a new camera against window size (2 cameras, one frame each; "
+             "process CPU seconds, llvmpipe's threads included, split as above: sort, the order as VTK cells, "
+             "VTK's index buffer build and upload, a one-cell draw submission; every timed Render() ends with "
+             "WaitForCompletion). On llvmpipe the one-cell submission still pays the window's full-screen passes "
+             "(clearing and compositing the float target), which a GPU does off the CPU; the sort no longer "
+             "depends on the window (issue #29):", "",
+             "| window | frame s (wall) | sort s | order s | upload s | submission s | CPU side proper s | "
+             "draw work s |", "|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        lines.append(f"| {r['size'][0]}x{r['size'][1]} | {r['frame_s']:.3f} | {r['sort_s']:.4f} | "
+                     f"{r['order_s']:.4f} | {r['ibo_s']:.4f} | {r['one_cell_s']:.4f} | "
+                     f"{r['cpu_side_proper_s']:.3f} | {r['draw_work_s']:.3f} |")
+    return lines
+
+
+def _sort_scan_lines(rows: list[dict[str, Any]] | None, n_tets: int) -> list[str]:
+    if not rows:
+        return []
+    sizes = list(rows[0]["seconds"])
+    lines = ["", f"Sort seconds against window size ({n_tets} tetrahedra; `visibility_order`, median over 2 cameras "
+             "x reps after a warm-up; M tets/s at the largest size in the last column):", "",
+             "| sort | " + " | ".join(sizes) + " | M tets/s |", "|---|" + "---|" * (len(sizes) + 1)]
+    for r in rows:
+        sec = r["seconds"]
+        lines.append(f"| {r['label']} | " + " | ".join(f"{sec[k]:.4f}" for k in sizes)
+                     + f" | {n_tets / sec[sizes[-1]] / 1e6:.1f} |")
+    return lines
 
 
 if __name__ == "__main__":
