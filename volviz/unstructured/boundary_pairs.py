@@ -132,8 +132,10 @@ def _project_faces(view: np.ndarray, near: float, parallel: bool, px: np.ndarray
             for a in range(n // 2):
                 px[i, a], px[i, n - 1 - a] = px[i, n - 1 - a], px[i, a]
                 py[i, a], py[i, n - 1 - a] = py[i, n - 1 - a], py[i, a]
-        box[i, 0], box[i, 1] = px[i, :n].min(), px[i, :n].max()
-        box[i, 2], box[i, 3] = py[i, :n].min(), py[i, :n].max()
+        box[i, 0], box[i, 1], box[i, 2], box[i, 3] = px[i, 0], px[i, 0], py[i, 0], py[i, 0]
+        for a in range(1, n):
+            box[i, 0], box[i, 1] = min(box[i, 0], px[i, a]), max(box[i, 1], px[i, a])
+            box[i, 2], box[i, 3] = min(box[i, 2], py[i, a]), max(box[i, 3], py[i, a])
         nv[i] = n
     return nv
 
@@ -185,7 +187,8 @@ def _pair_relations(px: np.ndarray, py: np.ndarray, nv: np.ndarray, box: np.ndar
                 fill[cy * gx + cx] += 1
     sxp, syp = np.empty(16), np.empty(16)
     tx, ty = np.empty(16), np.empty(16)
-    out = []
+    out = np.empty(max(16, 4 * k), np.int64)
+    n_out = 0
     for c in range(gx * gy):
         ccx, ccy = c % gx, c // gx
         for p in range(cnt[c], cnt[c + 1]):
@@ -222,43 +225,59 @@ def _pair_relations(px: np.ndarray, py: np.ndarray, nv: np.ndarray, box: np.ndar
                 ex, en = (a, b) if not entry[a] else (b, a)
                 t_ex, t_en = (ta, tb) if ex == a else (tb, ta)
                 if t_ex < t_en:
-                    out.append(cell[en] * m + cell[ex])
-    keys = np.empty(len(out), np.int64)
-    for i in range(len(out)):
-        keys[i] = out[i]
-    return keys
+                    if n_out == len(out):
+                        grown = np.empty(2 * len(out), np.int64)
+                        grown[:n_out] = out
+                        out = grown
+                    out[n_out] = cell[en] * m + cell[ex]
+                    n_out += 1
+    return out[:n_out]
+
+
+def _inner_faces(topo: Topology) -> tuple[np.ndarray, ...] | None:
+    """Per inner boundary face (cached on ``topo``): its cell, vertex ids, corners (k, 3, 3), normal and offset."""
+    cached = topo.__dict__.get("_inner_faces")
+    if cached is None:
+        inner = inner_boundary(topo)
+        if len(inner) == 0:
+            cached = ()
+        else:
+            bf = topo.boundary[inner]
+            vid = np.ascontiguousarray(topo.tets[bf[:, 0][:, None], FACES[bf[:, 1]]])
+            cached = (np.ascontiguousarray(bf[:, 0]), vid, topo.points[vid], topo.face_n[bf[:, 0], bf[:, 1]],
+                      topo.face_d[bf[:, 0], bf[:, 1]])
+        topo.__dict__["_inner_faces"] = cached
+    return cached or None
 
 
 def object_relations(topo: Topology, cam: Camera, size: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
     """(src, dst) cell pairs, src drawn before dst, from the inner boundary faces in object space (module docstring).
     ``size`` gives only the image's aspect (the part of the image plane in view); the cost does not depend on it."""
-    inner = inner_boundary(topo)
-    none = np.empty(0, np.int64)
-    if len(inner) == 0:
+    static = _inner_faces(topo)
+    if static is None:
+        none = np.empty(0, np.int64)
         return none, none
-    bf = topo.boundary[inner]
-    vid = topo.tets[bf[:, 0][:, None], FACES[bf[:, 1]]]                       # (k, 3)
+    cell, vid, corners, n, d = static
     r, u, f = cam.frame()
     rot = np.stack([r, u, f], axis=1)                                           # world -> view: p @ rot
     eye = cam.position - topo.origin
-    view = np.ascontiguousarray((topo.points[vid] - eye) @ rot)                 # (k, 3, 3)
-    n = topo.face_n[bf[:, 0], bf[:, 1]]
-    plane = np.empty((len(bf), 4))
+    view = np.ascontiguousarray((corners - eye) @ rot)                          # (k, 3, 3)
+    plane = np.empty((len(cell), 4))
     plane[:, :3] = n @ rot
-    plane[:, 3] = topo.face_d[bf[:, 0], bf[:, 1]] - n @ eye                    # n_v . p_view = d_v
+    plane[:, 3] = d - n @ eye                                                   # n_v . p_view = d_v
     if cam.parallel:
         entry, edge_on = plane[:, 2] < 0, plane[:, 2] == 0
     else:
         entry, edge_on = plane[:, 3] < 0, plane[:, 3] == 0
     near = cam.clipping_range[0]
-    px, py = np.zeros((len(bf), 4)), np.zeros((len(bf), 4))
-    box = np.zeros((len(bf), 4))
+    px, py = np.zeros((len(cell), 4)), np.zeros((len(cell), 4))
+    box = np.zeros((len(cell), 4))
     nv = _project_faces(view, near, cam.parallel, px, py, box)
     nv[edge_on] = 0
     w, h = size
     hy = cam.parallel_scale if cam.parallel else np.tan(np.radians(cam.view_angle) / 2.0)
     hx = hy * w / h
-    keys = _pair_relations(px, py, nv, box, np.ascontiguousarray(vid), plane, entry, bf[:, 0].copy(), cam.parallel,
+    keys = _pair_relations(px, py, nv, box, vid, plane, entry, cell, cam.parallel,
                            np.array([-hx, hx, -hy, hy]), topo.n_tets)
     keys = np.unique(keys)
     return keys // topo.n_tets, keys % topo.n_tets

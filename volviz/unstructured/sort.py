@@ -82,31 +82,53 @@ def _power_keys(cc: np.ndarray, r2: np.ndarray, eye: np.ndarray, fwd: np.ndarray
 
 # --------------------------------------------------------------------------------------------------------------------
 # MPVO (Kahn) with extra relations and cycle breaking
-@njit(cache=True, nogil=True)
-def _mpvo(neighbor: np.ndarray, face_n: np.ndarray, face_d: np.ndarray, eye: np.ndarray, fwd: np.ndarray,
-          parallel: bool, extra_ptr: np.ndarray, extra_dst: np.ndarray, fallback: np.ndarray
-          ) -> tuple[np.ndarray, int]:
-    """Topological sort; edge a -> b means a is drawn before b (a is behind b). Returns (order, cycle breaks)."""
+@njit(cache=True, nogil=True, inline="always")
+def _side(face_n: np.ndarray, face_d: np.ndarray, t: int, f: int, eye: np.ndarray, fwd: np.ndarray,
+          parallel: bool) -> float:
+    """> 0: the eye is outside face f of cell t (its neighbour there is in front of t); < 0: inside."""
+    if parallel:
+        return -(face_n[t, f, 0] * fwd[0] + face_n[t, f, 1] * fwd[1] + face_n[t, f, 2] * fwd[2])
+    return face_n[t, f, 0] * eye[0] + face_n[t, f, 1] * eye[1] + face_n[t, f, 2] * eye[2] - face_d[t, f]
+
+
+@njit(cache=True, nogil=True, parallel=True)
+def _face_dirs(neighbor: np.ndarray, face_n: np.ndarray, face_d: np.ndarray, eye: np.ndarray, fwd: np.ndarray,
+               parallel: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Per cell and face: 1 when the neighbour is in front, -1 behind, 0 none; and per cell the number of neighbours
+    behind it. Each shared face is decided once, by the plane of its lower-numbered cell, so both sides agree; every
+    cell fills only its own entries (parallel over cells)."""
     m = len(neighbor)
-    indeg = np.zeros(m, np.int64)
-    # direction of every shared face: +1: neighbour u in front of t (t -> u); -1: u behind t (u -> t); 0: none
     dirs = np.zeros((m, 4), np.int8)
-    for t in range(m):
+    indeg = np.zeros(m, np.int64)
+    for t in prange(m):
+        n_behind = 0
         for f in range(4):
             u = neighbor[t, f]
-            if u < t:          # each shared face once (u > t); boundary faces have u = -1
+            if u < 0:
                 continue
-            if parallel:
-                side = -(face_n[t, f, 0] * fwd[0] + face_n[t, f, 1] * fwd[1] + face_n[t, f, 2] * fwd[2])
+            if u > t:
+                side = _side(face_n, face_d, t, f, eye, fwd, parallel)
             else:
-                side = (face_n[t, f, 0] * eye[0] + face_n[t, f, 1] * eye[1] + face_n[t, f, 2] * eye[2]
-                        - face_d[t, f])
+                g = 0
+                for h in range(4):
+                    if neighbor[u, h] == t:
+                        g = h
+                side = -_side(face_n, face_d, u, g, eye, fwd, parallel)
             if side > 0.0:
                 dirs[t, f] = 1
-                indeg[u] += 1
             elif side < 0.0:
                 dirs[t, f] = -1
-                indeg[t] += 1
+                n_behind += 1
+        indeg[t] = n_behind
+    return dirs, indeg
+
+
+@njit(cache=True, nogil=True)
+def _mpvo(neighbor: np.ndarray, dirs: np.ndarray, indeg: np.ndarray, extra_ptr: np.ndarray, extra_dst: np.ndarray,
+          fallback: np.ndarray) -> tuple[np.ndarray, int]:
+    """Topological sort; edge a -> b means a is drawn before b (a is behind b). ``indeg`` (consumed) counts the MPVO
+    edges into each cell (``_face_dirs``). Returns (order, cycle breaks)."""
+    m = len(neighbor)
     for a in range(m):
         for k in range(extra_ptr[a], extra_ptr[a + 1]):
             indeg[extra_dst[k]] += 1
@@ -143,15 +165,7 @@ def _mpvo(neighbor: np.ndarray, face_n: np.ndarray, face_d: np.ndarray, eye: np.
             u = neighbor[t, f]
             if u < 0 or done[u]:
                 continue
-            # is u in front of t across this face?
-            if u > t:
-                front = dirs[t, f] == 1
-            else:
-                g = 0
-                for h in range(4):
-                    if neighbor[u, h] == t:
-                        g = h
-                front = dirs[u, g] == -1
+            front = dirs[t, f] == 1
             if front:
                 indeg[u] -= 1
                 if indeg[u] == 0:
@@ -374,9 +388,9 @@ def visibility_order(mesh: TetMesh | Topology, camera: Camera, size: tuple[int, 
     else:
         src, dst = np.empty(0, np.int64), np.empty(0, np.int64)
     ptr, dsts = _csr(src, dst, m)
-    args = (topo.neighbor, topo.face_n, topo.face_d, eye, fwd, camera.parallel, ptr, dsts)
-    order, cycles = _mpvo(*args, np.empty(0, np.int64))
+    dirs, indeg = _face_dirs(topo.neighbor, topo.face_n, topo.face_d, eye, fwd, camera.parallel)
+    order, cycles = _mpvo(topo.neighbor, dirs, indeg.copy(), ptr, dsts, np.empty(0, np.int64))
     if cycles < 0:                      # a cycle: redo with the farthest-first fallback for breaking it
         fallback = np.argsort(_centroid_keys(topo.centroid, eye, fwd, camera.parallel), kind="stable")
-        order, cycles = _mpvo(*args, fallback)
+        order, cycles = _mpvo(topo.neighbor, dirs, indeg, ptr, dsts, fallback)
     return SortResult(order, method, int(cycles), int(len(src)), time.perf_counter() - t0)
