@@ -33,6 +33,8 @@ from .docks.timeline import Timeline
 from .drop import FileDrop
 from .export_dialogs import ExportDialogs
 from .help import HelpMenu
+from .iso_tool import IsoTool
+from .slice_tool import SliceTool
 from .layout import WindowLayout, scrolled
 from .probe import ProbeTool
 from .recent import RecentFiles
@@ -62,15 +64,21 @@ class WindowWidgets(WindowBase):
         self.timeline_dock = self._dock("Timeline", "timelineDock", self.timeline, scroll=False)
         self.stats_dock = self._dock("Statistics", "statsDock", self.statistics)
         self.clip_dock = self._dock("Clipping", "clipDock", self.clipping)
+        self.slice_tool, self.iso_tool = SliceTool(self), IsoTool(self)
+        self.slices_dock = self._dock("Slices", "slicesDock", self.slice_tool.dock)
+        self.iso_dock = self._dock("Isosurfaces", "isoDock", self.iso_tool.dock)
         self.docks = [self.tf_dock, self.scene_dock, self.settings_dock, self.timeline_dock, self.stats_dock,
-                      self.clip_dock]
+                      self.clip_dock, self.slices_dock, self.iso_dock]
         self.layout_keeper = WindowLayout(self, self.settings, [self.tf_dock, self.scene_dock, self.settings_dock,
-                                                                self.clip_dock, self.stats_dock], [self.timeline_dock])
+                                                                self.clip_dock, self.stats_dock, self.slices_dock,
+                                                                self.iso_dock], [self.timeline_dock])
         self.layout_keeper.arrange()
 
         self.tf_editor.changed.connect(self._tf_changed)
         self.tf_editor.committed.connect(self._tf_committed)
         self.scene_tree.componentSelected.connect(self._select_component)
+        self.scene_tree.populated.connect(self.slice_tool.scene_shown)
+        self.scene_tree.populated.connect(self.iso_tool.scene_shown)
         self.scene_tree.visibilityChanged.connect(self._set_visibility)
         self.scene_tree.opacityChanged.connect(self._set_opacity)
         self.scene_tree.settingsEdited.connect(lambda comp_id, before, after: edit_settings(

@@ -101,6 +101,20 @@ def scalar_bar_ranges(window) -> list[tuple[float, float]]:
     return [] if bar is None else [tuple(float(v) for v in bar.GetLookupTable().GetRange())]
 
 
+def widget_pixels(widget) -> np.ndarray:
+    """What ``widget`` paints, as (H, W, 3) uint8: rendered into a 32-bit image (a grab takes the X server's depth,
+    16 bits under pytest-xvfb, and rounds colours to RGB565)."""
+    from PySide6.QtGui import QImage
+
+    image = QImage(widget.size(), QImage.Format.Format_RGB32)
+    image.fill(0)
+    widget.render(image)
+    image = image.convertToFormat(QImage.Format.Format_RGB888)
+    data = np.frombuffer(image.constBits(), np.uint8, image.sizeInBytes())
+    return data.reshape(image.height(), image.bytesPerLine())[:, :3 * image.width()].reshape(image.height(),
+                                                                                             image.width(), 3).copy()
+
+
 def hover(qtbot, widget, pos: QPoint) -> None:
     """The mouse moved (no button held) to ``pos`` over ``widget``, as a real move event."""
     _mouse(widget, QEvent.Type.MouseMove, QPointF(pos), Qt.MouseButton.NoButton, Qt.MouseButton.NoButton)
@@ -116,3 +130,20 @@ def click(qtbot, widget, pos: QPoint, double: bool = False) -> None:
         _mouse(widget, QEvent.Type.MouseButtonDblClick, QPointF(pos), left, left)
         _mouse(widget, QEvent.Type.MouseButtonRelease, QPointF(pos), Qt.MouseButton.NoButton, left)
     qtbot.wait(50)
+
+
+def open_and_show_dock(qtbot, window, path, dock) -> np.ndarray:
+    """Open ``path``, wait for its final picture, bring ``dock`` to the front; returns the screen before any edit."""
+    window.open_path(path)
+    wait_loaded(qtbot, window)
+    wait_settled(qtbot, window)
+    shown = screen(window)
+    dock.show()
+    dock.raise_()
+    qtbot.waitUntil(dock.widget().isVisible)
+    return shown
+
+
+def changed_share(a: np.ndarray, b: np.ndarray, levels: float = 8.0) -> float:
+    """The fraction of pixels of two frames that differ by more than ``levels`` (8-bit units) in a channel."""
+    return float((np.abs(a - b).max(axis=2) > levels).mean())

@@ -42,7 +42,7 @@ MAX_STRING_CHARS = 65_536    # characters of one string value
 MAX_KEY_CHARS = 128          # characters of one object key (keys appear in field paths of error messages)
 MAX_OPTION_ITEMS = 16        # items of a list-valued dataset option (dims, spacing, ...)
 
-COMPONENT_TYPES = ("volume", "mesh", "isosurface", "terrain", "fog", "clouds", "sky", "demo")
+COMPONENT_TYPES = ("volume", "mesh", "isosurface", "terrain", "fog", "clouds", "sky", "demo", "slices")
 RENDER_METHODS = ("auto", "pt", "reference", "vtk")
 RENDER_BACKENDS = get_args(Backend)   # render option "backend" (volviz.render.backend)
 

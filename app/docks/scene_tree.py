@@ -31,6 +31,7 @@ class SceneTree(QWidget):
     opacityChanged = Signal(str, float)
     componentSelected = Signal(str)
     settingsEdited = Signal(str, dict, dict)  # component id, settings before, settings after
+    populated = Signal()  # a (new) scene's components are listed
 
     def __init__(self, parent: Optional[QWidget] = None):
         super().__init__(parent)
@@ -100,6 +101,7 @@ class SceneTree(QWidget):
             self.tree.setCurrentItem(self.item(selected) if selected in self._components else first)
         else:
             self._show_form(None)
+        self.populated.emit()
 
     def _kind_label(self, comp: Any) -> str:
         """The Kind column: the component's type, or how it draws its dataset where that says more (a surface, a

@@ -20,7 +20,7 @@ __all__ = ["Settings", "TerrainSettings", "FogSettings", "CloudSettings", "SkySe
            "SETTINGS_MODELS", "FogMode", "CloudShadingName", "IsoMode", "IsoShading", "IsoOverlayMode", "Backend",
            "SortName", "APPLIES_TO", "array_key", "settings_model", "former_names", "validate_settings",
            "validate_render_options", "typed_settings", "validated", "SettingsError",
-           "ScalarBarStyle"]
+           "ScalarBarStyle", "SlicesSettings"]
 
 FogMode = Literal["emissive", "attenuated", "mip"]
 CloudShadingName = Literal["npr", "physical"]
@@ -191,6 +191,16 @@ class IsosurfaceSettings(Settings):
     scalars: Optional[str] = Field(None, title="Array", json_schema_extra={"array": True})
 
 
+class SlicesSettings(Settings):
+    """Axis-aligned planes through a regular volume, coloured by the component's transfer function
+    (``volviz.render.slices``); an index of null: that plane is off."""
+
+    x: Optional[int] = Field(None, ge=0, title="X slice", description="grid index of the plane x = const")
+    y: Optional[int] = Field(None, ge=0, title="Y slice", description="grid index of the plane y = const")
+    z: Optional[int] = Field(None, ge=0, title="Z slice", description="grid index of the plane z = const")
+    array: Optional[str] = Field(None, title="Array", json_schema_extra={"array": True})
+
+
 class DemoSettings(Settings):
     """The built-in demo volume (a tetrahedralised analytic field)."""
 
@@ -202,6 +212,7 @@ class DemoSettings(Settings):
 SETTINGS_MODELS: dict[str, type[Settings]] = {
     "terrain": TerrainSettings, "fog": FogSettings, "clouds": CloudSettings, "sky": SkySettings,
     "volume": VolumeSettings, "mesh": MeshSettings, "isosurface": IsosurfaceSettings, "demo": DemoSettings,
+    "slices": SlicesSettings,
 }
 
 

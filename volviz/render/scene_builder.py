@@ -241,7 +241,7 @@ def ensure_transfer_functions(session: Session, datasets: dict[str, Any]) -> Non
     from volviz.model import Image2D
 
     for comp in session.components:
-        if comp.transfer_function is None and comp.type in ("volume", "mesh", "demo"):
+        if comp.transfer_function is None and comp.type in ("volume", "mesh", "demo", "slices"):
             if comp.dataset is not None and comp.dataset not in datasets:
                 continue  # a hidden component's data is not read: it gets its TF when shown
             if comp.dataset is not None and isinstance(datasets.get(comp.dataset), Image2D):
@@ -338,6 +338,8 @@ def prepare_component(session: Session, comp: Component, datasets: dict[str, Any
         if series:  # the 4D blend of the display time (as ``SceneController.set_time`` does)
             comp.settings = {**comp.settings, "interpolate": bool(interpolate)}
         prepared.parts[comp.id] = isosurface_parts(comp, dataset, t if series else None, session.clip)
+        return
+    if comp.type == "slices":  # cheap planes, made on the GUI thread (``volviz.render.slices``)
         return
     if comp.transfer_function is not None and not is_lod(dataset):
         prepared.histograms[comp.id] = histogram(dataset)
@@ -475,9 +477,9 @@ def install_scene(plotter: Any, session: Session, datasets: dict[str, Any], prep
         if not comp.visible or comp.type in NATURE_TYPES:
             continue
         dataset = component_dataset(comp, datasets)
-        if comp.type != "isosurface" and is_lod(dataset):
+        if comp.type not in ("isosurface", "slices") and is_lod(dataset):
             lod_components.append((comp, dataset))   # selected for the final camera
-        elif comp.type != "isosurface" and uses_pt(session, dataset):
+        elif comp.type not in ("isosurface", "slices") and uses_pt(session, dataset):
             pt_components.append((comp, prepared.parts[comp.id]))  # drawn last: over the opaque scene's depth
         else:
             props[comp.id] = install_component(plotter, session, comp, datasets, prepared, spectrum, views)
@@ -514,6 +516,10 @@ def install_component(plotter: Any, session: Session, comp: Component, datasets:
     dataset = component_dataset(comp, datasets)
     if comp.type == "isosurface":
         return IsoSurfacesView(plotter, comp, prepared.parts[comp.id], spectrum=spectrum)
+    if comp.type == "slices":
+        from volviz.render.slices import SlicesView
+
+        return SlicesView(plotter, comp, dataset, component_transfer_function(session, comp))
     if is_lod(dataset):
         return add_lod_component(plotter, session, comp, dataset, update=views)
     if uses_pt(session, dataset):

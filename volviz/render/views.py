@@ -59,6 +59,7 @@ COMPONENT_VIEWS: dict[str, tuple[str, ...]] = {
     "lod": (VIEWS[("lod", "cpu")],),
     "vtk": ("volviz.render.component_views:VtkPropView",),
     "isosurfaces": ("volviz.render.component_views:IsoSurfacesView",),
+    "slices": ("volviz.render.slices:SlicesView",),
 }
 
 
