@@ -50,6 +50,15 @@ class IsosurfacesDock(QWidget):
         self.mode = QComboBox()
         for key, label in MODES.items():
             self.mode.addItem(label, key)
+        for widget, tip in ((self.table, "The isosurfaces: select one to edit or remove it"),
+                            (self.value, "Iso-value of a new or the selected surface"),
+                            (self.opacity, "Opacity of a new or the selected surface"),
+                            (self.color_button, "Color of a new or the selected surface"),
+                            (self.add_button, "Add a surface at the value"),
+                            (self.apply_button, "Give the selected surface the value, color and opacity above"),
+                            (self.remove_button, "Remove the selected surface"),
+                            (self.mode, "How translucent surfaces are blended: VTK, or 2-, 3- or 4-pass")):
+            widget.setToolTip(tip)
         self.note = QLabel("")
         self.note.setWordWrap(True)
         form = QFormLayout()
