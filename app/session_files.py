@@ -9,6 +9,7 @@ It expects of the window: ``session``, ``session_path``, ``controller``, ``recov
 starts the autosave timer (called by the window's ``__init__``)."""
 from __future__ import annotations
 
+import dataclasses
 import logging
 import os
 from pathlib import Path
@@ -77,9 +78,12 @@ class SessionFiles(WindowBase):
         layout = dict(session.layout)
         layout["window_state"] = self.saveState().toBase64().toStdString()
         camera = self.controller.camera() if self.controller is not None else session.camera
+        render = session.render
+        if self.controller is not None and self.controller.time_series():  # the time shown is what reopens
+            render = dataclasses.replace(render, options={**render.options, "time": float(self.controller.time)})
         return Session(datasets=refs, components=session.components, transfer_functions=session.transfer_functions,
                        camera=camera, camera_paths=session.camera_paths, bookmarks=session.bookmarks,
-                       render=session.render, layout=layout, clip=session.clip)
+                       render=render, layout=layout, clip=session.clip)
 
     def save_session(self, path: str | os.PathLike) -> bool:
         from volviz.session import save

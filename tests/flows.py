@@ -22,8 +22,18 @@ def wait_loaded(qtbot, window, timeout: int = 60000) -> None:
 
 def wait_settled(qtbot, window, timeout: int = 60000) -> None:
     """Until no background job is running and the window is not busy: the view is at its final quality."""
-    qtbot.waitUntil(lambda: not window.progress_bar.isVisible() and not window.jobs.busy(), timeout=timeout)
-    qtbot.wait(100)
+    import time
+
+    idle_since = [None]
+
+    def settled() -> bool:   # idle for 0.6 s in a row: edits wait on short timers (previews, cuts) before a job
+        if window.progress_bar.isVisible() or window.jobs.busy():
+            idle_since[0] = None
+            return False
+        idle_since[0] = idle_since[0] or time.monotonic()
+        return time.monotonic() - idle_since[0] > 0.6
+
+    qtbot.waitUntil(settled, timeout=timeout)
 
 
 def screen(window) -> np.ndarray:

@@ -120,7 +120,6 @@ class SceneController:
                                        views=False)
             self.plotter.camera_set = True  # install_scene chose the view; PyVista must not re-frame the props
             self.installed_bounds = self.bounds()  # (what the clipping dock starts from)
-            self.decorate()
             if self._views_of("pt"):
                 # VTK fits the clipping range to its own props only: a previous scene's near plane cut through a PT
                 # mesh (a 700k-tetrahedron first frame took minutes instead of 0.3 s)
@@ -131,6 +130,7 @@ class SceneController:
                 self._show_prepared_cut(comp_id, cut)
             if self.clip.all_planes():
                 self.apply_clip(update=False)
+            self.decorate()  # after the cuts: the outline box is around what is drawn, as after a clip edit
             self.set_iso_mode(self.iso_mode, update=False)
             if views:
                 self.update_views()
@@ -641,11 +641,15 @@ class SceneController:
         return self.views[comp_id].cut(self.clip if clip is None else clip)
 
     def show_cut(self, comp_id: str, cut: Any) -> None:
-        """GUI thread: show a ``cut`` (not rendered; a CPU PT volume's image is re-made afterwards)."""
+        """GUI thread: show a ``cut`` (not rendered; a CPU PT volume's image is re-made afterwards); the outline box
+        follows the cut data, as it does in a scene built with this clipping (``volviz render``)."""
         view = self.views.get(comp_id)
         if view is not None:
             view.show_cut(cut, self.component(comp_id).visible)
             self._sync_iso_overlay()
+            from volviz.render.decorations import update_outline
+
+            update_outline(self.plotter, self.session, self.shown_props())
 
     # -- isosurface transparency mode (per scene) -------------------------------------------------------------------
     @property
