@@ -19,8 +19,9 @@ MAX_FOLDERS = 8
 
 def remembered_folders(settings: QSettings) -> list[Path]:
     """Where to look first: the folders located before, then ``$VOLVIZ_DATA`` when it is set."""
-    value = settings.value(FOLDERS_KEY, [])
-    folders = [Path(v) for v in ([value] if isinstance(value, str) else list(value or [])) if v]
+    value: Any = settings.value(FOLDERS_KEY, [])
+    stored = [value] if isinstance(value, str) else list(value) if isinstance(value, (list, tuple)) else []
+    folders = [Path(str(v)) for v in stored if v]
     env = os.environ.get("VOLVIZ_DATA")
     return [f for f in folders + ([Path(env)] if env else []) if f.is_dir()]
 

@@ -118,10 +118,10 @@ def _headerless_names(lines: list[str], at: int, sep: str | None) -> list[str]:
     sample = [_fields(line, sep) for line in _rows(lines[at:at + SAMPLE_ROWS])]
     if n >= 6 and all(len(row) == n for row in sample):
         try:
-            colours = np.array([[float(v) for v in row[-3:]] for row in sample])
+            colors = np.array([[float(v) for v in row[-3:]] for row in sample])
         except ValueError:
             return names
-        if np.all(colours == np.round(colours)) and colours.min() >= 0 and colours.max() <= 255:
+        if np.all(colors == np.round(colors)) and colors.min() >= 0 and colors.max() <= 255:
             names[-3:] = ["red", "green", "blue"]
             if n == 7:
                 names[3] = "intensity"

@@ -17,8 +17,8 @@ from volviz.io.folders import MIN_SERIES_FILES, numbered_pattern
 from volviz.jobs import ProgressCallback, report
 from volviz.model.applicability import DatasetTraits
 from volviz.render.backend import backend_setting
-from volviz.session import (Component, DatasetRef, RenderSettings, Session, SessionError, missing_files, missing_message,
-                            resolve_path)
+from volviz.session import (Component, DatasetRef, RenderSettings, Session, SessionError, missing_files,
+                            missing_message, resolve_path)
 
 
 class SceneError(Exception):
