@@ -36,11 +36,12 @@ def test_the_marked_fields_and_their_traits() -> None:
 
 @pytest.mark.parametrize("kind", ["volume", "mesh"])
 def test_volume_fields_by_dataset(kind: str) -> None:
-    assert applicable_fields(kind, PLAIN) == ("array",)                   # a plain (e.g. tetrahedral) volume
-    assert applicable_fields(kind, SERIES) == ("array", "interpolate")
-    assert applicable_fields(kind, LOD) == ("array", "budget")
-    assert applicable_fields(kind, EVERYTHING) == ("array", "budget", "interpolate")
-    assert applicable_fields(kind, None) == ("array", "budget", "interpolate")   # dataset not known: every field
+    # (log_scale, the log color scale, applies to every dataset)
+    assert applicable_fields(kind, PLAIN) == ("array", "log_scale")      # a plain (e.g. tetrahedral) volume
+    assert applicable_fields(kind, SERIES) == ("array", "interpolate", "log_scale")
+    assert applicable_fields(kind, LOD) == ("array", "budget", "log_scale")
+    assert applicable_fields(kind, EVERYTHING) == ("array", "budget", "interpolate", "log_scale")
+    assert applicable_fields(kind, None) == ("array", "budget", "interpolate", "log_scale")   # not known: every field
 
 
 def test_isosurface_fields_by_dataset() -> None:
