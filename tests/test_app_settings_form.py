@@ -238,13 +238,14 @@ def test_form_shows_only_the_settings_that_apply_to_the_dataset(qtbot, make_wind
 
     tets = _select(window, "tets")
     assert "Block budget" not in _row_labels(tets) and "Interpolate in time" not in _row_labels(tets)
-    assert set(tets.rows) == {"log_scale"} and tets.settings == {"budget": 64}   # budget not shown, still set
+    # budget not shown, still set
+    assert set(tets.rows) == {"log_scale", "shade"} and tets.settings == {"budget": 64}
     series = _select(window, "series")       # its interpolation is the Timeline dock's switch, not a form row
     assert "Interpolate in time" not in _row_labels(series) and "Block budget" not in _row_labels(series)
-    assert list(series.rows) == ["log_scale"]
+    assert list(series.rows) == ["log_scale", "shade"]
     blob = _select(window, "blob")
     assert "Block budget" in _row_labels(blob) and "Interpolate in time" not in _row_labels(blob)
-    assert list(blob.rows) == ["budget", "log_scale"] and blob.editor("budget").value() == 16
+    assert list(blob.rows) == ["budget", "log_scale", "shade"] and blob.editor("budget").value() == 16
     iso = _select(window, "iso")
     assert "Interpolate in time" not in _row_labels(iso)
     assert {"Transparency mode", "Level of detail", "Triangles per pixel²"} <= set(_row_labels(iso))
@@ -256,9 +257,10 @@ def test_form_shows_only_the_settings_that_apply_to_the_dataset(qtbot, make_wind
     assert "Interpolate in time" not in _row_labels(_select(window, "iso"))
     assert _settings(window, "tets") == {"budget": 64}
 
-    assert list(_select(window, "later").rows) == ["budget", "log_scale"]   # not read: not known
+    assert list(_select(window, "later").rows) == ["budget", "log_scale", "shade"]   # not read: not known
     shown = window.components_shown
     window.scene_tree.item("later").setCheckState(0, Qt.CheckState.Checked)
     qtbot.waitUntil(lambda: window.components_shown > shown, timeout=60000)
-    assert window.scene_tree.current_component() == "later" and list(window.scene_tree.form.rows) == ["log_scale"]
+    assert window.scene_tree.current_component() == "later"
+    assert list(window.scene_tree.form.rows) == ["log_scale", "shade"]
     assert "Block budget" not in _row_labels(window.scene_tree.form)

@@ -37,11 +37,12 @@ def test_the_marked_fields_and_their_traits() -> None:
 @pytest.mark.parametrize("kind", ["volume", "mesh"])
 def test_volume_fields_by_dataset(kind: str) -> None:
     # (log_scale, the log color scale, applies to every dataset)
-    assert applicable_fields(kind, PLAIN) == ("array", "log_scale")      # a plain (e.g. tetrahedral) volume
-    assert applicable_fields(kind, SERIES) == ("array", "interpolate", "log_scale")
-    assert applicable_fields(kind, LOD) == ("array", "budget", "log_scale")
-    assert applicable_fields(kind, EVERYTHING) == ("array", "budget", "interpolate", "log_scale")
-    assert applicable_fields(kind, None) == ("array", "budget", "interpolate", "log_scale")   # not known: every field
+    assert applicable_fields(kind, PLAIN) == ("array", "log_scale", "shade")      # a plain (e.g. tetrahedral) volume
+    assert applicable_fields(kind, SERIES) == ("array", "interpolate", "log_scale", "shade")
+    assert applicable_fields(kind, LOD) == ("array", "budget", "log_scale", "shade")
+    assert applicable_fields(kind, EVERYTHING) == ("array", "budget", "interpolate", "log_scale", "shade")
+    # not known: every field
+    assert applicable_fields(kind, None) == ("array", "budget", "interpolate", "log_scale", "shade")
 
 
 def test_isosurface_fields_by_dataset() -> None:

@@ -162,6 +162,8 @@ class VolumeSettings(Settings):
                               "steps", json_schema_extra=_applies_to("time_series"))
     log_scale: bool = Field(False, title="Log color scale", description="color and opacity of log10 of the value "
                             "(values <= 0 take the color of the smallest positive value)")
+    shade: bool = Field(False, title="Shading", description="lighting of regular (uncompressed) volumes from the "
+                        "scalar's gradient: ambient, diffuse and specular; other volumes are drawn unlit")
 
 
 class MeshSettings(VolumeSettings):

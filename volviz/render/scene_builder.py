@@ -415,10 +415,11 @@ def time_input(series: Any, t: Optional[float] = None, interpolate: bool = True)
 
 
 def add_volume_prop(plotter: Any, dataset: Any, data: Any, tf: Any, opacity: float, name: str,
-                    backend: str = "auto") -> Any:
+                    backend: str = "auto", shade: bool = False) -> Any:
     """GUI thread: a vtkVolume drawing ``data`` (from ``prepared_volume_input``), the surface of a time series at
     its display time (``data`` from ``time_input``), or (``data`` None) ``add_dataset``'s default visual;
-    ``backend``: the render option (``volviz.render.backend``), which picks VTK's GPU or CPU ray caster."""
+    ``backend``: the render option (``volviz.render.backend``), which picks VTK's GPU or CPU ray caster; ``shade``:
+    the component's lighting setting (``vtk_scene.set_volume_shading``; regular volumes only)."""
     from volviz.model import RegularVolume, TimeSeries
     from volviz.render.vtk_scene import add_dataset, add_surface, is_surface, volume_prop
 
@@ -427,7 +428,7 @@ def add_volume_prop(plotter: Any, dataset: Any, data: Any, tf: Any, opacity: flo
     if is_surface(dataset):        # a time series' surface at the display time (``time_input``)
         return add_surface(plotter, data, tf, opacity, name)
     regular = isinstance(dataset.frame(0) if isinstance(dataset, TimeSeries) else dataset, RegularVolume)
-    return volume_prop(plotter, data, regular, tf, opacity, name, backend)
+    return volume_prop(plotter, data, regular, tf, opacity, name, backend, shade)
 
 
 def prepare_nature(session: Session, datasets: dict[str, Any]) -> Any:
@@ -526,7 +527,7 @@ def install_component(plotter: Any, session: Session, comp: Component, datasets:
         return add_pt_component(plotter, session, comp, prepared.parts[comp.id], update=views)
     tf = drawn_transfer_function(session, comp, dataset)
     return VtkPropView(add_volume_prop(plotter, dataset, prepared.parts.get(comp.id), tf, comp.opacity, comp.id,
-                                       backend_setting(session.render.options)))
+                                       backend_setting(session.render.options), bool(comp.settings.get("shade"))))
 
 
 def build_scene(plotter: Any, session: Session, datasets: dict[str, Any], spectrum: bool = True) -> dict[str, Any]:

@@ -55,13 +55,30 @@ def update_volume_property(prop: Any, tf: Any, opacity: float = 1.0) -> None:
     prop.SetScalarOpacityUnitDistance(unit)
 
 
-def vtk_volume_property(tf: Any, opacity: float = 1.0) -> Any:
+#: the lighting of a shaded volume (the setting ``shade``): ambient, diffuse, specular, specular power
+SHADING = (0.3, 0.7, 0.2, 10.0)
+
+
+def set_volume_shading(prop: Any, shade: bool) -> None:
+    """Lighting of a vtkVolumeProperty on or off: on, each sample is lit by the scene's lights with the normal the
+    scalar's gradient gives (ambient, diffuse and specular ``SHADING``), which shows the shape of the iso-structures
+    that the unlit emission-absorption picture flattens."""
+    ambient, diffuse, specular, power = SHADING
+    prop.SetShade(1 if shade else 0)
+    prop.SetAmbient(ambient)
+    prop.SetDiffuse(diffuse)
+    prop.SetSpecular(specular)
+    prop.SetSpecularPower(power)
+
+
+def vtk_volume_property(tf: Any, opacity: float = 1.0, shade: bool = False) -> Any:
+    """A vtkVolumeProperty of ``tf`` (``update_volume_property``), linearly interpolated, lit with ``shade``."""
     from volviz.render.vtk_facade import vtk
 
     prop = vtk.vtkVolumeProperty()
     update_volume_property(prop, tf, opacity)
     prop.SetInterpolationTypeToLinear()
-    prop.ShadeOff()
+    set_volume_shading(prop, shade)
     return prop
 
 
@@ -149,10 +166,11 @@ def add_dataset(plotter: Any, dataset: Any, tf: Any = None, opacity: float = 1.0
 
 
 def volume_prop(plotter: Any, data: Any, regular: bool, tf: Any, opacity: float, name: Optional[str],
-                backend: str = "auto") -> Any:
+                backend: str = "auto", shade: bool = False) -> Any:
     """Add a ``vtkVolume`` drawing the VTK dataset ``data`` with ``tf`` to ``plotter``: regular volumes through
     vtkSmartVolumeMapper (its CPU ray caster where ``backend`` picks "cpu": by default on a software OpenGL, see
-    ``volviz.render.backend``), others through vtkProjectedTetrahedraMapper. Returns the volume."""
+    ``volviz.render.backend``), lit with ``shade`` (the component setting); others through
+    vtkProjectedTetrahedraMapper, which draws no lighting. Returns the volume."""
     from volviz.render.vtk_facade import vtk
 
     from volviz.render.backend import choose_backend, plotter_gl_info
@@ -168,7 +186,7 @@ def volume_prop(plotter: Any, data: Any, regular: bool, tf: Any, opacity: float,
     mapper.SetInputData(data)
     volume = vtk.vtkVolume()
     volume.SetMapper(mapper)
-    volume.SetProperty(vtk_volume_property(tf, opacity))
+    volume.SetProperty(vtk_volume_property(tf, opacity, shade and regular))
     plotter.add_actor(volume, name=name, reset_camera=False)
     return volume
 
