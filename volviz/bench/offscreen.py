@@ -18,6 +18,12 @@ def bench_plotter(size: Sequence[int], background: Optional[Sequence[float] | st
     return pl
 
 
+def finish(window: Any) -> None:
+    """Wait until the GPU has completed the frame (``vtkOpenGLRenderWindow.WaitForCompletion``, a glFinish), so that
+    a timed ``Render()`` ends with the GPU's completion and not with the command submission (issue #29)."""
+    window.WaitForCompletion()
+
+
 def render_window(pl: Any) -> Any:
     """A plotter's render window (there is one until the plotter is closed)."""
     window = pl.ren_win

@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 
 from volviz.argtypes import MAX_IMAGE_SIDE, UsageParser, int_in
-from volviz.bench.offscreen import bench_plotter, render_window, screenshot_rgb
+from volviz.bench.offscreen import bench_plotter, finish, render_window, screenshot_rgb
 
 DEFAULT_DATA = Path(os.environ.get("VOLVIZ_DATA", Path(__file__).resolve().parents[2].parent / "shared" / "data"))
 VTK_MAPPERS = ("vtkProjectedTetrahedraMapper", "vtkUnstructuredGridVolumeRayCastMapper",
@@ -95,12 +95,6 @@ def _vtk_render(mesh: Any, tf: Any, cam: Any, size: int, mapper_name: str, reps:
     arr = vtk_to_numpy(w2i.GetOutput().GetPointData().GetScalars()).reshape(size, size, 3)[::-1]
     win.Finalize()
     return arr.astype(np.float64) / 255.0, times
-
-
-def finish(window: Any) -> None:
-    """Wait until the GPU has completed the frame (``vtkOpenGLRenderWindow.WaitForCompletion``, a glFinish), so that
-    a timed ``Render()`` ends with the GPU's completion and not with the command submission (issue #29)."""
-    window.WaitForCompletion()
 
 
 def _rgb_err(a: np.ndarray, b: np.ndarray) -> tuple[float, float]:
