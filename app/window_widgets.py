@@ -7,11 +7,12 @@ Cancel button: ``_set_busy`` shows them while a scene loads, its first views are
 
 It makes the docks (``tf_editor``, ``scene_tree``, ``render_settings``, ``timeline``, ``statistics``,
 ``clipping`` and their ``*_dock``), ``layout_keeper``, the undo group, ``array_choice``, ``export_dialogs``,
-``decorations``, ``help``, ``recent``, ``file_drop``, the actions, ``status_label``, ``progress_bar`` and
-``cancel_button``. It expects of the window: ``settings``, ``plotter``, ``jobs``, ``_current_job``,
-``_loading_views``, ``_export_run``, and the handlers its docks and actions call (``open_path``, the ``_ask_*``
-dialogs, ``set_fly_mode``, ``reset_camera``, ``set_recording``, ``set_clip``...). ``_build_docks()``,
-``_build_menus()`` and ``_build_status_bar()`` are called, in this order, by the window's ``__init__``."""
+``decorations``, ``python_console`` (stopped by ``closeEvent``), ``help``, ``recent``, ``file_drop``, the actions,
+``status_label``, ``progress_bar`` and ``cancel_button``. It expects of the window: ``settings``, ``plotter``,
+``jobs``, ``_current_job``, ``_loading_views``, ``_export_run``, and the handlers its docks and actions call
+(``open_path``, the ``_ask_*`` dialogs, ``set_fly_mode``, ``reset_camera``, ``set_recording``, ``set_clip``...).
+``_build_docks()``, ``_build_menus()`` and ``_build_status_bar()`` are called, in this order, by the window's
+``__init__``."""
 from __future__ import annotations
 
 from typing import Any
@@ -20,6 +21,7 @@ from PySide6.QtGui import QAction, QKeySequence, QUndoGroup, QUndoStack
 from PySide6.QtWidgets import QDockWidget, QLabel, QProgressBar, QPushButton, QWidget
 
 from .array_choice import ArrayChoice
+from .console import PythonConsole
 from .file_choices import FileChoices
 from .reload_data import ReloadData
 from .component_settings import edit_settings
@@ -136,6 +138,7 @@ class WindowWidgets(WindowBase):
         view_menu.addSeparator()
         self.decorations = DecorationToggles(self, view_menu)
         self.scalar_bar_editor = ScalarBarEditor(self, view_menu)
+        self.python_console = PythonConsole(self, view_menu)
         view_menu.addSeparator()
         self.action_fly = self._action(view_menu, "&Fly Mode", "F", self.set_fly_mode)
         self.action_fly.setCheckable(True)
@@ -150,6 +153,11 @@ class WindowWidgets(WindowBase):
         self.help = HelpMenu(self, self.menuBar().addMenu("&Help"), self.plotter.ren_win)
         self.recent = RecentFiles(self.settings, self.recent_menu, self.open_path_asking)
         self.file_drop = FileDrop([self, self.plotter.interactor], self.open_path_asking)
+
+    def closeEvent(self, event: Any) -> None:
+        """Reached once the window's own ``closeEvent`` accepted the close: the console's kernel stops with it."""
+        self.python_console.shutdown()
+        super().closeEvent(event)
 
     def _activate_undo_stack(self, stack: Any) -> None:
         import shiboken6
