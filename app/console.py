@@ -18,6 +18,9 @@ from PySide6.QtWidgets import QDockWidget, QLabel, QMenu
 #: what the dock says where qtconsole or ipykernel cannot be imported
 MISSING = "The Python console needs qtconsole and ipykernel, which are not installed: pip install 'volviz[console]'"
 
+#: the dock's height when it first opens (pixels): about a dozen lines
+CONSOLE_HEIGHT = 240
+
 #: names pushed to the console, described in its banner
 BANNER = ("volviz console: window (the main window), session (the shown session), controller (its scene), volviz, "
           "np\n")
@@ -58,8 +61,11 @@ class PythonConsole(QObject):
             self.dock.setObjectName("consoleDock")
             self.dock.setWidget(self._console() or self._missing())
             self.window.addDockWidget(Qt.DockWidgetArea.BottomDockWidgetArea, self.dock)
+            if self.window.timeline_dock.isVisible():   # a row of its own under the timeline, not beside it
+                self.window.splitDockWidget(self.window.timeline_dock, self.dock, Qt.Orientation.Vertical)
         self.dock.show()
         self.dock.raise_()
+        self.window.resizeDocks([self.dock], [CONSOLE_HEIGHT], Qt.Orientation.Vertical)  # a dozen lines to read
 
     def _missing(self) -> QLabel:
         self.message = QLabel(MISSING)
