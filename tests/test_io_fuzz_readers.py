@@ -155,9 +155,16 @@ def leftovers(folder: Path) -> list[str]:
 
 
 def write_vvz(path: Path, payload: bytes) -> None:
+    """A one-brick container whose metadata the reader accepts (``container.check_meta``): the payload as a raw
+    n x 1 x 1 volume of bytes."""
+    from volviz.regular.container import DTYPE_KINDS
+
+    n = len(payload)
+    meta = {"format": "volviz-vvz", "dims": [n, 1, 1], "dtype": "uint8", "kind": DTYPE_KINDS["uint8"],
+            "original_bytes": n, "payload_bytes": n, "levels": 0, "tile": 1, "coder": "raw", "delta": 0}
     with Writer(path) as w:
         w.add(0, 0, 0, np.frombuffer(payload, np.uint8))
-        w.close({"format": "volviz-vvz"})
+        w.close(meta)
 
 
 @FUZZ

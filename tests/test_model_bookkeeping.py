@@ -41,12 +41,12 @@ def test_a_physical_field_is_the_default_over_ids_first_in_line():
     assert default_array(volume) == "density"
 
 
-def test_a_surface_with_only_ids_is_drawn_plain_a_solid_mesh_keeps_them():
+def test_a_mesh_with_only_ids_is_drawn_plain():
     tri = UnstructuredMesh(np.eye(3), [(VTK_TRIANGLE, np.array([[0, 1, 2]]))], {"GlobalNodeId": np.arange(3)},
                            {"ObjectId": np.array([7]), "Normals": np.eye(3)[:1]})
     assert default_array(tri) is None
-    solid = _hexes({}, {"ObjectId": np.array([1, 2])})  # the volume renderer needs a field to draw
-    assert default_array(solid) == "ObjectId"
+    solid = _hexes({}, {"ObjectId": np.array([1, 2])})  # drawn as plain geometry (volviz.model.representation)
+    assert default_array(solid) is None
 
 
 def test_files_from_vtk_filters_open_on_their_field(tmp_path):
