@@ -27,6 +27,8 @@ MOVES: dict[int, tuple[int, int, int]] = {  # by key code (``QKeyEvent.key()``; 
 STEP_SECONDS = 0.05   # a key press moves this much flight time at once; held, the flight follows the clock
 TICK_MS = 33          # while a key is held the camera moves this often, by the time that passed (~30 steps a second)
 MAX_TICK_SECONDS = 0.1  # a tick after a long pause moves no further than this much flight time
+HELD_SECONDS = 1.0    # a key with no press or auto-repeat for this long counts as released (a release lost to a
+#                       focus change; X's auto-repeat starts within 0.66 s and then repeats every 40 ms)
 LOOK_DEGREES_PER_PIXEL = 0.2
 
 
@@ -41,7 +43,7 @@ class FlyMode(QObject):
         self.enabled = False
         self.on_camera_moved = on_camera_moved
         self._last_mouse: Optional[Any] = None
-        self.held: set[int] = set()      # the movement keys held down
+        self.held: dict[int, float] = {}  # the movement keys held down: the time of each one's last event
         self._last_step = 0.0
         self.steps = 0                   # camera steps made (keys, held keys' ticks, mouse looks)
         self.timer = QTimer(self, interval=TICK_MS)
@@ -81,6 +83,9 @@ class FlyMode(QObject):
             self.on_camera_moved()
 
     def _move(self, dt: float) -> None:
+        now = time.monotonic()
+        for key in [k for k, t in self.held.items() if now - t > HELD_SECONDS]:
+            del self.held[key]
         f = sum(MOVES[k][0] for k in self.held)
         r = sum(MOVES[k][1] for k in self.held)
         u = sum(MOVES[k][2] for k in self.held)
@@ -104,8 +109,10 @@ class FlyMode(QObject):
             key = event.key()
             if key in MOVES:
                 if event.isAutoRepeat():
+                    if key in self.held:
+                        self.held[key] = time.monotonic()
                     return True   # the timer flies while the key is held
-                self.held.add(key)
+                self.held[key] = time.monotonic()
                 f, r, u = MOVES[key]
                 self._apply(self.navigator.move(self._camera(), f, r, u, STEP_SECONDS))
                 self._last_step = time.monotonic()
@@ -121,7 +128,7 @@ class FlyMode(QObject):
             return True  # no VTK key bindings while flying
         if kind == QEvent.Type.KeyRelease:
             if isinstance(event, QKeyEvent) and not event.isAutoRepeat():
-                self.held.discard(event.key())
+                self.held.pop(event.key(), None)
                 if not self.held:
                     self.timer.stop()
             return True

@@ -231,6 +231,8 @@ def surface_input(dataset: Any, plain: bool = False) -> Any:
     if values.dtype.kind == "f" and not np.isfinite(values).all():   # cells touching NaN/Inf are not drawn
         grid = grid.extract_points(np.flatnonzero(np.isfinite(values)), adjacent_cells=False)
     surface = grid.extract_surface(algorithm="dataset_surface") if hasattr(grid, "extract_surface") else grid
+    if surface.n_points == 0 and grid.n_points and hasattr(grid, "extract_surface"):
+        surface = grid.extract_surface(algorithm=None)   # a grid of one line (170 x 1 x 1): its polyline
     if name is not None and name in surface.array_names:
         surface.set_active_scalars(name)
     else:                          # appearance alone (normals, texture coordinates, colours): no scalars
