@@ -151,7 +151,8 @@ class SceneLoading(WindowBase):
                 self.status_label.setText(f"Could not load {title}")
                 self.show_error(f"Cannot open {title}", open_error(path, outcome.error, title))
                 return
-            if self._install_session(controller, outcome.result, session_path, title, dirty, serial, path):
+            if self._install_session(controller, outcome.result, session_path, title, dirty, serial, path,
+                                     keep_frame=datasets is not None):
                 if datasets is None:  # another file or scene: the old one's settings edits are not undone on it
                     self.scene_undo_stack.clear()
                 if on_shown:
@@ -160,21 +161,28 @@ class SceneLoading(WindowBase):
         self._current_job = self.jobs.submit(load, name=f"load {title}", key="load", on_done=done)
 
     def _install_session(self, controller: SceneController, prepared: Any, session_path: Optional[Path], title: str,
-                         dirty: bool, serial: int, path: Optional[Path] = None) -> bool:
+                         dirty: bool, serial: int, path: Optional[Path] = None, keep_frame: bool = False) -> bool:
         """GUI thread: replace the shown scene by a prepared one (no numerics here: props added, docks filled, one
         render), then compute its view-dependent parts in the background; loading ends when they are shown. A scene
-        that cannot be installed is taken out again and the previous one rebuilt (False)."""
+        that cannot be installed is taken out again and the previous one rebuilt (False). ``keep_frame``: the same
+        data rebuilt; its last frame stays over the viewport until the first views are shown (``StandInFrame``)."""
         session = controller.session
         previous = self.controller
         camera = previous.camera() if previous is not None else None  # install places the new scene's camera
+        if keep_frame and previous is not None:
+            self.stand_in.grab()
+        else:
+            self.stand_in.drop()
         if previous is not None:
             previous.clear()
         self.plotter.clear()
+        self.stand_in.show()
         self._current_job = None
         try:
             controller.install(prepared, views=False)
         except Exception as exc:  # a scene that cannot be shown must not take the window down, nor the old scene
             log.exception("building the scene for %s failed", title)
+            self.stand_in.drop()
             controller.clear()
             self.controller = None
             self._set_busy(False)

@@ -85,6 +85,7 @@ class ViewScheduler(WindowBase):
 
         def settled() -> None:
             if serial == self._load_serial and self.controller is controller:
+                self.stand_in.drop()   # the new scene's views are all shown: the old frame goes
                 self._loading_views = False
                 self._set_busy(False)
                 self.status_label.setText(f"Showing {title}")

@@ -33,6 +33,7 @@ from .export_runs import ExportRuns
 from .gc_guard import GuiThreadCollector
 from .interaction_renders import SingleRenderDuringInteraction
 from .navigation import FlyMode
+from .stand_in import StandInFrame
 from .nonfinite_status import NonFiniteStatus
 from .scene_edits import SceneEdits
 from .scene_loading import SceneLoading
@@ -103,6 +104,7 @@ class MainWindow(SceneLoading, SessionFiles, ViewScheduler, SceneEdits, ExportRu
         self.resize(*self.layout_keeper.default_size())
         self.layout_keeper.restore()
         self.fly = FlyMode(self.plotter, on_camera_moved=self._fly_moved)
+        self.stand_in = StandInFrame(self.plotter)   # the last frame over the viewport while its scene is rebuilt
         self.single_render = SingleRenderDuringInteraction(self.plotter)  # one render per move of a drag
         self.clip_widget = ClipPlaneWidget(self.plotter, self.clipping)
         self._connect_view_scheduler()  # interaction observers, fly-mode settle and resize timers

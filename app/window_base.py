@@ -36,6 +36,7 @@ if TYPE_CHECKING:
     from volviz.render.controller import SceneController
     from volviz.session import Session
     from .array_choice import ArrayChoice
+    from .stand_in import StandInFrame
     from .decoration_toggles import DecorationToggles
     from .docks.clipping import ClippingDock
     from .docks.render_settings import RenderSettingsDock
@@ -103,6 +104,7 @@ class WindowBase(_QtWindow):
     decorations: DecorationToggles
     recent: RecentFiles
     bookmark_menu: QMenu
+    stand_in: StandInFrame
     action_fly: QAction
     action_record: QAction
     status_label: QLabel

@@ -91,6 +91,7 @@ def pick_combo_item(qtbot, combo, data: str) -> None:
     from PySide6.QtCore import Qt as _Qt
 
     index = combo.findData(data)
+    index = index if index >= 0 else combo.findText(data)   # a combo of plain texts
     assert index >= 0, f"{data!r} is not offered: {[combo.itemData(i) for i in range(combo.count())]}"
     qtbot.mouseClick(combo, _Qt.MouseButton.LeftButton)
     view = combo.view()
