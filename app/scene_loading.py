@@ -176,7 +176,6 @@ class SceneLoading(WindowBase):
         if previous is not None:
             previous.clear()
         self.plotter.clear()
-        self.stand_in.show()
         self._current_job = None
         try:
             controller.install(prepared, views=False)
@@ -193,6 +192,10 @@ class SceneLoading(WindowBase):
                 self._show_session(self.session, self.session_path, getattr(self, "title", ""), self.dirty,
                                    datasets=self.datasets)
             return False
+        if controller.camera_views():   # views made in the background: the last frame stays over them till then
+            self.stand_in.show()
+        else:                            # VTK draws the whole scene at once
+            self.stand_in.drop()
         self.session, self.session_path, self.datasets = session, session_path, controller.datasets
         self.controller = controller
         controller.changes.subscribe(self._scene_changed)   # the window follows the scene's state from now on
