@@ -45,6 +45,7 @@ class FrameExport:
         self.cancelled = False
         self.over = False
         self._job: Any = None
+        self._scene_drawn = False   # the window's first render with the scene (``_frame``)
         self._step(lambda progress=None: controller.prepare(progress, t), then=self._installed,
                    message="preparing the scene")
         # the offscreen window's GL context is made by a first (empty) render, in its own turn of the event loop
@@ -150,6 +151,13 @@ class FrameExport:
     def _frame(self, i: int) -> None:
         from volviz.render.export import size_window
 
+        if i == 0 and not self._scene_drawn:
+            # the offscreen window's first render with the scene (shaders, textures) at a tiny size in its own turn
+            # of the event loop, before the views begin at the frame's size (together they held it over 100 ms)
+            self._scene_drawn = True
+            self._snapshot((8, 8))
+            self._later(lambda: self._frame(i))
+            return
         camera, t = self.frames[i]
         c = self.controller
         size_window(self.plotter, self.size)  # the views begin at the frame's size (the GL warm-up render is 8x8)
@@ -174,10 +182,6 @@ class FrameExport:
 
     def _views(self, i: int, stage: int) -> None:
         if stage == 2:
-            if i == 0:
-                # the offscreen window's first render with the scene (shaders, textures) at a tiny size in one turn
-                # of the event loop, the render at full size in a later one: together they held it ~50 ms longer
-                self._snapshot((8, 8))
             self._later(lambda: self._render(i))
             return
         requests = self.controller.begin_views(stage)

@@ -43,11 +43,10 @@ class StandInFrame:
 
     def drop(self) -> None:
         self.frame = None
-        if self.overlay is not None:
-            self.overlay.remove()
-            self.overlay = None
-            if self.plotter.ren_win is not None:
-                self.plotter.interactor.update()   # one repaint without it
+        overlay, self.overlay = self.overlay, None
+        if overlay is not None and self.plotter.ren_win is not None:   # (a closed window has no renderers left)
+            overlay.remove()
+            self.plotter.interactor.update()   # one repaint without it
 
     @property
     def shown(self) -> bool:
