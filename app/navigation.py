@@ -1,17 +1,14 @@
 """Fly-through mode for the viewport: WASD/arrow keys move, Q/E (or PgDn/PgUp) sink and rise, mouse drag looks
 around, +/- change speed. The motion itself is volviz.render.camera_path.FlyNavigator (Qt-free).
 
-A held key flies by the clock, not by the keyboard's auto-repeat: a timer moves the camera by the time that passed
-since the last step, and nothing here draws: each step asks for one repaint (Qt merges them), so a slow frame makes
-the flight coarser, never the window stall behind a queue of renders (one synchronous render per key event held the
-event loop for seconds on the Yukon scene)."""
+Nothing here draws: each step (a key press or auto-repeat, a mouse look) asks for one repaint, which Qt merges with
+the others asked for before it is drawn, so a slow frame makes the flight coarser, never the window stall behind a
+queue of renders (one synchronous render per key event held the event loop for seconds on the Yukon scene)."""
 from __future__ import annotations
 
 from typing import Any, Callable, Optional
 
-import time
-
-from PySide6.QtCore import QEvent, QObject, Qt, QTimer
+from PySide6.QtCore import QEvent, QObject, Qt
 from PySide6.QtGui import QKeyEvent, QMouseEvent
 
 from volviz.render.camera_path import FlyNavigator
@@ -24,11 +21,7 @@ MOVES: dict[int, tuple[int, int, int]] = {  # by key code (``QKeyEvent.key()``; 
     Qt.Key.Key_E: (0, 0, 1), Qt.Key.Key_PageUp: (0, 0, 1),
     Qt.Key.Key_Q: (0, 0, -1), Qt.Key.Key_PageDown: (0, 0, -1),
 }
-STEP_SECONDS = 0.05   # a key press moves this much flight time at once; held, the flight follows the clock
-TICK_MS = 33          # while a key is held the camera moves this often, by the time that passed (~30 steps a second)
-MAX_TICK_SECONDS = 0.1  # a tick after a long pause moves no further than this much flight time
-HELD_SECONDS = 1.0    # a key with no press or auto-repeat for this long counts as released (a release lost to a
-#                       focus change; X's auto-repeat starts within 0.66 s and then repeats every 40 ms)
+STEP_SECONDS = 0.05   # one key press (or auto-repeat) moves this much flight time
 LOOK_DEGREES_PER_PIXEL = 0.2
 
 
@@ -43,17 +36,11 @@ class FlyMode(QObject):
         self.enabled = False
         self.on_camera_moved = on_camera_moved
         self._last_mouse: Optional[Any] = None
-        self.held: dict[int, float] = {}  # the movement keys held down: the time of each one's last event
-        self._last_step = 0.0
-        self.steps = 0                   # camera steps made (keys, held keys' ticks, mouse looks)
-        self.timer = QTimer(self, interval=TICK_MS)
-        self.timer.timeout.connect(self._tick)
+        self.steps = 0                   # camera steps made (key presses and repeats, mouse looks)
         plotter.interactor.installEventFilter(self)
 
     def set_enabled(self, enabled: bool, scene_size: float = 1.0) -> None:
         self.enabled = bool(enabled)
-        self.held.clear()
-        self.timer.stop()
         if enabled:
             self.navigator.speed = max(scene_size, 1e-9) * 0.25  # cross a quarter of the scene per second
 
@@ -82,42 +69,15 @@ class FlyMode(QObject):
         if self.on_camera_moved is not None:
             self.on_camera_moved()
 
-    def _move(self, dt: float) -> None:
-        now = time.monotonic()
-        for key in [k for k, t in self.held.items() if now - t > HELD_SECONDS]:
-            del self.held[key]
-        f = sum(MOVES[k][0] for k in self.held)
-        r = sum(MOVES[k][1] for k in self.held)
-        u = sum(MOVES[k][2] for k in self.held)
-        if f or r or u:
-            self._apply(self.navigator.move(self._camera(), f, r, u, dt))
-
-    def _tick(self) -> None:
-        """A held key's flight: the time since the last step, at most ``MAX_TICK_SECONDS``."""
-        if not self.held or not self.enabled:
-            self.timer.stop()
-            return
-        now = time.monotonic()
-        dt, self._last_step = min(now - self._last_step, MAX_TICK_SECONDS), now
-        self._move(dt)
-
     def eventFilter(self, watched: QObject, event: QEvent) -> bool:
         if not self.enabled:
             return False
         kind = event.type()
         if kind == QEvent.Type.KeyPress and isinstance(event, QKeyEvent):
             key = event.key()
-            if key in MOVES:
-                if event.isAutoRepeat():
-                    if key in self.held:
-                        self.held[key] = time.monotonic()
-                    return True   # the timer flies while the key is held
-                self.held[key] = time.monotonic()
+            if key in MOVES:   # each press and auto-repeat: one step (the repaints merge)
                 f, r, u = MOVES[key]
                 self._apply(self.navigator.move(self._camera(), f, r, u, STEP_SECONDS))
-                self._last_step = time.monotonic()
-                if not self.timer.isActive():
-                    self.timer.start()
                 return True
             if key in (Qt.Key.Key_Plus, Qt.Key.Key_Equal):
                 self.navigator.speed *= 1.5
@@ -127,10 +87,6 @@ class FlyMode(QObject):
                 return True
             return True  # no VTK key bindings while flying
         if kind == QEvent.Type.KeyRelease:
-            if isinstance(event, QKeyEvent) and not event.isAutoRepeat():
-                self.held.pop(event.key(), None)
-                if not self.held:
-                    self.timer.stop()
             return True
         if kind == QEvent.Type.MouseButtonPress and isinstance(event, QMouseEvent):
             self._last_mouse = event.position()

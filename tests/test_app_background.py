@@ -346,13 +346,13 @@ def test_pt_volume_keeps_showing_renders_while_flying(qtbot, make_window) -> Non
         QApplication.sendEvent(canvas, QKeyEvent(QEvent.Type.KeyPress, Qt.Key.Key_W, Qt.KeyboardModifier.NoModifier))
         presses += 1
         qtbot.wait(30)
-    # the key is let go (a held key flies on by the clock until its release)
-    QApplication.sendEvent(canvas, QKeyEvent(QEvent.Type.KeyRelease, Qt.Key.Key_W, Qt.KeyboardModifier.NoModifier))
     shown_while_flying = window.view_updates.get("pt:demo", 0) - before
     w, h = (int(v) for v in window.plotter.ren_win.GetSize())
     from volviz_app.view_scheduler import FLY_SCALE   # previews while flying: 1/4 x 1/4 since the fly-mode rework
 
     assert volume.image.shape[:2] == (h // FLY_SCALE, w // FLY_SCALE), "previews while flying: 1/16 of the pixels"
+    # the key is let go (a held key flies on by the clock until its release)
+    QApplication.sendEvent(canvas, QKeyEvent(QEvent.Type.KeyRelease, Qt.Key.Key_W, Qt.KeyboardModifier.NoModifier))
     final = np.asarray(window.plotter.camera.position, dtype=float).copy()
     # the keys have stopped: the full-size image of the final camera follows
     qtbot.waitUntil(lambda: volume.image.shape[:2] == (h, w) and not jobs["pt:demo"].running, timeout=60000)
