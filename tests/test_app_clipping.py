@@ -18,22 +18,29 @@ STYLES = [{"value": 0.3, "color": [1.0, 0.3, 0.2], "opacity": 0.5},
           {"value": 0.8, "color": [0.2, 0.4, 1.0], "opacity": 0.4}]
 
 
-@pytest.fixture
-def session_file(tmp_path: Path) -> Path:
+def ball_session(tmp_path: Path, render: dict | None = None) -> Path:
+    """A session of two isosurfaces (``STYLES``) of x² + y² + z² on a 24³ grid, written into ``tmp_path``."""
     g = np.linspace(-1, 1, 24)
     x, y, z = np.meshgrid(g, g, g, indexing="ij")
     grid = pv.ImageData(dimensions=(24, 24, 24))
     grid.point_data["s"] = (x * x + y * y + z * z).ravel(order="F")
     grid.save(tmp_path / "ball.vti")
     doc = {"format": "volviz-session", "version": 1, "datasets": [{"id": "b", "path": "ball.vti"}],
-           "components": [{"id": "iso", "type": "isosurface", "dataset": "b", "settings": {"styles": STYLES}}],
-           "camera": {"position": [11.5, -45.0, 11.5], "focal_point": [11.5, 11.5, 11.5], "view_up": [0, 0, 1]},
-           # the viewport is compared with CPU renders of the surfaces: no decorations
-           # the note's modes by the CPU overlay (auto takes the GPU's, tests/test_app_iso_backend.py)
-           "render": {"options": {"scalar_bar": False, "axes": False, "outline": False, "backend": "cpu"}}}
+           "components": [{"id": "iso", "type": "isosurface", "dataset": "b", "settings": {"styles": STYLES}}]}
+    if render is not None:
+        doc.update(render)
     path = tmp_path / "ball.json"
     path.write_text(json.dumps(doc))
     return path
+
+
+@pytest.fixture
+def session_file(tmp_path: Path) -> Path:
+    return ball_session(tmp_path, {
+        "camera": {"position": [11.5, -45.0, 11.5], "focal_point": [11.5, 11.5, 11.5], "view_up": [0, 0, 1]},
+        # the viewport is compared with CPU renders of the surfaces: no decorations
+        # the note's modes by the CPU overlay (auto takes the GPU's, tests/test_app_iso_backend.py)
+        "render": {"options": {"scalar_bar": False, "axes": False, "outline": False, "backend": "cpu"}}})
 
 
 def open_session(qtbot, window: MainWindow, path: Path) -> None:

@@ -8,7 +8,6 @@ rounding, text anti-aliasing and, for volviz's CPU overlays, the up to 1/255 of 
 (``volviz.render.image_overlay``): RMSE < 1.5 and under 0.5 % of the pixels off by more than 24 levels."""
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np
@@ -19,6 +18,7 @@ from PySide6.QtWidgets import QApplication
 
 from conftest import blob_vvz, data_file
 from flows import compare_with_render, drag_viewport, wait_loaded, wait_settled
+from test_app_clipping import ball_session
 
 RMSE, OFF = 1.5, 0.005
 
@@ -48,30 +48,13 @@ def _change_tf(qtbot, window) -> None:
     window.tf_editor.apply_preset("viridis")
 
 
-def _isosurface_session(tmp_path: Path) -> Path:
-    import pyvista as pv
-
-    g = np.linspace(-1, 1, 24)
-    x, y, z = np.meshgrid(g, g, g, indexing="ij")
-    grid = pv.ImageData(dimensions=(24, 24, 24))
-    grid.point_data["s"] = (x * x + y * y + z * z).ravel(order="F")
-    grid.save(tmp_path / "ball.vti")
-    styles = [{"value": 0.3, "color": [1.0, 0.3, 0.2], "opacity": 0.5},
-              {"value": 0.8, "color": [0.2, 0.4, 1.0], "opacity": 0.4}]
-    doc = {"format": "volviz-session", "version": 1, "datasets": [{"id": "b", "path": "ball.vti"}],
-           "components": [{"id": "iso", "type": "isosurface", "dataset": "b", "settings": {"styles": styles}}]}
-    path = tmp_path / "ball.json"
-    path.write_text(json.dumps(doc))
-    return path
-
-
 KINDS = {
     # kind: (what to open, the change a scientist makes)
     "regular": (lambda tmp: data_file("volumes/neghip.slc"), _change_tf),
     "unstructured": (lambda tmp: data_file("bluntfin/bluntfinxyz.bin"), _change_tf),
     "time series": (lambda tmp: data_file("storm/Storm.pvm-t01"), _change_time),
     "compressed LOD volume": (lambda tmp: blob_vvz(tmp / "blob.vvz", 64), _change_tf),
-    "isosurfaces": (_isosurface_session, None),
+    "isosurfaces": (ball_session, None),
 }
 
 
