@@ -8,7 +8,9 @@ Each file opens in a fresh window (default layout, settings in a temporary folde
 view-dependent parts (PT volume images, terrain, LOD blocks) are drawn, i.e. until the progress bar goes away, plus
 one render of the viewport; an open that fails stops the clock at its error dialog. All files are opened in one
 process, so imports and Numba's compiled kernels are warm after the first open that needs them. Only files named in
-``--only`` are opened when it is given (their rows are rewritten, the others kept from the existing table).
+``--only`` are opened when it is given (their rows are rewritten, the others kept from the existing table). Only
+this tool's section of the markdown (between ``BEGIN`` and ``END``) is rewritten: ``volviz bench first_open``'s
+section and the prose around them are kept.
 
 The data comes from ../shared/data (or $VOLVIZ_DATA): the files a user would open (one member of each numbered
 series, every file of ``ecosystem/``, the OpenFOAM case as its folder)."""
@@ -28,6 +30,9 @@ from .smoke import pump_events
 WINDOW_SIZE = (1366, 768)
 TIMEOUT_S = 300.0
 NOTE_CHARS = 320         # an error dialog's text is cut there in the table (the screenshot shows all of it)
+#: the markers of this tool's section of the markdown: it rewrites only what lies between them (``volviz bench
+#: first_open`` owns another section of the same file)
+BEGIN, END = "<!-- volviz_app.first_open: begin -->", "<!-- volviz_app.first_open: end -->"
 COMMAND = 'xvfb-run -a -s "-screen 0 1600x1000x24" .venv/bin/python -m volviz_app.first_open docs/first-open'
 
 #: what a user would open in ../shared/data, besides every entry of ecosystem/ (globbed entries in sorted order)
@@ -219,7 +224,8 @@ def _cell(text: str) -> str:
 
 
 def markdown(records: list[FirstOpen], folder: str) -> str:
-    """The table of ``docs/first-open.md`` with the command that regenerates it on top."""
+    """This tool's section of ``docs/first-open.md`` (without its markers): the table, with the command that
+    regenerates it on top."""
     import platform
 
     lines = ["# The first open of every shared dataset", "",
@@ -242,14 +248,29 @@ def markdown(records: list[FirstOpen], folder: str) -> str:
 
 
 def _kept_rows(md: Path) -> dict[str, str]:
-    """The table rows of an existing ``md`` by file name (for ``--only``)."""
-    if not md.exists():
-        return {}
+    """The table rows of this tool's section of an existing ``md`` by file name (for ``--only``)."""
+    from volviz.io.doc_section import read_section
+
     rows = {}
-    for line in md.read_text().splitlines():
+    for line in read_section(md, BEGIN, END).splitlines():
         if line.startswith("| `"):
             rows[line.split("`")[1]] = line
     return rows
+
+
+def write_table(md: Path, records: list[FirstOpen], folder: str, order: Optional[list[str]] = None) -> None:
+    """Write this tool's section of ``md`` (between ``BEGIN`` and ``END``; the rest of the file is kept). With
+    ``order`` (the names of every file, in table order: an ``--only`` run) the rows of ``records`` replace theirs
+    and the other rows are kept from the existing section."""
+    from volviz.io.doc_section import write_section
+
+    text = markdown(records, folder)
+    if order is not None:
+        lines = text.splitlines()
+        head, rows = lines[:len(lines) - len(records)], lines[len(lines) - len(records):]
+        rows_by_name = {**_kept_rows(md), **{r.name: line for r, line in zip(records, rows)}}
+        text = "\n".join(head + [rows_by_name[n] for n in order if n in rows_by_name]) + "\n"
+    write_section(md, BEGIN, END, text)
 
 
 def main(argv: Optional[list[str]] = None) -> int:
@@ -275,14 +296,8 @@ def main(argv: Optional[list[str]] = None) -> int:
             record = open_one(app, path, root, out, Path(workdir))
             print(f"{record.name}: {record.seconds:.1f} s {record.kind} {'; '.join(record.notes)}", flush=True)
             records.append(record)
-    text = markdown(records, out.name)
-    if args.only:
-        kept = _kept_rows(md)
-        fresh = {r.name: line for r, line in zip(records, text.splitlines()[-len(records):])}
-        order = [p.relative_to(root).as_posix() for p in dataset_paths(root)]
-        head = text.splitlines()[:-len(records)]
-        text = "\n".join(head + [fresh.get(n) or kept[n] for n in order if n in fresh or n in kept]) + "\n"
-    md.write_text(text)
+    write_table(md, records, out.name, [p.relative_to(root).as_posix() for p in dataset_paths(root)]
+                if args.only else None)
     print(f"wrote {md}")
     return 0
 

@@ -10,9 +10,9 @@ the legibility of the automatic transfer function (``volviz.optics.auto_tf``), i
 - *mode contrast*: the colour difference between the two main modes of the data's histogram, each seen as a slab
   of its value as thick as the mean chord of the data's box over the background (``mode_contrast``).
 
-Writes the section between ``BEGIN`` and ``END`` of ``docs/first-open.md`` (the app's table above it is kept), or
-only prints with ``--no-write``. ``--profile N`` adds where the time of the N slowest files goes (cProfile of an
-in-process render, by volviz module).
+Writes only its section of ``docs/first-open.md``, between ``BEGIN`` and ``END`` (``volviz.io.doc_section``: the
+app's window table and the prose around are kept), or only prints with ``--no-write``. ``--profile N`` adds where
+the time of the N slowest files goes (cProfile of an in-process render, by volviz module).
 """
 from __future__ import annotations
 
@@ -267,10 +267,10 @@ def _number(value: Optional[float], fmt: str) -> str:
 
 
 def markdown(records: list[FirstImage], profiles: dict[str, list[str]]) -> str:
-    """The section of ``docs/first-open.md`` this benchmark writes."""
+    """The section of ``docs/first-open.md`` this benchmark writes (without its markers)."""
     import platform
 
-    lines = [BEGIN, "", "## `volviz render`: time to the first image, and legibility of the automatic transfer "
+    lines = ["## `volviz render`: time to the first image, and legibility of the automatic transfer "
              "function", "", "Regenerate (about 3 minutes):", "", "```", COMMAND, "```", "",
              f"Each file is rendered by `volviz render FILE -o x.png` ({SIZE[0]}x{SIZE[1]}) in a fresh process: "
              "*first image* is that command's wall time (start-up, imports, reading, the transfer function, the "
@@ -291,19 +291,15 @@ def markdown(records: list[FirstImage], profiles: dict[str, list[str]]) -> str:
                   "cumulative seconds of the largest volviz calls):", ""]
         for name, rows in profiles.items():
             lines.append(f"- `{name}`: " + "; ".join(rows))
-    return "\n".join(lines + ["", END]) + "\n"
+    return "\n".join(lines) + "\n"
 
 
 def write_section(text: str, report: Path = REPORT) -> None:
-    """Replace the section between ``BEGIN`` and ``END`` of ``report`` by ``text`` (appended when absent)."""
-    from volviz.io.atomic import atomic_write_text
+    """Replace this benchmark's section of ``report`` (between ``BEGIN`` and ``END``) by ``text``, keeping the rest
+    of the document (the app's window table, prose)."""
+    from volviz.io.doc_section import write_section as write_marked
 
-    old = report.read_text() if report.exists() else ""
-    if BEGIN in old and END in old:
-        new = old[:old.index(BEGIN)] + text.rstrip("\n") + old[old.index(END) + len(END):]
-    else:
-        new = old.rstrip("\n") + "\n\n" + text
-    atomic_write_text(report, new)
+    write_marked(report, BEGIN, END, text)
 
 
 def main(argv: Optional[list[str]] = None) -> int:
