@@ -1,10 +1,11 @@
 """docs/first-open.md has two generators, each owning its own section between markers (issue #30): the app's window
 table (volviz_app.first_open) and `volviz bench first_open`'s render table; regenerating one keeps the other and the
-prose around them."""
+prose around them. And the bench measures a picture (PPM, JPEG: no transfer function) without an error in its row."""
 from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from volviz.bench import first_open as bench
@@ -77,3 +78,16 @@ def test_an_only_run_of_the_app_rewrites_its_rows_and_keeps_the_others(tmp_path)
     assert list(rows) == order
     assert "| volume (PT) |" in rows["volumes/neghip.slc"] and "| 9.9 s |" in rows["volumes/neghip.slc"]
     assert all(rows[n] == kept[n] for n in order if n != "volumes/neghip.slc")
+
+
+def test_the_bench_measures_a_picture_without_an_error(tmp_path):
+    """A colour PPM has no transfer function: the row says "picture", its time and drawn share, and no error (it
+    said AttributeError: 'NoneType' object has no attribute 'range')."""
+    rng = np.random.default_rng(3)
+    pixels = rng.integers(0, 256, size=(48, 64, 3), dtype=np.uint8)
+    (tmp_path / "photo.ppm").write_bytes(b"P6\n64 48\n255\n" + pixels.tobytes())
+    [record] = bench.measure(tmp_path)
+    assert record.note == ""
+    assert record.kind == "picture"
+    assert record.visible is None and record.contrast is None
+    assert record.seconds is not None and record.drawn is not None and record.drawn > 0.02

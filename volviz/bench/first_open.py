@@ -10,6 +10,9 @@ the legibility of the automatic transfer function (``volviz.optics.auto_tf``), i
 - *mode contrast*: the colour difference between the two main modes of the data's histogram, each seen as a slab
   of its value as thick as the mean chord of the data's box over the background (``mode_contrast``).
 
+A picture (PPM, JPEG) is drawn in its own colours, through no transfer function: its row says *picture* and has no
+legibility measures.
+
 Writes only its section of ``docs/first-open.md``, between ``BEGIN`` and ``END`` (``volviz.io.doc_section``: the
 app's window table and the prose around are kept), or only prints with ``--no-write``. ``--profile N`` adds where
 the time of the N slowest files goes (cProfile of an in-process render, by volviz module).
@@ -179,9 +182,11 @@ def legibility(path: Path) -> Optional[tuple[str, Optional[float], Optional[floa
         if kind != "volume":
             return kind, None, None
         ensure_transfer_functions(session, datasets)
+        tf = component_transfer_function(session, comp)
+        if tf is None:         # a picture (PPM, JPEG) drawn in its own colours: no transfer function to measure
+            return "picture", None, None
         session.render.options["axes"] = False
         image = render_session(session, None, METRIC_SIZE, datasets=datasets)
-        tf = component_transfer_function(session, comp)
         tf_name = str(comp.transfer_function)
         dataset = component_dataset(comp, datasets)
         chord = mean_chord(volume_grid(dataset).bounds)
