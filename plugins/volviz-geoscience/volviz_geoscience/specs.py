@@ -1,6 +1,6 @@
 """The reader specs this plugin registers (entry point ``volviz.readers``), with their content sniffers.
 
-Importing this module imports no segyio: volviz reads it to know the formats.
+Importing this module imports neither segyio nor laspy: volviz reads it to know the formats.
 """
 from __future__ import annotations
 
@@ -27,8 +27,17 @@ def is_segy(head: bytes) -> bool:
     return False
 
 
+def is_las(head: bytes) -> bool:
+    """A LAS or LAZ file: the public header's signature ``LASF`` and a major version 1."""
+    return len(head) >= 26 and head[:4] == b"LASF" and head[24] == 1
+
+
 SPECS: list[ReaderSpec] = [
     ReaderSpec("segy", "SEG-Y seismic", ("*.sgy", "*.segy"), "volviz_geoscience.segy:read_segy", sniff=is_segy,
                arrays="the amplitudes of a post-stack cube (inline, crossline, time) or of a 2D section",
                options=("allow_nonfinite",), isolated=True),
+    ReaderSpec("las", "LAS/LAZ lidar points", ("*.las", "*.laz"), "volviz_geoscience.las:read_las", sniff=is_las,
+               arrays="points at their scaled, offset coordinates; elevation (shown first), intensity, "
+                      "classification, return_number, number_of_returns, gps_time, red/green/blue, extra bytes",
+               isolated=True),
 ]
