@@ -42,33 +42,55 @@ def ray_box(origin: np.ndarray, direction: np.ndarray, lo: np.ndarray, hi: np.nd
     return (t0, t1) if t1 >= t0 else None
 
 
-def probe_regular(volume: Any, origin: Any, direction: Any, tf: Any = None, component: str = "",
-                  opacity: float = 1.0) -> Optional[ProbeResult]:
-    """The first voxel of the regular ``volume`` (data, origin, spacing) along the ray whose opacity under ``tf``
-    (a ``TransferFunction``, its extinction times ``opacity``) over half a voxel is visible; without ``tf`` the first
-    voxel the ray enters. Samples every half of the smallest spacing at the nearest voxel. None when nothing visible
-    is hit."""
+def ray_voxels(origin: Any, direction: Any, grid_origin: Any, spacing: Any,
+               shape: Any) -> Optional[tuple[np.ndarray, float]]:
+    """The voxels (n, 3) of a regular grid (sample ``(i, j, k)`` at ``grid_origin + (i, j, k) * spacing``) nearest
+    the samples of the ray ``origin + t * direction`` (unit) every half of the smallest spacing, front to back,
+    over the voxels' cells around their centres, and that step; None when the ray misses the grid."""
     o = np.asarray(origin, dtype=np.float64)
     d = np.asarray(direction, dtype=np.float64)
-    d = d / np.linalg.norm(d)
-    vo = np.asarray(volume.origin, dtype=np.float64)
-    sp = np.asarray(volume.spacing, dtype=np.float64)
-    shape = np.asarray(volume.data.shape)
-    span = ray_box(o, d, vo - 0.5 * sp, vo + (shape - 0.5) * sp)     # the voxels' cells around their centres
+    vo = np.asarray(grid_origin, dtype=np.float64)
+    sp = np.asarray(spacing, dtype=np.float64)
+    n = np.asarray(shape, dtype=np.int64)
+    span = ray_box(o, d, vo - 0.5 * sp, vo + (n - 0.5) * sp)
     if span is None:
         return None
     step = 0.5 * float(sp.min())
     t = np.arange(span[0], span[1] + 1e-12, step)
-    ijk = np.clip(np.rint((o + t[:, None] * d - vo) / sp).astype(np.int64), 0, shape - 1)
-    values = volume.data[ijk[:, 0], ijk[:, 1], ijk[:, 2]]
+    return np.clip(np.rint((o + t[:, None] * d - vo) / sp).astype(np.int64), 0, n - 1), step
+
+
+def first_visible(values: np.ndarray, tf: Any, opacity: float, step: float) -> Optional[int]:
+    """The index of the first of ``values`` (samples ``step`` apart) whose opacity under ``tf`` (its extinction
+    times ``opacity``) over the step reaches ``VISIBLE_OPACITY``; without ``tf`` the first sample; None: none."""
+    if not len(values):
+        return None
     if tf is None:
-        hit = 0 if len(values) else None
-    else:
-        _, extinction = tf.evaluate(values.astype(np.float64))
-        visible = 1.0 - np.exp(-np.asarray(extinction) * float(opacity) * step) >= VISIBLE_OPACITY
-        hit = int(np.argmax(visible)) if visible.any() else None
+        return 0
+    _, extinction = tf.evaluate(np.asarray(values, dtype=np.float64))
+    visible = 1.0 - np.exp(-np.asarray(extinction) * float(opacity) * step) >= VISIBLE_OPACITY
+    return int(np.argmax(visible)) if visible.any() else None
+
+
+def probe_regular(volume: Any, origin: Any, direction: Any, tf: Any = None, component: str = "",
+                  opacity: float = 1.0) -> Optional[ProbeResult]:
+    """The first voxel of the regular ``volume`` (data, origin, spacing) along the ray whose opacity under ``tf``
+    (a ``TransferFunction``, its extinction times ``opacity``) over half a voxel is visible; without ``tf`` the first
+    voxel the ray enters. Samples every half of the smallest spacing at the nearest voxel (``ray_voxels``). None
+    when nothing visible is hit."""
+    d = np.asarray(direction, dtype=np.float64)
+    march = ray_voxels(origin, d / np.linalg.norm(d), volume.origin, volume.spacing, volume.data.shape)
+    if march is None:
+        return None
+    ijk, step = march
+    hit = first_visible(volume.data[ijk[:, 0], ijk[:, 1], ijk[:, 2]], tf, opacity, step)
     if hit is None:
         return None
-    i, j, k = (int(v) for v in ijk[hit])
-    center = tuple(float(v) for v in vo + np.array([i, j, k]) * sp)
-    return ProbeResult(component, float(volume.data[i, j, k]), center, voxel=(i, j, k))  # type: ignore[arg-type]
+    return voxel_result(component, float(volume.data[tuple(ijk[hit])]), ijk[hit], volume.origin, volume.spacing)
+
+
+def voxel_result(component: str, value: float, ijk: Any, grid_origin: Any, spacing: Any) -> ProbeResult:
+    """The probe's answer at voxel ``ijk`` of a regular grid: its value, its centre and its index."""
+    i, j, k = (int(v) for v in ijk)
+    center = np.asarray(grid_origin, dtype=np.float64) + np.array([i, j, k]) * np.asarray(spacing, dtype=np.float64)
+    return ProbeResult(component, value, tuple(float(v) for v in center), voxel=(i, j, k))  # type: ignore[arg-type]
