@@ -1,6 +1,7 @@
 """View > Edit Scalar Bar… (or a double click on the scalar bar): its title, a fixed range or the transfer
 function's, and the number format of its labels. Saved in the session as the render option ``scalar_bar_style``
-(``volviz.model.settings.ScalarBarStyle``), so ``volviz render`` draws the same bar."""
+(``volviz.model.settings.ScalarBarStyle``), so ``volviz render`` draws the same bar. Each accepted edit is one step
+on the window's scene undo stack (Edit > Undo puts the previous bar back)."""
 from __future__ import annotations
 
 from typing import Any, Optional
@@ -11,6 +12,8 @@ from PySide6.QtWidgets import (QCheckBox, QDialog, QDialogButtonBox, QFormLayout
                                QVBoxLayout, QWidget)
 
 from volviz.model.settings import SettingsError, validate_render_options
+
+from .shown_edit import ShownEdit
 
 
 class ScalarBarDialog(QDialog):
@@ -61,7 +64,8 @@ class ScalarBarDialog(QDialog):
 
 class ScalarBarEditor(QObject):
     """The menu action and the double click on the bar; ``window`` provides ``session``, ``controller``,
-    ``plotter``, ``set_dirty`` and ``render_scene``. ``dialog`` is the open dialog (None when closed)."""
+    ``plotter``, ``scene_undo_stack``, ``set_dirty`` and ``render_scene``. ``dialog`` is the open dialog (None when
+    closed)."""
 
     def __init__(self, window: Any, menu: QMenu) -> None:
         super().__init__(window)
@@ -87,8 +91,7 @@ class ScalarBarEditor(QObject):
 
     def ask(self) -> None:
         """Open the dialog on the session's style (non-blocking); OK applies it."""
-        style = self.window.session.render.options.get("scalar_bar_style") or {}
-        self.dialog = ScalarBarDialog(style, self.window)
+        self.dialog = ScalarBarDialog(self.style(), self.window)
         self.dialog.buttons.accepted.connect(self._accept)
         self.dialog.finished.connect(self._closed)
         self.dialog.open()
@@ -109,13 +112,23 @@ class ScalarBarEditor(QObject):
         self.apply(style)
         dialog.accept()
 
+    def style(self) -> dict[str, Any]:
+        """The session's scalar bar style (``{}``: all follow the data)."""
+        return dict(self.window.session.render.options.get("scalar_bar_style") or {})
+
     def apply(self, style: dict[str, Any]) -> None:
-        """Set the session's scalar bar style (``{}``: all follow the data) and redraw the bar."""
-        window = self.window
-        if (window.session.render.options.get("scalar_bar_style") or {}) == style:
+        """Show ``style`` (``{}``: all follow the data) as one step on the scene undo stack; nothing when unchanged."""
+        before = self.style()
+        if before == style:
             return
+        self.show_style(style)
+        self.window.scene_undo_stack.push(ShownEdit("Edit the scalar bar", before, style, self.show_style))
+
+    def show_style(self, style: dict[str, Any]) -> None:
+        """Set the session's scalar bar style and redraw the bar (an edit, or an undo or redo step)."""
+        window = self.window
         if style:
-            window.session.render.options["scalar_bar_style"] = style
+            window.session.render.options["scalar_bar_style"] = dict(style)
         else:
             window.session.render.options.pop("scalar_bar_style", None)
         window.set_dirty()

@@ -90,7 +90,7 @@ def test_log_color_scale_is_drawn_saved_and_rendered_the_same(qtbot, make_window
 def test_scalar_bar_edited_by_double_click_is_saved_and_rendered(qtbot, make_window, tmp_path) -> None:
     """neghip: a double click on the scalar bar opens its dialog; title "Density", a fixed range 0 .. 100 and the
     format %.3g typed in; the bar shows them, a bad format is refused in the dialog in one line, and ``volviz
-    render`` of the saved session draws the same bar."""
+    render`` of the saved session draws the same bar; Edit > Undo puts the data's bar back, Redo the edited one."""
     import json
 
     from volviz.render.decorations import scalar_bar_actor, scalar_bar_title
@@ -126,3 +126,13 @@ def test_scalar_bar_edited_by_double_click_is_saved_and_rendered(qtbot, make_win
     assert saved["render"]["options"]["scalar_bar_style"] == {"title": "Density", "range": [0.0, 100.0],
                                                               "format": "%.3g"}
     assert err["rmse"] < 1.5 and err["off"] < 0.002, err
+
+    assert "Edit the scalar bar" in window.action_undo.text(), window.action_undo.text()
+    window.action_undo.trigger()            # the edit is one step on the undo stack
+    bar = scalar_bar_actor(window.plotter)
+    assert scalar_bar_title(window.plotter) == "SLCImage"
+    assert tuple(bar.GetLookupTable().GetRange()) == tuple(window.controller.transfer_function("data").range)
+    assert "scalar_bar_style" not in window.session.render.options
+    window.action_redo.trigger()
+    assert scalar_bar_title(window.plotter) == "Density"
+    assert tuple(scalar_bar_actor(window.plotter).GetLookupTable().GetRange()) == (0.0, 100.0)
