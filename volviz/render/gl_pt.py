@@ -51,6 +51,15 @@ How a frame is drawn:
   up to 37 and next to them up to 6.5, since the volume is integrated to one sample's depth rather than each
   sample's (exact there would need per-sample shading of every cell).
 
+- While the camera moves (``set_interactive``; by default while the window's desired update rate is VTK's
+  interactive one, which VTK's interactor styles set for a drag and the app for playback) the cells are drawn into a
+  smaller float target, at most ``interactive_pixels`` (1920x1080) pixels with the window's aspect
+  (``volviz.render.reduced_fill``: a drag at 3840x2160 fills what one at 1920x1080 does; at 1080p or less nothing
+  changes): the viewport, the pixel rays and the copy of the opaque depth (nearest sample) follow the smaller size,
+  and the resolve samples the target bilinearly over the window (a variant of its shader, ``PT_UPSAMPLE``). The
+  frame after the camera stops is drawn at full resolution, exactly as before. What that costs in image error during a
+  drag, and what it saves in fill: ``volviz bench unstructured`` (docs/bench/unstructured.md).
+
 Clipping planes and a box crop (``set_clip_planes``) cut each fragment's ray segment, as the near plane does.
 
 Exact segments instead of a table (as the CPU ``pt``; the same fragment, ray and compositing): ``iso`` draws
@@ -93,6 +102,7 @@ import numpy as np
 from volviz.model.datasets import TetMesh
 from volviz.render.image_overlay import hold_single_sample, release_single_sample, window_size
 from volviz.render.pt_view import PTView
+from volviz.render.reduced_fill import INTERACTIVE_PIXELS, reduced_size, scaled_rays
 from volviz.model.camera import Camera
 from volviz.unstructured.iso import iso_visible
 from volviz.unstructured.topology import FACES, cell_ranges, topology, visible_cells
@@ -106,6 +116,8 @@ _LOOKUPS = ("auto", "3d", "separable")
 _AMBIENT = 0.3                         # smooth isosurfaces: vertex_shade's default ambient term
 _GL_DRAW_FRAMEBUFFER_BINDING, _GL_READ_FRAMEBUFFER, _GL_DRAW_FRAMEBUFFER = 0x8CA6, 0x8CA8, 0x8CA9
 _GL_DEPTH_BUFFER_BIT, _GL_COLOR_BUFFER_BIT, _GL_NEAREST, _GL_DEPTH_WRITEMASK = 0x100, 0x4000, 0x2600, 0x0B72
+_GL_VIEWPORT = 0x0BA2
+_STILL_RATE_MAX = 1.0                  # frames/s: a window's desired update rate above it is an interaction's
 
 
 def shader_source(name: str) -> str:
@@ -194,7 +206,19 @@ def _shader(name: str, smooth: bool, kind: int = 0, clips: int = 0) -> str:
     pre-classified) and ``clips`` user clipping planes (``PT_CLIPS``), with ``PT_SMOOTH`` defined for smooth
     isosurfaces."""
     head = f"#define PT_KIND {kind}\n#define PT_CLIPS {clips}\n" + ("#define PT_SMOOTH\n" if smooth else "")
-    return shader_source(name).replace("//VTK::System::Dec\n", "//VTK::System::Dec\n" + head, 1)
+    return _with_defines(shader_source(name), head)
+
+
+def _with_defines(source: str, head: str) -> str:
+    """``source`` with the ``#define`` lines ``head`` right after VTK's system declarations."""
+    return source.replace("//VTK::System::Dec\n", "//VTK::System::Dec\n" + head, 1)
+
+
+def _resolve_shader(upsample: bool) -> str:
+    """The resolve's fragment shader: one texel per pixel, or (``upsample``, an interactive frame drawn smaller) the
+    target sampled bilinearly at each pixel's centre (``PT_UPSAMPLE``; compiled in, not switched: llvmpipe would pay
+    for both branches, module docstring)."""
+    return _with_defines(shader_source("pt_resolve_fs.glsl"), "#define PT_UPSAMPLE\n" if upsample else "")
 
 
 def install_scene_pass(renderer: Any, user: object) -> None:
@@ -237,7 +261,9 @@ class GLPTVolume(PTView):
     newest order it has (e.g. during a mouse drag: the image is then exact per cell but may composite some
     overlapping cells in the wrong order), and ``begin`` / ``compute`` / ``finish`` make the order for the camera of
     ``begin`` on a worker while the GPU draws (the app's background jobs, as for the CPU backend's images; the bench
-    states what a reused order costs). ``camera``: the camera of the last draw. The GPU side of the PT view interface
+    states what a reused order costs). ``camera``: the camera of the last draw. ``set_interactive`` /
+    ``interactive_pixels``: the reduced-resolution frames while the camera moves (module docstring); ``drawn_size``:
+    the size the last frame's cells were drawn at. The GPU side of the PT view interface
     ``volviz.render.pt_view.PTView``: VTK draws it at every render, so ``update`` has nothing to do.
     ``keep_multisampling``: leave the window's multisampling on (module docstring; default off while the volume is
     shown)."""
@@ -285,7 +311,12 @@ class GLPTVolume(PTView):
         self._order_key: Any = None
         self._table: Any = None
         self._table_tex: Any = None
-        self._targets: tuple[Any, ...] | None = None   # color texture, its FBO, depth texture, its FBO, format
+        self._targets: tuple[Any, ...] | None = None   # color, its FBO, depth, its FBO, format, drawn-size depth, FBO
+        self.interactive: bool | None = None        # None: interactive while the window's update rate says so
+        self.interactive_pixels = INTERACTIVE_PIXELS
+        self.drawn_size: tuple[int, int] | None = None  # the last frame's cells were drawn at this size
+        self._viewport: list[int] | None = None     # the scene's viewport while the cells draw smaller
+        self._upsample = False                      # the resolve's shader variant (``_resolve_shader``)
         self._bound = False                         # the volume's color target is bound (cells drawn, no resolve yet)
         self._drawn = False                         # the cells were drawn this frame
         self._table_dirty = True
@@ -317,7 +348,7 @@ class GLPTVolume(PTView):
         self.resolve_mapper.SetInputData(_resolve_polydata(np.stack([pts.min(axis=0), pts.max(axis=0)], axis=1)))
         rsp = vtk.vtkShaderProperty()
         rsp.SetVertexShaderCode(shader_source("pt_resolve_vs.glsl"))
-        rsp.SetFragmentShaderCode(shader_source("pt_resolve_fs.glsl"))
+        rsp.SetFragmentShaderCode(_resolve_shader(False))
         self.resolve_actor = vtk.vtkActor()
         self.resolve_actor.SetMapper(self.resolve_mapper)
         self.resolve_actor.SetShaderProperty(rsp)
@@ -365,8 +396,10 @@ class GLPTVolume(PTView):
         if not self.actor.GetVisibility():
             return
         self._apply_kind()
-        cam = self.camera = self._camera()
         size = window_size(self.renderer)
+        self.drawn_size = self.draw_size()
+        self._apply_upsample(self.drawn_size != size)
+        cam = self.camera = self._camera()
         key = _order_key(cam, size)
         if key == self._order_key and self._sorted is not None and not self._recull:
             return
@@ -446,73 +479,94 @@ class GLPTVolume(PTView):
         self._drawn = False
         if self._table_tex is not None:
             self._table_tex.Deactivate()
-        if self._targets is not None:
-            self._targets[0].Deactivate()
-            self._targets[2].Deactivate()
+        t = self._targets
+        for tex in (t[0], t[2], t[5]) if t is not None else ():   # the color and the depth textures
+            if tex is not None:
+                tex.Deactivate()
 
-    def _make_targets(self, w: int, h: int, depth_format: int) -> tuple[Any, ...]:
-        """The volume's (w, h) float32 RGBA target and its copy of the opaque depth (``depth_format``: the scene's
-        depth attachment's, as a depth blit needs), each attached to a framebuffer object of its own (made again when
-        the size changes)."""
+    def _make_targets(self, size: tuple[int, int], drawn: tuple[int, int], depth_format: int) -> tuple[Any, ...]:
+        """The volume's float32 RGBA target of the ``drawn`` size (linear filtering, for the upsampling resolve),
+        its copy of the opaque depth at the window's ``size`` (``depth_format``: the scene's depth attachment's, as a
+        depth blit needs) and, when ``drawn`` is smaller, that depth again at the ``drawn`` size (else None), each
+        attached to a framebuffer object of its own (made again when a size changes)."""
         from volviz.render.vtk_facade import vtk
 
         t = self._targets
-        if t is not None and (t[0].GetWidth(), t[0].GetHeight()) == (w, h) and t[4] == depth_format:
+        if (t is not None and (t[0].GetWidth(), t[0].GetHeight()) == drawn
+                and (t[2].GetWidth(), t[2].GetHeight()) == size and t[4] == depth_format):
             return t
         self._release_targets()
         ren_win = self.renderer.GetRenderWindow()
-        color = vtk.vtkTextureObject()
-        color.SetContext(ren_win)
-        color.Create2D(w, h, 4, vtk.VTK_FLOAT, False)
-        depth = vtk.vtkTextureObject()
-        depth.SetContext(ren_win)
-        depth.AllocateDepth(w, h, depth_format)
-        fbos = []
-        for tex, attach in ((color, "color"), (depth, "depth")):      # read by texelFetch: no filtering
+
+        def target(w: int, h: int, depth: bool) -> tuple[Any, Any]:
+            tex = vtk.vtkTextureObject()
+            tex.SetContext(ren_win)
             fbo = vtk.vtkOpenGLFramebufferObject()
             fbo.SetContext(ren_win)
             fbo.SaveCurrentBindingsAndBuffers()
             fbo.Bind()
-            if attach == "color":
-                fbo.AddColorAttachment(0, tex)
-            else:
+            if depth:                                                  # read by texelFetch: no filtering
+                tex.AllocateDepth(w, h, depth_format)
                 fbo.AddDepthAttachment(tex)
+            else:
+                tex.Create2D(w, h, 4, vtk.VTK_FLOAT, False)
+                tex.SetMinificationFilter(vtk.vtkTextureObject.Linear)
+                tex.SetMagnificationFilter(vtk.vtkTextureObject.Linear)
+                tex.SetWrapS(vtk.vtkTextureObject.ClampToEdge)
+                tex.SetWrapT(vtk.vtkTextureObject.ClampToEdge)
+                fbo.AddColorAttachment(0, tex)
             fbo.RestorePreviousBindingsAndBuffers()
-            fbos.append(fbo)
-        self._targets = (color, fbos[0], depth, fbos[1], depth_format)
+            return tex, fbo
+
+        small = target(*drawn, True) if drawn != size else (None, None)
+        self._targets = (*target(*drawn, False), *target(*size, True), depth_format, *small)
         return self._targets
 
     def _release_targets(self) -> None:
         ren_win = self.renderer.GetRenderWindow()
         if self._targets is not None and ren_win is not None:
-            for obj in self._targets[:4]:
-                obj.ReleaseGraphicsResources(ren_win)
+            for obj in self._targets[:4] + self._targets[5:]:
+                if obj is not None:
+                    obj.ReleaseGraphicsResources(ren_win)
         self._targets = None
 
-    def _bind_target(self, w: int, h: int) -> Any:
+    def _bind_target(self, size: tuple[int, int], drawn: tuple[int, int]) -> Any:
         """Copy the scene's depth at this point of the frame (after the opaque pass: the opaque geometry's; one sample
-        of each pixel when the window is multisampled) into the volume's depth texture, then bind and clear the
-        volume's color target for the cells. Returns the depth texture."""
+        of each pixel when the window is multisampled) into the volume's depth texture (then, for a frame drawn
+        smaller, the nearest sample of it into the ``drawn``-size one), then bind and clear the volume's color target
+        for the cells (and set the viewport to ``drawn``). Returns the depth texture the cells read."""
         from volviz.render.vtk_facade import vtk
 
         ren_win = self.renderer.GetRenderWindow()
         state = ren_win.GetState()
         scene = [0]
         state.vtkglGetIntegerv(_GL_DRAW_FRAMEBUFFER_BINDING, scene)
-        color, color_fbo, depth, depth_fbo, _ = self._make_targets(w, h, self._scene_depth_format(scene[0]))
+        color, color_fbo, depth, depth_fbo, _, small, small_fbo = self._make_targets(
+            size, drawn, self._scene_depth_format(scene[0]))
         color_fbo.SaveCurrentBindingsAndBuffers()
         self._bound = True
-        state.vtkglBindFramebuffer(_GL_READ_FRAMEBUFFER, scene[0])
-        state.vtkglBindFramebuffer(_GL_DRAW_FRAMEBUFFER, depth_fbo.GetFBOIndex())
+        w, h = size
         mask = [1]
         state.vtkglGetBooleanv(_GL_DEPTH_WRITEMASK, mask)
         state.vtkglDepthMask(True)                  # a depth blit writes through the depth write mask
+        state.vtkglBindFramebuffer(_GL_READ_FRAMEBUFFER, scene[0])
+        state.vtkglBindFramebuffer(_GL_DRAW_FRAMEBUFFER, depth_fbo.GetFBOIndex())
         vtk.vtkOpenGLFramebufferObject.Blit((0, w, 0, h), (0, w, 0, h), _GL_DEPTH_BUFFER_BIT, _GL_NEAREST)
+        if small is not None:                       # single-sampled to single-sampled: a scaling blit is allowed
+            state.vtkglBindFramebuffer(_GL_READ_FRAMEBUFFER, depth_fbo.GetFBOIndex())
+            state.vtkglBindFramebuffer(_GL_DRAW_FRAMEBUFFER, small_fbo.GetFBOIndex())
+            vtk.vtkOpenGLFramebufferObject.Blit((0, w, 0, h), (0, drawn[0], 0, drawn[1]), _GL_DEPTH_BUFFER_BIT,
+                                                _GL_NEAREST)
+            depth = small
         state.vtkglDepthMask(bool(mask[0]))
         color_fbo.Bind()
         color_fbo.ActivateDrawBuffer(0)
         state.vtkglClearColor(0.0, 0.0, 0.0, 0.0)
         state.vtkglClear(_GL_COLOR_BUFFER_BIT)
+        if drawn != size:
+            self._viewport = [0, 0, 0, 0]
+            state.vtkglGetIntegerv(_GL_VIEWPORT, self._viewport)
+            state.vtkglViewport(0, 0, drawn[0], drawn[1])
         return depth
 
     def _scene_depth_format(self, fbo_index: int) -> int:
@@ -531,11 +585,14 @@ class GLPTVolume(PTView):
                     internal, vtk.vtkTextureObject.Fixed32)
 
     def _restore(self) -> None:
-        """The scene's framebuffer again."""
+        """The scene's framebuffer (and viewport) again."""
         if self._bound:
             assert self._targets is not None  # bound to them
             self._targets[1].RestorePreviousBindingsAndBuffers()
             self._bound = False
+        if self._viewport is not None:
+            self.renderer.GetRenderWindow().GetState().vtkglViewport(*self._viewport)
+            self._viewport = None
 
     def _on_resolve(self, program: Any) -> None:
         """The resolve's draw: back to the scene's framebuffer; the volume's image goes over it."""
@@ -545,6 +602,8 @@ class GLPTVolume(PTView):
             color.Activate()
             program.SetUniformi("ptAccum", color.GetTextureUnit())
         program.SetUniformi("ptDrawn", int(self._drawn and color is not None))
+        if self._upsample:
+            program.SetUniform2f("ptViewSize", [float(v) for v in window_size(self.renderer)])
 
     def _visible(self) -> np.ndarray:
         """The cells drawn: those with some opacity under the TF (Roettger §9.1), or that an isovalue crosses."""
@@ -645,17 +704,20 @@ class GLPTVolume(PTView):
             self._table = self._build_table()
             self._upload_table(ren_win)
         cam = self._camera()
-        w, h = (int(v) for v in self.renderer.GetSize())
-        rb = cam.rays((w, h), origin=self.topo.origin)
+        size = window_size(self.renderer)
+        drawn = self.drawn_size or size
+        rb = cam.rays(size, origin=self.topo.origin)
+        if drawn != size:                          # an interactive frame: the same view's rays at fewer pixels
+            rb = scaled_rays(rb, size, drawn)
         for name, v in (("rayO0", rb.o0), ("rayOx", rb.ox), ("rayOy", rb.oy), ("rayD0", rb.d0), ("rayDx", rb.dx),
                         ("rayDy", rb.dy)):
             program.SetUniform3f(name, [float(x) for x in v])
-        program.SetUniformf("viewHeight", float(h))
+        program.SetUniformf("viewHeight", float(drawn[1]))
         program.SetUniform2f("clipRange", [float(x) for x in cam.clipping_range])
         program.SetUniformi("parallelView", int(cam.parallel))
         if len(self._clip):
             program.SetUniform4fv("clipPlanes", len(self._clip), [float(x) for x in self._clip.ravel()])
-        depth = self._bind_target(w, h)            # the opaque scene's depth, the volume's own color target
+        depth = self._bind_target(size, drawn)     # the opaque scene's depth, the volume's own color target
         depth.Activate()
         self._drawn = True
         program.SetUniformi("useDepth", 1)
@@ -680,7 +742,40 @@ class GLPTVolume(PTView):
             program.SetUniform4f("tableLength", [float(1.0 / table.l_max), 0.0, float(table.degree), 0.0])
             program.SetUniform3f("kappaMax", [float(x) for x in table.kappa_max])
 
+    def _apply_upsample(self, on: bool) -> None:
+        """The resolve's shader variant for this frame (VTK keeps both programs compiled once made)."""
+        if on != self._upsample:
+            self._upsample = on
+            self.resolve_actor.GetShaderProperty().SetFragmentShaderCode(_resolve_shader(on))
+
     # --- public --------------------------------------------------------------------------------------------------
+    def set_interactive(self, on: bool | None) -> None:
+        """Draw at reduced resolution from the next render on (True: the camera is moving; at most
+        ``interactive_pixels`` pixels, upsampled), at full resolution (False), or follow the render window (None,
+        the default: interactive while its desired update rate exceeds 1 frame/s, as VTK's interactor styles set it
+        for a drag and back to the still rate when the drag ends)."""
+        self.interactive = on
+
+    def is_interactive(self) -> bool:
+        """Whether the next render is an interactive one (``set_interactive``)."""
+        if self.interactive is not None:
+            return bool(self.interactive)
+        ren_win = self.renderer.GetRenderWindow()
+        return ren_win is not None and ren_win.GetDesiredUpdateRate() > _STILL_RATE_MAX
+
+    def draw_size(self) -> tuple[int, int]:
+        """The size the next render draws the cells at: the renderer's, or during an interaction the reduced one
+        (``volviz.render.reduced_fill.reduced_size``)."""
+        size = window_size(self.renderer)
+        return reduced_size(size, self.interactive_pixels) if self.is_interactive() else size
+
+    @property
+    def target_size(self) -> tuple[int, int] | None:
+        """The size of the float target the cells were last drawn into (None before the first draw)."""
+        if self._targets is None:
+            return None
+        return int(self._targets[0].GetWidth()), int(self._targets[0].GetHeight())
+
     def _use_tf(self, tf: Any) -> None:
         """A new transfer function (``set_tf``): the table texture is rebuilt at the next render and the
         zero-opacity culling follows it (a new index buffer from the same visibility order: the sort does not depend
