@@ -19,6 +19,11 @@ def data_root() -> Path:
     return Path(env).resolve() if env else (REPO.parent / "shared" / "data").resolve()
 
 
+# the app and the CLI find the shipped sessions' data where the tests do (CI sets it; a plain local run did not, and
+# the Yukon flows then waited on the missing-data dialog)
+os.environ.setdefault("VOLVIZ_DATA", str(data_root()))
+
+
 def data_file(relative: str) -> Path:
     """Path of a shared dataset; skip (or fail under VOLVIZ_REQUIRE_DATA=1) when it is missing."""
     path = data_root() / relative
