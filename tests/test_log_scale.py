@@ -69,3 +69,23 @@ def test_scalar_bar_styles_are_render_options(style):
 def test_bad_scalar_bar_styles_are_refused(style, message):
     with pytest.raises(SettingsError, match=f"render.options.scalar_bar_style.*{message}"):
         validate_render_options({"scalar_bar_style": style})
+
+
+def test_the_editor_axis_is_linear_or_log10_from_the_floor_and_inverts() -> None:
+    """The TF editor's axis: linear without a floor; with one, 1 -> 0, 10 -> 1/3, 100 -> 2/3, 1000 -> 1 over 0..1000
+    (values below the floor at 0), and ``axis_value`` gives the scalars back."""
+    from volviz.optics.log_scale import axis_fraction, axis_value
+
+    assert np.allclose(axis_fraction([0.0, 250.0, 1000.0], 0.0, 1000.0), [0.0, 0.25, 1.0])
+    f = axis_fraction([0.0, 0.5, 1.0, 10.0, 100.0, 1000.0], 0.0, 1000.0, 1.0)
+    assert np.allclose(f, [0.0, 0.0, 0.0, 1 / 3, 2 / 3, 1.0], atol=1e-15)
+    assert np.allclose(axis_value(f[2:], 0.0, 1000.0, 1.0), [1.0, 10.0, 100.0, 1000.0], rtol=1e-12)
+    assert np.allclose(axis_value([0.25, 0.5], 0.0, 1000.0), [250.0, 500.0])
+    assert np.allclose(axis_fraction([5.0, 50.0], 5.0, 500.0, 1.0), [0.0, 0.5])   # a positive range: from its low end
+
+
+def test_clamped_count_counts_values_at_or_below_zero_not_nan() -> None:
+    from volviz.optics.log_scale import clamped_count
+
+    assert clamped_count(np.array([-1.0, 0.0, 1e-9, np.nan, 3.0])) == 2
+    assert clamped_count(np.arange(5, dtype=np.uint8)) == 1

@@ -4,7 +4,9 @@ stops with a color picker, presets (ParaView JSON import/export), fit to data ra
 The editor holds a ``TransferFunction`` (volviz.optics) and never computes optics itself; where a point goes when
 one is added, moved or removed is ``volviz.optics.tf_points``. It emits ``changed(tf)`` continuously while the user
 drags (the window throttles re-rendering) and ``committed(tf)`` when an edit is finished; each finished edit is one
-entry of the undo stack.
+entry of the undo stack. With the component's log color scale on (``set_log_axis``), the scalar axis is in log10
+from the scale's smallest positive value, with its ticks labelled, so the color bar reads as the volume is colored
+(``volviz.optics.log_scale``).
 """
 from __future__ import annotations
 
@@ -17,6 +19,7 @@ from PySide6.QtWidgets import (QCheckBox, QColorDialog, QComboBox, QFileDialog, 
                                QPushButton, QSizePolicy, QVBoxLayout, QWidget)
 
 from volviz.optics import TransferFunction
+from volviz.optics.log_scale import axis_fraction, axis_value, log_ticks
 from volviz.optics.tf_points import MIN_POINTS, insert_point, moved_scalar, remove_point
 from . import set_tooltips
 
@@ -59,6 +62,7 @@ class TransferFunctionCanvas(QWidget):
         self.histogram: Optional[np.ndarray] = None
         self.histogram_edges: Optional[np.ndarray] = None
         self.log_histogram = False
+        self.log_floor: Optional[float] = None    # the scalar axis in log10 from this value (None: linear)
         self.histogram_pending = False  # computed in the background: a placeholder is drawn meanwhile
         self.selected: Optional[int] = None
         self._dragging = False
@@ -73,17 +77,20 @@ class TransferFunctionCanvas(QWidget):
             lo, hi = min(lo, float(self.histogram_edges[0])), max(hi, float(self.histogram_edges[-1]))
         return (lo, hi if hi > lo else lo + 1.0)
 
+    def x_of(self, s: Any) -> Any:
+        """The x pixel of scalar(s) ``s`` (the axis linear, or in log10 with ``log_floor``)."""
+        r = self._plot_rect()
+        return r.left() + axis_fraction(s, *self._view_range(), self.log_floor) * r.width()
+
     def to_screen(self, s: float, rho: float) -> QPointF:
         r = self._plot_rect()
-        lo, hi = self._view_range()
-        x = r.left() + (s - lo) / (hi - lo) * r.width()
         y = r.bottom() - min(rho / self.rho_view, 1.0) * r.height()
-        return QPointF(x, y)
+        return QPointF(float(self.x_of(s)), y)
 
     def from_screen(self, point: QPointF) -> tuple[float, float]:
         r = self._plot_rect()
         lo, hi = self._view_range()
-        s = lo + (point.x() - r.left()) / max(r.width(), 1.0) * (hi - lo)
+        s = float(axis_value((point.x() - r.left()) / max(r.width(), 1.0), lo, hi, self.log_floor))
         rho = (r.bottom() - point.y()) / max(r.height(), 1.0) * self.rho_view
         return (float(np.clip(s, lo, hi)), float(np.clip(rho, 0.0, self.rho_view)))
 
@@ -111,11 +118,11 @@ class TransferFunctionCanvas(QWidget):
             painter.setPen(Qt.PenStyle.NoPen)
             painter.setBrush(QColor(90, 90, 100))
             edges = self.histogram_edges
-            for c, a, b in zip(counts, edges[:-1], edges[1:]):
-                x0 = r.left() + (a - lo) / (hi - lo) * r.width()
-                x1 = r.left() + (b - lo) / (hi - lo) * r.width()
+            for c, x0, x1 in zip(counts, self.x_of(edges[:-1]), self.x_of(edges[1:])):
                 h = c / top * r.height()
                 painter.drawRect(QRectF(x0, r.bottom() - h, max(x1 - x0, 1.0), h))
+        if self.log_floor is not None:
+            self._paint_log_ticks(painter, r)
         path = QPainterPath()
         for i, (s, rho) in enumerate(zip(self.scalars, self.extinction)):
             p = self.to_screen(s, rho)
@@ -130,10 +137,19 @@ class TransferFunctionCanvas(QWidget):
             painter.drawEllipse(self.to_screen(s, rho), POINT_RADIUS, POINT_RADIUS)
         bar = QRectF(r.left(), r.bottom() + MARGIN, r.width(), COLOR_BAR_HEIGHT)
         gradient = QLinearGradient(bar.topLeft(), bar.topRight())
-        for s, c in zip(self.scalars, self.colors):
-            gradient.setColorAt(float(np.clip((s - lo) / (hi - lo), 0, 1)), QColor.fromRgbF(*np.clip(c, 0, 1)))
+        for f, c in zip(axis_fraction(self.scalars, lo, hi, self.log_floor), self.colors):
+            gradient.setColorAt(float(np.clip(f, 0, 1)), QColor.fromRgbF(*np.clip(c, 0, 1)))
         painter.fillRect(bar, QBrush(gradient))
         painter.end()
+
+    def _paint_log_ticks(self, painter: QPainter, r: QRectF) -> None:
+        """The log axis's ticks (``log_ticks`` from the floor to the top of the range): a line and its value each."""
+        lo, hi = self._view_range()
+        floor = max(lo, float(self.log_floor or lo))
+        painter.setPen(QPen(QColor(110, 110, 125), 1.0))
+        for tick, x in zip(log_ticks(floor, hi), self.x_of(log_ticks(floor, hi))):
+            painter.drawLine(QPointF(float(x), r.top()), QPointF(float(x), r.bottom()))
+            painter.drawText(QPointF(float(x) + 2.0, r.top() + 11.0), f"{tick:g}")
 
     # -- interaction ------------------------------------------------------------------------------------------------
     def mousePressEvent(self, event: Any) -> None:
@@ -268,6 +284,12 @@ class TransferFunctionEditor(QWidget):
         self.undo_stack.clear()
         self._apply(tf, commit=False)
         self._committed_tf = tf
+
+    def set_log_axis(self, floor: Optional[float]) -> None:
+        """Draw the scalar axis in log10 from ``floor`` (the log color scale's smallest positive value; None:
+        linear)."""
+        self.canvas.log_floor = None if floor is None else float(floor)
+        self.canvas.update()
 
     def set_histogram_pending(self) -> None:
         """The histogram is being computed in the background: a placeholder, no fit to data until it arrives."""

@@ -63,3 +63,35 @@ def log_ticks(lo: float, hi: float) -> np.ndarray:
         if ticks.size >= 3:
             break
     return np.unique(np.concatenate([[lo], ticks, [hi]]))
+
+
+def axis_fraction(s: np.ndarray | float, lo: float, hi: float, floor: float | None = None) -> np.ndarray:
+    """Where scalars ``s`` stand along an axis from ``lo`` to ``hi`` (0 at ``lo``, 1 at ``hi``): linear, or with a
+    ``floor`` (the log scale's smallest positive value) in log10 from ``max(lo, floor)``, values below it at 0 (the
+    TF editor's axis, which then reads as the volume is colored)."""
+    v = np.asarray(s, dtype=np.float64)
+    if floor is None:
+        return (v - lo) / (hi - lo)
+    a, b = _log_span(lo, hi, floor)
+    return (np.log10(np.maximum(v, 10.0 ** a)) - a) / (b - a)
+
+
+def axis_value(fraction: np.ndarray | float, lo: float, hi: float, floor: float | None = None) -> np.ndarray:
+    """The scalar at ``fraction`` of the axis of ``axis_fraction`` (its inverse above the floor)."""
+    f = np.asarray(fraction, dtype=np.float64)
+    if floor is None:
+        return lo + f * (hi - lo)
+    a, b = _log_span(lo, hi, floor)
+    return 10.0 ** (a + f * (b - a))
+
+
+def _log_span(lo: float, hi: float, floor: float) -> tuple[float, float]:
+    a = float(np.log10(max(lo, floor)))
+    b = float(np.log10(hi)) if hi > 10.0 ** a else a + 1.0
+    return a, b
+
+
+def clamped_count(values: np.ndarray) -> int:
+    """How many of ``values`` a log scale cannot map (at or below 0; NaN is not counted): drawn at its floor."""
+    v = np.asarray(values)
+    return int(np.count_nonzero(v <= 0))
