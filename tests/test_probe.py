@@ -97,3 +97,23 @@ def test_the_lod_probe_is_the_regular_probe_of_the_decoded_volume(blob, ray) -> 
         assert want is not None and got == want, (got, want)
         assert got.value == float(volume.data[got.voxel])
     assert got.voxel != probe_lod(tree, origin, direction, tf, "blob").voxel     # the TF moved the hit inwards
+
+
+def test_the_probes_skip_what_the_clipping_cuts_away(cube, blob) -> None:
+    """A clip plane keeping z >= 0.6 (the mesh) or x >= 20.6 (the volumes): the mesh probe enters at the plane; the
+    regular and LOD probes start behind it and still agree on the voxel and value."""
+    from volviz.model.clip import ClipPlane, ClipSettings
+    from volviz.regular.probe_lod import probe_lod
+
+    hit = probe_tetmesh(cube, (0.3, 0.4, -1.0), (0.0, 0.0, 1.0),
+                        clip=ClipSettings(planes=(ClipPlane((0.0, 0.0, 0.6), (0.0, 0.0, 1.0)),)))
+    assert np.allclose(hit.position, (0.3, 0.4, 0.6)) and hit.value == pytest.approx(0.3 + 0.8 + 1.8)
+    assert probe_tetmesh(cube, (0.3, 0.4, -1.0), (0.0, 0.0, 1.0),
+                         clip=ClipSettings(planes=(ClipPlane((0.0, 0.0, 0.6), (0.0, 0.0, -1.0)),
+                                                   ClipPlane((0.0, 0.0, 0.7), (0.0, 0.0, 1.0))))) is None
+    tree, volume = blob
+    clip = ClipSettings(planes=(ClipPlane((20.6, 0.0, 0.0), (1.0, 0.0, 0.0)),))
+    origin, direction = np.array([-5.0, 19.3, 21.6]), np.array([1.0, 0.0, 0.0])
+    want = probe_regular(volume, origin, direction, None, "blob", clip=clip)
+    assert want.voxel[0] == 21 and want == probe_lod(tree, origin, direction, None, "blob", clip=clip)
+    assert want.value == float(volume.data[want.voxel])

@@ -42,17 +42,37 @@ def ray_box(origin: np.ndarray, direction: np.ndarray, lo: np.ndarray, hi: np.nd
     return (t0, t1) if t1 >= t0 else None
 
 
-def ray_voxels(origin: Any, direction: Any, grid_origin: Any, spacing: Any,
-               shape: Any) -> Optional[tuple[np.ndarray, float]]:
+def clip_span(origin: np.ndarray, direction: np.ndarray, clip: Any,
+              span: Optional[tuple[float, float]]) -> Optional[tuple[float, float]]:
+    """The part of the ray's ``span`` (t0, t1) that ``clip`` (``volviz.model.clip.ClipSettings``: planes and box,
+    each keeping ``(x - point) . normal >= 0``) keeps: one interval, the kept region being convex; None: nothing."""
+    if span is None or clip is None:
+        return span
+    t0, t1 = span
+    for plane in clip.all_planes():
+        n = np.asarray(plane.normal, dtype=np.float64)
+        num, den = float((origin - np.asarray(plane.point)) @ n), float(direction @ n)
+        if den > 0:
+            t0 = max(t0, -num / den)
+        elif den < 0:
+            t1 = min(t1, -num / den)
+        elif num < 0:
+            return None
+    return (t0, t1) if t1 >= t0 else None
+
+
+def ray_voxels(origin: Any, direction: Any, grid_origin: Any, spacing: Any, shape: Any,
+               clip: Any = None) -> Optional[tuple[np.ndarray, float]]:
     """The voxels (n, 3) of a regular grid (sample ``(i, j, k)`` at ``grid_origin + (i, j, k) * spacing``) nearest
     the samples of the ray ``origin + t * direction`` (unit) every half of the smallest spacing, front to back,
-    over the voxels' cells around their centres, and that step; None when the ray misses the grid."""
+    over the voxels' cells around their centres and what ``clip`` keeps (``clip_span``), and that step; None when
+    the ray misses them."""
     o = np.asarray(origin, dtype=np.float64)
     d = np.asarray(direction, dtype=np.float64)
     vo = np.asarray(grid_origin, dtype=np.float64)
     sp = np.asarray(spacing, dtype=np.float64)
     n = np.asarray(shape, dtype=np.int64)
-    span = ray_box(o, d, vo - 0.5 * sp, vo + (n - 0.5) * sp)
+    span = clip_span(o, d, clip, ray_box(o, d, vo - 0.5 * sp, vo + (n - 0.5) * sp))
     if span is None:
         return None
     step = 0.5 * float(sp.min())
@@ -73,13 +93,13 @@ def first_visible(values: np.ndarray, tf: Any, opacity: float, step: float) -> O
 
 
 def probe_regular(volume: Any, origin: Any, direction: Any, tf: Any = None, component: str = "",
-                  opacity: float = 1.0) -> Optional[ProbeResult]:
+                  opacity: float = 1.0, clip: Any = None) -> Optional[ProbeResult]:
     """The first voxel of the regular ``volume`` (data, origin, spacing) along the ray whose opacity under ``tf``
     (a ``TransferFunction``, its extinction times ``opacity``) over half a voxel is visible; without ``tf`` the first
-    voxel the ray enters. Samples every half of the smallest spacing at the nearest voxel (``ray_voxels``). None
-    when nothing visible is hit."""
+    voxel the ray enters. Samples every half of the smallest spacing at the nearest voxel, in the part ``clip``
+    keeps (``ray_voxels``). None when nothing visible is hit."""
     d = np.asarray(direction, dtype=np.float64)
-    march = ray_voxels(origin, d / np.linalg.norm(d), volume.origin, volume.spacing, volume.data.shape)
+    march = ray_voxels(origin, d / np.linalg.norm(d), volume.origin, volume.spacing, volume.data.shape, clip)
     if march is None:
         return None
     ijk, step = march

@@ -29,12 +29,13 @@ def lod_voxel_values(tree: Any, ijk: np.ndarray) -> np.ndarray:
 
 
 def probe_lod(tree: Any, origin: Any, direction: Any, tf: Any = None, component: str = "",
-              opacity: float = 1.0) -> Optional[ProbeResult]:
+              opacity: float = 1.0, clip: Any = None) -> Optional[ProbeResult]:
     """The first full-resolution voxel of the ``LodTree`` along the ray whose opacity under ``tf`` over half a voxel
-    is visible (``probe_regular``'s rule), with its decoded value, centre and index; None when nothing visible is
-    hit. The nodes are decoded one at a time in the ray's order, and the search stops at the first hit."""
+    is visible (``probe_regular``'s rule, in the part ``clip`` keeps), with its decoded value, centre and index;
+    None when nothing visible is hit. The nodes are decoded one at a time in the ray's order, and the search stops
+    at the first hit."""
     d = np.asarray(direction, dtype=np.float64)
-    march = ray_voxels(origin, d / np.linalg.norm(d), tree.origin, tree.spacing, tree.decoder.dims)
+    march = ray_voxels(origin, d / np.linalg.norm(d), tree.origin, tree.spacing, tree.decoder.dims, clip)
     if march is None:
         return None
     ijk, step = march

@@ -14,7 +14,7 @@ from typing import Any, Optional
 import numpy as np
 from numba import njit
 
-from volviz.model.probe import VISIBLE_OPACITY, ProbeResult
+from volviz.model.probe import VISIBLE_OPACITY, ProbeResult, clip_span
 
 SUBSTEPS = 8     # midpoint samples of the extinction per tetrahedron crossed
 
@@ -72,14 +72,20 @@ def tet_value(mesh: Any, cell: int, x: Any) -> float:
 
 
 def probe_tetmesh(mesh: Any, origin: Any, direction: Any, tf: Any = None, component: str = "",
-                  opacity: float = 1.0) -> Optional[ProbeResult]:
+                  opacity: float = 1.0, clip: Any = None) -> Optional[ProbeResult]:
     """The first point of the ``TetMesh`` along the ray (``origin``, unit ``direction``) where the accumulated
-    opacity under ``tf`` reaches ``VISIBLE_OPACITY`` (without ``tf``: where the ray enters the mesh), with its
-    interpolated value, tetrahedron (``cell``) and nearest vertex (``point``); None when nothing visible is hit."""
+    opacity under ``tf`` reaches ``VISIBLE_OPACITY`` (without ``tf``: where the ray enters the mesh), in the part
+    ``clip`` keeps (a renderer that clips in its shader draws the uncut mesh), with its interpolated value,
+    tetrahedron (``cell``) and nearest vertex (``point``); None when nothing visible is hit."""
     o = np.asarray(origin, dtype=np.float64)
     d = np.asarray(direction, dtype=np.float64)
     d = d / np.linalg.norm(d)
     ids, t_in, t_out = _ray_spans(mesh.points, mesh.tets, o, d)
+    kept = clip_span(o, d, clip, (0.0, np.inf))
+    if kept is None:
+        return None
+    t_in, t_out = np.maximum(t_in, kept[0]), np.minimum(t_out, kept[1])
+    ids, t_in, t_out = ids[t_out > t_in], t_in[t_out > t_in], t_out[t_out > t_in]
     if not len(ids):
         return None
     order = np.argsort(t_in, kind="stable")
