@@ -76,8 +76,10 @@ def test_demo_scene_gpu_matches_cpu(demo, eye, focus) -> None:
     cam = Camera(eye, focus, (0.0, 0.0, 1.0), 60.0, clipping_range=(5.0, 10000.0))
     st_cpu, st_gpu = _compare(demo, cam, 0.75, "demo")
     # the same LOD: the GPU is also given the leaves whose morphed corners are all transparent (its geometry shader
-    # drops them; the CPU's morph finds them), a few per cent
-    assert st_cpu["cloud_tets"] <= st_gpu["cloud_tets"] <= 1.05 * st_cpu["cloud_tets"] and st_cpu["cloud_tets"] > 0
+    # drops them; the CPU's morph finds them, the GPU's list has only the static bound of any morph,
+    # ``CloudLOD.fbound``): measured 13.4-13.8 % more on these cameras (1.5-2 % while the zero-opacity test dropped
+    # the nodes of transparent data, and with them leaves the morph made visible: the seams of issue #28)
+    assert st_cpu["cloud_tets"] <= st_gpu["cloud_tets"] <= 1.16 * st_cpu["cloud_tets"] and st_cpu["cloud_tets"] > 0
     leaves = st_gpu["cloud_tets"] // 5
     # a first frame uploads the slot array whole (a texel of 16 bytes per slot, twice the leaves at least, rounded up
     # to a power of two), one point per slot and the draw order (4 bytes per leaf and the 2 reserved slots)

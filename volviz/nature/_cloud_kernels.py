@@ -56,10 +56,18 @@ def coarse_value(cv: np.ndarray, ii: int, jj: int, kk: int, p: int) -> float:
     return acc / cnt
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _node_corners(v, x0, y0, z0, s, out):
+    """The values of ``v`` at the 8 corners (index i<<2 | j<<1 | k) of the node of edge ``s`` at grid point
+    (x0, y0, z0)."""
+    for q in range(8):
+        out[q] = v[x0 + (q >> 2) * s, y0 + ((q >> 1) & 1) * s, z0 + (q & 1) * s]
+
+
 @njit(cache=True, nogil=True)
-def node_stats(f, g, g_weight, root, levels, roots, off, delta_local, fmax):
-    """Per stored node: local deviation Δ = max over the 19 non-corner lattice points of max(|f − coarse|,
-    g_weight |g − coarse|) (the maximum variant of §11.4), and fmax over the node's closed box."""
+def node_stats(f, g, g_weight, root, levels, roots, off, delta_local):
+    """Per stored node the local deviation Δ = max over the 19 non-corner lattice points of max(|f − coarse|,
+    g_weight |g − coarse|) (the maximum variant of §11.4)."""
     cf = np.empty(8)
     cg = np.empty(8)
     for lv in range(levels - 1, -1, -1):
@@ -71,31 +79,66 @@ def node_stats(f, g, g_weight, root, levels, roots, off, delta_local, fmax):
                 for c in range(nc):
                     x0, y0, z0 = a * s, b * s, c * s
                     p = (a + b + c) % 2
-                    for q in range(8):
-                        i, j, k = q >> 2, (q >> 1) & 1, q & 1
-                        cf[q] = f[x0 + i * s, y0 + j * s, z0 + k * s]
-                        cg[q] = g[x0 + i * s, y0 + j * s, z0 + k * s]
+                    _node_corners(f, x0, y0, z0, s, cf)
+                    _node_corners(g, x0, y0, z0, s, cg)
                     dev = 0.0
-                    m = -np.inf
                     for ii in range(3):
                         for jj in range(3):
                             for kk in range(3):
-                                v = f[x0 + ii * h, y0 + jj * h, z0 + kk * h]
-                                if h == 1:
-                                    m = max(m, v)
                                 if (ii & 1) + (jj & 1) + (kk & 1) == 0:
                                     continue
+                                v = f[x0 + ii * h, y0 + jj * h, z0 + kk * h]
                                 w = g[x0 + ii * h, y0 + jj * h, z0 + kk * h]
                                 dev = max(dev, abs(v - coarse_value(cf, ii, jj, kk, p)))
                                 dev = max(dev, g_weight * abs(w - coarse_value(cg, ii, jj, kk, p)))
-                    idx = off[lv] + (a * nb + b) * nc + c
-                    delta_local[idx] = dev
-                    if h > 1:
-                        cb, cc = nb << 1, nc << 1
+                    delta_local[(off[lv] + (a * nb + b) * nc + c)] = dev
+
+
+@njit(cache=True, nogil=True)
+def box_max(v, root, levels, roots, off, out):
+    """Per stored node the maximum of ``v`` over the grid points of its closed box (bottom-up: the 27 points of a
+    2-cell node, then the maximum of the 8 children)."""
+    for lv in range(levels - 1, -1, -1):
+        s = root >> lv
+        h = s // 2
+        na, nb, nc = roots[0] << lv, roots[1] << lv, roots[2] << lv
+        cb, cc = nb << 1, nc << 1
+        for a in range(na):
+            for b in range(nb):
+                for c in range(nc):
+                    m = -np.inf
+                    if h == 1:
+                        for q in range(27):
+                            m = max(m, v[a * s + q // 9, b * s + (q // 3) % 3, c * s + q % 3])
+                    else:
                         for q in range(8):
                             ch = off[lv + 1] + ((2 * a + (q >> 2)) * cb + 2 * b + ((q >> 1) & 1)) * cc + 2 * c + (q & 1)
-                            m = max(m, fmax[ch])
-                    fmax[idx] = m
+                            m = max(m, out[ch])
+                    out[off[lv] + (a * nb + b) * nc + c] = m
+
+
+@njit(cache=True, nogil=True)
+def morph_bound(f, root, levels, roots, hi):
+    """Per grid point the largest value the morph can give it for any weights (``hi``, f's shape): the corrected
+    Eq. (11.8) S' = (1 − w) coarse + w S is at most max(coarse, S), and the coarse value (``coarse_value``, a mean of
+    the introducing node's corners) at most the same mean of the corners' bounds; top-down, the root lattice keeps
+    f. A leaf is drawn from its morphed corners, which may exceed the data in its box (a T-vertex takes its coarser
+    neighbour's value), so the zero-opacity test of a node must bound these, not the data (``emit``)."""
+    hi[...] = f
+    cv = np.empty(8)
+    for lv in range(levels):
+        s = root >> lv
+        h = s // 2
+        nb, nc = roots[1] << lv, roots[2] << lv
+        for t in range((roots[0] << lv) * nb * nc):     # the level's nodes; no dependence within a level
+            a, b, c = t // (nb * nc), (t // nc) % nb, t % nc
+            _node_corners(hi, a * s, b * s, c * s, s, cv)
+            for q in range(27):
+                ii, jj, kk = q // 9, (q // 3) % 3, q % 3
+                if (ii & 1) + (jj & 1) + (kk & 1) == 0:
+                    continue
+                xi, yi, zi = a * s + ii * h, b * s + jj * h, c * s + kk * h
+                hi[xi, yi, zi] = max(f[xi, yi, zi], coarse_value(cv, ii, jj, kk, (a + b + c) % 2))
 
 
 @njit(cache=True, nogil=True)
@@ -245,12 +288,13 @@ def morph(f, g, root, roots, off, state, eprime, nodes, count, vf, vg, origin, s
 
 
 @njit(cache=True, nogil=True)
-def emit(fmax, cutoff, root, levels, roots, off, origin, spacing, eye, planes, state, root_order, vf, full,
+def emit(bound, cutoff, root, levels, roots, off, origin, spacing, eye, planes, state, root_order, vf, full,
          out, stack, corner_test=True):
     """Back-to-front octree traversal (§11.5): roots in a BSP order of the root grid, children far-to-near at every
-    level; per node frustum culling and the zero-opacity test (fmax <= cutoff; for leaves with ``corner_test`` also
-    the max of the morphed corner densities in ``vf``; without it the leaves whose morphed corners are all
-    transparent are listed too, for a caller that morphs them itself). Leaves go to ``out`` (lv, a, b, c) in
+    level; per node frustum culling and the zero-opacity test (§11.5, on the values drawn: ``bound`` <= cutoff, the
+    node's maximum of ``morph_bound``, so that no leaf whose morphed corners exceed the cutoff is dropped; for
+    leaves with ``corner_test`` also the max of the morphed corner densities in ``vf``; without it the leaves whose
+    morphed corners are all transparent are listed too, for a caller that morphs them itself). Leaves go to ``out`` (lv, a, b, c) in
     visibility order. ``full`` refines every node (the full-resolution reference). Returns the number of leaves, or
     -1 if ``out`` is too small."""
     n = 0
@@ -271,7 +315,7 @@ def emit(fmax, cutoff, root, levels, roots, off, origin, spacing, eye, planes, s
             if lv < levels:
                 nb, nc = roots[1] << lv, roots[2] << lv
                 idx = off[lv] + (a * nb + b) * nc + c
-                if fmax[idx] <= cutoff:
+                if bound[idx] <= cutoff:
                     continue
                 refined = full or state[idx] == 2
             if refined:
