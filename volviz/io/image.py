@@ -75,7 +75,7 @@ def _tiff_page(path: PathLike) -> np.ndarray:
 def _jpeg_pixels(path: PathLike) -> np.ndarray:
     """A JPEG's pixels by ``vtkJPEGReader`` (libjpeg's warnings are errors there): (rows, cols) grey or
     (rows, cols, 3), row 0 at the top."""
-    import vtk
+    from volviz.io.vtk_lazy import vtk
     from vtkmodules.util.numpy_support import vtk_to_numpy
 
     from volviz.io.vtkfiles import _run

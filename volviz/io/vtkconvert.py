@@ -72,7 +72,7 @@ def _with_partial_arrays(path: PathLike, leaves: list) -> tuple[list, dict[tuple
     blocks) added to the others as NaN, as doubles in every block: vtkAppendFilter keeps only the arrays all its
     inputs share, and ParaView shows a partial array with NaN (no colour) where a block lacks it. A ReadWarning names
     them. Arrays whose component counts differ between blocks stay left out."""
-    import vtk
+    from volviz.io.vtk_lazy import vtk
     from vtkmodules.util.numpy_support import numpy_to_vtk, vtk_to_numpy
 
     found: dict[tuple[str, str], list[int]] = {}
@@ -112,7 +112,7 @@ def _with_partial_arrays(path: PathLike, leaves: list) -> tuple[list, dict[tuple
 def merge_composite(path: PathLike, obj):
     """A composite data set (multiblock / partitioned) as one data set; ReadError if it holds nothing. Arrays only
     some blocks carry are kept, NaN elsewhere, with masks of the filled places in the field data (``_filled``)."""
-    import vtk
+    from volviz.io.vtk_lazy import vtk
     from vtkmodules.util.numpy_support import numpy_to_vtk
 
     if not obj.IsA("vtkCompositeDataSet"):
@@ -231,7 +231,7 @@ def _unstructured(path: PathLike, obj, allow_nonfinite: bool) -> UnstructuredMes
 
 def _image(path: PathLike, obj, allow_nonfinite: bool) -> RegularVolume:
     """vtkImageData -> RegularVolume keeping every point array (cell arrays through VTK's cell-to-point filter)."""
-    import vtk
+    from volviz.io.vtk_lazy import vtk
 
     from volviz.model.arrays import default_array, scalar_of
 

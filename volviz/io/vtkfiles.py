@@ -24,7 +24,7 @@ XML_READERS = {
 
 def _run(path: PathLike, reader) -> Any:
     """Update a VTK reader with its messages captured (kept off the console); ReadError on any error."""
-    import vtk
+    from volviz.io.vtk_lazy import vtk
 
     previous = vtk.vtkOutputWindow.GetInstance()
     capture = vtk.vtkStringOutputWindow()
@@ -61,7 +61,7 @@ def read_vtk_file(path: PathLike, allow_nonfinite: bool = True):
         check_xml_file(path, XML_READERS[ext][0])
     else:
         raise ReadError(path, f"extension {ext!r} is not a VTK format ({', '.join(['.vtk', *XML_READERS])})")
-    import vtk
+    from volviz.io.vtk_lazy import vtk
 
     if ext == ".vtk":
         reader = vtk.vtkDataSetReader()

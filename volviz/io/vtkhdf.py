@@ -57,7 +57,7 @@ def _printable(exc: Exception) -> str:
 
 
 def _read_step(path: PathLike, step: int | None, allow_nonfinite: bool):
-    import vtk
+    from volviz.io.vtk_lazy import vtk
 
     from volviz.io.vtkfiles import _run
 

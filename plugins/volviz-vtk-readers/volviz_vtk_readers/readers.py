@@ -58,7 +58,7 @@ def _information(path: PathLike, reader: Any) -> Any:
 
 
 def _time_steps(reader: Any) -> list[float]:
-    import vtk
+    from volviz.io.vtk_lazy import vtk
 
     info = reader.GetOutputInformation(0)
     key = vtk.vtkStreamingDemandDrivenPipeline.TIME_STEPS()
@@ -89,7 +89,7 @@ def _in_time(path: PathLike, reader: Any, loader: Callable[..., Any], options: d
 # -- blocks ------------------------------------------------------------------------------------------------------------
 def _leaves(obj: Any, prefix: str = "") -> Iterator[tuple[str, Any]]:
     """``(path, data set)`` of every non-empty block of a composite data set; a partitioned data set is one block."""
-    import vtk
+    from volviz.io.vtk_lazy import vtk
 
     if obj is None:
         return
@@ -124,7 +124,7 @@ def _pick(path: PathLike, available: Sequence[str], blocks: Sequence[str] | str)
 
 def _select_leaves(path: PathLike, obj: Any, blocks: Sequence[str] | str | None) -> Any:
     """``obj`` with only the chosen blocks (one block is returned as itself, keeping its structured type)."""
-    import vtk
+    from volviz.io.vtk_lazy import vtk
 
     if blocks is None or not obj.IsA("vtkCompositeDataSet"):
         return obj
@@ -152,7 +152,7 @@ def _check_sniffed(path: PathLike, sniff: Callable[[bytes], bool], what: str) ->
 
 
 def _reader(cls: str, file_name: PathLike, setter: str = "SetFileName") -> Any:
-    import vtk
+    from volviz.io.vtk_lazy import vtk
 
     reader = getattr(vtk, cls)()
     getattr(reader, setter)(str(file_name))
@@ -161,7 +161,7 @@ def _reader(cls: str, file_name: PathLike, setter: str = "SetFileName") -> Any:
 
 # -- Exodus II ---------------------------------------------------------------------------------------------------------
 def _exodus(path: PathLike) -> Any:
-    import vtk
+    from volviz.io.vtk_lazy import vtk
 
     check_container(path, "Exodus II")
     check_exodus_connectivity(path)            # VTK reads past its point array for a node number out of range
@@ -173,7 +173,7 @@ def _exodus(path: PathLike) -> Any:
 
 
 def _exodus_blocks(reader: Any) -> list[str]:
-    import vtk
+    from volviz.io.vtk_lazy import vtk
 
     kind = vtk.vtkExodusIIReader.ELEM_BLOCK
     return [reader.GetObjectName(kind, i) for i in range(reader.GetNumberOfObjects(kind))]
@@ -182,7 +182,7 @@ def _exodus_blocks(reader: Any) -> list[str]:
 def read_exodus(path: PathLike, blocks: Sequence[str] | str | None = None, time_index: int | None = None,
                 allow_nonfinite: bool = True):
     """Exodus II: every element block (or ``blocks``) with every nodal and element variable, merged."""
-    import vtk
+    from volviz.io.vtk_lazy import vtk
 
     reader = _exodus(path)
     if blocks is not None:

@@ -146,7 +146,7 @@ def _same_mesh(a: Any, b: Any) -> bool:
 def fields_on_shared_meshes(leaves: Sequence[tuple[str, Any]]) -> Any:
     """Blocks ``(name, data set)`` as one data object: blocks on one mesh become one data set with all their arrays
     (a name already taken gets `` (block)`` after it); several meshes a multiblock of them."""
-    import vtk
+    from volviz.io.vtk_lazy import vtk
 
     meshes: list[tuple[Any, set[str], set[str]]] = []
     for name, leaf in leaves:
