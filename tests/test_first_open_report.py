@@ -91,3 +91,20 @@ def test_the_bench_measures_a_picture_without_an_error(tmp_path):
     assert record.kind == "picture"
     assert record.visible is None and record.contrast is None
     assert record.seconds is not None and record.drawn is not None and record.drawn > 0.02
+
+
+def test_an_only_run_of_the_bench_keeps_the_other_rows_and_the_profiles(tmp_path):
+    doc = tmp_path / "first-open.md"
+    doc.write_text(REPORT.read_text())
+    old = read_section(doc, bench.BEGIN, bench.END)
+    kept = [line for line in old.splitlines() if line.startswith("| `")]
+    order = [line.split("`")[1] for line in kept]
+    assert "sky/clouds.jpeg" in order and len(order) > 20
+    fresh = bench.markdown([bench.FirstImage("sky/clouds.jpeg", 0.1, 1.5, 0.39, "picture")], {})
+    bench.write_section(bench.kept_rows(fresh, False, order, report=doc), doc)
+    new = read_section(doc, bench.BEGIN, bench.END)
+    rows = [line for line in new.splitlines() if line.startswith("| `")]
+    assert [line.split("`")[1] for line in rows] == order
+    assert rows[order.index("sky/clouds.jpeg")] == "| `sky/clouds.jpeg` | 0.1 | picture | 1.5 s | 39% |  |  |  |"
+    assert all(a == b for a, b in zip(rows, kept) if "sky/clouds.jpeg" not in a)
+    assert new[new.index(bench.PROFILE_HEAD):] == old[old.index(bench.PROFILE_HEAD):]

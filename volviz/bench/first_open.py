@@ -15,7 +15,8 @@ legibility measures.
 
 Writes only its section of ``docs/first-open.md``, between ``BEGIN`` and ``END`` (``volviz.io.doc_section``: the
 app's window table and the prose around are kept), or only prints with ``--no-write``. ``--profile N`` adds where
-the time of the N slowest files goes (cProfile of an in-process render, by volviz module).
+the time of the N slowest files goes (cProfile of an in-process render, by volviz module). ``--only`` measures some
+files and keeps the other rows (and the profiles, unless it makes new ones).
 """
 from __future__ import annotations
 
@@ -43,6 +44,7 @@ METRIC_SIZE = (320, 240)       # the legibility measures render smaller (they co
 VISIBLE_DE = 10.0              # CIE76 difference a viewer sees at a glance (2.3 is just noticeable)
 DRAWN_DIFFERENCE = 24          # summed |RGB| difference from the background of a drawn pixel
 TARGET_S = 5.0
+PROFILE_HEAD = "Where the time goes for the slowest files"
 MAX_MB = 100
 
 
@@ -292,11 +294,23 @@ def markdown(records: list[FirstImage], profiles: dict[str, list[str]]) -> str:
                      f"{' s' if r.seconds is not None else ''} | {_number(r.drawn, '.0%')} | "
                      f"{_number(r.visible, '.0%')} | {_number(r.contrast, '.0f')} | {r.note.replace('|', '/')} |")
     if profiles:
-        lines += ["", "Where the time goes for the slowest files (cProfile of the same render in one process, "
-                  "cumulative seconds of the largest volviz calls):", ""]
+        lines += ["", PROFILE_HEAD + " (cProfile of the same render in one process, cumulative seconds of the "
+                  "largest volviz calls):", ""]
         for name, rows in profiles.items():
             lines.append(f"- `{name}`: " + "; ".join(rows))
     return "\n".join(lines) + "\n"
+
+
+def kept_rows(text: str, profiled: bool, order: list[str], report: Path = REPORT) -> str:
+    """The section ``text`` of an ``--only`` run with the rows of the other files kept from ``report``'s section (in
+    ``order``), and its "where the time goes" list when this run profiled none."""
+    from volviz.io.doc_section import merge_rows, read_section
+
+    old = read_section(report, BEGIN, END)
+    text = merge_rows(old, text, order)
+    if not profiled and PROFILE_HEAD in old:
+        text = text.rstrip("\n") + "\n\n" + old[old.index(PROFILE_HEAD):].strip("\n") + "\n"
+    return text
 
 
 def write_section(text: str, report: Path = REPORT) -> None:
@@ -318,6 +332,9 @@ def main(argv: Optional[list[str]] = None) -> int:
     slowest = sorted((r for r in records if r.seconds is not None), key=lambda r: -float(r.seconds or 0))
     profiles = {r.name: where_time_goes(args.data.resolve() / r.name) for r in slowest[:max(args.profile, 0)]}
     text = markdown(records, profiles)
+    if args.only:
+        text = kept_rows(text, bool(profiles), [p.relative_to(args.data.resolve()).as_posix()
+                                                 for p in opened_files(args.data.resolve())])
     print(text)
     if not args.no_write:
         write_section(text)

@@ -46,3 +46,26 @@ def write_section(path: Path, begin: str, end: str, body: str) -> None:
     else:
         new = old[:span[0]] + section + old[span[1]:]
     atomic_write_text(path, new)
+
+
+def _row_name(line: str) -> str | None:
+    """The file a table row is about: the first code span of a line ``| `NAME` | ...``; None for other lines."""
+    return line.split("`")[1] if line.startswith("| `") and line.count("`") >= 2 else None
+
+
+def merge_rows(old: str, new: str, order: list[str]) -> str:
+    """``new`` (a section whose table has rows for some files only: a run over a few of them) with the rows of
+    ``old`` kept for the files it has no row for, all rows in ``order`` (the names of every file, in table order;
+    others after them). The table is the first run of lines that begin ``| `NAME` |``, or that follow the
+    ``|---|`` line."""
+    kept = {name: line for line in old.splitlines() if (name := _row_name(line)) is not None}
+    lines = new.splitlines()
+    start = next((i + 1 for i, line in enumerate(lines) if line.startswith("|---")), len(lines))
+    stop = start
+    while stop < len(lines) and _row_name(lines[stop]) is not None:
+        stop += 1
+    rows = dict(kept)
+    for line in lines[start:stop]:
+        rows[str(_row_name(line))] = line
+    ranked = sorted(rows, key=lambda n: (order.index(n) if n in order else len(order), n))
+    return "\n".join(lines[:start] + [rows[n] for n in ranked] + lines[stop:]) + "\n"
