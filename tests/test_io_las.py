@@ -176,3 +176,25 @@ def test_a_laz_file_without_a_decompressor_says_what_to_install(tmp_path):
                           timeout=120, env={**os.environ, "VOLVIZ_ISOLATE": "0"})
     assert done.stdout.strip() == (f"{tmp_path / 'scan.laz'}: is a compressed LAS file (LAZ) and no LAZ decompressor "
                                    "is installed; install one: pip install 'laspy[lazrs]'"), done.stderr
+
+
+def test_choosing_a_colour_array_shows_the_points_in_their_own_colours(tmp_path):
+    """A cloud red along x, green along y (16-bit colours): shown by --array red it is drawn in its colours, which
+    the transfer function's cool-to-warm map (no green) could not give."""
+    header = laspy.LasHeader(point_format=3, version="1.2")
+    header.scales = np.full(3, 0.01)
+    las = laspy.LasData(header)
+    x, y = (a.ravel() for a in np.meshgrid(np.arange(0, 30, 0.3), np.arange(0, 30, 0.3)))
+    las.x, las.y, las.z = x, y, np.sin(x / 4)
+    las.red, las.green = (x / 30 * 65535).astype(np.uint16), (y / 30 * 65535).astype(np.uint16)
+    las.blue = np.full(len(x), 20000, np.uint16)
+    las.write(str(tmp_path / "rgb.las"))
+    done = _volviz("render", str(tmp_path / "rgb.las"), "--array", "red", "-o", str(tmp_path / "rgb.png"), "--size",
+                   "400x300")
+    assert done.returncode == 0, done.stderr
+    from PIL import Image
+
+    image = np.asarray(Image.open(tmp_path / "rgb.png").convert("RGB")).astype(np.int32)
+    r, g, b = image[..., 0], image[..., 1], image[..., 2]
+    assert ((g > r + 60) & (g > b + 60)).mean() > 0.01          # the green corner
+    assert ((r > g + 60) & (r > b + 60)).mean() > 0.01          # the red corner
