@@ -294,9 +294,9 @@ def emit(bound, cutoff, root, levels, roots, off, origin, spacing, eye, planes, 
     level; per node frustum culling and the zero-opacity test (§11.5, on the values drawn: ``bound`` <= cutoff, the
     node's maximum of ``morph_bound``, so that no leaf whose morphed corners exceed the cutoff is dropped; for
     leaves with ``corner_test`` also the max of the morphed corner densities in ``vf``; without it the leaves whose
-    morphed corners are all transparent are listed too, for a caller that morphs them itself). Leaves go to ``out`` (lv, a, b, c) in
-    visibility order. ``full`` refines every node (the full-resolution reference). Returns the number of leaves, or
-    -1 if ``out`` is too small."""
+    morphed corners are all transparent are listed too, for a caller that morphs them itself). Leaves go to ``out``
+    (lv, a, b, c) in visibility order. ``full`` refines every node (the full-resolution reference). Returns the
+    number of leaves, or -1 if ``out`` is too small."""
     n = 0
     cap = out.shape[0]
     for r in range(root_order.shape[0]):

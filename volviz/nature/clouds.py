@@ -27,7 +27,8 @@
   coarser neighbour's values (T-vertices, morphing) is drawn; dropped, its neighbour's cloud ended at their shared
   face: straight vertical and horizontal seams along the leaves' faces (issue #28; at the demo camera, 1024 x 640,
   the centre column, the eye's plane x = 500, stepped 5.8x as much as its neighbours, 0.69x with ``fbound``;
-  tests/test_cloud_seams.py). Costs 17 % more leaves there (5,462 -> 6,447), each with a morphed corner above the cutoff.
+  tests/test_cloud_seams.py). Costs 17 % more leaves there (5,462 -> 6,447), each with a morphed corner above the
+  cutoff.
 - **Projection**: ``render_cloud_image`` is an exact per-pixel equivalent of pre-integrated projected tetrahedra:
   per leaf and pixel the ray is clipped to the cube and to [near, terrain depth] (volumetric near-plane clipping and
   terrain occlusion are exact), split into its ≤ 3 tetrahedra, and each piece looked up in the 3D pre-integration
