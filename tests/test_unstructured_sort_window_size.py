@@ -99,3 +99,20 @@ def test_visibility_cycle_at_a_large_window(parallel):
     side = Camera((0, -8, 0.3), (0, 0, 0), (0, 0, 1), 30, clipping_range=(1, 20))
     res = visibility_order(m, side, LARGE, "mpvo")
     assert res.cycles == 0 and order_violations(m, side, CHECK, res.order, 1e-9) == 0
+
+
+@pytest.mark.parametrize("case", ["cavity", "hole-below", "cavity-camera-inside"])
+def test_overlap_tests_on_all_cores_give_the_same_relations(case, monkeypatch):
+    """The candidate face pairs' overlap tests split over the cores (from ``PARALLEL_PAIRS`` pairs on, as for
+    meshes of millions of cells) give the relations of the serial tests, and the order stays exact."""
+    from volviz.unstructured import boundary_pairs
+
+    make, cam = _CASES[case]
+    mesh = make()
+    cam = _camera(mesh, cam)
+    topo = topology(mesh)
+    serial = object_relations(topo, cam, LARGE)
+    monkeypatch.setattr(boundary_pairs, "PARALLEL_PAIRS", 0)
+    split = object_relations(topo, cam, LARGE)
+    assert len(serial[0]) > 0 and all(np.array_equal(a, b) for a, b in zip(serial, split))
+    assert order_violations(mesh, cam, CHECK, visibility_order(mesh, cam, LARGE, "mpvo").order, 1e-9) == 0

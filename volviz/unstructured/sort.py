@@ -6,7 +6,7 @@ Roettger §8.1 and Guthe §4.3 (§3.1 of the thesis):
 - ``"power"``: approximate, sort by the power distance |E - c|^2 - r^2 of the eye to the circumsphere (perspective;
   for orthographic views the power "depth" (c . f) + r, i.e. the far end of the sphere along the view direction).
 - ``"mpvo"``: Williams' MPVO as a topological sort (Kahn) of the face-adjacency graph, each shared face directed by the
-  side of its plane the eye lies on. Correct for convex, connected, acyclic meshes.
+  side of its plane the eye lies on (``volviz.unstructured.mpvo``). Correct for convex, connected, acyclic meshes.
 - Non-convex or disconnected meshes (``"mpvo"`` adds them automatically unless the mesh is convex): the missing
   relations between boundary faces, where a ray leaves the mesh (cell A) and re-enters it later (cell B): "B before
   A". By default they come from object space (``volviz.unstructured.boundary_pairs``: the overlapping exit/entry
@@ -23,7 +23,7 @@ Roettger §8.1 and Guthe §4.3 (§3.1 of the thesis):
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from numba import njit, prange
@@ -31,6 +31,7 @@ from numba import njit, prange
 from volviz.model.datasets import TetMesh
 from volviz.model.camera import Camera
 from volviz.unstructured.boundary_pairs import inner_boundary, object_relations
+from volviz.unstructured.mpvo import add_extra, face_sides, kahn
 from volviz.unstructured.topology import FACES, Topology, topology
 
 METHODS = ("mpvo", "centroid", "power")
@@ -41,11 +42,12 @@ NONCONVEX = ("auto", "object", "sample", "none")
 class SortResult:
     """A back-to-front order of cell ids and what it took."""
 
-    order: np.ndarray                 # (m,) int64, back to front
+    order: np.ndarray                 # (m,) cell ids back to front: int32 (mpvo; int64 from 2^31 cells on) or int64
     method: str
     cycles: int = 0                   # Kahn stalls broken by force-emitting a cell
     boundary_relations: int = 0       # distinct relations sampled between boundary faces (non-convex handling)
     seconds: float = 0.0
+    stages: dict[str, float] = field(default_factory=dict)   # mpvo: seconds of "relations", "sides", "kahn"
 
 
 # --------------------------------------------------------------------------------------------------------------------
@@ -78,109 +80,6 @@ def _power_keys(cc: np.ndarray, r2: np.ndarray, eye: np.ndarray, fwd: np.ndarray
             dz = cc[i, 2] - eye[2]
             key[i] = -(dx * dx + dy * dy + dz * dz - r2[i])
     return key
-
-
-# --------------------------------------------------------------------------------------------------------------------
-# MPVO (Kahn) with extra relations and cycle breaking
-@njit(cache=True, nogil=True, inline="always")
-def _side(face_n: np.ndarray, face_d: np.ndarray, t: int, f: int, eye: np.ndarray, fwd: np.ndarray,
-          parallel: bool) -> float:
-    """> 0: the eye is outside face f of cell t (its neighbour there is in front of t); < 0: inside."""
-    if parallel:
-        return -(face_n[t, f, 0] * fwd[0] + face_n[t, f, 1] * fwd[1] + face_n[t, f, 2] * fwd[2])
-    return face_n[t, f, 0] * eye[0] + face_n[t, f, 1] * eye[1] + face_n[t, f, 2] * eye[2] - face_d[t, f]
-
-
-@njit(cache=True, nogil=True)
-def _face_dirs(neighbor: np.ndarray, face_n: np.ndarray, face_d: np.ndarray, eye: np.ndarray, fwd: np.ndarray,
-               parallel: bool) -> tuple[np.ndarray, np.ndarray]:
-    """Per cell and face: 1 when the neighbour is in front, -1 behind, 0 none; and per cell the number of neighbours
-    behind it. Each shared face is decided once, by the plane of its lower-numbered cell, so both sides agree; every
-    cell fills only its own entries. Serial: a prange over cells took 2.0 ms (min) on the Blunt Fin but 36 ms
-    (median) with the 2 cores shared, the serial loop 3.2 / 7.2 ms."""
-    m = len(neighbor)
-    dirs = np.zeros((m, 4), np.int8)
-    indeg = np.zeros(m, np.int64)
-    for t in range(m):
-        n_behind = 0
-        for f in range(4):
-            u = neighbor[t, f]
-            if u < 0:
-                continue
-            if u > t:
-                side = _side(face_n, face_d, t, f, eye, fwd, parallel)
-            else:
-                g = 0
-                for h in range(4):
-                    if neighbor[u, h] == t:
-                        g = h
-                side = -_side(face_n, face_d, u, g, eye, fwd, parallel)
-            if side > 0.0:
-                dirs[t, f] = 1
-            elif side < 0.0:
-                dirs[t, f] = -1
-                n_behind += 1
-        indeg[t] = n_behind
-    return dirs, indeg
-
-
-@njit(cache=True, nogil=True)
-def _mpvo(neighbor: np.ndarray, dirs: np.ndarray, indeg: np.ndarray, extra_ptr: np.ndarray, extra_dst: np.ndarray,
-          fallback: np.ndarray) -> tuple[np.ndarray, int]:
-    """Topological sort; edge a -> b means a is drawn before b (a is behind b). ``indeg`` (consumed) counts the MPVO
-    edges into each cell (``_face_dirs``). Returns (order, cycle breaks)."""
-    m = len(neighbor)
-    for a in range(m):
-        for k in range(extra_ptr[a], extra_ptr[a + 1]):
-            indeg[extra_dst[k]] += 1
-    stack = np.empty(m, np.int64)
-    top = 0
-    for t in range(m):
-        if indeg[t] == 0:
-            stack[top] = t
-            top += 1
-    done = np.zeros(m, np.bool_)
-    order = np.empty(m, np.int64)
-    n_out = 0
-    cycles = 0
-    fb = 0
-    while n_out < m:
-        if top == 0:
-            if len(fallback) == 0:
-                return order[:n_out], -1          # stalled: the caller retries with a fallback order
-            while done[fallback[fb]]:
-                fb += 1
-            t = fallback[fb]
-            cycles += 1
-            indeg[t] = 0
-            stack[0] = t
-            top = 1
-        top -= 1
-        t = stack[top]
-        if done[t]:
-            continue
-        done[t] = True
-        order[n_out] = t
-        n_out += 1
-        for f in range(4):
-            u = neighbor[t, f]
-            if u < 0 or done[u]:
-                continue
-            front = dirs[t, f] == 1
-            if front:
-                indeg[u] -= 1
-                if indeg[u] == 0:
-                    stack[top] = u
-                    top += 1
-        for k in range(extra_ptr[t], extra_ptr[t + 1]):
-            u = extra_dst[k]
-            if done[u]:
-                continue
-            indeg[u] -= 1
-            if indeg[u] == 0:
-                stack[top] = u
-                top += 1
-    return order, cycles
 
 
 # --------------------------------------------------------------------------------------------------------------------
@@ -340,13 +239,6 @@ def boundary_relations(topo: Topology, cam: Camera, size: tuple[int, int]) -> tu
     return keys // m, keys % m
 
 
-def _csr(src: np.ndarray, dst: np.ndarray, m: int) -> tuple[np.ndarray, np.ndarray]:
-    order = np.argsort(src, kind="stable")
-    ptr = np.zeros(m + 1, np.int64)
-    np.add.at(ptr, src + 1, 1)
-    return np.cumsum(ptr), np.ascontiguousarray(dst[order])
-
-
 def is_convex(topo: Topology) -> bool:
     """True when every boundary face lies on the convex hull of the mesh (convex and connected: MPVO is exact)."""
     return len(inner_boundary(topo)) == 0
@@ -382,16 +274,26 @@ def visibility_order(mesh: TetMesh | Topology, camera: Camera, size: tuple[int, 
     m = topo.n_tets
     if nonconvex not in NONCONVEX:
         raise ValueError(f"nonconvex must be one of {NONCONVEX}, got {nonconvex!r}")
+    t1 = time.perf_counter()
     if nonconvex == "sample":
         src, dst = boundary_relations(topo, camera, size)
     elif nonconvex == "object" or (nonconvex == "auto" and not is_convex(topo)):
         src, dst = object_relations(topo, camera, size)
     else:
         src, dst = np.empty(0, np.int64), np.empty(0, np.int64)
-    ptr, dsts = _csr(src, dst, m)
-    dirs, indeg = _face_dirs(topo.neighbor, topo.face_n, topo.face_d, eye, fwd, camera.parallel)
-    order, cycles = _mpvo(topo.neighbor, dirs, indeg.copy(), ptr, dsts, np.empty(0, np.int64))
-    if cycles < 0:                      # a cycle: redo with the farthest-first fallback for breaking it
-        fallback = np.argsort(_centroid_keys(topo.centroid, eye, fwd, camera.parallel), kind="stable")
-        order, cycles = _mpvo(topo.neighbor, dirs, indeg, ptr, dsts, fallback)
-    return SortResult(order, method, int(cycles), int(len(src)), time.perf_counter() - t0)
+    t2 = time.perf_counter()
+    front, indeg = face_sides(topo.neighbor, topo.back_face, topo.face_n, topo.face_d, eye, fwd,
+                              camera.parallel)
+    t3 = time.perf_counter()
+    by_src = np.argsort(src, kind="stable")
+    idx = topo.neighbor.dtype
+    ex_src, ex_dst = src[by_src].astype(idx), dst[by_src].astype(idx)
+    add_extra(ex_src, ex_dst, front, indeg)
+    order = np.empty(m, idx)
+    n_out, cycles = kahn(topo.neighbor, front, indeg, ex_src, ex_dst, order, 0, np.empty(0, idx))
+    if cycles < 0:                      # a cycle: carry on from the stall, breaking it farthest first
+        fallback = np.argsort(_centroid_keys(topo.centroid, eye, fwd, camera.parallel), kind="stable").astype(idx)
+        n_out, cycles = kahn(topo.neighbor, front, indeg, ex_src, ex_dst, order, n_out, fallback)
+    t4 = time.perf_counter()
+    return SortResult(order, method, int(cycles), int(len(src)), t4 - t0,
+                      {"relations": t2 - t1, "sides": t3 - t2, "kahn": t4 - t3})
