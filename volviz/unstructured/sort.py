@@ -22,8 +22,11 @@ Roettger §8.1 and Guthe §4.3 (§3.1 of the thesis):
 """
 from __future__ import annotations
 
+import threading
 import time
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
+from functools import partial
 
 import numpy as np
 from numba import njit, prange
@@ -31,6 +34,7 @@ from numba import njit, prange
 from volviz.model.datasets import TetMesh
 from volviz.model.camera import Camera
 from volviz.unstructured.boundary_pairs import inner_boundary, object_relations
+from volviz.unstructured import mpvo
 from volviz.unstructured.mpvo import add_extra, face_sides, kahn
 from volviz.unstructured.topology import FACES, Topology, topology
 
@@ -244,6 +248,19 @@ def is_convex(topo: Topology) -> bool:
     return len(inner_boundary(topo)) == 0
 
 
+_SECOND_CORE: ThreadPoolExecutor | None = None
+_SECOND_CORE_LOCK = threading.Lock()
+
+
+def _second_core() -> ThreadPoolExecutor:
+    """One worker thread for the boundary relations of a large mesh, made when first needed."""
+    global _SECOND_CORE
+    with _SECOND_CORE_LOCK:
+        if _SECOND_CORE is None:
+            _SECOND_CORE = ThreadPoolExecutor(1, thread_name_prefix="volviz-sort")
+        return _SECOND_CORE
+
+
 def _view(cam: Camera, topo: Topology) -> tuple[np.ndarray, np.ndarray]:
     _, _, f = cam.frame()
     return np.ascontiguousarray(cam.position - topo.origin), np.ascontiguousarray(f)
@@ -275,15 +292,23 @@ def visibility_order(mesh: TetMesh | Topology, camera: Camera, size: tuple[int, 
     if nonconvex not in NONCONVEX:
         raise ValueError(f"nonconvex must be one of {NONCONVEX}, got {nonconvex!r}")
     t1 = time.perf_counter()
+    relations: partial[tuple[np.ndarray, np.ndarray]] | None = None
     if nonconvex == "sample":
-        src, dst = boundary_relations(topo, camera, size)
+        relations = partial(boundary_relations, topo, camera, size)
     elif nonconvex == "object" or (nonconvex == "auto" and not is_convex(topo)):
-        src, dst = object_relations(topo, camera, size)
+        relations = partial(object_relations, topo, camera, size)
+    beside = relations is not None and m >= mpvo.PARALLEL_CELLS
+    if beside:              # both stages release the GIL: the relations on a second core while this one does the sides
+        pending = _second_core().submit(relations)     # type: ignore[arg-type]
+        front, indeg = face_sides(topo.neighbor, topo.back_face, topo.face_n, topo.face_d, eye, fwd,
+                                  camera.parallel, cores=False)
+        t2 = time.perf_counter()
+        src, dst = pending.result()
     else:
-        src, dst = np.empty(0, np.int64), np.empty(0, np.int64)
-    t2 = time.perf_counter()
-    front, indeg = face_sides(topo.neighbor, topo.back_face, topo.face_n, topo.face_d, eye, fwd,
-                              camera.parallel)
+        src, dst = relations() if relations is not None else (np.empty(0, np.int64), np.empty(0, np.int64))
+        t2 = time.perf_counter()
+        front, indeg = face_sides(topo.neighbor, topo.back_face, topo.face_n, topo.face_d, eye, fwd,
+                                  camera.parallel)
     t3 = time.perf_counter()
     by_src = np.argsort(src, kind="stable")
     idx = topo.neighbor.dtype
@@ -295,5 +320,6 @@ def visibility_order(mesh: TetMesh | Topology, camera: Camera, size: tuple[int, 
         fallback = np.argsort(_centroid_keys(topo.centroid, eye, fwd, camera.parallel), kind="stable").astype(idx)
         n_out, cycles = kahn(topo.neighbor, front, indeg, ex_src, ex_dst, order, n_out, fallback)
     t4 = time.perf_counter()
-    return SortResult(order, method, int(cycles), int(len(src)), t4 - t0,
-                      {"relations": t2 - t1, "sides": t3 - t2, "kahn": t4 - t3})
+    # with the relations beside the sides: "sides" is the face sides alone, "relations" the wait for them after
+    stages = {"sides": t2 - t1, "relations": t3 - t2} if beside else {"relations": t2 - t1, "sides": t3 - t2}
+    return SortResult(order, method, int(cycles), int(len(src)), t4 - t0, {**stages, "kahn": t4 - t3})
