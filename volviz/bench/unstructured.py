@@ -215,6 +215,8 @@ def main(argv: list[str] | None = None) -> int:
                    help="window sizes at which pt-gl's CPU side is taken apart, beside 64² (2 cameras, 1 frame each)")
     p.add_argument("--large-refine", type=float, default=0.0,
                    help="also sort the Blunt Fin refined by this factor per axis (2.3: 2.27 M tetrahedra; 0: not)")
+    p.add_argument("--large-out", default=None,
+                   help="also write that refined mesh to this VTK .vtu file (Density on the points)")
     p.add_argument("--out", default=str(Path(__file__).resolve().parents[2] / "docs" / "bench"))
     p.add_argument("--json", default=None, help="also write the results as JSON")
     args = p.parse_args(argv)
@@ -322,7 +324,10 @@ def main(argv: list[str] | None = None) -> int:
         if args.cpu_sizes:
             results["cpu_side"] = cpu_side_scan(mesh, tf, cams[:2], [(64, 64), *args.cpu_sizes], args.gl_lookup)
     if args.large_refine > 1.0:
-        results["large"] = large_mesh_row(refined_bluntfin(grid, args.large_refine), cams[:2], args.reps)
+        big_mesh = refined_bluntfin(grid, args.large_refine)
+        if args.large_out:
+            write_vtu(big_mesh, args.large_out)
+        results["large"] = large_mesh_row(big_mesh, tf, cams[:2], args.reps)
         results["large"]["refine"] = args.large_refine
     if args.sort_sizes:
         results["sort_scan"] = sort_scan(mesh, cams[:2] if len(cams) > 1 else cams * 2, args.sort_sizes, args.reps)
@@ -415,9 +420,30 @@ def refined_bluntfin(grid: Any, factor: float) -> Any:
     return tetrahedralize(CurvilinearGrid(pts, {"Density": dens}), "Density")
 
 
-def large_mesh_row(mesh: Any, cams: list[Any], reps: int) -> dict[str, Any]:
-    """Sort throughput (mpvo, 1920x1080) and the CPU bytes per cell of the mesh and its sort topology."""
+def write_vtu(mesh: Any, path: str) -> None:
+    """``mesh`` (a TetMesh) as a VTK XML unstructured grid, written atomically (a temporary file beside it, then
+    renamed)."""
+    import meshio
+
+    from volviz.io.atomic import check_output_path, temp_name
+
+    target = check_output_path(path)
+    tmp = temp_name(target)
+    try:
+        meshio.write(tmp, meshio.Mesh(mesh.points, [("tetra", mesh.tets)], point_data={"Density": mesh.scalars}),
+                     file_format="vtu")
+        os.replace(tmp, target)
+    finally:
+        tmp.unlink(missing_ok=True)
+
+
+def large_mesh_row(mesh: Any, tf: Any, cams: list[Any], reps: int, draw: int = 256) -> dict[str, Any]:
+    """The large mesh: topology seconds (once); the mpvo sort for 1920x1080 (median over ``cams`` x ``reps`` after a
+    warm-up, with its stages: boundary relations, face sides, Kahn); the CPU bytes per cell of the mesh and its sort
+    topology, and of one sort's own arrays; a ``draw``² frame by pt-gl (``gl_pt_frames``, 3D table: frame seconds
+    to the GPU's completion, sort included) against the CPU pt renderer's image of the same camera and table."""
     from volviz.unstructured.boundary_pairs import inner_boundary
+    from volviz.unstructured.render import render
     from volviz.unstructured.sort import visibility_order
     from volviz.unstructured.topology import topology
 
@@ -426,14 +452,27 @@ def large_mesh_row(mesh: Any, cams: list[Any], reps: int) -> dict[str, Any]:
     _ = topo.neighbor
     topo_s = time.perf_counter() - t0
     visibility_order(topo, cams[-1], (1920, 1080))
-    times = [visibility_order(topo, cam, (1920, 1080)).seconds for _ in range(reps) for cam in cams]
+    runs = [visibility_order(topo, cam, (1920, 1080)) for _ in range(reps) for cam in cams]
     arrays = [mesh.points, mesh.tets, mesh.scalars, topo.points, topo.tets, topo.face_n, topo.face_d, topo.centroid,
               topo.circ_center, topo.circ_r2, topo.neighbor]
-    row = {"n_tets": int(mesh.n_cells), "topology_s": topo_s, "sort_s": float(np.median(times)),
-           "sort_min_s": float(min(times)), "inner_faces": int(len(inner_boundary(topo))),
-           "boundary_faces": int(len(topo.boundary)),
-           "bytes_per_cell": sum(int(a.nbytes) for a in arrays) / mesh.n_cells}
-    print(f"large mesh: {row}", flush=True)
+    m = mesh.n_cells
+    row: dict[str, Any] = {
+        "n_tets": int(m), "topology_s": topo_s, "sort_s": float(np.median([r.seconds for r in runs])),
+        "sort_min_s": float(min(r.seconds for r in runs)), "cycles": int(max(r.cycles for r in runs)),
+        "stages_s": {k: float(np.median([r.stages[k] for r in runs])) for k in runs[0].stages},
+        "inner_faces": int(len(inner_boundary(topo))), "boundary_faces": int(len(topo.boundary)),
+        "bytes_per_cell": sum(int(a.nbytes) for a in arrays) / m,
+        # one sort's own arrays: the order, a state byte and an in-degree per cell, Kahn's stack
+        "sort_bytes_per_cell": (runs[0].order.nbytes + m * (1 + 4 + runs[0].order.itemsize)) / m}
+    print(f"large mesh sort: {row}", flush=True)
+    size = (draw, draw)
+    gl, gl_img = gl_pt_frames(mesh, tf, cams, size, 1, "3d")
+    c0 = time.perf_counter()
+    pt_img, st = render(mesh, tf, cams[0], size, "pt", lookup="3d", return_stats=True)
+    row["draw"] = {"size": draw, "pt_gl_frame_s": gl["frame_s"], "pt_gl_sort_s": gl["sort_s"],
+                   "pt_frame_s": time.perf_counter() - c0, "pt_sort_s": st.sort_s, "gl_renderer": gl["gl_renderer"]}
+    row["draw"]["rmse_rgb"], row["draw"]["max_rgb"] = _rgb_err(gl_img, pt_img)
+    print(f"large mesh draw: {row['draw']}", flush=True)
     return row
 
 
@@ -449,6 +488,7 @@ def cpu_side_scan(mesh: Any, tf: Any, cams: list[Any], sizes: list[tuple[int, in
         rows.append(row)
         print(f"cpu side {w}x{h}: {row}", flush=True)
     return rows
+
 
 
 def _size_scan(mesh: Any, tf: Any, cams: list[Any], sizes: list[tuple[int, int]], gl_lookup: str, sort: str,
@@ -598,12 +638,7 @@ def _markdown(results: dict[str, Any], path: Path) -> None:
     lines += _sort_scan_lines(results.get("sort_scan"), results["n_tets"])
     big = results.get("large")
     if big:
-        lines += ["", f"Large mesh: the Blunt Fin refined {big['refine']:g}x per axis (`--large-refine`), "
-                  f"{big['n_tets']} tetrahedra, {big['inner_faces']} of {big['boundary_faces']} boundary faces off "
-                  f"the hull; topology {big['topology_s']:.1f} s once; mpvo sort for 1920x1080 "
-                  f"{big['sort_s']:.3f} s median ({big['sort_min_s']:.3f} s min): "
-                  f"**{big['n_tets'] / big['sort_s'] / 1e6:.1f} M tetrahedra/s** (target ≥ 20); CPU memory of the "
-                  f"mesh and its sort topology {big['bytes_per_cell']:.0f} bytes per cell (not drawn here)."]
+        lines += _large_mesh_lines(big)
     scan = results.get("scan")
     if scan:
         lines += ["", "Seconds per frame against window size (median of 2 cameras, one frame each):", "",
@@ -626,6 +661,27 @@ def _markdown(results: dict[str, Any], path: Path) -> None:
               "sorting ≥ 2 M tetrahedra/s.", "",
               "![time vs error](unstructured_time_error.png)", "", "![side by side](unstructured_side_by_side.png)", ""]
     path.write_text("\n".join(lines))
+
+
+def _large_mesh_lines(big: dict[str, Any]) -> list[str]:
+    st = big.get("stages_s", {})
+    lines = ["", f"Large mesh: the Blunt Fin refined {big['refine']:g}x per axis (`--large-refine`), "
+             f"{big['n_tets']} tetrahedra, {big['inner_faces']} of {big['boundary_faces']} boundary faces off "
+             f"the hull; topology {big['topology_s']:.1f} s once; mpvo sort for 1920x1080 "
+             f"{big['sort_s']:.3f} s median ({big['sort_min_s']:.3f} s min, {big.get('cycles', 0)} cycles): "
+             f"**{big['n_tets'] / big['sort_s'] / 1e6:.1f} M tetrahedra/s** (target ≥ 20)"
+             + (f"; of which boundary relations {st['relations']:.3f} s, face sides {st['sides']:.3f} s, "
+                f"Kahn {st['kahn']:.3f} s (medians)" if st else "")
+             + f". CPU memory of the mesh and its sort topology {big['bytes_per_cell']:.0f} bytes per cell"
+             + (f", plus {big['sort_bytes_per_cell']:.0f} per cell while a sort runs (its order, state, "
+                "in-degrees and stack)" if "sort_bytes_per_cell" in big else "") + "."]
+    d = big.get("draw")
+    if d:
+        lines += ["", f"Drawn at {d['size']}² (3D table): pt-gl {d['pt_gl_frame_s']:.2f} s per frame for a new "
+                  f"camera to the GPU's completion (sort {d['pt_gl_sort_s']:.3f} s; {d['gl_renderer']}), the CPU pt "
+                  f"renderer {d['pt_frame_s']:.2f} s; pt-gl against pt: RMSE {d['rmse_rgb']:.2f}, max "
+                  f"{d['max_rgb']:.2f} (8-bit; bound RMSE ≤ 1, max ≤ 4)."]
+    return lines
 
 
 def _cpu_side_lines(rows: list[dict[str, Any]] | None, n_tets: int) -> list[str]:
