@@ -11,6 +11,8 @@
 """
 from __future__ import annotations
 
+import struct
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -18,6 +20,7 @@ import numpy as np
 from volviz.io._checks import HDF5_SIGNATURE, check_file, check_finite, read_bytes
 from volviz.io.array_choice import choose_array
 from volviz.io.errors import PathLike, ReadError
+from volviz.io.matcheck import check_mat5
 from volviz.model import Image2D, RegularVolume, TimeSeries
 from volviz.model.arrays import volume_of
 
@@ -36,8 +39,13 @@ def _choose(path: PathLike, found: list[tuple[str, tuple[int, ...]]], variable: 
 
 
 def _v5(path: PathLike, variable: str | None) -> tuple[str, np.ndarray]:
+    import mmap
+    import zlib
+
     import scipy.io
 
+    with open(path, "rb") as f, mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ) as data:
+        check_mat5(Path(path), data)  # SciPy trusts the tags: IndexError, zlib's words, even a crash
     try:
         listed = scipy.io.whosmat(str(path))
         found, others = [], []
@@ -51,7 +59,10 @@ def _v5(path: PathLike, variable: str | None) -> tuple[str, np.ndarray]:
         values = scipy.io.loadmat(str(path), variable_names=[name], squeeze_me=False, mat_dtype=False)[name]
     except ReadError:
         raise
-    except (ValueError, TypeError, OSError, EOFError, KeyError, NotImplementedError, MemoryError) as exc:
+    except zlib.error as exc:
+        raise ReadError(path, f"a compressed variable's zlib data is damaged ({exc})") from None
+    except (ValueError, TypeError, OSError, EOFError, KeyError, NotImplementedError, MemoryError, IndexError,
+            struct.error, UnicodeDecodeError, OverflowError) as exc:
         raise ReadError(path, f"SciPy could not read the MAT-file ({type(exc).__name__}: {str(exc)[:200]})") from None
     return name, np.asarray(values)
 
