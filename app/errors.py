@@ -28,7 +28,7 @@ def hide_temporary_names(text: str) -> str:
 def _problem(exc: BaseException, path: Optional[Path]) -> Optional[str]:
     """What volviz's own error says is wrong, without the path it starts with; None for any other exception."""
     from volviz.io.errors import ReadError
-    from volviz.render.scene_builder import SceneError
+    from volviz.scene.errors import SceneError
     from volviz.session import SessionError
 
     if isinstance(exc, ReadError):

@@ -86,7 +86,9 @@ def _format(window: Any, opened: Path) -> str:
 def _kind(window: Any) -> str:
     """How each visible component is drawn: ``volume (PT)``, ``volume (VTK ray cast)``, ``volume (surface)``,
     ``terrain (natural scene)`` ..."""
-    from volviz.render.scene_builder import component_dataset, is_lod, uses_pt
+    from volviz.render.scene_builder import uses_pt
+    from volviz.scene.datasets import component_dataset
+    from volviz.scene.lod import is_lod
     from volviz.render.vtk_scene import is_surface
 
     controller = window.controller

@@ -63,7 +63,7 @@ class SceneEdits(WindowBase):
         if tf is None:
             return
         if comp_id in self.controller.lod_volumes():  # too large to decode whole: the range from node statistics
-            from volviz.render.lod_volume import lod_scalar_range
+            from volviz.scene.lod import lod_scalar_range
 
             self.tf_editor.set_transfer_function(tf, data_range=lod_scalar_range(self.controller.dataset_of(comp_id)))
             return
@@ -83,7 +83,7 @@ class SceneEdits(WindowBase):
         read and the histogram computed on a worker (``volviz.model.stats.histogram``) while the editor shows a
         placeholder; a newer selection supersedes it. ``histograms_computed`` counts the ones shown."""
         from volviz.model.stats import histogram
-        from volviz.render.scene_builder import load_datasets
+        from volviz.scene.datasets import load_datasets
 
         controller, session_path = self.controller, self.session_path
         if controller is None:
@@ -133,7 +133,7 @@ class SceneEdits(WindowBase):
             self.render_scene()
 
     def _set_visibility(self, comp_id: str, visible: bool) -> None:
-        from volviz.render.scene_builder import NATURE_TYPES
+        from volviz.scene.datasets import NATURE_TYPES
 
         if self.controller is None:
             return
@@ -154,7 +154,7 @@ class SceneEdits(WindowBase):
         """A component hidden at load was shown: prepare it in the background (extraction, tetrahedralisation, VTK
         volume input, histogram; a newer request for it supersedes), add its prop on this thread, then compute its
         view-dependent parts in the background. ``components_shown`` counts the ones installed."""
-        from volviz.render.scene_builder import load_datasets
+        from volviz.scene.datasets import load_datasets
 
         controller, session_path = self.controller, self.session_path
         if controller is None:
@@ -202,7 +202,7 @@ class SceneEdits(WindowBase):
         (maps, fog prisms, cloud volumes; a newer toggle supersedes an older one), put it in on this thread, then
         compute its first view in the background; the old one stays on screen meanwhile. A scene that cannot be
         built (fog without terrain) leaves the component as it was, with a message."""
-        from volviz.render.scene_builder import load_datasets
+        from volviz.scene.datasets import load_datasets
 
         controller, session_path = self.controller, self.session_path
         if controller is None:

@@ -38,13 +38,13 @@ class SceneLoading(WindowBase):
     raw_dialog: Optional[Any] = None     # the layout dialog of the last headerless data opened
 
     def open_demo(self) -> None:
-        from volviz.render.scene_builder import demo_session
+        from volviz.scene.demo import demo_session
 
         self._show_session(demo_session(), None, "demo scene")
 
     def open_demo_volume(self) -> None:
         """The tetrahedral demo volume (an analytic field on a tetrahedralised cube), drawn by volviz's PT."""
-        from volviz.render.scene_builder import demo_volume_session
+        from volviz.scene.demo import demo_volume_session
 
         self._show_session(demo_volume_session(), None, "demo volume")
 
@@ -62,7 +62,7 @@ class SceneLoading(WindowBase):
         """Open a session file or a data file (the path behind every Open action and the command line); ``q``: the
         solution file of a PLOT3D grid."""
         from volviz.render.export import is_session_file
-        from volviz.render.scene_builder import data_session
+        from volviz.scene.opening import data_session
         from volviz.session import load
 
         p = Path(path)
@@ -122,7 +122,7 @@ class SceneLoading(WindowBase):
         stays until the new one is ready, and stays on when the new one fails (a message names ``path``, the file
         opened, and what is wrong with it). ``on_shown()`` runs once the new scene is installed."""
         from volviz.render.controller import SceneController
-        from volviz.render.scene_builder import load_datasets
+        from volviz.scene.datasets import load_datasets
 
         self._load_serial += 1
         serial = self._load_serial

@@ -94,7 +94,7 @@ def _render(session, size=(160, 120)):
 
 
 def test_height_maps_open_as_terrain_scenes():
-    from volviz.render.scene_builder import data_session
+    from volviz.scene.opening import data_session
 
     dem = data_session(data_file("terrain/SainteHelens.dem"))
     assert [c.type for c in dem.components] == ["terrain", "sky"]
@@ -113,7 +113,7 @@ def test_height_maps_open_as_terrain_scenes():
 
 
 def test_series_member_opens_at_its_time_step():
-    from volviz.render.scene_builder import data_session
+    from volviz.scene.opening import data_session
 
     first = data_session(data_file("storm/Storm.pvm-t01"))
     member = data_session(data_file("storm/Storm.pvm-t05"))
@@ -131,7 +131,7 @@ def _rho(tf, s):
 def test_flat_grids_and_surface_meshes_are_drawn_as_colored_surfaces():
     """A 2D curvilinear grid carrying a cell array (netCDF CF) shows as a surface colored through the transfer
     function, its NaN (land in an ocean field) not drawn."""
-    from volviz.render.scene_builder import data_session
+    from volviz.scene.opening import data_session
     from volviz.render.vtk_scene import is_surface
 
     from volviz.io import read
@@ -152,7 +152,7 @@ def test_flat_grids_and_surface_meshes_are_drawn_as_colored_surfaces():
 def test_pictures_open_flat_and_face_on():
     """A photo or a texture (not a height map) is a flat picture seen face-on, in its own colors."""
     from volviz.render.framing import view_direction
-    from volviz.render.scene_builder import data_session
+    from volviz.scene.opening import data_session
 
     assert view_direction((0, 4, 0, 2, 0, 0)) == ((0.0, 0.0, 1.0), (0.0, 1.0, 0.0))
     assert view_direction((0, 1, 0, 1, 0, 1))[0] == (1.0, 1.0, 1.0)
@@ -176,7 +176,7 @@ def test_messages_for_headerless_data_say_what_to_open(tmp_path):
 
 def test_demo_scene_bounds_are_its_terrain_and_clouds_not_the_sky_dome():
     from volviz.render.export import offscreen_scene
-    from volviz.render.scene_builder import demo_session
+    from volviz.scene.demo import demo_session
 
     plotter, controller = offscreen_scene(demo_session(), {}, (160, 120))
     try:
@@ -220,7 +220,8 @@ def test_surfaces_of_geometry_alone_are_drawn_plain_or_in_their_colours_without_
     from volviz.model.arrays import default_array, is_appearance_array
     from volviz.render.decorations import scalar_bar_title
     from volviz.render.export import close_scene, offscreen_scene, snapshot
-    from volviz.render.scene_builder import data_session, load_datasets
+    from volviz.scene.datasets import load_datasets
+    from volviz.scene.opening import data_session
 
     sphere = pv.Sphere(theta_resolution=24, phi_resolution=24)
     sphere.save(tmp_path / "geometry.stl")

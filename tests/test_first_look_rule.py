@@ -16,7 +16,8 @@ def _scene(path, size=(160, 120)):
     """(image, scalar bar title, session, recorded warnings) of ``path``'s first look."""
     from volviz.render.decorations import scalar_bar_title
     from volviz.render.export import close_scene, offscreen_scene, snapshot
-    from volviz.render.scene_builder import data_session, load_datasets
+    from volviz.scene.datasets import load_datasets
+    from volviz.scene.opening import data_session
 
     session = data_session(path)
     with warnings.catch_warnings(record=True) as said:
@@ -36,7 +37,7 @@ def _scene(path, size=(160, 120)):
 def test_a_mesh_with_only_block_ids_is_drawn_plain_without_a_scale():
     from volviz.bench.first_open import drawn_fraction
     from volviz.model.arrays import default_array
-    from volviz.render.scene_builder import drawn_as
+    from volviz.scene.datasets import drawn_as
 
     image, title, _, mesh, _ = _scene(data_file("ecosystem/mesh_fs8.exo"))
     assert default_array(mesh) is None and drawn_as(mesh) == "surface"
@@ -58,7 +59,7 @@ def _grid(path, dims, values, name):
 
 def test_single_layer_grid_constant_field_and_constant_first_step(tmp_path):
     from volviz.bench.first_open import drawn_fraction
-    from volviz.render.scene_builder import drawn_as
+    from volviz.scene.datasets import drawn_as
 
     x, y = np.meshgrid(np.linspace(0, 6, 72), np.linspace(0, 4, 45), indexing="ij")
     _grid(tmp_path / "layer.vti", (72, 45, 1), np.sin(x) * np.cos(y), "tas")

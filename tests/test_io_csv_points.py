@@ -122,7 +122,7 @@ def test_damaged_copies_read_or_are_refused(tmp_path):
 
 def test_a_point_table_opens_drawn_as_points(tmp_path):
     from volviz.render.export import render_session
-    from volviz.render.scene_builder import data_session
+    from volviz.scene.opening import data_session
 
     cloud = RNG.normal(0.0, 1.0, (400, 3))
     path = _table(tmp_path / "cloud.csv", ["x", "y", "z", "r"], [(*p, np.linalg.norm(p)) for p in cloud])

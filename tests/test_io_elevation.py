@@ -12,7 +12,7 @@ import volviz.io as vio
 from volviz.io.elevation import METRES_PER_DEGREE_LAT, METRES_PER_DEGREE_LON_AT_EQUATOR
 from volviz.io.errors import ReadError, ReadWarning
 from volviz.model import Image2D
-from volviz.render.scene_builder import data_session
+from volviz.scene.opening import data_session
 
 HEIGHTS = (np.random.default_rng(0).random((50, 60)) * 100 + 200).astype(np.float32)
 

@@ -12,7 +12,7 @@ from test_app_window import wait_loaded, window  # noqa: F401  (the fixture)
 from volviz.io.errors import ReadError
 from volviz.io.folders import folder_target
 from volviz.model import TimeSeries
-from volviz.render.scene_builder import data_session
+from volviz.scene.opening import data_session
 
 
 def _outputs(folder, name="out_{:04d}.vtu", steps=4, n=4):

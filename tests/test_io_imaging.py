@@ -21,7 +21,8 @@ import volviz.io as vio
 from volviz.io.errors import ChoiceWarning, ReadError, ReadWarning
 from volviz.io.registry import spec_of
 from volviz.model import RegularVolume, TimeSeries
-from volviz.render.scene_builder import data_session, series_pattern
+from volviz.scene.opening import data_session
+from volviz.scene.series import series_pattern
 
 # voxel (i, j, k) -> RAS: i along -y (0.5 mm), j along +z (2 mm), k along -x (3 mm): a permutation with two flips
 AFFINE = np.array([[0.0, 0.0, -3.0, 40.0],

@@ -82,7 +82,7 @@ def test_damaged_stacks_are_refused(tmp_path):
 
 def test_a_tiff_stack_renders_legibly_on_first_open(tmp_path):
     from volviz.render.export import render_session
-    from volviz.render.scene_builder import data_session
+    from volviz.scene.opening import data_session
 
     z, y, x = np.mgrid[-1:1:16j, -1:1:32j, -1:1:32j]
     cells = ((np.sqrt(x * x + y * y + z * z) < 0.7) * 3000 + 100).astype(np.uint16)

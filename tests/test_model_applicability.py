@@ -15,7 +15,7 @@ from volviz.model.applicability import DATASET_TRAITS, DatasetTraits, applicable
 from volviz.model.demo import demo_tet_mesh
 from volviz.model.settings import SETTINGS_MODELS
 from volviz.render.controller import SceneController
-from volviz.render.scene_builder import dataset_traits, read_any
+from volviz.scene.datasets import dataset_traits, read_any
 from volviz.session import Component, DatasetRef, Session
 
 PLAIN = DatasetTraits()

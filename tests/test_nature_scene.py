@@ -99,7 +99,7 @@ def test_session_files(name: str, monkeypatch) -> None:
 
 
 def test_demo_components_build_without_data() -> None:
-    from volviz.render.demo import demo_components
+    from volviz.scene.demo import demo_components
 
     comps = demo_components()
     assert {c.type for c in comps} == {"terrain", "fog", "clouds", "sky"}

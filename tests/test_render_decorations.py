@@ -13,8 +13,9 @@ from volviz.render.decorations import OUTLINE_NAME, scalar_bar_actor, scalar_bar
 
 def _scene(path, **options):
     from volviz.render.controller import SceneController
-    from volviz.render.export import offscreen_plotter
-    from volviz.render.scene_builder import data_session, load_datasets
+    from volviz.render.offscreen import offscreen_plotter
+    from volviz.scene.datasets import load_datasets
+    from volviz.scene.opening import data_session
 
     session = data_session(path)
     session.render.options.update(options)

@@ -230,8 +230,10 @@ def test_selection_follows_budget_and_camera(tree: LodTree, renderer: str) -> No
 
 def test_session_with_a_lod_dataset_follows_camera_and_transfer_function(tree: LodTree) -> None:
     from volviz.render.controller import SceneController
-    from volviz.render.export import offscreen_plotter
-    from volviz.render.scene_builder import LOD_VOXELS, data_session, load_datasets, vvz_voxels
+    from volviz.render.offscreen import offscreen_plotter
+    from volviz.scene.datasets import load_datasets
+    from volviz.scene.lod import LOD_VOXELS, vvz_voxels
+    from volviz.scene.opening import data_session
     from volviz.session import CameraState, Component, DatasetRef, RenderSettings, Session
 
     vvz = Path(tree.decoder.path)

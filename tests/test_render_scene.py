@@ -101,7 +101,7 @@ def test_missing_camera_path_is_a_clear_error(tmp_path: Path, capsys) -> None:
 
 
 def test_render_settings_map_to_the_pt_renderer() -> None:
-    from volviz.render.scene_builder import pt_options
+    from volviz.scene.tetra import pt_options
 
     assert pt_options({}) == {}
     assert pt_options({"table": "3d", "table_resolution": 64, "sort": "centroid"}) == \
@@ -113,7 +113,8 @@ def test_render_settings_map_to_the_pt_renderer() -> None:
 
 def test_movie_export_sorts_the_next_frame_in_the_background() -> None:
     from volviz.render.controller import SceneController
-    from volviz.render.export import _prefetch_sorts, offscreen_plotter
+    from volviz.render.export import _prefetch_sorts
+    from volviz.render.offscreen import offscreen_plotter
     from volviz.session import CameraState, Component, RenderSettings, Session
 
     session = Session(components=[Component(id="demo", type="demo", settings={"cells_per_edge": 5})],
@@ -142,7 +143,8 @@ def test_movie_export_sorts_the_next_frame_of_a_gpu_volume_in_the_background() -
     """The GPU backend's PT volume draws each movie frame with the order sorted while the frame before rendered, and
     that frame is the one a sort in the render gives."""
     from volviz.render.controller import SceneController
-    from volviz.render.export import _prefetch_sorts, offscreen_plotter
+    from volviz.render.export import _prefetch_sorts
+    from volviz.render.offscreen import offscreen_plotter
     from volviz.render.gl_pt import GLPTVolume
     from volviz.session import CameraState, Component, RenderSettings, Session
 
@@ -191,7 +193,8 @@ def test_first_offscreen_image_of_a_pt_volume_sees_the_outline_box() -> None:
     on the near side were covered by the volume in the first frame only: 291 pixels off by up to 229), and the GPU
     backend gives the same viewport. Measured: first frame equal to the second; GPU vs CPU RMSE 0.17, max 2."""
     from volviz.render.export import close_scene, offscreen_scene, snapshot
-    from volviz.render.scene_builder import data_session, load_datasets
+    from volviz.scene.datasets import load_datasets
+    from volviz.scene.opening import data_session
 
     images = {}
     for backend in ("cpu", "gpu"):
@@ -221,7 +224,8 @@ def test_a_time_series_of_surfaces_follows_the_display_time() -> None:
     scene opened at a later display time shows that time, and between steps the points move with the values."""
     from volviz.model.timeseries import frame_at
     from volviz.render.export import close_scene, offscreen_scene, snapshot
-    from volviz.render.scene_builder import data_session, load_datasets
+    from volviz.scene.datasets import load_datasets
+    from volviz.scene.opening import data_session
 
     session = data_session(data_file("series/warping_spheres.vtkhdf"))
     datasets = load_datasets(session, None)

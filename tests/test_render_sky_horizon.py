@@ -8,7 +8,7 @@ from pathlib import Path
 import imageio.v3 as iio
 import numpy as np
 
-from volviz.render.scene_builder import demo_session
+from volviz.scene.demo import demo_session
 from volviz.session import save
 
 

@@ -226,7 +226,7 @@ def _finite(pair: Sequence[float]) -> list[Optional[float]]:
 def _series_membership(path: Path) -> Optional[dict[str, Any]]:
     """Which numbered series ``path`` belongs to (the pattern, its position, its time), or None."""
     from volviz.io.series import expand_pattern, member_time
-    from volviz.render.scene_builder import series_pattern
+    from volviz.scene.series import series_pattern
 
     pattern = series_pattern(path)
     if pattern is None:
@@ -354,7 +354,7 @@ def _render(args: argparse.Namespace) -> int:
 def _read_for_render(session: Any, datasets: dict[str, Any], args: argparse.Namespace) -> None:
     """Read a data file's dataset into ``datasets`` (a PLOT3D solution file given alone says what to do) and check
     that it has the ``--array`` asked for (a usage error naming the arrays it has)."""
-    from volviz.render.scene_builder import read_any, shown_array
+    from volviz.scene.datasets import read_any, shown_array
 
     ref = session.datasets[0]
     with _reading(args.target, args.q):
@@ -382,7 +382,7 @@ def user_errors() -> tuple[type[BaseException], ...]:
     from volviz.io import ReadError
     from volviz.io.atomic import OutputPathError
     from volviz.render.export import ExportError
-    from volviz.render.scene_builder import SceneError
+    from volviz.scene.errors import SceneError
     from volviz.session import SessionError
 
     return (UsageError, ReadError, SessionError, SceneError, ExportError, OutputPathError, FileNotFoundError,

@@ -45,7 +45,7 @@ def _natural_scene(folder: Path) -> None:
     from volviz.nature.fog import FogLayer
     from volviz.render.export import render_session
     from volviz.render.gl_fog import prism_buffers
-    from volviz.render.scene_builder import demo_session
+    from volviz.scene.demo import demo_session
 
     render_session(demo_session(), None, SIZE)
     # the GPU backend's fog prism buffers (its kernels run on the CPU; the GL drawing needs no warm-up)
@@ -56,7 +56,7 @@ def _natural_scene(folder: Path) -> None:
 def _tetrahedral_volume(folder: Path) -> None:
     from volviz.optics import TransferFunction
     from volviz.render.export import render_session
-    from volviz.render.scene_builder import demo_volume_session
+    from volviz.scene.demo import demo_volume_session
     from volviz.unstructured import render
     from volviz.model.camera import Camera
     from volviz.unstructured.synthetic import box_tets, holed_box

@@ -53,7 +53,7 @@ def opened_files(root: Path) -> list[Path]:
     folder that a reader opens whole (an OpenFOAM case) as itself; no README, no sidecar a header names."""
     from volviz.io import ReadError
     from volviz.io.registry import spec_of
-    from volviz.render.scene_builder import series_pattern
+    from volviz.scene.series import series_pattern
 
     found: list[Path] = []
     seen: set[str] = set()
@@ -169,8 +169,9 @@ def legibility(path: Path) -> Optional[tuple[str, Optional[float], Optional[floa
     from volviz.optics import TransferFunction
     from volviz.optics.auto_tf import mean_chord
     from volviz.render.export import open_target, render_session
-    from volviz.render.scene_builder import (component_dataset, component_transfer_function, drawn_as,
-                                            ensure_transfer_functions, load_datasets)
+    from volviz.render.scene_builder import ensure_transfer_functions
+    from volviz.scene.datasets import component_dataset, drawn_as, load_datasets
+    from volviz.scene.drawn_tf import component_transfer_function
     from volviz.render.vtk_scene import volume_grid
 
     session, _ = open_target(path)

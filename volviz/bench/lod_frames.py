@@ -133,7 +133,7 @@ def render_walkthrough(tree: Any, volume: np.ndarray, tf: Any, budgets: Sequence
     (keys ``vtk_*``): median seconds per frame (select + decode + draw + read-back, after a cold first frame),
     frames per second, blocks drawn, RMSE / max (8-bit RGB over black) against the exact reference of the full
     volume; ``png``: last frames of each renderer beside the reference, and the time/error plot."""
-    from volviz.render.export import offscreen_plotter
+    from volviz.render.offscreen import offscreen_plotter
 
     views = orbit(volume.shape, frames + 1)
     plotter = offscreen_plotter((size, size))

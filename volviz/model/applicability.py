@@ -29,7 +29,7 @@ DATASET_TRAITS: tuple[str, ...] = typing.get_args(DatasetTrait)
 @dataclass(frozen=True)
 class DatasetTraits:
     """What a component's dataset is, for the settings that apply to some datasets only (``DATASET_TRAITS``; the
-    render layer describes a loaded dataset: ``volviz.render.scene_builder.dataset_traits``)."""
+    scene layer describes a loaded dataset: ``volviz.scene.datasets.dataset_traits``)."""
 
     time_series: bool = False
     lod_volume: bool = False

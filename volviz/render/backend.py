@@ -104,7 +104,7 @@ def plotter_gl_info(plotter: Any) -> GLInfo:
 
 def offscreen_gl_info() -> GLInfo:
     """The OpenGL driver of VTK's offscreen render windows on this machine (a tiny one, made and closed here)."""
-    from volviz.render.export import offscreen_plotter
+    from volviz.render.offscreen import offscreen_plotter
 
     plotter = offscreen_plotter((8, 8))
     try:

@@ -9,7 +9,7 @@ How each prop honours them:
 - VTK's projected tetrahedra (vtkProjectedTetrahedraMapper ignores clipping planes): its input is cut exactly and
   re-tetrahedralised (``volviz.iso.clip.clip_grid``);
 - volviz PT volumes: the tetrahedral mesh is cut exactly (``clip_tetmesh``) and re-rendered by the caller;
-- isosurfaces: the triangles are cut exactly (``clip_isosurfaces``, in ``volviz.render.scene_builder.add_isosurfaces``);
+- isosurfaces: the triangles are cut exactly (``clip_isosurfaces``, in ``volviz.scene.isosurfaces.isosurface_parts``);
 - any other actor (surfaces, height fields): mapper clipping planes, which OpenGL honours for at most
   ``MAX_GL_PLANES`` planes; further planes are left out with a logged warning.
 """
@@ -24,14 +24,6 @@ from volviz.model.clip import ClipPlane, ClipSettings
 log = logging.getLogger(__name__)
 
 MAX_GL_PLANES = 6
-NO_CLIP: dict[str, Any] = {"planes": [], "box": None}
-
-
-def clip_settings(clip: dict[str, Any] | ClipSettings | None) -> ClipSettings:
-    """``session.clip`` (or None) as ClipSettings."""
-    if isinstance(clip, ClipSettings):
-        return clip
-    return ClipSettings.from_dict(clip or NO_CLIP)
 
 
 def vtk_plane(plane: ClipPlane) -> Any:

@@ -12,6 +12,9 @@ from __future__ import annotations
 from typing import Any, Optional
 
 from volviz.render.framing import Bounds, points_bounds, prop_bounds, union
+from volviz.render.iso_actors import add_isosurface_actors
+from volviz.scene.clipping import clip_settings
+from volviz.scene.isosurfaces import isosurface_parts
 
 __all__ = ["IsoSurfacesView", "VtkPropView"]
 
@@ -78,7 +81,7 @@ class VtkPropView:
 
 
 class IsoSurfacesView(VtkPropView):
-    """The surfaces of an isosurface component (``volviz.render.scene_builder.IsoParts``) as VTK actors (``prop``: a
+    """The surfaces of an isosurface component (``volviz.scene.isosurfaces.IsoParts``) as VTK actors (``prop``: a
     vtkPropAssembly, ``add_isosurface_actors``). A new clipping or opacity is a new cut of the extracted surfaces:
     ``cut(clip)`` on any thread, ``show_cut(parts)`` here (or ``update`` does both now)."""
 
@@ -86,8 +89,6 @@ class IsoSurfacesView(VtkPropView):
     camera_dependent = False  # the transparency modes draw them through the scene-wide iso view
 
     def __init__(self, plotter: Any, comp: Any, parts: Any, spectrum: bool = True) -> None:
-        from volviz.render.clipping import clip_settings
-
         super().__init__(None)
         self.plotter, self.comp, self.spectrum = plotter, comp, spectrum
         self.parts = parts
@@ -113,8 +114,6 @@ class IsoSurfacesView(VtkPropView):
     def cut(self, clip: Any = None, meshes: Optional[list[Any]] = None, progress: Any = None) -> Any:
         """Any thread: the surfaces (``meshes``, default the extracted ones) cut by ``clip`` (default: the last
         ``set_clip``), scaled by the component's opacity, with their LOD chains."""
-        from volviz.render.scene_builder import isosurface_parts
-
         return isosurface_parts(self.comp, meshes=self.meshes if meshes is None else list(meshes),
                                 clip=self.clip if clip is None else clip)
 
@@ -124,8 +123,6 @@ class IsoSurfacesView(VtkPropView):
         self.visible = visible
 
     def show(self, parts: Any) -> None:
-        from volviz.render.scene_builder import add_isosurface_actors
-
         if self.prop is not None:
             self.plotter.remove_actor(self.prop, render=False)
         self.parts = parts

@@ -164,7 +164,7 @@ class SceneController:
         raise KeyError(comp_id)
 
     def dataset_of(self, comp_id: str) -> Any:
-        from volviz.render.scene_builder import component_dataset
+        from volviz.scene.datasets import component_dataset
 
         return component_dataset(self.component(comp_id), self.datasets)
 
@@ -172,7 +172,7 @@ class SceneController:
         """What the component's dataset is, for the settings that apply to some datasets only
         (``volviz.model.applicability``): no traits for a component without a dataset, None while its dataset is
         not read (a component hidden at load)."""
-        from volviz.render.scene_builder import dataset_traits
+        from volviz.scene.datasets import dataset_traits
 
         comp = self.component(comp_id)
         if comp.dataset is None:
@@ -180,9 +180,9 @@ class SceneController:
         return dataset_traits(self.datasets[comp.dataset]) if comp.dataset in self.datasets else None
 
     def drawn_as(self, comp_id: str) -> Optional[str]:
-        """How a volume component draws its dataset (``scene_builder.drawn_as``); None for other components and
-        while the dataset is not read."""
-        from volviz.render.scene_builder import drawn_as
+        """How a volume component draws its dataset (``volviz.scene.datasets.drawn_as``); None for other components
+        and while the dataset is not read."""
+        from volviz.scene.datasets import drawn_as
 
         comp = self.component(comp_id)
         if comp.type != "volume" or comp.dataset not in self.datasets:
@@ -191,13 +191,13 @@ class SceneController:
 
     # -- transfer functions, visibility, opacity --------------------------------------------------------------------
     def transfer_function(self, comp_id: str) -> Any:
-        from volviz.render.scene_builder import component_transfer_function
+        from volviz.scene.drawn_tf import component_transfer_function
 
         return component_transfer_function(self.session, self.component(comp_id))
 
     def _drawn(self, comp: Component, tf: Any) -> Any:
         """``tf`` as the component is drawn with it (through log10 with its setting ``log_scale``)."""
-        from volviz.render.drawn_tf import drawn_tf
+        from volviz.scene.drawn_tf import drawn_tf
 
         return tf if comp.dataset not in self.datasets else drawn_tf(comp, tf, self.dataset_of(comp.id))
 
@@ -231,7 +231,7 @@ class SceneController:
         self.changes.notify(SceneChange("visible", comp_id))
 
     def _set_visible(self, comp_id: str, visible: bool, nature: bool, build: bool) -> None:
-        from volviz.render.scene_builder import NATURE_TYPES
+        from volviz.scene.datasets import NATURE_TYPES
 
         comp = self.component(comp_id)
         comp.visible = bool(visible)
@@ -250,7 +250,7 @@ class SceneController:
 
     def needs_build(self, comp_id: str) -> bool:
         """Whether showing the component needs ``prepare_component`` / ``install_component`` (it has no view yet)."""
-        from volviz.render.scene_builder import NATURE_TYPES
+        from volviz.scene.datasets import NATURE_TYPES
 
         return self.component(comp_id).type not in NATURE_TYPES and self.views.get(comp_id) is None
 
@@ -397,7 +397,7 @@ class SceneController:
         neighbouring steps when interpolating, libMini note "4D Visualization"), cut by the component's own
         clipping (``volviz.iso.prepare``); ``show_isosurfaces`` puts them on screen."""
         from volviz.iso import IsoSettings, prepare
-        from volviz.render.scene_builder import SceneError
+        from volviz.scene.errors import SceneError
 
         comp = self.component(comp_id)
         settings_doc = dict(comp.settings)  # a snapshot: the GUI thread replaces (never mutates) comp.settings
@@ -411,8 +411,8 @@ class SceneController:
     def isosurface_parts(self, comp_id: str, t: float, interpolate: Optional[bool] = None,
                          progress: Any = None) -> Any:
         """Any thread: ``extract_isosurfaces`` cut by the scene's clipping, with their LOD chains
-        (``volviz.render.scene_builder.IsoParts``), so that ``show_isosurfaces`` only makes actors."""
-        from volviz.render.scene_builder import isosurface_parts
+        (``volviz.scene.isosurfaces.IsoParts``), so that ``show_isosurfaces`` only makes actors."""
+        from volviz.scene.isosurfaces import isosurface_parts
 
         meshes = self.extract_isosurfaces(comp_id, t, interpolate, progress)
         return isosurface_parts(self.component(comp_id), meshes=meshes, clip=self.session.clip)
@@ -422,7 +422,7 @@ class SceneController:
         ``extract_isosurfaces``, or better the ``isosurface_parts``, whose clipping and LOD chains were made off this
         thread and are redone here only when the clipping or opacity changed since); the overlay's meshes follow
         (not re-rendered)."""
-        from volviz.render.scene_builder import IsoParts
+        from volviz.scene.isosurfaces import IsoParts
 
         with no_render(self.plotter):  # no render per added actor: the caller draws once afterwards
             for comp_id, surfaces in meshes.items():
@@ -557,7 +557,7 @@ class SceneController:
 
     def prepare_nature(self, progress: Any = None) -> Any:
         """Any thread: the NatureScene of the visible terrain / fog / clouds / sky components (None: none)."""
-        from volviz.render.scene_builder import prepare_nature
+        from volviz.scene.nature import prepare_nature
 
         return prepare_nature(self.session, self.datasets)
 
@@ -600,7 +600,7 @@ class SceneController:
     # -- clipping (scene-wide) --------------------------------------------------------------------------------------
     @property
     def clip(self) -> Any:
-        from volviz.render.clipping import clip_settings
+        from volviz.scene.clipping import clip_settings
 
         return clip_settings(self.session.clip)
 

@@ -125,7 +125,7 @@ def _bar_scale(session: Session, comp: Any, datasets: dict[str, Any]) -> tuple[A
     range, else over the function's own."""
     from volviz.optics import TransferFunction
     from volviz.optics.log_scale import log_mapped, log_ticks
-    from volviz.render.drawn_tf import log_floor, uses_log_scale
+    from volviz.scene.drawn_tf import log_floor, uses_log_scale
     from volviz.render.vtk_facade import vtk
     from volviz.render.vtk_tf import tf_to_vtk
 
@@ -134,7 +134,8 @@ def _bar_scale(session: Session, comp: Any, datasets: dict[str, Any]) -> tuple[A
     lo, hi = style.range or tf.range
     log = False
     if uses_log_scale(comp):
-        from volviz.render.scene_builder import SceneError, component_dataset
+        from volviz.scene.datasets import component_dataset
+        from volviz.scene.errors import SceneError
 
         try:
             floor = log_floor(tf, component_dataset(comp, datasets))
@@ -219,7 +220,8 @@ def _array_title(comp: Any, datasets: dict[str, Any]) -> str:
     shown = comp.settings.get(array_key(comp.type))
     if shown:
         return _readable(str(shown))
-    from volviz.render.scene_builder import SceneError, component_dataset
+    from volviz.scene.datasets import component_dataset
+    from volviz.scene.errors import SceneError
 
     try:
         shown = component_dataset(comp, datasets)

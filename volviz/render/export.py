@@ -19,6 +19,7 @@ import numpy as np
 from volviz.argtypes import MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE, MAX_MOVIE_FRAMES
 from volviz.jobs import ProgressCallback, report
 from volviz.io.atomic import OutputPathError, atomic_write_bytes, check_output_path, remove_stale_temporaries, temp_name
+from volviz.render.offscreen import offscreen_plotter
 from volviz.session import Session
 
 #: image formats by file extension (Pillow's names)
@@ -83,17 +84,6 @@ def check_image_size(size: tuple[int, int]) -> None:
     if free is not None and need > free:
         raise ExportError(f"an image of {w}x{h} needs about {need / 2 ** 30:.1f} GB of memory to render, and "
                           f"{free / 2 ** 30:.1f} GB is free")
-
-
-def offscreen_plotter(size: tuple[int, int]) -> Any:
-    import pyvista as pv
-
-    if not os.environ.get("DISPLAY"):  # VTK tries X first and warns before it falls back to EGL: not the user's concern
-        from volviz.render.vtk_facade import vtk
-
-        vtk.vtkLogger.SetStderrVerbosity(vtk.vtkLogger.VERBOSITY_ERROR)
-
-    return pv.Plotter(off_screen=True, window_size=[int(size[0]), int(size[1])])
 
 
 def encode_image(image: np.ndarray, image_format: str = "PNG") -> bytes:
@@ -224,7 +214,7 @@ def render_session(session: Session, session_file: Optional[str | os.PathLike], 
                    datasets: Optional[dict[str, Any]] = None, transparent: bool = False) -> np.ndarray:
     """Render a session offscreen (its datasets read now unless given); returns the (H, W, 3) uint8 image, or with
     ``transparent`` the (H, W, 4) straight-alpha one without the background (``snapshot``)."""
-    from volviz.render.scene_builder import load_datasets
+    from volviz.scene.datasets import load_datasets
 
     datasets = load_datasets(session, session_file, progress, loaded=datasets)
     report(progress, 0.8, "rendering")
@@ -245,7 +235,8 @@ def open_target(target: str | os.PathLike, array: Optional[str] = None, q: Optio
     options of its reader (``dataset=`` of an HDF5 file ...), kept in the session's dataset. A member of a numbered
     series opens the whole series at that member's time step (``data_session``)."""
     from volviz.model.settings import array_key
-    from volviz.render.scene_builder import data_session, demo_session, demo_volume_session
+    from volviz.scene.demo import demo_session, demo_volume_session
+    from volviz.scene.opening import data_session
     from volviz.session import load
 
     if str(target) in ("demo", "demo-volume"):
@@ -323,7 +314,7 @@ def movie_frames(controller: Any, path_name: Optional[str], fps: float, through_
     cameras: list[Optional[Any]] = [None]
     if path_name is not None:
         if path_name not in session.camera_paths:
-            from volviz.render.scene_builder import SceneError
+            from volviz.scene.errors import SceneError
 
             known = ", ".join(sorted(session.camera_paths)) or "none"
             raise SceneError(f"the session has no camera path named {path_name!r} (it has: {known})")
@@ -372,7 +363,7 @@ def render_movie(session: Session, session_file: Optional[str | os.PathLike], ou
     """Render a movie offscreen (``movie_frames``): MP4/MOV (H.264 through imageio-ffmpeg) for ``.mp4``, ``.m4v``
     and ``.mov``, else a PNG sequence in the folder ``out`` (frame_00000.png, ...). The output and the size are
     checked first; the MP4 is written to a temporary file and renamed when complete."""
-    from volviz.render.scene_builder import load_datasets
+    from volviz.scene.datasets import load_datasets
 
     check_output(out, movie=True)
     check_image_size(size)

@@ -7,6 +7,8 @@ from typing import Any, Optional
 
 import numpy as np
 
+from volviz.scene.lod import lod_bounds
+
 Bounds = tuple[float, float, float, float, float, float]
 
 FILL = 0.8                                    # share of the viewport's limiting dimension the data fills
@@ -40,8 +42,6 @@ def prop_bounds(prop: Any) -> Optional[Bounds]:
         return points_bounds(mesh.points) if len(mesh.points) else None
     tree = getattr(prop, "tree", None)
     if tree is not None:
-        from volviz.render.lod_volume import lod_bounds
-
         return lod_bounds(tree)
     if hasattr(prop, "GetBounds"):
         if hasattr(prop, "GetVisibility") and not prop.GetVisibility():

@@ -47,10 +47,11 @@ from volviz.model import vec3
 from volviz.regular.lod import Block, LodCamera, LodTree, Selection
 from volviz.render.vtk_scene import update_volume_property, vtk_volume_property
 from volviz.render.image_overlay import ImageOverlay, unpremultiply_rgba8, zbuffer_to_depth
+from volviz.scene.lod import lod_bounds
 
 RENDERERS = ("volviz", "vtk")
 
-__all__ = ["LodVolume", "RENDERERS", "lod_bounds", "lod_camera", "lod_scalar_range"]
+__all__ = ["LodVolume", "RENDERERS", "lod_camera"]
 
 
 def lod_camera(vtk_camera: Any, size: tuple[int, int]) -> LodCamera:
@@ -59,18 +60,6 @@ def lod_camera(vtk_camera: Any, size: tuple[int, int]) -> LodCamera:
                      target=vec3(vtk_camera.GetFocalPoint()),
                      up=vec3(vtk_camera.GetViewUp()), fov_y=float(vtk_camera.GetViewAngle()),
                      width=int(size[0]), height=int(size[1]))
-
-
-def lod_scalar_range(tree: LodTree) -> tuple[float, float]:
-    """The data range of the whole volume (from the finest level's per-node statistics, no decoding)."""
-    st = tree.stats[0]
-    return float(tree._to_data(st.vmin.min())), float(tree._to_data(st.vmax.max()))
-
-
-def lod_bounds(tree: LodTree) -> tuple[float, float, float, float, float, float]:
-    """(xmin, xmax, ymin, ymax, zmin, zmax) of the volume's samples."""
-    hi = tree.origin + (np.asarray(tree.shapes[0], float) - 1.0) * tree.spacing
-    return tuple(float(v) for pair in zip(tree.origin, hi) for v in pair)  # type: ignore[return-value]
 
 
 def _image(block: Block) -> Any:

@@ -26,7 +26,7 @@ def probe_scene(controller: Any, x: float, y: float) -> Optional[ProbeResult]:
     """What is under display pixel (x, y) of ``controller``'s viewport: the nearest hit among the visible regular
     volumes (drawn transfer function, ``probe_regular``) and the meshes VTK can pick."""
     from volviz.model import RegularVolume
-    from volviz.render.drawn_tf import drawn_tf
+    from volviz.scene.drawn_tf import drawn_tf
 
     origin, direction = pick_ray(controller.plotter.renderer, x, y)
     hits: list[tuple[float, ProbeResult]] = []

@@ -44,7 +44,7 @@ class PTView:
     def cut(self, clip: Any, progress: Any = None) -> Any:
         """Any thread: the uncut mesh cut by ``clip`` exactly (``volviz.iso.clip.clip_tetmesh``), with its topology
         built; None when the clipping removes all of it."""
-        from volviz.render.scene_builder import cut_tetmesh
+        from volviz.scene.tetra import cut_tetmesh
 
         return cut_tetmesh(self.whole_mesh, clip)
 

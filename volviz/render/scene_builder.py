@@ -1,245 +1,40 @@
 """Build what a session (or a single data file) shows into any PyVista plotter: offscreen for export, or the app's.
 
-Only the components a session lists are loaded and added (DESIGN.md "Model only what a scene needs"); datasets shared
-by several components are read once.
+The VTK side of showing a scene: what a file or session becomes, its datasets and the CPU work that makes no VTK
+object are the scene layer's (``volviz.scene``); here the VTK inputs are prepared (``prepare_scene``, any thread) and
+the props and views are made (``install_scene``, GUI thread). Only the components a session lists are added.
 """
 from __future__ import annotations
 
-import os
-import re
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any, Optional
 
-import numpy as np
-
-from volviz.io.folders import MIN_SERIES_FILES, numbered_pattern
 from volviz.jobs import ProgressCallback, report
-from volviz.model.applicability import DatasetTraits
-from volviz.render.backend import backend_setting
-from volviz.session import (Component, DatasetRef, RenderSettings, Session, SessionError, missing_files,
-                            missing_message, resolve_path)
-
-
-class SceneError(Exception):
-    """A session that cannot be shown: names the component and the problem."""
-
-
-
-
-def series_pattern(path: str | os.PathLike) -> Optional[str]:
-    """``Storm.pvm-t%02d`` for ``Storm.pvm-t01`` when at least three numbered siblings exist (opened as one time
-    series, as ParaView groups numbered files); None otherwise, and for folders and for files whose reader reads
-    them with their siblings (``ReaderSpec.reads_siblings``: the slices of a DICOM series)."""
-    p = Path(path)
-    if not p.is_file() or _reads_siblings(p):
-        return None
-    match = re.search(r"(\d+)(?!.*\d)", p.name)
-    if match is None:
-        return None
-    head, tail = p.name[:match.start()], p.name[match.end():]
-    rx = re.compile(re.escape(head) + r"(\d+)" + re.escape(tail) + r"\Z")
-    try:
-        siblings = [name for name in os.listdir(p.parent) if rx.match(name)]
-    except OSError:
-        return None
-    if len(siblings) < MIN_SERIES_FILES:
-        return None
-    numbers = [rx.match(name).group(1) for name in siblings]  # type: ignore[union-attr]
-    return str(p.parent.resolve() / numbered_pattern(head, numbers, tail))
-
-
-def _shown_in_folder(path: str | os.PathLike) -> str | os.PathLike:
-    """A folder that no reader opens itself shows its collection file, or the first file of its largest numbered
-    series (``volviz.io.folders``); anything else is shown as it is."""
-    from volviz.io import ReadError
-    from volviz.io.folders import folder_target
-    from volviz.io.registry import spec_of
-    from volviz.io.series import expand_pattern
-
-    if not Path(path).is_dir():
-        return path
-    try:
-        spec_of(path)
-        return path
-    except ReadError:
-        target = folder_target(path)
-    if target is None:
-        return path                           # reading it says why it does not open
-    return expand_pattern(target)[0][1] if "%" in Path(target).name else target
-
-
-def _reads_siblings(path: Path) -> bool:
-    from volviz.io import ReadError
-    from volviz.io.registry import spec_of
-
-    try:
-        return spec_of(path).reads_siblings
-    except ReadError:
-        return False
-
-
-def data_session(path: str | os.PathLike, q: Optional[str | os.PathLike] = None) -> Session:
-    """A one-dataset session that shows ``path`` with its default visual (what opening a data file does): a file of a
-    numbered series opens the whole series at that file's time step; a height map (DEM, PGM) opens as a terrain
-    under a sky (``terrain_session``); a PLOT3D grid opens with the solution file ``q`` (default: the one named like
-    it), and a PLOT3D solution file opened alone opens with the grid named like it (a ReadError says what to do
-    when there is none)."""
-    from volviz.io.plot3d_pairs import grid_of_solution, is_plot3d_solution
-
-    path = _shown_in_folder(path)
-    if is_height_map(path):
-        return terrain_session(path)
-    if q is None and Path(path).is_file() and is_plot3d_solution(path):
-        grid = grid_of_solution(path)
-        if grid is None:
-            from volviz.io import ReadError
-
-            raise ReadError(path, "is a PLOT3D solution (q) file, and no grid (xyz) file named like it is beside it",
-                            "open it together with its grid file: select both files in the Open dialog (on the "
-                            "command line: GRID --q SOLUTION)")
-        path, q = grid, path
-    pattern = series_pattern(path)
-    ref = DatasetRef(id="data", path=pattern or str(Path(path).resolve()))
-    if q is not None:
-        ref.options["q"] = str(Path(q).resolve())
-    if Path(path).suffix.lower() == ".vvz" and vvz_voxels(path) > LOD_VOXELS:
-        ref.options["lod"] = True          # too large to decode whole: blocks per view (volviz.render.lod_volume)
-    session = Session(datasets=[ref], components=[Component(id="data", type="volume", dataset="data")])
-    if pattern is not None:
-        from volviz.io.series import member_time
-
-        t = member_time(pattern, path)
-        if t is not None:
-            session.render.options["time"] = t   # the session's display time (``SceneController.prepare``)
-    return session
-
-
-HEIGHT_MAP_SUFFIXES = (".dem", ".pgm")
-RELIEF = 0.1        # a grey-level height map opened directly rises to at most 1/10 of its width
-
-
-def is_height_map(path: str | os.PathLike) -> bool:
-    """Whether opening ``path`` should show a terrain: a USGS DEM, a grey PGM (not part of a numbered series), an
-    SRTM tile or a single-band GeoTIFF (``volviz.io.elevation``)."""
-    from volviz.io.elevation import is_elevation_model
-
-    p = Path(path)
-    if p.suffix.lower() in HEIGHT_MAP_SUFFIXES and p.is_file() and series_pattern(p) is None:
-        return True
-    return is_elevation_model(p)
-
-
-def terrain_session(path: str | os.PathLike) -> Session:
-    """A height map (DEM, GeoTIFF or SRTM tile in metres, PGM in grey levels) as a natural scene: its C-LOD terrain
-    under a sky, moved to the origin; a PGM's grey levels are scaled so that its relief is at most ``RELIEF`` of its
-    width (the others keep their true heights)."""
-    from volviz.io import read
-
-    image = read(path)
-    settings: dict[str, Any] = {"origin": [0.0, 0.0]}
-    if Path(path).suffix.lower() == ".pgm":
-        rows, cols = image.data.shape[:2]
-        lo, hi = image.scalar_range()
-        span = hi - lo if np.isfinite(hi - lo) and hi > lo else 1.0
-        settings["height_scale"] = min(1.0, RELIEF * max(rows, cols) / span)
-    ref = DatasetRef(id="height_map", path=str(Path(path).resolve()))
-    return Session(datasets=[ref], components=[Component(id="terrain", type="terrain", dataset="height_map",
-                                                         settings=settings),
-                                               Component(id="sky", type="sky")],
-                   render=RenderSettings(background=(0.78, 0.85, 0.95)))
-
-
-#: compressed volumes with more voxels than this open at a view-dependent level of detail instead of being decoded
-LOD_VOXELS = 256 ** 3
-
-
-def vvz_voxels(path: str | os.PathLike) -> int:
-    """Number of voxels of a ``.vvz`` file, from its header (nothing is decoded)."""
-    from volviz.regular.nodes import NodeDecoder
-
-    return int(np.prod(NodeDecoder(os.fspath(path)).dims))
-
-
-def demo_session() -> Session:
-    """The built-in procedural natural scene (fractal terrain, Perlin ground fog and clouds, sky), generated at
-    start-up from no files."""
-    from volviz.render.demo import demo_components
-    from volviz.session import CameraState
-
-    camera = CameraState(position=(500.0, -150.0, 330.0), focal_point=(500.0, 600.0, 80.0), view_up=(0.0, 0.0, 1.0),
-                         view_angle=60.0)
-    return Session(components=demo_components(), camera=camera,
-                   render=RenderSettings(size=(1024, 768), background=(0.78, 0.85, 0.95)))
-
-
-def demo_volume_session() -> Session:
-    """A tetrahedralised cube carrying an analytic field (``volviz render demo-volume``)."""
-    return Session(components=[Component(id="demo", type="demo", settings={"cells_per_edge": 20})])
-
-
-def load_datasets(session: Session, session_file: Optional[str | os.PathLike],
-                  progress: Optional[ProgressCallback] = None,
-                  loaded: Optional[dict[str, Any]] = None, also: tuple[str, ...] = ()) -> dict[str, Any]:
-    """Read every dataset that a visible component (or a component in ``also``) uses, once each, with progress;
-    those already in ``loaded`` are kept (the dict is filled in and returned)."""
-    from volviz.nature.nature_scene import nature_dataset_ids
-
-    used = {c.dataset for c in session.components if (c.visible or c.id in also) and c.dataset is not None}
-    used |= nature_dataset_ids([c for c in session.components if c.visible and c.type in NATURE_TYPES])
-    loaded = {} if loaded is None else loaded
-    refs = [ref for ref in session.datasets if ref.id in used and ref.id not in loaded]
-    missing = missing_files(session, session_file, {ref.id for ref in refs})
-    if missing:  # each one named at once, before any is read
-        raise SessionError(session_file, missing_message(missing), field="datasets")
-    for i, ref in enumerate(refs):
-        report(progress, i / max(len(refs), 1), f"reading {Path(ref.path).name}")
-        path = resolve_path(session_file, ref.path) if session_file else Path(ref.path)
-        loaded[ref.id] = read_any(path, ref.options, progress)
-    report(progress, 1.0, "datasets read")
-    return loaded
-
-
-def component_dataset(comp: Component, datasets: dict[str, Any]) -> Any:
-    """The dataset a component shows: generated for the demo, else the loaded dataset it names."""
-    if comp.type == "demo":
-        from volviz.model.demo import demo_tet_mesh
-
-        key = f"demo:{int(comp.settings.get('cells_per_edge', 20))}"
-        if key not in datasets:
-            datasets[key] = demo_tet_mesh(int(comp.settings.get("cells_per_edge", 20)))
-        return datasets[key]
-    if comp.dataset is None:
-        raise SceneError(f"component {comp.id!r} ({comp.type}) names no dataset")
-    if comp.type in NATURE_TYPES:
-        return datasets[comp.dataset]
-    try:
-        return shown_array(datasets[comp.dataset], comp.settings.get("array"))
-    except ValueError as exc:
-        raise SceneError(f"component {comp.id!r}: {exc}") from None
-
-
-def shown_array(dataset: Any, spec: Optional[str]) -> Any:
-    """``dataset`` showing the array ``spec`` (None: its default array; ``volviz.model.arrays``), made once per spec
-    and kept on the dataset, so the tetrahedralisation and topology cached on it are made once too."""
-    from volviz.model import Image2D
-
-    if isinstance(dataset, Image2D) or is_lod(dataset):
-        return dataset
-    from volviz.model.arrays import select_array
-
-    views = dataset.__dict__.setdefault("volviz_views", {})
-    if spec not in views:
-        views[spec] = select_array(dataset, spec)
-    return views[spec]
+from volviz.model import Image2D, RegularVolume, TimeSeries
+from volviz.model.stats import histogram
+from volviz.model.timeseries import frame_at
+from volviz.render.backend import backend_setting, choose_backend, plotter_gl_info
+from volviz.render.component_views import IsoSurfacesView, VtkPropView
+from volviz.render.decorations import legend_margin
+from volviz.render.framing import frame_bounds, nature_bounds, points_bounds, union
+from volviz.render.lod_volume import LodVolume
+from volviz.render.slices import SlicesView
+from volviz.render.views import view_class
+from volviz.render.vtk_scene import (add_dataset, add_surface, apply_camera, default_transfer_function_for, is_surface,
+                                     surface_input, volume_grid, volume_input, volume_prop)
+from volviz.scene.clipping import clip_settings
+from volviz.scene.datasets import NATURE_TYPES, component_dataset
+from volviz.scene.drawn_tf import component_transfer_function, drawn_transfer_function
+from volviz.scene.first_look import first_look
+from volviz.scene.isosurfaces import isosurface_parts
+from volviz.scene.lod import is_lod, lod_bounds
+from volviz.scene.nature import prepare_nature
+from volviz.scene.tetra import cut_tetmesh, pt_mesh, pt_options
+from volviz.session import Component, Session
 
 
 def ensure_transfer_functions(session: Session, datasets: dict[str, Any]) -> None:
     """Give every volume-like component without a transfer function a default one fitted to its data."""
-    from volviz.render.vtk_scene import default_transfer_function_for
-
-    from volviz.model import Image2D
-
     for comp in session.components:
         if comp.transfer_function is None and comp.type in ("volume", "mesh", "demo", "slices"):
             if comp.dataset is not None and comp.dataset not in datasets:
@@ -252,42 +47,6 @@ def ensure_transfer_functions(session: Session, datasets: dict[str, Any]) -> Non
             tf = default_transfer_function_for(component_dataset(comp, datasets), name)
             session.transfer_functions[name] = tf.to_dict()
             comp.transfer_function = name
-
-
-def drawn_transfer_function(session: Session, comp: Component, dataset: Any) -> Any:
-    """The component's transfer function as drawn (through log10 with the setting ``log_scale``)."""
-    from volviz.render.drawn_tf import drawn_tf
-
-    return drawn_tf(comp, component_transfer_function(session, comp), dataset)
-
-
-def component_transfer_function(session: Session, comp: Component) -> Any:
-    from volviz.optics import TransferFunction
-
-    if comp.transfer_function is None:
-        return None
-    return TransferFunction.from_dict(session.transfer_functions[comp.transfer_function])
-
-
-NATURE_TYPES = ("terrain", "fog", "clouds", "sky")
-
-
-def read_any(path: Path, options: dict[str, Any], progress: Optional[ProgressCallback] = None) -> Any:
-    """A data file through ``volviz.io.read``, or a volviz-compressed volume (``.vvz``): with the dataset option
-    ``lod`` a ``LodTree`` drawn at a view-dependent level of detail (``volviz.render.lod_volume``), else through the
-    wavelet decoder
-    (damaged bricks are filled from the coarser level and reported as warnings, never silently)."""
-    if path.suffix.lower() == ".vvz":
-        if options.get("lod"):           # level of detail: blocks decoded on demand for each view
-            from volviz.regular.lod import LodTree
-
-            return LodTree(path, cache_bytes=int(options.get("cache_mb", 256)) << 20)
-        from volviz.regular.codec import decompress
-
-        return decompress(path, progress=progress)
-    from volviz.io import read
-
-    return read(path, **options)
 
 
 @dataclass
@@ -308,8 +67,6 @@ def prepare_scene(session: Session, datasets: dict[str, Any], t: Optional[float]
     time ``t``, the natural scene's maps and volumes, data histograms). Touches no plotter; ``install_scene`` adds
     the props on the GUI thread."""
     ensure_transfer_functions(session, datasets)
-    from volviz.render.first_look import first_look
-
     t = first_look(session, datasets, t)   # a series constant at its first step: from where it varies
     prepared = PreparedScene(time=t)
     shown = [c for c in session.components if c.visible and c.type not in NATURE_TYPES]
@@ -327,10 +84,6 @@ def prepare_component(session: Session, comp: Component, datasets: dict[str, Any
     """Any thread: the heavy part of showing one non-nature component (isosurface extraction with clipping and LOD
     chains, tetrahedralisation and topology, the VTK volume input at display time ``t``, its data histogram), put into
     ``prepared``; ``install_component`` adds its prop on the GUI thread."""
-    from volviz.model import TimeSeries
-    from volviz.model.stats import histogram
-    from volviz.render.clipping import clip_settings
-
     clip = clip_settings(session.clip)
     dataset = component_dataset(comp, datasets)
     series = isinstance(dataset, TimeSeries)
@@ -354,43 +107,10 @@ def prepare_component(session: Session, comp: Component, datasets: dict[str, Any
         prepared.parts[comp.id] = time_input(dataset, t, interpolate) if series else prepared_volume_input(dataset)
 
 
-def pt_mesh(dataset: Any) -> Any:
-    """Any thread: the tetrahedral mesh a PT volume draws for ``dataset``, with its topology built (cached on it)."""
-    from volviz.model.datasets import TetMesh
-    from volviz.unstructured.topology import topology
-
-    mesh = dataset
-    if not isinstance(dataset, TetMesh):
-        from volviz.unstructured.tetrahedralize import tetrahedralize
-
-        mesh = tetrahedralize(dataset, getattr(dataset, "active", None))
-    topology(mesh)
-    return mesh
-
-
-def cut_tetmesh(mesh: Any, clip: Any) -> Any:
-    """Any thread: ``mesh`` cut exactly by ``clip`` (``volviz.iso.clip.clip_tetmesh``) with its topology built; None
-    when the clipping removes all of it."""
-    from volviz.iso.clip import clip_tetmesh
-    from volviz.unstructured.topology import topology
-
-    try:
-        cut = clip_tetmesh(mesh, clip)
-    except ValueError:  # everything clipped away
-        return None
-    topology(cut)
-    return cut
-
-
 def prepared_volume_input(dataset: Any, t: Optional[float] = None, interpolate: bool = True) -> Any:
     """Any thread: the VTK data object a volume mapper draws for ``dataset`` (a time series: blended at display
     time ``t``, libMini note "4D Visualization"), or None when ``add_dataset`` does not draw it as a volume."""
-    from volviz.model import Image2D, TimeSeries
-    from volviz.render.vtk_scene import is_surface, volume_grid, volume_input
-
     if isinstance(dataset, TimeSeries):
-        from volviz.model.timeseries import frame_at
-
         dataset = frame_at(dataset, float(dataset.times[0] if t is None else t), interpolate)
     if isinstance(dataset, Image2D) or is_surface(dataset) or volume_grid(dataset).active_scalars is None:
         return None
@@ -402,10 +122,6 @@ def time_input(series: Any, t: Optional[float] = None, interpolate: bool = True)
     volume's mapper input (``prepared_volume_input``, blended) or a surface's (``vtk_scene.surface_input`` of the
     frame at ``t``: points and values blended between steps of one topology); None for what does not follow the
     time (a 2D image)."""
-    from volviz.model import Image2D
-    from volviz.model.timeseries import frame_at
-    from volviz.render.vtk_scene import is_surface, surface_input
-
     t = float(series.times[0] if t is None else t)
     if isinstance(series.frame(0), Image2D):
         return None
@@ -420,31 +136,12 @@ def add_volume_prop(plotter: Any, dataset: Any, data: Any, tf: Any, opacity: flo
     its display time (``data`` from ``time_input``), or (``data`` None) ``add_dataset``'s default visual;
     ``backend``: the render option (``volviz.render.backend``), which picks VTK's GPU or CPU ray caster; ``shade``:
     the component's lighting setting (``vtk_scene.set_volume_shading``; regular volumes only)."""
-    from volviz.model import RegularVolume, TimeSeries
-    from volviz.render.vtk_scene import add_dataset, add_surface, is_surface, volume_prop
-
     if data is None:
         return add_dataset(plotter, dataset, tf=tf, opacity=opacity, name=name)
     if is_surface(dataset):        # a time series' surface at the display time (``time_input``)
         return add_surface(plotter, data, tf, opacity, name)
     regular = isinstance(dataset.frame(0) if isinstance(dataset, TimeSeries) else dataset, RegularVolume)
     return volume_prop(plotter, data, regular, tf, opacity, name, backend, shade)
-
-
-def prepare_nature(session: Session, datasets: dict[str, Any]) -> Any:
-    """Any thread: the NatureScene of the session's visible terrain / fog / clouds / sky components (None when it has
-    none): maps read into height fields, fog prisms, cloud volumes and lighting; ``NatureView`` shows it."""
-    components = [c for c in session.components if c.visible and c.type in NATURE_TYPES]
-    if not components:
-        return None
-    from volviz.nature.nature_scene import scene_from_components
-
-    try:
-        scene = scene_from_components(components, datasets)
-    except (ValueError, KeyError) as exc:
-        raise SceneError(f"natural scene: {exc}") from None
-    scene.finalize()
-    return scene
 
 
 def install_nature(plotter: Any, scene: Any, views: bool = True, backend: str = "cpu") -> Any:
@@ -454,8 +151,6 @@ def install_nature(plotter: Any, scene: Any, views: bool = True, backend: str = 
     ``begin`` / ``compute`` / ``finish``)."""
     if scene is None:
         return None
-    from volviz.render.views import view_class
-
     view = view_class("nature", backend)(plotter, scene)
     if views:
         view.update()
@@ -469,8 +164,6 @@ def install_scene(plotter: Any, session: Session, datasets: dict[str, Any], prep
     components together. The view-dependent parts (PT volume images, LOD block selections, the natural scene's
     terrain and overlay) are drawn now when ``views``; otherwise they stay empty until the caller updates them (the
     app does that in the background)."""
-    from volviz.render.vtk_scene import apply_camera
-
     props: dict[str, Any] = {}
     pt_components = []
     lod_components = []
@@ -486,9 +179,6 @@ def install_scene(plotter: Any, session: Session, datasets: dict[str, Any], prep
             props[comp.id] = install_component(plotter, session, comp, datasets, prepared, spectrum, views)
     plotter.set_background(session.render.background)
     if session.camera is None:  # framed on every component before the view-dependent parts are drawn
-        from volviz.render.decorations import legend_margin
-        from volviz.render.framing import frame_bounds, nature_bounds, points_bounds, union
-        from volviz.render.lod_volume import lod_bounds
 
         boxes = [view.bounds() for view in props.values()] + [points_bounds(m.points) for _, m in pt_components]
         boxes += [lod_bounds(d) for _, d in lod_components]
@@ -512,14 +202,10 @@ def install_component(plotter: Any, session: Session, comp: Component, datasets:
     (``volviz.render.views.ComponentView``: a PT volume, a LOD volume, its isosurfaces, or a VTK prop's view). A PT
     volume's image and a LOD volume's blocks are drawn now when ``views`` (else the caller updates them in the
     background)."""
-    from volviz.render.component_views import IsoSurfacesView, VtkPropView
-
     dataset = component_dataset(comp, datasets)
     if comp.type == "isosurface":
         return IsoSurfacesView(plotter, comp, prepared.parts[comp.id], spectrum=spectrum)
     if comp.type == "slices":
-        from volviz.render.slices import SlicesView
-
         return SlicesView(plotter, comp, dataset, component_transfer_function(session, comp))
     if is_lod(dataset):
         return add_lod_component(plotter, session, comp, dataset, update=views)
@@ -535,35 +221,10 @@ def build_scene(plotter: Any, session: Session, datasets: dict[str, Any], spectr
     return install_scene(plotter, session, datasets, prepare_scene(session, datasets), spectrum)
 
 
-def is_lod(dataset: Any) -> bool:
-    from volviz.regular.lod import LodTree
-
-    return isinstance(dataset, LodTree)
-
-
-def dataset_traits(dataset: Any) -> DatasetTraits:
-    """What a loaded dataset (as ``read_any`` gives it) is, for the settings that apply to some datasets only
-    (``volviz.model.applicability``): a time series, a compressed volume drawn at a level of detail."""
-    from volviz.model import TimeSeries
-
-    return DatasetTraits(time_series=isinstance(dataset, TimeSeries), lod_volume=is_lod(dataset))
-
-
-def drawn_as(dataset: Any) -> str:
-    """How a volume component draws a loaded dataset: ``"points"`` (a mesh of vertices only, e.g. a point table),
-    ``"surface"`` (surface cells, a flat grid, no field or a constant one: ``volviz.model.representation``) or
-    ``"volume"``."""
-    from volviz.model.representation import representation
-
-    return "volume" if is_lod(dataset) else representation(dataset).kind
-
-
 def add_lod_component(plotter: Any, session: Session, comp: Component, dataset: Any, update: bool = True) -> Any:
     """A compressed volume at a view-dependent level of detail (``volviz.render.lod_volume``); the component
     setting ``budget`` is the number of blocks per view (default 256). Its blocks are selected now when ``update``
     (the app selects them in the background: ``select`` / ``decode`` / ``show``)."""
-    from volviz.render.lod_volume import LodVolume
-
     if session.camera is None:
         lo, hi = dataset.node_box((dataset.levels, (0, 0, 0)))
         plotter.view_isometric()
@@ -582,10 +243,6 @@ PT_DATASETS = ("TetMesh", "UnstructuredMesh", "CurvilinearGrid")
 def uses_pt(session: Session, dataset: Any) -> bool:
     """Unstructured and curvilinear data are drawn by volviz's pre-integrated projected tetrahedra unless the
     session asks for VTK's own mappers (render method "vtk"); regular volumes go to VTK's ray casters."""
-    from volviz.model import TimeSeries
-
-    from volviz.render.vtk_scene import is_surface
-
     if isinstance(dataset, TimeSeries):
         return False  # time-varying meshes stay on VTK's mapper for now
     return session.render.method != "vtk" and type(dataset).__name__ in PT_DATASETS and not is_surface(dataset)
@@ -601,8 +258,6 @@ def add_pt_component(plotter: Any, session: Session, comp: Component, dataset: A
         tf = tf.scaled_extinction(comp.opacity)
     method = "reference" if session.render.method == "reference" else "pt"
     opts = pt_options(session.render.options) if method == "pt" else {}
-    from volviz.render.views import view_class
-
     if method == "pt" and pt_backend(plotter, session) == "gpu":
         return view_class("pt", "gpu")(plotter, dataset, tf, **{"lookup": "auto", **opts})  # the CPU path's table
     handle = view_class("pt", "cpu")(plotter, dataset, tf, method=method, scalars=getattr(dataset, "active", None),
@@ -620,110 +275,7 @@ def pt_backend(plotter: Any, session: Session) -> str:
 def view_backend(plotter: Any, session: Session, view_kind: str) -> str:
     """"gpu" or "cpu": where the session's views of ``view_kind`` ("pt", "nature", "iso", ...) are drawn in
     ``plotter``, as the render option ``backend`` picks for the plotter's OpenGL (``volviz.render.backend``)."""
-    from volviz.render.backend import choose_backend, plotter_gl_info
-
     return choose_backend(backend_setting(session.render.options), view_kind, plotter_gl_info(plotter))
-
-
-def pt_options(options: dict[str, Any]) -> dict[str, Any]:
-    """Render settings -> keywords of ``volviz.unstructured.render``: sort ("mpvo", "centroid", "power"), table
-    ("auto" by optical depth, "3d", or "separable-N" with a color polynomial of degree N) and its resolution."""
-    out: dict[str, Any] = {}
-    sort = options.get("sort")
-    if sort in ("mpvo", "centroid", "power"):
-        out["sort"] = sort
-    table = str(options.get("table", "auto"))
-    resolution = options.get("table_resolution")
-    if table == "3d":
-        out["lookup"] = "3d"
-    elif table.startswith("separable-") and table[len("separable-"):] in ("1", "2", "4"):
-        out.update(lookup="separable", degree=int(table[len("separable-"):]))
-    if table != "auto" and isinstance(resolution, int) and 16 <= resolution <= 1024:
-        out["n_s"] = resolution
-    return out
-
-
-@dataclass
-class IsoParts:
-    """An isosurface component's surfaces ready for actors (``isosurface_parts``): the extracted ones (uncut by the
-    scene clipping), the shown ones (cut, opacity scaled) and the LOD chains of the shown ones."""
-
-    meshes: list[Any]
-    shown: list[Any]
-    lod: Optional[list[Any]]
-    settings: Any
-    clip: dict[str, Any] = field(default_factory=dict)  # the scene clipping they were cut by (``to_dict``)
-    opacity: float = 1.0                                 # the component opacity they were scaled by
-
-
-def isosurface_parts(comp: Component, dataset: Any = None, t: Optional[float] = None, clip: Any = None,
-                     meshes: Optional[list[Any]] = None, progress: Optional[ProgressCallback] = None) -> IsoParts:
-    """Any thread: the surfaces of an ``isosurface`` component (settings: ``volviz.iso.IsoSettings``) extracted at
-    display time ``t`` (skipped when ``meshes`` are known), cut exactly by the scene's ``clip`` (``session.clip`` or
-    ClipSettings) on top of the component's own clipping, scaled by its opacity, with their LOD chains."""
-    from volviz.iso import IsoSettings, prepare
-    from volviz.iso.clip import clip_isosurfaces
-    from volviz.render.clipping import clip_settings
-
-    try:
-        settings = IsoSettings.from_dict(comp.settings)
-    except ValueError as exc:
-        raise SceneError(f"component {comp.id!r}: {exc}") from None
-    if not settings.styles:
-        raise SceneError(f"component {comp.id!r}: settings.styles lists no iso-values")
-    if meshes is None:
-        meshes = list(prepare(dataset, settings, t, progress=progress).meshes)
-    scene_clip = clip_settings(clip)
-    shown = clip_isosurfaces(meshes, scene_clip) if scene_clip.all_planes() else list(meshes)
-    if comp.opacity < 1.0:  # the component's opacity scales every surface's
-        from dataclasses import replace
-
-        shown = [replace(m, style=replace(m.style, opacity=m.style.opacity * comp.opacity)) for m in shown]
-    lod = None  # LOD chains of the shown surfaces (the CPU modes draw them view-dependently)
-    if settings.lod:
-        from volviz.iso.lod import build_lod
-
-        lod = [(build_lod(m), settings.triangles_per_pixel2) if m.n_triangles else None for m in shown]
-    return IsoParts(list(meshes), shown, lod, settings, scene_clip.to_dict(), float(comp.opacity))
-
-
-def add_isosurface_actors(plotter: Any, name: str, parts: IsoParts, spectrum: bool = True) -> Any:
-    """GUI thread: the shown surfaces of ``parts`` as one prop assembly of VTK actors named ``name``, with the
-    iso-spectrum shader when ``spectrum`` (drawn by VTK as the note's 2-pass blend). The assembly keeps the uncut
-    surfaces as ``volviz_meshes`` and the shown ones as ``volviz_shown`` (the CPU transparency modes draw those,
-    ``volviz.render.iso_overlay``).
-
-    The shader needs the renderer's lights: a renderer without lights (``pyvista.Plotter.clear`` removes them)
-    compiles VTK's unlit shader, which declares no normals (``normalVCVSOutput`` undeclared); the scene controller
-    restores the light kit before building."""
-    from volviz.render.vtk_facade import vtk
-
-    from volviz.render.iso_spectrum import iso_actor
-
-    assembly = vtk.vtkPropAssembly()
-    translucent = []  # the actors of translucent surfaces (hidden while a CPU mode draws those surfaces)
-    # (the VTK camera: pyvista's ``plotter.camera`` re-frames a camera it does not consider set)
-    parallel = bool(plotter.renderer.GetActiveCamera().GetParallelProjection())
-    for mesh in parts.shown:
-        if len(mesh.triangles):
-            actor = iso_actor(mesh, parallel=parallel, spectrum=spectrum and parts.settings.shading == "spectrum")
-            assembly.AddPart(actor)
-            if mesh.style.opacity < 1.0:
-                translucent.append(actor)
-    assembly.volviz_meshes, assembly.volviz_shown = parts.meshes, parts.shown
-    assembly.volviz_shading = parts.settings.shading
-    assembly.volviz_translucent = translucent
-    assembly.volviz_lod = parts.lod
-    plotter.add_actor(assembly, name=name, reset_camera=False)
-    return assembly
-
-
-def add_isosurfaces(plotter: Any, comp: Component, dataset: Any, t: Optional[float] = None,
-                    spectrum: bool = True, clip: Any = None, meshes: Optional[list[Any]] = None) -> Any:
-    """The isosurfaces of an ``isosurface`` component as one prop assembly, now: ``isosurface_parts`` (``clip``:
-    the scene's clipping; ``meshes``: the extracted surfaces when already known) then ``add_isosurface_actors``."""
-    return add_isosurface_actors(plotter, comp.id, isosurface_parts(comp, dataset, t, clip, meshes),
-                                 spectrum=spectrum)
 
 
 def build_nature(plotter: Any, session: Session, datasets: dict[str, Any]) -> Any:

@@ -16,7 +16,7 @@ import numpy as np
 from volviz.model.datasets import RegularVolume
 from volviz.render.component_views import VtkPropView
 from volviz.render.framing import Bounds, prop_bounds
-from volviz.render.scene_builder import SceneError
+from volviz.scene.errors import SceneError
 
 __all__ = ["AXES", "SlicesView", "slice_colors", "slice_image", "slice_indices", "slice_values", "SliceError",
            "value_color"]

@@ -13,6 +13,7 @@ import numpy as np
 
 from volviz.model import CurvilinearGrid, Image2D, RegularVolume, TetMesh, TimeSeries, UnstructuredMesh, vec3
 from volviz.render.vtk_tf import tf_to_vtk
+from volviz.scene.lod import is_lod, lod_bounds, lod_scalar_range
 from volviz.session import CameraState
 
 PLAIN_COLOR = (0.80, 0.80, 0.78)    # geometry without a field: a neutral light grey, shaded by the lights
@@ -102,11 +103,7 @@ def volume_grid(dataset: Any) -> Any:
 def default_transfer_function_for(dataset: Any, name: str = "default") -> Any:
     """The first-look transfer function of a dataset: placed from the histogram of its shown scalar (of every step,
     for a time series) by ``volviz.optics.auto_tf``; a compressed LOD volume gets the ramp over its range."""
-    from volviz.regular.lod import LodTree
-
-    if isinstance(dataset, LodTree):
-        from volviz.render.lod_volume import lod_bounds, lod_scalar_range
-
+    if is_lod(dataset):
         return default_transfer_function(lod_scalar_range(dataset), bounds_diagonal(lod_bounds(dataset)), name)
     from volviz.model.stats import scalar_values
     from volviz.optics.auto_tf import auto_transfer_function, mean_chord
@@ -264,7 +261,7 @@ def add_surface(plotter: Any, surface: Any, tf: Any, opacity: float, name: Optio
 def _add_image(plotter: Any, image: Image2D, name: Optional[str]) -> Any:
     """A 2D raster (a photo, a texture, a grey image) as a flat picture on the z = 0 plane, in its own colors (grey
     levels for one channel). Height maps open as terrain scenes instead
-    (``volviz.render.scene_builder.terrain_session``)."""
+    (``volviz.scene.terrain.terrain_session``)."""
     grid = image.to_pyvista()
     if image.channels >= 3:
         colors = np.asarray(image.data[..., :3], dtype=np.float64).reshape(-1, 3)

@@ -1,8 +1,8 @@
-"""The built-in demo scene as a session: the procedural natural scene (``volviz.nature.nature_scene.demo_scene``)
-written as session components, with no datasets."""
+"""The built-in demo scenes as sessions with no datasets: the procedural natural scene
+(``volviz.nature.nature_scene.demo_scene``) written as session components, and the analytic tetrahedral cube."""
 from __future__ import annotations
 
-from volviz.session import Component
+from volviz.session import CameraState, Component, RenderSettings, Session
 
 
 def demo_components() -> list[Component]:
@@ -18,3 +18,17 @@ def demo_components() -> list[Component]:
                                                         "base_height": 190.0, "rho_max": 0.06}),
         Component(id="sky", type="sky"),
     ]
+
+
+def demo_session() -> Session:
+    """The built-in procedural natural scene (fractal terrain, Perlin ground fog and clouds, sky), generated at
+    start-up from no files."""
+    camera = CameraState(position=(500.0, -150.0, 330.0), focal_point=(500.0, 600.0, 80.0), view_up=(0.0, 0.0, 1.0),
+                         view_angle=60.0)
+    return Session(components=demo_components(), camera=camera,
+                   render=RenderSettings(size=(1024, 768), background=(0.78, 0.85, 0.95)))
+
+
+def demo_volume_session() -> Session:
+    """A tetrahedralised cube carrying an analytic field (``volviz render demo-volume``)."""
+    return Session(components=[Component(id="demo", type="demo", settings={"cells_per_edge": 20})])

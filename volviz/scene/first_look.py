@@ -13,6 +13,7 @@ from typing import Any, Optional
 from volviz.io import ReadWarning
 from volviz.model import TimeSeries
 from volviz.model.representation import first_varying_step, representation
+from volviz.scene.datasets import component_dataset
 from volviz.session import Session
 
 SAID = "volviz_first_look_said"      # kept on a dataset once its notes were given
@@ -28,8 +29,6 @@ def first_look(session: Session, datasets: dict[str, Any], t: Optional[float]) -
     that step, and the session's display time none or that step: a series member opened first) whose field is
     constant there, the first step where it varies (kept as the session's display time). Says so, and says which
     shown fields are constant, once per dataset."""
-    from volviz.render.scene_builder import component_dataset
-
     for comp in session.components:
         if not comp.visible or comp.type != "volume" or comp.dataset not in datasets:
             continue

@@ -8,8 +8,11 @@ from typing import Any
 
 import numpy as np
 
+from volviz.model.stats import scalar_values
+from volviz.optics import TransferFunction
 from volviz.optics.log_scale import log_mapped, positive_floor
-from volviz.session import Component
+from volviz.scene.lod import is_lod, lod_scalar_range
+from volviz.session import Component, Session
 
 _FLOORS: dict[int, tuple[Any, float]] = {}   # id(dataset) -> (weak reference to it, its smallest positive value)
 
@@ -38,14 +41,8 @@ def log_floor(tf: Any, dataset: Any) -> float:
 
 
 def _values(dataset: Any) -> np.ndarray:
-    from volviz.regular.lod import LodTree
-
-    if isinstance(dataset, LodTree):   # a compressed volume: the range of its finest level (no decoding)
-        from volviz.render.lod_volume import lod_scalar_range
-
+    if is_lod(dataset):   # a compressed volume: the range of its finest level (no decoding)
         return np.asarray(lod_scalar_range(dataset), dtype=np.float64)
-    from volviz.model.stats import scalar_values
-
     try:
         return scalar_values(dataset)
     except TypeError:
@@ -58,3 +55,15 @@ def drawn_tf(comp: Component, tf: Any, dataset: Any) -> Any:
         return tf
     return log_mapped(tf, log_floor(tf, dataset))
 
+
+
+def component_transfer_function(session: Session, comp: Component) -> Any:
+    """The component's stored transfer function (in data values), or None when it has none."""
+    if comp.transfer_function is None:
+        return None
+    return TransferFunction.from_dict(session.transfer_functions[comp.transfer_function])
+
+
+def drawn_transfer_function(session: Session, comp: Component, dataset: Any) -> Any:
+    """The component's transfer function as drawn (through log10 with the setting ``log_scale``)."""
+    return drawn_tf(comp, component_transfer_function(session, comp), dataset)

@@ -1,0 +1,100 @@
+"""A session's datasets read once each, and the dataset each component shows ("Model only what a scene needs": only
+the datasets of shown components are read; an array choice is made once per dataset and kept on it)."""
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Any, Optional
+
+from volviz.io import read
+from volviz.jobs import ProgressCallback, report
+from volviz.model import Image2D, TimeSeries
+from volviz.model.applicability import DatasetTraits
+from volviz.model.demo import demo_tet_mesh
+from volviz.model.arrays import select_array
+from volviz.model.representation import representation
+from volviz.scene.errors import SceneError
+from volviz.scene.lod import is_lod
+from volviz.session import Component, Session, SessionError, missing_files, missing_message, resolve_path
+
+#: the component types the natural scene draws together (``volviz.scene.nature``)
+NATURE_TYPES = ("terrain", "fog", "clouds", "sky")
+
+
+def load_datasets(session: Session, session_file: Optional[str | os.PathLike],
+                  progress: Optional[ProgressCallback] = None,
+                  loaded: Optional[dict[str, Any]] = None, also: tuple[str, ...] = ()) -> dict[str, Any]:
+    """Read every dataset that a visible component (or a component in ``also``) uses, once each, with progress;
+    those already in ``loaded`` are kept (the dict is filled in and returned)."""
+    from volviz.nature.nature_scene import nature_dataset_ids   # heavy (the nature kernels): only for a session
+
+    used = {c.dataset for c in session.components if (c.visible or c.id in also) and c.dataset is not None}
+    used |= nature_dataset_ids([c for c in session.components if c.visible and c.type in NATURE_TYPES])
+    loaded = {} if loaded is None else loaded
+    refs = [ref for ref in session.datasets if ref.id in used and ref.id not in loaded]
+    missing = missing_files(session, session_file, {ref.id for ref in refs})
+    if missing:  # each one named at once, before any is read
+        raise SessionError(session_file, missing_message(missing), field="datasets")
+    for i, ref in enumerate(refs):
+        report(progress, i / max(len(refs), 1), f"reading {Path(ref.path).name}")
+        path = resolve_path(session_file, ref.path) if session_file else Path(ref.path)
+        loaded[ref.id] = read_any(path, ref.options, progress)
+    report(progress, 1.0, "datasets read")
+    return loaded
+
+
+def read_any(path: Path, options: dict[str, Any], progress: Optional[ProgressCallback] = None) -> Any:
+    """A data file through ``volviz.io.read``, or a volviz-compressed volume (``.vvz``): with the dataset option
+    ``lod`` a ``LodTree`` drawn at a view-dependent level of detail (``volviz.render.lod_volume``), else through the
+    wavelet decoder
+    (damaged bricks are filled from the coarser level and reported as warnings, never silently)."""
+    if path.suffix.lower() == ".vvz":
+        if options.get("lod"):           # level of detail: blocks decoded on demand for each view
+            from volviz.regular.lod import LodTree   # heavy (Numba kernels): only for a compressed volume
+
+            return LodTree(path, cache_bytes=int(options.get("cache_mb", 256)) << 20)
+        from volviz.regular.codec import decompress   # heavy (Numba kernels): only for a compressed volume
+
+        return decompress(path, progress=progress)
+    return read(path, **options)
+
+
+def component_dataset(comp: Component, datasets: dict[str, Any]) -> Any:
+    """The dataset a component shows: generated for the demo, else the loaded dataset it names."""
+    if comp.type == "demo":
+        key = f"demo:{int(comp.settings.get('cells_per_edge', 20))}"
+        if key not in datasets:
+            datasets[key] = demo_tet_mesh(int(comp.settings.get("cells_per_edge", 20)))
+        return datasets[key]
+    if comp.dataset is None:
+        raise SceneError(f"component {comp.id!r} ({comp.type}) names no dataset")
+    if comp.type in NATURE_TYPES:
+        return datasets[comp.dataset]
+    try:
+        return shown_array(datasets[comp.dataset], comp.settings.get("array"))
+    except ValueError as exc:
+        raise SceneError(f"component {comp.id!r}: {exc}") from None
+
+
+def shown_array(dataset: Any, spec: Optional[str]) -> Any:
+    """``dataset`` showing the array ``spec`` (None: its default array; ``volviz.model.arrays``), made once per spec
+    and kept on the dataset, so the tetrahedralisation and topology cached on it are made once too."""
+    if isinstance(dataset, Image2D) or is_lod(dataset):
+        return dataset
+    views = dataset.__dict__.setdefault("volviz_views", {})
+    if spec not in views:
+        views[spec] = select_array(dataset, spec)
+    return views[spec]
+
+
+def dataset_traits(dataset: Any) -> DatasetTraits:
+    """What a loaded dataset (as ``read_any`` gives it) is, for the settings that apply to some datasets only
+    (``volviz.model.applicability``): a time series, a compressed volume drawn at a level of detail."""
+    return DatasetTraits(time_series=isinstance(dataset, TimeSeries), lod_volume=is_lod(dataset))
+
+
+def drawn_as(dataset: Any) -> str:
+    """How a volume component draws a loaded dataset: ``"points"`` (a mesh of vertices only, e.g. a point table),
+    ``"surface"`` (surface cells, a flat grid, no field or a constant one: ``volviz.model.representation``) or
+    ``"volume"``."""
+    return "volume" if is_lod(dataset) else representation(dataset).kind

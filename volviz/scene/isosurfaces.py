@@ -1,0 +1,50 @@
+"""Any thread: an isosurface component's surfaces ready for actors (libMini note "Isosurfaces"): extracted at the
+display time, cut exactly by the scene's clipping, scaled by the component's opacity, with their LOD chains.
+``volviz.render.iso_actors`` makes the VTK actors from them."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from typing import Any, Optional
+
+from volviz.iso import IsoSettings, build_lod, prepare
+from volviz.iso.clip import clip_isosurfaces
+from volviz.jobs import ProgressCallback
+from volviz.scene.clipping import clip_settings
+from volviz.scene.errors import SceneError
+from volviz.session import Component
+
+
+@dataclass
+class IsoParts:
+    """An isosurface component's surfaces ready for actors (``isosurface_parts``): the extracted ones (uncut by the
+    scene clipping), the shown ones (cut, opacity scaled) and the LOD chains of the shown ones."""
+
+    meshes: list[Any]
+    shown: list[Any]
+    lod: Optional[list[Any]]
+    settings: Any
+    clip: dict[str, Any] = field(default_factory=dict)  # the scene clipping they were cut by (``to_dict``)
+    opacity: float = 1.0                                 # the component opacity they were scaled by
+
+
+def isosurface_parts(comp: Component, dataset: Any = None, t: Optional[float] = None, clip: Any = None,
+                     meshes: Optional[list[Any]] = None, progress: Optional[ProgressCallback] = None) -> IsoParts:
+    """Any thread: the surfaces of an ``isosurface`` component (settings: ``volviz.iso.IsoSettings``) extracted at
+    display time ``t`` (skipped when ``meshes`` are known), cut exactly by the scene's ``clip`` (``session.clip`` or
+    ClipSettings) on top of the component's own clipping, scaled by its opacity, with their LOD chains."""
+    try:
+        settings = IsoSettings.from_dict(comp.settings)
+    except ValueError as exc:
+        raise SceneError(f"component {comp.id!r}: {exc}") from None
+    if not settings.styles:
+        raise SceneError(f"component {comp.id!r}: settings.styles lists no iso-values")
+    if meshes is None:
+        meshes = list(prepare(dataset, settings, t, progress=progress).meshes)
+    scene_clip = clip_settings(clip)
+    shown = clip_isosurfaces(meshes, scene_clip) if scene_clip.all_planes() else list(meshes)
+    if comp.opacity < 1.0:  # the component's opacity scales every surface's
+        shown = [replace(m, style=replace(m.style, opacity=m.style.opacity * comp.opacity)) for m in shown]
+    lod = None  # LOD chains of the shown surfaces (the CPU modes draw them view-dependently)
+    if settings.lod:
+        lod = [(build_lod(m), settings.triangles_per_pixel2) if m.n_triangles else None for m in shown]
+    return IsoParts(list(meshes), shown, lod, settings, scene_clip.to_dict(), float(comp.opacity))

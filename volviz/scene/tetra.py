@@ -1,0 +1,49 @@
+"""Any thread: the tetrahedral meshes the pre-integrated projected tetrahedra draw (Röttger et al. §3: cells split
+into tetrahedra, their adjacency for the visibility sort), cut exactly by the scene's clipping, and the render
+options as the PT renderer's keywords."""
+from __future__ import annotations
+
+from typing import Any
+
+from volviz.iso.clip import clip_tetmesh
+from volviz.model.datasets import TetMesh
+from volviz.unstructured.tetrahedralize import tetrahedralize
+from volviz.unstructured.topology import topology
+
+
+def pt_mesh(dataset: Any) -> Any:
+    """Any thread: the tetrahedral mesh a PT volume draws for ``dataset``, with its topology built (cached on it)."""
+    mesh = dataset
+    if not isinstance(dataset, TetMesh):
+        mesh = tetrahedralize(dataset, getattr(dataset, "active", None))
+    topology(mesh)
+    return mesh
+
+
+def cut_tetmesh(mesh: Any, clip: Any) -> Any:
+    """Any thread: ``mesh`` cut exactly by ``clip`` (``volviz.iso.clip.clip_tetmesh``) with its topology built; None
+    when the clipping removes all of it."""
+    try:
+        cut = clip_tetmesh(mesh, clip)
+    except ValueError:  # everything clipped away
+        return None
+    topology(cut)
+    return cut
+
+
+def pt_options(options: dict[str, Any]) -> dict[str, Any]:
+    """Render settings -> keywords of ``volviz.unstructured.render``: sort ("mpvo", "centroid", "power"), table
+    ("auto" by optical depth, "3d", or "separable-N" with a color polynomial of degree N) and its resolution."""
+    out: dict[str, Any] = {}
+    sort = options.get("sort")
+    if sort in ("mpvo", "centroid", "power"):
+        out["sort"] = sort
+    table = str(options.get("table", "auto"))
+    resolution = options.get("table_resolution")
+    if table == "3d":
+        out["lookup"] = "3d"
+    elif table.startswith("separable-") and table[len("separable-"):] in ("1", "2", "4"):
+        out.update(lookup="separable", degree=int(table[len("separable-"):]))
+    if table != "auto" and isinstance(resolution, int) and 16 <= resolution <= 1024:
+        out["n_s"] = resolution
+    return out
