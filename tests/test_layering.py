@@ -1,8 +1,8 @@
 """The layering of ``pyproject.toml``'s import-linter contracts holds: ``volviz`` never imports Qt (nor the app),
-and each package imports only the layers below it (model at the bottom, then io and jobs, optics, the four method
-packages, the session, render, the benches and the CLI). The names of issue #18 hold too: one spelling of color in
-the library, no two classes of the same name in it and the app, no module named ``scene.py``; ruff and mypy find
-nothing."""
+each package imports only the layers below it (model at the bottom, then io and jobs, optics, the four method
+packages, the session, the scene layer, render, the benches and the CLI), and no module of render or scene is in an
+import circle (issue #31). The names of issue #18 hold too: one spelling of color in the library, no two classes of
+the same name in it and the app, no module named ``scene.py``; ruff and mypy find nothing."""
 from __future__ import annotations
 
 import shutil
@@ -19,6 +19,7 @@ def test_import_contracts_are_kept():
     done = subprocess.run([lint], cwd=ROOT, capture_output=True, text=True, timeout=600)
     assert done.returncode == 0, done.stdout[-4000:] + done.stderr[-2000:]
     assert "volviz never imports Qt KEPT" in done.stdout and "volviz's layers KEPT" in done.stdout
+    assert "no import circle in render and scene KEPT" in done.stdout
 
 
 def test_ruff_finds_nothing():

@@ -1,8 +1,8 @@
 """Issue #18's layering of VTK's rendering classes: nothing below ``volviz.render`` (model, io, jobs, optics, the four
-method packages, the session) builds actors, mappers, renderers or plotters; VTK's data classes, readers and filters
-are fine there. Read from the source (names imported or used), not from import-linter: it sees ``vtkmodules`` as one
-package and cannot tell ``vtkRenderingCore`` from ``vtkIOXML``. The iso-spectrum actor and the transfer function's VTK
-functions live in ``volviz.render`` (``iso_spectrum``, ``vtk_tf``)."""
+method packages, the session, the scene layer) builds actors, mappers, renderers or plotters; VTK's data classes,
+readers and filters are fine there. Read from the source (names imported or used), not from import-linter: it sees
+``vtkmodules`` as one package and cannot tell ``vtkRenderingCore`` from ``vtkIOXML``. The iso-spectrum actor and the
+transfer function's VTK functions live in ``volviz.render`` (``iso_spectrum``, ``vtk_tf``)."""
 from __future__ import annotations
 
 import ast
@@ -10,7 +10,7 @@ import re
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1] / "volviz"
-BELOW_RENDER = ("model", "io", "jobs", "optics", "unstructured", "regular", "nature", "iso", "session.py")
+BELOW_RENDER = ("model", "io", "jobs", "optics", "unstructured", "regular", "nature", "iso", "session.py", "scene")
 RENDERING = re.compile(r"^(vtk\w*(Actor|Mapper|Renderer|RenderWindow|Texture|ShaderProperty|Light)\w*|vtkRendering\w+|"
                        r"Plotter|BackgroundPlotter|add_mesh|add_actor|add_volume)$")
 
