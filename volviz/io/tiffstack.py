@@ -18,12 +18,15 @@ from __future__ import annotations
 
 import contextlib
 import logging
+import mmap
+from pathlib import Path
 from typing import Any, Iterator
 
 import numpy as np
 
-from volviz.io._checks import check_finite, file_size
+from volviz.io._checks import check_finite, file_size, read_bytes
 from volviz.io.errors import PathLike, ReadError, human_bytes
+from volviz.io.tiffcheck import check_tiff
 from volviz.model import RegularVolume, TimeSeries
 from volviz.model.arrays import volume_of
 
@@ -143,6 +146,11 @@ def read_tiff_stack(path: PathLike, allow_nonfinite: bool = True) -> RegularVolu
     its first page holds."""
     import tifffile
 
+    if file_size(path) < 8:
+        check_tiff(Path(path), read_bytes(path))
+    else:
+        with open(path, "rb") as fh, mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ) as data:
+            check_tiff(Path(path), data)  # tifffile trusts the directory: IndexError, ZeroDivisionError, zlib's words
     with _complaints() as complaints:
         result = _read(path, allow_nonfinite, tifffile)
     if complaints.messages:

@@ -94,12 +94,21 @@ def _quantity(ds: Any) -> str:
 def _header(path: Path) -> _Slice | None:
     """The geometry of one file, or None when it is not a DICOM image."""
     import pydicom
-    from pydicom.errors import InvalidDicomError
+    from pydicom.errors import BytesLengthException, InvalidDicomError
 
     try:
         ds = pydicom.dcmread(path, stop_before_pixels=False, specific_tags=list(_HEADER_TAGS), defer_size=256)
     except (InvalidDicomError, OSError, ValueError, EOFError, KeyError, TypeError, AttributeError):
         return None
+    try:
+        return _slice_of(path, ds)
+    except (BytesLengthException, NotImplementedError, ValueError, TypeError, KeyError, IndexError,
+            OverflowError) as exc:  # pydicom converts a deferred value when it is first used
+        raise ReadError(path, f"a DICOM header element is damaged ({type(exc).__name__}: "
+                              f"{str(exc).split('. ')[0][:160]})") from None
+
+
+def _slice_of(path: Path, ds: Any) -> _Slice | None:
     if not any(t in ds for t in ("PixelData", "FloatPixelData", "DoubleFloatPixelData")) or "Rows" not in ds:
         return None
     spacing = _floats(ds.get("PixelSpacing"), 2)
@@ -300,7 +309,15 @@ def _read(p: Path, series: str | None, allow_nonfinite: bool) -> RegularVolume |
     if p.is_file() and not is_dicom(read_bytes(p, 132)) and p.suffix.lower() not in (".dcm", ".dicom", ".ima"):
         raise ReadError(p, "is not a DICOM file (no DICM marker at byte 128)")
     folder, files, chosen = _candidates(p)
-    slices = _unique([s for s in (_header(f) for f in files) if s is not None], chosen)
+    found, damaged = [], []
+    for f in files:
+        try:
+            found.append(_header(f))
+        except ReadError as exc:  # another file of a folder may be damaged; this one's reason if none reads
+            damaged.append(exc)
+    slices = _unique([s for s in found if s is not None], chosen)
+    if not slices and damaged:
+        raise damaged[0]
     if not slices:
         raise ReadError(p, "holds no DICOM image pydicom can read" if p.is_dir()
                         else "is not a DICOM image (no pixel data, or not a DICOM file pydicom can read)")

@@ -9,6 +9,7 @@
 """
 from __future__ import annotations
 
+import zlib
 from pathlib import Path
 from typing import Any
 
@@ -25,8 +26,15 @@ _TO_RAS = {"right-anterior-superior": np.eye(4), "ras": np.eye(4),
            "left-anterior-superior": np.diag([-1.0, 1.0, 1.0, 1.0]), "las": np.diag([-1.0, 1.0, 1.0, 1.0]),
            "left-posterior-superior": LPS_TO_RAS, "lps": LPS_TO_RAS}
 _COMPRESSED = {"gzip": DEFLATE_MAX_RATIO, "gz": DEFLATE_MAX_RATIO, "bzip2": 50_000, "bz2": 50_000}
-_TYPE_SIZES = {"int8": 1, "uint8": 1, "int16": 2, "uint16": 2, "int32": 4, "uint32": 4, "int64": 8, "uint64": 8,
-               "float": 4, "double": 8, "block": 1}
+#: the NRRD type names pynrrd reads (the NRRD format's list), by bytes per sample
+_TYPE_NAMES = {1: "signed char|int8|int8_t|uchar|unsigned char|uint8|uint8_t|block",
+               2: "short|short int|signed short|signed short int|int16|int16_t|ushort|unsigned short|"
+                  "unsigned short int|uint16|uint16_t",
+               4: "int|signed int|int32|int32_t|uint|unsigned int|uint32|uint32_t|float",
+               8: "longlong|long long|long long int|signed long long|signed long long int|int64|int64_t|ulonglong|"
+                  "unsigned long long|unsigned long long int|uint64|uint64_t|double"}
+_TYPE_SIZES = {name: size for size, names in _TYPE_NAMES.items() for name in names.split("|")}
+_ENCODINGS = ("raw", "ascii", "ASCII", "text", "txt", *_COMPRESSED)
 
 
 def _header(p: Path) -> dict[str, Any]:
@@ -52,15 +60,27 @@ def _data_file(p: Path, header: dict[str, Any]) -> Path:
 
 
 def _check_size(p: Path, header: dict[str, Any]) -> None:
+    missing = [f for f in ("dimension", "type", "encoding", "sizes") if f not in header]
+    if missing:
+        raise ReadError(p, f"NRRD header lacks the required field(s) {', '.join(missing)}")
     sizes = [int(n) for n in header.get("sizes", [])]
+    if len(sizes) != int(header["dimension"]):
+        raise ReadError(p, f"NRRD dimension is {header['dimension']} but sizes lists {len(sizes)} axes")
+    if str(header.get("endian", "little")) not in ("little", "big"):
+        raise ReadError(p, f"NRRD endian is {str(header['endian'])[:20]!r}, not little or big")
     if not sizes or any(n < 1 for n in sizes):
         raise ReadError(p, f"NRRD sizes {sizes} must all be positive")
-    item = _TYPE_SIZES.get(str(header.get("type", "")).replace("_t", ""), 8)
+    kind, encoding = str(header.get("type", "")), str(header.get("encoding", "raw"))
+    if kind not in _TYPE_SIZES:
+        raise ReadError(p, f"NRRD type {kind[:40]!r} is not a NRRD sample type (int8 ... uint64, float, double)")
+    if encoding not in _ENCODINGS:
+        raise ReadError(p, f"NRRD encoding {encoding[:40]!r} is not one volviz reads ({', '.join(_ENCODINGS)})")
+    item = _TYPE_SIZES[kind]
     needed = int(np.prod(sizes, dtype=object)) * item
     data = _data_file(p, header)
     size = file_size(data)
-    what = f"NRRD {'x'.join(map(str, sizes))} {header.get('type')} data"
-    encoding = str(header.get("encoding", "raw")).lower()
+    what = f"NRRD {'x'.join(map(str, sizes))} {kind} data"
+    encoding = encoding.lower()
     if encoding in _COMPRESSED:
         if needed > _COMPRESSED[encoding] * size + 64:
             raise ReadError(p, f"{what} ({human_bytes(needed)}) is more than its {size} {encoding} bytes can "
@@ -117,8 +137,16 @@ def read_nrrd(path: PathLike, allow_nonfinite: bool = True) -> RegularVolume | T
     spatial, other, kind = _axes(p, header)
     try:
         data, _ = nrrd.read(str(p), index_order="F")
-    except (nrrd.NRRDError, ValueError, OSError, EOFError, TypeError) as exc:
-        raise ReadError(p, f"its data could not be read ({exc})") from None
+    except zlib.error as exc:
+        raise ReadError(p, f"its {header['encoding']} data is damaged (zlib: {exc})") from None
+    except nrrd.NRRDError as exc:  # pynrrd's own words are NRRD's
+        raise ReadError(p, f"its {header['encoding']} data does not fit its header ({str(exc)[:200]})") from None
+    except ValueError as exc:
+        raise ReadError(p, f"its {header['encoding']} data ends within a sample: the data is truncated "
+                           f"({str(exc)[:120]})") from None
+    except (OSError, EOFError, TypeError, KeyError, IndexError) as exc:
+        raise ReadError(p, f"its {header['encoding']} data could not be read ({type(exc).__name__}: "
+                           f"{str(exc)[:200]})") from None
     order = spatial + ([other] if other is not None else [])
     data = np.transpose(data, order)
     while data.ndim < (4 if other is not None else 3):  # a 2D image: one slice
