@@ -75,3 +75,21 @@ def test_kahn_resumes_after_a_stall_with_the_fallback():
     n, cycles = mpvo.kahn(nb, front, indeg, src[by], dst[by], order, n, np.array([2, 0, 1], np.int32))
     assert (n, cycles) == (3, 1)
     assert order.tolist() == [2, 1, 0]         # 2 forced; then 1 (freed by 2), then 0 (freed by 1)
+
+
+def test_relations_run_in_line_when_no_thread_can_start(monkeypatch):
+    """A background sort during interpreter shutdown: the sort's worker thread cannot take the boundary relations
+    (its executor refuses new work), so the calling thread computes them; the order is the same."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    from volviz.unstructured import sort
+
+    m = syn.cavity_box(7)
+    cam = Camera.orbit(m.points, 30, 20, 2.5)
+    ref = visibility_order(m, cam, (96, 80))
+    monkeypatch.setattr(mpvo, "PARALLEL_CELLS", 0)
+    closed = ThreadPoolExecutor(1)
+    closed.shutdown()
+    monkeypatch.setattr(sort, "_SECOND_CORE", closed)
+    res = visibility_order(m, cam, (96, 80))
+    assert np.array_equal(res.order, ref.order) and res.boundary_relations == ref.boundary_relations > 0

@@ -24,7 +24,8 @@ from __future__ import annotations
 
 import threading
 import time
-from concurrent.futures import ThreadPoolExecutor
+from collections.abc import Callable
+from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass, field
 from functools import partial
 
@@ -252,13 +253,17 @@ _SECOND_CORE: ThreadPoolExecutor | None = None
 _SECOND_CORE_LOCK = threading.Lock()
 
 
-def _second_core() -> ThreadPoolExecutor:
-    """One worker thread for the boundary relations of a large mesh, made when first needed."""
+def _beside(fn: Callable[[], tuple[np.ndarray, np.ndarray]]) -> Future[tuple[np.ndarray, np.ndarray]] | None:
+    """``fn`` started on the sort's worker thread (made when first needed), or None where no thread can start any
+    more (the interpreter shutting down while a background job sorts): the caller then runs it itself."""
     global _SECOND_CORE
     with _SECOND_CORE_LOCK:
         if _SECOND_CORE is None:
             _SECOND_CORE = ThreadPoolExecutor(1, thread_name_prefix="volviz-sort")
-        return _SECOND_CORE
+        try:
+            return _SECOND_CORE.submit(fn)
+        except RuntimeError:
+            return None
 
 
 def _view(cam: Camera, topo: Topology) -> tuple[np.ndarray, np.ndarray]:
@@ -297,9 +302,9 @@ def visibility_order(mesh: TetMesh | Topology, camera: Camera, size: tuple[int, 
         relations = partial(boundary_relations, topo, camera, size)
     elif nonconvex == "object" or (nonconvex == "auto" and not is_convex(topo)):
         relations = partial(object_relations, topo, camera, size)
-    beside = relations is not None and m >= mpvo.PARALLEL_CELLS
-    if beside:              # both stages release the GIL: the relations on a second core while this one does the sides
-        pending = _second_core().submit(relations)     # type: ignore[arg-type]
+    pending = _beside(relations) if relations is not None and m >= mpvo.PARALLEL_CELLS else None
+    beside = pending is not None
+    if pending is not None:  # both stages release the GIL: the relations on a second core while this one does the sides
         front, indeg = face_sides(topo.neighbor, topo.back_face, topo.face_n, topo.face_d, eye, fwd,
                                   camera.parallel, cores=False)
         t2 = time.perf_counter()
