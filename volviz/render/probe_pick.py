@@ -1,5 +1,8 @@
-"""The probe in a viewport: the ray through a pixel, and what is under it (``volviz.model.probe``): the first
-visible sample of a regular volume, else the cell of a mesh VTK's cell picker hits, with its nearest point's value."""
+"""The probe in a viewport: the ray through a pixel, and what is under it: the nearest of the first visible samples
+of the shown volumes (a regular volume or a time series' frame at the display time: ``volviz.model.probe``; a
+compressed multiresolution volume at full resolution: ``volviz.regular.probe_lod``; the tetrahedral mesh a
+projected-tetrahedra view draws, interpolated in its cell: ``volviz.unstructured.probe``) and the cell of a surface
+VTK's cell picker hits, with its nearest point's value."""
 from __future__ import annotations
 
 from typing import Any, Optional
@@ -23,26 +26,74 @@ def pick_ray(renderer: Any, x: float, y: float) -> tuple[np.ndarray, np.ndarray]
 
 
 def probe_scene(controller: Any, x: float, y: float) -> Optional[ProbeResult]:
-    """What is under display pixel (x, y) of ``controller``'s viewport: the nearest hit among the visible regular
-    volumes (drawn transfer function, ``probe_regular``) and the meshes VTK can pick."""
-    from volviz.model import RegularVolume
-    from volviz.scene.drawn_tf import drawn_tf
-
+    """What is under display pixel (x, y) of ``controller``'s viewport: the nearest hit among the visible volumes
+    (``probe_volume``, each with its drawn transfer function) and the meshes VTK can pick."""
     origin, direction = pick_ray(controller.plotter.renderer, x, y)
     hits: list[tuple[float, ProbeResult]] = []
     for comp in controller.session.components:
         if not comp.visible or comp.type != "volume" or comp.dataset not in controller.datasets:
             continue
-        dataset = controller.dataset_of(comp.id)
-        if isinstance(dataset, RegularVolume):
-            tf = drawn_tf(comp, controller.transfer_function(comp.id), dataset)
-            hit = probe_regular(dataset, origin, direction, tf, comp.id, comp.opacity)
-            if hit is not None:
-                hits.append((float(np.dot(np.asarray(hit.position) - origin, direction)), hit))
+        hit = probe_volume(controller, comp, origin, direction)
+        if hit is not None:
+            hits.append((float(np.dot(np.asarray(hit.position) - origin, direction)), hit))
     picked = _pick_cell(controller.plotter.renderer, x, y)
     if picked is not None:
         hits.append((float(np.dot(np.asarray(picked.position) - origin, direction)), picked))
     return min(hits, key=lambda h: h[0])[1] if hits else None
+
+
+def probe_volume(controller: Any, comp: Any, origin: np.ndarray, direction: np.ndarray) -> Optional[ProbeResult]:
+    """The first visible sample of volume component ``comp`` along the ray, by what its view draws: the mesh of a
+    projected-tetrahedra view, a LOD tree, a regular volume, or the frame of a time series at the controller's
+    display time (a regular volume, or a mesh through its tetrahedra), each in the part the scene's clipping keeps;
+    None for what none of these draws."""
+    from volviz.model import RegularVolume, TimeSeries
+    from volviz.model.timeseries import frame_at
+    from volviz.regular.lod import LodTree
+    from volviz.scene.drawn_tf import drawn_tf
+    from volviz.render.pt_view import is_pt_view
+
+    dataset = controller.dataset_of(comp.id)
+    tf = drawn_tf(comp, controller.transfer_function(comp.id), dataset)
+    view = getattr(controller.views.get(comp.id), "prop", None)
+    if is_pt_view(view):
+        if not view.visible:
+            return None
+        from volviz.unstructured.probe import probe_tetmesh
+
+        return probe_tetmesh(view.mesh, origin, direction, tf, comp.id, comp.opacity, controller.clip)
+    if isinstance(dataset, LodTree):
+        from volviz.regular.probe_lod import probe_lod
+
+        return probe_lod(dataset, origin, direction, tf, comp.id, comp.opacity, controller.clip)
+    if isinstance(dataset, TimeSeries):
+        dataset = frame_at(dataset, controller.time, controller.interpolate_time)
+    if isinstance(dataset, RegularVolume):
+        return probe_regular(dataset, origin, direction, tf, comp.id, comp.opacity, controller.clip)
+    mesh = _volume_tets(dataset)
+    if mesh is not None:        # a mesh VTK's volume mapper draws (a time series, the "vtk" render method)
+        from volviz.unstructured.probe import probe_tetmesh
+
+        return probe_tetmesh(mesh, origin, direction, tf, comp.id, comp.opacity, controller.clip)
+    return None
+
+
+def _volume_tets(dataset: Any) -> Optional[Any]:
+    """The tetrahedral mesh of a volumetric mesh dataset (made once and kept on it), None for anything else (a
+    surface: VTK's cell picker answers for it)."""
+    from volviz.model import CurvilinearGrid, TetMesh, UnstructuredMesh
+    from volviz.model.representation import representation
+
+    if not isinstance(dataset, (TetMesh, UnstructuredMesh, CurvilinearGrid)) or \
+            representation(dataset).kind != "volume":
+        return None
+    if isinstance(dataset, TetMesh):
+        return dataset
+    if "volviz_probe_tets" not in dataset.__dict__:
+        from volviz.unstructured.tetrahedralize import tetrahedralize
+
+        dataset.__dict__["volviz_probe_tets"] = tetrahedralize(dataset, dataset.active)
+    return dataset.__dict__["volviz_probe_tets"]
 
 
 def _pick_cell(renderer: Any, x: float, y: float) -> Optional[ProbeResult]:
