@@ -4,8 +4,9 @@ The planes are a ``slices`` component of the session (``volviz.render.slices``) 
 first regular volume, sharing that volume's transfer function, so they are saved with the session and
 ``volviz render`` draws them. Turning the first plane on adds the component (a document edit, rebuilt in the
 background: ``volviz_app.scene_doc``); moving or toggling a plane afterwards moves the planes of the shown view at
-once (``SlicesView.set_indices``, no rebuild). Every edit is on the scene's undo stack; consecutive moves of one
-plane are one step. A new transfer function recolours the planes and the 2D views.
+once (``SlicesView.set_indices``, no rebuild); a plane is also dragged in the 3D view (``volviz_app.slice_drag``,
+through the dock's spin box). Every edit is on the scene's undo stack; consecutive moves of one plane are one
+step. A new transfer function recolours the planes and the 2D views.
 """
 from __future__ import annotations
 
@@ -15,18 +16,19 @@ from PySide6.QtGui import QUndoCommand
 
 from .docks.slices import AXES, SlicesDock
 from .scene_doc import edit_document, free_id
+from .shown_edit import ShownEdit
+from .slice_drag import SliceDrag
 
 SLICES_ID = "slices"
 _MOVE_ID = 2801     # QUndoCommand.id of plane moves (merged)
 
 
-class MoveSlices(QUndoCommand):
+class MoveSlices(ShownEdit):
     """The slices component's planes from ``before`` to ``after`` (settings dicts), shown in place."""
 
     def __init__(self, tool: "SliceTool", before: dict[str, Any], after: dict[str, Any], axis: str) -> None:
-        super().__init__(f"Move the {axis} slice")
-        self.tool, self.before, self.after, self.axis = tool, dict(before), dict(after), axis
-        self.applied = True
+        super().__init__(f"Move the {axis} slice", before, after, tool.show_settings)
+        self.axis = axis
 
     def id(self) -> int:
         return _MOVE_ID
@@ -37,15 +39,6 @@ class MoveSlices(QUndoCommand):
         self.after = dict(other.after)
         return True
 
-    def redo(self) -> None:
-        if self.applied:
-            self.applied = False
-            return
-        self.tool.show_settings(self.after)
-
-    def undo(self) -> None:
-        self.tool.show_settings(self.before)
-
 
 class SliceTool:
     """Connects the Slices dock to the window (module docstring)."""
@@ -55,6 +48,7 @@ class SliceTool:
         self.dock = SlicesDock()
         self.dock.changed.connect(self._changed)
         self._unsubscribe: Optional[Callable[[], None]] = None
+        self.drag = SliceDrag(self)
 
     # -- what is sliced -----------------------------------------------------------------------------------------------
     def volume_id(self) -> Optional[str]:

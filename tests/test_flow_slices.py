@@ -68,3 +68,46 @@ def test_a_z_slice_moved_by_its_slider_shows_the_tf_colours_of_its_samples(qtbot
 
     window.action_undo.trigger()                 # the moves are one undo step: back to z = 0
     assert comp.settings == {"z": 0} and dock.spins["z"].value() == 0
+
+
+def test_a_z_slice_dragged_in_the_3d_view_moves_its_slider_and_2d_view(qtbot, make_window) -> None:
+    """neghip, Z checked (the plane at z = 0): a real press on the plane in the 3D view, moves and release up to
+    where the plane z = K projects; the dock's slider and spin box read K, the 2D view's pixels are the TF colours
+    of the samples at z = K exactly, the camera did not orbit, and one undo puts the plane back at 0."""
+    from PySide6.QtCore import QPoint
+
+    from flows import drag
+
+    window = make_window()
+    open_and_show_dock(qtbot, window, data_file("volumes/neghip.slc"), window.slices_dock)
+    dock = window.slice_tool.dock
+    qtbot.mouseClick(dock.checks["z"], Qt.MouseButton.LeftButton)
+    qtbot.waitUntil(lambda: any(c.type == "slices" for c in window.controller.session.components), timeout=30000)
+    wait_loaded(qtbot, window)
+    wait_settled(qtbot, window)
+    volume = window.controller.dataset_of("data")
+    canvas = window.plotter.interactor
+    renderer = window.plotter.renderer
+    ratio = canvas.devicePixelRatioF()
+    height = window.plotter.ren_win.GetSize()[1]
+
+    def on_screen(i: float, j: float, k: float) -> QPoint:
+        renderer.SetWorldPoint(*(np.asarray(volume.origin) + np.array([i, j, k]) * np.asarray(volume.spacing)), 1.0)
+        renderer.WorldToDisplay()
+        x, y, _ = renderer.GetDisplayPoint()
+        return QPoint(round(x / ratio), round((height - 1 - y) / ratio))
+
+    middle = (volume.dimensions[0] - 1) / 2, (volume.dimensions[1] - 1) / 2
+    camera = window.controller.camera()
+    drag(qtbot, canvas, on_screen(*middle, 0), on_screen(*middle, K), steps=12)
+    assert dock.sliders["z"].value() == K and dock.spins["z"].value() == K
+    comp = next(c for c in window.controller.session.components if c.type == "slices")
+    assert comp.settings == {"z": K}
+    assert window.controller.views[comp.id].indices == {"z": K}     # the 3D plane moved
+    after = window.controller.camera()
+    assert np.allclose(after.position, camera.position) and np.allclose(after.focal_point, camera.focal_point)
+    wait_settled(qtbot, window)
+    expected = _expected_z_slice(volume, window.controller.transfer_function("data"), K)
+    assert np.array_equal(_shown_pixels(dock.views["z"]), expected)
+    window.action_undo.trigger()
+    assert comp.settings == {"z": 0} and dock.sliders["z"].value() == 0

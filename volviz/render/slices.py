@@ -18,8 +18,8 @@ from volviz.render.component_views import VtkPropView
 from volviz.render.framing import Bounds, prop_bounds
 from volviz.scene.errors import SceneError
 
-__all__ = ["AXES", "SlicesView", "slice_colors", "slice_image", "slice_indices", "slice_values", "SliceError",
-           "value_color"]
+__all__ = ["AXES", "SlicesView", "drag_index", "slice_colors", "slice_image", "slice_indices", "slice_values",
+           "SliceError", "value_color"]
 
 AXES = ("x", "y", "z")
 
@@ -71,6 +71,23 @@ def slice_indices(settings: dict[str, Any]) -> dict[str, int]:
     return {axis: int(settings[axis]) for axis in AXES if settings.get(axis) is not None}
 
 
+def drag_index(dataset: Any, axis: str, anchor: Any, origin: Any, direction: Any) -> int:
+    """The index of plane ``axis`` a drag has moved to: the grid index nearest the point of the line through
+    ``anchor`` (where the plane was grabbed) along the axis that is closest to the mouse ray (``origin``,
+    ``direction``), clamped to the grid; a ray along the axis leaves the plane where it was grabbed."""
+    volume = _volume(dataset, axis, 0)
+    a = AXES.index(axis)
+    p = np.asarray(anchor, dtype=np.float64)
+    o = np.asarray(origin, dtype=np.float64)
+    d = np.asarray(direction, dtype=np.float64)
+    d = d / np.linalg.norm(d)
+    w = p - o
+    denom = 1.0 - d[a] ** 2                  # the axis is the unit vector e_a: |e_a x d|^2
+    s = 0.0 if denom < 1e-12 else (d[a] * float(d @ w) - w[a]) / denom
+    index = int(np.rint((p[a] + s - volume.origin[a]) / volume.spacing[a]))
+    return int(np.clip(index, 0, volume.dimensions[a] - 1))
+
+
 def _plane_grid(volume: RegularVolume, axis: str, index: int, tf: Any) -> Any:
     """A one-sample-thick ImageData at plane ``axis = index`` with the slice's colours as point data."""
     import pyvista as pv
@@ -87,8 +104,9 @@ def _plane_grid(volume: RegularVolume, axis: str, index: int, tf: Any) -> Any:
 
 
 class SlicesView(VtkPropView):
-    """The planes of a slices component as flat-coloured VTK actors in one prop assembly. ``set_tf`` recolours
-    them; ``set_indices`` moves them (no rebuild of the scene). The scene's clipping does not cut them."""
+    """The planes of a slices component as flat-coloured VTK actors in one prop assembly (``actors``: by axis).
+    ``set_tf`` recolours them; ``set_indices`` moves them (no rebuild of the scene); ``plane_at`` says which plane
+    is under a pixel (the app drags it). The scene's clipping does not cut them."""
 
     kind = "slices"
 
@@ -96,6 +114,7 @@ class SlicesView(VtkPropView):
         super().__init__(None)
         self.plotter, self.comp_id, self.dataset, self.tf = plotter, comp.id, dataset, tf
         self.indices = slice_indices(comp.settings)
+        self.actors: dict[str, Any] = {}
         try:
             for axis, index in self.indices.items():
                 _volume(dataset, axis, index)                      # a bad index fails here, before any actor
@@ -111,6 +130,7 @@ class SlicesView(VtkPropView):
             visible = bool(self.prop.GetVisibility())
             self.plotter.remove_actor(self.prop, render=False)
         assembly = vtk.vtkPropAssembly()
+        self.actors = {}
         for axis, index in self.indices.items():
             mapper = vtk.vtkDataSetMapper()
             mapper.SetInputData(_plane_grid(self.dataset, axis, index, self.tf))
@@ -122,6 +142,7 @@ class SlicesView(VtkPropView):
             actor.SetMapper(mapper)
             actor.GetProperty().LightingOff()
             assembly.AddPart(actor)
+            self.actors[axis] = actor
         assembly.SetVisibility(visible)
         self.prop = assembly
         self.plotter.add_actor(assembly, name=self.comp_id, reset_camera=False)
@@ -132,6 +153,24 @@ class SlicesView(VtkPropView):
             _volume(self.dataset, axis, index)
         self.indices = dict(indices)
         self._show()
+
+    def plane_at(self, renderer: Any, x: float, y: float) -> Optional[tuple[str, np.ndarray]]:
+        """The plane under display pixel (x, y) of ``renderer`` (VTK's coordinates, y up) and the world point hit
+        on it; None when no plane is there or the planes are hidden."""
+        from volviz.render.vtk_facade import vtk
+
+        if self.prop is None or not self.prop.GetVisibility() or not self.actors:
+            return None
+        picker = vtk.vtkCellPicker()
+        picker.SetTolerance(0.0005)
+        picker.PickFromListOn()
+        for actor in self.actors.values():
+            picker.AddPickList(actor)
+        if not picker.Pick(float(x), float(y), 0.0, renderer):
+            return None
+        actor = picker.GetActor()
+        axis = next((a for a, part in self.actors.items() if part is actor), None)
+        return None if axis is None else (axis, np.asarray(picker.GetPickPosition(), dtype=np.float64))
 
     def set_tf(self, tf: Any, opacity: float = 1.0) -> None:
         """Recolour the planes with ``tf``'s colours (the opacity does not apply: a slice is opaque)."""
