@@ -36,6 +36,7 @@ from .drop import FileDrop
 from .export_dialogs import ExportDialogs
 from .help import HelpMenu
 from .iso_tool import IsoTool
+from .log_scale_status import LogScaleStatus
 from .slice_tool import SliceTool
 from .layout import WindowLayout, scrolled
 from .probe import ProbeTool
@@ -138,6 +139,7 @@ class WindowWidgets(WindowBase):
         view_menu.addSeparator()
         self.decorations = DecorationToggles(self, view_menu)
         self.scalar_bar_editor = ScalarBarEditor(self, view_menu)
+        self.log_scale_status = LogScaleStatus(self)
         self.python_console = PythonConsole(self, view_menu)
         view_menu.addSeparator()
         self.action_fly = self._action(view_menu, "&Fly Mode", "F", self.set_fly_mode)

@@ -6,7 +6,8 @@ from __future__ import annotations
 import re
 
 import numpy as np
-from PySide6.QtCore import QPoint, Qt
+import pytest
+from PySide6.QtCore import QPoint, QPointF, Qt
 
 from conftest import data_file
 from flows import click, compare_with_render, hover, wait_loaded, wait_settled
@@ -18,6 +19,16 @@ def _open_neghip(qtbot, make_window):
     wait_loaded(qtbot, window)
     wait_settled(qtbot, window)
     return window
+
+
+def _tick_log_scale(qtbot, window) -> None:
+    """Click the selected component's Log color scale box in the scene dock's form, as the user does."""
+    qtbot.waitUntil(lambda: window.scene_tree.form is not None and "log_scale" in window.scene_tree.form.rows)
+    box = window.scene_tree.form.editor("log_scale")
+    window.scene_dock.raise_()
+    qtbot.waitUntil(box.isVisible)
+    qtbot.mouseClick(box, Qt.MouseButton.LeftButton, pos=QPoint(8, box.height() // 2))   # on the box itself
+
 
 
 def test_probe_shows_and_pins_the_value_under_the_cursor(qtbot, make_window) -> None:
@@ -64,12 +75,8 @@ def test_log_color_scale_is_drawn_saved_and_rendered_the_same(qtbot, make_window
     assert linear["rmse"] < 1.5, linear
     from flows import screen
     before = screen(window)
-    qtbot.waitUntil(lambda: window.scene_tree.form is not None and "log_scale" in window.scene_tree.form.rows)
-    box = window.scene_tree.form.editor("log_scale")
-    window.scene_dock.raise_()
-    qtbot.waitUntil(box.isVisible)
-    qtbot.mouseClick(box, Qt.MouseButton.LeftButton, pos=QPoint(8, box.height() // 2))   # on the box itself
-    assert box.isChecked()
+    _tick_log_scale(qtbot, window)
+    assert window.scene_tree.form.editor("log_scale").isChecked()
     qtbot.waitUntil(lambda: window.controller.component("data").settings.get("log_scale") is True, timeout=20000)
     wait_settled(qtbot, window)
     from volviz.render.decorations import scalar_bar_actor, scalar_bar_title
@@ -136,3 +143,45 @@ def test_scalar_bar_edited_by_double_click_is_saved_and_rendered(qtbot, make_win
     window.action_redo.trigger()
     assert scalar_bar_title(window.plotter) == "Density"
     assert tuple(scalar_bar_actor(window.plotter).GetLookupTable().GetRange()) == (0.0, 100.0)
+
+
+def test_log_color_scale_puts_the_tf_editor_axis_in_log_and_says_what_it_clamps(qtbot, make_window) -> None:
+    """neghip, Log color scale ticked: the TF editor's axis runs in log10 from 1 (its color bar, as painted, shows
+    the colors the volume is drawn with at 2, 10, 50 and 200), the status bar says how many voxels are 0 (the scale
+    draws them in the color of 1); unticked, the axis is linear again."""
+    from flows import widget_pixels
+    from volviz.scene.drawn_tf import drawn_tf
+
+    from volviz_app.docks.tf_editor import COLOR_BAR_HEIGHT, MARGIN
+
+    window = _open_neghip(qtbot, make_window)
+    canvas = window.tf_editor.canvas
+    assert canvas.log_floor is None
+    _tick_log_scale(qtbot, window)
+    qtbot.waitUntil(lambda: canvas.log_floor == 1.0, timeout=20000)
+    wait_settled(qtbot, window)
+    volume = window.datasets["data"]
+    zeros = int(np.count_nonzero(volume.data <= 0))
+    assert zeros > 0
+    assert window.statusBar().currentMessage() == (f"{zeros:,} values ≤ 0 are drawn in the color of 1, the smallest "
+                                                   "positive value (log color scale of data)")
+    comp = window.controller.component("data")
+    tf = window.controller.transfer_function("data")
+    drawn = drawn_tf(comp, tf, window.controller.dataset_of("data"))
+    pixels = widget_pixels(canvas).astype(int)
+    row = int(canvas._plot_rect().bottom() + MARGIN + COLOR_BAR_HEIGHT / 2)
+    values = np.array([2.0, 10.0, 50.0, 200.0])
+    xs = np.rint(canvas.x_of(values)).astype(int)
+    assert np.all(np.diff(xs) > 20)                      # a log axis: 2, 10, 50 and 200 spread across the width
+    at_pixels = np.array([canvas.from_screen(QPointF(x + 0.5, row))[0] for x in xs])   # the values there
+    rgb, _ = drawn.evaluate(at_pixels)
+    expected = np.rint(np.clip(rgb, 0, 1) * 255).astype(int)
+    shown = pixels[row, xs]
+    assert np.abs(shown - expected).max() <= 2, (shown, expected)      # Qt's gradient: 8-bit steps
+    linear, _ = tf.evaluate(values)                      # what a linear axis would show there: other colors
+    assert np.abs(np.rint(np.clip(linear, 0, 1) * 255).astype(int) - shown).max() > 20
+
+    _tick_log_scale(qtbot, window)                       # off again
+    qtbot.waitUntil(lambda: canvas.log_floor is None, timeout=20000)
+    lo, hi = canvas._view_range()
+    assert canvas.x_of(lo + 0.5 * (hi - lo)) == pytest.approx(canvas._plot_rect().center().x())
