@@ -99,6 +99,7 @@ class NetcdfVariable:
     nc_type: int
     begin: int
     record: bool
+    units: str = ""
 
 
 @dataclass
@@ -110,6 +111,7 @@ class NetcdfHeader:
     notes: list[str] = field(default_factory=list)
     dims: dict[str, int] = field(default_factory=dict)
     variables: dict[str, NetcdfVariable] = field(default_factory=dict)
+    record_size: int = 0
 
 
 def _netcdf_end(data: bytes) -> int:
@@ -168,7 +170,8 @@ def _netcdf_layout(data: bytes) -> NetcdfHeader:
         cf_vars.append((name, [dim_names[i] for i in ids], texts))
         variables.append((name, begin, exact, exact + (-exact % 4), record))
         table[name] = NetcdfVariable(name, tuple(dim_names[i] for i in ids),
-                                     tuple(numrecs if dims[i] == 0 else dims[i] for i in ids), nc_type, begin, record)
+                                     tuple(numrecs if dims[i] == 0 else dims[i] for i in ids), nc_type, begin, record,
+                                     texts.get("units", ""))
     header_end = c.pos
     names = {v[0] for v in variables}
     for name, key, ref in references:
@@ -184,10 +187,46 @@ def _netcdf_layout(data: bytes) -> NetcdfHeader:
         if b0 + e0 > b1:
             raise ValueError(f"variables {n0!r} and {n1!r} overlap")
     end = max([header_end, *(b + e for b, e, _ in fixed)])
+    record_size = records[0][1] if len(records) == 1 else sum(p for _, _, p in records)
     if records and numrecs not in (0, 0xFFFFFFFF, -1):
-        record_size = records[0][1] if len(records) == 1 else sum(p for _, _, p in records)
         end = max(end, max(b + e for b, e, _ in records) + (numrecs - 1) * record_size)
-    return NetcdfHeader(end, _cf_notes(cf_vars), dict(zip(dim_names, dims)), table)
+    return NetcdfHeader(end, _cf_notes(cf_vars), dict(zip(dim_names, dims)), table, record_size)
+
+
+#: netCDF numeric type codes -> struct format (big-endian): byte, short, int, float, double, and CDF-5's
+_NC_FORMATS = {1: "b", 3: "h", 4: "i", 5: "f", 6: "d", 7: "B", 8: "H", 9: "I", 10: "q", 11: "Q"}
+_TIME_LIMIT = 1_000_000  # time coordinates longer than this are not checked value by value
+
+
+def check_time_coordinates(path: Path, header: NetcdfHeader) -> None:
+    """A CF time coordinate (CF §4.4: a coordinate variable, one dimension of its own name, whose ``units`` are
+    "<unit> since <date>") holds finite values (else ReadError naming the variable, the index and the value) that
+    increase (else a ReadWarning: VTK's reader keeps one step of equal or decreasing times and drops the others,
+    so a damaged value would silently shorten the series)."""
+    import math
+
+    for var in header.variables.values():
+        if var.dims != (var.name,) or " since " not in var.units or var.nc_type not in _NC_FORMATS \
+                or not 1 < var.shape[0] <= _TIME_LIMIT:
+            continue
+        fmt, size = ">" + _NC_FORMATS[var.nc_type], _NC_TYPE_SIZE[var.nc_type]
+        step = header.record_size if var.record else size
+        with open(path, "rb") as fh:
+            values = []
+            for k in range(var.shape[0]):
+                fh.seek(var.begin + k * step)
+                values.append(struct.unpack(fmt, fh.read(size))[0])
+        for k, v in enumerate(values):
+            if not math.isfinite(v):
+                raise ReadError(path, f"netCDF: time coordinate {var.name!r} holds {v} at index {k} (of "
+                                      f"{len(values)}): the file is damaged")
+        for k in range(len(values) - 1):
+            if not values[k] < values[k + 1]:
+                warnings.warn(ReadWarning(
+                    f"{path}: time coordinate {var.name!r} does not increase: {values[k]:g} at index {k}, "
+                    f"{values[k + 1]:g} at index {k + 1} (of {len(values)}); the reader keeps one step of equal or "
+                    "decreasing times, so the series shown may be shorter than the file's"), stacklevel=3)
+                break
 
 
 def _cf_notes(variables: list[tuple[str, list[str], dict[str, str]]]) -> list[str]:
@@ -262,6 +301,8 @@ def check_container(path: PathLike, what: str, netcdf: bool = True, hdf5: bool =
         header = netcdf_header(p, what, head)
         for note in header.notes if cf and header is not None else []:
             warnings.warn(ReadWarning(f"{p}: {note}"), stacklevel=2)
+        if cf and header is not None:
+            check_time_coordinates(p, header)
         return p
     if hdf5 and head.startswith(HDF5_SIGNATURE):
         end, size = _hdf5_end(p, head), p.stat().st_size
