@@ -108,3 +108,15 @@ def test_a_dicom_element_of_an_unknown_value_representation(tmp_path):
     text = _refusal(path, data.replace(tag, b"\x08\x00\x3e\x10LN"))
     assert text.startswith(": a DICOM header element is damaged (NotImplementedError: Unknown Value Representation "
                            "'LN' in tag (0008,103E)")
+
+
+def test_a_cube_axis_of_a_damaged_length_is_refused_in_placement_terms(tmp_path):
+    from test_io_imaging import _cube_file
+
+    path = _cube_file(tmp_path / "c.cube", np.arange(60.0).reshape(3, 4, 5), (0, 0, 0), np.eye(3) * 0.5)
+    lines = path.read_text().splitlines()
+    assert lines[4].split()[1:] == ["0.000000", "0.500000", "0.000000"]  # the second axis' step
+    lines[4] = "    4     0.000000     0.500000     9223372036854775807"  # along z too: OrientationError escaped
+    path.write_text("\n".join(lines) + "\n")
+    assert _refusal(path) == (": the voxel-to-world transform has no nearest world axes (voxel sizes 0.265, "
+                              "4.88e+18, 0.265): a voxel size or direction is damaged")

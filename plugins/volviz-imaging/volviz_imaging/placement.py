@@ -48,7 +48,7 @@ def aligned_volume(path: PathLike, data: np.ndarray, affine: np.ndarray, name: s
     """``data`` (nx, ny, nz) or (nx, ny, nz, c) with its voxel-to-RAS ``affine`` as an axis-aligned volume named
     ``name`` (its components one array, by magnitude or component in the array selector). ``warn``: whether an
     oblique scan is reported (once per file: the later steps of a time series pass False)."""
-    from nibabel.orientations import apply_orientation, inv_ornt_aff, io_orientation
+    from nibabel.orientations import OrientationError, apply_orientation, inv_ornt_aff, io_orientation
 
     affine = np.asarray(affine, dtype=np.float64)
     if affine.shape != (4, 4) or not np.all(np.isfinite(affine)):
@@ -57,7 +57,14 @@ def aligned_volume(path: PathLike, data: np.ndarray, affine: np.ndarray, name: s
         raise ReadError(path, "the voxel-to-world transform is singular (a voxel size or direction is zero)")
     if data.ndim not in (3, 4) or min(data.shape[:3]) < 1:
         raise ReadError(path, f"{data.ndim}-dimensional voxel data of shape {data.shape} is not a volume")
-    ornt = io_orientation(affine)
+    try:
+        ornt = io_orientation(affine)
+        if np.isnan(ornt).any():  # an axis nibabel could not assign
+            raise OrientationError("an axis has no world axis")
+    except OrientationError:  # columns of wildly different lengths: no axis assignment is unambiguous
+        sizes = ", ".join(f"{v:.3g}" for v in np.linalg.norm(affine[:3, :3], axis=0))
+        raise ReadError(path, f"the voxel-to-world transform has no nearest world axes (voxel sizes {sizes}): "
+                              "a voxel size or direction is damaged") from None
     placed = affine @ inv_ornt_aff(ornt, data.shape[:3])  # the shape before the axes move
     data = apply_orientation(data, ornt)
     angle = oblique_degrees(placed)
