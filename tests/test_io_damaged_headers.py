@@ -76,8 +76,8 @@ def test_a_damaged_tiff_shape_description_is_not_echoed(tmp_path):
 
 
 def test_a_file_that_is_no_image_at_all(tmp_path):
-    assert _refusal(tmp_path / "x.png", b"\x01\x02 not an image") == (": its first bytes are not those of a PNG, "
-                                                                       "JPEG, TIFF or BMP image")
+    assert _refusal(tmp_path / "x.png", b"\x01\x02 not an image") == (": not a readable image: its first bytes are "
+                                                                       "not those of a PNG, JPEG, TIFF or BMP image")
 
 
 def test_nrrd_fields_and_gzip_data(tmp_path):

@@ -56,11 +56,14 @@ def read_image(path: PathLike) -> Image2D | RegularVolume | TimeSeries:
         except ReadError:
             raise
         except UnidentifiedImageError:
-            raise ReadError(path, "its first bytes are not those of a PNG, JPEG, TIFF or BMP image") from None
+            raise ReadError(path, "not a readable image: its first bytes are not those of a PNG, JPEG, TIFF or BMP "
+                                  "image") from None
         except OSError as exc:
-            if "truncated" in str(exc):
-                raise ReadError(path, "its pixel data ends before the image does: the file is truncated") from None
-            raise ReadError(path, f"its pixel data cannot be decoded ({str(exc)[:200]})") from None
+            if "truncated" in str(exc).lower():
+                raise ReadError(path, "not a readable image: its pixel data ends before the image does (the file is "
+                                      "truncated)") from None
+            raise ReadError(path, f"not a readable image: its pixel data cannot be decoded ({str(exc)[:200]})") \
+                from None
         except (ValueError, SyntaxError, Image.DecompressionBombError) as exc:
             raise ReadError(path, f"not a readable image ({type(exc).__name__}: {str(exc)[:200]})") from None
     maxval = 65535 if data.dtype == np.uint16 else 255
