@@ -41,7 +41,7 @@ class _Cursor:
 
     def take(self, n: int) -> bytes:
         if self.pos + n > len(self.data):
-            raise EOFError
+            raise EOFError(f"{n} bytes at byte {self.pos}")  # what was asked: a damaged count asks for too much
         out = self.data[self.pos:self.pos + n]
         self.pos += n
         return out
@@ -276,11 +276,12 @@ def netcdf_header(path: PathLike, what: str, head: bytes | None = None) -> Netcd
         try:
             header = _netcdf_layout(data)
             break
-        except EOFError:
+        except EOFError as exc:
             if len(data) >= min(size, _HEADER_LIMIT):
                 if size <= _HEADER_LIMIT:
-                    raise ReadError(p, f"{what}: the netCDF header runs past the end of the file ({size} bytes): "
-                                       "the file is truncated") from None
+                    raise ReadError(p, f"{what}: the netCDF header runs past the end of the file ({size} bytes; it "
+                                       f"asks for {exc}): the file is truncated or a count in its header is "
+                                       "damaged") from None
                 return None
             data = read_bytes(p, min(size, 4 * len(data)))
         except (ValueError, struct.error) as exc:
