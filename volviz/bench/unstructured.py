@@ -454,7 +454,7 @@ def large_mesh_row(mesh: Any, tf: Any, cams: list[Any], reps: int, draw: int = 2
     visibility_order(topo, cams[-1], (1920, 1080))
     runs = [visibility_order(topo, cam, (1920, 1080)) for _ in range(reps) for cam in cams]
     arrays = [mesh.points, mesh.tets, mesh.scalars, topo.points, topo.tets, topo.face_n, topo.face_d, topo.centroid,
-              topo.circ_center, topo.circ_r2, topo.neighbor]
+              topo.circ_center, topo.circ_r2, topo.neighbor, topo.back_face]
     m = mesh.n_cells
     row: dict[str, Any] = {
         "n_tets": int(m), "topology_s": topo_s, "sort_s": float(np.median([r.seconds for r in runs])),
@@ -671,7 +671,10 @@ def _large_mesh_lines(big: dict[str, Any]) -> list[str]:
              f"{big['sort_s']:.3f} s median ({big['sort_min_s']:.3f} s min, {big.get('cycles', 0)} cycles): "
              f"**{big['n_tets'] / big['sort_s'] / 1e6:.1f} M tetrahedra/s** (target ≥ 20)"
              + (f"; of which boundary relations {st['relations']:.3f} s, face sides {st['sides']:.3f} s, "
-                f"Kahn {st['kahn']:.3f} s (medians)" if st else "")
+                f"Kahn {st['kahn']:.3f} s (medians)" if "relations" in st else "")
+             + (f"; of which face sides {st['sides']:.3f} s with the boundary relations made beside them on a "
+                f"second thread (then {st['relations_wait']:.3f} s of waiting for them), Kahn {st['kahn']:.3f} s "
+                "(medians)" if "relations_wait" in st else "")
              + f". CPU memory of the mesh and its sort topology {big['bytes_per_cell']:.0f} bytes per cell"
              + (f", plus {big['sort_bytes_per_cell']:.0f} per cell while a sort runs (its order, state, "
                 "in-degrees and stack)" if "sort_bytes_per_cell" in big else "") + "."]
