@@ -254,7 +254,10 @@ def test_order_made_on_a_worker_is_drawn_and_reused_until_the_next_one():
 
     cams[2].apply_to(pl.renderer.GetActiveCamera())
     pl.ren_win.Render()                             # moved on before the next order: the newest one, reused
-    assert vol.stats["order_reused"] and not np.array_equal(_drawn(pl), exact[2])
+    assert vol.stats["order_reused"] and vol.frames[-1][1] == vol.frames[-1][0] - 1   # the previous camera's
+    # and the frame started this camera's sort on the worker: the next frame draws it (issue #29), exact
+    assert np.array_equal(_drawn(pl), exact[2]) and vol.stats["sort_prefetched"]
+    assert vol.frames[-1][1] == vol.frames[-1][0]
     request = vol.begin()
     vol.finish(request, *vol.compute(request))
     assert np.array_equal(_drawn(pl), exact[2]) and not vol.stats["order_reused"]

@@ -309,6 +309,13 @@ class GLPTVolume(PTView):
         self._cycles = 0
         self._prefetcher: Any = None
         self._order_key: Any = None
+        # the order's age in frames (issue #29): a serial per camera drawn (a new one when a frame's camera differs
+        # from the previous frame's), the serial the drawn order was made for, and per drawn frame the two
+        self.camera_serial = 0
+        self.order_serial = 0
+        self.frames: list[tuple[int, int]] = []     # (camera serial, order serial) of the last FRAME_LOG frames
+        self._frame_key: Any = None
+        self._pending: tuple[int, Camera, tuple[int, int]] | None = None   # the frame sort on the worker
         self._table: Any = None
         self._table_tex: Any = None
         self._targets: tuple[Any, ...] | None = None   # color, its FBO, depth, its FBO, format, drawn-size depth, FBO
@@ -390,7 +397,8 @@ class GLPTVolume(PTView):
 
     def _on_start(self, *_: Any) -> None:
         """Before each render: the back-to-front index buffer for this camera (unchanged cameras keep theirs; a
-        prefetched order for this camera is taken; with ``reuse_order`` the last order is kept for any camera)."""
+        prefetched order for this camera is taken; with ``reuse_order`` the last order is kept for any camera, but
+        never one older than the previous frame's camera: ``_follow``)."""
         from volviz.unstructured.sort import visibility_order
 
         if not self.actor.GetVisibility():
@@ -401,16 +409,27 @@ class GLPTVolume(PTView):
         self._apply_upsample(self.drawn_size != size)
         cam = self.camera = self._camera()
         key = _order_key(cam, size)
-        if key == self._order_key and self._sorted is not None and not self._recull:
+        if key != self._frame_key:
+            self.camera_serial += 1
+            self._frame_key = key
+        newer = self._pending is not None and self._pending[0] > self.order_serial
+        if key == self._order_key and self._sorted is not None and not self._recull and not newer:
+            self._log_frame()
             return
         t0 = time.perf_counter()
         exact = self._sorted is not None and key == self._sorted_key
         res = None if exact or self._prefetcher is None else self._prefetcher.take(cam, size)
+        serial, made_for = self.camera_serial, key
+        if not exact and res is None and self.reuse_order and self._sorted is not None:
+            res, serial, made_for = self._follow(cam, size)
         prefetched = res is not None
         if not exact and res is None and not (self.reuse_order and self._sorted is not None):
             res = visibility_order(self.topo, cam, size, self.sort, self.nonconvex)
         if res is not None:
-            self._sorted, self._cycles, self._sorted_key = res.order, int(res.cycles), key
+            self._sorted, self._cycles, self._sorted_key = res.order, int(res.cycles), made_for
+            self.order_serial = serial
+        elif exact:
+            self.order_serial = self.camera_serial
         self._recull = False
         t1 = time.perf_counter()
         assert self._sorted is not None  # this order, a prefetched one, a fresh sort or the earlier one reused
@@ -420,6 +439,33 @@ class GLPTVolume(PTView):
         self.stats = {"method": "pt-gl", "sort_s": t1 - t0, "order_s": time.perf_counter() - t1,
                       "n_visible": int(len(cells)), "cycles": self._cycles, "sorted": res is not None,
                       "sort_prefetched": prefetched, "order_reused": not exact and res is None}
+        self._log_frame()
+
+    FRAME_LOG = 1000
+
+    def _log_frame(self) -> None:
+        self.frames.append((self.camera_serial, self.order_serial))
+        del self.frames[:-self.FRAME_LOG]
+
+    def _follow(self, cam: Camera, size: tuple[int, int]) -> tuple[Any, int, Any]:
+        """A frame during an interaction (``reuse_order``), for a camera with no order yet: take the order of the
+        sort the previous frame started on the worker (waiting for it: a sort of the Blunt Fin takes ~13 ms, which
+        it has had the previous frame's draw to do), and start this camera's. So the drawn order is never older than
+        the previous frame's camera, and each camera's order is made on the worker within one frame (issue #29).
+        Returns (the order or None, the camera serial and ``_order_key`` it was made for)."""
+        from volviz.unstructured.prefetch import SortPrefetcher
+
+        res, serial, made_for = None, self.order_serial, self._sorted_key
+        if self._pending is not None and self._pending[0] > self.order_serial:
+            p_serial, p_cam, p_size = self._pending
+            res = self._prefetcher.take(p_cam, p_size)
+            if res is not None:
+                serial, made_for = p_serial, _order_key(p_cam, p_size)
+        if self._prefetcher is None:
+            self._prefetcher = SortPrefetcher(self.mesh, sort=self.sort, nonconvex=self.nonconvex)
+        self._prefetcher.prefetch(cam, size)
+        self._pending = (self.camera_serial, cam, size)
+        return res, serial, made_for
 
     def begin(self, scale: int = 1) -> dict[str, Any]:
         """GUI thread: the order to make next, for the renderer's camera and size now (``scale`` > 1: asked for
@@ -429,8 +475,9 @@ class GLPTVolume(PTView):
         cam = self._camera()
         size = window_size(self.renderer)
         key = _order_key(cam, size)
-        return {"camera": cam, "size": size, "key": key, "topo": self.topo, "preview": scale > 1,
-                "have": self._sorted is not None and key == self._sorted_key}
+        serial = self.camera_serial + (key != self._frame_key)   # a camera not drawn yet: the next frame's
+        return {"camera": cam, "size": size, "key": key, "topo": self.topo, "preview": scale > 1, "serial": serial,
+                "have": self._sorted is not None and key == self._sorted_key, "prefetcher": self._prefetcher}
 
     def compute(self, request: dict[str, Any], progress: Any = None) -> tuple[Any]:
         """Any thread: the visibility order for ``begin``'s camera (``volviz.unstructured.sort``); None when the
@@ -439,14 +486,19 @@ class GLPTVolume(PTView):
 
         if request["have"]:
             return (None,)
+        pre = request.get("prefetcher")
+        res = None if pre is None else pre.take(request["camera"], request["size"], consume=False)
+        if res is not None:        # a frame of a drag started this camera's sort (``_follow``): no second sort
+            return (res,)
         return (visibility_order(request["topo"], request["camera"], request["size"], self.sort, self.nonconvex),)
 
     def finish(self, request: dict[str, Any], result: Any) -> None:
         """GUI thread: draw with ``compute``'s order from the next render on: exact for its camera, and with
         ``reuse_order`` the newest order for any other (during an interaction the camera has moved on meanwhile)."""
-        if result is None or request["topo"] is not self.topo:
-            return
+        if result is None or request["topo"] is not self.topo or request.get("serial", 0) < self.order_serial:
+            return                 # none, of another mesh, or older than the order drawn now
         self._sorted, self._cycles, self._sorted_key = result.order, int(result.cycles), request["key"]
+        self.order_serial = request.get("serial", self.order_serial)
         self._recull = True
 
     def _set_index_buffer(self, cells: np.ndarray) -> None:

@@ -12,6 +12,7 @@ the frame sorts as usual, so a wrong guess costs time, never correctness.
 """
 from __future__ import annotations
 
+import threading
 import time
 from typing import Any, Iterator, Optional, Sequence
 
@@ -55,6 +56,7 @@ class SortPrefetcher:
         self.runner = runner or JobRunner(max_workers=1)
         self._job: Any = None
         self._for: Optional[tuple[Camera, tuple[int, int]]] = None
+        self._lock = threading.Lock()       # ``take`` may run on a worker while the GUI thread prefetches
         self.hits = 0
         self.misses = 0
 
@@ -64,20 +66,30 @@ class SortPrefetcher:
     def prefetch(self, camera: Camera, size: tuple[int, int]) -> None:
         """Start sorting for ``camera`` at image ``size`` in the background (no-op if that sort is already there)."""
         size = (int(size[0]), int(size[1]))
-        if self._for is not None and same_view(self._for[0], camera, self._for[1], size):
-            return
-        self._for = (camera, size)
-        self._job = self.runner.submit(self._sort, camera, size, name="sort for the next camera",
-                                       key=f"sort-prefetch-{id(self)}")
+        with self._lock:
+            if self._for is not None and same_view(self._for[0], camera, self._for[1], size):
+                return
+            self._for = (camera, size)
+            self._job = self.runner.submit(self._sort, camera, size, name="sort for the next camera",
+                                           key=f"sort-prefetch-{id(self)}")
 
-    def take(self, camera: Camera, size: tuple[int, int]) -> Optional[SortResult]:
-        """The prefetched order if it was made for this view (waits for it to finish), else None."""
+    def pending(self) -> Optional[tuple[Camera, tuple[int, int]]]:
+        """The camera and size of the sort in flight or finished and not yet taken, or None."""
+        with self._lock:
+            return self._for if self._job is not None else None
+
+    def take(self, camera: Camera, size: tuple[int, int], consume: bool = True) -> Optional[SortResult]:
+        """The prefetched order if it was made for this view (waits for it to finish), else None. ``consume=False``
+        leaves it for another taker (e.g. the frame drawn meanwhile on the GUI thread)."""
         size = (int(size[0]), int(size[1]))
-        if self._job is None or self._for is None or not same_view(self._for[0], camera, self._for[1], size):
-            self.misses += 1
-            return None
-        outcome = self._job.outcome()
-        self._job, self._for = None, None
+        with self._lock:
+            job, made_for = self._job, self._for
+            if job is None or made_for is None or not same_view(made_for[0], camera, made_for[1], size):
+                self.misses += 1
+                return None
+            if consume:
+                self._job, self._for = None, None
+        outcome = job.outcome()            # outside the lock: a prefetch meanwhile only replaces the job
         if not outcome.ok:
             self.misses += 1
             return None
