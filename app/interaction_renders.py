@@ -4,10 +4,15 @@ pyvistaqt's viewport renders twice for each move of a drag: VTK's interactor sty
 and the repaint that this render schedules renders again (pyvistaqt's ``paintGL`` always renders, since PyVista
 changes scenes without asking for a repaint). On a software OpenGL each render of a large viewport takes 20-30 ms, so
 a drag spent half its time drawing frames nobody saw. While an interaction lasts, the interactor's own renders are
-turned into repaint requests; the repaint draws the frame once. Outside interactions nothing changes."""
+turned into repaint requests; the repaint draws the frame once. Outside interactions nothing changes.
+
+The app re-makes its CPU volume images while the camera moves and after, so its plotter's CPU PT volumes draw those
+frames with the camera of the image they show (``volviz.render.preview_hold``, issue #28)."""
 from __future__ import annotations
 
 from typing import Any
+
+from volviz.render.preview_hold import hold_previews
 
 
 class SingleRenderDuringInteraction:
@@ -15,6 +20,7 @@ class SingleRenderDuringInteraction:
         self.widget = plotter.interactor
         self.iren = plotter.iren.interactor          # the vtkRenderWindowInteractor
         self.ren_win = plotter.ren_win
+        hold_previews(plotter)
         self.iren.AddObserver("StartInteractionEvent", self._start)
         self.iren.AddObserver("EndInteractionEvent", self._end)
         self.iren.AddObserver("RenderEvent", self._render_requested)

@@ -35,6 +35,7 @@ import numpy as np
 from volviz.model.datasets import TetMesh
 from volviz.render.image_overlay import (OverlayView, overlay_rgba8, unpremultiply_rgba8, window_size,
                                          zbuffer_to_depth)
+from volviz.render.preview_hold import PreviewCameraHold, holds_previews
 from volviz.render.pt_view import PTView
 from volviz.model.camera import Camera
 from volviz.unstructured.render import render
@@ -64,6 +65,8 @@ class PTVolume(OverlayView, PTView):
         self.method = method
         self.render_opts = render_opts
         self._prefetcher: Any = None                  # sorts for a known next camera in the background
+        # the app's frames drawn with the shown image's camera while the camera moves (``preview_hold``)
+        self.hold = PreviewCameraHold(plotter) if holds_previews(plotter) else None
 
     def _far(self, cam: Camera) -> float:
         p = self.mesh.points
@@ -74,8 +77,17 @@ class PTVolume(OverlayView, PTView):
 
     def begin(self, scale: int = 1) -> dict[str, Any]:
         """GUI-thread part 1: render the opaque scene, read its depth, fix the camera (see the module docstring);
-        ``scale`` > 1: a preview image that much smaller (``OverlayView.begin``)."""
-        request = super().begin(scale)
+        ``scale`` > 1: a preview image that much smaller (``OverlayView.begin``). The opaque scene is rendered with
+        the live camera (``hold`` suspended)."""
+        if self.hold is None:
+            request = super().begin(scale)
+        else:
+            self.hold.suspended = True
+            try:
+                request = super().begin(scale)
+            finally:
+                self.hold.suspended = False
+            request["held_camera"] = self.hold.snapshot()
         request["tf"], request["mesh"] = self.tf, self.mesh   # what the image is of, whatever is set meanwhile
         return request
 
@@ -134,6 +146,8 @@ class PTVolume(OverlayView, PTView):
     def finish(self, request: dict[str, Any], img: np.ndarray, st: Any, rgba8: np.ndarray | None = None) -> np.ndarray:
         """GUI-thread part 2: show a computed image as the overlay and record the statistics (``OverlayView``)."""
         super().finish(request, img, st, rgba8)
+        if self.hold is not None and "held_camera" in request:
+            self.hold.shown(request["held_camera"], bool(request.get("preview", False)))
         self.stats.update(method=self.method, sort_prefetched=bool(st.extra.get("sort_prefetched", False)))
         return img
 
@@ -152,6 +166,8 @@ class PTVolume(OverlayView, PTView):
         if self._prefetcher is not None:
             self._prefetcher.close()
             self._prefetcher = None
+        if self.hold is not None:
+            self.hold.remove()
         super().remove()
 
 def add_pt_volume(plotter: Any, mesh: Any, tf: Any, **opts: Any) -> PTVolume:

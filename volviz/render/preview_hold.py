@@ -1,0 +1,111 @@
+"""Draw a moving camera's frames with the camera of the CPU volume image on screen (issue #28).
+
+A CPU PT image (``volviz.render.pt_prop.PTVolume``) is made on a worker for the camera of its ``begin``; while the
+mouse drags the camera, VTK draws its own props (the outline box, opaque geometry) at every frame for the newest
+camera, so the volume preview was drawn for a camera several frames older than the box around it: the two slid
+apart and the opaque depth the image was cut by no longer lay under the box. From the start of an interaction until
+a full-size image of the live camera is shown after its end, each render of the plotter's renderer is drawn with
+the camera the shown image was made for (swapped in at the renderer's ``StartEvent``, the live camera put back at
+its ``EndEvent``): box and volume agree, and the whole view lags the mouse by the image's age instead. ``frames``
+logs per frame (live camera serial, image camera serial, drawn camera serial) for the flow test and the statement
+of the lag.
+
+Only for a plotter whose owner re-makes the images while the camera moves and after (the app:
+``hold_previews(plotter)``); elsewhere an interactive plotter would stay at the image's camera after a drag.
+"""
+from __future__ import annotations
+
+from typing import Any
+
+__all__ = ["PreviewCameraHold", "hold_previews", "holds_previews"]
+
+_HOLD = "_volviz_hold_previews"   # plotter attribute: its CPU volumes hold the camera of their images
+
+
+def hold_previews(plotter: Any) -> None:
+    """The CPU PT volumes of ``plotter`` made from now on draw moving frames with their image's camera."""
+    plotter.__dict__[_HOLD] = True
+
+
+def holds_previews(plotter: Any) -> bool:
+    return bool(plotter.__dict__.get(_HOLD, False))
+
+
+def _key(camera: Any) -> tuple[Any, ...]:
+    return (camera.GetPosition(), camera.GetFocalPoint(), camera.GetViewUp(), camera.GetViewAngle(),
+            camera.GetParallelProjection(), camera.GetParallelScale())
+
+
+class PreviewCameraHold:
+    """The camera swap of the module docstring for one plotter; ``snapshot`` in a view's ``begin``, ``shown`` in
+    its ``finish``, ``suspend`` around the opaque render of ``begin`` (which must see the live camera)."""
+
+    FRAME_LOG = 1000
+
+    def __init__(self, plotter: Any) -> None:
+        from volviz.render.vtk_facade import vtk
+
+        self._vtk = vtk
+        self.renderer = plotter.renderer
+        self.image_camera: Any = None      # a copy of the camera the shown image was made for
+        self.image_serial = 0
+        self.interacting = False
+        self.holding = False               # from an interaction's start until an image of the live camera is shown
+        self.suspended = False
+        self.live_serial = 0               # a new serial whenever a frame's live camera differs from the last one's
+        self.frames: list[tuple[int, int, int]] = []
+        self._last_key: Any = None
+        self._live = vtk.vtkCamera()
+        self._swapped = False
+        iren = plotter.iren.interactor
+        self._observers = [
+            (self.renderer, self.renderer.AddObserver("StartEvent", self._start)),
+            (self.renderer, self.renderer.AddObserver("EndEvent", self._end)),
+            (iren, iren.AddObserver("StartInteractionEvent", self._interaction_started)),
+            (iren, iren.AddObserver("EndInteractionEvent", lambda *a: setattr(self, "interacting", False))),
+        ]
+
+    def _interaction_started(self, *_: Any) -> None:
+        self.interacting = self.holding = True
+
+    def snapshot(self) -> tuple[Any, int]:
+        """The live camera now (a copy) and its serial, for the image a ``begin`` starts."""
+        live = self.renderer.GetActiveCamera()
+        copy = self._vtk.vtkCamera()
+        copy.DeepCopy(live)
+        return copy, self.live_serial + (_key(live) != self._last_key)
+
+    def shown(self, snapshot: tuple[Any, int], preview: bool) -> None:
+        """A ``finish`` showed an image made for ``snapshot``'s camera."""
+        self.image_camera, self.image_serial = snapshot
+        if self.holding and not self.interacting and not preview \
+                and _key(self.image_camera) == _key(self.renderer.GetActiveCamera()):
+            self.holding = False
+
+    def _start(self, *_: Any) -> None:
+        if self.suspended:
+            return
+        live = self.renderer.GetActiveCamera()
+        key = _key(live)
+        if key != self._last_key:
+            self.live_serial += 1
+            self._last_key = key
+        drawn = self.live_serial
+        if self.holding and self.image_camera is not None and _key(self.image_camera) != key:
+            self._live.DeepCopy(live)
+            live.DeepCopy(self.image_camera)
+            self._swapped = True
+            drawn = self.image_serial
+        self.frames.append((self.live_serial, self.image_serial, drawn))
+        del self.frames[:-self.FRAME_LOG]
+
+    def _end(self, *_: Any) -> None:
+        if self._swapped:
+            self.renderer.GetActiveCamera().DeepCopy(self._live)
+            self._swapped = False
+
+    def remove(self) -> None:
+        self._end()
+        for obj, tag in self._observers:
+            obj.RemoveObserver(tag)
+        self._observers = []
