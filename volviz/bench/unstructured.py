@@ -213,6 +213,11 @@ def main(argv: list[str] | None = None) -> int:
                    help="window sizes of the sort-seconds table (comma list of N or WxH; empty: no table)")
     p.add_argument("--cpu-sizes", type=_size_list, default=_size_list("512,1920x1080,3840x2160"),
                    help="window sizes at which pt-gl's CPU side is taken apart, beside 64² (2 cameras, 1 frame each)")
+    p.add_argument("--interactive-sizes", type=_size_list, default=_size_list("1920x1080,3840x2160"),
+                   help="window sizes of the interactive-resolution rows: pt-gl's reduced-resolution drag frames "
+                        "against its full-resolution frames (comma list of N or WxH; empty: no rows)")
+    p.add_argument("--interactive-pixels", type=int_in(1, MAX_IMAGE_SIDE ** 2), default=None,
+                   help="pt-gl's pixel cap during an interaction (default: volviz.render.reduced_fill's, 1920x1080)")
     p.add_argument("--large-refine", type=float, default=0.0,
                    help="also sort the Blunt Fin refined by this factor per axis (2.3: 2.27 M tetrahedra; 0: not)")
     p.add_argument("--large-out", default=None,
@@ -323,6 +328,9 @@ def main(argv: list[str] | None = None) -> int:
         print(f"pt-gl: {results['methods']['pt-gl']}", flush=True)
         if args.cpu_sizes:
             results["cpu_side"] = cpu_side_scan(mesh, tf, cams[:2], [(64, 64), *args.cpu_sizes], args.gl_lookup)
+        if args.interactive_sizes:
+            results["interactive"] = interactive_rows(mesh, tf, cams[:2], args.interactive_sizes, args.reps,
+                                                      args.gl_lookup, args.interactive_pixels)
     if args.large_refine > 1.0:
         big_mesh = refined_bluntfin(grid, args.large_refine)
         if args.large_out:
@@ -490,6 +498,58 @@ def cpu_side_scan(mesh: Any, tf: Any, cams: list[Any], sizes: list[tuple[int, in
     return rows
 
 
+def interactive_rows(mesh: Any, tf: Any, cams: list[Any], sizes: list[tuple[int, int]], reps: int, lookup: str,
+                     max_pixels: int | None = None) -> list[dict[str, Any]]:
+    """pt-gl while the camera moves (``GLPTVolume.set_interactive``, ``volviz.render.reduced_fill``) against its
+    full-resolution frames, one window per size, all open at once and taken in turn for each camera (so that a
+    change in the machine's load falls on every size alike): after a warm-up of both (shader variants compiled),
+    ``reps`` passes over ``cams``, each camera drawn three times in each window: interactive for the new camera
+    (``drag_s``: sort, index buffer and the reduced draw, as a drag frame), full resolution (``still_s``: the same
+    camera, the draw alone) and interactive again (``moving_s``: the reduced draw alone); every Render() ends with
+    WaitForCompletion. The error of the interactive image against the full-resolution one (8-bit RGB over black):
+    RMSE median over the cameras and the largest max."""
+    from volviz.optics.metrics import max_abs, rmse
+    from volviz.render.gl_pt import GLPTVolume
+
+    views: list[tuple[Any, Any, dict[str, list[float]], list[tuple[float, float]]]] = []
+    for size in sizes:
+        pl = bench_plotter(size, "black")
+        vol = GLPTVolume(pl, mesh, tf, lookup=lookup)
+        if max_pixels is not None:
+            vol.interactive_pixels = max_pixels
+        pl.camera_set = True
+        cams[0].apply_to(pl.renderer.GetActiveCamera())
+        for on in (False, True):
+            vol.set_interactive(on)
+            render_window(pl).Render()
+        views.append((pl, vol, {"drag_s": [], "still_s": [], "moving_s": []}, []))
+    for _ in range(reps):
+        for cam in cams[1:] + cams[:1] if len(cams) > 1 else cams * 2:
+            for pl, vol, times, errors in views:
+                ren_win = render_window(pl)
+                cam.apply_to(pl.renderer.GetActiveCamera())
+                imgs = []
+                for key, on in (("drag_s", True), ("still_s", False), ("moving_s", True)):
+                    vol.set_interactive(on)
+                    t0 = time.perf_counter()
+                    ren_win.Render()
+                    finish(ren_win)
+                    times[key].append(time.perf_counter() - t0)
+                    if key != "drag_s":
+                        imgs.append(screenshot_rgb(pl))
+                errors.append((rmse(imgs[1], imgs[0]), max_abs(imgs[1], imgs[0])))
+    rows = []
+    for (w, h), (pl, vol, times, errors) in zip(sizes, views):
+        row = {"size": [w, h], "drawn": list(vol.target_size or (0, 0)), "cap": int(vol.interactive_pixels),
+               **{k: float(np.median(v)) for k, v in times.items()},
+               "rmse": float(np.median([e[0] for e in errors])), "max": float(max(e[1] for e in errors)),
+               "frames_timed": len(errors)}
+        vol.remove()
+        pl.close()
+        rows.append(row)
+        print(f"interactive {w}x{h}: {row}", flush=True)
+    return rows
+
 
 def _size_scan(mesh: Any, tf: Any, cams: list[Any], sizes: list[tuple[int, int]], gl_lookup: str, sort: str,
                lookup: str) -> list[dict[str, Any]]:
@@ -635,6 +695,7 @@ def _markdown(results: dict[str, Any], path: Path) -> None:
                      f"pt-gl's total {gl['cpu_side_s'] / v64:.2f}x, proper {gl['cpu_side_proper_s'] / v64:.2f}x of "
                      "it)." if v64 else ".")]
     lines += _cpu_side_lines(results.get("cpu_side"), results["n_tets"])
+    lines += _interactive_lines(results.get("interactive"))
     lines += _sort_scan_lines(results.get("sort_scan"), results["n_tets"])
     big = results.get("large")
     if big:
@@ -702,6 +763,34 @@ def _cpu_side_lines(rows: list[dict[str, Any]] | None, n_tets: int) -> list[str]
         lines.append(f"| {r['size'][0]}x{r['size'][1]} | {r['frame_s']:.3f} | {r['sort_s']:.4f} | "
                      f"{r['order_s']:.4f} | {r['ibo_s']:.4f} | {r['one_cell_s']:.4f} | "
                      f"{r['cpu_side_proper_s']:.3f} | {r['draw_work_s']:.3f} |")
+    return lines
+
+
+def _interactive_lines(rows: list[dict[str, Any]] | None) -> list[str]:
+    if not rows:
+        return []
+    lines = ["", "pt-gl while the camera moves (issue #29): during an interaction the cells are drawn into a float "
+             f"target of at most {rows[0]['cap']} pixels (the window's aspect kept) and upsampled bilinearly over the "
+             "window; the frame after the camera stops is drawn at full resolution "
+             "(`GLPTVolume.set_interactive`, `volviz.render.reduced_fill`). One window per size, all open at once "
+             "and drawn in turn for each camera (a change of load falls on every size alike); 2 cameras x reps "
+             "after a warm-up, each Render() ending with WaitForCompletion, wall seconds (medians): a drag frame for "
+             "a new camera (sort, index buffer, reduced draw), then for the same camera the full-resolution draw and "
+             "the reduced draw alone (the fill); the error of the interactive image against the full-resolution one "
+             "(8-bit RGB, premultiplied over black; RMSE median over the cameras, max the largest):", "",
+             "| window | drawn at | drag frame s | full-resolution draw s | interactive draw s | RMSE | max |",
+             "|---|---|---|---|---|---|---|"]
+    for r in rows:
+        lines.append(f"| {r['size'][0]}x{r['size'][1]} | {r['drawn'][0]}x{r['drawn'][1]} | {r['drag_s']:.3f} | "
+                     f"{r['still_s']:.3f} | {r['moving_s']:.3f} | {r['rmse']:.2f} | {r['max']:.1f} |")
+    small = min(rows, key=lambda r: r["size"][0] * r["size"][1])
+    big = max(rows, key=lambda r: r["size"][0] * r["size"][1])
+    if big is not small:
+        lines += ["", f"The interactive draw at {big['size'][0]}x{big['size'][1]} takes "
+                  f"{big['moving_s'] / small['moving_s']:.2f}x the one at {small['size'][0]}x{small['size'][1]} "
+                  "(target ≤ 1: the cells fill the same pixels; the window's full-screen passes, its clear and the "
+                  f"resolve, still grow with the window) and {big['moving_s'] / big['still_s']:.2f}x its own "
+                  "full-resolution draw."]
     return lines
 
 
