@@ -6,7 +6,9 @@ frame takes the sort the previous frame started and starts its own), none on the
 ``GLPTVolume.frames`` (camera serial, order serial) while real mouse events drag the camera. Measured in a 900x650
 window on llvmpipe (load average 7 on 2 cores): 24 cameras in 25 frames, every frame drew the previous frame's
 camera's order, the still frame after the drag its own; the frame's wait for the worker's order median 0.7 ms,
-max 19.6 ms.
+max 19.6 ms. Negative control: with ``_follow`` patched out (only the app's order jobs) this flow also drew the
+previous camera's order in every frame here, even with each sort slowed by 150 ms, so the flow did not fail before;
+``_follow`` makes the rule hold by construction, and ``test_render_gl_pt``'s worker-order test shows it directly.
 
 CPU (``volviz.render.pt_prop`` + ``volviz.render.preview_hold``): the preview image is older than the camera by the
 time a preview takes (measured: previews of cameras 2, 12 and 20 shown during a 21-camera drag, so up to 10 frames
