@@ -27,7 +27,6 @@ from PySide6.QtCore import QTimer
 from volviz.jobs import JobOutcome, OneInFlight
 from volviz.render.controller import SceneController, no_render
 from volviz.render.error_budget import MOST_ACCURATE_TABLE, error_budget_choice
-from volviz.render.motion_samples import SingleSampleWhileMoving
 from .window_base import WindowBase
 
 MOVING_SCALE = 2         # previews while the camera moves or a TF point is dragged: 1/2 x 1/2 of the window
@@ -66,18 +65,12 @@ class ViewScheduler(WindowBase):
         # fly mode has no end-of-interaction event: the camera has stopped once no key moved it for a while
         self.fly_settle_timer = QTimer(self, singleShot=True, interval=FLY_SETTLE_MS)
         self.fly_settle_timer.timeout.connect(self._camera_moved)
-        self.motion_samples = SingleSampleWhileMoving(self.plotter)   # no multisampling while the camera moves
-
-        def interaction_started(*args: Any) -> None:
-            self.collector.interacting = True
-            self.motion_samples.moving()
-
-        self.plotter.iren.add_observer("StartInteractionEvent", interaction_started)
+        self.plotter.iren.add_observer("StartInteractionEvent", lambda *args: setattr(self.collector, "interacting",
+                                                                                      True))
         self.plotter.iren.add_observer("InteractionEvent", lambda *args: self._schedule_camera_moving())
 
         def interaction_ended(*args: Any) -> None:
             self.collector.interacting = False
-            self.motion_samples.stopped()   # before the interaction's last frame is drawn
             QTimer.singleShot(0, self._camera_moved)
 
         self.plotter.iren.add_observer("EndInteractionEvent", interaction_ended)
@@ -164,7 +157,6 @@ class ViewScheduler(WindowBase):
         """A fly-mode step moved the camera: previews follow it as during a mouse drag (``_camera_moving``, at
         ``FLY_SCALE``), and the full-size images once the keys have stopped for ``FLY_SETTLE_MS``."""
         self._moving_scheduled = False
-        self.motion_samples.moving()
         if self.controller is not None:
             self.refresh_views(scale=FLY_SCALE, estimate=False, moving=True)
         self.fly_settle_timer.start()
@@ -172,7 +164,6 @@ class ViewScheduler(WindowBase):
     def _camera_moved(self) -> None:
         """After the camera moved: draw, and refresh every camera view for the new camera (full size, with the error
         estimate)."""
-        self.motion_samples.stopped()
         if self.controller is None:
             return
         self.render_scene()

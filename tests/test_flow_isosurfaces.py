@@ -73,7 +73,10 @@ def test_add_edit_remove_and_undo_an_isosurface(qtbot, make_window, tmp_path) ->
     _rebuilt(qtbot, window, lambda: _iso(window) is not None)
     assert _iso(window).settings["styles"][0]["opacity"] == 0.3 and dock.table.rowCount() == 1
 
-    change = changed_share(screen(window), without, levels=3.0)
+    # both frames single-sampled (llvmpipe): the translucent surface, coloured as the TF at its value, changes
+    # ~1.2 % of the pixels by more than 1 level; the 3-level share of 0.8 % measured before counted the outline's
+    # multisampled edges, which the surface's single-sample pass had changed
+    change = changed_share(screen(window), without, levels=1.0)
     stats = window.controller.iso_stats()
     print("pixels changed by the surface:", change, "iso stats:", stats)
     n = sum(len(m.triangles) for m in window.controller.views[_iso(window).id].meshes)

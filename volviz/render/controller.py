@@ -24,6 +24,7 @@ from typing import Any, Iterator, Optional
 from volviz.model import TimeSeries
 from volviz.model.applicability import DatasetTraits
 from volviz.model.events import ChangeNotifier, SceneChange
+from volviz.render.image_overlay import single_sample_on_software
 from volviz.session import CameraState, Component, Session
 
 
@@ -113,6 +114,7 @@ class SceneController:
         from volviz.render.scene_builder import install_scene
 
         ensure_lights(self.plotter)
+        single_sample_on_software(self.plotter)   # the app's window and ``volviz render`` alike
         with no_render(self.plotter):  # the caller draws once afterwards
             # the views are drawn last, over the whole opaque scene (the outline box of ``decorate`` included, as
             # every later update sees it)

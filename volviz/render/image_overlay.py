@@ -26,6 +26,11 @@ last one is removed: with MSAA a silhouette pixel of opaque geometry has a blend
 it) but VTK's depth read-back gives one depth, so the image was cut there by that one depth for the whole pixel: a
 one-pixel edge around opaque objects (max 18 of 255 against 1.6 without MSAA on the PT test scene at 256x192).
 Compositing per sample would need every sample's depth, which ``GetZbufferData`` does not give.
+
+A plotter drawn by a software rasteriser has no multisampling at all (``single_sample_on_software``): on llvmpipe 4x
+MSAA made every frame 3-4x as costly (docs/bench/multisampling.md), so each still frame of the Yukon scene held the
+window for half a second. Hardware drivers keep the plotter's setting; ``volviz render`` and the app follow the same
+rule, so their pictures still agree.
 """
 from __future__ import annotations
 
@@ -34,8 +39,10 @@ from typing import Any
 
 import numpy as np
 
+from volviz.render.backend import plotter_gl_info
+
 __all__ = ["ImageOverlay", "OverlayView", "bleed_color", "block_min", "overlay_rgba8", "read_buffers",
-           "unpremultiply_rgba8", "zbuffer_to_depth"]
+           "single_sample_on_software", "unpremultiply_rgba8", "zbuffer_to_depth"]
 
 _SIBLINGS = "_volviz_pt_overlays"           # plotter attribute: every overlay renderer of the plotter
 _MULTISAMPLES = "_volviz_pt_multisamples"   # plotter attribute: the MSAA setting to restore
@@ -132,6 +139,15 @@ def hold_single_sample(plotter: Any, holder: Any) -> None:
         plotter.__dict__[_MULTISAMPLES] = int(plotter.ren_win.GetMultiSamples())
         plotter.ren_win.SetMultiSamples(0)
     plotter.__dict__.setdefault(_SINGLE_SAMPLE_HOLDERS, []).append(holder)
+
+
+def single_sample_on_software(plotter: Any) -> None:
+    """No multisampling in ``plotter`` when a software rasteriser draws it, and none to restore when the last
+    overlay leaves (module docstring); a hardware driver keeps the plotter's setting."""
+    if plotter_gl_info(plotter).software:
+        plotter.ren_win.SetMultiSamples(0)
+        if _MULTISAMPLES in plotter.__dict__:
+            plotter.__dict__[_MULTISAMPLES] = 0
 
 
 def release_single_sample(plotter: Any, holder: Any) -> None:
