@@ -12,6 +12,9 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     parser.add_argument("target", nargs="?", help="a session file (.json) or a data file; default: the demo scene")
     parser.add_argument("--screenshot", metavar="PNG", help="show the scene, save the window as PNG and quit (a check "
                         "that the app starts and renders)")
+    parser.add_argument("--flight-report", metavar="MD", help="fly through the natural scene (default: the shipped "
+                        "Yukon session) with W held, write the frame rate and the event loop's gaps to MD and quit")
+    parser.add_argument("--flight-seconds", type=float, default=30.0, help="how long --flight-report flies (30)")
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(levelname)s %(name)s: %(message)s")
 
@@ -24,17 +27,21 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     app.setApplicationName("volviz")
     app.setOrganizationName("volviz")
     app.setWindowIcon(_icon())
-    if args.screenshot:  # a throwaway window: the user's settings and recovery files stay untouched
-        import tempfile
+    if args.screenshot or args.flight_report:  # a throwaway window: the user's settings and recovery files stay
+        import tempfile                         # untouched
         from pathlib import Path
 
         from PySide6.QtCore import QSettings
 
-        from .smoke import screenshot
-
         scratch = Path(tempfile.mkdtemp(prefix="volviz-app-check-"))
         window = MainWindow(settings=QSettings(str(scratch / "settings.ini"), QSettings.Format.IniFormat),
                             recovery_dir=scratch / "recovery")
+        if args.flight_report:
+            from .flight_report import flight_report
+
+            return flight_report(app, window, args.target, Path(args.flight_report), args.flight_seconds)
+        from .smoke import screenshot
+
         return screenshot(app, window, args.target, Path(args.screenshot))
     window = MainWindow()
     window.show()

@@ -31,6 +31,7 @@ BENCHMARKS = {
     "robustness": "fuzz campaign: mutated shared files through volviz's readers and VTK's, side by side",
     "first_open": "volviz render of every shared file: time to the first image, drawn share, transfer-function "
                   "legibility",
+    "multisampling": "a still frame with 4x multisampling against one sample: time and image difference",
 }
 #: commands whose arguments go, unread here, to their own parser (``volviz.regular.cli``, ``volviz.bench.NAME``)
 PASSED_ON = ("bench", "compress")

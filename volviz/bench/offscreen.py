@@ -2,6 +2,7 @@
 and the exact references), their render window and their image as floats."""
 from __future__ import annotations
 
+import time
 from typing import Any, Optional, Sequence
 
 import numpy as np
@@ -22,6 +23,17 @@ def finish(window: Any) -> None:
     """Wait until the GPU has completed the frame (``vtkOpenGLRenderWindow.WaitForCompletion``, a glFinish), so that
     a timed ``Render()`` ends with the GPU's completion and not with the command submission (issue #29)."""
     window.WaitForCompletion()
+
+
+def timed_renders(window: Any, reps: int) -> list[float]:
+    """The seconds of ``reps`` draws of a render window, each to the GPU's completion (``finish``)."""
+    times = []
+    for _ in range(reps):
+        t0 = time.perf_counter()
+        window.Render()
+        finish(window)
+        times.append(time.perf_counter() - t0)
+    return times
 
 
 def render_window(pl: Any) -> Any:

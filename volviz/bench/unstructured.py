@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 
 from volviz.argtypes import MAX_IMAGE_SIDE, UsageParser, int_in
-from volviz.bench.offscreen import bench_plotter, finish, render_window, screenshot_rgb
+from volviz.bench.offscreen import bench_plotter, finish, render_window, screenshot_rgb, timed_renders
 
 DEFAULT_DATA = Path(os.environ.get("VOLVIZ_DATA", Path(__file__).resolve().parents[2].parent / "shared" / "data"))
 VTK_MAPPERS = ("vtkProjectedTetrahedraMapper", "vtkUnstructuredGridVolumeRayCastMapper",
@@ -81,12 +81,7 @@ def _vtk_render(mesh: Any, tf: Any, cam: Any, size: int, mapper_name: str, reps:
     win.AddRenderer(ren)
     cam.apply_to(ren.GetActiveCamera())
     ren.ResetCameraClippingRange()
-    times = []
-    for _ in range(reps):
-        t0 = time.perf_counter()
-        win.Render()
-        finish(win)
-        times.append(time.perf_counter() - t0)
+    times = timed_renders(win, reps)
     w2i = vtk.vtkWindowToImageFilter()
     w2i.SetInput(win)
     w2i.SetInputBufferTypeToRGB()

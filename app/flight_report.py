@@ -1,0 +1,99 @@
+"""``volviz-app --flight-report MD [TARGET]``: fly through a natural scene (default: the shipped Yukon session) with W
+held for ``--flight-seconds``, as a keyboard's auto-repeat sends it (30 presses a second), in the real window at
+1366x768, and write what the user got: frames drawn per second, camera steps, and the event loop's longest gaps
+(a 10 ms timer on the GUI thread; a gap is how long the window could not answer). Issue #28 asks for the frame rate
+of a 30-second flight on this machine; the report says the command and the load it ran under."""
+from __future__ import annotations
+
+import os
+import time
+from pathlib import Path
+from typing import Any
+
+from PySide6.QtCore import QEvent, Qt, QTimer
+from PySide6.QtGui import QKeyEvent
+from PySide6.QtWidgets import QApplication
+
+from .smoke import TIMEOUT_S, pump_events
+
+YUKON = Path(__file__).resolve().parents[1] / "resources" / "sessions" / "yukon.json"
+REPEAT_S = 1.0 / 30.0        # X's default auto-repeat rate
+SIZE = (1366, 768)
+
+
+class _Gaps:
+    """The gaps between the ticks of a 10 ms timer on the GUI thread."""
+
+    def __init__(self) -> None:
+        self.gaps: list[float] = []
+        self._last = time.perf_counter()
+        self.timer = QTimer(interval=10)
+        self.timer.timeout.connect(self._tick)
+        self.timer.start()
+
+    def _tick(self) -> None:
+        now = time.perf_counter()
+        self.gaps.append(now - self._last)
+        self._last = now
+
+
+def _key(widget: Any, kind: QEvent.Type, repeat: bool) -> None:
+    QApplication.sendEvent(widget, QKeyEvent(kind, Qt.Key.Key_W, Qt.KeyboardModifier.NoModifier, "w", repeat))
+
+
+def fly(app: Any, window: Any, target: str | None, seconds: float) -> dict[str, Any]:
+    """Open ``target``, wait for its full image, hold W for ``seconds`` in fly mode; the flight's figures."""
+    window.resize(*SIZE)
+    window.show()
+    window.open_path(target or YUKON)
+    loaded = pump_events(app, lambda: window.controller is not None and not window.progress_bar.isVisible()
+                         and not window.jobs.busy(), TIMEOUT_S)
+    if not loaded or window.controller.nature is None:
+        raise RuntimeError(f"{target or YUKON}: no natural scene was shown within {TIMEOUT_S:.0f} s")
+    pump_events(app, lambda: False, 1.0)
+    window.action_fly.trigger()
+    pump_events(app, lambda: not window.jobs.busy(), TIMEOUT_S)   # the coarse terrain fly mode makes at once
+    frames = [0]
+    observer = window.plotter.ren_win.AddObserver("EndEvent", lambda *a: frames.__setitem__(0, frames[0] + 1))
+    canvas = window.plotter.interactor
+    gaps = _Gaps()
+    began = time.perf_counter()
+    _key(canvas, QEvent.Type.KeyPress, False)
+    while time.perf_counter() - began < seconds:
+        pump_events(app, lambda: False, REPEAT_S)
+        _key(canvas, QEvent.Type.KeyPress, True)
+    _key(canvas, QEvent.Type.KeyRelease, False)
+    flown = time.perf_counter() - began
+    gaps.timer.stop()
+    window.plotter.ren_win.RemoveObserver(observer)
+    worst = sorted(gaps.gaps)
+    return {"seconds": flown, "frames": frames[0], "fps": frames[0] / flown, "steps": window.fly.steps,
+            "gap_max_ms": 1e3 * worst[-1], "gap_p99_ms": 1e3 * worst[int(0.99 * (len(worst) - 1))],
+            "gaps_over_100ms": sum(g > 0.1 for g in worst), "load": os.getloadavg()[0],
+            "size": f"{SIZE[0]}x{SIZE[1]}", "target": str(target or "resources/sessions/yukon.json")}
+
+
+def markdown(result: dict[str, Any], command: str) -> str:
+    r = result
+    return "\n".join([
+        "# A flight through the natural scene in the app", "",
+        f"Command: `{command}` (window {r['size']}, load average at the end {r['load']:.1f}).", "",
+        f"W held for {r['seconds']:.1f} s over {r['target']}, 30 key repeats a second: {r['steps']} camera steps, "
+        f"{r['frames']} frames drawn, **{r['fps']:.1f} frames per second**.", "",
+        f"Event-loop gaps (10 ms timer on the GUI thread): longest {r['gap_max_ms']:.0f} ms, 99th percentile "
+        f"{r['gap_p99_ms']:.0f} ms, {r['gaps_over_100ms']} over 100 ms. These are wall-clock gaps: time the machine "
+        "gave to other processes is in them.", ""])
+
+
+def flight_report(app: Any, window: Any, target: str | None, out: Path, seconds: float) -> int:
+    """Fly, write the report to ``out``, print it; 0 when the flight ran."""
+    from volviz.io.atomic import atomic_write_text
+
+    result = fly(app, window, target, seconds)
+    window.dirty = False
+    command = f"volviz-app --flight-report {out} --flight-seconds {seconds:g}" + (f" {target}" if target else "")
+    text = markdown(result, command)
+    atomic_write_text(out, text)
+    print(text)
+    window.close()
+    return 0
