@@ -64,7 +64,7 @@ class ViewScheduler(WindowBase):
         """The viewport's interaction observers, the fly-mode settle timer and the resize timer."""
         # fly mode has no end-of-interaction event: the camera has stopped once no key moved it for a while
         self.fly_settle_timer = QTimer(self, singleShot=True, interval=FLY_SETTLE_MS)
-        self.fly_settle_timer.timeout.connect(self._camera_moved)
+        self.fly_settle_timer.timeout.connect(self._fly_stopped)
         self.plotter.iren.add_observer("StartInteractionEvent", lambda *args: setattr(self.collector, "interacting",
                                                                                       True))
         self.plotter.iren.add_observer("InteractionEvent", lambda *args: self._schedule_camera_moving())
@@ -157,9 +157,16 @@ class ViewScheduler(WindowBase):
         """A fly-mode step moved the camera: previews follow it as during a mouse drag (``_camera_moving``, at
         ``FLY_SCALE``), and the full-size images once the keys have stopped for ``FLY_SETTLE_MS``."""
         self._moving_scheduled = False
+        if not self.fly_settle_timer.isActive():   # the flight starts: frames at the interactive rate until it stops
+            self._interactive_rate(True)
         if self.controller is not None:
             self.refresh_views(scale=FLY_SCALE, estimate=False, moving=True)
         self.fly_settle_timer.start()
+
+    def _fly_stopped(self) -> None:
+        """No fly-mode key moved the camera for ``FLY_SETTLE_MS``: the still rate again, and the full-size views."""
+        self._interactive_rate(False)
+        self._camera_moved()
 
     def _camera_moved(self) -> None:
         """After the camera moved: draw, and refresh every camera view for the new camera (full size, with the error
@@ -210,6 +217,8 @@ class ViewScheduler(WindowBase):
                 settled()
 
         for key, view in chosen:
+            if moving:   # an error estimate of an earlier camera would hold the one worker back from the previews
+                self.jobs.cancel(f"error:{key.split(':', 1)[-1]}")
             self._refresh_view(key, view, one_settled, scale, estimate)
         one_settled()
         return len(chosen)
@@ -274,11 +283,19 @@ class ViewScheduler(WindowBase):
         then cast fewer rays); at the pause the still rate, and one full-quality frame."""
         if self.plotter.ren_win is None:  # the window has closed
             return
-        iren = self.plotter.iren.interactor if hasattr(self.plotter.iren, "interactor") else self.plotter.iren
-        rate = iren.GetDesiredUpdateRate() if playing else iren.GetStillUpdateRate()
-        self.plotter.ren_win.SetDesiredUpdateRate(rate)
+        self._interactive_rate(playing)
         if not playing:
             self.schedule_render()
+
+    def _interactive_rate(self, on: bool) -> None:
+        """VTK's interactive update rate for the window (``on``; what its interactor styles set during a mouse drag)
+        or its still rate: during playback and flight, as during a drag, its ray casters cast fewer rays and the GPU
+        PT pass fills a reduced target (``GLPTVolume.set_interactive``)."""
+        ren_win = self.plotter.ren_win
+        if ren_win is None:   # the window has closed
+            return
+        iren = self.plotter.iren.interactor if hasattr(self.plotter.iren, "interactor") else self.plotter.iren
+        ren_win.SetDesiredUpdateRate(iren.GetDesiredUpdateRate() if on else iren.GetStillUpdateRate())
 
     def _interpolation_toggled(self, on: bool) -> None:
         if self.controller is not None:

@@ -163,8 +163,6 @@ class MainWindow(SceneLoading, SessionFiles, ViewScheduler, SceneEdits, ExportRu
         self.fly.set_bounds(fly_bounds(bounds, self.plotter.camera.position, terrain))
         if nature is not None:   # while flying, each full frame also makes the coarse terrain the next move draws
             nature.keep_coarse = enabled
-            if enabled and getattr(nature, "coarse_missing", False):   # one for the shown view, before a key moves
-                self.refresh_nature()
         self.action_fly.setChecked(enabled)
         self.status_label.setText("Fly mode: W/A/S/D or arrows move, Q/E sink/rise, drag to look, +/- speed"
                                   if enabled else "Orbit mode")

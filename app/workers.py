@@ -42,6 +42,10 @@ class JobBridge(QObject):
             self._handlers[job.job_id] = on_done
         return job
 
+    def cancel(self, key: str) -> None:
+        """Cancel the newest job submitted with ``key`` (``JobRunner.cancel``)."""
+        self.runner.cancel(key)
+
     def busy(self) -> bool:
         """Whether a job whose result the window waits for is still running or queued."""
         return bool(self._handlers)

@@ -34,7 +34,7 @@ def test_hold_w_over_yukon(qtbot, make_window, tmp_path: Path) -> None:
     view = window.controller.nature
     start = window.plotter.camera.position
     canvas = window.plotter.interactor
-    samples, scales = [], set()
+    samples, scales, rates = [], set(), set()
     gaps = LoopGaps()
     gaps.restart()
     began = time.monotonic()
@@ -46,11 +46,13 @@ def test_hold_w_over_yukon(qtbot, make_window, tmp_path: Path) -> None:
         presses += 1
         samples.append(window.plotter.camera.position)
         scales.add(view.shown_scale)
+        rates.add(window.plotter.ren_win.GetDesiredUpdateRate())
     _key(canvas, QEvent.Type.KeyRelease, Qt.Key.Key_W, False)
     gaps.stop()
     print(f"flight: {window.fly.steps} camera steps in 5 s, {gaps.summary()}")
     assert window.fly.steps == presses       # one step per key event, none dropped or queued
     assert 4 in scales                       # frames drawn while flying were previews
+    assert min(rates) > 1                    # at VTK's interactive rate (its ray casters, the GPU PT's reduced fill)
     end = window.plotter.camera.position
     assert end[1] > start[1] + 100           # forward: the view looks along +y
     for x, y, z in samples:                  # above the ground, inside the terrain's box
@@ -58,6 +60,7 @@ def test_hold_w_over_yukon(qtbot, make_window, tmp_path: Path) -> None:
         assert z >= terrain.height_at(x, y) - 1e-6
     wait_settled(qtbot, window, timeout=180000)
     qtbot.waitUntil(lambda: view.shown_scale == 1, timeout=180000)   # the full-size frame follows the stop
+    assert window.plotter.ren_win.GetDesiredUpdateRate() < 1              # at the still rate
     wait_settled(qtbot, window, timeout=180000)
     err = compare_with_render(window, tmp_path)
     assert err["rmse"] < 2.0 and err["off"] < 0.01, err

@@ -64,6 +64,21 @@ def test_newer_request_supersedes_stale_one() -> None:
     runner.shutdown()
 
 
+def test_cancel_by_key_stops_that_job_only() -> None:
+    """The app cancels a pending error estimate (key ``error:<id>``) when the camera moves: it stops, its on_done
+    hears so, and the job queued behind it on the one worker runs."""
+    runner = JobRunner(max_workers=1)
+    delivered = []
+    estimate = runner.submit(slow_count, 500, key="error:a", on_done=delivered.append)
+    preview = runner.submit(slow_count, 3, key="pt:a", on_done=delivered.append)
+    runner.cancel("error:a")
+    runner.cancel("nothing of that key")
+    assert preview.outcome(timeout=2).result == 3      # 500 steps of 10 ms would have held it back 5 s
+    assert estimate.outcome(timeout=2).cancelled
+    assert [o.job_id for o in delivered] == [estimate.job_id, preview.job_id]
+    runner.shutdown()
+
+
 def test_cancelled_is_an_exception_type() -> None:
     with pytest.raises(Cancelled):
         raise Cancelled()

@@ -186,6 +186,14 @@ class JobRunner:
                 self._latest[key] = job
         return job
 
+    def cancel(self, key: str) -> None:
+        """Cancel the newest job of ``key``, if one is queued or running (it stops at its next progress call; its
+        ``on_done`` gets a cancelled outcome)."""
+        with self._lock:
+            job = self._latest.get(key)
+        if job is not None:
+            job.cancel()
+
     def cancel_all(self) -> None:
         with self._lock:
             jobs = list(self._running.values())

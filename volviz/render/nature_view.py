@@ -87,13 +87,6 @@ class NatureView:
         sky.edge_clamp = True
         self.sky_actor = plotter.add_mesh(dome, texture=sky, lighting=False, name="nature-sky", render=False)
 
-    @property
-    def coarse_missing(self) -> bool:
-        """Whether a move would draw the full terrain: no coarse terrain of the shown view was made (``keep_coarse``
-        was off for the last full-size frame), and the shown terrain is larger than a preview's."""
-        shown = self._mesh.n_cells if self._mesh is not None else 0
-        return self._coarse is None and shown > 2 * PREVIEW_TRIANGLES
-
     def _camera(self) -> Any:
         from volviz.model.camera import Camera
 
