@@ -120,3 +120,15 @@ def test_a_cube_axis_of_a_damaged_length_is_refused_in_placement_terms(tmp_path)
     path.write_text("\n".join(lines) + "\n")
     assert _refusal(path) == (": the voxel-to-world transform has no nearest world axes (voxel sizes 0.265, "
                               "4.88e+18, 0.265): a voxel size or direction is damaged")
+
+
+def test_a_nrrd_space_direction_with_a_nan_is_refused(tmp_path):
+    """Found by the campaign (6 of 690 NRRD cases): one component set to nan made that axis a component axis, and the
+    5 x 6 slices of 4 components were shown without a word."""
+    path = tmp_path / "v.nrrd"
+    nrrd.write(str(path), STACK.astype(np.int16), {"space": "left-posterior-superior",
+                                                   "space directions": np.eye(3) * 0.5}, index_order="C")
+    data = path.read_bytes()
+    assert data.count(b"(0.5,0,0)") == 1
+    assert _refusal(path, data.replace(b"(0.5,0,0)", b"(0.5,nan,0)")) == (
+        ": NRRD space direction 0 is [0.5, nan, 0.0]: neither a vector of finite numbers nor 'none'")

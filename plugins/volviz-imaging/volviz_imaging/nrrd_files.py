@@ -116,6 +116,10 @@ def _axes(p: Path, header: dict[str, Any]) -> tuple[list[int], int | None, str]:
     kinds = [str(k).lower() for k in header.get("kinds", ["domain"] * len(sizes))]
     if directions is not None:
         rows = np.asarray(directions, dtype=np.float64)
+        for i in range(len(sizes)):  # a vector of numbers, or "none" (all NaN): a part NaN is a damaged vector
+            if not (np.all(np.isfinite(rows[i])) or np.all(np.isnan(rows[i]))):
+                raise ReadError(p, f"NRRD space direction {i} is {rows[i].tolist()}: neither a vector of finite "
+                                   "numbers nor 'none'")
         spatial = [i for i in range(len(sizes)) if np.all(np.isfinite(rows[i]))]
     else:
         spatial = [i for i in range(len(sizes)) if kinds[i] in ("domain", "space", "time") or len(sizes) <= 3]
