@@ -15,6 +15,7 @@
 """
 from __future__ import annotations
 
+import struct
 from pathlib import Path
 from typing import Any
 
@@ -41,6 +42,22 @@ def _open(p: Path) -> Any:
         return laspy.open(str(p))
     except (laspy.errors.LaspyException, ValueError, OSError, EOFError) as exc:
         raise ReadError(p, f"its LAS header cannot be read ({exc})") from None
+
+
+def _check_layout(p: Path, head: bytes) -> None:
+    """The public header block's sizes against each other and the file (LAS 1.4 R15, table 3: header size at byte
+    94, offset to point data at 96, number of VLRs at 100, each VLR at least 54 bytes) before laspy reads: an offset
+    of 2^31 made laspy run past the reader's time limit."""
+    header_size, offset, vlrs = struct.unpack_from("<HII", head, 94)
+    size = p.stat().st_size
+    if not HEADER_BYTES <= header_size <= offset <= size:
+        raise ReadError(p, f"its LAS header size ({header_size}) and offset to the point data ({offset}) do not fit "
+                           f"a file of {size} bytes (header size at least {HEADER_BYTES}, offset between it and the "
+                           "end of the file)")
+    if vlrs * 54 > offset - header_size:
+        room = offset - header_size
+        raise ReadError(p, f"its LAS header counts {vlrs} variable-length records, more than the {room} bytes "
+                           "between the header and the point data hold (54 bytes each at least)")
 
 
 def _check_room(p: Path, header: Any, compressed: bool) -> None:
@@ -76,6 +93,7 @@ def read_las(path: PathLike) -> UnstructuredMesh:
     if compressed and not laspy.LazBackend.detect_available():
         raise ReadError(p, "is a compressed LAS file (LAZ) and no LAZ decompressor is installed",
                         "install one: pip install 'laspy[lazrs]'")
+    _check_layout(p, head)
     with _open(p) as reader:
         header = reader.header
         _check_room(p, header, compressed)
