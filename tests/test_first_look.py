@@ -161,7 +161,9 @@ def test_pictures_open_flat_and_face_on():
         assert [c.type for c in session.components] == ["volume"]
         image = _render(session, (160, 120))
         drawn = np.abs(image.astype(int) - image[0, 0].astype(int)).sum(axis=2) > 30
-        assert drawn.mean() > 0.4                          # face-on, filling the view
+        # face-on, filling the view: the picture alone covers 0.386 (clouds.jpeg) and 0.455 at 160x120; the 0.4 this
+        # asked before counted the outline's sides, which llvmpipe drops single-sampled where they lie on pixel edges
+        assert drawn.mean() > 0.35
         assert session.transfer_functions == {}            # no transfer function: the picture's own colors
 
 

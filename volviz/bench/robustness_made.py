@@ -46,10 +46,10 @@ def _nifti(path: Path) -> None:
 def _dicom(path: Path) -> None:
     import pydicom
     from pydicom.dataset import FileMetaDataset
-    from pydicom.uid import ExplicitVRLittleEndian, generate_uid
+    from pydicom.uid import UID, ExplicitVRLittleEndian, generate_uid
 
     meta = FileMetaDataset()
-    meta.MediaStorageSOPClassUID = "1.2.840.10008.5.1.4.1.1.2"
+    meta.MediaStorageSOPClassUID = UID("1.2.840.10008.5.1.4.1.1.2")
     meta.MediaStorageSOPInstanceUID = generate_uid(entropy_srcs=["volviz-robustness"])
     meta.TransferSyntaxUID = ExplicitVRLittleEndian
     ds = pydicom.Dataset()
@@ -97,7 +97,7 @@ def _npy(path: Path) -> None:
 
 
 def _las(path: Path) -> None:
-    import laspy
+    import laspy  # type: ignore[import-untyped]   # laspy ships no type information
 
     header = laspy.LasHeader(point_format=3, version="1.2")
     header.scales, header.offsets = np.array([0.01, 0.01, 0.01]), np.array([500000.0, 5400000.0, 0.0])

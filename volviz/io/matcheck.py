@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 import re
+import mmap
 import struct
 import zlib
 from pathlib import Path
@@ -30,9 +31,10 @@ _CELL, _STRUCT, _OBJECT, _CHAR = 1, 2, 3, 4
 class _Bytes:
     """Forward-only access to a byte source: the file's bytes, or a zlib stream decompressed as far as asked."""
 
-    def __init__(self, data: bytes, compressed: bool = False) -> None:
+    def __init__(self, data: bytes | mmap.mmap, compressed: bool = False) -> None:
         self.raw, self.compressed = data, compressed
-        self.buf, self.base = (b"", 0) if compressed else (data, 0)
+        self.buf: bytes | mmap.mmap = b"" if compressed else data   # the plain stream: the bytes themselves
+        self.base = 0
         self.inflater = zlib.decompressobj() if compressed else None
         self.fed = 0
 
@@ -48,6 +50,8 @@ class _Bytes:
 
     def _more(self) -> bool:
         """Decompress one more chunk into the buffer; False at the end of the stream or of its input."""
+        if self.inflater is None:   # a plain stream: ``read`` slices the bytes themselves
+            return False
         if self.inflater.eof:
             return False
         if self.inflater.unconsumed_tail:
@@ -56,7 +60,7 @@ class _Bytes:
             data, self.fed = self.raw[self.fed:self.fed + _CHUNK], self.fed + _CHUNK
         else:
             return False
-        self.buf += self.inflater.decompress(data, _CHUNK)
+        self.buf = bytes(self.buf) + self.inflater.decompress(data, _CHUNK)
         return True
 
 
@@ -155,7 +159,7 @@ class _Walk:
                 self.matrix(src, sub, pos, where, depth + 1)
 
 
-def check_mat5(path: Path, data: bytes) -> None:
+def check_mat5(path: Path, data: bytes | mmap.mmap) -> None:
     """Refuse a v5 / v7 MAT-file (``data``: the whole file) whose element structure does not hold (see the module).
 
     Sparse, function-handle and opaque (class) variables are checked only to fit their container."""

@@ -170,6 +170,8 @@ class CloudPTVolume(GLPTVolume):
     ``reuse_order``), ``_vis``, ``topo`` (``_FrameGeometry``: a frame has no mesh topology), ``_on_update_shader``
     / ``_on_end`` (extended to bind the cloud textures and set the grid, octree and eye uniforms)."""
 
+    follows_camera = False   # the leaves' order comes with each frame (``set_frame``), for every camera
+
     def __init__(self, plotter: Any, leaves: CloudLeaves, lod: CloudLOD, shading: CloudShading, table: Any
                  ) -> None:
         from volviz.render.cloud_slots import LeafSlots

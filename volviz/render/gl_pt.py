@@ -270,6 +270,8 @@ class GLPTVolume(PTView):
 
     backend = "gpu"
     job = ("pt-order", "visibility order")   # the app's key for its updates, and what its worker makes
+    follows_camera = True   # during an interaction each frame starts its camera's sort (``_follow``); False: a
+    #                         subclass gives the order itself (``gl_nature.CloudPTVolume``: each frame's leaves)
 
     def __init__(self, plotter: Any, mesh: TetMesh, tf: Any, *, lookup: str = "3d", n_s: int | None = None,
                  n_l: int = 64, degree: int | None = None, sort: str = "mpvo", nonconvex: str = "auto",
@@ -315,7 +317,7 @@ class GLPTVolume(PTView):
         self.order_serial = 0
         self.frames: list[tuple[int, int]] = []     # (camera serial, order serial) of the last FRAME_LOG frames
         self._frame_key: Any = None
-        self._pending: tuple[int, Camera, tuple[int, int]] | None = None   # the frame sort on the worker
+        self._frame_sort: tuple[int, Camera, tuple[int, int]] | None = None   # the frame sort on the worker
         self._table: Any = None
         self._table_tex: Any = None
         self._targets: tuple[Any, ...] | None = None   # color, its FBO, depth, its FBO, format, drawn-size depth, FBO
@@ -412,7 +414,7 @@ class GLPTVolume(PTView):
         if key != self._frame_key:
             self.camera_serial += 1
             self._frame_key = key
-        newer = self._pending is not None and self._pending[0] > self.order_serial
+        newer = self._frame_sort is not None and self._frame_sort[0] > self.order_serial
         if key == self._order_key and self._sorted is not None and not self._recull and not newer:
             self._log_frame()
             return
@@ -420,7 +422,7 @@ class GLPTVolume(PTView):
         exact = self._sorted is not None and key == self._sorted_key
         res = None if exact or self._prefetcher is None else self._prefetcher.take(cam, size)
         serial, made_for = self.camera_serial, key
-        if not exact and res is None and self.reuse_order and self._sorted is not None:
+        if not exact and res is None and self.reuse_order and self._sorted is not None and self.follows_camera:
             res, serial, made_for = self._follow(cam, size)
         prefetched = res is not None
         if not exact and res is None and not (self.reuse_order and self._sorted is not None):
@@ -456,15 +458,15 @@ class GLPTVolume(PTView):
         from volviz.unstructured.prefetch import SortPrefetcher
 
         res, serial, made_for = None, self.order_serial, self._sorted_key
-        if self._pending is not None and self._pending[0] > self.order_serial:
-            p_serial, p_cam, p_size = self._pending
+        if self._frame_sort is not None and self._frame_sort[0] > self.order_serial:
+            p_serial, p_cam, p_size = self._frame_sort
             res = self._prefetcher.take(p_cam, p_size)
             if res is not None:
                 serial, made_for = p_serial, _order_key(p_cam, p_size)
         if self._prefetcher is None:
             self._prefetcher = SortPrefetcher(self.mesh, sort=self.sort, nonconvex=self.nonconvex)
         self._prefetcher.prefetch(cam, size)
-        self._pending = (self.camera_serial, cam, size)
+        self._frame_sort = (self.camera_serial, cam, size)
         return res, serial, made_for
 
     def begin(self, scale: int = 1) -> dict[str, Any]:
