@@ -23,7 +23,7 @@ from volviz.bench.offscreen import timed_renders
 from volviz.io.atomic import atomic_write_text
 
 REPO = Path(__file__).resolve().parents[2]
-SESSIONS = ("resources/sessions/yukon.json", "demo", "demo-volume")
+SESSIONS = ("resources/sessions/yukon.json", "demo")   # (a PT volume draws single-sampled on any driver)
 
 
 def _frame(plotter: Any, samples: int, reps: int) -> tuple[float, np.ndarray]:
