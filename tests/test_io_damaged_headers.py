@@ -132,3 +132,24 @@ def test_a_nrrd_space_direction_with_a_nan_is_refused(tmp_path):
     assert data.count(b"(0.5,0,0)") == 1
     assert _refusal(path, data.replace(b"(0.5,0,0)", b"(0.5,nan,0)")) == (
         ": NRRD space direction 0 is [0.5, nan, 0.0]: neither a vector of finite numbers nor 'none'")
+
+
+def _metaimage(tmp_path, dimsize: str, extra: bytes = b""):
+    (tmp_path / "v.raw").write_bytes(STACK.tobytes() + extra)                 # 6 x 5 x 4 (x fastest), 120 bytes
+    (tmp_path / "v.mhd").write_text(f"ObjectType = Image\nNDims = 3\nDimSize = {dimsize}\nElementType = MET_UCHAR\n"
+                                    "ElementDataFile = v.raw\n")
+    return tmp_path / "v.mhd"
+
+
+def test_a_metaimage_dimsize_that_claims_fewer_slices_than_its_data_file_holds_is_refused(tmp_path):
+    """The campaign's MetaImage bit flip (DimSize 48 62 42 -> 48 62 02): read as 48 x 62 x 2 from the first 5,952
+    of the data file's 124,992 bytes, without a word; a slice or more left over is refused, naming the header's
+    DimSize, both sizes and the data file; less than a slice (padding) is read with a ReadWarning."""
+    path = _metaimage(tmp_path, "6 5 3")
+    assert _refusal(path) == (f": data file {tmp_path / 'v.raw'}: its header gives DimSize 6 5 3 of MET_UCHAR: 90 "
+                              "bytes of data, but the file holds 30 bytes more (120 in all; one slice is 30 bytes): "
+                              "the header claims less data than the file holds")
+    with pytest.warns(vio.ReadWarning, match=r"v\.raw: 7 bytes follow the 120 bytes of data that its header gives "
+                                             r"\(DimSize 6 5 4 of MET_UCHAR\); they are ignored"):
+        volume = vio.read(_metaimage(tmp_path, "6 5 4", extra=b"padding"))
+    np.testing.assert_array_equal(volume.data, STACK.transpose(2, 1, 0))

@@ -16,6 +16,7 @@ from volviz.io._checks import (
     require_bytes,
 )
 from volviz.io.errors import PathLike, ReadError, ReadWarning, human_bytes
+from volviz.io.trailing import check_trailing
 from volviz.model import Image2D, RegularVolume, vec3
 
 ELEMENT_TYPES = {
@@ -220,6 +221,9 @@ def _read_metaimage(path: PathLike, allow_nonfinite: bool) -> RegularVolume | Im
         else:
             offset += header_size
             require_bytes(data_path, n_bytes, data_size - offset, what)
+            # a DimSize that claims fewer slices than the file holds would reinterpret the voxels (issue #32)
+            check_trailing(data_path, f"DimSize {' '.join(map(str, dims))} of {etype}", n_bytes,
+                           data_size - offset - n_bytes, n_bytes // dims[-1])
         values = np.frombuffer(read_at(data_path, offset, n_bytes), dtype=disk)
         if not disk.isnative:
             values = values.astype(disk.newbyteorder("="))
