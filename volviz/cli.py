@@ -129,7 +129,7 @@ def _reading(path: str | os.PathLike, q: Optional[str]) -> Iterator[None]:
     """Reading ``path`` (with the PLOT3D solution file ``q``) inside: a missing ``q`` and an option the reader does not
     take are usage errors, and a solution file given alone says what to do instead of failing to read."""
     from volviz.io import ReadError
-    from volviz.io.registry import ReaderOptionError
+    from volviz.io.loaders import ReaderOptionError
 
     if q is not None and not Path(q).is_file():
         raise UsageError(f"--q {q}: no such file")

@@ -28,40 +28,11 @@ Float data holding NaN/Inf is kept (renderers draw it transparent) with a ``NonF
 """
 from __future__ import annotations
 
-import functools
-import os
-from typing import Any
-
-from volviz.io.errors import ChoiceWarning, NonFiniteWarning, PathLike, ReadError, ReadWarning
-from volviz.io.folders import folder_target
+from volviz.io.errors import ChoiceWarning, NonFiniteWarning, ReadError, ReadWarning
 from volviz.io.raw import read_raw, read_slice_stack
-from volviz.io.registry import (ReaderSpec, call_reader, format_of, is_pattern, open_dialog_filter, reader_specs,
-                                supported_formats)
-from volviz.io.series import expand_pattern, read_series
-
-
-def read(path: PathLike, isolate: bool | None = None, **options: Any):
-    """Read any supported file (or a series pattern: a glob, ``name%02d.ext`` or a list) into a model dataset.
-
-    The format comes from the reader registry (options, folder markers, the name, else the file's magic bytes).
-    Options go to the format's reader (e.g. ``q=`` for PLOT3D, ``dims=, dtype=, byteorder=`` for raw files,
-    ``vtk_compatible=`` for DEM, ``blocks=`` for multiblock files, ``allow_nonfinite=``). Raises ReadError for bad
-    or unsupported files. Readers of native code (VTK, HDF5) run in a child process with memory and time limits, so
-    a file that crashes them gives a ReadError too; ``isolate=False`` (or ``VOLVIZ_ISOLATE=0``) reads in-process,
-    for debugging (``volviz.io.isolated``).
-    """
-    if is_pattern(path):
-        if isolate is None:
-            return read_series(path, **options)
-        return read_series(path, reader=functools.partial(read, isolate=isolate), **options)
-    try:
-        kind = format_of(path, options)
-    except ReadError:
-        target = folder_target(path) if os.path.isdir(path) else None
-        if target is None:
-            raise
-        return read(target, isolate, **options)      # a folder of output: its collection file or numbered series
-    return call_reader(kind, path, options, isolate)
+from volviz.io.reading import read, read_series
+from volviz.io.registry import ReaderSpec, format_of, open_dialog_filter, reader_specs, supported_formats
+from volviz.io.series import expand_pattern
 
 
 def __getattr__(name: str):
@@ -80,7 +51,7 @@ def __getattr__(name: str):
 
 __all__ = [
     "ChoiceWarning", "NonFiniteWarning", "ReadError", "ReadWarning", "ReaderSpec", "reader_specs", "expand_pattern",
-    "open_dialog_filter", "read", "read_dem", "read_image", "read_meshio", "read_metaimage", "read_plot3d",
+    "format_of", "open_dialog_filter", "read", "read_dem", "read_image", "read_meshio", "read_metaimage", "read_plot3d",
     "read_pnm", "read_pvm", "read_raw", "read_series", "read_slc", "read_slice_stack", "read_vtk_file", "read_vtkhdf",
     "supported_formats",
 ]

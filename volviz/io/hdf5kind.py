@@ -86,7 +86,8 @@ def hdf5_kind(path: PathLike) -> str | None:
 def read_as_kind(path: PathLike, kind: str, allow_nonfinite: bool = True) -> Any:
     """Read an HDF5 file of ``kind`` with the reader registered for it; a ReadError saying what the file is and what
     to do when no such reader is installed (the plugin's formats: Fluent CFF, CGNS, Exodus, netCDF)."""
-    from volviz.io.registry import get_reader, loader_call
+    from volviz.io.loaders import loader_call
+    from volviz.io.registry import get_reader
 
     spec_name, words = KINDS[kind]
     try:

@@ -102,7 +102,8 @@ def check_reader_options(path: PathLike, options: dict[str, Any]) -> None:
     """Check ``options`` against the reader that would read ``path``: every option one it takes, every parameter it
     needs given, every value of the annotated type. Raises :class:`OptionProblem`; a path whose reader cannot be
     found (missing, unknown format, a series pattern, a ``.vvz``) is left to the read, which reports it."""
-    from volviz.io.registry import ReaderOptionError, is_pattern, loader_call, spec_of
+    from volviz.io.loaders import ReaderOptionError, loader_call
+    from volviz.io.registry import is_pattern, spec_of
 
     if is_pattern(path) or os.fspath(path).lower().endswith(".vvz"):
         return

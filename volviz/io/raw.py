@@ -12,6 +12,7 @@ from numpy.typing import DTypeLike
 
 from volviz.io._checks import check_dims, check_finite, describe_dims, file_size, read_at
 from volviz.io.errors import PathLike, ReadError, human_bytes
+from volviz.io.series import expand_pattern
 from volviz.model import Image2D, RegularVolume, vec3
 
 _BYTEORDERS: dict[str, Literal["<", ">", "="]] = {"little": "<", "<": "<", "big": ">", ">": ">", "native": "=",
@@ -81,8 +82,6 @@ def read_slice_stack(pattern: str | Sequence[PathLike], dims: Sequence[int], dty
     their number (``quarter.2`` before ``quarter.10``) and stacked along z. Every file's size is checked before
     anything is allocated.
     """
-    from volviz.io.series import expand_pattern
-
     paths = [p for _, p in expand_pattern(pattern)]
     nx, ny, *rest = check_dims(str(pattern), dims, "slice dimensions")
     if rest and rest[0] != len(paths):

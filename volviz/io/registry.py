@@ -20,8 +20,6 @@ function returning either.
 from __future__ import annotations
 
 import fnmatch
-import importlib
-import inspect
 import os
 import re
 import stat
@@ -31,7 +29,9 @@ from pathlib import Path
 from typing import Any, Callable, Iterable, Union
 
 from volviz.io._checks import check_file, describe_bytes, read_bytes
+from volviz.io import isolated
 from volviz.io.errors import PathLike, ReadError
+from volviz.io.loaders import loader_call, resolve
 
 ENTRY_POINT_GROUP = "volviz.readers"
 HEAD_BYTES = 4096
@@ -92,7 +92,7 @@ class ReaderSpec:
         if isinstance(self.patterns, tuple):
             return self.patterns
         if "globs" not in self._cache:
-            self._cache["globs"] = tuple(_resolve(self.patterns)())
+            self._cache["globs"] = tuple(resolve(self.patterns)())
         return self._cache["globs"]
 
     def matches_name(self, name: str) -> bool:
@@ -103,7 +103,7 @@ class ReaderSpec:
         """Whether the sniffer recognises ``head`` (False without a sniffer)."""
         if self.sniff is None:
             return False
-        sniff = _resolve(self.sniff) if isinstance(self.sniff, str) else self.sniff
+        sniff = resolve(self.sniff) if isinstance(self.sniff, str) else self.sniff
         return bool(sniff(head))
 
     def opens_folder(self, folder: Path) -> bool:
@@ -115,7 +115,7 @@ class ReaderSpec:
         return self.sniffs_folders and any(self.accepts(_head_or_empty(f)) for f in _first_files(folder))
 
     def load_function(self) -> Callable[..., Any]:
-        return _resolve(self.loader)
+        return resolve(self.loader)
 
 
 FOLDER_SNIFF_FILES = 8  # files of a folder a ``sniffs_folders`` spec looks into
@@ -135,13 +135,6 @@ def _head_or_empty(path: Path) -> bytes:
         return read_bytes(path, HEAD_BYTES)
     except ReadError:
         return b""
-
-
-def _resolve(target: str) -> Callable[..., Any]:
-    module, _, attr = target.partition(":")
-    if not module or not attr:
-        raise ValueError(f"reader target {target!r} is not 'module:function'")
-    return getattr(importlib.import_module(module), attr)
 
 
 # -- volviz's own readers ----------------------------------------------------------------------------------------------
@@ -394,27 +387,6 @@ def format_of(path: PathLike, options: dict) -> str:
     return spec_of(path, options).name
 
 
-class ReaderOptionError(TypeError):
-    """An option the reader does not take."""
-
-
-def loader_call(kind: str, loader: str, options: dict) -> tuple[Callable[..., Any], dict]:
-    """The loader function named ``loader`` and the options to call it with: ``allow_nonfinite`` is dropped for
-    readers of integer-only formats, any other option it does not take is a ReaderOptionError naming it."""
-    f = _resolve(loader)
-    params = inspect.signature(f).parameters
-    accepts_kwargs = any(p.kind is inspect.Parameter.VAR_KEYWORD for p in params.values())
-    opts = dict(options)
-    if "allow_nonfinite" in opts and "allow_nonfinite" not in params and not accepts_kwargs:
-        opts.pop("allow_nonfinite")
-    unknown = [k for k in opts if k not in params and not accepts_kwargs]
-    if unknown:
-        taken = [name for name in list(params)[1:] if params[name].kind is not inspect.Parameter.VAR_KEYWORD]
-        raise ReaderOptionError(f"the {kind} reader does not take option(s) {', '.join(unknown)}; it takes "
-                                f"{', '.join(taken) or 'none'}")
-    return f, opts
-
-
 def call_reader(kind: str, path: PathLike, options: dict, isolate: bool | None = None):
     """Call the reader registered as ``kind`` (see ``loader_call`` for the options).
 
@@ -423,8 +395,6 @@ def call_reader(kind: str, path: PathLike, options: dict, isolate: bool | None =
     """
     spec = get_reader(kind)
     if spec.isolated:
-        from volviz.io import isolated
-
         if isolated.isolation_enabled(isolate):
             return isolated.read_isolated(spec, path, options)
     f, opts = loader_call(kind, spec.loader, options)

@@ -1,6 +1,6 @@
 """Numbered file series: ``Storm.pvm-t01..t21``, ``quarter.1..93``, given as a list, a glob or a printf pattern.
 
-``read_series`` turns them into one TimeSeries whose frames are read lazily (frame 0 is read at once so that a
+``lazy_series`` turns them into one TimeSeries whose frames are read lazily (frame 0 is read at once so that a
 bad series fails fast).
 """
 from __future__ import annotations
@@ -72,7 +72,7 @@ def series_times(items: Sequence[tuple[int | None, object]]) -> list[float]:
 
 
 def member_time(pattern: str | PathLike, member: PathLike) -> float | None:
-    """The time at which ``read_series(pattern)`` shows the file ``member`` (None when it is not in the series)."""
+    """The time at which ``lazy_series(pattern, ...)`` shows the file ``member`` (None when it is not in the series)."""
     items = expand_pattern(pattern)
     target = os.path.realpath(os.fspath(member))
     for (_, path), t in zip(items, series_times(items)):
@@ -81,20 +81,16 @@ def member_time(pattern: str | PathLike, member: PathLike) -> float | None:
     return None
 
 
-def read_series(paths_or_pattern: str | PathLike | Sequence[PathLike],
-                reader: Callable[..., object] | None = None, times: Sequence[float] | None = None,
-                **options) -> TimeSeries:
-    """A TimeSeries of every file of a numbered series, read lazily with ``reader`` (default ``volviz.io.read``).
+def lazy_series(paths_or_pattern: str | PathLike | Sequence[PathLike], reader: Callable[..., object],
+                times: Sequence[float] | None = None, **options) -> TimeSeries:
+    """A TimeSeries of every file of a numbered series, read lazily with ``reader`` (``volviz.io.read_series`` passes
+    ``volviz.io.read``: the reader is an argument, so this module stays below the one that reads any file).
 
     Globs and printf patterns are sorted by the number in the file name; an explicit list keeps its order. Times
     are those numbers when they increase strictly along the series (``t01`` -> 1.0), else 0, 1, 2...; ``times``
     overrides them. Frame 0 is read now; every later frame must have frame 0's kind and dimensions.
     """
     items = expand_pattern(paths_or_pattern)
-    if reader is None:
-        from volviz.io import read
-
-        reader = read
     read_frame: Callable[..., Any] = reader  # frames of any kind, checked against frame 0 below
     paths = [p for _, p in items]
     if times is None:

@@ -36,6 +36,7 @@ import numpy as np
 from volviz.io.errors import ChoiceWarning, NonFiniteWarning, PathLike, ReadError, ReadWarning, human_bytes
 from volviz.io.isolated.codec import CodecError, array_specs, decode
 from volviz.io.isolated.worker import ChildDied, ChildTimedOut, Pool
+from volviz.io.loaders import ReaderOptionError
 
 GIB = 1 << 30
 WORKDIR_PREFIX = "volviz-read-"
@@ -321,8 +322,6 @@ class _Read:
             advice = answer.get("advice") if isinstance(answer.get("advice"), str) else None
             return ReadError(self.shown if path in (self.path, "") else path, problem, advice)
         if kind == "options":
-            from volviz.io.registry import ReaderOptionError
-
             return ReaderOptionError(str(answer.get("message")))
         if kind == "memory":
             return self.fail(f"{engine(self.spec)} needs more memory than the limit of {human_bytes(memory)} "

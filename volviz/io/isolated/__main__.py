@@ -94,7 +94,7 @@ class Child:
         """The loader's dataset, or with ``frame`` one frame of the time series it returns. A lazy series stays open
         here (the last few, keyed by loader, path, options and the file's mtime and size) for its later frames,
         holding frame 0 only: a frame handed back is dropped again."""
-        from volviz.io.registry import loader_call
+        from volviz.io.loaders import loader_call
 
         f, opts = loader_call(request["kind"], request["loader"], request["options"])
         frame = request.get("frame")
@@ -125,7 +125,7 @@ class Child:
 
         from volviz.io.errors import ReadError
         from volviz.io.isolated.codec import CodecError, encode
-        from volviz.io.registry import ReaderOptionError
+        from volviz.io.loaders import ReaderOptionError
 
         for entry in request.get("sys_path", []):
             if isinstance(entry, str) and entry not in sys.path:
