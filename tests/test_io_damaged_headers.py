@@ -66,6 +66,22 @@ def test_tiff_directories_that_do_not_hold(tmp_path):
                                     "is damaged")
 
 
+def test_tiff_pages_whose_tags_split_the_stack_are_refused(tmp_path):
+    """The campaign's TIFF bit flips (issue #32): the shape description's tag code damaged and page 3's
+    Compression entry typed BYTE instead of SHORT made tifffile split the 6 pages into two series, and the stack
+    was read as 5 pages without a word. Now refused, naming the page groups and the tag that differs."""
+    data, entry = _tiff(tmp_path)
+    data[entry[270] + 1] ^= 0x80                                   # ImageDescription (270) -> an unknown tag
+    with tifffile.TiffFile(tmp_path / "s.tif") as tif:
+        third = tif.pages[2].offset
+    count = struct.unpack_from("<H", data, third)[0]
+    at = next(third + 2 + 12 * i for i in range(count) if struct.unpack_from("<H", data, third + 2 + 12 * i)[0] == 259)
+    data[at + 2:at + 4] = struct.pack("<H", 1)                     # Compression: type SHORT -> BYTE (value 1 kept)
+    assert _refusal(tmp_path / "split.tif", data) == (
+        ": its pages are 5x6 uint8 images alike, but their tags split them into 2 stacks (pages 1-2, 4; 3; tags that "
+        "differ: Compression (SHORT <COMPRESSION.NONE: 1> / BYTE b'\\x01')): the file is damaged or mixes stacks")
+
+
 def test_a_damaged_tiff_shape_description_is_not_echoed(tmp_path):
     data, _ = _tiff(tmp_path)
     at = data.find(b'{"shape": [4, 5, 6]}')

@@ -97,6 +97,60 @@ def _spacing(tif: Any) -> tuple[float, float, float]:
     return sx or 1.0, sy or sx or 1.0, sz or 1.0
 
 
+def _pages(indices: list[int]) -> str:
+    """``"1-2, 4-6"``: 1-based page numbers as runs."""
+    runs: list[list[int]] = []
+    for i in sorted(indices):
+        if runs and i == runs[-1][1] + 1:
+            runs[-1][1] = i
+        else:
+            runs.append([i, i])
+    return ", ".join(f"{a + 1}" if a == b else f"{a + 1}-{b + 1}" for a, b in runs)
+
+
+def check_one_stack(path: PathLike, tif: Any) -> None:
+    """Refuse pages of the stack's size and type that tifffile puts in a series of their own: their tags differ
+    from the stack's (a damaged tag type or code, issue #32), and reading the first series would leave them out
+    without a word, or read one page as an image. Files whose metadata defines the series (OME, ImageJ) and pages
+    of another size (thumbnails, masks) are not concerned."""
+    first = tif.series[0]
+    if len(tif.series) < 2 or first.kind not in ("generic", "shaped", "uniform") or first.keyframe is None:
+        return
+    alike = [s for s in tif.series if s.kind == first.kind and s.keyframe is not None
+             and s.keyframe.shape == first.keyframe.shape and s.dtype == first.dtype]
+    if len(alike) > 1:
+        groups = "; ".join(_pages([p.index for p in s.pages if p is not None]) for s in alike)
+        h, w = first.keyframe.shape[:2]
+        raise ReadError(path, f"its pages are {h}x{w} {first.dtype} images alike, but their tags split them into "
+                              f"{len(alike)} stacks (pages {groups}; tags that differ: "
+                              f"{_tag_differences(_neighbour(tif, alike[1].keyframe), alike[1].keyframe)}): the file is "
+                              "damaged or "
+                              "mixes stacks")
+
+
+def _neighbour(tif: Any, page: Any) -> Any:
+    """The page before ``page`` in the file (the one after it for the first), with its tags."""
+    other = tif.pages[page.index - 1 if page.index else page.index + 1]
+    return other if hasattr(other, "tags") else tif.series[0].keyframe
+
+
+def _tag_differences(a: Any, b: Any) -> str:
+    """``"Compression (SHORT 1 / BYTE b'\\x01')"``: the tags two pages hold with another type or value."""
+    def tags(page: Any) -> dict[int, Any]:
+        return {t.code: t for t in page.tags.values()}
+
+    ta, tb = tags(a), tags(b)
+    out = []
+    for code in sorted(set(ta) | set(tb)):
+        x, y = ta.get(code), tb.get(code)
+        if code in (270, 273, 305, 324) or (x is not None and y is not None and x.dtype == y.dtype
+                                       and repr(x.value) == repr(y.value)):
+            continue  # strip and tile offsets differ from page to page; description and software: the first only
+        show = lambda t: "none" if t is None else f"{t.dtype.name} {t.value!r}"[:40]  # noqa: E731
+        out.append(f"{(x or y).name} ({show(x)} / {show(y)})")
+    return ", ".join(out[:4]) or "none of the usual ones"
+
+
 def _check_size(path: PathLike, series: Any, tif: Any) -> None:
     needed = int(np.prod(series.shape, dtype=object)) * np.dtype(series.dtype).itemsize
     size = file_size(path)
@@ -164,6 +218,7 @@ def _read(path: PathLike, allow_nonfinite: bool, tifffile: Any) -> RegularVolume
         with tifffile.TiffFile(str(path)) as tif:
             if not tif.series:
                 return None
+            check_one_stack(path, tif)
             series = tif.series[0]
             layout = _layout(path, series.axes, tuple(series.shape))
             if layout is None:
