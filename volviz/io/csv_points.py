@@ -6,8 +6,9 @@ them; a Leica .pts point count before the rows is skipped); .csv and .tsv tables
 and z (any case; ParaView's own exports name them ``Points:0``, ``Points:1``, ``Points:2``) place the points, or the
 columns the options ``x=``, ``y=``, ``z=`` name; a table without a z column lies in the z = 0 plane. Every other
 numeric column is an array on the points; columns of text are left out (named in a warning). Comma, semicolon, tab
-or blank separated; ``#`` starts a comment. Rows whose coordinates are missing are left out with a warning. The
-points are vertices of an ``UnstructuredMesh``, drawn as points coloured by an array.
+or blank separated; ``#`` starts a comment. Rows whose coordinates are missing, and rows of another number of
+fields than the header's, are left out with a warning. The points are vertices of an ``UnstructuredMesh``, drawn
+as points coloured by an array.
 """
 from __future__ import annotations
 
@@ -77,22 +78,47 @@ def _coordinate_columns(p: Path, names: list[str], asked: tuple[str | None, ...]
     return out
 
 
-def _numbers(p: Path, sep: str | None, skip: int, columns: list[int]) -> np.ndarray:
+def _numbers(p: Path, sep: str | None, skip: int, columns: list[int], n_fields: int) -> np.ndarray:
     """The ``columns`` of the rows after the first ``skip`` lines as float64 (rows, columns): NumPy's fast parser
-    when every row is complete (about 10x genfromtxt's speed: a million rows in 0.2 s), else genfromtxt, which reads
-    missing values as NaN and leaves out rows of the wrong length."""
+    when every row is complete (about 10x genfromtxt's speed: a million rows in 0.2 s; with every column numeric it
+    also refuses a row of another length), else ``_complete_rows`` and genfromtxt, which reads missing values as NaN."""
+    if len(columns) < n_fields:                 # columns of text: the fast parser would not see a row's length
+        return _parse(p, sep, _complete_rows(p, sep, skip, n_fields), columns)
     try:
-        return np.loadtxt(p, delimiter=sep, skiprows=skip, usecols=columns, comments="#", dtype=np.float64, ndmin=2,
+        return np.loadtxt(p, delimiter=sep, skiprows=skip, comments="#", dtype=np.float64, ndmin=2,
                           encoding="utf-8")
     except (ValueError, UnicodeDecodeError):
-        pass
+        return _parse(p, sep, _complete_rows(p, sep, skip, n_fields), columns)
+
+
+def _parse(p: Path, sep: str | None, rows: list[str], columns: list[int]) -> np.ndarray:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")     # genfromtxt's per-row conversion warnings
         try:
-            return np.genfromtxt(p, delimiter=sep, skip_header=skip, usecols=columns, comments="#", dtype=np.float64,
-                                 invalid_raise=False, ndmin=2, encoding="utf-8")
+            return np.genfromtxt(rows, delimiter=sep, usecols=columns, comments="#", dtype=np.float64,
+                                 ndmin=2, encoding="utf-8")
         except (ValueError, UnicodeDecodeError) as exc:
             raise ReadError(p, f"has rows that cannot be read as numbers ({str(exc)[:200]})") from None
+
+
+def _complete_rows(p: Path, sep: str | None, skip: int, n_fields: int) -> list[str]:
+    """The rows after the first ``skip`` lines that hold the ``n_fields`` fields the header names; the others (a
+    row cut short by a truncated file, a decimal point turned into a comma) are left out with a ReadWarning naming
+    the first of them: before, genfromtxt dropped them without a word (issue #32)."""
+    with open(p, encoding="utf-8", errors="replace") as f:
+        lines = f.read().splitlines()[skip:]
+    good, bad = [], []
+    for number, line in enumerate(lines, start=skip + 1):
+        if not line.strip() or line.lstrip().startswith("#"):
+            continue
+        fields = _fields(line.split("#", 1)[0], sep)
+        count = len(fields) - (len(fields) == n_fields + 1 and not fields[-1])   # a separator ending the row
+        (good if count == n_fields else bad).append(line if count == n_fields else (number, count))
+    if bad:
+        warnings.warn(f"{p}: {len(bad):,} of {len(good) + len(bad):,} rows do not hold the {n_fields} fields its "
+                      f"header names (line {bad[0][0]} holds {bad[0][1]}) and are left out", ReadWarning,
+                      stacklevel=4)
+    return good
 
 
 def _rows(lines: list[str]) -> list[str]:
@@ -193,12 +219,13 @@ def _read_points(path: PathLike, asked: tuple[str | None, str | None, str | None
               if line.strip() and not line.lstrip().startswith("#")]
     if not sample:
         raise ReadError(p, "has a header row but no rows of values")
-    numeric = [i for i in range(len(names)) if all(i < len(row) and (_number(row[i]) or not row[i]) for row in sample)]
+    full = [row for row in sample if len(row) == len(names)] or sample  # a row cut short does not make text
+    numeric = [i for i in range(len(names)) if all(i < len(row) and (_number(row[i]) or not row[i]) for row in full)]
     for axis, col in enumerate(columns):
         if col is not None and col not in numeric:
             raise ReadError(p, f"its {'xyz'[axis]} column {names[col]!r} holds text, not numbers")
     text = [names[i] for i in range(len(names)) if i not in numeric]
-    table = _numbers(p, sep, skip, numeric)
+    table = _numbers(p, sep, skip, numeric, len(names))
     if table.size == 0:
         raise ReadError(p, "has no rows of numbers under its header")
     at = {col: k for k, col in enumerate(numeric)}
