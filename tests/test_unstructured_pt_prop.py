@@ -183,23 +183,6 @@ def test_preview_renders_a_smaller_image_cut_at_the_nearest_depth(scene):
     assert h.image.shape == (SIZE[1], SIZE[0], 4)
 
 
-def test_bleed_color_gives_transparent_edge_pixels_their_neighbours_color():
-    """Magnified previews interpolate straight alpha: a transparent pixel beside visible ones takes their mean color
-    (no dark fringe), keeps alpha 0; visible pixels and transparent ones away from any are unchanged."""
-    from volviz.render.image_overlay import bleed_color
-
-    img = np.zeros((4, 5, 4), np.uint8)
-    img[1, 1] = [200, 40, 0, 255]
-    img[1, 2] = [100, 80, 0, 128]
-    out = bleed_color(img)
-    assert np.array_equal(out[1, 1], img[1, 1]) and np.array_equal(out[1, 2], img[1, 2])
-    assert np.array_equal(out[..., 3], img[..., 3])
-    assert np.array_equal(out[0, 0], [200, 40, 0, 0])            # one visible neighbour
-    assert np.array_equal(out[0, 1], [150, 60, 0, 0])            # the mean of two
-    assert np.array_equal(out[1, 3], [100, 80, 0, 0])
-    assert np.array_equal(out[:, 4], np.zeros((4, 4))) and np.array_equal(out[3, 0], [0, 0, 0, 0])
-
-
 def test_a_request_is_of_the_mesh_shown_at_begin_though_a_cut_is_shown_meanwhile(scene):
     """The app shows a clipping's cut (``show_cut``) while a render or an error estimate of the uncut mesh may still
     run on a worker: both stay of the mesh of their ``begin``. (An estimate that rendered the uncut mesh fast and

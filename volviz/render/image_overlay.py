@@ -40,8 +40,9 @@ from typing import Any
 import numpy as np
 
 from volviz.render.backend import plotter_gl_info
+from volviz.render.preview_upsample import upsample_preview
 
-__all__ = ["ImageOverlay", "OverlayView", "bleed_color", "block_min", "overlay_rgba8", "read_buffers",
+__all__ = ["ImageOverlay", "OverlayView", "block_min", "overlay_rgba8", "read_buffers",
            "single_sample_on_software", "unpremultiply_rgba8", "zbuffer_to_depth"]
 
 _SIBLINGS = "_volviz_pt_overlays"           # plotter attribute: every overlay renderer of the plotter
@@ -74,32 +75,13 @@ def block_min(depth: np.ndarray, size: tuple[int, int]) -> np.ndarray:
     return np.minimum.reduceat(np.minimum.reduceat(depth, rows, axis=0), cols, axis=1)
 
 
-def bleed_color(rgba8: np.ndarray) -> np.ndarray:
-    """Straight-alpha RGBA8 with each transparent pixel next to visible ones given their mean color (alpha stays
-    0). Linear interpolation of straight alpha mixes a visible pixel's color with its transparent neighbour's; with
-    that color black (``unpremultiply_rgba8``) a magnified image got dark fringes at its edges."""
-    out = np.array(rgba8, dtype=np.uint8, copy=True)
-    seen = (out[..., 3] > 0).astype(np.float64)
-    col = out[..., :3].astype(np.float64) * seen[..., None]
-    pad_c = np.pad(col, ((1, 1), (1, 1), (0, 0)))
-    pad_s = np.pad(seen, 1)
-    h, w = seen.shape
-    total = np.zeros_like(col)
-    count = np.zeros_like(seen)
-    for dy, dx in ((0, 1), (2, 1), (1, 0), (1, 2), (0, 0), (0, 2), (2, 0), (2, 2)):
-        total += pad_c[dy:dy + h, dx:dx + w]
-        count += pad_s[dy:dy + h, dx:dx + w]
-    fill = (seen == 0) & (count > 0)
-    out[fill, :3] = np.rint(total[fill] / count[fill, None]).astype(np.uint8)
-    return out
-
-
-def overlay_rgba8(image: np.ndarray, preview: bool = False) -> np.ndarray:
-    """Premultiplied float RGBA as ``ImageOverlay.show`` takes it: straight-alpha RGBA8 (``unpremultiply_rgba8``),
-    for a preview (magnified when shown) with its edge colors bled (``bleed_color``). Made on a worker where
-    possible (``PTVolume.compute``): the bleeding takes ~16 ms for a 500 x 350 preview."""
-    rgba8 = unpremultiply_rgba8(image)
-    return bleed_color(rgba8) if preview else rgba8
+def overlay_rgba8(image: np.ndarray, request: dict[str, Any] | None = None) -> np.ndarray:
+    """Premultiplied float RGBA as ``ImageOverlay.show`` takes it: straight-alpha RGBA8 (``unpremultiply_rgba8``);
+    a preview of ``request`` (``OverlayView.begin`` with ``scale`` > 1) magnified to the window first
+    (``preview_upsample``). Made on a worker where possible (``PTVolume.compute``)."""
+    if request is not None and request.get("preview") and "window_depth" in request:
+        image = upsample_preview(image, request["depth"], request["window_depth"])
+    return unpremultiply_rgba8(image)
 
 
 def unpremultiply_rgba8(image: np.ndarray) -> np.ndarray:
@@ -198,11 +180,10 @@ class ImageOverlay:
             o.SetDraw(on)
         return out
 
-    def show(self, rgba8: np.ndarray, visible: bool = True, render: bool = True, smooth: bool = False) -> None:
+    def show(self, rgba8: np.ndarray, visible: bool = True, render: bool = True) -> None:
         """Upload straight-alpha RGBA8 (H, W, 4), row 0 at the top, and redraw the window unless ``render`` is False
-        or the plotter's rendering is suppressed. The image fills the window whatever its size; ``smooth``: an image
-        smaller than the window (a preview, ``overlay_rgba8``) is magnified with linear interpolation instead of pixel
-        blocks."""
+        or the plotter's rendering is suppressed. The image fills the window whatever its size (pixel blocks where
+        it is smaller: a preview is magnified by ``overlay_rgba8`` before)."""
         from volviz.render.vtk_facade import numpy_to_vtk
 
         h, w = rgba8.shape[:2]
@@ -219,7 +200,6 @@ class ImageOverlay:
         oc.SetViewUp(0.0, 1.0, 0.0)
         oc.SetParallelScale(h / 2.0)
         oc.SetClippingRange(0.5, 1.5)
-        self.actor.SetInterpolate(bool(smooth))
         self.renderer.SetDraw(bool(visible))
         if render and not getattr(self.plotter, "suppress_rendering", False):
             self.plotter.ren_win.Render()
@@ -276,8 +256,8 @@ class OverlayView:
     def begin(self, scale: int = 1) -> dict[str, Any]:
         """GUI-thread part 1: the opaque scene's depth and color, the camera and the image size: the window's, or
         for a preview (``scale`` > 1, e.g. while the camera moves) the window's divided by ``scale``, with the depth
-        limit of each preview pixel the nearest opaque depth under it (``block_min``) and the scene color at its
-        first pixel."""
+        limit of each preview pixel the nearest opaque depth under it (``block_min``), the scene color at its
+        first pixel and the window's own depth (``window_depth``, for ``upsample_preview``)."""
         from volviz.model.camera import Camera
 
         t_start = time.perf_counter()
@@ -291,11 +271,15 @@ class OverlayView:
         size = (w, h)
         if scale > 1:
             size = (max(1, w // int(scale)), max(1, h // int(scale)))
+            window_depth = depth
             depth = block_min(depth, size)
             rows, cols = _block_starts(rgb.shape, size)
             rgb = rgb[rows][:, cols]
-        return {"camera": cam, "depth": depth, "rgb": rgb, "size": size, "preview": scale > 1, "t_start": t_start,
-                "t_read": time.perf_counter()}
+        request = {"camera": cam, "depth": depth, "rgb": rgb, "size": size, "preview": scale > 1,
+                   "t_start": t_start, "t_read": time.perf_counter()}
+        if scale > 1:
+            request["window_depth"] = window_depth
+        return request
 
     def compute(self, request: dict[str, Any], progress: Any = None) -> tuple[Any, ...]:
         """Any-thread part: (premultiplied image, statistics with ``total_s``[, straight-alpha RGBA8])."""
@@ -307,8 +291,7 @@ class OverlayView:
         plotter's rendering is suppressed (the caller then draws once itself)."""
         t_show = time.perf_counter()
         w, h = request["size"]
-        preview = request.get("preview", False)
-        self._overlay.show(overlay_rgba8(img, preview) if rgba8 is None else rgba8, smooth=preview)
+        self._overlay.show(overlay_rgba8(img, request) if rgba8 is None else rgba8)
         t_end = time.perf_counter()
         depth = request["depth"]
         self.image, self.depth, self.scene_rgb, self.camera = img, depth, request["rgb"], request["camera"]

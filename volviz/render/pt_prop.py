@@ -93,8 +93,8 @@ class PTVolume(OverlayView, PTView):
 
     def compute(self, request: dict[str, Any], progress: Any = None) -> tuple[np.ndarray, Any, np.ndarray]:
         """Any-thread part: the volume image for a request of ``begin`` (pure NumPy/Numba, no VTK), its statistics,
-        and the image as VTK will show it (``overlay_rgba8``: straight-alpha 8-bit RGBA, a preview's edge colors
-        bled), made here so that ``finish`` on the GUI thread only hands it over."""
+        and the image as VTK will show it (``overlay_rgba8``: straight-alpha 8-bit RGBA, a preview magnified
+        to the window), made here so that ``finish`` on the GUI thread only hands it over."""
         if progress is not None:
             progress(0.0, "rendering volume")
         opts = dict(self.render_opts)
@@ -108,7 +108,7 @@ class PTVolume(OverlayView, PTView):
         img, st = render(mesh, request["tf"], request["camera"], request["size"], self.method,
                          depth=request["depth"], return_stats=True, **opts)
         st.extra["sort_prefetched"] = res is not None
-        return img, st, overlay_rgba8(img, request.get("preview", False))
+        return img, st, overlay_rgba8(img, request)
 
     def prefetch(self, camera: Camera, size: tuple[int, int] | None = None) -> None:
         """Sort the mesh for ``camera`` (the next frame's; ``size`` defaults to the window's) in the background, so
