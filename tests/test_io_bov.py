@@ -3,6 +3,7 @@ components, offsets, and headers or data files that do not fit."""
 from __future__ import annotations
 
 import random
+import warnings
 
 import numpy as np
 import pytest
@@ -67,3 +68,24 @@ def test_mutated_headers_read_consistently_or_raise_read_error(tmp_path):
     mutations = [rb.flip_bits(data, rng, len(data)) for _ in range(24)]
     mutations += [rb.truncate(data, at) for at in sorted(rng.sample(range(1, len(data)), 12))]
     assert read_mutations(path, mutations, truncated_reads_same=True) >= 12
+
+
+def test_a_header_cut_within_a_line_warns_naming_the_defaults_it_reads_with(tmp_path):
+    """Issue #32 (the new-format campaign's BOV truncations): a header cut within ``VARIABLE: density`` lost
+    ``DATA_ENDIAN: BIG`` and read every sample byte-swapped, without a word. A last line without its line end,
+    with keys left to their defaults, is now a ReadWarning naming the line and those defaults; a header ending with
+    its line end, or one that sets every key, says nothing."""
+    big = HEADER.replace("LITTLE", "BIG")
+    cut = big[:big.index("VARIABLE: dens") + len("VARIABLE: dens")]
+    path = _brick(tmp_path, cut, VALUES.astype(">f4").tobytes(order="F"))
+    with pytest.warns(vio.ReadWarning) as caught:
+        vio.read(path, isolate=False)
+    assert [str(w.message) for w in caught] == [
+        f"{path}: its header's last line ('VARIABLE: dens') has no line end: if the header was cut short, keys are "
+        "missing and read with their defaults (DATA_ENDIAN LITTLE, CENTERING zonal, BRICK_ORIGIN 0 0 0, BRICK_SIZE "
+        "DATA_SIZE, DATA_COMPONENTS 1, BYTE_OFFSET 0)"]
+    full = HEADER + "DATA_COMPONENTS: 1\nBYTE_OFFSET: 0"                # every key set, no final line end
+    for header in (cut + "\n", full):
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", vio.ReadWarning)
+            vio.read(_brick(tmp_path, header, VALUES.astype("<f4").tobytes(order="F")), isolate=False)

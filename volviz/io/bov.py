@@ -9,12 +9,13 @@ extent), ``TIME``. The data file must hold exactly what the header says (``volvi
 """
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 import numpy as np
 
 from volviz.io._checks import check_dims, check_file, describe_bytes, parse_float, parse_int, read_at, read_bytes
-from volviz.io.errors import PathLike, ReadError
+from volviz.io.errors import PathLike, ReadError, ReadWarning
 from volviz.io.raw import _size_problem, decode_samples, file_dtype
 from volviz.model import RegularVolume
 from volviz.model.arrays import volume_of
@@ -42,6 +43,24 @@ def parse_bov_header(path: PathLike, text: bytes) -> dict[str, str]:
     return fields
 
 
+#: the keys a header may leave out, and what is read then
+DEFAULTS = {"DATA_ENDIAN": "LITTLE", "CENTERING": "zonal", "BRICK_ORIGIN": "0 0 0", "BRICK_SIZE": "DATA_SIZE",
+            "DATA_COMPONENTS": "1", "BYTE_OFFSET": "0"}
+
+
+def _warn_if_cut(path: PathLike, head: bytes, fields: dict[str, str]) -> None:
+    """A header whose last line has no line end may have been cut short, and the keys after the cut read with
+    their defaults (a cut that drops ``DATA_ENDIAN: BIG`` reads every sample byte-swapped): a ReadWarning naming
+    the line and the defaults used (issue #32). A header that ends with its line end, or that sets every key,
+    says nothing."""
+    missing = [f"{k} {v}" for k, v in DEFAULTS.items() if k not in fields]
+    if head.endswith(b"\n") or not missing:
+        return
+    last = head.decode("utf-8", "replace").splitlines()[-1][:60]
+    warnings.warn(f"{path}: its header's last line ({last!r}) has no line end: if the header was cut short, keys "
+                  f"are missing and read with their defaults ({', '.join(missing)})", ReadWarning, stacklevel=3)
+
+
 def _floats(path: PathLike, fields: dict[str, str], key: str, default: tuple[float, ...]) -> tuple[float, ...]:
     if key not in fields:
         return default
@@ -59,6 +78,7 @@ def read_bov(path: PathLike, allow_nonfinite: bool = True) -> RegularVolume:
         raise ReadError(p, f"is not a BOV header (no DATA_FILE and DATA_SIZE lines; its content is "
                            f"{describe_bytes(head[:4096])})")
     fields = parse_bov_header(p, head)
+    _warn_if_cut(p, head, fields)
     for key in ("DATA_FILE", "DATA_SIZE", "DATA_FORMAT"):
         if not fields.get(key):
             raise ReadError(p, f"BOV header has no {key}")
