@@ -64,3 +64,35 @@ def test_cpu_pt_preview_leaves_no_dark_steps_along_the_box(qtbot, make_window) -
     assert np.abs(preview - bare).max() > 100, "the volume preview is not on screen"
     steps_still, steps_preview = _dark_steps(still, band, 8), _dark_steps(preview, band, 8)
     assert steps_preview <= steps_still + 0.02 * box.sum(), (steps_preview, steps_still, int(box.sum()))
+
+
+def test_outline_corners_are_the_bounds_at_utm_coordinates(tmp_path) -> None:
+    """A grid placed at UTM coordinates (x 500000.3, y 7000000.3 m): the outline box's corners are its bounds to a
+    micrometre (float32 points, as ``pv.Box`` made them, were 0.2 m off in y)."""
+    import warnings
+
+    import pyvista as pv
+
+    from volviz.render.controller import SceneController
+    from volviz.render.decorations import OUTLINE_NAME
+    from volviz.render.offscreen import offscreen_plotter
+    from volviz.scene.datasets import load_datasets
+    from volviz.scene.opening import data_session
+
+    grid = pv.ImageData(dimensions=(6, 5, 4), spacing=(1.7, 1.3, 0.9), origin=(500000.3, 7000000.3, 100.1))
+    grid.point_data["h"] = np.arange(grid.n_points, dtype=np.float64)
+    path = tmp_path / "utm.vti"
+    grid.save(path)
+    session = data_session(path)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        datasets = load_datasets(session, None)
+    plotter = offscreen_plotter((160, 120))
+    try:
+        SceneController(plotter, session, datasets).build()
+        points = np.asarray(plotter.renderer.actors[OUTLINE_NAME].GetMapper().GetInput().GetPoints().GetData())
+        lo, hi = np.array(grid.bounds[::2]), np.array(grid.bounds[1::2])
+        assert np.abs(points.min(axis=0) - lo).max() < 1e-6 and np.abs(points.max(axis=0) - hi).max() < 1e-6
+        assert len({tuple(p) for p in points}) == 8
+    finally:
+        plotter.close()

@@ -73,10 +73,19 @@ def update_outline(plotter: Any, session: Session, props: dict[str, Any]) -> Non
         data = {k: p for k, p in props.items() if k != "nature"}   # a landscape needs no box around it
         bounds = scene_bounds(data)
         if bounds is not None:
-            import pyvista as pv
+            plotter.add_mesh(outline_box(bounds), color=_contrast(session.render.background), name=OUTLINE_NAME,
+                             pickable=False, reset_camera=False, render=False, line_width=1)
 
-            plotter.add_mesh(pv.Box(bounds).outline(), color=_contrast(session.render.background),
-                             name=OUTLINE_NAME, pickable=False, reset_camera=False, render=False, line_width=1)
+
+def outline_box(bounds: Any) -> Any:
+    """The 12 edges of the box ``bounds`` (xmin, xmax, ymin, ymax, zmin, zmax) as a float64 ``pyvista.PolyData``:
+    ``pv.Box(...).outline()`` made float32 points, up to 0.5 m off at UTM coordinates (y = 7e6)."""
+    import pyvista as pv
+
+    b = np.asarray(bounds, dtype=np.float64).reshape(3, 2)
+    corners = np.array([[b[0, i], b[1, j], b[2, k]] for k in (0, 1) for j in (0, 1) for i in (0, 1)])
+    edges = [(0, 1), (2, 3), (4, 5), (6, 7), (0, 2), (1, 3), (4, 6), (5, 7), (0, 4), (1, 5), (2, 6), (3, 7)]
+    return pv.PolyData(corners, lines=np.array([[2, a, c] for a, c in edges]).ravel())
 
 
 def update_legend(plotter: Any, session: Session, datasets: dict[str, Any]) -> None:
