@@ -66,6 +66,40 @@ def test_cpu_pt_preview_leaves_no_dark_steps_along_the_box(qtbot, make_window) -
     assert steps_preview <= steps_still + 0.02 * box.sum(), (steps_preview, steps_still, int(box.sum()))
 
 
+def _render_flat_picture(size: tuple[int, int], outline: bool) -> np.ndarray:
+    import warnings
+
+    from volviz.render.export import render_session
+    from volviz.scene.opening import data_session
+
+    session = data_session(data_file("sky/clouds.jpeg"))
+    session.render.options["outline"] = outline
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return render_session(session, None, size).astype(int)
+
+
+def test_flat_picture_outline_draws_all_four_sides() -> None:
+    """clouds.jpeg shown flat and face-on (``volviz render``, single-sampled on llvmpipe): the outline box is the
+    picture's own border, and every side of it is drawn along its whole length. Before, the picture's border pixels
+    won the depth tie under the top, bottom and right sides: 64 outline pixels at 160 x 120 (the left side only),
+    none at 161 x 121; now all four sides."""
+    for size in ((160, 120), (161, 121)):
+        boxed, bare = _render_flat_picture(size, True), _render_flat_picture(size, False)
+        line = np.abs(boxed - bare).sum(axis=2) > 30
+        picture = np.abs(bare - bare[0, 0]).sum(axis=2) > 10
+        rows = np.nonzero(picture[:, size[0] // 4: 3 * size[0] // 4].any(axis=1))[0]   # clear of the axes widget
+        cols = np.nonzero(picture[size[1] // 3: 2 * size[1] // 3].any(axis=0))[0]
+        top, bottom, left, right = rows.min(), rows.max(), cols.min(), cols.max()
+        width, height = right - left + 1, bottom - top + 1
+        assert width > 0.6 * size[0] and height > 0.3 * size[1], (size, top, bottom, left, right)
+        sides = {"top": line[top - 1: top + 1, left:right + 1].any(axis=0).mean(),
+                 "bottom": line[bottom: bottom + 2, left:right + 1].any(axis=0).mean(),
+                 "left": line[top:bottom + 1, left - 1: left + 1].any(axis=1).mean(),
+                 "right": line[top:bottom + 1, right: right + 2].any(axis=1).mean()}
+        assert min(sides.values()) > 0.9, (size, sides)
+
+
 def test_outline_corners_are_the_bounds_at_utm_coordinates(tmp_path) -> None:
     """A grid placed at UTM coordinates (x 500000.3, y 7000000.3 m): the outline box's corners are its bounds to a
     micrometre (float32 points, as ``pv.Box`` made them, were 0.2 m off in y)."""

@@ -73,8 +73,10 @@ def update_outline(plotter: Any, session: Session, props: dict[str, Any]) -> Non
         data = {k: p for k, p in props.items() if k != "nature"}   # a landscape needs no box around it
         bounds = scene_bounds(data)
         if bounds is not None:
-            plotter.add_mesh(outline_box(bounds), color=_contrast(session.render.background), name=OUTLINE_NAME,
-                             pickable=False, reset_camera=False, render=False, line_width=1)
+            actor = plotter.add_mesh(outline_box(bounds), color=_contrast(session.render.background),
+                                     name=OUTLINE_NAME, pickable=False, reset_camera=False, render=False,
+                                     line_width=1)
+            _in_front_of_coincident(actor)
 
 
 def outline_box(bounds: Any) -> Any:
@@ -86,6 +88,19 @@ def outline_box(bounds: Any) -> Any:
     corners = np.array([[b[0, i], b[1, j], b[2, k]] for k in (0, 1) for j in (0, 1) for i in (0, 1)])
     edges = [(0, 1), (2, 3), (4, 5), (6, 7), (0, 2), (1, 3), (4, 6), (5, 7), (0, 4), (1, 5), (2, 6), (3, 7)]
     return pv.PolyData(corners, lines=np.array([[2, a, c] for a, c in edges]).ravel())
+
+
+OUTLINE_DEPTH_OFFSET = 4e-6   # normalised device depth the outline is drawn nearer by (~34 steps of a 24-bit buffer)
+
+
+def _in_front_of_coincident(actor: Any) -> None:
+    """Draw the outline's lines a hair nearer than a surface they lie on (a picture shown flat is its own box, its
+    border rows under three of the four sides): with equal depths the picture's pixels won and those sides vanished
+    (issue #28). VTK's coincident-topology offsets are one global switch for every mapper, so the outline's own
+    vertex shader moves it instead; in eye space that is ~0.2 % of the depth at 1000 times the near distance."""
+    actor.GetShaderProperty().AddVertexShaderReplacement(
+        "//VTK::PositionVC::Impl", True,
+        f"//VTK::PositionVC::Impl\n  gl_Position.z -= {OUTLINE_DEPTH_OFFSET!r} * gl_Position.w;\n", False)
 
 
 def update_legend(plotter: Any, session: Session, datasets: dict[str, Any]) -> None:
