@@ -50,12 +50,11 @@ RECORD_MS = 250          # camera-path recording samples the camera four times a
 def _import_gui_thread_modules() -> None:
     """Import at start-up what the GUI thread later imports inside functions: a first ``import vtk`` (the natural
     scene's overlay) took 0.2-0.5 s of a blocked event loop in the middle of loading a scene."""
-    import vtk  # noqa: F401
-
     import volviz.nature.nature_scene  # noqa: F401
     import volviz.render.controller  # noqa: F401
     import volviz.render.pt_prop  # noqa: F401
     import volviz.render.scene_builder  # noqa: F401
+    import volviz.render.vtk_facade  # noqa: F401
     import pyvista
 
     # pyvista asks once per process whether this system can plot (it runs ``xset -q``) when the first offscreen plotter

@@ -1,9 +1,15 @@
 """The one module of volviz that imports VTK's rendering side (issue #18): ``volviz.render``'s modules and the
 benchmarks that draw get VTK from here (``from volviz.render.vtk_facade import vtk``), never by ``import vtk``;
-``tests/test_layering_rendering.py`` checks it. Importing this module loads VTK (about a second), so modules import it
-inside the functions that draw, as they did VTK itself.
+``tests/test_layering_rendering.py`` checks it. Importing this module loads VTK's rendering libraries, so modules
+import it inside the functions that draw.
 
-Besides the VTK module and NumPy's bridge to it, it holds the VTK idioms the GL passes (``gl_pt``, ``gl_fog``,
+``vtk`` is not VTK's all-in-one module (about 150 modules; what that cost is in ``docs/architecture.md``) but a
+namespace of the classes volviz uses, each imported by name from its ``vtkmodules`` module, as PyVista's ``_vtk``
+does; ``tests/test_vtk_facade.py`` checks that it holds exactly the names its callers use. The modules that only
+register VTK's factory overrides (the OpenGL classes behind ``vtkRenderer``, ``vtkActor``, the volume mappers; text;
+the interactor styles) are imported here too, since nothing else may be loaded when volviz draws.
+
+Besides that namespace and NumPy's bridge to VTK, it holds the VTK idioms the GL passes (``gl_pt``, ``gl_fog``,
 ``gl_iso``, ``gl_nature``) share:
 
 - ``shader_observer(fn)``: a callback for a mapper's ``UpdateShaderEvent`` that hands ``fn`` the shader program
@@ -17,11 +23,44 @@ Besides the VTK module and NumPy's bridge to it, it holds the VTK idioms the GL 
 """
 from __future__ import annotations
 
+from types import SimpleNamespace
 from typing import Any, Callable, Sequence
 
 import numpy as np
-import vtk
+
+# factory overrides only: without them VTK makes abstract renderers, mappers and windows that draw nothing
+import vtkmodules.vtkInteractionStyle  # noqa: F401 - the interactor styles (VTK's default trackball camera)
+import vtkmodules.vtkRenderingFreeType  # noqa: F401 - text (scalar bar, text actors)
+import vtkmodules.vtkRenderingOpenGL2  # noqa: F401 - OpenGL renderers, windows, actors, poly data mappers
+import vtkmodules.vtkRenderingUI  # noqa: F401 - the platform's render window interactor
+import vtkmodules.vtkRenderingVolumeOpenGL2  # noqa: F401 - the GPU ray caster, OpenGL projected tetrahedra
 from vtkmodules.util.numpy_support import numpy_to_vtk, vtk_to_numpy
+
+# the classes and constants ``vtk`` (below) holds, by module (F401: they are used through it)
+from vtkmodules.vtkCommonCore import (  # noqa: F401
+    VTK_FLOAT, VTK_OBJECT, VTK_UNSIGNED_CHAR, VTK_UNSTRUCTURED_GRID, vtkCommand, vtkFloatArray, vtkIdList, vtkLogger,
+    vtkPoints, vtkUnsignedCharArray)
+from vtkmodules.vtkCommonDataModel import (  # noqa: F401
+    vtkCellArray, vtkCellLocator, vtkDataObject, vtkImageData, vtkMultiBlockDataSet, vtkPiecewiseFunction, vtkPlane,
+    vtkPolyData)
+from vtkmodules.vtkCommonTransforms import vtkTransform  # noqa: F401
+from vtkmodules.vtkFiltersCore import vtkAppendPolyData  # noqa: F401
+from vtkmodules.vtkFiltersGeneral import vtkDataSetTriangleFilter, vtkTransformPolyDataFilter  # noqa: F401
+from vtkmodules.vtkInteractionStyle import vtkInteractorStyleTrackballCamera  # noqa: F401
+from vtkmodules.vtkRenderingAnnotation import vtkScalarBarActor  # noqa: F401
+from vtkmodules.vtkRenderingCore import (  # noqa: F401
+    vtkActor, vtkActor2D, vtkCamera, vtkCellPicker, vtkColorTransferFunction, vtkDataSetMapper, vtkImageActor,
+    vtkImageMapper, vtkPolyDataMapper, vtkPropAssembly, vtkRenderer, vtkRenderWindow, vtkRenderWindowInteractor,
+    vtkShaderProperty, vtkTextActor, vtkTexture, vtkVolume, vtkVolumeProperty, vtkWindowToImageFilter)
+from vtkmodules.vtkRenderingOpenGL2 import (  # noqa: F401
+    vtkFramebufferPass, vtkOpenGLFramebufferObject, vtkOpenGLPolyDataMapper, vtkRenderStepsPass, vtkTextureObject)
+from vtkmodules.vtkRenderingVolume import (  # noqa: F401
+    vtkProjectedTetrahedraMapper, vtkUnstructuredGridVolumeRayCastMapper, vtkUnstructuredGridVolumeZSweepMapper)
+from vtkmodules.vtkRenderingVolumeOpenGL2 import vtkMultiBlockVolumeMapper, vtkSmartVolumeMapper  # noqa: F401
+
+#: the VTK classes and constants imported above, by their VTK names: ``vtk.vtkActor()`` as with VTK's own module
+vtk = SimpleNamespace(**{name: value for name, value in dict(globals()).items()
+                         if name.startswith("VTK_") or (name.startswith("vtk") and name[3:4].isupper())})
 
 __all__ = ["box_corners_polydata", "numpy_to_vtk", "premultiplied_texture", "shader_observer", "shared_polydata",
            "vtk", "vtk_to_numpy"]

@@ -256,11 +256,11 @@ def _vtk_tets(points: np.ndarray, cells: list[tuple[int, np.ndarray]]) -> tuple[
     splits shared faces alike by global point ids), for hexahedral meshes whose vertex graph is not bipartite; the
     points are kept as they are."""
     import pyvista as pv
-    import vtk
+    from vtkmodules.vtkFiltersGeneral import vtkDataSetTriangleFilter
 
     solid = {int(t): np.asarray(c, dtype=np.int64) for t, c in cells
              if t in (VTK_TETRA, VTK_HEXAHEDRON, VTK_WEDGE, VTK_PYRAMID) and len(c)}
-    triangulate = vtk.vtkDataSetTriangleFilter()
+    triangulate = vtkDataSetTriangleFilter()
     triangulate.SetInputData(pv.UnstructuredGrid(solid, points))
     triangulate.TetrahedraOnlyOn()
     triangulate.Update()

@@ -165,17 +165,22 @@ IDLE_SECONDS = 0.25
 
 
 def _load_vtk_when_idle() -> None:
-    """Import the whole of VTK unless a request is already waiting. A child kept warm for later reads (the app's
-    pool) has it loaded before they come; one started for a read at hand (``volviz render FILE``) answers at once,
-    its reader importing only the VTK modules it uses (``volviz.io.vtk_lazy``: 0.4 s instead of 1.2-2 s)."""
+    """Import the VTK modules of volviz's readers (``volviz.io.vtk_lazy.MODULE_OF``, by name: not the whole of VTK,
+    issue #31) unless a request is already waiting. A child kept warm for later reads (the app's pool) has them
+    loaded before they come; one started for a read at hand (``volviz render FILE``) answers at once, its reader
+    importing only the VTK modules it uses (``volviz.io.vtk_lazy``: 0.4 s instead of 1.2-2 s)."""
+    import importlib
     import select
+
+    from volviz.io.vtk_lazy import MODULE_OF
 
     if select.select([sys.stdin.buffer], [], [], IDLE_SECONDS)[0]:
         return
-    try:
-        import vtk  # noqa: F401
-    except ImportError:  # pragma: no cover - VTK is a dependency; readers report its absence themselves
-        pass
+    for module in sorted(set(MODULE_OF.values())):
+        try:
+            importlib.import_module(f"vtkmodules.{module}")
+        except ImportError:  # a module this VTK build lacks: its readers report that themselves
+            pass
 
 
 def main() -> None:
