@@ -107,13 +107,17 @@ def _complete_rows(p: Path, sep: str | None, skip: int, n_fields: int) -> list[s
     the first of them: before, genfromtxt dropped them without a word (issue #32)."""
     with open(p, encoding="utf-8", errors="replace") as f:
         lines = f.read().splitlines()[skip:]
-    good, bad = [], []
+    good: list[str] = []
+    bad: list[tuple[int, int]] = []
     for number, line in enumerate(lines, start=skip + 1):
         if not line.strip() or line.lstrip().startswith("#"):
             continue
         fields = _fields(line.split("#", 1)[0], sep)
         count = len(fields) - (len(fields) == n_fields + 1 and not fields[-1])   # a separator ending the row
-        (good if count == n_fields else bad).append(line if count == n_fields else (number, count))
+        if count == n_fields:
+            good.append(line)
+        else:
+            bad.append((number, count))
     if bad:
         warnings.warn(f"{p}: {len(bad):,} of {len(good) + len(bad):,} rows do not hold the {n_fields} fields its "
                       f"header names (line {bad[0][0]} holds {bad[0][1]}) and are left out", ReadWarning,

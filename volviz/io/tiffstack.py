@@ -121,11 +121,11 @@ def check_one_stack(path: PathLike, tif: Any) -> None:
     if len(alike) > 1:
         groups = "; ".join(_pages([p.index for p in s.pages if p is not None]) for s in alike)
         h, w = first.keyframe.shape[:2]
+        split = alike[1].keyframe
         raise ReadError(path, f"its pages are {h}x{w} {first.dtype} images alike, but their tags split them into "
                               f"{len(alike)} stacks (pages {groups}; tags that differ: "
-                              f"{_tag_differences(_neighbour(tif, alike[1].keyframe), alike[1].keyframe)}): the file is "
-                              "damaged or "
-                              "mixes stacks")
+                              f"{_tag_differences(_neighbour(tif, split), split)}): the file is damaged or mixes "
+                              "stacks")
 
 
 def _neighbour(tif: Any, page: Any) -> Any:
@@ -147,7 +147,7 @@ def _tag_differences(a: Any, b: Any) -> str:
                                        and repr(x.value) == repr(y.value)):
             continue  # strip and tile offsets differ from page to page; description and software: the first only
         show = lambda t: "none" if t is None else f"{t.dtype.name} {t.value!r}"[:40]  # noqa: E731
-        out.append(f"{(x or y).name} ({show(x)} / {show(y)})")
+        out.append(f"{(x or y or ta[code]).name} ({show(x)} / {show(y)})")
     return ", ".join(out[:4]) or "none of the usual ones"
 
 
