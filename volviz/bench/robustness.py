@@ -68,7 +68,8 @@ class Source:
     ``case.foam`` of an OpenFOAM case, the PLOT3D grid for its solution); ``links`` are the unchanged files put
     beside the mutated one (symbolic links); ``layout`` is how its header looks ("text", "xml", "binary", "hdf5",
     "none"); ``endian`` the byte order of binary header fields; ``vtk`` the name of VTK's reader recipe (None: VTK
-    has no reader of the format)."""
+    has no reader of the format); ``mirror`` the folder of a dataset of several files (a Zarr folder, a collection
+    and its pieces), put beside the mutated file as it is (``target`` is then relative to it)."""
 
     fmt: str
     path: Path
@@ -81,6 +82,8 @@ class Source:
     endian: str = ">"
     vtk: Optional[str] = None
     header_end: int = 0
+    mirror: Optional[Path] = None
+
 
     @property
     def name(self) -> str:
@@ -97,7 +100,9 @@ _KINDS = (
     ("*.vtu", "vtu", "vtu", "xml", "<"), ("*.vtkhdf", "vtkhdf", "vtkhdf", "hdf5", "<"),
     ("*.jpeg", "jpeg", "jpeg", "binary", ">"), ("*.ex2", "exodus", "exodus", "binary", ">"),
     ("*.cgns", "cgns", "cgns", "binary", ">"), ("*.nc", "netcdf", "netcdf", "binary", ">"),
-    ("quarter.*", "raw", "raw", "none", "<"),
+    ("quarter.*", "raw", "raw", "none", "<"), ("*.tec", "tecplot", "tecplot", "text", ">"),
+    ("*.cas.h5", "fluent-cff", "fluent-cff", "hdf5", "<"), ("*.dat.h5", "fluent-cff", "fluent-cff", "hdf5", "<"),
+    ("*.xdmf", "xdmf", "xdmf", "xml", "<"), ("*.h5", "xdmf", "xdmf", "hdf5", "<"),
 )
 
 
@@ -106,9 +111,9 @@ def _header_end(data: bytes, layout: str) -> int:
     records included), the first KB of a binary one, the tags of an XML file up to 64 KB."""
     if layout == "none":
         return 0
-    if layout in ("binary", "hdf5"):
+    if layout in ("binary", "hdf5", "vvz"):
         return min(len(data), 1024)
-    limit = 65536 if layout == "xml" else 4096
+    limit = 65536 if layout in ("xml", "json") else 4096
     for i, byte in enumerate(data[:limit]):
         if byte >= 127 or (byte < 32 and byte not in (9, 10, 13)):
             return i
@@ -134,30 +139,46 @@ def sources(root: Path) -> list[Source]:
             if kind is None:
                 continue
             src = Source(kind[1], path, root, name, layout=kind[3], endian=kind[4], vtk=kind[2])
-            _complete(src)
-            found.append(src)
+            if _complete(src):
+                found.append(src)
     for src in found:
         src.header_end = _header_end(src.path.read_bytes()[:65536], src.layout)
     return found
 
 
 def made_sources(folder: Path, formats: list[str] | None = None) -> list[Source]:
-    """Sources of the formats the data folder lacks, written into ``folder`` (``volviz.bench.robustness_made``)."""
+    """Sources of the formats the data folder lacks, written into ``folder`` (``volviz.bench.robustness_made``,
+    and the seeds of several files each of ``volviz.bench.robustness_formats``: one Source per file they damage)."""
+    from volviz.bench.robustness_formats import write_seeds
     from volviz.bench.robustness_made import MADE, write_made
 
     found = []
     for fmt, path in write_made(folder, formats).items():
         _name, _write, layout, endian, vtk = MADE[fmt]
-        src = Source(fmt, path, folder, path.name, layout=layout, endian=endian, vtk=vtk)
-        src.header_end = _header_end(path.read_bytes()[:65536], layout)
-        found.append(src)
+        found.append(Source(fmt, path, folder, path.name, layout=layout, endian=endian, vtk=vtk))
+    for seed, where in write_seeds(folder / "seeds", formats):
+        found += [Source(seed.fmt, where / rel, folder, seed.target, layout=layout, endian=endian, vtk=seed.vtk,
+                         mirror=where) for rel, layout, endian in seed.mutate]
+    for src in found:
+        src.header_end = _header_end(src.path.read_bytes()[:65536], src.layout)
     return found
 
 
-def _complete(src: Source) -> None:
-    """The companions and options of the formats read as pairs or with options."""
+def _complete(src: Source) -> bool:
+    """The companions and options of the formats read as pairs or with options; False for a file that is not
+    read on its own and has no partner here (an HDF5 file with no XDMF file beside it)."""
     folder, name = src.path.parent, src.path.name
-    if src.fmt == "metaimage" and name.endswith(".raw"):
+    if src.fmt in ("xdmf", "fluent-cff"):
+        partners = {".xdmf": [".h5"], ".h5": [".xdmf"], ".cas.h5": [".dat.h5"], ".dat.h5": [".cas.h5"]}
+        ending = next(e for e in (".cas.h5", ".dat.h5", ".xdmf", ".h5") if name.endswith(e))
+        stem = name[:-len(ending)]
+        others = [stem + e for e in partners[ending] if (folder / (stem + e)).exists()]
+        if src.fmt == "xdmf" and ending == ".h5" and not others:
+            return False
+        src.links.update({o: folder / o for o in others})
+        if ending in (".h5", ".dat.h5"):
+            src.target = others[0] if others else name
+    elif src.fmt == "metaimage" and name.endswith(".raw"):
         src.target = name[:-4] + ".mhd"
         src.links[src.target] = folder / src.target
     elif src.fmt == "metaimage":
@@ -171,6 +192,7 @@ def _complete(src: Source) -> None:
         src.options = {"q": q}
     elif src.fmt == "raw":
         src.options = {"dims": [64, 64, 1], "dtype": "uint16", "byteorder": "little"}
+    return True
 
 
 # -- mutations ---------------------------------------------------------------------------------------------------------
@@ -205,9 +227,9 @@ def boundaries(src: Source, data: bytes) -> list[int]:
     record (DEM: 1024 bytes); plus the header's end, the middle and one byte short of the whole file."""
     end = max(src.header_end, 0)
     cuts: set[int] = {0, end, len(data) // 2, len(data) - 1}
-    if src.layout in ("text", "xml"):
+    if src.layout in ("text", "xml", "json"):
         cuts.update(m.end() for m in re.finditer(rb"[\n> ]", data[:end]))
-    elif src.layout in ("binary", "hdf5"):
+    elif src.layout in ("binary", "hdf5", "vvz"):
         cuts.update(range(0, min(end, 256), 4))
     if src.fmt == "dem":
         cuts.update(range(1024, min(len(data), 16384), 1024))
@@ -235,7 +257,7 @@ def set_field(src: Source, data: bytes, rng: random.Random, index: int | None = 
               value: Any = None) -> Optional[Mutation]:
     """A numeric header field set to one of the values (text headers), or a 4/8-byte integer or a NaN double
     written over a field of a binary header."""
-    if src.layout in ("binary", "hdf5"):
+    if src.layout in ("binary", "hdf5", "vvz"):
         end = max(4, min(src.header_end, len(data)) - 8)
         pos = (rng.randrange(end) // 4) * 4 if index is None else index
         value = rng.choice((*INT_VALUES, "nan")) if value is None else value
@@ -247,7 +269,7 @@ def set_field(src: Source, data: bytes, rng: random.Random, index: int | None = 
             raw = struct.pack(src.endian + ("q" if value < 2**63 else "Q"), value)
         out = data[:pos] + raw + data[pos + len(raw):]
         return Mutation("field", f"binary field at byte {pos} set to {value}", out)
-    spans = number_spans(data, src.header_end) if src.layout == "text" else [
+    spans = number_spans(data, src.header_end) if src.layout in ("text", "json") else [
         s for a in xml_attributes(data) for s in ((a[0] + m.start(), a[0] + m.end())
                                                    for m in _NUMBER.finditer(data[a[0]:a[1]]))]
     if not spans:
@@ -322,21 +344,24 @@ def hdf5_meta(data: bytes, addresses: list[int], rng: random.Random) -> Mutation
     return Mutation("hdf5-meta", f"object header at {base}: byte {pos} damaged ({how})", bytes(out))
 
 
-def hdf5_field(path: Path, rng: random.Random) -> Mutation:
+def hdf5_field(path: Path, rng: random.Random) -> Optional[Mutation]:
     """A value of one of the VTKHDF count/offset/extent datasets or attributes set through h5py (0, -1, 2^31-1,
-    2^63-1, NaN) -- a file whose HDF5 structure is intact and whose VTKHDF content lies."""
+    2^63-1, NaN) -- a file whose HDF5 structure is intact and whose VTKHDF content lies (None: the file has no
+    numeric dataset or attribute)."""
     import h5py
     import numpy as np
 
     with h5py.File(path, "r") as f:
         names: list[str] = []
         f.visititems(lambda n, o: names.append(n) if isinstance(o, h5py.Dataset) and o.size and o.dtype.kind in "iuf"
-                     and o.ndim <= 2 else None)
+                     and o.ndim <= 3 else None)
         attrs = [(n, a) for n in ["", *names] for a in (f[n] if n else f).attrs
                  if np.asarray((f[n] if n else f).attrs[a]).dtype.kind in "iuf"]
+    if not names and not attrs:
+        return None
     choice = rng.random()
     value = rng.choice((*INT_VALUES[:4], "nan"))
-    if attrs and choice < 0.25:
+    if attrs and (choice < 0.25 or not names):
         obj, attr = rng.choice(attrs)
 
         def edit_attribute(p: Path) -> None:
@@ -373,7 +398,9 @@ def _cast(value: Any, dtype: Any) -> Any:
 RANDOM_KINDS = {"text": ("bitflip", "field", "field", "truncate"), "none": ("bitflip", "truncate"),
                 "binary": ("bitflip", "field", "truncate"), "xml": ("bitflip", "field", "xml-swap", "xml-flip",
                                                                     "xml-enlarge", "truncate"),
-                "hdf5": ("bitflip", "hdf5-meta", "hdf5-meta", "hdf5-field", "hdf5-field", "truncate")}
+                "hdf5": ("bitflip", "hdf5-meta", "hdf5-meta", "hdf5-field", "hdf5-field", "truncate"),
+                "vvz": ("bitflip", "field", "truncate", "vvz-meta", "vvz-meta", "vvz-table"),
+                "json": ("bitflip", "field", "truncate", "json", "json")}
 
 
 def random_mutation(src: Source, data: bytes, rng: random.Random, addresses: list[int] | None = None,
@@ -392,6 +419,11 @@ def random_mutation(src: Source, data: bytes, rng: random.Random, addresses: lis
         found = hdf5_meta(data, addresses or [0], rng)
     elif kind == "hdf5-field":
         found = hdf5_field(src.path, rng)
+    elif kind.startswith("vvz") or kind == "json":
+        from volviz.bench.robustness_formats import json_mutation, vvz_mutation
+
+        made = json_mutation(data, rng) if kind == "json" else vvz_mutation(data, rng, kind)
+        found = Mutation(kind, *made) if made else None
     return found or flip_bits(data, rng, src.header_end)
 
 
@@ -399,7 +431,7 @@ def systematic_recipes(src: Source, data: bytes) -> list[tuple]:
     """The systematic cases as recipes (a few numbers each, turned into bytes by ``make_mutation`` when the case
     runs): truncation at every header boundary and every text header field set to every value (the first 40)."""
     found: list[tuple] = [("truncate", at) for at in boundaries(src, data)]
-    if src.layout == "text":
+    if src.layout in ("text", "json"):
         for i in range(min(40, len(number_spans(data, src.header_end)))):
             found += [("field", i, v) for v in TEXT_VALUES]
     return found
@@ -491,7 +523,11 @@ VTK_READERS = {"slc": ("vtkIOImage", "vtkSLCReader"), "pnm": ("vtkIOImage", "vtk
                "netcdf": ("vtkIONetCDF", "vtkNetCDFCFReader"), "plot3d": ("vtkIOParallel", "vtkMultiBlockPLOT3DReader"),
                "openfoam": ("vtkIOGeometry", "vtkOpenFOAMReader"), "tiff": ("vtkIOImage", "vtkTIFFReader"),
                "nifti": ("vtkIOImage", "vtkNIFTIImageReader"), "dicom": ("vtkIOImage", "vtkDICOMImageReader"),
-               "mrc": ("vtkIOImage", "vtkMRCReader"), "nrrd": ("vtkIOImage", "vtkNrrdReader")}
+               "mrc": ("vtkIOImage", "vtkMRCReader"), "nrrd": ("vtkIOImage", "vtkNrrdReader"),
+               "xdmf": ("vtkIOXdmf2", "vtkXdmfReader"), "tecplot": ("vtkIOGeometry", "vtkTecplotReader"),
+               "ensight": ("vtkIOEnSight", "vtkGenericEnSightReader"), "avs": ("vtkIOGeometry", "vtkAVSucdReader"),
+               "minc": ("vtkIOMINC", "vtkMINCImageReader"), "fluent-cff": ("vtkIOFLUENTCFF", "vtkFLUENTCFFReader"),
+               "xyz": ("vtkIOLegacy", "vtkSimplePointsReader")}
 
 
 def _vtk_reader(recipe: str, path: str, options: dict) -> Any:
@@ -505,7 +541,12 @@ def _vtk_reader(recipe: str, path: str, options: dict) -> Any:
         r.SetQFileName(os.path.join(folder, options["q"]))
         r.AutoDetectFormatOn()
         return r
+    if recipe == "ensight":
+        r.SetCaseFileName(path)
+        return r
     r.SetFileName(path)
+    if recipe == "avs":
+        r.SetBinaryFile(open(path, "rb").read(1) == b"\x07")
     if recipe == "raw":
         r.SetDataScalarTypeToUnsignedShort()
         r.SetDataByteOrderToLittleEndian()
@@ -552,18 +593,34 @@ def _serve_volviz(request: dict) -> dict:
         options["q"] = os.path.join(os.path.dirname(request["path"]), options["q"])
     if "dims" in options:
         options["dims"] = tuple(options["dims"])
+    from volviz.regular.container import CorruptBrickWarning
+
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("ignore")
-        warnings.simplefilter("always", vio.ReadWarning)  # a doubt the reader states is not silent
+        for stated in (vio.ReadWarning, CorruptBrickWarning):  # a doubt the reader states is not silent
+            warnings.simplefilter("always", stated)
         try:
-            result = vio.read(request["path"], **options)
-            warned = next((str(w.message)[:300] for w in caught if issubclass(w.category, vio.ReadWarning)), "")
+            result = read_as_user(request["path"], options)
+            warned = next((str(w.message)[:300] for w in caught
+                           if issubclass(w.category, (vio.ReadWarning, CorruptBrickWarning))), "")
             return {"status": "ok", **fingerprint_volviz(result), "warned": warned}
         except vio.ReadError as exc:  # naming the file read or the file beside it that is wrong
             return {"status": "error", "message": str(exc)[:300],
                     "named": str(exc).startswith(os.path.dirname(request["path"]))}
         finally:
             isolated.prewarm()  # a reader child that crashed is replaced now, not in the next case's time
+
+
+def read_as_user(path: str, options: dict) -> Any:
+    """What the app does with a file: ``volviz.io.read``, or the ``.vvz`` codec's decoder for volviz's own
+    compressed volumes (``volviz.scene.datasets``)."""
+    import volviz.io as vio
+
+    if path.lower().endswith(".vvz"):
+        from volviz.regular.codec import decompress
+
+        return decompress(path)
+    return vio.read(path, **options)
 
 
 def _serve_vtk(request: dict) -> dict:
@@ -684,12 +741,11 @@ def prepare_folder(src: Source, base: Path, index: int) -> Path:
     folder = base / f"s{index}"
     if folder.exists():
         return folder
+    if src.mirror is not None:
+        _mirror(src.mirror, folder)
+        return folder
     if src.fmt == "openfoam":
-        case = next(p for p in src.path.parents if (p / "case.foam").exists())
-        for f in case.rglob("*"):
-            if f.is_file():
-                (folder / f.relative_to(case)).parent.mkdir(parents=True, exist_ok=True)
-                (folder / f.relative_to(case)).symlink_to(f)
+        _mirror(next(p for p in src.path.parents if (p / "case.foam").exists()), folder)
         src.target = "case.foam"
         src.links = {}
         return folder
@@ -699,15 +755,31 @@ def prepare_folder(src: Source, base: Path, index: int) -> Path:
     return folder
 
 
+def _mirror(root: Path, folder: Path) -> None:
+    """Every file under ``root`` as a symbolic link at the same place under ``folder``."""
+    for f in root.rglob("*"):
+        if f.is_file():
+            (folder / f.relative_to(root)).parent.mkdir(parents=True, exist_ok=True)
+            (folder / f.relative_to(root)).symlink_to(f)
+
+
 def mutated_path(src: Source, folder: Path) -> Path:
+    if src.mirror is not None:
+        return folder / src.path.relative_to(src.mirror)
     if src.fmt == "openfoam":
         case = next(p for p in src.path.parents if (p / "case.foam").exists())
         return folder / src.path.relative_to(case)
     return folder / src.path.name
 
 
-def _judge(answer: dict, original: Optional[dict], mutation: Mutation) -> str:
-    """The outcome of one read: clean, exception, crash, hang, memory, garbage, warned or accepted."""
+#: formats whose files carry no count of what they hold: a text table cut at (or within) its last rows is a table of
+#: fewer rows, which no reader can tell apart from one written that way
+UNSIZED = ("csv", "xyz")
+
+
+def _judge(answer: dict, original: Optional[dict], mutation: Mutation, fmt: str = "") -> str:
+    """The outcome of one read: clean, exception, crash, hang, memory, garbage, warned or accepted (for the
+    ``UNSIZED`` formats also a truncated file read as fewer points: it cannot be told apart)."""
     status = answer["status"]
     if status == "error":
         return "clean" if answer.get("named", True) else "exception"
@@ -720,6 +792,8 @@ def _judge(answer: dict, original: Optional[dict], mutation: Mutation) -> str:
     if original is None:
         return "accepted"
     same = (answer["n_points"], answer["crc"]) == (original["n_points"], original["crc"])
+    if mutation.kind == "truncate" and fmt in UNSIZED and 0 < answer["n_points"] <= original["n_points"]:
+        return "accepted"
     if mutation.kind == "truncate" and not same:
         return "garbage"  # the file lost bytes and the reader made up the rest
     if answer["n_points"] != original["n_points"]:
@@ -785,7 +859,7 @@ def run(data: Path, total: int, seed: int, formats: list[str] | None, minutes: f
             for t in threads:
                 t.join()
             for side, answer in answers.items():
-                outcome = _judge(answer, originals[(index[id(src)], side)], mutation)
+                outcome = _judge(answer, originals[(index[id(src)], side)], mutation, src.fmt)
                 key = (src.fmt, side)
                 stats[key][outcome] += 1
                 stats[key]["cases"] += 1
@@ -894,7 +968,10 @@ def report(result: dict, command: str) -> str:
         "",
         "Each case is one mutated copy of a file of `../shared/data`, or of a small file the run writes for each "
         "format the folder lacks (`volviz.bench.robustness_made`: MATLAB v5 plain and compressed, TIFF, NRRD raw "
-        "and gzip, NIfTI, DICOM, cube, FITS, MRC, .npy, LAS, SEG-Y) (bit flips; truncation at every header "
+        "and gzip, NIfTI, DICOM, cube, FITS, MRC, .npy, LAS, SEG-Y; `volviz.bench.robustness_formats`, several "
+        "seeds each, every file of a seed of several files damaged in turn: XDMF, Tecplot, EnSight, AVS UCD, "
+        "OME-Zarr, MINC, HDF5 arrays, CSV points, .xyz, BOV, PVD, LAZ, .vvz read as the app reads it) (bit flips; "
+        "truncation at every header "
         "boundary; header fields set to 0, -1, 2^31-1, 2^63-1, NaN, non-numbers, as text or binary integers; XML "
         "attributes swapped, flipped and enlarged; HDF5 object headers damaged and VTKHDF counts set through h5py), "
         "read by `volviz.io.read` (isolated as by default) and by VTK's reader of the format, each side in a worker "
@@ -904,7 +981,8 @@ def report(result: dict, command: str) -> str:
         "lost data, or with a grid size other than the original's, or with inconsistent arrays or non-finite "
         "spacing/origin; *warned*: a read that succeeds with a `ReadWarning` naming the file and what will be "
         "shown other than meant (e.g. a CF coordinate the reader takes for data); *accepted*: a read of the "
-        "original's size (a flipped data bit cannot be told apart); "
+        "original's size (a flipped data bit cannot be told apart), and for CSV and .xyz tables, which carry no "
+        "count, a truncated file read as the rows it still holds; "
         "*contained*: volviz refusals where its reader child crashed, ran out of memory or time (VTK's failure "
         "caught by the isolation, not by a header check).",
         "",
@@ -942,7 +1020,9 @@ def report(result: dict, command: str) -> str:
             median = "no refusal" if r["median_s"] is None else f"{r['median_s']:.3f} s"
             lines.append(f"- {r['format']}: {r['first_s']:.2f} s -> {median}, `{r['file']}` {r['mutation']} "
                          f"({r['detail']})")
-    lines += ["", "VTK has no PVM reader (—). Examples of each failure (at most five per format, side and kind):", ""]
+    lines += ["", "— : VTK has no reader of the format (PVM, MATLAB, cube, FITS, .npy, LAS/LAZ, SEG-Y, OME-Zarr, "
+                  "HDF5 arrays, CSV, BOV, PVD, .vvz). Examples of each failure (at most five per format, side and "
+                  "kind):", ""]
     for key, items in sorted(result["examples"].items()):
         for item in items:
             lines.append(f"- {key.replace('|', ' / ')}: `{item['file']}` {item['mutation']} ({item['detail']}): "
@@ -970,8 +1050,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--cases", type=int_in(1, 10_000_000), default=10000, help="mutated files (default 10000)")
     parser.add_argument("--seed", type=int_in(0, 2**31), default=1)
     parser.add_argument("--formats", nargs="+", metavar="FORMAT", help="only these formats (pvm slc pnm metaimage "
-                        "dem plot3d vtk-legacy vti vtu vtkhdf jpeg exodus cgns netcdf openfoam raw; written for the "
-                        "run: matlab matlab-z tiff nrrd nrrd-gzip nifti dicom cube fits mrc npy las segy)")
+                        "dem plot3d vtk-legacy vti vtu vtkhdf jpeg exodus cgns netcdf openfoam raw tecplot fluent-cff "
+                        "xdmf; written for the run: matlab matlab-z tiff nrrd nrrd-gzip nifti dicom cube fits mrc npy "
+                        "las segy xdmf tecplot ensight avs-ucd ome-zarr minc hdf5 csv xyz bov pvd laz vvz)")
     parser.add_argument("--minutes", type=float, default=0.0,
                         help="stop starting new cases after this many minutes (0: no limit); the report says so")
     parser.add_argument("--out", metavar="FILE", type=Path, default=REPORT,
