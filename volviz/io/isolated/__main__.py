@@ -188,7 +188,7 @@ def main() -> None:
     _die_with_parent()
     import numpy  # noqa: F401 - the imports every read needs, done before the parent is told we are ready
 
-    import volviz.io.registry  # noqa: F401
+    import volviz.io.loaders  # noqa: F401 - and with it the package: the registry, the series, the raw readers
     out.write(json.dumps({"ready": True, "pid": os.getpid()}).encode() + b"\n")
     _load_vtk_when_idle()
     child = Child()
