@@ -16,7 +16,9 @@ legibility measures.
 Writes only its section of ``docs/first-open.md``, between ``BEGIN`` and ``END`` (``volviz.io.doc_section``: the
 app's window table and the prose around are kept), or only prints with ``--no-write``. ``--profile N`` adds where
 the time of the N slowest files goes (cProfile of an in-process render, by volviz module). ``--only`` measures some
-files and keeps the other rows (and the profiles, unless it makes new ones).
+files and keeps the other rows (and the profiles, unless it makes new ones). ``--boundary-rule`` measures the
+legibility of regular volumes drawn with the boundary transfer function (Kindlmann & Durkin 1998,
+``volviz.optics.boundary``) in place of the first look's, for the comparison in ``docs/first-open.md``; it only prints.
 """
 from __future__ import annotations
 
@@ -163,11 +165,13 @@ def render_timed(path: Path, out: Path) -> tuple[float, int, str]:
     return seconds, done.returncode, lines[-1] if lines else ""
 
 
-def legibility(path: Path) -> Optional[tuple[str, Optional[float], Optional[float]]]:
-    """How ``path`` is drawn, and for a volume its visible footprint and mode contrast (see the module docstring)."""
+def legibility(path: Path, boundary_rule: bool = False) -> Optional[tuple[str, Optional[float], Optional[float]]]:
+    """How ``path`` is drawn, and for a volume its visible footprint and mode contrast (see the module docstring);
+    ``boundary_rule``: of a regular volume drawn with ``volviz.optics.boundary``'s transfer function instead."""
     from volviz.model.stats import scalar_values
     from volviz.optics import TransferFunction
     from volviz.optics.auto_tf import mean_chord
+    from volviz.optics.boundary import boundary_transfer_function, regular_fields
     from volviz.render.export import open_target, render_session
     from volviz.render.scene_builder import ensure_transfer_functions
     from volviz.scene.datasets import component_dataset, drawn_as, load_datasets
@@ -189,10 +193,14 @@ def legibility(path: Path) -> Optional[tuple[str, Optional[float], Optional[floa
         if tf is None:         # a picture (PPM, JPEG) drawn in its own colours: no transfer function to measure
             return "picture", None, None
         session.render.options["axes"] = False
-        image = render_session(session, None, METRIC_SIZE, datasets=datasets)
         tf_name = str(comp.transfer_function)
         dataset = component_dataset(comp, datasets)
         chord = mean_chord(volume_grid(dataset).bounds)
+        grid = regular_fields(dataset) if boundary_rule else None
+        if grid is not None:
+            tf = boundary_transfer_function(scalar_values(dataset), chord, grid, tf_name)
+            session.transfer_functions[tf_name] = tf.to_dict()
+        image = render_session(session, None, METRIC_SIZE, datasets=datasets)
         lo, hi = tf.range
         opaque = TransferFunction([lo, hi], [(1.0, 1.0, 1.0)] * 2, [60.0 / chord] * 2, name=tf_name)
         session.transfer_functions[tf_name] = opaque.to_dict()
@@ -235,8 +243,9 @@ def where_time_goes(path: Path, top: int = 6) -> list[str]:
     return [f"in-process render {total:.2f} s of own time"] + picked
 
 
-def measure(root: Path, names: Optional[list[str]] = None) -> list[FirstImage]:
-    """Every file of ``opened_files`` (or those named in ``names``, relative to ``root``) measured."""
+def measure(root: Path, names: Optional[list[str]] = None, boundary_rule: bool = False) -> list[FirstImage]:
+    """Every file of ``opened_files`` (or those named in ``names``, relative to ``root``) measured; legibility with
+    the boundary rule where ``boundary_rule``."""
     records = []
     with tempfile.TemporaryDirectory() as work:
         for path in opened_files(root):
@@ -258,7 +267,7 @@ def measure(root: Path, names: Optional[list[str]] = None) -> list[FirstImage]:
                     record.note = last.removeprefix("volviz: error: ")
             if not record.note:
                 try:
-                    shown = legibility(path)
+                    shown = legibility(path, boundary_rule)
                 except Exception as exc:  # a measure that cannot be made is said, the row kept
                     record.note = f"legibility: {type(exc).__name__}: {exc}"
                 else:
@@ -328,8 +337,10 @@ def main(argv: Optional[list[str]] = None) -> int:
     parser.add_argument("--only", nargs="*", default=None, help="only these files (relative to the data folder)")
     parser.add_argument("--profile", type=int, default=0, help="say where the time goes for the N slowest files")
     parser.add_argument("--no-write", action="store_true", help="print only; leave docs/first-open.md alone")
+    parser.add_argument("--boundary-rule", action="store_true", help="measure regular volumes' legibility with the "
+                        "boundary transfer function (volviz.optics.boundary) instead; print only")
     args = parser.parse_args(argv)
-    records = measure(args.data.resolve(), args.only)
+    records = measure(args.data.resolve(), args.only, args.boundary_rule)
     slowest = sorted((r for r in records if r.seconds is not None), key=lambda r: -float(r.seconds or 0))
     profiles = {r.name: where_time_goes(args.data.resolve() / r.name) for r in slowest[:max(args.profile, 0)]}
     text = markdown(records, profiles)
@@ -337,6 +348,6 @@ def main(argv: Optional[list[str]] = None) -> int:
         text = kept_rows(text, bool(profiles), [p.relative_to(args.data.resolve()).as_posix()
                                                  for p in opened_files(args.data.resolve())])
     print(text)
-    if not args.no_write:
+    if not args.no_write and not args.boundary_rule:
         write_section(text)
     return 0

@@ -16,6 +16,9 @@ than ``BACKGROUND_FRACTION`` of the values it is the background: at the low end 
 it; elsewhere (a free stream, the bright side of an inverted image) the function is centred on it, transparent there
 and rising with the distance from it on either side, cool below and warm above, as the signed view is about zero.
 
+``volviz.optics.boundary`` places the one-sided view's opacity at the data's boundaries instead (Kindlmann & Durkin
+1998); on the shared volumes it was less legible by the measures of docs/first-open.md, so the ramp stays.
+
 Signed data around zero (seismic amplitudes, a velocity component, vorticity, an orbital's two signs: robust
 percentiles of opposite signs, the smaller at least ``SIGNED_BALANCE`` of the larger) gets the diverging view
 instead: zero transparent and white, the ramp rising towards both signs alike, blue for negative and red for
@@ -96,22 +99,31 @@ def auto_transfer_function(values: np.ndarray, chord: float, name: str = "auto")
     mode = background_mode(sample)
     if mode is not None and mode[0] > full_lo:     # a background inside the range or at its top: centred on it
         return _around(sample, full_lo, full_hi, mode, chord, name)
+    span = one_sided_range(sample, mode)
+    if span is not None:
+        shape = np.interp(sample, np.linspace(span[0], span[1], len(RAMP)), RAMP, left=0.0)
+        return _ramp(full_lo, full_hi, span[0], span[1], peak_extinction(float(shape.mean()), chord), name)
+    lo, hi = robust_range(sample)
+    reach = max(-lo, hi)
+    shape = np.interp(np.abs(sample), np.linspace(0.0, reach, len(RAMP)), RAMP)
+    return _diverging(full_lo, full_hi, reach, peak_extinction(float(shape.mean()), chord), name)
+
+
+def one_sided_range(sample: np.ndarray, mode: tuple[float, float, float] | None = None) -> tuple[float, float] | None:
+    """Where the one-sided ramp of a finite, non-constant ``sample`` runs: from above a background mode at the bottom
+    of the range (``mode``, ``background_mode``'s answer) to the robust top, else the robust range; None where the
+    data gets another view (a background mode inside the range, signed data)."""
+    mode = background_mode(sample) if mode is None else mode
+    if mode is not None and mode[0] > float(sample.min()):
+        return None
     if mode is not None:                           # at the bottom: the ramp starts above it
         fg = sample[sample > mode[1]]
-        sample_lo, sample_hi = (float(v) for v in np.percentile(fg, [LOW_PERCENTILE, HIGH_PERCENTILE]))
-        if sample_hi > sample_lo and fg.size:
-            return _scaled_ramp(sample, full_lo, full_hi, sample_lo, sample_hi, chord, name)
+        if fg.size:
+            lo, hi = (float(v) for v in np.percentile(fg, [LOW_PERCENTILE, HIGH_PERCENTILE]))
+            if hi > lo:
+                return lo, hi
     lo, hi = robust_range(sample)
-    signed = is_signed(lo, hi)
-    reach = max(-lo, hi)
-    shape = (np.interp(np.abs(sample), np.linspace(0.0, reach, len(RAMP)), RAMP) if signed
-             else np.interp(sample, np.linspace(lo, hi, len(RAMP)), RAMP))
-    mean = float(shape.mean())
-    depth = TARGET_DEPTH / mean if mean > 0 else MAX_DEPTH
-    rho_max = float(np.clip(depth, MIN_DEPTH, MAX_DEPTH)) / chord
-    if signed:
-        return _diverging(full_lo, full_hi, reach, rho_max, name)
-    return _ramp(full_lo, full_hi, lo, hi, rho_max, name)
+    return None if is_signed(lo, hi) else (lo, hi)
 
 
 def background_mode(values: np.ndarray, bins: int = 256) -> tuple[float, float, float] | None:
@@ -133,14 +145,9 @@ def background_mode(values: np.ndarray, bins: int = 256) -> tuple[float, float, 
     return float(edges[a]), float(edges[b + 1]), float(0.5 * (edges[peak] + edges[peak + 1]))
 
 
-def _scaled_ramp(sample: np.ndarray, full_lo: float, full_hi: float, lo: float, hi: float, chord: float,
-                 name: str) -> TransferFunction:
-    """``_ramp`` between ``lo`` and ``hi`` with the peak extinction that gives the mean sample ``TARGET_DEPTH``."""
-    shape = np.interp(sample, np.linspace(lo, hi, len(RAMP)), RAMP, left=0.0)
-    return _ramp(full_lo, full_hi, lo, hi, _peak(float(shape.mean()), chord), name)
-
-
-def _peak(mean: float, chord: float) -> float:
+def peak_extinction(mean: float, chord: float) -> float:
+    """The peak extinction that gives a sample of mean extinction share ``mean`` the optical depth ``TARGET_DEPTH``
+    along ``chord`` (within ``MIN_DEPTH`` and ``MAX_DEPTH``)."""
     depth = TARGET_DEPTH / mean if mean > 0 else MAX_DEPTH
     return float(np.clip(depth, MIN_DEPTH, MAX_DEPTH)) / chord
 
@@ -170,8 +177,8 @@ def _around(sample: np.ndarray, full_lo: float, full_hi: float, mode: tuple[floa
     colors = [colors[i] for i in order]
     extinction = [extinction[i] for i in order]
     shape = np.interp(sample, stops, extinction)
-    rho_max = _peak(float(shape.mean()), chord)
-    return _held_flat(full_lo, full_hi, stops, colors, [e * rho_max for e in extinction], name, hold_low=True)
+    rho_max = peak_extinction(float(shape.mean()), chord)
+    return held_flat(full_lo, full_hi, stops, colors, [e * rho_max for e in extinction], name, hold_low=True)
 
 
 def is_signed(lo: float, hi: float) -> bool:
@@ -187,7 +194,7 @@ def _diverging(full_lo: float, full_hi: float, reach: float, rho_max: float, nam
     colors = [list(np.interp(f, np.linspace(-1.0, 1.0, n), np.asarray(COOL_WARM)[:, c]) for c in range(3))
               for f in fractions]
     extinction = [float(np.interp(abs(f), np.linspace(0.0, 1.0, n), RAMP)) * rho_max for f in fractions]
-    return _held_flat(full_lo, full_hi, stops, colors, extinction, name, hold_low=True)
+    return held_flat(full_lo, full_hi, stops, colors, extinction, name, hold_low=True)
 
 
 def _ramp(full_lo: float, full_hi: float, lo: float, hi: float, rho_max: float, name: str) -> TransferFunction:
@@ -195,10 +202,10 @@ def _ramp(full_lo: float, full_hi: float, lo: float, hi: float, rho_max: float, 
     stops = list(np.linspace(lo, hi, len(RAMP)))
     colors = [list(c) for c in COOL_WARM]
     extinction = [r * rho_max for r in RAMP]
-    return _held_flat(full_lo, full_hi, stops, colors, extinction, name)
+    return held_flat(full_lo, full_hi, stops, colors, extinction, name)
 
 
-def _held_flat(full_lo: float, full_hi: float, stops: list, colors: list, extinction: list, name: str,
+def held_flat(full_lo: float, full_hi: float, stops: list, colors: list, extinction: list, name: str,
                hold_low: bool = False) -> TransferFunction:
     """The function over ``stops`` extended to the full range: its last stop held above; below, transparent or
     (``hold_low``) its first stop held."""
