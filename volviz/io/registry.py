@@ -358,11 +358,6 @@ def spec_of(path: PathLike, options: dict | None = None) -> ReaderSpec:
     if catch_all:
         return catch_all[0]
     ext = p.suffix.lower()
-    if len(named) == 1:
-        return named[0]  # its loader says what is wrong with the content
-    if named:
-        raise ReadError(p, f"is named like {' or '.join(s.description for s in named)}, but its content fits none of "
-                           f"them (its content is {describe_bytes(head)})")
     if ext == ".raw":
         headers = sorted(h.name for h in p.parent.glob(p.stem + ".mh[da]"))
         if headers:
