@@ -93,3 +93,50 @@ def test_relations_run_in_line_when_no_thread_can_start(monkeypatch):
     monkeypatch.setattr(sort, "_SECOND_CORE", closed)
     res = visibility_order(m, cam, (96, 80))
     assert np.array_equal(res.order, ref.order) and res.boundary_relations == ref.boundary_relations > 0
+
+
+@pytest.mark.parametrize("parallel", [False, True])
+def test_float32_planes_decide_as_the_float64_planes_near_every_plane(parallel):
+    """The serial pass takes a side from the float32 planes only when it is clearly away from 0: eyes (and view
+    directions) on face planes and 1e-9 to 1e-5 off them, on a jittered mesh offset by 1e6, give the bits and
+    in-degrees of the float64 planes (the pass on all cores reads only those)."""
+    topo = topology(_offset(syn.box_tets(7, jitter=0.3)))
+    planes = mpvo.planes32(topo)
+    assert planes.dtype == np.float32 and planes.shape == (topo.n_tets, 4, 4)
+    rng = np.random.default_rng(3)
+    t, f = np.nonzero(topo.neighbor >= 0)
+    pick = rng.choice(len(t), 12, replace=False)
+    checked = 0
+    for k, off in zip(pick, [0.0, 1e-9, -1e-9, 1e-7, -1e-7, 1e-5, -1e-5, 0.0, 3e-8, -3e-8, 1e-6, -1e-6]):
+        n, d = topo.face_n[t[k], f[k]], topo.face_d[t[k], f[k]]
+        if parallel:           # a view direction in (or nearly in) the face's plane
+            fwd = np.cross(n, rng.normal(size=3))
+            fwd = np.ascontiguousarray(fwd / np.linalg.norm(fwd) + off * n)
+            eye = np.zeros(3)
+        else:                  # an eye on (or nearly on) the face's plane, outside the mesh
+            p = topo.centroid[t[k]] + 3.0 * np.cross(n, rng.normal(size=3))
+            eye = np.ascontiguousarray(p - (n @ p - d - off) * n)
+            fwd = np.array([0.0, 0.0, 1.0])
+        args = (topo.neighbor, topo.back_face, topo.face_n, topo.face_d, eye, fwd, parallel)
+        fast = mpvo.face_sides(*args, cores=False, planes=planes)
+        exact = mpvo.face_sides(*args, cores=True)
+        plain = mpvo.face_sides(*args, cores=False)
+        assert np.array_equal(fast[0], exact[0]) and np.array_equal(fast[1], exact[1])
+        assert np.array_equal(plain[0], exact[0]) and np.array_equal(plain[1], exact[1])
+        checked += 1
+    assert checked == 12
+
+
+def test_sorts_at_once_on_two_threads_give_the_serial_orders():
+    """A sort's work arrays come from a pool on the topology: two sorts running at once (the app's worker and its
+    GUI thread) take different ones, and each order equals the one made alone."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    m = syn.cavity_box(9)
+    topo = topology(m)
+    cams = [Camera.orbit(m.points, az, 20, 2.5) for az in (10, 100, 190, 280)]
+    alone = [visibility_order(topo, cam, (96, 80)).order for cam in cams]
+    with ThreadPoolExecutor(2) as pool:
+        both = list(pool.map(lambda cam: visibility_order(topo, cam, (96, 80)).order, cams * 3))
+    assert all(np.array_equal(o, alone[i % 4]) for i, o in enumerate(both))
+    assert 1 <= len(topo.__dict__["_sort_work"]) <= 2

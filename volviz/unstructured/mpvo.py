@@ -1,12 +1,16 @@
 """MPVO per view (Williams 1992; Roettger §8.1, Guthe §4.3): which neighbour of each cell is in front, and Kahn's
 topological sort of the resulting graph plus the extra (boundary) relations, with cycles broken farthest first.
 
-Only the face sides depend on the view: one pass over the cells, split over the cores for large meshes, each shared
-face decided by its lower-numbered cell's plane (found through ``Topology.back_face``, no search). Per cell the pass
-keeps 1 byte (a bit per neighbour in front, one for "has extra relations") and a 32-bit in-degree; Kahn then touches
-the adjacency row (int32), that byte and the in-degrees of the neighbours in front, in an unrolled loop without
-negative-index checks (the 2.27 M-cell refined Blunt Fin, one core: 58-62 ms; the previous loop, int64 adjacency,
-4 direction bytes and a "done" array per cell, 122-148 ms). Measured: docs/bench/unstructured.md.
+Only the face sides depend on the view: one pass over the cells, each shared face decided by its lower-numbered
+cell's plane. On one core (beside the boundary relations on the other) the pass decides each shared face once and
+writes both cells' entries (the neighbour's through ``Topology.back_face``), reading the planes in order from a
+float32 copy (``planes32``: 64 bytes per cell instead of 128) and the float64 planes only where the float32 side is
+too close to 0 to trust, so the decisions are the float64 ones exactly; split over the cores (large convex meshes)
+each cell fills its own entries from the float64 planes. Per cell the pass keeps 1 byte (a bit per neighbour in
+front, one for "has extra relations") and a 32-bit in-degree; Kahn then touches the adjacency row (int32), that byte
+and the in-degrees of the neighbours in front. The 2.27 M-cell refined Blunt Fin, process CPU at load 12-15: face
+sides 26 ms (the per-cell pass from the float64 planes 34-42 ms), Kahn 59 ms (a branch-free loop: 137 ms; the
+byte and in-degree packed into one word: no change). Measured: docs/bench/unstructured.md.
 """
 from __future__ import annotations
 
@@ -52,11 +56,67 @@ def _cell_sides(t: int, neighbor: np.ndarray, back: np.ndarray, face_n: np.ndarr
     indeg[t] = behind
 
 
+#: a side taken from the float32 planes is trusted when it exceeds this times (|eye|_1 + |d|) (the planes' rounding,
+#: 2^-24 relative, with a 4x margin for the float64 arithmetic); closer to 0 the float64 planes decide, so the
+#: decisions are those of the float64 planes bit for bit
+PLANE32_TOL = 2.0 ** -22
+
+
+def planes32(topo: object) -> np.ndarray:
+    """(m, 4, 4) float32 face planes (nx, ny, nz, d) of ``topo``'s cells, cached on it: the face sides read 64 bytes
+    per cell from them instead of 128 from ``face_n`` / ``face_d`` (one stream, half the memory traffic)."""
+    cached = topo.__dict__.get("_planes32")
+    if cached is None:
+        face_n, face_d = topo.face_n, topo.face_d           # type: ignore[attr-defined]
+        cached = np.empty((len(face_d), 4, 4), np.float32)
+        cached[:, :, :3] = face_n
+        cached[:, :, 3] = face_d
+        topo.__dict__["_planes32"] = cached
+    return cached
+
+
 @njit(cache=True, nogil=True)
-def _sides_serial(neighbor: np.ndarray, back: np.ndarray, face_n: np.ndarray, face_d: np.ndarray, eye: np.ndarray,
-                  fwd: np.ndarray, parallel: bool, front: np.ndarray, indeg: np.ndarray) -> None:
-    for t in range(len(neighbor)):
-        _cell_sides(t, neighbor, back, face_n, face_d, eye, fwd, parallel, front, indeg)
+def _sides_serial(neighbor: np.ndarray, back: np.ndarray, face_n: np.ndarray, face_d: np.ndarray,
+                  planes: np.ndarray, eye: np.ndarray, fwd: np.ndarray, parallel: bool, front: np.ndarray,
+                  indeg: np.ndarray) -> None:
+    """One core: each shared face decided once, by its lower-numbered cell t (its plane read in order), and written
+    to both cells (the neighbour's bit through ``back``); the neighbour's plane is never read, which a per-cell
+    pass does for half the faces at scattered addresses. The side comes from the float32 ``planes`` (``planes32``)
+    where it is clearly away from 0, else (or with ``planes`` empty) from the float64 ones."""
+    m = len(neighbor)
+    for t in range(m):
+        front[t] = 0
+        indeg[t] = 0
+    if parallel:                         # the side of an orthographic view: n . (-fwd), no offset
+        e0, e1, e2, dsc = -fwd[0], -fwd[1], -fwd[2], 0.0
+    else:
+        e0, e1, e2, dsc = eye[0], eye[1], eye[2], 1.0
+    tol_e = PLANE32_TOL * (abs(e0) + abs(e1) + abs(e2))
+    tol_d = PLANE32_TOL * dsc
+    f32 = len(planes) == m
+    for t in range(m):
+        bits = 0
+        behind = 0
+        for f in range(4):
+            u = neighbor[t, f]
+            if u <= t:                   # the boundary (-1), or decided by the lower-numbered u
+                continue
+            side = 0.0
+            if f32:
+                d = np.float64(planes[t, f, 3])
+                side = planes[t, f, 0] * e0 + planes[t, f, 1] * e1 + planes[t, f, 2] * e2 - dsc * d
+                if abs(side) <= tol_e + tol_d * abs(d):
+                    side = 0.0
+            if side == 0.0:
+                side = _side(face_n, face_d, t, f, eye, fwd, parallel)
+            if side > 0.0:               # u in front of t
+                bits |= 1 << f
+                indeg[u] += 1
+            elif side < 0.0:             # t in front of u: u's bit for the shared face
+                behind += 1
+                front[u] |= 1 << ((back[t] >> (2 * f)) & 3)
+        front[t] |= bits
+        indeg[t] += behind
 
 
 @njit(cache=True, nogil=True, parallel=True)
@@ -67,18 +127,25 @@ def _sides_parallel(neighbor: np.ndarray, back: np.ndarray, face_n: np.ndarray, 
 
 
 def face_sides(neighbor: np.ndarray, back: np.ndarray, face_n: np.ndarray, face_d: np.ndarray, eye: np.ndarray,
-               fwd: np.ndarray, parallel: bool, cores: bool | None = None) -> tuple[np.ndarray, np.ndarray]:
+               fwd: np.ndarray, parallel: bool, cores: bool | None = None,
+               out: tuple[np.ndarray, np.ndarray] | None = None, planes: np.ndarray | None = None
+               ) -> tuple[np.ndarray, np.ndarray]:
     """Per cell: a byte whose bit f says the neighbour across face f is in front (drawn after it), and the number of
     neighbours behind it (its MPVO in-degree, int32). A face whose plane holds the eye gives no relation. A shared
     face is decided by the plane of its lower-numbered cell for both (``back``: ``Topology.back_face``), so both
     sides agree; every cell fills only its own entries.
     ``parallel``: orthographic view along ``fwd``; else the eye at ``eye``. ``cores``: split the pass over the cores
-    (default: from ``PARALLEL_CELLS`` cells on)."""
+    (default: from ``PARALLEL_CELLS`` cells on). ``out``: (front, indeg) arrays of ``len(neighbor)`` to fill (a
+    sort's reused work arrays) instead of new ones. ``planes``: the float32 planes of the serial pass
+    (``planes32``; without them it reads the float64 planes only)."""
     m = len(neighbor)
-    front = np.empty(m, np.uint8)
-    indeg = np.empty(m, np.int32)
-    run = _sides_parallel if (m >= PARALLEL_CELLS if cores is None else cores) else _sides_serial
-    run(neighbor, back, face_n, face_d, eye, fwd, parallel, front, indeg)
+    front, indeg = out if out is not None else (np.empty(m, np.uint8), np.empty(m, np.int32))
+    if m >= PARALLEL_CELLS if cores is None else cores:
+        _sides_parallel(neighbor, back, face_n, face_d, eye, fwd, parallel, front, indeg)
+    else:
+        if planes is None:
+            planes = np.empty((0, 4, 4), np.float32)
+        _sides_serial(neighbor, back, face_n, face_d, planes, eye, fwd, parallel, front, indeg)
     return front, indeg
 
 
@@ -93,13 +160,21 @@ def add_extra(ex_src: np.ndarray, ex_dst: np.ndarray, front: np.ndarray, indeg: 
 @njit(cache=True, nogil=True)
 def kahn(neighbor: np.ndarray, front: np.ndarray, indeg: np.ndarray, ex_src: np.ndarray, ex_dst: np.ndarray,
          order: np.ndarray, n_out: int, fallback: np.ndarray) -> tuple[int, int]:
+    """``kahn_into`` with a stack of its own."""
+    return kahn_into(neighbor, front, indeg, ex_src, ex_dst, order, n_out, fallback,
+                     np.empty(len(neighbor), np.int32))
+
+
+@njit(cache=True, nogil=True)
+def kahn_into(neighbor: np.ndarray, front: np.ndarray, indeg: np.ndarray, ex_src: np.ndarray, ex_dst: np.ndarray,
+              order: np.ndarray, n_out: int, fallback: np.ndarray, stack: np.ndarray) -> tuple[int, int]:
     """Kahn's algorithm from ``face_sides`` + ``add_extra`` (``ex_src`` sorted), depth first (a stack: the cells
     just freed are near the last one, in space and mostly in memory). Fills ``order[n_out:]`` back to front and
     returns (cells in order, cycle breaks). A stall (a cycle) with an empty ``fallback`` returns (n, -1) with the
     state intact: call again with ``n_out = n`` and a fallback order (farthest first); a stalled run then emits the
-    first cell of it not yet emitted (an emitted cell has in-degree <= 0) and carries on."""
+    first cell of it not yet emitted (an emitted cell has in-degree <= 0) and carries on. ``stack``: int32 work
+    array of ``len(neighbor)`` (a sort's, reused between frames)."""
     m = len(neighbor)
-    stack = np.empty(m, np.int32)
     top = 0
     if n_out == 0:
         for t in range(m):

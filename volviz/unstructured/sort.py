@@ -19,6 +19,8 @@ Roettger §8.1 and Guthe §4.3 (§3.1 of the thesis):
 - Visibility cycles (real ones, or ones created by combining relations that hold on different rays) stall Kahn's
   algorithm. They are broken by emitting the farthest remaining cell (by centroid depth); ``SortResult.cycles`` counts
   the breaks.
+- Per frame only the order is a new array: the per-cell work arrays (state byte, in-degree, Kahn's stack) are kept
+  on the topology and reused (``_take_work``), so a frame neither allocates nor pages them in again.
 """
 from __future__ import annotations
 
@@ -36,7 +38,7 @@ from volviz.model.datasets import TetMesh
 from volviz.model.camera import Camera
 from volviz.unstructured.boundary_pairs import inner_boundary, object_relations
 from volviz.unstructured import mpvo
-from volviz.unstructured.mpvo import add_extra, face_sides, kahn
+from volviz.unstructured.mpvo import add_extra, face_sides, kahn_into
 from volviz.unstructured.topology import FACES, Topology, topology
 
 METHODS = ("mpvo", "centroid", "power")
@@ -267,6 +269,28 @@ def _beside(fn: Callable[[], tuple[np.ndarray, np.ndarray]]) -> Future[tuple[np.
             return None
 
 
+_WORK_LOCK = threading.Lock()
+
+
+def _take_work(topo: Topology) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A sort's work arrays for ``topo`` (per cell: state byte, in-degree, Kahn's stack; int32), taken from a pool
+    kept on ``topo`` so a frame does not allocate (and page in) them anew; sorts running at once (the app's worker
+    and its GUI thread) take different ones. Hand them back with ``_give_work``."""
+    with _WORK_LOCK:
+        pool = topo.__dict__.setdefault("_sort_work", [])
+        if pool:
+            return pool.pop()
+    m = topo.n_tets
+    return np.empty(m, np.uint8), np.empty(m, np.int32), np.empty(m, np.int32)
+
+
+def _give_work(topo: Topology, work: tuple[np.ndarray, np.ndarray, np.ndarray]) -> None:
+    with _WORK_LOCK:
+        pool = topo.__dict__.setdefault("_sort_work", [])
+        if len(pool) < 2:
+            pool.append(work)
+
+
 def _view(cam: Camera, topo: Topology) -> tuple[np.ndarray, np.ndarray]:
     _, _, f = cam.frame()
     return np.ascontiguousarray(cam.position - topo.origin), np.ascontiguousarray(f)
@@ -305,26 +329,32 @@ def visibility_order(mesh: TetMesh | Topology, camera: Camera, size: tuple[int, 
         relations = partial(object_relations, topo, camera, size)
     pending = _beside(relations) if relations is not None and m >= mpvo.PARALLEL_CELLS else None
     beside = pending is not None
-    if pending is not None:  # both stages release the GIL: the relations on a second core while this one does the sides
-        front, indeg = face_sides(topo.neighbor, topo.back_face, topo.face_n, topo.face_d, eye, fwd,
-                                  camera.parallel, cores=False)
-        t2 = time.perf_counter()
-        src, dst = pending.result()
-    else:
-        src, dst = relations() if relations is not None else (np.empty(0, np.int64), np.empty(0, np.int64))
-        t2 = time.perf_counter()
-        front, indeg = face_sides(topo.neighbor, topo.back_face, topo.face_n, topo.face_d, eye, fwd,
-                                  camera.parallel)
-    t3 = time.perf_counter()
-    by_src = np.argsort(src, kind="stable")
-    idx = topo.neighbor.dtype
-    ex_src, ex_dst = src[by_src].astype(idx), dst[by_src].astype(idx)
-    add_extra(ex_src, ex_dst, front, indeg)
-    order = np.empty(m, idx)
-    n_out, cycles = kahn(topo.neighbor, front, indeg, ex_src, ex_dst, order, 0, np.empty(0, idx))
-    if cycles < 0:                      # a cycle: carry on from the stall, breaking it farthest first
-        fallback = np.argsort(_centroid_keys(topo.centroid, eye, fwd, camera.parallel), kind="stable").astype(idx)
-        n_out, cycles = kahn(topo.neighbor, front, indeg, ex_src, ex_dst, order, n_out, fallback)
+    work = _take_work(topo)
+    front, indeg, stack = work
+    try:
+        if pending is not None:  # both stages release the GIL: the relations on a second core beside the sides
+            face_sides(topo.neighbor, topo.back_face, topo.face_n, topo.face_d, eye, fwd, camera.parallel,
+                       cores=False, out=(front, indeg), planes=mpvo.planes32(topo))
+            t2 = time.perf_counter()
+            src, dst = pending.result()
+        else:
+            src, dst = relations() if relations is not None else (np.empty(0, np.int64), np.empty(0, np.int64))
+            t2 = time.perf_counter()
+            face_sides(topo.neighbor, topo.back_face, topo.face_n, topo.face_d, eye, fwd, camera.parallel,
+                       out=(front, indeg), planes=None if m >= mpvo.PARALLEL_CELLS else mpvo.planes32(topo))
+        t3 = time.perf_counter()
+        by_src = np.argsort(src, kind="stable")
+        idx = topo.neighbor.dtype
+        ex_src, ex_dst = src[by_src].astype(idx), dst[by_src].astype(idx)
+        add_extra(ex_src, ex_dst, front, indeg)
+        order = np.empty(m, idx)
+        n_out, cycles = kahn_into(topo.neighbor, front, indeg, ex_src, ex_dst, order, 0, np.empty(0, idx), stack)
+        if cycles < 0:                  # a cycle: carry on from the stall, breaking it farthest first
+            fallback = np.argsort(_centroid_keys(topo.centroid, eye, fwd, camera.parallel),
+                                  kind="stable").astype(idx)
+            n_out, cycles = kahn_into(topo.neighbor, front, indeg, ex_src, ex_dst, order, n_out, fallback, stack)
+    finally:
+        _give_work(topo, work)
     t4 = time.perf_counter()
     # with the relations beside the sides: "sides" is the face sides alone, "relations_wait" the wait for them after
     stages = {"sides": t2 - t1, "relations_wait": t3 - t2} if beside else {"relations": t2 - t1, "sides": t3 - t2}
