@@ -130,3 +130,38 @@ def test_outline_corners_are_the_bounds_at_utm_coordinates(tmp_path) -> None:
         assert len({tuple(p) for p in points}) == 8
     finally:
         plotter.close()
+
+
+def test_point_cloud_shown_by_a_colour_array_has_no_scalar_bar(tmp_path) -> None:
+    """A point table with intensity and red, green, blue columns: shown by intensity (its default) it has a scalar
+    bar named after it; ``--array red`` draws the points in their own colours (``vtk_scene.surface_input``), so the
+    "red" scalar bar it kept before explains nothing and is gone (and the framing keeps no room for it)."""
+    import warnings
+
+    from volviz.render.decorations import legend_margin, scalar_bar_actor, scalar_bar_title
+    from volviz.render.export import close_scene, offscreen_scene, open_target, snapshot
+    from volviz.scene.datasets import load_datasets
+
+    rng = np.random.default_rng(7)
+    points = rng.random((400, 3))
+    colors = (points * 255).astype(int)
+    rows = [f"{p[0]},{p[1]},{p[2]},{7 * p[0]},{c[0]},{c[1]},{c[2]}" for p, c in zip(points, colors)]
+    path = tmp_path / "cloud.csv"
+    path.write_text("\n".join(["x,y,z,intensity,red,green,blue"] + rows) + "\n")
+    for array, title in ((None, "intensity"), ("red", None)):
+        session, _ = open_target(path, array=array)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            datasets = load_datasets(session, None)
+        plotter, controller = offscreen_scene(session, datasets, (160, 120))
+        try:
+            controller.build()
+            image = snapshot(plotter, (160, 120)).astype(int)
+            assert scalar_bar_title(plotter) == title
+            assert (scalar_bar_actor(plotter) is None) == (title is None)
+            assert (legend_margin(session, datasets) == 0.0) == (title is None)
+        finally:
+            close_scene(plotter, controller)
+        if array == "red":   # the points in their own colours: reddish and bluish ones both on screen
+            drawn = image[np.abs(image - image[0, 0]).sum(axis=2) > 60]
+            assert ((drawn[:, 0] > drawn[:, 2] + 60).sum() > 3) and ((drawn[:, 2] > drawn[:, 0] + 60).sum() > 3)

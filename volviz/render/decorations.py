@@ -223,20 +223,25 @@ def _add_scalar_bar(plotter: Any, session: Session, comp: Any, datasets: dict[st
 
 
 def _shows_array(comp: Any, datasets: dict[str, Any]) -> bool:
-    """Whether the component colors by an array (its setting, else its dataset's default): a surface of geometry
-    alone (an STL, a PLY of normals) is drawn in a plain color, with no scale to explain."""
-    if comp.settings.get(array_key(comp.type)) or comp.type != "volume":
+    """Whether the component colors by an array through its transfer function (its setting, else its dataset's
+    default): a surface of geometry alone (an STL, a PLY of normals) is drawn in a plain color, and one showing an
+    appearance array (``red`` of a coloured point cloud, ``volviz.model.arrays.is_appearance_array``) in its own
+    vertex colors (``vtk_scene.surface_input``): no scale to explain either way."""
+    if comp.type != "volume":
         return True
-    from volviz.model.arrays import default_array
+    from volviz.model.arrays import default_array, is_appearance_array, parse_array_spec
     from volviz.render.vtk_scene import is_surface
 
     dataset = datasets.get(comp.dataset)
     if dataset is None or not is_surface(dataset):
         return True
-    try:
-        return default_array(dataset) is not None
-    except (TypeError, ValueError, AttributeError):
-        return True
+    spec = comp.settings.get(array_key(comp.type))
+    if not spec:
+        try:
+            spec = default_array(dataset)
+        except (TypeError, ValueError, AttributeError):
+            return True
+    return spec is not None and not is_appearance_array(parse_array_spec(str(spec)).name)
 
 
 def _array_title(comp: Any, datasets: dict[str, Any]) -> str:
