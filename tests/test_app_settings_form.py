@@ -14,7 +14,8 @@ from PySide6.QtWidgets import QCheckBox, QComboBox, QDoubleSpinBox, QLabel, QSpi
 
 from test_app_workflows import viewport, wait_loaded
 from volviz.model.settings import SETTINGS_MODELS
-from volviz_app.settings_form import ColorButton, SettingsForm, StylesTable
+from volviz_app.settings_editors import ColorButton, StylesTable
+from volviz_app.settings_form import SettingsForm
 
 DATASETS = ["height_map", "fog_map"]
 ARRAYS = ["density", "temperature"]
