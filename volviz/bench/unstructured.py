@@ -29,6 +29,18 @@ VTK_MAPPERS = ("vtkProjectedTetrahedraMapper", "vtkUnstructuredGridVolumeRayCast
                "vtkUnstructuredGridVolumeZSweepMapper")
 
 
+ONLY_ROWS = ("sort", "large")
+
+
+def _only_list(text: str) -> list[str]:
+    """An argument type: a comma list of ``ONLY_ROWS`` names."""
+    names = [t for t in text.split(",") if t]
+    unknown = [name for name in names if name not in ONLY_ROWS]
+    if unknown or not names:
+        raise argparse.ArgumentTypeError(f"unknown row {(unknown or [text])[0]!r} (known: {', '.join(ONLY_ROWS)})")
+    return names
+
+
 def _mapper_list(text: str) -> str:
     """An argument type: 'all', 'none' or a comma list of ``VTK_MAPPERS`` names, kept as text."""
     unknown = [name for name in text.split(",") if name not in VTK_MAPPERS] if text not in ("all", "none") else []
@@ -217,9 +229,19 @@ def main(argv: list[str] | None = None) -> int:
                    help="also sort the Blunt Fin refined by this factor per axis (2.3: 2.27 M tetrahedra; 0: not)")
     p.add_argument("--large-out", default=None,
                    help="also write that refined mesh to this VTK .vtu file (Density on the points)")
+    p.add_argument("--only", type=_only_list, default=None,
+                   help="run only these rows (comma list of 'sort': the sort table and the index buffer, 'large': "
+                        "the large mesh, which needs --large-refine) and splice them into the existing "
+                        "unstructured.md under --out, each block naming this command")
     p.add_argument("--out", default=str(Path(__file__).resolve().parents[2] / "docs" / "bench"))
     p.add_argument("--json", default=None, help="also write the results as JSON")
     args = p.parse_args(argv)
+    if args.only is not None:
+        if "large" in args.only and args.large_refine <= 1.0:
+            p.error("--only large needs --large-refine > 1")
+        if "sort" in args.only and not args.sort_sizes:
+            p.error("--only sort needs --sort-sizes")
+        return only_rows(args, argv)
 
     from volviz.io.plot3d import read_plot3d
     from volviz.optics.metrics import max_abs, rmse
@@ -333,7 +355,9 @@ def main(argv: list[str] | None = None) -> int:
         results["large"] = large_mesh_row(big_mesh, tf, cams[:2], args.reps)
         results["large"]["refine"] = args.large_refine
     if args.sort_sizes:
-        results["sort_scan"] = sort_scan(mesh, cams[:2] if len(cams) > 1 else cams * 2, args.sort_sizes, args.reps)
+        two = cams[:2] if len(cams) > 1 else cams * 2
+        results["sort_scan"] = sort_scan(mesh, two, args.sort_sizes, args.reps)
+        results["index_buffer"] = index_buffer_row(mesh, tf, two, args.reps)
 
     results["methods"]["pt"]["path"] = along
     covered = int((pt_imgs[0][..., 3] > 0).sum())
@@ -387,24 +411,145 @@ SORT_ROWS = (("mpvo (object-space boundary relations)", "mpvo", "auto"),
              ("centroid", "centroid", "auto"), ("power", "power", "auto"))
 
 
-def sort_scan(mesh: Any, cams: list[Any], sizes: list[tuple[int, int]], reps: int) -> list[dict[str, Any]]:
-    """Seconds of ``visibility_order`` against window size for each of ``SORT_ROWS``: the median over ``cams`` x
-    ``reps`` calls after a warm-up call (each call for a camera other than the previous one)."""
+def only_rows(args: argparse.Namespace, argv: list[str] | None) -> int:
+    """``--only``: the sort table (with the Blunt Fin's index buffer row) and/or the large mesh, each block spliced
+    into the existing report (``splice``), which keeps every other row of the run that made it."""
+    from volviz.io.atomic import atomic_write_text
+    from volviz.io.plot3d import read_plot3d
+    from volviz.unstructured.tetrahedralize import tetrahedralize
+
+    command = "volviz bench unstructured " + " ".join(shlex.quote(a) for a in (argv if argv is not None
+                                                                             else sys.argv[1:]))
+    path = Path(args.out) / "unstructured.md"
+    text = path.read_text() if path.exists() else "# Unstructured volume rendering benchmark (Blunt Fin)\n"
+    ds = Path(args.dataset)
+    grid = read_plot3d(ds / "bluntfinxyz.bin", ds / "bluntfinq.bin")
+    mesh = tetrahedralize(grid, "Density")
+    tf = bluntfin_tf()
+    cams = camera_path(mesh.points, max(args.frames, 2))[:2]
+    results: dict[str, Any] = {"command": command}
+    if "sort" in args.only:
+        load = os.getloadavg()[0]
+        rows = sort_scan(mesh, cams, args.sort_sizes, args.reps)
+        ib = index_buffer_row(mesh, tf, cams, args.reps)
+        results["sort_scan"], results["index_buffer"] = rows, ib
+        note = _run_note(command, load)
+        text = splice(text, SORT_HEAD, [note, *_sort_scan_lines(rows, mesh.n_cells), "",
+                                        *_index_buffer_lines(ib, mesh.n_cells, "the Blunt Fin")])
+    if "large" in args.only:
+        load = os.getloadavg()[0]
+        big = large_mesh_row(refined_bluntfin(grid, args.large_refine), tf, cams, args.reps)
+        big["refine"] = args.large_refine
+        results["large"] = big
+        text = splice(text, LARGE_HEAD, [_run_note(command, load), *_large_mesh_lines(big)])
+    atomic_write_text(path, text)
+    if args.json:
+        atomic_write_text(Path(args.json), json.dumps(results, indent=2))
+    print(f"wrote {path}")
+    return 0
+
+
+def _run_note(command: str, load: float) -> str:
+    return (f"(The rows below come from a run of their own, spliced into this report: `{command}`, "
+            f"{time.strftime('%Y-%m-%d %H:%M')} UTC, 1-minute load average {load:.1f} at its start and "
+            f"{os.getloadavg()[0]:.1f} at its end on the 2 shared cores.)")
+
+
+#: the first words of the report's blocks ``--only`` replaces
+SORT_HEAD, LARGE_HEAD = "Sort seconds against window size", "Large mesh:"
+#: paragraphs that belong to a block (besides its table rows and blank lines)
+_BLOCK_TAILS = ("Drawn at ", "The order as the GPU pass's index buffer", "(The rows below come from a run")
+
+
+def splice(text: str, head: str, block: list[str]) -> str:
+    """``text`` with the block that starts at the line beginning with ``head`` (or at the run note just before it)
+    replaced by ``block``: the block runs on over blank lines, table rows and its own paragraphs
+    (``_BLOCK_TAILS``). Without such a block, ``block`` goes before the speed-up line (or at the end)."""
+    lines = text.split("\n")
+    block = [ln for ln in block]
+    while block and block[0] == "":
+        block.pop(0)
+    start = next((i for i, ln in enumerate(lines) if ln.startswith(head)), None)
+    if start is None:
+        at = next((i for i, ln in enumerate(lines) if ln.startswith("Speed-up of pt")), len(lines))
+        return "\n".join(lines[:at] + block + [""] + lines[at:])
+    end = start + 1
+    if start >= 2 and lines[start - 2].startswith(_BLOCK_TAILS[-1]):
+        start -= 2
+    while end < len(lines) and (lines[end] == "" or lines[end].startswith("|")
+                                or (lines[end].startswith(_BLOCK_TAILS) and not lines[end].startswith(head))):
+        if lines[end].startswith(_BLOCK_TAILS[-1]):
+            break                                   # the next block's run note
+        end += 1
+    while end > start + 1 and lines[end - 1] == "":
+        end -= 1
+    return "\n".join(lines[:start] + block + lines[end:])
+
+
+def timed_sort(topo: Any, cam: Any, size: tuple[int, int], method: str = "mpvo", nonconvex: str = "auto"
+               ) -> tuple[Any, float, float]:
+    """``visibility_order`` with its wall seconds and the process CPU seconds it took (all threads; less sensitive
+    than wall time to the other jobs on the shared cores)."""
     from volviz.unstructured.sort import visibility_order
+
+    t0, c0 = time.perf_counter(), time.process_time()
+    res = visibility_order(topo, cam, size, method, nonconvex)
+    return res, time.perf_counter() - t0, time.process_time() - c0
+
+
+def sort_scan(mesh: Any, cams: list[Any], sizes: list[tuple[int, int]], reps: int) -> list[dict[str, Any]]:
+    """Seconds of ``visibility_order`` against window size for each of ``SORT_ROWS``: the medians (wall and process
+    CPU) over ``cams`` x ``reps`` calls after a warm-up call (each call for a camera other than the previous one)."""
     from volviz.unstructured.topology import topology
 
     topo = topology(mesh)
     rows = []
     for label, method, nonconvex in SORT_ROWS:
-        row: dict[str, Any] = {"label": label, "seconds": {}}
-        visibility_order(topo, cams[-1], sizes[0], method, nonconvex)
+        row: dict[str, Any] = {"label": label, "seconds": {}, "cpu_seconds": {}}
+        timed_sort(topo, cams[-1], sizes[0], method, nonconvex)
         for w, h in sizes:
-            times = [visibility_order(topo, cam, (w, h), method, nonconvex).seconds
-                     for _ in range(reps) for cam in cams]
-            row["seconds"][f"{w}x{h}"] = float(np.median(times))
+            runs = [timed_sort(topo, cam, (w, h), method, nonconvex) for _ in range(reps) for cam in cams]
+            row["seconds"][f"{w}x{h}"] = float(np.median([r[1] for r in runs]))
+            row["cpu_seconds"][f"{w}x{h}"] = float(np.median([r[2] for r in runs]))
         rows.append(row)
         print(f"sort scan: {row}", flush=True)
     return rows
+
+
+def _numpy_chain(order: np.ndarray, visible: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The index buffer as numpy made it before ``volviz.unstructured.index_buffer`` (the baseline of
+    ``index_buffer_row``): the visible cells, then the 12 vertex ids of each."""
+    from volviz.unstructured.topology import FACES
+
+    cells = order[visible[order]]
+    return cells, ((4 * cells.astype(np.int32))[:, None] + FACES.reshape(1, 12).astype(np.int32)).reshape(-1)
+
+
+def index_buffer_row(mesh: Any, tf: Any, cams: list[Any], reps: int) -> dict[str, Any]:
+    """The order as the GPU pass's index buffer (zero-opacity cull and int32 connectivity) for each camera's mpvo
+    order: ``IndexBuffer.fill`` (one Numba pass into buffers kept between frames) against the numpy chain; medians
+    of wall and process CPU seconds over ``cams`` x ``reps`` after a warm-up, and the cells drawn."""
+    from volviz.unstructured.index_buffer import IndexBuffer
+    from volviz.unstructured.sort import visibility_order
+    from volviz.unstructured.topology import topology, visible_cells
+
+    topo = topology(mesh)
+    vis = visible_cells(mesh, tf.scalars, tf.extinction)
+    orders = [visibility_order(topo, cam, (1920, 1080)).order for cam in cams]
+    buf = IndexBuffer(topo.n_tets)
+    row: dict[str, Any] = {"cells": int(vis.sum())}
+    for name, fn in (("fill", buf.fill), ("numpy", _numpy_chain)):
+        fn(orders[-1], vis)
+        wall, cpu = [], []
+        for _ in range(reps):
+            for order in orders:
+                t0, c0 = time.perf_counter(), time.process_time()
+                fn(order, vis)
+                wall.append(time.perf_counter() - t0)
+                cpu.append(time.process_time() - c0)
+        row[f"{name}_s"], row[f"{name}_cpu_s"] = float(np.median(wall)), float(np.median(cpu))
+    print(f"index buffer ({topo.n_tets} cells): {row}", flush=True)
+    return row
 
 
 def refined_bluntfin(grid: Any, factor: float) -> Any:
@@ -445,6 +590,7 @@ def large_mesh_row(mesh: Any, tf: Any, cams: list[Any], reps: int, draw: int = 2
     warm-up, with its stages: boundary relations, face sides, Kahn); the CPU bytes per cell of the mesh and its sort
     topology, and of one sort's own arrays; a ``draw``² frame by pt-gl (``gl_pt_frames``, 3D table: frame seconds
     to the GPU's completion, sort included) against the CPU pt renderer's image of the same camera and table."""
+    from volviz.unstructured import mpvo
     from volviz.unstructured.boundary_pairs import inner_boundary
     from volviz.unstructured.render import render
     from volviz.unstructured.sort import visibility_order
@@ -455,19 +601,24 @@ def large_mesh_row(mesh: Any, tf: Any, cams: list[Any], reps: int, draw: int = 2
     _ = topo.neighbor
     topo_s = time.perf_counter() - t0
     visibility_order(topo, cams[-1], (1920, 1080))
-    runs = [visibility_order(topo, cam, (1920, 1080)) for _ in range(reps) for cam in cams]
+    timed = [timed_sort(topo, cam, (1920, 1080)) for _ in range(reps) for cam in cams]
+    runs = [r[0] for r in timed]
     arrays = [mesh.points, mesh.tets, mesh.scalars, topo.points, topo.tets, topo.face_n, topo.face_d, topo.centroid,
-              topo.circ_center, topo.circ_r2, topo.neighbor, topo.back_face]
+              topo.circ_center, topo.circ_r2, topo.neighbor, topo.back_face, mpvo.planes32(topo)]
     m = mesh.n_cells
     row: dict[str, Any] = {
         "n_tets": int(m), "topology_s": topo_s, "sort_s": float(np.median([r.seconds for r in runs])),
-        "sort_min_s": float(min(r.seconds for r in runs)), "cycles": int(max(r.cycles for r in runs)),
+        "sort_min_s": float(min(r.seconds for r in runs)), "sort_cpu_s": float(np.median([r[2] for r in timed])),
+        "cycles": int(max(r.cycles for r in runs)),
         "stages_s": {k: float(np.median([r.stages[k] for r in runs])) for k in runs[0].stages},
         "inner_faces": int(len(inner_boundary(topo))), "boundary_faces": int(len(topo.boundary)),
         "bytes_per_cell": sum(int(a.nbytes) for a in arrays) / m,
         # one sort's own arrays: the order, a state byte and an in-degree per cell, Kahn's stack
         "sort_bytes_per_cell": (runs[0].order.nbytes + m * (1 + 4 + runs[0].order.itemsize)) / m}
     print(f"large mesh sort: {row}", flush=True)
+    row["index_buffer"] = index_buffer_row(mesh, tf, cams, reps)
+    if not draw:
+        return row
     size = (draw, draw)
     gl, gl_img = gl_pt_frames(mesh, tf, cams, size, 1, "3d")
     c0 = time.perf_counter()
@@ -692,6 +843,8 @@ def _markdown(results: dict[str, Any], path: Path) -> None:
     lines += _cpu_side_lines(results.get("cpu_side"), results["n_tets"])
     lines += _interactive_lines(results.get("interactive"))
     lines += _sort_scan_lines(results.get("sort_scan"), results["n_tets"])
+    if results.get("index_buffer"):
+        lines += ["", *_index_buffer_lines(results["index_buffer"], results["n_tets"], "the Blunt Fin")]
     big = results.get("large")
     if big:
         lines += _large_mesh_lines(big)
@@ -726,14 +879,20 @@ def _large_mesh_lines(big: dict[str, Any]) -> list[str]:
              f"the hull; topology {big['topology_s']:.1f} s once; mpvo sort for 1920x1080 "
              f"{big['sort_s']:.3f} s median ({big['sort_min_s']:.3f} s min, {big.get('cycles', 0)} cycles): "
              f"**{big['n_tets'] / big['sort_s'] / 1e6:.1f} M tetrahedra/s** (target ≥ 20)"
+             + (f", process CPU {big['sort_cpu_s']:.3f} s median (both threads): "
+                f"{big['n_tets'] / big['sort_cpu_s'] / 1e6:.1f} M tetrahedra per CPU second" if "sort_cpu_s" in big
+                else "")
              + (f"; of which boundary relations {st['relations']:.3f} s, face sides {st['sides']:.3f} s, "
                 f"Kahn {st['kahn']:.3f} s (medians)" if "relations" in st else "")
              + (f"; of which face sides {st['sides']:.3f} s with the boundary relations made beside them on a "
                 f"second thread (then {st['relations_wait']:.3f} s of waiting for them), Kahn {st['kahn']:.3f} s "
                 "(medians)" if "relations_wait" in st else "")
-             + f". CPU memory of the mesh and its sort topology {big['bytes_per_cell']:.0f} bytes per cell"
-             + (f", plus {big['sort_bytes_per_cell']:.0f} per cell while a sort runs (its order, state, "
-                "in-degrees and stack)" if "sort_bytes_per_cell" in big else "") + "."]
+             + f". CPU memory of the mesh and its sort topology {big['bytes_per_cell']:.0f} bytes per cell (the "
+             "float32 face planes of the face sides, 64, included)"
+             + (f", plus {big['sort_bytes_per_cell']:.0f} per cell for a sort (its order, 4, and its state, "
+                "in-degrees and stack, 9, kept for the next sort)" if "sort_bytes_per_cell" in big else "") + "."]
+    if big.get("index_buffer"):
+        lines += ["", *_index_buffer_lines(big["index_buffer"], big["n_tets"], "the large mesh")]
     d = big.get("draw")
     if d:
         lines += ["", f"Drawn at {d['size']}² (3D table): pt-gl {d['pt_gl_frame_s']:.2f} s per frame for a new "
@@ -793,14 +952,30 @@ def _sort_scan_lines(rows: list[dict[str, Any]] | None, n_tets: int) -> list[str
     if not rows:
         return []
     sizes = list(rows[0]["seconds"])
-    lines = ["", f"Sort seconds against window size ({n_tets} tetrahedra; `visibility_order`, median over 2 cameras "
-             "x reps after a warm-up; M tets/s at the largest size in the last column):", "",
+    cpu = all("cpu_seconds" in r for r in rows)
+    lines = ["", f"{SORT_HEAD} ({n_tets} tetrahedra; `visibility_order`, median over 2 cameras "
+             "x reps after a warm-up" + (", wall seconds with the process CPU seconds (all threads) in brackets"
+                                         if cpu else "")
+             + "; M tets/s at the largest size in the last column" + (", wall (CPU)" if cpu else "") + "):", "",
              "| sort | " + " | ".join(sizes) + " | M tets/s |", "|---|" + "---|" * (len(sizes) + 1)]
     for r in rows:
-        sec = r["seconds"]
-        lines.append(f"| {r['label']} | " + " | ".join(f"{sec[k]:.4f}" for k in sizes)
-                     + f" | {n_tets / sec[sizes[-1]] / 1e6:.1f} |")
+        sec, c = r["seconds"], r.get("cpu_seconds", {})
+        rate = f"{n_tets / sec[sizes[-1]] / 1e6:.1f}" + (f" ({n_tets / c[sizes[-1]] / 1e6:.1f})" if cpu else "")
+        lines.append(f"| {r['label']} | " + " | ".join(f"{sec[k]:.4f}" + (f" ({c[k]:.4f})" if cpu else "")
+                                                       for k in sizes) + f" | {rate} |")
     return lines
+
+
+def _index_buffer_lines(ib: dict[str, Any] | None, n_tets: int, what: str) -> list[str]:
+    if not ib:
+        return []
+    return [f"The order as the GPU pass's index buffer for {what} ({n_tets} tetrahedra, {ib['cells']} of them "
+            "drawn: zero-opacity cull and int32 connectivity of 4 triangles per cell; medians over 2 cameras x reps "
+            f"after a warm-up): `volviz.unstructured.index_buffer.IndexBuffer.fill`, one Numba pass into buffers "
+            f"kept between frames, {ib['fill_s'] * 1e3:.1f} ms wall ({ib['fill_cpu_s'] * 1e3:.1f} ms CPU), against "
+            f"{ib['numpy_s'] * 1e3:.1f} ms ({ib['numpy_cpu_s'] * 1e3:.1f} ms CPU) for the numpy chain "
+            "(`order[visible[order]]`, then 4 c + corner broadcast) that `volviz.render.gl_pt` uses until it calls "
+            "`fill`."]
 
 
 if __name__ == "__main__":
