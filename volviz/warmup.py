@@ -56,6 +56,7 @@ def _natural_scene(folder: Path) -> None:
 def _tetrahedral_volume(folder: Path) -> None:
     from volviz.optics import TransferFunction
     from volviz.render.export import render_session
+    from volviz.render.preview_upsample import upsample_preview   # the previews of a moving camera (the app's)
     from volviz.scene.demo import demo_volume_session
     from volviz.unstructured import render
     from volviz.model.camera import Camera
@@ -74,6 +75,7 @@ def _tetrahedral_volume(folder: Path) -> None:
     clipped = demo_volume_session()
     clipped.clip = {"planes": [], "box": {"lo": [0.0, 0.0, 0.0], "hi": [0.5, 0.5, 0.5]}}  # a cut mesh
     render_session(clipped, None, SIZE)
+    upsample_preview(np.zeros((2, 2, 4)), np.full((2, 2), np.inf), np.full((4, 4), np.inf))
 
 
 def _compressed_volume(folder: Path) -> None:
