@@ -4,7 +4,7 @@ Long work in volviz (loading, decompression, sorting, table builds, extraction) 
 ``progress(fraction, message)`` callable. Run through a ``JobRunner``, that callable reports progress and raises
 ``Cancelled`` once the job's token is cancelled, so cancellation needs no extra plumbing in the numerics. A job
 submitted with a ``key`` supersedes the running job of the same key: the old one is cancelled and its result is never
-delivered (sorting for the newest camera, not every camera; DESIGN.md "Background work"). ``OneInFlight`` is the
+delivered (sorting for the newest camera, not every camera; docs/design.md "Background work"). ``OneInFlight`` is the
 other policy: one job of a kind at a time, the newest waiting request next, so that every finished result is shown
 while requests keep coming (the app's view refreshes).
 

@@ -1,4 +1,4 @@
-"""Session files: versioned, validated JSON; atomic save (DESIGN.md "Sessions").
+"""Session files: versioned, validated JSON; atomic save (docs/design.md "Sessions").
 
 A session is ``{"format": "volviz-session", "version": N, ...}`` with datasets (paths relative to the session file),
 scene components and their settings, transfer functions, camera, camera paths and bookmarks, render settings and the

@@ -1,4 +1,5 @@
-"""The built-in procedural demo data (DESIGN.md "Model only what a scene needs"): generated, never read from disk."""
+"""The built-in procedural demo data: generated, never read from disk (docs/design.md "Model only what a scene
+needs")."""
 from __future__ import annotations
 
 import numpy as np

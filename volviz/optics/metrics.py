@@ -1,4 +1,5 @@
-"""Image error metrics used by every benchmark (DESIGN.md: RMSE and max abs error in 8-bit units, PSNR).
+"""Image error metrics used by every benchmark: RMSE and max abs error in 8-bit units, PSNR (docs/design.md
+"Optical model and conventions").
 
 Inputs are premultiplied float RGBA images in 0..1 (any matching shapes; all channels count). Errors are reported in
 8-bit units (0..255). The error heat map reproduces the thesis's difference view (Roettger §9.2, Fig. 9.4: "error

@@ -6,9 +6,9 @@ ParaView's preset files hold a list (or one) of objects with ``"Name"``, ``"Colo
 - κ from ``RGBPoints``, linearly interpolated in RGB. Other color spaces (``"Diverging"``, ``"Lab"``, ``"HSV"``) are
   read as linear RGB between the given points: an approximation that is close when the points are dense (the
   shipped presets are RGB with 33 points).
-- ρ = opacity / unit_distance from ``Points`` (the VTK convention of DESIGN.md; midpoint and sharpness are ignored,
-  i.e. read as 0.5 and 0). Without ``Points`` the opacity is a linear ramp from 0 to 1 over the color range
-  (ParaView's default for volumes).
+- ρ = opacity / unit_distance from ``Points`` (the VTK convention of docs/design.md "Opacity conventions differ";
+  midpoint and sharpness are ignored, i.e. read as 0.5 and 0). Without ``Points`` the opacity is a linear ramp from 0
+  to 1 over the color range (ParaView's default for volumes).
 - Both are combined on the union of their control points, which is exact for piecewise-linear inputs.
 
 Export writes ``"ColorSpace": "RGB"``, both point lists (opacity = ρ · unit_distance, midpoint 0.5, sharpness 0) and

@@ -1,7 +1,7 @@
 """Measured error of a table against the exact reference ``integrate_segment`` over the table's domain.
 
-Every faster method states its error (DESIGN.md). A table is sampled at one of three point sets over
-[s_lo, s_hi]² × [0, l_max]:
+Every faster method states its error (docs/design.md "Optical model and conventions"). A table is sampled at one
+of three point sets over [s_lo, s_hi]² × [0, l_max]:
 
 - ``"nodes"``: the table's own sample points (storage and construction error only);
 - ``"centers"``: the centres of the grid cells, between all neighbouring samples (worst place for multilinear

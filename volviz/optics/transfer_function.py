@@ -4,9 +4,9 @@ Optical model (Roettger §7.1 and §8.4, Eq. 8.1; Guthe §1.2): the emitted colo
 pre-multiplied convention), the opacity of a segment is α = 1 − exp(−∫ρ). Both κ and ρ are linear between control
 points. Scalars outside ``[scalars[0], scalars[-1]]`` and NaN scalars are transparent (κ = 0, ρ = 0).
 
-VTK convention (DESIGN.md, "Opacity conventions differ"): a VTK scalar opacity value ``a`` with the volume property's
-``ScalarOpacityUnitDistance`` ``u`` is read as the extinction ρ = a / u (per unit length), and written back as
-a = ρ · u. VTK's color transfer function supplies κ directly.
+VTK convention (docs/design.md "Opacity conventions differ"): a VTK scalar opacity value ``a`` with the volume
+property's ``ScalarOpacityUnitDistance`` ``u`` is read as the extinction ρ = a / u (per unit length), and written back
+as a = ρ · u. VTK's color transfer function supplies κ directly.
 """
 from __future__ import annotations
 

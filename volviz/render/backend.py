@@ -28,8 +28,8 @@ Google SwiftShader) the GPU's work runs on the same CPU cores, so ``auto`` takes
   two overlapping Storm volumes and the Blunt Fin) has 10-13 / 61-107 ms per frame (GPU / CPU) for 2-pass, 20-36 /
   83-165 ms for 3-pass, 37-45 / 106-150 ms for 4-pass and 85-124 / 102-149 ms for exact: the GPU is faster in every
   mode on every scene, the GPU's time including the read-back of the frame.
-- regular: VTK's CPU ray caster (DESIGN.md: the embryo 256³ at 512² takes 0.07 s against 0.26 s with the GPU ray
-  caster on llvmpipe; in the app, loading the embryo blocked the event loop 4.3 s with the GPU mapper and 1.2 s
+- regular: VTK's CPU ray caster (measured on 2 cores: the embryo 256³ at 512² takes 0.07 s against 0.26 s with the
+  GPU ray caster on llvmpipe; in the app, loading the embryo blocked the event loop 4.3 s with the GPU mapper and 1.2 s
   with the CPU one, and a Storm playback frame took 450 ms against 230 ms).
 
     info = gl_info(plotter.ren_win)              # GLInfo(vendor, renderer, version)

@@ -51,7 +51,7 @@ def ensure_transfer_functions(session: Session, datasets: dict[str, Any]) -> Non
 
 @dataclass
 class PreparedScene:
-    """What ``prepare_scene`` computed off the GUI thread for ``install_scene`` (DESIGN.md "Background work")."""
+    """What ``prepare_scene`` computed off the GUI thread for ``install_scene`` (docs/design.md "Background work")."""
 
     time: Optional[float]                                   # display time of time series (None without one)
     parts: dict[str, Any] = field(default_factory=dict)     # comp id -> IsoParts | TetMesh (PT) | VTK volume input

@@ -1,4 +1,5 @@
-"""Put volviz datasets into a PyVista plotter with sensible defaults (the VTK side of DESIGN.md's `render` layer).
+"""Put volviz datasets into a PyVista plotter with sensible defaults (the VTK side of the `render` layer,
+docs/architecture.md).
 
 Each dataset kind gets the visual a user expects on first open: regular volumes and unstructured meshes as volumes with
 a transfer function fitted to the data range, 2D rasters as a height-field surface (or a flat image for color),

@@ -1,6 +1,6 @@
 """A ``volviz.optics.TransferFunction`` to and from VTK's transfer functions (``vtkColorTransferFunction`` for the
-color κ, ``vtkPiecewiseFunction`` for the opacity a = ρ · unit distance, DESIGN.md's convention for VTK's volume
-mappers): what VTK's own mappers, the scalar bar and ParaView-style imports need.
+color κ, ``vtkPiecewiseFunction`` for the opacity a = ρ · unit distance, the convention for VTK's volume mappers in
+docs/design.md "Opacity conventions differ"): what VTK's own mappers, the scalar bar and ParaView-style imports need.
 """
 from __future__ import annotations
 
