@@ -4,9 +4,9 @@ transfer function, in the same run. Writes docs/bench/unstructured.md, a time-vs
 with x8 error heat maps.
 
 Transfer-function convention for VTK: the same kappa (vtkColorTransferFunction, RGB) and opacity a = rho x
-unit_distance with ScalarOpacityUnitDistance = unit_distance (DESIGN.md: VTK's unstructured mappers behave as if
-rho = a / unit_distance). VTK images are read back against a black background, i.e. as premultiplied RGB, so every
-method is compared on the RGB channels (pt also on RGBA).
+unit_distance with ScalarOpacityUnitDistance = unit_distance (VTK's unstructured mappers behave as if
+rho = a / unit_distance: docs/design.md "Opacity conventions differ"). VTK images are read back against a black
+background, i.e. as premultiplied RGB, so every method is compared on the RGB channels (pt also on RGBA).
 """
 from __future__ import annotations
 
