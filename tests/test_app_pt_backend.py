@@ -18,7 +18,8 @@ from PySide6.QtCore import QEvent, QPoint, Qt
 
 from test_app_workflows import _mouse, viewport, wait_loaded
 from volviz.render.backend import plotter_gl_info
-from volviz.render.gl_pt import _PASS_MARK, GLPTVolume
+from volviz.render.gl import ScenePass
+from volviz.render.gl_pt import GLPTVolume
 from volviz.render.pt_prop import PTVolume
 from volviz_app.window import MainWindow
 
@@ -129,7 +130,7 @@ def test_closing_the_window_frees_the_gpu_volume_before_its_context(qtbot, make_
     assert isinstance(_set_backend(qtbot, window, "gpu"), GLPTVolume)
     window.render_scene()
     renderer = window.plotter.renderer
-    assert getattr(renderer, _PASS_MARK) is not None
+    assert ScenePass.of(renderer) is not None
     window.dirty = False
     window.close()
-    assert getattr(renderer, _PASS_MARK) is None, "the float target outlived the window"
+    assert ScenePass.of(renderer) is None, "the float target outlived the window"

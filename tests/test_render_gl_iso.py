@@ -212,18 +212,19 @@ def test_exact_mode_under_a_render_pass(meshes):
     ``vtkFramebufferPass``, under which VTK does not peel): the peeling layer gives the same image as without the
     pass, within the bounds against the CPU compositor; resetting the camera's clipping range in the plotter's
     renderer still holds the surfaces (the layer leaves a box of their bounds there)."""
-    from volviz.render.gl_pt import _PASS_MARK, install_scene_pass
+    from volviz.render.gl import ScenePass
 
     images = []
     for with_pass in (False, True):
         pl = _plotter(PERSPECTIVE)
         if with_pass:
-            install_scene_pass(pl.renderer, "test")
-            assert getattr(pl.renderer, _PASS_MARK) is pl.renderer.GetPass()
+            scene = ScenePass.acquire(pl.renderer, "test")
+            assert scene.framebuffer is pl.renderer.GetPass()
         iso = GLIsoSurfaces(pl, meshes, mode="exact")
         images.append(_shot(pl))
         iso.remove()
-        pl.renderer.SetPass(None)
+        if with_pass:
+            scene.release("test")
         pl.close()
     clear = [m for m in meshes if not m.style.opaque]
     pl = _plotter(PERSPECTIVE)

@@ -33,7 +33,7 @@ How a frame is drawn:
   premultiplied texture, as ``gl_pt``). Both actors are translucent and share the layer's bounds, so VTK culls or
   draws them together; after them the blend function, blend equation, framebuffer and depth state are VTK's again.
 - Opaque geometry (terrain, sky dome, boxes): the scene's float color target and depth texture come from the
-  ``vtkFramebufferPass`` that ``gl_pt`` installs (shared with GL PT volumes in the same renderer); when the prisms
+  renderer's ``volviz.render.gl.ScenePass`` (shared with GL PT volumes in the same renderer); when the prisms
   draw (translucent pass), that depth texture holds the opaque scene and is not attached to the layer's target, so
   the shader reads it as an ordinary texture.
 
@@ -70,16 +70,15 @@ from typing import Any
 import numpy as np
 
 from volviz.nature.fog import FogLayer, layer_emission
-from volviz.render.gl_pt import _PASS_MARK, _USERS, install_scene_pass, shader_source
+from volviz.render.gl import ScenePass, color_target, glenum, release, set_ray_uniforms, shader_source
 from volviz.model.camera import Camera
 
 __all__ = ["GLFogLayer", "PrismBuffers", "add_fog_layer", "layer_values", "prism_buffers"]
 
 _MODES = {"emissive": 0, "attenuated": 1, "mip": 2}
-_GL_FUNC_ADD, _GL_MAX = 0x8006, 0x8008
-_GL_BLEND_EQUATION_RGB, _GL_BLEND_EQUATION_ALPHA = 0x8009, 0x883D
-_GL_COLOR_BUFFER_BIT = 0x4000
 _ATTRIBUTES = ("fogValue",)
+
+
 def layer_values(points: np.ndarray, bottom: np.ndarray, top: np.ndarray, emission_bottom: np.ndarray,
                  emission_top: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The layer's centre (3,) (of the bounding box of its points between bottom and top), the points relative to it
@@ -175,6 +174,7 @@ class GLFogLayer:
         self._depth_tex: Any = None
         self._bound = False                   # the layer's target is bound (prisms drawn, resolve not yet)
         self._equation: list[int] | None = None
+        self._visible = True                  # shown (the actors also hide while no prism is drawn)
 
         self.mapper = vtk.vtkOpenGLPolyDataMapper()
         self.mapper.ScalarVisibilityOff()
@@ -196,7 +196,7 @@ class GLFogLayer:
         else:
             self.set_buffers(buffers)
 
-        install_scene_pass(self.renderer, self)   # the shared float color target and opaque depth texture
+        self.scene_pass = ScenePass.acquire(self.renderer, self)   # the shared float target and opaque depth
         self._observers = [
             (self.mapper, self.mapper.AddObserver(vtk.vtkCommand.UpdateShaderEvent,
                                                   shader_observer(self._on_prisms))),
@@ -241,30 +241,16 @@ class GLFogLayer:
         self.actor.SetPosition(*centre)
         self.resolve_mapper.SetInputData(_resolve_polydata(buffers.bounds if self.drawn else np.zeros((3, 2))))
         self.resolve_actor.SetPosition(*centre)
-        on = self.drawn > 0 and getattr(self, "_visible", True)
+        on = self.drawn > 0 and self._visible
         self.actor.SetVisibility(on)
         self.resolve_actor.SetVisibility(on)
 
     # --- per frame -----------------------------------------------------------------------------------------------
     def _target(self, w: int, h: int) -> Any:
         """The layer's (w, h) single-channel float32 target (made again when the renderer's size changes)."""
-        from volviz.render.vtk_facade import vtk
-
-        ren_win = self.renderer.GetRenderWindow()
         if self._accum is None or (self._accum.GetWidth(), self._accum.GetHeight()) != (w, h):
             self._release_target()
-            tex = vtk.vtkTextureObject()
-            tex.SetContext(ren_win)
-            tex.Create2D(w, h, 1, vtk.VTK_FLOAT, False)
-            tex.SetMinificationFilter(vtk.vtkTextureObject.Nearest)
-            tex.SetMagnificationFilter(vtk.vtkTextureObject.Nearest)
-            fbo = vtk.vtkOpenGLFramebufferObject()
-            fbo.SetContext(ren_win)
-            fbo.SaveCurrentBindingsAndBuffers()
-            fbo.Bind()
-            fbo.AddColorAttachment(0, tex)
-            fbo.RestorePreviousBindingsAndBuffers()
-            self._accum, self._fbo = tex, fbo
+            self._accum, self._fbo = color_target(self.renderer.GetRenderWindow(), w, h, 1, False)
         return self._fbo
 
     def _on_prisms(self, program: Any) -> None:
@@ -277,23 +263,18 @@ class GLFogLayer:
         fbo.ActivateDrawBuffer(0)
         self._bound = True
         state.vtkglClearColor(0.0, 0.0, 0.0, 0.0)
-        state.vtkglClear(_GL_COLOR_BUFFER_BIT)
+        state.vtkglClear(glenum.COLOR_BUFFER_BIT)
         if self.layer.mode == "mip":
             rgb, alpha = [0], [0]
-            state.vtkglGetIntegerv(_GL_BLEND_EQUATION_RGB, rgb)
-            state.vtkglGetIntegerv(_GL_BLEND_EQUATION_ALPHA, alpha)
+            state.vtkglGetIntegerv(glenum.BLEND_EQUATION_RGB, rgb)
+            state.vtkglGetIntegerv(glenum.BLEND_EQUATION_ALPHA, alpha)
             self._equation = [rgb[0], alpha[0]]
-            state.vtkglBlendEquation(_GL_MAX)
+            state.vtkglBlendEquation(glenum.MAX)
         cam = Camera.from_pyvista(self.renderer.GetActiveCamera())
         rb = cam.rays((w, h), origin=self.centre)
-        for name, v in (("rayO0", rb.o0), ("rayOx", rb.ox), ("rayOy", rb.oy), ("rayD0", rb.d0), ("rayDx", rb.dx),
-                        ("rayDy", rb.dy)):
-            program.SetUniform3f(name, [float(x) for x in v])
-        program.SetUniformf("viewHeight", float(h))
-        program.SetUniform2f("clipRange", [float(x) for x in cam.clipping_range])
-        program.SetUniformi("parallelView", 0)
+        set_ray_uniforms(program, rb, h, cam.clipping_range, False)
         program.SetUniformi("mipMode", int(self.layer.mode == "mip"))
-        depth = getattr(self.renderer, _PASS_MARK).GetDepthTexture()
+        depth = self.scene_pass.depth_texture()
         depth.Activate()
         self._depth_tex = depth
         program.SetUniformi("opaqueDepth", depth.GetTextureUnit())
@@ -326,10 +307,7 @@ class GLFogLayer:
             self._accum.Deactivate()
 
     def _release_target(self) -> None:
-        ren_win = self.renderer.GetRenderWindow()
-        for obj in (self._fbo, self._accum):
-            if obj is not None and ren_win is not None:
-                obj.ReleaseGraphicsResources(ren_win)
+        release(self.renderer.GetRenderWindow(), (self._fbo, self._accum))
         self._fbo = self._accum = None
 
     # --- public --------------------------------------------------------------------------------------------------
@@ -356,7 +334,7 @@ class GLFogLayer:
 
     @property
     def visible(self) -> bool:
-        return bool(getattr(self, "_visible", True))
+        return self._visible
 
     @visible.setter
     def visible(self, on: bool) -> None:
@@ -372,16 +350,7 @@ class GLFogLayer:
         self.renderer.RemoveActor(self.actor)
         self.renderer.RemoveActor(self.resolve_actor)
         self._release_target()
-        ren_win = self.renderer.GetRenderWindow()
-        users = getattr(self.renderer, _USERS, [])
-        if self in users:
-            users.remove(self)
-        fb = getattr(self.renderer, _PASS_MARK, None)
-        if not users and fb is not None:
-            if ren_win is not None:
-                fb.ReleaseGraphicsResources(ren_win)
-            self.renderer.SetPass(None)
-            setattr(self.renderer, _PASS_MARK, None)
+        self.scene_pass.release(self)
 
 
 def add_fog_layer(plotter: Any, mesh: Any, layer: FogLayer, top: str, bottom: str = "terrain",

@@ -31,7 +31,7 @@ surfaces (opacity 1) are one opaque actor. All actors share one shader program (
   (the translucent actor writes the straight color at the ``//VTK::DepthPeeling`` tags), by a ``PeelLayer``
   (``volviz.render.peel_layer``): a renderer drawn right after the plotter's, keeping its image and depth, so the
   surfaces are peeled over the finished scene whatever render pass the plotter's renderer runs (the float32 scene
-  target of a GPU PT volume or natural scene, ``volviz.render.gl_pt``, under which VTK does not peel).
+  target of a GPU PT volume or natural scene, ``volviz.render.gl.ScenePass``, under which VTK does not peel).
 
 The 2/3/4 passes are ordinary actors in the renderer's translucent pass, drawn in the order they were added (the
 renderer's OIT and depth peeling are off while they are shown), and each restores the GL state it changes (blend
@@ -73,7 +73,7 @@ import numpy as np
 from volviz.iso.composite import AMBIENT, MODES
 from volviz.iso.extract import IsoMesh
 from volviz.iso.spectrum import fit_spectrum
-from volviz.render.gl_pt import shader_source
+from volviz.render.gl import glenum, shader_source
 from volviz.render.image_overlay import hold_single_sample, release_single_sample, window_size
 from volviz.render.iso_overlay import IsoModeView
 from volviz.render.peel_layer import PeelLayer
@@ -82,7 +82,6 @@ __all__ = ["GLIsoSurfaces", "GLIsoView", "iso_polydata"]
 
 _OPAQUE, _OVER, _ATTENUATE, _BACK, _EMIT, _PEEL = range(6)
 _ATTRIBUTES = ("isoNormal", "isoStyle", "isoFit")
-_GL_DEPTH_BUFFER_BIT = 0x0100
 
 
 def _oriented_triangles(m: IsoMesh) -> np.ndarray:
@@ -271,7 +270,7 @@ class GLIsoSurfaces:
         self._fbo.ActivateDrawBuffer(0)
         state.vtkglDepthMask(True)        # VTK's actor restores the mask after the draw
         state.vtkglClearDepth(1.0)        # VTK's clear value (vtkOpenGLRenderer::Clear)
-        state.vtkglClear(_GL_DEPTH_BUFFER_BIT)
+        state.vtkglClear(glenum.DEPTH_BUFFER_BIT)
 
     def _on_end(self, *_: Any) -> None:
         state = self.renderer.GetState()

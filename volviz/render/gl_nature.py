@@ -59,7 +59,8 @@ from volviz.nature.nature_scene import NatureScene
 from volviz.numba_threads import numba_threads, share
 from volviz.render.nature_view import NatureView
 from volviz.render.gl_fog import GLFogLayer, prism_buffers
-from volviz.render.gl_pt import GLPTVolume, _resolve_polydata, shader_source
+from volviz.render.gl import release, resolve_polydata, shader_source, texel_array
+from volviz.render.gl_pt import GLPTVolume
 from volviz.render.image_overlay import hold_single_sample, release_single_sample
 
 __all__ = ["CloudLeaves", "CloudPTVolume", "GLNatureView", "cloud_field_texels", "cloud_leaves",
@@ -228,10 +229,10 @@ class CloudPTVolume(GLPTVolume):
             self.mapper.SetInputData(self.polydata)
             self._capacity = update.capacity
             self._vis = self._visible()
-        self.topo = _FrameGeometry(np.asarray(leaves.centre, np.float64), self._capacity)  # type: ignore[assignment]
+        self.topo = _FrameGeometry(np.asarray(leaves.centre, np.float64), self._capacity)
         self.actor.SetPosition(*leaves.centre)
         if self.last_update is None:
-            self.resolve_mapper.SetInputData(_resolve_polydata(leaves.bounds))   # VTK culls the resolve by these
+            self.resolve_mapper.SetInputData(resolve_polydata(leaves.bounds))   # VTK culls the resolve by these
         self.resolve_actor.SetPosition(*leaves.centre)
         self.last_update = update
         self.reuse_order = True
@@ -253,17 +254,8 @@ class CloudPTVolume(GLPTVolume):
 
     def _texture(self, name: str, texels: np.ndarray, ren_win: Any) -> None:
         """(Re)make the 2D-emulated texel array ``name`` from ``texels`` (n, components) float32."""
-        from volviz.render.vtk_facade import vtk
-
-        old = self._textures.pop(name, None)
-        if old is not None:
-            old.ReleaseGraphicsResources(ren_win)
-        tex = vtk.vtkTextureObject()
-        tex.SetContext(ren_win)
-        data = np.ascontiguousarray(texels, np.float32)
-        if not tex.EmulateTextureBufferWith2DTexturesFromRaw(len(data), data.shape[1], vtk.VTK_FLOAT, data):
-            raise RuntimeError(f"OpenGL refused the clouds' {name} texture of {len(data)} texels")
-        self._textures[name] = tex
+        release(ren_win, [self._textures.pop(name, None)])
+        self._textures[name] = texel_array(ren_win, texels, f"clouds' {name}")
 
     def _upload(self, ren_win: Any) -> None:
         """What changed since the last render: the grid's fields (once), the refinement thresholds (when C, c or
@@ -320,10 +312,7 @@ class CloudPTVolume(GLPTVolume):
 
     def remove(self) -> None:
         """GLPTVolume's ``remove`` and the cloud textures' GL resources."""
-        ren_win = self.renderer.GetRenderWindow()
-        if ren_win is not None:
-            for tex in self._textures.values():
-                tex.ReleaseGraphicsResources(ren_win)
+        release(self.renderer.GetRenderWindow(), self._textures.values())
         self._textures = {}
         super().remove()
 

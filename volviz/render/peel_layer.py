@@ -6,7 +6,7 @@
 
 VTK's depth peeling (``vtkDualDepthPeelingPass``) is the renderer's own translucent stage: a renderer given a custom
 pass (``renderer.SetPass``: the float32 scene target that the GPU PT volumes and fog layers install,
-``volviz.render.gl_pt.install_scene_pass``) does not peel. A ``PeelLayer`` is a second renderer on the same layer of
+``volviz.render.gl.ScenePass``) does not peel. A ``PeelLayer`` is a second renderer on the same layer of
 the render window, added after it, so it draws right after that renderer and before any renderer of a higher layer
 (volviz's CPU image overlays, ``volviz.render.image_overlay``): it keeps the color and depth buffers the renderer
 left (a ``vtkFramebufferPass`` copies its color and depth back to the window), has no opaque props, and peels its

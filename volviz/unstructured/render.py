@@ -89,7 +89,7 @@ def table_size(max_depth: float, n_s: int = 128, n_l: int = 64, depth_per_bin: f
     return n_s, n_l
 
 
-def _table_for(mesh: TetMesh, tf: Any, kind: str, sizes: tuple[int, int], l_max: float) -> Any:
+def table_for(mesh: TetMesh, tf: Any, kind: str, sizes: tuple[int, int], l_max: float) -> Any:
     """The pre-integration table (``kind`` "3d" or "pre" (pre-classified 3D): sizes = (n_s, n_l); "separable":
     sizes = (n_s, degree)) over the
     union of the TF range and the data range (so out-of-range parts stay transparent), cached on the mesh for the
@@ -220,9 +220,9 @@ def render(mesh: TetMesh, tf: Any, camera: Camera, size: tuple[int, int] = (512,
             table = Preclassified(tf)
         elif lookup == "3d" or method == "pt-st" or classification == "pre":
             kind = "pre" if classification == "pre" else "3d"
-            table = _table_for(mesh, tf, kind, table_size(tf.max_extinction * l_max, n_s or 128, n_l), l_max)
+            table = table_for(mesh, tf, kind, table_size(tf.max_extinction * l_max, n_s or 128, n_l), l_max)
         else:
-            table = _table_for(mesh, tf, "separable", (n_s or 256, int(degree or 2)), l_max)
+            table = table_for(mesh, tf, "separable", (n_s or 256, int(degree or 2)), l_max)
     elif method == "pt-st" and not hasattr(table, "rgba"):
         raise ValueError('method "pt-st" needs a 3D table (Table3D)')
     stats.table_s = time.perf_counter() - t0
