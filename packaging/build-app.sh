@@ -8,7 +8,8 @@ cd "$(dirname "$0")/.."
 dist="${1:-dist}"
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
-.venv/bin/python -m pip install -q -e ".[packaging]"
+# (CI installs the extra before its tests start, so pip does not rewrite the environment while they run)
+[ "${VOLVIZ_PACKAGING_INSTALLED:-0}" = 1 ] || .venv/bin/python -m pip install -q -e ".[packaging]"
 .venv/bin/pyinstaller --noconfirm --log-level WARN --distpath "$dist" --workpath "$work/build" packaging/volviz.spec
 app="$(cd "$dist/volviz" && pwd)/volviz-app"
 echo "built $app ($(du -sh "$dist/volviz" | cut -f1))"

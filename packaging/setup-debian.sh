@@ -25,11 +25,13 @@ fi
 PYTHON=${PYTHON:-python3}
 [ -x .venv/bin/python ] || "$PYTHON" -m venv .venv
 .venv/bin/python -m pip install -q --upgrade pip
-.venv/bin/python -m pip install -q -e ".[test]"
-# volviz's own optional plugins (plugins/*: extra readers, the Dask compression backend), each its own distribution
+# volviz with its test extra and its own optional plugins (plugins/*: extra readers, the Dask compression backend),
+# each plugin its own distribution, in one pip run (one resolution of the whole set)
+plugins=()
 for plugin in plugins/*/pyproject.toml; do
-  .venv/bin/python -m pip install -q -e "$(dirname "$plugin")"
+  plugins+=(-e "$(dirname "$plugin")")
 done
+.venv/bin/python -m pip install -q -e ".[test]" "${plugins[@]}"
 # Compile the Numba kernels once, now, into their on-disk cache: the first scene, first test or first benchmark does
 # not pay for it (about two minutes on 2 cores; seconds when the cache is already there).
 .venv/bin/volviz warmup || echo "warning: volviz warmup failed (see above); kernels will compile at first use" >&2
