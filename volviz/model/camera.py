@@ -14,9 +14,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any, Sequence
+from typing import TYPE_CHECKING, Any, Sequence, Union
 
 import numpy as np
+
+if TYPE_CHECKING:   # type-only imports for the signatures
+    import pyvista as pv
+    from vtkmodules.vtkRenderingCore import vtkCamera
 
 
 def _unit(v: np.ndarray, what: str) -> np.ndarray:
@@ -116,14 +120,14 @@ class Camera:
 
     # --- VTK / PyVista interop ---------------------------------------------------------------------------------
     @classmethod
-    def from_pyvista(cls, camera: Any) -> "Camera":
+    def from_pyvista(cls, camera: Union[pv.Camera, vtkCamera]) -> "Camera":
         """From a ``pyvista.Camera`` or any ``vtkCamera`` (horizontal view angles are refused)."""
         if hasattr(camera, "GetUseHorizontalViewAngle") and camera.GetUseHorizontalViewAngle():
             raise ValueError("cameras with a horizontal view angle are not supported")
         return cls(camera.GetPosition(), camera.GetFocalPoint(), camera.GetViewUp(), camera.GetViewAngle(),
                    bool(camera.GetParallelProjection()), camera.GetParallelScale(), tuple(camera.GetClippingRange()))
 
-    def apply_to(self, vtk_camera: Any) -> None:
+    def apply_to(self, vtk_camera: Union[pv.Camera, vtkCamera]) -> None:
         """Set a ``vtkCamera`` (or ``pyvista.Camera``) to this camera."""
         vtk_camera.SetPosition(*self.position)
         vtk_camera.SetFocalPoint(*self.focal_point)

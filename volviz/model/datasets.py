@@ -12,9 +12,12 @@ Conventions (used everywhere in volviz):
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Callable, Iterable, Union
+from typing import TYPE_CHECKING, Any, Callable, Iterable, Union
 
 import numpy as np
+
+if TYPE_CHECKING:   # type-only: PyVista loads VTK, which the model does not need at run time
+    import pyvista as pv
 
 # VTK cell type ids for the cell blocks of UnstructuredMesh (subset used by volviz).
 VTK_TETRA = 10
@@ -137,7 +140,7 @@ class CurvilinearGrid:
         name = name or self.active
         return _range(self.point_data[name]) if name else (float("nan"), float("nan"))
 
-    def to_pyvista(self) -> Any:
+    def to_pyvista(self) -> pv.StructuredGrid:
         import pyvista as pv
 
         nx, ny, nz = self.dimensions
@@ -199,7 +202,7 @@ class UnstructuredMesh:
         name = name or self.active
         return _range(self.point_data[name]) if name else (float("nan"), float("nan"))
 
-    def to_pyvista(self) -> Any:
+    def to_pyvista(self) -> pv.UnstructuredGrid:
         import pyvista as pv
 
         cells = {int(t): np.asarray(c, dtype=np.int64) for t, c in self.cells}
@@ -253,7 +256,7 @@ class TetMesh:
     def scalar_range(self) -> tuple[float, float]:
         return _range(self.scalars)
 
-    def to_pyvista(self) -> Any:
+    def to_pyvista(self) -> pv.UnstructuredGrid:
         import pyvista as pv
 
         grid = pv.UnstructuredGrid({VTK_TETRA: self.tets}, self.points)
@@ -299,7 +302,7 @@ class Image2D:
     def scalar_range(self) -> tuple[float, float]:
         return _range(self.data)
 
-    def to_pyvista(self) -> Any:
+    def to_pyvista(self) -> pv.ImageData:
         """Image data on the z = 0 plane, x along columns, y northwards (row 0, the top row, at the largest y)."""
         import pyvista as pv
 
@@ -372,5 +375,5 @@ class TimeSeries:
                 lo, hi = min(lo, a), max(hi, b)
         return (float(lo), float(hi)) if np.isfinite(lo) else (float("nan"), float("nan"))
 
-    def to_pyvista(self) -> Any:
+    def to_pyvista(self) -> pv.DataSet:
         return self.frame(0).to_pyvista()

@@ -4,9 +4,22 @@ dataset's array (issue #28's "value under the cursor")."""
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Optional
+from typing import TYPE_CHECKING, Optional, Protocol, Sequence
 
 import numpy as np
+
+if TYPE_CHECKING:   # type-only imports for the signatures
+    import numpy.typing as npt
+
+    from volviz.model.clip import ClipSettings
+    from volviz.model.datasets import RegularVolume
+
+class Extinction(Protocol):
+    """What the probe needs of a transfer function (``volviz.optics.TransferFunction``, a layer above the model):
+    ``evaluate(scalars)`` -> (rgb, extinction)."""
+
+    def evaluate(self, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]: ...
+
 
 VISIBLE_OPACITY = 0.01     # a sample whose opacity over half a voxel reaches this is what the user sees first
 
@@ -42,7 +55,7 @@ def ray_box(origin: np.ndarray, direction: np.ndarray, lo: np.ndarray, hi: np.nd
     return (t0, t1) if t1 >= t0 else None
 
 
-def clip_span(origin: np.ndarray, direction: np.ndarray, clip: Any,
+def clip_span(origin: np.ndarray, direction: np.ndarray, clip: Optional[ClipSettings],
               span: Optional[tuple[float, float]]) -> Optional[tuple[float, float]]:
     """The part of the ray's ``span`` (t0, t1) that ``clip`` (``volviz.model.clip.ClipSettings``: planes and box,
     each keeping ``(x - point) . normal >= 0``) keeps: one interval, the kept region being convex; None: nothing."""
@@ -61,8 +74,9 @@ def clip_span(origin: np.ndarray, direction: np.ndarray, clip: Any,
     return (t0, t1) if t1 >= t0 else None
 
 
-def ray_voxels(origin: Any, direction: Any, grid_origin: Any, spacing: Any, shape: Any,
-               clip: Any = None) -> Optional[tuple[np.ndarray, float]]:
+def ray_voxels(origin: npt.ArrayLike, direction: npt.ArrayLike, grid_origin: npt.ArrayLike, spacing: npt.ArrayLike,
+               shape: tuple[int, int, int],
+               clip: Optional[ClipSettings] = None) -> Optional[tuple[np.ndarray, float]]:
     """The voxels (n, 3) of a regular grid (sample ``(i, j, k)`` at ``grid_origin + (i, j, k) * spacing``) nearest
     the samples of the ray ``origin + t * direction`` (unit) every half of the smallest spacing, front to back,
     over the voxels' cells around their centres and what ``clip`` keeps (``clip_span``), and that step; None when
@@ -80,7 +94,7 @@ def ray_voxels(origin: Any, direction: Any, grid_origin: Any, spacing: Any, shap
     return np.clip(np.rint((o + t[:, None] * d - vo) / sp).astype(np.int64), 0, n - 1), step
 
 
-def first_visible(values: np.ndarray, tf: Any, opacity: float, step: float) -> Optional[int]:
+def first_visible(values: np.ndarray, tf: Optional[Extinction], opacity: float, step: float) -> Optional[int]:
     """The index of the first of ``values`` (samples ``step`` apart) whose opacity under ``tf`` (its extinction
     times ``opacity``) over the step reaches ``VISIBLE_OPACITY``; without ``tf`` the first sample; None: none."""
     if not len(values):
@@ -92,8 +106,9 @@ def first_visible(values: np.ndarray, tf: Any, opacity: float, step: float) -> O
     return int(np.argmax(visible)) if visible.any() else None
 
 
-def probe_regular(volume: Any, origin: Any, direction: Any, tf: Any = None, component: str = "",
-                  opacity: float = 1.0, clip: Any = None) -> Optional[ProbeResult]:
+def probe_regular(volume: RegularVolume, origin: npt.ArrayLike, direction: npt.ArrayLike,
+                  tf: Optional[Extinction] = None, component: str = "",
+                  opacity: float = 1.0, clip: Optional[ClipSettings] = None) -> Optional[ProbeResult]:
     """The first voxel of the regular ``volume`` (data, origin, spacing) along the ray whose opacity under ``tf``
     (a ``TransferFunction``, its extinction times ``opacity``) over half a voxel is visible; without ``tf`` the first
     voxel the ray enters. Samples every half of the smallest spacing at the nearest voxel, in the part ``clip``
@@ -109,7 +124,8 @@ def probe_regular(volume: Any, origin: Any, direction: Any, tf: Any = None, comp
     return voxel_result(component, float(volume.data[tuple(ijk[hit])]), ijk[hit], volume.origin, volume.spacing)
 
 
-def voxel_result(component: str, value: float, ijk: Any, grid_origin: Any, spacing: Any) -> ProbeResult:
+def voxel_result(component: str, value: float, ijk: Sequence[int] | np.ndarray, grid_origin: npt.ArrayLike,
+                 spacing: npt.ArrayLike) -> ProbeResult:
     """The probe's answer at voxel ``ijk`` of a regular grid: its value, its centre and its index."""
     i, j, k = (int(v) for v in ijk)
     center = np.asarray(grid_origin, dtype=np.float64) + np.array([i, j, k]) * np.asarray(spacing, dtype=np.float64)

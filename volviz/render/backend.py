@@ -39,9 +39,13 @@ Google SwiftShader) the GPU's work runs on the same CPU cores, so ``auto`` takes
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from volviz.session import RENDER_BACKENDS
+
+if TYPE_CHECKING:   # type-only imports for the signatures
+    import pyvista as pv
+    from vtkmodules.vtkRenderingCore import vtkRenderWindow
 
 __all__ = ["RENDER_BACKENDS", "VIEW_KINDS", "GLInfo", "backend_setting", "choose_backend", "gl_info",
            "is_software_renderer", "offscreen_gl_info", "parse_capabilities", "plotter_gl_info"]
@@ -84,7 +88,7 @@ def parse_capabilities(text: str) -> GLInfo:
     return GLInfo(**found)
 
 
-def gl_info(render_window: Any) -> GLInfo:
+def gl_info(render_window: vtkRenderWindow) -> GLInfo:
     """The OpenGL driver of a VTK render window (its context is made by one render when it has none yet)."""
     text = render_window.ReportCapabilities()
     if "renderer string" not in text:
@@ -93,11 +97,11 @@ def gl_info(render_window: Any) -> GLInfo:
     return parse_capabilities(text)
 
 
-def plotter_gl_info(plotter: Any) -> GLInfo:
+def plotter_gl_info(plotter: pv.BasePlotter) -> GLInfo:
     """``gl_info`` of a PyVista plotter's render window, asked once per plotter."""
     known = plotter.__dict__.get("_volviz_gl_info")
     if known is None:
-        known = gl_info(plotter.ren_win)
+        known = gl_info(plotter.ren_win)  # type: ignore[arg-type]  # None only once closed
         plotter.__dict__["_volviz_gl_info"] = known
     return known
 

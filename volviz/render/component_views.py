@@ -9,12 +9,17 @@ themselves.
 """
 from __future__ import annotations
 
-from typing import Any, Optional
+from typing import Any, Optional, TYPE_CHECKING
 
 from volviz.render.framing import Bounds, points_bounds, prop_bounds, union
 from volviz.render.iso_actors import add_isosurface_actors
 from volviz.scene.clipping import clip_settings
 from volviz.scene.isosurfaces import isosurface_parts
+
+if TYPE_CHECKING:   # type-only imports for the signatures
+    from volviz.jobs import ProgressCallback
+    from volviz.model.clip import ClipSettings
+    from volviz.optics.transfer_function import TransferFunction
 
 __all__ = ["IsoSurfacesView", "VtkPropView"]
 
@@ -44,7 +49,7 @@ class VtkPropView:
     def visible(self, on: bool) -> None:
         self.prop.SetVisibility(bool(on))
 
-    def set_tf(self, tf: Any, opacity: float = 1.0) -> None:
+    def set_tf(self, tf: Optional[TransferFunction], opacity: float = 1.0) -> None:
         """A volume's color and opacity functions, or a surface's opacity."""
         if self.prop.IsA("vtkVolume"):
             if tf is None:
@@ -55,14 +60,14 @@ class VtkPropView:
         else:
             self.prop.GetProperty().SetOpacity(float(opacity))
 
-    def set_clip(self, clip: Any) -> bool:
+    def set_clip(self, clip: ClipSettings) -> bool:
         """Clip by ``volviz.model.clip.ClipSettings`` at once (True: nothing for the caller to cut)."""
         from volviz.render.clipping import clip_vtk_prop
 
         self._uncut = clip_vtk_prop(self.prop, clip, self._uncut)
         return True
 
-    def set_input(self, data: Any, clip: Any) -> None:
+    def set_input(self, data: Any, clip: ClipSettings) -> None:
         """A new mapper input (a time series' volume at a new display time), cut by ``clip``."""
         self._uncut = None
         self.prop.GetMapper().SetInputData(data)
@@ -100,10 +105,10 @@ class IsoSurfacesView(VtkPropView):
         """The extracted, uncut surfaces."""
         return list(self.parts.meshes)
 
-    def set_tf(self, tf: Any, opacity: float = 1.0) -> None:
+    def set_tf(self, tf: Optional[TransferFunction], opacity: float = 1.0) -> None:
         """The surfaces keep their own colors; an opacity other than the shown cut's makes it stale (``update``)."""
 
-    def set_clip(self, clip: Any) -> bool:
+    def set_clip(self, clip: ClipSettings) -> bool:
         """Keep ``clip`` for the next cut; True when the shown cut already is of it and of the current opacity."""
         self.clip = clip
         return not self.stale()
@@ -111,7 +116,8 @@ class IsoSurfacesView(VtkPropView):
     def stale(self) -> bool:
         return self.parts.clip != self.clip.to_dict() or self.parts.opacity != float(self.comp.opacity)
 
-    def cut(self, clip: Any = None, meshes: Optional[list[Any]] = None, progress: Any = None) -> Any:
+    def cut(self, clip: Optional[ClipSettings] = None, meshes: Optional[list[Any]] = None,
+            progress: Optional[ProgressCallback] = None) -> Any:
         """Any thread: the surfaces (``meshes``, default the extracted ones) cut by ``clip`` (default: the last
         ``set_clip``), scaled by the component's opacity, with their LOD chains."""
         return isosurface_parts(self.comp, meshes=self.meshes if meshes is None else list(meshes),

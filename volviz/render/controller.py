@@ -19,13 +19,22 @@ the background).
 from __future__ import annotations
 
 from contextlib import contextmanager
-from typing import Any, Iterator, Optional
+from typing import Any, Iterator, Optional, TYPE_CHECKING
 
 from volviz.model import TimeSeries
 from volviz.model.applicability import DatasetTraits
 from volviz.model.events import ChangeNotifier, SceneChange
 from volviz.render.image_overlay import single_sample_on_software
 from volviz.session import CameraState, Component, Session
+
+if TYPE_CHECKING:   # type-only imports for the signatures
+    import pyvista as pv
+
+    from volviz.jobs import ProgressCallback
+    from volviz.model.clip import ClipSettings
+    from volviz.nature.nature_scene import NatureScene
+    from volviz.optics.transfer_function import TransferFunction
+    from volviz.scene.isosurfaces import IsoParts
 
 
 ISO_MODES = ("vtk", "2pass", "3pass", "4pass", "exact")
@@ -41,7 +50,7 @@ def iso_summary(stats: dict[str, Any]) -> str:
 
 
 @contextmanager
-def no_render(plotter: Any) -> Iterator[None]:
+def no_render(plotter: pv.BasePlotter) -> Iterator[None]:
     """PyVista renders after every added actor or mesh (``render=True``); inside this block it does not, and the
     caller draws once afterwards (each render of a big scene on llvmpipe is 50-600 ms of a blocked GUI thread)."""
     suppressed = getattr(plotter, "suppress_rendering", False)
@@ -52,7 +61,7 @@ def no_render(plotter: Any) -> Iterator[None]:
         plotter.suppress_rendering = suppressed
 
 
-def ensure_lights(plotter: Any) -> None:
+def ensure_lights(plotter: pv.BasePlotter) -> None:
     """Give a renderer without lights PyVista's default light kit again (``Plotter.clear`` removes all lights; unlit,
     VTK compiles shaders without normals, and the iso-spectrum shader cannot compile)."""
     if plotter.renderer.GetLights().GetNumberOfItems() == 0:
@@ -93,7 +102,7 @@ class SceneController:
         """Build the scene now (``prepare`` then ``install``, both on this thread)."""
         self.install(self.prepare())
 
-    def prepare(self, progress: Any = None, t: Optional[float] = None) -> Any:
+    def prepare(self, progress: Optional[ProgressCallback] = None, t: Optional[float] = None) -> Any:
         """Any thread, before ``install``: the heavy part of building (``volviz.render.scene_builder.prepare_scene``) at
         display time ``t`` of a time series (default: the session's display time). Touches no plotter, so the app
         runs it in the background."""
@@ -192,7 +201,7 @@ class SceneController:
         return drawn_as(self.datasets[comp.dataset])
 
     # -- transfer functions, visibility, opacity --------------------------------------------------------------------
-    def transfer_function(self, comp_id: str) -> Any:
+    def transfer_function(self, comp_id: str) -> Optional[TransferFunction]:
         from volviz.scene.drawn_tf import component_transfer_function
 
         return component_transfer_function(self.session, self.component(comp_id))
@@ -203,7 +212,7 @@ class SceneController:
 
         return tf if comp.dataset not in self.datasets else drawn_tf(comp, tf, self.dataset_of(comp.id))
 
-    def set_transfer_function(self, comp_id: str, tf: Any, update: bool = True) -> None:
+    def set_transfer_function(self, comp_id: str, tf: TransferFunction, update: bool = True) -> None:
         """Store ``tf`` in the session and give it to the component's view; a view that re-makes something for a new
         TF (a CPU PT volume's image, a LOD volume's block selection) does so now only when ``update`` (the app does it
         in the background: ``camera_views``, then ``begin`` / ``compute`` / ``finish``)."""
@@ -256,7 +265,7 @@ class SceneController:
 
         return self.component(comp_id).type not in NATURE_TYPES and self.views.get(comp_id) is None
 
-    def prepare_component(self, comp_id: str, progress: Any = None) -> Any:
+    def prepare_component(self, comp_id: str, progress: Optional[ProgressCallback] = None) -> Any:
         """Any thread: the heavy part of showing a non-nature component that was hidden at build time
         (``volviz.render.scene_builder.prepare_component`` at the display time). Touches no plotter."""
         from volviz.jobs import report
@@ -364,7 +373,8 @@ class SceneController:
                 and (views[comp_id].prop.IsA("vtkVolume") or (views[comp_id].prop.IsA("vtkActor")
                                                               and is_surface(series[comp_id])))]
 
-    def blend_volume(self, comp_id: str, t: float, interpolate: Optional[bool] = None, progress: Any = None) -> Any:
+    def blend_volume(self, comp_id: str, t: float, interpolate: Optional[bool] = None,
+                     progress: Optional[ProgressCallback] = None) -> Any:
         """Any thread: the VTK input of a time-series volume or surface at display time ``t`` (the 4D blend of the
         neighbouring steps when interpolating, libMini note "4D Visualization"; ``scene_builder.time_input``);
         ``show_volumes`` puts it on screen."""
@@ -394,7 +404,7 @@ class SceneController:
         return [comp_id for comp_id in self.time_series() if comp_id in views]
 
     def extract_isosurfaces(self, comp_id: str, t: float, interpolate: Optional[bool] = None,
-                            progress: Any = None) -> list[Any]:
+                            progress: Optional[ProgressCallback] = None) -> list[Any]:
         """Any thread: the surfaces of an isosurface component at display time ``t`` (the 4D blend of the
         neighbouring steps when interpolating, libMini note "4D Visualization"), cut by the component's own
         clipping (``volviz.iso.prepare``); ``show_isosurfaces`` puts them on screen."""
@@ -411,7 +421,7 @@ class SceneController:
         return list(prepare(self.dataset_of(comp_id), settings, float(t), progress=progress).meshes)
 
     def isosurface_parts(self, comp_id: str, t: float, interpolate: Optional[bool] = None,
-                         progress: Any = None) -> Any:
+                         progress: Optional[ProgressCallback] = None) -> IsoParts:
         """Any thread: ``extract_isosurfaces`` cut by the scene's clipping, with their LOD chains
         (``volviz.scene.isosurfaces.IsoParts``), so that ``show_isosurfaces`` only makes actors."""
         from volviz.scene.isosurfaces import isosurface_parts
@@ -510,7 +520,7 @@ class SceneController:
                 if (view.kind in first) == (stage == 0) and (stage == 0 or view.backend == "cpu")]
 
     @staticmethod
-    def compute_views(requests: list[tuple[str, Any, Any]], progress: Any = None) -> list[Any]:
+    def compute_views(requests: list[tuple[str, Any, Any]], progress: Optional[ProgressCallback] = None) -> list[Any]:
         """Any thread: the CPU images and meshes of ``begin_views`` requests (pure NumPy/Numba, no VTK calls): each
         view's ``compute`` (``volviz.render.views.View``)."""
         from volviz.jobs import report
@@ -557,13 +567,13 @@ class SceneController:
         """Rebuild the natural scene for the visible nature components now (``prepare_nature``, ``install_nature``)."""
         self.install_nature(self.prepare_nature())
 
-    def prepare_nature(self, progress: Any = None) -> Any:
+    def prepare_nature(self, progress: Optional[ProgressCallback] = None) -> Optional[NatureScene]:
         """Any thread: the NatureScene of the visible terrain / fog / clouds / sky components (None: none)."""
         from volviz.scene.nature import prepare_nature
 
         return prepare_nature(self.session, self.datasets)
 
-    def install_nature(self, scene: Any, views: bool = True) -> Any:
+    def install_nature(self, scene: Optional[NatureScene], views: bool = True) -> Any:
         """GUI thread: show a ``prepare_nature`` result. With ``views`` its first view is computed now; otherwise
         the old terrain and overlay stay on screen until the new view's first ``finish_nature`` replaces them."""
         from volviz.render.scene_builder import install_nature, view_backend
@@ -601,12 +611,12 @@ class SceneController:
 
     # -- clipping (scene-wide) --------------------------------------------------------------------------------------
     @property
-    def clip(self) -> Any:
+    def clip(self) -> ClipSettings:
         from volviz.scene.clipping import clip_settings
 
         return clip_settings(self.session.clip)
 
-    def set_clip(self, clip: Any, update: bool = True) -> list[str]:
+    def set_clip(self, clip: dict[str, Any] | ClipSettings, update: bool = True) -> list[str]:
         """Store new clipping (``session.clip`` JSON or ClipSettings) and give it to every view (``apply_clip``);
         returns the ids of the views drawn from a cut made on the CPU (a CPU PT volume's mesh, an isosurface
         component's surfaces), which are cut and re-made here when ``update``; the app instead cuts them in the
@@ -636,7 +646,8 @@ class SceneController:
         self.plotter.render()
         return pending
 
-    def cut(self, comp_id: str, clip: Any = None, progress: Any = None) -> Any:
+    def cut(self, comp_id: str, clip: Optional[ClipSettings] = None,
+            progress: Optional[ProgressCallback] = None) -> Any:
         """Any thread: the component's data cut by ``clip`` (default: the session's) as its view draws it (the
         view's ``cut``: the exact cut of a PT volume's tetrahedra, ``volviz.iso.clip.clip_tetmesh``; the isosurfaces'
         triangles, ``clip_isosurfaces``, scaled by the opacity, with their LOD chains)."""

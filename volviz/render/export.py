@@ -12,7 +12,7 @@ import math
 import os
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Any, Iterator, Optional
+from typing import TYPE_CHECKING, Any, Iterator, Optional, Sequence
 
 import numpy as np
 
@@ -21,6 +21,12 @@ from volviz.jobs import ProgressCallback, report
 from volviz.io.atomic import OutputPathError, atomic_write_bytes, check_output_path, remove_stale_temporaries, temp_name
 from volviz.render.offscreen import offscreen_plotter
 from volviz.session import Session
+
+if TYPE_CHECKING:   # type-only imports for the signatures
+    import pyvista as pv
+
+    from volviz.render.controller import SceneController
+    from volviz.session import CameraState
 
 #: image formats by file extension (Pillow's names)
 IMAGE_FORMATS = {".png": "PNG", ".jpg": "JPEG", ".jpeg": "JPEG", ".tif": "TIFF", ".tiff": "TIFF"}
@@ -131,7 +137,8 @@ def write_png(image: np.ndarray, path: str | os.PathLike) -> None:
     write_file(path, encode_image(image, "PNG"))
 
 
-def offscreen_scene(session: Session, datasets: dict[str, Any], size: tuple[int, int]) -> tuple[Any, Any]:
+def offscreen_scene(session: Session, datasets: dict[str, Any],
+                    size: tuple[int, int]) -> tuple[pv.Plotter, SceneController]:
     """An offscreen plotter of ``size`` and a ``SceneController`` of ``session`` over it, not built yet: ``build()``
     here, or (the app) ``prepare`` on a worker, ``install(views=False)``, then ``begin_views`` / ``compute_views`` /
     ``finish_views``, and ``snapshot``. The caller ends it with ``close_scene``."""
@@ -141,7 +148,7 @@ def offscreen_scene(session: Session, datasets: dict[str, Any], size: tuple[int,
     return plotter, SceneController(plotter, session, datasets)
 
 
-def close_scene(plotter: Any, controller: Any) -> None:
+def close_scene(plotter: pv.BasePlotter, controller: SceneController) -> None:
     """Take the controller's views out (the GPU passes free their GL resources while the plotter's context lives)
     and close the plotter: an offscreen scene's end, however its rendering ended."""
     try:
@@ -150,16 +157,16 @@ def close_scene(plotter: Any, controller: Any) -> None:
         plotter.close()
 
 
-def size_window(plotter: Any, size: tuple[int, int]) -> None:
+def size_window(plotter: pv.BasePlotter, size: tuple[int, int]) -> None:
     """Give the offscreen plotter's window ``size`` without rendering. The view-dependent CPU images (the natural
     scene's fog and cloud overlay) are computed at the window's size when they begin: begun at another size, they
     cover only part of the frame (issue #28: an export's first frame showed no clouds or fog)."""
     width, height = int(size[0]), int(size[1])
     if list(plotter.window_size) != [width, height]:
-        plotter.render_window.SetSize(width, height)
+        plotter.render_window.SetSize(width, height)  # type: ignore[union-attr]  # None only once closed
 
 
-def snapshot(plotter: Any, size: tuple[int, int], transparent: bool = False) -> np.ndarray:
+def snapshot(plotter: pv.BasePlotter, size: tuple[int, int], transparent: bool = False) -> np.ndarray:
     """Render the offscreen plotter (VTK side, the thread that owns it) once at ``size`` and return the (H, W, 3) uint8
     image, or with ``transparent`` the (H, W, 4) straight-alpha image without the background, from two renders
     (``separate_background``). (``screenshot(window_size=...)`` renders twice: once after resizing and again after
@@ -284,7 +291,7 @@ def is_session_file(path: Path) -> bool:
     return b"volviz-session" in head
 
 
-def orbit_cameras(camera: Any, n: int, turns: float = 1.0) -> list[Any]:
+def orbit_cameras(camera: CameraState, n: int, turns: float = 1.0) -> list[CameraState]:
     """``n`` cameras evenly spaced over ``turns`` full turns of ``camera`` around its view-up axis through the focal
     point (the last frame stops one step short of the first, so the movie loops)."""
     from dataclasses import replace
@@ -299,19 +306,20 @@ def orbit_cameras(camera: Any, n: int, turns: float = 1.0) -> list[Any]:
         # Rodrigues: the offset rotated by a about the axis (the view-up vector is on the axis: it stays)
         rotated = (offset * math.cos(a) + np.cross(axis, offset) * math.sin(a)
                    + axis * float(np.dot(axis, offset)) * (1.0 - math.cos(a)))
-        cameras.append(replace(camera, position=tuple(float(v) for v in focal + rotated)))
+        cameras.append(replace(camera, position=tuple(float(v) for v in focal + rotated)))  # type: ignore[arg-type]
     return cameras
 
 
-def movie_frames(controller: Any, path_name: Optional[str], fps: float, through_time: bool,
-                 duration: Optional[float] = None, orbit: bool = False) -> list[tuple[Optional[Any], Optional[float]]]:
+def movie_frames(controller: SceneController, path_name: Optional[str], fps: float, through_time: bool,
+                 duration: Optional[float] = None,
+                 orbit: bool = False) -> list[tuple[Optional[CameraState], Optional[float]]]:
     """(camera, display time) for every frame: along a recorded camera path or an orbit of the current camera
     (one turn over ``duration``, default 8 s), through the time series, or both. ExportError past
     ``MAX_MOVIE_FRAMES``."""
     from volviz.render.camera_path import frame_times, interpolate_path
 
     session = controller.session
-    cameras: list[Optional[Any]] = [None]
+    cameras: Sequence[Optional[CameraState]] = [None]
     if path_name is not None:
         if path_name not in session.camera_paths:
             from volviz.scene.errors import SceneError

@@ -3,11 +3,16 @@
 those bounds fill a given share of the viewport."""
 from __future__ import annotations
 
-from typing import Any, Optional
+from typing import TYPE_CHECKING, Any, Optional
 
 import numpy as np
 
 from volviz.scene.lod import lod_bounds
+
+if TYPE_CHECKING:   # type-only imports for the signatures
+    import numpy.typing as npt
+    import pyvista as pv
+    from vtkmodules.vtkRenderingCore import vtkProp
 
 Bounds = tuple[float, float, float, float, float, float]
 
@@ -30,7 +35,7 @@ def nature_bounds(scene: Any) -> Optional[Bounds]:
     return union([tuple(float(v) for v in b) for b in parts if _valid(b)])  # type: ignore[misc]
 
 
-def prop_bounds(prop: Any) -> Optional[Bounds]:
+def prop_bounds(prop: vtkProp) -> Optional[Bounds]:
     """The world bounds of one component's prop: a NatureView (its terrain, else its clouds), a PT volume (its
     mesh), a LOD volume (its samples), a VTK prop (what VTK reports); None when empty or a hidden VTK prop (callers
     leave out the props of hidden components)."""
@@ -70,7 +75,7 @@ def scene_bounds(props: dict[str, Any]) -> Optional[Bounds]:
     return union([b for b in (prop_bounds(p) for p in props.values()) if b is not None])
 
 
-def framing_distance(bounds: Bounds, direction: Any, view_up: Any, view_angle: float, aspect: float,
+def framing_distance(bounds: Bounds, direction: npt.ArrayLike, view_up: npt.ArrayLike, view_angle: float, aspect: float,
                      fill: float = FILL) -> tuple[np.ndarray, float]:
     """(focal point, distance) of a perspective camera looking along ``-direction`` at the box's centre from which
     every corner of the box projects inside ``fill`` of the viewport (exactly at ``fill`` in the limiting
@@ -102,13 +107,14 @@ def view_direction(bounds: Bounds) -> tuple[tuple[float, float, float], tuple[fl
     return ISOMETRIC, (0.0, 0.0, 1.0)
 
 
-def frame_bounds(plotter: Any, bounds: Optional[Bounds], fill: float = FILL, right_margin: float = 0.0) -> None:
+def frame_bounds(plotter: pv.BasePlotter, bounds: Optional[Bounds], fill: float = FILL,
+                 right_margin: float = 0.0) -> None:
     """Point the plotter's camera at ``bounds`` (from ``view_direction``) so they fill ``fill`` of the viewport
     left of a ``right_margin`` share of its width (kept for the scalar bar); with no bounds, VTK's own reset."""
     camera = plotter.renderer.GetActiveCamera()
     if bounds is None:
-        plotter.view_isometric()
-        plotter.reset_camera()
+        plotter.view_isometric()  # type: ignore[call-arg]  # pyvista's _Wrapped decorator hides self from mypy
+        plotter.reset_camera()  # type: ignore[call-arg]  # pyvista's _Wrapped decorator hides self from mypy
         return
     width, height = plotter.window_size
     aspect = width / max(height, 1)
@@ -133,6 +139,6 @@ def frame_bounds(plotter: Any, bounds: Optional[Bounds], fill: float = FILL, rig
     plotter.camera_set = True          # else PyVista re-frames its own props at the next render
 
 
-def frame_scene(plotter: Any, props: dict[str, Any], fill: float = FILL, right_margin: float = 0.0) -> None:
+def frame_scene(plotter: pv.BasePlotter, props: dict[str, Any], fill: float = FILL, right_margin: float = 0.0) -> None:
     """Frame every visible component of a scene (``scene_bounds``)."""
     frame_bounds(plotter, scene_bounds(props), fill, right_margin)

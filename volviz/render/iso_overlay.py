@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import time
 from types import SimpleNamespace
-from typing import Any, Sequence
+from typing import TYPE_CHECKING, Any, Optional, Sequence
 
 import numpy as np
 
@@ -33,6 +33,9 @@ from volviz.iso.extract import IsoMesh
 from volviz.iso.lod import lod_mesh, select_level
 from volviz.render.image_overlay import OverlayView
 from volviz.model.camera import Camera
+
+if TYPE_CHECKING:   # type-only imports for the signatures
+    from volviz.jobs import ProgressCallback
 
 __all__ = ["IsoModeView", "IsoOverlay", "cut_at_depth"]
 
@@ -104,7 +107,7 @@ class IsoOverlay(OverlayView, IsoModeView):
         request.update(meshes=list(self.meshes), lod=list(self.lod), mode=self.mode, shading=self.shading)
         return request
 
-    def compute(self, request: dict[str, Any], progress: Any = None) -> tuple[np.ndarray, Any]:
+    def compute(self, request: dict[str, Any], progress: Optional[ProgressCallback] = None) -> tuple[np.ndarray, Any]:
         """Any thread: rasterise all surfaces once, cut at the opaque depth, composite in the request's mode."""
         if progress is not None:
             progress(0.0, f"isosurfaces: {request['mode']}")

@@ -39,7 +39,7 @@ from __future__ import annotations
 
 import threading
 import time
-from typing import Any, Optional
+from typing import Any, Optional, Union, TYPE_CHECKING
 
 import numpy as np
 
@@ -49,12 +49,20 @@ from volviz.render.vtk_scene import update_volume_property, vtk_volume_property
 from volviz.render.image_overlay import ImageOverlay, unpremultiply_rgba8, zbuffer_to_depth
 from volviz.scene.lod import lod_bounds
 
+if TYPE_CHECKING:   # type-only imports for the signatures
+    import pyvista as pv
+    from vtkmodules.vtkRenderingCore import vtkCamera
+
+    from volviz.jobs import ProgressCallback
+    from volviz.model.clip import ClipSettings
+    from volviz.optics.transfer_function import TransferFunction
+
 RENDERERS = ("volviz", "vtk")
 
 __all__ = ["LodVolume", "RENDERERS", "lod_camera"]
 
 
-def lod_camera(vtk_camera: Any, size: tuple[int, int]) -> LodCamera:
+def lod_camera(vtk_camera: Union[pv.Camera, vtkCamera], size: tuple[int, int]) -> LodCamera:
     """The LOD selection's pinhole camera for a ``vtkCamera``/``pyvista.Camera`` and an image ``size`` (W, H)."""
     return LodCamera(eye=vec3(vtk_camera.GetPosition()),
                      target=vec3(vtk_camera.GetFocalPoint()),
@@ -172,13 +180,13 @@ class LodVolume:
     def visible(self, on: bool) -> None:
         self.volume.SetVisibility(bool(on))
 
-    def set_tf(self, tf: Any, opacity: float = 1.0) -> None:
+    def set_tf(self, tf: TransferFunction, opacity: float = 1.0) -> None:
         """A new TF and opacity (``volviz.render.views.ComponentView``): the current selection is drawn again; the
         caller re-selects (``update``, or ``begin`` / ``compute`` / ``finish``: the selection depends on the TF)."""
         self.opacity = float(opacity)
         self.set_transfer_function(tf)
 
-    def set_clip(self, clip: Any) -> bool:
+    def set_clip(self, clip: ClipSettings) -> bool:
         """The mapper's clipping planes, which the ray caster reads at the next selection's draw (True: nothing for
         the caller to cut)."""
         from volviz.render.clipping import clip_vtk_prop
@@ -189,7 +197,7 @@ class LodVolume:
     def bounds(self) -> tuple[float, float, float, float, float, float]:
         return lod_bounds(self.tree)
 
-    def set_transfer_function(self, tf: Any) -> None:
+    def set_transfer_function(self, tf: TransferFunction) -> None:
         """A new TF (and the current ``opacity``); with our renderer the current selection is drawn again."""
         self.tf = tf
         update_volume_property(self.volume.GetProperty(), tf, self.opacity)
@@ -375,7 +383,8 @@ class LodVolume:
         budget = max(1, self.budget // 8) if scale > 1 else self.budget
         return {"camera": self.camera(), "budget": budget, "preview": scale > 1}
 
-    def compute(self, request: dict[str, Any], progress: Any = None) -> tuple[Selection, list[Block], float, float]:
+    def compute(self, request: dict[str, Any], progress: Optional[ProgressCallback] = None) -> tuple[Selection,
+                list[Block], float, float]:
         """Any thread: the selection of ``begin``'s request and its decoded new blocks, with their seconds."""
         t0 = time.perf_counter()
         selection = self.select(request["camera"], request["budget"])

@@ -9,13 +9,24 @@ mesh and the overlay for a camera; the app does it in the background (``begin`` 
 """
 from __future__ import annotations
 
-from typing import Any, Sequence
+from typing import Any, Optional, Sequence, Union, TYPE_CHECKING
 
 import numpy as np
 
 from volviz.nature.nature_scene import NatureScene, scene_from_components
 from volviz.nature.raster import render_terrain
 
+if TYPE_CHECKING:   # type-only imports for the signatures
+    import pyvista as pv
+
+    from volviz.jobs import ProgressCallback
+    from volviz.model.camera import Camera
+    from volviz.render.framing import Bounds
+    from volviz.session import Component, CameraState
+
+
+#: a natural-scene view's request: (camera, image size (width, height), preview scale)
+NatureRequest = tuple["Camera", tuple[int, int], int]
 
 PREVIEW_TRIANGLES = 60_000   # terrain triangles of a frame drawn while the camera moves (~60 ms on llvmpipe)
 
@@ -28,7 +39,7 @@ class NatureView:
     job = ("nature", "natural scene")  # the app's key for its updates, and what its worker makes
     camera_dependent = True
 
-    def bounds(self) -> Any:
+    def bounds(self) -> Optional[Bounds]:
         """The terrain's and the clouds' box (``volviz.render.framing.nature_bounds``; not the sky dome's)."""
         from volviz.render.framing import nature_bounds
 
@@ -87,7 +98,7 @@ class NatureView:
         sky.edge_clamp = True
         self.sky_actor = plotter.add_mesh(dome, texture=sky, lighting=False, name="nature-sky", render=False)
 
-    def _camera(self) -> Any:
+    def _camera(self) -> Camera:
         from volviz.model.camera import Camera
 
         self._fit_clipping()
@@ -116,14 +127,14 @@ class NatureView:
         if far < need or near < 0.5 * self._near:
             pc.clipping_range = (max(near, self._near), max(far, need))
 
-    def update(self, camera: Any = None) -> dict[str, float]:
+    def update(self, camera: Optional[Camera] = None) -> dict[str, float]:
         """Re-triangulate the terrain and re-render the overlay for ``camera`` (default: the plotter's camera), now.
         An app renders it in the background instead: ``begin`` (GUI thread), ``compute`` (any thread), ``finish``
         (GUI thread)."""
         request = self.begin(camera)
         return self.finish(request, *self.compute(request))
 
-    def begin(self, camera: Any = None, scale: int = 1) -> tuple[Any, tuple[int, int], int]:
+    def begin(self, camera: Optional[Camera] = None, scale: int = 1) -> NatureRequest:
         """GUI thread: the view to compute (``camera`` or the plotter's, the image size and the preview ``scale``,
         see ``compute``); moves the sky dome to the eye (the sky is at infinity)."""
         self._fit_dome(camera.position if camera is not None else self.plotter.camera.position)
@@ -140,8 +151,8 @@ class NatureView:
             self.sky_actor.SetPosition(*np.asarray(cam.position, dtype=np.float64))
         return cam, size, max(1, int(scale))
 
-    def compute(self, request: tuple[Any, tuple[int, int], int],
-                progress: Any = None) -> tuple[Any, np.ndarray, dict[str, float]]:
+    def compute(self, request: NatureRequest, progress: Optional[ProgressCallback] = None
+                ) -> tuple[Optional[pv.PolyData], np.ndarray, dict[str, float]]:
         """Any thread (one at a time): the C-LOD terrain mesh as VTK poly data (None without terrain), the fog and
         cloud overlay as 8-bit straight RGBA rows bottom-up, and the statistics. ``progress(fraction, message)`` is
         called between the stages (a job runner cancels there). A preview (``scale`` > 1, e.g. while the camera
@@ -190,7 +201,7 @@ class NatureView:
             self.preview_detail = detail
         return mesh
 
-    def finish(self, request: tuple[Any, tuple[int, int], int], poly: Any, overlay: np.ndarray,
+    def finish(self, request: NatureRequest, poly: Optional[pv.PolyData], overlay: np.ndarray,
                stats: dict[str, float]) -> dict[str, float]:
         """GUI thread: show a ``compute`` result (terrain mesh and overlay image)."""
         self._show_terrain(poly)
@@ -250,7 +261,7 @@ class NatureView:
 ANISOTROPY = 1.0
 
 
-def texture_filtering(plotter: Any) -> bool:
+def texture_filtering(plotter: pv.BasePlotter) -> bool:
     """Whether the terrain texture is mip-mapped in ``plotter`` by default: on a hardware OpenGL driver (free there),
     not on a software rasteriser (``volviz.render.backend``): on llvmpipe the mip-mapped terrain took 62-78 ms
     against 35-39 ms per 320x200 frame, and its first frame (making the mip-maps) 170-260 ms against 95-145 ms, on
@@ -295,7 +306,8 @@ def _overlay_rgba(overlay: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray((rgba * 255.0 + 0.5).astype(np.uint8))
 
 
-def build_nature_components(plotter: Any, components: Sequence[Any], datasets: dict[str, Any], camera: Any = None,
+def build_nature_components(plotter: pv.BasePlotter, components: Sequence[Component], datasets: dict[str, Any],
+                            camera: Union[Camera, CameraState, None] = None,
                             size: tuple[int, int] | None = None) -> NatureView:
     """Add the session's terrain / fog / clouds / sky components to ``plotter`` and render the first overlay for
     ``camera`` (a ``volviz.model.camera.Camera``, a ``volviz.session.CameraState`` or None for the

@@ -28,7 +28,7 @@ volumes should be merged into one mesh). Multisampling is off while a volume is 
 """
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any, Optional
 
 import numpy as np
 
@@ -39,6 +39,13 @@ from volviz.render.preview_hold import PreviewCameraHold, holds_previews
 from volviz.render.pt_view import PTView
 from volviz.model.camera import Camera
 from volviz.unstructured.render import render
+
+if TYPE_CHECKING:   # type-only imports for the signatures
+    import pyvista as pv
+
+    from volviz.jobs import ProgressCallback
+    from volviz.model.clip import ClipSettings
+    from volviz.optics.transfer_function import TransferFunction
 
 __all__ = ["PTVolume", "add_pt_volume", "unpremultiply_rgba8", "zbuffer_to_depth"]
 
@@ -91,7 +98,8 @@ class PTVolume(OverlayView, PTView):
         request["tf"], request["mesh"] = self.tf, self.mesh   # what the image is of, whatever is set meanwhile
         return request
 
-    def compute(self, request: dict[str, Any], progress: Any = None) -> tuple[np.ndarray, Any, np.ndarray]:
+    def compute(self, request: dict[str, Any], progress: Optional[ProgressCallback] = None) -> tuple[np.ndarray, Any,
+                np.ndarray]:
         """Any-thread part: the volume image for a request of ``begin`` (pure NumPy/Numba, no VTK), its statistics,
         and the image as VTK will show it (``overlay_rgba8``: straight-alpha 8-bit RGBA, a preview magnified
         to the window), made here so that ``finish`` on the GUI thread only hands it over."""
@@ -127,7 +135,7 @@ class PTVolume(OverlayView, PTView):
         self._prefetcher.prefetch(camera, size)
 
     def error_estimate(self, request: dict[str, Any], size: tuple[int, int] = (96, 72),
-                       progress: Any = None) -> dict[str, Any]:
+                       progress: Optional[ProgressCallback] = None) -> dict[str, Any]:
         """Any-thread: the current method's error against the exact float64 reference for this view and TF, measured
         on a small image (``size``, same camera and aspect): RMSE and max abs in 8-bit units. This is what the app's
         statistics show as the error estimate."""
@@ -155,7 +163,7 @@ class PTVolume(OverlayView, PTView):
         """A new transfer function for the next image (``update``, or ``begin`` / ``compute`` / ``finish``)."""
         self.tf = tf
 
-    def set_clip(self, clip: Any) -> bool:
+    def set_clip(self, clip: ClipSettings) -> bool:
         """Clipping is not done here: the caller shows an exact cut of ``whole_mesh`` as ``mesh``
         (``cut``, ``show_cut``); returns False
         (``PTView.set_clip``)."""
@@ -170,7 +178,7 @@ class PTVolume(OverlayView, PTView):
             self.hold.remove()
         super().remove()
 
-def add_pt_volume(plotter: Any, mesh: Any, tf: Any, **opts: Any) -> PTVolume:
+def add_pt_volume(plotter: pv.BasePlotter, mesh: Any, tf: TransferFunction, **opts: Any) -> PTVolume:
     """Add a volviz PT volume to ``plotter`` (composited through the depth buffer) and render it once.
 
     ``opts``: ``method`` ("pt" or "reference"), ``scalars`` (point-data name when ``mesh`` is not a TetMesh) and any

@@ -5,9 +5,15 @@
 """
 from __future__ import annotations
 
-from typing import Any, TypeGuard
+from typing import Any, Optional, TypeGuard, TYPE_CHECKING
 
 from volviz.render.framing import Bounds, points_bounds
+
+if TYPE_CHECKING:   # type-only imports for the signatures
+    from volviz.jobs import ProgressCallback
+    from volviz.model.clip import ClipSettings
+    from volviz.model.datasets import TetMesh
+    from volviz.optics.transfer_function import TransferFunction
 
 __all__ = ["PTView", "is_pt_view"]
 
@@ -29,26 +35,26 @@ class PTView:
     def prop(self) -> PTView:
         return self
 
-    def set_tf(self, tf: Any, opacity: float = 1.0) -> None:
+    def set_tf(self, tf: TransferFunction, opacity: float = 1.0) -> None:
         """Draw with a new transfer function from the next frame on; ``opacity`` scales its extinction."""
         self._use_tf(tf.scaled_extinction(opacity) if opacity != 1.0 else tf)
 
     def _use_tf(self, tf: Any) -> None:
         raise NotImplementedError
 
-    def set_clip(self, clip: Any) -> bool:
+    def set_clip(self, clip: ClipSettings) -> bool:
         """Clip by ``volviz.model.clip.ClipSettings``. True: done; False: this view clips only by drawing a cut mesh,
         which the caller makes (``cut`` on any thread) and shows (``show_cut``)."""
         raise NotImplementedError
 
-    def cut(self, clip: Any, progress: Any = None) -> Any:
+    def cut(self, clip: ClipSettings, progress: Optional[ProgressCallback] = None) -> Optional[TetMesh]:
         """Any thread: the uncut mesh cut by ``clip`` exactly (``volviz.iso.clip.clip_tetmesh``), with its topology
         built; None when the clipping removes all of it."""
         from volviz.scene.tetra import cut_tetmesh
 
         return cut_tetmesh(self.whole_mesh, clip)
 
-    def show_cut(self, mesh: Any, visible: bool = True) -> None:
+    def show_cut(self, mesh: Optional[TetMesh], visible: bool = True) -> None:
         """Draw a ``cut`` from the next frame on (None: nothing left, the volume is hidden); re-render it after."""
         if mesh is None:
             self.visible = False
@@ -56,7 +62,7 @@ class PTView:
         self.mesh = mesh
         self.visible = visible
 
-    def update(self) -> Any:
+    def update(self) -> object:
         """Make the view current for the plotter's camera and scene now."""
         raise NotImplementedError
 

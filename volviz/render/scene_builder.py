@@ -7,7 +7,7 @@ the props and views are made (``install_scene``, GUI thread). Only the component
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Optional
+from typing import TYPE_CHECKING, Any, Optional
 
 from volviz.jobs import ProgressCallback, report
 from volviz.model import Image2D, RegularVolume, TimeSeries
@@ -31,6 +31,13 @@ from volviz.scene.lod import is_lod, lod_bounds
 from volviz.scene.nature import prepare_nature
 from volviz.scene.tetra import cut_tetmesh, pt_mesh, pt_options
 from volviz.session import Component, Session
+
+if TYPE_CHECKING:   # type-only imports for the signatures
+    import pyvista as pv
+
+    from volviz.nature.nature_scene import NatureScene
+    from volviz.optics.transfer_function import TransferFunction
+    from volviz.render.nature_view import NatureView
 
 
 def ensure_transfer_functions(session: Session, datasets: dict[str, Any]) -> None:
@@ -130,7 +137,7 @@ def time_input(series: Any, t: Optional[float] = None, interpolate: bool = True)
     return prepared_volume_input(series, t, interpolate)
 
 
-def add_volume_prop(plotter: Any, dataset: Any, data: Any, tf: Any, opacity: float, name: str,
+def add_volume_prop(plotter: pv.BasePlotter, dataset: Any, data: Any, tf: TransferFunction, opacity: float, name: str,
                     backend: str = "auto", shade: bool = False) -> Any:
     """GUI thread: a vtkVolume drawing ``data`` (from ``prepared_volume_input``), the surface of a time series at
     its display time (``data`` from ``time_input``), or (``data`` None) ``add_dataset``'s default visual;
@@ -144,7 +151,8 @@ def add_volume_prop(plotter: Any, dataset: Any, data: Any, tf: Any, opacity: flo
     return volume_prop(plotter, data, regular, tf, opacity, name, backend, shade)
 
 
-def install_nature(plotter: Any, scene: Any, views: bool = True, backend: str = "cpu") -> Any:
+def install_nature(plotter: pv.BasePlotter, scene: Optional[NatureScene], views: bool = True,
+                   backend: str = "cpu") -> Any:
     """GUI thread: a view of a prepared NatureScene (None: none): ``NatureView`` (fog and clouds rendered on the CPU
     as an overlay) or, for ``backend`` "gpu", ``volviz.render.gl_nature.GLNatureView`` (drawn by VTK's OpenGL; see
     ``view_backend``). Its first view is computed now when ``views`` (the app computes it in the background:
@@ -157,7 +165,7 @@ def install_nature(plotter: Any, scene: Any, views: bool = True, backend: str = 
     return view
 
 
-def install_scene(plotter: Any, session: Session, datasets: dict[str, Any], prepared: PreparedScene,
+def install_scene(plotter: pv.BasePlotter, session: Session, datasets: dict[str, Any], prepared: PreparedScene,
                   spectrum: bool = True, views: bool = True) -> dict[str, Any]:
     """GUI thread: add the props of a ``prepare_scene`` result to ``plotter``; returns the view of each component by
     id (``install_component``), and under ``"nature"`` the NatureView that draws the terrain, fog, clouds and sky
@@ -177,7 +185,7 @@ def install_scene(plotter: Any, session: Session, datasets: dict[str, Any], prep
             pt_components.append((comp, prepared.parts[comp.id]))  # drawn last: over the opaque scene's depth
         else:
             props[comp.id] = install_component(plotter, session, comp, datasets, prepared, spectrum, views)
-    plotter.set_background(session.render.background)
+    plotter.set_background(session.render.background)  # type: ignore[arg-type]  # pyvista's _Wrapped decorator
     if session.camera is None:  # framed on every component before the view-dependent parts are drawn
 
         boxes = [view.bounds() for view in props.values()] + [points_bounds(m.points) for _, m in pt_components]
@@ -196,7 +204,7 @@ def install_scene(plotter: Any, session: Session, datasets: dict[str, Any], prep
     return props
 
 
-def install_component(plotter: Any, session: Session, comp: Component, datasets: dict[str, Any],
+def install_component(plotter: pv.BasePlotter, session: Session, comp: Component, datasets: dict[str, Any],
                       prepared: PreparedScene, spectrum: bool = True, views: bool = True) -> Any:
     """GUI thread: add one non-nature component from its ``prepare_component`` result; returns its view
     (``volviz.render.views.ComponentView``: a PT volume, a LOD volume, its isosurfaces, or a VTK prop's view). A PT
@@ -216,18 +224,20 @@ def install_component(plotter: Any, session: Session, comp: Component, datasets:
                                        backend_setting(session.render.options), bool(comp.settings.get("shade"))))
 
 
-def build_scene(plotter: Any, session: Session, datasets: dict[str, Any], spectrum: bool = True) -> dict[str, Any]:
+def build_scene(plotter: pv.BasePlotter, session: Session, datasets: dict[str, Any],
+                spectrum: bool = True) -> dict[str, Any]:
     """Add every visible component to ``plotter`` now (``prepare_scene`` then ``install_scene``)."""
     return install_scene(plotter, session, datasets, prepare_scene(session, datasets), spectrum)
 
 
-def add_lod_component(plotter: Any, session: Session, comp: Component, dataset: Any, update: bool = True) -> Any:
+def add_lod_component(plotter: pv.BasePlotter, session: Session, comp: Component, dataset: Any,
+                      update: bool = True) -> Any:
     """A compressed volume at a view-dependent level of detail (``volviz.render.lod_volume``); the component
     setting ``budget`` is the number of blocks per view (default 256). Its blocks are selected now when ``update``
     (the app selects them in the background: ``select`` / ``decode`` / ``show``)."""
     if session.camera is None:
         lo, hi = dataset.node_box((dataset.levels, (0, 0, 0)))
-        plotter.view_isometric()
+        plotter.view_isometric()  # type: ignore[call-arg]  # pyvista's _Wrapped decorator hides self from mypy
         plotter.renderer.ResetCamera(lo[0], hi[0], lo[1], hi[1], lo[2], hi[2])
         plotter.camera_set = True
     lod = LodVolume(plotter, dataset, drawn_transfer_function(session, comp, dataset),
@@ -248,7 +258,8 @@ def uses_pt(session: Session, dataset: Any) -> bool:
     return session.render.method != "vtk" and type(dataset).__name__ in PT_DATASETS and not is_surface(dataset)
 
 
-def add_pt_component(plotter: Any, session: Session, comp: Component, dataset: Any, update: bool = True) -> Any:
+def add_pt_component(plotter: pv.BasePlotter, session: Session, comp: Component, dataset: Any,
+                     update: bool = True) -> Any:
     """A PT volume for a component (``volviz.render.pt_view``), with its TF scaled by its opacity: drawn on the GPU
     (``volviz.render.gl_pt``) or the CPU (``volviz.render.pt_prop``) as the render option ``backend`` picks for this
     plotter's OpenGL (``volviz.render.backend``; the exact "reference" method is CPU only). A CPU volume's image is
@@ -267,17 +278,17 @@ def add_pt_component(plotter: Any, session: Session, comp: Component, dataset: A
     return handle
 
 
-def pt_backend(plotter: Any, session: Session) -> str:
+def pt_backend(plotter: pv.BasePlotter, session: Session) -> str:
     """"gpu" or "cpu": where the session's PT volumes are drawn in ``plotter`` (``volviz.render.backend``)."""
     return view_backend(plotter, session, "pt")
 
 
-def view_backend(plotter: Any, session: Session, view_kind: str) -> str:
+def view_backend(plotter: pv.BasePlotter, session: Session, view_kind: str) -> str:
     """"gpu" or "cpu": where the session's views of ``view_kind`` ("pt", "nature", "iso", ...) are drawn in
     ``plotter``, as the render option ``backend`` picks for the plotter's OpenGL (``volviz.render.backend``)."""
     return choose_backend(backend_setting(session.render.options), view_kind, plotter_gl_info(plotter))
 
 
-def build_nature(plotter: Any, session: Session, datasets: dict[str, Any]) -> Any:
+def build_nature(plotter: pv.BasePlotter, session: Session, datasets: dict[str, Any]) -> Optional[NatureView]:
     """The NatureView of the session's visible terrain / fog / clouds / sky components (None when it has none)."""
     return install_nature(plotter, prepare_nature(session, datasets), backend=view_backend(plotter, session, "nature"))

@@ -9,7 +9,7 @@ clamped to 0..1: ``slice_colors``.
 """
 from __future__ import annotations
 
-from typing import Any, Optional
+from typing import Any, Optional, TYPE_CHECKING
 
 import numpy as np
 
@@ -17,6 +17,13 @@ from volviz.model.datasets import RegularVolume
 from volviz.render.component_views import VtkPropView
 from volviz.render.framing import Bounds, prop_bounds
 from volviz.scene.errors import SceneError
+
+if TYPE_CHECKING:   # type-only imports for the signatures
+    import numpy.typing as npt
+    from vtkmodules.vtkRenderingCore import vtkRenderer
+
+    from volviz.model.clip import ClipSettings
+    from volviz.optics.transfer_function import TransferFunction
 
 __all__ = ["AXES", "SlicesView", "drag_index", "slice_colors", "slice_image", "slice_indices", "slice_values",
            "SliceError", "value_color"]
@@ -47,7 +54,7 @@ def slice_values(dataset: Any, axis: str, index: int) -> np.ndarray:
     return np.ascontiguousarray(plane.T[::-1])
 
 
-def slice_colors(values: np.ndarray, tf: Any) -> np.ndarray:
+def slice_colors(values: np.ndarray, tf: TransferFunction) -> np.ndarray:
     """uint8 RGB of ``values`` (any shape): κ(clamp(s, range)) clamped to 0..1, times 255, rounded; NaN is black."""
     lo, hi = tf.range
     v = np.asarray(values, dtype=np.float64)
@@ -55,13 +62,13 @@ def slice_colors(values: np.ndarray, tf: Any) -> np.ndarray:
     return np.rint(np.clip(rgb, 0.0, 1.0) * 255.0).astype(np.uint8)
 
 
-def value_color(tf: Any, value: float) -> tuple[float, float, float]:
+def value_color(tf: TransferFunction, value: float) -> tuple[float, float, float]:
     """The colour (0..1) a slice gives ``value``: a new isosurface's default colour, so that it matches the planes."""
     rgb = slice_colors(np.array([value]), tf)[0]
     return (float(rgb[0]) / 255.0, float(rgb[1]) / 255.0, float(rgb[2]) / 255.0)
 
 
-def slice_image(dataset: Any, axis: str, index: int, tf: Any) -> np.ndarray:
+def slice_image(dataset: Any, axis: str, index: int, tf: TransferFunction) -> np.ndarray:
     """The (rows, cols, 3) uint8 image of one slice, row 0 at the top (``slice_values`` through ``slice_colors``)."""
     return slice_colors(slice_values(dataset, axis, index), tf)
 
@@ -71,7 +78,7 @@ def slice_indices(settings: dict[str, Any]) -> dict[str, int]:
     return {axis: int(settings[axis]) for axis in AXES if settings.get(axis) is not None}
 
 
-def drag_index(dataset: Any, axis: str, anchor: Any, origin: Any, direction: Any) -> int:
+def drag_index(dataset: Any, axis: str, anchor: npt.ArrayLike, origin: npt.ArrayLike, direction: npt.ArrayLike) -> int:
     """The index of plane ``axis`` a drag has moved to: the grid index nearest the point of the line through
     ``anchor`` (where the plane was grabbed) along the axis that is closest to the mouse ray (``origin``,
     ``direction``), clamped to the grid; a ray along the axis leaves the plane where it was grabbed."""
@@ -154,7 +161,7 @@ class SlicesView(VtkPropView):
         self.indices = dict(indices)
         self._show()
 
-    def plane_at(self, renderer: Any, x: float, y: float) -> Optional[tuple[str, np.ndarray]]:
+    def plane_at(self, renderer: vtkRenderer, x: float, y: float) -> Optional[tuple[str, np.ndarray]]:
         """The plane under display pixel (x, y) of ``renderer`` (VTK's coordinates, y up) and the world point hit
         on it; None when no plane is there or the planes are hidden."""
         from volviz.render.vtk_facade import vtk
@@ -172,13 +179,13 @@ class SlicesView(VtkPropView):
         axis = next((a for a, part in self.actors.items() if part is actor), None)
         return None if axis is None else (axis, np.asarray(picker.GetPickPosition(), dtype=np.float64))
 
-    def set_tf(self, tf: Any, opacity: float = 1.0) -> None:
+    def set_tf(self, tf: Optional[TransferFunction], opacity: float = 1.0) -> None:
         """Recolour the planes with ``tf``'s colours (the opacity does not apply: a slice is opaque)."""
         if tf is not None:
             self.tf = tf
             self._show()
 
-    def set_clip(self, clip: Any) -> bool:
+    def set_clip(self, clip: ClipSettings) -> bool:
         """Slices are not clipped."""
         return True
 

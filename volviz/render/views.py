@@ -22,9 +22,19 @@ views (``camera_dependent``); a component that VTK draws with its own props has 
 from __future__ import annotations
 
 import importlib
-from typing import Any, Protocol, runtime_checkable
+from typing import TYPE_CHECKING, Any, Optional, Protocol, TypeVar, runtime_checkable
 
-__all__ = ["COMPONENT_VIEWS", "ComponentView", "VIEWS", "View", "component_view_classes", "view_class"]
+if TYPE_CHECKING:   # type-only: the views' argument types, without importing the optics and VTK at run time
+    from volviz.jobs import ProgressCallback
+    from volviz.model.clip import ClipSettings
+    from volviz.optics.transfer_function import TransferFunction
+    from volviz.render.framing import Bounds
+
+__all__ = ["COMPONENT_VIEWS", "ComponentView", "RequestT", "VIEWS", "View", "component_view_classes", "view_class"]
+
+#: what a view's ``begin`` makes and its ``compute`` and ``finish`` take back (each view has its own: a dict of the
+#: camera and image size, the natural scene's (camera, size, scale), None for a view with nothing to compute)
+RequestT = TypeVar("RequestT")
 
 #: (view kind, backend) -> "module:class"
 VIEWS: dict[tuple[str, str], str] = {
@@ -39,16 +49,18 @@ VIEWS: dict[tuple[str, str], str] = {
 
 
 @runtime_checkable
-class View(Protocol):
-    """What every registered view offers (module docstring)."""
+class View(Protocol[RequestT]):
+    """What every registered view offers (module docstring), generic in its request type. ``begin`` is called with
+    ``scale`` by keyword (the natural scene's ``begin`` takes a camera first); ``finish`` takes back the tuple
+    ``compute`` returned, unpacked, whose shape each view chooses."""
 
     backend: str
 
-    def begin(self, scale: int = 1) -> Any: ...
+    def begin(self, *, scale: int = 1) -> RequestT: ...
 
-    def compute(self, request: Any, progress: Any = None) -> tuple[Any, ...]: ...
+    def compute(self, request: RequestT, progress: Optional[ProgressCallback] = None) -> tuple[object, ...]: ...
 
-    def finish(self, request: Any, *result: Any) -> Any: ...
+    def finish(self, request: RequestT, *result: Any) -> object: ...
 
     def remove(self) -> None: ...
 
@@ -73,15 +85,15 @@ class ComponentView(Protocol):
     stats: dict[str, Any]
 
     @property
-    def prop(self) -> Any: ...
+    def prop(self) -> object: ...
 
-    def set_tf(self, tf: Any, opacity: float = 1.0) -> None: ...
+    def set_tf(self, tf: TransferFunction, opacity: float = 1.0) -> None: ...
 
-    def set_clip(self, clip: Any) -> bool: ...
+    def set_clip(self, clip: ClipSettings) -> bool: ...
 
-    def update(self) -> Any: ...
+    def update(self) -> object: ...
 
-    def bounds(self) -> Any: ...
+    def bounds(self) -> Optional[Bounds]: ...
 
     def remove(self) -> None: ...
 

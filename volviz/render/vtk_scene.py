@@ -8,7 +8,7 @@ the app's viewport.
 """
 from __future__ import annotations
 
-from typing import Any, Optional
+from typing import TYPE_CHECKING, Any, Optional
 
 import numpy as np
 
@@ -17,11 +17,18 @@ from volviz.render.vtk_tf import tf_to_vtk
 from volviz.scene.lod import is_lod, lod_bounds, lod_scalar_range
 from volviz.session import CameraState
 
+if TYPE_CHECKING:   # type-only imports for the signatures
+    import pyvista as pv
+    from vtkmodules.vtkRenderingCore import vtkVolumeProperty
+
+    from volviz.optics.transfer_function import TransferFunction
+
 PLAIN_COLOR = (0.80, 0.80, 0.78)    # geometry without a field: a neutral light grey, shaded by the lights
 DEFAULT_COLORS = ((0.23, 0.30, 0.75), (0.87, 0.87, 0.87), (0.71, 0.02, 0.15))  # cool-warm: low, middle, high
 
 
-def default_transfer_function(scalar_range: tuple[float, float], diagonal: float, name: str = "default") -> Any:
+def default_transfer_function(scalar_range: tuple[float, float], diagonal: float,
+                              name: str = "default") -> TransferFunction:
     """A cool-warm color map with a ramp extinction over the data range: the first look at unknown data.
 
     The extinction peaks at 8 / diagonal, so a ray through the whole bounding box at the top of the range reaches an
@@ -41,13 +48,13 @@ def default_transfer_function(scalar_range: tuple[float, float], diagonal: float
     return TransferFunction(scalars, colors, extinction, name=name)
 
 
-def vtk_unit_distance(tf: Any) -> float:
+def vtk_unit_distance(tf: TransferFunction) -> float:
     """The opacity unit distance that keeps VTK's opacity a = ρ·unit ≤ 0.9 (VTK clamps a to 1)."""
     rho_max = float(tf.max_extinction)
     return 0.9 / rho_max if rho_max > 0.9 else 1.0
 
 
-def update_volume_property(prop: Any, tf: Any, opacity: float = 1.0) -> None:
+def update_volume_property(prop: vtkVolumeProperty, tf: TransferFunction, opacity: float = 1.0) -> None:
     """Point a vtkVolumeProperty at ``tf`` (VTK convention: ρ = opacity / unit distance); ``opacity`` scales ρ."""
     tf = tf.scaled_extinction(max(float(opacity), 0.0)) if opacity != 1.0 else tf
     unit = vtk_unit_distance(tf)
@@ -61,7 +68,7 @@ def update_volume_property(prop: Any, tf: Any, opacity: float = 1.0) -> None:
 SHADING = (0.3, 0.7, 0.2, 10.0)
 
 
-def set_volume_shading(prop: Any, shade: bool) -> None:
+def set_volume_shading(prop: vtkVolumeProperty, shade: bool) -> None:
     """Lighting of a vtkVolumeProperty on or off: on, each sample is lit by the scene's lights with the normal the
     scalar's gradient gives (ambient, diffuse and specular ``SHADING``), which shows the shape of the iso-structures
     that the unlit emission-absorption picture flattens."""
@@ -73,7 +80,7 @@ def set_volume_shading(prop: Any, shade: bool) -> None:
     prop.SetSpecularPower(power)
 
 
-def vtk_volume_property(tf: Any, opacity: float = 1.0, shade: bool = False) -> Any:
+def vtk_volume_property(tf: TransferFunction, opacity: float = 1.0, shade: bool = False) -> vtkVolumeProperty:
     """A vtkVolumeProperty of ``tf`` (``update_volume_property``), linearly interpolated, lit with ``shade``."""
     from volviz.render.vtk_facade import vtk
 
@@ -101,7 +108,7 @@ def volume_grid(dataset: Any) -> Any:
     return grid
 
 
-def default_transfer_function_for(dataset: Any, name: str = "default") -> Any:
+def default_transfer_function_for(dataset: Any, name: str = "default") -> TransferFunction:
     """The first-look transfer function of a dataset: placed from the histogram of its shown scalar (of every step,
     for a time series) by ``volviz.optics.auto_tf``; a compressed LOD volume gets the ramp over its range."""
     if is_lod(dataset):
@@ -146,7 +153,8 @@ def transparent_nonfinite(grid: Any) -> Any:
     return grid
 
 
-def add_dataset(plotter: Any, dataset: Any, tf: Any = None, opacity: float = 1.0, name: Optional[str] = None) -> Any:
+def add_dataset(plotter: pv.BasePlotter, dataset: Any, tf: Optional[TransferFunction] = None, opacity: float = 1.0,
+                name: Optional[str] = None) -> Any:
     """Add a dataset to ``plotter`` as its default visual (a volume with ``tf``); returns the VTK prop."""
     if isinstance(dataset, TimeSeries):
         return add_dataset(plotter, dataset.frame(0), tf, opacity, name)
@@ -163,7 +171,8 @@ def add_dataset(plotter: Any, dataset: Any, tf: Any = None, opacity: float = 1.0
     return volume_prop(plotter, volume_input(dataset), isinstance(dataset, RegularVolume), tf, opacity, name)
 
 
-def volume_prop(plotter: Any, data: Any, regular: bool, tf: Any, opacity: float, name: Optional[str],
+def volume_prop(plotter: pv.BasePlotter, data: Any, regular: bool, tf: TransferFunction, opacity: float,
+                name: Optional[str],
                 backend: str = "auto", shade: bool = False) -> Any:
     """Add a ``vtkVolume`` drawing the VTK dataset ``data`` with ``tf`` to ``plotter``: regular volumes through
     vtkSmartVolumeMapper (its CPU ray caster where ``backend`` picks "cpu": by default on a software OpenGL, see
@@ -239,7 +248,8 @@ def surface_input(dataset: Any, plain: bool = False) -> Any:
     return surface
 
 
-def add_surface(plotter: Any, surface: Any, tf: Any, opacity: float, name: Optional[str]) -> Any:
+def add_surface(plotter: pv.BasePlotter, surface: Any, tf: Optional[TransferFunction], opacity: float,
+                name: Optional[str]) -> Any:
     """A surface made by ``surface_input``, colored by its active scalars through the transfer function's colors, or
     in its own vertex colours when it shows no array."""
     if surface.active_scalars_name is None and VERTEX_COLORS in surface.point_data:
@@ -276,11 +286,11 @@ def _add_image(plotter: Any, image: Image2D, name: Optional[str]) -> Any:
                             nan_opacity=0.0, reset_camera=False)
 
 
-def apply_camera(plotter: Any, camera: Optional[CameraState]) -> None:
+def apply_camera(plotter: pv.BasePlotter, camera: Optional[CameraState]) -> None:
     """Set the plotter's camera from a session camera, or frame the scene from a pleasant oblique view."""
     if camera is None:
-        plotter.view_isometric()
-        plotter.reset_camera()
+        plotter.view_isometric()  # type: ignore[call-arg]  # pyvista's _Wrapped decorator hides self from mypy
+        plotter.reset_camera()  # type: ignore[call-arg]  # pyvista's _Wrapped decorator hides self from mypy
         return
     cam = plotter.camera
     cam.position = camera.position
@@ -292,7 +302,7 @@ def apply_camera(plotter: Any, camera: Optional[CameraState]) -> None:
     plotter.renderer.ResetCameraClippingRange()
 
 
-def camera_state(plotter: Any) -> CameraState:
+def camera_state(plotter: pv.BasePlotter) -> CameraState:
     cam = plotter.camera
     return CameraState(position=vec3(cam.position), focal_point=vec3(cam.focal_point),
                        view_up=vec3(cam.up), view_angle=float(cam.view_angle),

@@ -4,7 +4,7 @@ only what the renderers and the scalar bar are given changes."""
 from __future__ import annotations
 
 import weakref
-from typing import Any
+from typing import Any, Optional, TYPE_CHECKING
 
 import numpy as np
 
@@ -14,6 +14,9 @@ from volviz.optics.log_scale import log_mapped, positive_floor
 from volviz.scene.lod import is_lod, lod_scalar_range
 from volviz.session import Component, Session
 
+if TYPE_CHECKING:   # type-only imports for the signatures
+    from volviz.optics.transfer_function import TransferFunction
+
 _FLOORS: dict[int, tuple[Any, float]] = {}   # id(dataset) -> (weak reference to it, its smallest positive value)
 
 
@@ -22,7 +25,7 @@ def uses_log_scale(comp: Component) -> bool:
     return bool(comp.settings.get("log_scale", False))
 
 
-def log_floor(tf: Any, dataset: Any) -> float:
+def log_floor(tf: TransferFunction, dataset: Any) -> float:
     """The smallest positive value the log scale of ``tf`` over ``dataset``'s shown array maps (values at or below
     it take its color): the TF's low end when positive, else the data's smallest positive value (cached per
     dataset: one pass over the values)."""
@@ -49,7 +52,7 @@ def _values(dataset: Any) -> np.ndarray:
         return np.zeros(0)
 
 
-def drawn_tf(comp: Component, tf: Any, dataset: Any) -> Any:
+def drawn_tf(comp: Component, tf: Optional[TransferFunction], dataset: Any) -> Optional[TransferFunction]:
     """``tf`` (the component's stored function) as the component is drawn with it over ``dataset``."""
     if tf is None or not uses_log_scale(comp):
         return tf
@@ -57,7 +60,7 @@ def drawn_tf(comp: Component, tf: Any, dataset: Any) -> Any:
 
 
 
-def component_transfer_function(session: Session, comp: Component) -> Any:
+def component_transfer_function(session: Session, comp: Component) -> Optional[TransferFunction]:
     """The component's stored transfer function (in data values), or None when it has none."""
     if comp.transfer_function is None:
         return None

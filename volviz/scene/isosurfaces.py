@@ -4,7 +4,7 @@ display time, cut exactly by the scene's clipping, scaled by the component's opa
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
-from typing import Any, Optional
+from typing import TYPE_CHECKING, Any, Optional
 
 from volviz.iso import IsoSettings, build_lod, prepare
 from volviz.iso.clip import clip_isosurfaces
@@ -12,6 +12,9 @@ from volviz.jobs import ProgressCallback
 from volviz.scene.clipping import clip_settings
 from volviz.scene.errors import SceneError
 from volviz.session import Component
+
+if TYPE_CHECKING:   # type-only imports for the signatures
+    from volviz.model.clip import ClipSettings
 
 
 @dataclass
@@ -27,7 +30,8 @@ class IsoParts:
     opacity: float = 1.0                                 # the component opacity they were scaled by
 
 
-def isosurface_parts(comp: Component, dataset: Any = None, t: Optional[float] = None, clip: Any = None,
+def isosurface_parts(comp: Component, dataset: Any = None, t: Optional[float] = None,
+                     clip: dict[str, Any] | ClipSettings | None = None,
                      meshes: Optional[list[Any]] = None, progress: Optional[ProgressCallback] = None) -> IsoParts:
     """Any thread: the surfaces of an ``isosurface`` component (settings: ``volviz.iso.IsoSettings``) extracted at
     display time ``t`` (skipped when ``meshes`` are known), cut exactly by the scene's ``clip`` (``session.clip`` or

@@ -3,15 +3,18 @@ into tetrahedra, their adjacency for the visibility sort), cut exactly by the sc
 options as the PT renderer's keywords."""
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any, Optional
 
 from volviz.iso.clip import clip_tetmesh
 from volviz.model.datasets import TetMesh
 from volviz.unstructured.tetrahedralize import tetrahedralize
 from volviz.unstructured.topology import topology
 
+if TYPE_CHECKING:   # type-only imports for the signatures
+    from volviz.model.clip import ClipSettings
 
-def pt_mesh(dataset: Any) -> Any:
+
+def pt_mesh(dataset: Any) -> TetMesh:
     """Any thread: the tetrahedral mesh a PT volume draws for ``dataset``, with its topology built (cached on it)."""
     mesh = dataset
     if not isinstance(dataset, TetMesh):
@@ -20,7 +23,7 @@ def pt_mesh(dataset: Any) -> Any:
     return mesh
 
 
-def cut_tetmesh(mesh: Any, clip: Any) -> Any:
+def cut_tetmesh(mesh: TetMesh, clip: ClipSettings) -> Optional[TetMesh]:
     """Any thread: ``mesh`` cut exactly by ``clip`` (``volviz.iso.clip.clip_tetmesh``) with its topology built; None
     when the clipping removes all of it."""
     try:
