@@ -70,7 +70,6 @@ DATASET = ("a loaded dataset of any kind (volviz.model's datasets, TimeSeries, L
            "type of them exists yet")
 DATASET_TO_PROP = "a loaded dataset in (DATASET), a VTK prop of several classes out (VTK_ANY)"
 OVERLAY = "the request dict of image_overlay.OverlayView, which this change does not edit (GL passes: being moved)"
-LOD_REQUEST = "not yet typed: the LOD view's request dict (a TypedDict is the next step)"
 VIEW_OBJECTS = ("a view of one of several classes: View and ComponentView do not yet declare the job, kind and update "
                 "its callers use")
 ISO_PARTS = "not yet typed: isosurface meshes and their LOD chains (volviz.iso's types, by the view's mode)"
@@ -189,9 +188,7 @@ ALLOWED: dict[str, str] = {
     "volviz.render.iso_overlay:IsoOverlay.finish": OVERLAY,
     "volviz.render.iso_spectrum:apply_spectrum_shader": ELSEWHERE,
     "volviz.render.iso_spectrum:iso_actor": ELSEWHERE,
-    "volviz.render.lod_volume:LodVolume.begin": LOD_REQUEST,
-    "volviz.render.lod_volume:LodVolume.compute": LOD_REQUEST,
-    "volviz.render.lod_volume:LodVolume.finish": LOD_REQUEST,
+    "volviz.render.lod_volume:LodVolume.finish": STATS,
     "volviz.render.lod_volume:LodVolume.update": STATS,
     "volviz.render.lod_volume:LodVolume.show_stats": STATS,
     "volviz.render.nature_view:build_nature_components": DATASET,
@@ -323,28 +320,46 @@ def test_the_counter_sees_any_wherever_it_is_written(tmp_path: Path) -> None:
         "volviz.scene.m:a", "volviz.scene.m:b", "volviz.scene.m:c", "volviz.scene.m:d", "volviz.scene.m:C.g"]
 
 
+#: each registered view's request type (``View[RequestT]``), as mypy checks it: an import and the type
+REQUESTS: dict[tuple[str, str], tuple[str, str]] = {
+    ("pt", "gpu"): ("", "dict[str, Any]"),
+    ("pt", "cpu"): ("", "dict[str, Any]"),
+    ("nature", "gpu"): ("from volviz.render.nature_view import NatureRequest", "NatureRequest"),
+    ("nature", "cpu"): ("from volviz.render.nature_view import NatureRequest", "NatureRequest"),
+    ("iso", "gpu"): ("", "None"),
+    ("iso", "cpu"): ("", "dict[str, Any]"),
+    ("lod", "cpu"): ("from volviz.render.lod_volume import LodRequest", "LodRequest"),
+}
+
+
 def test_every_registered_view_satisfies_its_protocol(tmp_path: Path) -> None:
-    """mypy checks each class of ``VIEWS`` against ``View`` and each of ``COMPONENT_VIEWS`` against
-    ``ComponentView`` (an assignment to ``type[...]`` per class, in a file made from the registries)."""
+    """mypy checks each class of ``VIEWS`` against ``View`` of its request type (``REQUESTS``) and each of
+    ``COMPONENT_VIEWS`` against ``ComponentView`` (an assignment to ``type[...]`` per class, in a file made from the
+    registries), and sees a class that is no view, and a view of another request type, refused."""
     from volviz.render.views import COMPONENT_VIEWS, VIEWS
 
     mypy = shutil.which("mypy", path=str(Path(sys.executable).parent)) or shutil.which("mypy")
     assert mypy is not None, "mypy is a test dependency (pip install -e .[test])"
-    checks = [(spec, "View[Any]") for spec in VIEWS.values()]
+    assert set(REQUESTS) == set(VIEWS), "name the request type of every registered view in REQUESTS"
+    checks = [(spec, f"View[{REQUESTS[key][1]}]") for key, spec in VIEWS.items()]
     checks += [(spec, "ComponentView") for specs in COMPONENT_VIEWS.values() for spec in specs]
     lines = ["from typing import Any", "from volviz.render.views import ComponentView, View"]
+    lines += sorted({imp for imp, _ in REQUESTS.values() if imp})
     for i, (spec, protocol) in enumerate(checks):
         module, name = spec.split(":")
         lines += [f"from {module} import {name} as _C{i}", f"_v{i}: type[{protocol}] = _C{i}"]
-    # a class that is no view, so a check that cannot fail is seen failing
+    # what must be refused, so a check that cannot fail is seen failing: no view at all, and another request type
     lines += ["from volviz.model.clip import ClipSettings", "_bad: type[View[Any]] = ClipSettings"]
+    lines += [f"from {VIEWS[('lod', 'cpu')].split(':')[0]} import LodVolume",
+              "_wrong: type[View[NatureRequest]] = LodVolume"]
     source = tmp_path / "view_protocols.py"
     source.write_text("\n".join(lines) + "\n", encoding="utf-8")
     done = subprocess.run([mypy, "--config-file", str(ROOT / "pyproject.toml"), str(source)], cwd=ROOT,
                           capture_output=True, text=True, timeout=600)
     errors = [line for line in done.stdout.splitlines() if ": error:" in line]
     assert len(checks) == len(set(checks)) >= 12
-    assert len(errors) == 1 and f"{source.name}:{len(lines)}:" in errors[0], done.stdout[-4000:]
+    expected = [f"{source.name}:{len(lines) - 2}:", f"{source.name}:{len(lines)}:"]
+    assert len(errors) == 2 and all(e in error for e, error in zip(expected, errors)), done.stdout[-4000:]
 
 
 def _count_by_package() -> Counter[str]:

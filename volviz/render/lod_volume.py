@@ -39,7 +39,7 @@ from __future__ import annotations
 
 import threading
 import time
-from typing import Any, Optional, Union, TYPE_CHECKING
+from typing import TYPE_CHECKING, Any, Optional, TypedDict, Union
 
 import numpy as np
 
@@ -59,7 +59,16 @@ if TYPE_CHECKING:   # type-only imports for the signatures
 
 RENDERERS = ("volviz", "vtk")
 
-__all__ = ["LodVolume", "RENDERERS", "lod_camera"]
+__all__ = ["LodRequest", "LodVolume", "RENDERERS", "lod_camera"]
+
+
+class LodRequest(TypedDict):
+    """A LOD view's request (``LodVolume.begin``, ``volviz.render.views.View``): the camera and viewport to select
+    for, the block budget, and whether it is a preview while the camera moves."""
+
+    camera: LodCamera
+    budget: int
+    preview: bool
 
 
 def lod_camera(vtk_camera: Union[pv.Camera, vtkCamera], size: tuple[int, int]) -> LodCamera:
@@ -377,14 +386,14 @@ class LodVolume:
                            "render_s": t3 - t2, "upload_s": t4 - t3, "draw_s": t4 - t0, "size": (w, h)})
         return img
 
-    def begin(self, scale: int = 1) -> dict[str, Any]:
+    def begin(self, scale: int = 1) -> LodRequest:
         """GUI thread: the selection to make for the plotter's camera now (``volviz.render.views.View``); a preview
         (``scale`` > 1, while the camera moves) asks for an eighth of the block budget, as the app's coarse pass."""
         budget = max(1, self.budget // 8) if scale > 1 else self.budget
         return {"camera": self.camera(), "budget": budget, "preview": scale > 1}
 
-    def compute(self, request: dict[str, Any], progress: Optional[ProgressCallback] = None) -> tuple[Selection,
-                list[Block], float, float]:
+    def compute(self, request: LodRequest, progress: Optional[ProgressCallback] = None
+                ) -> tuple[Selection, list[Block], float, float]:
         """Any thread: the selection of ``begin``'s request and its decoded new blocks, with their seconds."""
         t0 = time.perf_counter()
         selection = self.select(request["camera"], request["budget"])
@@ -392,7 +401,7 @@ class LodVolume:
         blocks = self.decode(selection)
         return selection, blocks, t1 - t0, time.perf_counter() - t1
 
-    def finish(self, request: dict[str, Any], selection: Selection, blocks: list[Block], select_s: float = 0.0,
+    def finish(self, request: LodRequest, selection: Selection, blocks: list[Block], select_s: float = 0.0,
                decode_s: float = 0.0) -> dict[str, Any]:
         """GUI thread: draw ``compute``'s selection (``show``); returns the statistics."""
         self.show(selection, blocks, select_s, decode_s)
