@@ -19,7 +19,7 @@ the background).
 from __future__ import annotations
 
 from contextlib import contextmanager
-from typing import Any, Iterator, Optional, TYPE_CHECKING
+from typing import TYPE_CHECKING, Any, Iterator, Optional
 
 from volviz.model import TimeSeries
 from volviz.model.applicability import DatasetTraits
@@ -34,6 +34,7 @@ if TYPE_CHECKING:   # type-only imports for the signatures
     from volviz.model.clip import ClipSettings
     from volviz.nature.nature_scene import NatureScene
     from volviz.optics.transfer_function import TransferFunction
+    from volviz.scene.datasets import LoadedDataset
     from volviz.scene.isosurfaces import IsoParts
 
 
@@ -76,7 +77,7 @@ def session_interpolates(session: Session) -> bool:
 
 
 class SceneController:
-    def __init__(self, plotter: Any, session: Session, datasets: dict[str, Any], on_screen: bool = False):
+    def __init__(self, plotter: Any, session: Session, datasets: dict[str, LoadedDataset], on_screen: bool = False):
         self.plotter = plotter
         self.on_screen = on_screen  # the Qt viewport (kept for callers; both draw the iso-spectrum shader)
         self.session = session

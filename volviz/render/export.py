@@ -26,6 +26,7 @@ if TYPE_CHECKING:   # type-only imports for the signatures
     import pyvista as pv
 
     from volviz.render.controller import SceneController
+    from volviz.scene.datasets import LoadedDataset
     from volviz.session import CameraState
 
 #: image formats by file extension (Pillow's names)
@@ -137,7 +138,7 @@ def write_png(image: np.ndarray, path: str | os.PathLike) -> None:
     write_file(path, encode_image(image, "PNG"))
 
 
-def offscreen_scene(session: Session, datasets: dict[str, Any],
+def offscreen_scene(session: Session, datasets: dict[str, LoadedDataset],
                     size: tuple[int, int]) -> tuple[pv.Plotter, SceneController]:
     """An offscreen plotter of ``size`` and a ``SceneController`` of ``session`` over it, not built yet: ``build()``
     here, or (the app) ``prepare`` on a worker, ``install(views=False)``, then ``begin_views`` / ``compute_views`` /
@@ -218,7 +219,7 @@ def check_transparency(path: str | os.PathLike) -> None:
 
 def render_session(session: Session, session_file: Optional[str | os.PathLike], size: tuple[int, int],
                    progress: Optional[ProgressCallback] = None,
-                   datasets: Optional[dict[str, Any]] = None, transparent: bool = False) -> np.ndarray:
+                   datasets: Optional[dict[str, LoadedDataset]] = None, transparent: bool = False) -> np.ndarray:
     """Render a session offscreen (its datasets read now unless given); returns the (H, W, 3) uint8 image, or with
     ``transparent`` the (H, W, 4) straight-alpha one without the background (``snapshot``)."""
     from volviz.scene.datasets import load_datasets
@@ -261,7 +262,7 @@ def open_target(target: str | os.PathLike, array: Optional[str] = None, q: Optio
 
 def render_to_file(session: Session, session_file: Optional[str | os.PathLike], out: str | os.PathLike,
                    size: tuple[int, int], progress: Optional[ProgressCallback] = None,
-                   datasets: Optional[dict[str, Any]] = None, transparent: bool = False) -> Path:
+                   datasets: Optional[dict[str, LoadedDataset]] = None, transparent: bool = False) -> Path:
     """Render a session to the image ``out`` in the format its extension names (``transparent``: without the
     background, where the format keeps alpha); the output and the size are checked before anything renders
     (ExportError)."""
@@ -367,7 +368,7 @@ def render_movie(session: Session, session_file: Optional[str | os.PathLike], ou
                  size: tuple[int, int], path_name: Optional[str] = None, fps: float = 24.0,
                  through_time: bool = False, duration: Optional[float] = None,
                  progress: Optional[ProgressCallback] = None, orbit: bool = False,
-                 datasets: Optional[dict[str, Any]] = None) -> Path:
+                 datasets: Optional[dict[str, LoadedDataset]] = None) -> Path:
     """Render a movie offscreen (``movie_frames``): MP4/MOV (H.264 through imageio-ffmpeg) for ``.mp4``, ``.m4v``
     and ``.mov``, else a PNG sequence in the folder ``out`` (frame_00000.png, ...). The output and the size are
     checked first; the MP4 is written to a temporary file and renamed when complete."""

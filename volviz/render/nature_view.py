@@ -9,7 +9,7 @@ mesh and the overlay for a camera; the app does it in the background (``begin`` 
 """
 from __future__ import annotations
 
-from typing import Any, Optional, Sequence, Union, TYPE_CHECKING
+from typing import TYPE_CHECKING, Any, Optional, Sequence, Union
 
 import numpy as np
 
@@ -22,6 +22,7 @@ if TYPE_CHECKING:   # type-only imports for the signatures
     from volviz.jobs import ProgressCallback
     from volviz.model.camera import Camera
     from volviz.render.framing import Bounds
+    from volviz.scene.datasets import LoadedDataset
     from volviz.session import Component, CameraState
 
 
@@ -306,7 +307,8 @@ def _overlay_rgba(overlay: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray((rgba * 255.0 + 0.5).astype(np.uint8))
 
 
-def build_nature_components(plotter: pv.BasePlotter, components: Sequence[Component], datasets: dict[str, Any],
+def build_nature_components(plotter: pv.BasePlotter, components: Sequence[Component],
+                            datasets: dict[str, LoadedDataset],
                             camera: Union[Camera, CameraState, None] = None,
                             size: tuple[int, int] | None = None) -> NatureView:
     """Add the session's terrain / fog / clouds / sky components to ``plotter`` and render the first overlay for

@@ -38,9 +38,10 @@ if TYPE_CHECKING:   # type-only imports for the signatures
     from volviz.nature.nature_scene import NatureScene
     from volviz.optics.transfer_function import TransferFunction
     from volviz.render.nature_view import NatureView
+    from volviz.scene.datasets import LoadedDataset
 
 
-def ensure_transfer_functions(session: Session, datasets: dict[str, Any]) -> None:
+def ensure_transfer_functions(session: Session, datasets: dict[str, LoadedDataset]) -> None:
     """Give every volume-like component without a transfer function a default one fitted to its data."""
     for comp in session.components:
         if comp.transfer_function is None and comp.type in ("volume", "mesh", "demo", "slices"):
@@ -67,8 +68,8 @@ class PreparedScene:
     nature: Any = None                                      # the NatureScene of the terrain/fog/clouds/sky components
 
 
-def prepare_scene(session: Session, datasets: dict[str, Any], t: Optional[float] = None, interpolate: bool = True,
-                  progress: Optional[ProgressCallback] = None) -> PreparedScene:
+def prepare_scene(session: Session, datasets: dict[str, LoadedDataset], t: Optional[float] = None,
+                  interpolate: bool = True, progress: Optional[ProgressCallback] = None) -> PreparedScene:
     """Any thread: the heavy part of showing ``session`` (default transfer functions, isosurface extraction with
     clipping and LOD chains, tetrahedralisation and mesh topology, VTK volume inputs and time blending at display
     time ``t``, the natural scene's maps and volumes, data histograms). Touches no plotter; ``install_scene`` adds
@@ -86,7 +87,7 @@ def prepare_scene(session: Session, datasets: dict[str, Any], t: Optional[float]
     return prepared
 
 
-def prepare_component(session: Session, comp: Component, datasets: dict[str, Any], prepared: PreparedScene,
+def prepare_component(session: Session, comp: Component, datasets: dict[str, LoadedDataset], prepared: PreparedScene,
                       t: Optional[float] = None, interpolate: bool = True) -> None:
     """Any thread: the heavy part of showing one non-nature component (isosurface extraction with clipping and LOD
     chains, tetrahedralisation and topology, the VTK volume input at display time ``t``, its data histogram), put into
@@ -165,7 +166,8 @@ def install_nature(plotter: pv.BasePlotter, scene: Optional[NatureScene], views:
     return view
 
 
-def install_scene(plotter: pv.BasePlotter, session: Session, datasets: dict[str, Any], prepared: PreparedScene,
+def install_scene(plotter: pv.BasePlotter, session: Session, datasets: dict[str, LoadedDataset],
+                  prepared: PreparedScene,
                   spectrum: bool = True, views: bool = True) -> dict[str, Any]:
     """GUI thread: add the props of a ``prepare_scene`` result to ``plotter``; returns the view of each component by
     id (``install_component``), and under ``"nature"`` the NatureView that draws the terrain, fog, clouds and sky
@@ -204,7 +206,7 @@ def install_scene(plotter: pv.BasePlotter, session: Session, datasets: dict[str,
     return props
 
 
-def install_component(plotter: pv.BasePlotter, session: Session, comp: Component, datasets: dict[str, Any],
+def install_component(plotter: pv.BasePlotter, session: Session, comp: Component, datasets: dict[str, LoadedDataset],
                       prepared: PreparedScene, spectrum: bool = True, views: bool = True) -> Any:
     """GUI thread: add one non-nature component from its ``prepare_component`` result; returns its view
     (``volviz.render.views.ComponentView``: a PT volume, a LOD volume, its isosurfaces, or a VTK prop's view). A PT
@@ -224,7 +226,7 @@ def install_component(plotter: pv.BasePlotter, session: Session, comp: Component
                                        backend_setting(session.render.options), bool(comp.settings.get("shade"))))
 
 
-def build_scene(plotter: pv.BasePlotter, session: Session, datasets: dict[str, Any],
+def build_scene(plotter: pv.BasePlotter, session: Session, datasets: dict[str, LoadedDataset],
                 spectrum: bool = True) -> dict[str, Any]:
     """Add every visible component to ``plotter`` now (``prepare_scene`` then ``install_scene``)."""
     return install_scene(plotter, session, datasets, prepare_scene(session, datasets), spectrum)
@@ -289,6 +291,6 @@ def view_backend(plotter: pv.BasePlotter, session: Session, view_kind: str) -> s
     return choose_backend(backend_setting(session.render.options), view_kind, plotter_gl_info(plotter))
 
 
-def build_nature(plotter: pv.BasePlotter, session: Session, datasets: dict[str, Any]) -> Optional[NatureView]:
+def build_nature(plotter: pv.BasePlotter, session: Session, datasets: dict[str, LoadedDataset]) -> Optional[NatureView]:
     """The NatureView of the session's visible terrain / fog / clouds / sky components (None when it has none)."""
     return install_nature(plotter, prepare_nature(session, datasets), backend=view_backend(plotter, session, "nature"))

@@ -4,11 +4,11 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import Any, Optional
+from typing import TYPE_CHECKING, Any, Optional, Union
 
 from volviz.io import read
 from volviz.jobs import ProgressCallback, report
-from volviz.model import Image2D, TimeSeries
+from volviz.model import Dataset, Image2D, TimeSeries
 from volviz.model.applicability import DatasetTraits
 from volviz.model.demo import demo_tet_mesh
 from volviz.model.arrays import select_array
@@ -17,13 +17,21 @@ from volviz.scene.errors import SceneError
 from volviz.scene.lod import is_lod
 from volviz.session import Component, Session, SessionError, missing_files, missing_message, resolve_path
 
+if TYPE_CHECKING:   # type-only: the LOD tree's module loads the wavelet decoder's Numba kernels
+    from volviz.regular.lod import LodTree
+
+#: what a session's dataset id stands for once loaded (``load_datasets``): a model dataset, a time series of them,
+#: or a compressed volume drawn at a level of detail
+LoadedDataset = Union[Dataset, TimeSeries, "LodTree"]
+
 #: the component types the natural scene draws together (``volviz.scene.nature``)
 NATURE_TYPES = ("terrain", "fog", "clouds", "sky")
 
 
 def load_datasets(session: Session, session_file: Optional[str | os.PathLike],
                   progress: Optional[ProgressCallback] = None,
-                  loaded: Optional[dict[str, Any]] = None, also: tuple[str, ...] = ()) -> dict[str, Any]:
+                  loaded: Optional[dict[str, LoadedDataset]] = None,
+                  also: tuple[str, ...] = ()) -> dict[str, LoadedDataset]:
     """Read every dataset that a visible component (or a component in ``also``) uses, once each, with progress;
     those already in ``loaded`` are kept (the dict is filled in and returned)."""
     from volviz.nature.nature_scene import nature_dataset_ids   # heavy (the nature kernels): only for a session
@@ -43,7 +51,7 @@ def load_datasets(session: Session, session_file: Optional[str | os.PathLike],
     return loaded
 
 
-def read_any(path: Path, options: dict[str, Any], progress: Optional[ProgressCallback] = None) -> Any:
+def read_any(path: Path, options: dict[str, Any], progress: Optional[ProgressCallback] = None) -> LoadedDataset:
     """A data file through ``volviz.io.read``, or a volviz-compressed volume (``.vvz``): with the dataset option
     ``lod`` a ``LodTree`` drawn at a view-dependent level of detail (``volviz.render.lod_volume``), else through the
     wavelet decoder
@@ -59,7 +67,7 @@ def read_any(path: Path, options: dict[str, Any], progress: Optional[ProgressCal
     return read(path, **options)
 
 
-def component_dataset(comp: Component, datasets: dict[str, Any]) -> Any:
+def component_dataset(comp: Component, datasets: dict[str, LoadedDataset]) -> Any:
     """The dataset a component shows: generated for the demo, else the loaded dataset it names."""
     if comp.type == "demo":
         key = f"demo:{int(comp.settings.get('cells_per_edge', 20))}"
@@ -76,7 +84,7 @@ def component_dataset(comp: Component, datasets: dict[str, Any]) -> Any:
         raise SceneError(f"component {comp.id!r}: {exc}") from None
 
 
-def shown_array(dataset: Any, spec: Optional[str]) -> Any:
+def shown_array(dataset: LoadedDataset, spec: Optional[str]) -> LoadedDataset:
     """``dataset`` showing the array ``spec`` (None: its default array; ``volviz.model.arrays``), made once per spec
     and kept on the dataset, so the tetrahedralisation and topology cached on it are made once too."""
     if isinstance(dataset, Image2D) or is_lod(dataset):
@@ -87,13 +95,13 @@ def shown_array(dataset: Any, spec: Optional[str]) -> Any:
     return views[spec]
 
 
-def dataset_traits(dataset: Any) -> DatasetTraits:
+def dataset_traits(dataset: LoadedDataset) -> DatasetTraits:
     """What a loaded dataset (as ``read_any`` gives it) is, for the settings that apply to some datasets only
     (``volviz.model.applicability``): a time series, a compressed volume drawn at a level of detail."""
     return DatasetTraits(time_series=isinstance(dataset, TimeSeries), lod_volume=is_lod(dataset))
 
 
-def drawn_as(dataset: Any) -> str:
+def drawn_as(dataset: LoadedDataset) -> str:
     """How a volume component draws a loaded dataset: ``"points"`` (a mesh of vertices only, e.g. a point table),
     ``"surface"`` (surface cells, a flat grid, no field or a constant one: ``volviz.model.representation``) or
     ``"volume"``."""

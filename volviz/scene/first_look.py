@@ -8,13 +8,16 @@ warnings of the files it shows, ``volviz render`` prints them as one line each).
 from __future__ import annotations
 
 import warnings
-from typing import Any, Optional
+from typing import TYPE_CHECKING, Optional
 
 from volviz.io import ReadWarning
 from volviz.model import TimeSeries
 from volviz.model.representation import first_varying_step, representation
 from volviz.scene.datasets import component_dataset
 from volviz.session import Session
+
+if TYPE_CHECKING:   # type-only imports for the signatures
+    from volviz.scene.datasets import LoadedDataset
 
 SAID = "volviz_first_look_said"      # kept on a dataset once its notes were given
 
@@ -24,7 +27,7 @@ class FirstLookWarning(ReadWarning):
     time series from its first step where the field varies."""
 
 
-def first_look(session: Session, datasets: dict[str, Any], t: Optional[float]) -> Optional[float]:
+def first_look(session: Session, datasets: dict[str, LoadedDataset], t: Optional[float]) -> Optional[float]:
     """The display time to prepare the scene at: ``t``, or for a time series shown at its first step (``t`` None or
     that step, and the session's display time none or that step: a series member opened first) whose field is
     constant there, the first step where it varies (kept as the session's display time). Says so, and says which

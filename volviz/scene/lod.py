@@ -4,7 +4,7 @@ renderer (``volviz.render.lod_volume``)."""
 from __future__ import annotations
 
 import os
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, TypeGuard
 
 import numpy as np
 
@@ -22,7 +22,7 @@ def vvz_voxels(path: str | os.PathLike) -> int:
     return int(np.prod(NodeDecoder(os.fspath(path)).dims))
 
 
-def is_lod(dataset: Any) -> bool:
+def is_lod(dataset: object) -> TypeGuard[LodTree]:
     """Whether a loaded dataset is a compressed volume drawn at a level of detail."""
     from volviz.regular.lod import LodTree   # heavy (the wavelet decoder's Numba kernels): only once a scene is shown
 

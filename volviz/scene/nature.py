@@ -3,7 +3,7 @@ nature components, prepared: maps read into height fields, fog prisms, cloud vol
 layer's ``NatureView`` / ``GLNatureView`` show it."""
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any, Optional
+from typing import TYPE_CHECKING, Optional
 
 from volviz.scene.datasets import NATURE_TYPES
 from volviz.scene.errors import SceneError
@@ -11,9 +11,10 @@ from volviz.session import Session
 
 if TYPE_CHECKING:   # type-only imports for the signatures
     from volviz.nature.nature_scene import NatureScene
+    from volviz.scene.datasets import LoadedDataset
 
 
-def prepare_nature(session: Session, datasets: dict[str, Any]) -> Optional[NatureScene]:
+def prepare_nature(session: Session, datasets: dict[str, LoadedDataset]) -> Optional[NatureScene]:
     """Any thread: the NatureScene of the session's visible terrain / fog / clouds / sky components (None when it has
     none): maps read into height fields, fog prisms, cloud volumes and lighting; ``NatureView`` shows it."""
     components = [c for c in session.components if c.visible and c.type in NATURE_TYPES]
