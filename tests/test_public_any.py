@@ -73,7 +73,6 @@ OVERLAY = "the request dict of image_overlay.OverlayView, which this change does
 VIEW_OBJECTS = ("a view of one of several classes: View and ComponentView do not yet declare the job, kind and update "
                 "its callers use")
 ISO_PARTS = "not yet typed: isosurface meshes and their LOD chains (volviz.iso's types, by the view's mode)"
-PREPARED = "not yet typed: a scene's prepared inputs, a dict of per-component inputs of several kinds"
 
 #: the public signatures allowed to keep ``Any``, with the reason
 ALLOWED: dict[str, str] = {
@@ -93,14 +92,11 @@ ALLOWED: dict[str, str] = {
     "volviz.render.component_views:IsoSurfacesView.update": STATS,
     "volviz.render.controller:iso_summary": STATS,
     "volviz.render.controller:SceneController.props": VTK_ANY,
-    "volviz.render.controller:SceneController.prepare": PREPARED,
-    "volviz.render.controller:SceneController.install": PREPARED,
     "volviz.render.controller:SceneController.shown_props": VTK_ANY,
     "volviz.render.controller:SceneController.dataset_of": DATASET,
-    "volviz.render.controller:SceneController.prepare_component": PREPARED,
-    "volviz.render.controller:SceneController.install_component": PREPARED,
+    "volviz.render.controller:SceneController.install_component": VTK_ANY,
     "volviz.render.controller:SceneController.blend_volume": DATASET,
-    "volviz.render.controller:SceneController.show_volumes": PREPARED,
+    "volviz.render.controller:SceneController.show_volumes": DATASET,
     "volviz.render.controller:SceneController.extract_isosurfaces": ISO_PARTS,
     "volviz.render.controller:SceneController.show_isosurfaces": ISO_PARTS,
     "volviz.render.controller:SceneController.nature": VIEW_OBJECTS,
@@ -207,9 +203,6 @@ ALLOWED: dict[str, str] = {
     "volviz.render.scene_builder:time_input": DATASET,
     "volviz.render.scene_builder:add_volume_prop": DATASET_TO_PROP,
     "volviz.render.scene_builder:install_nature": VIEW_OBJECTS,
-    "volviz.render.scene_builder:install_scene": PREPARED,
-    "volviz.render.scene_builder:install_component": PREPARED,
-    "volviz.render.scene_builder:build_scene": PREPARED,
     "volviz.render.scene_builder:add_lod_component": DATASET_TO_PROP,
     "volviz.render.scene_builder:uses_pt": DATASET,
     "volviz.render.scene_builder:add_pt_component": DATASET_TO_PROP,

@@ -9,7 +9,7 @@ themselves.
 """
 from __future__ import annotations
 
-from typing import Any, Optional, TYPE_CHECKING
+from typing import TYPE_CHECKING, Any, Optional
 
 from volviz.render.framing import Bounds, points_bounds, prop_bounds, union
 from volviz.render.iso_actors import add_isosurface_actors

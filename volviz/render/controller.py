@@ -19,7 +19,7 @@ the background).
 from __future__ import annotations
 
 from contextlib import contextmanager
-from typing import TYPE_CHECKING, Any, Iterator, Optional
+from typing import Any, Iterator, Optional, TYPE_CHECKING
 
 from volviz.model import TimeSeries
 from volviz.model.applicability import DatasetTraits
@@ -34,6 +34,7 @@ if TYPE_CHECKING:   # type-only imports for the signatures
     from volviz.model.clip import ClipSettings
     from volviz.nature.nature_scene import NatureScene
     from volviz.optics.transfer_function import TransferFunction
+    from volviz.render.scene_builder import PreparedScene
     from volviz.scene.datasets import LoadedDataset
     from volviz.scene.isosurfaces import IsoParts
 
@@ -103,7 +104,7 @@ class SceneController:
         """Build the scene now (``prepare`` then ``install``, both on this thread)."""
         self.install(self.prepare())
 
-    def prepare(self, progress: Optional[ProgressCallback] = None, t: Optional[float] = None) -> Any:
+    def prepare(self, progress: Optional[ProgressCallback] = None, t: Optional[float] = None) -> PreparedScene:
         """Any thread, before ``install``: the heavy part of building (``volviz.render.scene_builder.prepare_scene``) at
         display time ``t`` of a time series (default: the session's display time). Touches no plotter, so the app
         runs it in the background."""
@@ -117,7 +118,7 @@ class SceneController:
                 t = float(start)  # the session's display time
         return prepare_scene(self.session, self.datasets, t, self.interpolate_time, progress)
 
-    def install(self, prepared: Any, views: bool = True) -> None:
+    def install(self, prepared: PreparedScene, views: bool = True) -> None:
         """GUI thread: add the props of a ``prepare`` result to the plotter without rendering. The view-dependent
         parts (PT images, LOD blocks, terrain and overlay) are drawn now when ``views``; the app instead updates them
         in the background (``pt_volume``, ``lod_volumes``, ``nature``: ``begin`` / ``compute`` / ``finish``)."""
@@ -266,7 +267,7 @@ class SceneController:
 
         return self.component(comp_id).type not in NATURE_TYPES and self.views.get(comp_id) is None
 
-    def prepare_component(self, comp_id: str, progress: Optional[ProgressCallback] = None) -> Any:
+    def prepare_component(self, comp_id: str, progress: Optional[ProgressCallback] = None) -> PreparedScene:
         """Any thread: the heavy part of showing a non-nature component that was hidden at build time
         (``volviz.render.scene_builder.prepare_component`` at the display time). Touches no plotter."""
         from volviz.jobs import report
@@ -280,7 +281,7 @@ class SceneController:
         report(progress, 1.0, f"{comp_id} prepared")
         return prepared
 
-    def install_component(self, comp_id: str, prepared: Any, views: bool = True) -> Any:
+    def install_component(self, comp_id: str, prepared: PreparedScene, views: bool = True) -> Any:
         """GUI thread: add the view of a ``prepare_component`` result without rendering (a PT volume's image and a
         LOD volume's blocks are drawn now when ``views``; the app updates them in the background)."""
         from volviz.render.scene_builder import install_component

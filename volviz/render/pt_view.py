@@ -5,7 +5,7 @@
 """
 from __future__ import annotations
 
-from typing import Any, Optional, TypeGuard, TYPE_CHECKING
+from typing import TYPE_CHECKING, Any, Optional, TypeGuard
 
 from volviz.render.framing import Bounds, points_bounds
 

@@ -7,7 +7,7 @@ the props and views are made (``install_scene``, GUI thread). Only the component
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, Optional
+from typing import Any, Optional, TYPE_CHECKING
 
 from volviz.jobs import ProgressCallback, report
 from volviz.model import Image2D, RegularVolume, TimeSeries
@@ -38,6 +38,7 @@ if TYPE_CHECKING:   # type-only imports for the signatures
     from volviz.nature.nature_scene import NatureScene
     from volviz.optics.transfer_function import TransferFunction
     from volviz.render.nature_view import NatureView
+    from volviz.render.views import ComponentView
     from volviz.scene.datasets import LoadedDataset
 
 
@@ -168,7 +169,7 @@ def install_nature(plotter: pv.BasePlotter, scene: Optional[NatureScene], views:
 
 def install_scene(plotter: pv.BasePlotter, session: Session, datasets: dict[str, LoadedDataset],
                   prepared: PreparedScene,
-                  spectrum: bool = True, views: bool = True) -> dict[str, Any]:
+                  spectrum: bool = True, views: bool = True) -> dict[str, ComponentView]:
     """GUI thread: add the props of a ``prepare_scene`` result to ``plotter``; returns the view of each component by
     id (``install_component``), and under ``"nature"`` the NatureView that draws the terrain, fog, clouds and sky
     components together. The view-dependent parts (PT volume images, LOD block selections, the natural scene's
@@ -207,7 +208,7 @@ def install_scene(plotter: pv.BasePlotter, session: Session, datasets: dict[str,
 
 
 def install_component(plotter: pv.BasePlotter, session: Session, comp: Component, datasets: dict[str, LoadedDataset],
-                      prepared: PreparedScene, spectrum: bool = True, views: bool = True) -> Any:
+                      prepared: PreparedScene, spectrum: bool = True, views: bool = True) -> ComponentView:
     """GUI thread: add one non-nature component from its ``prepare_component`` result; returns its view
     (``volviz.render.views.ComponentView``: a PT volume, a LOD volume, its isosurfaces, or a VTK prop's view). A PT
     volume's image and a LOD volume's blocks are drawn now when ``views`` (else the caller updates them in the
@@ -227,7 +228,7 @@ def install_component(plotter: pv.BasePlotter, session: Session, comp: Component
 
 
 def build_scene(plotter: pv.BasePlotter, session: Session, datasets: dict[str, LoadedDataset],
-                spectrum: bool = True) -> dict[str, Any]:
+                spectrum: bool = True) -> dict[str, ComponentView]:
     """Add every visible component to ``plotter`` now (``prepare_scene`` then ``install_scene``)."""
     return install_scene(plotter, session, datasets, prepare_scene(session, datasets), spectrum)
 

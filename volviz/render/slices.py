@@ -9,7 +9,7 @@ clamped to 0..1: ``slice_colors``.
 """
 from __future__ import annotations
 
-from typing import Any, Optional, TYPE_CHECKING
+from typing import TYPE_CHECKING, Any, Optional
 
 import numpy as np
 

@@ -4,7 +4,7 @@ only what the renderers and the scalar bar are given changes."""
 from __future__ import annotations
 
 import weakref
-from typing import Any, Optional, TYPE_CHECKING
+from typing import TYPE_CHECKING, Any, Optional
 
 import numpy as np
 
