@@ -348,6 +348,19 @@ def test_dem_truncated_at_a_record_boundary_is_refused(tmp_path):
     refused(write(tmp_path / "t.dem", data[:starts[200]]), "DEM file ends after 200 of the header's 327 profiles")
 
 
+def test_dem_whose_profile_count_is_less_than_its_profiles_is_refused(tmp_path):
+    """Issue #32 (the full campaign's one DEM silent acceptance): the profile-columns field "   327" at byte 858
+    read as "   214" (a longer number written over it shifted the record) read 214 of the 327 profiles as the whole
+    terrain, the other 341,047 bytes ignored without a word. An accuracy record (type C, 1024 bytes) may follow."""
+    data = dem_bytes()
+    assert data[858:864] == b"   327"
+    error = refused(write(tmp_path / "n.dem", data[:858] + b"   214" + data[864:]),
+                    "DEM header gives 214 profile columns, but .* bytes of data follow the last of them")
+    assert str(error).endswith("the header's count is less than the file holds")
+    assert data[993472:].split()[:4] == [b"1", b"3", b"3", b"3"]   # the file's own accuracy record
+    assert vio.read(write(tmp_path / "c.dem", data), isolate=False).data.shape == (466, 327)
+
+
 def test_dem_with_huge_vertical_resolution_is_refused(tmp_path):
     data = bytearray(dem_bytes())
     assert data[840:852].strip() == b"0.100000E+01"

@@ -29,6 +29,7 @@ from volviz.model import Image2D
 
 FEET = 0.3048
 ARC_SECOND = 23.111  # vtkDEMReader's metres per arc-second (VTK_METERS_PER_ARC_SECOND); crude, as in VTK
+TYPE_C_BYTES = 1024  # the optional accuracy record (type C) after the profiles
 _INT6 = re.compile(rb"[ \t\r\n\f\v]*([-+]?[0-9]{1,6})")
 
 
@@ -122,6 +123,10 @@ def _read_profiles(path: PathLike, buf: bytes, h: dict):
             values[k] = int(m.group(1))
             pos = m.end()
         out.append((row_id, col_id, x, y, values))
+    rest = len(buf[pos:].strip())
+    if rest > TYPE_C_BYTES:  # more than an accuracy record: profiles the header's count leaves out (issue #32)
+        raise ReadError(path, f"DEM header gives {n_profiles} profile columns, but {rest} bytes of data follow the "
+                              f"last of them (from byte {pos}): the header's count is less than the file holds")
     return out
 
 
