@@ -70,9 +70,10 @@ DATASET = ("a dataset of several kinds (volviz.scene.datasets.LoadedDataset, an 
            "whose body uses attributes of some kinds only: typing it needs narrowing there, a code change")
 DATASET_TO_PROP = "a loaded dataset in (DATASET), a VTK prop of several classes out (VTK_ANY)"
 OVERLAY = "the request dict of image_overlay.OverlayView, which this change does not edit (GL passes: being moved)"
-VIEW_OBJECTS = ("a view of one of several classes: View and ComponentView do not yet declare the job, kind and update "
-                "its callers use")
-ISO_PARTS = "not yet typed: isosurface meshes and their LOD chains (volviz.iso's types, by the view's mode)"
+VIEW_OBJECTS = ("a view of one of several classes, each with its own request type; View[Any] would not do: the "
+                "natural scene's view has no stats and the GL isosurfaces' no job, which these callers use")
+ISO_PARTS = ("IsoParts or a list of IsoMesh: the body tells them apart with a conditional expression mypy "
+             "cannot follow")
 
 #: the public signatures allowed to keep ``Any``, with the reason
 ALLOWED: dict[str, str] = {
@@ -85,10 +86,6 @@ ALLOWED: dict[str, str] = {
     "volviz.render.collision:fly_bounds": ELSEWHERE,
     "volviz.render.component_views:VtkPropView.set_input": DATASET,
     "volviz.render.component_views:VtkPropView.update": STATS,
-    "volviz.render.component_views:IsoSurfacesView.meshes": ISO_PARTS,
-    "volviz.render.component_views:IsoSurfacesView.cut": ISO_PARTS,
-    "volviz.render.component_views:IsoSurfacesView.show_cut": ISO_PARTS,
-    "volviz.render.component_views:IsoSurfacesView.show": ISO_PARTS,
     "volviz.render.component_views:IsoSurfacesView.update": STATS,
     "volviz.render.controller:iso_summary": STATS,
     "volviz.render.controller:SceneController.props": VTK_ANY,
@@ -97,7 +94,6 @@ ALLOWED: dict[str, str] = {
     "volviz.render.controller:SceneController.install_component": VTK_ANY,
     "volviz.render.controller:SceneController.blend_volume": DATASET,
     "volviz.render.controller:SceneController.show_volumes": DATASET,
-    "volviz.render.controller:SceneController.extract_isosurfaces": ISO_PARTS,
     "volviz.render.controller:SceneController.show_isosurfaces": ISO_PARTS,
     "volviz.render.controller:SceneController.nature": VIEW_OBJECTS,
     "volviz.render.controller:SceneController.camera_views": VIEW_OBJECTS,
@@ -174,7 +170,6 @@ ALLOWED: dict[str, str] = {
     "volviz.render.image_overlay:OverlayView.finish": GL,
     "volviz.render.iso_actors:add_isosurface_actors": ELSEWHERE,
     "volviz.render.iso_actors:add_isosurfaces": ELSEWHERE,
-    "volviz.render.iso_overlay:IsoOverlay.set_surfaces": ISO_PARTS,
     "volviz.render.iso_overlay:IsoOverlay.begin": OVERLAY,
     "volviz.render.iso_overlay:IsoOverlay.compute": OVERLAY,
     "volviz.render.iso_overlay:IsoOverlay.finish": OVERLAY,

@@ -17,9 +17,11 @@ from volviz.scene.clipping import clip_settings
 from volviz.scene.isosurfaces import isosurface_parts
 
 if TYPE_CHECKING:   # type-only imports for the signatures
+    from volviz.iso.extract import IsoMesh
     from volviz.jobs import ProgressCallback
     from volviz.model.clip import ClipSettings
     from volviz.optics.transfer_function import TransferFunction
+    from volviz.scene.isosurfaces import IsoParts
 
 __all__ = ["IsoSurfacesView", "VtkPropView"]
 
@@ -101,7 +103,7 @@ class IsoSurfacesView(VtkPropView):
         self.show(parts)
 
     @property
-    def meshes(self) -> list[Any]:
+    def meshes(self) -> list[IsoMesh]:
         """The extracted, uncut surfaces."""
         return list(self.parts.meshes)
 
@@ -116,19 +118,19 @@ class IsoSurfacesView(VtkPropView):
     def stale(self) -> bool:
         return self.parts.clip != self.clip.to_dict() or self.parts.opacity != float(self.comp.opacity)
 
-    def cut(self, clip: Optional[ClipSettings] = None, meshes: Optional[list[Any]] = None,
-            progress: Optional[ProgressCallback] = None) -> Any:
+    def cut(self, clip: Optional[ClipSettings] = None, meshes: Optional[list[IsoMesh]] = None,
+            progress: Optional[ProgressCallback] = None) -> IsoParts:
         """Any thread: the surfaces (``meshes``, default the extracted ones) cut by ``clip`` (default: the last
         ``set_clip``), scaled by the component's opacity, with their LOD chains."""
         return isosurface_parts(self.comp, meshes=self.meshes if meshes is None else list(meshes),
                                 clip=self.clip if clip is None else clip)
 
-    def show_cut(self, parts: Any, visible: bool = True) -> None:
+    def show_cut(self, parts: IsoParts, visible: bool = True) -> None:
         """GUI thread: show a ``cut`` (new actors, not rendered)."""
         self.show(parts)
         self.visible = visible
 
-    def show(self, parts: Any) -> None:
+    def show(self, parts: IsoParts) -> None:
         if self.prop is not None:
             self.plotter.remove_actor(self.prop, render=False)
         self.parts = parts

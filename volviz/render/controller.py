@@ -19,7 +19,7 @@ the background).
 from __future__ import annotations
 
 from contextlib import contextmanager
-from typing import Any, Iterator, Optional, TYPE_CHECKING
+from typing import TYPE_CHECKING, Any, Iterator, Optional
 
 from volviz.model import TimeSeries
 from volviz.model.applicability import DatasetTraits
@@ -30,6 +30,7 @@ from volviz.session import CameraState, Component, Session
 if TYPE_CHECKING:   # type-only imports for the signatures
     import pyvista as pv
 
+    from volviz.iso.extract import IsoMesh
     from volviz.jobs import ProgressCallback
     from volviz.model.clip import ClipSettings
     from volviz.nature.nature_scene import NatureScene
@@ -406,7 +407,7 @@ class SceneController:
         return [comp_id for comp_id in self.time_series() if comp_id in views]
 
     def extract_isosurfaces(self, comp_id: str, t: float, interpolate: Optional[bool] = None,
-                            progress: Optional[ProgressCallback] = None) -> list[Any]:
+                            progress: Optional[ProgressCallback] = None) -> list[IsoMesh]:
         """Any thread: the surfaces of an isosurface component at display time ``t`` (the 4D blend of the
         neighbouring steps when interpolating, libMini note "4D Visualization"), cut by the component's own
         clipping (``volviz.iso.prepare``); ``show_isosurfaces`` puts them on screen."""

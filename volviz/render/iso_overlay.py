@@ -35,6 +35,7 @@ from volviz.render.image_overlay import OverlayView
 from volviz.model.camera import Camera
 
 if TYPE_CHECKING:   # type-only imports for the signatures
+    from volviz.iso.lod import LodChain
     from volviz.jobs import ProgressCallback
 
 __all__ = ["IsoModeView", "IsoOverlay", "cut_at_depth"]
@@ -86,7 +87,8 @@ class IsoOverlay(OverlayView, IsoModeView):
         self.mode = mode
         self.shading = shading
 
-    def set_surfaces(self, meshes: Sequence[IsoMesh], lod: Sequence[Any], shading: str) -> None:
+    def set_surfaces(self, meshes: Sequence[IsoMesh], lod: Sequence[Optional[tuple[LodChain, float]]],
+                     shading: str) -> None:
         """Draw ``meshes`` with their LOD chains (``lod``: per mesh (LodChain, triangles per pixel²) or None) and
         ``shading`` from the next image on."""
         self.meshes, self.lod, self.shading = list(meshes), list(lod), shading

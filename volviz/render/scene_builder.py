@@ -7,7 +7,7 @@ the props and views are made (``install_scene``, GUI thread). Only the component
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Optional, TYPE_CHECKING
+from typing import TYPE_CHECKING, Any, Optional
 
 from volviz.jobs import ProgressCallback, report
 from volviz.model import Image2D, RegularVolume, TimeSeries

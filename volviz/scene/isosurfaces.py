@@ -14,6 +14,8 @@ from volviz.scene.errors import SceneError
 from volviz.session import Component
 
 if TYPE_CHECKING:   # type-only imports for the signatures
+    from volviz.iso.extract import IsoMesh
+    from volviz.iso.lod import LodChain
     from volviz.model.clip import ClipSettings
 
 
@@ -22,17 +24,17 @@ class IsoParts:
     """An isosurface component's surfaces ready for actors (``isosurface_parts``): the extracted ones (uncut by the
     scene clipping), the shown ones (cut, opacity scaled) and the LOD chains of the shown ones."""
 
-    meshes: list[Any]
-    shown: list[Any]
-    lod: Optional[list[Any]]
-    settings: Any
+    meshes: list[IsoMesh]
+    shown: list[IsoMesh]
+    lod: Optional[list[Optional[tuple[LodChain, float]]]]   # per shown surface: its chain, triangles per pixel²
+    settings: IsoSettings
     clip: dict[str, Any] = field(default_factory=dict)  # the scene clipping they were cut by (``to_dict``)
     opacity: float = 1.0                                 # the component opacity they were scaled by
 
 
 def isosurface_parts(comp: Component, dataset: Any = None, t: Optional[float] = None,
                      clip: dict[str, Any] | ClipSettings | None = None,
-                     meshes: Optional[list[Any]] = None, progress: Optional[ProgressCallback] = None) -> IsoParts:
+                     meshes: Optional[list[IsoMesh]] = None, progress: Optional[ProgressCallback] = None) -> IsoParts:
     """Any thread: the surfaces of an ``isosurface`` component (settings: ``volviz.iso.IsoSettings``) extracted at
     display time ``t`` (skipped when ``meshes`` are known), cut exactly by the scene's ``clip`` (``session.clip`` or
     ClipSettings) on top of the component's own clipping, scaled by its opacity, with their LOD chains."""
