@@ -233,9 +233,7 @@ ALLOWED: dict[str, str] = {
     "volviz.scene.isosurfaces:isosurface_parts": JSON,
     "volviz.scene.tetra:pt_mesh": DATASET,
     "volviz.scene.tetra:pt_options": JSON,
-    "volviz.model.arrays:list_arrays": DATASET,
     "volviz.model.arrays:vertex_colors": DATASET,
-    "volviz.model.arrays:default_array": DATASET,
     "volviz.model.arrays:select_array": DATASET,
     "volviz.model.camera:Camera.to_dict": JSON,
     "volviz.model.camera:Camera.from_dict": JSON,
@@ -247,15 +245,11 @@ ALLOWED: dict[str, str] = {
     "volviz.model.clip:ClipSettings.from_dict": JSON,
     "volviz.model.datasets:RegularVolume.to_pyvista":
         "pv.ImageData breaks volviz.iso.extract (a name reused as str and Optional[str]), outside this change",
-    "volviz.model.representation:shown_field": DATASET,
-    "volviz.model.representation:representation": DATASET,
     "volviz.model.session_schema:session_schema": JSON,
     "volviz.model.settings:validated": JSON,
     "volviz.model.settings:typed_settings": JSON,
     "volviz.model.settings:validate_settings": JSON,
     "volviz.model.settings:validate_render_options": JSON,
-    "volviz.model.stats:scalar_values": DATASET,
-    "volviz.model.stats:histogram": DATASET,
     "volviz.model.timeseries:frame_at": DATASET,
 }
 

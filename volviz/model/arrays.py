@@ -13,7 +13,7 @@ from typing import Any, Union
 
 import numpy as np
 
-from volviz.model.datasets import CurvilinearGrid, RegularVolume, TetMesh, TimeSeries, UnstructuredMesh
+from volviz.model.datasets import CurvilinearGrid, Dataset, RegularVolume, TetMesh, TimeSeries, UnstructuredMesh
 
 MAGNITUDE = "magnitude"
 MAX_COMPONENTS = 9           # tensors: 3x3
@@ -121,7 +121,7 @@ def _finite_range(values: np.ndarray) -> tuple[tuple[float, float], int]:
     return (float(kept.min()), float(kept.max())), bad
 
 
-def list_arrays(dataset: Any) -> list[ArrayInfo]:
+def list_arrays(dataset: Union[Dataset, TimeSeries]) -> list[ArrayInfo]:
     """Every numeric array of ``dataset`` (the first frame of a time series) with its range, number of non-finite
     values and the specs a user can choose for it."""
     d = _base(dataset)
@@ -197,7 +197,7 @@ def vertex_colors(dataset: Any) -> np.ndarray | None:
     return None
 
 
-def default_array(dataset: Any) -> str | None:
+def default_array(dataset: Union[Dataset, TimeSeries]) -> str | None:
     """The spec a first open shows: the dataset's active array when it varies, else the first point array that
     varies, else the first cell array that varies, else the first array (vectors by their magnitude). Bookkeeping
     arrays (``is_bookkeeping_array``: ids, ghost levels) are candidates only where nothing else is, and never on a

@@ -16,11 +16,11 @@ A time series whose first step is constant starts at the first step where the fi
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Optional
+from typing import Any, Optional, Union
 
 import numpy as np
 
-from volviz.model.datasets import CurvilinearGrid, RegularVolume, TetMesh, TimeSeries, UnstructuredMesh
+from volviz.model.datasets import CurvilinearGrid, Dataset, RegularVolume, TetMesh, TimeSeries, UnstructuredMesh
 
 VOLUME, SURFACE, POINTS = "volume", "surface", "points"
 
@@ -46,7 +46,7 @@ class Representation:
     reason: str = ""
 
 
-def shown_field(dataset: Any) -> tuple[Optional[str], Optional[np.ndarray]]:
+def shown_field(dataset: Union[Dataset, TimeSeries]) -> tuple[Optional[str], Optional[np.ndarray]]:
     """The name and values of the field ``dataset`` shows (its active array, as ``volviz.model.arrays.select_array``
     sets it; a regular volume's data, a tetrahedral mesh's scalars); (None, None) for geometry alone."""
     if isinstance(dataset, RegularVolume):
@@ -98,7 +98,7 @@ def _shape_kind(dataset: Any) -> tuple[str, str]:
     return VOLUME, ""
 
 
-def representation(dataset: Any) -> Representation:
+def representation(dataset: Union[Dataset, TimeSeries]) -> Representation:
     """How the first look draws ``dataset`` (see the module docstring); a time series as at its first step where the
     field varies. Kept on the dataset, so the many callers of one scene pay once."""
     cached = getattr(dataset, "__dict__", {}).get("volviz_representation")

@@ -2,17 +2,18 @@
 (for the transfer-function editor)."""
 from __future__ import annotations
 
-from typing import Any
+from typing import Union
 
 import numpy as np
 
-from volviz.model.datasets import CurvilinearGrid, Image2D, RegularVolume, TetMesh, TimeSeries, UnstructuredMesh
+from volviz.model.datasets import (CurvilinearGrid, Dataset, Image2D, RegularVolume, TetMesh, TimeSeries,
+                                   UnstructuredMesh)
 
 
 MAX_SERIES_VALUES = 50_000_000
 
 
-def scalar_values(dataset: Any) -> np.ndarray:
+def scalar_values(dataset: Union[Dataset, TimeSeries]) -> np.ndarray:
     """The active scalar of a dataset as a flat array (vector arrays by their magnitude); for a time series, the
     values of all its steps (of evenly spaced steps when that would exceed ``MAX_SERIES_VALUES``)."""
     if isinstance(dataset, TimeSeries):
@@ -35,7 +36,7 @@ def scalar_values(dataset: Any) -> np.ndarray:
     return np.asarray(values).reshape(-1)
 
 
-def histogram(dataset: Any, bins: int = 128) -> tuple[np.ndarray, np.ndarray]:
+def histogram(dataset: Union[Dataset, TimeSeries], bins: int = 128) -> tuple[np.ndarray, np.ndarray]:
     """Counts and bin edges of the finite active-scalar values (NaN/Inf are left out)."""
     values = scalar_values(dataset)
     if values.dtype.kind == "f":

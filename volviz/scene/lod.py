@@ -4,11 +4,13 @@ renderer (``volviz.render.lod_volume``)."""
 from __future__ import annotations
 
 import os
-from typing import TYPE_CHECKING, TypeGuard
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 if TYPE_CHECKING:
+    from typing_extensions import TypeIs   # (typing's own from Python 3.13)
+
     from volviz.regular.lod import LodTree
 
 #: compressed volumes with more voxels than this open at a view-dependent level of detail instead of being decoded
@@ -22,7 +24,7 @@ def vvz_voxels(path: str | os.PathLike) -> int:
     return int(np.prod(NodeDecoder(os.fspath(path)).dims))
 
 
-def is_lod(dataset: object) -> TypeGuard[LodTree]:
+def is_lod(dataset: object) -> TypeIs[LodTree]:
     """Whether a loaded dataset is a compressed volume drawn at a level of detail."""
     from volviz.regular.lod import LodTree   # heavy (the wavelet decoder's Numba kernels): only once a scene is shown
 
