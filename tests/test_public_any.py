@@ -101,9 +101,6 @@ ALLOWED: dict[str, str] = {
     "volviz.render.controller:SceneController.begin_views": VIEW_OBJECTS,
     "volviz.render.controller:SceneController.compute_views": VIEW_OBJECTS,
     "volviz.render.controller:SceneController.finish_views": VIEW_OBJECTS,
-    "volviz.render.controller:SceneController.lod_volumes": VIEW_OBJECTS,
-    "volviz.render.controller:SceneController.pt_volume": VIEW_OBJECTS,
-    "volviz.render.controller:SceneController.gl_pt_volume": VIEW_OBJECTS,
     "volviz.render.controller:SceneController.pt_stats": STATS,
     "volviz.render.controller:SceneController.install_nature": VIEW_OBJECTS,
     "volviz.render.controller:SceneController.finish_nature": VIEW_OBJECTS,
@@ -112,7 +109,6 @@ ALLOWED: dict[str, str] = {
         "a cut of one of several kinds (a TetMesh, isosurface parts), by the component's view",
     "volviz.render.controller:SceneController.show_cut":
         "a cut of one of several kinds (a TetMesh, isosurface parts), by the component's view",
-    "volviz.render.controller:SceneController.iso_overlay": VIEW_OBJECTS,
     "volviz.render.controller:SceneController.iso_stats": STATS,
     "volviz.render.decorations:legend_margin": GL,
     "volviz.render.decorations:apply_decorations": GL,

@@ -35,6 +35,10 @@ if TYPE_CHECKING:   # type-only imports for the signatures
     from volviz.model.clip import ClipSettings
     from volviz.nature.nature_scene import NatureScene
     from volviz.optics.transfer_function import TransferFunction
+    from volviz.render.gl_pt import GLPTVolume
+    from volviz.render.iso_overlay import IsoOverlay
+    from volviz.render.lod_volume import LodVolume
+    from volviz.render.pt_prop import PTVolume
     from volviz.render.scene_builder import PreparedScene
     from volviz.scene.datasets import LoadedDataset
     from volviz.scene.isosurfaces import IsoParts
@@ -542,17 +546,17 @@ class SceneController:
             for (_, view, request), result in zip(requests, results):
                 view.finish(request, *result)
 
-    def lod_volumes(self) -> dict[str, Any]:
+    def lod_volumes(self) -> dict[str, LodVolume]:
         """The visible volumes drawn at a level of detail (``volviz.render.lod_volume.LodVolume``) by component."""
         return {comp_id: view for comp_id, view in self._views_of("lod").items() if view.visible}
 
-    def pt_volume(self, comp_id: str) -> Any:
+    def pt_volume(self, comp_id: str) -> Optional[PTVolume]:
         """The PT volume of a component whose images volviz renders (the CPU backend: ``begin`` / ``compute`` /
         ``finish``), or None when VTK draws it (the GPU backend, or VTK's own mappers)."""
         view = self._views_of("pt").get(comp_id)
         return view if view is not None and view.backend == "cpu" else None
 
-    def gl_pt_volume(self, comp_id: str) -> Any:
+    def gl_pt_volume(self, comp_id: str) -> Optional[GLPTVolume]:
         """The GPU PT volume of a component (VTK draws it; its visibility order can be made on a worker:
         ``begin`` / ``compute`` / ``finish``), or None."""
         view = self._views_of("pt").get(comp_id)
@@ -669,7 +673,7 @@ class SceneController:
 
     # -- isosurface transparency mode (per scene) -------------------------------------------------------------------
     @property
-    def iso_overlay(self) -> Any:
+    def iso_overlay(self) -> Optional[IsoOverlay]:
         """The isosurfaces' CPU overlay (``IsoOverlay``: ``begin`` / ``compute`` / ``finish``) while a mode of the note
         is drawn on the CPU backend; None otherwise (VTK draws the GPU's ``GLIsoView`` at every render)."""
         view = self.iso_view
