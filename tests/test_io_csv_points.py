@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import volviz.io as vio
-from volviz.io.csv_points import VTK_VERTEX
+from volviz.model import VTK_VERTEX
 from volviz.io.registry import spec_of
 from volviz.model import UnstructuredMesh
 

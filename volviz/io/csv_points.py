@@ -23,7 +23,6 @@ from volviz.io._checks import check_file, check_finite
 from volviz.io.errors import PathLike, ReadError, ReadWarning
 from volviz.model import UnstructuredMesh
 
-VTK_VERTEX = 1
 #: the largest table read (bytes of text)
 MAX_BYTES = 2 << 30
 #: header names taken for each coordinate, in lower case without blanks
@@ -251,5 +250,4 @@ def _read_points(path: PathLike, asked: tuple[str | None, str | None, str | None
         values = table[:, at[col]]
         check_finite(p, values, allow_nonfinite)
         arrays[names[col]] = values
-    cells = [(VTK_VERTEX, np.arange(len(points), dtype=np.int64).reshape(-1, 1))]
-    return UnstructuredMesh(points, cells, point_data=arrays, source=str(p))
+    return UnstructuredMesh(points, [], point_data=arrays, source=str(p))  # points only: one vertex each

@@ -6,6 +6,7 @@ from volviz.model.datasets import (
     VTK_QUAD,
     VTK_TETRA,
     VTK_TRIANGLE,
+    VTK_VERTEX,
     VTK_WEDGE,
     CurvilinearGrid,
     Dataset,
@@ -18,7 +19,8 @@ from volviz.model.datasets import (
 )
 
 __all__ = [
-    "CELL_SIZES", "VTK_HEXAHEDRON", "VTK_PYRAMID", "VTK_QUAD", "VTK_TETRA", "VTK_TRIANGLE", "VTK_WEDGE",
+    "CELL_SIZES", "VTK_HEXAHEDRON", "VTK_PYRAMID", "VTK_QUAD", "VTK_TETRA", "VTK_TRIANGLE", "VTK_VERTEX",
+    "VTK_WEDGE",
     "CurvilinearGrid", "Dataset", "Image2D", "RegularVolume", "TetMesh", "TimeSeries", "UnstructuredMesh",
     "vec3",
 ]

@@ -26,6 +26,7 @@ VTK_WEDGE = 13
 VTK_PYRAMID = 14
 VTK_TRIANGLE = 5
 VTK_QUAD = 9
+VTK_VERTEX = 1
 CELL_SIZES = {VTK_TETRA: 4, VTK_HEXAHEDRON: 8, VTK_WEDGE: 6, VTK_PYRAMID: 5, VTK_TRIANGLE: 3, VTK_QUAD: 4}
 
 
@@ -178,6 +179,10 @@ class UnstructuredMesh:
         if self.points.ndim != 2 or self.points.shape[1] != 3:
             raise ValueError(f"mesh points must have shape (n, 3), got {self.points.shape}")
         n = len(self.points)
+        if n and not any(len(conn) for _, conn in self.cells) and not any(len(a) for a in self.cell_data.values()):
+            # points without cells (a PLY or VTK file of vertices only): a point cloud, one vertex cell per point
+            self.cells = [(VTK_VERTEX, np.arange(n, dtype=np.int64).reshape(-1, 1))]
+            self.cell_data = {}
         for cell_type, conn in self.cells:
             if conn.ndim != 2:
                 raise ValueError(f"cell block of type {cell_type} must be 2D, got shape {conn.shape}")

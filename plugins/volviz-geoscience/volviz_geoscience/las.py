@@ -25,7 +25,6 @@ from volviz.io._checks import check_file, describe_bytes, read_bytes
 from volviz.io.errors import PathLike, ReadError
 from volviz.model import UnstructuredMesh
 
-VTK_VERTEX = 1
 HEADER_BYTES = 227          # the public header of LAS 1.0-1.2; 1.3 and 1.4 add to it
 #: byte 104 of the public header: the point data format; LAZ writers set bit 7 (bit 6 by older ones) on it
 FORMAT_BYTE = 104
@@ -117,5 +116,5 @@ def read_las(path: PathLike) -> UnstructuredMesh:
         values = np.asarray(points[name])
         if values.ndim == 1 and values.dtype.kind in "biuf" and name not in arrays:
             arrays[name] = values
-    cells = [(VTK_VERTEX, np.arange(len(xyz), dtype=np.int64).reshape(-1, 1))]
-    return UnstructuredMesh(xyz, cells, point_data=arrays, active="elevation", source=str(p))
+    # points only: the mesh makes one vertex cell per point
+    return UnstructuredMesh(xyz, [], point_data=arrays, active="elevation", source=str(p))
