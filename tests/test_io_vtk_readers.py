@@ -342,3 +342,81 @@ def test_ensight_gold_case_written_by_vtk(tmp_path):
     _assert_same(mesh, ref)
     assert {"height_n", "disp_n"} <= set(mesh.point_data)                # EnSight names per-node variables so
     np.testing.assert_allclose(mesh.point_data["height_n"], beam.point_data["height"], rtol=1e-6)
+
+
+# -- EnSight: the case and the files it names checked before VTK's reader (issue #32, ensightcheck) ------------------
+def _ensight_case(folder, case: str | None = None):
+    """The bench's EnSight Gold ASCII seed (one part of 8 nodes and 5 tetra4, a scalar per node), its case file
+    replaced by ``case`` when given."""
+    from volviz.bench.robustness_formats import _ensight
+
+    _ensight(folder)
+    if case is not None:
+        (folder / "mesh.case").write_text(case)
+    return folder / "mesh.case"
+
+
+def _ensight_refusal(path) -> str:
+    with pytest.raises(vio.ReadError) as info:
+        vio.read(path)
+    return str(info.value)
+
+
+def test_ensight_case_cut_in_a_section_name_refused_naming_the_line(tmp_path):
+    """VTK's reader looped to the 10 s time limit on this case file (the campaign's slow refusals)."""
+    case = _ensight_case(tmp_path)
+    case.write_bytes(case.read_bytes()[:58])
+    assert _ensight_refusal(case) == (f"{case}: line 7 of the case file ('VARIA') is neither a section nor a "
+                                      "'key: value' line")
+
+
+def test_ensight_time_values_against_number_of_steps(tmp_path):
+    case = _ensight_case(tmp_path, "FORMAT\ntype: ensight gold\nGEOMETRY\nmodel: 1 mesh.geo\nTIME\ntime set: 1\n"
+                                   "number of steps: 3\ntime values: 0.0 0.5\n")
+    assert _ensight_refusal(case) == f"{case}: time set 1: 'number of steps' is 3 but 'time values' holds 2 values"
+
+
+def test_ensight_wildcard_names_a_missing_step_file(tmp_path):
+    case = _ensight_case(tmp_path, "FORMAT\ntype: ensight gold\nGEOMETRY\nmodel: mesh.geo\nVARIABLE\n"
+                                   "scalar per node: 1 temperature temp.scl**\nTIME\ntime set: 1\n"
+                                   "number of steps: 2\nfilename start number: 0\nfilename increment: 1\n"
+                                   "time values: 0.0 1.0\n")
+    (tmp_path / "temp.scl00").write_bytes((tmp_path / "temp.scl").read_bytes())
+    assert _ensight_refusal(case) == (f"{case}: the variable file temp.scl01 (VARIABLE scalar per node "
+                                      "'temp.scl**') does not exist")
+
+
+def test_ensight_variable_cut_short_refused_naming_the_part(tmp_path):
+    """VTK's reader read the 8 node values of this file cut after 5 as other values."""
+    case = _ensight_case(tmp_path)
+    scl = tmp_path / "temp.scl"
+    scl.write_bytes(scl.read_bytes()[:114])
+    assert _ensight_refusal(case) == (f"{scl}: part 1's coordinates (8 values of the geometry's counts) needs 8 lines "
+                                      "of values but the file holds 6 more: the file is truncated or the count is "
+                                      "wrong")
+
+
+def test_ensight_geometry_node_count_against_its_lines(tmp_path):
+    case = _ensight_case(tmp_path)
+    geo = tmp_path / "mesh.geo"
+    geo.write_text(geo.read_text().replace("coordinates\n         8\n", "coordinates\n         7\n"))
+    assert _ensight_refusal(case) == (f"{geo}: line 31 is '5.00000e-01' where an element type or 'part' should be: "
+                                      "a count before it is wrong (part 1 has 7 nodes)")
+
+
+def test_ensight_c_binary_geometry_cut_refused_naming_the_elements(tmp_path):
+    """A C Binary geometry (VTK's own writer) cut inside its hexa8 connectivity."""
+    writer = vtk.vtkEnSightWriter()
+    beam = _beam()
+    beam.cell_data["BlockId"] = np.ones(beam.n_cells, dtype=np.int32)
+    writer.SetInputData(beam)
+    writer.SetPath(str(tmp_path) + "/")
+    writer.SetBaseName("beam")
+    writer.SetNumberOfBlocks(1)
+    writer.Write()
+    writer.WriteCaseFile(1)
+    geo = tmp_path / "beam.0.00000.geo"
+    geo.write_bytes(geo.read_bytes()[:-100])
+    assert _ensight_refusal(tmp_path / "beam.0.case") == (
+        f"{geo}: part 1's 40 hexa8 elements needs 1440 bytes but the file holds 1340 more: the file is truncated "
+        "or the count is wrong")

@@ -28,6 +28,7 @@ from volviz.model import TimeSeries
 
 from volviz_vtk_readers import specs, xdmf
 from volviz_vtk_readers.containers import check_container
+from volviz_vtk_readers.ensightcheck import check_ensight_case
 from volviz_vtk_readers.exodus_check import check_exodus_connectivity
 from volviz_vtk_readers.foamcheck import check_time_folder
 from volviz_vtk_readers.tecplotcheck import check_tecplot_zones
@@ -266,6 +267,7 @@ def read_cgns(path: PathLike, blocks: Sequence[str] | str | None = None, time_in
 
 def _ensight(path: PathLike) -> Any:
     _check_sniffed(path, specs.is_ensight_case, "EnSight case")
+    check_ensight_case(path)  # VTK's reader loops on a damaged case file and reads files cut short as other values
     reader = _information(path, _reader("vtkGenericEnSightReader", path, "SetCaseFileName"))
     reader.ReadAllVariablesOn()
     return reader
