@@ -420,3 +420,60 @@ def test_ensight_c_binary_geometry_cut_refused_naming_the_elements(tmp_path):
     assert _ensight_refusal(tmp_path / "beam.0.case") == (
         f"{geo}: part 1's 40 hexa8 elements needs 1440 bytes but the file holds 1340 more: the file is truncated "
         "or the count is wrong")
+
+
+# -- AVS UCD: the header's counts against the file before VTK's reader (issue #32, avscheck) ------------------------
+def _avs_tets(folder):
+    """The bench's AVS UCD seed written by meshio: 8 nodes, 5 tets, one value per node and per cell."""
+    from volviz.bench.robustness_formats import _avs
+
+    _avs(folder, False)
+    return folder / "mesh.inp"
+
+
+@pytest.mark.parametrize("edit, message", [
+    # the campaign's cut at byte 175 of 553, within the second cell line: VTK's reader read it as other cells
+    (lambda data: data[:175], "line 12 ('2 0 tet 2') is not cell 2 of 5 (id, material, type and its nodes) that the "
+                              "header's count needs"),
+    (lambda data: data.replace(b"8 5 1 1 0", b"8 6 1 1 0"),
+     "line 16 ('1 1') is not cell 6 of 6 (id, material, type and its nodes) that the header's count needs"),
+    (lambda data: data.replace(b"8 5 1 1 0", b"8 5 2 1 0"),
+     "line 16: the node data's component sizes add up to 1 but the header says 2 node values"),
+], ids=["cut-in-cells", "cell-count", "node-values"])
+def test_avs_ucd_counts_against_the_lines_refused_naming_the_line(tmp_path, edit, message):
+    path = _avs_tets(tmp_path)
+    path.write_bytes(edit(path.read_bytes()))
+    with pytest.raises(vio.ReadError) as info:
+        vio.read(path)
+    assert str(info.value) == f"{path}: {message}"
+
+
+def test_avs_ucd_last_line_without_its_end_is_a_warning(tmp_path):
+    path = _avs_tets(tmp_path)
+    path.write_bytes(path.read_bytes()[:-1])
+    with pytest.warns(vio.ReadWarning) as record:
+        mesh = vio.read(path)
+    assert mesh.n_points == 8 and mesh.n_cells == 5
+    assert [str(w.message) for w in record if issubclass(w.category, vio.ReadWarning)] == [
+        f"{path}: the file does not end with a line end: line 32, its last, may be cut short (a value of fewer "
+        "digits)"]
+
+
+def _binary_ucd() -> bytes:
+    """A binary AVS UCD tetrahedron (VTK's binary layout: byte 7, six counts, cell records, connectivity, x, y, z)."""
+    head = b"\x07" + np.array([4, 1, 0, 0, 0, 4], dtype="<i4").tobytes()
+    cells = np.array([1, 1, 4, 4, 1, 2, 3, 4], dtype="<i4").tobytes()   # id, material, nodes, type (4: tet); nodes
+    return head + cells + np.array([[0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]], dtype="<f4").tobytes()
+
+
+def test_avs_ucd_binary_size_against_its_counts(tmp_path):
+    path = tmp_path / "tet.inp"
+    path.write_bytes(_binary_ucd())
+    mesh = vio.read(path)
+    assert (mesh.n_points, mesh.n_cells) == (4, 1)
+    path.write_bytes(_binary_ucd()[:-4])
+    with pytest.raises(vio.ReadError) as info:
+        vio.read(path)
+    assert str(info.value) == (f"{path}: binary AVS UCD: the header's counts (nodes, cells, node fields, cell fields, "
+                               "model fields, connectivity length) [4, 1, 0, 0, 0, 4] need 105 bytes but the file "
+                               "holds 101: it is truncated or the header is wrong")

@@ -27,6 +27,7 @@ from volviz.io.vtkfiles import _run
 from volviz.model import TimeSeries
 
 from volviz_vtk_readers import specs, xdmf
+from volviz_vtk_readers.avscheck import check_avs_ucd
 from volviz_vtk_readers.containers import check_container
 from volviz_vtk_readers.ensightcheck import check_ensight_case
 from volviz_vtk_readers.exodus_check import check_exodus_connectivity
@@ -396,6 +397,7 @@ def read_xdmf(path: PathLike, blocks: Sequence[str] | str | None = None, time_in
 def read_avs_ucd(path: PathLike, allow_nonfinite: bool = True):
     """AVS UCD (.inp, ASCII or binary): the mesh with every node and cell component."""
     p = _check_sniffed(path, specs.is_avs_ucd, "AVS UCD")
+    check_avs_ucd(p)  # VTK's reader reads a file cut within its node or cell lines as other values
     reader = _reader("vtkAVSucdReader", p)
     reader.SetBinaryFile(read_bytes(p, 1) == b"\x07")
     _information(p, reader)
