@@ -73,6 +73,37 @@ def test_fluent_cff_files_apart_or_misnamed_are_refused_or_read_as_the_mesh_with
         vio.read(tmp_path / "cut.cas.h5")
 
 
+def _room_pair(folder):
+    source = data_file("ecosystem/fluent-room")
+    for name in ("room.cas.h5", "room.dat.h5"):
+        shutil.copyfile(source / name, folder / name)
+    return folder / "room.cas.h5", folder / "room.dat.h5"
+
+
+@pytest.mark.parametrize("cut, problem", [
+    (20, "the file holds 20 bytes and ends inside its HDF5 superblock (the end-of-file address is at bytes 40 to "
+         "48): it is truncated"),
+    (8, "the file holds 8 bytes, fewer than an HDF5 superblock: it is truncated")])
+def test_fluent_cff_data_file_cut_inside_its_superblock_refused_naming_it(tmp_path, cut, problem):
+    """Issue #32: VTK's reader read the case alone, without a word, beside a data file cut in its first 48 bytes."""
+    case, data = _room_pair(tmp_path)
+    data.write_bytes(data.read_bytes()[:cut])
+    with pytest.raises(ReadError) as info:
+        vio.read(case)
+    assert str(info.value) == f"{data}: {problem}"
+
+
+def test_fluent_cff_cell_field_length_against_the_case_cells(tmp_path):
+    case, data = _room_pair(tmp_path)
+    with h5py.File(data, "r+", locking=False) as f:
+        del f["results/1/phase-1/cells/SV_T/1"]
+        f["results/1/phase-1/cells/SV_T/1"] = np.zeros(4337, np.float32)
+    with pytest.raises(ReadError) as info:
+        vio.read(case)
+    assert str(info.value) == (f"{data}: cell field /results/1/phase-1/cells/SV_T holds 4337 values but the case "
+                               "room.cas.h5 has 4338 cells")
+
+
 def _volume_file(path, userblock: int = 0):
     f = h5py.File(path, "w", userblock_size=userblock) if userblock else h5py.File(path, "w")
     f["volume"] = VOLUME

@@ -250,18 +250,25 @@ def _cf_notes(variables: list[tuple[str, list[str], dict[str, str]]]) -> list[st
 
 
 def _hdf5_end(path: PathLike, head: bytes) -> int:
-    """The end-of-file address an HDF5 superblock records (0 when the layout is not one we know)."""
+    """The end-of-file address an HDF5 superblock records; ReadError when the superblock is cut short or of a
+    version HDF5 does not write (0 to 3: HDF5 File Format Specification, "Superblock")."""
     version = head[8] if len(head) > 8 else -1
-    if version in (0, 1) and len(head) >= 48:
+    if version in (0, 1) and len(head) > 13:
         width = head[13]
         at = 24 + (4 if version == 1 else 0) + 2 * width
-    elif version in (2, 3) and len(head) >= 48:
+    elif version in (2, 3) and len(head) > 9:
         width = head[9]
         at = 12 + 2 * width
+    elif version == -1 or len(head) < 48:
+        raise ReadError(path, f"the file holds {len(head)} bytes, fewer than an HDF5 superblock: it is truncated")
     else:
-        return 0
+        raise ReadError(path, f"HDF5 superblock version {version} is not one HDF5 writes (0 to 3): the file is "
+                              "damaged")
     if width not in (4, 8):
         raise ReadError(path, f"HDF5 superblock gives {width}-byte offsets")
+    if len(head) < at + width:
+        raise ReadError(path, f"the file holds {len(head)} bytes and ends inside its HDF5 superblock (the end-of-file "
+                              f"address is at bytes {at} to {at + width}): it is truncated")
     return int.from_bytes(head[at:at + width], "little")
 
 

@@ -4,7 +4,9 @@
 VTK's reader finds the data file by replacing the case's ``.cas.h5`` with ``.dat.h5``, so the pair must be named so:
 a case under another name, a data file without its case, or a case without its data are said before VTK runs (the
 last is read, mesh only, with a ReadWarning). Both files are checked against their HDF5 superblock first (a
-truncated file is refused), and the reader runs isolated like every loader of this plugin.
+truncated file is refused), the data file must open as Fluent CFF data and each cell field (``SV_*``) must hold one
+value row per cell of its zone in the case (VTK's reader read a data file cut in its superblock as the case alone),
+and the reader runs isolated like every loader of this plugin.
 """
 from __future__ import annotations
 
@@ -61,7 +63,50 @@ def case_file(path: PathLike) -> Path:
                       stacklevel=3)
     else:
         check_container(data, "Fluent CFF", netcdf=False)
+        if _cff_part(data) != "data":
+            raise ReadError(data, f"is the data file of {p.name} but not Fluent CFF data (no /results beside "
+                                  "/settings)")
+        check_cell_fields(p, data)
     return p
+
+
+def _cell_count(case: Path) -> int | None:
+    """The cells of the case's first mesh: the sum over its cell zones of ``maxId - minId + 1``
+    (``meshes/1/cells/zoneTopology``); None when the case does not say."""
+    import h5py
+    import numpy as np
+
+    with h5py.File(case, "r") as f:
+        topology = f.get("meshes/1/cells/zoneTopology")
+        if not isinstance(topology, h5py.Group) or not {"minId", "maxId"} <= set(topology):
+            return None
+        lo, hi = (np.asarray(topology[k][()], dtype=np.int64).reshape(-1) for k in ("minId", "maxId"))
+    return int((hi - lo + 1).sum()) if lo.shape == hi.shape else None
+
+
+def check_cell_fields(case: Path, data: Path) -> None:
+    """Every cell field of the data file (``results/1/<phase>/cells/SV_*``, one dataset per zone section) holds one
+    row per cell of the case in all: VTK's reader takes a field of another length without a word."""
+    import h5py
+
+    cells = _cell_count(case)
+    if cells is None:
+        return
+    try:
+        with h5py.File(data, "r") as f:
+            results = f.get("results/1")
+            for phase in results.values() if isinstance(results, h5py.Group) else []:
+                fields = phase.get("cells") if isinstance(phase, h5py.Group) else None
+                for name, field in fields.items() if isinstance(fields, h5py.Group) else []:
+                    if not isinstance(field, h5py.Group):
+                        continue
+                    rows = sum(v.shape[0] for v in field.values() if isinstance(v, h5py.Dataset) and v.shape)
+                    if rows != cells:
+                        raise ReadError(data, f"cell field {field.name} holds {rows} values but the case "
+                                              f"{case.name} has {cells} cells")
+    except (OSError, RuntimeError, ValueError, KeyError, TypeError) as exc:
+        raise ReadError(data, f"the HDF5 library could not read its cell fields ({type(exc).__name__}: "
+                              f"{str(exc)[:200]})") from None
 
 
 def fluent_cff_reader(path: PathLike) -> Any:
