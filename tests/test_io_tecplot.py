@@ -77,3 +77,18 @@ def test_the_cli_says_one_line_and_exits_non_zero(tmp_path, capsys):
         err = capsys.readouterr().err.strip()
         assert err.count("\n") == 0 and f"{cut}: zone 1 (block)" in err and "truncated" in err
     assert not (tmp_path / "x.png").exists()
+
+
+@pytest.mark.parametrize("old, new, problem", [
+    # the campaign's field: the '-6' of VARLOCATION's [4,5-6] set to -2147483648 (1.37 s, then VTK's memory limit)
+    (b"5-6", b"5-2147483648", "zone 1 (ZONE1), at line 3: VARLOCATION names variables 5-2147483648 but the file has "
+                              "7 variables (1 to 7)"),
+    (b"N=4", b"N=-2147483648", "zone 1 (ZONE1), at line 3: N=-2147483648; a count cannot be negative"),
+    (b"I=2", b"I=-1", "zone 2 (ZONE2), at line 10: I=-1; a count cannot be negative"),
+], ids=["varlocation", "nodes", "ordered"])
+def test_nonsensical_zone_counts_are_refused_before_vtk(tmp_path, old, new, problem):
+    path = tmp_path / "cellcentered.tec"
+    path.write_bytes(data_file("ecosystem/cellcentered.tec").read_bytes().replace(old, new, 1))
+    with pytest.raises(ReadError) as info:
+        vio.read(path)
+    assert str(info.value) == f"{path}: {problem}"

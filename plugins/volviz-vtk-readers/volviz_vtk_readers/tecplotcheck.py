@@ -34,21 +34,27 @@ class _Zone:
     values: int = 0
 
 
-def _cell_centred(varlocation: str, n_vars: int) -> set[int]:
-    """The 0-based indices of the variables ``VARLOCATION=([4,5-6]=CELLCENTERED, ...)`` makes cell-centred."""
+def _cell_centred(path: Path, zone: _Zone, varlocation: str, n_vars: int) -> set[int]:
+    """The 0-based indices of the variables ``VARLOCATION=([4,5-6]=CELLCENTERED, ...)`` makes cell-centred; a
+    variable number outside 1..n_vars is refused (a range up to 2^31 once took seconds and gigabytes here)."""
     found: set[int] = set()
     for group, where in re.findall(r"\[([^\]]*)\]\s*=\s*(\w+)", varlocation):
-        if where.upper() != "CELLCENTERED":
-            continue
         for part in group.split(","):
             lo, _, hi = part.strip().partition("-")
-            if lo.strip().isdigit() and (not hi or hi.strip().isdigit()):
-                found.update(range(int(lo) - 1, int(hi or lo)))
-    return {i for i in found if 0 <= i < n_vars}
+            if not lo.strip().isdigit() or (hi and not hi.strip().isdigit()):
+                continue
+            first, last = int(lo), int(hi or lo)
+            if not 1 <= first <= last <= n_vars:
+                raise ReadError(path, f"{zone.title}, at line {zone.line}: VARLOCATION names variables "
+                                      f"{part.strip()} but the file has {n_vars} variables (1 to {n_vars})")
+            if where.upper() == "CELLCENTERED":
+                found.update(range(first - 1, last))
+    return found
 
 
-def _needed(zone: _Zone, n_vars: int) -> tuple[int, str] | None:
-    """(values the zone's header asks for, what they are in words), or None when this check cannot tell."""
+def _needed(path: Path, zone: _Zone, n_vars: int) -> tuple[int, str] | None:
+    """(values the zone's header asks for, what they are in words), or None when this check cannot tell; a
+    negative count is refused (VTK's reader ran out of memory or time on one)."""
     params = {k.upper(): v.strip('"') for k, v in _PARAM.findall(zone.header)}
     if any(k in params for k in _UNCHECKED):
         return None
@@ -68,9 +74,13 @@ def _needed(zone: _Zone, n_vars: int) -> tuple[int, str] | None:
             return None
     except ValueError:
         return None
-    if points < 0 or cells < 0 or packing not in ("POINT", "BLOCK", "FEPOINT", "FEBLOCK"):
+    counts = {k: params[k] for k in ("I", "J", "K", "NODES", "N", "ELEMENTS", "E") if k in params}
+    for key, value in counts.items():
+        if value.lstrip("-").isdigit() and int(value) < 0:
+            raise ReadError(path, f"{zone.title}, at line {zone.line}: {key}={value}; a count cannot be negative")
+    if packing not in ("POINT", "BLOCK", "FEPOINT", "FEBLOCK"):
         return None
-    centred = _cell_centred(params.get("VARLOCATION", ""), n_vars) if "BLOCK" in packing else set()
+    centred = _cell_centred(path, zone, params.get("VARLOCATION", ""), n_vars) if "BLOCK" in packing else set()
     values = sum(cells if i in centred else points for i in range(n_vars)) + cells * per_cell
     return values, f"{n_vars} variables on {shape}" + (" and their connectivity" if per_cell else "")
 
@@ -128,7 +138,7 @@ def check_tecplot_zones(path: PathLike, max_bytes: int = 1 << 31) -> None:
     for index, zone in enumerate(zones, 1):
         m = re.search(r'\bT\s*=\s*"([^"]*)"', zone.header)
         zone.title = f"zone {index}" + (f" ({m.group(1)})" if m else "")
-        needed = _needed(zone, n_vars) if n_vars else None
+        needed = _needed(p, zone, n_vars) if n_vars else None
         if zone.values == 0:
             raise ReadError(p, f"{zone.title}, at line {zone.line}, holds no values: the file is truncated",
                             "write the file again completely")
