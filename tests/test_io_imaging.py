@@ -572,6 +572,32 @@ def test_mutated_minc_files_read_consistently_or_raise_read_error(tmp_path):
         assert read_mutations(path, mutations, truncated_reads_same=False) >= 12
 
 
+@pytest.mark.parametrize("edit, problem", [
+    # the header cut inside the 'image' variable's record: nibabel said "IndexError: index 0 is out of bounds ..."
+    (lambda data: data[:100], "MINC 1: its netCDF header does not parse: a variable's record (name, dimensions, "
+                              "attributes, type, size and offset) is damaged (IndexError); the file is truncated or "
+                              "corrupt"),
+    (lambda data: data.replace(b"signtype", b"signt}pe"),
+     "MINC 1: the image's signtype is None, not 'signed__' or 'unsigned'"),
+    (lambda data: data.replace(b"image-max", b"image-mbx"),
+     "MINC 1: the image has no 'image-max' / 'image-min' pair (its value scaling)"),
+    (lambda data: data.replace(b"regular__", b"regulaR__", 1),
+     "MINC 1: dimension variable 'zspace' has spacing b'regulaR__'; volviz reads 'regular__' only (nibabel's MINC "
+     "reader needs it)"),
+], ids=["header-cut", "signtype", "image-max", "spacing"])
+def test_a_damaged_minc1_header_is_refused_in_minc_terms(tmp_path, edit, problem):
+    """Issue #32: these reached the user as nibabel's IndexError, KeyError or AttributeError text alone."""
+    from volviz.bench.robustness_formats import _minc1
+
+    _minc1(tmp_path, "int16")
+    path = tmp_path / "brain.mnc"
+    assert vio.read(path).data.shape == (4, 5, 6)
+    path.write_bytes(edit(path.read_bytes()))
+    with pytest.raises(ReadError) as info:
+        vio.read(path)
+    assert str(info.value) == f"{path}: {problem}"
+
+
 # -- Gaussian cube -----------------------------------------------------------------------------------------------------
 BOHR = 0.529177210903
 

@@ -8,15 +8,21 @@ minc-toolkit output) through nibabel.
   is shown; ``time_index=i`` reads one. A ``vector_dimension`` (RGB, displacement) gives components.
 - Before any voxel is read, the data size is held against the file: a MINC 2 dataset may be compressed, so it must
   be one the file could inflate to.
+- A MINC 1 file's netCDF header and MINC structure are checked before nibabel interprets them (issue #32: nibabel
+  answered a damaged file with "IndexError: list index out of range" and the like): a header that does not parse is
+  refused naming the part of the netCDF header (MINC 1 Programmer's Guide, "An Introduction to NetCDF") where it
+  broke; a missing ``image`` variable, dimension variable, ``spacing`` / ``signtype`` attribute, or ``image-max`` /
+  ``image-min`` pair is refused by name (Guide, "Image dimensions", "Image conversion variables").
 """
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from volviz.io._checks import file_size
+from volviz.io._checks import check_file, file_size, read_bytes
 from volviz.io.errors import PathLike, ReadError, human_bytes
 from volviz.io.metaimage import DEFLATE_MAX_RATIO
 from volviz.model import RegularVolume, TimeSeries
@@ -33,9 +39,69 @@ def dimension_names(img: Any) -> list[str]:
     return [n.decode() if isinstance(n, bytes) else str(n) for n in names]
 
 
+#: nibabel's netCDF reader's steps, innermost first, and the part of a netCDF classic header each reads
+_NETCDF_PARTS = (("_read_att_values", "an attribute's values"), ("_read_var", "a variable's record (name, "
+                 "dimensions, attributes, type, size and offset)"), ("_read_att_array", "an attribute list"),
+                 ("_read_gatt_array", "the global attributes"), ("_read_dim_array", "the dimension list"),
+                 ("_read_var_array", "the variable list"), ("_read_numrecs", "the record count"))
+_SIGNTYPES = (b"signed__", b"unsigned")
+
+
+def _netcdf_part(exc: BaseException) -> str:
+    """The part of the netCDF header nibabel's reader was in when ``exc`` stopped it."""
+    names = set()
+    tb = exc.__traceback__
+    while tb is not None:
+        names.add(tb.tb_frame.f_code.co_name)
+        tb = tb.tb_next
+    return next((part for name, part in _NETCDF_PARTS if name in names), "its header")
+
+
+def check_minc1(path: PathLike) -> None:
+    """ReadError in MINC's terms when a MINC 1 (netCDF classic) file's header does not parse or lacks what a MINC
+    image needs (see the module)."""
+    from nibabel.externals.netcdf import netcdf_file
+
+    try:
+        f = netcdf_file(str(path), "r", mmap=False) if file_size(path) < (64 << 20) else netcdf_file(str(path), "r")
+    except Exception as exc:                    # noqa: BLE001 - any failure of the header parse is the file's
+        raise ReadError(path, f"MINC 1: its netCDF header does not parse: {_netcdf_part(exc)} is damaged "
+                              f"({type(exc).__name__}); the file is truncated or corrupt") from None
+    try:
+        variables = f.variables
+        image = variables.get("image")
+        if image is None:
+            raise ReadError(path, f"MINC 1: no 'image' variable (the file holds {', '.join(variables) or 'none'})")
+        for dim in image.dimensions:
+            var = variables.get(dim)
+            if var is None:
+                raise ReadError(path, f"MINC 1: the image's dimension {dim!r} has no dimension variable")
+            spacing = getattr(var, "spacing", None)
+            if spacing != b"regular__":
+                raise ReadError(path, f"MINC 1: dimension variable {dim!r} has spacing {spacing!r}; volviz reads "
+                                      "'regular__' only (nibabel's MINC reader needs it)")
+        if image.typecode() not in "fd" and getattr(image, "signtype", None) not in _SIGNTYPES:
+            raise ReadError(path, f"MINC 1: the image's signtype is {getattr(image, 'signtype', None)!r}, not "
+                                  "'signed__' or 'unsigned'")
+        high, low = variables.get("image-max"), variables.get("image-min")
+        if high is None or low is None:
+            raise ReadError(path, "MINC 1: the image has no 'image-max' / 'image-min' pair (its value scaling)")
+        dims, image_dims = tuple(high.dimensions), tuple(image.dimensions)
+        if dims != tuple(low.dimensions) or dims != image_dims[:len(dims)] or len(dims) > len(image_dims) - 2:
+            raise ReadError(path, f"MINC 1: image-max's dimensions {dims} and image-min's {tuple(low.dimensions)} "
+                                  f"must be the same leading dimensions of the image's {image_dims}, without its "
+                                  "last two")
+    finally:
+        with warnings.catch_warnings():          # mmap'ed (files over 64 MiB): the map goes with its last view
+            warnings.simplefilter("ignore", RuntimeWarning)
+            f.close()
+
+
 def read_minc(path: PathLike, time_index: int | None = None,
               allow_nonfinite: bool = True) -> RegularVolume | TimeSeries:
     """A MINC volume, or its time dimension as a time series (see the module)."""
+    if read_bytes(check_file(path), 4)[:3] == b"CDF":
+        check_minc1(path)
     img = load_image(path, "MINC")
     shape = tuple(int(n) for n in img.shape)
     names = dimension_names(img)
