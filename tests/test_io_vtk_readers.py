@@ -376,7 +376,7 @@ def test_ensight_time_values_against_number_of_steps(tmp_path):
     assert _ensight_refusal(case) == f"{case}: time set 1: 'number of steps' is 3 but 'time values' holds 2 values"
 
 
-def test_ensight_wildcard_names_a_missing_step_file(tmp_path):
+def test_ensight_wildcard_steps_each_checked_then_read_as_a_series(tmp_path):
     case = _ensight_case(tmp_path, "FORMAT\ntype: ensight gold\nGEOMETRY\nmodel: mesh.geo\nVARIABLE\n"
                                    "scalar per node: 1 temperature temp.scl**\nTIME\ntime set: 1\n"
                                    "number of steps: 2\nfilename start number: 0\nfilename increment: 1\n"
@@ -384,6 +384,11 @@ def test_ensight_wildcard_names_a_missing_step_file(tmp_path):
     (tmp_path / "temp.scl00").write_bytes((tmp_path / "temp.scl").read_bytes())
     assert _ensight_refusal(case) == (f"{case}: the variable file temp.scl01 (VARIABLE scalar per node "
                                       "'temp.scl**') does not exist")
+    (tmp_path / "temp.scl01").write_text((tmp_path / "temp.scl").read_text().replace("0.00000e+00", "1.00000e+01"))
+    series = vio.read(case)                                 # both steps there: read as VTK reads them
+    assert isinstance(series, TimeSeries) and list(series.times) == [0.0, 1.0]
+    first, second = series.frame(0), series.frame(1)
+    assert first.point_data["temperature"][0] == 0.0 and second.point_data["temperature"][0] == 10.0
 
 
 def test_ensight_variable_cut_short_refused_naming_the_part(tmp_path):

@@ -30,7 +30,7 @@ _TIME_KEYS = {"time set", "number of steps", "filename start number", "filename 
               "time values", "filename numbers file", "time values file"}
 _VARIABLE = re.compile(r"(constant per case( file)?|(complex )?(scalar|vector|tensor symm|tensor asym|tensor9)"
                        r" per (measured )?(node|element))$")
-_CONTROL = re.compile(r"[\x00-\x08\x0b-\x1f\x7f-\xff]")    # none in a case file VTK reads as meant
+_CONTROL = re.compile(r"[\x00-\x08\x0b-\x1f\x7f]")    # none in a case file VTK reads as meant
 _COMPONENTS = {"scalar": 1, "vector": 3, "tensor symm": 6, "tensor asym": 9, "tensor9": 9}
 NODES_PER_ELEMENT = {"point": 1, "bar2": 2, "bar3": 3, "tria3": 3, "tria6": 6, "quad4": 4, "quad8": 8,
                      "tetra4": 4, "tetra10": 10, "pyramid5": 5, "pyramid13": 13, "penta6": 6, "penta15": 15,
@@ -46,6 +46,7 @@ class TimeSet:
     increment: int = 1
     numbers: list[int] = field(default_factory=list)
     values: list[float] = field(default_factory=list)
+    external: bool = False                              # numbers or values in a file of their own: not checked
 
 
 @dataclass
@@ -149,6 +150,8 @@ def parse_case(path: PathLike) -> Case:
                 t.increment = _int(p, rest, f"time set {ts}: 'filename increment'")
             elif key in ("time values", "filename numbers"):
                 _continue_list(p, t, key, rest, number)
+            else:                                        # 'time values file:' / 'filename numbers file:'
+                t.external = True
         elif section in ("FILE", "MATERIAL", "BLOCK_CONTINUATION", "SCRIPTS") and section:
             case.file_sets = case.file_sets or section == "FILE"
         else:
@@ -159,6 +162,8 @@ def parse_case(path: PathLike) -> Case:
     if case.geometry is None:
         raise ReadError(p, "the case file names no geometry (no GEOMETRY 'model:' line)")
     for number, t in case.times.items():
+        if t.external:
+            continue
         if len(t.values) != t.steps:
             raise ReadError(p, f"time set {number}: 'number of steps' is {t.steps} but 'time values' holds "
                                f"{len(t.values)} values")
@@ -187,6 +192,8 @@ def file_names(p: Path, case: Case, time_set: int | None, name: str, what: str) 
     if time_set not in case.times:
         raise ReadError(p, f"the {what} file name {name!r} has a '*' wildcard but time set {time_set} is not defined")
     t = case.times[time_set]
+    if t.external:
+        return []
     numbers = t.numbers or [t.start + i * t.increment for i in range(t.steps)]
     stars = re.search(r"\*+", name)
     assert stars is not None
