@@ -482,3 +482,11 @@ def test_avs_ucd_binary_size_against_its_counts(tmp_path):
     assert str(info.value) == (f"{path}: binary AVS UCD: the header's counts (nodes, cells, node fields, cell fields, "
                                "model fields, connectivity length) [4, 1, 0, 0, 0, 4] need 105 bytes but the file "
                                "holds 101: it is truncated or the header is wrong")
+
+
+def test_ensight_case_cut_after_a_section_name_refused(tmp_path):
+    """The campaign's cut at byte 62 of 100 ('VARIABLE' and its line end): VTK's reader read the geometry alone."""
+    case = _ensight_case(tmp_path)
+    case.write_bytes(case.read_bytes()[:62])
+    assert _ensight_refusal(case) == (f"{case}: the case file's VARIABLE section is empty: the file is cut after its "
+                                      "name or damaged")

@@ -89,7 +89,7 @@ def parse_case(path: PathLike) -> Case:
     """The case file's contents, every line known or a ReadError naming the line."""
     p = Path(path)
     case, section, last_key, ts = Case(), "", "", None
-    fmt = ""
+    fmt, entries = "", 0
     for number, raw in enumerate(p.read_text(encoding="latin-1").split("\n"), 1):
         line = raw.split("#", 1)[0].strip(" \t\r")
         bad = _CONTROL.search(line)
@@ -99,7 +99,8 @@ def parse_case(path: PathLike) -> Case:
             continue
         if ":" not in line:
             if line in _SECTIONS:
-                section, last_key = line, ""
+                _check_not_empty(p, section, entries)
+                section, last_key, entries = line, "", 0
                 continue
             if section == "TIME" and last_key in ("time values", "filename numbers") and ts is not None:
                 _continue_list(p, case.times[ts], last_key, line, number)
@@ -107,6 +108,7 @@ def parse_case(path: PathLike) -> Case:
             raise ReadError(p, f"line {number} of the case file ({line[:40]!r}) is neither a section nor a "
                                "'key: value' line")
         key, rest = (s.strip(" \t") for s in line.split(":", 1))
+        entries += 1
         if rest and line[len(line.split(":", 1)[0]) + 1] not in " \t":
             raise ReadError(p, f"line {number} of the case file ({line[:40]!r}) has no space after its ':'")
         key = " ".join(_words(key))
@@ -157,6 +159,7 @@ def parse_case(path: PathLike) -> Case:
         else:
             raise ReadError(p, f"line {number} of the case file: {key!r} is not a key of the "
                                f"{section or 'missing'} section")
+    _check_not_empty(p, section, entries)
     if not fmt:
         raise ReadError(p, "the case file has no FORMAT 'type:' line")
     if case.geometry is None:
@@ -171,6 +174,12 @@ def parse_case(path: PathLike) -> Case:
             raise ReadError(p, f"time set {number}: 'number of steps' is {t.steps} but 'filename numbers' holds "
                                f"{len(t.numbers)} numbers")
     return case
+
+
+def _check_not_empty(p: Path, section: str, entries: int) -> None:
+    """A section holds a line: a case file cut right after a section's name reads as one without it."""
+    if section and not entries:
+        raise ReadError(p, f"the case file's {section} section is empty: the file is cut after its name or damaged")
 
 
 def _continue_list(p: Path, t: TimeSet, key: str, text: str, line: int) -> None:
