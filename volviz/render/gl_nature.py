@@ -239,11 +239,12 @@ class CloudPTVolume(GLPTVolume):
         self._sorted = update.order.astype(np.int64)
         self._sorted_key = self._order_key = None
 
-    def _set_index_buffer(self, cells: np.ndarray) -> None:
-        """Draw the slots ``cells`` in this order from the next render on: one point each (32-bit indices shared
-        with VTK, kept referenced here)."""
+    def _set_index_buffer(self, order: np.ndarray, visible: np.ndarray) -> np.ndarray:
+        """Draw the slots of ``order`` with ``visible[slot]`` in this order from the next render on, one point each
+        (32-bit indices shared with VTK, kept referenced here); returns them."""
         from volviz.render.vtk_facade import numpy_to_vtk, vtk
 
+        cells = order[visible[order]]
         conn = np.ascontiguousarray(cells, dtype=np.int32)
         offsets = np.arange(len(conn) + 1, dtype=np.int32)
         self._cell_arrays = (offsets, conn)
@@ -251,6 +252,7 @@ class CloudPTVolume(GLPTVolume):
         verts.SetData(numpy_to_vtk(offsets, deep=False), numpy_to_vtk(conn, deep=False))
         self.polydata.SetVerts(verts)
         self.polydata.Modified()
+        return cells
 
     def _texture(self, name: str, texels: np.ndarray, ren_win: Any) -> None:
         """(Re)make the 2D-emulated texel array ``name`` from ``texels`` (n, components) float32."""

@@ -89,13 +89,14 @@ import numpy as np
 
 from volviz.model.datasets import TetMesh
 from volviz.render.gl import ScenePass, resolve_polydata, set_ray_uniforms, shader_source
-from volviz.render.gl_pt_mesh import tet_polydata, triangles
+from volviz.render.gl_pt_mesh import tet_polydata
 from volviz.render.gl_pt_order import CellOrder
 from volviz.render.gl_pt_tables import KINDS, pt_shader, resolve_shader, set_table_uniforms, upload_table
 from volviz.render.gl_pt_targets import PTTargets
 from volviz.render.image_overlay import hold_single_sample, release_single_sample, window_size
 from volviz.render.pt_view import PTView
 from volviz.render.reduced_fill import INTERACTIVE_PIXELS, reduced_size, scaled_rays
+from volviz.unstructured.index_buffer import IndexBuffer
 from volviz.unstructured.iso import iso_visible
 from volviz.unstructured.topology import topology, visible_cells
 
@@ -156,8 +157,7 @@ class GLPTVolume(CellOrder, PTView):
         self.lookup, self.n_s, self.n_l, self.degree = lookup, n_s, n_l, degree
         self.stats: dict[str, Any] = {"method": "pt-gl"}
         self.camera: Any = None
-        self._offsets: np.ndarray | None = None     # 0, 3, 6, ...: the index buffer's triangle offsets
-        self._cell_arrays: tuple[np.ndarray, np.ndarray] | None = None   # the arrays VTK's cells share
+        self._index_buffer: IndexBuffer | None = None   # the arrays VTK's cells share, refilled per order
         self._table: Any = None
         self._table_tex: Any = None
         self.targets = PTTargets(self.renderer)     # the cells' float target and the opaque depth's copies
@@ -236,18 +236,19 @@ class GLPTVolume(CellOrder, PTView):
         self.camera = self._camera()
         self._order_frame(self.camera, size)
 
-    def _set_index_buffer(self, cells: np.ndarray) -> None:
-        """Draw ``cells`` back to front (4 triangles each) from the next render on: the polydata's cells are 32-bit
-        numpy arrays shared with VTK (kept referenced here), VTK builds and uploads the index buffer from them."""
+    def _set_index_buffer(self, order: np.ndarray, visible: np.ndarray) -> np.ndarray:
+        """Draw the cells of ``order`` with ``visible[cell]`` back to front (4 triangles each) from the next render
+        on; returns them. The cull and the 32-bit triangles are one Numba pass into arrays kept between frames
+        (``volviz.unstructured.index_buffer``) and shared with VTK, which builds and uploads the index buffer from
+        them; they are refilled only here, between renders."""
         from volviz.render.vtk_facade import numpy_to_vtk
 
-        if self.topo.n_tets * 4 >= 2 ** 31:
-            raise ValueError("too many tetrahedra for 32-bit vertex indices")
-        offsets, conn = triangles(cells, self._offsets)
-        self._offsets = offsets.base if offsets.base is not None else offsets
-        self._cell_arrays = (offsets, conn)
+        if self._index_buffer is None:
+            self._index_buffer = IndexBuffer(self.topo.n_tets)   # refuses meshes beyond 32-bit vertex indices
+        offsets, conn, cells = self._index_buffer.fill(order, visible)
         self.polydata.GetPolys().SetData(numpy_to_vtk(offsets, deep=False), numpy_to_vtk(conn, deep=False))
         self.polydata.Modified()
+        return cells.copy()     # the buffer's cells are overwritten by the next order
 
     def _on_end(self, *_: Any) -> None:
         self.targets.restore()                     # only if the resolve did not draw

@@ -1,7 +1,6 @@
-"""The GPU PT pass's vertex and index buffers (Roettger Ch. 8-9; ``volviz.render.gl_pt``): the static vertex buffer,
-4 vertices per tetrahedron each carrying its cell's face planes, scalar form and range (relative to the mesh's
-centre: meshes offset by 1e6 keep their precision), uploaded once; and per order the index buffer, 4 triangles per
-cell in back-to-front order, as 32-bit arrays VTK shares without a copy."""
+"""The GPU PT pass's static vertex buffer (Roettger Ch. 8-9; ``volviz.render.gl_pt``): 4 vertices per tetrahedron,
+each carrying its cell's face planes, scalar form and range (relative to the mesh's centre: meshes offset by 1e6 keep
+their precision), uploaded once. The index buffer, made per order, is ``volviz.unstructured.index_buffer``'s."""
 from __future__ import annotations
 
 from typing import Any
@@ -9,9 +8,9 @@ from typing import Any
 import numpy as np
 
 from volviz.model.datasets import TetMesh
-from volviz.unstructured.topology import FACES, cell_ranges, topology
+from volviz.unstructured.topology import cell_ranges, topology
 
-__all__ = ["cell_attributes", "tet_polydata", "triangles"]
+__all__ = ["cell_attributes", "tet_polydata"]
 
 
 def cell_attributes(mesh: TetMesh, smooth: bool = False) -> dict[str, np.ndarray]:
@@ -62,13 +61,3 @@ def tet_polydata(mesh: TetMesh, smooth: bool = False) -> Any:
     pd.SetPolys(vtk.vtkCellArray())
     return pd
 
-
-def triangles(cells: np.ndarray, offsets: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """(offsets, connectivity), int32, of the 4 faces of each cell in ``cells`` (in that order), for
-    vtkCellArray.SetData; ``offsets``: 0, 3, 6, ... for at least as many triangles, sliced instead of made. 32-bit
-    arrays handed to VTK without a copy: 3 ms for the Blunt Fin's 750,000 triangles, 28 ms with 64-bit copies."""
-    conn = ((4 * cells.astype(np.int32))[:, None] + FACES.reshape(1, 12).astype(np.int32)).reshape(-1)
-    n = len(conn) // 3 + 1
-    if offsets is None or len(offsets) < n:
-        offsets = np.arange(0, 3 * n, 3, dtype=np.int32)
-    return offsets[:n], conn

@@ -26,7 +26,8 @@ def order_key(cam: Camera, size: tuple[int, ...]) -> tuple[Any, ...]:
 class CellOrder:
     """The order state of a volume drawn in ``renderer`` (a base of ``GLPTVolume``): it sorts the cells of ``topo``
     (the volume's ``mesh``'s topology) with ``sort`` / ``nonconvex`` (as ``visibility_order``) and hands the
-    visible ones (``_vis``) in that order to ``_set_index_buffer``, which the volume defines.
+    order with the cells' visibility (``_vis``) to ``_set_index_buffer``, which the volume defines: it draws the
+    visible ones in that order and returns them.
 
     ``order``: the cells drawn, back to front; ``reuse_order = True`` never sorts in a render: it draws the newest
     order it has. ``follows_camera``: during an interaction each frame starts its camera's sort (``_follow``);
@@ -58,7 +59,7 @@ class CellOrder:
         self._frame_key: Any = None
         self._frame_sort: tuple[int, Camera, tuple[int, int]] | None = None   # the frame sort on the worker
 
-    def _set_index_buffer(self, cells: np.ndarray) -> None:
+    def _set_index_buffer(self, order: np.ndarray, visible: np.ndarray) -> np.ndarray:
         raise NotImplementedError
 
     def _camera(self) -> Camera:
@@ -95,8 +96,7 @@ class CellOrder:
         self._recull = False
         t1 = time.perf_counter()
         assert self._sorted is not None  # this order, a prefetched one, a fresh sort or the earlier one reused
-        cells = self._sorted[self._vis[self._sorted]]
-        self._set_index_buffer(cells)
+        cells = self._set_index_buffer(self._sorted, self._vis)
         self.order, self._order_key = cells, key
         self.stats = {"method": "pt-gl", "sort_s": t1 - t0, "order_s": time.perf_counter() - t1,
                       "n_visible": int(len(cells)), "cycles": self._cycles, "sorted": res is not None,
