@@ -314,7 +314,8 @@ class _GLFrames:
         if view.clouds is not None and view.clouds.order is not None:
             from volviz.render.cloud_slots import RESERVED
 
-            view.clouds._set_index_buffer(view.clouds.order[:RESERVED + 1])   # the reserved slots and one leaf
+            first = view.clouds.order[:RESERVED + 1]                           # the reserved slots and one leaf
+            view.clouds._set_index_buffer(first, np.ones(int(first.max()) + 1, bool))
 
     def image(self, cam: Any) -> np.ndarray:
         """One frame of the GPU backend for ``cam`` in the large window (RGB in [0, 1]), untimed."""

@@ -195,7 +195,7 @@ def _timed_render(pl: Any) -> float:
 
 def _one_cell_order(vol: Any) -> None:
     """Draw only the first cell of ``vol``'s order (the 4 triangles of one tetrahedron) until the camera changes."""
-    vol._set_index_buffer(vol.order[:1])
+    vol._set_index_buffer(vol.order[:1], np.ones(vol.topo.n_tets, bool))
 
 
 def main(argv: list[str] | None = None) -> int:
