@@ -490,3 +490,12 @@ def test_ensight_case_cut_after_a_section_name_refused(tmp_path):
     case.write_bytes(case.read_bytes()[:62])
     assert _ensight_refusal(case) == (f"{case}: the case file's VARIABLE section is empty: the file is cut after its "
                                       "name or damaged")
+
+
+def test_ensight_variable_file_without_a_part_refused(tmp_path):
+    """The re-run's temp.scl cut at byte 12, inside its description line: VTK's reader read the mesh without it."""
+    case = _ensight_case(tmp_path)
+    scl = tmp_path / "temp.scl"
+    scl.write_bytes(scl.read_bytes()[:12])
+    assert _ensight_refusal(case) == (f"{scl}: holds its description line and no part (the geometry has parts [1]): "
+                                      "the file is truncated")

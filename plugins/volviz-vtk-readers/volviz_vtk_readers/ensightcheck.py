@@ -407,6 +407,9 @@ def check_variable(path: Path, kind: str, parts: dict[int, Part], binary: bool) 
     f: _Lines | _Bytes = _Bytes(path) if binary else _Lines(path)
     f.word("the description")
     f.before_parts(80)
+    if not f.more():
+        raise ReadError(path, f"holds its description line and no part (the geometry has parts {sorted(parts)}): "
+                              "the file is truncated")
     while f.more():
         line = f.word("'part'")
         if line.lower() != "part":
