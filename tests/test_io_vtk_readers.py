@@ -499,3 +499,11 @@ def test_ensight_variable_file_without_a_part_refused(tmp_path):
     scl.write_bytes(scl.read_bytes()[:12])
     assert _ensight_refusal(case) == (f"{scl}: holds its description line and no part (the geometry has parts [1]): "
                                       "the file is truncated")
+
+
+def test_ensight_geometry_part_without_elements_refused(tmp_path):
+    """The re-run's mesh.geo cut at byte 436, in its last coordinate: VTK's reader made 8 vertex cells of it."""
+    case = _ensight_case(tmp_path)
+    geo = tmp_path / "mesh.geo"
+    geo.write_bytes(geo.read_bytes()[:436])
+    assert _ensight_refusal(case) == f"{geo}: ends where part 1's first element type should be: the file is truncated"

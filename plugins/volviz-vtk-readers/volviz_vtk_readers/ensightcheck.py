@@ -357,10 +357,10 @@ def _walk_geometry(f: _Lines | _Bytes) -> dict[int, Part]:
             raise ReadError(path, f"{f.where()} is {kind[:40]!r} where part {number}'s 'coordinates' should be")
         part = parts[number] = Part(f.count(f"part {number}'s node count"))
         f.values(part.nodes * (4 if given_nodes else 3), f"part {number}'s {part.nodes} nodes")
-        while f.more():
-            line = f.word("an element type")
+        while f.more() or not part.elements:             # a part holds at least one element block
+            line = f.word(f"part {number}'s first element type")
             kind = line.lower()
-            if kind == "part":
+            if kind == "part" and part.elements:
                 break
             if kind in _UNCHECKED_ELEMENTS:
                 part.checked = False
