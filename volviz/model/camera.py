@@ -14,13 +14,33 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, Sequence, Union
+from typing import TYPE_CHECKING, Any, Protocol, Sequence, Union
 
 import numpy as np
 
 if TYPE_CHECKING:   # type-only imports for the signatures
     import pyvista as pv
-    from vtkmodules.vtkRenderingCore import vtkCamera
+
+
+class VtkCamera(Protocol):
+    """What ``Camera`` reads and sets of a VTK camera (a ``vtkCamera`` or ``pyvista.Camera``): the model layer names
+    no VTK rendering class (tests/test_layering_rendering.py)."""
+
+    def GetPosition(self) -> Sequence[float]: ...
+    def GetFocalPoint(self) -> Sequence[float]: ...
+    def GetViewUp(self) -> Sequence[float]: ...
+    def GetViewAngle(self) -> float: ...
+    def GetParallelProjection(self) -> int: ...
+    def GetParallelScale(self) -> float: ...
+    def GetClippingRange(self) -> Sequence[float]: ...
+    def SetPosition(self, x: float, y: float, z: float, /) -> None: ...
+    def SetFocalPoint(self, x: float, y: float, z: float, /) -> None: ...
+    def SetViewUp(self, x: float, y: float, z: float, /) -> None: ...
+    def SetViewAngle(self, angle: float, /) -> None: ...
+    def SetParallelProjection(self, on: int, /) -> None: ...
+    def SetParallelScale(self, scale: float, /) -> None: ...
+    def SetClippingRange(self, near: float, far: float, /) -> None: ...
+    def OrthogonalizeViewUp(self) -> None: ...
 
 
 def _unit(v: np.ndarray, what: str) -> np.ndarray:
@@ -120,14 +140,14 @@ class Camera:
 
     # --- VTK / PyVista interop ---------------------------------------------------------------------------------
     @classmethod
-    def from_pyvista(cls, camera: Union[pv.Camera, vtkCamera]) -> "Camera":
+    def from_pyvista(cls, camera: Union[pv.Camera, VtkCamera]) -> "Camera":
         """From a ``pyvista.Camera`` or any ``vtkCamera`` (horizontal view angles are refused)."""
         if hasattr(camera, "GetUseHorizontalViewAngle") and camera.GetUseHorizontalViewAngle():
             raise ValueError("cameras with a horizontal view angle are not supported")
         return cls(camera.GetPosition(), camera.GetFocalPoint(), camera.GetViewUp(), camera.GetViewAngle(),
                    bool(camera.GetParallelProjection()), camera.GetParallelScale(), tuple(camera.GetClippingRange()))
 
-    def apply_to(self, vtk_camera: Union[pv.Camera, vtkCamera]) -> None:
+    def apply_to(self, vtk_camera: Union[pv.Camera, VtkCamera]) -> None:
         """Set a ``vtkCamera`` (or ``pyvista.Camera``) to this camera."""
         vtk_camera.SetPosition(*self.position)
         vtk_camera.SetFocalPoint(*self.focal_point)

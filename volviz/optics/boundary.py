@@ -20,6 +20,7 @@ in the grid's own units; h is the derivative of |∇f| along ∇f, which equals 
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any, Optional, Sequence
 
@@ -126,7 +127,7 @@ def boundary_profile(fields: Sequence[np.ndarray], spacing: Sequence[float], lo:
         return None
     g_max = float(np.nanmax(np.where(reliable, g, np.nan)))
     h_max = float(np.nanmax(np.where(reliable, np.abs(h), np.nan)))
-    sigma = g_max / (np.sqrt(np.e) * h_max) if h_max > 0 else 0.0
+    sigma = g_max / (math.exp(0.5) * h_max) if h_max > 0 else 0.0     # sqrt(e)
     floor = GRADIENT_FLOOR * g_max
     with np.errstate(invalid="ignore", divide="ignore"):
         position = np.where(reliable & (g > floor), -sigma ** 2 * h / (g - floor), np.nan)

@@ -45,7 +45,7 @@ from volviz.session import RENDER_BACKENDS
 
 if TYPE_CHECKING:   # type-only imports for the signatures
     import pyvista as pv
-    from vtkmodules.vtkRenderingCore import vtkRenderWindow
+    from volviz.render.vtk_facade import vtkRenderWindow
 
 __all__ = ["RENDER_BACKENDS", "VIEW_KINDS", "GLInfo", "backend_setting", "choose_backend", "gl_info",
            "is_software_renderer", "offscreen_gl_info", "parse_capabilities", "plotter_gl_info"]

@@ -12,7 +12,7 @@ from volviz.scene.lod import lod_bounds
 if TYPE_CHECKING:   # type-only imports for the signatures
     import numpy.typing as npt
     import pyvista as pv
-    from vtkmodules.vtkRenderingCore import vtkProp
+    from volviz.render.vtk_facade import vtkProp
 
 Bounds = tuple[float, float, float, float, float, float]
 

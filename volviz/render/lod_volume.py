@@ -51,7 +51,7 @@ from volviz.scene.lod import lod_bounds
 
 if TYPE_CHECKING:   # type-only imports for the signatures
     import pyvista as pv
-    from vtkmodules.vtkRenderingCore import vtkCamera
+    from volviz.render.vtk_facade import vtkCamera
 
     from volviz.jobs import ProgressCallback
     from volviz.model.clip import ClipSettings

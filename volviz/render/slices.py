@@ -20,7 +20,7 @@ from volviz.scene.errors import SceneError
 
 if TYPE_CHECKING:   # type-only imports for the signatures
     import numpy.typing as npt
-    from vtkmodules.vtkRenderingCore import vtkRenderer
+    from volviz.render.vtk_facade import vtkRenderer
 
     from volviz.model.clip import ClipSettings
     from volviz.optics.transfer_function import TransferFunction

@@ -24,7 +24,7 @@ Besides that namespace and NumPy's bridge to VTK, it holds the VTK idioms the GL
 from __future__ import annotations
 
 from types import SimpleNamespace
-from typing import Any, Callable, Sequence
+from typing import TYPE_CHECKING, Any, Callable, Sequence
 
 import numpy as np
 
@@ -57,6 +57,9 @@ from vtkmodules.vtkRenderingOpenGL2 import (  # noqa: F401
 from vtkmodules.vtkRenderingVolume import (  # noqa: F401
     vtkProjectedTetrahedraMapper, vtkUnstructuredGridVolumeRayCastMapper, vtkUnstructuredGridVolumeZSweepMapper)
 from vtkmodules.vtkRenderingVolumeOpenGL2 import vtkMultiBlockVolumeMapper, vtkSmartVolumeMapper  # noqa: F401
+
+if TYPE_CHECKING:   # a type other modules of render annotate with; not one ``vtk`` holds (no caller makes one)
+    from vtkmodules.vtkRenderingCore import vtkProp  # noqa: F401
 
 #: the VTK classes and constants imported above, by their VTK names: ``vtk.vtkActor()`` as with VTK's own module
 vtk = SimpleNamespace(**{name: value for name, value in dict(globals()).items()

@@ -19,7 +19,7 @@ from volviz.session import CameraState
 
 if TYPE_CHECKING:   # type-only imports for the signatures
     import pyvista as pv
-    from vtkmodules.vtkRenderingCore import vtkVolumeProperty
+    from volviz.render.vtk_facade import vtkVolumeProperty
 
     from volviz.optics.transfer_function import TransferFunction
 
