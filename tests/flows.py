@@ -12,12 +12,22 @@ from PySide6.QtCore import QEvent, QPoint, QPointF, Qt
 from PySide6.QtGui import QMouseEvent
 from PySide6.QtWidgets import QApplication
 
+from conftest import data_file
 from volviz.optics.metrics import max_abs, rmse
 
 
 def wait_loaded(qtbot, window, timeout: int = 60000) -> None:
     """Until the scene and its first views are shown."""
     qtbot.waitUntil(lambda: not window.progress_bar.isVisible() and window.controller is not None, timeout=timeout)
+
+
+def open_blunt_fin(qtbot, make_window):
+    """A 900x650 window with the Blunt Fin (PLOT3D, a PT volume) opened and its first views shown."""
+    window = make_window()
+    window.resize(900, 650)
+    window.open_path(data_file("bluntfin/bluntfinxyz.bin"))
+    wait_loaded(qtbot, window)
+    return window
 
 
 def wait_settled(qtbot, window, timeout: int = 60000) -> None:

@@ -19,17 +19,13 @@ from __future__ import annotations
 
 from PySide6.QtCore import QEvent, QPoint, QPointF, Qt
 
-from conftest import data_file
-from flows import _mouse, drag, wait_loaded, wait_settled
+from flows import _mouse, drag, open_blunt_fin, wait_loaded, wait_settled
 from volviz.render.gl_pt import GLPTVolume
 from volviz.render.pt_prop import PTVolume
 
 
 def test_gpu_drag_draws_no_order_older_than_the_previous_frames_camera(qtbot, make_window) -> None:
-    window = make_window()
-    window.resize(900, 650)
-    window.open_path(data_file("bluntfin/bluntfinxyz.bin"))
-    wait_loaded(qtbot, window)
+    window = open_blunt_fin(qtbot, make_window)
     old = window.controller
     window.render_settings.backend.setCurrentText("gpu")
     qtbot.waitUntil(lambda: window.controller is not old, timeout=60000)
@@ -60,10 +56,7 @@ def test_cpu_drag_draws_the_box_with_the_previews_camera(qtbot, make_window) -> 
     """CPU (issue #28): while the mouse drags the camera each frame is drawn with the camera the shown preview was
     made for (``volviz.render.preview_hold``), so the outline box and the volume image agree in every frame; the
     view lags the mouse by the preview's age instead (stated in frames by the log: live minus image serial)."""
-    window = make_window()
-    window.resize(900, 650)
-    window.open_path(data_file("bluntfin/bluntfinxyz.bin"))
-    wait_loaded(qtbot, window)
+    window = open_blunt_fin(qtbot, make_window)
     wait_settled(qtbot, window)
     cpu = next(v for v in window.controller.props.values() if isinstance(v, PTVolume))
     hold = cpu.hold

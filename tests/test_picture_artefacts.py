@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from conftest import data_file
-from flows import screen, wait_loaded, wait_settled
+from flows import open_blunt_fin, screen, wait_settled
 
 
 def _luma(img: np.ndarray) -> np.ndarray:
@@ -39,10 +39,7 @@ def test_cpu_pt_preview_leaves_no_dark_steps_along_the_box(qtbot, make_window) -
     from volviz.render.pt_prop import PTVolume
     from volviz_app.view_scheduler import MOVING_SCALE
 
-    window = make_window()
-    window.resize(900, 650)
-    window.open_path(data_file("bluntfin/bluntfinxyz.bin"))
-    wait_loaded(qtbot, window)
+    window = open_blunt_fin(qtbot, make_window)
     wait_settled(qtbot, window)
     cpu = next(v for v in window.controller.props.values() if isinstance(v, PTVolume))
     outline = window.plotter.renderer.actors[OUTLINE_NAME]
