@@ -35,6 +35,8 @@ rule, so their pictures still agree.
 from __future__ import annotations
 
 import time
+import weakref
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -46,8 +48,6 @@ __all__ = ["ImageOverlay", "OverlayView", "block_min", "overlay_rgba8", "read_bu
            "single_sample_on_software", "unpremultiply_rgba8", "zbuffer_to_depth"]
 
 _SIBLINGS = "_volviz_pt_overlays"           # plotter attribute: every overlay renderer of the plotter
-_MULTISAMPLES = "_volviz_pt_multisamples"   # plotter attribute: the MSAA setting to restore
-_SINGLE_SAMPLE_HOLDERS = "_volviz_single_sample_holders"   # plotter attribute: what keeps MSAA off
 
 
 def zbuffer_to_depth(z: np.ndarray, clipping_range: tuple[float, float], parallel: bool) -> np.ndarray:
@@ -114,13 +114,26 @@ def window_size(window: Any) -> tuple[int, int]:
     return int(width), int(height)
 
 
+@dataclass
+class _SingleSample:
+    """A plotter's multisampling while overlays hold it off: the setting to restore and the ids of the holders (ids,
+    not the holders: they refer to the plotter, which would then never leave ``_single_sample``)."""
+
+    restore: int
+    holders: list[int] = field(default_factory=list)
+
+
+_single_sample: weakref.WeakKeyDictionary[Any, _SingleSample] = weakref.WeakKeyDictionary()   # by plotter
+
+
 def hold_single_sample(plotter: Any, holder: Any) -> None:
     """Multisampling off while ``holder`` is in the plotter (one color and depth per pixel: the overlays read the
     depth back, the GL PT pass draws into a single-sample float target; module docstring)."""
-    if _MULTISAMPLES not in plotter.__dict__:
-        plotter.__dict__[_MULTISAMPLES] = int(plotter.ren_win.GetMultiSamples())
+    held = _single_sample.get(plotter)
+    if held is None:
+        held = _single_sample[plotter] = _SingleSample(int(plotter.ren_win.GetMultiSamples()))
         plotter.ren_win.SetMultiSamples(0)
-    plotter.__dict__.setdefault(_SINGLE_SAMPLE_HOLDERS, []).append(holder)
+    held.holders.append(id(holder))
 
 
 def single_sample_on_software(plotter: Any) -> None:
@@ -128,17 +141,20 @@ def single_sample_on_software(plotter: Any) -> None:
     overlay leaves (module docstring); a hardware driver keeps the plotter's setting."""
     if plotter_gl_info(plotter).software:
         plotter.ren_win.SetMultiSamples(0)
-        if _MULTISAMPLES in plotter.__dict__:
-            plotter.__dict__[_MULTISAMPLES] = 0
+        held = _single_sample.get(plotter)
+        if held is not None:
+            held.restore = 0
 
 
 def release_single_sample(plotter: Any, holder: Any) -> None:
     """``holder`` is gone: the last one restores the plotter's multisampling."""
-    holders = plotter.__dict__.get(_SINGLE_SAMPLE_HOLDERS, [])
-    if holder in holders:
-        holders.remove(holder)
-    if not holders and _MULTISAMPLES in plotter.__dict__:
-        plotter.ren_win.SetMultiSamples(plotter.__dict__.pop(_MULTISAMPLES))
+    held = _single_sample.get(plotter)
+    if held is None:
+        return
+    if id(holder) in held.holders:
+        held.holders.remove(id(holder))
+    if not held.holders:
+        plotter.ren_win.SetMultiSamples(_single_sample.pop(plotter).restore)
 
 
 class ImageOverlay:
