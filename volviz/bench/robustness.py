@@ -805,10 +805,17 @@ OUTCOMES = ("clean", "exception", "crash", "hang", "memory", "garbage", "warned"
 
 
 def run(data: Path, total: int, seed: int, formats: list[str] | None, minutes: float = 0.0,
-        progress: bool = True) -> dict:
-    """The campaign: ``total`` cases (fewer when ``minutes`` > 0 runs out first), counted per format and side."""
+        progress: bool = True, record: Optional[Path] = None) -> dict:
+    """The campaign: ``total`` cases (fewer when ``minutes`` > 0 runs out first), counted per format and side;
+    with ``record``, one JSON line per case there (``volviz.bench.robustness_replay``: what each case changed,
+    enough to rebuild it with ``--replay``)."""
+    from volviz.bench.robustness_replay import Recorder, case_record
+
     made_folder = Path(tempfile.mkdtemp(prefix="volviz-bench-made-"))
-    srcs = [s for s in sources(data) + made_sources(made_folder, formats) if not formats or s.fmt in formats]
+    shared = sources(data)
+    srcs = [s for s in shared + made_sources(made_folder, formats) if not formats or s.fmt in formats]
+    origin = {id(s): "data" for s in shared}
+    recorder = Recorder(record)
     todo = cases(srcs, total, seed)
     t_start = time.perf_counter()
     stats: dict[tuple[str, str], Counter] = defaultdict(Counter)
@@ -851,6 +858,8 @@ def run(data: Path, total: int, seed: int, formats: list[str] | None, minutes: f
                     mutation.edit(target)
                 except Exception as exc:  # h5py refused the edit: the case is a plain copy
                     mutation = Mutation("hdf5-field", f"edit failed ({exc})", None)
+            case = case_record(n, seed, src, origin.get(id(src), "made"), recipe, mutation, raw,
+                               target.read_bytes() if mutation.data is None else mutation.data)
             answers: dict[str, dict] = {}
             threads = [threading.Thread(target=lambda s=s: answers.__setitem__(s, sides[s].ask(requests[s])))
                        for s in active]
@@ -858,8 +867,9 @@ def run(data: Path, total: int, seed: int, formats: list[str] | None, minutes: f
                 t.start()
             for t in threads:
                 t.join()
+            outcomes: dict[str, str] = {}
             for side, answer in answers.items():
-                outcome = _judge(answer, originals[(index[id(src)], side)], mutation, src.fmt)
+                outcome = outcomes[side] = _judge(answer, originals[(index[id(src)], side)], mutation, src.fmt)
                 key = (src.fmt, side)
                 stats[key][outcome] += 1
                 stats[key]["cases"] += 1
@@ -878,12 +888,16 @@ def run(data: Path, total: int, seed: int, formats: list[str] | None, minutes: f
                     examples[(src.fmt, side, outcome)].append(
                         {"file": src.name, "mutation": mutation.kind, "detail": mutation.detail[:160],
                          "message": (answer.get("message") or answer.get("warned", ""))[:240]})
+            recorder.write({**case, "outcome": outcomes,
+                            "message": {side: (a.get("message") or a.get("warned") or "")[:240]
+                                        for side, a in answers.items()}})
             if progress and (n + 1) % 200 == 0:
                 rate = (n + 1) / (time.perf_counter() - t_start)
                 print(f"{n + 1}/{len(todo)} cases, {rate:.1f}/s", file=sys.stderr, flush=True)
         retimed = _retime(slow_cases, sides["volviz"], base, index, addresses)
         for w in sides.values():
             w.close()
+    recorder.close()
     shutil.rmtree(made_folder, ignore_errors=True)
     return {"retimed": retimed, "stats": {f"{k[0]}|{k[1]}": dict(v) for k, v in stats.items()},
             "slowest": {f"{k[0]}|{k[1]}": v for k, v in slowest.items()}, "contained": dict(contained),
@@ -1058,15 +1072,35 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--out", metavar="FILE", type=Path, default=REPORT,
                         help="the markdown file whose section is written (default docs/reliability.md)")
     parser.add_argument("--json", metavar="OUT", help="also write the raw results as JSON")
+    parser.add_argument("--record", metavar="FILE", type=Path,
+                        help="one JSON line per case: its seed file, recipe, the bytes and bits it changed, the "
+                             "damaged file's SHA-256 and both outcomes (default: the --out file with .cases.jsonl)")
+    parser.add_argument("--replay", metavar="CASE", type=int_in(0),
+                        help="rebuild case CASE of --record (the damaged file among its seed's other files, checked "
+                             "against the recorded SHA-256) and read it as the campaign does; no campaign")
+    parser.add_argument("--into", metavar="DIR", type=Path, help="where --replay rebuilds the case (default: a new "
+                        "temporary folder)")
     args = parser.parse_args([] if argv is None else argv)
     if not args.data.is_dir():
         parser.error(f"--data {args.data} is not a folder (set VOLVIZ_DATA)")
-    result = run(args.data.resolve(), args.cases, args.seed, args.formats, args.minutes)
+    record = args.record or args.out.with_suffix(".cases.jsonl")
+    if args.replay is not None:
+        from volviz.bench.robustness_replay import ReplayError, replay
+
+        if args.record is None:
+            parser.error("--replay needs --record FILE, the campaign's record of its cases")
+        try:
+            print("\n".join(replay(args.record, args.replay, args.data.resolve(), args.into)))
+        except ReplayError as exc:
+            print(f"volviz bench robustness: {exc}", file=sys.stderr)
+            return 1
+        return 0
+    result = run(args.data.resolve(), args.cases, args.seed, args.formats, args.minutes, record=record)
     command = " ".join(["volviz bench robustness", *(shlex.quote(a) for a in argv or [])])
     write_section(args.out, report(result, command))
     if args.json:
         Path(args.json).write_text(json.dumps(result, indent=1), encoding="utf-8")
-    print("\n".join([f"wrote {args.out}", *_targets(result)]))
+    print("\n".join([f"wrote {args.out} and the record of every case, {record}", *_targets(result)]))
     return 0
 
 

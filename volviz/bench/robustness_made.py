@@ -7,6 +7,7 @@ files. Each comes with its VTK reader where VTK has one (NIfTI, TIFF, DICOM, MRC
 """
 from __future__ import annotations
 
+import re
 from pathlib import Path
 from typing import Callable
 
@@ -141,6 +142,19 @@ MADE: dict[str, tuple[str, Callable[[Path], None], str, str, str | None]] = {
 }
 
 
+#: the writing time some libraries put in a header (SciPy's MATLAB header, pynrrd's comment, mrcfile's label)
+_STAMPS = ((re.compile(rb"\d{4}-\d\d-\d\d \d\d:\d\d:\d\d"), b"2026-01-01 00:00:00"),
+           (re.compile(rb"[A-Z][a-z]{2} [A-Z][a-z]{2} [ \d]\d \d\d:\d\d:\d\d \d{4}"), b"Thu Jan  1 00:00:00 2026"))
+
+
+def _pinned(data: bytes) -> bytes:
+    """The file with its writing time set to a fixed one (same length), so that a run's files are the same
+    whenever they are written and a recorded case can be rebuilt byte for byte (``robustness_replay``)."""
+    for pattern, fixed in _STAMPS:
+        data = pattern.sub(fixed, data, count=1)
+    return data
+
+
 def write_made(folder: Path, formats: list[str] | None = None) -> dict[str, Path]:
     """Write one file of each made format (those named, else all whose library imports) into ``folder``; a format
     whose library is not installed is left out."""
@@ -155,5 +169,6 @@ def write_made(folder: Path, formats: list[str] | None = None) -> dict[str, Path
             write(path)
         except ImportError:
             continue
+        path.write_bytes(_pinned(path.read_bytes()))
         written[fmt] = path
     return written
