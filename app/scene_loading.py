@@ -8,7 +8,7 @@ open supersedes an older one; the shown scene stays until the new one is ready, 
 It expects of the window: ``controller``, ``session``, ``session_path``, ``datasets``, ``dirty``, ``title``,
 ``plotter``, ``jobs``, ``_load_serial``, ``_loading_views``, ``_current_job``, ``status_label``, ``_set_busy``,
 ``show_error``, ``set_dirty``, ``recent``, the docks (``scene_tree``, ``render_settings``, ``clipping``,
-``timeline``), ``array_choice``, ``decorations``, ``scene_undo_stack``, ``_refresh_bookmark_menu``,
+``timeline``), ``array_choice``, ``decorations``, ``scene_undo_stack``, ``camera_bookmarks``,
 ``_show_first_views``, ``render_scene()`` and ``restoreState`` (``QMainWindow``)."""
 from __future__ import annotations
 
@@ -217,7 +217,7 @@ class SceneLoading(WindowBase):
             self.timeline.blockSignals(False)
         self.volume_time_shown = self.iso_time_shown = None
         self.cuts_pending = set()  # cut in ``prepare``
-        self._refresh_bookmark_menu()
+        self.camera_bookmarks.refresh_menu()
         self.title = title
         self.error_estimate = None
         self.last_error_rmse = None

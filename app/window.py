@@ -1,5 +1,10 @@
 """The main window: a PyVista viewport with docks, menus and a status bar. No numerics here: everything is a call
-into volviz. ``MainWindow`` is put together from one mixin per responsibility, each in its own module:
+into volviz. ``MainWindow`` holds its parts as objects with their own state, given their collaborators (the shown
+scene, typed by ``shown_scene.ShownScene``, widgets, callbacks) when they are made:
+
+- ``camera_bookmarks``: camera bookmarks and camera-path recording (``camera_bookmarks.CameraBookmarks``);
+
+and is put together from one mixin per responsibility for the rest, each in its own module:
 
 - ``window_widgets.WindowWidgets``: the docks, menus and actions, the status bar with progress and cancel;
 - ``scene_loading.SceneLoading``: ``open_path`` and showing a session (prepared in the background, then installed);
@@ -9,11 +14,11 @@ into volviz. ``MainWindow`` is put together from one mixin per responsibility, e
   estimate and budget;
 - ``scene_edits.SceneEdits``: what the docks' edits do to the shown scene (TF, visibility, opacity, settings,
   clipping, render settings);
-- ``export_runs.ExportRuns``: screenshot and movie export in the background;
-- ``camera_bookmarks.CameraBookmarks``: camera bookmarks and camera-path recording.
+- ``export_runs.ExportRuns``: screenshot and movie export in the background.
 
 This module sets the window's shared state (``session``, ``controller``, ``jobs``, ``plotter``..., typed in
-``window_base.WindowBase``), and holds its construction, ``render_scene``, fly mode, ``show_error`` and closing."""
+``window_base.WindowBase``), and holds its construction, ``render_scene``, fly mode, ``show_error``, closing, and
+one-line forwarders to its parts for what other modules and the tests call on the window."""
 from __future__ import annotations
 
 import logging
@@ -21,7 +26,7 @@ import time
 from pathlib import Path
 from typing import Any, Optional
 
-from PySide6.QtCore import QSettings, Qt, QTimer
+from PySide6.QtCore import QSettings, Qt
 from PySide6.QtWidgets import QMainWindow, QMessageBox, QWidget
 
 from volviz.render.backend import plotter_gl_info
@@ -44,9 +49,6 @@ from .workers import JobBridge
 
 log = logging.getLogger(__name__)
 
-RECORD_MS = 250          # camera-path recording samples the camera four times a second
-
-
 def _import_gui_thread_modules() -> None:
     """Import at start-up what the GUI thread later imports inside functions: a first ``import vtk`` (the natural
     scene's overlay) took 0.2-0.5 s of a blocked event loop in the middle of loading a scene."""
@@ -62,8 +64,7 @@ def _import_gui_thread_modules() -> None:
     pyvista.system_supports_plotting()
 
 
-class MainWindow(SceneLoading, SessionFiles, ViewScheduler, SceneEdits, ExportRuns, CameraBookmarks, WindowWidgets,
-                 QMainWindow):
+class MainWindow(SceneLoading, SessionFiles, ViewScheduler, SceneEdits, ExportRuns, WindowWidgets, QMainWindow):
     """volviz main window. ``open_path`` is the single code path behind File > Open and the command line."""
 
     def __init__(self, parent: Optional[QWidget] = None, settings: Optional[QSettings] = None,
@@ -94,12 +95,11 @@ class MainWindow(SceneLoading, SessionFiles, ViewScheduler, SceneEdits, ExportRu
         self._load_serial = 0              # the newest open/rebuild; an older one's late callbacks do nothing
         self._loading_views = False        # the newest scene is installed, its first views are computed
         self._init_view_scheduler()        # its OneInFlight jobs and what they have shown
-        self._recording = None
-        self._record_start = 0.0
 
         self._build_docks()
-        self._build_menus()
         self._build_status_bar()
+        self.camera_bookmarks = CameraBookmarks(self, self, self.status_label, self.set_dirty, self._camera_moved)
+        self._build_menus()
         self.resize(*self.layout_keeper.default_size())
         self.layout_keeper.restore()
         self.fly = FlyMode(self.plotter, on_camera_moved=self._fly_moved)
@@ -109,8 +109,6 @@ class MainWindow(SceneLoading, SessionFiles, ViewScheduler, SceneEdits, ExportRu
         self._connect_view_scheduler()  # interaction observers, fly-mode settle and resize timers
         self._connect_scene_edits()  # the TF preview timer
         self._connect_session_files()  # the autosave timer
-        self.record_timer = QTimer(self, interval=RECORD_MS)
-        self.record_timer.timeout.connect(self._record_sample)
         self.nonfinite = NonFiniteStatus(self)  # the status bar's note on non-finite values
         self.collector.freeze_long_lived()
 
@@ -173,6 +171,14 @@ class MainWindow(SceneLoading, SessionFiles, ViewScheduler, SceneEdits, ExportRu
             self.controller.set_camera(None, update=False)
             self._camera_moved()
 
+    # ------------------------------------------------------------------------------------------------ forwarders
+    # what tests and other modules call on the window, kept while they move to its parts
+    def add_bookmark(self, name: str) -> None:
+        self.camera_bookmarks.add_bookmark(name)
+
+    def set_recording(self, recording: bool) -> Optional[str]:
+        return self.camera_bookmarks.set_recording(recording)
+
     # ------------------------------------------------------------------------------------------------ errors
     def show_error(self, title: str, text: str) -> None:
         """A non-blocking error dialog (the app keeps running); also logged."""
@@ -193,7 +199,7 @@ class MainWindow(SceneLoading, SessionFiles, ViewScheduler, SceneEdits, ExportRu
         self.layout_keeper.save()
         self.autosave_timer.stop()
         self.preview_timer.stop()
-        self.record_timer.stop()
+        self.camera_bookmarks.stop()
         self.timeline.set_playing(False)
         if self.controller is not None:  # before the plotter closes: the GPU PT pass frees its GL resources
             self.controller.clear()

@@ -28,7 +28,7 @@ from typing import TYPE_CHECKING, Any, Callable, Optional
 if TYPE_CHECKING:
     from PySide6.QtCore import QSettings
     from PySide6.QtGui import QAction, QUndoStack
-    from PySide6.QtWidgets import QLabel, QMainWindow, QMenu, QMessageBox, QProgressBar, QPushButton
+    from PySide6.QtWidgets import QLabel, QMainWindow, QMessageBox, QProgressBar, QPushButton
     from pyvistaqt import QtInteractor
 
     from volviz.jobs import Job
@@ -36,6 +36,7 @@ if TYPE_CHECKING:
     from volviz.render.controller import SceneController
     from volviz.session import Session
     from .array_choice import ArrayChoice
+    from .camera_bookmarks import CameraBookmarks
     from .stand_in import StandInFrame
     from .decoration_toggles import DecorationToggles
     from .docks.clipping import ClippingDock
@@ -103,10 +104,9 @@ class WindowBase(_QtWindow):
     array_choice: ArrayChoice
     decorations: DecorationToggles
     recent: RecentFiles
-    bookmark_menu: QMenu
     stand_in: StandInFrame
+    camera_bookmarks: CameraBookmarks  # (window.py)
     action_fly: QAction
-    action_record: QAction
     status_label: QLabel
     progress_bar: QProgressBar
     cancel_button: QPushButton
@@ -159,11 +159,6 @@ class WindowBase(_QtWindow):
         def _tf_changed(self, tf: Any) -> None: ...
         def _tf_committed(self, tf: Any) -> None: ...
         def _scene_changed(self, change: SceneChange) -> None: ...
-
-        # -- CameraBookmarks
-        def set_recording(self, recording: bool) -> Optional[str]: ...
-        def _ask_bookmark(self) -> None: ...
-        def _refresh_bookmark_menu(self) -> None: ...
 
         # -- WindowWidgets
         def _set_busy(self, busy: bool) -> None: ...

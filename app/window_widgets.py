@@ -10,9 +10,9 @@ It makes the docks (``tf_editor``, ``scene_tree``, ``render_settings``, ``timeli
 ``decorations``, ``python_console`` (stopped by ``closeEvent``), ``help``, ``recent``, ``file_drop``, the actions,
 ``status_label``, ``progress_bar`` and ``cancel_button``. It expects of the window: ``settings``, ``plotter``,
 ``jobs``, ``_current_job``, ``_loading_views``, ``_export_run``, and the handlers its docks and actions call
-(``open_path``, the ``_ask_*`` dialogs, ``set_fly_mode``, ``reset_camera``, ``set_recording``, ``set_clip``...).
-``_build_docks()``, ``_build_menus()`` and ``_build_status_bar()`` are called, in this order, by the window's
-``__init__``."""
+(``open_path``, the ``_ask_*`` dialogs, ``set_fly_mode``, ``reset_camera``, ``set_clip``...), and
+``camera_bookmarks``, which adds the Camera menu's entries. ``_build_docks()``, ``_build_status_bar()`` and
+``_build_menus()`` are called, in this order, by the window's ``__init__``."""
 from __future__ import annotations
 
 from typing import Any
@@ -20,6 +20,7 @@ from typing import Any
 from PySide6.QtGui import QAction, QKeySequence, QUndoGroup, QUndoStack
 from PySide6.QtWidgets import QDockWidget, QLabel, QProgressBar, QPushButton, QWidget
 
+from .actions import menu_action
 from .array_choice import ArrayChoice
 from .console import PythonConsole
 from .file_choices import FileChoices
@@ -146,12 +147,7 @@ class WindowWidgets(WindowBase):
         self.action_fly.setCheckable(True)
         self._action(view_menu, "&Reset Camera", "R", self.reset_camera)
 
-        camera_menu = self.menuBar().addMenu("&Camera")
-        self._action(camera_menu, "Add &Bookmark…", "Ctrl+B", self._ask_bookmark)
-        self.bookmark_menu = camera_menu.addMenu("Go to Bookmark")
-        camera_menu.addSeparator()
-        self.action_record = self._action(camera_menu, "&Record Camera Path", "Ctrl+R", self.set_recording)
-        self.action_record.setCheckable(True)
+        self.camera_bookmarks.add_to_menu(self.menuBar().addMenu("&Camera"))
         self.help = HelpMenu(self, self.menuBar().addMenu("&Help"), self.plotter.ren_win)
         self.recent = RecentFiles(self.settings, self.recent_menu, self.open_path_asking)
         self.file_drop = FileDrop([self, self.plotter.interactor], self.open_path_asking)
@@ -168,11 +164,7 @@ class WindowWidgets(WindowBase):
             self.undo_group.setActiveStack(stack)
 
     def _action(self, menu: Any, text: str, shortcut: Any, slot: Any) -> QAction:
-        action = QAction(text, self)
-        action.setShortcut(QKeySequence(shortcut))
-        action.triggered.connect(slot)
-        menu.addAction(action)
-        return action
+        return menu_action(self, menu, text, shortcut, slot)
 
     def _build_status_bar(self) -> None:
         bar = self.statusBar()
