@@ -222,6 +222,7 @@ def test_terrain_texture_is_mip_mapped_on_a_hardware_driver_only(demo) -> None:
     asked for; on a software rasteriser (this machine's llvmpipe) the app draws it unfiltered by default."""
     import pyvista as pv
 
+    from volviz.render import backend
     from volviz.render.backend import GLInfo, plotter_gl_info
     from volviz.render.nature_view import texture_filtering
 
@@ -232,7 +233,7 @@ def test_terrain_texture_is_mip_mapped_on_a_hardware_driver_only(demo) -> None:
         assert not plain.GetMipmap() and not plain.GetInterpolate()
         asked = NatureView(plotter, demo, filter_texture=True)._texture
         assert asked.GetMipmap() and asked.GetInterpolate() and asked.GetMaximumAnisotropicFiltering() == 1.0
-        plotter.__dict__["_volviz_gl_info"] = GLInfo("NVIDIA Corporation", "NVIDIA H100/PCIe/SSE2", "4.6.0")
+        backend._plotter_gl_info[plotter] = GLInfo("NVIDIA Corporation", "NVIDIA H100/PCIe/SSE2", "4.6.0")
         assert texture_filtering(plotter) and NatureView(plotter, demo)._texture.GetMipmap()
     finally:
         plotter.close()

@@ -38,6 +38,7 @@ Google SwiftShader) the GPU's work runs on the same CPU cores, so ``auto`` takes
 """
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -97,12 +98,14 @@ def gl_info(render_window: vtkRenderWindow) -> GLInfo:
     return parse_capabilities(text)
 
 
+_plotter_gl_info: weakref.WeakKeyDictionary[Any, GLInfo] = weakref.WeakKeyDictionary()   # by plotter, once asked
+
+
 def plotter_gl_info(plotter: pv.BasePlotter) -> GLInfo:
     """``gl_info`` of a PyVista plotter's render window, asked once per plotter."""
-    known = plotter.__dict__.get("_volviz_gl_info")
+    known = _plotter_gl_info.get(plotter)
     if known is None:
-        known = gl_info(plotter.ren_win)  # type: ignore[arg-type]  # None only once closed
-        plotter.__dict__["_volviz_gl_info"] = known
+        known = _plotter_gl_info[plotter] = gl_info(plotter.ren_win)  # type: ignore[arg-type]  # None once closed
     return known
 
 

@@ -15,20 +15,21 @@ Only for a plotter whose owner re-makes the images while the camera moves and af
 """
 from __future__ import annotations
 
+import weakref
 from typing import Any
 
 __all__ = ["PreviewCameraHold", "hold_previews", "holds_previews"]
 
-_HOLD = "_volviz_hold_previews"   # plotter attribute: its CPU volumes hold the camera of their images
+_holding: weakref.WeakSet[Any] = weakref.WeakSet()   # the plotters whose CPU volumes hold their images' camera
 
 
 def hold_previews(plotter: Any) -> None:
     """The CPU PT volumes of ``plotter`` made from now on draw moving frames with their image's camera."""
-    plotter.__dict__[_HOLD] = True
+    _holding.add(plotter)
 
 
 def holds_previews(plotter: Any) -> bool:
-    return bool(plotter.__dict__.get(_HOLD, False))
+    return plotter in _holding
 
 
 def _key(camera: Any) -> tuple[Any, ...]:

@@ -5,11 +5,16 @@ projected-tetrahedra view draws, interpolated in its cell: ``volviz.unstructured
 VTK's cell picker hits, with its nearest point's value."""
 from __future__ import annotations
 
+import weakref
 from typing import Any, Optional
 
 import numpy as np
 
 from volviz.model.probe import ProbeResult, probe_regular
+
+# id(dataset) -> (weak reference to it, its tetrahedra): the datasets are dataclasses compared by value, so no weak
+# dictionary can key them; an entry leaves with its dataset
+_TETS: dict[int, tuple[weakref.ref[Any], Any]] = {}
 
 
 def pick_ray(renderer: Any, x: float, y: float) -> tuple[np.ndarray, np.ndarray]:
@@ -79,8 +84,8 @@ def probe_volume(controller: Any, comp: Any, origin: np.ndarray, direction: np.n
 
 
 def _volume_tets(dataset: Any) -> Optional[Any]:
-    """The tetrahedral mesh of a volumetric mesh dataset (made once and kept on it), None for anything else (a
-    surface: VTK's cell picker answers for it)."""
+    """The tetrahedral mesh of a volumetric mesh dataset (made once and kept while it lives), None for anything else
+    (a surface: VTK's cell picker answers for it)."""
     from volviz.model import CurvilinearGrid, TetMesh, UnstructuredMesh
     from volviz.model.representation import representation
 
@@ -89,11 +94,21 @@ def _volume_tets(dataset: Any) -> Optional[Any]:
         return None
     if isinstance(dataset, TetMesh):
         return dataset
-    if "volviz_probe_tets" not in dataset.__dict__:
+    kept = _TETS.get(id(dataset))
+    if kept is None or kept[0]() is not dataset:
         from volviz.unstructured.tetrahedralize import tetrahedralize
 
-        dataset.__dict__["volviz_probe_tets"] = tetrahedralize(dataset, dataset.active)
-    return dataset.__dict__["volviz_probe_tets"]
+        tets = tetrahedralize(dataset, dataset.active)
+        kept = _TETS[id(dataset)] = (weakref.ref(dataset, _forget_tets(id(dataset))), tets)
+    return kept[1]
+
+
+def _forget_tets(key: int) -> Any:
+    """The callback that drops ``_TETS[key]`` when its dataset is collected (not a later dataset's at that id)."""
+    def forget(ref: weakref.ref[Any]) -> None:
+        if key in _TETS and _TETS[key][0] is ref:
+            del _TETS[key]
+    return forget
 
 
 def _pick_cell(renderer: Any, x: float, y: float) -> Optional[ProbeResult]:
