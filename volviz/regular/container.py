@@ -256,6 +256,62 @@ def check_meta(meta: dict[str, Any], payload_bytes: int, name: str = "<vvz>") ->
     _field(meta, "origin", name, list, "3 finite numbers", lambda v: len(v) == 3 and all(
         isinstance(x, (int, float)) and not isinstance(x, bool) and _finite(x) for x in v), default=None)
     _field(meta, "name", name, str, "a name of at most 1024 characters", lambda v: len(v) <= 1024, default=None)
+    check_described(meta, kind, name)
+
+
+#: every key the codec writes (``codec.compress``); any other key is refused, so ``volviz info`` shows none unchecked
+META_KEYS = frozenset(("format", "dims", "dtype", "kind", "levels", "tile", "coder", "coder_version", "mode", "delta",
+                       "quality", "psnr_target", "psnr", "psnr_scope", "lossless", "peak", "transform", "float_lo",
+                       "float_hi", "spacing", "origin", "name", "original_bytes", "payload_bytes"))
+#: the PSNR's peak the codec records per sample kind (the type's range; 65535 for the quantised kinds)
+PEAKS = {"uint8": 255, "int8": 255, "uint16": 65535, "int16": 65535, "float": 65535, "int-quantised": 65535}
+PSNR_SCOPES = ("volume", "central 256^3 crop")
+_LOSSLESS_TRANSFORMS = ("auto", "5/3", "haar")
+
+
+def _number(lo: float, hi: float) -> Any:
+    return lambda v: _finite(v) and lo <= v <= hi
+
+
+def check_described(meta: dict[str, Any], kind: str, name: str = "<vvz>") -> None:
+    """The fields that describe how the file was made, which the decoder does not use but ``volviz info`` shows:
+    known keys only; ``mode`` and ``lossless`` agree with the quantiser step ``delta`` (0 exactly when lossless, and
+    ``2 ** ((90 - quality) / 10)`` in quality mode: Guthe §2.2.2's dead-zone step from the quality knob); the
+    quality, PSNR target and measured PSNR in their ranges (a lossless file measures none); the PSNR's scope; the
+    peak of the sample kind; the wavelet choice (lossy files: 5/3). Raises :class:`VVZError` naming the field, its
+    value and what it should be (files of older writers lack some of these keys: each is then not checked)."""
+    unknown = sorted(k for k in meta if k not in META_KEYS)
+    if unknown:
+        raise VVZError(name, f"metadata field {unknown[0][:60]!r} is not a .vvz metadata field (known: "
+                       f"{', '.join(sorted(META_KEYS))})")
+    delta = meta["delta"]
+    mode = _field(meta, "mode", name, str, "lossless, quality or psnr", lambda v: v in ("lossless", "quality", "psnr"),
+                  default=None)
+    _field(meta, "lossless", name, bool, f"{str(delta == 0).lower()} (delta is {delta})", lambda v: v == (delta == 0),
+           default=None)
+    if mode == "lossless" and delta != 0:
+        raise VVZError(name, f"metadata field 'delta' is {delta}; expected 0 in a file of mode 'lossless'")
+    quality = _field(meta, "quality", name, (int, float, type(None)), "null or a number from 0 to 100",
+                     lambda v: v is None or _number(0, 100)(v), default=None)
+    if mode == "quality":
+        if quality is None:
+            raise VVZError(name, "metadata field 'quality' is None; expected a number from 0 to 100 in a file of mode "
+                           "'quality'")
+        step = 2.0 ** ((90.0 - quality) / 10.0)
+        if not math.isclose(delta, step, rel_tol=1e-9):
+            raise VVZError(name, f"metadata field 'delta' is {delta}; expected {step} (quality {quality})")
+    target = _field(meta, "psnr_target", name, (int, float, type(None)), "null or a number of dB from 0 to 1000",
+                    lambda v: v is None or (_number(0, 1000)(v) and v > 0), default=None)
+    if mode == "psnr" and target is None:
+        raise VVZError(name, "metadata field 'psnr_target' is None; expected a number of dB in a file of mode 'psnr'")
+    _field(meta, "psnr", name, (int, float, type(None)), "null (lossless)" if delta == 0 else
+           "null or a number of dB from 0 to 1000", lambda v: v is None or (delta != 0 and _number(0, 1000)(v)),
+           default=None)
+    _field(meta, "psnr_scope", name, str, " or ".join(PSNR_SCOPES), lambda v: v in PSNR_SCOPES, default=None)
+    _field(meta, "peak", name, (int, float), f"{PEAKS[kind]} (the peak of kind {kind!r})",
+           lambda v: v == PEAKS[kind], default=None)
+    _field(meta, "transform", name, str, "auto, 5/3 or haar" if delta == 0 else "5/3 (a lossy file)",
+           lambda v: v in (_LOSSLESS_TRANSFORMS if delta == 0 else ("5/3",)), default=None)
 
 
 def check_table(table: np.ndarray, meta_off: int, name: str = "<vvz>") -> None:
