@@ -16,7 +16,8 @@ scene through the depth buffer exactly as volviz's PT volumes are (``volviz.rend
 
 The 8-bit overlay costs at most about 1/255 per channel against the float image (measured in the tests).
 ``begin`` / ``compute`` / ``finish`` split the work as every ``image_overlay.OverlayView`` does: ``compute`` is pure
-NumPy/Numba and runs in a background worker; the app recomputes after every camera change. Surfaces of components with
+NumPy/Numba and runs in a background worker (a preview magnified to the window there too, ``_shown_rgba8``); the app
+recomputes after every camera change. Surfaces of components with
 LOD on are drawn at the level their screen size asks for, geomorphed (``volviz.iso.lod``); the statistics report the
 triangles drawn.
 """
@@ -31,7 +32,7 @@ import numpy as np
 from volviz.iso.composite import MODES, Fragments, composite, fragments, triangles_drawn
 from volviz.iso.extract import IsoMesh
 from volviz.iso.lod import lod_mesh, select_level
-from volviz.render.image_overlay import OverlayView
+from volviz.render.image_overlay import OverlayView, overlay_rgba8
 from volviz.model.camera import Camera
 
 if TYPE_CHECKING:   # type-only imports for the signatures
@@ -39,6 +40,7 @@ if TYPE_CHECKING:   # type-only imports for the signatures
     from volviz.jobs import ProgressCallback
 
 __all__ = ["IsoModeView", "IsoOverlay", "cut_at_depth"]
+
 
 def cut_at_depth(frags: Fragments, depth: np.ndarray) -> Fragments:
     """The fragments strictly in front of the opaque depth of their pixel (``depth`` (H, W), +inf = nothing)."""
@@ -49,6 +51,22 @@ def cut_at_depth(frags: Fragments, depth: np.ndarray) -> Fragments:
     np.cumsum(np.bincount(pix[keep], minlength=len(counts)), out=ptr[1:])
     return Fragments(frags.size, ptr, frags.depth[keep], frags.rgba[keep], frags.opaque[keep], frags.back[keep],
                      frags.n_triangles, frags.n_opaque_triangles, frags.seconds)
+
+
+def _shown_rgba8(img: np.ndarray, request: dict[str, Any]) -> tuple[np.ndarray, int]:
+    """Any thread: the overlay image ``img`` (premultiplied) as VTK shows it (``overlay_rgba8``; a preview magnified
+    to the window) and the number of saturated pixels. Straight-alpha blending cannot show a color above its alpha,
+    which the order-independent sums of 3/4-pass produce; those pixels are composited over the scene color read back
+    in ``begin`` and drawn opaque (exact for the opaque scene; a PT volume's overlay under such a pixel is not seen
+    through)."""
+    over = np.any(img[..., :3] > img[..., 3:4] + 0.5 / 255.0, axis=-1)
+    shown = img
+    if over.any():
+        shown = img.copy()
+        scene = request["rgb"][over].astype(np.float64) / 255.0
+        shown[over, :3] = np.minimum(img[over, :3] + (1.0 - img[over, 3:4]) * scene, 1.0)
+        shown[over, 3] = 1.0
+    return overlay_rgba8(shown, request), int(over.sum())
 
 
 class IsoModeView:
@@ -109,8 +127,12 @@ class IsoOverlay(OverlayView, IsoModeView):
         request.update(meshes=list(self.meshes), lod=list(self.lod), mode=self.mode, shading=self.shading)
         return request
 
-    def compute(self, request: dict[str, Any], progress: Optional[ProgressCallback] = None) -> tuple[np.ndarray, Any]:
-        """Any thread: rasterise all surfaces once, cut at the opaque depth, composite in the request's mode."""
+    def compute(self, request: dict[str, Any], progress: Optional[ProgressCallback] = None) -> tuple[np.ndarray, Any,
+                np.ndarray]:
+        """Any thread: rasterise all surfaces once, cut at the opaque depth, composite in the request's mode; then the
+        image as VTK will show it (``_shown_rgba8``: saturated pixels over the scene color, straight-alpha RGBA8, a
+        preview magnified to the window), made here so that ``finish`` on the GUI thread only hands it over (the
+        magnification took 40-60 ms of the GUI thread per preview, issue #28)."""
         if progress is not None:
             progress(0.0, f"isosurfaces: {request['mode']}")
         t0 = time.perf_counter()
@@ -122,26 +144,21 @@ class IsoOverlay(OverlayView, IsoModeView):
         t1 = time.perf_counter()
         img = composite(fr, request["mode"])
         t2 = time.perf_counter()
+        rgba8, saturated = _shown_rgba8(img, request)
         st = SimpleNamespace(sort_s=0.0, project_s=0.0, raster_s=t1 - t0, total_s=t2 - t0, fragments=len(fr.depth),
                              n_visible=fr.n_triangles, triangles_drawn=triangles_drawn(fr, request["mode"]),
-                             full_triangles=sum(m.n_triangles for m in request["meshes"]), extra={})
-        return img, st
+                             full_triangles=sum(m.n_triangles for m in request["meshes"]), saturated_px=saturated,
+                             extra={})
+        return img, st, rgba8
 
     def finish(self, request: dict[str, Any], img: np.ndarray, st: Any, rgba8: np.ndarray | None = None) -> np.ndarray:
-        """Show the image. Straight-alpha blending cannot show a color above its alpha, which the order-independent
-        sums of 3/4-pass produce; those pixels are composited here over the scene color read back in ``begin`` and
-        drawn opaque (exact for the opaque scene; a PT volume's overlay under such a pixel is not seen through).
-        ``compute`` makes no ``rgba8``: the parameter is the base class's."""
-        shown = img
-        over = np.any(img[..., :3] > img[..., 3:4] + 0.5 / 255.0, axis=-1)
-        if over.any():
-            shown = img.copy()
-            scene = request["rgb"][over].astype(np.float64) / 255.0
-            shown[over, :3] = np.minimum(img[over, :3] + (1.0 - img[over, 3:4]) * scene, 1.0)
-            shown[over, 3] = 1.0
-        super().finish(request, shown, st)
-        self.image = img
+        """GUI thread: show ``rgba8`` as ``compute`` made it (made here from ``img`` when not given) and record the
+        statistics; returns the premultiplied image."""
+        saturated = getattr(st, "saturated_px", 0)
+        if rgba8 is None:
+            rgba8, saturated = _shown_rgba8(img, request)
+        super().finish(request, img, st, rgba8)
         self.stats.update(method=f"iso {request['mode']}", composite_s=st.total_s - st.raster_s,
-                          triangles=st.n_visible, triangles_drawn=st.triangles_drawn, saturated_px=int(over.sum()),
+                          triangles=st.n_visible, triangles_drawn=st.triangles_drawn, saturated_px=saturated,
                           full_triangles=st.full_triangles)
         return img
