@@ -3,6 +3,7 @@ into volviz. ``MainWindow`` holds its parts as objects with their own state, giv
 scene, typed by ``shown_scene.ShownScene``, widgets, callbacks) when they are made:
 
 - ``camera_bookmarks``: camera bookmarks and camera-path recording (``camera_bookmarks.CameraBookmarks``);
+- ``export_runs``: screenshot and movie export in the background (``export_runs.ExportRuns``);
 
 and is put together from one mixin per responsibility for the rest, each in its own module:
 
@@ -13,8 +14,7 @@ and is put together from one mixin per responsibility for the rest, each in its 
 - ``view_scheduler.ViewScheduler``: the background refreshes of the views (one job in flight per kind), the error
   estimate and budget;
 - ``scene_edits.SceneEdits``: what the docks' edits do to the shown scene (TF, visibility, opacity, settings,
-  clipping, render settings);
-- ``export_runs.ExportRuns``: screenshot and movie export in the background.
+  clipping, render settings).
 
 This module sets the window's shared state (``session``, ``controller``, ``jobs``, ``plotter``..., typed in
 ``window_base.WindowBase``), and holds its construction, ``render_scene``, fly mode, ``show_error``, closing, and
@@ -22,6 +22,7 @@ one-line forwarders to its parts for what other modules and the tests call on th
 from __future__ import annotations
 
 import logging
+import os
 import time
 from pathlib import Path
 from typing import Any, Optional
@@ -64,7 +65,7 @@ def _import_gui_thread_modules() -> None:
     pyvista.system_supports_plotting()
 
 
-class MainWindow(SceneLoading, SessionFiles, ViewScheduler, SceneEdits, ExportRuns, WindowWidgets, QMainWindow):
+class MainWindow(SceneLoading, SessionFiles, ViewScheduler, SceneEdits, WindowWidgets, QMainWindow):
     """volviz main window. ``open_path`` is the single code path behind File > Open and the command line."""
 
     def __init__(self, parent: Optional[QWidget] = None, settings: Optional[QSettings] = None,
@@ -91,7 +92,6 @@ class MainWindow(SceneLoading, SessionFiles, ViewScheduler, SceneEdits, ExportRu
         self.last_stats = {}
         self._current_job = None
         self._init_scene_edits()           # histograms, the pending TF preview, what the edits have shown
-        self._init_exports()               # the running export and the last one's result
         self._load_serial = 0              # the newest open/rebuild; an older one's late callbacks do nothing
         self._loading_views = False        # the newest scene is installed, its first views are computed
         self._init_view_scheduler()        # its OneInFlight jobs and what they have shown
@@ -99,6 +99,8 @@ class MainWindow(SceneLoading, SessionFiles, ViewScheduler, SceneEdits, ExportRu
         self._build_docks()
         self._build_status_bar()
         self.camera_bookmarks = CameraBookmarks(self, self, self.status_label, self.set_dirty, self._camera_moved)
+        self.export_runs = ExportRuns(self, self.jobs, self.plotter, self.status_label, self._set_busy,
+                                      self._busy_elsewhere, self.show_error)
         self._build_menus()
         self.resize(*self.layout_keeper.default_size())
         self.layout_keeper.restore()
@@ -179,6 +181,22 @@ class MainWindow(SceneLoading, SessionFiles, ViewScheduler, SceneEdits, ExportRu
     def set_recording(self, recording: bool) -> Optional[str]:
         return self.camera_bookmarks.set_recording(recording)
 
+    def export_screenshot(self, path: str | os.PathLike, size: Optional[tuple[int, int]] = None,
+                          transparent: bool = False) -> None:
+        self.export_runs.export_screenshot(path, size, transparent)
+
+    def export_movie(self, path: str | os.PathLike, path_name: Optional[str], through_time: bool,
+                     fps: float = 24.0, size: Optional[tuple[int, int]] = None, orbit: bool = False) -> None:
+        self.export_runs.export_movie(path, path_name, through_time, fps, size, orbit)
+
+    @property
+    def export_result(self) -> Optional[bool]:
+        return self.export_runs.result
+
+    @property
+    def export_threads(self) -> set[int]:
+        return self.export_runs.threads
+
     # ------------------------------------------------------------------------------------------------ errors
     def show_error(self, title: str, text: str) -> None:
         """A non-blocking error dialog (the app keeps running); also logged."""
@@ -204,9 +222,7 @@ class MainWindow(SceneLoading, SessionFiles, ViewScheduler, SceneEdits, ExportRu
         if self.controller is not None:  # before the plotter closes: the GPU PT pass frees its GL resources
             self.controller.clear()
         self.controller = None  # late timer callbacks find no scene to update
-        if self._export_run is not None:  # no partial movie left behind, no callbacks into a closed window
-            self._export_run.abandon()
-            self._export_run = None
+        self.export_runs.abandon()  # no partial movie left behind, no callbacks into a closed window
         self.jobs.shutdown()
         self.plotter.close()
         self.collector.unfreeze()  # what was long-lived while the window was open can be collected again

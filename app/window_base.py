@@ -1,8 +1,8 @@
 """The typed view that ``MainWindow``'s mixins have of the window they are mixed into.
 
 Each mixin (``scene_loading.SceneLoading``, ``session_files.SessionFiles``, ``view_scheduler.ViewScheduler``,
-``scene_edits.SceneEdits``, ``export_runs.ExportRuns``, ``camera_bookmarks.CameraBookmarks``,
-``window_widgets.WindowWidgets``) derives from ``WindowBase``, which declares, once and with their types:
+``scene_edits.SceneEdits``, ``window_widgets.WindowWidgets``) derives from ``WindowBase``, which declares, once and
+with their types:
 
 - the window's shared state: what more than one part of the window reads or writes (``session``, ``controller``,
   ``jobs``, ``plotter``, the docks, ``status_label``...), whichever of ``MainWindow.__init__`` or a mixin sets it;
@@ -37,6 +37,7 @@ if TYPE_CHECKING:
     from volviz.session import Session
     from .array_choice import ArrayChoice
     from .camera_bookmarks import CameraBookmarks
+    from .export_runs import ExportRuns
     from .stand_in import StandInFrame
     from .decoration_toggles import DecorationToggles
     from .docks.clipping import ClippingDock
@@ -47,7 +48,6 @@ if TYPE_CHECKING:
     from .file_choices import FileChoices
     from .reload_data import ReloadData
     from .docks.timeline import Timeline
-    from .frame_export import FrameExport
     from .gc_guard import GuiThreadCollector
     from .layout import WindowLayout
     from .nonfinite_status import NonFiniteStatus
@@ -91,7 +91,6 @@ class WindowBase(_QtWindow):
     error_estimate: Optional[str]
     last_error_rmse: Optional[float]
     cuts_pending: set[str]             # SceneEdits
-    _export_run: Optional[FrameExport]  # ExportRuns
     # -- widgets (WindowWidgets)
     tf_editor: TransferFunctionEditor
     scene_tree: SceneTree
@@ -106,6 +105,7 @@ class WindowBase(_QtWindow):
     recent: RecentFiles
     stand_in: StandInFrame
     camera_bookmarks: CameraBookmarks  # (window.py)
+    export_runs: ExportRuns            # (window.py)
     action_fly: QAction
     status_label: QLabel
     progress_bar: QProgressBar

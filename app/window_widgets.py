@@ -9,7 +9,7 @@ It makes the docks (``tf_editor``, ``scene_tree``, ``render_settings``, ``timeli
 ``clipping`` and their ``*_dock``), ``layout_keeper``, the undo group, ``array_choice``, ``export_dialogs``,
 ``decorations``, ``python_console`` (stopped by ``closeEvent``), ``help``, ``recent``, ``file_drop``, the actions,
 ``status_label``, ``progress_bar`` and ``cancel_button``. It expects of the window: ``settings``, ``plotter``,
-``jobs``, ``_current_job``, ``_loading_views``, ``_export_run``, and the handlers its docks and actions call
+``jobs``, ``_current_job``, ``_loading_views``, ``export_runs``, and the handlers its docks and actions call
 (``open_path``, the ``_ask_*`` dialogs, ``set_fly_mode``, ``reset_camera``, ``set_clip``...), and
 ``camera_bookmarks``, which adds the Camera menu's entries. ``_build_docks()``, ``_build_status_bar()`` and
 ``_build_menus()`` are called, in this order, by the window's ``__init__``."""
@@ -178,7 +178,8 @@ class WindowWidgets(WindowBase):
         self.probe = ProbeTool(self)   # the value under the cursor, left of the progress bar
         bar.addPermanentWidget(self.progress_bar)
         bar.addPermanentWidget(self.cancel_button)
-        self._set_busy(False)
+        self.progress_bar.setVisible(False)   # shown while busy (``_set_busy``)
+        self.cancel_button.setVisible(False)
 
     def _on_progress(self, job_id: int, fraction: float, message: str) -> None:
         bar = self.progress_bar
@@ -192,7 +193,7 @@ class WindowWidgets(WindowBase):
 
     def _set_busy(self, busy: bool) -> None:
         was = self.progress_bar.isVisible()
-        busy = busy or self._export_run is not None  # a running export keeps its progress bar and cancel button
+        busy = busy or self.export_runs.running  # a running export keeps its progress bar and cancel button
         self.progress_bar.setVisible(busy)
         self.cancel_button.setVisible(busy)
         if busy and not was:
@@ -203,8 +204,8 @@ class WindowWidgets(WindowBase):
         return (self._current_job is not None and not self._current_job.done()) or self._loading_views
 
     def cancel_current_job(self) -> None:
-        if self._export_run is not None:  # an export runs alongside whatever else: the button stops it first
-            self._export_run.cancel()
+        if self.export_runs.running:  # an export runs alongside whatever else: the button stops it first
+            self.export_runs.cancel()
         elif self._current_job is not None and not self._current_job.done():
             self._current_job.cancel()
         elif self._loading_views:  # the scene is shown; stop computing its first views
