@@ -158,23 +158,25 @@ def _headerless_names(lines: list[str], at: int, sep: str | None) -> list[str]:
 
 
 def is_point_text(head: bytes) -> bool:
-    """Text whose first rows (after ``#`` comments and a lone point count) hold the same number, 3 or more, of
-    numbers each: a header-less point table (.xyz, .pts, .txt), or one whose header row names x and y columns."""
-    if b"\0" in head:
-        return False
+    """Text whose first rows (after ``#`` comments and a lone point count) hold numbers, the same number of them
+    (3 or more) in at least three rows of four: a header-less point table (.xyz, .pts, .txt), or one whose header row
+    names x and y columns. A minority of damaged rows (a first row with a flipped bit, a field lost) leaves it a
+    table, so the table's reader names them, not the reader of another format sharing the name (issue #32); a
+    binary file's "rows" are not numbers."""
     lines = head.decode("utf-8", errors="replace").splitlines()
     rows = _rows(lines[:-1] if len(head) >= HEAD_SNIFF else lines)[:20]  # the last line may be cut
     if len(rows) > 1 and _count_line(rows, 0):
         rows = rows[1:]
     if not rows:
         return False
-    sep = _separator(rows[0])
-    first = _fields(rows[0], sep)
-    keys = {_key(f) for f in first}
+    sep = _separator(rows[min(1, len(rows) - 1)])   # the first row may be the damaged one
+    keys = {_key(f) for f in _fields(rows[0], sep)}
     if keys & COORDINATE_NAMES[0] and keys & COORDINATE_NAMES[1] and len(rows) > 1:
         rows = rows[1:]
-    counts = {len(_fields(row, sep)) for row in rows}
-    return len(counts) == 1 and counts.pop() >= 3 and all(_number(f) for row in rows for f in _fields(row, sep))
+    shapes = [len(f) if all(_number(v) for v in f) and "\0" not in row else 0
+              for row, f in ((row, _fields(row, sep)) for row in rows)]
+    width = max(set(shapes), key=shapes.count)
+    return width >= 3 and 4 * shapes.count(width) >= 3 * len(shapes)
 
 
 def read_csv_points(path: PathLike, x: str | None = None, y: str | None = None, z: str | None = None,

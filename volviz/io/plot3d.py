@@ -161,6 +161,22 @@ def detect_layout(path: PathLike, kind: str, head: bytes, size: int, *, byteorde
                           f"but the file holds {size} bytes ({human_bytes(size)})")
 
 
+def is_plot3d_grid(head: bytes, size: int | None = None) -> bool:
+    """Whether ``head`` starts a PLOT3D grid (xyz) file of ``size`` bytes: a layout whose dimension header gives
+    exactly that size (or up to ``PADDING_LIMIT`` less), as ``detect_layout`` reads it. The registry's sniffer for
+    the names PLOT3D shares with text point clouds (``*.xyz``): a text table read as integers claims far more
+    bytes than it holds (issue #32: a point cloud with a damaged first row was taken for PLOT3D by its name).
+    ``size`` None (not known): a plausible header in some layout and zero bytes in the head (binary integers)."""
+    if size is None:
+        return b"\0" in head[:16] and any(_header(head, bo, mk, mg) is not None
+                                          for bo, mk, mg in product("<>", (False, True), (False, True)))
+    try:
+        detect_layout("<sniff>", "xyz", head, size)
+    except ReadError:
+        return False
+    return True
+
+
 def _check_markers(path: PathLike, kind: str, head: bytes, layout: Plot3DLayout) -> Plot3DLayout:
     if layout.record_markers:
         expect = (_xyz_block_bytes(layout.dims[0], layout.precision, layout.iblanking) if kind == "xyz"

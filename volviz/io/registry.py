@@ -56,6 +56,8 @@ class ReaderSpec:
     ``reads_siblings``: the loader reads a file together with the files beside it that belong with it (the slices
     of a DICOM series), so numbered files of this format are not grouped into a time series.
     ``select_options``: options that pick this reader whatever the file is called (``dims`` for raw volumes).
+    ``sniff_size``: the sniffer takes the file's size too, ``f(first_bytes, size)`` (``size`` None where it is not
+    known): a format recognised by a header that must agree with the file's size (PLOT3D's dimensions).
     ``sniff_opens``: False when the loader needs the file's extension, so a file recognised only by content is
     refused with a hint to rename it. ``claims_name``: False for extensions other formats share (``.dat``, ``.inp``):
     the name then picks this reader only when its sniffer accepts the content too.
@@ -74,6 +76,7 @@ class ReaderSpec:
     sniffs_folders: bool = False
     reads_siblings: bool = False
     select_options: tuple[str, ...] = ()
+    sniff_size: bool = False
     sniff_opens: bool = True
     claims_name: bool = True
     catch_all: bool = False
@@ -99,12 +102,12 @@ class ReaderSpec:
         low = name.lower()
         return any(fnmatch.fnmatchcase(low, g.lower()) for g in self.globs())
 
-    def accepts(self, head: bytes) -> bool:
-        """Whether the sniffer recognises ``head`` (False without a sniffer)."""
+    def accepts(self, head: bytes, size: int | None = None) -> bool:
+        """Whether the sniffer recognises ``head`` of a file of ``size`` bytes (False without a sniffer)."""
         if self.sniff is None:
             return False
-        sniff = resolve(self.sniff) if isinstance(self.sniff, str) else self.sniff
-        return bool(sniff(head))
+        sniff: Callable[..., Any] = resolve(self.sniff) if isinstance(self.sniff, str) else self.sniff
+        return bool(sniff(head, size) if self.sniff_size else sniff(head))
 
     def opens_folder(self, folder: Path) -> bool:
         for marker in self.folder_markers:
@@ -164,6 +167,7 @@ BUILTIN_READERS: list[ReaderSpec] = [
     ReaderSpec("plot3d", "PLOT3D grid (+ q solution)", ("*.xyz", "*.x", "*.p3d", "*.g", "*.grd", "*xyz*.bin",
                                                          "*xyz*.dat", "*xyz"),
                "volviz.io.registry:read_plot3d_auto", select_options=("q",),
+               sniff="volviz.io.plot3d:is_plot3d_grid", sniff_size=True, sniff_opens=False,
                arrays="point: Density, Momentum, StagnationEnergy and derived quantities",
                options=("q", "block", "gamma", "allow_nonfinite")),
     ReaderSpec("pvm", "PVM volume", ("*.pvm", "*.pvm-t*"), "volviz.io.pvm:read_pvm", sniff="volviz.io.pvm:is_pvm",
@@ -339,12 +343,14 @@ def spec_of(path: PathLike, options: dict | None = None) -> ReaderSpec:
         return _folder_spec(Path(os.fspath(path)))
     p = check_file(path)
     head = read_bytes(p, HEAD_BYTES)
-    named = [s for s in specs if not s.catch_all and s.matches_name(p.name) and (s.claims_name or s.accepts(head))]
-    for candidates in ([s for s in named if s.accepts(head)], [s for s in named if s.sniff is None]):
+    size = p.stat().st_size
+    named = [s for s in specs if not s.catch_all and s.matches_name(p.name) and
+             (s.claims_name or s.accepts(head, size))]
+    for candidates in ([s for s in named if s.accepts(head, size)], [s for s in named if s.sniff is None]):
         if candidates:
             return candidates[0]
     for spec in specs:
-        if spec.accepts(head):
+        if spec.accepts(head, size):
             if not spec.sniff_opens:
                 raise ReadError(p, f"looks like a {spec.description} file; give it its extension "
                                    f"({' '.join(g[1:] for g in spec.globs())})")
