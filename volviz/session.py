@@ -24,12 +24,17 @@ import re
 import stat
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable, get_args
+from typing import TYPE_CHECKING, Any, Callable, get_args
 
 from volviz.io._checks import path_kind
 from volviz.io.atomic import OutputPathError, atomic_write_bytes
 from volviz.io.jsonbounds import nesting_depth, outside_strings
-from volviz.model.settings import Backend, SettingsError, validate_render_options, validate_settings
+from volviz.model.clip import ClipSettings
+from volviz.model.events import ChangeNotifier, SceneChange
+from volviz.model.settings import Backend, IsoOverlayMode, SettingsError, validate_render_options, validate_settings
+
+if TYPE_CHECKING:
+    from volviz.optics.transfer_function import TransferFunction
 
 FORMAT = "volviz-session"
 VERSION = 1
@@ -45,6 +50,7 @@ MAX_OPTION_ITEMS = 16        # items of a list-valued dataset option (dims, spac
 COMPONENT_TYPES = ("volume", "mesh", "isosurface", "terrain", "fog", "clouds", "sky", "demo", "slices")
 RENDER_METHODS = ("auto", "pt", "reference", "vtk")
 RENDER_BACKENDS = get_args(Backend)   # render option "backend" (volviz.render.backend)
+ISO_MODES: tuple[str, ...] = get_args(IsoOverlayMode)  # render option "iso_mode": "vtk" or a libMini note §4 mode
 
 
 class SessionError(Exception):
@@ -112,12 +118,57 @@ class Session:
     render: RenderSettings = field(default_factory=RenderSettings)
     layout: dict[str, Any] = field(default_factory=dict)
     clip: dict[str, Any] = field(default_factory=lambda: {"planes": [], "box": None})
+    #: announces each edit made through the methods below (``volviz.model.events``); not part of the document
+    changes: ChangeNotifier = field(default_factory=ChangeNotifier, repr=False, compare=False)
 
     def dataset(self, dataset_id: str) -> DatasetRef:
         for ref in self.datasets:
             if ref.id == dataset_id:
                 return ref
         raise KeyError(dataset_id)
+
+    def component(self, comp_id: str) -> Component:
+        for comp in self.components:
+            if comp.id == comp_id:
+                return comp
+        raise KeyError(comp_id)
+
+    # -- edits (issue #31): each changes the session, then announces it on ``changes``; whoever made it (a dock, an
+    # undo step, a script), the views follow through their subscription (``volviz.render.controller``)
+    def set_transfer_function(self, comp_id: str, tf: TransferFunction, preview: bool = False) -> None:
+        """Give component ``comp_id`` the transfer function ``tf`` (stored under the component's TF name, else its
+        id); ``preview``: an edit under way (a point being dragged)."""
+        comp = self.component(comp_id)
+        name = comp.transfer_function or comp.id
+        self.transfer_functions[name] = tf.to_dict()
+        comp.transfer_function = name
+        self.changes.notify(SceneChange("transfer_function", comp_id, preview))
+
+    def set_visible(self, comp_id: str, visible: bool) -> None:
+        self.component(comp_id).visible = bool(visible)
+        self.changes.notify(SceneChange("visible", comp_id))
+
+    def set_opacity(self, comp_id: str, opacity: float) -> None:
+        """Set a component's opacity, clamped to [0, 1]."""
+        self.component(comp_id).opacity = float(min(max(opacity, 0.0), 1.0))
+        self.changes.notify(SceneChange("opacity", comp_id))
+
+    def set_clip(self, clip: dict[str, Any] | ClipSettings) -> None:
+        """New scene-wide clipping (``ClipSettings`` or its JSON); raises ``ValueError`` naming what is wrong with
+        it, changing nothing."""
+        self.clip = (clip if isinstance(clip, ClipSettings) else ClipSettings.from_dict(clip)).to_dict()
+        self.changes.notify(SceneChange("clip"))
+
+    def set_iso_mode(self, mode: str) -> None:
+        """The isosurfaces' transparency mode (render option ``iso_mode``, one of ``ISO_MODES``); announced only when
+        it changes."""
+        if mode not in ISO_MODES:
+            raise ValueError(f"unknown isosurface mode {mode!r}; choose from {ISO_MODES}")
+        changed = mode != self.render.options.get("iso_mode", "vtk")
+        if mode != "vtk" or "iso_mode" in self.render.options:
+            self.render.options["iso_mode"] = mode
+        if changed:
+            self.changes.notify(SceneChange("iso_mode"))
 
 
 # --------------------------------------------------------------------------------------------------------- validation

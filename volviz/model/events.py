@@ -1,7 +1,9 @@
-"""Change events of a scene (issue #18): what a ``volviz.render.controller.SceneController`` changed in its session
-and views, for whoever shows that state (the app's window and docks subscribe once instead of being told by each
-caller). Qt-free: subscribers are plain callables, called on the thread that made the change, in the order they
-subscribed."""
+"""Change events of a scene (issues #18, #31): what an edit changed in a ``volviz.session.Session``, announced by the
+session itself (``Session.changes``) whoever made the edit (a dock, an undo step, a script); the render controller
+adapts each to its views and passes it on (``SceneController.changes``), and the app's window refreshes its views on
+it instead of being told by each caller. Qt-free: subscribers are plain callables, called on the thread that made
+the change, in the order they subscribed. A copy of a model has no subscribers (``copy.deepcopy(session)`` never
+copies the views and windows that listen to the original)."""
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -17,10 +19,12 @@ CHANGE_KINDS: tuple[str, ...] = get_args(ChangeKind)
 
 @dataclass(frozen=True)
 class SceneChange:
-    """One change: ``what`` changed (``ChangeKind``), of ``component`` (None for a scene-wide change)."""
+    """One change: ``what`` changed (``ChangeKind``), of ``component`` (None for a scene-wide change); ``preview``: an
+    edit under way (a transfer-function point being dragged), which a view may show as a cheaper preview."""
 
     what: ChangeKind
     component: Optional[str] = None
+    preview: bool = False
 
     def __post_init__(self) -> None:
         if self.what not in CHANGE_KINDS:
@@ -42,6 +46,12 @@ class ChangeNotifier:
                 self._subscribers.remove(fn)
 
         return unsubscribe
+
+    def __copy__(self) -> ChangeNotifier:
+        return ChangeNotifier()
+
+    def __deepcopy__(self, memo: dict[int, object]) -> ChangeNotifier:
+        return ChangeNotifier()
 
     def notify(self, change: SceneChange) -> None:
         for fn in list(self._subscribers):

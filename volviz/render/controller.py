@@ -1,8 +1,12 @@
 """A live scene in one plotter: what the app's docks change and what export renders, through one code path.
 
-Each edit of the session's state through it (a component's visibility, opacity or transfer function, the clipping,
-the isosurfaces' mode) is announced to the subscribers of ``changes`` (``volviz.model.events``), e.g. the app's
-window, which marks the session edited and shows the new state in its docks.
+The controller is the adapter from the session's edits to the views (issue #31): each edit of the session's state
+(a component's visibility, opacity or transfer function, the clipping, the isosurfaces' mode) is made in the model
+(``volviz.session.Session.set_transfer_function`` ..., by a dock, an undo step or a script), which announces it
+(``Session.changes``, ``volviz.model.events``); the installed controller hears it, gives it to its views, and passes
+it on to the subscribers of its own ``changes`` (e.g. the app's window, which marks the session edited, shows the
+new state in its docks and refreshes the camera views in the background). Its ``set_transfer_function`` ... are
+that edit of the model with the choice of what the views re-make at once (``update``).
 
 ``SceneController`` owns one view per shown component (``views``: ``volviz.render.views.ComponentView``, made by
 ``volviz.render.scene_builder.install_component``; the natural scene's view under ``"nature"``) and talks to every
@@ -19,13 +23,14 @@ the background).
 from __future__ import annotations
 
 from contextlib import contextmanager
-from typing import TYPE_CHECKING, Any, Iterator, Optional
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any, Callable, Iterator, Optional
 
 from volviz.model import TimeSeries
 from volviz.model.applicability import DatasetTraits
 from volviz.model.events import ChangeNotifier, SceneChange
 from volviz.render.image_overlay import single_sample_on_software
-from volviz.session import CameraState, Component, Session
+from volviz.session import ISO_MODES, CameraState, Component, Session
 
 if TYPE_CHECKING:   # type-only imports for the signatures
     import pyvista as pv
@@ -43,8 +48,7 @@ if TYPE_CHECKING:   # type-only imports for the signatures
     from volviz.scene.datasets import LoadedDataset
     from volviz.scene.isosurfaces import IsoParts
 
-
-ISO_MODES = ("vtk", "2pass", "3pass", "4pass", "exact")
+__all__ = ["ISO_MODES", "SceneController", "ensure_lights", "iso_summary", "no_render", "session_interpolates"]
 
 
 def iso_summary(stats: dict[str, Any]) -> str:
@@ -82,18 +86,49 @@ def session_interpolates(session: Session) -> bool:
     return all(comp.settings.get("interpolate", True) is not False for comp in session.components)
 
 
+@dataclass(frozen=True)
+class _Edit:
+    """What the views re-make at once for an edit of the model: camera-dependent parts (``update``: a CPU PT image,
+    a cut), the natural scene (``nature``), a component hidden at build time (``build``)."""
+
+    update: bool = True
+    nature: bool = True
+    build: bool = True
+
+
 class SceneController:
     def __init__(self, plotter: Any, session: Session, datasets: dict[str, LoadedDataset], on_screen: bool = False):
         self.plotter = plotter
-        self.on_screen = on_screen  # the Qt viewport (kept for callers; both draw the iso-spectrum shader)
-        self.session = session
+        # the Qt viewport: an edit made in the model re-makes nothing at once (the window refreshes the camera views,
+        # rebuilds the natural scene and shows hidden components in the background); off screen (scripts, export)
+        # it re-makes all at once
+        self.on_screen = on_screen
+        self._unsubscribe: Optional[Callable[[], None]] = None  # from ``session.changes`` while installed
+        self._session = session
         self.datasets = datasets
         self.views: dict[str, Any] = {}  # comp id -> its view (``ComponentView``); "nature" -> the natural scene's
         self.iso_view: Any = None         # GLIsoView or IsoOverlay while a mode of the note is on
         self.histograms: dict[str, Any] = {}   # comp id -> (counts, edges) of its data, from ``prepare``
         self.time = 0.0
         self.interpolate_time = session_interpolates(session)
-        self.changes = ChangeNotifier()   # a SceneChange after each edit of the session's state (``model.events``)
+        self.changes = ChangeNotifier()   # each edit of the session (``Session.changes``) once the views show it
+        self.pending: list[str] = []      # after an opacity or clipping edit: the ids whose CPU cut is stale
+        self._edit = _Edit(not on_screen, not on_screen, not on_screen)  # for edits made in the model directly
+
+    @property
+    def session(self) -> Session:
+        return self._session
+
+    @session.setter
+    def session(self, session: Session) -> None:
+        """Another session object for the scene shown (the app's File > Save captures one): its edits reach the
+        views from now on."""
+        listening = self._unsubscribe is not None
+        if listening:
+            self._stop_listening()
+        self._session = session
+        if listening:
+            self._listen()
 
     @property
     def props(self) -> dict[str, Any]:
@@ -129,6 +164,8 @@ class SceneController:
         in the background (``pt_volume``, ``lod_volumes``, ``nature``: ``begin`` / ``compute`` / ``finish``)."""
         from volviz.render.scene_builder import install_scene
 
+        self._listen()
+
         ensure_lights(self.plotter)
         single_sample_on_software(self.plotter)   # the app's window and ``volviz render`` alike
         with no_render(self.plotter):  # the caller draws once afterwards
@@ -162,6 +199,51 @@ class SceneController:
             self.iso_view = None
         self.views = {}
         self.plotter.clear()
+        self._stop_listening()   # the session's edits no longer reach this scene
+
+    # -- the model's edits ------------------------------------------------------------------------------------------
+    def _listen(self) -> None:
+        if self._unsubscribe is None:
+            self._unsubscribe = self.session.changes.subscribe(self._model_changed)
+
+    def _stop_listening(self) -> None:
+        if self._unsubscribe is not None:
+            self._unsubscribe()
+            self._unsubscribe = None
+
+    @contextmanager
+    def _editing(self, edit: _Edit) -> Iterator[None]:
+        """An edit of the model made through this controller: its views re-make what ``edit`` says (heard even
+        before ``install``)."""
+        previous, listening = self._edit, self._unsubscribe is not None
+        self._edit = edit
+        self._listen()
+        try:
+            yield
+        finally:
+            self._edit = previous
+            if not listening:
+                self._stop_listening()
+
+    def _model_changed(self, change: SceneChange) -> None:
+        """The session announced an edit: give it to the views (what they re-make at once: ``_edit``), then pass it
+        on to ``changes``."""
+        edit, comp_id = self._edit, change.component
+        self.pending = []
+        if change.what == "transfer_function" and comp_id is not None:
+            self._show_transfer_function(comp_id, edit.update)
+        elif change.what == "visible" and comp_id is not None:
+            try:
+                self._show_visible(comp_id, edit.nature, edit.build)
+            finally:
+                self.decorate()        # the outline and the scalar bar follow what is shown
+        elif change.what == "opacity" and comp_id is not None:
+            self.pending = self._show_opacity(comp_id, edit.update)
+        elif change.what == "clip":
+            self.pending = self.apply_clip(edit.update)
+        elif change.what == "iso_mode":
+            self._show_iso_mode(edit.update)
+        self.changes.notify(change)
 
     def decorate(self) -> None:
         """(Re)draw the scalar bar, orientation axes and outline box as the session's render options say
@@ -176,10 +258,7 @@ class SceneController:
         return {k: p for k, p in self.props.items() if k == "nature" or k in visible}
 
     def component(self, comp_id: str) -> Component:
-        for comp in self.session.components:
-            if comp.id == comp_id:
-                return comp
-        raise KeyError(comp_id)
+        return self.session.component(comp_id)
 
     def dataset_of(self, comp_id: str) -> Any:
         from volviz.scene.datasets import component_dataset
@@ -220,39 +299,37 @@ class SceneController:
         return tf if comp.dataset not in self.datasets else drawn_tf(comp, tf, self.dataset_of(comp.id))
 
     def set_transfer_function(self, comp_id: str, tf: TransferFunction, update: bool = True) -> None:
-        """Store ``tf`` in the session and give it to the component's view; a view that re-makes something for a new
-        TF (a CPU PT volume's image, a LOD volume's block selection) does so now only when ``update`` (the app does it
-        in the background: ``camera_views``, then ``begin`` / ``compute`` / ``finish``)."""
+        """Store ``tf`` in the session (``Session.set_transfer_function``), which the component's view then shows; a
+        view that re-makes something for a new TF (a CPU PT volume's image, a LOD volume's block selection) does so
+        now only when ``update`` (the app does it in the background: ``camera_views``, then ``begin`` / ``compute``
+        / ``finish``)."""
+        with self._editing(_Edit(update=update)):
+            self.session.set_transfer_function(comp_id, tf)
+
+    def _show_transfer_function(self, comp_id: str, update: bool) -> None:
         comp = self.component(comp_id)
-        name = comp.transfer_function or comp.id
-        self.session.transfer_functions[name] = tf.to_dict()
-        comp.transfer_function = name
         view = self.views.get(comp_id)
         if view is not None:
-            view.set_tf(self._drawn(comp, tf), comp.opacity)
+            view.set_tf(self._drawn(comp, self.transfer_function(comp_id)), comp.opacity)
             if update:
                 view.update()
         from volviz.render.decorations import update_legend
 
         update_legend(self.plotter, self.session, self.datasets)   # the scalar bar shows the new colors and range
-        self.changes.notify(SceneChange("transfer_function", comp_id))
 
     def set_visible(self, comp_id: str, visible: bool, nature: bool = True, build: bool = True) -> None:
-        """Show or hide a component. A terrain / fog / clouds / sky component rebuilds the natural scene now unless
-        ``nature`` is false (the app rebuilds it in the background: ``prepare_nature``, ``install_nature``). Another
-        component hidden at build time is built now unless ``build`` is false (the app prepares it in the
-        background: ``prepare_component``, ``install_component``)."""
-        try:
-            self._set_visible(comp_id, visible, nature, build)
-        finally:
-            self.decorate()        # the outline and the scalar bar follow what is shown
-        self.changes.notify(SceneChange("visible", comp_id))
+        """Show or hide a component (``Session.set_visible``). A terrain / fog / clouds / sky component rebuilds the
+        natural scene now unless ``nature`` is false (the app rebuilds it in the background: ``prepare_nature``,
+        ``install_nature``). Another component hidden at build time is built now unless ``build`` is false (the app
+        prepares it in the background: ``prepare_component``, ``install_component``)."""
+        with self._editing(_Edit(nature=nature, build=build)):
+            self.session.set_visible(comp_id, visible)
 
-    def _set_visible(self, comp_id: str, visible: bool, nature: bool, build: bool) -> None:
+    def _show_visible(self, comp_id: str, nature: bool, build: bool) -> None:
         from volviz.scene.datasets import NATURE_TYPES
 
         comp = self.component(comp_id)
-        comp.visible = bool(visible)
+        visible = comp.visible
         if comp.type in NATURE_TYPES:  # the natural scene is one view of all its components
             if nature:
                 self.rebuild_nature()
@@ -310,11 +387,16 @@ class SceneController:
             view.show_cut(cut, self.component(comp_id).visible)
 
     def set_opacity(self, comp_id: str, opacity: float, update: bool = True) -> list[str]:
-        """Set a component's opacity (its view's ``set_tf``). What that re-makes (a PT image, a cut of the
-        isosurfaces) is made now when ``update``; otherwise returns the ids whose cut is stale, which the app makes in
-        the background (``cut`` on a worker, then ``show_cut``; images through ``camera_views``)."""
+        """Set a component's opacity (``Session.set_opacity``; its view's ``set_tf``). What that re-makes (a PT
+        image, a cut of the isosurfaces) is made now when ``update``; otherwise returns the ids whose cut is stale
+        (``pending``), which the app makes in the background (``cut`` on a worker, then ``show_cut``; images through
+        ``camera_views``)."""
+        with self._editing(_Edit(update=update)):
+            self.session.set_opacity(comp_id, opacity)
+        return self.pending
+
+    def _show_opacity(self, comp_id: str, update: bool) -> list[str]:
         comp = self.component(comp_id)
-        comp.opacity = float(min(max(opacity, 0.0), 1.0))
         view = self.views.get(comp_id)
         stale: list[str] = []
         if view is not None:
@@ -324,7 +406,6 @@ class SceneController:
             self._sync_iso_overlay()
             is_stale = getattr(view, "stale", None)
             stale = [comp_id] if is_stale is not None and is_stale() else []
-        self.changes.notify(SceneChange("opacity", comp_id))
         return stale
 
     # -- time -------------------------------------------------------------------------------------------------------
@@ -624,16 +705,13 @@ class SceneController:
         return clip_settings(self.session.clip)
 
     def set_clip(self, clip: dict[str, Any] | ClipSettings, update: bool = True) -> list[str]:
-        """Store new clipping (``session.clip`` JSON or ClipSettings) and give it to every view (``apply_clip``);
-        returns the ids of the views drawn from a cut made on the CPU (a CPU PT volume's mesh, an isosurface
-        component's surfaces), which are cut and re-made here when ``update``; the app instead cuts them in the
-        background (``cut`` on a worker, then ``show_cut``) and re-renders."""
-        from volviz.model.clip import ClipSettings
-
-        self.session.clip = clip.to_dict() if isinstance(clip, ClipSettings) else self.clip.from_dict(clip).to_dict()
-        pending = self.apply_clip(update)
-        self.changes.notify(SceneChange("clip"))
-        return pending
+        """Store new clipping (``session.clip`` JSON or ClipSettings: ``Session.set_clip``), which every view is then
+        given (``apply_clip``); returns the ids of the views drawn from a cut made on the CPU (a CPU PT volume's mesh,
+        an isosurface component's surfaces; ``pending``), which are cut and re-made here when ``update``; the app
+        instead cuts them in the background (``cut`` on a worker, then ``show_cut``) and re-renders."""
+        with self._editing(_Edit(update=update)):
+            self.session.set_clip(clip)
+        return self.pending
 
     def apply_clip(self, update: bool = True) -> list[str]:
         """Give the session's clipping to every view (``set_clip``: VTK's mapper planes, a GPU PT volume's
@@ -695,14 +773,18 @@ class SceneController:
     def set_iso_mode(self, mode: str, update: bool = True) -> None:
         """Draw the isosurfaces with VTK's blend ("vtk") or a mode of the note on the backend's ``iso_view`` (the CPU
         overlay is rendered now when ``update``; the app renders it in the background: ``iso_overlay.begin`` /
-        ``compute`` / ``finish``)."""
+        ``compute`` / ``finish``). A new mode is an edit of the session (``Session.set_iso_mode``); the current one
+        is applied again (after a build) without one."""
+        with self._editing(_Edit(update=update)):
+            changed = mode != self.iso_mode
+            self.session.set_iso_mode(mode)   # checks the mode; a new one is announced, and shown through it
+        if not changed:
+            self._show_iso_mode(update)
+
+    def _show_iso_mode(self, update: bool) -> None:
         from volviz.render.scene_builder import view_backend
 
-        if mode not in ISO_MODES:
-            raise ValueError(f"unknown isosurface mode {mode!r}; choose from {ISO_MODES}")
-        changed = mode != self.iso_mode
-        if mode != "vtk" or "iso_mode" in self.session.render.options:
-            self.session.render.options["iso_mode"] = mode
+        mode = self.iso_mode
         backend = view_backend(self.plotter, self.session, "iso")
         view = self.iso_view
         if view is not None and (mode == "vtk" or not self._iso_props() or view.backend != backend):
@@ -719,8 +801,6 @@ class SceneController:
             self.iso_overlay.update()
         else:
             self.plotter.render()
-        if changed:
-            self.changes.notify(SceneChange("iso_mode"))
 
     def _iso_props(self) -> dict[str, Any]:
         return {comp_id: view.prop for comp_id, view in self._views_of("isosurfaces").items()}
@@ -745,3 +825,16 @@ class SceneController:
                 shading = prop.volviz_shading
         if overlay is not None:
             overlay.set_surfaces(meshes, lod, shading)
+        self._peel_volumes()
+
+    def _peel_volumes(self) -> None:
+        """In "vtk" mode translucent isosurfaces inside a regular volume are depth-peeled with it, so the volume
+        behind a surface, the surface and the volume in front composite in that order
+        (``volviz.render.volume_peeling``); the app's window, ``volviz render`` and exports alike."""
+        from volviz.render.volume_peeling import peel_volumes
+
+        shown = self.shown_props()
+        translucent = self.iso_view is None and any(
+            prop.GetVisibility() and any(a.GetVisibility() for a in prop.volviz_translucent)
+            for comp_id, prop in self._iso_props().items() if comp_id in shown)
+        peel_volumes(self.plotter, [p for p in shown.values() if hasattr(p, "IsA")], translucent)
