@@ -1,25 +1,31 @@
-"""Session I/O of the main window (a mixin of ``MainWindow``): File > Open Data / Open Session / Save Session /
-Save Session As (non-blocking file dialogs that start in the folder used last), saving, dirty tracking in the window
-title, autosave to a crash-recovery file of the window's own (``volviz_app.recovery``) with the offer to restore one
-left by a crash, File > Open Recent (``volviz_app.recent``), and the question about unsaved changes on closing.
+"""Session I/O of the main window: File > Open Data / Open Folder / Open Session / Save Session / Save Session As
+(non-blocking file dialogs that start in the folder used last), saving, dirty tracking in the window title, autosave
+to a crash-recovery file of the window's own (``volviz_app.recovery``) with the offer to restore one left by a
+crash, File > Open Recent (``volviz_app.recent``), and the question about unsaved changes on closing.
 
-It expects of the window: ``session``, ``session_path``, ``controller``, ``recovery_dir``, ``recent`` (a
-``RecentFiles``), ``status_label``, ``show_error(title, text)``, ``open_path``, ``open_paths`` and
-``_show_session`` (``volviz_app.scene_loading``), ``saveState()`` (``QMainWindow``); ``_connect_session_files()``
-starts the autosave timer (called by the window's ``__init__``)."""
+Held by the window as ``window.session_files``; its collaborators are the shown scene (``shown_scene``: it saves the
+session, marks it dirty, and takes a saved session as the shown one), the window (the parent of its dialogs and
+timers, its title and dock state), the recovery folder, the recent files, the status label, and the window's scene
+loading: ``open_path(path)``, ``open_paths(paths)`` and ``show_session(session, session_path, title, dirty=...)``
+(``volviz_app.scene_loading``), with ``show_error(title, text)``. Its autosave timer runs from when it is made;
+``stop()`` ends it when the window closes."""
 from __future__ import annotations
 
 import dataclasses
 import logging
 import os
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any, Callable, Optional
 
 from PySide6.QtCore import QStandardPaths, QTimer
-from PySide6.QtWidgets import QFileDialog, QMessageBox
+from PySide6.QtWidgets import QFileDialog, QLabel, QMainWindow, QMessageBox
 
 from volviz.session import Session, SessionError, relative_path
-from .window_base import WindowBase
+from .recent import RecentFiles
+from .shown_scene import ShownScene
+
+if TYPE_CHECKING:
+    OpenPath = Callable[[str | os.PathLike], None]
 
 log = logging.getLogger("volviz_app.window")  # the logger these methods had in window.py
 
@@ -49,38 +55,53 @@ def default_recovery_dir() -> Path:
     return Path(base or Path.home() / ".volviz") / "recovery"
 
 
-class SessionFiles(WindowBase):
+class SessionFiles:
     """Open, save, autosave, recovery, recent files and dirty tracking of the window (see the module's docstring)."""
 
-    def _connect_session_files(self) -> None:
-        self.autosave_timer = QTimer(self, interval=AUTOSAVE_MS)
+    def __init__(self, scene: ShownScene, window: QMainWindow, recovery_dir: Path, recent: RecentFiles,
+                 status: QLabel, open_path: OpenPath, open_paths: Callable[[list[str]], None],
+                 show_session: Callable[..., None], show_error: Callable[[str, str], None]) -> None:
+        self.scene, self.window, self.recovery_dir = scene, window, recovery_dir
+        self.recent, self.status, self.show_error = recent, status, show_error
+        self.open_path, self.open_paths, self.show_session = open_path, open_paths, show_session
+        self.file_dialog: Optional[QFileDialog] = None       # the last file dialog (``ask_file``)
+        self.unsaved_dialog: Optional[QMessageBox] = None    # the last unsaved-changes question
+        self.recovery_dialog: Optional[QMessageBox] = None   # the offer to restore a crashed window's work
+        self._recovery_file: Optional[Path] = None
+        self.autosave_timer = QTimer(window, interval=AUTOSAVE_MS)
         self.autosave_timer.timeout.connect(self.autosave)
         self.autosave_timer.start()
-        self.edit_autosave_timer = QTimer(self, singleShot=True, interval=EDIT_AUTOSAVE_MS)
+        self.edit_autosave_timer = QTimer(window, singleShot=True, interval=EDIT_AUTOSAVE_MS)
         self.edit_autosave_timer.timeout.connect(self.autosave)
 
+    def stop(self) -> None:
+        """The window closes: no more autosaves."""
+        self.autosave_timer.stop()
+        self.edit_autosave_timer.stop()
+
     def set_dirty(self, dirty: bool = True) -> None:
-        self.dirty = dirty
-        if dirty and hasattr(self, "edit_autosave_timer"):
+        self.scene.dirty = dirty
+        if dirty:
             self.edit_autosave_timer.start()  # (re)started by each edit: one write after a burst of edits
-        name = self.session_path.name if self.session_path else getattr(self, "title", "untitled")
-        self.setWindowTitle(f"volviz — {name}{' *' if dirty else ''}")
+        path = self.scene.session_path
+        name = path.name if path else getattr(self.scene, "title", "untitled")
+        self.window.setWindowTitle(f"volviz — {name}{' *' if dirty else ''}")
 
     def capture_session(self, target: Path) -> Session:
         """The current state as a session to be saved at ``target`` (paths made relative to it)."""
         from volviz.session import DatasetRef, resolve_path
 
-        session = self.session
+        session, session_path, controller = self.scene.session, self.scene.session_path, self.scene.controller
         refs = []
         for ref in session.datasets:
-            absolute = resolve_path(self.session_path, ref.path) if self.session_path else Path(ref.path)
+            absolute = resolve_path(session_path, ref.path) if session_path else Path(ref.path)
             refs.append(DatasetRef(ref.id, relative_path(target, absolute), dict(ref.options)))
         layout = dict(session.layout)
-        layout["window_state"] = self.saveState().toBase64().toStdString()
-        camera = self.controller.camera() if self.controller is not None else session.camera
+        layout["window_state"] = self.window.saveState().toBase64().toStdString()
+        camera = controller.camera() if controller is not None else session.camera
         render = session.render
-        if self.controller is not None and self.controller.time_series():  # the time shown is what reopens
-            render = dataclasses.replace(render, options={**render.options, "time": float(self.controller.time)})
+        if controller is not None and controller.time_series():  # the time shown is what reopens
+            render = dataclasses.replace(render, options={**render.options, "time": float(controller.time)})
         return Session(datasets=refs, components=session.components, transfer_functions=session.transfer_functions,
                        camera=camera, camera_paths=session.camera_paths, bookmarks=session.bookmarks,
                        render=render, layout=layout, clip=session.clip)
@@ -95,13 +116,13 @@ class SessionFiles(WindowBase):
         except SessionError as exc:
             self.show_error("Cannot save session", str(exc))
             return False
-        self.session, self.session_path = session, target
-        if self.controller is not None:
-            self.controller.session = session
+        self.scene.session, self.scene.session_path = session, target
+        if self.scene.controller is not None:
+            self.scene.controller.session = session
         self.recent.add(target)
         self.set_dirty(False)
         self.clear_recovery()
-        self.status_label.setText(f"Saved {target.name}")
+        self.status.setText(f"Saved {target.name}")
         return True
 
     @property
@@ -109,25 +130,25 @@ class SessionFiles(WindowBase):
         """This window's own recovery file (``volviz_app.recovery``): other windows never write or delete it."""
         from .recovery import window_file
 
-        if "_own_recovery_file" not in self.__dict__:
-            self.__dict__["_own_recovery_file"] = window_file(self.recovery_dir)
-        return self.__dict__["_own_recovery_file"]
+        if self._recovery_file is None:
+            self._recovery_file = window_file(self.recovery_dir)
+        return self._recovery_file
 
     def autosave(self) -> bool:
         """Write the current state to the recovery file (only when there are unsaved changes)."""
-        if not self.dirty or self.controller is None:
+        if not self.scene.dirty or self.scene.controller is None:
             return False
         from volviz.session import save
 
         self.recovery_dir.mkdir(parents=True, exist_ok=True)
         session = self.capture_session(self.recovery_file)
-        session.layout["recovered_from"] = str(self.session_path) if self.session_path else ""
+        session.layout["recovered_from"] = str(self.scene.session_path) if self.scene.session_path else ""
         try:
             save(session, self.recovery_file)
         except SessionError as exc:
             log.error("autosave failed: %s", exc)
             return False
-        self.status_label.setText("Autosaved")
+        self.status.setText("Autosaved")
         return True
 
     def clear_recovery(self) -> None:
@@ -142,7 +163,7 @@ class SessionFiles(WindowBase):
             return False
         box = QMessageBox(QMessageBox.Icon.Question, "Recover unsaved work",
                           "volviz did not shut down cleanly last time. Restore the unsaved work it kept?",
-                          QMessageBox.StandardButton.Yes | QMessageBox.StandardButton.No, self)
+                          QMessageBox.StandardButton.Yes | QMessageBox.StandardButton.No, self.window)
         box.finished.connect(lambda result: self._recovery_answer(box.result()))
         box.open()
         self.recovery_dialog = box
@@ -168,7 +189,7 @@ class SessionFiles(WindowBase):
 
             for ref in session.datasets:
                 ref.path = relative_path(origin, resolve_path(self.recovery_file, ref.path))
-        self._show_session(session, Path(origin) if origin else None, "recovered session", dirty=True)
+        self.show_session(session, Path(origin) if origin else None, "recovered session", dirty=True)
 
     def recent_files(self) -> list[str]:
         """File > Open Recent: the files that opened, newest first (``volviz_app.recent``)."""
@@ -179,7 +200,7 @@ class SessionFiles(WindowBase):
         """A non-blocking file dialog (kept as ``self.file_dialog``) that starts in the folder used last;
         ``on_chosen(path)`` runs when accepted. ``folder``: it chooses a folder, and the next dialog starts in the
         folder that holds it (among its siblings)."""
-        dialog = QFileDialog(self, title, self.recent.last_folder(), name_filter)
+        dialog = QFileDialog(self.window, title, self.recent.last_folder(), name_filter)
         dialog.setOption(QFileDialog.Option.DontUseNativeDialog, True)
         if save:
             dialog.setAcceptMode(QFileDialog.AcceptMode.AcceptSave)
@@ -211,15 +232,15 @@ class SessionFiles(WindowBase):
         self.file_dialog = dialog
         return dialog
 
-    def _ask_open_data(self) -> None:
+    def ask_open_data(self) -> None:
         self.keeping_unsaved_work(lambda: self.ask_file("Open data (a PLOT3D grid with its solution: select both)",
                                                         _data_filter(), self.open_paths, multiple=True))
 
-    def _ask_open_folder(self) -> None:
+    def ask_open_folder(self) -> None:
         self.keeping_unsaved_work(lambda: self.ask_file("Open a folder (a DICOM series, an OpenFOAM case)", "",
                                                         self.open_path, folder=True))
 
-    def _ask_open_session(self) -> None:
+    def ask_open_session(self) -> None:
         self.keeping_unsaved_work(lambda: self.ask_file("Open session", "volviz sessions (*.json);;All files (*)",
                                                         self.open_path))
 
@@ -232,21 +253,22 @@ class SessionFiles(WindowBase):
         """Run ``then()`` (which replaces the scene) now if nothing is unsaved; else ask, without blocking, Save /
         Discard / Cancel (kept as ``unsaved_dialog``): Save saves (asking for a file when the session has none) and
         then goes on, Discard goes on, Cancel keeps everything as it is."""
-        if not self.dirty:
+        if not self.scene.dirty:
             then()
             return
         box = QMessageBox(QMessageBox.Icon.Warning, "Unsaved changes",
                           "The scene has unsaved changes. Save them before opening another?",
                           QMessageBox.StandardButton.Save | QMessageBox.StandardButton.Discard
-                          | QMessageBox.StandardButton.Cancel, self)
+                          | QMessageBox.StandardButton.Cancel, self.window)
 
         def answered(_: int) -> None:
             answer = box.standardButton(box.clickedButton()) if box.clickedButton() else None
             if answer == QMessageBox.StandardButton.Discard:
                 then()
             elif answer == QMessageBox.StandardButton.Save:
-                if self.session_path is not None:
-                    if self.save_session(self.session_path):
+                session_path = self.scene.session_path
+                if session_path is not None:
+                    if self.save_session(session_path):
                         then()
                 else:
                     self.ask_file("Save session", "volviz sessions (*.json)",
@@ -256,28 +278,30 @@ class SessionFiles(WindowBase):
         box.open()
         self.unsaved_dialog = box
 
-    def _save_session(self) -> bool:
-        if self.session_path is None:
-            self._ask_save_session_as()
+    def save(self) -> bool:
+        """File > Save Session: to the session's file, else asking for one (False: not saved now)."""
+        session_path = self.scene.session_path
+        if session_path is None:
+            self.ask_save_as()
             return False
-        return self.save_session(self.session_path)
+        return self.save_session(session_path)
 
-    def _ask_save_session_as(self) -> None:
+    def ask_save_as(self) -> None:
         self.ask_file("Save session", "volviz sessions (*.json)", self.save_session, save=True,
                       default_name="session.json")
 
     def ask_unsaved_changes(self) -> QMessageBox.StandardButton:
         box = QMessageBox(QMessageBox.Icon.Warning, "Unsaved changes", "Save the changes to this session?",
                           QMessageBox.StandardButton.Save | QMessageBox.StandardButton.Discard
-                          | QMessageBox.StandardButton.Cancel, self)
+                          | QMessageBox.StandardButton.Cancel, self.window)
         self.unsaved_dialog = box
         return QMessageBox.StandardButton(box.exec())
 
-    def _confirm_close(self) -> bool:
+    def confirm_close(self) -> bool:
         """Closing with unsaved changes asks whether to save them; False: the window stays open (Cancel, or Save
         and the session was not saved)."""
-        if not self.dirty:
+        if not self.scene.dirty:
             return True
         answer = self.ask_unsaved_changes()
         return not (answer == QMessageBox.StandardButton.Cancel or (
-            answer == QMessageBox.StandardButton.Save and not self._save_session()))
+            answer == QMessageBox.StandardButton.Save and not self.save()))

@@ -4,13 +4,13 @@ scene, typed by ``shown_scene.ShownScene``, widgets, callbacks) when they are ma
 
 - ``camera_bookmarks``: camera bookmarks and camera-path recording (``camera_bookmarks.CameraBookmarks``);
 - ``export_runs``: screenshot and movie export in the background (``export_runs.ExportRuns``);
+- ``session_files``: open/save dialogs, saving, dirty tracking, autosave, crash recovery, the unsaved-changes
+  question on closing (``session_files.SessionFiles``; ``recent``: File > Open Recent);
 
 and is put together from one mixin per responsibility for the rest, each in its own module:
 
 - ``window_widgets.WindowWidgets``: the docks, menus and actions, the status bar with progress and cancel;
 - ``scene_loading.SceneLoading``: ``open_path`` and showing a session (prepared in the background, then installed);
-- ``session_files.SessionFiles``: open/save dialogs, saving, dirty tracking, autosave, crash recovery, recent files,
-  the unsaved-changes question on closing;
 - ``view_scheduler.ViewScheduler``: the background refreshes of the views (one job in flight per kind), the error
   estimate and budget;
 - ``scene_edits.SceneEdits``: what the docks' edits do to the shown scene (TF, visibility, opacity, settings,
@@ -27,8 +27,8 @@ import time
 from pathlib import Path
 from typing import Any, Optional
 
-from PySide6.QtCore import QSettings, Qt
-from PySide6.QtWidgets import QMainWindow, QMessageBox, QWidget
+from PySide6.QtCore import QSettings, Qt, QTimer
+from PySide6.QtWidgets import QFileDialog, QMainWindow, QMenu, QMessageBox, QWidget
 
 from volviz.render.backend import plotter_gl_info
 from volviz.render.controller import iso_summary
@@ -41,6 +41,7 @@ from .interaction_renders import SingleRenderDuringInteraction
 from .navigation import FlyMode
 from .stand_in import StandInFrame
 from .nonfinite_status import NonFiniteStatus
+from .recent import RecentFiles
 from .scene_edits import SceneEdits
 from .scene_loading import SceneLoading
 from .session_files import SessionFiles, default_recovery_dir
@@ -65,7 +66,7 @@ def _import_gui_thread_modules() -> None:
     pyvista.system_supports_plotting()
 
 
-class MainWindow(SceneLoading, SessionFiles, ViewScheduler, SceneEdits, WindowWidgets, QMainWindow):
+class MainWindow(SceneLoading, ViewScheduler, SceneEdits, WindowWidgets, QMainWindow):
     """volviz main window. ``open_path`` is the single code path behind File > Open and the command line."""
 
     def __init__(self, parent: Optional[QWidget] = None, settings: Optional[QSettings] = None,
@@ -77,7 +78,6 @@ class MainWindow(SceneLoading, SessionFiles, ViewScheduler, SceneEdits, WindowWi
         _import_gui_thread_modules()
         self.collector = GuiThreadCollector(self)  # cycles are freed on this thread, never in a worker
         self.settings = settings or QSettings("volviz", "volviz")
-        self.recovery_dir = Path(recovery_dir) if recovery_dir else default_recovery_dir()
         self.plotter = QtInteractor(self, auto_update=False)  # we render when something changed, never on a timer
         self.setCentralWidget(self.plotter.interactor)
         self.jobs = JobBridge(self)
@@ -87,7 +87,6 @@ class MainWindow(SceneLoading, SessionFiles, ViewScheduler, SceneEdits, WindowWi
         self.datasets = {}
         self.controller = None
         self.error_dialog = None
-        self.recovery_dialog = None
         self.dirty = False
         self.last_stats = {}
         self._current_job = None
@@ -101,6 +100,11 @@ class MainWindow(SceneLoading, SessionFiles, ViewScheduler, SceneEdits, WindowWi
         self.camera_bookmarks = CameraBookmarks(self, self, self.status_label, self.set_dirty, self._camera_moved)
         self.export_runs = ExportRuns(self, self.jobs, self.plotter, self.status_label, self._set_busy,
                                       self._busy_elsewhere, self.show_error)
+        self.recent_menu = QMenu("Open &Recent", self)   # File > Open Recent
+        self.recent = RecentFiles(self.settings, self.recent_menu, self.open_path_asking)
+        self.session_files = SessionFiles(self, self, Path(recovery_dir) if recovery_dir else default_recovery_dir(),
+                                          self.recent, self.status_label, self.open_path, self.open_paths,
+                                          self._show_session, self.show_error)   # its autosave timer runs from now
         self._build_menus()
         self.resize(*self.layout_keeper.default_size())
         self.layout_keeper.restore()
@@ -110,7 +114,6 @@ class MainWindow(SceneLoading, SessionFiles, ViewScheduler, SceneEdits, WindowWi
         self.clip_widget = ClipPlaneWidget(self.plotter, self.clipping)
         self._connect_view_scheduler()  # interaction observers, fly-mode settle and resize timers
         self._connect_scene_edits()  # the TF preview timer
-        self._connect_session_files()  # the autosave timer
         self.nonfinite = NonFiniteStatus(self)  # the status bar's note on non-finite values
         self.collector.freeze_long_lived()
 
@@ -197,6 +200,51 @@ class MainWindow(SceneLoading, SessionFiles, ViewScheduler, SceneEdits, WindowWi
     def export_threads(self) -> set[int]:
         return self.export_runs.threads
 
+    def set_dirty(self, dirty: bool = True) -> None:
+        self.session_files.set_dirty(dirty)
+
+    def save_session(self, path: str | os.PathLike) -> bool:
+        return self.session_files.save_session(path)
+
+    def autosave(self) -> bool:
+        return self.session_files.autosave()
+
+    def offer_recovery(self) -> bool:
+        return self.session_files.offer_recovery()
+
+    def recent_files(self) -> list[str]:
+        return self.session_files.recent_files()
+
+    def ask_file(self, title: str, name_filter: str, on_chosen: Any, save: bool = False,
+                 default_name: str = "", multiple: bool = False, folder: bool = False) -> QFileDialog:
+        return self.session_files.ask_file(title, name_filter, on_chosen, save, default_name, multiple, folder)
+
+    def open_path_asking(self, path: str | os.PathLike) -> None:
+        self.session_files.open_path_asking(path)
+
+    def _ask_open_data(self) -> None:
+        self.session_files.ask_open_data()
+
+    @property
+    def recovery_file(self) -> Path:
+        return self.session_files.recovery_file
+
+    @property
+    def recovery_dialog(self) -> Optional[QMessageBox]:
+        return self.session_files.recovery_dialog
+
+    @property
+    def file_dialog(self) -> Optional[QFileDialog]:
+        return self.session_files.file_dialog
+
+    @property
+    def unsaved_dialog(self) -> Optional[QMessageBox]:
+        return self.session_files.unsaved_dialog
+
+    @property
+    def autosave_timer(self) -> QTimer:
+        return self.session_files.autosave_timer
+
     # ------------------------------------------------------------------------------------------------ errors
     def show_error(self, title: str, text: str) -> None:
         """A non-blocking error dialog (the app keeps running); also logged."""
@@ -210,12 +258,12 @@ class MainWindow(SceneLoading, SessionFiles, ViewScheduler, SceneEdits, WindowWi
 
     # ------------------------------------------------------------------------------------------------ closing
     def closeEvent(self, event: Any) -> None:
-        if not self._confirm_close():
+        if not self.session_files.confirm_close():
             event.ignore()
             return
-        self.clear_recovery()
+        self.session_files.clear_recovery()
         self.layout_keeper.save()
-        self.autosave_timer.stop()
+        self.session_files.stop()
         self.preview_timer.stop()
         self.camera_bookmarks.stop()
         self.timeline.set_playing(False)

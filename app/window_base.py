@@ -1,6 +1,6 @@
 """The typed view that ``MainWindow``'s mixins have of the window they are mixed into.
 
-Each mixin (``scene_loading.SceneLoading``, ``session_files.SessionFiles``, ``view_scheduler.ViewScheduler``,
+Each mixin (``scene_loading.SceneLoading``, ``view_scheduler.ViewScheduler``,
 ``scene_edits.SceneEdits``, ``window_widgets.WindowWidgets``) derives from ``WindowBase``, which declares, once and
 with their types:
 
@@ -28,7 +28,7 @@ from typing import TYPE_CHECKING, Any, Callable, Optional
 if TYPE_CHECKING:
     from PySide6.QtCore import QSettings
     from PySide6.QtGui import QAction, QUndoStack
-    from PySide6.QtWidgets import QLabel, QMainWindow, QMessageBox, QProgressBar, QPushButton
+    from PySide6.QtWidgets import QLabel, QMainWindow, QMenu, QMessageBox, QProgressBar, QPushButton
     from pyvistaqt import QtInteractor
 
     from volviz.jobs import Job
@@ -38,6 +38,7 @@ if TYPE_CHECKING:
     from .array_choice import ArrayChoice
     from .camera_bookmarks import CameraBookmarks
     from .export_runs import ExportRuns
+    from .session_files import SessionFiles
     from .stand_in import StandInFrame
     from .decoration_toggles import DecorationToggles
     from .docks.clipping import ClippingDock
@@ -64,7 +65,6 @@ class WindowBase(_QtWindow):
 
     # -- set by MainWindow.__init__
     settings: QSettings
-    recovery_dir: Path
     collector: GuiThreadCollector
     plotter: QtInteractor
     jobs: JobBridge
@@ -72,7 +72,6 @@ class WindowBase(_QtWindow):
     file_choices: FileChoices
     reload_data: ReloadData
     error_dialog: Optional[QMessageBox]
-    recovery_dialog: Optional[QMessageBox]
     last_stats: dict[str, Any]
     # -- the shown scene (set by MainWindow.__init__, replaced by SceneLoading and SessionFiles)
     session: Session
@@ -106,6 +105,8 @@ class WindowBase(_QtWindow):
     stand_in: StandInFrame
     camera_bookmarks: CameraBookmarks  # (window.py)
     export_runs: ExportRuns            # (window.py)
+    session_files: SessionFiles        # (window.py)
+    recent_menu: QMenu                 # (window.py)
     action_fly: QAction
     status_label: QLabel
     progress_bar: QProgressBar
@@ -128,13 +129,6 @@ class WindowBase(_QtWindow):
 
         # -- SessionFiles
         def set_dirty(self, dirty: bool = True) -> None: ...
-        def open_path_asking(self, path: str | os.PathLike) -> None: ...
-        def keeping_unsaved_work(self, then: Callable[[], Any]) -> None: ...
-        def _ask_open_data(self) -> None: ...
-        def _ask_open_folder(self) -> None: ...
-        def _ask_open_session(self) -> None: ...
-        def _save_session(self) -> bool: ...
-        def _ask_save_session_as(self) -> None: ...
 
         # -- ViewScheduler
         def schedule_render(self) -> None: ...

@@ -7,12 +7,13 @@ Cancel button: ``_set_busy`` shows them while a scene loads, its first views are
 
 It makes the docks (``tf_editor``, ``scene_tree``, ``render_settings``, ``timeline``, ``statistics``,
 ``clipping`` and their ``*_dock``), ``layout_keeper``, the undo group, ``array_choice``, ``export_dialogs``,
-``decorations``, ``python_console`` (stopped by ``closeEvent``), ``help``, ``recent``, ``file_drop``, the actions,
+``decorations``, ``python_console`` (stopped by ``closeEvent``), ``help``, ``file_drop``, the actions,
 ``status_label``, ``progress_bar`` and ``cancel_button``. It expects of the window: ``settings``, ``plotter``,
-``jobs``, ``_current_job``, ``_loading_views``, ``export_runs``, and the handlers its docks and actions call
-(``open_path``, the ``_ask_*`` dialogs, ``set_fly_mode``, ``reset_camera``, ``set_clip``...), and
-``camera_bookmarks``, which adds the Camera menu's entries. ``_build_docks()``, ``_build_status_bar()`` and
-``_build_menus()`` are called, in this order, by the window's ``__init__``."""
+``jobs``, ``_current_job``, ``_loading_views``, ``export_runs``, the handlers its docks and actions call
+(``open_path``, ``set_fly_mode``, ``reset_camera``, ``set_clip``...), ``session_files`` (the File menu's open and
+save entries, ``recent_menu``), and ``camera_bookmarks``, which adds the Camera menu's entries. ``_build_docks()``
+and ``_build_status_bar()`` are called by the window's ``__init__`` before its parts are made, ``_build_menus()``
+after."""
 from __future__ import annotations
 
 from typing import Any
@@ -41,7 +42,6 @@ from .log_scale_status import LogScaleStatus
 from .slice_tool import SliceTool
 from .layout import WindowLayout, scrolled
 from .probe import ProbeTool
-from .recent import RecentFiles
 from .scalar_bar_editor import ScalarBarEditor
 from .window_base import WindowBase
 
@@ -95,17 +95,18 @@ class WindowWidgets(WindowBase):
 
     def _build_menus(self) -> None:
         file_menu = self.menuBar().addMenu("&File")
+        files = self.session_files
         self.action_open_data = self._action(file_menu, "Open &Data…", QKeySequence.StandardKey.Open,
-                                             self._ask_open_data)
-        self.action_open_folder = self._action(file_menu, "Open &Folder…", "Ctrl+Alt+O", self._ask_open_folder)
-        self.action_open_session = self._action(file_menu, "Open &Session…", "Ctrl+Shift+O", self._ask_open_session)
-        self.recent_menu = file_menu.addMenu("Open &Recent")
+                                             files.ask_open_data)
+        self.action_open_folder = self._action(file_menu, "Open &Folder…", "Ctrl+Alt+O", files.ask_open_folder)
+        self.action_open_session = self._action(file_menu, "Open &Session…", "Ctrl+Shift+O", files.ask_open_session)
+        file_menu.addMenu(self.recent_menu)
         self.file_choices = FileChoices(self, file_menu)
         self.reload_data = ReloadData(self, file_menu)
         self.action_save_session = self._action(file_menu, "&Save Session", QKeySequence.StandardKey.Save,
-                                                self._save_session)
+                                                files.save)
         self.action_save_session_as = self._action(file_menu, "Save Session &As…", QKeySequence.StandardKey.SaveAs,
-                                                   self._ask_save_session_as)
+                                                   files.ask_save_as)
         file_menu.addSeparator()
         self.action_export_screenshot = self._action(file_menu, "&Export Screenshot…", "Ctrl+E",
                                                      lambda: self.export_dialogs.ask_screenshot())
@@ -149,8 +150,7 @@ class WindowWidgets(WindowBase):
 
         self.camera_bookmarks.add_to_menu(self.menuBar().addMenu("&Camera"))
         self.help = HelpMenu(self, self.menuBar().addMenu("&Help"), self.plotter.ren_win)
-        self.recent = RecentFiles(self.settings, self.recent_menu, self.open_path_asking)
-        self.file_drop = FileDrop([self, self.plotter.interactor], self.open_path_asking)
+        self.file_drop = FileDrop([self, self.plotter.interactor], files.open_path_asking)
 
     def closeEvent(self, event: Any) -> None:
         """Reached once the window's own ``closeEvent`` accepted the close: the console's kernel stops with it."""
