@@ -23,6 +23,8 @@ from volviz.io.errors import PathLike, ReadError
 _PARAM = re.compile(r'([A-Za-z]+)\s*=\s*("[^"]*"|\([^)]*\)|[^,\s]+)')
 _NODES_PER_ELEMENT = {"LINESEG": 2, "TRIANGLE": 3, "QUADRILATERAL": 4, "TETRAHEDRON": 4, "BRICK": 8,
                       "FELINESEG": 2, "FETRIANGLE": 3, "FEQUADRILATERAL": 4, "FETETRAHEDRON": 4, "FEBRICK": 8}
+#: a count of a zone header with nothing after its '=' (VTK's reader took the default, 1, for a damaged "J=2")
+_EMPTY_COUNT = re.compile(r"(?<![A-Za-z])(I|J|K|N|E|NODES|ELEMENTS)\s*=\s*(?=,|$)", re.IGNORECASE)
 _UNCHECKED = ("VARSHARELIST", "CONNECTIVITYSHAREZONE", "PASSIVEVARLIST", "FACES", "TOTALNUMFACENODES")
 
 
@@ -56,6 +58,10 @@ def _needed(path: Path, zone: _Zone, n_vars: int) -> tuple[int, str] | None:
     """(values the zone's header asks for, what they are in words), or None when this check cannot tell; a
     negative count is refused (VTK's reader ran out of memory or time on one)."""
     params = {k.upper(): v.strip('"') for k, v in _PARAM.findall(zone.header)}
+    empty = _EMPTY_COUNT.search(zone.header)
+    if empty:
+        raise ReadError(path, f"{zone.title}, at line {zone.line}: {empty.group(1).upper()}= has no value; a count "
+                              "must be a whole number")
     if any(k in params for k in _UNCHECKED):
         return None
     packing = params.get("DATAPACKING", params.get("F", "POINT")).upper()
@@ -146,3 +152,6 @@ def check_tecplot_zones(path: PathLike, max_bytes: int = 1 << 31) -> None:
             raise ReadError(p, f"{zone.title}, at line {zone.line}, holds {zone.values} values where its header "
                                f"needs {needed[0]} ({needed[1]}): the file is truncated or the zone header is wrong",
                             "write the file again completely")
+        if needed is not None and zone.values > needed[0]:
+            raise ReadError(p, f"{zone.title}, at line {zone.line}, holds {zone.values} values where its header "
+                               f"needs {needed[0]} ({needed[1]}): the zone header is wrong")
