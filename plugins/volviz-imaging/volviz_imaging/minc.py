@@ -57,17 +57,45 @@ def _netcdf_part(exc: BaseException) -> str:
     return next((part for name, part in _NETCDF_PARTS if name in names), "its header")
 
 
+def _recording_netcdf_file() -> Any:
+    """nibabel's netCDF reader, keeping each variable's header record (``records``: name, dimensions, shape,
+    attributes, type code, item size, dtype, offset, size field), which it reads and then drops."""
+    from nibabel.externals.netcdf import netcdf_file
+
+    class Recording(netcdf_file):
+        def _read_var(self) -> tuple:
+            record = super()._read_var()
+            self.__dict__.setdefault("records", []).append(record)
+            return record
+    return Recording
+
+
+def _check_sizes(path: PathLike, records: list[tuple]) -> None:
+    """Each variable's size field against its dimensions (netCDF classic: the product of the dimension lengths
+    times the type's size, rounded up to 4 bytes; 2^32 - 1 for a variable over 4 GiB; issue #32: a flipped bit made
+    ``zspace`` 7 instead of 6, and nibabel read the image's 240 bytes as 280, the next variable's bytes among them).
+    Data past the end of the file already stops nibabel's reader (a header that does not parse)."""
+    for name, dims, shape, _attrs, _code, item, _dtype, _begin, vsize in records:
+        if shape and shape[0] is None:               # a record variable: its size is per record
+            continue
+        exact = int(np.prod(shape, dtype=object)) * item
+        if vsize not in (exact, exact + (-exact % 4)) and not (vsize == 0xFFFFFFFF and exact > 0xFFFFFFFB):
+            layout = " x ".join(f"{d} {n}" for d, n in zip(dims, shape)) or "a scalar"
+            raise ReadError(path, f"MINC 1: variable {name!r} holds {exact} bytes by its dimensions ({layout} of "
+                                  f"{item} bytes) but its size field says {vsize}: the header is damaged")
+
+
 def check_minc1(path: PathLike) -> None:
     """ReadError in MINC's terms when a MINC 1 (netCDF classic) file's header does not parse or lacks what a MINC
     image needs (see the module)."""
-    from nibabel.externals.netcdf import netcdf_file
-
+    netcdf_file = _recording_netcdf_file()
     try:
         f = netcdf_file(str(path), "r", mmap=False) if file_size(path) < (64 << 20) else netcdf_file(str(path), "r")
     except Exception as exc:                    # noqa: BLE001 - any failure of the header parse is the file's
         raise ReadError(path, f"MINC 1: its netCDF header does not parse: {_netcdf_part(exc)} is damaged "
                               f"({type(exc).__name__}); the file is truncated or corrupt") from None
     try:
+        _check_sizes(path, f.__dict__.get("records", []))
         variables = f.variables
         image = variables.get("image")
         if image is None:
