@@ -127,3 +127,18 @@ def test_a_cleared_scene_hears_no_more_edits_and_a_copied_session_no_listeners()
         pl.close()
     # the notifier is no part of the document: what is saved is unchanged by listeners
     assert "changes" not in session_to_dict(session)
+
+
+def test_the_session_hands_out_its_transfer_functions_as_typed_models() -> None:
+    from volviz.optics import TransferFunction
+
+    session, _ = _scene_session()
+    assert session.transfer_function("vol") is None
+    tf = TransferFunction.ramp(0.0, 2.0, 3.0)
+    session.set_transfer_function("vol", tf)
+    assert session.transfer_function("vol") is tf                    # the object given, not a copy made from JSON
+    other = TransferFunction.ramp(0.0, 1.0, 5.0)
+    session.transfer_functions["vol"] = other.to_dict()              # the JSON replaced behind the model's back
+    read = session.transfer_function("vol")
+    assert read is not other and read.to_dict() == other.to_dict()
+    assert copy.deepcopy(session).transfer_function("vol").to_dict() == other.to_dict()

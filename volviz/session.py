@@ -120,6 +120,9 @@ class Session:
     clip: dict[str, Any] = field(default_factory=lambda: {"planes": [], "box": None})
     #: announces each edit made through the methods below (``volviz.model.events``); not part of the document
     changes: ChangeNotifier = field(default_factory=ChangeNotifier, repr=False, compare=False)
+    #: name -> (the stored JSON, its typed model): the transfer functions as ``transfer_function`` hands them out
+    _tf_models: dict[str, tuple[dict[str, Any], TransferFunction]] = field(
+        default_factory=dict, init=False, repr=False, compare=False)
 
     def dataset(self, dataset_id: str) -> DatasetRef:
         for ref in self.datasets:
@@ -140,9 +143,24 @@ class Session:
         id); ``preview``: an edit under way (a point being dragged)."""
         comp = self.component(comp_id)
         name = comp.transfer_function or comp.id
-        self.transfer_functions[name] = tf.to_dict()
+        stored = self.transfer_functions[name] = tf.to_dict()
+        self._tf_models[name] = (stored, tf)
         comp.transfer_function = name
         self.changes.notify(SceneChange("transfer_function", comp_id, preview))
+
+    def transfer_function(self, comp_id: str) -> TransferFunction | None:
+        """Component ``comp_id``'s transfer function as a typed model (None without one): the very object last given
+        to ``set_transfer_function`` while the stored JSON is still the one it wrote, else made from the JSON."""
+        name = self.component(comp_id).transfer_function
+        if name is None:
+            return None
+        stored = self.transfer_functions[name]
+        known = self._tf_models.get(name)
+        if known is None or known[0] is not stored:
+            from volviz.optics import TransferFunction
+
+            known = self._tf_models[name] = (stored, TransferFunction.from_dict(stored))
+        return known[1]
 
     def set_visible(self, comp_id: str, visible: bool) -> None:
         self.component(comp_id).visible = bool(visible)

@@ -310,7 +310,7 @@ class SceneController:
         comp = self.component(comp_id)
         view = self.views.get(comp_id)
         if view is not None:
-            view.set_tf(self._drawn(comp, self.transfer_function(comp_id)), comp.opacity)
+            view.set_tf(self._drawn(comp, self.session.transfer_function(comp_id)), comp.opacity)
             if update:
                 view.update()
         from volviz.render.decorations import update_legend
