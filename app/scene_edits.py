@@ -1,16 +1,19 @@
-"""Edits of the shown scene in the main window (a mixin of ``MainWindow``): what the docks' signals do. The scene
-dock selects a component (its transfer function and histogram, computed in the background when missing, go to the TF
-editor), shows or hides it (a component hidden at load is prepared in the background, a natural-scene component
-rebuilds the natural scene in the background), and sets its opacity and settings; the TF editor's edits are
-throttled to one re-render per ``PREVIEW_MS`` (previews while dragging, full size with an error estimate once an
-edit is finished); the clipping dock cuts every view (what is cut on the CPU, isosurfaces and PT meshes, in the
-background); the render
-settings dock changes the renderer (the scene rebuilt with the same camera), the isosurface mode or the error budget.
+"""Edits of the shown scene in the main window (a mixin of ``MainWindow``): what the docks' signals do. Each edit is
+made in the session (``volviz.session.Session.set_transfer_function`` ...), which announces it; the window hears it
+once the controller's views show it (``_scene_changed``) and the view scheduler refreshes the camera views for it
+(``volviz_app.view_scheduler.ViewScheduler.views_follow``): no edit here refreshes a view itself (issue #31). The
+scene dock selects a component (its transfer function and histogram, computed in the background when missing, go to
+the TF editor), shows or hides it (a component hidden at load is prepared in the background, a natural-scene
+component rebuilds the natural scene in the background), and sets its opacity and settings; the TF editor's edits are
+throttled to one edit of the session per ``PREVIEW_MS`` (previews while dragging, full size with an error estimate
+once an edit is finished); the clipping dock's clipping cuts every view (what is cut on the CPU, isosurfaces and PT
+meshes, in the background: ``cut_in_background``); the render settings dock changes the renderer (the scene rebuilt
+with the same camera), the isosurface mode or the error budget.
 
 It expects of the window: ``controller``, ``session``, ``session_path``, ``datasets``, ``jobs``, ``status_label``,
 ``tf_editor``, ``scene_tree``, ``array_choice``, ``render_scene()``, ``schedule_render()``, ``set_dirty``,
-``show_error``, ``_show_session`` (``volviz_app.scene_loading``), the refreshes of ``volviz_app.view_scheduler``
-(``refresh_views``, ``refresh_iso_overlay``, ``_enforce_error_budget``) and
+``show_error``, ``_show_session`` (``volviz_app.scene_loading``), of ``volviz_app.view_scheduler`` ``views_follow``
+and the refreshes (``refresh_views`` after a background cut or show, ``_enforce_error_budget``) and
 ``last_error_rmse``; ``_init_scene_edits()`` makes its state and ``_connect_scene_edits()`` its preview timer (both
 called by the window's ``__init__``; the docks' signals are connected where the docks are built)."""
 from __future__ import annotations
@@ -23,7 +26,6 @@ from PySide6.QtCore import QTimer
 from volviz.jobs import JobOutcome
 from volviz.session import SessionError
 from .docks.render_settings import RENDERER_DEFAULTS
-from .view_scheduler import MOVING_SCALE
 from .window_base import WindowBase
 
 if TYPE_CHECKING:
@@ -125,12 +127,7 @@ class SceneEdits(WindowBase):
             return
         comp_id, tf, finished = self._pending_tf
         self._pending_tf = None
-        self.controller.set_transfer_function(comp_id, tf, update=False)
-        # what the view re-makes for the TF (a CPU PT image, a GPU PT volume's culling, a LOD block selection) runs
-        # in the background; the newest edit next, while dragging as a preview (``MOVING_SCALE``), a finished edit at
-        # full size with a fresh error estimate. VTK's own mappers draw the new functions at once.
-        if not self.refresh_views([comp_id], estimate=finished, scale=1 if finished else MOVING_SCALE):
-            self.render_scene()
+        self.session.set_transfer_function(comp_id, tf, preview=not finished)   # the views follow (``views_follow``)
 
     def _set_visibility(self, comp_id: str, visible: bool) -> None:
         from volviz.scene.datasets import NATURE_TYPES
@@ -140,15 +137,11 @@ class SceneEdits(WindowBase):
         controller = self.controller
         nature = controller.component(comp_id).type in NATURE_TYPES
         build = visible and controller.needs_build(comp_id)
-        controller.set_visible(comp_id, visible, nature=False, build=False)
+        self.session.set_visible(comp_id, visible)   # a component with a view: refreshed by ``views_follow``
         if nature:
             self.rebuild_nature(comp_id, visible)
-            return
-        if build:
+        elif build:
             self.show_component(comp_id)
-            return
-        self.render_scene()
-        self.refresh_views([comp_id, "iso-overlay"])
 
     def show_component(self, comp_id: str) -> None:
         """A component hidden at load was shown: prepare it in the background (extraction, tetrahedralisation, VTK
@@ -189,13 +182,20 @@ class SceneEdits(WindowBase):
         controller.set_visible(comp_id, not visible, nature=False, build=False)
 
     def _scene_changed(self, change: SceneChange) -> None:
-        """The shown scene's controller changed the session's state (``SceneController.changes``, wherever the edit
-        came from: a dock, an undo step, a failed show reverted): the session is marked edited, and the scene dock
-        shows a component's visibility and opacity as they now are."""
+        """The session's state was edited and the shown scene's views hold the edit (``SceneController.changes``,
+        wherever the edit came from: a dock, an undo step, a failed show reverted, a script): the session is marked
+        edited, the scene dock shows a component's visibility and opacity as they now are, and the camera views
+        follow (``views_follow``)."""
         self.set_dirty()
         if change.what in ("visible", "opacity") and change.component is not None and self.controller is not None:
             comp = self.controller.component(change.component)
             self.scene_tree.show_state(comp.id, comp.visible, comp.opacity)
+        self.views_follow(change)
+        controller = self.controller
+        if change.what in ("opacity", "clip") and controller is not None:  # stale cuts made in the background
+            if change.what == "clip":
+                self.cuts_pending.intersection_update(controller.pending)  # the others show it already (an undo)
+            self.cut_in_background(controller, controller.clip, controller.pending)
 
     def rebuild_nature(self, comp_id: str, visible: bool) -> None:
         """A terrain / fog / clouds / sky component was shown or hidden: rebuild the natural scene in the background
@@ -228,36 +228,21 @@ class SceneEdits(WindowBase):
         self.jobs.submit(prepare, name="natural scene", key="nature-build", on_done=done)
 
     def _set_opacity(self, comp_id: str, opacity: float) -> None:
-        if self.controller is None:
-            return
-        controller = self.controller
-        stale = controller.set_opacity(comp_id, opacity, update=False)
-        self.render_scene()
-        if stale:  # surfaces scaled by the opacity: cut again in the background, then their views are refreshed
-            self._cut_in_background(controller, controller.clip, stale)
-        else:
-            self.refresh_views([comp_id, "iso-overlay"])
+        if self.controller is not None:  # the views follow (``views_follow``)
+            self.session.set_opacity(comp_id, opacity)
 
     def set_clip(self, clip: dict[str, Any]) -> None:
-        """New scene-wide clipping (from the clipping dock): every view is given it; what is cut on the CPU
-        (isosurfaces: a 535k-triangle isosurface takes 0.2 s of clipping and LOD chains; CPU PT meshes) is cut in
-        the background, then re-rendered; the other camera views (volumes at a level of detail ray cast with the
-        planes, the iso overlay) are refreshed in the background."""
+        """New scene-wide clipping (from the clipping dock, an undo step included): every view is given it and the
+        views follow (``views_follow``: what is cut on the CPU is cut in the background); invalid clipping gives a
+        message and changes nothing."""
         if self.controller is None:
             return
-        controller = self.controller
         try:
-            pending = controller.set_clip(clip, update=False)
+            self.session.set_clip(clip)
         except ValueError as exc:
             self.show_error("Invalid clipping", str(exc))
-            return
-        self.render_scene()
-        self.refresh_views([key for key, view in controller.camera_views().items()
-                            if view.kind != "nature" and key.split(":", 1)[-1] not in pending])
-        self.cuts_pending.intersection_update(pending)  # the others show this clipping already (an undo, say)
-        self._cut_in_background(controller, controller.clip, pending)
 
-    def _cut_in_background(self, controller: SceneController, settings: Any, comp_ids: list[str]) -> None:
+    def cut_in_background(self, controller: SceneController, settings: Any, comp_ids: list[str]) -> None:
         """Cut the views of ``comp_ids`` by ``settings`` (``SceneController.cut``: a PT volume's tetrahedra, an
         isosurface component's surfaces with their LOD chains) on a worker (a newer request for a component
         supersedes), then show each cut here and refresh its camera views; ``clipping_shown()`` tells when all
@@ -312,14 +297,14 @@ class SceneEdits(WindowBase):
         budget_changed = values["options"].get("error_budget") != self.session.render.options.get("error_budget")
         iso_mode = values["options"].get("iso_mode", "vtk")
         iso_changed = iso_mode != self.session.render.options.get("iso_mode", "vtk")
+        follow = iso_changed and not rebuild and self.controller is not None   # a new mode in the shown scene
+        options = {k: v for k, v in values["options"].items() if not (follow and k == "iso_mode")}
         self.session.render.method = values["method"]
         self.session.render.size = values["size"]
-        self.session.render.options.update(values["options"])
+        self.session.render.options.update(options)
         self.set_dirty()
-        if iso_changed and not rebuild and self.controller is not None:
-            self.controller.set_iso_mode(iso_mode, update=False)
-            self.render_scene()
-            self.refresh_iso_overlay()
+        if follow:
+            self.session.set_iso_mode(iso_mode)   # the views follow (``views_follow``)
         if budget_changed and not rebuild and self.last_error_rmse is not None:
             self._enforce_error_budget(self.last_error_rmse)
             return

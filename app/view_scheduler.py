@@ -1,5 +1,6 @@
 """The view scheduler of the main window (a mixin of ``MainWindow``): the background refreshes of the views that depend
-on the camera, the transfer function, the viewport's size or the display time.
+on the camera, the session's edits (``views_follow``: a transfer function, visibility, opacity, clipping, the
+isosurfaces' mode, however the edit was made), the viewport's size or the display time.
 
 Every view that re-makes something for a camera (``SceneController.camera_views``: the natural scene, volumes at a
 level of detail, PT volumes on either backend, the isosurfaces' CPU overlay) is refreshed through one path over the
@@ -20,7 +21,7 @@ state and ``_connect_view_scheduler()`` its timers and the viewport's interactio
 window's ``__init__``)."""
 from __future__ import annotations
 
-from typing import Any, Callable, Optional
+from typing import TYPE_CHECKING, Any, Callable, Optional
 
 from PySide6.QtCore import QTimer
 
@@ -28,6 +29,9 @@ from volviz.jobs import JobOutcome, OneInFlight
 from volviz.render.controller import SceneController, no_render
 from volviz.render.error_budget import MOST_ACCURATE_TABLE, error_budget_choice
 from .window_base import WindowBase
+
+if TYPE_CHECKING:
+    from volviz.model.events import SceneChange
 
 MOVING_SCALE = 2         # previews while the camera moves or a TF point is dragged: 1/2 x 1/2 of the window
 FLY_SCALE = 4            # previews while flying: 1/4 x 1/4 (a flight near the ground fills the window with fog)
@@ -186,6 +190,32 @@ class ViewScheduler(WindowBase):
                  if tuple(getattr(view, "stats", {}).get("size", ())) != size]
         if stale:
             self.refresh_views(stale)
+
+    def views_follow(self, change: SceneChange) -> None:
+        """The camera views follow an edit of the session once the controller's views hold it (the window hears it
+        through its one subscription, ``_scene_changed``). A transfer function: re-made in the background, while a
+        point is dragged as a preview (``MOVING_SCALE``), a finished edit at full size with a fresh error estimate
+        (VTK's own mappers draw it at once). Visibility, opacity, clipping: drawn, and the views refreshed except
+        those waiting for a cut made on the CPU (``controller.pending``, refreshed once their cut is shown) and those
+        of a component without a view yet (a natural-scene component or one being prepared: refreshed once
+        installed). The isosurfaces' mode: the CPU overlay re-rendered."""
+        controller = self.controller
+        comp = change.component
+        if controller is None or (change.what == "visible" and comp not in controller.views):
+            return
+        if change.what == "transfer_function":
+            if not self.refresh_views([comp] if comp else None, estimate=not change.preview,
+                                      scale=MOVING_SCALE if change.preview else 1):
+                self.render_scene()
+            return
+        self.render_scene()
+        if change.what == "iso_mode":
+            self.refresh_iso_overlay()
+        elif comp is None:   # clipping: every camera view but the natural scene's
+            self.refresh_views([key for key, view in controller.camera_views().items()
+                                if view.kind != "nature" and key.split(":", 1)[-1] not in controller.pending])
+        elif comp not in controller.pending:
+            self.refresh_views([comp, "iso-overlay"])
 
     def refresh_nature(self, settled: Optional[Callable[[], None]] = None, scale: int = 1) -> None:
         """Re-compute the natural scene's view-dependent parts (C-LOD terrain, fog and clouds) for the newest camera
