@@ -29,6 +29,23 @@ def _select_row(qtbot, table, row: int) -> None:
     qtbot.mouseClick(table.viewport(), Qt.MouseButton.LeftButton, pos=rect.center())
 
 
+def _surface_share(window) -> float:
+    """The share of the viewport's pixels that the isosurface's translucent actors change by more than 3 levels
+    (the frame with them and without them, nothing else changed)."""
+    actors = window.controller.props[_iso(window).id].volviz_translucent
+    assert actors
+    shown = screen(window)
+    for actor in actors:
+        actor.SetVisibility(False)
+    try:
+        bare = screen(window)
+    finally:
+        for actor in actors:
+            actor.SetVisibility(True)
+        window.plotter.render()
+    return changed_share(shown, bare, levels=3.0)
+
+
 def _rebuilt(qtbot, window, test) -> None:
     qtbot.waitUntil(lambda: window.controller is not None and test(), timeout=60000)
     wait_loaded(qtbot, window)
@@ -37,8 +54,9 @@ def _rebuilt(qtbot, window, test) -> None:
 
 def test_add_edit_remove_and_undo_an_isosurface(qtbot, make_window, tmp_path) -> None:
     """neghip: type a value, Add: the scene gets an isosurface component with that value (the TF's colour there);
-    select it, type an opacity, Apply; choose the 3-pass mode; Remove: the component goes; Edit > Undo brings it
-    back with its opacity; the screen matches ``volviz render`` of the saved session."""
+    select it, type an opacity, Apply: the translucent surface shows inside the volume; choose the 3-pass mode;
+    Remove: the component goes; Edit > Undo brings it back with its opacity; the screen matches ``volviz render`` of
+    the saved session."""
     window = make_window()
     without = open_and_show_dock(qtbot, window, data_file("volumes/neghip.slc"), window.iso_dock)
     dock = window.iso_tool.dock
@@ -59,6 +77,14 @@ def test_add_edit_remove_and_undo_an_isosurface(qtbot, make_window, tmp_path) ->
     qtbot.mouseClick(dock.apply_button, Qt.MouseButton.LeftButton)
     _rebuilt(qtbot, window, lambda: _iso(window).settings["styles"][0]["opacity"] == 0.3)
     assert _iso(window).settings["styles"][0]["value"] == VALUE
+    # in VTK's own mode the translucent surface is depth-peeled with the volume (volviz.render.volume_peeling): it lies
+    # between the volume behind it and in front of it. Against the same frame with only the surface's actors hidden
+    # (same ray caster), 0.14 % of the viewport's pixels (1024x805) changed by > 3 levels before (the whole volume was
+    # composited over the surface), 3.1 % after
+    assert window.session.render.options.get("iso_mode", "vtk") == "vtk"
+    peeled = _surface_share(window)
+    print("pixels the translucent surface changes in VTK's mode:", peeled)
+    assert peeled > 0.015, peeled
 
     pick_combo_item(qtbot, dock.mode, "3pass")
     _rebuilt(qtbot, window, lambda: window.session.render.options.get("iso_mode") == "3pass")
