@@ -32,6 +32,8 @@ BENCHMARKS = {
     "first_open": "volviz render of every shared file: time to the first image, drawn share, transfer-function "
                   "legibility",
     "multisampling": "a still frame with 4x multisampling against one sample: time and image difference",
+    "volume_peeling": "a translucent isosurface in a regular volume: depth peeling's frame time and the surface's "
+                      "visible share",
 }
 #: commands whose arguments go, unread here, to their own parser (``volviz.regular.cli``, ``volviz.bench.NAME``)
 PASSED_ON = ("bench", "compress")
