@@ -126,22 +126,49 @@ def _time_series(folder: Path) -> None:
              "components": [{"id": "vol", "type": "volume", "dataset": "series"}]}, folder, "blend")
 
 
+#: the exercises, longest first (the codec's kernels take most of the compile time), so that parallel workers end
+#: together
 EXERCISES: list[tuple[str, Callable[[Path], None]]] = [
-    ("natural scene", _natural_scene),
-    ("tetrahedral volume", _tetrahedral_volume),
     ("compressed volume", _compressed_volume),
+    ("tetrahedral volume", _tetrahedral_volume),
+    ("natural scene", _natural_scene),
     ("time series", _time_series),
 ]
 
 
-def warm_up(progress: Optional[ProgressCallback] = None) -> list[tuple[str, float]]:
-    """Run every exercise once (compiling, or loading from the cache, what it uses); returns (name, seconds)."""
-    timings = []
+def _run_exercise(index: int) -> float:
+    """Run ``EXERCISES[index]`` in a folder of its own; its seconds (a worker process's task)."""
     with tempfile.TemporaryDirectory(prefix="volviz-warmup-") as tmp:
-        for i, (name, exercise) in enumerate(EXERCISES):
+        start = time.perf_counter()
+        EXERCISES[index][1](Path(tmp))
+        return time.perf_counter() - start
+
+
+def warm_up(progress: Optional[ProgressCallback] = None, workers: Optional[int] = None) -> list[tuple[str, float]]:
+    """Run every exercise once (compiling, or loading from the cache, what it uses); returns (name, seconds) in
+    ``EXERCISES``' order. The exercises compile mostly disjoint kernels (Numba's cache takes
+    concurrent writers), so they run in ``workers`` processes at once (one
+    per core, at most one per exercise; Numba compiles on one thread): on 2 cores the warm-up takes about its
+    longest exercise instead of their sum."""
+    import os
+    from concurrent.futures import ProcessPoolExecutor, as_completed
+    from multiprocessing import get_context
+
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+    workers = max(1, min(len(EXERCISES), workers or cores))
+    seconds: dict[int, float] = {}
+    if workers == 1:
+        for i, (name, _) in enumerate(EXERCISES):
             report(progress, i / len(EXERCISES), f"compiling the kernels of the {name}")
-            start = time.perf_counter()
-            exercise(Path(tmp))
-            timings.append((name, time.perf_counter() - start))
+            seconds[i] = _run_exercise(i)
+        report(progress, 1.0, "kernels compiled")
+        return [(name, seconds[i]) for i, (name, _) in enumerate(EXERCISES)]
+    report(progress, 0.0, "compiling the kernels of " + ", ".join(name for name, _ in EXERCISES))
+    with ProcessPoolExecutor(workers, mp_context=get_context("spawn")) as pool:
+        futures = {pool.submit(_run_exercise, i): i for i in range(len(EXERCISES))}
+        for future in as_completed(futures):
+            seconds[futures[future]] = future.result()
+            report(progress, len(seconds) / len(EXERCISES),
+                   f"compiled the kernels of the {EXERCISES[futures[future]][0]}")
     report(progress, 1.0, "kernels compiled")
-    return timings
+    return [(name, seconds[i]) for i, (name, _) in enumerate(EXERCISES)]
