@@ -39,3 +39,11 @@ def test_a_zone_with_more_values_than_its_header_needs_is_refused(tec):
                                             r"header needs 19 \(7 variables on 2x2x1 points\): the zone header is "
                                             r"wrong$"):
         vio.read(path)
+
+
+def test_a_count_that_is_not_a_whole_number_is_refused(tec):
+    path, text = tec
+    path.write_text(text.replace("I=2, J=2", "I=abc, J=2"))      # the re-run's case 2706: VTK read it as I = 1
+    with pytest.raises(vio.ReadError, match=rf"^{path}: zone 2 \(ZONE2\), at line 10: I=abc; a count must be a "
+                                            r"whole number$"):
+        vio.read(path)

@@ -24,6 +24,7 @@ _PARAM = re.compile(r'([A-Za-z]+)\s*=\s*("[^"]*"|\([^)]*\)|[^,\s]+)')
 _NODES_PER_ELEMENT = {"LINESEG": 2, "TRIANGLE": 3, "QUADRILATERAL": 4, "TETRAHEDRON": 4, "BRICK": 8,
                       "FELINESEG": 2, "FETRIANGLE": 3, "FEQUADRILATERAL": 4, "FETETRAHEDRON": 4, "FEBRICK": 8}
 #: a count of a zone header with nothing after its '=' (VTK's reader took the default, 1, for a damaged "J=2")
+_COUNTS = ("I", "J", "K", "NODES", "N", "ELEMENTS", "E")
 _EMPTY_COUNT = re.compile(r"(?<![A-Za-z])(I|J|K|N|E|NODES|ELEMENTS)\s*=\s*(?=,|$)", re.IGNORECASE)
 _UNCHECKED = ("VARSHARELIST", "CONNECTIVITYSHAREZONE", "PASSIVEVARLIST", "FACES", "TOTALNUMFACENODES")
 
@@ -62,6 +63,10 @@ def _needed(path: Path, zone: _Zone, n_vars: int) -> tuple[int, str] | None:
     if empty:
         raise ReadError(path, f"{zone.title}, at line {zone.line}: {empty.group(1).upper()}= has no value; a count "
                               "must be a whole number")
+    for key in _COUNTS:
+        if key in params and not re.fullmatch(r"[-+]?\d+", params[key]):
+            raise ReadError(path, f"{zone.title}, at line {zone.line}: {key}={params[key][:40]}; a count must be a "
+                                  "whole number")
     if any(k in params for k in _UNCHECKED):
         return None
     packing = params.get("DATAPACKING", params.get("F", "POINT")).upper()
@@ -80,7 +85,7 @@ def _needed(path: Path, zone: _Zone, n_vars: int) -> tuple[int, str] | None:
             return None
     except ValueError:
         return None
-    counts = {k: params[k] for k in ("I", "J", "K", "NODES", "N", "ELEMENTS", "E") if k in params}
+    counts = {k: params[k] for k in _COUNTS if k in params}
     for key, value in counts.items():
         if value.lstrip("-").isdigit() and int(value) < 0:
             raise ReadError(path, f"{zone.title}, at line {zone.line}: {key}={value}; a count cannot be negative")
