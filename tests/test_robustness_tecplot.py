@@ -47,3 +47,12 @@ def test_a_count_that_is_not_a_whole_number_is_refused(tec):
     with pytest.raises(vio.ReadError, match=rf"^{path}: zone 2 \(ZONE2\), at line 10: I=abc; a count must be a "
                                             r"whole number$"):
         vio.read(path)
+
+
+def test_a_value_that_is_not_a_number_is_refused(tec):
+    path, text = tec
+    head, _, tail = text.rpartition("0.05")                       # zone 2's last value: the re-run's case 2865
+    path.write_text(head + "abc" + tail)
+    with pytest.raises(vio.ReadError, match=rf"^{path}: line 15 holds 'abc' among the values of zone 2; a value must "
+                                            r"be a number$"):
+        vio.read(path)

@@ -24,6 +24,8 @@ _PARAM = re.compile(r'([A-Za-z]+)\s*=\s*("[^"]*"|\([^)]*\)|[^,\s]+)')
 _NODES_PER_ELEMENT = {"LINESEG": 2, "TRIANGLE": 3, "QUADRILATERAL": 4, "TETRAHEDRON": 4, "BRICK": 8,
                       "FELINESEG": 2, "FETRIANGLE": 3, "FEQUADRILATERAL": 4, "FETETRAHEDRON": 4, "FEBRICK": 8}
 #: a count of a zone header with nothing after its '=' (VTK's reader took the default, 1, for a damaged "J=2")
+#: a value of a zone (a number, ``n*value`` for n repeats; Fortran's ``D`` exponent too)
+_VALUE = re.compile(r"(\d+\*)?[-+]?(\d+\.?\d*|\.\d+)([eEdD][-+]?\d+)?")
 _COUNTS = ("I", "J", "K", "NODES", "N", "ELEMENTS", "E")
 _EMPTY_COUNT = re.compile(r"(?<![A-Za-z])(I|J|K|N|E|NODES|ELEMENTS)\s*=\s*(?=,|$)", re.IGNORECASE)
 _UNCHECKED = ("VARSHARELIST", "CONNECTIVITYSHAREZONE", "PASSIVEVARLIST", "FACES", "TOTALNUMFACENODES")
@@ -142,6 +144,10 @@ def check_tecplot_zones(path: PathLike, max_bytes: int = 1 << 31) -> None:
                 continue
             in_header = ""
             if zones:
+                bad = next((t for t in line.replace(",", " ").split() if not _VALUE.fullmatch(t)), None)
+                if bad is not None:
+                    raise ReadError(p, f"line {number} holds {bad[:40]!r} among the values of zone {len(zones)}; "
+                                       "a value must be a number")
                 zones[-1].values += _count(line)
     n_vars = _variables(variables)
     if not zones:
