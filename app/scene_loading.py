@@ -1,15 +1,17 @@
-"""Loading a scene in the main window (a mixin of ``MainWindow``): ``open_path``, the one code path behind File >
-Open, Open Recent, drag-and-drop and the command line, the demo scenes, and ``_show_session``, which shows a session:
-its datasets are read and the scene prepared in the background (``SceneController.prepare``) with progress and
-cancel in the status bar, then installed on the GUI thread (``_install_session``: props added, docks filled, one
-render) in short stages, and its first views computed in the background (``volviz_app.view_scheduler``). A newer
-open supersedes an older one; the shown scene stays until the new one is ready, and stays on when it fails.
+"""Loading a scene in the main window: ``open_path``, the one code path behind File > Open, Open Recent,
+drag-and-drop and the command line, the demo scenes, and ``show_session``, which shows a session: its datasets are
+read and the scene prepared in the background (``SceneController.prepare``) with progress and cancel in the status
+bar, then installed on the GUI thread (``_install``: props added, the window told, one render) in short stages, and
+its first views computed in the background (``volviz_app.view_scheduler``). A newer open supersedes an older one;
+the shown scene stays until the new one is ready, and stays on when it fails.
 
-It expects of the window: ``controller``, ``session``, ``session_path``, ``datasets``, ``dirty``, ``title``,
-``plotter``, ``jobs``, ``_load_serial``, ``_loading_views``, ``_current_job``, ``status_label``, ``_set_busy``,
-``show_error``, ``set_dirty``, ``recent``, the docks (``scene_tree``, ``render_settings``, ``clipping``,
-``timeline``), ``array_choice``, ``decorations``, ``scene_undo_stack``, ``camera_bookmarks``,
-``_show_first_views``, ``render_scene()`` and ``restoreState`` (``QMainWindow``)."""
+Held by the window as ``window.scene_loading``; its collaborators are the shown scene (``shown_scene``: it replaces
+the session, file, datasets and controller), the window (the parent of its dialogs, whose dock state a session
+restores), the plotter, the window's ``jobs``, the settings (remembered data folders), the recent files, the
+stand-in frame, the status label, and the window's side of a new scene as callbacks: ``set_busy(busy)``,
+``show_error(title, text)``, ``supersede()`` (a newer scene comes: the shown scene's background work stops),
+``installed(controller, title, dirty, new_data)`` (the window's docks, menus and view state take the scene),
+``first_render()`` and ``first_views(controller, serial, title)`` (which end the loading)."""
 from __future__ import annotations
 
 import logging
@@ -17,36 +19,59 @@ import os
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, Optional
 
-from PySide6.QtCore import QByteArray, Qt, QTimer
+from PySide6.QtCore import QByteArray, QSettings, Qt, QTimer
+from PySide6.QtWidgets import QLabel, QMainWindow
 
-from volviz.jobs import JobOutcome
+from volviz.jobs import Job, JobOutcome
 from volviz.session import Session
 from .errors import open_error
-from .window_base import WindowBase
+from .recent import RecentFiles
+from .shown_scene import ShownScene
+from .stand_in import StandInFrame
 
 if TYPE_CHECKING:
+    from pyvistaqt import QtInteractor
+
     from volviz.render.controller import SceneController
+    from .workers import JobBridge
 
 log = logging.getLogger("volviz_app.window")  # the logger these methods had in window.py
 
 STAGE_MS = 30            # pause between GUI-thread stages of showing a new scene (other events run in between)
 
 
-class SceneLoading(WindowBase):
+class SceneLoading:
     """Opening files and showing sessions (see the module's docstring)."""
 
-    raw_dialog: Optional[Any] = None     # the layout dialog of the last headerless data opened
+    def __init__(self, scene: ShownScene, window: QMainWindow, plotter: QtInteractor, jobs: JobBridge,
+                 settings: QSettings, recent: RecentFiles, stand_in: StandInFrame, status: QLabel, *,
+                 set_busy: Callable[[bool], None], show_error: Callable[[str, str], None],
+                 supersede: Callable[[], None], installed: Callable[[SceneController, str, bool, bool], None],
+                 first_render: Callable[[], None],
+                 first_views: Callable[[SceneController, int, str], None]) -> None:
+        self.scene, self.window, self.plotter, self.jobs = scene, window, plotter, jobs
+        self.settings, self.recent, self.stand_in, self.status = settings, recent, stand_in, status
+        self.set_busy, self.show_error, self.supersede, self.installed = set_busy, show_error, supersede, installed
+        self.first_render, self.first_views = first_render, first_views
+        self.serial = 0                          # the newest open/rebuild; an older one's late callbacks do nothing
+        self.current_job: Optional[Job] = None   # the newest scene's reading and preparing, until it is installed
+        self.raw_dialog: Optional[Any] = None    # the layout dialog of the last headerless data opened
+        self.missing_dialog: Optional[Any] = None  # the dialog locating a session's missing data files
+
+    def loading(self) -> bool:
+        """A scene is being read and prepared (the Cancel button stops it)."""
+        return self.current_job is not None and not self.current_job.done()
 
     def open_demo(self) -> None:
         from volviz.scene.demo import demo_session
 
-        self._show_session(demo_session(), None, "demo scene")
+        self.show_session(demo_session(), None, "demo scene")
 
     def open_demo_volume(self) -> None:
         """The tetrahedral demo volume (an analytic field on a tetrahedralised cube), drawn by volviz's PT."""
         from volviz.scene.demo import demo_volume_session
 
-        self._show_session(demo_volume_session(), None, "demo volume")
+        self.show_session(demo_volume_session(), None, "demo volume")
 
     def open_paths(self, paths: list[str]) -> None:
         """Open what the Open dialog chose: a PLOT3D grid and its solution file together, else the first file."""
@@ -78,7 +103,7 @@ class SceneLoading(WindowBase):
         if session_path is not None and self._ask_missing_data(session, session_path, path=p):
             return
         # File > Open Recent lists it once it has opened
-        self._show_session(session, session_path, p.name, path=p, on_shown=lambda: self.recent.add(p))
+        self.show_session(session, session_path, p.name, path=p, on_shown=lambda: self.recent.add(p))
 
     def _ask_missing_data(self, session: Session, session_path: Path, path: Path) -> bool:
         """A session whose data files are not where it says: those in the remembered folders are used; for the
@@ -91,9 +116,9 @@ class SceneLoading(WindowBase):
             return False
 
         def complete(found: Session) -> None:
-            self._show_session(found, session_path, path.name, path=path, on_shown=lambda: self.recent.add(path))
+            self.show_session(found, session_path, path.name, path=path, on_shown=lambda: self.recent.add(path))
 
-        self.missing_dialog = MissingDataDialog(session, session_path, missing, self.settings, complete, self)
+        self.missing_dialog = MissingDataDialog(session, session_path, missing, self.settings, complete, self.window)
         self.missing_dialog.open()
         return True
 
@@ -107,12 +132,12 @@ class SceneLoading(WindowBase):
         files = headerless_data(path)
         if not files:
             return False
-        self.raw_dialog = RawImportDialog(files, self.open_path, self)
+        self.raw_dialog = RawImportDialog(files, self.open_path, self.window)
         self.raw_dialog.setWindowModality(Qt.WindowModality.WindowModal)
         self.raw_dialog.open()
         return True
 
-    def _show_session(self, session: Session, session_path: Optional[Path], title: str,
+    def show_session(self, session: Session, session_path: Optional[Path], title: str,
                       dirty: bool = False, datasets: Optional[dict[str, Any]] = None, path: Optional[Path] = None,
                       on_shown: Optional[Callable[[], None]] = None) -> None:
         """Show ``session``: its datasets are read (unless ``datasets`` are given) and the scene prepared in the
@@ -124,12 +149,11 @@ class SceneLoading(WindowBase):
         from volviz.render.controller import SceneController
         from volviz.scene.datasets import load_datasets
 
-        self._load_serial += 1
-        serial = self._load_serial
-        self.jobs.runner.cancel_all()  # the shown scene's background work (error estimates...) would delay this one
-        self._loading_views = False
-        self.status_label.setText(f"Loading {title}…")
-        self._set_busy(True)
+        self.serial += 1
+        serial = self.serial
+        self.supersede()  # the shown scene's background work (error estimates...) would delay this one
+        self.status.setText(f"Loading {title}…")
+        self.set_busy(True)
         controller = SceneController(self.plotter, session, {}, on_screen=True)
 
         def load(progress: Any = None) -> Any:
@@ -140,96 +164,74 @@ class SceneLoading(WindowBase):
             return controller.prepare(part(0.6, 1.0))
 
         def done(outcome: JobOutcome) -> None:
-            if serial != self._load_serial:
+            if serial != self.serial:
                 return
             if outcome.cancelled:
-                self._set_busy(False)
-                self.status_label.setText(f"Loading {title} cancelled")
+                self.set_busy(False)
+                self.status.setText(f"Loading {title} cancelled")
                 return
             if outcome.error is not None:
-                self._set_busy(False)
-                self.status_label.setText(f"Could not load {title}")
+                self.set_busy(False)
+                self.status.setText(f"Could not load {title}")
                 self.show_error(f"Cannot open {title}", open_error(path, outcome.error, title))
                 return
-            if self._install_session(controller, outcome.result, session_path, title, dirty, serial, path,
-                                     keep_frame=datasets is not None):
-                if datasets is None:  # another file or scene: the old one's settings edits are not undone on it
-                    self.scene_undo_stack.clear()
-                if on_shown:
-                    on_shown()
+            if self._install(controller, outcome.result, session_path, title, dirty, serial, path,
+                             same_data=datasets is not None) and on_shown:
+                on_shown()
 
-        self._current_job = self.jobs.submit(load, name=f"load {title}", key="load", on_done=done)
+        self.current_job = self.jobs.submit(load, name=f"load {title}", key="load", on_done=done)
 
-    def _install_session(self, controller: SceneController, prepared: Any, session_path: Optional[Path], title: str,
-                         dirty: bool, serial: int, path: Optional[Path] = None, keep_frame: bool = False) -> bool:
-        """GUI thread: replace the shown scene by a prepared one (no numerics here: props added, docks filled, one
-        render), then compute its view-dependent parts in the background; loading ends when they are shown. A scene
-        that cannot be installed is taken out again and the previous one rebuilt (False). ``keep_frame``: the same
-        data rebuilt; its last frame stays over the viewport until the first views are shown (``StandInFrame``)."""
+    def _install(self, controller: SceneController, prepared: Any, session_path: Optional[Path], title: str,
+                 dirty: bool, serial: int, path: Optional[Path] = None, same_data: bool = False) -> bool:
+        """GUI thread: replace the shown scene by a prepared one (no numerics here: props added, the window's docks
+        filled, one render), then compute its view-dependent parts in the background; loading ends when they are
+        shown. A scene that cannot be installed is taken out again and the previous one rebuilt (False).
+        ``same_data``: the same data rebuilt; its last frame stays over the viewport until the first views are shown
+        (``StandInFrame``)."""
+        shown = self.scene
         session = controller.session
-        previous = self.controller
+        previous = shown.controller
         camera = previous.camera() if previous is not None else None  # install places the new scene's camera
-        if keep_frame and previous is not None:
+        if same_data and previous is not None:
             self.stand_in.grab()
         else:
             self.stand_in.drop()
         if previous is not None:
             previous.clear()
         self.plotter.clear()
-        self._current_job = None
+        self.current_job = None
         try:
             controller.install(prepared, views=False)
         except Exception as exc:  # a scene that cannot be shown must not take the window down, nor the old scene
             log.exception("building the scene for %s failed", title)
             self.stand_in.drop()
             controller.clear()
-            self.controller = None
-            self._set_busy(False)
-            self.status_label.setText(f"Could not show {title}")
+            shown.controller = None
+            self.set_busy(False)
+            self.status.setText(f"Could not show {title}")
             self.show_error(f"Cannot open {title}", open_error(path, exc, title))
             if previous is not None:  # the window's state still describes it: show it again, same camera
-                self.session.camera = camera
-                self._show_session(self.session, self.session_path, getattr(self, "title", ""), self.dirty,
-                                   datasets=self.datasets)
+                shown.session.camera = camera
+                self.show_session(shown.session, shown.session_path, getattr(shown, "title", ""), shown.dirty,
+                                  datasets=shown.datasets)
             return False
         if controller.camera_views():   # views made in the background: the last frame stays over them till then
             self.stand_in.show()
         else:                            # VTK draws the whole scene at once
             self.stand_in.drop()
-        self.session, self.session_path, self.datasets = session, session_path, controller.datasets
-        self.controller = controller
-        controller.changes.subscribe(self._scene_changed)   # the window follows the scene's state from now on
+        shown.session, shown.session_path, shown.datasets = session, session_path, controller.datasets
+        shown.controller = controller
         if "window_state" in session.layout:
-            self.restoreState(QByteArray.fromBase64(session.layout["window_state"].encode("ascii")))
-        self.scene_tree.populate(session.components, [ref.id for ref in session.datasets], self.array_choice.names,
-                                 controller.dataset_traits, controller.drawn_as)
-        self.render_settings.load(session.render)
-        self.decorations.sync()
-        self.clipping.load(session.clip, controller.installed_bounds)
-        display_time = controller.time  # the session's display time, which set_steps would reset to the first step
-        self.timeline.blockSignals(True)  # the scene already shows the display time: no re-blend, no re-extraction
-        try:
-            self.timeline.interpolate.setChecked(controller.interpolate_time)   # the session's switch
-            self.timeline.set_steps(controller.time_steps())
-            if controller.time_series():
-                self.timeline.set_time(display_time)
-        finally:
-            self.timeline.blockSignals(False)
-        self.volume_time_shown = self.iso_time_shown = None
-        self.cuts_pending = set()  # cut in ``prepare``
-        self.camera_bookmarks.refresh_menu()
-        self.title = title
-        self.error_estimate = None
-        self.last_error_rmse = None
-        self.set_dirty(dirty)
+            self.window.restoreState(QByteArray.fromBase64(session.layout["window_state"].encode("ascii")))
+        self.installed(controller, title, dirty, not same_data)
 
         def first_render() -> None:
-            if self.controller is controller:
-                self.render_scene()
+            if self.scene.controller is controller:
+                self.first_render()
 
         # the first render and the first views' GUI-thread parts (a PT volume's depth read-back renders too) in
         # later turns of the event loop, with room for other events between them: in one turn they held it 160-330
         # ms for a big PT scene under load
         QTimer.singleShot(STAGE_MS, first_render)
-        QTimer.singleShot(2 * STAGE_MS, lambda: self._show_first_views(controller, serial, title))
+        QTimer.singleShot(2 * STAGE_MS, lambda: self.first_views(controller, serial, title))
         return True

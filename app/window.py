@@ -25,13 +25,13 @@ import logging
 import os
 import time
 from pathlib import Path
-from typing import Any, Optional
+from typing import Any, Callable, Optional
 
-from PySide6.QtCore import QSettings, Qt, QTimer
+from PySide6.QtCore import QSettings, Qt
 from PySide6.QtWidgets import QFileDialog, QMainWindow, QMenu, QMessageBox, QWidget
 
 from volviz.render.backend import plotter_gl_info
-from volviz.render.controller import iso_summary
+from volviz.render.controller import SceneController, iso_summary
 from volviz.session import Session
 from .camera_bookmarks import CameraBookmarks
 from .clip_widget import ClipPlaneWidget
@@ -41,6 +41,7 @@ from .interaction_renders import SingleRenderDuringInteraction
 from .navigation import FlyMode
 from .stand_in import StandInFrame
 from .nonfinite_status import NonFiniteStatus
+from .part_attribute import PartAttribute
 from .recent import RecentFiles
 from .scene_edits import SceneEdits
 from .scene_loading import SceneLoading
@@ -66,7 +67,7 @@ def _import_gui_thread_modules() -> None:
     pyvista.system_supports_plotting()
 
 
-class MainWindow(SceneLoading, ViewScheduler, SceneEdits, WindowWidgets, QMainWindow):
+class MainWindow(ViewScheduler, SceneEdits, WindowWidgets, QMainWindow):
     """volviz main window. ``open_path`` is the single code path behind File > Open and the command line."""
 
     def __init__(self, parent: Optional[QWidget] = None, settings: Optional[QSettings] = None,
@@ -89,9 +90,7 @@ class MainWindow(SceneLoading, ViewScheduler, SceneEdits, WindowWidgets, QMainWi
         self.error_dialog = None
         self.dirty = False
         self.last_stats = {}
-        self._current_job = None
         self._init_scene_edits()           # histograms, the pending TF preview, what the edits have shown
-        self._load_serial = 0              # the newest open/rebuild; an older one's late callbacks do nothing
         self._loading_views = False        # the newest scene is installed, its first views are computed
         self._init_view_scheduler()        # its OneInFlight jobs and what they have shown
 
@@ -102,20 +101,46 @@ class MainWindow(SceneLoading, ViewScheduler, SceneEdits, WindowWidgets, QMainWi
                                       self._busy_elsewhere, self.show_error)
         self.recent_menu = QMenu("Open &Recent", self)   # File > Open Recent
         self.recent = RecentFiles(self.settings, self.recent_menu, self.open_path_asking)
+        self.stand_in = StandInFrame(self.plotter)   # the last frame over the viewport while its scene is rebuilt
+        loading = self.scene_loading = SceneLoading(
+            self, self, self.plotter, self.jobs, self.settings, self.recent, self.stand_in, self.status_label,
+            set_busy=self._set_busy, show_error=self.show_error, supersede=self._supersede_views,
+            installed=self._scene_installed, first_render=self.render_scene, first_views=self._show_first_views)
         self.session_files = SessionFiles(self, self, Path(recovery_dir) if recovery_dir else default_recovery_dir(),
-                                          self.recent, self.status_label, self.open_path, self.open_paths,
-                                          self._show_session, self.show_error)   # its autosave timer runs from now
+                                          self.recent, self.status_label, loading.open_path, loading.open_paths,
+                                          loading.show_session, self.show_error)   # its autosave timer runs from now
         self._build_menus()
         self.resize(*self.layout_keeper.default_size())
         self.layout_keeper.restore()
         self.fly = FlyMode(self.plotter, on_camera_moved=self._fly_moved)
-        self.stand_in = StandInFrame(self.plotter)   # the last frame over the viewport while its scene is rebuilt
         self.single_render = SingleRenderDuringInteraction(self.plotter)  # one render per move of a drag
         self.clip_widget = ClipPlaneWidget(self.plotter, self.clipping)
         self._connect_view_scheduler()  # interaction observers, fly-mode settle and resize timers
         self._connect_scene_edits()  # the TF preview timer
         self.nonfinite = NonFiniteStatus(self)  # the status bar's note on non-finite values
         self.collector.freeze_long_lived()
+
+    # ------------------------------------------------------------------------------------------------ a new scene
+    def _supersede_views(self) -> None:
+        """A newer scene is being shown: the shown scene's background work (error estimates...) would delay it."""
+        self.jobs.runner.cancel_all()
+        self._loading_views = False
+
+    def _scene_installed(self, controller: SceneController, title: str, dirty: bool, new_data: bool) -> None:
+        """``scene_loading`` installed ``controller``'s scene as the shown one: the window follows its state, the
+        docks and the bookmark menu show it, the views' state starts afresh. ``new_data``: another file or scene,
+        whose settings edits are not undone on the new one."""
+        controller.changes.subscribe(self._scene_changed)   # the window follows the scene's state from now on
+        self._fill_docks(controller)
+        self.volume_time_shown = self.iso_time_shown = None
+        self.cuts_pending = set()  # cut in ``prepare``
+        self.camera_bookmarks.refresh_menu()
+        self.title = title
+        self.error_estimate = None
+        self.last_error_rmse = None
+        self.set_dirty(dirty)
+        if new_data:
+            self.scene_undo_stack.clear()
 
     # ------------------------------------------------------------------------------------------------ rendering
     def render_scene(self) -> None:
@@ -177,7 +202,18 @@ class MainWindow(SceneLoading, ViewScheduler, SceneEdits, WindowWidgets, QMainWi
             self._camera_moved()
 
     # ------------------------------------------------------------------------------------------------ forwarders
-    # what tests and other modules call on the window, kept while they move to its parts
+    # what tests and other modules call or read on the window, kept while they move to its parts
+    export_result = PartAttribute("export_runs", "result")
+    export_threads = PartAttribute("export_runs", "threads")
+    recovery_file = PartAttribute("session_files")
+    recovery_dialog = PartAttribute("session_files")
+    file_dialog = PartAttribute("session_files")
+    unsaved_dialog = PartAttribute("session_files")
+    autosave_timer = PartAttribute("session_files")
+    raw_dialog = PartAttribute("scene_loading")
+    missing_dialog = PartAttribute("scene_loading")
+    _load_serial = PartAttribute("scene_loading", "serial")
+
     def add_bookmark(self, name: str) -> None:
         self.camera_bookmarks.add_bookmark(name)
 
@@ -192,13 +228,22 @@ class MainWindow(SceneLoading, ViewScheduler, SceneEdits, WindowWidgets, QMainWi
                      fps: float = 24.0, size: Optional[tuple[int, int]] = None, orbit: bool = False) -> None:
         self.export_runs.export_movie(path, path_name, through_time, fps, size, orbit)
 
-    @property
-    def export_result(self) -> Optional[bool]:
-        return self.export_runs.result
+    def open_path(self, path: str | os.PathLike, q: Optional[str | os.PathLike] = None) -> None:
+        self.scene_loading.open_path(path, q)
 
-    @property
-    def export_threads(self) -> set[int]:
-        return self.export_runs.threads
+    def open_paths(self, paths: list[str]) -> None:
+        self.scene_loading.open_paths(paths)
+
+    def open_demo(self) -> None:
+        self.scene_loading.open_demo()
+
+    def open_demo_volume(self) -> None:
+        self.scene_loading.open_demo_volume()
+
+    def _show_session(self, session: Session, session_path: Optional[Path], title: str, dirty: bool = False,
+                      datasets: Optional[dict[str, Any]] = None, path: Optional[Path] = None,
+                      on_shown: Optional[Callable[[], None]] = None) -> None:
+        self.scene_loading.show_session(session, session_path, title, dirty, datasets, path, on_shown)
 
     def set_dirty(self, dirty: bool = True) -> None:
         self.session_files.set_dirty(dirty)
@@ -224,26 +269,6 @@ class MainWindow(SceneLoading, ViewScheduler, SceneEdits, WindowWidgets, QMainWi
 
     def _ask_open_data(self) -> None:
         self.session_files.ask_open_data()
-
-    @property
-    def recovery_file(self) -> Path:
-        return self.session_files.recovery_file
-
-    @property
-    def recovery_dialog(self) -> Optional[QMessageBox]:
-        return self.session_files.recovery_dialog
-
-    @property
-    def file_dialog(self) -> Optional[QFileDialog]:
-        return self.session_files.file_dialog
-
-    @property
-    def unsaved_dialog(self) -> Optional[QMessageBox]:
-        return self.session_files.unsaved_dialog
-
-    @property
-    def autosave_timer(self) -> QTimer:
-        return self.session_files.autosave_timer
 
     # ------------------------------------------------------------------------------------------------ errors
     def show_error(self, title: str, text: str) -> None:

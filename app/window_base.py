@@ -1,8 +1,7 @@
 """The typed view that ``MainWindow``'s mixins have of the window they are mixed into.
 
-Each mixin (``scene_loading.SceneLoading``, ``view_scheduler.ViewScheduler``,
-``scene_edits.SceneEdits``, ``window_widgets.WindowWidgets``) derives from ``WindowBase``, which declares, once and
-with their types:
+Each mixin (``view_scheduler.ViewScheduler``, ``scene_edits.SceneEdits``, ``window_widgets.WindowWidgets``) derives
+from ``WindowBase``, which declares, once and with their types:
 
 - the window's shared state: what more than one part of the window reads or writes (``session``, ``controller``,
   ``jobs``, ``plotter``, the docks, ``status_label``...), whichever of ``MainWindow.__init__`` or a mixin sets it;
@@ -21,7 +20,6 @@ that protocol would have to list everything the mixin's methods touch, its own s
 method would repeat the annotation; the base class needs only what is shared, and no annotation on ``self``."""
 from __future__ import annotations
 
-import os
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, Optional
 
@@ -31,13 +29,13 @@ if TYPE_CHECKING:
     from PySide6.QtWidgets import QLabel, QMainWindow, QMenu, QMessageBox, QProgressBar, QPushButton
     from pyvistaqt import QtInteractor
 
-    from volviz.jobs import Job
     from volviz.model.events import SceneChange
     from volviz.render.controller import SceneController
     from volviz.session import Session
     from .array_choice import ArrayChoice
     from .camera_bookmarks import CameraBookmarks
     from .export_runs import ExportRuns
+    from .scene_loading import SceneLoading
     from .session_files import SessionFiles
     from .stand_in import StandInFrame
     from .decoration_toggles import DecorationToggles
@@ -73,18 +71,16 @@ class WindowBase(_QtWindow):
     reload_data: ReloadData
     error_dialog: Optional[QMessageBox]
     last_stats: dict[str, Any]
-    # -- the shown scene (set by MainWindow.__init__, replaced by SceneLoading and SessionFiles)
+    # -- the shown scene (set by MainWindow.__init__, replaced by scene_loading and session_files: ``ShownScene``)
     session: Session
     session_path: Optional[Path]
     datasets: dict[str, Any]
     controller: Optional[SceneController]
     title: str                         # what the window title names when there is no session file
     dirty: bool
-    # -- loading (SceneLoading) and the progress it shows (WindowWidgets)
-    _current_job: Optional[Job]
-    _load_serial: int
+    # -- the first views of a new scene are computed (ViewScheduler; reset by MainWindow when a newer one loads)
     _loading_views: bool
-    # -- the shown views (ViewScheduler, reset by SceneLoading for a new scene)
+    # -- the shown views (ViewScheduler, reset by MainWindow._scene_installed for a new scene)
     volume_time_shown: Optional[tuple[float, bool]]
     iso_time_shown: Optional[tuple[float, bool]]
     error_estimate: Optional[str]
@@ -106,6 +102,7 @@ class WindowBase(_QtWindow):
     camera_bookmarks: CameraBookmarks  # (window.py)
     export_runs: ExportRuns            # (window.py)
     session_files: SessionFiles        # (window.py)
+    scene_loading: SceneLoading        # (window.py)
     recent_menu: QMenu                 # (window.py)
     action_fly: QAction
     status_label: QLabel
@@ -120,14 +117,14 @@ class WindowBase(_QtWindow):
         def set_fly_mode(self, enabled: bool) -> None: ...
         def reset_camera(self) -> None: ...
 
-        # -- SceneLoading
-        def open_path(self, path: str | os.PathLike, q: Optional[str | os.PathLike] = None) -> None: ...
-        def open_paths(self, paths: list[str]) -> None: ...
+        # -- forwarded by MainWindow to scene_loading
+        @property
+        def _load_serial(self) -> int: ...
         def _show_session(self, session: Session, session_path: Optional[Path], title: str,
                           dirty: bool = False, datasets: Optional[dict[str, Any]] = None, path: Optional[Path] = None,
                           on_shown: Optional[Callable[[], None]] = None) -> None: ...
 
-        # -- SessionFiles
+        # -- forwarded by MainWindow to session_files
         def set_dirty(self, dirty: bool = True) -> None: ...
 
         # -- ViewScheduler

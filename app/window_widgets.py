@@ -9,14 +9,14 @@ It makes the docks (``tf_editor``, ``scene_tree``, ``render_settings``, ``timeli
 ``clipping`` and their ``*_dock``), ``layout_keeper``, the undo group, ``array_choice``, ``export_dialogs``,
 ``decorations``, ``python_console`` (stopped by ``closeEvent``), ``help``, ``file_drop``, the actions,
 ``status_label``, ``progress_bar`` and ``cancel_button``. It expects of the window: ``settings``, ``plotter``,
-``jobs``, ``_current_job``, ``_loading_views``, ``export_runs``, the handlers its docks and actions call
+``jobs``, ``scene_loading``, ``_loading_views``, ``export_runs``, the handlers its docks and actions call
 (``open_path``, ``set_fly_mode``, ``reset_camera``, ``set_clip``...), ``session_files`` (the File menu's open and
 save entries, ``recent_menu``), and ``camera_bookmarks``, which adds the Camera menu's entries. ``_build_docks()``
 and ``_build_status_bar()`` are called by the window's ``__init__`` before its parts are made, ``_build_menus()``
 after."""
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from PySide6.QtGui import QAction, QKeySequence, QUndoGroup, QUndoStack
 from PySide6.QtWidgets import QDockWidget, QLabel, QProgressBar, QPushButton, QWidget
@@ -45,9 +45,31 @@ from .probe import ProbeTool
 from .scalar_bar_editor import ScalarBarEditor
 from .window_base import WindowBase
 
+if TYPE_CHECKING:
+    from volviz.render.controller import SceneController
+
 
 class WindowWidgets(WindowBase):
     """Docks, menus and the status bar of the window (see the module's docstring)."""
+
+    def _fill_docks(self, controller: SceneController) -> None:
+        """The docks show a newly installed scene: its components, render settings, decorations, clipping, and its
+        time steps at the session's display time (no re-blend, no re-extraction: the scene already shows it)."""
+        session = controller.session
+        self.scene_tree.populate(session.components, [ref.id for ref in session.datasets], self.array_choice.names,
+                                 controller.dataset_traits, controller.drawn_as)
+        self.render_settings.load(session.render)
+        self.decorations.sync()
+        self.clipping.load(session.clip, controller.installed_bounds)
+        display_time = controller.time  # the session's display time, which set_steps would reset to the first step
+        self.timeline.blockSignals(True)
+        try:
+            self.timeline.interpolate.setChecked(controller.interpolate_time)   # the session's switch
+            self.timeline.set_steps(controller.time_steps())
+            if controller.time_series():
+                self.timeline.set_time(display_time)
+        finally:
+            self.timeline.blockSignals(False)
 
     def _dock(self, title: str, name: str, widget: QWidget, scroll: bool = True) -> QDockWidget:
         dock = QDockWidget(title, self)
@@ -201,12 +223,12 @@ class WindowWidgets(WindowBase):
 
     def _busy_elsewhere(self) -> bool:
         """A job other than an export still shows progress (a scene loading, its first views)."""
-        return (self._current_job is not None and not self._current_job.done()) or self._loading_views
+        return self.scene_loading.loading() or self._loading_views
 
     def cancel_current_job(self) -> None:
         if self.export_runs.running:  # an export runs alongside whatever else: the button stops it first
             self.export_runs.cancel()
-        elif self._current_job is not None and not self._current_job.done():
-            self._current_job.cancel()
+        elif self.scene_loading.loading() and self.scene_loading.current_job is not None:
+            self.scene_loading.current_job.cancel()
         elif self._loading_views:  # the scene is shown; stop computing its first views
             self.jobs.runner.cancel_all()

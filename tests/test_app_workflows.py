@@ -214,7 +214,7 @@ def test_cancel_a_long_job_and_ui_stays_responsive(qtbot, make_window) -> None:
     window._set_busy(True)
     job = window.jobs.submit(build_table3d_job, tf, n_s=512, n_l=256, l_max=1.0, name="table",
                              on_done=outcomes.append)
-    window._current_job = job
+    window.scene_loading.current_job = job
     gaps = LoopGaps()
     qtbot.waitUntil(lambda: window.progress_bar.value() > 0, timeout=30000)
     gaps.restart()  # from the first progress report on: the one-time Numba compilation (cached on disk) is over
