@@ -79,3 +79,31 @@ def test_replay_command_rebuilds_and_reads_the_case(campaign, tmp_path, capsys):
     assert out[0].startswith(f"case {item['case']}: {item['format']} `{item['file']}` {item['kind']}")
     assert "as recorded" in out[1] and out[2] == "recorded outcome: volviz clean"
     assert out[3].startswith(f"volviz now: error: {tmp_path}/s{item['case']}/")
+
+
+def test_a_case_is_placed_as_a_new_file_while_a_reader_holds_the_last_one(tmp_path):
+    """A reader child may still hold the previous case of an HDF5 file open (and locked); the next case is written
+    as a new file, which h5py can edit (the retiming of the re-run stopped on 'unable to lock file')."""
+    import subprocess
+    import sys
+
+    import h5py
+    import numpy as np
+
+    target = tmp_path / "case.h5"
+    with h5py.File(target, "w") as f:
+        f["x"] = np.arange(3)
+    raw = target.read_bytes()
+    holder = subprocess.Popen([sys.executable, "-c", "import h5py, sys; f = h5py.File(sys.argv[1], 'r'); "
+                               "print('open', flush=True); sys.stdin.read()", str(target)],
+                              stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+    try:
+        assert holder.stdout.readline() == "open\n"
+        rb.place(target, raw)
+        with h5py.File(target, "r+") as f:
+            f["x"][0] = 7
+        with h5py.File(target, "r") as f:
+            assert list(f["x"][:]) == [7, 1, 2]
+    finally:
+        holder.stdin.close()
+        holder.wait()

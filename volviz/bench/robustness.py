@@ -940,9 +940,10 @@ def _retime(slow: list[tuple[Source, tuple, float]], worker: "BenchWorker", base
 
 
 def place(target: Path, data: bytes) -> None:
-    """Write the case's bytes at ``target`` (replacing the symbolic link of a mirrored case)."""
-    if target.is_symlink():
-        target.unlink()
+    """Write the case's bytes as a new file at ``target`` (replacing the symbolic link of a mirrored case): a reader
+    child that still holds the previous case open (an HDF5 file, locked) keeps that file, and h5py can edit this
+    one (the retiming after a campaign stopped on "unable to lock file" editing it in place)."""
+    target.unlink(missing_ok=True)
     target.write_bytes(data)
 
 
