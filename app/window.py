@@ -6,11 +6,12 @@ scene, typed by ``shown_scene.ShownScene``, widgets, callbacks) when they are ma
 - ``export_runs``: screenshot and movie export in the background (``export_runs.ExportRuns``);
 - ``session_files``: open/save dialogs, saving, dirty tracking, autosave, crash recovery, the unsaved-changes
   question on closing (``session_files.SessionFiles``; ``recent``: File > Open Recent);
+- ``scene_loading``: ``open_path`` and showing a session, prepared in the background, then installed
+  (``scene_loading.SceneLoading``; the window's side of a new scene is ``_scene_installed``);
 
 and is put together from one mixin per responsibility for the rest, each in its own module:
 
 - ``window_widgets.WindowWidgets``: the docks, menus and actions, the status bar with progress and cancel;
-- ``scene_loading.SceneLoading``: ``open_path`` and showing a session (prepared in the background, then installed);
 - ``view_scheduler.ViewScheduler``: the background refreshes of the views (one job in flight per kind), the error
   estimate and budget;
 - ``scene_edits.SceneEdits``: what the docks' edits do to the shown scene (TF, visibility, opacity, settings,
@@ -51,6 +52,7 @@ from .window_widgets import WindowWidgets
 from .workers import JobBridge
 
 log = logging.getLogger(__name__)
+
 
 def _import_gui_thread_modules() -> None:
     """Import at start-up what the GUI thread later imports inside functions: a first ``import vtk`` (the natural
