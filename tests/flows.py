@@ -86,6 +86,11 @@ def render_saved(session: Path, size: tuple[int, int], out: Path) -> np.ndarray:
 def compare_with_render(window, tmp_path: Path, name: str = "flow") -> dict[str, float]:
     """Save the window's session, render it offscreen at the viewport's size and camera, and return the error of the
     on-screen frame against it (8-bit units: rmse, max; and the fraction of pixels off by more than 24)."""
+    return _compare_with_render(window, tmp_path, name)[0]
+
+
+def _compare_with_render(window, tmp_path: Path, name: str) -> tuple[dict[str, float], np.ndarray]:
+    """``compare_with_render``'s error, and the on-screen frame it was measured on."""
     session = tmp_path / f"{name}.json"
     assert window.save_session(session)
     shown = screen(window)
@@ -93,7 +98,23 @@ def compare_with_render(window, tmp_path: Path, name: str = "flow") -> dict[str,
     ref = render_saved(session, size, tmp_path / f"{name}.png")
     assert ref.shape == shown.shape
     return {"rmse": rmse(shown / 255.0, ref / 255.0), "max": max_abs(shown / 255.0, ref / 255.0),
-            "off": float((np.abs(shown - ref).max(axis=2) > 24).mean())}
+            "off": float((np.abs(shown - ref).max(axis=2) > 24).mean())}, shown
+
+
+def assert_matches_render(window, tmp_path: Path, name: str = "flow", max_rmse: float = 2.0,
+                          max_off: float = 0.01) -> dict[str, float]:
+    """``compare_with_render`` held to its bounds (RMSE in 8-bit units, the share of pixels off by more than 24). On
+    failure the screen grab is kept beside the reference (``NAME-screen.png`` and ``NAME.png``, with the session
+    ``NAME.json``, in ``tmp_path``) and both paths are printed and named in the message, so that a failure on CI can
+    be looked at."""
+    err, shown = _compare_with_render(window, tmp_path, name)
+    if not (err["rmse"] < max_rmse and err["off"] < max_off):
+        grab = tmp_path / f"{name}-screen.png"
+        iio.imwrite(grab, np.clip(np.rint(shown), 0, 255).astype(np.uint8))
+        where = f"screen grab {grab}, reference {tmp_path / f'{name}.png'}"
+        print(where)
+        raise AssertionError(f"{err} (bounds: rmse < {max_rmse}, off < {max_off}); {where}")
+    return err
 
 
 def pick_combo_item(qtbot, combo, data: str) -> None:

@@ -9,7 +9,8 @@ mesh and the overlay for a camera; the app does it in the background (``begin`` 
 """
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any, Optional, Sequence, Union
+import weakref
+from typing import TYPE_CHECKING, Any, Callable, Optional, Sequence, Union
 
 import numpy as np
 
@@ -98,6 +99,9 @@ class NatureView:
         sky.repeat = False
         sky.edge_clamp = True
         self.sky_actor = plotter.add_mesh(dome, texture=sky, lighting=False, name="nature-sky", render=False)
+        # VTK's own fit of the clipping range (each fly step, each drag) is replaced by the view's (``_fit_clipping``)
+        self._clip_observer: Optional[int] = plotter.renderer.AddObserver("ResetCameraClippingRangeEvent",
+                                                                          _refit(weakref.ref(self)))
 
     def _camera(self) -> Camera:
         from volviz.model.camera import Camera
@@ -106,10 +110,13 @@ class NatureView:
         return Camera.from_pyvista(self.plotter.camera)
 
     def _fit_dome(self, eye: Any) -> None:
-        """Grow the sky dome (centred on the eye, see ``begin``) to twice the distance from the eye to the farthest
-        corner of the terrain, so that it never hides the terrain however far the camera backs away (a camera framed
-        on the whole terrain sits more than the dome's base radius away from its far side)."""
-        if self.sky_actor is None or self.scene.terrain is None:
+        """Centre the sky dome on the eye (the sky is at infinity) and grow it to twice the distance from the eye to
+        the farthest corner of the terrain, so that it never hides the terrain however far the camera backs away (a
+        camera framed on the whole terrain sits more than the dome's base radius away from its far side)."""
+        if self.sky_actor is None:
+            return
+        self.sky_actor.SetPosition(*np.asarray(eye, dtype=np.float64))
+        if self.scene.terrain is None:
             return
         b = self.scene.terrain.bounds()
         corners = np.array([[x, y, z] for x in b[0:2] for y in b[2:4] for z in b[4:6]], dtype=np.float64)
@@ -118,15 +125,29 @@ class NatureView:
         self.sky_actor.SetScale(scale, scale, scale)
         self.dome_radius = self._base_dome_radius * scale
 
-    def _fit_clipping(self) -> None:
-        """Make the plotter camera's clipping range hold the sky dome around the eye. A session camera applied before
-        any actor existed leaves VTK's default range (0.01, 1000.01), whose far plane cut the dome (radius 3 x the
-        terrain extent) away so the background color showed instead of the sky."""
-        pc = self.plotter.camera
-        near, far = (float(v) for v in pc.clipping_range)
-        need = 1.05 * self.dome_radius
-        if far < need or near < 0.5 * self._near:
-            pc.clipping_range = (max(near, self._near), max(far, need))
+    def clipping_range(self, eye: Sequence[float]) -> tuple[float, float]:
+        """The view's near and far planes for an eye at ``eye``: the near plane at 1e-3 of the terrain's extent (as
+        ``volviz render``'s camera, ``_as_camera``), the far one just beyond the sky dome. A function of the scene,
+        the eye and the dome alone: VTK's fit to the props' bounds put the near plane at 1e-3 of a far plane that
+        depended on where the dome stood (about 6.4 units on Yukon, where ``volviz render`` had 1.0), and a flight
+        that ended a few terrain cells from a hillside showed it cut open (issue #28: RMSE 20-27 against the
+        render of the saved session)."""
+        centre = np.asarray(self.sky_actor.GetPosition() if self.sky_actor is not None else eye, dtype=np.float64)
+        offset = float(np.linalg.norm(np.asarray(eye, dtype=np.float64) - centre))
+        return self._near, 1.05 * (self.dome_radius + offset)
+
+    def _fit_clipping(self, given: Optional[tuple[float, float]] = None) -> None:
+        """Set the plotter camera's clipping range to the view's (``clipping_range``), whatever set it before: VTK's
+        fit to the props' bounds (each fly step, each drag), or a session camera applied before any actor existed
+        (VTK's default range 0.01 .. 1000.01, whose far plane cut the dome away so the background showed instead of
+        the sky). ``given``: a caller's camera range (``begin(camera)``), kept where it holds the dome and its near
+        plane is not far below the view's. The renderer's VTK camera, not ``plotter.camera``: PyVista frames the
+        scene on its first read of an unset camera, which refits the range and calls this again."""
+        camera = self.plotter.renderer.GetActiveCamera()
+        near, far = self.clipping_range(camera.GetPosition())
+        if given is not None:
+            near, far = (given[0] if given[0] >= 0.5 * near else near), max(given[1], far)
+        camera.SetClippingRange(near, far)
 
     def update(self, camera: Optional[Camera] = None) -> dict[str, float]:
         """Re-triangulate the terrain and re-render the overlay for ``camera`` (default: the plotter's camera), now.
@@ -139,18 +160,15 @@ class NatureView:
         """GUI thread: the view to compute (``camera`` or the plotter's, the image size and the preview ``scale``,
         see ``compute``); moves the sky dome to the eye (the sky is at infinity)."""
         self._fit_dome(camera.position if camera is not None else self.plotter.camera.position)
-        cam = camera or self._camera()
+        cam = camera or self._camera()     # after the dome moved: the clipping range depends on where it stands
         coarse, self._coarse = self._coarse, None
         if scale > 1 and coarse is not None:  # the camera starts moving: draw the shown view's coarse terrain at once
             self._show_terrain(coarse)
         if camera is not None:
             camera.apply_to(self.plotter.camera)
-            self._fit_clipping()  # the VTK side only: ``cam`` keeps the caller's range for the CPU overlay
+            self._fit_clipping(camera.clipping_range)  # the VTK side only: ``cam`` keeps the caller's range
         w, h = self.size or (int(self.plotter.window_size[0]), int(self.plotter.window_size[1]))
-        size = (w, h)
-        if self.sky_actor is not None:
-            self.sky_actor.SetPosition(*np.asarray(cam.position, dtype=np.float64))
-        return cam, size, max(1, int(scale))
+        return cam, (w, h), max(1, int(scale))
 
     def compute(self, request: NatureRequest, progress: Optional[ProgressCallback] = None
                 ) -> tuple[Optional[pv.PolyData], np.ndarray, dict[str, float]]:
@@ -229,7 +247,10 @@ class NatureView:
             self.plotter.remove_actor("nature-terrain", render=False)
 
     def remove(self) -> None:
-        """Take the view's actors (sky, terrain, overlay) out of the plotter."""
+        """Take the view's actors (sky, terrain, overlay) and its clipping observer out of the plotter."""
+        if self._clip_observer is not None and self.plotter.renderer is not None:
+            self.plotter.renderer.RemoveObserver(self._clip_observer)
+        self._clip_observer = None
         for name in ("nature-sky", "nature-terrain", "nature-overlay"):
             self.plotter.remove_actor(name, render=False)
         self.terrain_actor = self._overlay_actor = self._overlay_image = None
@@ -256,6 +277,18 @@ class NatureView:
         arr.SetNumberOfComponents(4)
         img.GetPointData().SetScalars(arr)
         img.Modified()
+
+
+def _refit(view: weakref.ref[NatureView]) -> Callable[..., None]:
+    """The observer that sets the view's clipping range after VTK fitted its own (the view held weakly: the
+    renderer outlives it)."""
+
+    def refit(*args: Any) -> None:
+        shown = view()
+        if shown is not None:
+            shown._fit_clipping()
+
+    return refit
 
 
 #: anisotropic filtering of the terrain texture: none (VTK's default is 4), as the CPU raster's isotropic mip-map
