@@ -26,7 +26,7 @@ from volviz.io._checks import HDF5_SIGNATURE, check_file, check_finite, file_siz
 from volviz.io.array_choice import choose_array
 from volviz.io.axis_order import check_order, to_xyz
 from volviz.io.errors import PathLike, ReadError, ReadWarning, human_bytes
-from volviz.io.hdf5kind import hdf5_kind, read_as_kind
+from volviz.io.hdf5kind import check_named_kind, hdf5_kind, read_as_kind
 from volviz.model import Image2D, RegularVolume, TimeSeries
 from volviz.model.arrays import volume_of
 
@@ -146,6 +146,8 @@ def read_hdf5(path: PathLike, dataset: str | None = None, order: str = "zyx",
         _warn_if_heavy_data(p)
     try:
         with h5py.File(p, "r") as f:
+            if dataset is None:
+                check_named_kind(p, f)
             name = _pick(p, f, dataset)
             ds = f[name]
             _check_storage(p, ds)

@@ -83,6 +83,23 @@ def hdf5_kind(path: PathLike) -> str | None:
         return None
 
 
+#: names Fluent gives its CFF files (``vtkFLUENTCFFReader`` reads the pair)
+_FLUENT_ENDINGS = (".cas.h5", ".dat.h5")
+
+
+def check_named_kind(path: PathLike, f: Any) -> None:
+    """A file named like Fluent CFF (``.cas.h5``, ``.dat.h5``) whose root lacks Fluent's groups is refused, naming
+    them and what the root holds: read as plain arrays, a Fluent case with one renamed group (a flipped bit:
+    ``settings`` -> ``setdings``) showed as a 4565 x 2 image of its node coordinates (issue #32). ``dataset=``
+    still reads one of its arrays."""
+    name = str(path).lower()
+    if name.endswith(_FLUENT_ENDINGS):
+        held = ", ".join(sorted(f)[:12]) or "nothing"
+        raise ReadError(path, f"is named like a Fluent CFF file but its root lacks the /settings group with /meshes "
+                              f"(case) or /results (data) (it holds: {held}): the file is damaged or not Fluent CFF",
+                        "pass dataset= to read one of its arrays")
+
+
 def read_as_kind(path: PathLike, kind: str, allow_nonfinite: bool = True) -> Any:
     """Read an HDF5 file of ``kind`` with the reader registered for it; a ReadError saying what the file is and what
     to do when no such reader is installed (the plugin's formats: Fluent CFF, CGNS, Exodus, netCDF)."""
