@@ -385,21 +385,30 @@ def test_multisampled_window_keeps_antialiased_opaque_edges():
     assert empty.sum() > 500 and np.array_equal(img[empty], opaque[empty])
 
 
-def test_tf_edit_replaces_only_the_table():
+@pytest.mark.parametrize("order_texture", [False, True], ids=["index-buffer", "order-texture"])
+def test_tf_edit_replaces_only_the_table(order_texture):
     """set_tf: the next render uses the new table and the new zero-opacity culling of the same order (no new sort);
-    the vertex buffer's arrays are not touched."""
+    the mesh data are not touched (the vertex buffer's arrays; with the order texture, the vertex buffer, the static
+    index buffer and the cells' texture)."""
     mesh = syn.box_tets(4, jitter=0.2)
     size = (48, 40)
     cam = Camera.orbit(mesh.points, 50, 30, 2.5)
     tf2 = TransferFunction([0.0, 0.6, 0.9], [[0.2, 0.4, 1.0], [1.0, 0.8, 0.1], [1.0, 1.0, 1.0]], [0.0, 0.0, 5.0])
     pl = _plotter(size, cam)
-    vol = GLPTVolume(pl, mesh, TF, lookup="separable")
+    vol = GLPTVolume(pl, mesh, TF, lookup="separable", order_texture=order_texture)
     first = pl.screenshot(return_img=True)
-    stamps = [vol.polydata.GetPointData().GetArray(i).GetMTime() for i in range(6)]
+    data = vol.polydata.GetPointData()
+    assert data.GetNumberOfArrays() == (0 if order_texture else 6)
+
+    def stamps():
+        arrays = [data.GetArray(i) for i in range(data.GetNumberOfArrays())] + [vol.polydata.GetPoints()]
+        return [a.GetMTime() for a in arrays] + ([vol.polydata.GetMTime(), vol._cells_tex] if order_texture else [])
+
+    before = stamps()
     vol.set_tf(tf2)
     pl.ren_win.Render()                    # PyVista's screenshot does not notice the change
     img = pl.screenshot(return_img=True)
-    assert stamps == [vol.polydata.GetPointData().GetArray(i).GetMTime() for i in range(6)]
+    assert before == stamps()
     assert vol.stats["n_visible"] < mesh.n_cells                    # rho = 0 below 0.6: inner cells culled
     assert not vol.stats["sorted"]                                  # culled again, not sorted again
     vol.remove()
@@ -407,6 +416,36 @@ def test_tf_edit_replaces_only_the_table():
     assert _err(first, render(mesh, TF, cam, size, "reference")[..., :3])[0] <= RMSE
     e = _err(img, render(mesh, tf2, cam, size, "reference")[..., :3])
     assert e[0] <= RMSE and e[1] <= MAX, e
+
+
+def test_order_texture_draws_what_the_index_buffer_draws():
+    """The order as a texture of cell ids read by the vertex shader (the default below 2^24 cells) and the order as
+    VTK's index buffer give the same pixels, bit for bit, on the hard cases where the order matters most (a cavity,
+    the camera inside, a 1e6 offset, NaN cells culled, a zero-opacity cull by the TF) and for smooth isosurfaces (the
+    14-texel layout); and a new camera changes no mesh data in texture mode (the index buffer is made once)."""
+    for case in ("cavity", "inside", "offset-1e6", "nan"):
+        make, cam, _ = _CASES[case]
+        mesh = make()
+        cam = cam if isinstance(cam, Camera) else Camera.orbit(mesh.points, 30, 20, 2.5)
+        images = [_gl_image(mesh, TF, cam, (40, 32), order_texture=on) for on in (False, True)]
+        assert images[0].max() > 20 and np.array_equal(images[0], images[1]), case
+    m8 = syn.box_tets(8, jitter=0.2)
+    cam = Camera.orbit(m8.points, 30, 20, 2.5)
+    images = [_gl_image(m8, None, cam, ISO_SIZE, iso=ISO, iso_shading="smooth", order_texture=on)
+              for on in (False, True)]
+    assert images[0].max() > 20 and np.array_equal(images[0], images[1])
+    pl = _plotter((40, 32), cam)
+    vol = GLPTVolume(pl, m8, TF, order_texture=True)
+    pl.ren_win.Render()
+    stamp, orders = vol.polydata.GetMTime(), []
+    for azimuth in (60, 150, 240):
+        Camera.orbit(m8.points, azimuth, 20, 2.5).apply_to(pl.renderer.GetActiveCamera())
+        pl.ren_win.Render()
+        assert vol.stats["sorted"]
+        orders.append(vol.order.copy())
+    assert vol.polydata.GetMTime() == stamp and not np.array_equal(orders[0], orders[1])
+    vol.remove()
+    pl.close()
 
 
 def test_auto_lookup_follows_the_tf():

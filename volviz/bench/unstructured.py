@@ -29,7 +29,7 @@ VTK_MAPPERS = ("vtkProjectedTetrahedraMapper", "vtkUnstructuredGridVolumeRayCast
                "vtkUnstructuredGridVolumeZSweepMapper")
 
 
-ONLY_ROWS = ("sort", "large")
+ONLY_ROWS = ("sort", "large", "cpu")
 
 
 def _only_list(text: str) -> list[str]:
@@ -164,9 +164,11 @@ def gl_pt_frames(mesh: Any, tf: Any, cams: list[Any], size: tuple[int, int], rep
             order.append(vol.stats["order_s"])
             if split:
                 same.append(_timed_render(pl))
-                _one_cell_order(vol)
+                restore = _one_cell_order(vol)
                 ren_win.Render()
                 one.append(_timed_render(pl))
+                restore()
+                ren_win.Render()
     cams[0].apply_to(pl.renderer.GetActiveCamera())
     ren_win.Render()
     img = screenshot_rgb(pl)
@@ -175,7 +177,8 @@ def gl_pt_frames(mesh: Any, tf: Any, cams: list[Any], size: tuple[int, int], rep
     vol.remove()
     pl.close()
     res = {"frame_s": float(np.median(frame)), "cpu_s": float(np.median(cpu)), "sort_s": float(np.median(sort)),
-           "order_s": float(np.median(order)), "frames_timed": len(frame), "lookup": lookup, "gl_renderer": renderer}
+           "order_s": float(np.median(order)), "frames_timed": len(frame), "lookup": lookup, "gl_renderer": renderer,
+           "order_texture": bool(vol.order_texture), "gpu_bytes_per_cell": vol.gpu_bytes() / mesh.n_cells}
     if split:
         f, sa, on, so, od = (np.array(v) for v in (cpu, same, one, sort, order))
         res["same_s"], res["one_cell_s"] = float(np.median(sa)), float(np.median(on))
@@ -193,9 +196,28 @@ def _timed_render(pl: Any) -> float:
     return time.process_time() - c0
 
 
-def _one_cell_order(vol: Any) -> None:
-    """Draw only the first cell of ``vol``'s order (the 4 triangles of one tetrahedron) until the camera changes."""
+def _one_cell_order(vol: Any) -> Any:
+    """Draw only the first cell of ``vol``'s order (the 4 triangles of one tetrahedron) until the camera changes;
+    returns the function that puts the volume's own index buffer back. With the order texture the static index
+    buffer is cut to its first slot too (else the vertex shader still runs over every slot, work a GPU does), and
+    put back by that function (VTK rebuilds it at the next render, which the caller does not time)."""
     vol._set_index_buffer(vol.order[:1], np.ones(vol.topo.n_tets, bool))
+    if not getattr(vol, "order_texture", False):
+        return lambda: None
+    from volviz.render.vtk_facade import vtk
+
+    full = vol.polydata.GetPolys()
+    conn = full.GetConnectivityArray()
+    one = vtk.vtkCellArray()
+    for tri in range(4):                                 # the first slot's triangles
+        one.InsertNextCell(3)
+        for k in range(3):
+            one.InsertCellPoint(int(conn.GetValue(3 * tri + k)))
+    vol.polydata.SetPolys(one)
+
+    def restore() -> None:
+        vol.polydata.SetPolys(full)
+    return restore
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -231,7 +253,8 @@ def main(argv: list[str] | None = None) -> int:
                    help="also write that refined mesh to this VTK .vtu file (Density on the points)")
     p.add_argument("--only", type=_only_list, default=None,
                    help="run only these rows (comma list of 'sort': the sort table and the index buffer, 'large': "
-                        "the large mesh, which needs --large-refine) and splice them into the existing "
+                        "the large mesh, which needs --large-refine, 'cpu': the CPU side against --cpu-sizes) and "
+                        "splice them into the existing "
                         "unstructured.md under --out, each block naming this command")
     p.add_argument("--out", default=str(Path(__file__).resolve().parents[2] / "docs" / "bench"))
     p.add_argument("--json", default=None, help="also write the results as JSON")
@@ -241,6 +264,8 @@ def main(argv: list[str] | None = None) -> int:
             p.error("--only large needs --large-refine > 1")
         if "sort" in args.only and not args.sort_sizes:
             p.error("--only sort needs --sort-sizes")
+        if "cpu" in args.only and not args.cpu_sizes:
+            p.error("--only cpu needs --cpu-sizes")
         return only_rows(args, argv)
 
     from volviz.io.plot3d import read_plot3d
@@ -436,6 +461,11 @@ def only_rows(args: argparse.Namespace, argv: list[str] | None) -> int:
         note = _run_note(command, load)
         text = splice(text, SORT_HEAD, [note, *_sort_scan_lines(rows, mesh.n_cells), "",
                                         *_index_buffer_lines(ib, mesh.n_cells, "the Blunt Fin")])
+    if "cpu" in args.only:
+        load = os.getloadavg()[0]
+        results["cpu_side"] = cpu_side_scan(mesh, tf, cams, [(64, 64), *args.cpu_sizes], args.gl_lookup)
+        text = splice(text, CPU_HEAD, [_run_note(command, load), *_cpu_side_lines(results["cpu_side"],
+                                                                                  mesh.n_cells)])
     if "large" in args.only:
         load = os.getloadavg()[0]
         big = large_mesh_row(refined_bluntfin(grid, args.large_refine), tf, cams, args.reps)
@@ -457,6 +487,7 @@ def _run_note(command: str, load: float) -> str:
 
 #: the first words of the report's blocks ``--only`` replaces
 SORT_HEAD, LARGE_HEAD = "Sort seconds against window size", "Large mesh:"
+CPU_HEAD = "The CPU side of a pt-gl frame for a new camera"
 #: paragraphs that belong to a block (besides its table rows and blank lines)
 _BLOCK_TAILS = ("Drawn at ", "The order as the GPU pass's index buffer", "(The rows below come from a run")
 
@@ -624,7 +655,8 @@ def large_mesh_row(mesh: Any, tf: Any, cams: list[Any], reps: int, draw: int = 2
     c0 = time.perf_counter()
     pt_img, st = render(mesh, tf, cams[0], size, "pt", lookup="3d", return_stats=True)
     row["draw"] = {"size": draw, "pt_gl_frame_s": gl["frame_s"], "pt_gl_sort_s": gl["sort_s"],
-                   "pt_frame_s": time.perf_counter() - c0, "pt_sort_s": st.sort_s, "gl_renderer": gl["gl_renderer"]}
+                   "pt_frame_s": time.perf_counter() - c0, "pt_sort_s": st.sort_s, "gl_renderer": gl["gl_renderer"],
+                   "gpu_bytes_per_cell": gl["gpu_bytes_per_cell"], "order_texture": gl["order_texture"]}
     row["draw"]["rmse_rgb"], row["draw"]["max_rgb"] = _rgb_err(gl_img, pt_img)
     print(f"large mesh draw: {row['draw']}", flush=True)
     return row
@@ -633,12 +665,19 @@ def large_mesh_row(mesh: Any, tf: Any, cams: list[Any], reps: int, draw: int = 2
 def cpu_side_scan(mesh: Any, tf: Any, cams: list[Any], sizes: list[tuple[int, int]], lookup: str
                   ) -> list[dict[str, Any]]:
     """The CPU side of a pt-gl frame for a new camera at each window size (``gl_pt_frames`` with ``split``: sort,
-    order, index buffer upload, draw submission; one pass over ``cams``)."""
-    rows = []
+    order, index buffer or order texture upload, draw submission; one pass over ``cams``). ``sizes`` starts with a
+    small window (64²), whose one-cell submission is the draw call's CPU cost: at a larger window llvmpipe's
+    one-cell frame also fills the window's full-screen passes (the float target's clear and resolve), GPU work that
+    a GPU does off the CPU, reported apart (``passes_s``); ``cpu_side_s`` = sort + order + upload + that submission."""
+    rows: list[dict[str, Any]] = []
     for w, h in sizes:
         res, _ = gl_pt_frames(mesh, tf, cams, (w, h), 1, lookup, split=True)
         row = {"size": [w, h], **{k: res[k] for k in ("frame_s", "cpu_s", "sort_s", "order_s", "ibo_s",
-                                                       "one_cell_s", "draw_work_s", "cpu_side_proper_s")}}
+                                                       "one_cell_s", "draw_work_s", "cpu_side_proper_s",
+                                                       "order_texture")}}
+        submission = rows[0]["one_cell_s"] if rows else row["one_cell_s"]
+        row["passes_s"] = max(row["one_cell_s"] - submission, 0.0)
+        row["cpu_side_s"] = row["sort_s"] + row["order_s"] + row["ibo_s"] + submission
         rows.append(row)
         print(f"cpu side {w}x{h}: {row}", flush=True)
     return rows
@@ -898,25 +937,46 @@ def _large_mesh_lines(big: dict[str, Any]) -> list[str]:
         lines += ["", f"Drawn at {d['size']}² (3D table): pt-gl {d['pt_gl_frame_s']:.2f} s per frame for a new "
                   f"camera to the GPU's completion (sort {d['pt_gl_sort_s']:.3f} s; {d['gl_renderer']}), the CPU pt "
                   f"renderer {d['pt_frame_s']:.2f} s; pt-gl against pt: RMSE {d['rmse_rgb']:.2f}, max "
-                  f"{d['max_rgb']:.2f} (8-bit; bound RMSE ≤ 1, max ≤ 4)."]
+                  f"{d['max_rgb']:.2f} (8-bit; bound RMSE ≤ 1, max ≤ 4)."
+                  + (f" GPU memory of the mesh {d['gpu_bytes_per_cell']:.0f} bytes per cell ("
+                     + ("the order as a texture: the vertex buffer's corners, the static index buffer, the cells' "
+                        "texels and the order" if d.get("order_texture") else "vertex and index buffers")
+                     + "; `GLPTVolume.gpu_bytes`)." if "gpu_bytes_per_cell" in d else "")]
     return lines
 
 
 def _cpu_side_lines(rows: list[dict[str, Any]] | None, n_tets: int) -> list[str]:
     if not rows:
         return []
-    lines = ["", "The CPU side of a pt-gl frame for a new camera against window size (2 cameras, one frame each; "
-             "process CPU seconds, llvmpipe's threads included, split as above: sort, the order as VTK cells, "
-             "VTK's index buffer build and upload, a one-cell draw submission; every timed Render() ends with "
-             "WaitForCompletion). On llvmpipe the one-cell submission still pays the window's full-screen passes "
-             "(clearing and compositing the float target), which a GPU does off the CPU; the sort no longer "
-             "depends on the window (issue #29):", "",
-             "| window | frame s (wall) | sort s | order s | upload s | submission s | CPU side proper s | "
-             "draw work s |", "|---|---|---|---|---|---|---|---|"]
+    texture = rows[0].get("order_texture", False)
+    base = rows[0]
+    lines = ["", "The CPU side of a pt-gl frame for a new camera against window size (2 cameras, one frame each, "
+             "every timed Render() ending with WaitForCompletion; the order "
+             + ("as a texture of cell ids read by the vertex shader, the index buffer static"
+                if texture else "as VTK's index buffer") + "): the sort and the order (wall seconds of the volume's "
+             "own timings), the upload (the frame minus the same frame drawn again without a new order, minus sort "
+             "and order: " + ("the order texture" if texture else "VTK's index buffer build and upload") + "; process "
+             "CPU seconds), the draw submission (the same frame with one cell drawn, process CPU seconds) measured "
+             f"in the {base['size'][0]}x{base['size'][1]} window, where llvmpipe's fill is nil: at larger windows "
+             "llvmpipe's one-cell frame also fills the window's full-screen passes (the float target's clear and "
+             "resolve), GPU work that a GPU does off the CPU, shown apart; the CPU side = sort + order + upload + "
+             "submission. The draw work (the full frame minus the one-cell frame) is what a GPU takes off the CPU "
+             f"({n_tets} tetrahedra; issue #29):", "",
+             "| window | frame s (wall) | sort s | order s | upload s | submission s | CPU side s | "
+             "llvmpipe's full-screen passes s | draw work s |", "|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
+        side = r.get("cpu_side_s", r["cpu_side_proper_s"])
         lines.append(f"| {r['size'][0]}x{r['size'][1]} | {r['frame_s']:.3f} | {r['sort_s']:.4f} | "
-                     f"{r['order_s']:.4f} | {r['ibo_s']:.4f} | {r['one_cell_s']:.4f} | "
-                     f"{r['cpu_side_proper_s']:.3f} | {r['draw_work_s']:.3f} |")
+                     f"{r['order_s']:.4f} | {r['ibo_s']:.4f} | {base['one_cell_s']:.4f} | **{side * 1e3:.1f} ms** | "
+                     f"{r.get('passes_s', 0.0):.4f} | {r['draw_work_s']:.3f} |")
+    ref = next((r for r in rows if tuple(r["size"]) == (512, 512)), None)
+    if ref is not None:
+        at_512 = max(ref.get("cpu_side_s", 1.0), 1e-9)
+        ratios = [f"{r['size'][0]}x{r['size'][1]} {r.get('cpu_side_s', 0.0) / at_512:.2f}x"
+                  for r in rows if tuple(r["size"]) not in ((512, 512), tuple(base["size"]))]
+        if ratios:
+            lines += ["", "The CPU side against its cost at 512² (target ≤ 1.25x, and ≤ 16 ms at 1920x1080): "
+                      + ", ".join(ratios) + "."]
     return lines
 
 

@@ -11,8 +11,14 @@ How a frame is drawn:
   face planes (n . x <= d inside), the scalar's affine form s(x) = g . x + c and the cell's scalar range, all relative
   to the mesh's centre (``topology``: meshes offset by 1e6 keep their precision; the actor is placed at the centre).
 - Per render (the renderer's ``StartEvent``): the back-to-front cell order for the camera (``visibility_order``, as
-  the CPU ``pt``) with zero-opacity and NaN cells culled (Roettger §9.1) becomes the index buffer, 4 triangles per
-  cell, as 32-bit arrays shared with VTK (no copy); nothing else is uploaded.
+  the CPU ``pt``) with zero-opacity and NaN cells culled (Roettger §9.1) is the only upload. By default
+  (``order_texture``, meshes below 2^24 cells) it is a float32 texture of cell ids: the index buffer is static (slot
+  s draws vertices 4 s .. 4 s + 3, made once) and the vertex shader reads the cell of its slot, its corners and its
+  data from a texture of the cells (``gl_pt_mesh.cell_texels``, uploaded once; slots past the order are moved
+  outside the clip volume), so a new camera costs a 4-byte-per-cell texture upload instead of VTK rebuilding its
+  index buffer from the cells (about 15 ms of CPU for the Blunt Fin's 749,272 triangles, more than the sort), and
+  the mesh takes 260 bytes per cell on the GPU instead of 480. With ``order_texture=False`` the order becomes the
+  index buffer, 4 triangles per cell, as 32-bit arrays shared with VTK (no copy); both give the same pixels.
 - Per fragment (``resources/shaders/pt_tet_fs.glsl``): only back (exit) faces are rasterised (front faces culled),
   so a cell cut by the near plane (camera inside the mesh) is still drawn. The pixel ray is rebuilt from
   ``gl_FragCoord`` with the camera's affine ray basis (no interpolated varyings), clipped against the cell's planes,
@@ -88,15 +94,15 @@ from typing import Any
 import numpy as np
 
 from volviz.model.datasets import TetMesh
-from volviz.render.gl import ScenePass, resolve_polydata, set_ray_uniforms, shader_source
-from volviz.render.gl_pt_mesh import tet_polydata
+from volviz.render.gl import ScenePass, resolve_polydata, set_ray_uniforms, shader_source, texel_array, with_defines
+from volviz.render.gl_pt_mesh import cell_texels, tet_polydata, texels_per_cell
 from volviz.render.gl_pt_order import CellOrder
 from volviz.render.gl_pt_tables import KINDS, pt_shader, resolve_shader, set_table_uniforms, upload_table
 from volviz.render.gl_pt_targets import PTTargets
 from volviz.render.image_overlay import hold_single_sample, release_single_sample, window_size
 from volviz.render.pt_view import PTView
 from volviz.render.reduced_fill import INTERACTIVE_PIXELS, reduced_size, scaled_rays
-from volviz.unstructured.index_buffer import IndexBuffer
+from volviz.unstructured.index_buffer import IndexBuffer, fill_cells
 from volviz.unstructured.iso import iso_visible
 from volviz.unstructured.topology import topology, visible_cells
 
@@ -104,6 +110,7 @@ __all__ = ["GLPTVolume"]
 
 _MAX_CLIP = 8                          # clipping planes the fragment shader takes
 _LOOKUPS = ("auto", "3d", "separable")
+_ORDER_TEXTURE_CELLS = 2 ** 24         # cell ids a float32 order texture holds exactly
 _STILL_RATE_MAX = 1.0                  # frames/s: a window's desired update rate above it is an interaction's
 
 
@@ -124,7 +131,8 @@ class GLPTVolume(CellOrder, PTView):
     the size the last frame's cells were drawn at. The GPU side of the PT view interface
     ``volviz.render.pt_view.PTView``: VTK draws it at every render, so ``update`` has nothing to do.
     ``keep_multisampling``: leave the window's multisampling on (module docstring; default off while the volume is
-    shown)."""
+    shown). ``order_texture``: the order as a texture of cell ids over a static index buffer (None, the default:
+    below 2^24 cells) or as VTK's index buffer (False); ``gpu_bytes`` states what the mesh takes on the GPU."""
 
     backend = "gpu"
     job = ("pt-order", "visibility order")   # the app's key for its updates, and what its worker makes
@@ -132,8 +140,8 @@ class GLPTVolume(CellOrder, PTView):
     def __init__(self, plotter: Any, mesh: TetMesh, tf: Any, *, lookup: str = "3d", n_s: int | None = None,
                  n_l: int = 64, degree: int | None = None, sort: str = "mpvo", nonconvex: str = "auto",
                  iso: Any = None, iso_shading: str = "flat", classification: str = "post",
-                 keep_multisampling: bool = False) -> None:
-        from volviz.render.vtk_facade import premultiplied_texture, shader_observer, vtk
+                 keep_multisampling: bool = False, order_texture: bool | None = None) -> None:
+        from volviz.render.vtk_facade import numpy_to_vtk, premultiplied_texture, shader_observer, vtk
 
         if not isinstance(mesh, TetMesh):
             raise TypeError(f"GLPTVolume needs a TetMesh, got {type(mesh).__name__}")
@@ -170,13 +178,30 @@ class GLPTVolume(CellOrder, PTView):
         self._clip = np.zeros((0, 4))
         self.tf = tf
         self._vis = self._visible()
+        self.order_texture = self.topo.n_tets < _ORDER_TEXTURE_CELLS if order_texture is None else order_texture
+        if self.order_texture and self.topo.n_tets >= _ORDER_TEXTURE_CELLS:
+            raise ValueError(f"an order texture holds cell ids below {_ORDER_TEXTURE_CELLS}, "
+                             f"the mesh has {self.topo.n_tets} cells")
+        self._order_cells = np.empty(self.topo.n_tets if self.order_texture else 0, np.float32)
+        self._order_count = 0
+        self._order_tex: Any = None                 # the order texture (uploaded as the program is bound)
+        self._order_dirty = False
+        self._cells_tex: Any = None                 # the cells' corners and data as texels (uploaded once)
 
-        self.polydata = tet_polydata(mesh, smooth)
+        self.polydata = tet_polydata(mesh, smooth, attributes=not self.order_texture)
+        if self.order_texture:                       # the static index buffer: slot s draws vertices 4 s .. 4 s + 3
+            n = self.topo.n_tets
+            offsets, conn, _ = IndexBuffer(n).fill(np.arange(n, dtype=np.int32), np.ones(n, bool))
+            self.polydata.GetPolys().SetData(numpy_to_vtk(offsets, deep=True), numpy_to_vtk(conn, deep=True))
         self.mapper = vtk.vtkOpenGLPolyDataMapper()
         self.mapper.SetInputData(self.polydata)
         self.mapper.ScalarVisibilityOff()
         sp = vtk.vtkShaderProperty()
-        sp.SetVertexShaderCode(pt_shader("pt_tet_vs.glsl", smooth))
+        vertex_shader = pt_shader("pt_tet_vs.glsl", smooth)
+        if self.order_texture:
+            vertex_shader = with_defines(vertex_shader, "#define PT_ORDER_TEXTURE\n"
+                                                        f"#define PT_TEXELS {texels_per_cell(smooth)}\n")
+        sp.SetVertexShaderCode(vertex_shader)
         self._kind: tuple[int, int] = (-1, -1)   # the fragment shader's (PT_KIND, PT_CLIPS)
         attributes = self.polydata.GetPointData()
         for name in (attributes.GetArrayName(i) for i in range(attributes.GetNumberOfArrays())):
@@ -243,6 +268,10 @@ class GLPTVolume(CellOrder, PTView):
         them; they are refilled only here, between renders."""
         from volviz.render.vtk_facade import numpy_to_vtk
 
+        if self.order_texture:                       # the order texture's cells, uploaded as the program is bound
+            self._order_count = fill_cells(order, visible, self._order_cells)
+            self._order_dirty = True
+            return self._order_cells[:self._order_count].astype(np.int32)
         if self._index_buffer is None:
             self._index_buffer = IndexBuffer(self.topo.n_tets)   # refuses meshes beyond 32-bit vertex indices
         offsets, conn, cells = self._index_buffer.fill(order, visible)
@@ -253,8 +282,9 @@ class GLPTVolume(CellOrder, PTView):
     def _on_end(self, *_: Any) -> None:
         self.targets.restore()                     # only if the resolve did not draw
         self._drawn = False
-        if self._table_tex is not None:
-            self._table_tex.Deactivate()
+        for tex in (self._table_tex, self._order_tex, self._cells_tex):
+            if tex is not None:
+                tex.Deactivate()
         self.targets.deactivate()
 
     def _on_resolve(self, program: Any) -> None:
@@ -335,7 +365,25 @@ class GLPTVolume(CellOrder, PTView):
         program.SetUniformi("opaqueDepth", depth.GetTextureUnit())
         self._table_tex.Activate()
         program.SetUniformi("ptTable", self._table_tex.GetTextureUnit())
+        if self.order_texture:
+            self._bind_order(program, ren_win)
         set_table_uniforms(program, self._table, self.iso_shading == "smooth", cam.frame()[2])
+
+    def _bind_order(self, program: Any, ren_win: Any) -> None:
+        """The order texture's uniforms (``PT_ORDER_TEXTURE``): the cells' texels (uploaded at the first draw) and the
+        order, uploaded when a new one was set since the last draw (0.75 MB for the Blunt Fin: the only per-camera
+        upload; VTK's index buffer stays)."""
+        if self._cells_tex is None:
+            self._cells_tex = texel_array(ren_win, cell_texels(self.mesh, self.iso is not None
+                                                               and self.iso_shading == "smooth"), "cells'")
+        if self._order_dirty or self._order_tex is None:
+            self._order_tex = texel_array(ren_win, self._order_cells[:, None], "cell order", into=self._order_tex)
+            self._order_dirty = False
+        for name, tex in (("ptCells", self._cells_tex), ("ptOrder", self._order_tex)):
+            tex.Activate()
+            program.SetUniformi(name, tex.GetTextureUnit())
+            program.SetUniformi(name + "Width", int(tex.GetWidth()))
+        program.SetUniformi("ptCount", int(self._order_count))
 
     def _apply_upsample(self, on: bool) -> None:
         """The resolve's shader variant for this frame (VTK keeps both programs compiled once made)."""
@@ -344,6 +392,17 @@ class GLPTVolume(CellOrder, PTView):
             self.resolve_actor.GetShaderProperty().SetFragmentShaderCode(resolve_shader(on))
 
     # --- public --------------------------------------------------------------------------------------------------
+    def gpu_bytes(self) -> int:
+        """The bytes of the mesh's data on the GPU: the vertex buffer (float32 corners, and without the order texture
+        the cell data repeated at each), the index buffer (4 triangles of 32-bit indices per cell) and, with the order
+        texture, the cells' texels and the order (the table and the targets do not grow with the mesh)."""
+        data = self.polydata.GetPointData()
+        vertex = self.polydata.GetNumberOfPoints() * 12 + sum(
+            4 * data.GetArray(i).GetNumberOfValues() for i in range(data.GetNumberOfArrays()))
+        n = self.topo.n_tets
+        texels = n * (16 * texels_per_cell(self.iso is not None and self.iso_shading == "smooth") + 4)
+        return int(vertex + 48 * n + (texels if self.order_texture else 0))
+
     def set_interactive(self, on: bool | None) -> None:
         """Draw at reduced resolution from the next render on (True: the camera is moving; at most
         ``interactive_pixels`` pixels, upsampled), at full resolution (False), or follow the render window (None,
@@ -425,9 +484,10 @@ class GLPTVolume(CellOrder, PTView):
         self.renderer.RemoveActor(self.actor)
         self.renderer.RemoveActor(self.resolve_actor)
         ren_win = self.renderer.GetRenderWindow()
-        if self._table_tex is not None and ren_win is not None:
-            self._table_tex.ReleaseGraphicsResources(ren_win)
-        self._table_tex = None
+        for tex in (self._table_tex, self._order_tex, self._cells_tex):
+            if tex is not None and ren_win is not None:
+                tex.ReleaseGraphicsResources(ren_win)
+        self._table_tex = self._order_tex = self._cells_tex = None
         self.targets.release()
         if not self.keep_multisampling:
             release_single_sample(self.plotter, self)

@@ -1,6 +1,8 @@
 """The GPU PT pass's static vertex buffer (Roettger Ch. 8-9; ``volviz.render.gl_pt``): 4 vertices per tetrahedron,
 each carrying its cell's face planes, scalar form and range (relative to the mesh's centre: meshes offset by 1e6 keep
-their precision), uploaded once. The index buffer, made per order, is ``volviz.unstructured.index_buffer``'s."""
+their precision), uploaded once. The index buffer, made per order, is ``volviz.unstructured.index_buffer``'s; with
+the order as a texture (``GLPTVolume(order_texture=True)``) the same data are texels, ``cell_texels``, read by cell
+id, and the vertex buffer keeps only the corners."""
 from __future__ import annotations
 
 from typing import Any
@@ -10,7 +12,7 @@ import numpy as np
 from volviz.model.datasets import TetMesh
 from volviz.unstructured.topology import cell_ranges, topology
 
-__all__ = ["cell_attributes", "tet_polydata"]
+__all__ = ["cell_attributes", "cell_texels", "tet_polydata", "texels_per_cell"]
 
 
 def cell_attributes(mesh: TetMesh, smooth: bool = False) -> dict[str, np.ndarray]:
@@ -44,9 +46,25 @@ def cell_attributes(mesh: TetMesh, smooth: bool = False) -> dict[str, np.ndarray
     return {k: np.ascontiguousarray(v, dtype=np.float32) for k, v in out.items()}
 
 
-def tet_polydata(mesh: TetMesh, smooth: bool = False) -> Any:
+def texels_per_cell(smooth: bool) -> int:
+    """Texels of one cell in ``cell_texels``: 4 corners, 4 planes, scalar form, range (and 3 normals, barycentric)."""
+    return 14 if smooth else 10
+
+
+def cell_texels(mesh: TetMesh, smooth: bool = False) -> np.ndarray:
+    """(m * ``texels_per_cell``, 4) float32: per cell its 4 corners (x, y, z, 0; relative to the centre) and then
+    ``cell_attributes`` in their order (the layout ``pt_tet_vs.glsl`` reads with ``PT_ORDER_TEXTURE``)."""
+    topo = topology(mesh)
+    corners = np.zeros((topo.n_tets, 4, 4), np.float32)
+    corners[..., :3] = topo.points[topo.tets]
+    parts = [corners] + [a[:, None, :] for a in cell_attributes(mesh, smooth).values()]
+    return np.concatenate(parts, axis=1).reshape(-1, 4)
+
+
+def tet_polydata(mesh: TetMesh, smooth: bool = False, attributes: bool = True) -> Any:
     """The static vertex buffer as vtkPolyData: 4 points per tetrahedron (relative to the centre) with the cell
-    attributes repeated at each, and no cells yet (the order sets them)."""
+    attributes repeated at each (unless ``attributes`` is False: the order texture's layout reads them from
+    ``cell_texels``), and no cells yet (the order sets them)."""
     from volviz.render.vtk_facade import numpy_to_vtk, vtk
 
     topo = topology(mesh)
@@ -54,7 +72,7 @@ def tet_polydata(mesh: TetMesh, smooth: bool = False) -> Any:
     pts = vtk.vtkPoints()
     pts.SetData(numpy_to_vtk(np.ascontiguousarray(topo.points[topo.tets].reshape(-1, 3), np.float32), deep=True))
     pd.SetPoints(pts)
-    for name, arr in cell_attributes(mesh, smooth).items():
+    for name, arr in (cell_attributes(mesh, smooth) if attributes else {}).items():
         va = numpy_to_vtk(np.ascontiguousarray(np.repeat(arr, 4, axis=0)), deep=True)
         va.SetName(name)
         pd.GetPointData().AddArray(va)

@@ -14,7 +14,7 @@ from numba import njit
 
 from volviz.unstructured.topology import FACES
 
-__all__ = ["IndexBuffer", "fill_triangles"]
+__all__ = ["IndexBuffer", "fill_cells", "fill_triangles"]
 
 #: the 12 corner ids of a cell's 4 faces, in FACES order
 _CORNERS = np.ascontiguousarray(FACES.reshape(12), dtype=np.int32)
@@ -36,6 +36,19 @@ def fill_triangles(order: np.ndarray, visible: np.ndarray, cells: np.ndarray, co
             conn[k + j] = base + _CORNERS[j]
         cells[n] = c
         n += 1
+    return n
+
+
+@njit(cache=True, nogil=True)
+def fill_cells(order: np.ndarray, visible: np.ndarray, cells: np.ndarray) -> int:
+    """The cells of ``order`` with ``visible[cell]`` into ``cells[:n]`` as float32 (the GPU pass's order texture,
+    exact for ids below 2^24); returns n."""
+    n = 0
+    for i in range(len(order)):
+        c = order[i]
+        if visible[c]:
+            cells[n] = c
+            n += 1
     return n
 
 

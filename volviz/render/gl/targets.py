@@ -82,13 +82,16 @@ def table_texture(ren_win: Any, data: np.ndarray, layered: bool) -> Any:
     return tex
 
 
-def texel_array(ren_win: Any, texels: np.ndarray, what: str) -> Any:
+def texel_array(ren_win: Any, texels: np.ndarray, what: str, into: Any = None) -> Any:
     """``texels`` (n, components) as float32 texels in VTK's 2D emulation of a texture buffer (read by index in the
-    shader with the texture's width); ``what`` names it in the error when OpenGL refuses it."""
+    shader with the texture's width); ``what`` names it in the error when OpenGL refuses it. ``into``: a texture
+    made here before, whose storage is replaced (a per-frame upload keeps one texture object)."""
     from volviz.render.vtk_facade import vtk
 
-    tex = vtk.vtkTextureObject()
-    tex.SetContext(ren_win)
+    tex = into
+    if tex is None:
+        tex = vtk.vtkTextureObject()
+        tex.SetContext(ren_win)
     data = np.ascontiguousarray(texels, np.float32)
     if not tex.EmulateTextureBufferWith2DTexturesFromRaw(len(data), data.shape[1], vtk.VTK_FLOAT, data):
         raise RuntimeError(f"OpenGL refused the {what} texture of {len(data)} texels")
