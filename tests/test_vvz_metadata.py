@@ -81,3 +81,14 @@ def test_volviz_info_refuses_a_described_field_in_one_line(files, tmp_path, caps
     assert main(["info", str(path)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert err == [f"volviz: error: {path}: metadata field 'peak' is 'loud'; expected 255 (the peak of kind 'uint8')"]
+
+
+def test_a_brick_record_s_reserved_field_and_the_root_s_transform_are_checked(files, tmp_path):
+    """The re-run's .vvz cases accepted with checksums recomputed: a record's reserved word set to 4294967295, the
+    root brick's transform set to 65535 (the decoder ignores both)."""
+    root = lambda t: int(np.nonzero(t["kind"] == 0)[0][0])  # noqa: E731
+
+    path = _crafted(files["lossless"], tmp_path, table_edit=lambda t: t["res1"].__setitem__(0, 4294967295))
+    _refused(path, r"brick 0 \(level 1, tile 0\) field reserved is 4294967295; expected 0$")
+    path = _crafted(files["lossless"], tmp_path, table_edit=lambda t: t["transform"].__setitem__(root(t), 65535))
+    _refused(path, r"brick \d+ \(level \d+, tile 0\) field transform is 65535; the root brick's is 0$")

@@ -325,6 +325,13 @@ def check_table(table: np.ndarray, meta_off: int, name: str = "<vvz>") -> None:
     if bad.size:
         raise VVZError(name, f"{brick(int(bad[0]))} field kind is {int(table[bad[0]]['kind'])}; expected "
                        f"{KIND_ROOT} (root) or {KIND_NODE} (node)")
+    bad = np.nonzero(table["res1"] != 0)[0]
+    if bad.size:
+        raise VVZError(name, f"{brick(int(bad[0]))} field reserved is {int(table[bad[0]]['res1'])}; expected 0")
+    bad = np.nonzero((table["kind"] == KIND_ROOT) & (table["transform"] != 0))[0]
+    if bad.size:
+        raise VVZError(name, f"{brick(int(bad[0]))} field transform is {int(table[bad[0]]['transform'])}; the root "
+                       "brick's is 0")
     sizes = table["size"].astype(np.uint64)
     if sizes.max() > np.uint64(meta_off):
         i = int(np.argmax(sizes))
