@@ -56,3 +56,11 @@ def test_a_value_that_is_not_a_number_is_refused(tec):
     with pytest.raises(vio.ReadError, match=rf"^{path}: line 15 holds 'abc' among the values of zone 2; a value must "
                                             r"be a number$"):
         vio.read(path)
+
+
+def test_a_nan_value_is_a_value(tec):
+    """NaN is data a writer of floats may print, not damage: the file reads with its 8 points."""
+    path, text = tec
+    head, _, tail = text.rpartition("0.05")
+    path.write_text(head + "NaN" + tail)
+    assert vio.read(path).n_points == 8

@@ -24,8 +24,9 @@ _PARAM = re.compile(r'([A-Za-z]+)\s*=\s*("[^"]*"|\([^)]*\)|[^,\s]+)')
 _NODES_PER_ELEMENT = {"LINESEG": 2, "TRIANGLE": 3, "QUADRILATERAL": 4, "TETRAHEDRON": 4, "BRICK": 8,
                       "FELINESEG": 2, "FETRIANGLE": 3, "FEQUADRILATERAL": 4, "FETETRAHEDRON": 4, "FEBRICK": 8}
 #: a count of a zone header with nothing after its '=' (VTK's reader took the default, 1, for a damaged "J=2")
-#: a value of a zone (a number, ``n*value`` for n repeats; Fortran's ``D`` exponent too)
-_VALUE = re.compile(r"(\d+\*)?[-+]?(\d+\.?\d*|\.\d+)([eEdD][-+]?\d+)?")
+#: a value of a zone (a number, ``n*value`` for n repeats; Fortran's ``D`` exponent too; NaN and infinities, which
+#: a writer of floats may print and the reader draws as missing)
+_VALUE = re.compile(r"(\d+\*)?[-+]?((\d+\.?\d*|\.\d+)([eEdD][-+]?\d+)?|nan|inf(inity)?)", re.IGNORECASE)
 _COUNTS = ("I", "J", "K", "NODES", "N", "ELEMENTS", "E")
 _EMPTY_COUNT = re.compile(r"(?<![A-Za-z])(I|J|K|N|E|NODES|ELEMENTS)\s*=\s*(?=,|$)", re.IGNORECASE)
 _UNCHECKED = ("VARSHARELIST", "CONNECTIVITYSHAREZONE", "PASSIVEVARLIST", "FACES", "TOTALNUMFACENODES")
