@@ -1,10 +1,10 @@
 """A translucent isosurface inside a regular volume drawn by VTK (issue #28; ``volviz.render.volume_peeling``): along
 each ray the volume behind the surface, the surface and the volume in front composite in that order.
 
-The reference is made of the same scene's own renders, without peeling, in float: F the volume alone, V_f (premultiplied)
-and a_f the volume cut at the surface (the surface made opaque, black and then white, unlit), S (premultiplied) and a_S
-the surface alone (over black and over white). For one surface layer per ray the right composite is
-V_f + (1 − a_f)(S + (1 − a_S) V_b) with F = V_f + (1 − a_f) V_b, i.e. (1 − a_S) F + a_S V_f + (1 − a_f) S.
+The reference is made of the same scene's own renders, without peeling, in float: F the volume alone, V_f
+(premultiplied) and a_f the volume cut at the surface (the surface made opaque, black and then white, unlit),
+S (premultiplied) and a_S the surface alone (over black and over white). For one surface layer per ray the right
+composite is V_f + (1 − a_f)(S + (1 − a_S) V_b) with F = V_f + (1 − a_f) V_b, i.e. (1 − a_S) F + a_S V_f + (1 − a_f) S.
 A plane isosurface (of a second dataset, f = y) through a ball-shaped volume gives each ray exactly one layer."""
 from __future__ import annotations
 
@@ -16,6 +16,7 @@ from volviz.model.datasets import RegularVolume
 from volviz.render.backend import plotter_gl_info
 from volviz.render.controller import SceneController
 from volviz.render.export import separate_background
+from volviz.render.iso_spectrum import apply_spectrum_shader
 from volviz.render.volume_peeling import peeling_volumes, peel_volumes
 from volviz.session import CameraState, Component, DatasetRef, Session
 
@@ -99,7 +100,6 @@ def reference(c: SceneController, p: pv.Plotter) -> tuple[np.ndarray, np.ndarray
     prop.SetOpacity(kept[0])
     prop.SetColor(*kept[1])
     prop.SetLighting(kept[2])
-    from volviz.render.iso_spectrum import apply_spectrum_shader
     apply_spectrum_shader(actor, kept[0])
     return (1.0 - a_s) * full + a_s * v_f + one_minus_a_f * s, a_s[..., 0], full
 

@@ -83,7 +83,8 @@ def report(rows: list[dict[str, Any]], command: str, value: float, opacity: floa
              "", f"Isosurface value {value:g}, opacity {opacity:g}, VTK's own mode. Median of the timed draws after a "
              "warm-up, each ending with `WaitForCompletion`. Shows: share of pixels the surface changes by more "
              "than 3 levels against the same ray caster without it.", "",
-             "| volume | window | ray caster | surface | peeled | ms per frame | shows |", "|---|---|---|---|---|---|---|"]
+             "| volume | window | ray caster | surface | peeled | ms per frame | shows |",
+             "|---|---|---|---|---|---|---|"]
     for r in rows:
         shows = "" if r["shows"] is None else f"{100 * r['shows']:.2f} %"
         lines.append(f"| {r['volume']} | {r['size']} | {r['caster']} | {'yes' if r['surface'] else 'no'} | "
