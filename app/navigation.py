@@ -3,7 +3,11 @@ around, +/- change speed. The motion itself is volviz.render.camera_path.FlyNavi
 
 Nothing here draws: each step (a key press or auto-repeat, a mouse look) asks for one repaint, which Qt merges with
 the others asked for before it is drawn, so a slow frame makes the flight coarser, never the window stall behind a
-queue of renders (one synchronous render per key event held the event loop for seconds on the Yukon scene)."""
+queue of renders (one synchronous render per key event held the event loop for seconds on the Yukon scene).
+
+A movement key counts as held from its press to its release by the user (``held``; the keyboard's auto-repeat sends
+presses, and on X11 releases too, marked as auto-repeated), so that a long frame on the GUI thread, which delays the
+next repeat past the window's settle time, is not taken for the end of the flight."""
 from __future__ import annotations
 
 from typing import Any, Callable, Optional
@@ -37,10 +41,17 @@ class FlyMode(QObject):
         self.on_camera_moved = on_camera_moved
         self._last_mouse: Optional[Any] = None
         self.steps = 0                   # camera steps made (key presses and repeats, mouse looks)
+        self._held: set[int] = set()     # movement keys pressed and not yet released by the user
         plotter.interactor.installEventFilter(self)
+
+    @property
+    def held(self) -> bool:
+        """Whether a movement key is held down (the flight goes on, however long since its last step)."""
+        return self.enabled and bool(self._held)
 
     def set_enabled(self, enabled: bool, scene_size: float = 1.0) -> None:
         self.enabled = bool(enabled)
+        self._held.clear()
         if enabled:
             self.navigator.speed = max(scene_size, 1e-9) * 0.25  # cross a quarter of the scene per second
 
@@ -76,6 +87,7 @@ class FlyMode(QObject):
         if kind == QEvent.Type.KeyPress and isinstance(event, QKeyEvent):
             key = event.key()
             if key in MOVES:   # each press and auto-repeat: one step (the repaints merge)
+                self._held.add(key)
                 f, r, u = MOVES[key]
                 self._apply(self.navigator.move(self._camera(), f, r, u, STEP_SECONDS))
                 return True
@@ -87,7 +99,12 @@ class FlyMode(QObject):
                 return True
             return True  # no VTK key bindings while flying
         if kind == QEvent.Type.KeyRelease:
+            if isinstance(event, QKeyEvent) and not event.isAutoRepeat():   # the user let go
+                self._held.discard(event.key())
             return True
+        if kind == QEvent.Type.FocusOut:   # a key released elsewhere sends no release here
+            self._held.clear()
+            return False
         if kind == QEvent.Type.MouseButtonPress and isinstance(event, QMouseEvent):
             self._last_mouse = event.position()
             return True

@@ -49,6 +49,7 @@ if TYPE_CHECKING:
     from .docks.timeline import Timeline
     from .gc_guard import GuiThreadCollector
     from .layout import WindowLayout
+    from .navigation import FlyMode
     from .nonfinite_status import NonFiniteStatus
     from .recent import RecentFiles
     from .workers import JobBridge
@@ -105,6 +106,7 @@ class WindowBase(_QtWindow):
     scene_loading: SceneLoading        # (window.py)
     recent_menu: QMenu                 # (window.py)
     action_fly: QAction
+    fly: FlyMode                       # (window.py)
     status_label: QLabel
     progress_bar: QProgressBar
     cancel_button: QPushButton
