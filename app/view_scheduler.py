@@ -168,7 +168,12 @@ class ViewScheduler(WindowBase):
         self.fly_settle_timer.start()
 
     def _fly_stopped(self) -> None:
-        """No fly-mode key moved the camera for ``FLY_SETTLE_MS``: the still rate again, and the full-size views."""
+        """No fly-mode key moved the camera for ``FLY_SETTLE_MS``: the still rate again, and the full-size views;
+        unless a movement key is still held (``FlyMode.held``: a long frame delayed its auto-repeat; a full-size
+        frame then, with a synchronous render at the still rate, stalled the flight further)."""
+        if self.fly.held:
+            self.fly_settle_timer.start()
+            return
         self._interactive_rate(False)
         self._camera_moved()
 
