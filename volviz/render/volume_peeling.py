@@ -16,12 +16,14 @@ peeling is not turned on there.
 """
 from __future__ import annotations
 
+import weakref
 from typing import Any, Sequence
 
 __all__ = ["PEELS", "peel_volumes", "peeling_volumes"]
 
 PEELS = 16          # dual-peeling passes at most (two layers each); with occlusion ratio 0 VTK stops when none is left
-_SAVED = "_volviz_volume_peeling"   # plotter attribute: the renderer's settings and the volumes' ray casters to restore
+#: by plotter while peeling is on: the renderer's settings and the volumes' ray casters (by mapper) to restore
+_saved: weakref.WeakKeyDictionary[Any, dict[str, Any]] = weakref.WeakKeyDictionary()
 
 
 def _regular_volumes(props: Sequence[Any]) -> list[Any]:
@@ -32,7 +34,7 @@ def _regular_volumes(props: Sequence[Any]) -> list[Any]:
 
 def peeling_volumes(plotter: Any) -> bool:
     """Whether ``peel_volumes`` has peeling on in ``plotter``."""
-    return _SAVED in plotter.__dict__
+    return plotter in _saved
 
 
 def peel_volumes(plotter: Any, props: Sequence[Any], on: bool, peels: int = PEELS) -> bool:
@@ -42,10 +44,10 @@ def peel_volumes(plotter: Any, props: Sequence[Any], on: bool, peels: int = PEEL
     ren = plotter.renderer
     volumes = _regular_volumes(props)
     on = bool(on) and bool(volumes) and ren.GetPass() is None
-    saved = plotter.__dict__.get(_SAVED)
+    saved = _saved.get(plotter)
     if on:
         if saved is None:
-            saved = plotter.__dict__[_SAVED] = {
+            saved = _saved[plotter] = {
                 "renderer": (ren.GetUseDepthPeeling(), ren.GetUseDepthPeelingForVolumes(),
                              ren.GetMaximumNumberOfPeels(), ren.GetOcclusionRatio()),
                 "modes": {}}
@@ -61,7 +63,7 @@ def peel_volumes(plotter: Any, props: Sequence[Any], on: bool, peels: int = PEEL
         ren.SetOcclusionRatio(0.0)
         return True
     if saved is not None:
-        del plotter.__dict__[_SAVED]
+        del _saved[plotter]
         peel, for_volumes, n, ratio = saved["renderer"]
         if ren.GetPass() is None:      # a scene pass installed meanwhile keeps its own setting (peeling off)
             ren.SetUseDepthPeeling(peel)
