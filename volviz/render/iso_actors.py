@@ -1,5 +1,7 @@
 """GUI thread: an isosurface component's surfaces (``volviz.scene.isosurfaces.IsoParts``) as VTK actors, with the
-iso-spectrum shader (libMini note "Isosurfaces": drawn by VTK as the note's 2-pass blend)."""
+iso-spectrum shader (libMini note "Isosurfaces": drawn by VTK as the note's 2-pass blend; inside a regular volume
+depth-peeled with it, ``volviz.render.volume_peeling``, so that the volume in front of a surface covers it and the
+volume behind it does not)."""
 from __future__ import annotations
 
 from typing import Any, Optional
