@@ -1034,8 +1034,8 @@ def _index_buffer_lines(ib: dict[str, Any] | None, n_tets: int, what: str) -> li
             f"after a warm-up): `volviz.unstructured.index_buffer.IndexBuffer.fill`, one Numba pass into buffers "
             f"kept between frames, {ib['fill_s'] * 1e3:.1f} ms wall ({ib['fill_cpu_s'] * 1e3:.1f} ms CPU), against "
             f"{ib['numpy_s'] * 1e3:.1f} ms ({ib['numpy_cpu_s'] * 1e3:.1f} ms CPU) for the numpy chain "
-            "(`order[visible[order]]`, then 4 c + corner broadcast) that `volviz.render.gl_pt` uses until it calls "
-            "`fill`."]
+            "(`order[visible[order]]`, then 4 c + corner broadcast) it replaced. (`volviz.render.gl_pt` uses it with "
+            "`order_texture=False`; by default the order is a texture of cell ids, filled by `fill_cells`.)"]
 
 
 if __name__ == "__main__":
