@@ -17,7 +17,11 @@ peeling is not turned on there.
 from __future__ import annotations
 
 import weakref
-from typing import Any, Sequence
+from typing import TYPE_CHECKING, Any, Sequence
+
+if TYPE_CHECKING:   # type-only imports for the signatures
+    import pyvista as pv
+    from volviz.render.vtk_facade import vtkProp
 
 __all__ = ["PEELS", "peel_volumes", "peeling_volumes"]
 
@@ -26,18 +30,18 @@ PEELS = 16          # dual-peeling passes at most (two layers each); with occlus
 _saved: weakref.WeakKeyDictionary[Any, dict[str, Any]] = weakref.WeakKeyDictionary()
 
 
-def _regular_volumes(props: Sequence[Any]) -> list[Any]:
+def _regular_volumes(props: Sequence[vtkProp]) -> list[Any]:
     """The props that VTK's smart volume mapper draws (volviz's regular volumes)."""
-    return [p for p in props if p is not None and p.IsA("vtkVolume") and p.GetMapper() is not None
-            and p.GetMapper().IsA("vtkSmartVolumeMapper")]
+    volumes: list[Any] = [p for p in props if p is not None and p.IsA("vtkVolume")]
+    return [v for v in volumes if v.GetMapper() is not None and v.GetMapper().IsA("vtkSmartVolumeMapper")]
 
 
-def peeling_volumes(plotter: Any) -> bool:
+def peeling_volumes(plotter: pv.BasePlotter) -> bool:
     """Whether ``peel_volumes`` has peeling on in ``plotter``."""
     return plotter in _saved
 
 
-def peel_volumes(plotter: Any, props: Sequence[Any], on: bool, peels: int = PEELS) -> bool:
+def peel_volumes(plotter: pv.BasePlotter, props: Sequence[vtkProp], on: bool, peels: int = PEELS) -> bool:
     """Depth-peel the translucent geometry of ``plotter``'s renderer together with the regular volumes among
     ``props`` when ``on`` (the caller: translucent surfaces are shown by VTK) and there are such volumes and the
     renderer runs VTK's own passes; otherwise restore what was set before. Returns whether peeling is on."""
