@@ -62,7 +62,7 @@ def test_the_app_table_and_the_bench_table_keep_each_other(tmp_path):
     bench.write_section(bench.markdown([bench.FirstImage("sky/clouds.jpeg", 0.1, 1.5, 0.39, "picture")], {}), doc)
     before, section, rest = _split(doc.read_text(), bench.BEGIN, bench.END)
     assert before + rest == "".join(_split(after_app, bench.BEGIN, bench.END)[::2])
-    assert "| `sky/clouds.jpeg` | 0.1 | picture | 1.5 s | 39% |  |  |  |" in section.splitlines()
+    assert "| `sky/clouds.jpeg` | 0.1 | picture | 1.5 s | 39% |  |  |  |  |" in section.splitlines()
 
 
 def test_an_only_run_of_the_app_rewrites_its_rows_and_keeps_the_others(tmp_path):
@@ -105,6 +105,6 @@ def test_an_only_run_of_the_bench_keeps_the_other_rows_and_the_profiles(tmp_path
     new = read_section(doc, bench.BEGIN, bench.END)
     rows = [line for line in new.splitlines() if line.startswith("| `")]
     assert [line.split("`")[1] for line in rows] == order
-    assert rows[order.index("sky/clouds.jpeg")] == "| `sky/clouds.jpeg` | 0.1 | picture | 1.5 s | 39% |  |  |  |"
+    assert rows[order.index("sky/clouds.jpeg")] == "| `sky/clouds.jpeg` | 0.1 | picture | 1.5 s | 39% |  |  |  |  |"
     assert all(a == b for a, b in zip(rows, kept) if "sky/clouds.jpeg" not in a)
     assert new[new.index(bench.PROFILE_HEAD):] == old[old.index(bench.PROFILE_HEAD):]

@@ -7,6 +7,10 @@ the legibility of the automatic transfer function (``volviz.optics.auto_tf``), i
 
 - *visible footprint*: of the pixels the data covers (the same view rendered with an opaque transfer function),
   the share whose colour differs visibly from the background (CIE76 colour difference above ``VISIBLE_DE``);
+- *object visible*: the same share of the object's footprint, the view with an opaque transfer function that is
+  transparent over the histogram's background mode as ``volviz.optics.auto_tf.background_mode`` finds it for the
+  first look (``object_transfer_function``): a volume with a large background (CT air, the empty space around a
+  molecule) covers its whole box with the first, the object only a part of it;
 - *mode contrast*: the colour difference between the two main modes of the data's histogram, each seen as a slab
   of its value as thick as the mean chord of the data's box over the background (``mode_contrast``).
 
@@ -16,7 +20,9 @@ legibility measures.
 Writes only its section of ``docs/first-open.md``, between ``BEGIN`` and ``END`` (``volviz.io.doc_section``: the
 app's window table and the prose around are kept), or only prints with ``--no-write``. ``--profile N`` adds where
 the time of the N slowest files goes (cProfile of an in-process render, by volviz module). ``--only`` measures some
-files and keeps the other rows (and the profiles, unless it makes new ones). ``--boundary-rule`` measures the
+files and keeps the other rows (and the profiles, unless it makes new ones). ``--legibility-only`` renders no
+file in a fresh process: it keeps each row's time, drawn share and notes (and the profiles) from the report, so the
+legibility columns can be measured again on a busy machine. ``--boundary-rule`` measures the
 legibility of regular volumes drawn with the boundary transfer function (Kindlmann & Durkin 1998,
 ``volviz.optics.boundary``) in place of the first look's, for the comparison in ``docs/first-open.md``; it only prints.
 """
@@ -150,6 +156,7 @@ class FirstImage:
     drawn: Optional[float] = None
     kind: str = ""
     visible: Optional[float] = None
+    object_visible: Optional[float] = None
     contrast: Optional[float] = None
     note: str = ""
     profile: list[str] = field(default_factory=list)
@@ -165,12 +172,63 @@ def render_timed(path: Path, out: Path) -> tuple[float, int, str]:
     return seconds, done.returncode, lines[-1] if lines else ""
 
 
-def legibility(path: Path, boundary_rule: bool = False) -> Optional[tuple[str, Optional[float], Optional[float]]]:
-    """How ``path`` is drawn, and for a volume its visible footprint and mode contrast (see the module docstring);
-    ``boundary_rule``: of a regular volume drawn with ``volviz.optics.boundary``'s transfer function instead."""
-    from volviz.model.stats import scalar_values
+@dataclass
+class Footprints:
+    """Pixel masks of one volume's view (``legibility``): ``seen``, its colour differs from the background by more
+    than ``VISIBLE_DE``; ``data``, drawn by an opaque transfer function over the whole range; ``object``, drawn by
+    one that is transparent over the background mode (``object_transfer_function``). The scalar bar's strip is in
+    neither footprint."""
+
+    seen: np.ndarray
+    data: np.ndarray
+    object: np.ndarray
+
+    @property
+    def visible(self) -> float:
+        """The share of the data's footprint that is seen (the *visible* column)."""
+        return _share(self.seen, self.data)
+
+    @property
+    def object_visible(self) -> float:
+        """The share of the object's footprint that is seen (the *object visible* column)."""
+        return _share(self.seen, self.object)
+
+
+def _share(seen: np.ndarray, footprint: np.ndarray) -> float:
+    return float((seen & footprint).sum() / max(int(footprint.sum()), 1))
+
+
+def object_transfer_function(lo: float, hi: float, chord: float, mode: Optional[tuple[float, float, float]],
+                             name: str = "") -> Any:
+    """White and opaque (optical depth 60 along ``chord``) over ``[lo, hi]``, transparent over the background mode
+    ``mode`` (``volviz.optics.auto_tf.background_mode``'s (low edge, high edge, centre): its histogram bins, the
+    values ``low <= v < high``, or up to ``hi`` when the mode ends the range); opaque everywhere without one. The
+    steps are ``1e-6`` of the range wide, far below a histogram bin (1/256 of it). The function runs a thousandth of
+    the range past ``hi``: VTK draws a homogeneous region whose value is a function's very top nearly transparent
+    (a made sphere of the data's maximum came out blotchy), and a footprint must not have holes."""
     from volviz.optics import TransferFunction
-    from volviz.optics.auto_tf import mean_chord
+
+    rho = 60.0 / chord
+    top = hi + 1e-3 * (hi - lo)
+    if mode is None:
+        return TransferFunction([lo, top], [(1.0, 1.0, 1.0)] * 2, [rho] * 2, name=name)
+    eps = 1e-6 * (hi - lo)
+    low, high = max(mode[0], lo), mode[1]
+    points = [(lo, rho), (low - eps, rho)] if low - eps > lo else []
+    if high < hi:
+        points += [(low, 0.0), (high - eps, 0.0), (high, rho), (top, rho)]
+    else:                  # the mode ends the range: transparent up to the top
+        points += [(low, 0.0), (top, 0.0)]
+    stops, extinction = zip(*points)
+    return TransferFunction(stops, [(1.0, 1.0, 1.0)] * len(stops), extinction, name=name)
+
+
+def legibility(path: Path, boundary_rule: bool = False) -> tuple[str, Optional[Footprints], Optional[float]]:
+    """How ``path`` (a data or session file) is drawn, and for a volume its footprints (``Footprints``) and mode
+    contrast (see the module docstring); ``boundary_rule``: of a regular volume drawn with
+    ``volviz.optics.boundary``'s transfer function instead."""
+    from volviz.model.stats import scalar_values
+    from volviz.optics.auto_tf import background_mode, finite_sample, mean_chord
     from volviz.optics.boundary import boundary_transfer_function, regular_fields
     from volviz.render.export import open_target, render_session
     from volviz.render.scene_builder import ensure_transfer_functions
@@ -178,13 +236,13 @@ def legibility(path: Path, boundary_rule: bool = False) -> Optional[tuple[str, O
     from volviz.scene.drawn_tf import component_transfer_function
     from volviz.render.vtk_scene import volume_grid
 
-    session, _ = open_target(path)
+    session, session_file = open_target(path)
     comp = session.components[0]
     if comp.type != "volume" or comp.dataset is None:
         return comp.type, None, None
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        datasets = load_datasets(session, None)
+        datasets = load_datasets(session, session_file)
         kind = drawn_as(datasets[comp.dataset])
         if kind != "volume":
             return kind, None, None
@@ -192,27 +250,39 @@ def legibility(path: Path, boundary_rule: bool = False) -> Optional[tuple[str, O
         tf = component_transfer_function(session, comp)
         if tf is None:         # a picture (PPM, JPEG) drawn in its own colours: no transfer function to measure
             return "picture", None, None
-        session.render.options["axes"] = False
+        session.render.options.update(axes=False, outline=False)   # the data alone (the box's outline is no data)
         tf_name = str(comp.transfer_function)
         dataset = component_dataset(comp, datasets)
         chord = mean_chord(volume_grid(dataset).bounds)
+        raw = scalar_values(dataset)
+        values = np.asarray(raw, dtype=np.float64).reshape(-1)
+        values = values[np.isfinite(values)]
         grid = regular_fields(dataset) if boundary_rule else None
         if grid is not None:
-            tf = boundary_transfer_function(scalar_values(dataset), chord, grid, tf_name)
+            tf = boundary_transfer_function(values, chord, grid, tf_name)
             session.transfer_functions[tf_name] = tf.to_dict()
-        image = render_session(session, None, METRIC_SIZE, datasets=datasets)
         lo, hi = tf.range
-        opaque = TransferFunction([lo, hi], [(1.0, 1.0, 1.0)] * 2, [60.0 / chord] * 2, name=tf_name)
-        session.transfer_functions[tf_name] = opaque.to_dict()
-        mask_image = render_session(session, None, METRIC_SIZE, datasets=datasets)
+        mode = background_mode(finite_sample(raw))         # the sample and the mode auto_transfer_function uses
+        masks: list[np.ndarray] = []
+        for shown in (tf, object_transfer_function(lo, hi, chord, None, tf_name),
+                      object_transfer_function(lo, hi, chord, mode, tf_name) if mode is not None else None):
+            if shown is None:      # no background mode: the object's footprint is the data's
+                masks.append(masks[-1])
+                continue
+            session.transfer_functions[tf_name] = shown.to_dict()
+            masks.append(render_session(session, session_file, METRIC_SIZE, datasets=datasets))
     background = np.asarray(session.render.background, dtype=np.float64)
-    footprint = np.abs(mask_image.astype(np.int32) - mask_image[0, 0]).sum(axis=2) > DRAWN_DIFFERENCE
-    footprint[:, int(0.8 * METRIC_SIZE[0]):] = False          # the scalar bar
+    image, data_image, object_image = masks
     seen = color_difference(image / 255.0, background) > VISIBLE_DE
-    visible = float((seen & footprint).sum() / max(int(footprint.sum()), 1))
-    values = np.asarray(scalar_values(dataset), dtype=np.float64).reshape(-1)
-    values = values[np.isfinite(values)]
-    return kind, visible, mode_contrast(values, tf, chord, background)
+    prints = Footprints(seen, _footprint(data_image), _footprint(object_image))
+    return kind, prints, mode_contrast(values, tf, chord, background)
+
+
+def _footprint(image: np.ndarray) -> np.ndarray:
+    """The pixels an opaque white transfer function draws, less the scalar bar's strip (the right fifth)."""
+    drawn = np.abs(image.astype(np.int32) - image[0, 0]).sum(axis=2) > DRAWN_DIFFERENCE
+    drawn[:, int(0.8 * METRIC_SIZE[0]):] = False
+    return drawn
 
 
 def where_time_goes(path: Path, top: int = 6) -> list[str]:
@@ -243,9 +313,11 @@ def where_time_goes(path: Path, top: int = 6) -> list[str]:
     return [f"in-process render {total:.2f} s of own time"] + picked
 
 
-def measure(root: Path, names: Optional[list[str]] = None, boundary_rule: bool = False) -> list[FirstImage]:
+def measure(root: Path, names: Optional[list[str]] = None, boundary_rule: bool = False,
+            timings: Optional[dict[str, tuple[Optional[float], Optional[float], str]]] = None) -> list[FirstImage]:
     """Every file of ``opened_files`` (or those named in ``names``, relative to ``root``) measured; legibility with
-    the boundary rule where ``boundary_rule``."""
+    the boundary rule where ``boundary_rule``; with ``timings`` (``kept_timings``: file -> seconds, drawn share,
+    note) each file's time, drawn share and note are taken from there instead of rendering it (legibility only)."""
     records = []
     with tempfile.TemporaryDirectory() as work:
         for path in opened_files(root):
@@ -255,7 +327,9 @@ def measure(root: Path, names: Optional[list[str]] = None, boundary_rule: bool =
             size = sum(p.stat().st_size for p in path.rglob("*") if p.is_file()) if path.is_dir() else \
                 path.stat().st_size
             record = FirstImage(name, size / 1e6)
-            if record.megabytes < MAX_MB:
+            if timings is not None:
+                record.seconds, record.drawn, record.note = timings.get(name, (None, None, ""))
+            elif record.megabytes < MAX_MB:
                 out = Path(work) / "x.png"
                 seconds, status, last = render_timed(path, out)
                 if status == 0:
@@ -271,10 +345,11 @@ def measure(root: Path, names: Optional[list[str]] = None, boundary_rule: bool =
                 except Exception as exc:  # a measure that cannot be made is said, the row kept
                     record.note = f"legibility: {type(exc).__name__}: {exc}"
                 else:
-                    if shown is not None:
-                        record.kind, record.visible, record.contrast = shown
+                    record.kind, prints, record.contrast = shown
+                    if prints is not None:
+                        record.visible, record.object_visible = prints.visible, prints.object_visible
             print(f"{name}: {record.seconds} s drawn {record.drawn} {record.kind} visible {record.visible} "
-                  f"contrast {record.contrast} {record.note}", flush=True)
+                  f"object {record.object_visible} contrast {record.contrast} {record.note}", flush=True)
             records.append(record)
     return records
 
@@ -287,28 +362,64 @@ def markdown(records: list[FirstImage], profiles: dict[str, list[str]]) -> str:
     """The section of ``docs/first-open.md`` this benchmark writes (without its markers)."""
     import platform
 
+    from volviz.optics.auto_tf import BACKGROUND_FRACTION, MODE_WIDTH
+
     lines = ["## `volviz render`: time to the first image, and legibility of the automatic transfer "
              "function", "", "Regenerate (about 3 minutes):", "", "```", COMMAND, "```", "",
+             f"The legibility columns alone, keeping each file's time, drawn share and notes (and the profiles) as "
+             f"they are here: `{COMMAND.replace(' --profile 3', '')} --legibility-only`.", "",
              f"Each file is rendered by `volviz render FILE -o x.png` ({SIZE[0]}x{SIZE[1]}) in a fresh process: "
              "*first image* is that command's wall time (start-up, imports, reading, the transfer function, the "
              f"render, the PNG); target under {TARGET_S:g} s for files under {MAX_MB} MB. *Drawn* is the share of "
              "the image's pixels that differ from the background. For volumes, *visible* is the share of the data's "
              "footprint (the same view with an opaque transfer function) whose colour differs from the background "
-             f"by more than ΔE {VISIBLE_DE:g} (CIE76), and *contrast* the ΔE between the two main modes of the "
-             "histogram, each seen as a slab one mean chord thick (`volviz.bench.first_open`). Measured on "
+             f"by more than ΔE {VISIBLE_DE:g} (CIE76). *Object visible* is the same share within the object's "
+             "footprint: the view with an opaque transfer function that is transparent over the histogram's "
+             "background mode, where the data differs from the dominant background. The background mode is the one "
+             "`volviz.optics.auto_tf.background_mode` finds for the first look (the tallest bin of a 256-bin "
+             "histogram of the values, followed down both flanks of the lightly smoothed histogram to the valleys, "
+             f"when it spans at most {MODE_WIDTH:.1%} of the range and holds more than {BACKGROUND_FRACTION:.0%} "
+             "of the values); its values are those of its bins (low edge ≤ v < high edge). Without such a mode the "
+             "object's footprint is the data's and the two columns agree. *Contrast* is the ΔE between the two "
+             "main modes of the histogram, each seen as a slab one mean chord thick (`volviz.bench.first_open`). "
+             f"The legibility images are {METRIC_SIZE[0]}x{METRIC_SIZE[1]}, drawn without the axes and the box's "
+             "outline (no data); the scalar bar's strip (the right fifth) is in no footprint. "
+             "Measured on "
              f"{platform.machine()} with {os.cpu_count()} cores, Mesa llvmpipe, while other work ran.", "",
-             "| file | MB | drawn as | first image | drawn | visible | contrast (ΔE) | notes |",
-             "|---|---|---|---|---|---|---|---|"]
+             "| file | MB | drawn as | first image | drawn | visible | object visible | contrast (ΔE) | notes |",
+             "|---|---|---|---|---|---|---|---|---|"]
     for r in records:
         lines.append(f"| `{r.name}` | {r.megabytes:.1f} | {r.kind} | {_number(r.seconds, '.1f')}"
                      f"{' s' if r.seconds is not None else ''} | {_number(r.drawn, '.0%')} | "
-                     f"{_number(r.visible, '.0%')} | {_number(r.contrast, '.0f')} | {r.note.replace('|', '/')} |")
+                     f"{_number(r.visible, '.0%')} | {_number(r.object_visible, '.0%')} | "
+                     f"{_number(r.contrast, '.0f')} | {r.note.replace('|', '/')} |")
     if profiles:
         lines += ["", PROFILE_HEAD + " (cProfile of the same render in one process, cumulative seconds of the "
                   "largest volviz calls):", ""]
         for name, rows in profiles.items():
             lines.append(f"- `{name}`: " + "; ".join(rows))
     return "\n".join(lines) + "\n"
+
+
+def kept_timings(report: Path = REPORT) -> dict[str, tuple[Optional[float], Optional[float], str]]:
+    """File -> (seconds, drawn share, note) of the rows of ``report``'s section, read by its header's column names
+    (*first image*, *drawn*, *notes*): what a ``--legibility-only`` run keeps."""
+    from volviz.io.doc_section import read_section
+
+    timings: dict[str, tuple[Optional[float], Optional[float], str]] = {}
+    columns: list[str] = []
+    for line in read_section(report, BEGIN, END).splitlines():
+        cells = [cell.strip() for cell in line.strip().strip("|").split("|")]
+        if line.startswith("| file |"):
+            columns = cells
+        elif line.startswith("| `") and columns:
+            row = dict(zip(columns, cells))
+            seconds, drawn = row.get("first image", ""), row.get("drawn", "")
+            note = row.get("notes", "")            # a legibility error is measured again, a render's kept
+            timings[cells[0].strip("`")] = (float(seconds.removesuffix(" s")) if seconds else None,
+                                            float(drawn.removesuffix("%")) / 100.0 if drawn else None,
+                                            "" if note.startswith("legibility:") else note)
+    return timings
 
 
 def kept_rows(text: str, profiled: bool, order: list[str], report: Path = REPORT) -> str:
@@ -337,14 +448,18 @@ def main(argv: Optional[list[str]] = None) -> int:
     parser.add_argument("--only", nargs="*", default=None, help="only these files (relative to the data folder)")
     parser.add_argument("--profile", type=int, default=0, help="say where the time goes for the N slowest files")
     parser.add_argument("--no-write", action="store_true", help="print only; leave docs/first-open.md alone")
+    parser.add_argument("--legibility-only", action="store_true", help="measure only the legibility columns; keep "
+                        "each file's time, drawn share and notes (and the profiles) from docs/first-open.md")
     parser.add_argument("--boundary-rule", action="store_true", help="measure regular volumes' legibility with the "
                         "boundary transfer function (volviz.optics.boundary) instead; print only")
     args = parser.parse_args(argv)
-    records = measure(args.data.resolve(), args.only, args.boundary_rule)
+    timings = kept_timings() if args.legibility_only else None
+    records = measure(args.data.resolve(), args.only, args.boundary_rule, timings)
     slowest = sorted((r for r in records if r.seconds is not None), key=lambda r: -float(r.seconds or 0))
-    profiles = {r.name: where_time_goes(args.data.resolve() / r.name) for r in slowest[:max(args.profile, 0)]}
+    profiled = [] if args.legibility_only else slowest[:max(args.profile, 0)]
+    profiles = {r.name: where_time_goes(args.data.resolve() / r.name) for r in profiled}
     text = markdown(records, profiles)
-    if args.only:
+    if args.only or args.legibility_only:
         text = kept_rows(text, bool(profiles), [p.relative_to(args.data.resolve()).as_posix()
                                                  for p in opened_files(args.data.resolve())])
     print(text)
