@@ -4,10 +4,12 @@ from __future__ import annotations
 import argparse
 import logging
 import sys
+import time
 from typing import Optional, Sequence
 
 
 def main(argv: Optional[Sequence[str]] = None) -> int:
+    began = time.time()
     parser = argparse.ArgumentParser(prog="volviz-app", description="volviz desktop application")
     parser.add_argument("target", nargs="?", help="a session file (.json) or a data file; default: the demo scene")
     parser.add_argument("--screenshot", metavar="PNG", help="show the scene, save the window as PNG and quit (a check "
@@ -15,6 +17,8 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     parser.add_argument("--flight-report", metavar="MD", help="fly through the natural scene (default: the shipped "
                         "Yukon session) with W held, write the frame rate and the event loop's gaps to MD and quit")
     parser.add_argument("--flight-seconds", type=float, default=30.0, help="how long --flight-report flies (30)")
+    parser.add_argument("--first-frame", action="store_true", help="open the target, print the time of its first "
+                        "complete frame (seconds since the epoch and since main() began) and quit (volviz bench startup)")
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(levelname)s %(name)s: %(message)s")
 
@@ -27,8 +31,8 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     app.setApplicationName("volviz")
     app.setOrganizationName("volviz")
     app.setWindowIcon(_icon())
-    if args.screenshot or args.flight_report:  # a throwaway window: the user's settings and recovery files stay
-        import tempfile                         # untouched
+    if args.screenshot or args.flight_report or args.first_frame:  # a throwaway window: the user's settings and
+        import tempfile                                             # recovery files stay untouched
         from pathlib import Path
 
         from PySide6.QtCore import QSettings
@@ -42,6 +46,8 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
             return flight_report(app, window, args.target, Path(args.flight_report), args.flight_seconds)
         from .smoke import screenshot
 
+        if args.first_frame:
+            return _first_frame(app, window, args.target, began)
         return screenshot(app, window, args.target, Path(args.screenshot))
     window = MainWindow()
     window.show()
@@ -51,6 +57,20 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         window.open_demo()
     window.offer_recovery()
     return int(app.exec())
+
+
+def _first_frame(app, window, target: Optional[str], began: float) -> int:
+    """Show ``target`` (None: the demo) and print when its first complete frame is drawn, as ``--screenshot`` waits
+    for it: ``first frame <epoch seconds> <seconds since main() began>`` (``volviz bench startup``, issue #31)."""
+    from .smoke import show_target
+
+    shown = show_target(app, window, target)
+    window.plotter.render()
+    now = time.time()
+    print(f"first frame {now:.3f} {now - began:.3f}", flush=True)
+    window.dirty = False
+    window.close()
+    return 0 if shown and window.error_dialog is None else 1
 
 
 def _icon():

@@ -20,8 +20,9 @@ def pump_events(app: Any, until: Any, seconds: float) -> bool:
     return True
 
 
-def screenshot(app: Any, window: Any, target: str | None, out: Path) -> int:
-    """Show ``target`` (None: the demo) in ``window``, save its grab to ``out``; 0 when it showed, 1 otherwise."""
+def show_target(app: Any, window: Any, target: str | None) -> bool:
+    """Show ``window`` with ``target`` (None: the demo) and wait for its first complete image, an error or the
+    layout dialog of headerless data; False when none came within ``TIMEOUT_S``."""
     window.resize(1024, 700)
     window.show()
     pump_events(app, lambda: window.isVisible(), 10.0)
@@ -29,8 +30,13 @@ def screenshot(app: Any, window: Any, target: str | None, out: Path) -> int:
         window.open_path(target)
     else:
         window.open_demo()
-    shown = pump_events(app, lambda: window.error_dialog is not None or window.raw_dialog is not None or (
+    return pump_events(app, lambda: window.error_dialog is not None or window.raw_dialog is not None or (
         window.controller is not None and not window.progress_bar.isVisible()), TIMEOUT_S)
+
+
+def screenshot(app: Any, window: Any, target: str | None, out: Path) -> int:
+    """Show ``target`` (None: the demo) in ``window``, save its grab to ``out``; 0 when it showed, 1 otherwise."""
+    shown = show_target(app, window, target)
     pump_events(app, lambda: False, 0.5)
     window.plotter.render()
     (window.raw_dialog or window).grab().save(str(out))    # headerless data: the dialog asking its layout

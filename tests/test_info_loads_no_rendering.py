@@ -37,8 +37,10 @@ def test_volviz_info_loads_no_rendering_module():
 
 
 def test_the_probe_sees_a_rendering_module():
-    """The same probe, with the render layer imported on top, lists it (the check can fail)."""
-    probe = PROBE.replace("from volviz.cli import main", "import volviz.render.scene_builder\nfrom volviz.cli import main")
+    """The same probe, with the render layer imported on top, lists it (the check can fail). The scene builder
+    imports VTK's rendering through the facade only where it draws (issue #31, start-up): the facade is imported too."""
+    probe = PROBE.replace("from volviz.cli import main",
+                          "import volviz.render.scene_builder, volviz.render.vtk_facade\nfrom volviz.cli import main")
     done = subprocess.run([sys.executable, "-c", probe.format(rendering=RENDERING),
                            str(data_file("volumes/embryo.slc"))], cwd=REPO, capture_output=True, text=True,
                           timeout=300)

@@ -34,6 +34,7 @@ BENCHMARKS = {
     "multisampling": "a still frame with 4x multisampling against one sample: time and image difference",
     "volume_peeling": "a translucent isosurface in a regular volume: depth peeling's frame time and the surface's "
                       "visible share",
+    "startup": "fresh processes: volviz info / render and the app's first frame (wall time, peak memory, imports)",
 }
 #: commands whose arguments go, unread here, to their own parser (``volviz.regular.cli``, ``volviz.bench.NAME``)
 PASSED_ON = ("bench", "compress")
@@ -332,6 +333,8 @@ def _render(args: argparse.Namespace) -> int:
     if data_file and not target.exists():
         raise UsageError(f"{target}: no such file (give a session, a data file, 'demo' or 'demo-volume')")
     check_output(args.output, movie)
+    if data_file:
+        _start_reader(target, {**dict(args.option), **({"q": args.q} if args.q else {})})
     session, session_file = open_target(args.target, args.array, args.q, dict(args.option))
     size = args.size or session.render.size
     check_image_size(size)
@@ -352,6 +355,21 @@ def _render(args: argparse.Namespace) -> int:
     print(file=sys.stderr)
     print(f"wrote {out} ({size[0]}x{size[1]})")
     return 0
+
+
+def _start_reader(path: Path, options: dict[str, Any]) -> None:
+    """Start the reader child now when ``path``'s reader runs in one (``volviz.io.isolated``): the child is a fresh
+    interpreter (a crash cannot take the render with it), so its start (Python, numpy, ``volviz.io``) overlaps the
+    import of the render layer instead of following it (issue #31, docs/architecture.md "Start-up")."""
+    from volviz.io import ReadError, isolated
+    from volviz.io.registry import format_of, get_reader
+
+    try:
+        isolates = get_reader(format_of(path, options)).isolated
+    except (ReadError, OSError, KeyError, ValueError):   # the read itself says what is wrong with the file
+        return
+    if isolates and isolated.isolation_enabled():
+        isolated.prewarm()
 
 
 def _read_for_render(session: Any, datasets: dict[str, Any], args: argparse.Namespace) -> None:

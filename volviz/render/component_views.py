@@ -12,7 +12,6 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any, Optional
 
 from volviz.render.framing import Bounds, points_bounds, prop_bounds, union
-from volviz.render.iso_actors import add_isosurface_actors
 from volviz.scene.clipping import clip_settings
 from volviz.scene.isosurfaces import isosurface_parts
 
@@ -134,6 +133,8 @@ class IsoSurfacesView(VtkPropView):
         if self.prop is not None:
             self.plotter.remove_actor(self.prop, render=False)
         self.parts = parts
+        from volviz.render.iso_actors import add_isosurface_actors   # volviz.iso: only for isosurfaces (start-up)
+
         self.prop = add_isosurface_actors(self.plotter, self.comp.id, parts, spectrum=self.spectrum)
 
     def update(self) -> dict[str, Any]:

@@ -17,7 +17,6 @@ from volviz.render.backend import backend_setting, choose_backend, plotter_gl_in
 from volviz.render.component_views import IsoSurfacesView, VtkPropView
 from volviz.render.decorations import legend_margin
 from volviz.render.framing import frame_bounds, nature_bounds, points_bounds, union
-from volviz.render.lod_volume import LodVolume
 from volviz.render.slices import SlicesView
 from volviz.render.views import view_class
 from volviz.render.vtk_scene import (add_dataset, add_surface, apply_camera, default_transfer_function_for, is_surface,
@@ -29,7 +28,6 @@ from volviz.scene.first_look import first_look
 from volviz.scene.isosurfaces import isosurface_parts
 from volviz.scene.lod import is_lod, lod_bounds
 from volviz.scene.nature import prepare_nature
-from volviz.scene.tetra import cut_tetmesh, pt_mesh, pt_options
 from volviz.session import Component, Session
 
 if TYPE_CHECKING:   # type-only imports for the signatures
@@ -108,6 +106,8 @@ def prepare_component(session: Session, comp: Component, datasets: dict[str, Loa
     if is_lod(dataset):
         return
     if uses_pt(session, dataset):
+        from volviz.scene.tetra import cut_tetmesh, pt_mesh   # the tetrahedra's modules: only for meshes (start-up)
+
         mesh = pt_mesh(dataset)
         prepared.parts[comp.id] = mesh
         if clip.all_planes():
@@ -243,6 +243,8 @@ def add_lod_component(plotter: pv.BasePlotter, session: Session, comp: Component
         plotter.view_isometric()  # type: ignore[call-arg]  # pyvista's _Wrapped decorator hides self from mypy
         plotter.renderer.ResetCamera(lo[0], hi[0], lo[1], hi[1], lo[2], hi[2])
         plotter.camera_set = True
+    from volviz.render.lod_volume import LodVolume   # the LOD codec's modules: only for compressed volumes
+
     lod = LodVolume(plotter, dataset, drawn_transfer_function(session, comp, dataset),
                     budget=int(comp.settings.get("budget", 256)), opacity=comp.opacity)
     if update:
@@ -271,6 +273,8 @@ def add_pt_component(plotter: pv.BasePlotter, session: Session, comp: Component,
     if comp.opacity != 1.0:
         tf = tf.scaled_extinction(comp.opacity)
     method = "reference" if session.render.method == "reference" else "pt"
+    from volviz.scene.tetra import pt_options   # the tetrahedra's modules: only for meshes (start-up)
+
     opts = pt_options(session.render.options) if method == "pt" else {}
     if method == "pt" and pt_backend(plotter, session) == "gpu":
         return view_class("pt", "gpu")(plotter, dataset, tf, **{"lookup": "auto", **opts})  # the CPU path's table

@@ -34,10 +34,12 @@ def load_datasets(session: Session, session_file: Optional[str | os.PathLike],
                   also: tuple[str, ...] = ()) -> dict[str, LoadedDataset]:
     """Read every dataset that a visible component (or a component in ``also``) uses, once each, with progress;
     those already in ``loaded`` are kept (the dict is filled in and returned)."""
-    from volviz.nature.nature_scene import nature_dataset_ids   # heavy (the nature kernels): only for a session
-
     used = {c.dataset for c in session.components if (c.visible or c.id in also) and c.dataset is not None}
-    used |= nature_dataset_ids([c for c in session.components if c.visible and c.type in NATURE_TYPES])
+    nature = [c for c in session.components if c.visible and c.type in NATURE_TYPES]
+    if nature:
+        from volviz.nature.nature_scene import nature_dataset_ids   # heavy (the nature kernels): only when shown
+
+        used |= nature_dataset_ids(nature)
     loaded = {} if loaded is None else loaded
     refs = [ref for ref in session.datasets if ref.id in used and ref.id not in loaded]
     missing = missing_files(session, session_file, {ref.id for ref in refs})

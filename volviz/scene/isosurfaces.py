@@ -6,14 +6,13 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any, Optional
 
-from volviz.iso import IsoSettings, build_lod, prepare
-from volviz.iso.clip import clip_isosurfaces
 from volviz.jobs import ProgressCallback
 from volviz.scene.clipping import clip_settings
 from volviz.scene.errors import SceneError
 from volviz.session import Component
 
 if TYPE_CHECKING:   # type-only imports for the signatures
+    from volviz.iso import IsoSettings
     from volviz.iso.extract import IsoMesh
     from volviz.iso.lod import LodChain
     from volviz.model.clip import ClipSettings
@@ -38,6 +37,9 @@ def isosurface_parts(comp: Component, dataset: Any = None, t: Optional[float] = 
     """Any thread: the surfaces of an ``isosurface`` component (settings: ``volviz.iso.IsoSettings``) extracted at
     display time ``t`` (skipped when ``meshes`` are known), cut exactly by the scene's ``clip`` (``session.clip`` or
     ClipSettings) on top of the component's own clipping, scaled by its opacity, with their LOD chains."""
+    from volviz.iso import IsoSettings, build_lod, prepare   # the iso kernels: only for isosurfaces (start-up)
+    from volviz.iso.clip import clip_isosurfaces
+
     try:
         settings = IsoSettings.from_dict(comp.settings)
     except ValueError as exc:

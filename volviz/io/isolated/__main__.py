@@ -166,7 +166,7 @@ IDLE_SECONDS = 0.25
 
 def _load_vtk_when_idle() -> None:
     """Import the VTK modules of volviz's readers (``volviz.io.vtk_lazy.MODULE_OF``, by name: not the whole of VTK,
-    issue #31) unless a request is already waiting. A child kept warm for later reads (the app's pool) has them
+    issue #31) until a request is waiting. A child kept warm for later reads (the app's pool) has them
     loaded before they come; one started for a read at hand (``volviz render FILE``) answers at once, its reader
     importing only the VTK modules it uses (``volviz.io.vtk_lazy``: 0.4 s instead of 1.2-2 s)."""
     import importlib
@@ -177,6 +177,8 @@ def _load_vtk_when_idle() -> None:
     if select.select([sys.stdin.buffer], [], [], IDLE_SECONDS)[0]:
         return
     for module in sorted(set(MODULE_OF.values())):
+        if select.select([sys.stdin.buffer], [], [], 0)[0]:   # a request came meanwhile (a child started ahead of
+            return                                            # its read, ``volviz render``): it is not kept waiting
         try:
             importlib.import_module(f"vtkmodules.{module}")
         except ImportError:  # a module this VTK build lacks: its readers report that themselves
