@@ -18,7 +18,8 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
                         "Yukon session) with W held, write the frame rate and the event loop's gaps to MD and quit")
     parser.add_argument("--flight-seconds", type=float, default=30.0, help="how long --flight-report flies (30)")
     parser.add_argument("--first-frame", action="store_true", help="open the target, print the time of its first "
-                        "complete frame (seconds since the epoch and since main() began) and quit (volviz bench startup)")
+                        "complete frame (seconds since the epoch and since main() began) and quit (volviz bench "
+                        "startup)")
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(levelname)s %(name)s: %(message)s")
 

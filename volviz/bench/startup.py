@@ -105,7 +105,8 @@ def measure(name: str, argv: list[str], reps: int, first_frame: bool, trees: lis
 
 
 def report(results: list[Result], command: str, loads: tuple[str, str]) -> str:
-    lines = ["# Start-up of fresh processes", "", f"Made by `{command}`. " + " ".join(__doc__.split("\n\n")[1].split()), "",
+    method = " ".join(__doc__.split("\n\n")[1].split())
+    lines = ["# Start-up of fresh processes", "", f"Made by `{command}`. {method}", "",
              f"Load average (1, 5, 15 min) before: {loads[0]}; after: {loads[1]} (2 cores).", "",
              "| case | tree | wall median (min-max) | CPU median | peak RSS | imports (own times summed) |",
              "|---|---|---|---|---|---|"]
