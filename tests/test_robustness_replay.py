@@ -47,7 +47,7 @@ def test_each_recorded_case_rebuilds_byte_identical(campaign, tmp_path):
     base, _result, items = campaign
     kinds = set()
     for item in items:
-        target, opened, src = rr.rebuild(item, base / "data", tmp_path / "replay")
+        target, opened, src = rb.rebuild(item, base / "data", tmp_path / "replay")
         damaged = target.read_bytes()
         assert rr.sha256(damaged) == item["sha256"] and opened.exists()
         original = src.path.read_bytes()
@@ -64,7 +64,7 @@ def test_a_case_whose_bytes_differ_from_the_record_is_refused(campaign, tmp_path
     base, _result, items = campaign
     item = dict(items[0], sha256="0" * 64)
     with pytest.raises(rr.ReplayError, match="is not the recorded file"):
-        rr.rebuild(item, base / "data", tmp_path)
+        rb.rebuild(item, base / "data", tmp_path)
     with pytest.raises(rr.ReplayError, match="no case 99 in the record"):
         rr.load(base / "cases.jsonl", 99)
 

@@ -39,6 +39,7 @@ from pathlib import Path
 from typing import Any, Callable, Optional
 
 from volviz.argtypes import UsageParser, int_in
+from volviz.bench.robustness_replay import Recorder, ReplayError, case_record, decode_recipe, load, sha256
 
 DEFAULT_DATA = Path(os.environ.get("VOLVIZ_DATA", Path(__file__).resolve().parents[2].parent / "shared" / "data"))
 REPORT = Path(__file__).resolve().parents[2] / "docs" / "reliability.md"
@@ -809,8 +810,6 @@ def run(data: Path, total: int, seed: int, formats: list[str] | None, minutes: f
     """The campaign: ``total`` cases (fewer when ``minutes`` > 0 runs out first), counted per format and side;
     with ``record``, one JSON line per case there (``volviz.bench.robustness_replay``: what each case changed,
     enough to rebuild it with ``--replay``)."""
-    from volviz.bench.robustness_replay import Recorder, case_record
-
     made_folder = Path(tempfile.mkdtemp(prefix="volviz-bench-made-"))
     shared = sources(data)
     srcs = [s for s in shared + made_sources(made_folder, formats) if not formats or s.fmt in formats]
@@ -1086,8 +1085,6 @@ def main(argv: list[str] | None = None) -> int:
         parser.error(f"--data {args.data} is not a folder (set VOLVIZ_DATA)")
     record = args.record or args.out.with_suffix(".cases.jsonl")
     if args.replay is not None:
-        from volviz.bench.robustness_replay import ReplayError, replay
-
         if args.record is None:
             parser.error("--replay needs --record FILE, the campaign's record of its cases")
         try:
@@ -1103,6 +1100,64 @@ def main(argv: list[str] | None = None) -> int:
         Path(args.json).write_text(json.dumps(result, indent=1), encoding="utf-8")
     print("\n".join([f"wrote {args.out} and the record of every case, {record}", *_targets(result)]))
     return 0
+
+
+
+# ------------------------------------------------------------------------------------ replay of a recorded case
+def _source(item: dict[str, Any], data: Path, made: Path) -> Source:
+    if item["origin"] == "made":
+        candidates = made_sources(made, [item["format"]])
+    else:
+        candidates = [s for s in sources(data) if s.fmt == item["format"]]
+    src = next((s for s in candidates if s.name == item["file"]), None)
+    if src is None:
+        where = "the seeds written for the run" if item["origin"] == "made" else str(data)
+        raise ReplayError(f"case {item['case']}: its seed file {item['file']} is not among {where}")
+    held = sha256(src.path.read_bytes())
+    if held != item["source_sha256"]:
+        raise ReplayError(f"case {item['case']}: the seed file {src.path} is not the recorded one "
+                          f"(SHA-256 {held[:12]}..., recorded {item['source_sha256'][:12]}...)")
+    return src
+
+
+def rebuild(item: dict[str, Any], data: Path, into: Path) -> tuple[Path, Path, Source]:
+    """Rebuild the damaged file of a recorded case under ``into`` (the seeds a run writes under ``into/made``, the
+    case among its seed's other files under ``into/s<case>``); returns the damaged file, the file to open and the
+    source. Raises ``ReplayError`` when the rebuilt bytes are not the recorded ones."""
+    into.mkdir(parents=True, exist_ok=True)
+    src = _source(item, data, into / "made")
+    raw = src.path.read_bytes()
+    addresses = hdf5_object_addresses(src.path) if src.layout == "hdf5" else None
+    mutation = make_mutation(src, raw, decode_recipe(item["recipe"]), addresses)
+    folder = prepare_folder(src, into, int(item["case"]))
+    target = mutated_path(src, folder)
+    place(target, mutation.data if mutation.data is not None else raw)
+    if mutation.edit is not None:
+        mutation.edit(target)
+    made = sha256(target.read_bytes())
+    if made != item["sha256"]:
+        raise ReplayError(f"case {item['case']}: the rebuilt {target} is not the recorded file "
+                          f"(SHA-256 {made[:12]}..., recorded {item['sha256'][:12]}...)")
+    return target, folder / src.target, src
+
+
+def replay(record: Path, case: int, data: Path, into: Optional[Path], read: bool = True) -> list[str]:
+    """``volviz bench robustness --replay CASE``: rebuild the case, say where it is and, with ``read``, what
+    volviz's reader makes of it now (as the campaign's volviz side reads it)."""
+    item = load(record, case)
+    into = into if into is not None else Path(tempfile.mkdtemp(prefix=f"volviz-replay-{case}-"))
+    target, opened, src = rebuild(item, data, into)
+    lines = [f"case {case}: {item['format']} `{item['file']}` {item['kind']} ({item['detail']})",
+             f"rebuilt {target} (SHA-256 {item['sha256'][:16]}... as recorded); open {opened}"]
+    if item.get("outcome"):
+        lines.append("recorded outcome: " + ", ".join(f"{k} {v}" for k, v in item["outcome"].items()))
+    if read:
+        answer = _serve_volviz({"path": str(opened), "options": src.options})
+        now = answer["status"] if answer["status"] != "ok" else (
+            "read, warned" if answer.get("warned") else "read")
+        lines.append(f"volviz now: {now}: {answer.get('message') or answer.get('warned') or answer.get('problem')}"
+                     .rstrip(": "))
+    return lines
 
 
 if __name__ == "__main__":

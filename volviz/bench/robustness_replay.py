@@ -7,20 +7,18 @@ the run's written seeds, its SHA-256 and size), the recipe, the campaign's seed,
 it changed (the size before and after, each run of changed bytes with its offset and the bytes before and after,
 and the bits flipped), the damaged file's SHA-256, and both sides' outcomes. ``--replay CASE`` rebuilds exactly that
 damaged file, among its seed's other files, checks it against the recorded SHA-256 and reads it as the campaign's
-volviz side does, so a silent acceptance found by a run can be looked at, fixed and tested.
+volviz side does (``robustness.rebuild`` / ``replay``, beside the campaign's mutations: this module is the record
+alone, below the campaign), so a silent acceptance found by a run can be looked at, fixed and tested.
 """
 from __future__ import annotations
 
 import hashlib
 import json
 import os
-import tempfile
 from pathlib import Path
 from typing import Any, Optional
 
 import numpy as np
-
-from volviz.bench import robustness as rb
 
 #: runs of changed bytes a record lists (a bit flip changes up to 8, a field one; the rest are counted)
 MAX_RUNS = 32
@@ -82,9 +80,10 @@ def decode_recipe(items: list) -> tuple:
     return tuple(bytes.fromhex(v["bytes"]) if isinstance(v, dict) else v for v in items)
 
 
-def case_record(number: int, seed: int, src: rb.Source, origin: str, recipe: tuple, mutation: rb.Mutation,
+def case_record(number: int, seed: int, src: Any, origin: str, recipe: tuple, mutation: Any,
                 original: bytes, damaged: bytes) -> dict[str, Any]:
-    """The record of one case (its outcomes are added when both sides have read it)."""
+    """The record of one case (its outcomes are added when both sides have read it): ``src`` a campaign's
+    ``robustness.Source``, ``mutation`` its ``robustness.Mutation``."""
     return {"case": number, "seed": seed, "format": src.fmt, "origin": origin, "file": src.name,
             "target": src.target, "source_sha256": sha256(original), "recipe": encode_recipe(recipe),
             "kind": mutation.kind, "detail": mutation.detail, "sha256": sha256(damaged),
@@ -130,59 +129,3 @@ def load(record: Path, case: int) -> dict[str, Any]:
         if isinstance(item, dict) and item.get("case") == case:
             return item
     raise ReplayError(f"{record}: no case {case} in the record ({len(lines)} cases)")
-
-
-def _source(item: dict[str, Any], data: Path, made: Path) -> rb.Source:
-    if item["origin"] == "made":
-        candidates = rb.made_sources(made, [item["format"]])
-    else:
-        candidates = [s for s in rb.sources(data) if s.fmt == item["format"]]
-    src = next((s for s in candidates if s.name == item["file"]), None)
-    if src is None:
-        where = "the seeds written for the run" if item["origin"] == "made" else str(data)
-        raise ReplayError(f"case {item['case']}: its seed file {item['file']} is not among {where}")
-    held = sha256(src.path.read_bytes())
-    if held != item["source_sha256"]:
-        raise ReplayError(f"case {item['case']}: the seed file {src.path} is not the recorded one "
-                          f"(SHA-256 {held[:12]}..., recorded {item['source_sha256'][:12]}...)")
-    return src
-
-
-def rebuild(item: dict[str, Any], data: Path, into: Path) -> tuple[Path, Path, rb.Source]:
-    """Rebuild the damaged file of a recorded case under ``into`` (the seeds a run writes under ``into/made``, the
-    case among its seed's other files under ``into/s<case>``); returns the damaged file, the file to open and the
-    source. Raises ``ReplayError`` when the rebuilt bytes are not the recorded ones."""
-    into.mkdir(parents=True, exist_ok=True)
-    src = _source(item, data, into / "made")
-    raw = src.path.read_bytes()
-    addresses = rb.hdf5_object_addresses(src.path) if src.layout == "hdf5" else None
-    mutation = rb.make_mutation(src, raw, decode_recipe(item["recipe"]), addresses)
-    folder = rb.prepare_folder(src, into, int(item["case"]))
-    target = rb.mutated_path(src, folder)
-    rb.place(target, mutation.data if mutation.data is not None else raw)
-    if mutation.edit is not None:
-        mutation.edit(target)
-    made = sha256(target.read_bytes())
-    if made != item["sha256"]:
-        raise ReplayError(f"case {item['case']}: the rebuilt {target} is not the recorded file "
-                          f"(SHA-256 {made[:12]}..., recorded {item['sha256'][:12]}...)")
-    return target, folder / src.target, src
-
-
-def replay(record: Path, case: int, data: Path, into: Optional[Path], read: bool = True) -> list[str]:
-    """``volviz bench robustness --replay CASE``: rebuild the case, say where it is and, with ``read``, what
-    volviz's reader makes of it now (as the campaign's volviz side reads it)."""
-    item = load(record, case)
-    into = into if into is not None else Path(tempfile.mkdtemp(prefix=f"volviz-replay-{case}-"))
-    target, opened, src = rebuild(item, data, into)
-    lines = [f"case {case}: {item['format']} `{item['file']}` {item['kind']} ({item['detail']})",
-             f"rebuilt {target} (SHA-256 {item['sha256'][:16]}... as recorded); open {opened}"]
-    if item.get("outcome"):
-        lines.append("recorded outcome: " + ", ".join(f"{k} {v}" for k, v in item["outcome"].items()))
-    if read:
-        answer = rb._serve_volviz({"path": str(opened), "options": src.options})
-        now = answer["status"] if answer["status"] != "ok" else (
-            "read, warned" if answer.get("warned") else "read")
-        lines.append(f"volviz now: {now}: {answer.get('message') or answer.get('warned') or answer.get('problem')}"
-                     .rstrip(": "))
-    return lines

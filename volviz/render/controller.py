@@ -87,7 +87,7 @@ def session_interpolates(session: Session) -> bool:
 
 
 @dataclass(frozen=True)
-class _Edit:
+class _Remake:
     """What the views re-make at once for an edit of the model: camera-dependent parts (``update``: a CPU PT image,
     a cut), the natural scene (``nature``), a component hidden at build time (``build``)."""
 
@@ -113,7 +113,7 @@ class SceneController:
         self.interpolate_time = session_interpolates(session)
         self.changes = ChangeNotifier()   # each edit of the session (``Session.changes``) once the views show it
         self.pending: list[str] = []      # after an opacity or clipping edit: the ids whose CPU cut is stale
-        self._edit = _Edit(not on_screen, not on_screen, not on_screen)  # for edits made in the model directly
+        self._edit = _Remake(not on_screen, not on_screen, not on_screen)  # for edits made in the model directly
 
     @property
     def session(self) -> Session:
@@ -212,7 +212,7 @@ class SceneController:
             self._unsubscribe = None
 
     @contextmanager
-    def _editing(self, edit: _Edit) -> Iterator[None]:
+    def _editing(self, edit: _Remake) -> Iterator[None]:
         """An edit of the model made through this controller: its views re-make what ``edit`` says (heard even
         before ``install``)."""
         previous, listening = self._edit, self._unsubscribe is not None
@@ -303,7 +303,7 @@ class SceneController:
         view that re-makes something for a new TF (a CPU PT volume's image, a LOD volume's block selection) does so
         now only when ``update`` (the app does it in the background: ``camera_views``, then ``begin`` / ``compute``
         / ``finish``)."""
-        with self._editing(_Edit(update=update)):
+        with self._editing(_Remake(update=update)):
             self.session.set_transfer_function(comp_id, tf)
 
     def _show_transfer_function(self, comp_id: str, update: bool) -> None:
@@ -322,7 +322,7 @@ class SceneController:
         natural scene now unless ``nature`` is false (the app rebuilds it in the background: ``prepare_nature``,
         ``install_nature``). Another component hidden at build time is built now unless ``build`` is false (the app
         prepares it in the background: ``prepare_component``, ``install_component``)."""
-        with self._editing(_Edit(nature=nature, build=build)):
+        with self._editing(_Remake(nature=nature, build=build)):
             self.session.set_visible(comp_id, visible)
 
     def _show_visible(self, comp_id: str, nature: bool, build: bool) -> None:
@@ -391,7 +391,7 @@ class SceneController:
         image, a cut of the isosurfaces) is made now when ``update``; otherwise returns the ids whose cut is stale
         (``pending``), which the app makes in the background (``cut`` on a worker, then ``show_cut``; images through
         ``camera_views``)."""
-        with self._editing(_Edit(update=update)):
+        with self._editing(_Remake(update=update)):
             self.session.set_opacity(comp_id, opacity)
         return self.pending
 
@@ -709,7 +709,7 @@ class SceneController:
         given (``apply_clip``); returns the ids of the views drawn from a cut made on the CPU (a CPU PT volume's mesh,
         an isosurface component's surfaces; ``pending``), which are cut and re-made here when ``update``; the app
         instead cuts them in the background (``cut`` on a worker, then ``show_cut``) and re-renders."""
-        with self._editing(_Edit(update=update)):
+        with self._editing(_Remake(update=update)):
             self.session.set_clip(clip)
         return self.pending
 
@@ -775,7 +775,7 @@ class SceneController:
         overlay is rendered now when ``update``; the app renders it in the background: ``iso_overlay.begin`` /
         ``compute`` / ``finish``). A new mode is an edit of the session (``Session.set_iso_mode``); the current one
         is applied again (after a build) without one."""
-        with self._editing(_Edit(update=update)):
+        with self._editing(_Remake(update=update)):
             changed = mode != self.iso_mode
             self.session.set_iso_mode(mode)   # checks the mode; a new one is announced, and shown through it
         if not changed:
