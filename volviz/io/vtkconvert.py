@@ -18,6 +18,9 @@ from volviz.io.errors import PathLike, ReadError, ReadWarning
 from volviz.model import CELL_SIZES, CurvilinearGrid, RegularVolume, UnstructuredMesh
 
 _VTK_POLYHEDRON = 42
+#: VTK's axis-aligned cells as the general ones, corners reordered: a voxel (11) is a hexahedron (12) and a pixel (8)
+#: a quad (9) whose corners run x fastest instead of around the face (VTK's cell type documentation)
+_AXIS_ALIGNED = {11: (12, np.array([0, 1, 3, 2, 4, 5, 7, 6])), 8: (9, np.array([0, 1, 3, 2]))}
 # VTK's quadratic cell types with a linear counterpart: edge, triangle, quad, tetra, hexahedron, wedge, pyramid
 _QUADRATIC = (21, 22, 23, 24, 25, 26, 27, 28, 29, 30, 31, 32, 33)
 
@@ -216,6 +219,9 @@ def _unstructured(path: PathLike, obj, allow_nonfinite: bool) -> UnstructuredMes
     for ctype, size in sorted({(int(t), int(s)) for t, s in keys}):
         idx = np.flatnonzero((types == ctype) & (sizes == size))
         block = conn[(offsets[idx][:, None] + np.arange(size)[None, :])] if size else np.empty((len(idx), 0), np.int64)
+        if ctype in _AXIS_ALIGNED and size == len(_AXIS_ALIGNED[ctype][1]):
+            ctype, corner_order = _AXIS_ALIGNED[ctype]
+            block = block[:, corner_order]
         corners = CELL_SIZES.get(ctype, size)
         cells.append((ctype, block[:, :corners] if size > corners else block))
         order.append(idx)
