@@ -144,3 +144,10 @@ def read_every_frame(path: Path, mutations, names: tuple[str, ...]) -> tuple[int
             continue
         read.append((mutation, found, frames))
     return refused, read
+
+
+def pytest_xdist_auto_num_workers(config) -> int:
+    """``-n auto`` (pyproject's addopts): one worker per core, at most four. Much of the suite waits on Xvfb, reader
+    processes and real-time flows, so two workers on CI's two cores nearly halve its time; more than four only
+    multiply the memory of VTK, Qt and Numba per worker."""
+    return max(1, min(4, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1))
