@@ -34,12 +34,13 @@ def is_tecplot(head: bytes) -> bool:
 
 def is_avs_ucd(head: bytes) -> bool:
     """AVS UCD: binary files start with byte 7; ASCII ones with a line of counts after their # comments (five;
-    fewer in a header line cut short, which the AVS UCD check then refuses by name: issue #32, it went to the other
-    reader of ``.inp``, meshio's Abaqus reader, whose files start with ``*`` keywords)."""
+    two to four in a header line cut short, which the AVS UCD check then refuses by name: issue #32, it went to the
+    other reader of ``.inp``, meshio's Abaqus reader, whose files start with ``*`` keywords). A single number is not
+    taken: other formats start so (an SLC file's magic number, a PLOT3D block count)."""
     if head[:1] == b"\x07":
         return True
     lines = _first_lines(head)
-    return bool(lines) and re.fullmatch(rb"(\d+\s+){0,4}\d+", lines[0]) is not None
+    return bool(lines) and re.fullmatch(rb"(\d+\s+){1,4}\d+", lines[0]) is not None
 
 
 def is_fluent(head: bytes) -> bool:
