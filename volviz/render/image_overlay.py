@@ -47,7 +47,8 @@ from volviz.render.preview_upsample import upsample_preview
 __all__ = ["ImageOverlay", "OverlayView", "block_min", "overlay_rgba8", "read_buffers",
            "single_sample_on_software", "unpremultiply_rgba8", "zbuffer_to_depth"]
 
-_SIBLINGS = "_volviz_pt_overlays"           # plotter attribute: every overlay renderer of the plotter
+#: every overlay renderer of a plotter (the renderers are VTK objects: a plotter's list lives as long as it does)
+_SIBLINGS: "weakref.WeakKeyDictionary[Any, list[Any]]" = weakref.WeakKeyDictionary()
 
 
 def zbuffer_to_depth(z: np.ndarray, clipping_range: tuple[float, float], parallel: bool) -> np.ndarray:
@@ -181,7 +182,7 @@ class ImageOverlay:
         self.renderer.GetActiveCamera().ParallelProjectionOn()
         ren_win.AddRenderer(self.renderer)
         self.renderer.DrawOff()
-        self.siblings: list[Any] = plotter.__dict__.setdefault(_SIBLINGS, [])
+        self.siblings: list[Any] = _SIBLINGS.setdefault(plotter, [])
         self.siblings.append(self.renderer)
 
     def opaque_buffers(self, size: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
