@@ -260,7 +260,7 @@ def legibility(path: Path, boundary_rule: bool = False) -> tuple[str, Optional[F
         grid = regular_fields(dataset) if boundary_rule else None
         if grid is not None:
             tf = boundary_transfer_function(values, chord, grid, tf_name)
-            session.transfer_functions[tf_name] = tf.to_dict()
+            session.set_transfer_function(comp.id, tf)
         lo, hi = tf.range
         mode = background_mode(finite_sample(raw))         # the sample and the mode auto_transfer_function uses
         masks: list[np.ndarray] = []
@@ -269,7 +269,7 @@ def legibility(path: Path, boundary_rule: bool = False) -> tuple[str, Optional[F
             if shown is None:      # no background mode: the object's footprint is the data's
                 masks.append(masks[-1])
                 continue
-            session.transfer_functions[tf_name] = shown.to_dict()
+            session.set_transfer_function(comp.id, shown)
             masks.append(render_session(session, session_file, METRIC_SIZE, datasets=datasets))
     background = np.asarray(session.render.background, dtype=np.float64)
     image, data_image, object_image = masks
