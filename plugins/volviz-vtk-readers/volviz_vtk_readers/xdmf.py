@@ -14,7 +14,11 @@ What opens by default, and why:
 
 Before VTK's reader sees the file, a streaming pass over the XML (expat: no entity expansion bombs, no XInclude
 processing) finds the top-level grids and the HDF5 data items; each item's file must exist and its dataset hold the
-values its ``Dimensions`` declare (VTK's reader reads past a smaller dataset and crashes).
+values its ``Dimensions`` declare (VTK's reader reads past a smaller dataset and crashes). The same pass holds every
+attribute of a fixed kind to its field (``check_attribute``): a number must parse (a ``Time`` whose ``Value`` is
+``T`` was read by VTK as time 0, a second step at the same time), a keyword must be one of the XDMF model's
+(compared without case, as Xdmf2 does), so two attribute values swapped are refused naming the element, the
+attribute and the value instead of read as something else (issue #32).
 """
 from __future__ import annotations
 
@@ -56,6 +60,53 @@ def _dimensions(p: Path, text: str | None) -> tuple[int, ...] | None:
     return dims
 
 
+#: keyword attributes of the XDMF model (Xdmf2 and XDMF 3 names, lower case: Xdmf compares them without case)
+KEYWORDS: dict[tuple[str, str], frozenset[str]] = {
+    ("DataItem", "NumberType"): frozenset({"float", "int", "uint", "char", "uchar"}),
+    ("DataItem", "DataType"): frozenset({"float", "int", "uint", "char", "uchar"}),
+    ("DataItem", "Format"): frozenset({"xml", "hdf", "binary", "tiff"}),
+    ("DataItem", "Endian"): frozenset({"native", "big", "little"}),
+    ("DataItem", "ItemType"): frozenset({"uniform", "collection", "tree", "hyperslab", "coordinates", "function"}),
+    ("Attribute", "Center"): frozenset({"node", "cell", "grid", "face", "edge", "other"}),
+    ("Attribute", "AttributeType"): frozenset({"scalar", "vector", "tensor", "tensor6", "matrix", "globalid"}),
+    ("Grid", "GridType"): frozenset({"uniform", "collection", "tree", "subset"}),
+    ("Grid", "CollectionType"): frozenset({"spatial", "temporal"}),
+    ("Geometry", "GeometryType"): frozenset({"xyz", "xy", "x_y_z", "x_y", "vxvyvz", "origin_dxdydz", "origin_dxdy",
+                                             "polar", "spherical"}),
+    ("Time", "TimeType"): frozenset({"single", "hyperslab", "list", "range"}),
+}
+#: attributes that hold whole numbers: (element, attribute) -> how many (None: one or more)
+WHOLE_NUMBERS: dict[tuple[str, str], int | None] = {
+    ("DataItem", "Precision"): 1, ("DataItem", "Dimensions"): None, ("DataItem", "Seek"): 1,
+    ("Topology", "NumberOfElements"): None, ("Topology", "Dimensions"): None, ("Topology", "NodesPerElement"): 1,
+    ("Attribute", "Dimensions"): None,
+}
+
+
+def check_attribute(p: Path, tag: str, name: str, value: str) -> None:
+    """ReadError unless ``value`` is a valid value of the attribute ``name`` of an element ``tag``: a keyword of the
+    model (``KEYWORDS``), a whole number >= 0 (``WHOLE_NUMBERS``; ``Precision`` 1, 2, 4 or 8) or a finite number
+    (``Time``'s ``Value``); other attributes (names, references) are free text."""
+    where = f"{'an' if tag[0] in 'AEIOU' else 'a'} {tag} element's {name} {value[:40]!r}"
+    allowed = KEYWORDS.get((tag, name))
+    if allowed is not None and value.strip().lower() not in allowed:
+        raise ReadError(p, f"{where} is not one of XDMF's ({', '.join(sorted(allowed))})")
+    count = WHOLE_NUMBERS.get((tag, name), 0)
+    if count != 0:
+        words = value.split()
+        if not words or not all(w.isdigit() for w in words) or (count is not None and len(words) != count):
+            raise ReadError(p, f"{where} " + ("is not a whole number" if count == 1 else "are not whole numbers >= 0"))
+        if name == "Precision" and words[0] not in ("1", "2", "4", "8"):
+            raise ReadError(p, f"{where} is not a byte count XDMF knows (1, 2, 4 or 8)")
+    if (tag, name) == ("Time", "Value"):
+        try:
+            times = [float(w) for w in value.replace(",", " ").split()]
+        except ValueError:
+            times = []
+        if not times or not all(math.isfinite(t) for t in times):
+            raise ReadError(p, f"{where} is not a finite number (a time step)")
+
+
 def outline(path: PathLike) -> Outline:
     """The file's ``Outline``, from one streaming pass over its XML; ReadError if it is not XDMF or does not
     parse."""
@@ -71,6 +122,8 @@ def outline(path: PathLike) -> Outline:
             tag = element.tag.rsplit("}", 1)[-1]
             if event == "start":
                 depth += 1
+                for name, value in element.attrib.items():
+                    check_attribute(p, tag, name, value)
                 if tag == "Domain" and domain_depth < 0:
                     domain_depth = depth
                 elif (tag == "Grid" and depth == domain_depth + 1 and element.get("GridType") == "Collection"
