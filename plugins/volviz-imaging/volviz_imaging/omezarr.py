@@ -11,6 +11,11 @@ through zarr-python. A Zarr store is a folder (``image.ome.zarr/``); it opens as
 - Safety: before zarr-python decodes anything, every array's codecs are checked against ``SAFE_CODECS`` on its JSON
   metadata: a Zarr v2 array may name any numcodecs codec, and numcodecs' ``pickle`` codec would unpickle the file's
   bytes. Object and structured dtypes are refused.
+- Consistency (issue #32): an array's ``shape`` and ``chunks`` must be sizes of one length, and every chunk the store
+  holds must lie inside the chunk grid they make (``check_stored_chunks``: a ``.zarray`` whose ``shape[0]`` was set
+  from 6 to 1 read as one slice, the second chunk ignored); a multiscale's levels must have the shapes their scales
+  give from level 0 (``check_levels``, within one voxel of the coarser level). Chunks missing inside the grid are
+  valid Zarr (read as the fill value; writers skip empty chunks), so a shape made larger cannot be told from that.
 """
 from __future__ import annotations
 
@@ -78,6 +83,87 @@ def check_array_metadata(folder: Path) -> None:
         raise ReadError(folder, f"its Zarr array holds {text} values; volviz reads numbers")
 
 
+def _sizes(value: Any, least: int) -> bool:
+    return isinstance(value, list) and all(type(n) is int and n >= least for n in value)
+
+
+def _grid(meta: dict[str, Any]) -> tuple[Any, Any, str, str]:
+    """(shape, chunk shape, chunk key prefix, separator) of a Zarr v2 ``.zarray`` or v3 ``zarr.json``."""
+    if "chunks" in meta or meta.get("zarr_format") == 2:
+        return meta.get("shape"), meta.get("chunks"), "", str(meta.get("dimension_separator") or ".")
+    grid = meta.get("chunk_grid") if isinstance(meta.get("chunk_grid"), dict) else {}
+    chunks = (grid.get("configuration") or {}).get("chunk_shape") if isinstance(grid.get("configuration"), dict) \
+        else None
+    encoding = meta.get("chunk_key_encoding") if isinstance(meta.get("chunk_key_encoding"), dict) else {}
+    config = encoding.get("configuration") if isinstance(encoding.get("configuration"), dict) else {}
+    if encoding.get("name") == "v2":
+        return meta.get("shape"), chunks, "", str(config.get("separator") or ".")
+    return meta.get("shape"), chunks, "c", str(config.get("separator") or "/")
+
+
+def check_stored_chunks(folder: Path) -> None:
+    """ReadError unless the array's ``shape`` and ``chunks`` are sizes of one length and every chunk stored in
+    ``folder`` lies inside the grid of ``ceil(shape / chunks)`` chunks they make: a stored chunk outside it means the
+    shape was made smaller than the data written (zarr-python deletes such chunks when it shrinks an array)."""
+    meta_file = folder / ".zarray" if (folder / ".zarray").is_file() else folder / "zarr.json"
+    shape, chunks, prefix, sep = _grid(_json(meta_file))
+    if not _sizes(shape, 0):
+        raise ReadError(meta_file, f"its shape {json.dumps(shape)[:80]} is not a list of sizes (whole numbers >= 0)")
+    if not _sizes(chunks, 1) or len(chunks) != len(shape):
+        raise ReadError(meta_file, f"its chunk shape {json.dumps(chunks)[:80]} is not {len(shape)} sizes >= 1 "
+                                   f"(one per axis of the shape {shape})")
+    if not shape:
+        return
+    grid = [-(-n // c) for n, c in zip(shape, chunks)]
+    start = folder / prefix if prefix else folder
+    for key in _chunk_keys(start, sep):
+        if len(key) != len(grid) or any(i >= n for i, n in zip(key, grid)):
+            name = (prefix + sep if prefix else "") + sep.join(map(str, key))
+            raise ReadError(meta_file, f"its shape {shape} (chunks {chunks}: a grid of {' x '.join(map(str, grid))} "
+                                       f"chunks) disagrees with its stored chunk {name}, which lies outside it: the "
+                                       "shape or the chunk shape is damaged")
+
+
+def _chunk_keys(start: Path, sep: str) -> list[tuple[int, ...]]:
+    """The chunk indices of the files under ``start`` named as chunk keys (numbers joined by ``sep``; with ``/``,
+    nested folders); other files (metadata, a stray ``.DS_Store``) are not chunks."""
+    import os
+
+    keys = []
+    if sep == "/":
+        for here, _, files in os.walk(start):
+            parts = Path(here).relative_to(start).parts
+            if all(part.isdigit() for part in parts):
+                keys += [tuple(int(v) for v in (*parts, f)) for f in files if f.isdigit()]
+        return keys
+    if start.is_dir():
+        for entry in os.scandir(start):
+            words = entry.name.split(sep)
+            if entry.is_file() and all(w.isdigit() for w in words):
+                keys.append(tuple(int(w) for w in words))
+    return keys
+
+
+def check_levels(root: Path, datasets: list[dict[str, Any]], arrays: list[Any]) -> None:
+    """ReadError unless each level's shape is what its scale gives from level 0's (``n0 * scale0 / scale``, within
+    one voxel: a writer may round a halved size either way) on every axis."""
+    if len(arrays) < 2:
+        return
+    n = len(arrays[0].shape)
+    first = np.asarray(arrays[0].shape, dtype=np.float64)
+    scale0, _ = _transform(datasets[0].get("coordinateTransformations"), n)
+    for dataset, array in zip(datasets[1:], arrays[1:]):
+        scale, _ = _transform(dataset.get("coordinateTransformations"), n)
+        if len(array.shape) != n or not (np.all(np.isfinite(scale)) and np.all(scale > 0)
+                                         and np.all(np.isfinite(scale0)) and np.all(scale0 > 0)):
+            continue
+        expected = first * scale0 / scale
+        if np.any(np.abs(np.asarray(array.shape) - expected) > 1 + 1e-9):
+            raise ReadError(root / str(dataset["path"]), f"its shape {list(array.shape)} disagrees with level 0's "
+                            f"{list(arrays[0].shape)} at the scales {scale.tolist()} and {scale0.tolist()} "
+                            f"(expected about {[round(float(v), 2) for v in expected]}): a shape or a scale is damaged")
+
+
 def _arrays(root: Path) -> list[Path]:
     """Every array folder under ``root`` (itself included), by its metadata file."""
     found = []
@@ -116,6 +202,7 @@ def _open(folder: Path) -> Any:
     import zarr
 
     check_array_metadata(folder)
+    check_stored_chunks(folder)
     try:
         return zarr.open_array(str(folder), mode="r")
     except Exception as exc:  # zarr-python raises many kinds on damaged metadata
@@ -141,6 +228,7 @@ def read_zarr(path: PathLike, level: int | str | None = None,
     if not datasets:
         raise ReadError(root, "its OME multiscales metadata lists no datasets")
     arrays = [_open(root / str(d["path"])) for d in datasets]
+    check_levels(root, datasets, arrays)
     if level is not None:
         if not (isinstance(level, int) and 0 <= level < len(arrays)):
             raise ReadError(root, f"level {level!r} is not one of its {len(arrays)} levels (0 = finest)")
