@@ -75,7 +75,7 @@ def test_rows_without_coordinates_are_left_out(tmp_path):
     assert np.isnan(mesh.point_data["v"][2])               # a missing value is NaN (drawn transparent)
 
 
-def test_rows_of_another_length_are_left_out_with_a_warning_naming_the_first(tmp_path):
+def test_rows_of_another_length_are_left_out_with_a_warning_naming_them(tmp_path):
     """Issue #32: a row cut short by a truncated file made its value column "text" (left out, the warning blaming
     the column), and a row whose decimal point became a comma (5 fields under a 4-column header) was dropped by
     genfromtxt without a word, or read shifted. A separator ending a row is not a field."""
@@ -84,7 +84,7 @@ def test_rows_of_another_length_are_left_out_with_a_warning_naming_the_first(tmp
     with pytest.warns(vio.ReadWarning) as caught:
         mesh = vio.read(path, isolate=False)
     assert [str(w.message) for w in caught] == [f"{path}: 2 of 6 rows do not hold the 4 fields its header names "
-                                                "(line 5 holds 5) and are left out"]
+                                                "(line 5 holds 5, line 7 holds 3) and are left out"]
     np.testing.assert_array_equal(mesh.points, [[1, 2, 3], [4, 5, 6], [7, 8, 9], [2, 2, 2]])
     np.testing.assert_array_equal(mesh.point_data["v"], [10, 11, 12, 14])
     path.write_text("x,y,z,v,label\n1,2,3,10,a\n4,5,6,11,b\n7,8,9,1,2,c\n")  # a text column: no fast parser

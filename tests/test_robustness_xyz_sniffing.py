@@ -27,7 +27,6 @@ def cloud(tmp_path):
 
 
 @pytest.mark.parametrize("first, message", [
-    (b"0 0\n", r"has no header row naming its columns \(its first row is numbers, 2 of them, not the 3 or more"),
     (b"0 0 1x0\n", r"has empty or repeated column names in its header row: 0, 0, 1x0$"),
     (b"0 0\x10100\n", r"has no column named x for the points' x coordinate; its columns are: 0, 0\x10100;"),
     (b"0 \x000 100\n", r"is not a text table \(it holds zero bytes\)$"),
@@ -41,12 +40,19 @@ def test_a_point_cloud_with_a_damaged_first_row_is_refused_as_a_table(cloud, fir
     assert "PLOT3D" not in str(caught.value)
 
 
-def test_a_first_row_with_one_field_more_is_read_with_a_warning(cloud):
+@pytest.mark.parametrize("first, holds", [(b"0 0 100 5\n", 4), (b"0 0\n", 2)])
+def test_a_first_row_with_a_field_more_or_less_is_the_odd_row_left_out(cloud, first, holds):
+    """The table's width is the one most rows hold: the damaged first row is left out with a warning naming it,
+    the other 79 rows read (the first row's width made 79 of 80 rows the odd ones; issue #32)."""
     path, rest = cloud
-    path.write_bytes(b"0 0 100 5\n" + rest)
+    path.write_bytes(first + rest)
     assert spec_of(path).name == "points-text"
-    with pytest.warns(vio.ReadWarning, match=r"79 of 80 rows do not hold the 4 fields its header names \(line 2 "):
-        vio.read(path, isolate=False)
+    with pytest.warns(vio.ReadWarning) as caught:
+        mesh = vio.read(path, isolate=False)
+    assert [str(w.message) for w in caught] == [f"{path}: 1 of 80 rows do not hold the 3 fields most of its rows "
+                                                f"hold (line 1 holds {holds}) and are left out"]
+    assert mesh.n_points == 79
+    assert mesh.points[0].tolist() == [0.37, 3.5, 101.0]
 
 
 def test_the_sniffers_on_the_intact_cloud_and_a_plot3d_grid(cloud, data, tmp_path):

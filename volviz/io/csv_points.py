@@ -7,8 +7,9 @@ and z (any case; ParaView's own exports name them ``Points:0``, ``Points:1``, ``
 columns the options ``x=``, ``y=``, ``z=`` name; a table without a z column lies in the z = 0 plane. Every other
 numeric column is an array on the points; columns of text are left out (named in a warning). Comma, semicolon, tab
 or blank separated; ``#`` starts a comment. Rows whose coordinates are missing, and rows of another number of
-fields than the header's, are left out with a warning. The points are vertices of an ``UnstructuredMesh``, drawn
-as points coloured by an array.
+fields than the header's (without a header: than most rows hold, the first row's count being no better than any
+other's), are left out with one warning naming them by line. The points are vertices of an ``UnstructuredMesh``,
+drawn as points coloured by an array.
 """
 from __future__ import annotations
 
@@ -77,17 +78,18 @@ def _coordinate_columns(p: Path, names: list[str], asked: tuple[str | None, ...]
     return out
 
 
-def _numbers(p: Path, sep: str | None, skip: int, columns: list[int], n_fields: int) -> np.ndarray:
+def _numbers(p: Path, sep: str | None, skip: int, columns: list[int], n_fields: int,
+             headerless: bool = False) -> np.ndarray:
     """The ``columns`` of the rows after the first ``skip`` lines as float64 (rows, columns): NumPy's fast parser
     when every row is complete (about 10x genfromtxt's speed: a million rows in 0.2 s; with every column numeric it
     also refuses a row of another length), else ``_complete_rows`` and genfromtxt, which reads missing values as NaN."""
     if len(columns) < n_fields:                 # columns of text: the fast parser would not see a row's length
-        return _parse(p, sep, _complete_rows(p, sep, skip, n_fields), columns)
+        return _parse(p, sep, _complete_rows(p, sep, skip, n_fields, headerless), columns)
     try:
         return np.loadtxt(p, delimiter=sep, skiprows=skip, comments="#", dtype=np.float64, ndmin=2,
                           encoding="utf-8")
     except (ValueError, UnicodeDecodeError):
-        return _parse(p, sep, _complete_rows(p, sep, skip, n_fields), columns)
+        return _parse(p, sep, _complete_rows(p, sep, skip, n_fields, headerless), columns)
 
 
 def _parse(p: Path, sep: str | None, rows: list[str], columns: list[int]) -> np.ndarray:
@@ -100,10 +102,15 @@ def _parse(p: Path, sep: str | None, rows: list[str], columns: list[int]) -> np.
             raise ReadError(p, f"has rows that cannot be read as numbers ({str(exc)[:200]})") from None
 
 
-def _complete_rows(p: Path, sep: str | None, skip: int, n_fields: int) -> list[str]:
-    """The rows after the first ``skip`` lines that hold the ``n_fields`` fields the header names; the others (a
-    row cut short by a truncated file, a decimal point turned into a comma) are left out with a ReadWarning naming
-    the first of them: before, genfromtxt dropped them without a word (issue #32)."""
+#: odd rows a warning names by line
+NAMED_ROWS = 10
+
+
+def _complete_rows(p: Path, sep: str | None, skip: int, n_fields: int, headerless: bool = False) -> list[str]:
+    """The rows after the first ``skip`` lines that hold the ``n_fields`` fields the header names (or, without a
+    header, most rows hold); the others (a row cut short by a truncated file, a decimal point turned into a comma)
+    are left out with one ReadWarning naming them by line (``NAMED_ROWS`` at most): before, genfromtxt dropped them
+    without a word (issue #32)."""
     with open(p, encoding="utf-8", errors="replace") as f:
         lines = f.read().splitlines()[skip:]
     good: list[str] = []
@@ -118,9 +125,11 @@ def _complete_rows(p: Path, sep: str | None, skip: int, n_fields: int) -> list[s
         else:
             bad.append((number, count))
     if bad:
-        warnings.warn(f"{p}: {len(bad):,} of {len(good) + len(bad):,} rows do not hold the {n_fields} fields its "
-                      f"header names (line {bad[0][0]} holds {bad[0][1]}) and are left out", ReadWarning,
-                      stacklevel=4)
+        named = ", ".join(f"line {number} holds {count}" for number, count in bad[:NAMED_ROWS])
+        more = f", {len(bad) - NAMED_ROWS:,} more" if len(bad) > NAMED_ROWS else ""
+        whose = "most of its rows hold" if headerless else "its header names"
+        warnings.warn(f"{p}: {len(bad):,} of {len(good) + len(bad):,} rows do not hold the {n_fields} fields "
+                      f"{whose} ({named}{more}) and are left out", ReadWarning, stacklevel=4)
     return good
 
 
@@ -138,14 +147,27 @@ def _count_line(lines: list[str], at: int) -> int:
     return 0
 
 
-def _headerless_names(lines: list[str], at: int, sep: str | None) -> list[str]:
-    """Names for the columns of a table without a header row: x, y, z, then ``column 4`` ...; the last three extra
-    columns are red, green, blue when they hold whole numbers 0 to 255 in every sampled row (scanners' x y z r g b
-    and x y z intensity r g b), a lone column before them ``intensity``."""
-    n = len(_fields(lines[at], sep))
+def _headerless_width(p: Path, lines: list[str], at: int, sep: str | None) -> int:
+    """The number of fields of a table without a header row: the one most of its first ``SAMPLE_ROWS`` rows hold
+    (the first row's on a tie), so a damaged row, the first one too, is the odd one left out, not the other 79 of 80
+    (issue #32); ReadError when no count is shared by half of them."""
+    counts = [len(_fields(line, sep)) for line in _rows(lines[at:at + SAMPLE_ROWS])]
+    tally = {n: counts.count(n) for n in counts}
+    width = max(tally, key=lambda n: (tally[n], n == counts[0]))
+    if 2 * tally[width] < len(counts):
+        shown = ", ".join(f"{n} in {k}" for n, k in sorted(tally.items())[:8])
+        raise ReadError(p, f"its rows disagree in their number of fields, none shared by half of the first "
+                           f"{len(counts)} ({shown}): not a table of points")
+    return width
+
+
+def _headerless_names(lines: list[str], at: int, sep: str | None, n: int) -> list[str]:
+    """Names for the ``n`` columns of a table without a header row: x, y, z, then ``column 4`` ...; the last three
+    extra columns are red, green, blue when they hold whole numbers 0 to 255 in every sampled row of ``n`` fields
+    (scanners' x y z r g b and x y z intensity r g b), a lone column before them ``intensity``."""
     names = ["x", "y", "z"] + [f"column {i}" for i in range(4, n + 1)]
-    sample = [_fields(line, sep) for line in _rows(lines[at:at + SAMPLE_ROWS])]
-    if n >= 6 and all(len(row) == n for row in sample):
+    sample = [row for row in (_fields(line, sep) for line in _rows(lines[at:at + SAMPLE_ROWS])) if len(row) == n]
+    if n >= 6 and sample:
         try:
             colors = np.array([[float(v) for v in row[-3:]] for row in sample])
         except ValueError:
@@ -211,12 +233,14 @@ def _read_points(path: PathLike, asked: tuple[str | None, str | None, str | None
     sep = _separator(lines[header_at])
     names = _fields(lines[header_at], sep)
     skip = header_at + 1
-    if all(_number(n) for n in names):
-        if not headerless or len(names) < 3:
+    bare = all(_number(n) for n in names)
+    if bare:
+        width = _headerless_width(p, lines, header_at, sep) if headerless else len(names)
+        if not headerless or width < 3:
             raise ReadError(p, "has no header row naming its columns (its first row is numbers" + (
-                f", {len(names)} of them, not the 3 or more of x y z columns)" if headerless else ")"),
+                f", {width} of them in most rows, not the 3 or more of x y z columns)" if headerless else ")"),
                 "add a first row naming the columns, with x, y and z for the coordinates")
-        names, skip = _headerless_names(lines, header_at, sep), header_at
+        names, skip = _headerless_names(lines, header_at, sep, width), header_at
     if len(set(names)) != len(names) or any(not n for n in names):
         raise ReadError(p, "has empty or repeated column names in its header row: " + ", ".join(names[:30]))
     columns = _coordinate_columns(p, names, asked)
@@ -230,7 +254,7 @@ def _read_points(path: PathLike, asked: tuple[str | None, str | None, str | None
         if col is not None and col not in numeric:
             raise ReadError(p, f"its {'xyz'[axis]} column {names[col]!r} holds text, not numbers")
     text = [names[i] for i in range(len(names)) if i not in numeric]
-    table = _numbers(p, sep, skip, numeric, len(names))
+    table = _numbers(p, sep, skip, numeric, len(names), bare)
     if table.size == 0:
         raise ReadError(p, "has no rows of numbers under its header")
     at = {col: k for k, col in enumerate(numeric)}
