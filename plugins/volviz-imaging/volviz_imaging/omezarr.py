@@ -87,18 +87,20 @@ def _sizes(value: Any, least: int) -> bool:
     return isinstance(value, list) and all(type(n) is int and n >= least for n in value)
 
 
+def _mapping(value: Any) -> dict[str, Any]:
+    return value if isinstance(value, dict) else {}
+
+
 def _grid(meta: dict[str, Any]) -> tuple[Any, Any, str, str]:
     """(shape, chunk shape, chunk key prefix, separator) of a Zarr v2 ``.zarray`` or v3 ``zarr.json``."""
     if "chunks" in meta or meta.get("zarr_format") == 2:
         return meta.get("shape"), meta.get("chunks"), "", str(meta.get("dimension_separator") or ".")
-    grid = meta.get("chunk_grid") if isinstance(meta.get("chunk_grid"), dict) else {}
-    chunks = (grid.get("configuration") or {}).get("chunk_shape") if isinstance(grid.get("configuration"), dict) \
-        else None
-    encoding = meta.get("chunk_key_encoding") if isinstance(meta.get("chunk_key_encoding"), dict) else {}
-    config = encoding.get("configuration") if isinstance(encoding.get("configuration"), dict) else {}
+    chunks = _mapping(_mapping(meta.get("chunk_grid")).get("configuration")).get("chunk_shape")
+    encoding = _mapping(meta.get("chunk_key_encoding"))
+    separator = _mapping(encoding.get("configuration")).get("separator")
     if encoding.get("name") == "v2":
-        return meta.get("shape"), chunks, "", str(config.get("separator") or ".")
-    return meta.get("shape"), chunks, "c", str(config.get("separator") or "/")
+        return meta.get("shape"), chunks, "", str(separator or ".")
+    return meta.get("shape"), chunks, "c", str(separator or "/")
 
 
 def check_stored_chunks(folder: Path) -> None:
