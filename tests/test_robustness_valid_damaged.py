@@ -64,3 +64,20 @@ def test_the_report_has_the_column(case):
     assert "| garbage | valid | warned |" in text
     assert "| ensight | 3 | 1 \\| 1 | 0 \\| 0 | 0 \\| 0 | 0 \\| 0 | 0 \\| 0 | 0 \\| 0 | 2 \\| 2 | 0 \\| 0 |" in text
     assert "silent garbage: 0 — met (besides, valid as damaged: 2," in text
+
+
+def test_replay_says_a_recorded_cut_case_file_is_valid_as_damaged(tmp_path):
+    """``--replay`` of the campaign's case (recorded as the campaign records it) reads it on both sides now."""
+    from volviz.bench.robustness_replay import Recorder, case_record
+
+    src = next(s for s in rb.made_sources(tmp_path / "made", ["ensight"]) if s.name.endswith("mesh.case"))
+    raw = src.path.read_bytes()
+    mutation = rb.make_mutation(src, raw, ("truncate", 52))
+    record = tmp_path / "cases.jsonl"
+    recorder = Recorder(record)
+    recorder.write({**case_record(56, 33, src, "made", ("truncate", 52), mutation, raw, mutation.data),
+                    "outcome": {"volviz": "garbage", "vtk": "garbage"}})
+    recorder.close()
+    lines = rb.replay(record, 56, tmp_path / "data", tmp_path / "replay")
+    assert lines[2:] == ["recorded outcome: volviz garbage, vtk garbage", "volviz now: read",
+                         "VTK's reader now: ok, the same content: valid as damaged"]

@@ -1155,7 +1155,8 @@ def rebuild(item: dict[str, Any], data: Path, into: Path) -> tuple[Path, Path, S
 
 def replay(record: Path, case: int, data: Path, into: Optional[Path], read: bool = True) -> list[str]:
     """``volviz bench robustness --replay CASE``: rebuild the case, say where it is and, with ``read``, what
-    volviz's reader makes of it now (as the campaign's volviz side reads it)."""
+    volviz's reader makes of it now (as the campaign's volviz side reads it); a truncated file volviz reads is read
+    by VTK's reader too (in the campaign's worker child), to say whether it is valid as damaged."""
     item = load(record, case)
     into = into if into is not None else Path(tempfile.mkdtemp(prefix=f"volviz-replay-{case}-"))
     target, opened, src = rebuild(item, data, into)
@@ -1169,6 +1170,16 @@ def replay(record: Path, case: int, data: Path, into: Optional[Path], read: bool
             "read, warned" if answer.get("warned") else "read")
         lines.append(f"volviz now: {now}: {answer.get('message') or answer.get('warned') or answer.get('problem')}"
                      .rstrip(": "))
+        if answer["status"] == "ok" and src.vtk and item["kind"] == "truncate":
+            side = BenchWorker("vtk", 3 << 30, VTK_SECONDS, into)
+            try:
+                theirs = side.ask({"path": str(opened), "options": src.options, "recipe": src.vtk})
+            finally:
+                side.close()
+            same = valid_as_damaged(item["kind"], {"volviz": answer, "vtk": theirs})
+            lines.append(f"VTK's reader now: {theirs['status']}" + (
+                ", the same content: valid as damaged" if same else
+                ", other content" if theirs["status"] == "ok" else f": {theirs.get('message', '')}"))
     return lines
 
 
