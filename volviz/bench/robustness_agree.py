@@ -43,7 +43,8 @@ def content_volviz(frame: Any) -> dict:
                 seen.setdefault(id(a), a)
     bounds: Optional[list[float]] = None
     points = getattr(frame, "points", None)
-    if isinstance(points, np.ndarray) and points.ndim == 2 and len(points):
+    if isinstance(points, np.ndarray) and points.ndim >= 2 and points.size:
+        points = points.reshape(-1, points.shape[-1])          # a curvilinear grid's (nx, ny, nz, 3)
         padded = np.zeros((len(points), 3))
         padded[:, :min(3, points.shape[1])] = points[:, :3]
         bounds = [float(v) for lo, hi in zip(padded.min(axis=0), padded.max(axis=0)) for v in (lo, hi)]
