@@ -42,7 +42,6 @@ from typing import Any
 import numpy as np
 
 from volviz.render.backend import plotter_gl_info
-from volviz.render.preview_upsample import upsample_preview
 
 __all__ = ["ImageOverlay", "OverlayView", "block_min", "overlay_rgba8", "read_buffers",
            "single_sample_on_software", "unpremultiply_rgba8", "zbuffer_to_depth"]
@@ -81,6 +80,8 @@ def overlay_rgba8(image: np.ndarray, request: dict[str, Any] | None = None) -> n
     a preview of ``request`` (``OverlayView.begin`` with ``scale`` > 1) magnified to the window first
     (``preview_upsample``). Made on a worker where possible (``PTVolume.compute``)."""
     if request is not None and request.get("preview") and "window_depth" in request:
+        from volviz.render.preview_upsample import upsample_preview   # Numba: loaded by a moving camera's preview
+
         image = upsample_preview(image, request["depth"], request["window_depth"])
     return unpremultiply_rgba8(image)
 

@@ -1,0 +1,74 @@
+"""Issue #30, time to the first image: the imports a fresh process defers to their first use. ``volviz.optics``
+resolves its public names on first use (``import volviz.optics`` and its ``TransferFunction`` load no Numba, a
+table's name loads the kernels it needs), and the render layer runs matplotlib's pyplot, which pyvista imports for
+nothing a render uses, only when a name of it is used (``volviz.render.lazy_pyplot``)."""
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+
+from conftest import REPO, data_file
+
+
+def _child(code: str) -> dict:
+    """The JSON object the last line of ``code``'s output holds, run in a fresh interpreter (matplotlib on its file
+    backend: no window of its own under the tests' display)."""
+    done = subprocess.run([sys.executable, "-c", code], cwd=REPO, capture_output=True, text=True, timeout=300,
+                          env={**os.environ, "MPLBACKEND": "Agg"})
+    assert done.returncode == 0, done.stderr[-3000:]
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+def test_optics_loads_no_numba_until_a_kernel_is_named() -> None:
+    report = _child("""
+import json, sys
+import volviz.optics as optics
+from volviz.optics import TransferFunction
+tf = TransferFunction.ramp(0.0, 1.0)
+before = "numba" in sys.modules or "scipy" in sys.modules
+build = optics.build_table3d
+from volviz.optics.table3d import build_table3d
+names = {}
+exec("from volviz.optics import *", names)
+print(json.dumps({"before": before, "after": "numba" in sys.modules, "same": build is build_table3d,
+                  "star": sorted(n for n in names if not n.startswith("__")), "all": sorted(optics.__all__),
+                  "tf": TransferFunction is sys.modules["volviz.optics.transfer_function"].TransferFunction}))
+""")
+    assert report["before"] is False
+    assert report["after"] is True and report["same"] is True and report["tf"] is True
+    assert report["star"] == report["all"] and len(report["all"]) == 23
+
+
+def test_optics_refuses_an_unknown_name() -> None:
+    import pytest
+
+    import volviz.optics
+
+    with pytest.raises(AttributeError, match="no attribute 'build_table4d'"):
+        getattr(volviz.optics, "build_table4d")
+
+
+def test_a_render_runs_no_pyplot_and_pyplot_still_works(tmp_path) -> None:
+    out = tmp_path / "v.png"
+    report = _child(f"""
+import json, sys
+from volviz.cli import main
+code = main(["render", {str(data_file("volumes/HeadMRVolume.mhd"))!r}, "-o", {str(out)!r}, "--size", "64x48"])
+from volviz.render.lazy_pyplot import pyplot_ran
+imported, ran, figure = "matplotlib.pyplot" in sys.modules, pyplot_ran(), "matplotlib.figure" in sys.modules
+import matplotlib.pyplot as plt                      # a second import binds the same module, still not run
+again = pyplot_ran()
+fig = plt.figure(figsize=(2, 1))                     # the first use runs it in place
+names = {{}}
+exec("from matplotlib.pyplot import *", names)
+print(json.dumps({{"code": code, "imported": imported, "ran": ran, "figure": figure, "again": again,
+                  "now": pyplot_ran(), "same": sys.modules["matplotlib.pyplot"] is plt,
+                  "fig": type(fig).__name__, "inches": [float(v) for v in fig.get_size_inches()],
+                  "star": "subplots" in names}}))
+""")
+    assert out.stat().st_size > 0 and report["code"] == 0
+    assert report["imported"] is True and report["ran"] is False and report["figure"] is False
+    assert report["again"] is False and report["now"] is True and report["same"] is True
+    assert report["fig"] == "Figure" and report["inches"] == [2.0, 1.0] and report["star"] is True
