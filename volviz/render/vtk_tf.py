@@ -12,6 +12,10 @@ from volviz.optics.transfer_function import TransferFunction
 
 __all__ = ["tf_from_vtk", "tf_to_vtk"]
 
+#: the opacity function's last node is repeated this share of the span above the top (see ``tf_to_vtk``); closer,
+#: VTK's GPU ray caster asks for an opacity texture fine enough to resolve it (a million texels at 1e-6) and warns
+TOP_GUARD = 1e-3
+
 
 def tf_from_vtk(ctf: Any, otf: Any, unit_distance: float, name: str = "",
                 samples: int = 256) -> TransferFunction:
@@ -21,7 +25,9 @@ def tf_from_vtk(ctf: Any, otf: Any, unit_distance: float, name: str = "",
     (color space RGB, every node midpoint 0.5 and sharpness 0). Otherwise (HSV/Lab/diverging color space or
     non-default midpoints) the functions are additionally sampled at ``samples`` evenly spaced scalars: the result
     is then a piecewise-linear approximation of VTK's curve. VTK clamps outside its range; volviz is transparent
-    there (the range is the union of both functions' ranges).
+    there (the range is the union of both functions' ranges). The guard node ``tf_to_vtk`` adds above the top (the
+    last opacity node, ``TOP_GUARD`` of the span above the color function's last node, repeating its opacity) is
+    left out.
     """
     unit_distance = float(unit_distance)
     if not (np.isfinite(unit_distance) and unit_distance > 0):
@@ -40,6 +46,8 @@ def tf_from_vtk(ctf: Any, otf: Any, unit_distance: float, name: str = "",
         val4 = [0.0] * 4
         otf.GetNodeValue(i, val4)
         onodes[i] = val4
+    if n_o > 2 and _is_top_guard(onodes, cnodes[-1, 0]):
+        onodes = onodes[:-1]
     exact = (
         int(ctf.GetColorSpace()) == 0  # VTK_CTF_RGB
         and np.allclose(cnodes[:, 4], 0.5, atol=1e-12, rtol=0) and np.allclose(cnodes[:, 5], 0.0, atol=1e-12)
@@ -67,8 +75,12 @@ def tf_to_vtk(tf: TransferFunction, unit_distance: float) -> tuple[Any, Any]:
     """``tf`` as ``(vtkColorTransferFunction, vtkPiecewiseFunction)`` with opacity a = ρ · unit_distance.
 
     Set the same ``unit_distance`` as the volume property's ``ScalarOpacityUnitDistance``. Clamping is turned off
-    on both, so VTK is transparent outside the range like volviz. Opacity values above 1 are kept as they are (VTK
-    clamps them when it uses them), so round-trips are exact.
+    on both, so VTK is transparent outside the range like volviz. Without clamping VTK's piecewise function counts
+    its last node's own scalar as outside (``GetValue`` and the mappers' tables give 0 there), so a region of the
+    data exactly at the function's top value drew transparent (a made sphere of the data's maximum came out hollow
+    and blotchy): the last opacity is repeated ``TOP_GUARD`` of the span above the top, which VTK then counts as
+    outside instead. Opacity values above 1 are kept as they are (VTK clamps them when it uses them), so round-trips
+    (``tf_from_vtk``, which leaves the guard out) are exact.
     """
     unit_distance = float(unit_distance)
     if not (np.isfinite(unit_distance) and unit_distance > 0):
@@ -83,4 +95,16 @@ def tf_to_vtk(tf: TransferFunction, unit_distance: float) -> tuple[Any, Any]:
     for s, (r, g, b), rho in zip(tf.scalars, tf.colors, tf.extinction):
         ctf.AddRGBPoint(float(s), float(r), float(g), float(b))
         otf.AddPoint(float(s), float(rho) * unit_distance)
+    top = float(tf.scalars[-1])
+    guard = max(top + TOP_GUARD * (top - float(tf.scalars[0])), float(np.nextafter(top, np.inf)))
+    otf.AddPoint(guard, float(tf.extinction[-1]) * unit_distance)
     return ctf, otf
+
+
+def _is_top_guard(onodes: np.ndarray, color_top: float) -> bool:
+    """Whether the last of the opacity nodes (x, value, midpoint, sharpness) is ``tf_to_vtk``'s guard above the
+    color function's top ``color_top``: just above it, repeating the opacity of the node at it."""
+    (x0, a0), (x1, a1) = onodes[-2, :2], onodes[-1, :2]
+    span = x0 - float(onodes[0, 0])
+    reach = max(x0 + TOP_GUARD * span, float(np.nextafter(x0, np.inf)))
+    return bool(x0 == color_top and a1 == a0 and x0 < x1 <= reach)
