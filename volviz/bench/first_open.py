@@ -203,22 +203,20 @@ def object_transfer_function(lo: float, hi: float, chord: float, mode: Optional[
     """White and opaque (optical depth 60 along ``chord``) over ``[lo, hi]``, transparent over the background mode
     ``mode`` (``volviz.optics.auto_tf.background_mode``'s (low edge, high edge, centre): its histogram bins, the
     values ``low <= v < high``, or up to ``hi`` when the mode ends the range); opaque everywhere without one. The
-    steps are ``1e-6`` of the range wide, far below a histogram bin (1/256 of it). The function runs a thousandth of
-    the range past ``hi``: VTK draws a homogeneous region whose value is a function's very top nearly transparent
-    (a made sphere of the data's maximum came out blotchy), and a footprint must not have holes."""
+    steps are ``1e-6`` of the range wide, far below a histogram bin (1/256 of it). A region at ``hi`` itself is
+    opaque (``volviz.render.vtk_tf.tf_to_vtk`` keeps VTK's top inclusive): a footprint has no holes there."""
     from volviz.optics import TransferFunction
 
     rho = 60.0 / chord
-    top = hi + 1e-3 * (hi - lo)
     if mode is None:
-        return TransferFunction([lo, top], [(1.0, 1.0, 1.0)] * 2, [rho] * 2, name=name)
+        return TransferFunction([lo, hi], [(1.0, 1.0, 1.0)] * 2, [rho] * 2, name=name)
     eps = 1e-6 * (hi - lo)
     low, high = max(mode[0], lo), mode[1]
     points = [(lo, rho), (low - eps, rho)] if low - eps > lo else []
     if high < hi:
-        points += [(low, 0.0), (high - eps, 0.0), (high, rho), (top, rho)]
+        points += [(low, 0.0), (high - eps, 0.0), (high, rho), (hi, rho)]
     else:                  # the mode ends the range: transparent up to the top
-        points += [(low, 0.0), (top, 0.0)]
+        points += [(low, 0.0), (hi, 0.0)]
     stops, extinction = zip(*points)
     return TransferFunction(stops, [(1.0, 1.0, 1.0)] * len(stops), extinction, name=name)
 
