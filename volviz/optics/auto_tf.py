@@ -3,7 +3,13 @@
 The opacity ramp runs between robust percentiles of the values (2 % and 99.5 %), computed without the background: a
 histogram bin at either end of the range that holds more than ``BACKGROUND_FRACTION`` of the values (the air around a
 CT scan, the zero outside a simulation's domain) is left out, and so stays transparent. The color is a cool-warm map
-over the same percentiles. The peak extinction is set so that a ray crossing the data's bounding box reaches an
+over the same stops. The stops are placed by histogram equalization (Chourasia & Schulze 2007, "Data centric transfer
+functions for high dynamic range volume data", WSCG, §3; their equalization, without the opacity weighting): at equal
+steps of the cumulative distribution of the values between the percentiles, so each of the ramp's four segments holds
+a quarter of the object's samples. Evenly spaced stops put most of a long-tailed object (a density falling off over
+decades, soft tissue under bone, a storm's thin edge) under the first segment, nearly transparent (docs/first-open.md
+has the figures). Ties (a value holding over a quarter of the samples, as in 8-bit data) are split by
+``MIN_STOP_GAP`` of the span. The peak extinction is set so that a ray crossing the data's bounding box reaches an
 optical depth of about ``TARGET_DEPTH`` for the average sample, whatever the data's units and spread: the image is
 neither faint nor a solid block. Values above the upper percentile keep the peak opacity and color; the function
 spans the whole finite range, because volviz draws scalars outside a transfer function's range as transparent.
@@ -17,7 +23,7 @@ it; elsewhere (a free stream, the bright side of an inverted image) the function
 and rising with the distance from it on either side, cool below and warm above, as the signed view is about zero.
 
 ``volviz.optics.boundary`` places the one-sided view's opacity at the data's boundaries instead (Kindlmann & Durkin
-1998); on the shared volumes it was less legible by the measures of docs/first-open.md, so the ramp stays.
+1998); on the shared volumes it was less legible by the measures of docs/first-open.md, so the equalized ramp stays.
 
 Signed data around zero (seismic amplitudes, a velocity component, vorticity, an orbital's two signs: robust
 percentiles of opposite signs, the smaller at least ``SIGNED_BALANCE`` of the larger) gets the diverging view
@@ -40,6 +46,7 @@ RAMP = (0.0, 0.08, 0.3, 0.65, 1.0)     # extinction at the five color stops, as 
 MODE_WIDTH = 0.125             # a background mode spans at most this share of the value range
 SMOOTHING = 5                  # bins of the box filter the mode's flanks are followed on
 SIGNED_BALANCE = 0.25          # signed data: the smaller of |low| and |high| percentile over the larger, at least
+MIN_STOP_GAP = 1.0 / 256       # equalized stops lie at least this share of their span apart (one histogram bin)
 
 
 def finite_sample(values: np.ndarray) -> np.ndarray:
@@ -91,18 +98,20 @@ def auto_transfer_function(values: np.ndarray, chord: float, name: str = "auto")
     sample = finite_sample(values)
     chord = float(chord) if np.isfinite(chord) and chord > 0 else 1.0
     if sample.size == 0:
-        return _ramp(0.0, 1.0, 0.0, 1.0, TARGET_DEPTH / chord, name)
+        return _ramp(0.0, 1.0, np.linspace(0.0, 1.0, len(RAMP)), TARGET_DEPTH / chord, name)
     full_lo, full_hi = float(sample.min()), float(sample.max())
     if full_hi <= full_lo:   # constant data: a faint uniform fog around the one value
         pad = max(abs(full_lo) * 1e-3, 1e-6)
-        return _ramp(full_lo - pad, full_hi + pad, full_lo - pad, full_hi + pad, MIN_DEPTH / chord, name)
+        return _ramp(full_lo - pad, full_hi + pad, np.linspace(full_lo - pad, full_hi + pad, len(RAMP)),
+                     MIN_DEPTH / chord, name)
     mode = background_mode(sample)
     if mode is not None and mode[0] > full_lo:     # a background inside the range or at its top: centred on it
         return _around(sample, full_lo, full_hi, mode, chord, name)
     span = one_sided_range(sample, mode)
     if span is not None:
-        shape = np.interp(sample, np.linspace(span[0], span[1], len(RAMP)), RAMP, left=0.0)
-        return _ramp(full_lo, full_hi, span[0], span[1], peak_extinction(float(shape.mean()), chord), name)
+        stops = equalized_stops(sample, *span)
+        shape = np.interp(sample, stops, RAMP, left=0.0)
+        return _ramp(full_lo, full_hi, stops, peak_extinction(float(shape.mean()), chord), name)
     lo, hi = robust_range(sample)
     reach = max(-lo, hi)
     shape = np.interp(np.abs(sample), np.linspace(0.0, reach, len(RAMP)), RAMP)
@@ -124,6 +133,21 @@ def one_sided_range(sample: np.ndarray, mode: tuple[float, float, float] | None 
                 return lo, hi
     lo, hi = robust_range(sample)
     return None if is_signed(lo, hi) else (lo, hi)
+
+
+def equalized_stops(sample: np.ndarray, lo: float, hi: float, n: int = len(RAMP)) -> np.ndarray:
+    """``n`` stops from ``lo`` to ``hi`` at equal steps of the cumulative distribution of the values of
+    ``sample`` within [``lo``, ``hi``] (histogram equalization, see the module docstring), at least ``MIN_STOP_GAP``
+    of the span apart: the quantiles 0, 1/(n-1), ..., 1 of those values, ties moved up (down near ``hi``)."""
+    inside = sample[(sample >= lo) & (sample <= hi)]
+    stops = np.quantile(inside, np.linspace(0.0, 1.0, n)) if inside.size else np.linspace(lo, hi, n)
+    stops[0], stops[-1] = lo, hi
+    gap = MIN_STOP_GAP * (hi - lo)
+    for i in range(1, n - 1):
+        stops[i] = max(stops[i], stops[i - 1] + gap)
+    for i in range(n - 2, 0, -1):
+        stops[i] = min(stops[i], stops[i + 1] - gap)
+    return stops
 
 
 def background_mode(values: np.ndarray, bins: int = 256) -> tuple[float, float, float] | None:
@@ -197,9 +221,9 @@ def _diverging(full_lo: float, full_hi: float, reach: float, rho_max: float, nam
     return held_flat(full_lo, full_hi, stops, colors, extinction, name, hold_low=True)
 
 
-def _ramp(full_lo: float, full_hi: float, lo: float, hi: float, rho_max: float, name: str) -> TransferFunction:
-    """Cool-warm color and the extinction ``RAMP`` between ``lo`` and ``hi``, held flat out to the full range."""
-    stops = list(np.linspace(lo, hi, len(RAMP)))
+def _ramp(full_lo: float, full_hi: float, at: np.ndarray, rho_max: float, name: str) -> TransferFunction:
+    """Cool-warm color and the extinction ``RAMP`` at the stops ``at``, held flat out to the full range."""
+    stops = [float(v) for v in at]
     colors = [list(c) for c in COOL_WARM]
     extinction = [r * rho_max for r in RAMP]
     return held_flat(full_lo, full_hi, stops, colors, extinction, name)
