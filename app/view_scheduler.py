@@ -203,13 +203,14 @@ class ViewScheduler(WindowBase):
         (VTK's own mappers draw it at once). Visibility, opacity, clipping: drawn, and the views refreshed except
         those waiting for a cut made on the CPU (``controller.pending``, refreshed once their cut is shown) and those
         of a component without a view yet (a natural-scene component or one being prepared: refreshed once
-        installed). The isosurfaces' mode: the CPU overlay re-rendered."""
+        installed). The isosurfaces' mode, and a transfer function (the overlay splits a regular volume at the surfaces,
+        ``volviz.render.iso_volume_split``): the CPU overlay re-rendered."""
         controller = self.controller
         comp = change.component
         if controller is None or (change.what == "visible" and comp not in controller.views):
             return
-        if change.what == "transfer_function":
-            if not self.refresh_views([comp] if comp else None, estimate=not change.preview,
+        if change.what == "transfer_function":   # the isosurfaces' CPU overlay holds the volume in front of them
+            if not self.refresh_views([comp, "iso-overlay"] if comp else None, estimate=not change.preview,
                                       scale=MOVING_SCALE if change.preview else 1):
                 self.render_scene()
             return

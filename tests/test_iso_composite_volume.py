@@ -1,107 +1,22 @@
 """A translucent isosurface inside a regular volume drawn by VTK (issue #28; ``volviz.render.volume_peeling``): along
-each ray the volume behind the surface, the surface and the volume in front composite in that order.
-
-The reference is made of the same scene's own renders, without peeling, in float: F the volume alone, V_f
-(premultiplied) and a_f the volume cut at the surface (the surface made opaque, black and then white, unlit),
-S (premultiplied) and a_S the surface alone (over black and over white). For one surface layer per ray the right
-composite is V_f + (1 − a_f)(S + (1 − a_S) V_b) with F = V_f + (1 − a_f) V_b, i.e. (1 − a_S) F + a_S V_f + (1 − a_f) S.
-A plane isosurface (of a second dataset, f = y) through a ball-shaped volume gives each ray exactly one layer."""
+each ray the volume behind the surface, the surface and the volume in front composite in that order, against the
+exact composite of the scene's own unpeeled renders (``iso_volume_scene``: a plane isosurface through a ball-shaped
+volume, one layer per ray)."""
 from __future__ import annotations
 
 import numpy as np
-import pytest
 import pyvista as pv
 
-from volviz.model.datasets import RegularVolume
+from iso_volume_scene import close_plotters, one_layer_composite, scene, shot, surface_alone, volume_cut  # noqa: F401
 from volviz.render.backend import plotter_gl_info
-from volviz.render.controller import SceneController
-from volviz.render.export import separate_background
-from volviz.render.iso_spectrum import apply_spectrum_shader
 from volviz.render.volume_peeling import peeling_volumes, peel_volumes
-from volviz.session import CameraState, Component, DatasetRef, Session
-
-SIZE = (200, 150)
-N = 32
-STYLE = {"value": (N - 1) / 2.0, "color": [0.1, 0.9, 0.2], "opacity": 0.4}
-PLAIN = {"scalar_bar": False, "axes": False, "outline": False}
 
 
-def datasets() -> dict[str, RegularVolume]:
-    g = np.linspace(-1.0, 1.0, N)
-    x, y, z = np.meshgrid(g, g, g, indexing="ij")
-    ball = np.clip(1.0 - (x * x + y * y + z * z), 0.0, None).astype(np.float32)   # dense in the middle
-    plane = np.broadcast_to(np.arange(N, dtype=np.float32)[None, :, None], (N, N, N)).copy()   # f = y (voxels)
-    return {"v": RegularVolume(ball), "p": RegularVolume(plane)}
-
-
-_PLOTTERS: list[pv.Plotter] = []
-
-
-@pytest.fixture(autouse=True)
-def _close_plotters():
-    yield
-    while _PLOTTERS:
-        _PLOTTERS.pop().close()
-
-
-def scene(backend: str) -> tuple[SceneController, pv.Plotter]:
-    s = Session(datasets=[DatasetRef("v", "/unused"), DatasetRef("p", "/unused")],
-                components=[Component("vol", "volume", "v", opacity=0.15),
-                            Component("iso", "isosurface", "p", settings={"styles": [STYLE]})],
-                camera=CameraState((-12.0, -40.0, 34.0), (15.5, 15.5, 15.5), (0.0, 0.0, 1.0)))
-    s.render.background = (0.0, 0.0, 0.0)
-    s.render.options.update(PLAIN, backend=backend)
-    p = pv.Plotter(off_screen=True, window_size=SIZE)
-    p.ren_win.SetMultiSamples(0)
-    _PLOTTERS.append(p)
-    c = SceneController(p, s, datasets())
-    c.build()
-    return c, p
-
-
-def shot(p: pv.Plotter) -> np.ndarray:
-    p.render()
-    return p.screenshot(None, return_img=True)[..., :3].astype(np.float64) / 255.0
-
-
-def surface_actor(c: SceneController):
-    prop = c.props["iso"]
-    assert len(prop.volviz_translucent) == 1
-    return prop.volviz_translucent[0]
-
-
-def reference(c: SceneController, p: pv.Plotter) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(expected composite, a_S, F) from the scene's unpeeled renders (module docstring), all over black."""
-    volume, actor = c.props["vol"], surface_actor(c)
-    peel_volumes(p, [volume], False)
-    actor.SetVisibility(False)
-    full = shot(p)                                   # F
-    actor.SetVisibility(True)
-    volume.SetVisibility(False)
-    ren = p.renderer
-    on_black = shot(p)
-    ren.SetBackground(1.0, 1.0, 1.0)
-    on_white = shot(p)
-    ren.SetBackground(0.0, 0.0, 0.0)
-    surf = separate_background(np.rint(on_black * 255).astype(np.uint8), np.rint(on_white * 255).astype(np.uint8))
-    a_s = surf[..., 3:4].astype(np.float64) / 255.0
-    s = on_black                                     # premultiplied S: the surface over black
-    volume.SetVisibility(True)
-    prop, shader = actor.GetProperty(), actor.GetShaderProperty()
-    kept = (prop.GetOpacity(), prop.GetColor(), prop.GetLighting())
-    shader.ClearAllFragmentShaderReplacements()
-    prop.SetOpacity(1.0)
-    prop.LightingOff()
-    cut = []
-    for grey in (0.0, 1.0):                          # V_f over the opaque surface in black, then white
-        prop.SetColor(grey, grey, grey)
-        cut.append(shot(p))
-    v_f, one_minus_a_f = cut[0], (cut[1] - cut[0]).mean(axis=-1, keepdims=True)
-    prop.SetOpacity(kept[0])
-    prop.SetColor(*kept[1])
-    prop.SetLighting(kept[2])
-    apply_spectrum_shader(actor, kept[0])
-    return (1.0 - a_s) * full + a_s * v_f + one_minus_a_f * s, a_s[..., 0], full
+def reference(c, p: pv.Plotter) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(expected composite, a_S, F) from the scene's unpeeled renders (``iso_volume_scene``), all over black."""
+    full, v_f, one_minus_a_f = volume_cut(c, p)
+    s, a_s = surface_alone(c, p)
+    return one_layer_composite(full, v_f, one_minus_a_f, s, a_s), a_s, full
 
 
 def test_surface_lies_between_the_volume_behind_and_in_front():

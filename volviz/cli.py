@@ -35,6 +35,8 @@ BENCHMARKS = {
     "volume_peeling": "a translucent isosurface in a regular volume: depth peeling's frame time and the surface's "
                       "visible share",
     "startup": "fresh processes: volviz info / render and the app's first frame (wall time, peak memory, imports)",
+    "iso_modes_volume": "the note's isosurface modes with a regular volume: frame time before and after the volume "
+                        "split",
 }
 #: commands whose arguments go, unread here, to their own parser (``volviz.regular.cli``, ``volviz.bench.NAME``)
 PASSED_ON = ("bench", "compress")

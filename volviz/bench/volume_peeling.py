@@ -29,7 +29,9 @@ DEFAULT_DATA = Path(os.environ.get("VOLVIZ_DATA", REPO.parent / "shared" / "data
 WAYS = (("cpu", False, False), ("cpu", True, False), ("gpu", False, False), ("gpu", True, False), ("gpu", True, True))
 
 
-def _session(volume: Path, value: float, opacity: float, surface: bool) -> Any:
+def iso_session(volume: Path, value: float, opacity: float, surface: bool) -> Any:
+    """A session of the regular volume ``volume`` and, when ``surface``, an isosurface of it (``value``,
+    ``opacity``)."""
     from volviz.session import Component, DatasetRef, Session
 
     comps = [Component("vol", "volume", "data")]
@@ -48,7 +50,7 @@ def _draw(volume: Path, size: tuple[int, int], way: tuple[str, bool, bool], reps
     from volviz.scene.datasets import load_datasets
 
     caster, surface, peel = way
-    session = _session(volume, value, opacity, surface)
+    session = iso_session(volume, value, opacity, surface)
     session.render.options["backend"] = caster
     plotter, controller = offscreen_scene(session, load_datasets(session, None), size)
     try:
@@ -76,11 +78,16 @@ def measure(volume: Path, size: tuple[int, int], reps: int, value: float, opacit
     return rows
 
 
-def report(rows: list[dict[str, Any]], command: str, value: float, opacity: float) -> str:
+def report_head(title: str, command: str, rows: list[dict[str, Any]]) -> list[str]:
+    """A report's title and its command line with the load average at its end and the rows' OpenGL."""
     load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
-    lines = ["# A translucent isosurface inside a regular volume: depth peeling's cost", "",
-             f"Command: `{command}` (load average at the end {load:.1f}; OpenGL: {rows[0]['gl'] if rows else '?'}).",
-             "", f"Isosurface value {value:g}, opacity {opacity:g}, VTK's own mode. Median of the timed draws after a "
+    return [f"# {title}", "",
+            f"Command: `{command}` (load average at the end {load:.1f}; OpenGL: {rows[0]['gl'] if rows else '?'})."]
+
+
+def report(rows: list[dict[str, Any]], command: str, value: float, opacity: float) -> str:
+    lines = report_head("A translucent isosurface inside a regular volume: depth peeling's cost", command, rows)
+    lines += ["", f"Isosurface value {value:g}, opacity {opacity:g}, VTK's own mode. Median of the timed draws after a "
              "warm-up, each ending with `WaitForCompletion`. Shows: share of pixels the surface changes by more "
              "than 3 levels against the same ray caster without it.", "",
              "| volume | window | ray caster | surface | peeled | ms per frame | shows |",
@@ -95,17 +102,24 @@ def report(rows: list[dict[str, Any]], command: str, value: float, opacity: floa
     return "\n".join(lines)
 
 
-def main(argv: list[str] | None = None) -> int:
-    ap = UsageParser(prog="volviz bench volume_peeling", description=__doc__.split("\n\n")[0])
+def iso_volume_parser(name: str, doc: str, sizes: list[tuple[int, int]], out: str) -> UsageParser:
+    """The arguments of ``volviz bench NAME`` for an isosurface in regular volumes (this bench's and
+    ``volviz.bench.iso_modes_volume``'s): data, volumes, the surface's value and opacity, sizes, repeats, out."""
+    ap = UsageParser(prog=f"volviz bench {name}", description=doc.split("\n\n")[0])
     ap.add_argument("--data", type=Path, default=DEFAULT_DATA, help="the shared data folder (volumes/ in it)")
     ap.add_argument("--volumes", nargs="+", default=["volumes/neghip.slc"],
                     help="regular volumes, relative to --data")
     ap.add_argument("--value", type=float, default=120.0, help="the isosurface's value (default 120)")
     ap.add_argument("--opacity", type=float, default=0.3, help="the isosurface's opacity (default 0.3)")
-    ap.add_argument("--sizes", type=image_size, nargs="+", default=[(512, 384), (1024, 768)],
-                    help="window sizes WxH (default 512x384 1024x768)")
+    shown = " ".join(f"{w}x{h}" for w, h in sizes)
+    ap.add_argument("--sizes", type=image_size, nargs="+", default=sizes, help=f"window sizes WxH (default {shown})")
     ap.add_argument("--reps", type=int_in(1, 1000), default=5, help="timed draws per way, median (default 5)")
-    ap.add_argument("--out", type=Path, default=REPO / "docs" / "bench" / "volume_peeling.md")
+    ap.add_argument("--out", type=Path, default=REPO / "docs" / "bench" / out)
+    return ap
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = iso_volume_parser("volume_peeling", __doc__ or "", [(512, 384), (1024, 768)], "volume_peeling.md")
     args = ap.parse_args(argv)
     rows = []
     for name in args.volumes:
@@ -114,11 +128,20 @@ def main(argv: list[str] | None = None) -> int:
                 print(f"{row['volume']} {row['size']} {row['caster']} surface={row['surface']} "
                       f"peeled={row['peeled']}: {row['ms']:.0f} ms shows={row['shows']}", flush=True)
                 rows.append(row)
-    command = "volviz bench volume_peeling " + " ".join(shlex.quote(a) for a in (argv if argv is not None
-                                                                                 else sys.argv[1:]))
-    atomic_write_text(args.out, report(rows, command.strip(), args.value, args.opacity))
-    print(f"wrote {args.out}")
+    write_report(args.out, report(rows, bench_command("volume_peeling", argv), args.value, args.opacity))
     return 0
+
+
+def bench_command(name: str, argv: list[str] | None) -> str:
+    """The command line ``volviz bench NAME ARGS`` that a report names (``argv``: None for the process's own)."""
+    args = argv if argv is not None else sys.argv[1:]
+    return f"volviz bench {name} {' '.join(shlex.quote(a) for a in args)}".strip()
+
+
+def write_report(out: Path, text: str) -> None:
+    """Write a report atomically and say where."""
+    atomic_write_text(out, text)
+    print(f"wrote {out}")
 
 
 if __name__ == "__main__":

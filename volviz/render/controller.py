@@ -781,11 +781,20 @@ class SceneController:
         if not changed:
             self._show_iso_mode(update)
 
-    def _show_iso_mode(self, update: bool) -> None:
+    def _iso_backend(self) -> str:
+        """Where a mode of the note is drawn: the backend's choice (``view_backend``), but the CPU overlay while a
+        regular volume is shown, whose volume it splits at the surfaces (``volviz.render.iso_volume_split``; the
+        GPU passes are blended before VTK's volume pass, so the whole volume would lie over them)."""
         from volviz.render.scene_builder import view_backend
+        from volviz.render.volume_peeling import regular_volumes
 
+        if regular_volumes([p for p in self.shown_props().values() if hasattr(p, "IsA")]):
+            return "cpu"
+        return view_backend(self.plotter, self.session, "iso")
+
+    def _show_iso_mode(self, update: bool) -> None:
         mode = self.iso_mode
-        backend = view_backend(self.plotter, self.session, "iso")
+        backend = self._iso_backend()
         view = self.iso_view
         if view is not None and (mode == "vtk" or not self._iso_props() or view.backend != backend):
             view.remove()
@@ -808,8 +817,12 @@ class SceneController:
     def _sync_iso_overlay(self) -> None:
         """In a mode of the note the iso view (either backend) draws the visible components' translucent surfaces;
         opaque surfaces stay VTK actors, so they are the modes' opaque pass in the depth buffer (for PT volumes too).
-        In "vtk" mode VTK draws everything."""
+        In "vtk" mode VTK draws everything. A view on the wrong backend (a regular volume shown or hidden:
+        ``_iso_backend``) is made again."""
         overlay = self.iso_view
+        if overlay is not None and overlay.backend != self._iso_backend():
+            self._show_iso_mode(update=False)
+            return
         meshes, lod, shading = [], [], "spectrum"
         for comp_id, prop in self._iso_props().items():
             visible = self.component(comp_id).visible

@@ -12,7 +12,10 @@ scene through the depth buffer exactly as volviz's PT volumes are (``volviz.rend
    a full-window overlay with (SRC_ALPHA, ONE_MINUS_SRC_ALPHA), i.e. C = C_iso + (1 − α_iso)·C_scene. For 3/4-pass
    α_iso = 1 − Π(1 − α_i), so this equals the mode's Π(1 − α_i)·B + Σ e_i with B the scene color; where the sum
    of emissions exceeds α_iso (straight alpha cannot carry that) the pixel is composited on the CPU over the
-   read-back scene color and drawn opaque (see ``finish``).
+   read-back scene color and drawn opaque (see ``finish``);
+4. with a regular (VTK) volume shown, ``begin`` renders it once more from the eye to the nearest translucent surface
+   and the image becomes (1 − a_f)·I + α·V_f (``volviz.render.iso_volume_split``): the volume in front of the
+   surfaces lies over them, the rest under them (issue #28), exact where a ray meets one translucent layer.
 
 The 8-bit overlay costs at most about 1/255 per channel against the float image (measured in the tests).
 ``begin`` / ``compute`` / ``finish`` split the work as every ``image_overlay.OverlayView`` does: ``compute`` is pure
@@ -33,6 +36,7 @@ from volviz.iso.composite import MODES, Fragments, composite, fragments, triangl
 from volviz.iso.extract import IsoMesh
 from volviz.iso.lod import lod_mesh, select_level
 from volviz.render.image_overlay import OverlayView, overlay_rgba8
+from volviz.render.iso_volume_split import SurfaceOccluder, front_volume, in_volume
 from volviz.model.camera import Camera
 
 if TYPE_CHECKING:   # type-only imports for the signatures
@@ -91,7 +95,12 @@ class IsoModeView:
 
 
 class IsoOverlay(OverlayView, IsoModeView):
-    """The isosurfaces of a scene drawn by one of the CPU transparency modes as a depth-composited overlay."""
+    """The isosurfaces of a scene drawn by one of the CPU transparency modes as a depth-composited overlay. With a
+    regular volume shown, ``split_volume`` (default) puts the volume in front of the surfaces over them and the rest
+    under them (``volviz.render.iso_volume_split``); False draws the overlay over the whole scene (the order before
+    issue #28, kept for ``volviz bench iso_modes_volume``)."""
+
+    split_volume = True
 
     kind = "iso"
     backend = "cpu"
@@ -100,6 +109,7 @@ class IsoOverlay(OverlayView, IsoModeView):
     def __init__(self, plotter: Any, meshes: Sequence[IsoMesh] = (), mode: str = "3pass",
                  shading: str = "spectrum") -> None:
         super().__init__(plotter)
+        self._occluder = SurfaceOccluder()
         self.meshes = list(meshes)
         self.lod: list[Any] = [None] * len(self.meshes)  # per mesh: (LodChain, triangles per pixel²) or None
         self.mode = mode
@@ -119,17 +129,27 @@ class IsoOverlay(OverlayView, IsoModeView):
         return float(((p - cam.position) @ cam.frame()[2]).max())
 
     def begin(self, scale: int = 1) -> dict[str, Any]:
+        """GUI thread: ``OverlayView.begin`` (the scene drawn and read back), and before it, with a regular volume
+        shown, the volume in front of the translucent surfaces (``front_volume``; drawn first, so that the window is
+        left with the scene as before)."""
+        translucent = [m for m in self.meshes if m.style.opacity < 1.0] if self.split_volume else []
+        front = front_volume(self.plotter, translucent, self._occluder, self._overlay.siblings)
         request = super().begin(scale)
         cam = request["camera"]
         near = min(cam.clipping_range[0], 1e-3 * cam.clipping_range[1])  # VTK's range ignores the hidden actors
         request["camera"] = Camera(cam.position, cam.focal_point, cam.view_up, cam.view_angle, cam.parallel,
                                    cam.parallel_scale, (near, cam.clipping_range[1]))
         request.update(meshes=list(self.meshes), lod=list(self.lod), mode=self.mode, shading=self.shading)
+        if front is not None and request["preview"]:    # the preview pixel's first window pixel, as its scene color
+            (w, h), (big_h, big_w) = request["size"], front.shape[:2]
+            front = front[(np.arange(h) * big_h) // h][:, (np.arange(w) * big_w) // w]
+        request["front"] = front
         return request
 
     def compute(self, request: dict[str, Any], progress: Optional[ProgressCallback] = None) -> tuple[np.ndarray, Any,
                 np.ndarray]:
-        """Any thread: rasterise all surfaces once, cut at the opaque depth, composite in the request's mode; then the
+        """Any thread: rasterise all surfaces once, cut at the opaque depth, composite in the request's mode (the
+        volume in front of the surfaces over it, ``in_volume``); then the
         image as VTK will show it (``_shown_rgba8``: saturated pixels over the scene color, straight-alpha RGBA8, a
         preview magnified to the window), made here so that ``finish`` on the GUI thread only hands it over (the
         magnification took 40-60 ms of the GUI thread per preview, issue #28)."""
@@ -142,7 +162,7 @@ class IsoOverlay(OverlayView, IsoModeView):
                   for m, lv in zip(request["meshes"], lod)]
         fr = cut_at_depth(fragments(meshes, cam, size, request["shading"]), request["depth"])
         t1 = time.perf_counter()
-        img = composite(fr, request["mode"])
+        img = in_volume(composite(fr, request["mode"]), request.get("front"))
         t2 = time.perf_counter()
         rgba8, saturated = _shown_rgba8(img, request)
         st = SimpleNamespace(sort_s=0.0, project_s=0.0, raster_s=t1 - t0, total_s=t2 - t0, fragments=len(fr.depth),

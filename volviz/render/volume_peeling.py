@@ -17,22 +17,22 @@ peeling is not turned on there.
 from __future__ import annotations
 
 import weakref
-from typing import TYPE_CHECKING, Any, Sequence
+from typing import TYPE_CHECKING, Any, Sequence, cast
 
 if TYPE_CHECKING:   # type-only imports for the signatures
     import pyvista as pv
-    from volviz.render.vtk_facade import vtkProp
+    from volviz.render.vtk_facade import vtkProp, vtkVolume
 
-__all__ = ["PEELS", "peel_volumes", "peeling_volumes"]
+__all__ = ["PEELS", "peel_volumes", "peeling_volumes", "regular_volumes"]
 
 PEELS = 16          # dual-peeling passes at most (two layers each); with occlusion ratio 0 VTK stops when none is left
 #: by plotter while peeling is on: the renderer's settings and the volumes' ray casters (by mapper) to restore
 _saved: weakref.WeakKeyDictionary[Any, dict[str, Any]] = weakref.WeakKeyDictionary()
 
 
-def _regular_volumes(props: Sequence[vtkProp]) -> list[Any]:
+def regular_volumes(props: Sequence[vtkProp]) -> list[vtkVolume]:
     """The props that VTK's smart volume mapper draws (volviz's regular volumes)."""
-    volumes: list[Any] = [p for p in props if p is not None and p.IsA("vtkVolume")]
+    volumes: list[vtkVolume] = [cast("vtkVolume", p) for p in props if p is not None and p.IsA("vtkVolume")]
     return [v for v in volumes if v.GetMapper() is not None and v.GetMapper().IsA("vtkSmartVolumeMapper")]
 
 
@@ -46,7 +46,7 @@ def peel_volumes(plotter: pv.BasePlotter, props: Sequence[vtkProp], on: bool, pe
     ``props`` when ``on`` (the caller: translucent surfaces are shown by VTK) and there are such volumes and the
     renderer runs VTK's own passes; otherwise restore what was set before. Returns whether peeling is on."""
     ren = plotter.renderer
-    volumes = _regular_volumes(props)
+    volumes = regular_volumes(props)
     on = bool(on) and bool(volumes) and ren.GetPass() is None
     saved = _saved.get(plotter)
     if on:
@@ -57,7 +57,7 @@ def peel_volumes(plotter: pv.BasePlotter, props: Sequence[vtkProp], on: bool, pe
                 "modes": {}}
         modes: dict[Any, int] = saved["modes"]
         for volume in volumes:
-            mapper = volume.GetMapper()
+            mapper: Any = volume.GetMapper()     # a vtkSmartVolumeMapper (``regular_volumes``)
             modes.setdefault(mapper, int(mapper.GetRequestedRenderMode()))
             if mapper.GetRequestedRenderMode() != mapper.GPURenderMode:
                 mapper.SetRequestedRenderModeToGPU()
