@@ -8,7 +8,7 @@ the overlay's own optics), V_f, a_f and F come from renders of VTK's actors (the
 the expected frame is V_f + (1 − a_f)·I + (1 − α)·(F − V_f). Before the split the frames were far off on the
 surface's pixels: the CPU overlay drew the surfaces over the finished scene, the whole volume under them (RMSE 26.9
 levels); the GPU's 2/3/4 passes are blended before VTK's volume pass, the whole volume over them (RMSE 9.4); the
-GPU's exact mode peels the surfaces over the finished scene (RMSE 28.0).""""""
+GPU's exact mode peels the surfaces over the finished scene (RMSE 28.0)."""
 from __future__ import annotations
 
 import numpy as np
