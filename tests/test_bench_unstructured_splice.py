@@ -38,7 +38,7 @@ def test_a_missing_block_goes_before_the_speed_up_line():
 def test_only_refuses_unknown_rows_and_a_large_row_without_a_refinement():
     from volviz.argtypes import UsageError
 
-    with pytest.raises(UsageError, match=r"argument --only: unknown row 'raster' \(known: sort, large, cpu\)"):
+    with pytest.raises(UsageError, match=r"argument --only: unknown row 'raster' \(known: sort, large, cpu, exact\)"):
         main(["--only", "sort,raster"])
     with pytest.raises(UsageError, match="--only large needs --large-refine > 1"):
         main(["--only", "large"])

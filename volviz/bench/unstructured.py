@@ -29,7 +29,7 @@ VTK_MAPPERS = ("vtkProjectedTetrahedraMapper", "vtkUnstructuredGridVolumeRayCast
                "vtkUnstructuredGridVolumeZSweepMapper")
 
 
-ONLY_ROWS = ("sort", "large", "cpu")
+ONLY_ROWS = ("sort", "large", "cpu", "exact")
 
 
 def _only_list(text: str) -> list[str]:
@@ -66,14 +66,20 @@ def camera_path(points: np.ndarray, n: int) -> list[Any]:
             for i in range(n)]
 
 
-def _vtk_render(mesh: Any, tf: Any, cam: Any, size: int, mapper_name: str, reps: int) -> tuple[np.ndarray, list[float]]:
+def _vtk_render(mesh: Any, tf: Any, cam: Any, size: int | tuple[int, int], mapper_name: str, reps: int,
+                grid: Any = None) -> tuple[np.ndarray, list[float]]:
+    """One of VTK's volume mappers on ``mesh`` (or on ``grid`` when given, e.g. an image for the GPU ray caster) in an
+    offscreen window of ``size`` (N or (W, H)): the image of the last of ``reps`` timed draws, each to the GPU's
+    completion, as float RGB over black."""
     from volviz.render.vtk_facade import vtk_to_numpy, vtk
 
     from volviz.render.vtk_tf import tf_to_vtk
 
-    grid = mesh.to_pyvista()
+    w, h = (size, size) if isinstance(size, int) else size
     mapper = getattr(vtk, mapper_name)()
-    mapper.SetInputData(grid)
+    mapper.SetInputData(mesh.to_pyvista() if grid is None else grid)
+    if mapper_name == "vtkSmartVolumeMapper":
+        mapper.SetRequestedRenderModeToGPU()                            # the GPU ray caster, as in VTK's own apps
     ctf, otf = tf_to_vtk(tf, 1.0)
     prop = vtk.vtkVolumeProperty()
     prop.SetColor(ctf)
@@ -89,7 +95,7 @@ def _vtk_render(mesh: Any, tf: Any, cam: Any, size: int, mapper_name: str, reps:
     ren.AddVolume(vol)
     win = vtk.vtkRenderWindow()
     win.SetOffScreenRendering(1)
-    win.SetSize(size, size)
+    win.SetSize(w, h)
     win.AddRenderer(ren)
     cam.apply_to(ren.GetActiveCamera())
     ren.ResetCameraClippingRange()
@@ -99,7 +105,7 @@ def _vtk_render(mesh: Any, tf: Any, cam: Any, size: int, mapper_name: str, reps:
     w2i.SetInputBufferTypeToRGB()
     w2i.ReadFrontBufferOff()
     w2i.Update()
-    arr = vtk_to_numpy(w2i.GetOutput().GetPointData().GetScalars()).reshape(size, size, 3)[::-1]
+    arr = vtk_to_numpy(w2i.GetOutput().GetPointData().GetScalars()).reshape(h, w, 3)[::-1]
     win.Finalize()
     return arr.astype(np.float64) / 255.0, times
 
@@ -126,7 +132,7 @@ def _size_list(text: str) -> list[tuple[int, int]]:
 
 
 def gl_pt_frames(mesh: Any, tf: Any, cams: list[Any], size: tuple[int, int], reps: int, lookup: str = "3d",
-                 split: bool = False) -> tuple[dict[str, Any], np.ndarray]:
+                 split: bool = False, same: bool = False) -> tuple[dict[str, Any], np.ndarray]:
     """Method "pt-gl" (``volviz.render.gl_pt``) in an offscreen PyVista window of ``size``: a warm-up render
     (shader compile, table and vertex buffer upload), then ``reps`` passes over the cameras, each render for a new
     camera (so each includes the sort and the index buffer upload). Returns the medians (wall ``frame_s``, the
@@ -141,7 +147,10 @@ def gl_pt_frames(mesh: Any, tf: Any, cams: list[Any], size: tuple[int, int], rep
     CPU seconds (llvmpipe's threads included; other jobs on the machine are not), paired per camera; medians:
     ``ibo_s`` = frame - same - sort - order (VTK's index buffer build and upload; sort and order are the volume's
     own timings), ``draw_work_s`` = same - one_cell (the full draw's vertex and fragment work, which a GPU takes
-    off the CPU) and ``cpu_side_proper_s`` = sort + order + ibo_s + one_cell_s."""
+    off the CPU) and ``cpu_side_proper_s`` = sort + order + ibo_s + one_cell_s.
+
+    ``same``: also draw each camera a second time (no new sort or order), wall seconds to the GPU's completion
+    (``draw_s``): the draw alone, what a frame costs while the camera rests."""
 
     from volviz.render.gl_pt import GLPTVolume
 
@@ -151,7 +160,7 @@ def gl_pt_frames(mesh: Any, tf: Any, cams: list[Any], size: tuple[int, int], rep
     cams[0].apply_to(pl.renderer.GetActiveCamera())
     pl.camera_set = True
     pl.screenshot(return_img=True)
-    frame, cpu, sort, order, same, one = [], [], [], [], [], []          # same, one: CPU seconds
+    frame, cpu, sort, order, same_cpu, one, draw = [], [], [], [], [], [], []  # same_cpu, one: CPU seconds
     for _ in range(reps):
         for cam in cams[1:] + cams[:1] if len(cams) > 1 else cams * 2:     # each render a new camera
             cam.apply_to(pl.renderer.GetActiveCamera())
@@ -162,8 +171,10 @@ def gl_pt_frames(mesh: Any, tf: Any, cams: list[Any], size: tuple[int, int], rep
             cpu.append(time.process_time() - c0)
             sort.append(vol.stats["sort_s"])
             order.append(vol.stats["order_s"])
+            if same:
+                draw.extend(timed_renders(ren_win, 1))
             if split:
-                same.append(_timed_render(pl))
+                same_cpu.append(_timed_render(pl))
                 restore = _one_cell_order(vol)
                 ren_win.Render()
                 one.append(_timed_render(pl))
@@ -179,8 +190,10 @@ def gl_pt_frames(mesh: Any, tf: Any, cams: list[Any], size: tuple[int, int], rep
     res = {"frame_s": float(np.median(frame)), "cpu_s": float(np.median(cpu)), "sort_s": float(np.median(sort)),
            "order_s": float(np.median(order)), "frames_timed": len(frame), "lookup": lookup, "gl_renderer": renderer,
            "order_texture": bool(vol.order_texture), "gpu_bytes_per_cell": vol.gpu_bytes() / mesh.n_cells}
+    if same:
+        res["draw_s"] = float(np.median(draw))
     if split:
-        f, sa, on, so, od = (np.array(v) for v in (cpu, same, one, sort, order))
+        f, sa, on, so, od = (np.array(v) for v in (cpu, same_cpu, one, sort, order))
         res["same_s"], res["one_cell_s"] = float(np.median(sa)), float(np.median(on))
         res["ibo_s"] = float(np.median(np.maximum(f - sa - so - od, 0.0)))
         res["draw_work_s"] = float(np.median(sa - on))
@@ -238,6 +251,13 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--scan", type=_size_list, default=[],
                    help="also time pt, pt-gl and vtkProjectedTetrahedraMapper at these window sizes "
                         "(comma list of N or WxH, e.g. 256,512,1024,1920x1080; 2 cameras, 1 frame each)")
+    p.add_argument("--scan-reps", type=int_in(1, 100), default=1,
+                   help="timed frames per camera and method in the --scan rows (after a warm-up)")
+    p.add_argument("--raycast-grid", type=int_in(0, 1024), default=0,
+                   help="also time VTK's GPU ray caster in the --scan rows on the mesh resampled to N³ (0: not)")
+    p.add_argument("--exact", type=_size_list, default=[],
+                   help="window sizes at which pt-gl and vtkProjectedTetrahedraMapper are compared with the exact "
+                        "reference (comma list of N or WxH)")
     p.add_argument("--sort-sizes", type=_size_list, default=_size_list("256,512,1024,1920x1080,3840x2160"),
                    help="window sizes of the sort-seconds table (comma list of N or WxH; empty: no table)")
     p.add_argument("--cpu-sizes", type=_size_list, default=_size_list("512,1920x1080,3840x2160"),
@@ -266,6 +286,8 @@ def main(argv: list[str] | None = None) -> int:
             p.error("--only sort needs --sort-sizes")
         if "cpu" in args.only and not args.cpu_sizes:
             p.error("--only cpu needs --cpu-sizes")
+        if "exact" in args.only and not args.exact:
+            p.error("--only exact needs --exact")
         return only_rows(args, argv)
 
     from volviz.io.plot3d import read_plot3d
@@ -415,7 +437,10 @@ def main(argv: list[str] | None = None) -> int:
         results["vtk_pt_64_s"] = float(np.median(t64))
 
     if args.scan:
-        results["scan"] = _size_scan(mesh, tf, cams[:2], args.scan, args.gl_lookup, args.sort, args.lookup)
+        results["scan"] = _size_scan(mesh, tf, cams[:2], args.scan, args.gl_lookup, args.sort, args.lookup,
+                                     args.scan_reps, args.raycast_grid)
+    if args.exact:
+        results["exact"] = exact_rows(mesh, tf, cams[0], args.exact, args.gl_lookup)
 
     results["load_average_end"] = os.getloadavg()[0]
     vtk_best = min((v["frame_s"] for k, v in results["methods"].items() if k.startswith("vtk")), default=None)
@@ -472,6 +497,10 @@ def only_rows(args: argparse.Namespace, argv: list[str] | None) -> int:
         big["refine"] = args.large_refine
         results["large"] = big
         text = splice(text, LARGE_HEAD, [_run_note(command, load), *_large_mesh_lines(big)])
+    if "exact" in args.only:
+        load = os.getloadavg()[0]
+        results["exact"] = exact_rows(mesh, tf, cams[0], args.exact, args.gl_lookup)
+        text = splice(text, EXACT_HEAD, [_run_note(command, load), *_exact_lines(results["exact"])])
     atomic_write_text(path, text)
     if args.json:
         atomic_write_text(Path(args.json), json.dumps(results, indent=2))
@@ -488,6 +517,7 @@ def _run_note(command: str, load: float) -> str:
 #: the first words of the report's blocks ``--only`` replaces
 SORT_HEAD, LARGE_HEAD = "Sort seconds against window size", "Large mesh:"
 CPU_HEAD = "The CPU side of a pt-gl frame for a new camera"
+EXACT_HEAD = "Against the exact float64 reference at the window's size"
 #: paragraphs that belong to a block (besides its table rows and blank lines)
 _BLOCK_TAILS = ("Drawn at ", "The order as the GPU pass's index buffer", "(The rows below come from a run",
                 "The CPU side against its cost")
@@ -740,25 +770,82 @@ def interactive_rows(mesh: Any, tf: Any, cams: list[Any], sizes: list[tuple[int,
 
 
 def _size_scan(mesh: Any, tf: Any, cams: list[Any], sizes: list[tuple[int, int]], gl_lookup: str, sort: str,
-               lookup: str) -> list[dict[str, Any]]:
-    """Seconds per frame against window size for pt (the CPU renderer), pt-gl and vtkProjectedTetrahedraMapper:
-    the median over ``cams``, one frame each after a warm-up (pt-gl: each render for a new camera)."""
+               lookup: str, reps: int = 1, raycast_grid: int = 0) -> list[dict[str, Any]]:
+    """Seconds per frame against window size for pt (the CPU renderer; one frame per camera), pt-gl (each render
+    for a new camera, and the same camera drawn again: the draw alone) and vtkProjectedTetrahedraMapper, and with
+    ``raycast_grid`` VTK's GPU ray caster on the mesh resampled to that many points a side: the medians over
+    ``cams`` and ``reps`` after a warm-up, every GPU frame timed to its completion."""
     from volviz.unstructured.render import render
 
     rows = []
+    image = _resampled_image(mesh, raycast_grid) if raycast_grid else None
     for w, h in sizes:
         render(mesh, tf, cams[0], (w, h), "pt", sort=sort, lookup=lookup)
         pt = [render(mesh, tf, cam, (w, h), "pt", sort=sort, lookup=lookup, return_stats=True)[1].total_s
               for cam in cams]
-        gl, _ = gl_pt_frames(mesh, tf, cams, (w, h), 1, gl_lookup)
-        row = {"size": [w, h], "pt_s": float(np.median(pt)), "pt_gl_s": gl["frame_s"]}
-        if w == h:                                   # _vtk_render makes square windows
-            _vtk_render(mesh, tf, cams[0], w, "vtkProjectedTetrahedraMapper", 1)
-            row["vtk_pt_s"] = float(np.median([_vtk_render(mesh, tf, cam, w, "vtkProjectedTetrahedraMapper", 1)[1][0]
-                                               for cam in cams]))
+        gl, _ = gl_pt_frames(mesh, tf, cams, (w, h), reps, gl_lookup, same=True)
+        row = {"size": [w, h], "pt_s": float(np.median(pt)), "pt_gl_s": gl["frame_s"], "pt_gl_draw_s": gl["draw_s"],
+               "pt_gl_sort_s": gl["sort_s"]}
+        _vtk_render(mesh, tf, cams[0], (w, h), "vtkProjectedTetrahedraMapper", 1)
+        row["vtk_pt_s"] = float(np.median([t for cam in cams for t in
+                                           _vtk_render(mesh, tf, cam, (w, h), "vtkProjectedTetrahedraMapper",
+                                                       reps)[1]]))
+        if image is not None:
+            _vtk_render(mesh, tf, cams[0], (w, h), "vtkSmartVolumeMapper", 1, grid=image)
+            row["vtk_gpu_ray_s"] = float(np.median([t for cam in cams for t in
+                                                    _vtk_render(mesh, tf, cam, (w, h), "vtkSmartVolumeMapper",
+                                                                reps, grid=image)[1]]))
+            row["raycast_grid"] = raycast_grid
         rows.append(row)
         print(f"scan {w}x{h}: {row}", flush=True)
     return rows
+
+
+def _resampled_image(mesh: Any, n: int) -> Any:
+    """The mesh's point field resampled onto an n³ image over its bounds (PyVista's ``sample``): the input
+    of the GPU ray caster peer, the way a user of VTK without an unstructured GPU mapper would draw it."""
+    import pyvista as pv
+
+    grid = mesh.to_pyvista()
+    lo, hi = np.array(grid.bounds[0::2]), np.array(grid.bounds[1::2])
+    image = pv.ImageData(dimensions=(n, n, n), spacing=tuple((hi - lo) / (n - 1)), origin=tuple(lo))
+    sampled = image.sample(grid)
+    sampled.set_active_scalars(grid.active_scalars_name)
+    return sampled
+
+
+def exact_rows(mesh: Any, tf: Any, cam: Any, sizes: list[tuple[int, int]], gl_lookup: str) -> list[dict[str, Any]]:
+    """pt-gl and vtkProjectedTetrahedraMapper against the exact float64 reference at each window size (one camera;
+    RGB over black, 8-bit units), with the reference's own seconds."""
+    from volviz.unstructured.render import render
+
+    rows = []
+    for w, h in sizes:
+        t0 = time.perf_counter()
+        ref = render(mesh, tf, cam, (w, h), "reference")
+        ref_s = time.perf_counter() - t0
+        _, gl_img = gl_pt_frames(mesh, tf, [cam], (w, h), 1, gl_lookup)
+        vtk_img = _vtk_render(mesh, tf, cam, (w, h), "vtkProjectedTetrahedraMapper", 1)[0]
+        e_gl, e_vtk = _rgb_err(gl_img, ref), _rgb_err(vtk_img, ref)
+        row = {"size": [w, h], "reference_s": ref_s, "pt_gl_rmse": e_gl[0], "pt_gl_max": e_gl[1],
+               "vtk_pt_rmse": e_vtk[0], "vtk_pt_max": e_vtk[1]}
+        rows.append(row)
+        print(f"exact {w}x{h}: {row}", flush=True)
+    return rows
+
+
+def _exact_lines(rows: list[dict[str, Any]] | None) -> list[str]:
+    """The markdown of ``exact_rows``."""
+    if not rows:
+        return []
+    lines = ["", f"{EXACT_HEAD} (frame 0; RGB over black, 8-bit units; "
+             "target for pt-gl RMSE ≤ 1, max ≤ 4):", "",
+             "| window | pt-gl RMSE | pt-gl max | vtkProjectedTetrahedraMapper RMSE | its max | reference s |",
+             "|---|---|---|---|---|---|"]
+    for r in rows:
+        lines.append(f"| {r['size'][0]}x{r['size'][1]} | {r['pt_gl_rmse']:.2f} | {r['pt_gl_max']:.2f} | "
+                     f"{r['vtk_pt_rmse']:.2f} | {r['vtk_pt_max']:.2f} | {r['reference_s']:.1f} |")
+    return lines
 
 
 def _plots(results: dict[str, Any], images: dict[str, np.ndarray], ref: np.ndarray, out: Path) -> None:
@@ -892,11 +979,21 @@ def _markdown(results: dict[str, Any], path: Path) -> None:
         lines += _large_mesh_lines(big)
     scan = results.get("scan")
     if scan:
-        lines += ["", "Seconds per frame against window size (median of 2 cameras, one frame each):", "",
-                  "| window | pt | pt-gl | vtkProjectedTetrahedraMapper |", "|---|---|---|---|"]
+        ray = any("vtk_gpu_ray_s" in r for r in scan)
+        lines += ["", "Seconds per frame against window size (medians over 2 cameras; pt one frame each; the GPU "
+                  "methods after a warm-up, each frame to the GPU's completion): pt-gl for a new camera (sort, order, "
+                  "draw), its sort, and the same camera drawn again (the draw alone)"
+                  + (f"; VTK's GPU ray caster (vtkSmartVolumeMapper in GPU mode) on the mesh resampled to an image of "
+                     f"{scan[0].get('raycast_grid', '')}³ points" if ray else "") + ":", "",
+                  "| window | pt | pt-gl new camera | of which sort | pt-gl same camera | vtkProjectedTetrahedraMapper "
+                  "| pt-gl speed-up |" + (" vtkGPUVolumeRayCastMapper (resampled) |" if ray else ""),
+                  "|---|---|---|---|---|---|---|" + ("---|" if ray else "")]
         for r in scan:
-            vt = f"{r['vtk_pt_s']:.3f}" if "vtk_pt_s" in r else ""
-            lines.append(f"| {r['size'][0]}x{r['size'][1]} | {r['pt_s']:.3f} | {r['pt_gl_s']:.3f} | {vt} |")
+            row = (f"| {r['size'][0]}x{r['size'][1]} | {r['pt_s']:.3f} | {r['pt_gl_s']:.4f} | "
+                   f"{r.get('pt_gl_sort_s', float('nan')):.4f} | {r.get('pt_gl_draw_s', float('nan')):.4f} | "
+                   f"{r['vtk_pt_s']:.4f} | {r['vtk_pt_s'] / r['pt_gl_s']:.2f}x |")
+            lines.append(row + (f" {r['vtk_gpu_ray_s']:.4f} |" if ray else ""))
+    lines += _exact_lines(results.get("exact"))
     if v64 and vpt and results["size"] > 64 and not gl:
         lines += ["", f"vtkProjectedTetrahedraMapper takes {v64:.3f} s per frame in a 64² window (its CPU work "
                   f"without the {results['size']}² fill) and {vpt:.3f} s at {results['size']}²: drawing the same "
