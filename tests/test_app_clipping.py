@@ -82,21 +82,21 @@ def test_clip_plane_cuts_the_view_undo_and_survives_save_and_reopen(qtbot, make_
     dock = window.clipping
     shown = window.controller.props["iso"].volviz_shown
     dock.add_button.click()                              # a plane through the centre, normal +x: keeps x >= 11.5
-    assert len(window.session.clip["planes"]) == 1 and window.dirty
+    assert len(window.session.clip.planes) == 1 and window.dirty
     assert window.controller.props["iso"].volviz_shown is shown and not window.clipping_shown(), \
         "the isosurfaces were cut on the GUI thread"
     cut = viewport(window)
     assert np.abs(cut[left] - background).max() <= 3     # the left half is gone
     assert np.abs(cut[right] - before[right]).max() <= 3  # the right half is as it was
     dock.offset.setValue(13.0)                           # move the plane with the spin box
-    assert window.session.clip["planes"][0]["point"] == pytest.approx([13.0, 0.0, 0.0])
+    assert window.session.clip.planes[0].point == pytest.approx([13.0, 0.0, 0.0])
     window.action_undo.trigger()                         # Edit > Undo acts on the clipping edits
-    assert window.session.clip["planes"][0]["point"] == pytest.approx([11.5, 0.0, 0.0])
+    assert window.session.clip.planes[0].point == pytest.approx([11.5, 0.0, 0.0])
     assert np.abs(viewport(window) - cut).max() <= 3
     dock.undo_button.click()                             # undo the plane itself
-    assert window.session.clip["planes"] == [] and np.abs(viewport(window) - before).max() <= 3
+    assert window.session.clip.planes == () and np.abs(viewport(window) - before).max() <= 3
     dock.redo_button.click()
-    assert len(window.session.clip["planes"]) == 1
+    assert len(window.session.clip.planes) == 1
 
     saved = tmp_path / "clipped.json"
     assert window.save_session(saved)
@@ -116,23 +116,24 @@ def test_clip_plane_cuts_the_view_undo_and_survives_save_and_reopen(qtbot, make_
     widget.SetNormal(0.0, -1.0, 0.0)
     widget.SetOrigin(11.5, 11.5, 11.5)
     widget.InvokeEvent("EndInteractionEvent")
-    assert other.session.clip["planes"][0]["normal"] == pytest.approx([0.0, -1.0, 0.0])
-    assert other.session.clip["planes"][0]["point"] == pytest.approx([0.0, 11.5, 0.0])
+    assert other.session.clip.planes[0].normal == pytest.approx([0.0, -1.0, 0.0])
+    assert other.session.clip.planes[0].point == pytest.approx([0.0, 11.5, 0.0])
     dragged = viewport(other)
     assert np.abs(dragged[left] - reopened[left]).max() > 20      # the plane now faces the camera: both
     assert np.abs(dragged[right] - reopened[right]).max() > 3     # halves show the cut (back) half
     other.clipping.undo_button.click()
-    assert other.session.clip["planes"][0]["normal"] == pytest.approx([1.0, 0.0, 0.0])
+    assert other.session.clip.planes[0].normal == pytest.approx([1.0, 0.0, 0.0])
     assert widget.GetNormal() == pytest.approx((1.0, 0.0, 0.0))   # the widget follows the dock
     other.clipping.box_enabled.setChecked(True)           # box crop: default box = the scene bounds; drag it
     box_widget = other.clip_widget.box_widget
-    assert box_widget is not None and other.session.clip["box"] is not None
+    assert box_widget is not None and other.session.clip.box is not None
     top = pixel(other, (15.0, 11.5, 17.0))
     unboxed = viewport(other)
     assert np.abs(unboxed[top] - background).max() > 20
     box_widget.PlaceWidget([-5.0, 30.0, -5.0, 30.0, -5.0, 14.0])
     box_widget.InvokeEvent("EndInteractionEvent")
-    assert other.session.clip["box"] == {"lo": pytest.approx([-5.0] * 3), "hi": pytest.approx([30.0, 30.0, 14.0])}
+    box = other.session.clip.box
+    assert box is not None and box.lo == pytest.approx((-5.0,) * 3) and box.hi == pytest.approx((30.0, 30.0, 14.0))
     boxed = viewport(other)
     assert np.abs(boxed[top] - background).max() <= 3                 # above z = 14: cropped
     low = pixel(other, (17.0, 11.5, 8.0))                             # (clear of the widgets' handles)

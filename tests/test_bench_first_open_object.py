@@ -22,6 +22,7 @@ import numpy as np
 import pytest
 
 from volviz.bench import first_open as bench
+from volviz.optics.transfer_function import TransferFunction
 
 R = 40
 SCALE = 60.0                   # parallel scale: the image's half-height in world units
@@ -84,7 +85,7 @@ def _write_sphere(path: Path, inside: np.ndarray) -> None:
     grid.save(path)
 
 
-def _sphere_session(tmp_path: Path, inside: np.ndarray, tf: dict) -> Path:
+def _sphere_session(tmp_path: Path, inside: np.ndarray, tf: TransferFunction) -> Path:
     """A session file showing a .vti of the sphere (values ``inside`` of shape (97, 97, 97) within it, 10 outside)
     head-on, with the transfer function ``tf``."""
     from volviz.render.export import open_target
@@ -110,10 +111,9 @@ def test_the_object_footprint_is_the_sphere_disc_and_the_old_footprint_the_box(t
     """Value 200 in a background of 10, a transfer function white and opaque (1 per unit) from 11 up to 300: the
     disc is seen (every ray at least one unit inside it crosses 18 units or more of the sphere) and nothing outside
     the object's footprint, so nearly all the object is visible; the *visible* share divides by the whole box."""
-    from volviz.optics import TransferFunction
 
     tf = TransferFunction([10.0, 11.0, 300.0], [(1.0, 1.0, 1.0)] * 3, [0.0, 1.0, 1.0], name="shown")
-    prints = _measured(_sphere_session(tmp_path, np.full((97, 97, 97), 200.0), tf.to_dict()))
+    prints = _measured(_sphere_session(tmp_path, np.full((97, 97, 97), 200.0), tf))
     expected = _object_footprint()
     _assert_to_a_pixel(prints.object, expected)
     _assert_to_a_pixel(prints.data, _box_footprint())
@@ -134,12 +134,11 @@ def test_a_transfer_function_showing_half_of_the_values_shows_half_of_the_object
     exact under trilinear interpolation), a transfer function opaque and white from 110 up, transparent below: the
     half disc x >= 0 is seen, the other half not; about half of the object's footprint (the rim of the seen half,
     where the sphere's values mix with the background's, is between 0 and 1.4 units wide)."""
-    from volviz.optics import TransferFunction
 
     axis = np.arange(-48, 49, dtype=np.float64)
     x3 = np.broadcast_to(axis[None, None, :], (97, 97, 97))
     tf = TransferFunction([10.0, 109.99, 110.0, 200.0], [(1.0, 1.0, 1.0)] * 4, [0.0, 0.0, 1.0, 1.0], name="half")
-    prints = _measured(_sphere_session(tmp_path, 110.0 + 90.0 * x3 / R, tf.to_dict()))
+    prints = _measured(_sphere_session(tmp_path, 110.0 + 90.0 * x3 / R, tf))
     expected = _object_footprint()
     _assert_to_a_pixel(prints.object, expected)
 

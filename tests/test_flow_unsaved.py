@@ -31,14 +31,14 @@ def test_open_over_unsaved_work_asks_and_cancel_keeps_it(qtbot, make_window) -> 
     window.open_path(data_file("volumes/neghip.slc"))
     wait_loaded(qtbot, window)
     _add_plane(qtbot, window)
-    planes = len(window.session.clip["planes"])
+    planes = len(window.session.clip.planes)
 
     window.action_open_data.trigger()      # File > Open Data: the question comes before the file dialog
     _answer(qtbot, window, QMessageBox.StandardButton.Cancel)
     qtbot.wait(200)
     assert getattr(window, "file_dialog", None) is None or not window.file_dialog.isVisible()
     assert window.dirty and "neghip.slc" in window.windowTitle()
-    assert len(window.session.clip["planes"]) == planes
+    assert len(window.session.clip.planes) == planes
 
     window.action_open_data.trigger()
     _answer(qtbot, window, QMessageBox.StandardButton.Discard)

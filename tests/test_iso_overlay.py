@@ -9,6 +9,7 @@ import pyvista as pv
 from volviz.iso.composite import fragments, render
 from volviz.render.iso_overlay import cut_at_depth
 from volviz.model.datasets import RegularVolume
+from volviz.model.clip import ClipSettings
 from volviz.model.demo import demo_tet_mesh
 from volviz.render.controller import SceneController
 from volviz.session import CameraState, Component, DatasetRef, Session
@@ -50,7 +51,7 @@ def scene(components: list[Component], clip: dict | None = None) -> tuple[SceneC
     s.render.background = BG
     s.render.options.update(PLAIN, **CPU)
     if clip is not None:
-        s.clip = clip
+        s.clip = ClipSettings.from_dict(clip)
     p = plotter()
     c = SceneController(p, s, {"b": ball()})
     c.build()
@@ -275,7 +276,8 @@ def test_opaque_isosurfaces_stay_vtk_geometry_and_hide_what_is_behind_them_in_cp
 def test_a_session_without_camera_stays_framed_through_clip_and_cpu_mode():
     # regression: add_isosurfaces read ``plotter.camera``, which re-frames PyVista's "unset" camera to its default
     s = Session(datasets=[DatasetRef("b", "/unused")], components=[iso_component()],
-                clip={"planes": [{"point": [11.5, 0.0, 0.0], "normal": [1.0, 0.0, 0.0]}], "box": None})
+                clip=ClipSettings.from_dict({"planes": [{"point": [11.5, 0.0, 0.0], "normal": [1.0, 0.0, 0.0]}],
+                                             "box": None}))
     s.render.options["iso_mode"] = "3pass"
     p = plotter()
     SceneController(p, s, {"b": ball()}).build()

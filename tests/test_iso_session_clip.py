@@ -5,7 +5,7 @@ import json
 
 import pytest
 
-from volviz.model.clip import ClipSettings
+from volviz.model.clip import BoxCrop, ClipPlane, ClipSettings
 from volviz.session import SessionError, dumps, loads
 
 OLD = {"format": "volviz-session", "version": 1, "components": [{"id": "demo", "type": "demo"}]}
@@ -13,14 +13,17 @@ OLD = {"format": "volviz-session", "version": 1, "components": [{"id": "demo", "
 
 def test_session_without_clip_loads_with_no_clipping_and_round_trips():
     s = loads(json.dumps(OLD))
-    assert s.clip == {"planes": [], "box": None}
+    assert s.clip == ClipSettings() and json.loads(dumps(s))["clip"] == {"planes": [], "box": None}
     clip = {"planes": [{"point": [1, 2, 3], "normal": [0, 0, 2]}], "box": {"lo": [0, 0, 0], "hi": [1, 1, 1]}}
     s = loads(json.dumps({**OLD, "clip": clip}))
-    assert s.clip["planes"][0]["normal"] == [0.0, 0.0, 2.0]
-    back = loads(dumps(s))
-    assert back.clip == s.clip
-    cs = ClipSettings.from_dict(back.clip)
-    assert cs.planes[0].normal == (0.0, 0.0, 1.0) and len(cs.all_planes()) == 7
+    cs = s.clip                                # the typed model: its normal unit length (the same half-space)
+    assert cs.planes[0] == ClipPlane((1.0, 2.0, 3.0), (0.0, 0.0, 1.0)) and cs.box == BoxCrop((0, 0, 0), (1, 1, 1))
+    assert len(cs.all_planes()) == 7
+    text = dumps(s)                            # saved in the model's form, which then saves byte for byte
+    assert json.loads(text)["clip"] == {"planes": [{"point": [1.0, 2.0, 3.0], "normal": [0.0, 0.0, 1.0]}],
+                                        "box": {"lo": [0.0, 0.0, 0.0], "hi": [1.0, 1.0, 1.0]}}
+    back = loads(text)
+    assert back.clip == s.clip and dumps(back) == text
 
 
 @pytest.mark.parametrize("clip, field", [

@@ -218,7 +218,6 @@ ALLOWED: dict[str, str] = {
     "volviz.render.vtk_scene:add_surface": DATASET_TO_PROP,
     "volviz.render.vtk_tf:tf_from_vtk": ELSEWHERE,
     "volviz.render.vtk_tf:tf_to_vtk": ELSEWHERE,
-    "volviz.scene.clipping:clip_settings": JSON,
     "volviz.scene.datasets:read_any": JSON,
     "volviz.scene.datasets:component_dataset":
         "LoadedDataset breaks app.first_open, which narrows it by class name (outside this change)",
@@ -226,7 +225,7 @@ ALLOWED: dict[str, str] = {
     "volviz.scene.drawn_tf:drawn_tf": DATASET,
     "volviz.scene.drawn_tf:drawn_transfer_function":
         "Optional[TransferFunction] needs narrowing in scene_builder's callers (a behaviour edit, not this change)",
-    "volviz.scene.isosurfaces:isosurface_parts": JSON,
+    "volviz.scene.isosurfaces:isosurface_parts": DATASET,
     "volviz.scene.tetra:pt_mesh": DATASET,
     "volviz.scene.tetra:pt_options": JSON,
     "volviz.model.arrays:vertex_colors": DATASET,

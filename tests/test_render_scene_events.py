@@ -52,8 +52,8 @@ def test_the_controller_announces_each_edit_after_applying_it():
         def state(change: SceneChange) -> object:          # what a subscriber reads back when it is told
             comp = None if change.component is None else c.component(change.component)
             return {"visible": lambda: comp.visible, "opacity": lambda: comp.opacity,
-                    "transfer_function": lambda: session.transfer_functions[comp.transfer_function]["extinction"],
-                    "clip": lambda: len(session.clip["planes"]), "iso_mode": lambda: c.iso_mode}[change.what]()
+                    "transfer_function": lambda: list(session.transfer_functions[comp.transfer_function].extinction),
+                    "clip": lambda: len(session.clip.planes), "iso_mode": lambda: c.iso_mode}[change.what]()
 
         c.changes.subscribe(lambda change: heard.append((change, state(change))))
         c.set_visible("vol", False)

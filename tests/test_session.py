@@ -5,9 +5,12 @@ import json
 import os
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from volviz import session as S
+from volviz.model.clip import BoxCrop, ClipPlane, ClipSettings
+from volviz.optics.transfer_function import TransferFunction
 
 
 def sample_session() -> S.Session:
@@ -19,7 +22,7 @@ def sample_session() -> S.Session:
         datasets=[S.DatasetRef(id="fin", path="data/bluntfinxyz.bin", options={"q": "data/bluntfinq.bin"})],
         components=[S.Component(id="fin", type="mesh", dataset="fin", opacity=0.75, transfer_function="ramp",
                                 settings={"array": "Density", "budget": 128})],
-        transfer_functions={"ramp": tf},
+        transfer_functions={"ramp": TransferFunction.from_dict(tf)},
         camera=cam,
         camera_paths={"orbit": [S.CameraKey(0.0, cam), S.CameraKey(2.5, S.CameraState(position=(0, 5, 1)))]},
         bookmarks={"front": cam},
@@ -51,6 +54,8 @@ def test_round_trip_is_identity(tmp_path: Path) -> None:
     (lambda d: d.__setitem__("colour", 3), "colour", "unknown field"),
     (lambda d: d["transfer_functions"]["ramp"].__setitem__("extinction", [0, -1, 2]), "transfer_functions.ramp",
      "invalid transfer function"),
+    (lambda d: d["transfer_functions"]["ramp"].__setitem__("gamma", 2.2), "transfer_functions.ramp.gamma",
+     "unknown field"),
 ])
 def test_validation_names_the_offending_field(tmp_path: Path, mutate, field: str, words: str) -> None:
     doc = S.session_to_dict(sample_session())
@@ -62,6 +67,37 @@ def test_validation_names_the_offending_field(tmp_path: Path, mutate, field: str
     assert info.value.field == field
     assert words in str(info.value)
     assert str(path) in str(info.value)
+
+
+def test_transfer_functions_and_clipping_load_as_typed_models_and_save_byte_for_byte(tmp_path: Path) -> None:
+    original = sample_session()
+    original.camera_paths["orbit"][1].camera.position = (0.0, 5.0, 1.0)   # (whole numbers would be written as floats)
+    original.set_clip(ClipSettings((ClipPlane((1.5, 2.0, 3.0), (0.6, 0.8, 0.0)),), BoxCrop((0, 0, 0), (10, 20, 30.5))))
+    S.save(original, tmp_path / "a.json")
+    text = (tmp_path / "a.json").read_text()
+    doc = json.loads(text)
+    assert doc["transfer_functions"] == {"ramp": {
+        "format": "volviz-transfer-function", "version": 1, "name": "ramp", "scalars": [0.0, 0.5, 1.0],
+        "colors": [[0.0, 0.0, 1.0], [1.0, 1.0, 1.0], [1.0, 0.0, 0.0]], "extinction": [0.0, 2.0, 5.0]}}
+    assert doc["clip"] == {"planes": [{"point": [1.5, 2.0, 3.0], "normal": [0.6, 0.8, 0.0]}],
+                           "box": {"lo": [0.0, 0.0, 0.0], "hi": [10.0, 20.0, 30.5]}}
+    loaded = S.load(tmp_path / "a.json")
+    assert isinstance(loaded.transfer_functions["ramp"], TransferFunction) and isinstance(loaded.clip, ClipSettings)
+    assert loaded.transfer_function("fin") == original.transfer_functions["ramp"] and loaded.clip == original.clip
+    assert S.dumps(loaded) == text                            # what volviz wrote is written again to the byte
+
+
+def test_a_hand_written_transfer_function_is_saved_in_the_models_form() -> None:
+    doc = S.session_to_dict(sample_session())
+    doc["transfer_functions"]["ramp"] = {"scalars": [0, 1, 2.5], "colors": [[1, 0, 0], [0, 1, 0], [0, 0, 1]],
+                                         "extinction": [0, 2, 1]}
+    session = S.loads(json.dumps(doc))
+    assert session.transfer_functions["ramp"] == TransferFunction([0.0, 1.0, 2.5], np.eye(3), [0.0, 2.0, 1.0])
+    text = S.dumps(session)
+    assert json.loads(text)["transfer_functions"]["ramp"] == {
+        "format": "volviz-transfer-function", "version": 1, "name": "", "scalars": [0.0, 1.0, 2.5],
+        "colors": [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]], "extinction": [0.0, 2.0, 1.0]}
+    assert S.dumps(S.loads(text)) == text
 
 
 def test_newer_version_is_refused_clearly(tmp_path: Path) -> None:

@@ -4,6 +4,7 @@ and passes it on to its own ``changes``, after the views hold it. Real VTK rende
 from __future__ import annotations
 
 import copy
+import dataclasses
 
 import numpy as np
 import pytest
@@ -60,7 +61,7 @@ def test_a_script_edit_of_the_session_re_renders_the_view_it_reaches() -> None:
     dense = TransferFunction.ramp(0.0, 3.0, 6.0, (1.0, 0.4, 0.1))
     after, model, views = _picture(session, datasets, lambda s: s.set_transfer_function("vol", dense))
     assert model == views == [SceneChange("transfer_function", "vol")]
-    assert session.transfer_functions["vol"] == dense.to_dict() and session.components[0].transfer_function == "vol"
+    assert session.transfer_functions["vol"] is dense and session.components[0].transfer_function == "vol"
     # the view re-made its image for the edit: the frame is the one a scene built with that function shows
     built, _, _ = _picture(copy.deepcopy(session), datasets)
     assert (np.abs(after - before).sum(axis=2) > 30).mean() > 0.05
@@ -92,7 +93,9 @@ def test_every_kind_of_edit_is_announced_once_then_passed_on_by_the_controller()
     assert model == views == expected
     assert order == ["model opacity", "model opacity", "model visible", "model visible", "model clip", "model iso_mode"]
     assert session.components[0].opacity == 0.4 and session.components[0].visible
-    assert session.clip == {"planes": [{"point": [0.0, 0.0, 0.0], "normal": [1.0, 0.0, 0.0]}], "box": None}
+    assert session.clip == ClipSettings(planes=[ClipPlane((0.0, 0.0, 0.0), (1.0, 0.0, 0.0))])   # the normal made unit
+    assert session_to_dict(session)["clip"] == {"planes": [{"point": [0.0, 0.0, 0.0], "normal": [1.0, 0.0, 0.0]}],
+                                                "box": None}
     assert session.render.options["iso_mode"] == "2pass"
     built, _, _ = _picture(copy.deepcopy(session), datasets)   # the views hold the edits: as built with them
     assert np.abs(edited - built).max() <= 2.0
@@ -129,16 +132,20 @@ def test_a_cleared_scene_hears_no_more_edits_and_a_copied_session_no_listeners()
     assert "changes" not in session_to_dict(session)
 
 
-def test_the_session_hands_out_its_transfer_functions_as_typed_models() -> None:
+def test_the_session_holds_its_transfer_functions_and_clipping_as_immutable_models() -> None:
     from volviz.optics import TransferFunction
 
     session, _ = _scene_session()
-    assert session.transfer_function("vol") is None
+    assert session.transfer_function("vol") is None and session.clip == ClipSettings()
     tf = TransferFunction.ramp(0.0, 2.0, 3.0)
     session.set_transfer_function("vol", tf)
-    assert session.transfer_function("vol") is tf                    # the object given, not a copy made from JSON
-    other = TransferFunction.ramp(0.0, 1.0, 5.0)
-    session.transfer_functions["vol"] = other.to_dict()              # the JSON replaced behind the model's back
-    read = session.transfer_function("vol")
-    assert read is not other and read.to_dict() == other.to_dict()
-    assert copy.deepcopy(session).transfer_function("vol").to_dict() == other.to_dict()
+    assert session.transfer_function("vol") is tf and session.transfer_functions == {"vol": tf}   # no JSON copy
+    with pytest.raises(ValueError, match="read-only"):
+        tf.extinction[1] = 9.0                                       # a model is edited by making a new one
+    clip = ClipSettings(planes=[ClipPlane((0.0, 0.0, 0.0), (0.0, 3.0, 4.0))])
+    session.set_clip(clip)
+    assert session.clip is clip and clip.planes[0].normal == (0.0, 0.6, 0.8)
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        clip.box = None                                              # type: ignore[misc]
+    twin = copy.deepcopy(session)                                    # immutable: a copy shares the models
+    assert twin.transfer_function("vol") is tf and twin.clip == clip and twin == session

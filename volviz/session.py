@@ -6,6 +6,13 @@ window layout. Loading validates every field and names the offending one (``comp
 version is refused; older versions are migrated step by step through ``MIGRATIONS``. Nothing read is executed or
 unpickled: the file is parsed with ``json`` and every value is checked against the schema below.
 
+The transfer functions and the clipping are held as typed, immutable models (``volviz.optics.TransferFunction``,
+``volviz.model.clip.ClipSettings``), made from the JSON when a document is read (``session_from_dict``) and written
+back only when it is saved (``session_to_dict``), so every reader takes the model (issue #31). A file volviz wrote
+saves byte for byte as it was read; a hand-written one is saved in the models' form: whole numbers of a transfer
+function as floats (``1`` -> ``1.0``), its ``format``, ``version`` and ``name`` (``""``) written out, and a clipping
+normal as its unit vector (``[0, 0, 2]`` -> ``[0.0, 0.0, 1.0]``: the same half-space).
+
 Untrusted files cannot make loading slow, deep or large: the file must be a regular file (a FIFO or device is refused
 before it is opened, so it can never block the reader) of at most ``MAX_SESSION_BYTES``; before parsing, a scan of
 the bytes bounds the nesting depth (``MAX_DEPTH``) and the number of values (``MAX_VALUES``); while parsing, numbers
@@ -29,7 +36,7 @@ from typing import TYPE_CHECKING, Any, Callable, get_args
 from volviz.io._checks import path_kind
 from volviz.io.atomic import OutputPathError, atomic_write_bytes
 from volviz.io.jsonbounds import nesting_depth, outside_strings
-from volviz.model.clip import ClipSettings
+from volviz.model.clip import BoxCrop, ClipPlane, ClipSettings
 from volviz.model.events import ChangeNotifier, SceneChange
 from volviz.model.settings import Backend, IsoOverlayMode, SettingsError, validate_render_options, validate_settings
 
@@ -111,18 +118,15 @@ class RenderSettings:
 class Session:
     datasets: list[DatasetRef] = field(default_factory=list)
     components: list[Component] = field(default_factory=list)
-    transfer_functions: dict[str, dict[str, Any]] = field(default_factory=dict)
+    transfer_functions: dict[str, TransferFunction] = field(default_factory=dict)
     camera: CameraState | None = None
     camera_paths: dict[str, list[CameraKey]] = field(default_factory=dict)
     bookmarks: dict[str, CameraState] = field(default_factory=dict)
     render: RenderSettings = field(default_factory=RenderSettings)
     layout: dict[str, Any] = field(default_factory=dict)
-    clip: dict[str, Any] = field(default_factory=lambda: {"planes": [], "box": None})
+    clip: ClipSettings = field(default_factory=ClipSettings)
     #: announces each edit made through the methods below (``volviz.model.events``); not part of the document
     changes: ChangeNotifier = field(default_factory=ChangeNotifier, repr=False, compare=False)
-    #: name -> (the stored JSON, its typed model): the transfer functions as ``transfer_function`` hands them out
-    _tf_models: dict[str, tuple[dict[str, Any], TransferFunction]] = field(
-        default_factory=dict, init=False, repr=False, compare=False)
 
     def dataset(self, dataset_id: str) -> DatasetRef:
         for ref in self.datasets:
@@ -143,24 +147,14 @@ class Session:
         id); ``preview``: an edit under way (a point being dragged)."""
         comp = self.component(comp_id)
         name = comp.transfer_function or comp.id
-        stored = self.transfer_functions[name] = tf.to_dict()
-        self._tf_models[name] = (stored, tf)
+        self.transfer_functions[name] = tf
         comp.transfer_function = name
         self.changes.notify(SceneChange("transfer_function", comp_id, preview))
 
     def transfer_function(self, comp_id: str) -> TransferFunction | None:
-        """Component ``comp_id``'s transfer function as a typed model (None without one): the very object last given
-        to ``set_transfer_function`` while the stored JSON is still the one it wrote, else made from the JSON."""
+        """Component ``comp_id``'s transfer function (None without one)."""
         name = self.component(comp_id).transfer_function
-        if name is None:
-            return None
-        stored = self.transfer_functions[name]
-        known = self._tf_models.get(name)
-        if known is None or known[0] is not stored:
-            from volviz.optics import TransferFunction
-
-            known = self._tf_models[name] = (stored, TransferFunction.from_dict(stored))
-        return known[1]
+        return None if name is None else self.transfer_functions[name]
 
     def set_visible(self, comp_id: str, visible: bool) -> None:
         self.component(comp_id).visible = bool(visible)
@@ -172,9 +166,9 @@ class Session:
         self.changes.notify(SceneChange("opacity", comp_id))
 
     def set_clip(self, clip: dict[str, Any] | ClipSettings) -> None:
-        """New scene-wide clipping (``ClipSettings`` or its JSON); raises ``ValueError`` naming what is wrong with
-        it, changing nothing."""
-        self.clip = (clip if isinstance(clip, ClipSettings) else ClipSettings.from_dict(clip)).to_dict()
+        """New scene-wide clipping (``ClipSettings``, or its JSON as the clipping dock emits it, read here once);
+        raises ``ValueError`` naming what is wrong with it, changing nothing."""
+        self.clip = clip if isinstance(clip, ClipSettings) else ClipSettings.from_dict(clip)
         self.changes.notify(SceneChange("clip"))
 
     def set_iso_mode(self, mode: str) -> None:
@@ -293,17 +287,20 @@ def _quote(text: str) -> str:
     return "an empty string" if not text else f"a string of {len(text)} characters"
 
 
-def _validate_transfer_function(reader: _Reader, value: Any, where: str) -> dict[str, Any]:
+TF_FIELDS = {"format", "version", "name", "scalars", "colors", "extinction"}  # TransferFunction.to_dict's
+
+
+def _read_transfer_function(reader: _Reader, value: Any, where: str) -> TransferFunction:
+    """A transfer function of the document as the typed model (``TransferFunction.from_dict``, Roettger §7.1)."""
+    # here, not at the top: volviz.optics loads numba (+0.1 s), which a session without transfer functions skips
+    from volviz.optics.transfer_function import TransferFunction
+
     d = reader.json_value(reader.obj(value, where), where)
+    reader.known_keys(d, where, TF_FIELDS)
     try:
-        from volviz.optics import TransferFunction
-    except ImportError:  # the optics layer is optional for plain session handling
-        return d
-    try:
-        TransferFunction.from_dict(d)
+        return TransferFunction.from_dict(d)
     except (ValueError, TypeError, KeyError) as exc:
         raise reader.fail(where, f"invalid transfer function: {exc}") from None
-    return d
 
 
 def session_from_dict(doc: Any, source: str | os.PathLike | None = None) -> Session:
@@ -332,7 +329,7 @@ def session_from_dict(doc: Any, source: str | os.PathLike | None = None) -> Sess
 
     tfs = r.obj(d.get("transfer_functions", {}), "transfer_functions")
     for name, value in tfs.items():
-        session.transfer_functions[name] = _validate_transfer_function(r, value, f"transfer_functions.{name}")
+        session.transfer_functions[name] = _read_transfer_function(r, value, f"transfer_functions.{name}")
 
     component_ids: set[str] = set()
     for i, item in enumerate(r.lst(d.get("components", []), "components")):
@@ -431,13 +428,13 @@ def _option_scalar(r: _Reader, value: Any, where: str) -> Any:
     raise r.fail(where, f"expected a string, number, boolean or null, got {_kind(value)}")
 
 
-def _read_clip(r: _Reader, value: Any) -> dict[str, Any]:
-    """Scene-wide clipping (``volviz.model.clip.ClipSettings`` as JSON): any number of planes ``{"point", "normal"}``
-    keeping ``(x - point)·normal >= 0``, and an optional box ``{"lo", "hi"}``. Sessions written before clipping
-    existed have no ``clip`` field and load with no clipping."""
+def _read_clip(r: _Reader, value: Any) -> ClipSettings:
+    """Scene-wide clipping (``volviz.model.clip.ClipSettings``, libMini note Fig. 6): any number of planes
+    ``{"point", "normal"}`` keeping ``(x - point)·normal >= 0`` (the normal made unit length), and an optional box
+    ``{"lo", "hi"}``. Sessions written before clipping existed have no ``clip`` field and load with no clipping."""
     d = r.obj(value, "clip")
     r.known_keys(d, "clip", {"planes", "box"})
-    planes = []
+    planes: list[ClipPlane] = []
     for i, item in enumerate(r.lst(d.get("planes", []), "clip.planes")):
         where = f"clip.planes[{i}]"
         o = r.obj(item, where)
@@ -445,16 +442,16 @@ def _read_clip(r: _Reader, value: Any) -> dict[str, Any]:
         normal = r.vector(o.get("normal"), f"{where}.normal")
         if math.sqrt(sum(v * v for v in normal)) < 1e-12:
             raise r.fail(f"{where}.normal", "must not be the zero vector")
-        planes.append({"point": list(r.vector(o.get("point"), f"{where}.point")), "normal": list(normal)})
-    box = None
+        planes.append(ClipPlane(r.vector(o.get("point"), f"{where}.point"), normal))  # type: ignore[arg-type]
+    box: BoxCrop | None = None
     if d.get("box") is not None:
         o = r.obj(d["box"], "clip.box")
         r.known_keys(o, "clip.box", {"lo", "hi"})
         lo, hi = r.vector(o.get("lo"), "clip.box.lo"), r.vector(o.get("hi"), "clip.box.hi")
         if any(a > b for a, b in zip(lo, hi)):
             raise r.fail("clip.box", f"needs lo <= hi on every axis, got lo={list(lo)} hi={list(hi)}")
-        box = {"lo": list(lo), "hi": list(hi)}
-    return {"planes": planes, "box": box}
+        box = BoxCrop(lo, hi)  # type: ignore[arg-type]
+    return ClipSettings(tuple(planes), box)
 
 
 def _camera_dict(cam: CameraState) -> dict[str, Any]:
@@ -468,7 +465,7 @@ def session_to_dict(session: Session) -> dict[str, Any]:
         "format": FORMAT,
         "version": VERSION,
         "datasets": [{"id": d.id, "path": d.path, "options": copy.deepcopy(d.options)} for d in session.datasets],
-        "transfer_functions": copy.deepcopy(session.transfer_functions),
+        "transfer_functions": {name: tf.to_dict() for name, tf in session.transfer_functions.items()},
         "components": [{"id": c.id, "type": c.type, "dataset": c.dataset, "visible": c.visible, "opacity": c.opacity,
                         "transfer_function": c.transfer_function, "settings": copy.deepcopy(c.settings)}
                        for c in session.components],
@@ -479,7 +476,7 @@ def session_to_dict(session: Session) -> dict[str, Any]:
         "render": {"method": session.render.method, "size": list(session.render.size),
                    "background": list(session.render.background), "options": copy.deepcopy(session.render.options)},
         "layout": copy.deepcopy(session.layout),
-        "clip": copy.deepcopy(session.clip),
+        "clip": session.clip.to_dict(),
     }
     return doc
 

@@ -60,6 +60,7 @@ def _tetrahedral_volume(folder: Path) -> None:
     from volviz.scene.demo import demo_volume_session
     from volviz.unstructured import render
     from volviz.model.camera import Camera
+    from volviz.model.clip import BoxCrop, ClipSettings
     from volviz.unstructured.synthetic import box_tets, holed_box
 
     render_session(demo_volume_session(), None, SIZE)
@@ -73,7 +74,7 @@ def _tetrahedral_volume(folder: Path) -> None:
     render(mesh, tf, camera, (24, 24), method="reference")
     render(holed_box(4), tf, camera, (24, 24))  # a non-convex mesh: the sort's boundary-gap relations
     clipped = demo_volume_session()
-    clipped.clip = {"planes": [], "box": {"lo": [0.0, 0.0, 0.0], "hi": [0.5, 0.5, 0.5]}}  # a cut mesh
+    clipped.clip = ClipSettings(box=BoxCrop((0.0, 0.0, 0.0), (0.5, 0.5, 0.5)))  # a cut mesh
     render_session(clipped, None, SIZE)
     upsample_preview(np.zeros((2, 2, 4)), np.full((2, 2), np.inf), np.full((4, 4), np.inf))
 

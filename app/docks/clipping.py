@@ -15,6 +15,8 @@ from PySide6.QtGui import QUndoCommand, QUndoStack
 from PySide6.QtWidgets import (QCheckBox, QDoubleSpinBox, QFormLayout, QGroupBox, QListWidget,
                                QPushButton, QVBoxLayout, QWidget)
 
+from volviz.model.clip import ClipSettings
+
 from ..widget_row import widget_row
 from . import set_tooltips
 
@@ -136,13 +138,13 @@ class ClippingDock(QWidget):
         self._refresh()
 
     # -- public ---------------------------------------------------------------------------------------------------
-    def load(self, clip: Optional[dict[str, Any]], bounds: Optional[Sequence[float]] = None) -> None:
+    def load(self, clip: Optional[ClipSettings], bounds: Optional[Sequence[float]] = None) -> None:
         """Show a session's clipping (no signal, fresh undo history); ``bounds`` (xmin, xmax, ...) of the scene
         place new planes and the default box."""
         if bounds is not None and all(math.isfinite(float(v)) for v in bounds):
             self.bounds = tuple(float(v) for v in bounds)
         self.undo_stack.clear()
-        self._apply(copy.deepcopy(clip or NO_CLIP), emit=False)
+        self._apply(NO_CLIP if clip is None else clip.to_dict(), emit=False)
 
     def add_plane(self) -> None:
         """A new plane through the scene's centre, normal +x."""

@@ -72,6 +72,18 @@ class RenderDoc(_Strict):
     options: RenderOptions = Field(default_factory=RenderOptions)
 
 
+class TransferFunctionDoc(_Strict):
+    """A piecewise-linear transfer function (``volviz.optics.TransferFunction.to_dict``, Roettger §7.1): at each
+    control point a chromaticity κ (RGB) and an extinction ρ per unit length, linear between them."""
+
+    format: Literal["volviz-transfer-function"] = "volviz-transfer-function"
+    version: Literal[1] = 1
+    name: str = ""
+    scalars: list[float] = Field(min_length=2, description="control-point scalars, strictly increasing")
+    colors: list[tuple[float, float, float]] = Field(min_length=2, description="κ >= 0 at each control point")
+    extinction: list[float] = Field(min_length=2, description="ρ >= 0 at each control point, per unit length")
+
+
 class ClipPlaneDoc(_Strict):
     point: Vec3
     normal: Vec3
@@ -94,8 +106,8 @@ class SessionDocument(_Strict):
     version: Literal[1] = 1
     datasets: list[DatasetDoc] = Field(default_factory=list)
     components: list[ComponentDoc] = Field(default_factory=list)
-    transfer_functions: dict[str, dict[str, Any]] = Field(default_factory=dict, description="named transfer "
-                                                          "functions (volviz.optics.TransferFunction.to_dict)")
+    transfer_functions: dict[str, TransferFunctionDoc] = Field(default_factory=dict,
+                                                               description="named transfer functions")
     camera: Optional[CameraDoc] = None
     camera_paths: dict[str, list[CameraKeyDoc]] = Field(default_factory=dict)
     bookmarks: dict[str, CameraDoc] = Field(default_factory=dict)

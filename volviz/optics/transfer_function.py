@@ -116,6 +116,12 @@ class TransferFunction:
 
     __hash__ = None  # type: ignore[assignment]
 
+    def __copy__(self) -> "TransferFunction":
+        return self  # immutable: a copy (of a session holding it, say) shares it, as it would share a string
+
+    def __deepcopy__(self, memo: dict[int, Any]) -> "TransferFunction":
+        return self
+
     @property
     def max_extinction(self) -> float:
         """max ρ over the range (the maximum is at a control point)."""

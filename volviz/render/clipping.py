@@ -1,5 +1,5 @@
 """Scene-wide clipping planes and box crop (libMini note, Fig. 6) applied to every kind of prop a scene shows, so
-volumes, isosurfaces and unstructured meshes are cut alike. The settings are ``session.clip`` (JSON of
+volumes, isosurfaces and unstructured meshes are cut alike. The settings are ``session.clip`` (a
 ``volviz.model.clip.ClipSettings``: a plane keeps ``(x − point)·normal ≥ 0``, the box keeps ``lo ≤ x ≤ hi``).
 
 How each prop honours them:

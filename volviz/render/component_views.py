@@ -12,7 +12,6 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any, Optional
 
 from volviz.render.framing import Bounds, points_bounds, prop_bounds, union
-from volviz.scene.clipping import clip_settings
 from volviz.scene.isosurfaces import isosurface_parts
 
 if TYPE_CHECKING:   # type-only imports for the signatures
@@ -98,7 +97,7 @@ class IsoSurfacesView(VtkPropView):
         super().__init__(None)
         self.plotter, self.comp, self.spectrum = plotter, comp, spectrum
         self.parts = parts
-        self.clip = clip_settings(parts.clip)
+        self.clip = parts.clip
         self.show(parts)
 
     @property
@@ -115,7 +114,7 @@ class IsoSurfacesView(VtkPropView):
         return not self.stale()
 
     def stale(self) -> bool:
-        return self.parts.clip != self.clip.to_dict() or self.parts.opacity != float(self.comp.opacity)
+        return self.parts.clip != self.clip or self.parts.opacity != float(self.comp.opacity)
 
     def cut(self, clip: Optional[ClipSettings] = None, meshes: Optional[list[IsoMesh]] = None,
             progress: Optional[ProgressCallback] = None) -> IsoParts:

@@ -531,7 +531,7 @@ class SceneController:
                     continue
                 comp = self.component(comp_id)
                 parts = surfaces if isinstance(surfaces, IsoParts) else None
-                if parts is None or parts.clip != self.clip.to_dict() or parts.opacity != comp.opacity:
+                if parts is None or parts.clip != self.clip or parts.opacity != comp.opacity:
                     parts = view.cut(self.clip, meshes=list(parts.meshes if parts else surfaces))
                 view.show(parts)
         self._sync_iso_overlay()
@@ -700,9 +700,7 @@ class SceneController:
     # -- clipping (scene-wide) --------------------------------------------------------------------------------------
     @property
     def clip(self) -> ClipSettings:
-        from volviz.scene.clipping import clip_settings
-
-        return clip_settings(self.session.clip)
+        return self.session.clip
 
     def set_clip(self, clip: dict[str, Any] | ClipSettings, update: bool = True) -> list[str]:
         """Store new clipping (``session.clip`` JSON or ClipSettings: ``Session.set_clip``), which every view is then

@@ -147,14 +147,13 @@ def _bar_scale(session: Session, comp: Any, datasets: dict[str, Any]) -> tuple[A
     """The scalar bar's color function, label values, label format and whether it is logarithmic: the component's
     transfer function (through log10 with ``log_scale``: log ticks from the smallest positive value) over the edited
     range, else over the function's own."""
-    from volviz.optics import TransferFunction
     from volviz.optics.log_scale import log_mapped, log_ticks
     from volviz.scene.drawn_tf import log_floor, uses_log_scale
     from volviz.render.vtk_facade import vtk
     from volviz.render.vtk_tf import tf_to_vtk
 
     style = scalar_bar_style(session)
-    tf = TransferFunction.from_dict(session.transfer_functions[comp.transfer_function])
+    tf = session.transfer_functions[comp.transfer_function]
     lo, hi = style.range or tf.range
     log = False
     if uses_log_scale(comp):

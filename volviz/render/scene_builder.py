@@ -21,7 +21,6 @@ from volviz.render.slices import SlicesView
 from volviz.render.views import view_class
 from volviz.render.vtk_scene import (add_dataset, add_surface, apply_camera, default_transfer_function_for, is_surface,
                                      surface_input, volume_grid, volume_input, volume_prop)
-from volviz.scene.clipping import clip_settings
 from volviz.scene.datasets import NATURE_TYPES, component_dataset
 from volviz.scene.drawn_tf import component_transfer_function, drawn_transfer_function
 from volviz.scene.first_look import first_look
@@ -52,7 +51,7 @@ def ensure_transfer_functions(session: Session, datasets: dict[str, LoadedDatase
             while name in session.transfer_functions:
                 name += "'"
             tf = default_transfer_function_for(component_dataset(comp, datasets), name)
-            session.transfer_functions[name] = tf.to_dict()
+            session.transfer_functions[name] = tf
             comp.transfer_function = name
 
 
@@ -91,7 +90,7 @@ def prepare_component(session: Session, comp: Component, datasets: dict[str, Loa
     """Any thread: the heavy part of showing one non-nature component (isosurface extraction with clipping and LOD
     chains, tetrahedralisation and topology, the VTK volume input at display time ``t``, its data histogram), put into
     ``prepared``; ``install_component`` adds its prop on the GUI thread."""
-    clip = clip_settings(session.clip)
+    clip = session.clip
     dataset = component_dataset(comp, datasets)
     series = isinstance(dataset, TimeSeries)
     if comp.type == "isosurface":

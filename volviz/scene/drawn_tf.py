@@ -9,7 +9,6 @@ from typing import TYPE_CHECKING, Any, Optional
 import numpy as np
 
 from volviz.model.stats import scalar_values
-from volviz.optics import TransferFunction
 from volviz.optics.log_scale import log_mapped, positive_floor
 from volviz.scene.lod import is_lod, lod_scalar_range
 from volviz.session import Component, Session
@@ -64,7 +63,7 @@ def component_transfer_function(session: Session, comp: Component) -> Optional[T
     """The component's stored transfer function (in data values), or None when it has none."""
     if comp.transfer_function is None:
         return None
-    return TransferFunction.from_dict(session.transfer_functions[comp.transfer_function])
+    return session.transfer_functions[comp.transfer_function]
 
 
 def drawn_transfer_function(session: Session, comp: Component, dataset: Any) -> Any:

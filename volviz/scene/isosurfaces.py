@@ -7,7 +7,7 @@ from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any, Optional
 
 from volviz.jobs import ProgressCallback
-from volviz.scene.clipping import clip_settings
+from volviz.model.clip import ClipSettings
 from volviz.scene.errors import SceneError
 from volviz.session import Component
 
@@ -15,7 +15,6 @@ if TYPE_CHECKING:   # type-only imports for the signatures
     from volviz.iso import IsoSettings
     from volviz.iso.extract import IsoMesh
     from volviz.iso.lod import LodChain
-    from volviz.model.clip import ClipSettings
 
 
 @dataclass
@@ -27,16 +26,16 @@ class IsoParts:
     shown: list[IsoMesh]
     lod: Optional[list[Optional[tuple[LodChain, float]]]]   # per shown surface: its chain, triangles per pixel²
     settings: IsoSettings
-    clip: dict[str, Any] = field(default_factory=dict)  # the scene clipping they were cut by (``to_dict``)
+    clip: ClipSettings = field(default_factory=ClipSettings)  # the scene clipping they were cut by
     opacity: float = 1.0                                 # the component opacity they were scaled by
 
 
 def isosurface_parts(comp: Component, dataset: Any = None, t: Optional[float] = None,
-                     clip: dict[str, Any] | ClipSettings | None = None,
+                     clip: Optional[ClipSettings] = None,
                      meshes: Optional[list[IsoMesh]] = None, progress: Optional[ProgressCallback] = None) -> IsoParts:
     """Any thread: the surfaces of an ``isosurface`` component (settings: ``volviz.iso.IsoSettings``) extracted at
-    display time ``t`` (skipped when ``meshes`` are known), cut exactly by the scene's ``clip`` (``session.clip`` or
-    ClipSettings) on top of the component's own clipping, scaled by its opacity, with their LOD chains."""
+    display time ``t`` (skipped when ``meshes`` are known), cut exactly by the scene's ``clip`` (``session.clip``; None:
+    none) on top of the component's own clipping, scaled by its opacity, with their LOD chains."""
     from volviz.iso import IsoSettings, build_lod, prepare   # the iso kernels: only for isosurfaces (start-up)
     from volviz.iso.clip import clip_isosurfaces
 
@@ -48,11 +47,11 @@ def isosurface_parts(comp: Component, dataset: Any = None, t: Optional[float] = 
         raise SceneError(f"component {comp.id!r}: settings.styles lists no iso-values")
     if meshes is None:
         meshes = list(prepare(dataset, settings, t, progress=progress).meshes)
-    scene_clip = clip_settings(clip)
+    scene_clip = ClipSettings() if clip is None else clip
     shown = clip_isosurfaces(meshes, scene_clip) if scene_clip.all_planes() else list(meshes)
     if comp.opacity < 1.0:  # the component's opacity scales every surface's
         shown = [replace(m, style=replace(m.style, opacity=m.style.opacity * comp.opacity)) for m in shown]
     lod = None  # LOD chains of the shown surfaces (the CPU modes draw them view-dependently)
     if settings.lod:
         lod = [(build_lod(m), settings.triangles_per_pixel2) if m.n_triangles else None for m in shown]
-    return IsoParts(list(meshes), shown, lod, settings, scene_clip.to_dict(), float(comp.opacity))
+    return IsoParts(list(meshes), shown, lod, settings, scene_clip, float(comp.opacity))
