@@ -372,7 +372,7 @@ def test_pt_volume_keeps_showing_renders_while_flying(qtbot, make_window) -> Non
 
 def test_natural_scene_follows_a_mouse_drag_with_previews(qtbot, make_window) -> None:
     """The demo scene's fog and clouds (and the terrain's C-LOD mesh) follow a mouse drag while the button is held,
-    as half-size previews magnified to the window; the full-size view follows the release."""
+    as half-size previews (OpenGL magnifies them over the viewport); the full-size view follows the release."""
     from test_app_workflows import _mouse
 
     window = make_window()
@@ -391,7 +391,7 @@ def test_natural_scene_follows_a_mouse_drag_with_previews(qtbot, make_window) ->
     qtbot.waitUntil(lambda: window.view_updates.get("nature", 0) > updates, timeout=60000)
     assert view.shown_scale == 2 and view._mesh is not mesh
     w, h = (int(v) for v in window.plotter.window_size)
-    assert view._overlay_image.GetDimensions()[:2] == (w, h)  # magnified to the window
+    assert view._overlay_image.GetDimensions()[:2] == (w // 2, h // 2)  # half size, magnified by OpenGL
     _mouse(canvas, QEvent.Type.MouseButtonRelease, centre + QPoint(60, 0), Qt.MouseButton.NoButton)
     qtbot.waitUntil(lambda: view.shown_scale == 1 and not window._view_jobs["nature"].running, timeout=60000)
 

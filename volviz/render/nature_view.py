@@ -1,8 +1,10 @@
 """The natural scene in a PyVista plotter, CPU backend (Roettger Ch. 10-11 images made by ``volviz.nature``):
 the terrain's C-LOD mesh as a textured VTK mesh (the baked color map, lighting off, so it matches the CPU image), the
 sky dome around the eye, and the fog and cloud volumes as one screen-space RGBA overlay in front (the terrain
-occlusion is already in it, from the CPU terrain z-buffer). ``NatureView.update(camera)`` recomputes the terrain LOD
-mesh and the overlay for a camera; the app does it in the background (``begin`` / ``compute`` / ``finish``).
+occlusion is already in it, from the CPU terrain z-buffer): a premultiplied texture on a quad spanning the viewport,
+so that an image of any size covers it (a preview smaller than the window, a frame drawn at a reduced size).
+``NatureView.update(camera)`` recomputes the terrain LOD mesh and the overlay for a camera; the app does it in the
+background (``begin`` / ``compute`` / ``finish``).
 ``volviz.render.gl_nature.GLNatureView`` is the GPU backend with the same calls.
 
 ``build_nature_components`` builds a view from a session's terrain / fog / clouds / sky components.
@@ -173,12 +175,12 @@ class NatureView:
     def compute(self, request: NatureRequest, progress: Optional[ProgressCallback] = None
                 ) -> tuple[Optional[pv.PolyData], np.ndarray, dict[str, float]]:
         """Any thread (one at a time): the C-LOD terrain mesh as VTK poly data (None without terrain), the fog and
-        cloud overlay as 8-bit straight RGBA rows bottom-up, and the statistics. ``progress(fraction, message)`` is
-        called between the stages (a job runner cancels there). A preview (``scale`` > 1, e.g. while the camera
-        moves) renders the fog and clouds at 1/scale of the size in each direction and magnifies them (``_magnify``)
-        over a coarser terrain of about ``PREVIEW_TRIANGLES`` triangles (the C-LOD resolution scaled by
-        ``preview_detail``, refitted after each preview): the full mesh, half a million triangles on Yukon, took
-        0.4 s to draw on a software OpenGL, and each frame drawn while flying blocked the window that long. The
+        cloud overlay as 8-bit premultiplied RGBA rows bottom-up, and the statistics. ``progress(fraction, message)``
+        is called between the stages (a job runner cancels there). A preview (``scale`` > 1, e.g. while the camera
+        moves) renders the fog and clouds at 1/scale of the size in each direction (OpenGL magnifies them:
+        ``_set_overlay``) over a coarser terrain of about ``PREVIEW_TRIANGLES`` triangles (the C-LOD resolution
+        scaled by ``preview_detail``, refitted after each preview): the full mesh, half a million triangles on Yukon,
+        took 0.4 s to draw on a software OpenGL, and each frame drawn while flying blocked the window that long. The
         clouds' levels of detail are those of the full size."""
         cam, size, scale = request
         preview = scale > 1 and not self.full
@@ -201,8 +203,6 @@ class NatureView:
         if progress is not None:
             progress(0.5, "fog and clouds")
         overlay = _overlay_rgba(self.scene.render_volumes(cam, size, mesh, depth, full=self.full, stats=stats))
-        if scale > 1:
-            overlay = _magnify(overlay, request[1])
         return poly, overlay, stats
 
     def _preview_mesh(self, cam: Any, size: tuple[int, int]) -> Any:
@@ -224,7 +224,7 @@ class NatureView:
                stats: dict[str, float]) -> dict[str, float]:
         """GUI thread: show a ``compute`` result (terrain mesh and overlay image)."""
         self._show_terrain(poly)
-        self._set_overlay(overlay)
+        self._set_overlay(overlay, smooth=int(request[2]) > 1)
         self.last_stats = stats
         self.shown_scale = int(request[2])
         return stats
@@ -255,28 +255,26 @@ class NatureView:
             self.plotter.remove_actor(name, render=False)
         self.terrain_actor = self._overlay_actor = self._overlay_image = None
 
-    def _set_overlay(self, overlay: np.ndarray) -> None:
-        """Show an overlay image of ``_overlay_rgba`` (8-bit straight RGBA, rows bottom-up) in front of the scene."""
+    def _set_overlay(self, overlay: np.ndarray, smooth: bool = False) -> None:
+        """Show an overlay image of ``_overlay_rgba`` (8-bit premultiplied RGBA, rows bottom-up) in front of the scene,
+        over the whole viewport whatever the image's size (``_viewport_quad``). ``smooth``: filtered linearly (a
+        preview smaller than the viewport); at the viewport's size each pixel shows its texel either way. A preview
+        uploads 1/scale² of the pixels and needs no magnification on the CPU (PIL took 34 ms per 990x673 preview on
+        the worker, beside 2.6 MB copied and uploaded on the GUI thread)."""
         from volviz.render.vtk_facade import numpy_to_vtk, vtk
 
         h, w = overlay.shape[:2]
-        data = overlay.reshape(-1, 4)
         if self._overlay_image is None:
             self._overlay_image = vtk.vtkImageData()
-            mapper = vtk.vtkImageMapper()
-            mapper.SetInputData(self._overlay_image)
-            mapper.SetColorWindow(255.0)
-            mapper.SetColorLevel(127.5)
-            actor = vtk.vtkActor2D()
-            actor.SetMapper(mapper)
-            self.plotter.add_actor(actor, name="nature-overlay", reset_camera=False, render=False)
-            self._overlay_actor = actor
+            self._overlay_actor = _viewport_quad(self._overlay_image)
+            self.plotter.add_actor(self._overlay_actor, name="nature-overlay", reset_camera=False, render=False)
         img = self._overlay_image
         img.SetDimensions(w, h, 1)
-        arr = numpy_to_vtk(data, deep=True)
+        arr = numpy_to_vtk(overlay.reshape(-1, 4), deep=True)
         arr.SetNumberOfComponents(4)
         img.GetPointData().SetScalars(arr)
         img.Modified()
+        self._overlay_actor.GetTexture().SetInterpolate(bool(smooth))
 
 
 def _refit(view: weakref.ref[NatureView]) -> Callable[..., None]:
@@ -319,24 +317,46 @@ def _filtered_texture(texture: Any) -> Any:
     return texture
 
 
-def _magnify(rgba8: np.ndarray, size: tuple[int, int]) -> np.ndarray:
-    """A straight-alpha RGBA8 image resampled bilinearly to ``size`` (W, H) pixels over the same view (Pillow:
-    premultiplied while filtering, so no color bleeds from transparent pixels; pixel centres aligned)."""
-    from PIL import Image
+def _viewport_quad(image: Any) -> Any:
+    """A 2D actor showing ``image`` (vtkImageData of 8-bit premultiplied RGBA) as a texture on a quad spanning the
+    viewport (corners in normalized viewport coordinates, texture coordinates 0..1: at the viewport's size the
+    centre of pixel i samples texel i exactly), blended with (ONE, ONE_MINUS_SRC_ALPHA) (``PremultipliedAlpha``), so
+    no colour bleeds from transparent texels where OpenGL filters it."""
+    from volviz.render.vtk_facade import numpy_to_vtk, vtk
 
-    img = Image.fromarray(np.ascontiguousarray(rgba8), "RGBA").convert("RGBa")
-    return np.asarray(img.resize((int(size[0]), int(size[1])), Image.Resampling.BILINEAR).convert("RGBA"))
+    quad = vtk.vtkPolyData()
+    points = vtk.vtkPoints()
+    points.SetData(numpy_to_vtk(np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], np.float32), deep=True))
+    quad.SetPoints(points)
+    cells = vtk.vtkCellArray()
+    cells.InsertNextCell(4, [0, 1, 2, 3])
+    quad.SetPolys(cells)
+    quad.GetPointData().SetTCoords(numpy_to_vtk(np.array([[0, 0], [1, 0], [1, 1], [0, 1]], np.float32), deep=True))
+    corners = vtk.vtkCoordinate()
+    corners.SetCoordinateSystemToNormalizedViewport()
+    mapper = vtk.vtkPolyDataMapper2D()
+    mapper.SetInputData(quad)
+    mapper.SetTransformCoordinate(corners)
+    texture = vtk.vtkTexture()
+    texture.SetInputData(image)
+    texture.SetColorModeToDirectScalars()
+    texture.PremultipliedAlphaOn()
+    texture.InterpolateOff()
+    texture.RepeatOff()
+    texture.EdgeClampOn()
+    actor = vtk.vtkTexturedActor2D()
+    actor.SetMapper(mapper)
+    actor.SetTexture(texture)
+    return actor
 
 
 def _overlay_rgba(overlay: np.ndarray) -> np.ndarray:
-    """A premultiplied RGBA image as 8-bit straight-alpha RGBA, rows bottom-up (VTK's order), for blending in front
-    of the scene. Pure emission (α = 0, color > 0) is shown with α' = max(α, max color): C + (1 − α') B instead of
-    C + B (error ≤ α' B)."""
-    alpha = np.maximum(overlay[..., 3], overlay[..., :3].max(axis=-1))
-    alpha = np.clip(alpha, 0.0, 1.0)
-    safe = np.where(alpha > 1e-6, alpha, 1.0)
-    straight = np.clip(overlay[..., :3] / safe[..., None], 0.0, 1.0)
-    rgba = np.concatenate([straight, alpha[..., None]], axis=-1)[::-1]  # VTK rows start at the bottom
+    """A premultiplied RGBA image as 8-bit premultiplied RGBA, rows bottom-up (VTK's order), for blending in front
+    of the scene with (ONE, ONE_MINUS_SRC_ALPHA). Pure emission (α = 0, color > 0) is shown with α' = max(α, max
+    color): C + (1 − α') B instead of C + B (error ≤ α' B)."""
+    alpha = np.clip(np.maximum(overlay[..., 3], overlay[..., :3].max(axis=-1)), 0.0, 1.0)
+    color = np.minimum(np.clip(overlay[..., :3], 0.0, 1.0), alpha[..., None])
+    rgba = np.concatenate([color, alpha[..., None]], axis=-1)[::-1]  # VTK rows start at the bottom
     return np.ascontiguousarray((rgba * 255.0 + 0.5).astype(np.uint8))
 
 

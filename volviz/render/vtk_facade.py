@@ -49,9 +49,10 @@ from vtkmodules.vtkFiltersGeneral import vtkDataSetTriangleFilter, vtkTransformP
 from vtkmodules.vtkInteractionStyle import vtkInteractorStyleTrackballCamera  # noqa: F401
 from vtkmodules.vtkRenderingAnnotation import vtkScalarBarActor  # noqa: F401
 from vtkmodules.vtkRenderingCore import (  # noqa: F401
-    vtkActor, vtkActor2D, vtkCamera, vtkCellPicker, vtkColorTransferFunction, vtkDataSetMapper, vtkImageActor,
-    vtkImageMapper, vtkPolyDataMapper, vtkPropAssembly, vtkRenderer, vtkRenderWindow, vtkRenderWindowInteractor,
-    vtkShaderProperty, vtkTextActor, vtkTexture, vtkVolume, vtkVolumeProperty, vtkWindowToImageFilter)
+    vtkActor, vtkCamera, vtkCellPicker, vtkColorTransferFunction, vtkCoordinate, vtkDataSetMapper,
+    vtkImageActor, vtkPolyDataMapper, vtkPolyDataMapper2D, vtkPropAssembly, vtkRenderer, vtkRenderWindow,
+    vtkRenderWindowInteractor, vtkShaderProperty, vtkTextActor, vtkTexture, vtkTexturedActor2D, vtkVolume,
+    vtkVolumeProperty, vtkWindowToImageFilter)
 from vtkmodules.vtkRenderingOpenGL2 import (  # noqa: F401
     vtkFramebufferPass, vtkOpenGLFramebufferObject, vtkOpenGLPolyDataMapper, vtkRenderStepsPass, vtkTextureObject)
 from vtkmodules.vtkRenderingVolume import (  # noqa: F401
