@@ -7,7 +7,11 @@ queue of renders (one synchronous render per key event held the event loop for s
 
 A movement key counts as held from its press to its release by the user (``held``; the keyboard's auto-repeat sends
 presses, and on X11 releases too, marked as auto-repeated), so that a long frame on the GUI thread, which delays the
-next repeat past the window's settle time, is not taken for the end of the flight."""
+next repeat past the window's settle time, is not taken for the end of the flight.
+
+While flying, the viewport's frames are drawn at a reduced resolution and magnified to it (``frames``, a
+``ReducedFrames``: each step starts them; the window ends them once the views' full-size updates after the flight's
+stop are shown)."""
 from __future__ import annotations
 
 from typing import Any, Callable, Optional
@@ -16,6 +20,8 @@ from PySide6.QtCore import QEvent, QObject, Qt
 from PySide6.QtGui import QKeyEvent, QMouseEvent
 
 from volviz.render.camera_path import FlyNavigator
+
+from .reduced_frames import ReducedFrames
 
 MOVES: dict[int, tuple[int, int, int]] = {  # by key code (``QKeyEvent.key()``; a ``Qt.Key`` is an int)
     Qt.Key.Key_W: (1, 0, 0), Qt.Key.Key_Up: (1, 0, 0),
@@ -42,6 +48,7 @@ class FlyMode(QObject):
         self._last_mouse: Optional[Any] = None
         self.steps = 0                   # camera steps made (key presses and repeats, mouse looks)
         self._held: set[int] = set()     # movement keys pressed and not yet released by the user
+        self.frames = ReducedFrames(plotter)   # the flight's frames at a reduced resolution
         plotter.interactor.installEventFilter(self)
 
     @property
@@ -52,6 +59,8 @@ class FlyMode(QObject):
     def set_enabled(self, enabled: bool, scene_size: float = 1.0) -> None:
         self.enabled = bool(enabled)
         self._held.clear()
+        if not enabled:
+            self.frames.stop()
         if enabled:
             self.navigator.speed = max(scene_size, 1e-9) * 0.25  # cross a quarter of the scene per second
 
@@ -76,6 +85,7 @@ class FlyMode(QObject):
 
         apply_camera(self.plotter, cam)
         self.steps += 1
+        self.frames.start()
         self.plotter.interactor.update()  # one repaint, merged with any other asked for before it is drawn
         if self.on_camera_moved is not None:
             self.on_camera_moved()

@@ -170,12 +170,14 @@ class ViewScheduler(WindowBase):
     def _fly_stopped(self) -> None:
         """No fly-mode key moved the camera for ``FLY_SETTLE_MS``: the still rate again, and the full-size views;
         unless a movement key is still held (``FlyMode.held``: a long frame delayed its auto-repeat; a full-size
-        frame then, with a synchronous render at the still rate, stalled the flight further)."""
+        frame then, with a synchronous render at the still rate, stalled the flight further). The flight's reduced
+        frames (``FlyMode.frames``) go on until the views' full-size updates are shown, then the full-resolution
+        frame: no synchronous full-size render of the flight's previews before them."""
         if self.fly.held:
             self.fly_settle_timer.start()
             return
         self._interactive_rate(False)
-        self._camera_moved()
+        self.refresh_views(settled=self.fly.frames.ending())
 
     def _camera_moved(self) -> None:
         """After the camera moved: draw, and refresh every camera view for the new camera (full size, with the error
