@@ -25,12 +25,12 @@ class ClipPlaneWidget:
 
     def _refresh_box(self) -> None:
         """The box widget on the crop box while box crop is on and widgets are shown."""
-        box = self.dock.clip["box"]
+        box = self.dock.clip.box
         if not (self.dock.show_widget.isChecked() and box is not None):
             _drop(self.box_widget, self.plotter.widgets.box_widgets)
             self.box_widget = None
             return
-        bounds = [v for pair in zip(box["lo"], box["hi"]) for v in pair]
+        bounds = [v for pair in zip(box.lo, box.hi) for v in pair]
         self._placing = True
         try:
             if self.box_widget is None:
@@ -42,7 +42,7 @@ class ClipPlaneWidget:
             self._placing = False
 
     def _box_moved(self, box: Any) -> None:
-        if self._placing or self.dock.clip["box"] is None:
+        if self._placing or self.dock.clip.box is None:
             return
         b = box.bounds
         self.dock.set_box(b[0::2], b[1::2])
@@ -50,13 +50,13 @@ class ClipPlaneWidget:
     def _refresh_plane(self) -> None:
         """Show the widget on the selected plane when the dock asks for it, else remove it."""
         row = self.dock.plane_list.currentRow()
-        planes = self.dock.clip["planes"]
+        planes = self.dock.clip.planes
         wanted = self.dock.show_widget.isChecked() and 0 <= row < len(planes)
         if not wanted:
             self._remove()
             return
         normal, _ = plane_offset(planes[row])
-        origin = planes[row]["point"]
+        origin = planes[row].point
         if self.widget is None:
             self.widget = self.plotter.add_plane_widget(self._moved, normal=normal, origin=origin,
                                                         bounds=self.dock.bounds, test_callback=False,
@@ -68,7 +68,7 @@ class ClipPlaneWidget:
         self.plotter.render()
 
     def _moved(self, normal: Any, origin: Any) -> None:
-        if 0 <= self._row < len(self.dock.clip["planes"]):
+        if 0 <= self._row < len(self.dock.clip.planes):
             n = [float(v) for v in normal]
             self.dock.set_plane(self._row, n, sum(float(o) * v for o, v in zip(origin, n)))
 

@@ -29,6 +29,7 @@ from .docks.render_settings import RENDERER_DEFAULTS
 from .window_base import WindowBase
 
 if TYPE_CHECKING:
+    from volviz.model.clip import ClipSettings
     from volviz.model.events import SceneChange
     from volviz.render.controller import SceneController
 
@@ -231,10 +232,10 @@ class SceneEdits(WindowBase):
         if self.controller is not None:  # the views follow (``views_follow``)
             self.session.set_opacity(comp_id, opacity)
 
-    def set_clip(self, clip: dict[str, Any]) -> None:
-        """New scene-wide clipping (from the clipping dock, an undo step included): every view is given it and the
-        views follow (``views_follow``: what is cut on the CPU is cut in the background); invalid clipping gives a
-        message and changes nothing."""
+    def set_clip(self, clip: ClipSettings | dict[str, Any]) -> None:
+        """New scene-wide clipping (from the clipping dock, an undo step included; a script may give its JSON): every
+        view is given it and the views follow (``views_follow``: what is cut on the CPU is cut in the background);
+        invalid clipping gives a message and changes nothing."""
         if self.controller is None:
             return
         try:

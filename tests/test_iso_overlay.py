@@ -9,7 +9,7 @@ import pyvista as pv
 from volviz.iso.composite import fragments, render
 from volviz.render.iso_overlay import cut_at_depth
 from volviz.model.datasets import RegularVolume
-from volviz.model.clip import ClipSettings
+from volviz.model.clip import ClipPlane, ClipSettings
 from volviz.model.demo import demo_tet_mesh
 from volviz.render.controller import SceneController
 from volviz.session import CameraState, Component, DatasetRef, Session
@@ -45,13 +45,13 @@ def plotter() -> pv.Plotter:
     return p
 
 
-def scene(components: list[Component], clip: dict | None = None) -> tuple[SceneController, pv.Plotter]:
+def scene(components: list[Component], clip: ClipSettings | None = None) -> tuple[SceneController, pv.Plotter]:
     s = Session(datasets=[DatasetRef("b", "/unused")], components=components,
                 camera=CameraState((11.5, -40.0, 11.5), (11.5, 11.5, 11.5), (0.0, 0.0, 1.0)))
     s.render.background = BG
     s.render.options.update(PLAIN, **CPU)
     if clip is not None:
-        s.clip = ClipSettings.from_dict(clip)
+        s.clip = clip
     p = plotter()
     c = SceneController(p, s, {"b": ball()})
     c.build()
@@ -101,7 +101,7 @@ def test_overlay_is_hidden_behind_opaque_geometry():
 
 
 def test_scene_clip_cuts_isosurfaces_volumes_and_pt_meshes_alike():
-    half = {"planes": [{"point": [11.5, 0.0, 0.0], "normal": [1.0, 0.0, 0.0]}], "box": None}
+    half = ClipSettings((ClipPlane((11.5, 0.0, 0.0), (1.0, 0.0, 0.0)),))
     row, left, right = SIZE[1] // 2, SIZE[0] // 2 - 15, SIZE[0] // 2 + 15
     bg = np.asarray(BG)
     for comp in (iso_component(), Component("vol", "volume", "b")):
@@ -276,8 +276,7 @@ def test_opaque_isosurfaces_stay_vtk_geometry_and_hide_what_is_behind_them_in_cp
 def test_a_session_without_camera_stays_framed_through_clip_and_cpu_mode():
     # regression: add_isosurfaces read ``plotter.camera``, which re-frames PyVista's "unset" camera to its default
     s = Session(datasets=[DatasetRef("b", "/unused")], components=[iso_component()],
-                clip=ClipSettings.from_dict({"planes": [{"point": [11.5, 0.0, 0.0], "normal": [1.0, 0.0, 0.0]}],
-                                             "box": None}))
+                clip=ClipSettings((ClipPlane((11.5, 0.0, 0.0), (1.0, 0.0, 0.0)),)))
     s.render.options["iso_mode"] = "3pass"
     p = plotter()
     SceneController(p, s, {"b": ball()}).build()

@@ -1,12 +1,13 @@
 """Clipping dock: any number of clipping planes (normal + offset) and a box crop for the whole scene (volumes,
 isosurfaces and unstructured meshes alike; ``volviz.render.clipping``), with its own undo/redo.
 
-A plane with unit normal n and offset d keeps the points with x·n ≥ d (stored in the session as
-``{"point": d·n, "normal": n}``, ``volviz.iso.clip.ClipPlane``). Edits emit ``changed(dict)`` with the new
-``session.clip``; every edit is one undo step."""
+A plane with unit normal n and offset d keeps the points with x·n ≥ d (in the session a
+``volviz.model.clip.ClipPlane(point=d·n, normal=n)``). The dock holds the clipping as the session does, an immutable
+``ClipSettings``; an edit makes a new one and emits it (``changed``) for ``session.clip``; every edit is one undo
+step."""
 from __future__ import annotations
 
-import copy
+import dataclasses
 import math
 from typing import Any, Optional, Sequence
 
@@ -15,12 +16,11 @@ from PySide6.QtGui import QUndoCommand, QUndoStack
 from PySide6.QtWidgets import (QCheckBox, QDoubleSpinBox, QFormLayout, QGroupBox, QListWidget,
                                QPushButton, QVBoxLayout, QWidget)
 
-from volviz.model.clip import ClipSettings
+from volviz.model.clip import BoxCrop, ClipPlane, ClipSettings
 
 from ..widget_row import widget_row
 from . import set_tooltips
 
-NO_CLIP: dict[str, Any] = {"planes": [], "box": None}
 LIMIT = 1e9
 
 
@@ -33,24 +33,22 @@ def _spin(decimals: int = 4) -> QDoubleSpinBox:
     return box
 
 
-def plane_offset(plane: dict[str, Any]) -> tuple[tuple[float, float, float], float]:
+def plane_offset(plane: ClipPlane) -> tuple[tuple[float, float, float], float]:
     """(unit normal, offset d) of a session plane: it keeps x·n ≥ d."""
-    n = [float(v) for v in plane["normal"]]
-    length = math.sqrt(sum(v * v for v in n)) or 1.0
-    n = [v / length for v in n]
-    return (n[0], n[1], n[2]), sum(p * v for p, v in zip(plane["point"], n))
+    return plane.normal, sum(p * v for p, v in zip(plane.point, plane.normal))
 
 
-def plane_dict(normal: Sequence[float], offset: float) -> dict[str, Any]:
+def offset_plane(normal: Sequence[float], offset: float) -> ClipPlane:
+    """The plane with normal ``normal`` (made unit length) that keeps x·n ≥ ``offset``."""
     length = math.sqrt(sum(float(v) ** 2 for v in normal))
     if length < 1e-12:
         raise ValueError("a clipping plane needs a non-zero normal")
-    n = [float(v) / length for v in normal]
-    return {"point": [offset * v for v in n], "normal": n}
+    n = (float(normal[0]) / length, float(normal[1]) / length, float(normal[2]) / length)
+    return ClipPlane((offset * n[0], offset * n[1], offset * n[2]), n)
 
 
 class _Edit(QUndoCommand):
-    def __init__(self, dock: "ClippingDock", before: dict[str, Any], after: dict[str, Any], text: str):
+    def __init__(self, dock: "ClippingDock", before: ClipSettings, after: ClipSettings, text: str):
         super().__init__(text)
         self.dock, self.before, self.after = dock, before, after
 
@@ -62,14 +60,14 @@ class _Edit(QUndoCommand):
 
 
 class ClippingDock(QWidget):
-    """Edits ``session.clip``; emits ``changed(dict)``."""
+    """Edits ``session.clip``; emits ``changed(ClipSettings)``."""
 
-    changed = Signal(dict)
+    changed = Signal(object)
     refreshed = Signal()  # the shown planes or the selection changed (the viewport widget follows)
 
     def __init__(self, parent: Optional[QWidget] = None):
         super().__init__(parent)
-        self.clip: dict[str, Any] = copy.deepcopy(NO_CLIP)
+        self.clip = ClipSettings()
         self.bounds: tuple[float, ...] = (0.0, 1.0, 0.0, 1.0, 0.0, 1.0)
         self.undo_stack = QUndoStack(self)
         self._loading = False
@@ -144,52 +142,51 @@ class ClippingDock(QWidget):
         if bounds is not None and all(math.isfinite(float(v)) for v in bounds):
             self.bounds = tuple(float(v) for v in bounds)
         self.undo_stack.clear()
-        self._apply(NO_CLIP if clip is None else clip.to_dict(), emit=False)
+        self._apply(ClipSettings() if clip is None else clip, emit=False)
 
     def add_plane(self) -> None:
         """A new plane through the scene's centre, normal +x."""
         centre = [(self.bounds[2 * k] + self.bounds[2 * k + 1]) / 2.0 for k in range(3)]
-        after = copy.deepcopy(self.clip)
-        after["planes"].append(plane_dict((1.0, 0.0, 0.0), centre[0]))
-        self._push(after, "add clipping plane", select=len(after["planes"]) - 1)
+        planes = self.clip.planes + (offset_plane((1.0, 0.0, 0.0), centre[0]),)
+        self._push(dataclasses.replace(self.clip, planes=planes), "add clipping plane", select=len(planes) - 1)
 
     def remove_plane(self) -> None:
         row = self.plane_list.currentRow()
-        if 0 <= row < len(self.clip["planes"]):
-            after = copy.deepcopy(self.clip)
-            del after["planes"][row]
-            self._push(after, "remove clipping plane", select=min(row, len(after["planes"]) - 1))
+        planes = self.clip.planes
+        if 0 <= row < len(planes):
+            self._push(dataclasses.replace(self.clip, planes=planes[:row] + planes[row + 1:]), "remove clipping plane",
+                       select=min(row, len(planes) - 2))
 
     def flip_plane(self) -> None:
         row = self.plane_list.currentRow()
-        if 0 <= row < len(self.clip["planes"]):
-            n, d = plane_offset(self.clip["planes"][row])
+        if 0 <= row < len(self.clip.planes):
+            n, d = plane_offset(self.clip.planes[row])
             self.set_plane(row, [-v for v in n], -d)
 
     def set_plane(self, index: int, normal: Sequence[float], offset: float) -> None:
-        after = copy.deepcopy(self.clip)
-        after["planes"][index] = plane_dict(normal, offset)
-        self._push(after, "edit clipping plane", select=index)
+        planes = list(self.clip.planes)
+        planes[index] = offset_plane(normal, offset)
+        self._push(dataclasses.replace(self.clip, planes=tuple(planes)), "edit clipping plane", select=index)
 
     def set_box(self, lo: Optional[Sequence[float]], hi: Optional[Sequence[float]] = None) -> None:
         """Crop to the box [lo, hi] (None: no box)."""
-        after = copy.deepcopy(self.clip)
-        after["box"] = None if lo is None else {"lo": [float(v) for v in lo],
-                                                "hi": [float(v) for v in (lo if hi is None else hi)]}
-        self._push(after, "box crop")
+        top = lo if hi is None else hi
+        box = None if lo is None or top is None else BoxCrop((float(lo[0]), float(lo[1]), float(lo[2])),
+                                                             (float(top[0]), float(top[1]), float(top[2])))
+        self._push(dataclasses.replace(self.clip, box=box), "box crop")
 
     # -- internals --------------------------------------------------------------------------------------------------
-    def _push(self, after: dict[str, Any], text: str, select: Optional[int] = None) -> None:
+    def _push(self, after: ClipSettings, text: str, select: Optional[int] = None) -> None:
         if after == self.clip:
             return
         self._select = select
-        self.undo_stack.push(_Edit(self, copy.deepcopy(self.clip), after, text))
+        self.undo_stack.push(_Edit(self, self.clip, after, text))
 
-    def _apply(self, clip: dict[str, Any], emit: bool = True) -> None:
-        self.clip = copy.deepcopy(clip)
+    def _apply(self, clip: ClipSettings, emit: bool = True) -> None:
+        self.clip = clip
         self._refresh()
         if emit:
-            self.changed.emit(copy.deepcopy(self.clip))
+            self.changed.emit(self.clip)
 
     def _refresh(self) -> None:
         self._loading = True
@@ -198,16 +195,16 @@ class ClippingDock(QWidget):
             row = self.plane_list.currentRow()
         self._select = None
         self.plane_list.clear()
-        for i, p in enumerate(self.clip["planes"]):
+        for i, p in enumerate(self.clip.planes):
             n, d = plane_offset(p)
             self.plane_list.addItem(f"plane {i + 1}: n = ({n[0]:.2f}, {n[1]:.2f}, {n[2]:.2f}), offset {d:.3g}")
-        count = len(self.clip["planes"])
+        count = len(self.clip.planes)
         self.plane_list.setCurrentRow(min(max(row, 0), count - 1) if count else -1)
         self._show_plane(self.plane_list.currentRow())
-        box = self.clip["box"]
+        box = self.clip.box
         self.box_enabled.setChecked(box is not None)
-        lo = box["lo"] if box else self.bounds[0::2]
-        hi = box["hi"] if box else self.bounds[1::2]
+        lo = box.lo if box else self.bounds[0::2]
+        hi = box.hi if box else self.bounds[1::2]
         for b, v in zip(self.box_lo + self.box_hi, list(lo) + list(hi)):
             b.setValue(float(v))
             b.setEnabled(box is not None)
@@ -218,8 +215,8 @@ class ClippingDock(QWidget):
 
     def _show_plane(self, row: int) -> None:
         loading, self._loading = self._loading, True
-        has = 0 <= row < len(self.clip["planes"])
-        n, d = plane_offset(self.clip["planes"][row]) if has else ((1.0, 0.0, 0.0), 0.0)
+        has = 0 <= row < len(self.clip.planes)
+        n, d = plane_offset(self.clip.planes[row]) if has else ((1.0, 0.0, 0.0), 0.0)
         for b, v in zip(self.normal, n):
             b.setValue(v)
             b.setEnabled(has)
@@ -235,7 +232,7 @@ class ClippingDock(QWidget):
 
     def _plane_edited(self, *args: Any) -> None:
         row = self.plane_list.currentRow()
-        if self._loading or not 0 <= row < len(self.clip["planes"]):
+        if self._loading or not 0 <= row < len(self.clip.planes):
             return
         normal = [b.value() for b in self.normal]
         if math.sqrt(sum(v * v for v in normal)) < 1e-12:
