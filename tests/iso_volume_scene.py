@@ -51,24 +51,27 @@ def write_datasets(folder: Path) -> dict[str, str]:
     return paths
 
 
-def session(backend: str, iso_mode: str = "vtk", paths: dict[str, str] | None = None) -> Session:
-    """The scene's session (datasets at ``paths``, by default not to be read: ``scene`` hands them over)."""
+def session(backend: str, iso_mode: str = "vtk", paths: dict[str, str] | None = None,
+            styles: list[dict] | None = None) -> Session:
+    """The scene's session (datasets at ``paths``, by default not to be read: ``scene`` hands them over; the plane's
+    isosurface ``styles``, by default ``STYLE`` alone)."""
     paths = paths or {"v": "/unused", "p": "/unused"}
     s = Session(datasets=[DatasetRef("v", paths["v"]), DatasetRef("p", paths["p"])],
                 components=[Component("vol", "volume", "v", opacity=0.15),
-                            Component("iso", "isosurface", "p", settings={"styles": [STYLE]})],
+                            Component("iso", "isosurface", "p", settings={"styles": styles or [STYLE]})],
                 camera=CameraState((-12.0, -40.0, 34.0), (15.5, 15.5, 15.5), (0.0, 0.0, 1.0)))
     s.render.background = (0.0, 0.0, 0.0)
     s.render.options.update(PLAIN, backend=backend, iso_mode=iso_mode)
     return s
 
 
-def scene(backend: str, size: tuple[int, int] = SIZE, iso_mode: str = "vtk") -> tuple[SceneController, pv.Plotter]:
+def scene(backend: str, size: tuple[int, int] = SIZE, iso_mode: str = "vtk",
+          styles: list[dict] | None = None) -> tuple[SceneController, pv.Plotter]:
     """The scene in a new off-screen plotter (closed after the test by ``close_plotters``)."""
     p = pv.Plotter(off_screen=True, window_size=size)
     p.ren_win.SetMultiSamples(0)
     PLOTTERS.append(p)
-    c = SceneController(p, session(backend, iso_mode), datasets())
+    c = SceneController(p, session(backend, iso_mode, styles=styles), datasets())
     c.build()
     return c, p
 
@@ -78,24 +81,26 @@ def shot(p: pv.Plotter) -> np.ndarray:
     return p.screenshot(None, return_img=True)[..., :3].astype(np.float64) / 255.0
 
 
-def surface_actor(c: SceneController):
-    prop = c.props["iso"]
-    assert len(prop.volviz_translucent) == 1
-    return prop.volviz_translucent[0]
-
-
-def volume_cut(c: SceneController, p: pv.Plotter) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(F, V_f, 1 − a_f) over black from renders of VTK's own actors, unpeeled, the note's overlay hidden: F the
-    volume alone, V_f and 1 − a_f the volume in front of the surface made opaque black, then white, unlit."""
-    volume, actor, overlay = c.props["vol"], surface_actor(c), c.iso_overlay
-    shown = actor.GetVisibility()
+def volume_cut(c: SceneController, p: pv.Plotter, layer: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(F, V_f, 1 − a_f) over black from renders of VTK's own actors, unpeeled, the note's views hidden, the volume
+    by the ray caster that drew the frame: F the volume alone, V_f and 1 − a_f the volume in front of the translucent
+    surface ``layer`` made opaque black, then white, unlit (the other surfaces hidden)."""
+    volume, overlay = c.props["vol"], c.iso_overlay
+    actors = c.props["iso"].volviz_translucent
+    actor, shown = actors[layer], [a.GetVisibility() for a in actors]
     if overlay is not None:
         overlay.visible = False
     gl = getattr(c.iso_view, "surfaces", None)        # the GPU passes of a note mode (``GLIsoView``)
+    peeled = gl is not None and gl.peels_volumes
     for a in gl.actors.values() if gl is not None else ():
         a.SetVisibility(False)
+    mapper = volume.GetMapper()
+    caster = mapper.GetRequestedRenderMode()
     peel_volumes(p, [volume], False)
-    actor.SetVisibility(False)
+    own = mapper.GetRequestedRenderMode()
+    mapper.SetRequestedRenderMode(caster)          # the frame's ray caster (the GPU's while peeled)
+    for a in actors:
+        a.SetVisibility(False)
     full = shot(p)
     actor.SetVisibility(True)
     prop, shader = actor.GetProperty(), actor.GetShaderProperty()
@@ -111,12 +116,47 @@ def volume_cut(c: SceneController, p: pv.Plotter) -> tuple[np.ndarray, np.ndarra
     prop.SetColor(*kept[1])
     prop.SetLighting(kept[2])
     apply_spectrum_shader(actor, kept[0])
-    actor.SetVisibility(shown)
+    for a, on in zip(actors, shown):
+        a.SetVisibility(on)
     if overlay is not None:
         overlay.visible = True
+    mapper.SetRequestedRenderMode(own)
     if gl is not None:
         gl.set_mode(gl.mode)
+    if peeled:
+        peel_volumes(p, [volume], True)
     return full, cut[0], (cut[1] - cut[0]).mean(axis=-1, keepdims=True)
+
+
+def surface_image(c: SceneController, p: pv.Plotter, mode: str, layer: int | None = None) -> np.ndarray:
+    """The mode's premultiplied image (``volviz.iso.composite.render``, the CPU compositor's optics) of the shown
+    translucent surfaces (only the ``layer``-th when given) for the plotter's camera and size (the overlay's near
+    plane: VTK's clipping range ignores the hidden actors)."""
+    from volviz.iso.composite import render
+    from volviz.model.camera import Camera
+
+    cam = Camera.from_pyvista(p.renderer.GetActiveCamera())
+    near = min(cam.clipping_range[0], 1e-3 * cam.clipping_range[1])
+    cam = Camera(cam.position, cam.focal_point, cam.view_up, cam.view_angle, cam.parallel, cam.parallel_scale,
+                 (near, cam.clipping_range[1]))
+    meshes = [m for m in c.props["iso"].volviz_shown if m.style.opacity < 1.0]
+    img, _ = render(meshes if layer is None else [meshes[layer]], cam, tuple(int(v) for v in p.ren_win.GetSize()),
+                    mode)
+    return img
+
+
+def two_layer_composite(c: SceneController, p: pv.Plotter) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(the exact composite, the surfaces over the whole volume, the pixels both surfaces cover with α > 0.2) over
+    black for a scene of two translucent surfaces, the first in front of the second on every ray: with G_k, A_k the
+    volume in front of surface k (``volume_cut``) and S_k, α_k its image, C = G_1 + (1 − A_1) S_1
+    + (1 − α_1)[(G_2 − G_1) + (1 − A_2) S_2 + (1 − α_2)(F − G_2)]."""
+    full, g1, one_minus_a1 = volume_cut(c, p, 0)
+    _, g2, one_minus_a2 = volume_cut(c, p, 1)
+    s1, s2 = surface_image(c, p, "exact", 0), surface_image(c, p, "exact", 1)
+    t1, t2 = 1.0 - s1[..., 3:4], 1.0 - s2[..., 3:4]
+    exact = g1 + one_minus_a1 * s1[..., :3] + t1 * ((g2 - g1) + one_minus_a2 * s2[..., :3] + t2 * (full - g2))
+    over_all = s1[..., :3] + t1 * (s2[..., :3] + t2 * full)
+    return exact, over_all, (s1[..., 3] > 0.2) & (s2[..., 3] > 0.2)
 
 
 def surface_alone(c: SceneController, p: pv.Plotter) -> tuple[np.ndarray, np.ndarray]:

@@ -1,14 +1,16 @@
 """``volviz bench iso_modes_volume``: what the note's transparency modes cost a frame with a regular volume in the
-scene, before and after the volume was split at the surfaces (issue #28, ``volviz.render.iso_volume_split``).
+scene, before and after they were made to composite with it in depth order (issue #28).
 
 A regular volume (default neghip) and an isosurface of it (value 120, opacity 0.3) are built as ``volviz render``
-builds them (``offscreen_scene``), then each mode is drawn in three ways, peers in the same run: the GPU passes
-(``GLIsoView``, what ``auto`` drew on any OpenGL before: the surfaces under the whole volume), the CPU overlay over
-the whole scene (the CPU backend before: the surfaces over the whole volume) and the CPU overlay with the volume
-split (what volviz draws now on either backend). A GPU frame is one draw of the window to the GPU's completion; a CPU
-overlay's frame is its whole update (``begin``: the scene drawn and read back, now with the volume in front of the
-surfaces drawn once more; ``compute``; ``finish``: the window drawn with the overlay), its ``begin`` (GUI thread)
-also shown alone. Median of ``--reps`` frames after a warm-up. Writes docs/bench/iso_modes_with_volume.md.
+builds them (``offscreen_scene``), then each mode is drawn in three ways, peers in the same run: the GPU passes as
+``auto`` drew them on any OpenGL before (``GLIsoSurfaces`` with ``peel_with_volumes=False``: the 2/3/4-pass surfaces
+under the whole volume, exact mode's over it), the CPU overlay over the whole scene (the CPU backend before: the
+surfaces over the whole volume) and what the scene controller draws now (2/3/4-pass: the CPU overlay with the volume
+split at the nearest surface, ``volviz.render.iso_volume_split``; exact: the GPU's surfaces peeled with the volume,
+``volviz.render.gl_iso``). A GPU frame is one draw of the window to the GPU's completion; a CPU overlay's frame is
+its whole update (``begin``: the scene drawn and read back, with the split also the volume in front of the surfaces;
+``compute``; ``finish``: the window drawn with the overlay), its ``begin`` (GUI thread) also shown alone. Median of
+``--reps`` frames after a warm-up. Writes docs/bench/iso_modes_with_volume.md.
 """
 from __future__ import annotations
 
@@ -22,24 +24,32 @@ from volviz.bench.offscreen import finish, timed_renders
 from volviz.bench.volume_peeling import bench_command, iso_session, iso_volume_parser, report_head, write_report
 from volviz.iso.composite import MODES
 
-#: (label, the note's passes on the GPU, the CPU overlay's volume split)
-WAYS = (("GPU passes (before)", True, False), ("CPU overlay, unsplit (before)", False, False),
-        ("CPU overlay, volume split (now)", False, True))
+#: (label, kind): the note's passes on the GPU as drawn before (exact mode peeled over the finished scene), the CPU
+#: overlay without the volume split, and what the scene controller draws now
+WAYS = (("GPU passes (before)", "gpu-before"), ("CPU overlay, unsplit (before)", "cpu-unsplit"), ("now", "now"))
 
 
-def _frames(controller: Any, gpu: bool, split: bool, reps: int) -> tuple[float, float]:
-    """(median seconds of a frame, median seconds of the CPU overlay's ``begin``; 0 on the GPU) after one warm-up."""
-    from volviz.render.gl_iso import GLIsoView
+def _frames(controller: Any, kind: str, reps: int) -> tuple[float, float | None, str]:
+    """(median seconds of a frame, median seconds of the CPU overlay's ``begin`` or None on the GPU, what drew it)
+    after one warm-up."""
+    from volviz.render.gl_iso import GLIsoSurfaces
 
     plotter = controller.plotter
     view = controller.iso_view
     window = plotter.ren_win
-    if gpu:                  # the GPU passes as the controller made them before: VTK's volume pass after them
-        meshes = list(view.meshes)
+    if kind == "gpu-before":   # VTK's volume pass after the 2/3/4 passes; exact mode's layer over the finished frame
+        meshes, mode = list(view.meshes), view.mode
         view.remove()
-        view = controller.iso_view = GLIsoView(plotter, meshes, mode=view.mode)
-        return float(np.median(timed_renders(window, reps + 1)[1:])), 0.0
-    view.split_volume = split
+        controller.iso_view = None
+        surfaces = GLIsoSurfaces(plotter, meshes, mode, peel_with_volumes=False)
+        try:
+            return float(np.median(timed_renders(window, reps + 1)[1:])), None, "GPU passes"
+        finally:
+            surfaces.remove()
+    if view.backend == "gpu":  # now: exact mode peeled with the volume
+        drawn = "GPU, peeled with the volume" if view.peels_volumes else "GPU passes"
+        return float(np.median(timed_renders(window, reps + 1)[1:])), None, drawn
+    view.split_volume = kind == "now"
     frames, begins = [], []
     for _ in range(reps + 1):
         t0 = time.perf_counter()
@@ -49,7 +59,8 @@ def _frames(controller: Any, gpu: bool, split: bool, reps: int) -> tuple[float, 
         finish(window)
         frames.append(time.perf_counter() - t0)
         begins.append(t1 - t0)
-    return float(np.median(frames[1:])), float(np.median(begins[1:]))
+    drawn = "CPU overlay, volume split" if view.split_volume else "CPU overlay"
+    return float(np.median(frames[1:])), float(np.median(begins[1:])), drawn
 
 
 def measure(volume: Path, size: tuple[int, int], reps: int, value: float, opacity: float,
@@ -61,40 +72,42 @@ def measure(volume: Path, size: tuple[int, int], reps: int, value: float, opacit
 
     rows = []
     for mode in modes:
-        for label, gpu, split in WAYS:
+        for label, kind in WAYS:
             session = iso_session(volume, value, opacity, True)
-            session.render.options.update(iso_mode=mode, backend="auto")
+            session.render.options.update(iso_mode=mode, backend="cpu" if kind == "cpu-unsplit" else "auto")
             plotter, controller = offscreen_scene(session, load_datasets(session, None), size)
             try:
                 controller.build()
-                frame_s, begin_s = _frames(controller, gpu, split, reps)
+                frame_s, begin_s, drawn = _frames(controller, kind, reps)
                 gl = plotter_gl_info(plotter).renderer
             finally:
                 close_scene(plotter, controller)
-            rows.append({"volume": volume.name, "size": f"{size[0]}x{size[1]}", "mode": mode, "way": label,
-                         "ms": 1e3 * frame_s, "begin_ms": 1e3 * begin_s if not gpu else None, "gl": gl})
-            print(f"{volume.name} {size[0]}x{size[1]} {mode} {label}: {1e3 * frame_s:.0f} ms "
-                  f"(begin {1e3 * begin_s:.0f} ms)", flush=True)
+            way = f"now: {drawn}" if kind == "now" else label
+            rows.append({"volume": volume.name, "size": f"{size[0]}x{size[1]}", "mode": mode, "way": way,
+                         "ms": 1e3 * frame_s, "begin_ms": None if begin_s is None else 1e3 * begin_s, "gl": gl})
+            begin = "" if begin_s is None else f" (begin {1e3 * begin_s:.0f} ms)"
+            print(f"{volume.name} {size[0]}x{size[1]} {mode} {way}: {1e3 * frame_s:.0f} ms{begin}", flush=True)
     return rows
 
 
 def report(rows: list[dict[str, Any]], command: str, value: float, opacity: float) -> str:
-    lines = report_head("The note's isosurface modes with a regular volume: frame time before and after the volume "
-                        "split", command, rows)
-    lines += ["", f"Isosurface value {value:g}, opacity {opacity:g}; the volume drawn by the ray caster `auto` picks. "
-             "Median of the timed frames after a warm-up (module docstring of `volviz.bench.iso_modes_volume`): a "
-             "GPU frame is one draw of the window; a CPU overlay's frame its whole update, its `begin` (the GUI "
-             "thread's part: the scene drawn and read back, now also the volume in front of the surfaces) shown "
-             "alone.", "",
-             "| volume | window | mode | drawn by | ms per frame | of which begin |", "|---|---|---|---|---|---|"]
+    lines = report_head("The note's isosurface modes with a regular volume: frame time before and after issue #28",
+                        command, rows)
+    lines += ["", f"Isosurface value {value:g}, opacity {opacity:g}; the volume drawn by the ray caster `auto` picks "
+              "(the GPU's while peeled). Median of the timed frames after a warm-up (module docstring of "
+              "`volviz.bench.iso_modes_volume`): a GPU frame is one draw of the window; a CPU overlay's frame its "
+              "whole update, its `begin` (the GUI thread's part: the scene drawn and read back, with the split also "
+              "the volume in front of the surfaces) shown alone.", "",
+              "| volume | window | mode | drawn by | ms per frame | of which begin |", "|---|---|---|---|---|---|"]
     for r in rows:
         begin = "" if r["begin_ms"] is None else f"{r['begin_ms']:.0f}"
         lines.append(f"| {r['volume']} | {r['size']} | {r['mode']} | {r['way']} | {r['ms']:.0f} | {begin} |")
     lines += ["", "Before, both drawings put the surfaces on the wrong side of the whole volume (the GPU passes are "
-              "blended before VTK's volume pass: the volume over them; the CPU overlay went over the finished "
-              "scene); with a regular volume shown volviz now draws every mode by the CPU overlay with the volume "
-              "split (`volviz.render.iso_volume_split`; errors against the exact composite: "
-              "tests/test_iso_modes_volume.py).", ""]
+              "blended before VTK's volume pass: the volume over them; the GPU's exact mode and the CPU overlay went "
+              "over the finished scene). Now, with a regular volume shown, the 2/3/4-pass modes are drawn by the CPU "
+              "overlay with the volume split at the nearest surface (`volviz.render.iso_volume_split`) and exact "
+              "mode on the GPU peeled with the volume (`volviz.render.gl_iso`); errors against the exact composite: "
+              "tests/test_iso_modes_volume.py.", ""]
     return "\n".join(lines)
 
 

@@ -780,15 +780,19 @@ class SceneController:
             self._show_iso_mode(update)
 
     def _iso_backend(self) -> str:
-        """Where a mode of the note is drawn: the backend's choice (``view_backend``), but the CPU overlay while a
-        regular volume is shown, whose volume it splits at the surfaces (``volviz.render.iso_volume_split``; the
-        GPU passes are blended before VTK's volume pass, so the whole volume would lie over them)."""
+        """Where a mode of the note is drawn: the backend's choice (``view_backend``), but while a regular volume is
+        shown the 2/3/4-pass modes by the CPU overlay, which splits the volume at the surfaces
+        (``volviz.render.iso_volume_split``; the GPU passes are blended before VTK's volume pass, so the whole volume
+        would lie over them), and exact mode on the GPU only where the renderer can peel the surfaces with the volume
+        (no render pass of its own: ``volviz.render.gl_iso``)."""
         from volviz.render.scene_builder import view_backend
         from volviz.render.volume_peeling import regular_volumes
 
+        backend = view_backend(self.plotter, self.session, "iso")
         if regular_volumes([p for p in self.shown_props().values() if hasattr(p, "IsA")]):
-            return "cpu"
-        return view_backend(self.plotter, self.session, "iso")
+            peels = self.iso_mode == "exact" and self.plotter.renderer.GetPass() is None
+            return "gpu" if backend == "gpu" and peels else "cpu"
+        return backend
 
     def _show_iso_mode(self, update: bool) -> None:
         mode = self.iso_mode
@@ -839,8 +843,8 @@ class SceneController:
         self._peel_volumes()
 
     def _peel_volumes(self) -> None:
-        """In "vtk" mode translucent isosurfaces inside a regular volume are depth-peeled with it, so the volume
-        behind a surface, the surface and the volume in front composite in that order
+        """In "vtk" mode (and the GPU's exact mode) translucent isosurfaces inside a regular volume are depth-peeled
+        with it, so the volume behind a surface, the surface and the volume in front composite in that order
         (``volviz.render.volume_peeling``); the app's window, ``volviz render`` and exports alike."""
         from volviz.render.volume_peeling import peel_volumes
 
@@ -848,4 +852,5 @@ class SceneController:
         translucent = self.iso_view is None and any(
             prop.GetVisibility() and any(a.GetVisibility() for a in prop.volviz_translucent)
             for comp_id, prop in self._iso_props().items() if comp_id in shown)
+        translucent = translucent or bool(getattr(self.iso_view, "peels_volumes", False))   # the GPU's exact mode
         peel_volumes(self.plotter, [p for p in shown.values() if hasattr(p, "IsA")], translucent)

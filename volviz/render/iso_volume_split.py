@@ -15,7 +15,9 @@ meets one translucent layer (every mode: a plane through a ball, RMSE 0.42 level
 scene's own renders, tests/test_iso_modes_volume.py; 27 with the surface over the whole volume). The volume between
 two layers is composited behind both: two parallel planes through the ball's dense middle, exact mode, RMSE 8.0
 against the exact composite with the volume between them (24 for the surfaces over the whole volume); splitting at
-every layer would take one more volume render per layer.
+every layer would take one more volume render per layer. The GPU's exact mode peels the surfaces with the volume
+instead (``volviz.render.gl_iso``: 0.57 there), so the scene controller draws only the 2/3/4-pass modes this way
+when the GPU backend is chosen.
 
 ``front_volume`` renders V_f, a_f with VTK itself, so that they match the scene's own volume: the renderer's other
 props hidden, the translucent surfaces drawn as an opaque occluder that writes depth and the colour (0, 0, 0, 0)
