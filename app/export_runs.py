@@ -87,7 +87,7 @@ class ExportRuns:
         self.result = None
         live, shown = self.scene.controller, self.scene.session
         session = Session(datasets=shown.datasets, components=copy.deepcopy(shown.components),
-                          transfer_functions=copy.deepcopy(shown.transfer_functions),
+                          transfer_functions=dict(shown.transfer_functions),  # immutable models: shared
                           camera=live.camera() if live else None, render=shown.render,
                           clip=shown.clip, camera_paths=copy.deepcopy(shown.camera_paths))
         plotter, controller = offscreen_scene(session, self.scene.datasets, size)
