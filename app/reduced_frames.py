@@ -7,7 +7,8 @@ of it scales with the pixels drawn: the sky dome, the terrain's shaded fragments
 direction (set on the render window at the render's ``StartEvent``), and the widget's blit of VTK's frame into its own
 framebuffer (pyvistaqt's ``paintGL``: ``BlitDisplayFramebuffer`` with linear filtering, from the render window's
 size to the widget's) magnifies it to the viewport. As soon as Qt composes the window after the paint
-(``aboutToCompose``), the render window has the viewport's size again: whatever reads it between paints (the camera
+(``aboutToCompose``), or at the latest when the event loop runs next (a zero timer, where nothing composes), the
+render window has the viewport's size again: whatever reads it between paints (the camera
 views' requests, read-backs, screenshots, a render outside a paint) sees the full size, and a render outside a paint
 is never reduced.
 
@@ -17,6 +18,8 @@ follow the flight's stop are shown, so no frame between the stop and them is dra
 from __future__ import annotations
 
 from typing import Any, Callable
+
+from PySide6.QtCore import QTimer
 
 FACTOR = 2   # a quarter of the pixels: a Yukon flight frame's render, median 21-45 -> 9-17 ms (docs/bench/flight.md)
 
@@ -72,6 +75,7 @@ class ReducedFrames:
         self.renders += 1
         if size != self.last_size:
             self.ren_win.SetSize(*self.last_size)
+            QTimer.singleShot(0, self._restore)     # after the paint's blit, whether or not the window composes
 
     def _restore(self) -> None:
         """The render window back at its size (the paint's blit has used the reduced frame)."""
