@@ -1,8 +1,9 @@
 """A session's datasets read once each, and the dataset each component shows ("Model only what a scene needs": only
-the datasets of shown components are read; an array choice is made once per dataset and kept on it)."""
+the datasets of shown components are read; an array choice is made once per dataset and kept while it lives)."""
 from __future__ import annotations
 
 import os
+import weakref
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Optional, Union
 
@@ -88,13 +89,47 @@ def component_dataset(comp: Component, datasets: dict[str, LoadedDataset]) -> An
 
 def shown_array(dataset: LoadedDataset, spec: Optional[str]) -> LoadedDataset:
     """``dataset`` showing the array ``spec`` (None: its default array; ``volviz.model.arrays``), made once per spec
-    and kept on the dataset, so the tetrahedralisation and topology cached on it are made once too."""
+    and kept while the dataset lives, so the tetrahedralisation and topology cached on the view are made once too.
+    The views are kept here by the dataset's identity (``_VIEWS``), not on the dataset, and dropped with it."""
     if isinstance(dataset, Image2D) or is_lod(dataset):
         return dataset
-    views = dataset.__dict__.setdefault("volviz_views", {})
+    views = _views_of(dataset)
+    if views is None:   # an object without weak references: nothing to drop the views with, so none kept
+        return select_array(dataset, spec)
     if spec not in views:
-        views[spec] = select_array(dataset, spec)
-    return views[spec]
+        view = select_array(_detached(dataset), spec)
+        views.setdefault(spec, None if view is dataset else view)   # two threads asking at once get one view
+    kept = views[spec]
+    return dataset if kept is None else kept
+
+
+#: id(dataset) -> array spec -> the view showing it (None: the dataset itself), by identity since the model's datasets
+#: are dataclasses compared by value (unhashable: no WeakKeyDictionary); an entry is removed when its dataset is
+#: collected (``weakref.finalize``), before its id can name another object. No view refers to its dataset
+#: (``_detached``), so the entry never keeps the dataset alive.
+_VIEWS: dict[int, dict[Optional[str], Any]] = {}
+
+
+def _views_of(dataset: LoadedDataset) -> Optional[dict[Optional[str], Any]]:
+    """The views kept for ``dataset`` (None when it takes no weak reference)."""
+    fresh: dict[Optional[str], Any] = {}
+    views = _VIEWS.setdefault(id(dataset), fresh)
+    if views is fresh:
+        try:
+            weakref.finalize(dataset, _VIEWS.pop, id(dataset), None)
+        except TypeError:
+            del _VIEWS[id(dataset)]
+            return None
+    return views
+
+
+def _detached(dataset: LoadedDataset) -> LoadedDataset:
+    """What the views of ``dataset`` are made from: the dataset, or for a time series a twin sharing its frame list
+    and loader (frames loaded through a view are kept in the series as before), since a series' view loads its
+    frames through what it was made from, and a view kept in ``_VIEWS`` must not keep its dataset alive."""
+    if isinstance(dataset, TimeSeries):
+        return TimeSeries(dataset.times, dataset.frames, dataset.loader, dataset.source)
+    return dataset
 
 
 def dataset_traits(dataset: LoadedDataset) -> DatasetTraits:
