@@ -72,3 +72,23 @@ print(json.dumps({{"code": code, "imported": imported, "ran": ran, "figure": fig
     assert report["imported"] is True and report["ran"] is False and report["figure"] is False
     assert report["again"] is False and report["now"] is True and report["same"] is True
     assert report["fig"] == "Figure" and report["inches"] == [2.0, 1.0] and report["star"] is True
+
+
+def test_a_render_of_a_regular_volume_loads_no_numba_scipy_or_lod_codec(tmp_path) -> None:
+    """``scene.lod.is_lod`` asks whether a dataset is a LodTree without importing the LOD codec (a LodTree exists only
+    once its module was imported), so drawing a plain regular volume loads neither the codec nor Numba nor SciPy;
+    a LodTree is still recognised."""
+    out = tmp_path / "h.png"
+    report = _child(f"""
+import json, sys
+from volviz.cli import main
+code = main(["render", {str(data_file("volumes/hydrogen.vti"))!r}, "-o", {str(out)!r}, "--size", "64x48"])
+loaded = {{name: name in sys.modules for name in ("numba", "scipy", "volviz.regular.lod")}}
+from volviz.scene.lod import is_lod
+from volviz.regular.lod import LodTree
+tree = LodTree.__new__(LodTree)
+print(json.dumps({{"code": code, "loaded": loaded, "tree": is_lod(tree), "other": is_lod(object())}}))
+""")
+    assert out.stat().st_size > 0 and report["code"] == 0
+    assert report["loaded"] == {"numba": False, "scipy": False, "volviz.regular.lod": False}
+    assert report["tree"] is True and report["other"] is False

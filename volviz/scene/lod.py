@@ -4,6 +4,7 @@ renderer (``volviz.render.lod_volume``)."""
 from __future__ import annotations
 
 import os
+import sys
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -25,10 +26,11 @@ def vvz_voxels(path: str | os.PathLike) -> int:
 
 
 def is_lod(dataset: object) -> TypeIs[LodTree]:
-    """Whether a loaded dataset is a compressed volume drawn at a level of detail."""
-    from volviz.regular.lod import LodTree   # heavy (the wavelet decoder's Numba kernels): only once a scene is shown
-
-    return isinstance(dataset, LodTree)
+    """Whether a loaded dataset is a compressed volume drawn at a level of detail. A LodTree exists only once its
+    module was imported, so the question never imports that module (the wavelet decoder's Numba kernels and SciPy,
+    0.4-0.9 s of a render of any regular volume, issue #30)."""
+    lod = sys.modules.get("volviz.regular.lod")
+    return lod is not None and isinstance(dataset, lod.LodTree)
 
 
 def lod_scalar_range(tree: LodTree) -> tuple[float, float]:
