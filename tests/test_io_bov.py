@@ -80,12 +80,35 @@ def test_a_header_cut_within_a_line_warns_naming_the_defaults_it_reads_with(tmp_
     path = _brick(tmp_path, cut, VALUES.astype(">f4").tobytes(order="F"))
     with pytest.warns(vio.ReadWarning) as caught:
         vio.read(path, isolate=False)
-    assert [str(w.message) for w in caught] == [
+    assert [str(w.message) for w in caught][0] == (
         f"{path}: its header's last line ('VARIABLE: dens') has no line end: if the header was cut short, keys are "
         "missing and read with their defaults (DATA_ENDIAN LITTLE, CENTERING zonal, BRICK_ORIGIN 0 0 0, BRICK_SIZE "
-        "DATA_SIZE, DATA_COMPONENTS 1, BYTE_OFFSET 0)"]
+        "DATA_SIZE, DATA_COMPONENTS 1, BYTE_OFFSET 0)")
+    # and the samples, big-endian floats read little-endian, look byte-swapped (the check of a header cut at a line end)
+    assert len(caught) == 2 and "does not state DATA_ENDIAN" in str(caught[1].message)
     full = HEADER + "DATA_COMPONENTS: 1\nBYTE_OFFSET: 0"                # every key set, no final line end
     for header in (cut + "\n", full):
         with warnings.catch_warnings():
             warnings.simplefilter("error", vio.ReadWarning)
             vio.read(_brick(tmp_path, header, VALUES.astype("<f4").tobytes(order="F")), isolate=False)
+
+
+@pytest.mark.parametrize("fmt, dtype, values", [
+    ("SHORT", "i2", np.arange(120).reshape(6, 5, 4) * 37 % 251),          # the campaign's seed: small integers
+    ("FLOAT", "f4", np.linspace(1.0, 5.0, 120).reshape(6, 5, 4)),                  # 22 % odd swapped, 0 % right
+    ("INT", "i4", np.round(1e4 * np.sin(np.linspace(0, 3, 120))).reshape(6, 5, 4))])
+def test_a_header_cut_at_a_line_end_that_lost_its_big_endian_line_warns(tmp_path, fmt, dtype, values):
+    """Issue #32, the last silent acceptance of the campaign at seed 33 (case 1900): a header cut at a line end
+    before ``DATA_ENDIAN: BIG`` is a valid header that reads big-endian samples little-endian (BOV's default). When
+    the samples so read look byte-swapped (`volviz.io.raw.swapped_looks_right`: small integers whose low byte is
+    always 0, a field far smoother swapped, floats of random exponents), a ReadWarning says so; the same samples
+    stored little-endian, or a header that states its byte order, say nothing and read the values exactly."""
+    header = HEADER.replace("FLOAT", fmt).replace("LITTLE", "BIG")
+    cut = header[:header.index("DATA_ENDIAN")]
+    with pytest.warns(vio.ReadWarning, match="does not state DATA_ENDIAN.*look byte-swapped"):
+        vio.read(_brick(tmp_path, cut, values.astype(">" + dtype).tobytes(order="F")), isolate=False)
+    for text, order in ((cut, "<"), (header, ">")):
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", vio.ReadWarning)
+            vol = vio.read(_brick(tmp_path, text, values.astype(order + dtype).tobytes(order="F")), isolate=False)
+        assert np.array_equal(vol.data, values.astype(dtype))

@@ -16,7 +16,7 @@ import numpy as np
 
 from volviz.io._checks import check_dims, check_file, describe_bytes, parse_float, parse_int, read_at, read_bytes
 from volviz.io.errors import PathLike, ReadError, ReadWarning
-from volviz.io.raw import _size_problem, decode_samples, file_dtype
+from volviz.io.raw import _size_problem, decode_samples, file_dtype, swapped_looks_right
 from volviz.model import RegularVolume
 from volviz.model.arrays import volume_of
 
@@ -61,6 +61,17 @@ def _warn_if_cut(path: PathLike, head: bytes, fields: dict[str, str]) -> None:
                   f"are missing and read with their defaults ({', '.join(missing)})", ReadWarning, stacklevel=3)
 
 
+def _warn_if_swapped(path: PathLike, raw: bytes | bytearray, disk: np.dtype) -> None:
+    """A header that does not state ``DATA_ENDIAN`` is read little-endian (BOV's default); when the samples look
+    byte-swapped so (``raw.swapped_looks_right``), a ReadWarning says why (a header that lost its
+    ``DATA_ENDIAN: BIG`` line reads every sample byte-swapped; issue #32)."""
+    why = swapped_looks_right(raw, disk)
+    if why is not None:
+        warnings.warn(f"{path}: its header does not state DATA_ENDIAN, so its samples are read little-endian (BOV's "
+                      f"default), but they look byte-swapped: {why}; if the header lost a 'DATA_ENDIAN: BIG' line, "
+                      "add it", ReadWarning, stacklevel=3)
+
+
 def _floats(path: PathLike, fields: dict[str, str], key: str, default: tuple[float, ...]) -> tuple[float, ...]:
     if key not in fields:
         return default
@@ -103,7 +114,10 @@ def read_bov(path: PathLike, allow_nonfinite: bool = True) -> RegularVolume:
         raise ReadError(p, f"its data file {fields['DATA_FILE']} is missing (looked for {data_path})")
     _size_problem(data_path, (components, *dims), disk, offset, data_path.stat().st_size)
     n = components * int(np.prod(dims))
-    values = decode_samples(data_path, read_at(data_path, offset, n * disk.itemsize), disk, allow_nonfinite)
+    raw = read_at(data_path, offset, n * disk.itemsize)
+    if "DATA_ENDIAN" not in fields:
+        _warn_if_swapped(p, raw, disk)
+    values = decode_samples(data_path, raw, disk, allow_nonfinite)
     data = values.reshape((components, *dims), order="F")
     data = data[0] if components == 1 else np.moveaxis(data, 0, -1)
     nodal = fields.get("CENTERING", "zonal").lower().startswith("nod")

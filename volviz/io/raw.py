@@ -40,6 +40,51 @@ def decode_samples(path: PathLike, raw: bytes | bytearray, disk: np.dtype, allow
     return values
 
 
+def swapped_looks_right(raw: bytes | bytearray, disk: np.dtype, samples: int = 65536) -> str | None:
+    """Why multi-byte samples read in ``disk``'s byte order look byte-swapped, or None when the stored reading is as
+    plausible (noise, constant data, single bytes). Over the first ``samples`` samples in file order: integers whose
+    least significant byte is 0 in every sample while the other bytes vary (small values stored in the other order),
+    or whose median step between neighbours, over their 5-95 % spread, is at least 8 times the swapped reading's (a
+    finely sampled field varies smoothly, its swapped bytes do not); floats of which a tenth or more are not finite,
+    beyond 1e30 or within 1e-30 of 0 while at most 1 % are so swapped (random exponent bits). The mark of a byte
+    order a header failed to state."""
+    if disk.itemsize == 1:
+        return None
+    n = min(len(raw) // disk.itemsize, samples)
+    if n < 16:
+        return None
+    head = np.frombuffer(raw, dtype=np.uint8, count=n * disk.itemsize).reshape(n, disk.itemsize)
+    low = head[:, -1] if disk.byteorder == ">" else head[:, 0]     # the least significant byte as read
+    if disk.kind in "iu" and not low.any() and head.any():
+        return "every sample's low byte is 0, as when small values are stored in the other byte order"
+    stored, swapped = np.frombuffer(raw, dtype=disk, count=n), np.frombuffer(raw, dtype=disk.newbyteorder(), count=n)
+    if disk.kind == "f":
+        a, b = _implausible_share(stored), _implausible_share(swapped)
+        if a >= 0.1 and b <= 0.01:
+            return (f"{a:.0%} of the samples are not finite, beyond 1e30 or within 1e-30 of 0 (not 0), read in the "
+                    f"other byte order {b:.0%}")
+        return None
+    a, b = _relative_step(stored.astype(np.float64)), _relative_step(swapped.astype(np.float64))
+    if b < np.inf and a > 8.0 * b:
+        return f"read in the other byte order they vary far more smoothly (median step {b:.3g} against {a:.3g})"
+    return None
+
+
+def _implausible_share(values: np.ndarray) -> float:
+    """The share of float samples no field holds: not finite, beyond 1e30, or within 1e-30 of 0 but not 0 (what
+    random exponent bits give)."""
+    with np.errstate(invalid="ignore", over="ignore"):
+        mag = np.abs(values.astype(np.float64))
+    odd = ~np.isfinite(mag) | (mag > 1e30) | ((mag < 1e-30) & (mag > 0))
+    return float(odd.mean())
+
+
+def _relative_step(values: np.ndarray) -> float:
+    """The median step between neighbouring samples over their 5-95 % spread (inf when they do not spread)."""
+    lo, hi = np.percentile(values, [5.0, 95.0])
+    return float(np.median(np.abs(np.diff(values))) / (hi - lo)) if hi > lo else np.inf
+
+
 def _size_problem(path: PathLike, dims: Sequence[int], disk: np.dtype, header_bytes: int, size: int) -> None:
     need = header_bytes + int(np.prod([int(d) for d in dims], dtype=object)) * disk.itemsize
     if need != size:
