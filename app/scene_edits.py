@@ -1,6 +1,6 @@
-"""Edits of the shown scene in the main window (a mixin of ``MainWindow``): what the docks' signals do. Each edit is
-made in the session (``volviz.session.Session.set_transfer_function`` ...), which announces it; the window hears it
-once the controller's views show it (``_scene_changed``) and the view scheduler refreshes the camera views for it
+"""Edits of the shown scene in the main window: what the docks' signals do. Each edit is made in the session
+(``volviz.session.Session.set_transfer_function`` ...), which announces it; the window hears it once the
+controller's views show it (``scene_changed``) and the view scheduler refreshes the camera views for it
 (``volviz_app.view_scheduler.ViewScheduler.views_follow``): no edit here refreshes a view itself (issue #31). The
 scene dock selects a component (its transfer function and histogram, computed in the background when missing, go to
 the TF editor), shows or hides it (a component hidden at load is prepared in the background, a natural-scene
@@ -10,28 +10,40 @@ once an edit is finished); the clipping dock's clipping cuts every view (what is
 meshes, in the background: ``cut_in_background``); the render settings dock changes the renderer (the scene rebuilt
 with the same camera), the isosurface mode or the error budget.
 
-It expects of the window: ``controller``, ``session``, ``session_path``, ``datasets``, ``jobs``, ``status_label``,
-``tf_editor``, ``scene_tree``, ``array_choice``, ``render_scene()``, ``schedule_render()``, ``set_dirty``,
-``show_error``, ``_show_session`` (``volviz_app.scene_loading``), of ``volviz_app.view_scheduler`` ``views_follow``
-and the refreshes (``refresh_views`` after a background cut or show, ``_enforce_error_budget``) and
-``last_error_rmse``; ``_init_scene_edits()`` makes its state and ``_connect_scene_edits()`` its preview timer (both
-called by the window's ``__init__``; the docks' signals are connected where the docks are built)."""
+Held by the window as ``window.scene_edits``; its collaborators are the shown scene (``shown_scene``), the parent of
+its preview timer, the views' refreshes (``ViewRefreshes``: the window's view scheduler), the window's ``jobs``, the
+status label, the TF editor, the scene tree and the array choice, and as callbacks ``render_scene()``,
+``set_dirty(dirty)``, ``show_error(title, text)``, ``show_session(...)`` (``volviz_app.scene_loading``: a rebuild
+with the same camera) and ``enforce_error_budget(rmse)``. The window subscribes ``scene_changed`` to each installed
+scene's changes and calls ``scene_installed()``; it connects the docks' signals to its forwarders of
+``select_component``, ``tf_changed``, ``tf_committed``, ``set_visibility``, ``set_opacity``, ``settings_changed`` and
+``set_clip``."""
 from __future__ import annotations
 
 import threading
-from typing import TYPE_CHECKING, Any, Optional
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Callable, Optional, Protocol
 
-from PySide6.QtCore import QTimer
+from PySide6.QtCore import QObject, QTimer
+from PySide6.QtWidgets import QLabel
 
-from volviz.jobs import JobOutcome
-from volviz.session import SessionError
+from volviz.jobs import Job, JobOutcome
+from volviz.session import Session, SessionError
 from .docks.render_settings import RENDERER_DEFAULTS
-from .window_base import WindowBase
+from .shown_scene import ShownScene
 
 if TYPE_CHECKING:
     from volviz.model.clip import ClipSettings
     from volviz.model.events import SceneChange
     from volviz.render.controller import SceneController
+    from .array_choice import ArrayChoice
+    from .docks.scene_tree import SceneTree
+    from .docks.tf_editor import TransferFunctionEditor
+    from .workers import JobBridge
+
+#: ``volviz_app.scene_loading.SceneLoading.show_session``: a session shown (session, its file, title, dirty, the
+#: datasets already read), prepared in the background while the current scene stays
+ShowSession = Callable[[Session, Optional[Path], str, bool, dict[str, Any]], None]
 
 PREVIEW_MS = 40          # live transfer-function preview: at most one re-render per 40 ms while dragging
 
@@ -41,23 +53,64 @@ def _histogram_range(hist: Any) -> Optional[tuple[float, float]]:
     return None if hist is None else (float(hist[1][0]), float(hist[1][-1]))
 
 
-class SceneEdits(WindowBase):
+class ViewRefreshes(Protocol):
+    """What the edits ask of the views' refreshes (``volviz_app.view_scheduler.ViewScheduler``): to follow an edit
+    the views hold, to refresh some camera views or the natural scene after a background cut or show, to draw once
+    control returns to the event loop, and the last measured error (None: none measured)."""
+
+    last_error_rmse: Optional[float]
+
+    def views_follow(self, change: SceneChange) -> None: ...
+    def refresh_views(self, keys: Optional[list[str]] = None, settled: Optional[Callable[[], None]] = None,
+                      scale: int = 1, estimate: bool = True, moving: bool = False) -> int: ...
+    def refresh_nature(self, settled: Optional[Callable[[], None]] = None, scale: int = 1) -> None: ...
+    def schedule_render(self) -> None: ...
+
+
+class SceneEdits:
     """The docks' edits of the shown scene (see the module's docstring)."""
 
-    def _init_scene_edits(self) -> None:
+    def __init__(self, scene: ShownScene, parent: QObject, views: ViewRefreshes, jobs: JobBridge, status: QLabel,
+                 tf_editor: TransferFunctionEditor, scene_tree: SceneTree, array_choice: ArrayChoice, *,
+                 render_scene: Callable[[], None], set_dirty: Callable[[], None],
+                 show_error: Callable[[str, str], None],
+                 show_session: ShowSession, enforce_error_budget: Callable[[float], None]) -> None:
+        self.scene, self.views, self.jobs, self.status = scene, views, jobs, status
+        self.tf_editor, self.scene_tree, self.array_choice = tf_editor, scene_tree, array_choice
+        self.render_scene, self.set_dirty, self.show_error = render_scene, set_dirty, show_error
+        self.show_session, self.enforce_error_budget = show_session, enforce_error_budget
         self.components_shown = 0          # components hidden at load, prepared in the background and added
-        self._histogram_job: Any = None
+        self._histogram_job: Optional[Job] = None
         self.histograms_computed = 0       # TF-editor histograms computed in the background and shown
         self.histogram_threads: set[int] = set()       # the threads they were computed on
         self._pending_tf: Optional[tuple[str, Any, bool]] = None  # (component, TF, a finished edit)
         self.nature_rebuilds = 0           # natural scenes rebuilt in the background (visibility toggles)
         self.cuts_pending: set[str] = set()  # components whose cut for the current clipping or opacity is not shown
-
-    def _connect_scene_edits(self) -> None:
-        self.preview_timer = QTimer(self, singleShot=True, interval=PREVIEW_MS)
+        self.preview_timer = QTimer(parent, singleShot=True, interval=PREVIEW_MS)
         self.preview_timer.timeout.connect(self._apply_pending_tf)
 
-    def _select_component(self, comp_id: str) -> None:
+    # the shown scene's, read at each edit: the window replaces them when it shows another scene
+    @property
+    def controller(self) -> Optional[SceneController]:
+        return self.scene.controller
+
+    @property
+    def session(self) -> Session:
+        return self.scene.session
+
+    @property
+    def session_path(self) -> Optional[Path]:
+        return self.scene.session_path
+
+    def scene_installed(self) -> None:
+        """A new scene is shown: its cuts were made in its preparation."""
+        self.cuts_pending = set()
+
+    def stop(self) -> None:
+        """The window closes: no TF preview waits."""
+        self.preview_timer.stop()
+
+    def select_component(self, comp_id: str) -> None:
         if self.controller is None:
             return
         self.array_choice.show_component(comp_id)
@@ -111,7 +164,7 @@ class SceneEdits(WindowBase):
 
         self._histogram_job = self.jobs.submit(compute, name=f"histogram {comp_id}", key="histogram", on_done=done)
 
-    def _tf_changed(self, tf: Any) -> None:
+    def tf_changed(self, tf: Any) -> None:
         comp_id = self.scene_tree.current_component()
         if comp_id is None or self.controller is None:
             return
@@ -120,8 +173,8 @@ class SceneEdits(WindowBase):
         if not self.preview_timer.isActive():
             self.preview_timer.start()
 
-    def _tf_committed(self, tf: Any) -> None:
-        self._tf_changed(tf)
+    def tf_committed(self, tf: Any) -> None:
+        self.tf_changed(tf)
 
     def _apply_pending_tf(self) -> None:
         if self._pending_tf is None or self.controller is None:
@@ -130,7 +183,7 @@ class SceneEdits(WindowBase):
         self._pending_tf = None
         self.session.set_transfer_function(comp_id, tf, preview=not finished)   # the views follow (``views_follow``)
 
-    def _set_visibility(self, comp_id: str, visible: bool) -> None:
+    def set_visibility(self, comp_id: str, visible: bool) -> None:
         from volviz.scene.datasets import NATURE_TYPES
 
         if self.controller is None:
@@ -153,7 +206,7 @@ class SceneEdits(WindowBase):
         controller, session_path = self.controller, self.session_path
         if controller is None:
             return
-        self.status_label.setText(f"Preparing {comp_id}…")
+        self.status.setText(f"Preparing {comp_id}…")
 
         def prepare(progress: Any = None) -> Any:
             load_datasets(controller.session, session_path, loaded=controller.datasets)  # a component shown anew
@@ -168,9 +221,9 @@ class SceneEdits(WindowBase):
                 controller.install_component(comp_id, outcome.result, views=False)
                 self.scene_tree.dataset_read(comp_id)
                 self.components_shown += 1
-                self.status_label.setText(f"Showing {comp_id}")
-                self.schedule_render()
-                self.refresh_views([comp_id, "iso-overlay"])
+                self.status.setText(f"Showing {comp_id}")
+                self.views.schedule_render()
+                self.views.refresh_views([comp_id, "iso-overlay"])
             elif outcome.error is not None:
                 self._revert_visibility(controller, comp_id, True)
                 self.show_error(f"Cannot show {comp_id}", str(outcome.error))
@@ -179,10 +232,10 @@ class SceneEdits(WindowBase):
 
     def _revert_visibility(self, controller: SceneController, comp_id: str, visible: bool) -> None:
         """Showing (``visible``) or hiding a component failed: it keeps its previous state (its box follows through
-        ``_scene_changed``)."""
+        ``scene_changed``)."""
         controller.set_visible(comp_id, not visible, nature=False, build=False)
 
-    def _scene_changed(self, change: SceneChange) -> None:
+    def scene_changed(self, change: SceneChange) -> None:
         """The session's state was edited and the shown scene's views hold the edit (``SceneController.changes``,
         wherever the edit came from: a dock, an undo step, a failed show reverted, a script): the session is marked
         edited, the scene dock shows a component's visibility and opacity as they now are, and the camera views
@@ -191,7 +244,7 @@ class SceneEdits(WindowBase):
         if change.what in ("visible", "opacity") and change.component is not None and self.controller is not None:
             comp = self.controller.component(change.component)
             self.scene_tree.show_state(comp.id, comp.visible, comp.opacity)
-        self.views_follow(change)
+        self.views.views_follow(change)
         controller = self.controller
         if change.what in ("opacity", "clip") and controller is not None:  # stale cuts made in the background
             if change.what == "clip":
@@ -220,15 +273,15 @@ class SceneEdits(WindowBase):
                 controller.install_nature(outcome.result, views=False)
                 self.nature_rebuilds += 1
                 if controller.nature is None:
-                    self.schedule_render()
-                self.refresh_nature()
+                    self.views.schedule_render()
+                self.views.refresh_nature()
             elif outcome.error is not None:
                 self._revert_visibility(controller, comp_id, visible)
                 self.show_error(f"Cannot {'show' if visible else 'hide'} {comp_id}", str(outcome.error))
 
         self.jobs.submit(prepare, name="natural scene", key="nature-build", on_done=done)
 
-    def _set_opacity(self, comp_id: str, opacity: float) -> None:
+    def set_opacity(self, comp_id: str, opacity: float) -> None:
         if self.controller is not None:  # the views follow (``views_follow``)
             self.session.set_opacity(comp_id, opacity)
 
@@ -256,7 +309,7 @@ class SceneEdits(WindowBase):
                     controller.show_cut(comp_id, outcome.result)
                     self.cuts_pending.discard(comp_id)
                     self.render_scene()
-                    self.refresh_views([comp_id, "iso-overlay"])
+                    self.views.refresh_views([comp_id, "iso-overlay"])
                 elif outcome.error is not None:
                     self.show_error("Cannot clip", f"{comp_id}: {outcome.error}")
 
@@ -288,10 +341,10 @@ class SceneEdits(WindowBase):
         candidate.camera = self.controller.camera()
         candidate.layout.pop("window_state", None)  # the docks stay where they are
         # prepared in the background; the current scene stays until the new one is ready (or shown on an error)
-        self._show_session(candidate, self.session_path, getattr(self, "title", ""), True, datasets=self.datasets)
+        self.show_session(candidate, self.session_path, self.scene.title, True, self.scene.datasets)
         return True
 
-    def _settings_changed(self, values: dict[str, Any]) -> None:
+    def settings_changed(self, values: dict[str, Any]) -> None:
         current = {**RENDERER_DEFAULTS, **self.session.render.options}  # a missing option is its default
         rebuild = (values["method"] != self.session.render.method
                    or any(values["options"].get(k) != current[k] for k in RENDERER_DEFAULTS))
@@ -306,14 +359,13 @@ class SceneEdits(WindowBase):
         self.set_dirty()
         if follow:
             self.session.set_iso_mode(iso_mode)   # the views follow (``views_follow``)
-        if budget_changed and not rebuild and self.last_error_rmse is not None:
-            self._enforce_error_budget(self.last_error_rmse)
+        if budget_changed and not rebuild and self.views.last_error_rmse is not None:
+            self.enforce_error_budget(self.views.last_error_rmse)
             return
         if rebuild and self.controller is not None:  # another renderer: rebuild the scene with the same camera
             self.session.camera = self.controller.camera()
             self.session.layout.pop("window_state", None)
-            self._show_session(self.session, self.session_path, getattr(self, "title", ""), True,
-                               datasets=self.datasets)
+            self.show_session(self.session, self.session_path, self.scene.title, True, self.scene.datasets)
 
 
 def _refit_on_new_array(doc: dict[str, Any], comp: dict[str, Any], settings: dict[str, Any]) -> None:

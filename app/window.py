@@ -8,14 +8,14 @@ scene, typed by ``shown_scene.ShownScene``, widgets, callbacks) when they are ma
   question on closing (``session_files.SessionFiles``; ``recent``: File > Open Recent);
 - ``scene_loading``: ``open_path`` and showing a session, prepared in the background, then installed
   (``scene_loading.SceneLoading``; the window's side of a new scene is ``_scene_installed``);
+- ``scene_edits``: what the docks' edits do to the shown scene (TF, visibility, opacity, settings, clipping, render
+  settings; ``scene_edits.SceneEdits``);
 
 and is put together from one mixin per responsibility for the rest, each in its own module:
 
 - ``window_widgets.WindowWidgets``: the docks, menus and actions, the status bar with progress and cancel;
 - ``view_scheduler.ViewScheduler``: the background refreshes of the views (one job in flight per kind), the error
-  estimate and budget;
-- ``scene_edits.SceneEdits``: what the docks' edits do to the shown scene (TF, visibility, opacity, settings,
-  clipping, render settings).
+  estimate and budget.
 
 This module sets the window's shared state (``session``, ``controller``, ``jobs``, ``plotter``..., typed in
 ``window_base.WindowBase``), and holds its construction, ``render_scene``, fly mode, ``show_error``, closing, and
@@ -26,7 +26,7 @@ import logging
 import os
 import time
 from pathlib import Path
-from typing import Any, Callable, Optional
+from typing import TYPE_CHECKING, Any, Callable, Optional
 
 from PySide6.QtCore import QSettings, Qt
 from PySide6.QtWidgets import QFileDialog, QMainWindow, QMenu, QMessageBox, QWidget
@@ -51,6 +51,9 @@ from .view_scheduler import ViewScheduler
 from .window_widgets import WindowWidgets
 from .workers import JobBridge
 
+if TYPE_CHECKING:
+    from volviz.model.clip import ClipSettings
+
 log = logging.getLogger(__name__)
 
 
@@ -69,7 +72,7 @@ def _import_gui_thread_modules() -> None:
     pyvista.system_supports_plotting()
 
 
-class MainWindow(ViewScheduler, SceneEdits, WindowWidgets, QMainWindow):
+class MainWindow(ViewScheduler, WindowWidgets, QMainWindow):
     """volviz main window. ``open_path`` is the single code path behind File > Open and the command line."""
 
     def __init__(self, parent: Optional[QWidget] = None, settings: Optional[QSettings] = None,
@@ -92,7 +95,6 @@ class MainWindow(ViewScheduler, SceneEdits, WindowWidgets, QMainWindow):
         self.error_dialog = None
         self.dirty = False
         self.last_stats = {}
-        self._init_scene_edits()           # histograms, the pending TF preview, what the edits have shown
         self._loading_views = False        # the newest scene is installed, its first views are computed
         self._init_view_scheduler()        # its OneInFlight jobs and what they have shown
 
@@ -112,13 +114,16 @@ class MainWindow(ViewScheduler, SceneEdits, WindowWidgets, QMainWindow):
                                           self.recent, self.status_label, loading.open_path, loading.open_paths,
                                           loading.show_session, self.show_error)   # its autosave timer runs from now
         self._build_menus()
+        self.scene_edits = SceneEdits(self, self, self, self.jobs, self.status_label, self.tf_editor, self.scene_tree,
+                                      self.array_choice, render_scene=self.render_scene, set_dirty=self.set_dirty,
+                                      show_error=self.show_error, show_session=loading.show_session,
+                                      enforce_error_budget=self._enforce_error_budget)   # its TF preview timer
         self.resize(*self.layout_keeper.default_size())
         self.layout_keeper.restore()
         self.fly = FlyMode(self.plotter, on_camera_moved=self._fly_moved)
         self.single_render = SingleRenderDuringInteraction(self.plotter)  # one render per move of a drag
         self.clip_widget = ClipPlaneWidget(self.plotter, self.clipping)
         self._connect_view_scheduler()  # interaction observers, fly-mode settle and resize timers
-        self._connect_scene_edits()  # the TF preview timer
         self.nonfinite = NonFiniteStatus(self)  # the status bar's note on non-finite values
         self.collector.freeze_long_lived()
 
@@ -132,10 +137,10 @@ class MainWindow(ViewScheduler, SceneEdits, WindowWidgets, QMainWindow):
         """``scene_loading`` installed ``controller``'s scene as the shown one: the window follows its state, the
         docks and the bookmark menu show it, the views' state starts afresh. ``new_data``: another file or scene,
         whose settings edits are not undone on the new one."""
-        controller.changes.subscribe(self._scene_changed)   # the window follows the scene's state from now on
+        controller.changes.subscribe(self.scene_edits.scene_changed)   # the window follows the scene from now on
         self._fill_docks(controller)
         self.volume_time_shown = self.iso_time_shown = None
-        self.cuts_pending = set()  # cut in ``prepare``
+        self.scene_edits.scene_installed()
         self.camera_bookmarks.refresh_menu()
         self.title = title
         self.error_estimate = None
@@ -215,6 +220,10 @@ class MainWindow(ViewScheduler, SceneEdits, WindowWidgets, QMainWindow):
     raw_dialog = PartAttribute("scene_loading")
     missing_dialog = PartAttribute("scene_loading")
     _load_serial = PartAttribute("scene_loading", "serial")
+    components_shown = PartAttribute("scene_edits")
+    histograms_computed = PartAttribute("scene_edits")
+    histogram_threads = PartAttribute("scene_edits")
+    nature_rebuilds = PartAttribute("scene_edits")
 
     def add_bookmark(self, name: str) -> None:
         self.camera_bookmarks.add_bookmark(name)
@@ -272,6 +281,35 @@ class MainWindow(ViewScheduler, SceneEdits, WindowWidgets, QMainWindow):
     def _ask_open_data(self) -> None:
         self.session_files.ask_open_data()
 
+    # the docks' signals (connected in ``window_widgets``), the budget's switch of table (``view_scheduler``), the
+    # settings path (``component_settings``, ``array_choice``) and the tests' waits
+    def _select_component(self, comp_id: str) -> None:
+        self.scene_edits.select_component(comp_id)
+
+    def _tf_changed(self, tf: Any) -> None:
+        self.scene_edits.tf_changed(tf)
+
+    def _tf_committed(self, tf: Any) -> None:
+        self.scene_edits.tf_committed(tf)
+
+    def _set_visibility(self, comp_id: str, visible: bool) -> None:
+        self.scene_edits.set_visibility(comp_id, visible)
+
+    def _set_opacity(self, comp_id: str, opacity: float) -> None:
+        self.scene_edits.set_opacity(comp_id, opacity)
+
+    def _settings_changed(self, values: dict[str, Any]) -> None:
+        self.scene_edits.settings_changed(values)
+
+    def set_clip(self, clip: ClipSettings | dict[str, Any]) -> None:
+        self.scene_edits.set_clip(clip)
+
+    def clipping_shown(self) -> bool:
+        return self.scene_edits.clipping_shown()
+
+    def apply_component_settings(self, comp_id: str, settings: dict[str, Any]) -> bool:
+        return self.scene_edits.apply_component_settings(comp_id, settings)
+
     # ------------------------------------------------------------------------------------------------ errors
     def show_error(self, title: str, text: str) -> None:
         """A non-blocking error dialog (the app keeps running); also logged."""
@@ -291,7 +329,7 @@ class MainWindow(ViewScheduler, SceneEdits, WindowWidgets, QMainWindow):
         self.session_files.clear_recovery()
         self.layout_keeper.save()
         self.session_files.stop()
-        self.preview_timer.stop()
+        self.scene_edits.stop()
         self.camera_bookmarks.stop()
         self.timeline.set_playing(False)
         if self.controller is not None:  # before the plotter closes: the GPU PT pass frees its GL resources

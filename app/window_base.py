@@ -1,7 +1,7 @@
 """The typed view that ``MainWindow``'s mixins have of the window they are mixed into.
 
-Each mixin (``view_scheduler.ViewScheduler``, ``scene_edits.SceneEdits``, ``window_widgets.WindowWidgets``) derives
-from ``WindowBase``, which declares, once and with their types:
+Each mixin (``view_scheduler.ViewScheduler``, ``window_widgets.WindowWidgets``) derives from ``WindowBase``, which
+declares, once and with their types:
 
 - the window's shared state: what more than one part of the window reads or writes (``session``, ``controller``,
   ``jobs``, ``plotter``, the docks, ``status_label``...), whichever of ``MainWindow.__init__`` or a mixin sets it;
@@ -36,6 +36,7 @@ if TYPE_CHECKING:
     from .array_choice import ArrayChoice
     from .camera_bookmarks import CameraBookmarks
     from .export_runs import ExportRuns
+    from .scene_edits import SceneEdits
     from .scene_loading import SceneLoading
     from .session_files import SessionFiles
     from .stand_in import StandInFrame
@@ -87,7 +88,6 @@ class WindowBase(_QtWindow):
     iso_time_shown: Optional[tuple[float, bool]]
     error_estimate: Optional[str]
     last_error_rmse: Optional[float]
-    cuts_pending: set[str]             # SceneEdits
     # -- widgets (WindowWidgets)
     tf_editor: TransferFunctionEditor
     scene_tree: SceneTree
@@ -105,6 +105,7 @@ class WindowBase(_QtWindow):
     export_runs: ExportRuns            # (window.py)
     session_files: SessionFiles        # (window.py)
     scene_loading: SceneLoading        # (window.py)
+    scene_edits: SceneEdits            # (window.py)
     recent_menu: QMenu                 # (window.py)
     action_fly: QAction
     fly: FlyMode                       # (window.py)
@@ -144,7 +145,7 @@ class WindowBase(_QtWindow):
         def _playing_changed(self, playing: bool) -> None: ...
         def _interpolation_toggled(self, on: bool) -> None: ...
 
-        # -- SceneEdits
+        # -- forwarded by MainWindow to scene_edits (the docks' signals, the error budget's switch of table)
         def set_clip(self, clip: ClipSettings | dict[str, Any]) -> None: ...
         def _select_component(self, comp_id: str) -> None: ...
         def _set_visibility(self, comp_id: str, visible: bool) -> None: ...
@@ -152,7 +153,6 @@ class WindowBase(_QtWindow):
         def _settings_changed(self, values: dict[str, Any]) -> None: ...
         def _tf_changed(self, tf: Any) -> None: ...
         def _tf_committed(self, tf: Any) -> None: ...
-        def _scene_changed(self, change: SceneChange) -> None: ...
 
         # -- WindowWidgets
         def _set_busy(self, busy: bool) -> None: ...
