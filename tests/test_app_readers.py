@@ -63,7 +63,8 @@ def legend(window: MainWindow) -> str | None:
 
 READERS = [  # file, component, how it is drawn, scalar bar title (None: no legend), least share of data pixels
     ("ecosystem/disk_out_ref.ex2", "data", "pt", "Temp", 0.03),
-    ("ecosystem/notch_disp.vtu", "data", "pt", "Nodal Displacement (magnitude)", 0.05),
+    # 4.9 % since the first look's histogram-equalized stops (638b48e) leave its near-zero end fainter
+    ("ecosystem/notch_disp.vtu", "data", "pt", "Nodal Displacement (magnitude)", 0.045),
     ("ecosystem/openfoam-cavity", "data", "volume", "U (magnitude)", 0.0),
     ("ecosystem/sampleCurveGrid4.nc", "data", "surface", "sample", 0.1),
     ("ecosystem/sqnz_s.adf.cgns", "data", "pt", "Density", 0.1),
@@ -89,8 +90,10 @@ def test_each_reader_opens_in_the_window(qtbot, make_window, name: str, comp_id:
 
 
 def test_openfoam_cavity_shows_its_flow_once_the_lid_has_moved(qtbot, make_window) -> None:
-    """At t = 0 the cavity's U is zero inside (only the lid moves), so the first image is nearly empty (reported in
-    docs/first-open.md); the last step shows the vortex."""
+    """At t = 0 the cavity's U is zero inside (only the lid moves), so the first image shows the lid alone (reported
+    in docs/first-open.md): its layer at the TF's top value, drawn since 2a27a37 (before, VTK left a region at the
+    top value transparent and the image was nearly empty), 1.4 % of this window; the last step shows the vortex,
+    several times that."""
     window = small_window(make_window)
     window.open_path(data_file("ecosystem/openfoam-cavity"))
     wait_loaded(qtbot, window)
@@ -100,7 +103,8 @@ def test_openfoam_cavity_shows_its_flow_once_the_lid_has_moved(qtbot, make_windo
     window.timeline.set_time(steps[-1])
     qtbot.waitUntil(lambda: window.volume_time_shown is not None and window.volume_time_shown[0] == steps[-1],
                     timeout=30000)
-    assert at_rest < 0.01 and data_share(window) > 0.05     # from the lid's corner glow to the whole vortex
+    moved = data_share(window)
+    assert at_rest < 0.02 and moved > 0.05 and moved > 4 * at_rest     # from the lid to the whole vortex
 
 
 def _reset_camera_action(window: MainWindow):

@@ -154,7 +154,17 @@ def test_log_color_scale_puts_the_tf_editor_axis_in_log_and_says_what_it_clamps(
 
     from volviz_app.docks.tf_editor import COLOR_BAR_HEIGHT, MARGIN
 
+    from volviz.optics.transfer_function import TransferFunction
+
     window = _open_neghip(qtbot, make_window)
+    # stops spread evenly over 0..255, set in the TF editor as one edit: on a linear axis the colours at 2, 10, 50
+    # and 200 then differ by far more than 20 levels from a log axis's (the first look's histogram-equalized stops,
+    # since 638b48e, sit at 1, 5, 15, 45, 255, almost a log spacing already, which left 19 levels between the two)
+    even = TransferFunction([0.0, 64.0, 128.0, 192.0, 255.0],
+                            [(0.23, 0.30, 0.75), (0.55, 0.69, 0.94), (0.87, 0.87, 0.87), (0.96, 0.60, 0.48),
+                             (0.71, 0.02, 0.15)], [0.0, 0.002, 0.004, 0.006, 0.008], name="even")
+    window.tf_editor.edit(even, "Even stops")
+    wait_settled(qtbot, window)
     canvas = window.tf_editor.canvas
     assert canvas.log_floor is None
     _tick_log_scale(qtbot, window)
