@@ -66,6 +66,12 @@ def _import_gui_thread_modules() -> None:
     import volviz.render.scene_builder  # noqa: F401
     import volviz.render.vtk_facade  # noqa: F401
     import pyvista
+    from volviz.io.registry import reader_specs
+
+    # every reader's file-name patterns resolved now (meshio's extensions import meshio, the plugins' entry points are
+    # read): a first File > Open did it on the GUI thread, 80-150 ms of a blocked event loop while a session loaded
+    for spec in reader_specs():
+        spec.globs()
 
     # pyvista asks once per process whether this system can plot (it runs ``xset -q``) when the first offscreen plotter
     # of an export is made: ~60 ms of a blocked event loop at the start of the first export, here at start-up instead
