@@ -66,6 +66,8 @@ def _import_gui_thread_modules() -> None:
     import volviz.render.scene_builder  # noqa: F401
     import volviz.render.vtk_facade  # noqa: F401
     import pyvista
+    import scipy.optimize  # noqa: F401 - the iso-spectrum fit's least squares, when an isosurface is first shown
+
     from volviz.io.registry import reader_specs
 
     # every reader's file-name patterns resolved now (meshio's extensions import meshio, the plugins' entry points are
