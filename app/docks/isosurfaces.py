@@ -1,7 +1,7 @@
 """The Isosurfaces dock: the surfaces of the scene's isosurface component (value, colour, opacity), editors to add
-one, change the selected one or remove it, and the transparency mode of the isosurfaces (VTK's blend or the 2-, 3-
-or 4-pass modes of the libMini note §4). The window's iso tool (``volviz_app.iso_tool``) turns the signals into
-undoable scene edits."""
+one, change the selected one or remove it, and the transparency mode of the isosurfaces (VTK's blend, the 2-, 3-
+or 4-pass modes of the libMini note §4, or its exact per-pixel sorted reference). The window's iso tool
+(``volviz_app.iso_tool``) turns the signals into undoable scene edits."""
 from __future__ import annotations
 
 from typing import Any, Optional
@@ -11,8 +11,11 @@ from PySide6.QtGui import QColor
 from PySide6.QtWidgets import (QAbstractItemView, QColorDialog, QComboBox, QDoubleSpinBox, QFormLayout, QHBoxLayout,
                                QLabel, QPushButton, QTableWidget, QTableWidgetItem, QVBoxLayout, QWidget)
 
-#: the transparency modes offered (render option ``iso_mode``), with their labels
-MODES = {"vtk": "VTK blend", "2pass": "2-pass", "3pass": "3-pass", "4pass": "4-pass"}
+from volviz.session import ISO_MODES
+
+_LABELS = {"vtk": "VTK blend", "2pass": "2-pass", "3pass": "3-pass", "4pass": "4-pass", "exact": "Exact (sorted)"}
+#: the transparency modes offered (every render option ``iso_mode`` the session accepts), with their labels
+MODES = {mode: _LABELS[mode] for mode in ISO_MODES}
 
 
 class IsosurfacesDock(QWidget):
@@ -57,7 +60,8 @@ class IsosurfacesDock(QWidget):
                             (self.add_button, "Add a surface at the value"),
                             (self.apply_button, "Give the selected surface the value, color and opacity above"),
                             (self.remove_button, "Remove the selected surface"),
-                            (self.mode, "How translucent surfaces are blended: VTK, or 2-, 3- or 4-pass")):
+                            (self.mode, "How translucent surfaces are blended: VTK, 2-, 3- or 4-pass, or exact "
+                                        "(sorted per pixel)")):
             widget.setToolTip(tip)
         self.note = QLabel("")
         self.note.setWordWrap(True)
