@@ -1,8 +1,11 @@
 """``*.xyz`` is both a PLOT3D grid and a text point cloud (issue #32): the content decides. A PLOT3D grid's dimension
 header must give the file's size (``plot3d.is_plot3d_grid``); a text table must parse, in at least three of four of
-its first rows (``csv_points.is_point_text``). A point cloud whose first row is damaged was taken for PLOT3D by its
-name and refused in PLOT3D's words ("PLOT3D xyz header claims 1 block(s) of 540024880x..."); it now goes to the
-table's reader, which names the row."""
+its first rows, or more than half of them when that is 8 rows or more (``csv_points.is_point_text``). A point cloud
+whose first row is damaged was taken for PLOT3D by its name and refused in PLOT3D's words ("PLOT3D xyz header claims
+1 block(s) of 540024880x..."); it now goes to the table's reader, which names the row. One whose first row is 2-5
+whole numbers, a third of its rows with a field more, was taken for AVS UCD by content ("line 1 ('0 0 100') is not
+the header line"): AVS UCD's sniffer now holds the lines after its header against the counts (``id x y z`` node
+lines, cell lines with an AVS cell type), which a table's rows are not."""
 from __future__ import annotations
 
 import shutil
@@ -14,6 +17,7 @@ from volviz.bench.robustness_formats import _xyz
 from volviz.io.csv_points import is_point_text
 from volviz.io.plot3d import is_plot3d_grid
 from volviz.io.registry import HEAD_BYTES, spec_of
+from volviz_vtk_readers.specs import is_avs_ucd
 
 
 @pytest.fixture
@@ -74,3 +78,22 @@ def test_a_plot3d_grid_named_xyz_is_plot3d_and_a_cut_one_refused_in_plot3d_words
     assert spec_of(grid).name == "plot3d"           # the only reader of the name that is not a sniffed table
     with pytest.raises(vio.ReadError, match=r"PLOT3D xyz header claims 1 block\(s\) of 40x32x32 points"):
         vio.read(grid, isolate=False)
+
+
+@pytest.mark.parametrize("first", [None, b"12 7", b"12 7 3", b"5 4 3 2 1"])
+def test_a_cloud_whose_first_row_is_whole_numbers_and_a_third_of_rows_odd_is_no_avs_ucd(cloud, first):
+    """The seed (first row ``0 0 100``, or 2, 3 or 5 whole numbers) with a fourth field on every third row (26 rows):
+    not AVS UCD, a table, read with the odd rows (the first too, when of another width) named and left out."""
+    path, rest = cloud
+    rows = [b"0 0 100"] + rest.splitlines()
+    rows = [first or rows[0]] + [row + b" 7" if i % 3 == 2 else row for i, row in enumerate(rows) if i]
+    path.write_bytes(b"\n".join(rows) + b"\n")
+    head = path.read_bytes()[:HEAD_BYTES]
+    assert not is_avs_ucd(head) and is_point_text(head)
+    assert spec_of(path).name == "points-text"
+    kept = [row for row in rows if len(row.split()) == 3]
+    first_odd = f"line 1 holds {len(first.split())}, " if first and len(first.split()) != 3 else ""
+    with pytest.warns(vio.ReadWarning, match=rf"^{path}: {80 - len(kept)} of 80 rows do not hold the 3 fields most of "
+                                             rf"its rows hold \({first_odd}line 3 holds 4, line 6 holds 4, "):
+        mesh = vio.read(path, isolate=False)
+    assert mesh.points.tolist() == [[float(v) for v in row.split()] for row in kept]

@@ -32,6 +32,7 @@ COORDINATE_NAMES = ({"x", "points:0", "coordsx", "coordinatex", "posx", "positio
                     {"z", "points:2", "coordsz", "coordinatez", "posz", "positionz"})
 SAMPLE_ROWS = 200
 HEAD_SNIFF = 4096  # the bytes the registry gives a sniffer
+TABLE_ROWS = 8     # rows of one width that make a table even beside a large minority of odd ones (is_point_text)
 
 
 def _separator(line: str) -> str | None:
@@ -181,10 +182,12 @@ def _headerless_names(lines: list[str], at: int, sep: str | None, n: int) -> lis
 
 def is_point_text(head: bytes) -> bool:
     """Text whose first rows (after ``#`` comments and a lone point count) hold numbers, the same number of them
-    (3 or more) in at least three rows of four: a header-less point table (.xyz, .pts, .txt), or one whose header row
-    names x and y columns. A minority of damaged rows (a first row with a flipped bit, a field lost) leaves it a
-    table, so the table's reader names them, not the reader of another format sharing the name (issue #32); a
-    binary file's "rows" are not numbers."""
+    (3 or more) in at least three rows of four, or in more than half of them when that is ``TABLE_ROWS`` rows or
+    more: a header-less point table (.xyz, .pts, .txt), or one whose header row names x and y columns. A minority of
+    damaged rows (a first row with a flipped bit, a field lost, a third of the rows with a field more) leaves it a
+    table, so the table's reader names them, not the reader of another format sharing the name (issue #32: a .xyz
+    with a third of its rows odd went to AVS UCD or PLOT3D). A few rows need three of four (an AVS UCD header line
+    and two nodes is not a table); a binary file's "rows" are not numbers."""
     lines = head.decode("utf-8", errors="replace").splitlines()
     rows = _rows(lines[:-1] if len(head) >= HEAD_SNIFF else lines)[:20]  # the last line may be cut
     if len(rows) > 1 and _count_line(rows, 0):
@@ -198,7 +201,8 @@ def is_point_text(head: bytes) -> bool:
     shapes = [len(f) if all(_number(v) for v in f) and "\0" not in row else 0
               for row, f in ((row, _fields(row, sep)) for row in rows)]
     width = max(set(shapes), key=shapes.count)
-    return width >= 3 and 4 * shapes.count(width) >= 3 * len(shapes)
+    n = shapes.count(width)
+    return width >= 3 and (4 * n >= 3 * len(shapes) or (2 * n > len(shapes) and n >= TABLE_ROWS))
 
 
 def read_csv_points(path: PathLike, x: str | None = None, y: str | None = None, z: str | None = None,

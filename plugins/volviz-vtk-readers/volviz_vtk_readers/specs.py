@@ -11,6 +11,7 @@ from typing import Any
 from volviz.io._checks import is_hdf5
 from volviz.io.registry import ReaderSpec
 
+from volviz_vtk_readers.avscheck import NODES_PER_CELL
 from volviz_vtk_readers.containers import is_cgns, is_netcdf
 from volviz_vtk_readers.xdmf import is_xdmf
 
@@ -33,14 +34,64 @@ def is_tecplot(head: bytes) -> bool:
 
 
 def is_avs_ucd(head: bytes) -> bool:
-    """AVS UCD: binary files start with byte 7; ASCII ones with a line of counts after their # comments (five;
-    two to four in a header line cut short, which the AVS UCD check then refuses by name: issue #32, it went to the
-    other reader of ``.inp``, meshio's Abaqus reader, whose files start with ``*`` keywords). A single number is not
-    taken: other formats start so (an SLC file's magic number, a PLOT3D block count)."""
+    """AVS UCD: binary files start with byte 7; ASCII ones with a line of counts after their # comments
+    (``nodes cells node_values cell_values model_values``; two to four in a header line cut short, which the AVS UCD
+    check then refuses by name: issue #32, it went to meshio's Abaqus reader, the other reader of ``.inp``) followed
+    by the lines those counts make (``avs_body_fits``). A single number is not taken: other formats start so (an SLC
+    file's magic number, a PLOT3D block count). Nor is a header-less point table whose first row is 2-5 whole
+    numbers: its rows are not the ``id x y z`` node lines the counts ask for (issue #32)."""
     if head[:1] == b"\x07":
         return True
     lines = _first_lines(head)
-    return bool(lines) and re.fullmatch(rb"(\d+\s+){1,4}\d+", lines[0]) is not None
+    if not lines or re.fullmatch(rb"(\d+\s+){1,4}\d+", lines[0]) is None:
+        return False
+    complete = lines if head.rstrip(b" \t").endswith((b"\n", b"\r")) else lines[:-1]  # the last may be cut
+    return avs_body_fits([int(t) for t in lines[0].split()], [ln.split() for ln in complete[1:AVS_SNIFF_LINES + 1]])
+
+
+AVS_SNIFF_LINES = 32   # lines after the header line the AVS UCD sniffer holds against the header's counts
+
+
+def _number(token: bytes) -> bool:
+    try:
+        float(token)
+    except ValueError:
+        return False
+    return True
+
+
+def _whole(tokens: list[bytes]) -> bool:
+    return bool(tokens) and all(t.isdigit() for t in tokens)
+
+
+def _avs_line_fits(kind: str, tokens: list[bytes]) -> bool:
+    """Whether a line's tokens are an AVS UCD node line (``id x y z``), cell line (``id material type nodes...``,
+    the type one of AVS's) or the first line of a data section (``components size1 ...``, whole numbers)."""
+    if kind == "node":
+        return len(tokens) == 4 and tokens[0].isdigit() and all(_number(t) for t in tokens[1:])
+    if kind == "cell":
+        return (len(tokens) >= 4 and _whole(tokens[:2]) and tokens[2].decode("latin-1").lower() in NODES_PER_CELL
+                and _whole(tokens[3:]))
+    return len(tokens) >= 2 and _whole(tokens)
+
+
+def avs_body_fits(counts: list[int], body: list[list[bytes]]) -> bool:
+    """Whether the lines after an AVS UCD header line are the ones its counts make: ``counts[0]`` node lines, then
+    ``counts[1]`` cell lines, then a data section's first line when the header counts values; at least three of
+    four of them, so a damaged line or count leaves the file AVS UCD for its check to name (issue #32), or any
+    line a cell line (a node or cell count damaged, the cells further on). A header with nothing after it (cut) is
+    taken. A header-less point table whose first row is whole numbers fails: its rows are 3 or more numbers, the
+    first one rarely whole, and hold no cell type."""
+    if not body:
+        return True
+    nodes, cells = counts[0], counts[1] if len(counts) > 1 else 0
+    kinds = ["node"] * min(nodes, len(body)) + ["cell"] * min(cells, len(body))
+    kinds += ["data"] if len(counts) == 5 and (counts[2] or counts[3]) else []
+    checked = list(zip(kinds, body))
+    fits = sum(_avs_line_fits(kind, tokens) for kind, tokens in checked)
+    if checked and 4 * fits >= 3 * len(checked):
+        return True
+    return any(_avs_line_fits("cell", tokens) for tokens in body)
 
 
 def is_fluent(head: bytes) -> bool:
