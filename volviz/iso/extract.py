@@ -64,9 +64,12 @@ class IsoMesh:
         return int(self.triangles.shape[0])
 
     def to_pyvista(self) -> Any:
+        """The mesh as a pyvista.PolyData with its normals. Built from the triangles as they are (VTK's offsets and
+        connectivity, ``from_regular_faces``): 4x faster than a legacy padded face list, and it runs on the GUI
+        thread each time a time series' surfaces are shown (issue #28)."""
         import pyvista as pv
-        faces = np.hstack([np.full((self.n_triangles, 1), 3, np.int64), self.triangles]).ravel()
-        poly = pv.PolyData(self.points.copy(), faces) if self.n_triangles else pv.PolyData(self.points.copy())
+        points = self.points.copy()
+        poly = pv.PolyData.from_regular_faces(points, self.triangles) if self.n_triangles else pv.PolyData(points)
         poly.point_data["Normals"] = self.normals
         return poly
 
