@@ -90,8 +90,14 @@ def parse_capabilities(text: str) -> GLInfo:
 
 
 def gl_info(render_window: vtkRenderWindow) -> GLInfo:
-    """The OpenGL driver of a VTK render window (its context is made by one render when it has none yet)."""
+    """The OpenGL driver of a VTK render window. One without a context yet gets one: an offscreen window by
+    ``Initialize()``, which makes the context without drawing the scene (issue #30: the render it replaces drew the
+    whole scene once more before the first image, 0.47 s of CPU for a 1024x768 sphere on llvmpipe against 0.01 s);
+    an on-screen one, whose context its toolkit makes, by one render."""
     text = render_window.ReportCapabilities()
+    if "renderer string" not in text and render_window.GetOffScreenRendering():
+        render_window.Initialize()
+        text = render_window.ReportCapabilities()
     if "renderer string" not in text:
         render_window.Render()
         text = render_window.ReportCapabilities()
