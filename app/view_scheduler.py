@@ -1,42 +1,64 @@
-"""The view scheduler of the main window (a mixin of ``MainWindow``): the background refreshes of the views that depend
-on the camera, the session's edits (``views_follow``: a transfer function, visibility, opacity, clipping, the
-isosurfaces' mode, however the edit was made), the viewport's size or the display time.
+"""The view scheduler of the main window: the background refreshes of the views that depend on the camera, the
+session's edits (``views_follow``: a transfer function, visibility, opacity, clipping, the isosurfaces' mode, however
+the edit was made) or the viewport's size.
 
 Every view that re-makes something for a camera (``SceneController.camera_views``: the natural scene, volumes at a
 level of detail, PT volumes on either backend, the isosurfaces' CPU overlay) is refreshed through one path over the
 view calls of ``volviz.render.views`` (``refresh_views``: ``begin`` on this thread, ``compute`` on a worker,
 ``finish`` here), one job in flight per view and the newest request next (``volviz.jobs.OneInFlight``), so that every
 finished update is shown while requests keep coming. While the camera moves the images are previews
-(``MOVING_SCALE``), the full-size images follow its end (``_camera_moved``); a view that asks for it
+(``MOVING_SCALE``), the full-size images follow its end (``camera_moved``); a view that asks for it
 (``coarse_first``: the LOD volumes' block selection) first shows a coarse update. A new scene's first views end its
-loading (``_show_first_views``). After a CPU PT render the error is measured against the exact reference and the
-error budget applied (``volviz.render.error_budget``). The blended volumes and re-extracted isosurfaces of time
-series follow the display time (``refresh_time_volumes``, ``refresh_time_isosurfaces``).
+loading (``show_first_views``). After a CPU PT render the error is measured against the exact reference and the
+error budget applied (``volviz.render.error_budget``). (The display time's blends and isosurfaces:
+``volviz_app.time_views``.)
 
-It expects of the window: ``controller`` (a ``SceneController`` or None), ``plotter``, ``jobs`` (a ``JobBridge``),
-``session``, ``render_scene()``, ``show_statistics()``, ``show_error(title, text)``, ``status_label``,
-``render_settings`` and ``_settings_changed(values)`` (the budget's switch of table), ``timeline``, ``nonfinite``,
-``collector``, ``_set_busy(busy)``, ``_load_serial`` and ``_loading_views``. ``_init_view_scheduler()`` makes its
-state and ``_connect_view_scheduler()`` its timers and the viewport's interaction observers (both called by the
-window's ``__init__``)."""
+Held by the window as ``window.view_scheduler`` (issue #31: a part with its own state, not a mixin). Its collaborators
+are the shown scene (``shown_scene.ShownScene``: the controller and session of the moment), the parent of its
+timers, the plotter, the window's ``jobs``, the status label, the render settings dock (the budget's switch of
+table), the stand-in frame (dropped when a new scene's first views are shown) and the window's ``collector``
+(interacting while the mouse moves the camera), and as callbacks ``render_scene()``, ``show_statistics()``,
+``show_error(title, text)``, ``set_busy(busy)``, ``settings_changed(values)`` (``volviz_app.scene_edits``: the
+budget's table applied), ``load_serial()`` (the newest open, ``volviz_app.scene_loading``) and
+``report_nonfinite(title)``. ``watch_viewport(fly)`` adds the viewport's interaction observers and the fly-mode
+settle timer once the window's fly mode exists."""
 from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any, Callable, Optional
 
-from PySide6.QtCore import QTimer
+from PySide6.QtCore import QObject, QTimer
+from PySide6.QtWidgets import QLabel
 
 from volviz.jobs import JobOutcome, OneInFlight
 from volviz.render.controller import SceneController, no_render
-from volviz.render.error_budget import MOST_ACCURATE_TABLE, error_budget_choice
-from .window_base import WindowBase
+from volviz.render.error_budget import error_budget_choice
+from .shown_scene import ShownScene
 
 if TYPE_CHECKING:
+    from pyvistaqt import QtInteractor
+
     from volviz.model.events import SceneChange
+    from .docks.render_settings import RenderSettingsDock
+    from .gc_guard import GuiThreadCollector
+    from .navigation import FlyMode
+    from .stand_in import StandInFrame
+    from .workers import JobBridge
 
 MOVING_SCALE = 2         # previews while the camera moves or a TF point is dragged: 1/2 x 1/2 of the window
 FLY_SCALE = 4            # previews while flying: 1/4 x 1/4 (a flight near the ground fills the window with fog)
 RESIZE_MS = 200          # overlays re-render once the viewport stopped resizing for 200 ms
 FLY_SETTLE_MS = 300      # fly mode: full-size images once no key moved the camera for 300 ms
+
+
+def interactive_rate(plotter: QtInteractor, on: bool) -> None:
+    """VTK's interactive update rate for the window (``on``; what its interactor styles set during a mouse drag) or its
+    still rate: during playback and flight, as during a drag, its ray casters cast fewer rays and the GPU PT pass fills
+    a reduced target (``GLPTVolume.set_interactive``)."""
+    ren_win = plotter.ren_win
+    if ren_win is None:   # the window has closed
+        return
+    iren = plotter.iren.interactor if hasattr(plotter.iren, "interactor") else plotter.iren
+    ren_win.SetDesiredUpdateRate(iren.GetDesiredUpdateRate() if on else iren.GetStillUpdateRate())
 
 
 def _shown(request: Any, result: Any) -> dict[str, Any]:
@@ -49,53 +71,78 @@ def _shown(request: Any, result: Any) -> dict[str, Any]:
     return kept
 
 
-class ViewScheduler(WindowBase):
+class ViewScheduler:
     """The window's background view refreshes (see the module's docstring)."""
 
-    def _init_view_scheduler(self) -> None:
-        self._view_jobs: dict[str, OneInFlight] = {}  # per camera view (by its key): its updates
+    def __init__(self, scene: ShownScene, parent: QObject, plotter: QtInteractor, jobs: JobBridge, status: QLabel,
+                 render_settings: RenderSettingsDock, stand_in: StandInFrame,
+                 collector: GuiThreadCollector, *, render_scene: Callable[[], None],
+                 show_statistics: Callable[[], None], show_error: Callable[[str, str], None],
+                 set_busy: Callable[[bool], None], settings_changed: Callable[[dict[str, Any]], None],
+                 load_serial: Callable[[], int], report_nonfinite: Callable[[str], None]) -> None:
+        self.scene, self.parent, self.plotter, self.jobs, self.status = scene, parent, plotter, jobs, status
+        self.render_settings, self.stand_in = render_settings, stand_in
+        self.collector = collector
+        self.render_scene, self.show_statistics, self.show_error = render_scene, show_statistics, show_error
+        self.set_busy, self.settings_changed, self.load_serial = set_busy, settings_changed, load_serial
+        self.report_nonfinite = report_nonfinite
+        self.fly: Optional[FlyMode] = None   # the window's fly mode (``watch_viewport``)
+        self.view_jobs: dict[str, OneInFlight] = {}  # per camera view (by its key): its updates
         self.view_updates: dict[str, int] = {}  # per camera view: the updates shown so far
         self.view_shown: dict[str, dict[str, Any]] = {}  # per camera view: the last shown update (``_shown``)
         self._moving_scheduled = False     # a refresh for the camera the mouse is moving is queued
-        self._iso_jobs = OneInFlight()     # isosurface extraction for the display time
-        self._volume_jobs = OneInFlight()  # blended volumes of time series for the display time
-        self.volume_time_shown = None      # (time, interpolated) of the shown volumes
-        self.iso_time_shown = None         # (time, interpolated) of the shown isosurfaces
-        self.error_estimate = None         # the last CPU PT error estimate, as the statistics dock shows it
-        self.last_error_rmse = None        # and its RMSE, which the error budget is checked against
+        self.error_estimate: Optional[str] = None   # the last CPU PT error estimate, as the statistics dock shows it
+        self.last_error_rmse: Optional[float] = None   # and its RMSE, which the error budget is checked against
+        self.loading_views = False         # the newest scene is installed, its first views are computed
 
-    def _connect_view_scheduler(self) -> None:
-        """The viewport's interaction observers, the fly-mode settle timer and the resize timer."""
+    @property
+    def controller(self) -> Optional[SceneController]:
+        """The shown scene's, read when needed: the window replaces it when it shows another scene."""
+        return self.scene.controller
+
+    def supersede(self) -> None:
+        """A newer scene is being shown: the shown scene's background work (error estimates...) would delay it."""
+        self.jobs.runner.cancel_all()
+        self.loading_views = False
+
+    def scene_installed(self) -> None:
+        """A new scene is shown: nothing of it has been measured yet."""
+        self.error_estimate = None
+        self.last_error_rmse = None
+
+    def watch_viewport(self, fly: FlyMode) -> None:
+        """The viewport's interaction observers, the fly-mode (``fly``) settle timer and the resize timer."""
+        self.fly = fly
         # fly mode has no end-of-interaction event: the camera has stopped once no key moved it for a while
-        self.fly_settle_timer = QTimer(self, singleShot=True, interval=FLY_SETTLE_MS)
-        self.fly_settle_timer.timeout.connect(self._fly_stopped)
+        self.fly_settle_timer = QTimer(self.parent, singleShot=True, interval=FLY_SETTLE_MS)
+        self.fly_settle_timer.timeout.connect(self.fly_stopped)
         self.plotter.iren.add_observer("StartInteractionEvent", lambda *args: setattr(self.collector, "interacting",
                                                                                       True))
         self.plotter.iren.add_observer("InteractionEvent", lambda *args: self._schedule_camera_moving())
 
         def interaction_ended(*args: Any) -> None:
             self.collector.interacting = False
-            QTimer.singleShot(0, self._camera_moved)
+            QTimer.singleShot(0, self.camera_moved)
 
         self.plotter.iren.add_observer("EndInteractionEvent", interaction_ended)
         # a resized viewport makes the overlay images (PT volumes, CPU-mode isosurfaces) the wrong size: redo them
-        self.resize_timer = QTimer(self, singleShot=True, interval=RESIZE_MS)
+        self.resize_timer = QTimer(self.parent, singleShot=True, interval=RESIZE_MS)
         self.resize_timer.timeout.connect(self._viewport_resized)
         self.plotter.iren.add_observer("ConfigureEvent", lambda *args: self.resize_timer.start())
 
-    def _show_first_views(self, controller: SceneController, serial: int, title: str) -> None:
+    def show_first_views(self, controller: SceneController, serial: int, title: str) -> None:
         """Compute the new scene's camera views in the background (natural scene, LOD blocks, PT volumes, the
         isosurfaces' CPU mode); the loading ends when all are shown (or failed, or were cancelled)."""
 
         def settled() -> None:
-            if serial == self._load_serial and self.controller is controller:
+            if serial == self.load_serial() and self.controller is controller:
                 self.stand_in.drop()   # the new scene's views are all shown: the old frame goes
-                self._loading_views = False
-                self._set_busy(False)
-                self.status_label.setText(f"Showing {title}")
-                self.nonfinite.report(title)  # NaN / Inf counts, once, when they arrive
+                self.loading_views = False
+                self.set_busy(False)
+                self.status.setText(f"Showing {title}")
+                self.report_nonfinite(title)  # NaN / Inf counts, once, when they arrive
 
-        self._loading_views = True
+        self.loading_views = True
         self.refresh_views(settled=settled)
 
     def estimate_error(self, comp_id: str, request: Optional[dict[str, Any]] = None) -> None:
@@ -114,25 +161,23 @@ class ViewScheduler(WindowBase):
                                        f"({e['size'][0]}x{e['size'][1]})")
                 self.last_error_rmse = e["rmse"]
                 self.render_scene()
-                self._enforce_error_budget(e["rmse"])
+                self.enforce_error_budget(e["rmse"])
 
         self.jobs.submit(volume.error_estimate, request, name="error estimate", key=f"error:{comp_id}",
                          on_done=done)
 
-    MOST_ACCURATE_TABLE = MOST_ACCURATE_TABLE
-
-    def _enforce_error_budget(self, rmse: float) -> None:
+    def enforce_error_budget(self, rmse: float) -> None:
         """Measured error above the budget: switch to the most accurate table once, or say that it cannot be met
         (``volviz.render.error_budget``)."""
-        choice = error_budget_choice(rmse, self.session.render.options)
+        choice = error_budget_choice(rmse, self.scene.session.render.options)
         if choice.message is not None:
-            self.status_label.setText(choice.message)
+            self.status.setText(choice.message)
         if choice.table is None:
             return
         values = self.render_settings.settings()
         values["options"].update(choice.table)
         self.render_settings.load_values(values)
-        self._settings_changed(values)
+        self.settings_changed(values)
 
     def schedule_render(self) -> None:
         """Draw once control returns to the event loop: a repaint of the viewport, which renders (Qt merges the
@@ -145,41 +190,44 @@ class ViewScheduler(WindowBase):
         event loop (one queued refresh however many motion events arrive before)."""
         if not self._moving_scheduled:
             self._moving_scheduled = True
-            QTimer.singleShot(0, self._camera_moving)
+            QTimer.singleShot(0, self.camera_moving)
 
-    def _camera_moving(self) -> None:
+    def camera_moving(self) -> None:
         """While the mouse moves the camera, the camera views follow it (``refresh_views`` with ``moving``): re-made
         in the background, one update of each in flight and the newest camera next (``OneInFlight``), so each shows
         every update it finishes. VTK draws its own props at once. Images are previews at 1 / ``MOVING_SCALE`` of the
         window's size in each direction (a quarter of the pixels, magnified smoothly); the full-size images, the
-        error estimate and the LOD re-selection follow at the end of the interaction (``_camera_moved``)."""
+        error estimate and the LOD re-selection follow at the end of the interaction (``camera_moved``)."""
         self._moving_scheduled = False
         if self.controller is not None:
             self.refresh_views(scale=MOVING_SCALE, estimate=False, moving=True)
 
-    def _fly_moved(self) -> None:
-        """A fly-mode step moved the camera: previews follow it as during a mouse drag (``_camera_moving``, at
+    def fly_moved(self) -> None:
+        """A fly-mode step moved the camera: previews follow it as during a mouse drag (``camera_moving``, at
         ``FLY_SCALE``), and the full-size images once the keys have stopped for ``FLY_SETTLE_MS``."""
         self._moving_scheduled = False
         if not self.fly_settle_timer.isActive():   # the flight starts: frames at the interactive rate until it stops
-            self._interactive_rate(True)
+            interactive_rate(self.plotter, True)
         if self.controller is not None:
             self.refresh_views(scale=FLY_SCALE, estimate=False, moving=True)
         self.fly_settle_timer.start()
 
-    def _fly_stopped(self) -> None:
+    def fly_stopped(self) -> None:
         """No fly-mode key moved the camera for ``FLY_SETTLE_MS``: the still rate again, and the full-size views;
         unless a movement key is still held (``FlyMode.held``: a long frame delayed its auto-repeat; a full-size
         frame then, with a synchronous render at the still rate, stalled the flight further). The flight's reduced
         frames (``FlyMode.frames``) go on until the views' full-size updates are shown, then the full-resolution
         frame: no synchronous full-size render of the flight's previews before them."""
-        if self.fly.held:
+        fly = self.fly
+        if fly is None:   # not reached: the settle timer is made with the fly mode (``watch_viewport``)
+            return
+        if fly.held:
             self.fly_settle_timer.start()
             return
-        self._interactive_rate(False)
-        self.refresh_views(settled=self.fly.frames.ending())
+        interactive_rate(self.plotter, False)
+        self.refresh_views(settled=fly.frames.ending())
 
-    def _camera_moved(self) -> None:
+    def camera_moved(self) -> None:
         """After the camera moved: draw, and refresh every camera view for the new camera (full size, with the error
         estimate)."""
         if self.controller is None:
@@ -200,11 +248,11 @@ class ViewScheduler(WindowBase):
 
     def views_follow(self, change: SceneChange) -> None:
         """The camera views follow an edit of the session once the controller's views hold it (the window hears it
-        through its one subscription, ``_scene_changed``). A transfer function: re-made in the background, while a
-        point is dragged as a preview (``MOVING_SCALE``), a finished edit at full size with a fresh error estimate
-        (VTK's own mappers draw it at once). Visibility, opacity, clipping: drawn, and the views refreshed except
-        those waiting for a cut made on the CPU (``controller.pending``, refreshed once their cut is shown) and those
-        of a component without a view yet (a natural-scene component or one being prepared: refreshed once
+        through ``volviz_app.scene_edits.SceneEdits.scene_changed``). A transfer function: re-made in the background,
+        while a point is dragged as a preview (``MOVING_SCALE``), a finished edit at full size with a fresh error
+        estimate (VTK's own mappers draw it at once). Visibility, opacity, clipping: drawn, and the views refreshed
+        except those waiting for a cut made on the CPU (``controller.pending``, refreshed once their cut is shown) and
+        those of a component without a view yet (a natural-scene component or one being prepared: refreshed once
         installed). The isosurfaces' mode, and a transfer function (the overlay splits a regular volume at the surfaces,
         ``volviz.render.iso_volume_split``): the CPU overlay re-rendered."""
         controller = self.controller
@@ -274,7 +322,7 @@ class ViewScheduler(WindowBase):
         controller = self.controller
         if controller is None:
             return
-        jobs = self._view_jobs.setdefault(key, OneInFlight())
+        jobs = self.view_jobs.setdefault(key, OneInFlight())
         what = view.job[1]
         comp_id = key.split(":", 1)[-1]
 
@@ -311,94 +359,3 @@ class ViewScheduler(WindowBase):
         if scale == 1 and getattr(view, "coarse_first", False):
             jobs.request(step(2))
         jobs.request(step(scale), settled)
-
-    def _time_changed(self, t: float) -> None:
-        if self.controller is not None and self.controller.time_series():
-            self._show_time(t, None)
-
-    def _playing_changed(self, playing: bool) -> None:
-        """During playback VTK draws at its interactive rate, as while the mouse moves the camera (its ray casters
-        then cast fewer rays); at the pause the still rate, and one full-quality frame."""
-        if self.plotter.ren_win is None:  # the window has closed
-            return
-        self._interactive_rate(playing)
-        if not playing:
-            self.schedule_render()
-
-    def _interactive_rate(self, on: bool) -> None:
-        """VTK's interactive update rate for the window (``on``; what its interactor styles set during a mouse drag)
-        or its still rate: during playback and flight, as during a drag, its ray casters cast fewer rays and the GPU
-        PT pass fills a reduced target (``GLPTVolume.set_interactive``)."""
-        ren_win = self.plotter.ren_win
-        if ren_win is None:   # the window has closed
-            return
-        iren = self.plotter.iren.interactor if hasattr(self.plotter.iren, "interactor") else self.plotter.iren
-        ren_win.SetDesiredUpdateRate(iren.GetDesiredUpdateRate() if on else iren.GetStillUpdateRate())
-
-    def _interpolation_toggled(self, on: bool) -> None:
-        if self.controller is not None:
-            self._show_time(self.timeline.time, on)
-
-    def _show_time(self, t: float, interpolate: Optional[bool]) -> None:
-        controller = self.controller
-        if controller is None:
-            return
-        controller.set_time(t, interpolate=interpolate, update=False, isosurfaces=False, volumes=False)
-        self.refresh_time_volumes()
-        self.refresh_time_isosurfaces()
-
-    def refresh_time_volumes(self) -> None:
-        """Blend the volumes of time series for the display time in the background (one blend in flight, the
-        newest display time next: ``OneInFlight``), then give them to VTK on this thread and draw once."""
-
-        def shown(controller: Any, result: dict[str, Any], key: tuple[float, bool]) -> None:
-            controller.show_volumes(result)
-            self.volume_time_shown = key
-
-        self._time_job(self._volume_jobs, "time blend", "Cannot show the volume at this time",
-                       lambda c: c.time_volumes(), lambda c: c.blend_volume, shown)
-
-    def _time_job(self, jobs: OneInFlight, name: str, error: str, comp_ids: Callable[[Any], list[str]],
-                  compute: Callable[[Any], Callable[..., Any]], shown: Callable[[Any, Any, tuple], None]) -> None:
-        """For the display time: ``compute(controller)(comp_id, t, interpolate, progress=...)`` for every component
-        of ``comp_ids(controller)`` on a worker (``OneInFlight``: playback never waits), then
-        ``shown(controller, results, (t, interpolate))`` on this thread and one repaint."""
-        controller = self.controller
-        if controller is None or not comp_ids(controller):
-            return
-        t, interpolate = controller.time, controller.interpolate_time
-
-        def start(next_request: Callable[[], None]) -> None:
-            ids = comp_ids(controller) if self.controller is controller else []
-            if not ids:
-                next_request()
-                return
-            fn = compute(controller)
-
-            def run(progress: Any = None) -> dict[str, Any]:
-                return {comp_id: fn(comp_id, t, interpolate, progress=progress) for comp_id in ids}
-
-            def done(outcome: JobOutcome) -> None:
-                if outcome.ok and self.controller is controller:
-                    shown(controller, outcome.result, (t, interpolate))
-                    self.schedule_render()
-                elif outcome.error is not None:
-                    self.show_error(error, str(outcome.error))
-                next_request()
-
-            self.jobs.submit(run, name=name, on_done=done)
-
-        jobs.request(start)
-
-    def refresh_time_isosurfaces(self) -> None:
-        """Re-extract the isosurfaces of time series for the display time in the background (issue #8: playback
-        never waits for the extraction; ``OneInFlight``), with their clipping and LOD chains, then replace their
-        actors on this thread."""
-
-        def shown(controller: Any, result: dict[str, Any], key: tuple[float, bool]) -> None:
-            controller.show_isosurfaces(result)
-            self.iso_time_shown = key
-            self.refresh_iso_overlay()
-
-        self._time_job(self._iso_jobs, "isosurfaces", "Cannot extract the isosurfaces",
-                       lambda c: c.time_isosurfaces(), lambda c: c.isosurface_parts, shown)

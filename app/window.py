@@ -10,12 +10,13 @@ scene, typed by ``shown_scene.ShownScene``, widgets, callbacks) when they are ma
   (``scene_loading.SceneLoading``; the window's side of a new scene is ``_scene_installed``);
 - ``scene_edits``: what the docks' edits do to the shown scene (TF, visibility, opacity, settings, clipping, render
   settings; ``scene_edits.SceneEdits``);
+- ``view_scheduler``: the background refreshes of the views (one job in flight per view), the error estimate and
+  budget (``view_scheduler.ViewScheduler``);
+- ``time_views``: the timeline's display time shown, volumes blended and isosurfaces re-extracted in the background
+  (``time_views.TimeViews``);
 
-and is put together from one mixin per responsibility for the rest, each in its own module:
-
-- ``window_widgets.WindowWidgets``: the docks, menus and actions, the status bar with progress and cancel;
-- ``view_scheduler.ViewScheduler``: the background refreshes of the views (one job in flight per kind), the error
-  estimate and budget.
+and is put together from one mixin for the rest, ``window_widgets.WindowWidgets``: the docks, menus and actions, the
+status bar with progress and cancel.
 
 This module sets the window's shared state (``session``, ``controller``, ``jobs``, ``plotter``..., typed in
 ``window_base.WindowBase``), and holds its construction, ``render_scene``, fly mode, ``show_error``, closing, and
@@ -47,6 +48,7 @@ from .recent import RecentFiles
 from .scene_edits import SceneEdits
 from .scene_loading import SceneLoading
 from .session_files import SessionFiles, default_recovery_dir
+from .time_views import TimeViews
 from .view_scheduler import ViewScheduler
 from .window_widgets import WindowWidgets
 from .workers import JobBridge
@@ -80,7 +82,7 @@ def _import_gui_thread_modules() -> None:
     pyvista.system_supports_plotting()
 
 
-class MainWindow(ViewScheduler, WindowWidgets, QMainWindow):
+class MainWindow(WindowWidgets, QMainWindow):
     """volviz main window. ``open_path`` is the single code path behind File > Open and the command line."""
 
     def __init__(self, parent: Optional[QWidget] = None, settings: Optional[QSettings] = None,
@@ -103,56 +105,56 @@ class MainWindow(ViewScheduler, WindowWidgets, QMainWindow):
         self.error_dialog = None
         self.dirty = False
         self.last_stats = {}
-        self._loading_views = False        # the newest scene is installed, its first views are computed
-        self._init_view_scheduler()        # its OneInFlight jobs and what they have shown
 
         self._build_docks()
         self._build_status_bar()
-        self.camera_bookmarks = CameraBookmarks(self, self, self.status_label, self.set_dirty, self._camera_moved)
+        self.nonfinite = NonFiniteStatus(self)  # the status bar's note on non-finite values
+        self.stand_in = StandInFrame(self.plotter)   # the last frame over the viewport while its scene is rebuilt
+        views = self.view_scheduler = ViewScheduler(
+            self, self, self.plotter, self.jobs, self.status_label, self.render_settings, self.stand_in, self.collector,
+            render_scene=self.render_scene, show_statistics=self.show_statistics, show_error=self.show_error,
+            set_busy=self._set_busy, settings_changed=self._settings_changed,
+            load_serial=lambda: self.scene_loading.serial, report_nonfinite=self.nonfinite.report)
+        self.time_views = TimeViews(self, self.plotter, self.jobs, self.timeline, show_error=self.show_error,
+                                    schedule_render=views.schedule_render,
+                                    refresh_iso_overlay=views.refresh_iso_overlay)
+        self.camera_bookmarks = CameraBookmarks(self, self, self.status_label, self.set_dirty, views.camera_moved)
         self.export_runs = ExportRuns(self, self.jobs, self.plotter, self.status_label, self._set_busy,
                                       self._busy_elsewhere, self.show_error)
         self.recent_menu = QMenu("Open &Recent", self)   # File > Open Recent
         self.recent = RecentFiles(self.settings, self.recent_menu, self.open_path_asking)
-        self.stand_in = StandInFrame(self.plotter)   # the last frame over the viewport while its scene is rebuilt
         loading = self.scene_loading = SceneLoading(
             self, self, self.plotter, self.jobs, self.settings, self.recent, self.stand_in, self.status_label,
-            set_busy=self._set_busy, show_error=self.show_error, supersede=self._supersede_views,
-            installed=self._scene_installed, first_render=self.render_scene, first_views=self._show_first_views)
+            set_busy=self._set_busy, show_error=self.show_error, supersede=views.supersede,
+            installed=self._scene_installed, first_render=self.render_scene, first_views=views.show_first_views)
         self.session_files = SessionFiles(self, self, Path(recovery_dir) if recovery_dir else default_recovery_dir(),
                                           self.recent, self.status_label, loading.open_path, loading.open_paths,
                                           loading.show_session, self.show_error)   # its autosave timer runs from now
         self._build_menus()
-        self.scene_edits = SceneEdits(self, self, self, self.jobs, self.status_label, self.tf_editor, self.scene_tree,
+        self.scene_edits = SceneEdits(self, self, views, self.jobs, self.status_label, self.tf_editor, self.scene_tree,
                                       self.array_choice, render_scene=self.render_scene, set_dirty=self.set_dirty,
                                       show_error=self.show_error, show_session=loading.show_session,
-                                      enforce_error_budget=self._enforce_error_budget)   # its TF preview timer
+                                      enforce_error_budget=views.enforce_error_budget)   # its TF preview timer
         self.resize(*self.layout_keeper.default_size())
         self.layout_keeper.restore()
-        self.fly = FlyMode(self.plotter, on_camera_moved=self._fly_moved)
+        self.fly = FlyMode(self.plotter, on_camera_moved=views.fly_moved)
         self.single_render = SingleRenderDuringInteraction(self.plotter)  # one render per move of a drag
         self.clip_widget = ClipPlaneWidget(self.plotter, self.clipping)
-        self._connect_view_scheduler()  # interaction observers, fly-mode settle and resize timers
-        self.nonfinite = NonFiniteStatus(self)  # the status bar's note on non-finite values
+        views.watch_viewport(self.fly)  # interaction observers, fly-mode settle and resize timers
         self.collector.freeze_long_lived()
 
     # ------------------------------------------------------------------------------------------------ a new scene
-    def _supersede_views(self) -> None:
-        """A newer scene is being shown: the shown scene's background work (error estimates...) would delay it."""
-        self.jobs.runner.cancel_all()
-        self._loading_views = False
-
     def _scene_installed(self, controller: SceneController, title: str, dirty: bool, new_data: bool) -> None:
         """``scene_loading`` installed ``controller``'s scene as the shown one: the window follows its state, the
         docks and the bookmark menu show it, the views' state starts afresh. ``new_data``: another file or scene,
         whose settings edits are not undone on the new one."""
         controller.changes.subscribe(self.scene_edits.scene_changed)   # the window follows the scene from now on
         self._fill_docks(controller)
-        self.volume_time_shown = self.iso_time_shown = None
+        self.view_scheduler.scene_installed()
+        self.time_views.scene_installed()
         self.scene_edits.scene_installed()
         self.camera_bookmarks.refresh_menu()
         self.title = title
-        self.error_estimate = None
-        self.last_error_rmse = None
         self.set_dirty(dirty)
         if new_data:
             self.scene_undo_stack.clear()
@@ -179,7 +181,7 @@ class MainWindow(ViewScheduler, WindowWidgets, QMainWindow):
                          project_seconds=sum(s.get("project_s", 0.0) for s in last),
                          raster_seconds=sum(s.get("raster_s", 0.0) for s in last),
                          method=", ".join(sorted({str(s.get("method")) for s in last})),
-                         error=getattr(self, "error_estimate", None), backends=self.controller.pt_backends())
+                         error=self.view_scheduler.error_estimate, backends=self.controller.pt_backends())
         iso = self.controller.iso_stats() if self.controller is not None else {}
         if iso:
             stats["iso"] = iso_summary(iso)
@@ -214,7 +216,7 @@ class MainWindow(ViewScheduler, WindowWidgets, QMainWindow):
     def reset_camera(self) -> None:
         if self.controller is not None:
             self.controller.set_camera(None, update=False)
-            self._camera_moved()
+            self.view_scheduler.camera_moved()
 
     # ------------------------------------------------------------------------------------------------ forwarders
     # what tests and other modules call or read on the window, kept while they move to its parts
@@ -232,6 +234,20 @@ class MainWindow(ViewScheduler, WindowWidgets, QMainWindow):
     histograms_computed = PartAttribute("scene_edits")
     histogram_threads = PartAttribute("scene_edits")
     nature_rebuilds = PartAttribute("scene_edits")
+    _view_jobs = PartAttribute("view_scheduler", "view_jobs")
+    view_updates = PartAttribute("view_scheduler")
+    view_shown = PartAttribute("view_scheduler")
+    volume_time_shown = PartAttribute("time_views")
+    iso_time_shown = PartAttribute("time_views")
+
+    def schedule_render(self) -> None:
+        self.view_scheduler.schedule_render()
+
+    def _camera_moving(self) -> None:
+        self.view_scheduler.camera_moving()
+
+    def _camera_moved(self) -> None:
+        self.view_scheduler.camera_moved()
 
     def add_bookmark(self, name: str) -> None:
         self.camera_bookmarks.add_bookmark(name)

@@ -1,7 +1,6 @@
 """The typed view that ``MainWindow``'s mixins have of the window they are mixed into.
 
-Each mixin (``view_scheduler.ViewScheduler``, ``window_widgets.WindowWidgets``) derives from ``WindowBase``, which
-declares, once and with their types:
+The mixin (``window_widgets.WindowWidgets``) derives from ``WindowBase``, which declares, once and with their types:
 
 - the window's shared state: what more than one part of the window reads or writes (``session``, ``controller``,
   ``jobs``, ``plotter``, the docks, ``status_label``...), whichever of ``MainWindow.__init__`` or a mixin sets it;
@@ -30,7 +29,6 @@ if TYPE_CHECKING:
     from pyvistaqt import QtInteractor
 
     from volviz.model.clip import ClipSettings
-    from volviz.model.events import SceneChange
     from volviz.render.controller import SceneController
     from volviz.session import Session
     from .array_choice import ArrayChoice
@@ -39,6 +37,7 @@ if TYPE_CHECKING:
     from .scene_edits import SceneEdits
     from .scene_loading import SceneLoading
     from .session_files import SessionFiles
+    from .view_scheduler import ViewScheduler
     from .stand_in import StandInFrame
     from .decoration_toggles import DecorationToggles
     from .docks.clipping import ClippingDock
@@ -81,13 +80,6 @@ class WindowBase(_QtWindow):
     controller: Optional[SceneController]
     title: str                         # what the window title names when there is no session file
     dirty: bool
-    # -- the first views of a new scene are computed (ViewScheduler; reset by MainWindow when a newer one loads)
-    _loading_views: bool
-    # -- the shown views (ViewScheduler, reset by MainWindow._scene_installed for a new scene)
-    volume_time_shown: Optional[tuple[float, bool]]
-    iso_time_shown: Optional[tuple[float, bool]]
-    error_estimate: Optional[str]
-    last_error_rmse: Optional[float]
     # -- widgets (WindowWidgets)
     tf_editor: TransferFunctionEditor
     scene_tree: SceneTree
@@ -106,6 +98,7 @@ class WindowBase(_QtWindow):
     session_files: SessionFiles        # (window.py)
     scene_loading: SceneLoading        # (window.py)
     scene_edits: SceneEdits            # (window.py)
+    view_scheduler: ViewScheduler      # (window.py)
     recent_menu: QMenu                 # (window.py)
     action_fly: QAction
     fly: FlyMode                       # (window.py)
@@ -130,20 +123,6 @@ class WindowBase(_QtWindow):
 
         # -- forwarded by MainWindow to session_files
         def set_dirty(self, dirty: bool = True) -> None: ...
-
-        # -- ViewScheduler
-        def schedule_render(self) -> None: ...
-        def refresh_views(self, keys: Optional[list[str]] = None, settled: Optional[Callable[[], None]] = None,
-                          scale: int = 1, estimate: bool = True, moving: bool = False) -> int: ...
-        def refresh_nature(self, settled: Optional[Callable[[], None]] = None, scale: int = 1) -> None: ...
-        def refresh_iso_overlay(self, settled: Optional[Callable[[], None]] = None, scale: int = 1) -> None: ...
-        def views_follow(self, change: SceneChange) -> None: ...
-        def _show_first_views(self, controller: SceneController, serial: int, title: str) -> None: ...
-        def _enforce_error_budget(self, rmse: float) -> None: ...
-        def _camera_moved(self) -> None: ...
-        def _time_changed(self, t: float) -> None: ...
-        def _playing_changed(self, playing: bool) -> None: ...
-        def _interpolation_toggled(self, on: bool) -> None: ...
 
         # -- forwarded by MainWindow to scene_edits (the docks' signals, the error budget's switch of table)
         def set_clip(self, clip: ClipSettings | dict[str, Any]) -> None: ...

@@ -1,19 +1,19 @@
-"""The main window's widgets (a mixin of ``MainWindow``): the docks (transfer function, scene tree, render
-settings, timeline, statistics, clipping) with their signals connected to the window's handlers
-(``volviz_app.scene_edits``, ``volviz_app.view_scheduler``), the menus and their actions (File, Edit with undo and
-redo over the TF, clipping and scene stacks, View, Camera, Help), and the status bar with its progress bar and
-Cancel button: ``_set_busy`` shows them while a scene loads, its first views are computed or an export runs, and
-``cancel_current_job`` stops the export first, else the loading, else the first views.
+"""The main window's widgets (a mixin of ``MainWindow``): the docks (transfer function, scene tree, render settings,
+timeline, statistics, clipping) with their signals connected to the window's handlers (``volviz_app.scene_edits``; the
+timeline's are connected by ``volviz_app.view_scheduler``), the menus and their actions (File, Edit with undo and redo
+over the TF, clipping and scene stacks, View, Camera, Help), and the status bar with its progress bar and Cancel button:
+``_set_busy`` shows them while a scene loads, its first views are computed or an export runs, and ``cancel_current_job``
+stops the export first, else the loading, else the first views.
 
-It makes the docks (``tf_editor``, ``scene_tree``, ``render_settings``, ``timeline``, ``statistics``,
-``clipping`` and their ``*_dock``), ``layout_keeper``, the undo group, ``array_choice``, ``export_dialogs``,
-``decorations``, ``python_console`` (stopped by ``closeEvent``), ``help``, ``file_drop``, the actions,
-``status_label``, ``progress_bar`` and ``cancel_button``. It expects of the window: ``settings``, ``plotter``,
-``jobs``, ``scene_loading``, ``_loading_views``, ``export_runs``, the handlers its docks and actions call
-(``open_path``, ``set_fly_mode``, ``reset_camera``, ``set_clip``...), ``session_files`` (the File menu's open and
-save entries, ``recent_menu``), and ``camera_bookmarks``, which adds the Camera menu's entries. ``_build_docks()``
-and ``_build_status_bar()`` are called by the window's ``__init__`` before its parts are made, ``_build_menus()``
-after."""
+It makes the docks (``tf_editor``, ``scene_tree``,
+``render_settings``, ``timeline``, ``statistics``, ``clipping`` and their ``*_dock``), ``layout_keeper``, the undo
+group, ``array_choice``, ``export_dialogs``, ``decorations``, ``python_console`` (stopped by ``closeEvent``), ``help``,
+``file_drop``, the actions, ``status_label``, ``progress_bar`` and ``cancel_button``. It expects of the window:
+``settings``, ``plotter``, ``jobs``, ``scene_loading``, ``view_scheduler`` (its ``loading_views``), ``export_runs``, the
+handlers its docks and actions call (``open_path``, ``set_fly_mode``, ``reset_camera``, ``set_clip``...),
+``session_files`` (the File menu's open and save entries, ``recent_menu``), and ``camera_bookmarks``, which adds the
+Camera menu's entries. ``_build_docks()`` and ``_build_status_bar()`` are called by the window's ``__init__`` before its
+parts are made, ``_build_menus()`` after."""
 from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
@@ -110,9 +110,6 @@ class WindowWidgets(WindowBase):
         self.scene_tree.settingsEdited.connect(lambda comp_id, before, after: edit_settings(
             self, self.scene_undo_stack, comp_id, before, after))
         self.render_settings.changed.connect(self._settings_changed)
-        self.timeline.timeChanged.connect(self._time_changed)
-        self.timeline.interpolationToggled.connect(self._interpolation_toggled)
-        self.timeline.play_button.toggled.connect(self._playing_changed)
         self.clipping.changed.connect(self.set_clip)
 
     def _build_menus(self) -> None:
@@ -223,12 +220,12 @@ class WindowWidgets(WindowBase):
 
     def _busy_elsewhere(self) -> bool:
         """A job other than an export still shows progress (a scene loading, its first views)."""
-        return self.scene_loading.loading() or self._loading_views
+        return self.scene_loading.loading() or self.view_scheduler.loading_views
 
     def cancel_current_job(self) -> None:
         if self.export_runs.running:  # an export runs alongside whatever else: the button stops it first
             self.export_runs.cancel()
         elif self.scene_loading.loading() and self.scene_loading.current_job is not None:
             self.scene_loading.current_job.cancel()
-        elif self._loading_views:  # the scene is shown; stop computing its first views
+        elif self.view_scheduler.loading_views:  # the scene is shown; stop computing its first views
             self.jobs.runner.cancel_all()
