@@ -154,22 +154,23 @@ def test_a_transfer_function_showing_half_of_the_values_shows_half_of_the_object
 
 
 def test_a_legibility_only_run_keeps_each_rows_time_and_measures_the_rest(tmp_path):
-    """``--legibility-only`` (a busy machine): the time, drawn share and note come from the report's rows, read by
-    its header's column names; the legibility columns are measured; a row's old legibility error is measured
+    """``--legibility-only`` (a busy machine): the time, CPU time, drawn share and note come from the report's rows,
+    read by its header's column names; the legibility columns are measured; a row's old legibility error is measured
     again, a render's error is kept (that file is not measured)."""
     doc = tmp_path / "first-open.md"
-    rows = [bench.FirstImage("ball.vti", 3.6, 4.2, 0.31, "volume", 0.9, 0.8, 50.0, "legibility: ValueError: x"),
+    rows = [bench.FirstImage("ball.vti", 3.6, 4.2, 0.31, "volume", 0.9, 0.8, 50.0, "legibility: ValueError: x", 2.75),
             bench.FirstImage("bad.vti", 0.0, note="bad.vti: cannot be read")]
     bench.write_section(bench.markdown(rows, {}), doc)
     kept = bench.kept_timings(doc)
-    assert kept == {"ball.vti": (4.2, 0.31, ""), "bad.vti": (None, None, "bad.vti: cannot be read")}
+    assert kept == {"ball.vti": (4.2, 2.75, 0.31, ""), "bad.vti": (None, None, None, "bad.vti: cannot be read")}
 
     data = tmp_path / "data"
     data.mkdir()
     _write_sphere(data / "ball.vti", np.full((97, 97, 97), 200.0))
     (data / "bad.vti").write_text("not a VTK file")
     bad, ball = bench.measure(data, timings=kept)           # in name order
-    assert (ball.name, ball.seconds, ball.drawn, ball.note, ball.kind) == ("ball.vti", 4.2, 0.31, "", "volume")
+    assert (ball.name, ball.seconds, ball.cpu, ball.drawn, ball.note, ball.kind) == ("ball.vti", 4.2, 2.75, 0.31, "",
+                                                                                     "volume")
     assert ball.visible is not None and ball.object_visible is not None and ball.contrast is not None
     assert ball.visible < ball.object_visible          # the sphere covers part of its box's footprint
     assert (bad.seconds, bad.drawn, bad.note, bad.kind, bad.visible) == (None, None, "bad.vti: cannot be read", "",

@@ -54,6 +54,8 @@ DRAWN_DIFFERENCE = 24          # summed |RGB| difference from the background of 
 TARGET_S = 5.0
 PROFILE_HEAD = "Where the time goes for the slowest files"
 MAX_MB = 100
+#: a file's kept measures (``kept_timings``): wall seconds, CPU seconds, drawn share, note
+Timing = tuple[Optional[float], Optional[float], Optional[float], str]
 
 
 def opened_files(root: Path) -> list[Path]:
@@ -159,17 +161,25 @@ class FirstImage:
     object_visible: Optional[float] = None
     contrast: Optional[float] = None
     note: str = ""
+    cpu: Optional[float] = None         # CPU seconds (user + system) of the render's process and its reader child
     profile: list[str] = field(default_factory=list)
 
 
-def render_timed(path: Path, out: Path) -> tuple[float, int, str]:
-    """Wall seconds, exit status and last stderr line of ``volviz render PATH -o OUT`` in a fresh process."""
-    start = time.perf_counter()
+def render_timed(path: Path, out: Path) -> tuple[float, float, int, str]:
+    """Wall seconds, CPU seconds (user + system of the process and the children it waited for), exit status and
+    last stderr line of ``volviz render PATH -o OUT`` in a fresh process."""
+    import resource
+
+    def cpu() -> float:
+        used = resource.getrusage(resource.RUSAGE_CHILDREN)
+        return used.ru_utime + used.ru_stime
+
+    start, cpu_start = time.perf_counter(), cpu()
     done = subprocess.run([str(Path(sys.executable).parent / "volviz"), "render", str(path), "-o", str(out), "--size",
                            f"{SIZE[0]}x{SIZE[1]}"], capture_output=True, text=True, timeout=600)
-    seconds = time.perf_counter() - start
+    seconds, cpu_seconds = time.perf_counter() - start, cpu() - cpu_start
     lines = [line for line in done.stderr.splitlines() if line.strip()]
-    return seconds, done.returncode, lines[-1] if lines else ""
+    return seconds, cpu_seconds, done.returncode, lines[-1] if lines else ""
 
 
 @dataclass
@@ -312,10 +322,11 @@ def where_time_goes(path: Path, top: int = 6) -> list[str]:
 
 
 def measure(root: Path, names: Optional[list[str]] = None, boundary_rule: bool = False,
-            timings: Optional[dict[str, tuple[Optional[float], Optional[float], str]]] = None) -> list[FirstImage]:
+            timings: Optional[dict[str, Timing]] = None) -> list[FirstImage]:
     """Every file of ``opened_files`` (or those named in ``names``, relative to ``root``) measured; legibility with
-    the boundary rule where ``boundary_rule``; with ``timings`` (``kept_timings``: file -> seconds, drawn share,
-    note) each file's time, drawn share and note are taken from there instead of rendering it (legibility only)."""
+    the boundary rule where ``boundary_rule``; with ``timings`` (``kept_timings``: file -> seconds, CPU seconds,
+    drawn share, note) each file's times, drawn share and note are taken from there instead of rendering it
+    (legibility only)."""
     records = []
     with tempfile.TemporaryDirectory() as work:
         for path in opened_files(root):
@@ -326,14 +337,14 @@ def measure(root: Path, names: Optional[list[str]] = None, boundary_rule: bool =
                 path.stat().st_size
             record = FirstImage(name, size / 1e6)
             if timings is not None:
-                record.seconds, record.drawn, record.note = timings.get(name, (None, None, ""))
+                record.seconds, record.cpu, record.drawn, record.note = timings.get(name, (None, None, None, ""))
             elif record.megabytes < MAX_MB:
                 out = Path(work) / "x.png"
-                seconds, status, last = render_timed(path, out)
+                seconds, cpu_seconds, status, last = render_timed(path, out)
                 if status == 0:
                     from PIL import Image
 
-                    record.seconds = seconds
+                    record.seconds, record.cpu = seconds, cpu_seconds
                     record.drawn = drawn_fraction(np.asarray(Image.open(out).convert("RGB")))
                 else:
                     record.note = last.removeprefix("volviz: error: ")
@@ -346,8 +357,9 @@ def measure(root: Path, names: Optional[list[str]] = None, boundary_rule: bool =
                     record.kind, prints, record.contrast = shown
                     if prints is not None:
                         record.visible, record.object_visible = prints.visible, prints.object_visible
-            print(f"{name}: {record.seconds} s drawn {record.drawn} {record.kind} visible {record.visible} "
-                  f"object {record.object_visible} contrast {record.contrast} {record.note}", flush=True)
+            print(f"{name}: {record.seconds} s (CPU {record.cpu} s) drawn {record.drawn} {record.kind} "
+                  f"visible {record.visible} object {record.object_visible} contrast {record.contrast} "
+                  f"{record.note}", flush=True)
             records.append(record)
     return records
 
@@ -356,8 +368,10 @@ def _number(value: Optional[float], fmt: str) -> str:
     return "" if value is None else format(value, fmt)
 
 
-def markdown(records: list[FirstImage], profiles: dict[str, list[str]]) -> str:
-    """The section of ``docs/first-open.md`` this benchmark writes (without its markers)."""
+def markdown(records: list[FirstImage], profiles: dict[str, list[str]], loads: Optional[tuple[str, str]] = None
+             ) -> str:
+    """The section of ``docs/first-open.md`` this benchmark writes (without its markers); ``loads``: the machine's
+    load averages at the run's start and end, said when given."""
     import platform
 
     from volviz.optics.auto_tf import BACKGROUND_FRACTION, MODE_WIDTH
@@ -368,7 +382,9 @@ def markdown(records: list[FirstImage], profiles: dict[str, list[str]]) -> str:
              f"they are here: `{COMMAND.replace(' --profile 3', '')} --legibility-only`.", "",
              f"Each file is rendered by `volviz render FILE -o x.png` ({SIZE[0]}x{SIZE[1]}) in a fresh process: "
              "*first image* is that command's wall time (start-up, imports, reading, the transfer function, the "
-             f"render, the PNG); target under {TARGET_S:g} s for files under {MAX_MB} MB. *Drawn* is the share of "
+             f"render, the PNG); target under {TARGET_S:g} s for files under {MAX_MB} MB. *CPU* is the CPU time of "
+             "that process and the reader child it waited for (user + system, all threads), which a machine loaded "
+             "by other work inflates far less than the wall time. *Drawn* is the share of "
              "the image's pixels that differ from the background. For volumes, *visible* is the share of the data's "
              "footprint (the same view with an opaque transfer function) whose colour differs from the background "
              f"by more than ΔE {VISIBLE_DE:g} (CIE76). *Object visible* is the same share within the object's "
@@ -383,12 +399,15 @@ def markdown(records: list[FirstImage], profiles: dict[str, list[str]]) -> str:
              f"The legibility images are {METRIC_SIZE[0]}x{METRIC_SIZE[1]}, drawn without the axes and the box's "
              "outline (no data); the scalar bar's strip (the right fifth) is in no footprint. "
              "Measured on "
-             f"{platform.machine()} with {os.cpu_count()} cores, Mesa llvmpipe, while other work ran.", "",
-             "| file | MB | drawn as | first image | drawn | visible | object visible | contrast (ΔE) | notes |",
-             "|---|---|---|---|---|---|---|---|---|"]
+             f"{platform.machine()} with {os.cpu_count()} cores, Mesa llvmpipe, while other work ran"
+             + (f"; load average (1, 5, 15 min) at the start {loads[0]}, at the end {loads[1]}." if loads else "."),
+             "",
+             "| file | MB | drawn as | first image | CPU | drawn | visible | object visible | contrast (ΔE) | notes |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
     for r in records:
         lines.append(f"| `{r.name}` | {r.megabytes:.1f} | {r.kind} | {_number(r.seconds, '.1f')}"
-                     f"{' s' if r.seconds is not None else ''} | {_number(r.drawn, '.0%')} | "
+                     f"{' s' if r.seconds is not None else ''} | {_number(r.cpu, '.2f')}"
+                     f"{' s' if r.cpu is not None else ''} | {_number(r.drawn, '.0%')} | "
                      f"{_number(r.visible, '.0%')} | {_number(r.object_visible, '.0%')} | "
                      f"{_number(r.contrast, '.0f')} | {r.note.replace('|', '/')} |")
     if profiles:
@@ -399,12 +418,12 @@ def markdown(records: list[FirstImage], profiles: dict[str, list[str]]) -> str:
     return "\n".join(lines) + "\n"
 
 
-def kept_timings(report: Path = REPORT) -> dict[str, tuple[Optional[float], Optional[float], str]]:
-    """File -> (seconds, drawn share, note) of the rows of ``report``'s section, read by its header's column names
-    (*first image*, *drawn*, *notes*): what a ``--legibility-only`` run keeps."""
+def kept_timings(report: Path = REPORT) -> dict[str, Timing]:
+    """File -> (seconds, CPU seconds, drawn share, note) of the rows of ``report``'s section, read by its header's
+    column names (*first image*, *CPU*, *drawn*, *notes*): what a ``--legibility-only`` run keeps."""
     from volviz.io.doc_section import read_section
 
-    timings: dict[str, tuple[Optional[float], Optional[float], str]] = {}
+    timings: dict[str, Timing] = {}
     columns: list[str] = []
     for line in read_section(report, BEGIN, END).splitlines():
         cells = [cell.strip() for cell in line.strip().strip("|").split("|")]
@@ -412,9 +431,10 @@ def kept_timings(report: Path = REPORT) -> dict[str, tuple[Optional[float], Opti
             columns = cells
         elif line.startswith("| `") and columns:
             row = dict(zip(columns, cells))
-            seconds, drawn = row.get("first image", ""), row.get("drawn", "")
+            seconds, cpu, drawn = row.get("first image", ""), row.get("CPU", ""), row.get("drawn", "")
             note = row.get("notes", "")            # a legibility error is measured again, a render's kept
             timings[cells[0].strip("`")] = (float(seconds.removesuffix(" s")) if seconds else None,
+                                            float(cpu.removesuffix(" s")) if cpu else None,
                                             float(drawn.removesuffix("%")) / 100.0 if drawn else None,
                                             "" if note.startswith("legibility:") else note)
     return timings
@@ -452,11 +472,12 @@ def main(argv: Optional[list[str]] = None) -> int:
                         "boundary transfer function (volviz.optics.boundary) instead; print only")
     args = parser.parse_args(argv)
     timings = kept_timings() if args.legibility_only else None
+    load_start = ", ".join(f"{v:.1f}" for v in os.getloadavg())
     records = measure(args.data.resolve(), args.only, args.boundary_rule, timings)
     slowest = sorted((r for r in records if r.seconds is not None), key=lambda r: -float(r.seconds or 0))
     profiled = [] if args.legibility_only else slowest[:max(args.profile, 0)]
     profiles = {r.name: where_time_goes(args.data.resolve() / r.name) for r in profiled}
-    text = markdown(records, profiles)
+    text = markdown(records, profiles, (load_start, ", ".join(f"{v:.1f}" for v in os.getloadavg())))
     if args.only or args.legibility_only:
         text = kept_rows(text, bool(profiles), [p.relative_to(args.data.resolve()).as_posix()
                                                  for p in opened_files(args.data.resolve())])
