@@ -21,6 +21,7 @@ from typing import Any, Optional, Union
 import numpy as np
 
 from volviz.model.datasets import CurvilinearGrid, Dataset, RegularVolume, TetMesh, TimeSeries, UnstructuredMesh
+from volviz.model.object_cache import ObjectCache
 
 VOLUME, SURFACE, POINTS = "volume", "surface", "points"
 
@@ -82,6 +83,10 @@ def _varies(lo: float, hi: float) -> bool:
     return bool(np.isfinite(lo) and np.isfinite(hi) and hi > lo)
 
 
+#: each dataset's representation, kept while it lives (``representation``)
+_REPRESENTATIONS: ObjectCache[Representation] = ObjectCache()
+
+
 def _shape_kind(dataset: Any) -> tuple[str, str]:
     """The kind the data's shape allows, and why it is not a volume."""
     if isinstance(dataset, UnstructuredMesh):
@@ -100,8 +105,8 @@ def _shape_kind(dataset: Any) -> tuple[str, str]:
 
 def representation(dataset: Union[Dataset, TimeSeries]) -> Representation:
     """How the first look draws ``dataset`` (see the module docstring); a time series as at its first step where the
-    field varies. Kept on the dataset, so the many callers of one scene pay once."""
-    cached = getattr(dataset, "__dict__", {}).get("volviz_representation")
+    field varies. Kept for the dataset while it lives, so the many callers of one scene pay once."""
+    cached = _REPRESENTATIONS.get(dataset)
     if cached is not None:
         return cached
     if isinstance(dataset, TimeSeries):
@@ -109,9 +114,7 @@ def representation(dataset: Union[Dataset, TimeSeries]) -> Representation:
         shown = representation(dataset.frame(step or 0))
     else:
         shown = _representation(dataset)
-    if hasattr(dataset, "__dict__"):
-        dataset.__dict__["volviz_representation"] = shown
-    return shown
+    return _REPRESENTATIONS.put(dataset, shown)
 
 
 def _representation(dataset: Any) -> Representation:

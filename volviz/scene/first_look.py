@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING, Optional
 
 from volviz.io import ReadWarning
 from volviz.model import TimeSeries
+from volviz.model.object_cache import ObjectCache
 from volviz.model.representation import first_varying_step, representation
 from volviz.scene.datasets import component_dataset
 from volviz.session import Session
@@ -19,7 +20,8 @@ from volviz.session import Session
 if TYPE_CHECKING:   # type-only imports for the signatures
     from volviz.scene.datasets import LoadedDataset
 
-SAID = "volviz_first_look_said"      # kept on a dataset once its notes were given
+#: per dataset, the notes already given ("step", "constant"), kept while it lives: each is said once
+_SAID: ObjectCache[set[str]] = ObjectCache()
 
 
 class FirstLookWarning(ReadWarning):
@@ -37,7 +39,7 @@ def first_look(session: Session, datasets: dict[str, LoadedDataset], t: Optional
             continue
         dataset = component_dataset(comp, datasets)
         path = next((ref.path for ref in session.datasets if ref.id == comp.dataset), comp.dataset)
-        said = dataset.__dict__.setdefault(SAID, set()) if hasattr(dataset, "__dict__") else set()
+        said = _SAID.setdefault(dataset, set)
         if isinstance(dataset, TimeSeries):
             first = float(dataset.times[0])
             start = session.render.options.get("time", first)

@@ -38,8 +38,8 @@ PARALLEL_PAIRS = 20_000
 
 def inner_boundary(topo: Topology) -> np.ndarray:
     """Indices into ``topo.boundary`` of the boundary faces not on the convex hull (empty: the mesh is convex and
-    connected). Cached on ``topo``."""
-    cached = topo.__dict__.get("_inner_boundary")
+    connected). Kept in ``topo.inner_boundary_faces``."""
+    cached = topo.inner_boundary_faces
     if cached is not None:
         return cached
     from scipy.spatial import ConvexHull, QhullError
@@ -59,7 +59,7 @@ def inner_boundary(topo: Topology) -> np.ndarray:
             out = np.concatenate([(n[s:s + 4096] @ hull_pts.T - d[s:s + 4096, None]).max(axis=1)
                                   for s in range(0, len(n), 4096)])
             inner = np.flatnonzero(out > HULL_REL_TOL * scale).astype(np.int64)
-    topo.__dict__["_inner_boundary"] = inner
+    topo.inner_boundary_faces = inner
     return inner
 
 
@@ -297,8 +297,9 @@ def _pair_relations(px: np.ndarray, py: np.ndarray, nv: np.ndarray, box: np.ndar
 
 
 def _inner_faces(topo: Topology) -> tuple[np.ndarray, ...] | None:
-    """Per inner boundary face (cached on ``topo``): its cell, vertex ids, corners (k, 3, 3), normal and offset."""
-    cached = topo.__dict__.get("_inner_faces")
+    """Per inner boundary face (kept in ``topo.inner_face_planes``): its cell, vertex ids, corners (k, 3, 3), normal
+    and offset."""
+    cached = topo.inner_face_planes
     if cached is None:
         inner = inner_boundary(topo)
         if len(inner) == 0:
@@ -308,7 +309,7 @@ def _inner_faces(topo: Topology) -> tuple[np.ndarray, ...] | None:
             vid = np.ascontiguousarray(topo.tets[bf[:, 0][:, None], FACES[bf[:, 1]]])
             cached = (np.ascontiguousarray(bf[:, 0]), vid, topo.points[vid], topo.face_n[bf[:, 0], bf[:, 1]],
                       topo.face_d[bf[:, 0], bf[:, 1]])
-        topo.__dict__["_inner_faces"] = cached
+        topo.inner_face_planes = cached
     return cached or None
 
 

@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 
 from volviz.model.datasets import TetMesh
+from volviz.model.object_cache import ObjectCache
 from volviz.unstructured.topology import cell_ranges
 
 
@@ -51,10 +52,14 @@ def iso_visible(mesh: TetMesh, table: Any) -> np.ndarray:
     return vis & ~r.nan
 
 
+#: per mesh while it lives: its vertex normals (``vertex_normals``)
+_NORMALS: ObjectCache[np.ndarray] = ObjectCache()
+
+
 def vertex_normals(mesh: TetMesh) -> np.ndarray:
     """Unit vertex normals (n, 3): the volume-weighted mean scalar gradient of the incident cells (zero where the
-    field is flat or undefined). Cached on the mesh."""
-    cached = mesh.__dict__.get("_volviz_vertex_normals")
+    field is flat or undefined). Kept for the mesh while it lives."""
+    cached = _NORMALS.get(mesh)
     if cached is not None:
         return cached
     p = mesh.points[mesh.tets]                                       # (m, 4, 3)
@@ -70,8 +75,7 @@ def vertex_normals(mesh: TetMesh) -> np.ndarray:
         np.add.at(acc, mesh.tets[:, v], grad * vol[:, None])
     norm = np.linalg.norm(acc, axis=1, keepdims=True)
     out = np.divide(acc, norm, out=np.zeros_like(acc), where=norm > 0)
-    mesh.__dict__["_volviz_vertex_normals"] = out
-    return out
+    return _NORMALS.put(mesh, out)
 
 
 def vertex_shade(mesh: TetMesh, light: np.ndarray, ambient: float = 0.3) -> np.ndarray:

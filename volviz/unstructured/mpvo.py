@@ -14,8 +14,13 @@ byte and in-degree packed into one word: no change). Measured: docs/bench/unstru
 """
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 from numba import njit, prange
+
+if TYPE_CHECKING:   # type-only: the topology's module does not import this one, but needs none of it
+    from volviz.unstructured.topology import Topology
 
 #: cells from which the face sides are computed on all cores (below, the threads' start-up and the shared cores'
 #: scheduling cost more than the pass: a prange on the Blunt Fin's 187,318 cells had a 36 ms median, serial 7 ms)
@@ -62,17 +67,9 @@ def _cell_sides(t: int, neighbor: np.ndarray, back: np.ndarray, face_n: np.ndarr
 PLANE32_TOL = 2.0 ** -22
 
 
-def planes32(topo: object) -> np.ndarray:
-    """(m, 4, 4) float32 face planes (nx, ny, nz, d) of ``topo``'s cells, cached on it: the face sides read 64 bytes
-    per cell from them instead of 128 from ``face_n`` / ``face_d`` (one stream, half the memory traffic)."""
-    cached = topo.__dict__.get("_planes32")
-    if cached is None:
-        face_n, face_d = topo.face_n, topo.face_d           # type: ignore[attr-defined]
-        cached = np.empty((len(face_d), 4, 4), np.float32)
-        cached[:, :, :3] = face_n
-        cached[:, :, 3] = face_d
-        topo.__dict__["_planes32"] = cached
-    return cached
+def planes32(topo: Topology) -> np.ndarray:
+    """(m, 4, 4) float32 face planes (nx, ny, nz, d) of ``topo``'s cells (``Topology.planes32``, made once)."""
+    return topo.planes32
 
 
 @njit(cache=True, nogil=True)

@@ -22,6 +22,7 @@ from typing import Any, Literal, overload
 import numpy as np
 
 from volviz.model.datasets import TetMesh
+from volviz.model.object_cache import ObjectCache
 from volviz.optics.integrate import integrate_preclassified
 from volviz.model.camera import Camera
 from volviz.unstructured.iso import iso_lut, iso_segment_rgba, iso_visible, vertex_shade
@@ -89,11 +90,14 @@ def table_size(max_depth: float, n_s: int = 128, n_l: int = 64, depth_per_bin: f
     return n_s, n_l
 
 
+#: per mesh while it lives, by table kind: (the TF, range and sizes it was made for, the table) (``table_for``)
+_TABLES: ObjectCache[dict[str, tuple[tuple[Any, ...], Any]]] = ObjectCache()
+
+
 def table_for(mesh: TetMesh, tf: Any, kind: str, sizes: tuple[int, int], l_max: float) -> Any:
     """The pre-integration table (``kind`` "3d" or "pre" (pre-classified 3D): sizes = (n_s, n_l); "separable":
-    sizes = (n_s, degree)) over the
-    union of the TF range and the data range (so out-of-range parts stay transparent), cached on the mesh for the
-    last (kind, TF, sizes)."""
+    sizes = (n_s, degree)) over the union of the TF range and the data range (so out-of-range parts stay transparent),
+    kept per mesh while it lives for the last TF and sizes of each kind."""
     from volviz.optics import build_table3d
     from volviz.optics.separable import SeparableTable, build_separable
     from volviz.optics.table3d import Table3D
@@ -104,8 +108,8 @@ def table_for(mesh: TetMesh, tf: Any, kind: str, sizes: tuple[int, int], l_max: 
     if ok.any():
         lo, hi = min(lo, float(r.smin[ok].min())), max(hi, float(r.smax[ok].max()))
     key = (kind, tf.scalars.tobytes(), tf.colors.tobytes(), tf.extinction.tobytes(), lo, hi, sizes, l_max)
-    slot = "_volviz_table_" + kind
-    cached = mesh.__dict__.get(slot)
+    tables = _TABLES.setdefault(mesh, dict)
+    cached = tables.get(kind)
     if cached is not None and cached[0] == key:
         return cached[1]
     table: Table3D | SeparableTable
@@ -114,7 +118,7 @@ def table_for(mesh: TetMesh, tf: Any, kind: str, sizes: tuple[int, int], l_max: 
                               classification="pre" if kind == "pre" else "post")
     else:
         table = build_separable(tf, n_s=sizes[0], l_max=l_max, degree=sizes[1], s_range=(lo, hi))
-    mesh.__dict__[slot] = (key, table)
+    tables[kind] = (key, table)
     return table
 
 

@@ -277,7 +277,7 @@ def _take_work(topo: Topology) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     kept on ``topo`` so a frame does not allocate (and page in) them anew; sorts running at once (the app's worker
     and its GUI thread) take different ones. Hand them back with ``_give_work``."""
     with _WORK_LOCK:
-        pool = topo.__dict__.setdefault("_sort_work", [])
+        pool = topo._sort_work
         if pool:
             return pool.pop()
     m = topo.n_tets
@@ -286,7 +286,7 @@ def _take_work(topo: Topology) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 def _give_work(topo: Topology, work: tuple[np.ndarray, np.ndarray, np.ndarray]) -> None:
     with _WORK_LOCK:
-        pool = topo.__dict__.setdefault("_sort_work", [])
+        pool = topo._sort_work
         if len(pool) < 2:
             pool.append(work)
 
@@ -334,14 +334,14 @@ def visibility_order(mesh: TetMesh | Topology, camera: Camera, size: tuple[int, 
     try:
         if pending is not None:  # both stages release the GIL: the relations on a second core beside the sides
             face_sides(topo.neighbor, topo.back_face, topo.face_n, topo.face_d, eye, fwd, camera.parallel,
-                       cores=False, out=(front, indeg), planes=mpvo.planes32(topo))
+                       cores=False, out=(front, indeg), planes=topo.planes32)
             t2 = time.perf_counter()
             src, dst = pending.result()
         else:
             src, dst = relations() if relations is not None else (np.empty(0, np.int64), np.empty(0, np.int64))
             t2 = time.perf_counter()
             face_sides(topo.neighbor, topo.back_face, topo.face_n, topo.face_d, eye, fwd, camera.parallel,
-                       out=(front, indeg), planes=None if m >= mpvo.PARALLEL_CELLS else mpvo.planes32(topo))
+                       out=(front, indeg), planes=None if m >= mpvo.PARALLEL_CELLS else topo.planes32)
         t3 = time.perf_counter()
         by_src = np.argsort(src, kind="stable")
         idx = topo.neighbor.dtype
