@@ -13,9 +13,10 @@ scene through the depth buffer exactly as volviz's PT volumes are (``volviz.rend
    α_iso = 1 − Π(1 − α_i), so this equals the mode's Π(1 − α_i)·B + Σ e_i with B the scene color; where the sum
    of emissions exceeds α_iso (straight alpha cannot carry that) the pixel is composited on the CPU over the
    read-back scene color and drawn opaque (see ``finish``);
-4. with a regular (VTK) volume shown, ``begin`` renders it once more from the eye to the nearest translucent surface
-   and the image becomes (1 − a_f)·I + α·V_f (``volviz.render.iso_volume_split``): the volume in front of the
-   surfaces lies over them, the rest under them (issue #28), exact where a ray meets one translucent layer.
+4. with a regular (VTK) volume shown, ``compute`` renders it once more from the eye to the nearest translucent
+   surface, in an offscreen window of a thread of its own (``begin`` only copies the camera, lights and volume
+   properties), and the image becomes (1 − a_f)·I + α·V_f (``volviz.render.iso_volume_split``): the volume in front
+   of the surfaces lies over them, the rest under them (issue #28), exact where a ray meets one translucent layer.
 
 The 8-bit overlay costs at most about 1/255 per channel against the float image (measured in the tests).
 ``begin`` / ``compute`` / ``finish`` split the work as every ``image_overlay.OverlayView`` does: ``compute`` is pure
@@ -36,7 +37,7 @@ from volviz.iso.composite import MODES, Fragments, composite, fragments, triangl
 from volviz.iso.extract import IsoMesh
 from volviz.iso.lod import lod_mesh, select_level
 from volviz.render.image_overlay import OverlayView, overlay_rgba8
-from volviz.render.iso_volume_split import SurfaceOccluder, front_volume, in_volume
+from volviz.render.iso_volume_split import FrontVolume, in_volume
 from volviz.model.camera import Camera
 
 if TYPE_CHECKING:   # type-only imports for the signatures
@@ -97,8 +98,8 @@ class IsoModeView:
 class IsoOverlay(OverlayView, IsoModeView):
     """The isosurfaces of a scene drawn by one of the CPU transparency modes as a depth-composited overlay. With a
     regular volume shown, ``split_volume`` (default) puts the volume in front of the surfaces over them and the rest
-    under them (``volviz.render.iso_volume_split``); False draws the overlay over the whole scene (the order before
-    issue #28, kept for ``volviz bench iso_modes_volume``)."""
+    under them (``volviz.render.iso_volume_split``; ``front_volume`` draws that volume on a thread of its own); False
+    draws the overlay over the whole scene (the order before issue #28, kept for ``volviz bench iso_modes_volume``)."""
 
     split_volume = True
 
@@ -109,7 +110,7 @@ class IsoOverlay(OverlayView, IsoModeView):
     def __init__(self, plotter: Any, meshes: Sequence[IsoMesh] = (), mode: str = "3pass",
                  shading: str = "spectrum") -> None:
         super().__init__(plotter)
-        self._occluder = SurfaceOccluder()
+        self.front_volume = FrontVolume()
         self.meshes = list(meshes)
         self.lod: list[Any] = [None] * len(self.meshes)  # per mesh: (LodChain, triangles per pixel²) or None
         self.mode = mode
@@ -129,22 +130,31 @@ class IsoOverlay(OverlayView, IsoModeView):
         return float(((p - cam.position) @ cam.frame()[2]).max())
 
     def begin(self, scale: int = 1) -> dict[str, Any]:
-        """GUI thread: ``OverlayView.begin`` (the scene drawn and read back), and before it, with a regular volume
-        shown, the volume in front of the translucent surfaces (``front_volume``; drawn first, so that the window is
-        left with the scene as before)."""
+        """GUI thread: ``OverlayView.begin`` (the scene drawn and read back), and with a regular volume shown what
+        ``compute`` needs to draw the volume in front of the translucent surfaces off this thread
+        (``FrontVolume.snapshot``)."""
         translucent = [m for m in self.meshes if m.style.opacity < 1.0] if self.split_volume else []
-        front = front_volume(self.plotter, translucent, self._occluder, self._overlay.siblings)
+        front = self.front_volume.snapshot(self.plotter, translucent) if translucent else None
         request = super().begin(scale)
         cam = request["camera"]
         near = min(cam.clipping_range[0], 1e-3 * cam.clipping_range[1])  # VTK's range ignores the hidden actors
         request["camera"] = Camera(cam.position, cam.focal_point, cam.view_up, cam.view_angle, cam.parallel,
                                    cam.parallel_scale, (near, cam.clipping_range[1]))
-        request.update(meshes=list(self.meshes), lod=list(self.lod), mode=self.mode, shading=self.shading)
-        if front is not None and request["preview"]:    # the preview pixel's first window pixel, as its scene color
+        request.update(meshes=list(self.meshes), lod=list(self.lod), mode=self.mode, shading=self.shading,
+                       front_scene=front)
+        return request
+
+    def _front_image(self, request: dict[str, Any]) -> np.ndarray | None:
+        """Any thread: the volume in front of the surfaces for ``request`` (``FrontVolume.render``, at the window's
+        size; for a preview each preview pixel's first window pixel, as its scene color), or None."""
+        scene = request.get("front_scene")
+        if scene is None:
+            return None
+        front = self.front_volume.render(scene)
+        if request["preview"]:
             (w, h), (big_h, big_w) = request["size"], front.shape[:2]
             front = front[(np.arange(h) * big_h) // h][:, (np.arange(w) * big_w) // w]
-        request["front"] = front
-        return request
+        return front
 
     def compute(self, request: dict[str, Any], progress: Optional[ProgressCallback] = None) -> tuple[np.ndarray, Any,
                 np.ndarray]:
@@ -162,7 +172,7 @@ class IsoOverlay(OverlayView, IsoModeView):
                   for m, lv in zip(request["meshes"], lod)]
         fr = cut_at_depth(fragments(meshes, cam, size, request["shading"]), request["depth"])
         t1 = time.perf_counter()
-        img = in_volume(composite(fr, request["mode"]), request.get("front"))
+        img = in_volume(composite(fr, request["mode"]), self._front_image(request))
         t2 = time.perf_counter()
         rgba8, saturated = _shown_rgba8(img, request)
         st = SimpleNamespace(sort_s=0.0, project_s=0.0, raster_s=t1 - t0, total_s=t2 - t0, fragments=len(fr.depth),
@@ -170,6 +180,11 @@ class IsoOverlay(OverlayView, IsoModeView):
                              full_triangles=sum(m.n_triangles for m in request["meshes"]), saturated_px=saturated,
                              extra={})
         return img, st, rgba8
+
+    def remove(self) -> None:
+        """Detach the overlay and end the thread that draws the volume in front of the surfaces."""
+        super().remove()
+        self.front_volume.close()
 
     def finish(self, request: dict[str, Any], img: np.ndarray, st: Any, rgba8: np.ndarray | None = None) -> np.ndarray:
         """GUI thread: show ``rgba8`` as ``compute`` made it (made here from ``img`` when not given) and record the

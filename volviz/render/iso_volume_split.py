@@ -19,13 +19,16 @@ every layer would take one more volume render per layer. The GPU's exact mode pe
 instead (``volviz.render.gl_iso``: 0.57 there), so the scene controller draws only the 2/3/4-pass modes this way
 when the GPU backend is chosen.
 
-``front_volume`` renders V_f, a_f with VTK itself, so that they match the scene's own volume: the renderer's other
-props hidden, the translucent surfaces drawn as an opaque occluder that writes depth and the colour (0, 0, 0, 0)
-over a transparent black background; VTK's ray casters (CPU and GPU) stop at that depth and blend their
-premultiplied colour and alpha over it. One more volume render per overlay image (docs/bench/iso_modes_with_volume.md).
+``FrontVolume`` renders V_f, a_f with VTK itself, so that they match the scene's own volume (the same mapper
+settings, property, camera and lights; the same pixels as the scene's window gives): the regular volumes alone, the
+translucent surfaces drawn as an opaque occluder that writes depth and the colour (0, 0, 0, 0) over a transparent
+black background; VTK's ray casters (CPU and GPU) stop at that depth and blend their premultiplied colour and alpha
+over it. One more volume render per overlay image (docs/bench/iso_modes_with_volume.md), in an offscreen window of a
+thread of its own, off the GUI thread (docs/bench/iso_split_off_gui_thread.md).
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Sequence
 
 import numpy as np
@@ -38,7 +41,7 @@ if TYPE_CHECKING:   # type-only imports for the signatures
     from volviz.iso.extract import IsoMesh
     from volviz.render.vtk_facade import vtkActor, vtkRenderer, vtkVolume
 
-__all__ = ["SurfaceOccluder", "front_volume", "in_volume", "shown_regular_volumes"]
+__all__ = ["FrontScene", "FrontVolume", "SurfaceOccluder", "in_volume", "shown_regular_volumes"]
 
 # depth only: colour and alpha 0, written after VTK's test that discards fragments of alpha 0
 _WRITE_NOTHING = "gl_FragData[0] = vec4(0.0);\n  //VTK::Picking::Impl"
@@ -86,55 +89,150 @@ class SurfaceOccluder:
         return self._actor
 
 
-def front_volume(plotter: pv.BasePlotter, meshes: Sequence[IsoMesh], occluder: SurfaceOccluder,
-                 others: Sequence[vtkRenderer] = ()) -> np.ndarray | None:
-    """GUI thread: the shown regular volumes of ``plotter`` from the eye to the nearest of ``meshes`` (translucent
-    surfaces, drawn as ``occluder``) as premultiplied float RGBA (H, W, 4), row 0 at the top, in 8-bit steps
-    (module docstring); None when
-    the scene shows no regular volume or ``meshes`` no triangle. ``others``: renderers of the window (volviz's
-    overlays) kept from drawing meanwhile. The window is left with that render: draw the scene after it."""
+@dataclass
+class FrontScene:
+    """What ``FrontVolume.render`` draws, taken on the GUI thread by ``FrontVolume.snapshot``: the window's size, the
+    renderer's viewport, copies of its camera and lights, the shown regular volumes (per volume its mapper's input
+    and settings, a copy of its property and its matrix) and the translucent surfaces."""
+
+    size: tuple[int, int]
+    viewport: tuple[float, ...]
+    camera: Any
+    lights: list[Any]
+    two_sided: bool
+    volumes: list[tuple[int, Any, dict[str, Any], Any, Any]]
+    meshes: list[IsoMesh]
+
+
+#: the smart mapper's settings that change its picture, copied to the offscreen volume (Get/Set pairs)
+_MAPPER_SETTINGS = ("RequestedRenderMode", "BlendMode", "InterpolationMode", "SampleDistance",
+                    "AutoAdjustSampleDistances", "InteractiveAdjustSampleDistances", "InteractiveUpdateRate",
+                    "FinalColorWindow", "FinalColorLevel", "Cropping", "CroppingRegionFlags", "CroppingRegionPlanes",
+                    "GlobalIlluminationReach", "VolumetricScatteringBlending")
+
+
+def _copy_planes(mapper: Any) -> list[Any]:
+    """Copies of ``mapper``'s clipping planes."""
+    from volviz.render.vtk_facade import vtk
+
+    planes = mapper.GetClippingPlanes()
+    out = []
+    for i in range(planes.GetNumberOfItems() if planes is not None else 0):
+        src, dst = planes.GetItemAsObject(i), vtk.vtkPlane()
+        dst.SetOrigin(src.GetOrigin())
+        dst.SetNormal(src.GetNormal())
+        out.append(dst)
+    return out
+
+
+class FrontVolume:
+    """The shown regular volumes of a plotter from the eye to the nearest translucent surface, rendered in an
+    offscreen window of a thread of its own (``volviz.render.gl_thread``; the module docstring says how): the GUI
+    thread only takes a ``snapshot`` (copies of the camera, lights and volume properties); ``render`` draws it from
+    any thread. Before, the plotter's own window drew it on the GUI thread after every camera change: an overlay
+    update's GUI-thread part 1416-1760 ms against 883-963 ms now at 1000x700 on llvmpipe
+    (docs/bench/iso_split_off_gui_thread.md). ``close`` ends the thread."""
+
+    def __init__(self) -> None:
+        from volviz.render.gl_thread import GLThread
+
+        self.gl = GLThread("volviz-front-volume")
+
+    def snapshot(self, plotter: pv.BasePlotter, meshes: Sequence[IsoMesh]) -> FrontScene | None:
+        """GUI thread: what ``render`` needs of ``plotter``'s scene now; None when it shows no regular volume or
+        ``meshes`` (the translucent surfaces) no triangle."""
+        from volviz.render.vtk_facade import vtk
+
+        ren = plotter.renderer
+        shown = shown_regular_volumes(ren)
+        if not shown or not any(m.n_triangles for m in meshes):
+            return None
+        camera = vtk.vtkCamera()
+        camera.DeepCopy(ren.GetActiveCamera())
+        lights = []
+        for light in (ren.GetLights().GetItemAsObject(i) for i in range(ren.GetLights().GetNumberOfItems())):
+            copy = light.NewInstance()
+            copy.DeepCopy(light)
+            lights.append(copy)
+        volumes = []
+        for v in shown:
+            mapper = v.GetMapper()
+            settings = {k: getattr(mapper, f"Get{k}")() for k in _MAPPER_SETTINGS if hasattr(mapper, f"Get{k}")}
+            settings["planes"] = _copy_planes(mapper)
+            prop = vtk.vtkVolumeProperty()
+            prop.DeepCopy(v.GetProperty())
+            matrix = vtk.vtkTransform()
+            matrix.SetMatrix(v.GetMatrix())     # a copy of the prop's matrix, which the GUI thread goes on changing
+            volumes.append((id(v), mapper.GetInputDataObject(0, 0), settings, prop, matrix))
+        w, h = (int(s) for s in ren.GetRenderWindow().GetSize())
+        return FrontScene((w, h), tuple(ren.GetViewport()), camera, lights, bool(ren.GetTwoSidedLighting()),
+                          volumes, list(meshes))
+
+    def render(self, scene: FrontScene) -> np.ndarray:
+        """Any thread: ``scene``'s volumes in front of its surfaces as premultiplied float RGBA (H, W, 4), row 0 at
+        the top, in 8-bit steps (drawn on the window's thread)."""
+        return self.gl.call(_draw, self.gl.state, scene)
+
+    def close(self) -> None:
+        self.gl.close()
+
+
+def _draw(ren: vtkRenderer, state: dict[str, Any], scene: FrontScene) -> np.ndarray:
+    """On the window's thread: bring ``ren`` to ``scene`` (the volumes made or updated, the occluder of the surfaces,
+    the camera and lights), render and read back."""
     from volviz.render.vtk_facade import vtk, vtk_to_numpy
 
-    ren = plotter.renderer
-    volumes = shown_regular_volumes(ren)
-    if not volumes or not any(m.n_triangles for m in meshes):
-        return None
-    actor = occluder.actor(meshes)
-    props = ren.GetViewProps()
-    hidden = [p for p in (props.GetItemAsObject(i) for i in range(props.GetNumberOfItems()))
-              if p.GetVisibility() and not any(p is v for v in volumes)]
-    drawn = [o for o in others if o.GetDraw()]
-    background, alpha = ren.GetBackground(), ren.GetBackgroundAlpha()
-    gradient = ren.GetGradientBackground()
-    ren_win = ren.GetRenderWindow()
-    try:
-        for p in hidden:
-            p.SetVisibility(False)
-        for o in drawn:
-            o.DrawOff()
+    kept: dict[int, Any] = state.setdefault("volumes", {})
+    for key in set(kept) - {v[0] for v in scene.volumes}:
+        ren.RemoveVolume(kept.pop(key))
+    for key, data, settings, prop, matrix in scene.volumes:
+        volume = kept.get(key)
+        if volume is None:
+            volume = kept[key] = vtk.vtkVolume()
+            volume.SetMapper(vtk.vtkSmartVolumeMapper())
+            ren.AddVolume(volume)
+        mapper = volume.GetMapper()
+        if mapper.GetInputDataObject(0, 0) is not data:
+            mapper.SetInputData(data)
+        for k, value in settings.items():
+            if k != "planes" and getattr(mapper, f"Get{k}")() != value:
+                getattr(mapper, f"Set{k}")(value)
+        mapper.RemoveAllClippingPlanes()
+        for plane in settings["planes"]:
+            mapper.AddClippingPlane(plane)
+        volume.SetProperty(prop)
+        volume.SetUserTransform(matrix)
+    occluder: SurfaceOccluder = state.setdefault("occluder", SurfaceOccluder())
+    actor = occluder.actor(scene.meshes)
+    if state.get("actor") is not actor:
+        if state.get("actor") is not None:
+            ren.RemoveActor(state["actor"])
         ren.AddActor(actor)
-        ren.SetBackground(0.0, 0.0, 0.0)
-        ren.SetBackgroundAlpha(0.0)
-        ren.GradientBackgroundOff()
-        ren_win.Render()
-        w, h = (int(v) for v in ren_win.GetSize())
-        rgba = vtk.vtkUnsignedCharArray()
-        ren_win.GetRGBACharPixelData(0, 0, w - 1, h - 1, 0, rgba)
-    finally:
-        ren.RemoveActor(actor)
-        for p in hidden:
-            p.SetVisibility(True)
-        for o in drawn:
-            o.DrawOn()
-        ren.SetBackground(*background)
-        ren.SetBackgroundAlpha(alpha)
-        ren.SetGradientBackground(gradient)
+        state["actor"] = actor
+    ren.SetViewport(*scene.viewport)
+    camera = ren.GetActiveCamera()
+    camera.DeepCopy(scene.camera)
+    camera.Modified()           # DeepCopy keeps the time stamp: VTK's CPU ray caster would re-use its last image
+    ren.AutomaticLightCreationOff()
+    ren.RemoveAllLights()
+    for light in scene.lights:
+        ren.AddLight(light)
+    ren.SetTwoSidedLighting(scene.two_sided)
+    ren.SetBackground(0.0, 0.0, 0.0)
+    ren.SetBackgroundAlpha(0.0)
+    window = ren.GetRenderWindow()
+    w, h = scene.size
+    if tuple(window.GetSize()) != (w, h):
+        window.SetSize(w, h)
+    window.Render()
+    rgba = vtk.vtkUnsignedCharArray()
+    window.GetRGBACharPixelData(0, 0, w - 1, h - 1, 0, rgba)
     return vtk_to_numpy(rgba).reshape(h, w, 4)[::-1].astype(np.float64) / 255.0
 
 
 def in_volume(image: np.ndarray, front: np.ndarray | None) -> np.ndarray:
     """The modes' premultiplied overlay ``image`` (H, W, 4) with the volume in front of the surfaces, ``front``
-    (``front_volume``, the same size), over it and the volume behind under it: I' = (1 − a_f)·I + α·V_f (module
+    (``FrontVolume.render``, the same size), over it and the volume behind under it: I' = (1 − a_f)·I + α·V_f (module
     docstring); ``image`` itself when ``front`` is None."""
     if front is None:
         return image
