@@ -10,9 +10,14 @@ work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 # (CI installs the extra before its tests start, so pip does not rewrite the environment while they run)
 [ "${VOLVIZ_PACKAGING_INSTALLED:-0}" = 1 ] || .venv/bin/python -m pip install -q -e ".[packaging]"
-.venv/bin/pyinstaller --noconfirm --log-level WARN --distpath "$dist" --workpath "$work/build" packaging/volviz.spec
+# the build and the warm-up are batch work, run at low priority: beside other work they take the CPU it leaves (CI runs
+# them beside the tests, whose event-loop checks measure the app's latency)
+nice -n 10 .venv/bin/pyinstaller --noconfirm --log-level WARN --distpath "$dist" --workpath "$work/build" packaging/volviz.spec
 app="$(cd "$dist/volviz" && pwd)/volviz-app"
 echo "built $app ($(du -sh "$dist/volviz" | cut -f1))"
+# the install step: compile the Numba kernels into their on-disk cache, as the setup script's `volviz warmup` does for a
+# development install (without it the first start compiles the demo's kernels: about 65 s of CPU)
+(cd "$work" && env -u VIRTUAL_ENV PATH=/usr/bin:/bin nice -n 10 "$app" -m volviz warmup)
 # a small VTK XML volume: its reader runs in the isolated reader process, which the packaged app starts as itself
 .venv/bin/python -c "import pyvista as pv, numpy as np; g = pv.ImageData(dimensions=(24, 24, 24)); \
 x = np.linspace(-1, 1, 24); X, Y, Z = np.meshgrid(x, x, x, indexing='ij'); \
