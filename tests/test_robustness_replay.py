@@ -107,3 +107,17 @@ def test_a_case_is_placed_as_a_new_file_while_a_reader_holds_the_last_one(tmp_pa
     finally:
         holder.stdin.close()
         holder.wait()
+
+
+def test_the_laz_seeds_carry_a_pinned_date_so_they_rebuild_any_day(tmp_path):
+    """laspy stamps a LAS header with today's date (day of year and year, bytes 90-93): the seed-33 campaign's LAZ
+    cases, written on 2026-11-28, could not be rebuilt the next day ("the seed file ... is not the recorded one")."""
+    import struct
+
+    from volviz.bench.robustness_formats import SEEDS
+
+    for seed in [s for s in SEEDS if s.fmt == "laz"]:
+        folder = tmp_path / seed.label
+        folder.mkdir()
+        seed.write(folder)
+        assert struct.unpack("<HH", (folder / "cloud.laz").read_bytes()[90:94]) == (1, 2026)

@@ -11,6 +11,7 @@ beside it unchanged. Fluent CFF, Tecplot and XDMF also come from ``../shared/dat
 """
 from __future__ import annotations
 
+import datetime
 import json
 import os
 import random
@@ -198,10 +199,14 @@ def _pvd(folder: Path) -> None:
                                     "  <Collection>\n" + "\n".join(entries) + "\n  </Collection>\n</VTKFile>\n")
 
 
+LAZ_DATE = datetime.date(2026, 1, 1)   # the LAZ seeds' creation date, so that --replay rebuilds them any day
+
+
 def _laz(folder: Path, point_format: int, version: str) -> None:
     import laspy  # type: ignore[import-untyped]   # laspy ships no type information
 
     header = laspy.LasHeader(point_format=point_format, version=version)
+    header.creation_date = LAZ_DATE   # laspy stamps today's date: a seed written another day was another file
     header.scales, header.offsets = np.array([0.01, 0.01, 0.01]), np.array([1000.0, 2000.0, 0.0])
     las = laspy.LasData(header)
     p = _points(150)
