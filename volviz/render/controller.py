@@ -609,8 +609,9 @@ class SceneController:
 
     @staticmethod
     def compute_views(requests: list[tuple[str, Any, Any]], progress: Optional[ProgressCallback] = None) -> list[Any]:
-        """Any thread: the CPU images and meshes of ``begin_views`` requests (pure NumPy/Numba, no VTK calls): each
-        view's ``compute`` (``volviz.render.views.View``)."""
+        """Any thread: the CPU images and meshes of ``begin_views`` requests (NumPy/Numba; no VTK call on the
+        calling thread: the iso overlay's volume in front of its surfaces renders on its own GL thread,
+        ``volviz.render.gl_thread``): each view's ``compute`` (``volviz.render.views.View``)."""
         from volviz.jobs import report
 
         results: list[Any] = []
