@@ -423,6 +423,22 @@ def _show_warning(message: Warning | str, category: type[Warning], filename: str
     print(f"volviz: warning: {_one_line(message)}", file=sys.stderr)
 
 
+#: the garbage collector's thresholds of the ``volviz`` program (``gc.set_threshold``; Python's are 700, 10, 10)
+PROGRAM_GC_THRESHOLDS = (10_000, 10, 10)
+
+
+def _as_program() -> None:
+    """Garbage collection for a run of the ``volviz`` program: a first generation of 10,000 objects instead of 700,
+    so that the start-up's imports (hundreds of thousands of objects that live to the end) are not traversed again
+    and again (issue #30: a Blunt Fin render ran 555 young, 50 middle and 4 full collections, 0.30 s of CPU; with
+    these thresholds 39, 3 and 0, 0.12 s, the same peak memory), and no collection at the exit
+    (``_no_collection_at_exit``)."""
+    import gc
+
+    gc.set_threshold(*PROGRAM_GC_THRESHOLDS)
+    atexit.register(_no_collection_at_exit)
+
+
 def _no_collection_at_exit() -> None:
     """The interpreter's exit skips the garbage collector's last passes over every object still alive: they only
     free memory the exit returns anyway, and took 0.55-0.6 s of CPU (1-2 s of wall on 2 loaded cores) after a render
@@ -436,10 +452,10 @@ def _no_collection_at_exit() -> None:
 
 def main(argv: Optional[Sequence[str]] = None) -> int:
     """``volviz`` with ``argv`` (default: the command line); the exit code. Called without ``argv`` (the program
-    itself: the console script, ``python -m volviz.cli``), the process's exit skips the last garbage collections
-    (``_no_collection_at_exit``); a caller in-process keeps its own."""
+    itself: the console script, ``python -m volviz.cli``), the process collects its garbage as a program
+    (``_as_program``); a caller in-process keeps its own collector's settings."""
     if argv is None:
-        atexit.register(_no_collection_at_exit)
+        _as_program()
     debug = "--debug" in (sys.argv[1:] if argv is None else argv)
     try:
         with warnings.catch_warnings():
