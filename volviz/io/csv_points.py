@@ -187,9 +187,11 @@ def is_point_text(head: bytes) -> bool:
     damaged rows (a first row with a flipped bit, a field lost, a third of the rows with a field more) leaves it a
     table, so the table's reader names them, not the reader of another format sharing the name (issue #32: a .xyz
     with a third of its rows odd went to AVS UCD or PLOT3D). A few rows need three of four (an AVS UCD header line
-    and two nodes is not a table); a binary file's "rows" are not numbers."""
+    and two nodes is not a table); a last row without its line end, cut, is left out of the sample (a table cut in
+    its third row was refused as PLOT3D); a binary file's "rows" are not numbers."""
     lines = head.decode("utf-8", errors="replace").splitlines()
-    rows = _rows(lines[:-1] if len(head) >= HEAD_SNIFF else lines)[:20]  # the last line may be cut
+    cut = len(head) >= HEAD_SNIFF or (len(lines) > 1 and not head.endswith((b"\n", b"\r")))
+    rows = _rows(lines[:-1] if cut else lines)[:20]  # the last line may be cut (the sample's end, or the file's)
     if len(rows) > 1 and _count_line(rows, 0):
         rows = rows[1:]
     if not rows:
