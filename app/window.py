@@ -14,12 +14,13 @@ scene, typed by ``shown_scene.ShownScene``, widgets, callbacks) when they are ma
   budget (``view_scheduler.ViewScheduler``);
 - ``time_views``: the timeline's display time shown, volumes blended and isosurfaces re-extracted in the background
   (``time_views.TimeViews``);
+- ``busy``: the status bar's progress bar and Cancel button (``busy_status.BusyStatus``);
 
-and is put together from one mixin for the rest, ``window_widgets.WindowWidgets``: the docks, menus and actions, the
-status bar with progress and cancel.
+and gets its docks, menus and actions and its status bar from ``window_widgets``' builder functions (no mixin).
 
 This module sets the window's shared state (``session``, ``controller``, ``jobs``, ``plotter``..., typed in
-``window_base.WindowBase``), and holds its construction, ``render_scene``, fly mode, ``show_error``, closing, and
+``window_base.WindowBase``), and holds its construction (a part made later is given to an earlier one as a callback
+that reads it when called), ``render_scene``, fly mode, ``show_error``, closing, and
 one-line forwarders to its parts for what other modules and the tests call on the window."""
 from __future__ import annotations
 
@@ -35,6 +36,7 @@ from PySide6.QtWidgets import QFileDialog, QMainWindow, QMenu, QMessageBox, QWid
 from volviz.render.backend import plotter_gl_info
 from volviz.render.controller import SceneController, iso_summary
 from volviz.session import Session
+from .busy_status import BusyStatus
 from .camera_bookmarks import CameraBookmarks
 from .clip_widget import ClipPlaneWidget
 from .export_runs import ExportRuns
@@ -50,7 +52,8 @@ from .scene_loading import SceneLoading
 from .session_files import SessionFiles, default_recovery_dir
 from .time_views import TimeViews
 from .view_scheduler import ViewScheduler
-from .window_widgets import WindowWidgets
+from .window_base import WindowBase
+from .window_widgets import build_docks, build_menus, build_status_bar, fill_docks
 from .workers import JobBridge
 
 if TYPE_CHECKING:
@@ -82,7 +85,7 @@ def _import_gui_thread_modules() -> None:
     pyvista.system_supports_plotting()
 
 
-class MainWindow(WindowWidgets, QMainWindow):
+class MainWindow(WindowBase, QMainWindow):
     """volviz main window. ``open_path`` is the single code path behind File > Open and the command line."""
 
     def __init__(self, parent: Optional[QWidget] = None, settings: Optional[QSettings] = None,
@@ -97,7 +100,6 @@ class MainWindow(WindowWidgets, QMainWindow):
         self.plotter = QtInteractor(self, auto_update=False)  # we render when something changed, never on a timer
         self.setCentralWidget(self.plotter.interactor)
         self.jobs = JobBridge(self)
-        self.jobs.progress.connect(self._on_progress)
         self.session = Session()
         self.session_path = None
         self.datasets = {}
@@ -106,31 +108,36 @@ class MainWindow(WindowWidgets, QMainWindow):
         self.dirty = False
         self.last_stats = {}
 
-        self._build_docks()
-        self._build_status_bar()
+        build_docks(self)
+        build_status_bar(self)
+        busy = self.busy = BusyStatus(
+            self.status_label, self.progress_bar, self.cancel_button, self.jobs,
+            exporting=lambda: self.export_runs.running, cancel_export=lambda: self.export_runs.cancel(),
+            loading=lambda: self.scene_loading.current_job if self.scene_loading.loading() else None,
+            first_views=lambda: self.view_scheduler.loading_views)
         self.nonfinite = NonFiniteStatus(self)  # the status bar's note on non-finite values
         self.stand_in = StandInFrame(self.plotter)   # the last frame over the viewport while its scene is rebuilt
         views = self.view_scheduler = ViewScheduler(
             self, self, self.plotter, self.jobs, self.status_label, self.render_settings, self.stand_in, self.collector,
             render_scene=self.render_scene, show_statistics=self.show_statistics, show_error=self.show_error,
-            set_busy=self._set_busy, settings_changed=self._settings_changed,
+            set_busy=busy.set_busy, settings_changed=self._settings_changed,
             load_serial=lambda: self.scene_loading.serial, report_nonfinite=self.nonfinite.report)
         self.time_views = TimeViews(self, self.plotter, self.jobs, self.timeline, show_error=self.show_error,
                                     schedule_render=views.schedule_render,
                                     refresh_iso_overlay=views.refresh_iso_overlay)
         self.camera_bookmarks = CameraBookmarks(self, self, self.status_label, self.set_dirty, views.camera_moved)
-        self.export_runs = ExportRuns(self, self.jobs, self.plotter, self.status_label, self._set_busy,
-                                      self._busy_elsewhere, self.show_error)
+        self.export_runs = ExportRuns(self, self.jobs, self.plotter, self.status_label, busy.set_busy,
+                                      busy.busy_elsewhere, self.show_error)
         self.recent_menu = QMenu("Open &Recent", self)   # File > Open Recent
         self.recent = RecentFiles(self.settings, self.recent_menu, self.open_path_asking)
         loading = self.scene_loading = SceneLoading(
             self, self, self.plotter, self.jobs, self.settings, self.recent, self.stand_in, self.status_label,
-            set_busy=self._set_busy, show_error=self.show_error, supersede=views.supersede,
+            set_busy=busy.set_busy, show_error=self.show_error, supersede=views.supersede,
             installed=self._scene_installed, first_render=self.render_scene, first_views=views.show_first_views)
         self.session_files = SessionFiles(self, self, Path(recovery_dir) if recovery_dir else default_recovery_dir(),
                                           self.recent, self.status_label, loading.open_path, loading.open_paths,
                                           loading.show_session, self.show_error)   # its autosave timer runs from now
-        self._build_menus()
+        build_menus(self)
         self.scene_edits = SceneEdits(self, self, views, self.jobs, self.status_label, self.tf_editor, self.scene_tree,
                                       self.array_choice, render_scene=self.render_scene, set_dirty=self.set_dirty,
                                       show_error=self.show_error, show_session=loading.show_session,
@@ -149,7 +156,7 @@ class MainWindow(WindowWidgets, QMainWindow):
         docks and the bookmark menu show it, the views' state starts afresh. ``new_data``: another file or scene,
         whose settings edits are not undone on the new one."""
         controller.changes.subscribe(self.scene_edits.scene_changed)   # the window follows the scene from now on
-        self._fill_docks(controller)
+        fill_docks(self, controller)
         self.view_scheduler.scene_installed()
         self.time_views.scene_installed()
         self.scene_edits.scene_installed()
@@ -248,6 +255,12 @@ class MainWindow(WindowWidgets, QMainWindow):
 
     def _camera_moved(self) -> None:
         self.view_scheduler.camera_moved()
+
+    def _set_busy(self, busy: bool) -> None:
+        self.busy.set_busy(busy)
+
+    def cancel_current_job(self) -> None:
+        self.busy.cancel_current_job()
 
     def add_bookmark(self, name: str) -> None:
         self.camera_bookmarks.add_bookmark(name)
@@ -363,4 +376,5 @@ class MainWindow(WindowWidgets, QMainWindow):
         self.jobs.shutdown()
         self.plotter.close()
         self.collector.unfreeze()  # what was long-lived while the window was open can be collected again
+        self.python_console.shutdown()   # the console's kernel stops with the window
         super().closeEvent(event)

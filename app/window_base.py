@@ -1,22 +1,18 @@
-"""The typed view that ``MainWindow``'s mixins have of the window they are mixed into.
+"""The typed view of the main window that ``window_widgets``' builder functions have (issue #31: they build the docks,
+menus and status bar into the window; no mixin is left).
 
-The mixin (``window_widgets.WindowWidgets``) derives from ``WindowBase``, which declares, once and with their types:
+``MainWindow`` derives from ``WindowBase``, which declares, once and with their types:
 
 - the window's shared state: what more than one part of the window reads or writes (``session``, ``controller``,
-  ``jobs``, ``plotter``, the docks, ``status_label``...), whichever of ``MainWindow.__init__`` or a mixin sets it;
-- the signatures of the methods a mixin calls on another mixin or on ``MainWindow`` (``render_scene``,
-  ``show_error``, ``set_dirty``, ``refresh_views``, the handlers the docks and actions are connected to...).
+  ``jobs``, ``plotter``, the docks, ``status_label``...), whichever of ``MainWindow.__init__`` or a builder sets it;
+- the signatures of the window's methods a builder connects widgets to (``set_fly_mode``, the handlers the docks and
+  actions are connected to...).
 
-A mixin's own state, which only its methods use, stays declared where the mixin sets it. The methods are declared
-under ``TYPE_CHECKING`` only: at run time ``WindowBase`` holds nothing but annotations, so the real definitions (in
-the mixins, in ``MainWindow``, or ``QMainWindow``'s) are what the window runs, whatever their place in its MRO. mypy
-checks every real definition against its declaration here as an override. For the type checker ``WindowBase`` is a
-``QMainWindow`` (the mixins pass ``self`` as the parent of widgets and timers, call ``menuBar()``, ``saveState()``...);
-at run time it is a plain class, so that ``MainWindow`` keeps a single Qt base (PySide6 does not allow two).
-
-A base class rather than a ``Protocol`` for ``self``: mypy takes a mixin's ``self`` annotated with a protocol, but
-that protocol would have to list everything the mixin's methods touch, its own state and methods included, and every
-method would repeat the annotation; the base class needs only what is shared, and no annotation on ``self``."""
+The methods are declared under ``TYPE_CHECKING`` only: at run time ``WindowBase`` holds nothing but annotations, so
+the real definitions (in ``MainWindow`` or ``QMainWindow``'s) are what the window runs. mypy checks every real
+definition against its declaration here as an override. For the type checker ``WindowBase`` is a ``QMainWindow`` (the
+builders pass the window as the parent of widgets, call ``menuBar()``, ``statusBar()``...); at run time it is a plain
+class, so that ``MainWindow`` keeps a single Qt base."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -24,14 +20,25 @@ from typing import TYPE_CHECKING, Any, Callable, Optional
 
 if TYPE_CHECKING:
     from PySide6.QtCore import QSettings
-    from PySide6.QtGui import QAction, QUndoStack
-    from PySide6.QtWidgets import QLabel, QMainWindow, QMenu, QMessageBox, QProgressBar, QPushButton
+    from PySide6.QtGui import QAction, QUndoGroup, QUndoStack
+    from PySide6.QtWidgets import QDockWidget, QLabel, QMainWindow, QMenu, QMessageBox, QProgressBar, QPushButton
     from pyvistaqt import QtInteractor
 
     from volviz.model.clip import ClipSettings
     from volviz.render.controller import SceneController
     from volviz.session import Session
     from .array_choice import ArrayChoice
+    from .busy_status import BusyStatus
+    from .console import PythonConsole
+    from .drop import FileDrop
+    from .export_dialogs import ExportDialogs
+    from .help import HelpMenu
+    from .iso_tool import IsoTool
+    from .log_scale_status import LogScaleStatus
+    from .probe import ProbeTool
+    from .scalar_bar_editor import ScalarBarEditor
+    from .slice_tool import SliceTool
+    from .time_views import TimeViews
     from .camera_bookmarks import CameraBookmarks
     from .export_runs import ExportRuns
     from .scene_edits import SceneEdits
@@ -80,7 +87,7 @@ class WindowBase(_QtWindow):
     controller: Optional[SceneController]
     title: str                         # what the window title names when there is no session file
     dirty: bool
-    # -- widgets (WindowWidgets)
+    # -- widgets (window_widgets' builders)
     tf_editor: TransferFunctionEditor
     scene_tree: SceneTree
     render_settings: RenderSettingsDock
@@ -99,12 +106,42 @@ class WindowBase(_QtWindow):
     scene_loading: SceneLoading        # (window.py)
     scene_edits: SceneEdits            # (window.py)
     view_scheduler: ViewScheduler      # (window.py)
+    time_views: TimeViews              # (window.py)
+    busy: BusyStatus                   # (window.py)
     recent_menu: QMenu                 # (window.py)
     action_fly: QAction
     fly: FlyMode                       # (window.py)
     status_label: QLabel
     progress_bar: QProgressBar
     cancel_button: QPushButton
+    probe: ProbeTool
+    tf_dock: QDockWidget
+    scene_dock: QDockWidget
+    settings_dock: QDockWidget
+    timeline_dock: QDockWidget
+    stats_dock: QDockWidget
+    clip_dock: QDockWidget
+    slices_dock: QDockWidget
+    iso_dock: QDockWidget
+    docks: list[QDockWidget]
+    slice_tool: SliceTool
+    iso_tool: IsoTool
+    undo_group: QUndoGroup
+    action_undo: QAction
+    action_redo: QAction
+    action_open_data: QAction
+    action_open_folder: QAction
+    action_open_session: QAction
+    action_save_session: QAction
+    action_save_session_as: QAction
+    action_export_screenshot: QAction
+    action_export_movie: QAction
+    export_dialogs: ExportDialogs
+    scalar_bar_editor: ScalarBarEditor
+    log_scale_status: LogScaleStatus
+    python_console: PythonConsole
+    help: HelpMenu
+    file_drop: FileDrop
 
     if TYPE_CHECKING:
         # -- MainWindow
@@ -133,6 +170,3 @@ class WindowBase(_QtWindow):
         def _tf_changed(self, tf: Any) -> None: ...
         def _tf_committed(self, tf: Any) -> None: ...
 
-        # -- WindowWidgets
-        def _set_busy(self, busy: bool) -> None: ...
-        def _busy_elsewhere(self) -> bool: ...
