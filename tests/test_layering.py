@@ -33,7 +33,8 @@ def test_ruff_finds_nothing():
 
 def test_mypy_finds_nothing():
     """The types of pyproject.toml's [tool.mypy] (issue #18: not strict yet, the bodies of unannotated functions
-    checked too) in the library, the app (its window's mixins through ``volviz_app.window_base``) and the plugins."""
+    checked too) in the library, the app (the window and its parts, typed through ``volviz_app.window_base``) and the
+    plugins."""
     mypy = shutil.which("mypy", path=str(Path(sys.executable).parent)) or shutil.which("mypy")
     assert mypy is not None, "mypy is a test dependency (pip install -e .[test])"
     done = subprocess.run([mypy, "volviz", "app", "plugins"], cwd=ROOT, capture_output=True, text=True, timeout=600)
