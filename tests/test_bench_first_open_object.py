@@ -158,19 +158,21 @@ def test_a_legibility_only_run_keeps_each_rows_time_and_measures_the_rest(tmp_pa
     read by its header's column names; the legibility columns are measured; a row's old legibility error is measured
     again, a render's error is kept (that file is not measured)."""
     doc = tmp_path / "first-open.md"
-    rows = [bench.FirstImage("ball.vti", 3.6, 4.2, 0.31, "volume", 0.9, 0.8, 50.0, "legibility: ValueError: x", 2.75),
+    rows = [bench.FirstImage("ball.vti", 3.6, 4.2, 0.31, "volume", 0.9, 0.8, 50.0, "legibility: ValueError: x", 2.75,
+                             4.9),
             bench.FirstImage("bad.vti", 0.0, note="bad.vti: cannot be read")]
     bench.write_section(bench.markdown(rows, {}), doc)
     kept = bench.kept_timings(doc)
-    assert kept == {"ball.vti": (4.2, 2.75, 0.31, ""), "bad.vti": (None, None, None, "bad.vti: cannot be read")}
+    assert kept == {"ball.vti": (4.2, 2.75, 0.31, "", 4.9), "bad.vti": (None, None, None, "bad.vti: cannot be read",
+                                                                    None)}
 
     data = tmp_path / "data"
     data.mkdir()
     _write_sphere(data / "ball.vti", np.full((97, 97, 97), 200.0))
     (data / "bad.vti").write_text("not a VTK file")
     bad, ball = bench.measure(data, timings=kept)           # in name order
-    assert (ball.name, ball.seconds, ball.cpu, ball.drawn, ball.note, ball.kind) == ("ball.vti", 4.2, 2.75, 0.31, "",
-                                                                                     "volume")
+    assert (ball.name, ball.seconds, ball.cpu, ball.drawn, ball.note, ball.kind, ball.slowest) == \
+        ("ball.vti", 4.2, 2.75, 0.31, "", "volume", 4.9)
     assert ball.visible is not None and ball.object_visible is not None and ball.contrast is not None
     assert ball.visible < ball.object_visible          # the sphere covers part of its box's footprint
     assert (bad.seconds, bad.drawn, bad.note, bad.kind, bad.visible) == (None, None, "bad.vti: cannot be read", "",

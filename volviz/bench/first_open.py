@@ -47,6 +47,7 @@ DEFAULT_DATA = Path(os.environ.get("VOLVIZ_DATA", Path(__file__).resolve().paren
 REPORT = Path(__file__).resolve().parents[2] / "docs" / "first-open.md"
 BEGIN, END = "<!-- volviz bench first_open: begin -->", "<!-- volviz bench first_open: end -->"
 COMMAND = "VOLVIZ_DATA=../shared/data .venv/bin/volviz bench first_open --profile 3"
+REPEATS = 3                    # timed runs per file after one untimed warm-up run (median reported, slowest too)
 SIZE = (1024, 768)
 METRIC_SIZE = (320, 240)       # the legibility measures render smaller (they compare shares, not details)
 VISIBLE_DE = 10.0              # CIE76 difference a viewer sees at a glance (2.3 is just noticeable)
@@ -54,8 +55,8 @@ DRAWN_DIFFERENCE = 24          # summed |RGB| difference from the background of 
 TARGET_S = 5.0
 PROFILE_HEAD = "Where the time goes for the slowest files"
 MAX_MB = 100
-#: a file's kept measures (``kept_timings``): wall seconds, CPU seconds, drawn share, note
-Timing = tuple[Optional[float], Optional[float], Optional[float], str]
+#: a file's kept measures (``kept_timings``): wall seconds, CPU seconds, drawn share, note, slowest wall seconds
+Timing = tuple[Optional[float], Optional[float], Optional[float], str, Optional[float]]
 
 
 def opened_files(root: Path) -> list[Path]:
@@ -162,6 +163,7 @@ class FirstImage:
     contrast: Optional[float] = None
     note: str = ""
     cpu: Optional[float] = None         # CPU seconds (user + system) of the render's process and its reader child
+    slowest: Optional[float] = None     # wall seconds of the slowest timed run
     profile: list[str] = field(default_factory=list)
 
 
@@ -322,11 +324,13 @@ def where_time_goes(path: Path, top: int = 6) -> list[str]:
 
 
 def measure(root: Path, names: Optional[list[str]] = None, boundary_rule: bool = False,
-            timings: Optional[dict[str, Timing]] = None) -> list[FirstImage]:
-    """Every file of ``opened_files`` (or those named in ``names``, relative to ``root``) measured; legibility with
-    the boundary rule where ``boundary_rule``; with ``timings`` (``kept_timings``: file -> seconds, CPU seconds,
-    drawn share, note) each file's times, drawn share and note are taken from there instead of rendering it
-    (legibility only)."""
+            timings: Optional[dict[str, Timing]] = None, repeats: int = REPEATS) -> list[FirstImage]:
+    """Every file of ``opened_files`` (or those named in ``names``, relative to ``root``) measured: one untimed
+    warm-up render (the file and the compiled kernels' cache read from disk once), then the median wall and CPU
+    seconds of ``repeats`` fresh processes and the slowest of them; legibility with the boundary rule where
+    ``boundary_rule``; with ``timings`` (``kept_timings``: file -> seconds, CPU seconds, drawn share, note,
+    slowest) each file's times, drawn share and note are taken from there instead of rendering it (legibility
+    only)."""
     records = []
     with tempfile.TemporaryDirectory() as work:
         for path in opened_files(root):
@@ -337,14 +341,18 @@ def measure(root: Path, names: Optional[list[str]] = None, boundary_rule: bool =
                 path.stat().st_size
             record = FirstImage(name, size / 1e6)
             if timings is not None:
-                record.seconds, record.cpu, record.drawn, record.note = timings.get(name, (None, None, None, ""))
+                record.seconds, record.cpu, record.drawn, record.note, record.slowest = \
+                    timings.get(name, (None, None, None, "", None))
             elif record.megabytes < MAX_MB:
                 out = Path(work) / "x.png"
-                seconds, cpu_seconds, status, last = render_timed(path, out)
+                runs = [render_timed(path, out) for _ in range(1 + max(repeats, 1))][1:]   # the first warms caches
+                status, last = runs[-1][2], runs[-1][3]
                 if status == 0:
                     from PIL import Image
 
-                    record.seconds, record.cpu = seconds, cpu_seconds
+                    record.seconds = float(np.median([run[0] for run in runs]))
+                    record.cpu = float(np.median([run[1] for run in runs]))
+                    record.slowest = max(run[0] for run in runs)
                     record.drawn = drawn_fraction(np.asarray(Image.open(out).convert("RGB")))
                 else:
                     record.note = last.removeprefix("volviz: error: ")
@@ -357,7 +365,8 @@ def measure(root: Path, names: Optional[list[str]] = None, boundary_rule: bool =
                     record.kind, prints, record.contrast = shown
                     if prints is not None:
                         record.visible, record.object_visible = prints.visible, prints.object_visible
-            print(f"{name}: {record.seconds} s (CPU {record.cpu} s) drawn {record.drawn} {record.kind} "
+            print(f"{name}: {record.seconds} s (slowest {record.slowest} s, CPU {record.cpu} s) drawn {record.drawn} "
+                  f"{record.kind} "
                   f"visible {record.visible} object {record.object_visible} contrast {record.contrast} "
                   f"{record.note}", flush=True)
             records.append(record)
@@ -368,8 +377,8 @@ def _number(value: Optional[float], fmt: str) -> str:
     return "" if value is None else format(value, fmt)
 
 
-def markdown(records: list[FirstImage], profiles: dict[str, list[str]], loads: Optional[tuple[str, str]] = None
-             ) -> str:
+def markdown(records: list[FirstImage], profiles: dict[str, list[str]], loads: Optional[tuple[str, str]] = None,
+             repeats: int = REPEATS) -> str:
     """The section of ``docs/first-open.md`` this benchmark writes (without its markers); ``loads``: the machine's
     load averages at the run's start and end, said when given."""
     import platform
@@ -377,12 +386,14 @@ def markdown(records: list[FirstImage], profiles: dict[str, list[str]], loads: O
     from volviz.optics.auto_tf import BACKGROUND_FRACTION, MODE_WIDTH
 
     lines = ["## `volviz render`: time to the first image, and legibility of the automatic transfer "
-             "function", "", "Regenerate (about 3 minutes):", "", "```", COMMAND, "```", "",
+             "function", "", "Regenerate (about 10 minutes):", "", "```", COMMAND, "```", "",
              f"The legibility columns alone, keeping each file's time, drawn share and notes (and the profiles) as "
              f"they are here: `{COMMAND.replace(' --profile 3', '')} --legibility-only`.", "",
-             f"Each file is rendered by `volviz render FILE -o x.png` ({SIZE[0]}x{SIZE[1]}) in a fresh process: "
-             "*first image* is that command's wall time (start-up, imports, reading, the transfer function, the "
-             f"render, the PNG); target under {TARGET_S:g} s for files under {MAX_MB} MB. *CPU* is the CPU time of "
+             f"Each file is rendered by `volviz render FILE -o x.png` ({SIZE[0]}x{SIZE[1]}) in a fresh process, "
+             f"once untimed (a warm-up: the file and the compiled kernels' cache come from disk), then {repeats} "
+             "times: *first image* is the median of that command's wall times (start-up, imports, reading, the "
+             "transfer function, the render, the PNG), *slowest* the longest of them; target under "
+             f"{TARGET_S:g} s for files under {MAX_MB} MB. *CPU* is the median CPU time of "
              "that process and the reader child it waited for (user + system, all threads), which a machine loaded "
              "by other work inflates far less than the wall time. *Drawn* is the share of "
              "the image's pixels that differ from the background. For volumes, *visible* is the share of the data's "
@@ -402,11 +413,13 @@ def markdown(records: list[FirstImage], profiles: dict[str, list[str]], loads: O
              f"{platform.machine()} with {os.cpu_count()} cores, Mesa llvmpipe, while other work ran"
              + (f"; load average (1, 5, 15 min) at the start {loads[0]}, at the end {loads[1]}." if loads else "."),
              "",
-             "| file | MB | drawn as | first image | CPU | drawn | visible | object visible | contrast (ΔE) | notes |",
-             "|---|---|---|---|---|---|---|---|---|---|"]
+             "| file | MB | drawn as | first image | slowest | CPU | drawn | visible | object visible | contrast (ΔE) "
+             "| notes |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in records:
         lines.append(f"| `{r.name}` | {r.megabytes:.1f} | {r.kind} | {_number(r.seconds, '.1f')}"
-                     f"{' s' if r.seconds is not None else ''} | {_number(r.cpu, '.2f')}"
+                     f"{' s' if r.seconds is not None else ''} | {_number(r.slowest, '.1f')}"
+                     f"{' s' if r.slowest is not None else ''} | {_number(r.cpu, '.2f')}"
                      f"{' s' if r.cpu is not None else ''} | {_number(r.drawn, '.0%')} | "
                      f"{_number(r.visible, '.0%')} | {_number(r.object_visible, '.0%')} | "
                      f"{_number(r.contrast, '.0f')} | {r.note.replace('|', '/')} |")
@@ -419,8 +432,9 @@ def markdown(records: list[FirstImage], profiles: dict[str, list[str]], loads: O
 
 
 def kept_timings(report: Path = REPORT) -> dict[str, Timing]:
-    """File -> (seconds, CPU seconds, drawn share, note) of the rows of ``report``'s section, read by its header's
-    column names (*first image*, *CPU*, *drawn*, *notes*): what a ``--legibility-only`` run keeps."""
+    """File -> (seconds, CPU seconds, drawn share, note, slowest seconds) of the rows of ``report``'s section, read
+    by its header's column names (*first image*, *CPU*, *drawn*, *notes*, *slowest*; a report without a column
+    gives None): what a ``--legibility-only`` run keeps."""
     from volviz.io.doc_section import read_section
 
     timings: dict[str, Timing] = {}
@@ -432,11 +446,12 @@ def kept_timings(report: Path = REPORT) -> dict[str, Timing]:
         elif line.startswith("| `") and columns:
             row = dict(zip(columns, cells))
             seconds, cpu, drawn = row.get("first image", ""), row.get("CPU", ""), row.get("drawn", "")
-            note = row.get("notes", "")            # a legibility error is measured again, a render's kept
+            note, slowest = row.get("notes", ""), row.get("slowest", "")   # a legibility error is measured again
             timings[cells[0].strip("`")] = (float(seconds.removesuffix(" s")) if seconds else None,
                                             float(cpu.removesuffix(" s")) if cpu else None,
                                             float(drawn.removesuffix("%")) / 100.0 if drawn else None,
-                                            "" if note.startswith("legibility:") else note)
+                                            "" if note.startswith("legibility:") else note,
+                                            float(slowest.removesuffix(" s")) if slowest else None)
     return timings
 
 
@@ -464,6 +479,8 @@ def main(argv: Optional[list[str]] = None) -> int:
     parser = UsageParser(prog="volviz bench first_open", description=__doc__.split("\n")[0])
     parser.add_argument("--data", type=Path, default=DEFAULT_DATA, help="the data folder (default $VOLVIZ_DATA)")
     parser.add_argument("--only", nargs="*", default=None, help="only these files (relative to the data folder)")
+    parser.add_argument("--repeats", type=int, default=REPEATS, help="timed runs per file after one untimed "
+                        f"warm-up; the median is reported (default {REPEATS})")
     parser.add_argument("--profile", type=int, default=0, help="say where the time goes for the N slowest files")
     parser.add_argument("--no-write", action="store_true", help="print only; leave docs/first-open.md alone")
     parser.add_argument("--legibility-only", action="store_true", help="measure only the legibility columns; keep "
@@ -473,11 +490,11 @@ def main(argv: Optional[list[str]] = None) -> int:
     args = parser.parse_args(argv)
     timings = kept_timings() if args.legibility_only else None
     load_start = ", ".join(f"{v:.1f}" for v in os.getloadavg())
-    records = measure(args.data.resolve(), args.only, args.boundary_rule, timings)
+    records = measure(args.data.resolve(), args.only, args.boundary_rule, timings, args.repeats)
     slowest = sorted((r for r in records if r.seconds is not None), key=lambda r: -float(r.seconds or 0))
     profiled = [] if args.legibility_only else slowest[:max(args.profile, 0)]
     profiles = {r.name: where_time_goes(args.data.resolve() / r.name) for r in profiled}
-    text = markdown(records, profiles, (load_start, ", ".join(f"{v:.1f}" for v in os.getloadavg())))
+    text = markdown(records, profiles, (load_start, ", ".join(f"{v:.1f}" for v in os.getloadavg())), args.repeats)
     if args.only or args.legibility_only:
         text = kept_rows(text, bool(profiles), [p.relative_to(args.data.resolve()).as_posix()
                                                  for p in opened_files(args.data.resolve())])
