@@ -210,6 +210,7 @@ def test_prefetched_and_reused_orders():
     pl.ren_win.Render()
     img = pl.screenshot(return_img=True)
     assert vol.stats["sorted"] and vol.stats["sort_prefetched"] and not vol.stats["order_reused"]
+    assert vol.order_texture and vol.stats["upload_s"] > 0       # the new order's texture upload, timed for the bench
     order = vol.order
     vol.reuse_order = True
     cams[0].apply_to(pl.renderer.GetActiveCamera())

@@ -136,8 +136,9 @@ def gl_pt_frames(mesh: Any, tf: Any, cams: list[Any], size: tuple[int, int], rep
     """Method "pt-gl" (``volviz.render.gl_pt``) in an offscreen PyVista window of ``size``: a warm-up render
     (shader compile, table and vertex buffer upload), then ``reps`` passes over the cameras, each render for a new
     camera (so each includes the sort and the index buffer upload). Returns the medians (wall ``frame_s``, the
-    sort and order-building seconds of the frame, the process CPU time ``cpu_s``, which on a software rasteriser
-    includes its threads) and the RGB image of ``cams[0]`` (float, premultiplied over black), plus the OpenGL renderer
+    sort and order-building seconds of the frame, the order texture's upload call ``upload_s`` where the volume
+    draws its order as a texture, the process CPU time ``cpu_s``, which on a software rasteriser includes its
+    threads) and the RGB image of ``cams[0]`` (float, premultiplied over black), plus the OpenGL renderer
     string.
 
     ``split``: also take the frame apart, for each camera after its timed frame: the same frame again (no new sort
@@ -161,6 +162,7 @@ def gl_pt_frames(mesh: Any, tf: Any, cams: list[Any], size: tuple[int, int], rep
     pl.camera_set = True
     pl.screenshot(return_img=True)
     frame, cpu, sort, order, same_cpu, one, draw = [], [], [], [], [], [], []  # same_cpu, one: CPU seconds
+    upload: list[float] = []                     # the order texture's upload call, timed by the volume
     for _ in range(reps):
         for cam in cams[1:] + cams[:1] if len(cams) > 1 else cams * 2:     # each render a new camera
             cam.apply_to(pl.renderer.GetActiveCamera())
@@ -171,6 +173,8 @@ def gl_pt_frames(mesh: Any, tf: Any, cams: list[Any], size: tuple[int, int], rep
             cpu.append(time.process_time() - c0)
             sort.append(vol.stats["sort_s"])
             order.append(vol.stats["order_s"])
+            if "upload_s" in vol.stats:
+                upload.append(vol.stats["upload_s"])
             if same:
                 draw.extend(timed_renders(ren_win, 1))
             if split:
@@ -192,6 +196,8 @@ def gl_pt_frames(mesh: Any, tf: Any, cams: list[Any], size: tuple[int, int], rep
            "order_texture": bool(vol.order_texture), "gpu_bytes_per_cell": vol.gpu_bytes() / mesh.n_cells}
     if same:
         res["draw_s"] = float(np.median(draw))
+    if upload:
+        res["upload_s"] = float(np.median(upload))
     if split:
         f, sa, on, so, od = (np.array(v) for v in (cpu, same_cpu, one, sort, order))
         res["same_s"], res["one_cell_s"] = float(np.median(sa)), float(np.median(on))
@@ -391,7 +397,8 @@ def main(argv: list[str] | None = None) -> int:
         images["pt-gl"] = gl_img
         print(f"pt-gl: {results['methods']['pt-gl']}", flush=True)
         if args.cpu_sizes:
-            results["cpu_side"] = cpu_side_scan(mesh, tf, cams[:2], [(64, 64), *args.cpu_sizes], args.gl_lookup)
+            results["cpu_side"] = cpu_side_scan(mesh, tf, cams[:2], [(64, 64), *args.cpu_sizes], args.gl_lookup,
+                                                args.reps)
         if args.interactive_sizes:
             results["interactive"] = interactive_rows(mesh, tf, cams[:2], args.interactive_sizes, args.reps,
                                                       args.gl_lookup, args.interactive_pixels)
@@ -488,7 +495,7 @@ def only_rows(args: argparse.Namespace, argv: list[str] | None) -> int:
                                         *_index_buffer_lines(ib, mesh.n_cells, "the Blunt Fin")])
     if "cpu" in args.only:
         load = os.getloadavg()[0]
-        results["cpu_side"] = cpu_side_scan(mesh, tf, cams, [(64, 64), *args.cpu_sizes], args.gl_lookup)
+        results["cpu_side"] = cpu_side_scan(mesh, tf, cams, [(64, 64), *args.cpu_sizes], args.gl_lookup, args.reps)
         text = splice(text, CPU_HEAD, [_run_note(command, load), *_cpu_side_lines(results["cpu_side"],
                                                                                   mesh.n_cells)])
     if "large" in args.only:
@@ -693,7 +700,7 @@ def large_mesh_row(mesh: Any, tf: Any, cams: list[Any], reps: int, draw: int = 2
     return row
 
 
-def cpu_side_scan(mesh: Any, tf: Any, cams: list[Any], sizes: list[tuple[int, int]], lookup: str
+def cpu_side_scan(mesh: Any, tf: Any, cams: list[Any], sizes: list[tuple[int, int]], lookup: str, reps: int = 1
                   ) -> list[dict[str, Any]]:
     """The CPU side of a pt-gl frame for a new camera at each window size (``gl_pt_frames`` with ``split``: sort,
     order, index buffer or order texture upload, draw submission; one pass over ``cams``). ``sizes`` starts with a
@@ -701,16 +708,20 @@ def cpu_side_scan(mesh: Any, tf: Any, cams: list[Any], sizes: list[tuple[int, in
     one-cell frame also fills the window's full-screen passes (the float target's clear and resolve), GPU work that
     a GPU does off the CPU, reported apart (``passes_s``); the upload is the small window's too (the order's upload
     does not depend on the window, and at a large one it drowns in the difference of two seconds-long llvmpipe
-    frames); ``cpu_side_s`` = sort + order (at each size) + that upload + that submission."""
+    frames); ``cpu_side_s`` = sort + order (at each size) + that upload + that submission. With the order as a
+    texture the upload is the texture upload call as the volume times it (``upload_s``; the frame difference,
+    ``ibo_s``, is kept beside it); with VTK's index buffer it is that difference. ``reps`` passes over ``cams``
+    per size (medians)."""
     rows: list[dict[str, Any]] = []
     for w, h in sizes:
-        res, _ = gl_pt_frames(mesh, tf, cams, (w, h), 1, lookup, split=True)
+        res, _ = gl_pt_frames(mesh, tf, cams, (w, h), reps, lookup, split=True)
         row = {"size": [w, h], **{k: res[k] for k in ("frame_s", "cpu_s", "sort_s", "order_s", "ibo_s",
                                                        "one_cell_s", "draw_work_s", "cpu_side_proper_s",
                                                        "order_texture")}}
+        row["upload_s"] = res.get("upload_s", res["ibo_s"])
         base = rows[0] if rows else row
         row["passes_s"] = max(row["one_cell_s"] - base["one_cell_s"], 0.0)
-        row["cpu_side_s"] = row["sort_s"] + row["order_s"] + base["ibo_s"] + base["one_cell_s"]
+        row["cpu_side_s"] = row["sort_s"] + row["order_s"] + base["upload_s"] + base["one_cell_s"]
         rows.append(row)
         print(f"cpu side {w}x{h}: {row}", flush=True)
     return rows
@@ -1050,14 +1061,17 @@ def _cpu_side_lines(rows: list[dict[str, Any]] | None, n_tets: int) -> list[str]
         return []
     texture = rows[0].get("order_texture", False)
     base = rows[0]
-    lines = ["", "The CPU side of a pt-gl frame for a new camera against window size (2 cameras, one frame each, "
+    lines = ["", "The CPU side of a pt-gl frame for a new camera against window size (2 cameras, --reps frames each, "
              "every timed Render() ending with WaitForCompletion; the order "
              + ("as a texture of cell ids read by the vertex shader, the index buffer static"
                 if texture else "as VTK's index buffer") + "): the sort and the order (wall seconds of the volume's "
-             "own timings), measured at each size; the upload (the frame minus the same frame drawn again without a "
-             "new order, minus sort and order: " + ("the order texture" if texture else "VTK's index buffer build "
-             "and upload") + "; process CPU seconds; at a large window it drowns in the difference of two "
-             "seconds-long llvmpipe frames, shown in the last column) and the draw submission (the same frame with "
+             "own timings), measured at each size; the upload (" + ("the order texture's upload call as the "
+             "volume times it, wall seconds; the frame minus the same frame drawn again without a new order, minus "
+             "sort and order, is in the last column: in process CPU seconds it is the difference of two llvmpipe "
+             "frames, noise of several milliseconds" if texture else "the frame minus the same frame drawn again "
+             "without a new order, minus sort and order: VTK's index buffer build and upload; process CPU seconds; at "
+             "a large window it drowns in the difference of two seconds-long llvmpipe frames, shown in the last "
+             "column") + ") and the draw submission (the same frame with "
              "one cell drawn, process CPU seconds), neither of which depends on the window, measured "
              f"in the {base['size'][0]}x{base['size'][1]} window, where llvmpipe's fill is nil: at larger windows "
              "llvmpipe's one-cell frame also fills the window's full-screen passes (the float target's clear and "
@@ -1070,7 +1084,8 @@ def _cpu_side_lines(rows: list[dict[str, Any]] | None, n_tets: int) -> list[str]
     for r in rows:
         side = r.get("cpu_side_s", r["cpu_side_proper_s"])
         lines.append(f"| {r['size'][0]}x{r['size'][1]} | {r['frame_s']:.3f} | {r['sort_s']:.4f} | "
-                     f"{r['order_s']:.4f} | {base['ibo_s']:.4f} | {base['one_cell_s']:.4f} | **{side * 1e3:.1f} ms** | "
+                     f"{r['order_s']:.4f} | {base.get('upload_s', base['ibo_s']):.4f} | {base['one_cell_s']:.4f} | "
+                     f"**{side * 1e3:.1f} ms** | "
                      f"{r.get('passes_s', 0.0):.4f} | {r['draw_work_s']:.3f} | {r['ibo_s']:.4f} |")
     ref = next((r for r in rows if tuple(r["size"]) == (512, 512)), None)
     if ref is not None:
