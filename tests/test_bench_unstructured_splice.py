@@ -42,3 +42,34 @@ def test_only_refuses_unknown_rows_and_a_large_row_without_a_refinement():
         main(["--only", "sort,raster"])
     with pytest.raises(UsageError, match="--only large needs --large-refine > 1"):
         main(["--only", "large"])
+
+
+def test_each_block_keeps_one_run_note_when_several_are_spliced_in_turn():
+    """``--only sort,cpu`` on a report whose blocks each start with a run note: each block's note is replaced, the
+    next block's note is left to it (the run note was taken for the CPU block's ratio line, which came last among
+    the block tails: the sort and CPU blocks got two notes each and the large block lost its own)."""
+    from volviz.bench.unstructured import CPU_HEAD, RUN_NOTE
+
+    def note(what: str) -> str:
+        return f"{RUN_NOTE} of their own, spliced into this report: `{what}`.)"
+
+    report = "\n".join([
+        "# Report", "",
+        note("cpu old"), "", f"{CPU_HEAD} (old):", "", "| window | s |", "|---|---|", "| 64x64 | 1 |", "",
+        "The CPU side against its cost at 512²: 1.00x.", "",
+        note("sort old"), "", f"{SORT_HEAD} (old):", "", "| mpvo | 0.1 |", "",
+        "The order as the GPU pass's index buffer: 1 ms.", "",
+        note("large old"), "", f"{LARGE_HEAD} old numbers.", "", "Drawn at 256² old draw.", "",
+        "Speed-up of pt over the fastest VTK mapper in this run: **1.04x** (target ≥ 5x).", ""])
+    out = splice(report, SORT_HEAD, [note("sort new"), "", f"{SORT_HEAD} (new):", "", "| mpvo | 0.01 |", "",
+                                     "The order as the GPU pass's index buffer: 2 ms."])
+    out = splice(out, CPU_HEAD, [note("cpu new"), "", f"{CPU_HEAD} (new):", "", "| 64x64 | 2 |", "",
+                                 "The CPU side against its cost at 512²: 0.99x."])
+    assert out.split("\n") == [
+        "# Report", "",
+        note("cpu new"), "", f"{CPU_HEAD} (new):", "", "| 64x64 | 2 |", "",
+        "The CPU side against its cost at 512²: 0.99x.", "",
+        note("sort new"), "", f"{SORT_HEAD} (new):", "", "| mpvo | 0.01 |", "",
+        "The order as the GPU pass's index buffer: 2 ms.", "",
+        note("large old"), "", f"{LARGE_HEAD} old numbers.", "", "Drawn at 256² old draw.", "",
+        "Speed-up of pt over the fastest VTK mapper in this run: **1.04x** (target ≥ 5x).", ""]

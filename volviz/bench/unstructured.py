@@ -516,7 +516,7 @@ def only_rows(args: argparse.Namespace, argv: list[str] | None) -> int:
 
 
 def _run_note(command: str, load: float) -> str:
-    return (f"(The rows below come from a run of their own, spliced into this report: `{command}`, "
+    return (f"{RUN_NOTE} of their own, spliced into this report: `{command}`, "
             f"{time.strftime('%Y-%m-%d %H:%M')} UTC, 1-minute load average {load:.1f} at its start and "
             f"{os.getloadavg()[0]:.1f} at its end on the 2 shared cores.)")
 
@@ -526,8 +526,8 @@ SORT_HEAD, LARGE_HEAD = "Sort seconds against window size", "Large mesh:"
 CPU_HEAD = "The CPU side of a pt-gl frame for a new camera"
 EXACT_HEAD = "Against the exact float64 reference at the window's size"
 #: paragraphs that belong to a block (besides its table rows and blank lines)
-_BLOCK_TAILS = ("Drawn at ", "The order as the GPU pass's index buffer", "(The rows below come from a run",
-                "The CPU side against its cost")
+RUN_NOTE = "(The rows below come from a run"       # a block's first line when a run of its own made it
+_BLOCK_TAILS = ("Drawn at ", "The order as the GPU pass's index buffer", RUN_NOTE, "The CPU side against its cost")
 
 
 def splice(text: str, head: str, block: list[str]) -> str:
@@ -543,11 +543,11 @@ def splice(text: str, head: str, block: list[str]) -> str:
         at = next((i for i, ln in enumerate(lines) if ln.startswith("Speed-up of pt")), len(lines))
         return "\n".join(lines[:at] + block + [""] + lines[at:])
     end = start + 1
-    if start >= 2 and lines[start - 2].startswith(_BLOCK_TAILS[-1]):
+    if start >= 2 and lines[start - 2].startswith(RUN_NOTE):
         start -= 2
     while end < len(lines) and (lines[end] == "" or lines[end].startswith("|")
                                 or (lines[end].startswith(_BLOCK_TAILS) and not lines[end].startswith(head))):
-        if lines[end].startswith(_BLOCK_TAILS[-1]):
+        if lines[end].startswith(RUN_NOTE):
             break                                   # the next block's run note
         end += 1
     while end > start + 1 and lines[end - 1] == "":
