@@ -152,7 +152,7 @@ def test_log_color_scale_puts_the_tf_editor_axis_in_log_and_says_what_it_clamps(
     from flows import widget_pixels
     from volviz.scene.drawn_tf import drawn_tf
 
-    from volviz_app.docks.tf_editor import COLOR_BAR_HEIGHT, MARGIN
+    from volviz_app.docks.tf_canvas import COLOR_BAR_HEIGHT, MARGIN
 
     from volviz.optics.transfer_function import TransferFunction
 
