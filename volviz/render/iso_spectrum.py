@@ -17,9 +17,13 @@ them).
 """
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING
 
 from volviz.iso.spectrum import SpectrumFit, fit_spectrum
+
+if TYPE_CHECKING:   # type-only: the surface and VTK's actor, not imported at run time
+    from volviz.iso.extract import IsoMesh
+    from volviz.render.vtk_facade import vtkActor
 
 __all__ = ["apply_spectrum_shader", "iso_actor", "SPECTRUM_GLSL"]
 
@@ -33,7 +37,7 @@ SPECTRUM_GLSL = """//VTK::Light::Impl
 """
 
 
-def apply_spectrum_shader(actor: Any, opacity: float, parallel: bool = False) -> SpectrumFit:
+def apply_spectrum_shader(actor: vtkActor, opacity: float, parallel: bool = False) -> SpectrumFit:
     """Install the iso-spectrum alpha on ``actor`` (a vtkActor with a vtkOpenGLPolyDataMapper); returns the fit.
 
     ``parallel``: the camera uses parallel projection (call again when it changes).
@@ -50,7 +54,7 @@ def apply_spectrum_shader(actor: Any, opacity: float, parallel: bool = False) ->
     return fit
 
 
-def iso_actor(mesh: Any, parallel: bool = False, spectrum: bool = True) -> Any:
+def iso_actor(mesh: IsoMesh, parallel: bool = False, spectrum: bool = True) -> vtkActor:
     """A vtkActor for an ``IsoMesh`` (vtkOpenGLPolyDataMapper, the surface color, Phong-interpolated normals).
 
     Translucent surfaces get the iso-spectrum shader when ``spectrum`` is true, else constant opacity; VTK then

@@ -6,18 +6,21 @@ VTK's cell picker hits, with its nearest point's value."""
 from __future__ import annotations
 
 import weakref
-from typing import Any, Optional
+from typing import TYPE_CHECKING, Any, Optional
 
 import numpy as np
 
 from volviz.model.probe import ProbeResult, probe_regular
+
+if TYPE_CHECKING:   # type-only: VTK's renderer, reached through the facade at run time
+    from volviz.render.vtk_facade import vtkRenderer
 
 # id(dataset) -> (weak reference to it, its tetrahedra): the datasets are dataclasses compared by value, so no weak
 # dictionary can key them; an entry leaves with its dataset
 _TETS: dict[int, tuple[weakref.ref[Any], Any]] = {}
 
 
-def pick_ray(renderer: Any, x: float, y: float) -> tuple[np.ndarray, np.ndarray]:
+def pick_ray(renderer: vtkRenderer, x: float, y: float) -> tuple[np.ndarray, np.ndarray]:
     """The world-space ray (origin on the near plane, unit direction) through display pixel (x, y) of ``renderer``
     (VTK's display coordinates: y up from the bottom)."""
     ends = []

@@ -59,8 +59,9 @@ from vtkmodules.vtkRenderingVolume import (  # noqa: F401
     vtkProjectedTetrahedraMapper, vtkUnstructuredGridVolumeRayCastMapper, vtkUnstructuredGridVolumeZSweepMapper)
 from vtkmodules.vtkRenderingVolumeOpenGL2 import vtkMultiBlockVolumeMapper, vtkSmartVolumeMapper  # noqa: F401
 
-if TYPE_CHECKING:   # a type other modules of render annotate with; not one ``vtk`` holds (no caller makes one)
+if TYPE_CHECKING:   # types other modules of render annotate with; not ones ``vtk`` holds (no caller makes one)
     from vtkmodules.vtkRenderingCore import vtkProp  # noqa: F401
+    from vtkmodules.vtkRenderingOpenGL2 import vtkOpenGLRenderWindow, vtkShaderProgram  # noqa: F401
 
 #: the VTK classes and constants imported above, by their VTK names: ``vtk.vtkActor()`` as with VTK's own module
 vtk = SimpleNamespace(**{name: value for name, value in dict(globals()).items()
@@ -70,10 +71,10 @@ __all__ = ["box_corners_polydata", "numpy_to_vtk", "premultiplied_texture", "sha
            "vtk", "vtk_to_numpy"]
 
 
-def shader_observer(fn: Callable[[Any], None]) -> Callable[..., None]:
+def shader_observer(fn: Callable[[vtkShaderProgram], None]) -> Callable[..., None]:
     """An ``UpdateShaderEvent`` callback that calls ``fn(program)`` with the program being bound (none: not called)."""
 
-    def on_update_shader(caller: Any, event: str, program: Any = None) -> None:
+    def on_update_shader(caller: Any, event: str, program: vtkShaderProgram | None = None) -> None:
         if program is not None:
             fn(program)
 
@@ -81,7 +82,7 @@ def shader_observer(fn: Callable[[Any], None]) -> Callable[..., None]:
     return on_update_shader
 
 
-def premultiplied_texture() -> Any:
+def premultiplied_texture() -> vtkTexture:
     """A 1x1 white texture with PremultipliedAlphaOn: VTK then blends the actor with (ONE, ONE_MINUS_SRC_ALPHA) and
     restores its blend state after it."""
     img = vtk.vtkImageData()
@@ -95,7 +96,7 @@ def premultiplied_texture() -> Any:
 
 
 def shared_polydata(points: np.ndarray, attributes: dict[str, np.ndarray],
-                    connectivity: np.ndarray | None = None) -> Any:
+                    connectivity: np.ndarray | None = None) -> vtkPolyData:
     """A vtkPolyData sharing NumPy vertex buffers (no copy; the VTK arrays keep them referenced): float32 ``points``
     (n, 3), named per-vertex ``attributes``, triangles ``connectivity`` (3 indices each; None: no cells yet, e.g.
     when a visibility order sets them later). 32-bit ``connectivity`` keeps VTK's cells in 32-bit storage, from which
@@ -116,7 +117,7 @@ def shared_polydata(points: np.ndarray, attributes: dict[str, np.ndarray],
     return pd
 
 
-def box_corners_polydata(bounds: np.ndarray, triangles: Sequence[tuple[int, int, int]] = ()) -> Any:
+def box_corners_polydata(bounds: np.ndarray, triangles: Sequence[tuple[int, int, int]] = ()) -> vtkPolyData:
     """Poly data with the 8 corners of ``bounds`` (3, 2) as float32 points (corner i at x = bounds[0][i & 1],
     y = bounds[1][(i >> 1) & 1], z = bounds[2][(i >> 2) & 1]), the ``triangles`` given, and the zero-area triangle
     (0, 7, 7) between opposite corners. VTK's mappers take their bounds (frustum culling, the camera's clipping range)

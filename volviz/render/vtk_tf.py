@@ -4,11 +4,14 @@ docs/design.md "Opacity conventions differ"): what VTK's own mappers, the scalar
 """
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from volviz.optics.transfer_function import TransferFunction
+
+if TYPE_CHECKING:   # type-only: VTK's classes, reached through the facade at run time
+    from volviz.render.vtk_facade import vtkColorTransferFunction, vtkPiecewiseFunction
 
 __all__ = ["tf_from_vtk", "tf_to_vtk"]
 
@@ -17,7 +20,7 @@ __all__ = ["tf_from_vtk", "tf_to_vtk"]
 TOP_GUARD = 1e-3
 
 
-def tf_from_vtk(ctf: Any, otf: Any, unit_distance: float, name: str = "",
+def tf_from_vtk(ctf: vtkColorTransferFunction, otf: vtkPiecewiseFunction, unit_distance: float, name: str = "",
                 samples: int = 256) -> TransferFunction:
     """From a ``vtkColorTransferFunction`` (κ) and a ``vtkPiecewiseFunction`` (opacity a): ρ = a / unit_distance.
 
@@ -71,7 +74,7 @@ def tf_from_vtk(ctf: Any, otf: Any, unit_distance: float, name: str = "",
     return TransferFunction(s, np.clip(colors, 0.0, None), np.clip(opacity, 0.0, None) / unit_distance, name=name)
 
 
-def tf_to_vtk(tf: TransferFunction, unit_distance: float) -> tuple[Any, Any]:
+def tf_to_vtk(tf: TransferFunction, unit_distance: float) -> tuple[vtkColorTransferFunction, vtkPiecewiseFunction]:
     """``tf`` as ``(vtkColorTransferFunction, vtkPiecewiseFunction)`` with opacity a = ρ · unit_distance.
 
     Set the same ``unit_distance`` as the volume property's ``ScalarOpacityUnitDistance``. Clamping is turned off

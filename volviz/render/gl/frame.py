@@ -4,15 +4,19 @@ interpolated varyings) and the resolve's geometry (one triangle over the viewpor
 culls it with the pass)."""
 from __future__ import annotations
 
-from typing import Any, Sequence
+from typing import TYPE_CHECKING, Sequence
 
 import numpy as np
+
+if TYPE_CHECKING:   # type-only: the camera's ray basis and VTK's classes, not imported at run time
+    from volviz.model.camera import RayBasis
+    from volviz.render.vtk_facade import vtkPolyData, vtkShaderProgram
 
 __all__ = ["resolve_polydata", "set_ray_uniforms"]
 
 
-def set_ray_uniforms(program: Any, rays: Any, view_height: float, clip_range: Sequence[float], parallel: bool
-                     ) -> None:
+def set_ray_uniforms(program: vtkShaderProgram, rays: RayBasis, view_height: float, clip_range: Sequence[float],
+                     parallel: bool) -> None:
     """The uniforms of ``ray_pixel.glsl``: the ray basis ``rays`` (``Camera.rays``: o0, ox, oy, d0, dx, dy) of a
     target ``view_height`` pixels high, the camera's near and far planes ``clip_range``, parallel projection."""
     for name, v in (("rayO0", rays.o0), ("rayOx", rays.ox), ("rayOy", rays.oy), ("rayD0", rays.d0),
@@ -23,7 +27,7 @@ def set_ray_uniforms(program: Any, rays: Any, view_height: float, clip_range: Se
     program.SetUniformi("parallelView", int(parallel))
 
 
-def resolve_polydata(bounds: np.ndarray) -> Any:
+def resolve_polydata(bounds: np.ndarray) -> vtkPolyData:
     """The resolve's geometry: the 8 corners of ``bounds`` (3, 2) in the actor's bounds, so that VTK culls it with
     the pass, and the triangle (0, 1, 2), which ``pt_resolve_vs.glsl`` places over the viewport by ``gl_VertexID``
     (vertex 7 of the bounds' zero-area triangle lands on vertex 0)."""

@@ -7,7 +7,10 @@ resources). The shared passes are kept here by renderer, not on the renderer."""
 from __future__ import annotations
 
 import weakref
-from typing import Any
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:   # type-only: VTK's classes, reached through the facade at run time
+    from volviz.render.vtk_facade import vtkRenderer, vtkTextureObject
 
 __all__ = ["ScenePass"]
 
@@ -16,9 +19,9 @@ class ScenePass:
     """The float scene target installed on ``renderer`` (``framebuffer``: the ``vtkFramebufferPass``) and the
     objects using it (``users``). Made by ``acquire``; found by ``of``."""
 
-    _installed: weakref.WeakKeyDictionary[Any, ScenePass] = weakref.WeakKeyDictionary()
+    _installed: weakref.WeakKeyDictionary[vtkRenderer, ScenePass] = weakref.WeakKeyDictionary()
 
-    def __init__(self, renderer: Any) -> None:
+    def __init__(self, renderer: vtkRenderer) -> None:
         from volviz.render.vtk_facade import vtk
 
         self.renderer = renderer
@@ -28,12 +31,12 @@ class ScenePass:
         self.framebuffer.SetDelegatePass(vtk.vtkRenderStepsPass())
 
     @classmethod
-    def of(cls, renderer: Any) -> ScenePass | None:
+    def of(cls, renderer: vtkRenderer) -> ScenePass | None:
         """The scene target installed on ``renderer``, or None."""
         return cls._installed.get(renderer)
 
     @classmethod
-    def acquire(cls, renderer: Any, user: object) -> ScenePass:
+    def acquire(cls, renderer: vtkRenderer, user: object) -> ScenePass:
         """The renderer's scene target (installed now if it has none), with ``user`` counted as one of its users;
         the renderer's depth peeling and OIT are switched off (translucent props drawn in order)."""
         renderer.SetUseDepthPeeling(False)
@@ -54,9 +57,9 @@ class ScenePass:
         ren_win = self.renderer.GetRenderWindow()
         if ren_win is not None:
             self.framebuffer.ReleaseGraphicsResources(ren_win)
-        self.renderer.SetPass(None)
+        self.renderer.SetPass(None)  # type: ignore[arg-type]  # VTK takes None (no pass); its stubs do not say so
         del self._installed[self.renderer]
 
-    def depth_texture(self) -> Any:
+    def depth_texture(self) -> vtkTextureObject:
         """The depth texture of the scene target (the opaque scene's depth while the translucent props draw)."""
         return self.framebuffer.GetDepthTexture()

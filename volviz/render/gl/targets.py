@@ -4,16 +4,23 @@ emulation of a texture buffer), the depth format of a framebuffer's depth attach
 formats), and releasing them. ``ren_win`` is the render window whose context they live in."""
 from __future__ import annotations
 
-from typing import Any, Iterable
+from typing import TYPE_CHECKING, Callable, Iterable, Optional, Union
 
 import numpy as np
+
+if TYPE_CHECKING:   # type-only: VTK's classes, reached through the facade at run time
+    from volviz.render.vtk_facade import vtkOpenGLFramebufferObject, vtkOpenGLRenderWindow, vtkTextureObject
+
+    #: a texture with the framebuffer object it is attached to
+    Target = tuple[vtkTextureObject, vtkOpenGLFramebufferObject]
 
 __all__ = ["color_target", "depth_format", "depth_target", "release", "table_texture", "texel_array"]
 
 _DEPTH_FORMATS = {0x81A5: "Fixed16", 0x81A6: "Fixed24", 0x81A7: "Fixed32", 0x8CAC: "Float32"}  # GL internal formats
 
 
-def _attached(ren_win: Any, tex: Any, attach: Any) -> tuple[Any, Any]:
+def _attached(ren_win: vtkOpenGLRenderWindow, tex: vtkTextureObject,
+              attach: Callable[[vtkOpenGLFramebufferObject, vtkTextureObject], None]) -> Target:
     """(``tex``, a new framebuffer object with ``tex`` attached by ``attach(fbo, tex)``), the caller's binding kept."""
     from volviz.render.vtk_facade import vtk
 
@@ -26,7 +33,7 @@ def _attached(ren_win: Any, tex: Any, attach: Any) -> tuple[Any, Any]:
     return tex, fbo
 
 
-def color_target(ren_win: Any, width: int, height: int, components: int, linear: bool) -> tuple[Any, Any]:
+def color_target(ren_win: vtkOpenGLRenderWindow, width: int, height: int, components: int, linear: bool) -> Target:
     """(texture, framebuffer object): a float32 color target of ``components`` channels; ``linear``: filtered
     linearly and clamped to its edges (a target sampled between texels), else nearest."""
     from volviz.render.vtk_facade import vtk
@@ -43,7 +50,7 @@ def color_target(ren_win: Any, width: int, height: int, components: int, linear:
     return _attached(ren_win, tex, lambda fbo, t: fbo.AddColorAttachment(0, t))
 
 
-def depth_target(ren_win: Any, width: int, height: int, fmt: int) -> tuple[Any, Any]:
+def depth_target(ren_win: vtkOpenGLRenderWindow, width: int, height: int, fmt: int) -> Target:
     """(texture, framebuffer object): a depth target of the vtkTextureObject depth format ``fmt`` (read by
     texelFetch: no filtering)."""
     from volviz.render.vtk_facade import vtk
@@ -54,7 +61,7 @@ def depth_target(ren_win: Any, width: int, height: int, fmt: int) -> tuple[Any, 
     return _attached(ren_win, tex, lambda fbo, t: fbo.AddDepthAttachment(t))
 
 
-def depth_format(depth_texture: Any) -> int:
+def depth_format(depth_texture: Optional[vtkTextureObject]) -> int:
     """The vtkTextureObject depth format of ``depth_texture`` (a framebuffer's depth attachment; None: Fixed32)."""
     from volviz.render.vtk_facade import vtk
 
@@ -62,7 +69,7 @@ def depth_format(depth_texture: Any) -> int:
     return int(getattr(vtk.vtkTextureObject, _DEPTH_FORMATS.get(internal, "Fixed32")))
 
 
-def table_texture(ren_win: Any, data: np.ndarray, layered: bool) -> Any:
+def table_texture(ren_win: vtkOpenGLRenderWindow, data: np.ndarray, layered: bool) -> vtkTextureObject:
     """A float32 RGBA lookup table, linear and clamped to its edges: ``data`` (nz, ny, nx, 4) as a 3D texture, or
     (``layered``) as a 2D array of nz layers (bilinear within a layer: 4 taps instead of 8)."""
     from volviz.render.vtk_facade import vtk
@@ -82,7 +89,8 @@ def table_texture(ren_win: Any, data: np.ndarray, layered: bool) -> Any:
     return tex
 
 
-def texel_array(ren_win: Any, texels: np.ndarray, what: str, into: Any = None) -> Any:
+def texel_array(ren_win: vtkOpenGLRenderWindow, texels: np.ndarray, what: str,
+                into: Optional[vtkTextureObject] = None) -> vtkTextureObject:
     """``texels`` (n, components) as float32 texels in VTK's 2D emulation of a texture buffer (read by index in the
     shader with the texture's width); ``what`` names it in the error when OpenGL refuses it. ``into``: a texture
     made here before, whose storage is replaced (a per-frame upload keeps one texture object)."""
@@ -98,7 +106,8 @@ def texel_array(ren_win: Any, texels: np.ndarray, what: str, into: Any = None) -
     return tex
 
 
-def release(ren_win: Any, objects: Iterable[Any]) -> None:
+def release(ren_win: Optional[vtkOpenGLRenderWindow],
+            objects: Iterable[Union[vtkTextureObject, vtkOpenGLFramebufferObject, None]]) -> None:
     """Free the GL resources of ``objects`` (textures, framebuffer objects; None skipped) in ``ren_win``'s context
     (none without a window: nothing to free)."""
     if ren_win is None:
