@@ -93,6 +93,7 @@ def _leave_a_core_free() -> None:
     """Parallel Numba kernels started from this worker thread use all cores but one (a per-thread setting), so the
     UI thread and the display server are never starved while background work runs."""
     try:
+        # Numba (heavy): only in a worker thread, where kernels run
         import numba
     except ImportError:  # pragma: no cover - numba is a dependency
         return

@@ -35,7 +35,11 @@ from typing import TYPE_CHECKING, Any, Callable, get_args
 
 from volviz.io._checks import path_kind
 from volviz.io.atomic import OutputPathError, atomic_write_bytes
+from volviz.io.errors import ReadError
 from volviz.io.jsonbounds import nesting_depth, outside_strings
+from volviz.io.option_check import OptionProblem, check_reader_options
+from volviz.io.registry import reader_specs
+from volviz.io.series import expand_pattern
 from volviz.model.clip import BoxCrop, ClipPlane, ClipSettings
 from volviz.model.events import ChangeNotifier, SceneChange
 from volviz.model.settings import Backend, IsoOverlayMode, SettingsError, validate_render_options, validate_settings
@@ -646,8 +650,6 @@ def _check_dataset_path(session_file: Path, stored: str, where: str) -> None:
 def _check_dataset_options(session_file: Path, ref: DatasetRef, where: str) -> None:
     """The options of a dataset that exists, checked against its reader (``volviz.io.option_check``): an unknown
     option, a missing one or a value of another type is refused here, naming the field."""
-    from volviz.io.option_check import OptionProblem, check_reader_options
-
     try:
         check_reader_options(resolve_path(session_file, ref.path), ref.options)
     except OptionProblem as exc:
@@ -657,8 +659,6 @@ def _check_dataset_options(session_file: Path, ref: DatasetRef, where: str) -> N
 
 
 def _read_as_folder(folder: Path) -> bool:
-    from volviz.io.registry import reader_specs
-
     return any(spec.opens_folder(folder) for spec in reader_specs())
 
 
@@ -717,9 +717,6 @@ def _present(path: Path) -> bool:
         return True
     if not re.search(r"%0?\d*d|[*?\[]", path.name):
         return False
-    from volviz.io.errors import ReadError
-    from volviz.io.series import expand_pattern
-
     try:
         return any(p.exists() for _, p in expand_pattern(str(path)))
     except (ReadError, OSError):

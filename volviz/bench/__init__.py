@@ -2,6 +2,7 @@
 dependency (``pip install 'volviz[bench]'``)."""
 from __future__ import annotations
 
+import importlib.util
 from typing import Any
 
 from volviz.argtypes import UsageError
@@ -12,8 +13,6 @@ PLOTTING = ("tables", "unstructured", "compression", "nature", "iso", "lod_frame
 
 def require_plotting(name: str) -> None:
     """A UsageError before a plotting benchmark starts when matplotlib is missing (not after minutes of work)."""
-    import importlib.util
-
     if name in PLOTTING and importlib.util.find_spec("matplotlib") is None:
         raise UsageError(f"volviz bench {name} draws its figures with matplotlib, which is not installed: "
                          "pip install 'volviz[bench]'")
@@ -21,9 +20,9 @@ def require_plotting(name: str) -> None:
 
 def pyplot() -> Any:
     """matplotlib's pyplot on the Agg (file) backend."""
-    import matplotlib
+    import matplotlib  # optional (volviz[bench]): only the benches that draw figures
 
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    import matplotlib.pyplot as plt  # after use("Agg"), which must come first
 
     return plt

@@ -60,6 +60,7 @@ def field512(n: int = 512, seed: int = 6) -> np.ndarray:
 
 
 def _load(name: str) -> tuple[np.ndarray, float]:
+    # the readers (registry and plugins): loaded when a case first reads a file
     from volviz.io import read, read_slice_stack
 
     if name == "embryo":
@@ -100,6 +101,7 @@ def _row(method: str, setting: str, nbytes: int, vol: np.ndarray, rec: np.ndarra
 
 
 def _ours(vol: np.ndarray, peak: float, tmp: Path, reps: int, speed_at: set[str]) -> list[dict[str, Any]]:
+    # the kernels (Numba) of this case only: a bench loads what its cases run
     from volviz.model.datasets import RegularVolume
     from volviz.regular.codec import compress, decompress
 
@@ -123,6 +125,7 @@ def _ours(vol: np.ndarray, peak: float, tmp: Path, reps: int, speed_at: set[str]
 
 
 def _zfp(vol: np.ndarray, peak: float, reps: int) -> list[dict[str, Any]]:
+    # optional: zfpy (volviz[bench]), a peer measured beside volviz's codec
     import zfpy
 
     info = np.iinfo(vol.dtype)
@@ -137,6 +140,7 @@ def _zfp(vol: np.ndarray, peak: float, reps: int) -> list[dict[str, Any]]:
 
 
 def _blosc(vol: np.ndarray, peak: float, reps: int) -> list[dict[str, Any]]:
+    # optional: blosc2 (volviz[bench]), a peer measured beside volviz's codec
     import blosc2
 
     c = np.ascontiguousarray(vol)
@@ -147,6 +151,7 @@ def _blosc(vol: np.ndarray, peak: float, reps: int) -> list[dict[str, Any]]:
 
 def _wavelet_zstd(vol: np.ndarray, peak: float, reps: int) -> list[dict[str, Any]]:
     """Baseline: the same tiled 5/3 pyramid and quantiser, sign-mapped 16-bit coefficients, zstd level 19."""
+    # optional: zstandard (volviz[bench]), a peer measured beside volviz's codec
     import zstandard
 
     from volviz.regular import kernels as K
@@ -195,6 +200,7 @@ def _interp_psnr(rows: list[dict[str, Any]], method: str, bpv: float) -> float |
 
 
 def _plot(results: dict[str, list[dict[str, Any]]], out: Path) -> None:
+    # optional: matplotlib (volviz[bench]), only for the figures
     from volviz.bench import pyplot
 
     plt = pyplot()
@@ -281,6 +287,7 @@ def _series_psnr(ref: Sequence[np.ndarray], rec: Sequence[np.ndarray], idx: Sequ
 def _generated_series(n: int, size: int) -> list[np.ndarray]:
     """A smooth random 8-bit field (Gaussian-filtered noise) drifting by (0.8, 0.45, 0.3) voxels per step
     (sub-voxel motion, trilinear resampling) whose contrast slowly changes."""
+    # heavy: SciPy, only for this case
     from scipy import ndimage
 
     rng = np.random.default_rng(1)
@@ -299,6 +306,7 @@ def _generated_series(n: int, size: int) -> list[np.ndarray]:
 def _animation(name: str, vols: list[np.ndarray], settings: Sequence[float | None], tmp: Path
                ) -> list[dict[str, Any]]:
     """Ratio and PSNR per sequence type (Guthe Table 2.11), playback rate through the one-decode schedule."""
+    # the kernels (Numba) of this case only: a bench loads what its cases run
     from volviz.regular import animation as A
 
     rows = []
@@ -331,6 +339,7 @@ def _lod_walkthrough(vol: np.ndarray, tmp: Path, budgets: Sequence[int], frames:
                      render_frames: int = 0) -> list[dict[str, Any]]:
     """Per-frame LOD work along an orbit at 512^2: selection (Eq. 2.7 TF priority) + block decoding through the
     LRU cache; with ``render_frames`` also whole rendered frames (``volviz.bench.lod_frames``)."""
+    # the kernels (Numba) of this case only: a bench loads what its cases run
     from volviz.model.datasets import RegularVolume
     from volviz.optics import TransferFunction
     from volviz.regular.codec import compress
@@ -368,6 +377,7 @@ def _lod_walkthrough(vol: np.ndarray, tmp: Path, budgets: Sequence[int], frames:
                      "cache_hit_rate": tree.cache.hits / max(1, tree.cache.hits + tree.cache.misses),
                      "stats_s": stats_s})
     if render_frames > 0:        # the same budgets drawn offscreen (volviz.render.lod_volume) at 512^2
+        # another bench's module (it loads VTK or its own dependencies): only for this case
         from volviz.bench.lod_frames import render_walkthrough
 
         for row, r in zip(rows, render_walkthrough(tree, vol, tf, budgets, frames=render_frames, size=512)):
@@ -404,6 +414,7 @@ def _anim_markdown(anim: list[dict[str, Any]], lod: list[dict[str, Any]], cmd: s
                          f"{r['cache_hit_rate']:.2f} |")
         lines += ["", f"Node statistics (exact L2 errors, deviation histograms) took {lod[0]['stats_s']:.1f} s."]
         if "render_render_s_per_frame" in lod[0]:
+            # optional: matplotlib (volviz[bench]), only for the figures
             from volviz.bench import lod_frames
 
             lines += [""] + lod_frames.markdown(lod)
@@ -418,6 +429,7 @@ def _load_avg() -> str:
 
 
 def main_animation(args: argparse.Namespace, argv: Sequence[str] | None) -> int:
+    # the readers (registry and plugins): loaded when a case first reads a file
     from volviz.io import read
 
     env0 = _load_avg()

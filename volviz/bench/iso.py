@@ -62,6 +62,7 @@ def _shift(meshes: list[IsoMesh], offset: tuple[float, float, float]) -> list[Is
 
 
 def _scenes(data: Path) -> dict[str, tuple[list[IsoMesh], Camera, str]]:
+    # the readers (registry and plugins): loaded when a case first reads a file
     import volviz.io
     storm = volviz.io.read(str(data / "storm" / "Storm.pvm-t%02d"))
     s = extract_at(storm, 15.5, STORM_STYLES).meshes
@@ -79,6 +80,7 @@ def _scenes(data: Path) -> dict[str, tuple[list[IsoMesh], Camera, str]]:
 
 
 def _vtk_blend(meshes: list[IsoMesh], cam: Camera, size: int, reps: int) -> tuple[float, np.ndarray]:
+    # heavy: VTK's rendering, loaded where a case draws (not for --help or a refused argument)
     import pyvista as pv
     pl = pv.Plotter(off_screen=True, window_size=[size, size])
     pl.set_background(BG[:3])  # type: ignore[arg-type]  # pyvista types its functools.wraps wrapper wrongly
@@ -103,6 +105,7 @@ def _gpu_modes(meshes: list[IsoMesh], cam: Camera, size: int, reps: int, cpu: di
                ) -> dict[str, dict[str, float]]:
     """Per mode: GPU frame time (s) and RMSE / max (8-bit units) of the screen against the CPU image ``cpu[mode]``."""
 
+    # heavy: VTK's rendering, loaded where a case draws (not for --help or a refused argument)
     from volviz.render.gl_iso import GLIsoSurfaces
     pl = bench_plotter((size, size), BG[:3])
     ren_win = render_window(pl)
@@ -185,6 +188,7 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _animation(data: Path) -> dict[str, Any]:
+    # the readers (registry and plugins): loaded when a case first reads a file
     import volviz.io
     storm = volviz.io.read(str(data / "storm" / "Storm.pvm-t%02d"))
     ts = np.linspace(12.0, 14.0, 9)
@@ -200,6 +204,7 @@ def _animation(data: Path) -> dict[str, Any]:
 
 
 def _lod(data: Path, size: tuple[int, int]) -> dict[str, Any]:
+    # the readers (registry and plugins): loaded when a case first reads a file
     import volviz.io
     fin = volviz.io.read(str(data / "bluntfin" / "bluntfinxyz.bin"))
     (m,) = extract(fin, [FIN_STYLES[0]], scalars="Density")
@@ -221,8 +226,10 @@ def _lod(data: Path, size: tuple[int, int]) -> dict[str, Any]:
 
 
 def _plot(images: dict[str, dict[str, np.ndarray]], path: Path) -> None:
+    # optional: matplotlib (volviz[bench]), only for the figures
     import matplotlib
     matplotlib.use("Agg")
+    # optional: matplotlib (volviz[bench]), only for the figures
     import matplotlib.pyplot as plt
     cols = list(next(iter(images.values())).keys())
     fig, axes = plt.subplots(2 * len(images), len(cols), figsize=(2.6 * len(cols), 5.4 * len(images)))

@@ -47,6 +47,7 @@ class _Drawn:
 def _frames(controller: Any, kind: str, reps: int) -> tuple[float, float | None, float | None, str]:
     """(median seconds of a frame, median seconds of the CPU overlay's ``begin`` and of its GUI-thread part, or None
     on the GPU, what drew it) after one warm-up."""
+    # heavy: VTK's rendering, loaded where a case draws (not for --help or a refused argument)
     from volviz.render.gl_iso import GLIsoSurfaces
 
     plotter = controller.plotter
@@ -89,6 +90,7 @@ def _frames(controller: Any, kind: str, reps: int) -> tuple[float, float | None,
 def measure(volume: Path, size: tuple[int, int], reps: int, value: float, opacity: float,
             modes: list[str]) -> list[dict[str, Any]]:
     """Every mode of ``modes`` in the ``WAYS`` at one size, each in a fresh scene."""
+    # heavy: VTK's rendering, loaded where a case draws (not for --help or a refused argument)
     from volviz.render.backend import plotter_gl_info
     from volviz.render.export import close_scene, offscreen_scene
     from volviz.scene.datasets import load_datasets

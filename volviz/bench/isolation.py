@@ -34,6 +34,7 @@ LARGE_RATIO_TARGET = 2.0
 
 def isolated_inputs(root: Path) -> list[Path]:
     """Every file (or folder a reader opens whole) under ``root`` that the registry gives to an isolated reader."""
+    # the readers (registry and plugins): loaded when a case first reads a file
     from volviz.io import ReadError
     from volviz.io.registry import spec_of
 
@@ -61,6 +62,7 @@ def isolated_inputs(root: Path) -> list[Path]:
 
 def write_large(folder: Path, megabytes: int) -> list[Path]:
     """A VTK XML image (float32) and a VTK XML hexahedral mesh of about ``megabytes`` MB each, raw appended data."""
+    # heavy: VTK's rendering, loaded where a case draws (not for --help or a refused argument)
     import pyvista as pv
 
     n = max(8, round((megabytes * 1e6 / 4) ** (1 / 3)))
@@ -92,6 +94,7 @@ def _paired_medians(first: Callable[[], Any], second: Callable[[], Any], repeats
 
 def _read_all(path: Path, isolate: bool) -> Any:
     """Read ``path``; for a time series also every later frame (each one more read)."""
+    # the readers (registry and plugins): loaded when a case first reads a file
     import volviz.io as vio
 
     data = vio.read(path, isolate=isolate)
@@ -102,6 +105,7 @@ def _read_all(path: Path, isolate: bool) -> Any:
 
 
 def _row(path: Path, label: str, repeats: int, all_frames: bool = False) -> dict:
+    # the readers (registry and plugins): loaded when a case first reads a file
     import volviz.io as vio
 
     read = (lambda iso: _read_all(path, iso)) if all_frames else (lambda iso: vio.read(path, isolate=iso))
@@ -113,6 +117,7 @@ def _row(path: Path, label: str, repeats: int, all_frames: bool = False) -> dict
 
 def cold_start(path: Path, repeats: int) -> float:
     """Median time of the first isolated read after the reader children were ended (a child starts for it)."""
+    # the readers (registry and plugins): loaded when a case first reads a file
     import volviz.io as vio
     from volviz.io import isolated
 
@@ -126,6 +131,7 @@ def cold_start(path: Path, repeats: int) -> float:
 
 
 def run(data: Path, repeats: int, large_mb: int) -> dict:
+    # the readers (registry and plugins): loaded when a case first reads a file
     import volviz.io as vio
     from volviz.io import isolated
 

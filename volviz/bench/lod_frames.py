@@ -53,6 +53,7 @@ def _references(plotter: Any, tree: Any, volume: np.ndarray, tf: Any, views: lis
                 ref_step: float) -> tuple[list[np.ndarray], list[np.ndarray], dict[str, float]]:
     """Per view: the exact reference (8-bit-scaled RGB over black) and VTK's full volume as one block; plus the
     reference's convergence (its step halved, on the first measured view) and its cost."""
+    # heavy: VTK's rendering, loaded where a case draws (not for --help or a refused argument)
     import pyvista as pv
     from volviz.render.vtk_facade import vtk
 
@@ -95,6 +96,7 @@ def _references(plotter: Any, tree: Any, volume: np.ndarray, tf: Any, views: lis
 
 def _walk(plotter: Any, tree: Any, tf: Any, budget: int, views: list, renderer: str, exact: list,
           vtk_full: list) -> tuple[dict[str, Any], np.ndarray]:
+    # heavy: VTK's rendering, loaded where a case draws (not for --help or a refused argument)
     from volviz.render.lod_volume import LodVolume
 
     tree.cache = type(tree.cache)(tree.cache.budget, tree.levels)        # cold cache per budget and renderer
@@ -133,6 +135,7 @@ def render_walkthrough(tree: Any, volume: np.ndarray, tf: Any, budgets: Sequence
     (keys ``vtk_*``): median seconds per frame (select + decode + draw + read-back, after a cold first frame),
     frames per second, blocks drawn, RMSE / max (8-bit RGB over black) against the exact reference of the full
     volume; ``png``: last frames of each renderer beside the reference, and the time/error plot."""
+    # heavy: VTK's rendering, loaded where a case draws (not for --help or a refused argument)
     from volviz.render.offscreen import offscreen_plotter
 
     views = orbit(volume.shape, frames + 1)
@@ -158,6 +161,7 @@ def render_walkthrough(tree: Any, volume: np.ndarray, tf: Any, budgets: Sequence
 
 def _plot(rows: list[dict[str, Any]], shots: dict[int, tuple[np.ndarray, np.ndarray]], exact: np.ndarray,
           png: Path) -> None:
+    # optional: matplotlib (volviz[bench]), only for the figures
     from volviz.bench import pyplot
 
     plt = pyplot()

@@ -37,6 +37,7 @@ def _frame(plotter: Any, samples: int, reps: int) -> tuple[float, np.ndarray]:
 
 def measure(target: str, size: tuple[int, int], reps: int) -> dict[str, Any]:
     """One session at one window size: 4-sample and single-sample frame times and the image difference."""
+    # heavy: VTK's rendering, loaded where a case draws (not for --help or a refused argument)
     from volviz.render.backend import plotter_gl_info
     from volviz.render.export import close_scene, offscreen_scene, open_target
     from volviz.scene.datasets import load_datasets

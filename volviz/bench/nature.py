@@ -40,6 +40,8 @@ import numpy as np
 
 from volviz.argtypes import UsageParser, float_in, image_size, int_in, joined
 from volviz.bench.offscreen import bench_plotter, finish, render_window, screenshot_rgb
+from volviz.model.camera import Camera
+from volviz.optics.metrics import error_heatmap, max_abs, rmse
 
 DEFAULT_DATA = Path(os.environ.get("VOLVIZ_DATA", Path(__file__).resolve().parents[2].parent / "shared" / "data"))
 REPO = Path(__file__).resolve().parents[2]
@@ -114,8 +116,6 @@ NOTES = [
 
 def path_cameras(n: int, t0: float = 0.0, t1: float = 1.0) -> list[Any]:
     """n cameras along the piecewise-linear key path between path parameters t0 and t1 (0..1)."""
-    from volviz.model.camera import Camera
-
     out = []
     for t in np.linspace(t0, t1, n):
         x = t * (len(KEYS) - 1)
@@ -129,6 +129,7 @@ def path_cameras(n: int, t0: float = 0.0, t1: float = 1.0) -> list[Any]:
 
 def build_scene(data: Path, cloud_shape: tuple[int, int, int], terrain_c: tuple[float, float],
                 cloud_c: tuple[float, float]) -> tuple[Any, str]:
+    # the kernels (Numba) of this case only: a bench loads what its cases run
     from volviz.nature import noise
     from volviz.nature.clouds import CloudShading, CloudVolume
     from volviz.nature.fog import FogLayer
@@ -138,6 +139,7 @@ def build_scene(data: Path, cloud_shape: tuple[int, int, int], terrain_c: tuple[
 
     yukon = data / "yukon" / "Yukon.map.pgm"
     if yukon.exists():
+        # the readers (registry and plugins): loaded when a case first reads a file
         from volviz.io import read
 
         hf = HeightField.from_image(read(yukon), (1000.0, 1000.0), 0.33)
@@ -186,10 +188,10 @@ def _split(scene: Any, cam: Any, size: tuple[int, int]) -> dict[str, float]:
     """Where the frame's error is: terrain + sky alone (LOD mesh vs full mesh), the fog overlay and the cloud overlay
     (premultiplied RGBA), the overlays both over the full-resolution terrain depth so only the layer's own LOD
     differs."""
+    # the kernels (Numba) of this case only: a bench loads what its cases run
     from volviz.nature.clouds import render_cloud_image
     from volviz.nature.fog import render_layer
     from volviz.nature.raster import render_sky, render_terrain
-    from volviz.optics.metrics import rmse
 
     lod_mesh, full_mesh = scene.terrain_mesh(cam, size), scene.terrain_mesh(cam, size, full=True)
     out: dict[str, float] = {}
@@ -224,6 +226,7 @@ class _BufferUploadTimer:
         self._since: dict[int, float] = {}
 
     def watch(self, mappers: list[Any]) -> None:
+        # heavy: VTK's rendering, loaded where a case draws (not for --help or a refused argument)
         from volviz.render.vtk_facade import vtk
 
         for mapper in mappers:
@@ -259,6 +262,7 @@ class _GLFrames:
     SMALL = (64, 48)
 
     def __init__(self, scene: Any, size: tuple[int, int], reps: int) -> None:
+        # heavy: VTK's rendering, loaded where a case draws (not for --help or a refused argument)
         from volviz.render.nature_view import NatureView
         from volviz.render.gl_nature import GLNatureView
 
@@ -302,6 +306,7 @@ class _GLFrames:
     def _one_each(self) -> None:
         """Cut every prism layer to its first prism, the clouds to their first leaf and the terrain to its first
         triangle (until the next frame)."""
+        # heavy: VTK's rendering, loaded where a case draws (not for --help or a refused argument)
         import pyvista as pv
 
         view = self.views[1]
@@ -312,6 +317,7 @@ class _GLFrames:
         for name, layer in view.layers.items():
             layer.set_buffers(self._prisms[name][1].first_prism())
         if view.clouds is not None and view.clouds.order is not None:
+            # heavy: VTK's rendering, loaded where a case draws (not for --help or a refused argument)
             from volviz.render.cloud_slots import RESERVED
 
             first = view.clouds.order[:RESERVED + 1]                           # the reserved slots and one leaf
@@ -389,6 +395,7 @@ class _GLFrames:
         return out, img
 
     def close(self) -> dict[str, str]:
+        # heavy: VTK's rendering, loaded where a case draws (not for --help or a refused argument)
         from volviz.render.backend import gl_info
 
         info = gl_info(self.plotters[0].ren_win).to_dict()
@@ -411,6 +418,7 @@ def _changed_part(frames: list[Any]) -> dict[str, Any]:
     GPU morphs the leaves, so a leaf that stays uploads nothing). Terrain triangles (their 3 morphed vertices) and
     fog prisms (their 3 vertices' heights and emissions): those the previous frame does not have bit for bit
     (wherever they were in it), the part an upload of only what changed would send."""
+    # heavy: VTK's rendering, loaded where a case draws (not for --help or a refused argument)
     from volviz.render.cloud_slots import LeafSlots
 
     out: dict[str, Any] = {"clouds": [], "terrain": [], "fog": []}
@@ -446,6 +454,7 @@ def _cloud_uploads(scene: Any, size: tuple[int, int], frames: int = 13) -> list[
     leaves the GPU clouds draw, those new to their LOD mesh and the bytes a frame uploads (the slots of the new
     leaves and the draw order, ``volviz.render.cloud_slots``; compactions re-send the whole slot array), means over
     ``frames - 1`` steps, against 96 bytes a leaf (a leaf's place and its 16 morphed corner values)."""
+    # heavy: VTK's rendering, loaded where a case draws (not for --help or a refused argument)
     from volviz.render.cloud_slots import LeafSlots
     from volviz.render.gl_nature import cloud_leaves
 
@@ -472,9 +481,9 @@ def _cloud_uploads(scene: Any, size: tuple[int, int], frames: int = 13) -> list[
 
 def _terrain_sweep(scene: Any, cams: list[Any], size: tuple[int, int], spec: str) -> list[dict[str, float]]:
     """Terrain triangles against the terrain + sky error (LOD vs full mesh, no volumes) for C,c settings."""
+    # the kernels (Numba) of this case only: a bench loads what its cases run
     from volviz.nature.raster import render_sky, render_terrain
     from volviz.nature.terrain import TerrainLOD, frustum_planes
-    from volviz.optics.metrics import rmse
 
     out = []
     full = scene.lod.full_mesh()
@@ -533,8 +542,6 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--out", type=Path, default=REPO / "docs" / "bench" / "nature.md")
     args = ap.parse_args(argv)
     size, cloud_shape, tc, cc = args.size, args.cloud_shape, args.terrain_lod, args.cloud_lod
-    from volviz.optics.metrics import error_heatmap, max_abs, rmse
-
     t_build = time.perf_counter()
     scene, source = build_scene(args.data, cloud_shape, tc, cc)
     t_build = time.perf_counter() - t_build
@@ -618,6 +625,7 @@ def main(argv: list[str] | None = None) -> int:
         scene.cloud_lod.geomorph = True
     sweep = []
     if args.sweep:
+        # the kernels (Numba) of this case only: a bench loads what its cases run
         from volviz.nature.clouds import render_cloud_image
 
         lod = scene.cloud_lod
@@ -679,6 +687,7 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _write_report(out: Path, result: dict[str, Any], images: list[tuple[np.ndarray, ...]]) -> None:
+    # optional: matplotlib (volviz[bench]), only for the figures
     from volviz.bench import pyplot
 
     plt = pyplot()

@@ -10,6 +10,7 @@ import numpy as np
 
 def bench_plotter(size: Sequence[int], background: Optional[Sequence[float] | str] = None) -> Any:
     """An offscreen plotter of ``size`` (width, height) without multisampling, on ``background`` if given."""
+    # heavy: VTK's rendering, loaded where a case draws (not for --help or a refused argument)
     import pyvista as pv
 
     pl = pv.Plotter(off_screen=True, window_size=[int(size[0]), int(size[1])])

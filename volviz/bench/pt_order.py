@@ -24,6 +24,8 @@ import numpy as np
 
 from volviz.argtypes import MAX_IMAGE_SIDE, UsageParser, float_in, int_in
 from volviz.io.atomic import atomic_write_text
+from volviz.model.camera import Camera
+from volviz.optics.metrics import max_abs, rmse
 from volviz.bench.unstructured import DEFAULT_DATA, bluntfin_tf
 from volviz.bench.offscreen import bench_plotter, render_window, screenshot_rgb
 
@@ -45,14 +47,10 @@ def _lags(text: str) -> list[float]:
 
 
 def _orbit(points: np.ndarray, azimuth: float) -> Any:
-    from volviz.model.camera import Camera
-
     return Camera.orbit(points, azimuth, 25.0, 1.6, view_angle=30.0, up=(0, 0, 1))
 
 
 def _err(img: np.ndarray, ref: np.ndarray) -> tuple[float, float]:
-    from volviz.optics.metrics import max_abs, rmse
-
     return rmse(img[..., :3], ref[..., :3]), max_abs(img[..., :3], ref[..., :3])
 
 
@@ -60,6 +58,7 @@ def measure(mesh: Any, tf: Any, size: int, lags: list[float], window: int, drag_
             frames: int) -> dict[str, Any]:
     """The errors of each frame drawn with its own order and with lagged ones (module docstring)."""
 
+    # heavy: VTK's rendering, loaded where a case draws (not for --help or a refused argument)
     from volviz.render.gl_pt import GLPTVolume
     from volviz.unstructured.render import render
 
@@ -167,6 +166,7 @@ def main(argv: list[str] | None = None) -> int:
     except ValueError as exc:
         p.error(str(exc))
 
+    # the kernels (Numba) of this case only: a bench loads what its cases run
     from volviz.io.plot3d import read_plot3d
     from volviz.unstructured.tetrahedralize import tetrahedralize
 

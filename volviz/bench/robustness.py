@@ -19,11 +19,15 @@ than volviz's own, 0 silent garbage, every refusal under 1 s. The mutations are 
 """
 from __future__ import annotations
 
+import fnmatch
+import importlib
 import json
+import math
 import os
 import platform
 import random
 import re
+import resource
 import shlex
 import shutil
 import signal
@@ -33,11 +37,14 @@ import sys
 import tempfile
 import threading
 import time
+import warnings
 import zlib
 from collections import Counter, defaultdict
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Optional
+
+import numpy as np
 
 from volviz.argtypes import UsageParser, int_in
 from volviz.bench.robustness_agree import content_volviz, content_vtk, valid_as_damaged
@@ -125,7 +132,6 @@ def _header_end(data: bytes, layout: str) -> int:
 
 def sources(root: Path) -> list[Source]:
     """Every file under ``root`` as a Source (OpenFOAM case files are read through their ``case.foam``)."""
-    import fnmatch
 
     found: list[Source] = []
     for folder, dirs, files in os.walk(root):
@@ -152,6 +158,7 @@ def sources(root: Path) -> list[Source]:
 def made_sources(folder: Path, formats: list[str] | None = None) -> list[Source]:
     """Sources of the formats the data folder lacks, written into ``folder`` (``volviz.bench.robustness_made``,
     and the seeds of several files each of ``volviz.bench.robustness_formats``: one Source per file they damage)."""
+    # another bench's module (it loads VTK or its own dependencies): only for this case
     from volviz.bench.robustness_formats import write_seeds
     from volviz.bench.robustness_made import MADE, write_made
 
@@ -320,6 +327,7 @@ def xml_mutation(data: bytes, rng: random.Random, kind: str) -> Optional[Mutatio
 
 def hdf5_object_addresses(path: Path) -> list[int]:
     """File addresses of the object headers of every group and dataset of an HDF5 file (its metadata)."""
+    # h5py: only the robustness seeds in its format need it (imported where they are written)
     import h5py
 
     found: list[int] = [0]
@@ -351,8 +359,8 @@ def hdf5_field(path: Path, rng: random.Random) -> Optional[Mutation]:
     """A value of one of the VTKHDF count/offset/extent datasets or attributes set through h5py (0, -1, 2^31-1,
     2^63-1, NaN) -- a file whose HDF5 structure is intact and whose VTKHDF content lies (None: the file has no
     numeric dataset or attribute)."""
+    # h5py: only the robustness seeds in its format need it (imported where they are written)
     import h5py
-    import numpy as np
 
     with h5py.File(path, "r") as f:
         names: list[str] = []
@@ -386,7 +394,6 @@ def hdf5_field(path: Path, rng: random.Random) -> Optional[Mutation]:
 
 
 def _cast(value: Any, dtype: Any) -> Any:
-    import numpy as np
 
     dtype = np.dtype(dtype)
     if value == "nan":
@@ -423,6 +430,7 @@ def random_mutation(src: Source, data: bytes, rng: random.Random, addresses: lis
     elif kind == "hdf5-field":
         found = hdf5_field(src.path, rng)
     elif kind.startswith("vvz") or kind == "json":
+        # another bench's module (it loads VTK or its own dependencies): only for this case
         from volviz.bench.robustness_formats import json_mutation, vvz_mutation
 
         made = json_mutation(data, rng) if kind == "json" else vvz_mutation(data, rng, kind)
@@ -486,10 +494,7 @@ def cases(srcs: list[Source], total: int, seed: int) -> list[tuple[Source, tuple
 def fingerprint_volviz(dataset: Any) -> dict:
     """Grid size, a CRC of every array, and whether the dataset is consistent: it survives the isolation codec's
     checks (shapes, dtypes, indices) and its spacing and origin are finite."""
-    import math
-
-    import numpy as np
-
+    # the readers (registry and plugins): loaded when a case first reads a file
     from volviz.io.isolated.codec import CodecError, decode, encode
 
     frames = [dataset.frame(i) for i in frames_to_read(len(dataset))] \
@@ -536,7 +541,6 @@ VTK_READERS = {"slc": ("vtkIOImage", "vtkSLCReader"), "pnm": ("vtkIOImage", "vtk
 
 
 def _vtk_reader(recipe: str, path: str, options: dict) -> Any:
-    import importlib
 
     module, name = VTK_READERS[recipe]
     r = getattr(importlib.import_module(f"vtkmodules.{module}"), name)()
@@ -562,6 +566,7 @@ def _vtk_reader(recipe: str, path: str, options: dict) -> Any:
 def fingerprint_vtk(output: Any) -> dict:
     """Points of every leaf of VTK's output, a CRC of the arrays (coordinates, point and cell data) and the
     output's ``content`` (``robustness_agree``)."""
+    # VTK's readers and NumPy bridge: only for the files VTK reads
     from vtkmodules.util.numpy_support import vtk_to_numpy
     from vtkmodules.vtkCommonDataModel import vtkDataSet
 
@@ -588,8 +593,7 @@ def fingerprint_vtk(output: Any) -> dict:
 
 
 def _serve_volviz(request: dict) -> dict:
-    import warnings
-
+    # the readers (registry and plugins): loaded when a case first reads a file
     import volviz.io as vio
     from volviz.io import isolated
 
@@ -598,6 +602,7 @@ def _serve_volviz(request: dict) -> dict:
         options["q"] = os.path.join(os.path.dirname(request["path"]), options["q"])
     if "dims" in options:
         options["dims"] = tuple(options["dims"])
+    # the kernels (Numba) of this case only: a bench loads what its cases run
     from volviz.regular.container import CorruptBrickWarning
 
     with warnings.catch_warnings(record=True) as caught:
@@ -619,9 +624,11 @@ def _serve_volviz(request: dict) -> dict:
 def read_as_user(path: str, options: dict) -> Any:
     """What the app does with a file: ``volviz.io.read``, or the ``.vvz`` codec's decoder for volviz's own
     compressed volumes (``volviz.scene.datasets``)."""
+    # the readers (registry and plugins): loaded when a case first reads a file
     import volviz.io as vio
 
     if path.lower().endswith(".vvz"):
+        # the kernels (Numba) of this case only: a bench loads what its cases run
         from volviz.regular.codec import decompress
 
         return decompress(path)
@@ -629,6 +636,7 @@ def read_as_user(path: str, options: dict) -> Any:
 
 
 def _serve_vtk(request: dict) -> dict:
+    # VTK's readers: only for the files VTK reads
     from vtkmodules.vtkCommonCore import vtkOutputWindow, vtkStringOutputWindow
     from vtkmodules.vtkCommonExecutionModel import vtkStreamingDemandDrivenPipeline
 
@@ -684,7 +692,6 @@ class BenchWorker:
         self.restarts = 0
 
     def _start(self) -> subprocess.Popen:
-        import resource
 
         def limit() -> None:
             resource.setrlimit(resource.RLIMIT_AS, (self.memory, resource.RLIM_INFINITY))

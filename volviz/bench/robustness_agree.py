@@ -59,6 +59,7 @@ def content_volviz(frame: Any) -> dict:
 def content_vtk(leaves: list[Any]) -> dict:
     """The ``content`` of VTK's output (its data set leaves): point count and bounds over the leaves, each point or
     cell array's summary over the leaves that hold it (by name: a multiblock's parts are one mesh in volviz)."""
+    # VTK's NumPy bridge: only for a dataset VTK read
     from vtkmodules.util.numpy_support import vtk_to_numpy
 
     n, bounds = 0, None

@@ -55,6 +55,7 @@ def _tets() -> tuple[np.ndarray, np.ndarray]:
 def _xdmf(folder: Path, steps: int) -> None:
     """A time series of a tetrahedral mesh (meshio's TimeSeriesWriter, as FEniCS and meshio users write it). The
     writer puts its heavy data file in the working folder: it is written there, then moved beside the XDMF file."""
+    # meshio: only the robustness seeds in its format need it (imported where they are written)
     import meshio
 
     pts, cells = _tets()
@@ -106,6 +107,7 @@ def _ensight(folder: Path) -> None:
 
 
 def _avs(folder: Path, hexahedra: bool) -> None:
+    # meshio: only the robustness seeds in its format need it (imported where they are written)
     import meshio
 
     pts, cells = _tets()
@@ -116,6 +118,7 @@ def _avs(folder: Path, hexahedra: bool) -> None:
 
 
 def _zarr(folder: Path, chunks: tuple[int, int, int], compressor: str) -> None:
+    # optional: zarr (a reader plugin's dependency), only to write the files it reads
     import zarr
 
     values = _grid((6, 5, 4)).astype(np.uint16)
@@ -131,6 +134,7 @@ def _zarr(folder: Path, chunks: tuple[int, int, int], compressor: str) -> None:
 def _minc1(folder: Path, dtype: str) -> None:
     """MINC 1: a netCDF classic file (SciPy's writer) with the image, its per-slice image-min / image-max and the
     three space dimensions' step, start and direction cosines, as minc-toolkit writes them."""
+    # heavy: SciPy, only for this case
     from scipy.io import netcdf_file
 
     values = _grid((6, 5, 4)).astype(dtype)
@@ -153,6 +157,7 @@ def _minc1(folder: Path, dtype: str) -> None:
 
 
 def _hdf5(folder: Path, chunked: bool) -> None:
+    # h5py: only the robustness seeds in its format need it (imported where they are written)
     import h5py
 
     values = _grid((6, 5, 4)).astype(np.float32)
@@ -187,6 +192,7 @@ def _bov(folder: Path, fmt: str, dtype: str, endian: str, centering: str) -> Non
 
 
 def _pvd(folder: Path) -> None:
+    # heavy: PyVista (VTK), only to write the seeds in VTK's formats
     import pyvista as pv
 
     entries = []
@@ -216,6 +222,7 @@ def _laz(folder: Path, point_format: int, version: str) -> None:
 
 
 def _vvz(folder: Path, mode: str, dtype: str) -> None:
+    # the kernels (Numba) of this case only: a bench loads what its cases run
     from volviz.model import RegularVolume
     from volviz.regular.codec import compress
 
@@ -294,6 +301,7 @@ def vvz_mutation(data: bytes, rng: random.Random, kind: str) -> tuple[str, bytes
     The metadata is written again (the table moves after it) and every CRC of the header is recomputed, so the file
     passes its checksums: only the reader's checks of the content against itself can refuse it (the issue's
     "dtype changed to int64 with recomputed checksums"). None when the file's header no longer parses."""
+    # the kernels (Numba) of this case only: a bench loads what its cases run
     from volviz.regular.container import _HDR, BRICK_DTYPE, crc32
 
     try:

@@ -18,6 +18,7 @@ _VALUES = (np.arange(6 * 5 * 4, dtype=np.int64) * 37 % 251).reshape(6, 5, 4)
 
 
 def _mat(path: Path, compress: bool) -> None:
+    # heavy: SciPy, only for this case
     import scipy.io
 
     scipy.io.savemat(path, {"V": _VALUES.astype(np.float64), "label": "scan", "M": np.eye(3)},
@@ -25,12 +26,14 @@ def _mat(path: Path, compress: bool) -> None:
 
 
 def _tiff(path: Path) -> None:
+    # tifffile: only the robustness seeds in its format need it (imported where they are written)
     import tifffile
 
     tifffile.imwrite(path, _VALUES.astype(np.uint16), photometric="minisblack")
 
 
 def _nrrd(path: Path, encoding: str) -> None:
+    # optional: nrrd (a reader plugin's dependency), only to write the files it reads
     import nrrd
 
     nrrd.write(str(path), _VALUES.astype(np.int16), {"encoding": encoding, "space": "left-posterior-superior",
@@ -39,12 +42,14 @@ def _nrrd(path: Path, encoding: str) -> None:
 
 
 def _nifti(path: Path) -> None:
+    # optional: nibabel (a reader plugin's dependency), only to write the files it reads
     import nibabel as nib
 
     nib.save(nib.Nifti1Image(_VALUES.T.astype(np.int16), np.diag([0.5, 0.5, 2.0, 1.0])), str(path))
 
 
 def _dicom(path: Path) -> None:
+    # optional: pydicom (a reader plugin's dependency), only to write the files it reads
     import pydicom
     from pydicom.dataset import FileMetaDataset
     from pydicom.uid import UID, ExplicitVRLittleEndian, generate_uid
@@ -80,12 +85,14 @@ def _cube(path: Path) -> None:
 
 
 def _fits(path: Path) -> None:
+    # optional: astropy (a reader plugin's dependency), only to write the files it reads
     from astropy.io import fits
 
     fits.PrimaryHDU(_VALUES.astype(np.float32)).writeto(path)
 
 
 def _mrc(path: Path) -> None:
+    # optional: mrcfile (a reader plugin's dependency), only to write the files it reads
     import mrcfile
 
     with mrcfile.new(str(path)) as mrc:
@@ -112,6 +119,7 @@ def _las(path: Path) -> None:
 
 
 def _segy(path: Path) -> None:
+    # optional: segyio (a reader plugin's dependency), only to write the files it reads
     import segyio
 
     spec = segyio.spec()

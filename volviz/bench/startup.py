@@ -154,6 +154,7 @@ def report(results: list[Result], command: str, loads: tuple[str, str]) -> str:
 
 def file_cases(data: Path) -> list[tuple[str, list[str], bool]]:
     """``render NAME`` of every file under ``data`` that ``volviz bench first_open`` opens (under its size limit)."""
+    # first_open (its file list and size limit): only with --files
     from volviz.bench.first_open import MAX_MB, opened_files
 
     cases = []

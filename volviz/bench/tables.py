@@ -230,6 +230,7 @@ def _fmt(v: Any) -> str:
 
 
 def _plot(result: dict, path: Path) -> None:
+    # optional: matplotlib (volviz[bench]), only for the figures
     from volviz.bench import pyplot
 
     plt = pyplot()

@@ -23,6 +23,9 @@ import numpy as np
 
 from volviz.argtypes import MAX_IMAGE_SIDE, UsageParser, int_in
 from volviz.bench.offscreen import bench_plotter, finish, render_window, screenshot_rgb, timed_renders
+from volviz.model.camera import Camera
+from volviz.optics import TransferFunction
+from volviz.optics.metrics import error_heatmap, max_abs, rmse
 
 DEFAULT_DATA = Path(os.environ.get("VOLVIZ_DATA", Path(__file__).resolve().parents[2].parent / "shared" / "data"))
 VTK_MAPPERS = ("vtkProjectedTetrahedraMapper", "vtkUnstructuredGridVolumeRayCastMapper",
@@ -51,8 +54,6 @@ def _mapper_list(text: str) -> str:
 
 def bluntfin_tf() -> Any:
     """The Density transfer function used by the benchmark and the tests (rho per unit length of the grid)."""
-    from volviz.optics import TransferFunction
-
     return TransferFunction([0.19, 1.0, 2.0, 3.0, 5.0],
                             [[0.2, 0.3, 1.0], [0.2, 0.9, 0.9], [1.0, 0.9, 0.2], [1.0, 0.3, 0.1], [1.0, 1.0, 1.0]],
                             [0.0, 0.05, 0.3, 0.8, 0.0], name="bluntfin-density")
@@ -60,8 +61,6 @@ def bluntfin_tf() -> Any:
 
 def camera_path(points: np.ndarray, n: int) -> list[Any]:
     """n perspective views orbiting the fin (azimuth 20..110 degrees, elevation 25, 30 degree view angle)."""
-    from volviz.model.camera import Camera
-
     return [Camera.orbit(points, 20.0 + 90.0 * i / max(n - 1, 1), 25.0, 1.6, view_angle=30.0, up=(0, 0, 1))
             for i in range(n)]
 
@@ -71,6 +70,7 @@ def _vtk_render(mesh: Any, tf: Any, cam: Any, size: int | tuple[int, int], mappe
     """One of VTK's volume mappers on ``mesh`` (or on ``grid`` when given, e.g. an image for the GPU ray caster) in an
     offscreen window of ``size`` (N or (W, H)): the image of the last of ``reps`` timed draws, each to the GPU's
     completion, as float RGB over black."""
+    # heavy: VTK's rendering, loaded where a case draws (not for --help or a refused argument)
     from volviz.render.vtk_facade import vtk_to_numpy, vtk
 
     from volviz.render.vtk_tf import tf_to_vtk
@@ -111,8 +111,6 @@ def _vtk_render(mesh: Any, tf: Any, cam: Any, size: int | tuple[int, int], mappe
 
 
 def _rgb_err(a: np.ndarray, b: np.ndarray) -> tuple[float, float]:
-    from volviz.optics.metrics import max_abs, rmse
-
     return rmse(a[..., :3], b[..., :3]), max_abs(a[..., :3], b[..., :3])
 
 
@@ -153,6 +151,7 @@ def gl_pt_frames(mesh: Any, tf: Any, cams: list[Any], size: tuple[int, int], rep
     ``same``: also draw each camera a second time (no new sort or order), wall seconds to the GPU's completion
     (``draw_s``): the draw alone, what a frame costs while the camera rests."""
 
+    # heavy: VTK's rendering, loaded where a case draws (not for --help or a refused argument)
     from volviz.render.gl_pt import GLPTVolume
 
     pl = bench_plotter(size, "black")
@@ -223,6 +222,7 @@ def _one_cell_order(vol: Any) -> Any:
     vol._set_index_buffer(vol.order[:1], np.ones(vol.topo.n_tets, bool))
     if not getattr(vol, "order_texture", False):
         return lambda: None
+    # heavy: VTK's rendering, loaded where a case draws (not for --help or a refused argument)
     from volviz.render.vtk_facade import vtk
 
     full = vol.polydata.GetPolys()
@@ -296,8 +296,8 @@ def main(argv: list[str] | None = None) -> int:
             p.error("--only exact needs --exact")
         return only_rows(args, argv)
 
+    # the kernels (Numba) of this case only: a bench loads what its cases run
     from volviz.io.plot3d import read_plot3d
-    from volviz.optics.metrics import max_abs, rmse
     from volviz.unstructured.render import render
     from volviz.unstructured.tetrahedralize import tetrahedralize
 
@@ -314,6 +314,7 @@ def main(argv: list[str] | None = None) -> int:
     def run_path(lookup: str) -> dict[str, Any]:
         """The camera path as a movie export renders it: frame i + 1 sorted in the background while frame i draws
         (``volviz.unstructured.prefetch.render_path``); median wall time per frame over ``reps`` passes."""
+        # the kernels (Numba) of this case only: a bench loads what its cases run
         from volviz.unstructured.prefetch import render_path
 
         frame_s, waits = [], []
@@ -471,6 +472,7 @@ SORT_ROWS = (("mpvo (object-space boundary relations)", "mpvo", "auto"),
 def only_rows(args: argparse.Namespace, argv: list[str] | None) -> int:
     """``--only``: the sort table (with the Blunt Fin's index buffer row) and/or the large mesh, each block spliced
     into the existing report (``splice``), which keeps every other row of the run that made it."""
+    # the kernels (Numba) of this case only: a bench loads what its cases run
     from volviz.io.atomic import atomic_write_text
     from volviz.io.plot3d import read_plot3d
     from volviz.unstructured.tetrahedralize import tetrahedralize
@@ -559,6 +561,7 @@ def timed_sort(topo: Any, cam: Any, size: tuple[int, int], method: str = "mpvo",
                ) -> tuple[Any, float, float]:
     """``visibility_order`` with its wall seconds and the process CPU seconds it took (all threads; less sensitive
     than wall time to the other jobs on the shared cores)."""
+    # the kernels (Numba) of this case only: a bench loads what its cases run
     from volviz.unstructured.sort import visibility_order
 
     t0, c0 = time.perf_counter(), time.process_time()
@@ -569,6 +572,7 @@ def timed_sort(topo: Any, cam: Any, size: tuple[int, int], method: str = "mpvo",
 def sort_scan(mesh: Any, cams: list[Any], sizes: list[tuple[int, int]], reps: int) -> list[dict[str, Any]]:
     """Seconds of ``visibility_order`` against window size for each of ``SORT_ROWS``: the medians (wall and process
     CPU) over ``cams`` x ``reps`` calls after a warm-up call (each call for a camera other than the previous one)."""
+    # the kernels (Numba) of this case only: a bench loads what its cases run
     from volviz.unstructured.topology import topology
 
     topo = topology(mesh)
@@ -588,6 +592,7 @@ def sort_scan(mesh: Any, cams: list[Any], sizes: list[tuple[int, int]], reps: in
 def _numpy_chain(order: np.ndarray, visible: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The index buffer as numpy made it before ``volviz.unstructured.index_buffer`` (the baseline of
     ``index_buffer_row``): the visible cells, then the 12 vertex ids of each."""
+    # the kernels (Numba) of this case only: a bench loads what its cases run
     from volviz.unstructured.topology import FACES
 
     cells = order[visible[order]]
@@ -598,6 +603,7 @@ def index_buffer_row(mesh: Any, tf: Any, cams: list[Any], reps: int) -> dict[str
     """The order as the GPU pass's index buffer (zero-opacity cull and int32 connectivity) for each camera's mpvo
     order: ``IndexBuffer.fill`` (one Numba pass into buffers kept between frames) against the numpy chain; medians
     of wall and process CPU seconds over ``cams`` x ``reps`` after a warm-up, and the cells drawn."""
+    # the kernels (Numba) of this case only: a bench loads what its cases run
     from volviz.unstructured.index_buffer import IndexBuffer
     from volviz.unstructured.sort import visibility_order
     from volviz.unstructured.topology import topology, visible_cells
@@ -624,6 +630,7 @@ def index_buffer_row(mesh: Any, tf: Any, cams: list[Any], reps: int) -> dict[str
 def refined_bluntfin(grid: Any, factor: float) -> Any:
     """The Blunt Fin's curvilinear grid resampled ``factor`` times finer along each axis (trilinear in the grid's
     index space, coordinates and Density alike), tetrahedralised: a large non-convex mesh made by a command."""
+    # heavy: SciPy, only for this case
     from scipy.ndimage import map_coordinates
 
     from volviz.model.datasets import CurvilinearGrid
@@ -640,6 +647,7 @@ def refined_bluntfin(grid: Any, factor: float) -> Any:
 def write_vtu(mesh: Any, path: str) -> None:
     """``mesh`` (a TetMesh) as a VTK XML unstructured grid, written atomically (a temporary file beside it, then
     renamed)."""
+    # optional: meshio (a reader plugin's dependency), only to write the files it reads
     import meshio
 
     from volviz.io.atomic import check_output_path, temp_name
@@ -659,6 +667,7 @@ def large_mesh_row(mesh: Any, tf: Any, cams: list[Any], reps: int, draw: int = 2
     warm-up, with its stages: boundary relations, face sides, Kahn); the CPU bytes per cell of the mesh and its sort
     topology, and of one sort's own arrays; a ``draw``² frame by pt-gl (``gl_pt_frames``, 3D table: frame seconds
     to the GPU's completion, sort included) against the CPU pt renderer's image of the same camera and table."""
+    # the kernels (Numba) of this case only: a bench loads what its cases run
     from volviz.unstructured import mpvo
     from volviz.unstructured.boundary_pairs import inner_boundary
     from volviz.unstructured.render import render
@@ -737,7 +746,7 @@ def interactive_rows(mesh: Any, tf: Any, cams: list[Any], sizes: list[tuple[int,
     camera, the draw alone) and interactive again (``moving_s``: the reduced draw alone); every Render() ends with
     WaitForCompletion. The error of the interactive image against the full-resolution one (8-bit RGB over black):
     RMSE median over the cameras and the largest max."""
-    from volviz.optics.metrics import max_abs, rmse
+    # heavy: VTK's rendering, loaded where a case draws (not for --help or a refused argument)
     from volviz.render.gl_pt import GLPTVolume
 
     views: list[tuple[Any, Any, dict[str, list[float]], list[tuple[float, float]]]] = []
@@ -786,6 +795,7 @@ def _size_scan(mesh: Any, tf: Any, cams: list[Any], sizes: list[tuple[int, int]]
     for a new camera, and the same camera drawn again: the draw alone) and vtkProjectedTetrahedraMapper, and with
     ``raycast_grid`` VTK's GPU ray caster on the mesh resampled to that many points a side: the medians over
     ``cams`` and ``reps`` after a warm-up, every GPU frame timed to its completion."""
+    # the kernels (Numba) of this case only: a bench loads what its cases run
     from volviz.unstructured.render import render
 
     rows = []
@@ -815,6 +825,7 @@ def _size_scan(mesh: Any, tf: Any, cams: list[Any], sizes: list[tuple[int, int]]
 def _resampled_image(mesh: Any, n: int) -> Any:
     """The mesh's point field resampled onto an n³ image over its bounds (PyVista's ``sample``): the input
     of the GPU ray caster peer, the way a user of VTK without an unstructured GPU mapper would draw it."""
+    # heavy: VTK's rendering, loaded where a case draws (not for --help or a refused argument)
     import pyvista as pv
 
     grid = mesh.to_pyvista()
@@ -828,6 +839,7 @@ def _resampled_image(mesh: Any, n: int) -> Any:
 def exact_rows(mesh: Any, tf: Any, cam: Any, sizes: list[tuple[int, int]], gl_lookup: str) -> list[dict[str, Any]]:
     """pt-gl and vtkProjectedTetrahedraMapper against the exact float64 reference at each window size (one camera;
     RGB over black, 8-bit units), with the reference's own seconds."""
+    # the kernels (Numba) of this case only: a bench loads what its cases run
     from volviz.unstructured.render import render
 
     rows = []
@@ -860,11 +872,11 @@ def _exact_lines(rows: list[dict[str, Any]] | None) -> list[str]:
 
 
 def _plots(results: dict[str, Any], images: dict[str, np.ndarray], ref: np.ndarray, out: Path) -> None:
+    # optional: matplotlib (volviz[bench]), only for the figures
     from volviz.bench import pyplot
 
     plt = pyplot()
 
-    from volviz.optics.metrics import error_heatmap
 
     fig, ax = plt.subplots(figsize=(6, 4))
     for name, r in results["methods"].items():

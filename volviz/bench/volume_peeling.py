@@ -21,6 +21,7 @@ import numpy as np
 from volviz.argtypes import UsageParser, image_size, int_in
 from volviz.bench.offscreen import timed_renders
 from volviz.io.atomic import atomic_write_text
+from volviz.session import Component, DatasetRef, Session
 
 REPO = Path(__file__).resolve().parents[2]
 DEFAULT_DATA = Path(os.environ.get("VOLVIZ_DATA", REPO.parent / "shared" / "data"))
@@ -32,8 +33,6 @@ WAYS = (("cpu", False, False), ("cpu", True, False), ("gpu", False, False), ("gp
 def iso_session(volume: Path, value: float, opacity: float, surface: bool) -> Any:
     """A session of the regular volume ``volume`` and, when ``surface``, an isosurface of it (``value``,
     ``opacity``)."""
-    from volviz.session import Component, DatasetRef, Session
-
     comps = [Component("vol", "volume", "data")]
     if surface:
         comps.append(Component("iso", "isosurface", "data",
@@ -44,6 +43,7 @@ def iso_session(volume: Path, value: float, opacity: float, surface: bool) -> An
 def _draw(volume: Path, size: tuple[int, int], way: tuple[str, bool, bool], reps: int, value: float,
           opacity: float) -> tuple[float, np.ndarray, bool, str]:
     """(median seconds of a draw, the image, whether peeling was on, the OpenGL renderer) for one way of drawing."""
+    # heavy: VTK's rendering, loaded where a case draws (not for --help or a refused argument)
     from volviz.render.backend import plotter_gl_info
     from volviz.render.export import close_scene, offscreen_scene
     from volviz.render.volume_peeling import peel_volumes, peeling_volumes

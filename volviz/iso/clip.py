@@ -52,6 +52,7 @@ def clip_volume(volume: RegularVolume, clip: ClipSettings | Sequence[ClipPlane] 
 
 
 def _clip_vtk(dataset: Any, planes: list[ClipPlane], poly: bool) -> Any:
+    # VTK's clipping filters: loaded only where something is clipped
     from vtkmodules.vtkCommonDataModel import vtkPlane
     from vtkmodules.vtkFiltersCore import vtkClipPolyData
     from vtkmodules.vtkFiltersGeneral import vtkTableBasedClipDataSet
@@ -74,6 +75,7 @@ def _clip_vtk(dataset: Any, planes: list[ClipPlane], poly: bool) -> Any:
 
 def clip_isosurface(mesh: IsoMesh, clip: ClipSettings | Sequence[ClipPlane] | BoxCrop) -> IsoMesh:
     """The part of the surface inside all planes and the box, cut exactly (normals interpolated, renormalised)."""
+    # PyVista (VTK) and extract's poly data conversion: only where a surface is clipped
     import pyvista as pv
     from volviz.iso.extract import _poly_to_arrays
     cs = _as_settings(clip)
@@ -96,6 +98,7 @@ def clip_isosurfaces(meshes: Sequence[IsoMesh], clip: ClipSettings | Sequence[Cl
 def clip_grid(grid: Any, clip: ClipSettings | Sequence[ClipPlane] | BoxCrop) -> Any:
     """A VTK/PyVista volumetric grid cut by the planes and box and re-tetrahedralised (a vtkUnstructuredGrid of
     tetrahedra; point data interpolated linearly along the cut edges, exact for a linear field on tetrahedra)."""
+    # VTK's tetrahedralising filter: only where a grid is clipped
     from vtkmodules.vtkFiltersGeneral import vtkDataSetTriangleFilter
     out = _clip_vtk(grid, _as_settings(clip).all_planes(), poly=False)
     tf = vtkDataSetTriangleFilter()
@@ -107,6 +110,7 @@ def clip_grid(grid: Any, clip: ClipSettings | Sequence[ClipPlane] | BoxCrop) -> 
 
 def clip_tetmesh(mesh: TetMesh, clip: ClipSettings | Sequence[ClipPlane] | BoxCrop) -> TetMesh:
     """The tetrahedral mesh cut by the planes and box, re-tetrahedralised; scalars exact for the linear field."""
+    # PyVista (VTK): only where a mesh is clipped
     import pyvista as pv
     cs = _as_settings(clip)
     if not cs.all_planes():

@@ -67,6 +67,7 @@ class IsoMesh:
         """The mesh as a pyvista.PolyData with its normals. Built from the triangles as they are (VTK's offsets and
         connectivity, ``from_regular_faces``): 4x faster than a legacy padded face list, and it runs on the GUI
         thread each time a time series' surfaces are shown (issue #28)."""
+        # PyVista (VTK): only where a surface is shown
         import pyvista as pv
         points = self.points.copy()
         poly = pv.PolyData.from_regular_faces(points, self.triangles) if self.n_triangles else pv.PolyData(points)
@@ -96,6 +97,7 @@ def _vtk_input(volume: Any, scalars: str | None) -> tuple[Any, bool]:
 
 
 def _poly_to_arrays(poly: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    # PyVista and VTK's filters: only where surfaces are extracted
     import pyvista as pv
     from vtkmodules.vtkFiltersCore import vtkCleanPolyData, vtkTriangleFilter
     clean = vtkCleanPolyData()  # merge coincident points (degenerate grid cells), degenerate triangles -> lines
@@ -144,6 +146,7 @@ def _orient_normals(pts: np.ndarray, tris: np.ndarray, nrm: np.ndarray, grad_at:
 def _gradient_sampler(grid: Any) -> Callable[[np.ndarray], np.ndarray]:
     """∇s at arbitrary points, by probing VTK's point gradients (vtkGradientFilter + vtkProbeFilter)."""
     def grad_at(points: np.ndarray) -> np.ndarray:
+        # PyVista (VTK): only where gradients are probed
         import pyvista as pv
         idx = np.linspace(0, len(points) - 1, min(len(points), 64)).astype(np.int64)
         g = grid.compute_derivative(scalars=grid.active_scalars_name, gradient="grad")
@@ -161,6 +164,7 @@ def extract(volume: Any, styles: Sequence[IsoStyle | float], scalars: str | None
     Plain numbers are accepted as styles (white, opacity 0.5). Empty surfaces (value outside the data range) are
     returned as meshes with no triangles, so the list always matches ``styles``.
     """
+    # VTK's contour filters: only where surfaces are extracted
     from vtkmodules.vtkFiltersCore import vtkContourFilter, vtkFlyingEdges3D, vtkPolyDataNormals
     sty = [s if isinstance(s, IsoStyle) else IsoStyle(float(s)) for s in styles]
     grid, is_image = _vtk_input(volume, scalars)

@@ -51,6 +51,7 @@ def spectrum_alpha(mu: np.ndarray | float, a: float, b: float) -> np.ndarray:
 @lru_cache(maxsize=256)
 def fit_spectrum(opacity: float, n: int = 2000) -> SpectrumFit:
     """Least-squares (a, b) for a surface of normal-incidence opacity ``opacity`` in (0, 1)."""
+    # SciPy's optimizer (heavy): only when a spectrum is fitted, once per opacity (cached)
     from scipy.optimize import least_squares
     o = float(opacity)
     if not 0.0 < o < 1.0:

@@ -92,6 +92,7 @@ class RegularVolume:
         return (lo[0], hi[0], lo[1], hi[1], lo[2], hi[2])
 
     def to_pyvista(self) -> Any:
+        # PyVista (VTK, heavy): the model stays VTK-free until a PyVista form is asked for
         import pyvista as pv
 
         grid = pv.ImageData(dimensions=self.data.shape, spacing=self.spacing, origin=self.origin)
@@ -142,6 +143,7 @@ class CurvilinearGrid:
         return _range(self.point_data[name]) if name else (float("nan"), float("nan"))
 
     def to_pyvista(self) -> pv.StructuredGrid:
+        # PyVista (VTK, heavy): only for the PyVista form
         import pyvista as pv
 
         nx, ny, nz = self.dimensions
@@ -208,6 +210,7 @@ class UnstructuredMesh:
         return _range(self.point_data[name]) if name else (float("nan"), float("nan"))
 
     def to_pyvista(self) -> pv.UnstructuredGrid:
+        # PyVista (VTK, heavy): only for the PyVista form
         import pyvista as pv
 
         cells = {int(t): np.asarray(c, dtype=np.int64) for t, c in self.cells}
@@ -262,6 +265,7 @@ class TetMesh:
         return _range(self.scalars)
 
     def to_pyvista(self) -> pv.UnstructuredGrid:
+        # PyVista (VTK, heavy): only for the PyVista form
         import pyvista as pv
 
         grid = pv.UnstructuredGrid({VTK_TETRA: self.tets}, self.points)
@@ -309,6 +313,7 @@ class Image2D:
 
     def to_pyvista(self) -> pv.ImageData:
         """Image data on the z = 0 plane, x along columns, y northwards (row 0, the top row, at the largest y)."""
+        # PyVista (VTK, heavy): only for the PyVista form
         import pyvista as pv
 
         rows, cols = self.data.shape[:2]

@@ -18,6 +18,7 @@ def demo_scalar_field(points: np.ndarray) -> np.ndarray:
 
 def demo_tet_mesh(n: int = 16) -> TetMesh:
     """A tetrahedralised cube [-1, 1]^3 with ``n`` cells per edge carrying ``demo_scalar_field`` (5 tets per cube)."""
+    # PyVista (VTK, heavy): the model stays VTK-free until the demo mesh is made
     import pyvista as pv
 
     if n < 1:

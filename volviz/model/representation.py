@@ -20,6 +20,7 @@ from typing import Any, Optional, Union
 
 import numpy as np
 
+from volviz.model.arrays import default_array, list_arrays, parse_array_spec
 from volviz.model.datasets import CurvilinearGrid, Dataset, RegularVolume, TetMesh, TimeSeries, UnstructuredMesh
 from volviz.model.object_cache import ObjectCache
 
@@ -135,8 +136,6 @@ def _representation(dataset: Any) -> Representation:
 
 def _by_default_array(dataset: Any, kind: str, reason: str) -> Representation:
     """A dataset as read (no array chosen yet) drawn through its default array (``arrays.default_array``)."""
-    from volviz.model.arrays import default_array, list_arrays, parse_array_spec
-
     spec = default_array(dataset)
     if spec is None:
         return Representation(POINTS if kind == POINTS else SURFACE, None,

@@ -49,9 +49,12 @@ from typing import Any
 import numba
 import numpy as np
 
+from volviz.model.datasets import TetMesh
 from volviz.nature import _cloud_kernels as K
 from volviz.nature.heightfield import pow2_plus_one, resample_bilinear
 from volviz.nature.raster import row_bands, view_params
+from volviz.nature.terrain import frustum_planes
+from volviz.optics import TransferFunction
 
 
 def kmax(big_c: float) -> float:
@@ -150,16 +153,12 @@ class CloudShading:
             ) -> "CloudShading":
         """§11.6.2: κ(f) an inverse color ramp (bright where thin, dark where dense), ρ(f) zero up to ``cutoff``
         then linear to ``rho_max`` at f = 1; γ modulates the segment length."""
-        from volviz.optics import TransferFunction
-
         tf = TransferFunction([0.0, cutoff, 1.0], [bright, bright, dark], [0.0, 0.0, rho_max], name="clouds-npr")
         return cls("npr", tf, cutoff)
 
     @classmethod
     def physical(cls, rho_max: float = 0.08, color=(1.0, 1.0, 1.0), dark=(0.25, 0.28, 0.35)) -> "CloudShading":
         """§11.6.1: κ(γ) pre-integrated at the maximum optical density ρ_max; f modulates the length."""
-        from volviz.optics import TransferFunction
-
         tf = TransferFunction([0.0, 1.0], [dark, color], [rho_max, rho_max], name="clouds-physical")
         return cls("physical", tf, 0.0)
 
@@ -181,8 +180,6 @@ class CloudFrame:
         returns (TetMesh, the other field per vertex). With ``eye`` the tets are in back-to-front order (leaves
         back to front; per leaf the corner tets behind the central one, the central one, then those in front), ready
         for PT with ``order=np.arange(n)``."""
-        from volviz.model.datasets import TetMesh
-
         lod = self.lod
         vol = lod.volume
         nx, ny, nz = vol.shape
@@ -310,8 +307,6 @@ class CloudLOD:
         (``morphed`` holds stale values elsewhere). Without ``morph`` the fields are left unmorphed and the leaves
         whose morphed corners are all transparent are listed too: for a renderer that morphs the leaves itself
         (``resources/shaders/cloud_leaf_vs.glsl``)."""
-        from volviz.nature.terrain import frustum_planes
-
         t0 = time.perf_counter()
         eye = np.asarray(camera.position, dtype=np.float64)
         vol = self.volume
@@ -360,6 +355,7 @@ class CloudLOD:
 
 def build_cloud_table(shading: CloudShading, l_max: float, n_s: int = 64, n_l: int = 256):
     """The 3D pre-integration table over the table field's range [0, 1] (64 x 64 x 256 by default)."""
+    # the table kernels (Numba): loaded when a cloud table is built
     from volviz.optics import build_table3d
 
     return build_table3d(shading.tf, n_s=n_s, n_l=n_l, l_max=float(l_max), s_range=(0.0, 1.0))

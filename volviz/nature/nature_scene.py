@@ -20,6 +20,7 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
+from volviz.model.camera import Camera
 from volviz.model.settings import CloudSettings, FogSettings, TerrainSettings, validated
 from volviz.nature.clouds import CloudLOD, CloudShading, CloudVolume, build_cloud_table, render_cloud_image
 from volviz.nature.fog import FogLayer, render_layer
@@ -198,6 +199,7 @@ def demo_scene(seed: int = 0, terrain_size: int = 257, cloud_shape: tuple[int, i
 
     1000 x 1000 units, relief 160; fog up to 25 units deep in the valleys; a cumulus layer from height 190 to 315.
     """
+    # the noise generators (Numba kernels): only for generated scenes
     from volviz.nature import noise
 
     extent = 1000.0
@@ -216,8 +218,6 @@ def demo_scene(seed: int = 0, terrain_size: int = 257, cloud_shape: tuple[int, i
 
 
 def demo_camera(scene: NatureScene | None = None) -> Any:
-    from volviz.model.camera import Camera
-
     return Camera((500.0, -150.0, 330.0), (500.0, 600.0, 80.0), (0.0, 0.0, 1.0), 60.0,
                   clipping_range=(5.0, 10000.0))
 
@@ -268,6 +268,7 @@ def scene_from_components(components: Sequence[Any], datasets: dict[str, Any]) -
       ``coverage``; ``base_height``, ``thickness``, ``extent``; ``shading`` (npr | physical), ``rho_max``, ``C``, ``c``.
     sky: ``dataset`` = the polar sky image (optional; default a gradient).
     """
+    # the noise generators (Numba kernels) and the sky texture: only for generated parts
     from volviz.nature import noise
     from volviz.nature.sky import sky_texture
 

@@ -17,6 +17,8 @@ from typing import Any
 import numpy as np
 from numba import njit, prange
 
+from volviz.nature.heightfield import grid_from_image, resample_bilinear
+
 
 def view_params(camera: Any, size: tuple[int, int]) -> np.ndarray:
     """(16,) float64: eye(3), right(3), up(3), forward(3), hx, hy, near, far (perspective only)."""
@@ -279,8 +281,6 @@ def bake_color_map(normals: np.ndarray, texture: np.ndarray | None = None, light
     """The terrain's static light map times its color texture on the height-field grid, (N, N, 3) float32
     (Roettger §4.4: static ambient + diffuse light map).
     ``normals[i, j]`` x-major; the texture image has row 0 north."""
-    from volviz.nature.heightfield import grid_from_image, resample_bilinear
-
     n = normals.shape[0]
     L = np.asarray(light, dtype=np.float64)
     L = L / np.linalg.norm(L)

@@ -18,6 +18,7 @@ def sky_dome_mesh(radius: float, centre: Sequence[float] = (0.0, 0.0, 0.0), n_az
                   n_elevation: int = 16, skirt: float = 0.5 * np.pi) -> Any:
     """A hemisphere (plus a short skirt ``skirt`` radians below the horizon, colored like the horizon) as
     ``pyvista.PolyData`` with texture coordinates; normals point inwards (seen from inside)."""
+    # PyVista (VTK, heavy): only where the sky dome is drawn by VTK
     import pyvista as pv
 
     if not radius > 0:

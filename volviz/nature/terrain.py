@@ -59,6 +59,7 @@ class TerrainMesh:
         return int(len(self.triangles))
 
     def to_pyvista(self, normals: np.ndarray | None = None):
+        # PyVista (VTK, heavy): only where the terrain is drawn by VTK
         import pyvista as pv
 
         mesh = pv.PolyData.from_regular_faces(self.points, self.triangles)

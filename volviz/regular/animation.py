@@ -48,6 +48,7 @@ from volviz.io.atomic import new_temp_dir, recover_directory, replace_directory
 from volviz.io.errors import ReadError
 from volviz.model.datasets import RegularVolume, TimeSeries
 
+from .backends import compression_backend
 from .codec import compress, decompress
 
 BLOCK = 8
@@ -389,8 +390,6 @@ def compress_series(series: TimeSeries | Sequence[np.ndarray | RegularVolume], p
     if scheduler is None:
         store(_encode_part(checked, frames, order, list(range(n)), kw, b_res, search))
     else:
-        from .backends import compression_backend
-
         pos = {d: i for i, d in enumerate(order)}
 
         def tasks():

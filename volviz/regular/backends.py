@@ -7,6 +7,7 @@ cluster at ``address`` and yields the results, in any order. volviz's own Dask b
 """
 from __future__ import annotations
 
+from importlib.metadata import entry_points
 from typing import Any, Callable, Iterable, Iterator
 
 ENTRY_POINT_GROUP = "volviz.compression_backends"
@@ -21,15 +22,11 @@ class BackendMissing(RuntimeError):
 
 
 def backend_names() -> list[str]:
-    from importlib.metadata import entry_points
-
     return sorted({ep.name for ep in entry_points(group=ENTRY_POINT_GROUP)})
 
 
 def compression_backend(name: str) -> Backend:
     """The ``run`` function of the backend registered as ``name``; BackendMissing says which package to install."""
-    from importlib.metadata import entry_points
-
     found = [ep for ep in entry_points(group=ENTRY_POINT_GROUP) if ep.name == name]
     if not found:
         hint = KNOWN_BACKENDS.get(name, f"a package registering {name!r} in the entry-point group {ENTRY_POINT_GROUP}")

@@ -50,6 +50,7 @@ def _progress_bar(stream: Any = None) -> Any:
 def _raw_input(args: argparse.Namespace) -> None:
     """``--raw`` input checked before it is memory-mapped: a regular file (a FIFO or device would block the map, as
     ``volviz info`` refuses them: ``volviz.io._checks.check_file``) holding exactly NX*NY*NZ samples."""
+    # the readers (registry and plugins): only for raw input
     from volviz.io._checks import file_size
 
     nx, ny, nz = args.raw
@@ -68,6 +69,7 @@ def _load(args: argparse.Namespace) -> RegularVolume:
         dtype = np.dtype(args.dtype)
         data = np.memmap(args.input, dtype=dtype, mode="r", shape=(nx, ny, nz), order="F")
         return RegularVolume(data=data, source=args.input)
+    # the readers (registry and plugins): only for a subcommand that reads a file
     from volviz.io import read
 
     vol = read(args.input)
@@ -78,6 +80,7 @@ def _load(args: argparse.Namespace) -> RegularVolume:
 
 def _gop_pattern(text: str) -> str:
     """An argument type: a GOP pattern ``frame_types`` accepts (I first, then I, P and B)."""
+    # the animation codec (Numba kernels): only for a series
     from .animation import frame_types
 
     try:
@@ -135,6 +138,7 @@ def compress_main(argv: Sequence[str] | None = None) -> int:
 
 
 def _series_main(args: argparse.Namespace) -> int:
+    # the readers and the animation codec (Numba kernels): only for a series
     from volviz.io import read
     from volviz.model.datasets import TimeSeries
 
@@ -143,6 +147,7 @@ def _series_main(args: argparse.Namespace) -> int:
     if args.psnr is not None or args.raw:
         raise SystemExit("--series supports --lossless or --quality (not --psnr or --raw)")
     if args.scheduler:
+        # a compression backend is a plugin: only when one is named
         from .backends import BackendMissing, compression_backend
 
         try:

@@ -39,7 +39,7 @@ import numpy as np
 from volviz.model.datasets import RegularVolume
 
 from .cache import NodeCache
-from .nodes import HALF, Key, LevelStats, NodeDecoder, node_statistics
+from .nodes import HALF, Key, LevelStats, NodeDecoder, _expand, node_statistics
 
 
 @dataclass(frozen=True)
@@ -413,7 +413,6 @@ class LodTree:
     def reconstruct(self, selection: Selection) -> np.ndarray:
         """Full-resolution int32 volume of a selection (unselected regions 0): each node is expanded with zero
         details. With every leaf selected (or all non-zero-error nodes refined) this equals the decoded volume."""
-        from .nodes import _expand
         out = np.zeros(self.decoder.dims, np.int32)
         for key in selection.nodes:
             level, p = key

@@ -41,6 +41,7 @@ import math
 from dataclasses import dataclass
 from typing import Any, Optional, Sequence
 
+import numba
 import numpy as np
 
 from volviz.optics import TransferFunction
@@ -219,8 +220,6 @@ def as_camera(camera: Any) -> Camera:
 
 
 def _threads() -> int:
-    import numba
-
     return max(1, int(numba.get_num_threads()))
 
 
