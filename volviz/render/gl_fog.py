@@ -5,62 +5,12 @@ PCP, Roettger §10.3 (the three-pass recipe) and §10.4 (the near-plane cap, the
     fog = GLFogLayer(plotter, points, bottom, top, triangles, FogLayer(mode="attenuated"))
     plotter.screenshot()                # terrain, sky and other props are ordinary VTK props of the same renderer
 
-How a frame is drawn:
-
-- Uploaded per geometry: the layer's terrain triangles, each vertex with its xy and its bottom and top heights and
-  emissions (4 floats, ``prism_buffers``); a geometry shader (``resources/shaders/fog_prism_gs.glsl``) makes each
-  triangle's prism on the GPU: its three vertical side planes, the affine bottom and top heights zb(x, y),
-  zt(x, y) and the affine bottom and top emissions E_b(x, y), E_t(x, y), all relative to the layer's centre (float32
-  keeps its precision for layers far from the origin), and its 8 triangles wound outward. The emission at a point is
-  E_b + u (E_t - E_b), u the height fraction between bottom and top: the CPU's Σ λ_i [(1 - u) e_bottom,i +
-  u e_top,i]. Prisms whose six emissions are all zero (or with no thickness or no area) emit nothing (§10.3:
-  "zero-emission cells were discarded"). A C-LOD frame hands VTK only the terrain's vertices (7 floats each) and
-  triangles.
-- Per fragment (``resources/shaders/fog_prism_fs.glsl`` with ``ray_pixel.glsl``): only back (exit) faces are
-  rasterised, so every pixel of a prism's footprint gets one fragment, also for a prism cut by the near plane. The
-  pixel ray is rebuilt from ``gl_FragCoord`` with the camera's affine ray basis (as ``gl_pt``), intersected with the
-  prism's 5 half-spaces and clipped to [near, min(far, opaque depth at the pixel)]: a prism cut by the near plane
-  starts there, which is the near-plane cap of §10.4. The segment's emission ½ (e_f + e_b) l is written without
-  sorting: PCP's per-pixel result (§10.3's three passes, front-face emission·depth, back-face emission·depth and
-  their difference, give the same trapezoid; here one fragment has both ends), exact where the emission is linear
-  along the ray.
-- Accumulation and resolve: the prisms draw into the layer's own single-channel float32 target (bound while the
-  prism actor draws), with additive blending (emissive, attenuated) or blend equation MAX (mip: the maximum of e at
-  the entry/exit points). A second actor right after it, a triangle covering the viewport, restores the scene's
-  framebuffer and blend equation and converts the sum: emissive RGB = color · density · Σ (α = 0, i.e. added);
-  attenuated τ = density · Σ, α = 1 - e^-τ, RGB = color · α; mip α = min(gain · max, 1), RGB = color · α; it is
-  composited premultiplied "over" the scene (ONE, ONE_MINUS_SRC_ALPHA, set and restored by VTK through a 1x1
-  premultiplied texture, as ``gl_pt``). Both actors are translucent and share the layer's bounds, so VTK culls or
-  draws them together; after them the blend function, blend equation, framebuffer and depth state are VTK's again.
-- Opaque geometry (terrain, sky dome, boxes): the scene's float color target and depth texture come from the
-  renderer's ``volviz.render.gl.ScenePass`` (shared with GL PT volumes in the same renderer); when the prisms
-  draw (translucent pass), that depth texture holds the opaque scene and is not attached to the layer's target, so
-  the shader reads it as an ordinary texture.
-
-Errors, measured on llvmpipe (Mesa, VTK 9.7.2) in ``tests/test_render_gl_fog.py`` (a 33x33-vertex fractal terrain
-with a fog map, 1428 prisms; 8-bit screen units): against the CPU ``render_layer`` with the same opaque depth, every
-mode, the camera inside the fog and an opaque box in the fog, RMSE 0.12-0.29 and max 0.50-0.51 (the screen's
-rounding: both compute the same integral) except at grazing pixels (1 in 6,144 to 65,536: a ray in the plane of a
-prism face, or touching a prism's edge in MIP mode, where the integral jumps and float64 plane tests and the
-rasteriser's fixed-point edge functions decide differently; up to 32); the emissive mode against the exact emissive
-integral (dense ray marching) for fields linear along rays, top-down view at 128^2: RMSE 0.25-0.30, max 1.26-1.42.
-
-Timings, measured on llvmpipe, 2 cores (shared with other work), attenuated mode, the oblique camera of the tests:
-frame time with the layer minus without it, against the CPU ``render_layer`` (Numba) for the same layer with no
-opaque depth:
-
-    terrain (prisms)       64x48 window    256^2            1024^2
-    33^2 (1,428)           2.5 ms / 0.8    8.8 ms / 4.8     39 ms / 70
-    129^2 (17,336)         32 ms / 7.3     58 ms / 42       331 ms / 512      (GPU / CPU)
-
-In the 64x48 window (few pixels to shade) the time is llvmpipe's vertex and geometry work for the prisms, which a GPU
-takes off the CPU; the Python callbacks (camera, ray basis, uniforms, target) take 0.6-1.8 ms. The per-point buffer
-(``prism_buffers``) takes 0.6 ms for the 129^2 terrain.
-
-Not handled: a renderer that does not fill its window (the ray basis and the target assume the renderer's size with
-the origin at the framebuffer's corner), parallel projection (natural scenes are perspective), depth peeling for
-other translucent props of the renderer (the pass draws them in order). The window should be single-sample (the
-float target is). Call ``remove()`` before closing the plotter.
+A geometry shader makes each terrain triangle's prism; each back face's fragment integrates the prism's segment of
+its pixel ray (cut by the near plane and the opaque depth) and adds it, unsorted, into the layer's float32 target,
+which a resolve quad converts (emissive, attenuated, MIP) and blends over the scene. How a frame is drawn and what is
+not handled: docs/gl-passes.md "gl_fog: ground fog and cloud layers (Roettger §10.3-10.4)"; errors and timings:
+docs/bench/gl-passes.md "gl_fog". The window should be single-sample (the float target is). Call ``remove()`` before
+closing the plotter.
 """
 from __future__ import annotations
 

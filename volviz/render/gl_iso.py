@@ -10,67 +10,11 @@
 "iso"): the calls of the CPU overlay ``volviz.render.iso_overlay.IsoOverlay`` (``mode``, ``set_surfaces``, ``update``,
 ``remove``, ``stats``, ``backend``) over a ``GLIsoSurfaces`` made again when the surfaces change.
 
-Every pass runs over all surfaces of all volumes at once (the note: "each render pass must be executed for all
-volumes"): the translucent surfaces of every mesh are one vertex buffer (in ``meshes`` order, the CPU's draw order)
-drawn by one actor per pass, so the per-pixel sums and products are order-independent across volumes. Opaque
-surfaces (opacity 1) are one opaque actor. All actors share one shader program (``resources/shaders/iso_surface_*``):
-
-- ``"2pass"``: the opaque pass, then the translucent surfaces blended unsorted in draw order, C ← e + (1 − α)·C
-  (VTK's straight-alpha blending of the color c and α).
-- ``"3pass"``: the opaque pass (B); an attenuation pass writing (0, α) under the same blending, C ← (1 − α)·C, so
-  C = Π(1 − α_i)·B and the alpha 1 − Π(1 − α_i)(1 − α_B); an emission pass writing (e, 0) with premultiplied
-  blending (ONE, ONE_MINUS_SRC_ALPHA; a 1x1 premultiplied actor texture makes VTK set and restore it), C ← C + e.
-  The window's fixed-point color saturates at 1 as in composite.py.
-- ``"4pass"``: as 3pass, with a back-face pass between them: the back faces of the translucent surfaces (triangles
-  are wound so that GL's facing is the CPU's, the geometric normal oriented by the vertex normals) are drawn with
-  depth writes into volviz's own framebuffer (a float depth texture, cleared per frame; bound and unbound in the
-  mappers' ``UpdateShaderEvent`` observers), and the emission shader discards fragments behind that z_b
-  (``gl_FragCoord.z`` against the texel; the same program computes both, so a back face at z_b itself counts, as the
-  CPU's depth ≤ z_b). The scene's depth buffer is never written by the translucent passes.
-- ``"exact"``: VTK's (dual) depth peeling, ``peels`` layers at most and occlusion ratio 0, with the same shading
-  (the translucent actor writes the straight color at the ``//VTK::DepthPeeling`` tags), by a ``PeelLayer``
-  (``volviz.render.peel_layer``): a renderer drawn right after the plotter's, keeping its image and depth, so the
-  surfaces are peeled over the finished scene whatever render pass the plotter's renderer runs (the float32 scene
-  target of a GPU PT volume or natural scene, ``volviz.render.gl.ScenePass``, under which VTK does not peel). With a
-  regular (VTK) volume shown in a renderer without such a pass, the surfaces are peeled by that renderer itself
-  together with its volumes instead (``volviz.render.volume_peeling``: VTK composites the volume's ray segments
-  between the peeled layers), so the volume in front of a surface lies over it and the volume behind under it, also
-  between layers (issue #28: a plane through a ball RMSE 0.45 levels against the exact composite of the scene's own
-  renders; two planes through its dense middle 0.57, where the CPU overlay's split at the nearest layer,
-  ``volviz.render.iso_volume_split``, is off by 8.0; tests/test_iso_modes_volume.py). VTK restarts the volume's
-  samples at each peeled layer, so a dense volume seen obliquely differs from its unpeeled render: the plane turned
-  40° away with the ball's extinction four times larger, 1000x700, RMSE 1.1, 0.9 % of the surface's pixels over 3
-  levels (at most 10) against the exact composite of unpeeled renders (not a test: measured by hand).
-
-The 2/3/4 passes are ordinary actors in the renderer's translucent pass, drawn in the order they were added (the
-renderer's OIT and depth peeling are off while they are shown), and each restores the GL state it changes (blend
-function, depth mask, framebuffer binding), so other props of the renderer render normally; the renderer's OIT and
-depth-peeling settings are restored by ``remove`` (and left as they were in exact mode). Other translucent props of
-the renderer are blended unsorted in the 2/3/4-pass modes (no OIT); in exact mode they are drawn by the renderer as
-before and the surfaces composited over them, as the CPU overlay composites its image over the rendered scene.
-
-Shading, per fragment in GLSL, as composite.py: μ = |n·v| per vertex, interpolated and clamped to [0, 1]; α = the
-surface opacity ("flat") or 1 − clamp(μ^a − b, 0, 1) with the least-squares (a, b) of the surface's opacity
-("spectrum"); color c·(k_a + (1 − k_a)·μ), k_a = ``volviz.iso.composite.AMBIENT``. The view ray v is built from the
-vertex buffer's points (relative to the meshes' centre), so VTK's automatic shift and scale of the vertex buffer is
-turned off: VTK rescales each axis of data more than about 32 units across, which bends v (with it on, μ on the
-Storm scene of ``volviz bench iso`` was off by up to 0.17 and the image by RMSE 1.9 instead of 0.4).
-
-Measured on llvmpipe (Mesa, VTK 9.7.2) against ``volviz.iso.composite.render`` of the same mode, 8-bit units of
-RGB, two synthetic 24³ volumes with three overlapping translucent surfaces and an opaque one at 256², perspective
-and parallel, spectrum and flat shading (``tests/test_render_gl_iso.py``): RMSE 0.49-0.67 in every mode, 99.9% of
-the pixels within 2.1, at most 2 pixels over 3 (silhouette pixels, up to 111, that GL's edge rule and the CPU
-rasteriser's assign differently). The rest is 8-bit rounding of each blend step in the window's color buffer. The
-pixels no surface covers are exactly those of the scene without the surfaces, opaque and translucent props included.
-On the real scenes of ``volviz bench iso`` (Storm, two overlapping Storm volumes, Blunt Fin; 384², docs/bench/iso.md):
-RMSE 0.31-0.59 against the CPU mode, 1 to 13 pixels over 3 (silhouettes); frame time (render + read-back, llvmpipe
-on 2 cores, load 0.7) 4-6 ms for 2-pass, 8-12 ms 3-pass, 9-16 ms 4-pass, 30-58 ms exact, where the CPU compositor
-takes 11-30 ms per frame in the same run.
-
-Exact mode under the float32 scene target gives the same image as without it (tested), and all four modes are tested
-beside a GPU PT volume in ``tests/test_render_gl_iso_view.py``. Not handled or not tested: renderers that do not
-fill their window (the back-face texture is the renderer's size, read at ``gl_FragCoord``); multisampled windows
-(the tests use one sample per pixel, as the CPU compositor does).
+Every pass runs over all surfaces of all volumes at once (one vertex buffer per pass, so the per-pixel sums and
+products are order-independent across volumes); "2pass", "3pass", "4pass" are ordinary translucent actors, "exact"
+is VTK's depth peeling in a ``PeelLayer``. The modes, the shading and the GL state each restores:
+docs/gl-passes.md "gl_iso: many translucent isosurfaces (libMini note §4)"; errors against the CPU compositor and
+frame times: docs/bench/gl-passes.md "gl_iso", ``docs/bench/iso.md``.
 """
 from __future__ import annotations
 

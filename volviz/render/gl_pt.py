@@ -5,87 +5,16 @@ digest §6-7: cell projection in visibility order with a pre-integration table l
     plotter.show() / plotter.screenshot()          # every render sorts for the camera of that render
     vol.set_tf(tf2)                                # replaces only the table texture
 
-How a frame is drawn:
+The mesh is uploaded once and per render only the back-to-front cell order (a texture of cell ids); each back face's
+fragment integrates its cell's ray segment by a table lookup (3D §8.4, separable §9.1) or exactly (isosurfaces
+§8.8-8.13, pre-classified §8.14), and the cells are composited "over" into a float32 target that a resolve quad
+blends over the scene. How a frame is drawn (upload, order, fragment, compositing, opaque depth, multisampling,
+the reduced target while the camera moves, clipping): docs/gl-passes.md "gl_pt: pre-integrated projected tetrahedra
+(Roettger Ch. 8-9)"; the VTK/OpenGL facts it relies on: docs/design.md "VTK's OpenGL: what the GPU passes rely on";
+errors and timings: docs/bench/gl-passes.md "gl_pt", ``docs/bench/pt-gl/``.
 
-- Mesh data is uploaded once: a static vertex buffer with 4 vertices per tetrahedron, each carrying its cell's four
-  face planes (n . x <= d inside), the scalar's affine form s(x) = g . x + c and the cell's scalar range, all relative
-  to the mesh's centre (``topology``: meshes offset by 1e6 keep their precision; the actor is placed at the centre).
-- Per render (the renderer's ``StartEvent``): the back-to-front cell order for the camera (``visibility_order``, as
-  the CPU ``pt``) with zero-opacity and NaN cells culled (Roettger §9.1) is the only upload. By default
-  (``order_texture``, meshes below 2^24 cells) it is a float32 texture of cell ids: the index buffer is static (slot
-  s draws vertices 4 s .. 4 s + 3, made once) and the vertex shader reads the cell of its slot, its corners and its
-  data from a texture of the cells (``gl_pt_mesh.cell_texels``, uploaded once; slots past the order are moved
-  outside the clip volume), so a new camera costs a 4-byte-per-cell texture upload instead of VTK rebuilding its
-  index buffer from the cells (about 15 ms of CPU for the Blunt Fin's 749,272 triangles, more than the sort), and
-  the mesh takes 260 bytes per cell on the GPU instead of 480. With ``order_texture=False`` the order becomes the
-  index buffer, 4 triangles per cell, as 32-bit arrays shared with VTK (no copy); both give the same pixels.
-- Per fragment (``resources/shaders/pt_tet_fs.glsl``): only back (exit) faces are rasterised (front faces culled),
-  so a cell cut by the near plane (camera inside the mesh) is still drawn. The pixel ray is rebuilt from
-  ``gl_FragCoord`` with the camera's affine ray basis (no interpolated varyings), clipped against the cell's planes,
-  the near and far planes and the opaque scene's depth at the pixel; the exact (s_f, s_b, l) of that segment look up
-  the 3D table (Roettger §8.4, trilinear) or the separable one (§9.1: exact opacity 1 - exp(-l rho_hat), color
-  polynomial in l; its layers a 2D texture array, bilinear within a layer), both float32. The fragment shader is
-  made for one kind of segment evaluation (``PT_KIND``: 3D table, separable table, isosurfaces, pre-classified; VTK
-  recompiles it when the kind changes):
-  llvmpipe runs every branch of a fragment shader under a lane mask, so a run-time switch between kinds made every
-  fragment pay for all of them (measured at 512^2 on the Blunt Fin: 3.7 s per frame with the four kinds behind a
-  uniform, 1.8 s with the two table kinds, 1.4 s with the 3D table alone).
-- Compositing: the cells are composited back to front with premultiplied "over" (ONE, ONE_MINUS_SRC_ALPHA, set
-  and restored by VTK through a 1x1 premultiplied actor texture) into the volume's own float32 RGBA target, cleared
-  to transparent black each frame (~95 cells overlap per pixel on the Blunt Fin, which an 8-bit target does not
-  accumulate accurately). A second actor drawn right after the cells (``resolve_actor``: one triangle covering the
-  viewport, with the volume's bounds so that VTK culls both together) binds the scene's framebuffer again and
-  composites that image "over" the scene. Both actors are translucent and drawn in order (no OIT, no depth peeling
-  for this renderer); other props of the renderer are drawn by VTK as usual (a translucent prop added later is
-  blended over the volume; pixels the volume does not cover are the scene's).
-- Opaque geometry: when the cells draw (translucent pass, after the opaque one), the depth buffer of the framebuffer
-  being drawn holds the opaque scene (translucent props do not write depth); it is blitted into the volume's own
-  depth texture, which the shader reads (texelFetch): each segment ends at the opaque depth of its pixel, so a cell
-  straddling a surface is integrated only up to it. The volume's color target has no depth attachment, so GL's depth
-  test never drops a fragment whose exit face lies behind the surface.
-- Multisampling: by default the window's multisampling is switched off while the volume is in it (one color per
-  pixel, as volviz's CPU overlays: the two backends then give the same viewport image), and the renderer draws
-  into a float32 scene target (``volviz.render.gl.ScenePass``, shared with ``volviz.render.gl_fog``'s
-  layers, which read its depth texture; the volume itself does not need it and blits its depth from it). With
-  ``keep_multisampling=True`` it stays on and no scene target is installed (its single-sample texture would undo
-  the antialiasing, as it does when a fog layer in the same renderer installs one): the opaque scene (and
-  translucent props) are antialiased in the window's multisampled framebuffer as without the volume, the depth blit
-  resolves the opaque depth to one sample per pixel, and the resolve composites the volume's single-sample image
-  over every sample. Measured on llvmpipe (4 samples,
-  ``tests/test_render_gl_pt.py``): against the reference clipped at the single-sample depth over the antialiased
-  opaque image, RMSE 0.32 / max 2.6 away from an opaque sphere's silhouette; on silhouette pixels (partly covered)
-  up to 37 and next to them up to 6.5, since the volume is integrated to one sample's depth rather than each
-  sample's (exact there would need per-sample shading of every cell).
-
-- While the camera moves (``set_interactive``; by default while the window's desired update rate is VTK's
-  interactive one, which VTK's interactor styles set for a drag and the app for playback) the cells are drawn into a
-  smaller float target, at most ``interactive_pixels`` (1920x1080) pixels with the window's aspect
-  (``volviz.render.reduced_fill``: a drag at 3840x2160 fills what one at 1920x1080 does; at 1080p or less nothing
-  changes): the viewport, the pixel rays and the copy of the opaque depth (nearest sample) follow the smaller size,
-  and the resolve samples the target bilinearly over the window (a variant of its shader, ``PT_UPSAMPLE``). The
-  frame after the camera stops is drawn at full resolution, exactly as before. What that costs in image error during a
-  drag, and what it saves in fill: ``volviz bench unstructured`` (docs/bench/unstructured.md).
-
-Clipping planes and a box crop (``set_clip_planes``) cut each fragment's ray segment, as the near plane does.
-
-Exact segments instead of a table (as the CPU ``pt``; the same fragment, ray and compositing): ``iso`` draws
-isosurfaces (Roettger §8.8-8.10) by the §8.13 Heaviside limit of each fragment's segment (H(0) = 1/2, the surfaces
-crossed composited in ray order with the color of the side seen, only cells an isovalue crosses drawn), with
-``iso_shading="smooth"`` shaded by a headlight through vertex normals (§8.9: the intensity linear in the cell through
-its barycentric coordinates, which are the face planes scaled per cell, taken where the ray crosses the surface);
-``classification="pre"`` (§8.14) classifies the segment's ends by the TF and integrates kappa and rho linear in
-between in closed form (Gauss-Legendre up to optical depth 1, erfcx or Dawson's integral beyond, float32). Measured
-against the CPU reference on llvmpipe (``tests/test_render_gl_pt.py``, 8-bit): three flat surfaces RMSE 0.24 / max
-0.49 (camera inside 0.16 / 0.29), smooth 0.17 / 0.50 and 0.22 / 0.50, pre-classified 0.24-0.28 / 0.50: the screen's
-rounding.
-
-Timings on llvmpipe and what the fragment shader's parts cost (why the lookup kind and the number of clipping
-planes are compiled in): docs/bench/pt-gl/shader-costs.md and ``volviz bench unstructured``.
-
-Not handled yet: a renderer that does not fill its window (the ray basis, the targets and the depth blit assume the
-renderer's size with its origin at the framebuffer's corner: tested with full-window renderers only), depth peeling
-for other translucent props of the same renderer (the pass draws them in order). Call ``remove()`` before closing
-the plotter.
+Not handled: a renderer that does not fill its window; depth peeling for other translucent props of the same
+renderer (drawn in order). Call ``remove()`` before closing the plotter.
 """
 from __future__ import annotations
 

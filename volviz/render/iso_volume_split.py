@@ -129,9 +129,8 @@ class FrontVolume:
     """The shown regular volumes of a plotter from the eye to the nearest translucent surface, rendered in an
     offscreen window of a thread of its own (``volviz.render.gl_thread``; the module docstring says how): the GUI
     thread only takes a ``snapshot`` (copies of the camera, lights and volume properties); ``render`` draws it from
-    any thread. Before, the plotter's own window drew it on the GUI thread after every camera change: an overlay
-    update's GUI-thread part 1416-1760 ms against 883-963 ms now at 1000x700 on llvmpipe
-    (docs/bench/iso_split_off_gui_thread.md). ``close`` ends the thread."""
+    any thread, so the GUI thread no longer draws it after every camera change
+    (``docs/bench/iso_split_off_gui_thread.md``). ``close`` ends the thread."""
 
     def __init__(self) -> None:
         from volviz.render.gl_thread import GLThread

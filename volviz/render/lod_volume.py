@@ -17,11 +17,10 @@ Two renderers:
   into an overlay renderer on a higher layer with (SRC_ALPHA, ONE_MINUS_SRC_ALPHA) blending (8-bit round trip ≤
   1/255). The overlay joins the plotter's list of volviz overlays, so PT volumes and LOD volumes hide each other
   while reading depth. Mapper clipping planes (``self.mapper``, set by the controller) clip the rays at the next
-  draw. Measured on the embryo walkthrough at 512^2 (``docs/bench/compression-animation.md``): 0.3-0.4 s per
-  frame on 2 cores, 10-25x faster than the VTK path, with the error of the selection itself.
+  draw. Frame times against the VTK path: ``docs/bench/compression-animation.md``.
 - ``"vtk"``: one ``vtkVolume`` whose ``vtkMultiBlockVolumeMapper`` draws each block as its own image with its own
-  spacing, sorted back to front by VTK. On this machine (no GPU, llvmpipe) each block costs about 40 ms, so the
-  embryo (256^3) at 512^2 takes 2.7 s per frame with 64 blocks against 0.29 s for the whole volume as one block.
+  spacing, sorted back to front by VTK. Each block is a pass of its own, so the frame time grows with the number of
+  blocks (``docs/bench/compression-animation.md``).
 
 Blocks carry a one-voxel overlap with their +x/+y/+z neighbours of the same level (``LodTree.block``), so trilinear
 interpolation is continuous across the boundary of two blocks of one level: the image of a selection that is one

@@ -2,7 +2,7 @@
 each), in one Numba pass: the zero-opacity cull (Roettger §9.1, cells whose scalar range meets no rho > 0) and the
 int32 triangle connectivity for ``vtkCellArray.SetData`` written together into buffers kept between frames, so a new
 camera's order costs no numpy temporaries (the previous chain ``order[visible[order]]``, ``4 * cells``, broadcast
-add: 3 passes and 4 arrays per frame; measured in docs/bench/unstructured.md).
+add, made 3 passes and 4 arrays per frame; ``docs/bench/unstructured.md``).
 
 Vertex ``4 c + k`` is corner k of cell c in the static vertex buffer (``volviz.render.gl_pt_mesh.tet_polydata``);
 triangle f of a cell is its face f, ``topology.FACES``.

@@ -8,9 +8,8 @@ float32 copy (``planes32``: 64 bytes per cell instead of 128) and the float64 pl
 too close to 0 to trust, so the decisions are the float64 ones exactly; split over the cores (large convex meshes)
 each cell fills its own entries from the float64 planes. Per cell the pass keeps 1 byte (a bit per neighbour in
 front, one for "has extra relations") and a 32-bit in-degree; Kahn then touches the adjacency row (int32), that byte
-and the in-degrees of the neighbours in front. The 2.27 M-cell refined Blunt Fin, process CPU at load 12-15: face
-sides 26 ms (the per-cell pass from the float64 planes 34-42 ms), Kahn 59 ms (a branch-free loop: 137 ms; the
-byte and in-degree packed into one word: no change). Measured: docs/bench/unstructured.md.
+and the in-degrees of the neighbours in front. Times: ``docs/bench/unstructured.md``,
+``docs/bench/docstring-figures.md``.
 """
 from __future__ import annotations
 

@@ -19,10 +19,8 @@ Compositing is front to back over the reversed visibility order (equivalent to b
 C = C_seg + (1 - a_seg) C_behind), in screen tiles processed in parallel; a tile stops when every pixel's transmittance
 is below ``t_min`` (early ray termination; error <= t_min per channel). The segment color comes from the separable
 tables (Roettger §9.1: exact opacity 1 - exp(-l rho_hat), color polynomial of degree 2 in l; default, 256^2) or the
-3D table (trilinear). Measured on the Blunt Fin at 512^2 against the reference: separable 256^2 degree 2 RMSE 0.04,
-max 0.23 (8-bit); 3D 128^2 x 64 RMSE 0.43, max 1.9. Cost (CPU time of the raster, 20.7 M fragments, loaded 2-core
-machine): separable 1.26-1.33 s, 3D 1.08-1.09 s, i.e. the separable lookup is 10x more accurate but ~20 % slower
-(its expm1 is not the cost: a libm-free exp changed nothing); without any lookup the raster takes ~40 % of that.
+3D table (trilinear). The separable tables are the default because they are about 10x more
+accurate than the 3D table for about 20 % more raster time (``docs/bench/docstring-figures.md``).
 """
 from __future__ import annotations
 

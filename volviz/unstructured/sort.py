@@ -15,7 +15,7 @@ Roettger §8.1 and Guthe §4.3 (§3.1 of the thesis):
   ``nonconvex="sample"`` keeps the previous image-space variant of XMPVO (Cook, Max, Silva, Williams 2004, "SXMPVO"):
   every boundary face ray-cast at every pixel centre of the image it covers, each entry face after an exit face along
   a pixel ray giving a relation; exact for that image's pixel centres, at a cost that grows with the window
-  (Blunt Fin: 32 ms at 512², 262 ms at 1920x1080); the tests use it as the witness of the object-space relations.
+  (``docs/bench/docstring-figures.md``); the tests use it as the witness of the object-space relations.
 - Visibility cycles (real ones, or ones created by combining relations that hold on different rays) stall Kahn's
   algorithm. They are broken by emitting the farthest remaining cell (by centroid depth); ``SortResult.cycles`` counts
   the breaks.
