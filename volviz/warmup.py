@@ -7,21 +7,59 @@ the app loaded its first tetrahedral scene on a fresh install, none with the cac
 scene the app and the CLI draw (natural scene, tetrahedral volume, compressed level-of-detail volume, isosurfaces and
 a blended volume of a time series), compresses with every coder and transform, and runs each unstructured method,
 all at tiny sizes through the same code paths, so the kernels and the type signatures they are called with are
-compiled once and written to the cache.
+compiled once and written to the cache. First it writes the bytecode of volviz's modules (``compile_bytecode``).
 """
 from __future__ import annotations
 
+import compileall
 import json
+import os
+import py_compile
+import sys
 import tempfile
 import time
+from importlib.metadata import distributions
+from importlib.util import find_spec
 from pathlib import Path
-from typing import Callable, Optional
+from typing import Callable, Optional, Sequence
 
 import numpy as np
 
 from volviz.jobs import ProgressCallback, report
 
 SIZE = (64, 48)
+#: the bytecode's check against its module: a hash of the source, so that an edited module never runs stale bytecode
+BYTECODE_CHECK = py_compile.PycInvalidationMode.CHECKED_HASH
+
+
+def bytecode_folders() -> list[Path]:
+    """The packages whose bytecode ``compile_bytecode`` writes: volviz's, its plugins' (entry points of a
+    ``volviz.*`` group) and the app's, where each is a folder of source files (not in a frozen app)."""
+    plugins = {ep.module.split(".")[0] for dist in distributions() for ep in dist.entry_points
+               if ep.group.startswith("volviz.")}
+    names = ["volviz", *sorted(plugins), "volviz_app"]
+    folders: list[Path] = []
+    for name in dict.fromkeys(names):
+        spec = find_spec(name)
+        for location in (spec.submodule_search_locations or []) if spec is not None else []:
+            if Path(location).is_dir() and Path(location) not in folders:
+                folders.append(Path(location))
+    return folders
+
+
+def compile_bytecode(folders: Optional[Sequence[Path]] = None) -> list[Path]:
+    """Write the bytecode of every module under ``folders`` (default ``bytecode_folders``) that has none or whose
+    source changed, checked against the source's hash (``BYTECODE_CHECK``); returns the folders written to. pip
+    compiles a package it installs; an editable install, or ``PYTHONDONTWRITEBYTECODE`` (which stops Python writing
+    what it compiles, not ``compileall``), leaves volviz's modules without bytecode, and every fresh process compiled
+    the 120-odd modules a render imports again: 0.2-0.5 s of CPU of each ``volviz render`` (issue #30, time to the
+    first image; docs/bench/startup-cuts.md). Folders it may not write to (a system install) are left as they are."""
+    if getattr(sys, "frozen", False):   # a frozen app runs its bundled bytecode
+        return []
+    written = [Path(f) for f in (bytecode_folders() if folders is None else folders) if os.access(f, os.W_OK)]
+    for folder in written:
+        compileall.compile_dir(str(folder), quiet=1, invalidation_mode=BYTECODE_CHECK)
+    return written
 
 
 def _blob(n: int, phase: float = 0.0) -> np.ndarray:
@@ -146,15 +184,18 @@ def _run_exercise(index: int) -> float:
 
 
 def warm_up(progress: Optional[ProgressCallback] = None, workers: Optional[int] = None) -> list[tuple[str, float]]:
-    """Run every exercise once (compiling, or loading from the cache, what it uses); returns (name, seconds) in
-    ``EXERCISES``' order. The exercises compile mostly disjoint kernels (Numba's cache takes
-    concurrent writers), so they run in ``workers`` processes at once (one
-    per core, at most one per exercise; Numba compiles on one thread): on 2 cores the warm-up takes about its
-    longest exercise instead of their sum."""
-    import os
+    """Write volviz's bytecode (``compile_bytecode``), then run every exercise once (compiling, or loading from the
+    cache, what it uses); returns (name, seconds): "bytecode", then the exercises in ``EXERCISES``' order. The
+    exercises compile mostly disjoint kernels (Numba's cache takes concurrent writers), so they run in ``workers``
+    processes at once (one per core, at most one per exercise; Numba compiles on one thread): on 2 cores the warm-up
+    takes about its longest exercise instead of their sum."""
     from concurrent.futures import ProcessPoolExecutor, as_completed
     from multiprocessing import get_context
 
+    report(progress, 0.0, "compiling volviz's modules to bytecode")
+    start = time.perf_counter()
+    compile_bytecode()
+    timings = [("bytecode", time.perf_counter() - start)]
     cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
     workers = max(1, min(len(EXERCISES), workers or cores))
     seconds: dict[int, float] = {}
@@ -163,7 +204,7 @@ def warm_up(progress: Optional[ProgressCallback] = None, workers: Optional[int] 
             report(progress, i / len(EXERCISES), f"compiling the kernels of the {name}")
             seconds[i] = _run_exercise(i)
         report(progress, 1.0, "kernels compiled")
-        return [(name, seconds[i]) for i, (name, _) in enumerate(EXERCISES)]
+        return timings + [(name, seconds[i]) for i, (name, _) in enumerate(EXERCISES)]
     report(progress, 0.0, "compiling the kernels of " + ", ".join(name for name, _ in EXERCISES))
     with ProcessPoolExecutor(workers, mp_context=get_context("spawn")) as pool:
         futures = {pool.submit(_run_exercise, i): i for i in range(len(EXERCISES))}
@@ -172,4 +213,4 @@ def warm_up(progress: Optional[ProgressCallback] = None, workers: Optional[int] 
             report(progress, len(seconds) / len(EXERCISES),
                    f"compiled the kernels of the {EXERCISES[futures[future]][0]}")
     report(progress, 1.0, "kernels compiled")
-    return [(name, seconds[i]) for i, (name, _) in enumerate(EXERCISES)]
+    return timings + [(name, seconds[i]) for i, (name, _) in enumerate(EXERCISES)]
