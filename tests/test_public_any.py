@@ -80,7 +80,6 @@ ISO_PARTS = ("IsoParts or a list of IsoMesh: the body tells them apart with a co
 ALLOWED: dict[str, str] = {
     "volviz.render.backend:GLInfo.to_dict": JSON,
     "volviz.render.backend:backend_setting": JSON,
-    "volviz.render.clipping:vtk_plane": ELSEWHERE,
     "volviz.render.clipping:set_mapper_planes": ELSEWHERE,
     "volviz.render.clipping:clip_vtk_prop": ELSEWHERE,
     "volviz.render.collision:fly_clearance": ELSEWHERE,
@@ -135,7 +134,6 @@ ALLOWED: dict[str, str] = {
     "volviz.render.gl_nature:GLNatureView.finish": GL,
     "volviz.render.gl_pt:GLPTVolume.set_clip_planes": GL,
     "volviz.render.gl_pt:GLPTVolume.set_clip": GL,
-    "volviz.render.gl_pt_mesh:tet_polydata": GL,
     "volviz.render.gl_pt_order:order_key": GL,
     "volviz.render.gl_pt_order:CellOrder.begin": GL,
     "volviz.render.gl_pt_order:CellOrder.compute": GL,
@@ -143,8 +141,6 @@ ALLOWED: dict[str, str] = {
     "volviz.render.gl_pt_tables:table_texels": GL,
     "volviz.render.gl_pt_tables:upload_table": GL,
     "volviz.render.gl_pt_tables:set_table_uniforms": GL,
-    "volviz.render.gl_pt_targets:PTTargets.color": GL,
-    "volviz.render.gl_pt_targets:PTTargets.bind": GL,
     "volviz.render.image_overlay:overlay_rgba8": GL,
     "volviz.render.image_overlay:read_buffers": GL,
     "volviz.render.image_overlay:window_size": GL,
@@ -164,7 +160,6 @@ ALLOWED: dict[str, str] = {
     "volviz.render.lod_volume:LodVolume.show_stats": STATS,
     "volviz.render.offscreen:offscreen_plotter":
         "pv.Plotter: PyVista 0.49's _Wrapped decorator mistypes its methods for callers outside this change (bench)",
-    "volviz.render.peel_layer:PeelLayer.add": ELSEWHERE,
     "volviz.render.preview_hold:hold_previews": GL,
     "volviz.render.preview_hold:holds_previews": GL,
     "volviz.render.preview_hold:PreviewCameraHold.snapshot": GL,

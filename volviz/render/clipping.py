@@ -16,17 +16,20 @@ How each prop honours them:
 from __future__ import annotations
 
 import logging
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from volviz.iso.clip import clip_grid
 from volviz.model.clip import ClipPlane, ClipSettings
+
+if TYPE_CHECKING:   # type-only: VTK's classes, reached through the facade at run time
+    from volviz.render.vtk_facade import vtkPlane
 
 log = logging.getLogger(__name__)
 
 MAX_GL_PLANES = 6
 
 
-def vtk_plane(plane: ClipPlane) -> Any:
+def vtk_plane(plane: ClipPlane) -> vtkPlane:
     from volviz.render.vtk_facade import vtk
 
     p = vtk.vtkPlane()

@@ -5,12 +5,15 @@ the order as a texture (``GLPTVolume(order_texture=True)``) the same data are te
 id, and the vertex buffer keeps only the corners."""
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from volviz.model.datasets import TetMesh
 from volviz.unstructured.topology import cell_ranges, topology
+
+if TYPE_CHECKING:   # type-only: VTK's classes, reached through the facade at run time
+    from volviz.render.vtk_facade import vtkPolyData
 
 __all__ = ["cell_attributes", "cell_texels", "tet_polydata", "texels_per_cell"]
 
@@ -61,7 +64,7 @@ def cell_texels(mesh: TetMesh, smooth: bool = False) -> np.ndarray:
     return np.concatenate(parts, axis=1).reshape(-1, 4)
 
 
-def tet_polydata(mesh: TetMesh, smooth: bool = False, attributes: bool = True) -> Any:
+def tet_polydata(mesh: TetMesh, smooth: bool = False, attributes: bool = True) -> vtkPolyData:
     """The static vertex buffer as vtkPolyData: 4 points per tetrahedron (relative to the centre) with the cell
     attributes repeated at each (unless ``attributes`` is False: the order texture's layout reads them from
     ``cell_texels``), and no cells yet (the order sets them)."""

@@ -5,9 +5,12 @@ segments at (blitted from the framebuffer being drawn), and for a frame drawn sm
 depth at the smaller size; binding them around the cells' draw and giving the scene its framebuffer back."""
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from volviz.render.gl import ScenePass, color_target, depth_format, depth_target, glenum, release
+
+if TYPE_CHECKING:   # type-only: VTK's classes, reached through the facade at run time
+    from volviz.render.vtk_facade import vtkTextureObject
 
 __all__ = ["PTTargets"]
 
@@ -22,7 +25,7 @@ class PTTargets:
         self._bound = False                           # the color target is bound (cells drawn, no resolve yet)
 
     @property
-    def color(self) -> Any:
+    def color(self) -> vtkTextureObject | None:
         """The color texture the cells were last drawn into (None before the first draw)."""
         return self._targets[0] if self._targets is not None else None
 
@@ -63,7 +66,7 @@ class PTTargets:
         fb = self.renderer.GetRenderWindow().GetRenderFramebuffer()
         return depth_format(fb.GetDepthAttachmentAsTextureObject())
 
-    def bind(self, size: tuple[int, int], drawn: tuple[int, int]) -> Any:
+    def bind(self, size: tuple[int, int], drawn: tuple[int, int]) -> vtkTextureObject:
         """Copy the scene's depth at this point of the frame (after the opaque pass: the opaque geometry's; one sample
         of each pixel when the window is multisampled) into the volume's depth texture (then, for a frame drawn
         smaller, the nearest sample of it into the ``drawn``-size one), then bind and clear the color target for the

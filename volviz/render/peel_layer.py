@@ -25,9 +25,12 @@ geometry.
 """
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+if TYPE_CHECKING:   # type-only: VTK's classes, reached through the facade at run time
+    from volviz.render.vtk_facade import vtkActor
 
 __all__ = ["PeelLayer"]
 
@@ -64,7 +67,7 @@ class PeelLayer:
             self.renderer.SetActiveCamera(cam)
         self.renderer.SetViewport(self.base.GetViewport())
 
-    def add(self, actor: Any) -> None:
+    def add(self, actor: vtkActor) -> None:
         """Peel ``actor`` from the next render on; a box of its bounds joins the renderer's bounds."""
         from volviz.render.vtk_facade import box_corners_polydata, vtk
 
