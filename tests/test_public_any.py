@@ -73,6 +73,8 @@ DATASET_TO_PROP = "a loaded dataset in (DATASET), a VTK prop of several classes 
 OVERLAY = "the request dict of image_overlay.OverlayView, which this change does not edit (GL passes: being moved)"
 VIEW_OBJECTS = ("a view of one of several classes, each with its own request type; View[Any] would not do: the "
                 "natural scene's view has no stats and the GL isosurfaces' no job, which these callers use")
+PLOTTER = ("a PyVista plotter (pv.Plotter offscreen, pyvistaqt's QtInteractor in the app), untyped for the reason "
+           "of offscreen_plotter's entry")
 ISO_PARTS = ("IsoParts or a list of IsoMesh: the body tells them apart with a conditional expression mypy "
              "cannot follow")
 
@@ -110,14 +112,13 @@ ALLOWED: dict[str, str] = {
     "volviz.render.controller:SceneController.show_cut":
         "a cut of one of several kinds (a TetMesh, isosurface parts), by the component's view",
     "volviz.render.controller:SceneController.iso_stats": STATS,
-    "volviz.render.decorations:legend_margin": GL,
-    "volviz.render.decorations:apply_decorations": GL,
-    "volviz.render.decorations:update_outline": GL,
-    "volviz.render.decorations:outline_box": GL,
-    "volviz.render.decorations:update_legend": GL,
-    "volviz.render.decorations:scalar_bar_actor": GL,
-    "volviz.render.decorations:scalar_bar_title": GL,
-    "volviz.render.decorations:scalar_bar_hit": GL,
+    "volviz.render.decorations:legend_margin": DATASET,
+    "volviz.render.decorations:apply_decorations": PLOTTER,
+    "volviz.render.decorations:update_outline": PLOTTER,
+    "volviz.render.decorations:update_legend": PLOTTER,
+    "volviz.render.decorations:scalar_bar_actor": PLOTTER,
+    "volviz.render.decorations:scalar_bar_title": PLOTTER,
+    "volviz.render.decorations:scalar_bar_hit": PLOTTER,
     "volviz.render.error_budget:error_budget_choice": ELSEWHERE,
     "volviz.render.export:open_target": JSON,
     "volviz.render.framing:nature_bounds":
@@ -160,8 +161,8 @@ ALLOWED: dict[str, str] = {
     "volviz.render.lod_volume:LodVolume.show_stats": STATS,
     "volviz.render.offscreen:offscreen_plotter":
         "pv.Plotter: PyVista 0.49's _Wrapped decorator mistypes its methods for callers outside this change (bench)",
-    "volviz.render.preview_hold:hold_previews": GL,
-    "volviz.render.preview_hold:holds_previews": GL,
+    "volviz.render.preview_hold:hold_previews": PLOTTER,
+    "volviz.render.preview_hold:holds_previews": PLOTTER,
     "volviz.render.preview_hold:PreviewCameraHold.snapshot": GL,
     "volviz.render.preview_hold:PreviewCameraHold.shown": GL,
     "volviz.render.probe_pick:probe_scene": ELSEWHERE,

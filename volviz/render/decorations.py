@@ -3,12 +3,15 @@ the orientation axes and the outline box of the data. Each is a render option of
 ``axes``, ``outline``; on unless set to false), so it is saved with the session and can be switched off."""
 from __future__ import annotations
 
-from typing import Any, Optional
+from typing import TYPE_CHECKING, Any, Optional, Sequence
 
 import numpy as np
 
 from volviz.model.settings import ScalarBarStyle, array_key, validated
 from volviz.session import Session
+
+if TYPE_CHECKING:   # type-only: PyVista's mesh class, imported where an outline is made
+    import pyvista as pv
 
 DECORATIONS = ("scalar_bar", "axes", "outline")
 OUTLINE_NAME = "volviz-outline"
@@ -79,7 +82,7 @@ def update_outline(plotter: Any, session: Session, props: dict[str, Any]) -> Non
             _in_front_of_coincident(actor)
 
 
-def outline_box(bounds: Any) -> Any:
+def outline_box(bounds: Sequence[float]) -> pv.PolyData:
     """The 12 edges of the box ``bounds`` (xmin, xmax, ymin, ymax, zmin, zmax) as a float64 ``pyvista.PolyData``:
     ``pv.Box(...).outline()`` made float32 points, up to 0.5 m off at UTM coordinates (y = 7e6)."""
     import pyvista as pv
