@@ -19,7 +19,7 @@ frame times: docs/bench/gl-passes.md "gl_iso", ``docs/bench/iso.md``.
 from __future__ import annotations
 
 import time
-from typing import Any, Sequence
+from typing import TYPE_CHECKING, Any, Sequence
 
 import numpy as np
 
@@ -32,6 +32,9 @@ from volviz.render.iso_overlay import IsoModeView
 from volviz.render.iso_volume_split import shown_regular_volumes
 from volviz.render.peel_layer import PeelLayer
 from volviz.render.volume_peeling import peel_volumes
+
+if TYPE_CHECKING:   # type-only: VTK's classes, reached through the facade at run time
+    from volviz.render.vtk_facade import vtkPolyData
 
 __all__ = ["GLIsoSurfaces", "GLIsoView", "iso_polydata"]
 
@@ -54,7 +57,7 @@ def _oriented_triangles(m: IsoMesh) -> np.ndarray:
     return out
 
 
-def iso_polydata(meshes: Sequence[IsoMesh], centre: np.ndarray, shading: str = "spectrum") -> Any:
+def iso_polydata(meshes: Sequence[IsoMesh], centre: np.ndarray, shading: str = "spectrum") -> vtkPolyData:
     """One vtkPolyData of ``meshes`` in their order: points relative to ``centre`` (float32), triangles wound as
     ``_oriented_triangles``, and per-vertex attributes ``isoNormal`` (unit normal), ``isoStyle`` (color, opacity)
     and ``isoFit`` (the iso-spectrum (a, b) of translucent surfaces with ``shading="spectrum"``, else (0, 0))."""

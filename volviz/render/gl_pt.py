@@ -19,7 +19,7 @@ renderer (drawn in order). Call ``remove()`` before closing the plotter.
 from __future__ import annotations
 
 import time
-from typing import Any
+from typing import TYPE_CHECKING, Any, Sequence
 
 import numpy as np
 
@@ -35,6 +35,9 @@ from volviz.render.reduced_fill import INTERACTIVE_PIXELS, reduced_size, scaled_
 from volviz.unstructured.index_buffer import IndexBuffer, fill_cells
 from volviz.unstructured.iso import iso_visible
 from volviz.unstructured.topology import topology, visible_cells
+
+if TYPE_CHECKING:   # type-only: the session's clipping model
+    from volviz.model.clip import ClipSettings
 
 __all__ = ["GLPTVolume"]
 
@@ -369,7 +372,8 @@ class GLPTVolume(CellOrder, PTView):
         self._table_dirty = True
         self._recull = True
 
-    def set_clip_planes(self, planes: Any = (), box: Any = None) -> None:
+    def set_clip_planes(self, planes: Sequence[tuple[Sequence[float], Sequence[float]]] = (),
+                        box: Sequence[float] | None = None) -> None:
         """Clip the volume per fragment (the exact ray segment is cut, not the cells): ``planes`` is a sequence of
         (normal, origin), each keeping the half-space its normal points into (VTK's convention for a mapper's
         clipping planes); ``box`` (xmin, xmax, ymin, ymax, zmin, zmax) crops to an axis-aligned box. At most 8 in
@@ -388,7 +392,7 @@ class GLPTVolume(CellOrder, PTView):
             raise ValueError(f"at most {_MAX_CLIP} clipping planes, got {len(rows)}")
         self._clip = np.array(rows, np.float64).reshape(-1, 4)
 
-    def set_clip(self, clip: Any) -> bool:
+    def set_clip(self, clip: ClipSettings) -> bool:
         """Clip by ``volviz.model.clip.ClipSettings`` (its planes and box) per fragment (``set_clip_planes``); returns
         True (``PTView.set_clip``: nothing for the caller to cut)."""
         self.set_clip_planes([(p.normal, p.point) for p in clip.all_planes()])

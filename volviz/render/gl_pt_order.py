@@ -17,7 +17,7 @@ from volviz.render.image_overlay import window_size
 __all__ = ["CellOrder", "order_key"]
 
 
-def order_key(cam: Camera, size: tuple[int, ...]) -> tuple[Any, ...]:
+def order_key(cam: Camera, size: tuple[int, ...]) -> tuple[object, ...]:
     """What a visibility order depends on: the camera and the image size."""
     return (tuple(cam.position), tuple(cam.focal_point), tuple(cam.view_up), cam.view_angle, cam.parallel,
             cam.parallel_scale, tuple(size))
