@@ -33,7 +33,8 @@ from volviz.render.iso_volume_split import shown_regular_volumes
 from volviz.render.peel_layer import PeelLayer
 from volviz.render.volume_peeling import peel_volumes
 
-if TYPE_CHECKING:   # type-only: VTK's classes, reached through the facade at run time
+if TYPE_CHECKING:   # type-only: VTK's classes, reached through the facade at run time; the progress callback
+    from volviz.jobs import ProgressCallback
     from volviz.render.vtk_facade import vtkPolyData
 
 __all__ = ["GLIsoSurfaces", "GLIsoView", "iso_polydata"]
@@ -400,7 +401,7 @@ class GLIsoView(IsoModeView):
         """The view calls (``volviz.render.views.View``): nothing to make off the GUI thread, VTK draws the passes."""
         return None
 
-    def compute(self, request: None, progress: Any = None) -> tuple[()]:
+    def compute(self, request: None, progress: ProgressCallback | None = None) -> tuple[()]:
         return ()
 
     def finish(self, request: None) -> dict[str, Any]:
