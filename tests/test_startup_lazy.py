@@ -92,3 +92,55 @@ print(json.dumps({{"code": code, "loaded": loaded, "tree": is_lod(tree), "other"
     assert out.stat().st_size > 0 and report["code"] == 0
     assert report["loaded"] == {"numba": False, "scipy": False, "volviz.regular.lod": False}
     assert report["tree"] is True and report["other"] is False
+
+
+def test_a_render_runs_no_agg_backend_and_pyvistas_matplotlib_chart_still_draws(tmp_path) -> None:
+    """pyvista's charts import the Agg backend's canvas for ``ChartMPL``: a render does not run the backend
+    (``matplotlib.backend_bases``: text, fonts, mathtext), and a ``ChartMPL`` made afterwards runs it at its first
+    canvas and is drawn."""
+    out = tmp_path / "v.png"
+    report = _child(f"""
+import json, sys
+import numpy as np
+from volviz.cli import main
+code = main(["render", {str(data_file("volumes/HeadMRVolume.mhd"))!r}, "-o", {str(out)!r}, "--size", "64x48"])
+from volviz.render.lazy_pyplot import AGG, ran
+before = {{"ran": ran(AGG), "bases": "matplotlib.backend_bases" in sys.modules}}
+import matplotlib.pyplot as plt
+import pyvista as pv
+fig, ax = plt.subplots(figsize=(2, 2))
+ax.plot([0, 1], [0, 1], color="red", linewidth=8)
+chart = pv.ChartMPL(fig)
+real = sys.modules[AGG].FigureCanvasAgg
+plotter = pv.Plotter(off_screen=True, window_size=(120, 120))
+plotter.set_background("white")
+plotter.add_chart(chart)
+image = np.asarray(plotter.screenshot(None, return_img=True))[..., :3].astype(int)
+plotter.close()
+red = int(((image[..., 0] > 200) & (image[..., 1] < 80) & (image[..., 2] < 80)).sum())
+print(json.dumps({{"code": code, "before": before, "after": ran(AGG), "real": isinstance(chart._canvas, real),
+                  "red": red}}))
+""")
+    assert report["code"] == 0 and report["before"] == {"ran": False, "bases": False}
+    assert report["after"] is True and report["real"] is True and report["red"] > 50
+
+
+def test_any_other_importer_of_the_agg_canvas_gets_the_class_itself(tmp_path) -> None:
+    """The stand-in is pyvista's charts' alone: another ``from`` import of the canvas (matplotlib's Qt backend
+    subclasses it) gets the real class, and the backend has run."""
+    out = tmp_path / "v.png"
+    report = _child(f"""
+import json
+from volviz.cli import main
+code = main(["render", {str(data_file("volumes/HeadMRVolume.mhd"))!r}, "-o", {str(out)!r}, "--size", "64x48"])
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from volviz.render.lazy_pyplot import AGG, ran
+class Canvas(FigureCanvasAgg):
+    pass
+from matplotlib.figure import Figure
+canvas = Canvas(Figure(figsize=(1, 1), dpi=50))
+canvas.draw()
+print(json.dumps({{"code": code, "class": isinstance(FigureCanvasAgg, type), "ran": ran(AGG),
+                  "size": list(canvas.buffer_rgba().shape)}}))
+""")
+    assert report == {"code": 0, "class": True, "ran": True, "size": [50, 50, 4]}

@@ -1,14 +1,18 @@
-"""matplotlib's pyplot run on first use: pyvista 0.49 imports ``matplotlib.pyplot`` in ``pyvista.plotting.colors``
-and ``.charts`` for one rcParams lookup (its default color cycler) and its matplotlib charts, which a render never
-uses; pyplot's body (the figure manager, the backend's resolution) costs 0.2-1 s of a fresh process's start under
-load (issue #30, docs/bench/startup.md).
+"""matplotlib's pyplot and Agg backend run on first use: pyvista 0.49 imports ``matplotlib.pyplot`` in
+``pyvista.plotting.colors`` and ``.charts`` for one rcParams lookup (its default color cycler) and its matplotlib
+charts, and ``matplotlib.backends.backend_agg`` in ``.charts`` for the canvas of ``ChartMPL``, which a render never
+makes; pyplot's body (the figure manager, the backend's resolution) costs 0.2-1 s of a fresh process's start under
+load (issue #30, docs/bench/startup.md), the backend's (``matplotlib.backend_bases``: text, fonts, mathtext, patches,
+widgets) 0.18 s of CPU on a quiet machine (docs/bench/startup-cuts.md).
 
-``defer_pyplot`` puts a finder first on ``sys.meta_path`` that gives ``matplotlib.pyplot`` a module whose body runs
+``defer_pyplot`` puts a finder first on ``sys.meta_path`` that gives each of ``DEFERRED`` a module whose body runs
 at the first lookup of a name it does not hold yet (a module-level ``__getattr__``): ``import matplotlib.pyplot``
 binds it for nothing, any use of ``plt.NAME`` gets the real module (the same object, its body run in place), so
-code that uses pyplot sees no difference. The standard library's ``importlib.util.LazyLoader`` does not serve:
-in Python 3.11 a second ``import matplotlib.pyplot`` reads the module's ``__spec__``, which runs the body. pyvista's
-files are not changed.
+code that uses pyplot sees no difference. A ``from`` import is such a lookup, so the one of ``STAND_INS`` gets a
+stand-in instead, which runs the body at its first call and calls the real object: only the importer named there
+(pyvista's charts, which only call the canvas class); any other importer gets the real object. The standard
+library's ``importlib.util.LazyLoader`` does not serve: in Python 3.11 a second ``import matplotlib.pyplot`` reads
+the module's ``__spec__``, which runs the body. pyvista's files are not changed.
 """
 from __future__ import annotations
 
@@ -19,9 +23,14 @@ import threading
 from types import ModuleType
 from typing import Any, Optional, Sequence
 
-__all__ = ["PYPLOT", "defer_pyplot", "pyplot_ran"]
+__all__ = ["DEFERRED", "PYPLOT", "STAND_INS", "defer_pyplot", "pyplot_ran", "ran"]
 
 PYPLOT = "matplotlib.pyplot"
+AGG = "matplotlib.backends.backend_agg"
+#: the modules whose body runs at its first use
+DEFERRED = (PYPLOT, AGG)
+#: (module, name) -> the one importer whose ``from module import name`` gets a stand-in (``_StandIn``)
+STAND_INS = {(AGG, "FigureCanvasAgg"): "pyvista.plotting.charts"}
 _LOCK = threading.RLock()
 _RUNNING: set[str] = set()   # modules whose body runs now
 
@@ -34,6 +43,9 @@ class _Deferred(ModuleType):
     def __getattr__(self, name: str) -> Any:
         if name.startswith("__") and name.endswith("__") and name != "__all__":
             raise AttributeError(name)
+        importer = STAND_INS.get((self.__name__, name))
+        if importer is not None and sys._getframe(1).f_globals.get("__name__") == importer:
+            return _StandIn(self, name)
         _run(self)
         if type(self) is _Deferred:         # its body is running in this thread and lacks the name so far
             raise AttributeError(f"partially initialized module {self.__name__!r} has no attribute {name!r}")
@@ -64,6 +76,19 @@ def _run(module: ModuleType) -> None:
         setattr(module, "__class__", ModuleType)   # a plain module from now on (no more __getattr__)
 
 
+class _StandIn:
+    """A name of a deferred module, handed to the importer ``STAND_INS`` names: its first call runs the module's
+    body (``_run``); every call calls the real object."""
+
+    def __init__(self, module: ModuleType, name: str) -> None:
+        self._module = module
+        self._name = name
+
+    def __call__(self, *args: Any, **kwargs: Any) -> Any:
+        _run(self._module)
+        return getattr(self._module, self._name)(*args, **kwargs)
+
+
 class _DeferredLoader(importlib.abc.Loader):
     """Creates a ``_Deferred`` module and leaves its body to its first use."""
 
@@ -75,11 +100,11 @@ class _DeferredLoader(importlib.abc.Loader):
 
 
 class _PyplotFinder(importlib.abc.MetaPathFinder):
-    """Finds ``matplotlib.pyplot`` as the finders after it do; its loader kept in the spec's ``loader_state``."""
+    """Finds each of ``DEFERRED`` as the finders after it do; its loader kept in the spec's ``loader_state``."""
 
     def find_spec(self, fullname: str, path: Optional[Sequence[str]],
                   target: Optional[ModuleType] = None) -> Optional[importlib.machinery.ModuleSpec]:
-        if fullname != PYPLOT:
+        if fullname not in DEFERRED:
             return None
         for finder in sys.meta_path:
             if finder is self or not hasattr(finder, "find_spec"):
@@ -95,14 +120,19 @@ class _PyplotFinder(importlib.abc.MetaPathFinder):
 
 
 def defer_pyplot() -> None:
-    """From now on in this process, ``matplotlib.pyplot`` runs at its first use, not at its import (nothing when
-    it is imported already or the finder is in place)."""
-    if PYPLOT in sys.modules or any(isinstance(f, _PyplotFinder) for f in sys.meta_path):
+    """From now on in this process, each of ``DEFERRED`` not imported yet runs at its first use, not at its import
+    (nothing when the finder is in place)."""
+    if any(isinstance(f, _PyplotFinder) for f in sys.meta_path):
         return
     sys.meta_path.insert(0, _PyplotFinder())
 
 
+def ran(name: str) -> bool:
+    """Whether the body of the module ``name`` has run in this process."""
+    module = sys.modules.get(name)
+    return module is not None and type(module) is not _Deferred
+
+
 def pyplot_ran() -> bool:
     """Whether pyplot's body has run in this process."""
-    module = sys.modules.get(PYPLOT)
-    return module is not None and type(module) is not _Deferred
+    return ran(PYPLOT)
