@@ -56,6 +56,7 @@ def test_rendering_a_mesh_loads_the_mesh_modules(tmp_path) -> None:
     grid.save(tmp_path / "mesh.vtu")
     loaded = _loaded("render", str(tmp_path / "mesh.vtu"), "-o", str(tmp_path / "m.png"), "--size", "64x48")
     assert "volviz.unstructured" in loaded and "volviz.nature" not in loaded
+    assert [m for m in loaded if m.startswith("volviz.iso")] == []     # the isosurfaces' modules: only for a clip
 
 
 def test_render_starts_an_isolated_reader_ahead() -> None:

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any, Optional
 
-from volviz.iso.clip import clip_tetmesh
 from volviz.model.datasets import TetMesh
 from volviz.unstructured.tetrahedralize import tetrahedralize
 from volviz.unstructured.topology import topology
@@ -26,6 +25,8 @@ def pt_mesh(dataset: Any) -> TetMesh:
 def cut_tetmesh(mesh: TetMesh, clip: ClipSettings) -> Optional[TetMesh]:
     """Any thread: ``mesh`` cut exactly by ``clip`` (``volviz.iso.clip.clip_tetmesh``) with its topology built; None
     when the clipping removes all of it."""
+    from volviz.iso.clip import clip_tetmesh   # the isosurface package's modules: only for a clipped mesh (start-up)
+
     try:
         cut = clip_tetmesh(mesh, clip)
     except ValueError:  # everything clipped away
