@@ -28,6 +28,8 @@ Float data holding NaN/Inf is kept (renderers draw it transparent) with a ``NonF
 """
 from __future__ import annotations
 
+import importlib
+
 from volviz.io.errors import ChoiceWarning, NonFiniteWarning, ReadError, ReadWarning
 from volviz.io.raw import read_raw, read_slice_stack
 from volviz.io.reading import read, read_series
@@ -43,8 +45,6 @@ def __getattr__(name: str):
         "read_image": "image",
     }
     if name in modules:
-        import importlib
-
         return getattr(importlib.import_module(f"volviz.io.{modules[name]}"), name)
     raise AttributeError(f"module 'volviz.io' has no attribute {name!r}")
 

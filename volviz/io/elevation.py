@@ -33,6 +33,7 @@ _SRTM_NAME = re.compile(r"([NS])(\d{1,2})([EW])(\d{1,3})", re.I)
 
 def geotiff_tags(path: PathLike) -> dict[str, Any] | None:
     """The GeoTIFF tags of a single-band, one-image TIFF (a DEM), or None for any other TIFF."""
+    # heavy: tifffile (about 15 modules), loaded only when a GeoTIFF is read
     import tifffile
 
     try:
@@ -71,6 +72,7 @@ def _filled(path: PathLike, heights: np.ndarray, missing: np.ndarray) -> np.ndar
 
 def read_geotiff_dem(path: PathLike, tags: dict[str, Any]) -> Image2D:
     """A single-band GeoTIFF (``tags``: ``geotiff_tags``) as heights in metres."""
+    # heavy: tifffile (about 15 modules), loaded only when a GeoTIFF is read
     import tifffile
 
     scale = tags.get("ModelPixelScale")

@@ -14,6 +14,7 @@ from collections import defaultdict
 from pathlib import Path
 
 from volviz.io.errors import PathLike, ReadError
+from volviz.io.registry import spec_of
 
 COLLECTION_SUFFIXES = (".pvd", ".xdmf", ".xmf", ".vtm", ".vtpd", ".foam", ".case")
 MIN_SERIES_FILES = 3          # numbered files that make a series (fewer are separate files)
@@ -30,8 +31,6 @@ def numbered_pattern(head: str, numbers: list[str], tail: str) -> str:
 
 def folder_target(folder: PathLike) -> str | None:
     """The collection file or numbered series pattern opening ``folder`` shows (see the module), or None."""
-    from volviz.io.registry import spec_of
-
     try:
         files = sorted((entry for entry in os.scandir(folder) if entry.is_file()), key=lambda e: e.name)
     except OSError:

@@ -17,6 +17,7 @@ netCDF-4, MAT v7.3: ``volviz.io.hdf5kind``) go to their own readers unless ``dat
 """
 from __future__ import annotations
 
+import re
 import warnings
 from typing import Any
 
@@ -36,6 +37,7 @@ _SPACING_ATTRS = ("element_size_um", "spacing", "voxel_size")
 
 
 def has_vtkhdf_group(path: PathLike) -> bool:
+    # heavy: h5py (about 45 modules), loaded only when an HDF5 file is read
     import h5py
 
     try:
@@ -47,6 +49,7 @@ def has_vtkhdf_group(path: PathLike) -> bool:
 
 def _arrays(f: Any) -> list[tuple[str, tuple[int, ...]]]:
     """(path, shape) of every numeric dataset of 2 to 4 dimensions of more than one entry each."""
+    # heavy: h5py (about 45 modules), loaded only when an HDF5 file is read
     import h5py
 
     found: list[tuple[str, tuple[int, ...]]] = []
@@ -115,8 +118,6 @@ def _warn_if_heavy_data(p: Any) -> None:
     """A ReadWarning when an XDMF file beside ``p`` names it as its heavy data (meshio, dolfinx, FEniCS and many
     solvers write a .xdmf describing the mesh and a .h5 holding its arrays): the .xdmf is what shows the data as the
     solver meant (the .h5 alone is a list of arrays: points, cell connectivity, fields)."""
-    import re
-
     for sibling in sorted(p.parent.glob("*.xmf"))[:MAX_XDMF_SIBLINGS] + sorted(
             p.parent.glob("*.xdmf"))[:MAX_XDMF_SIBLINGS]:
         try:
@@ -133,6 +134,7 @@ def read_hdf5(path: PathLike, dataset: str | None = None, order: str = "zyx",
               allow_nonfinite: bool = True) -> RegularVolume | TimeSeries | Image2D | Any:
     """An HDF5 file's array as a volume, a time series or an image (see the module; ``order``:
     ``volviz.io.axis_order``); VTKHDF files as VTK data."""
+    # heavy: h5py (about 45 modules), loaded only when an HDF5 file is read
     import h5py
 
     p = check_file(path)

@@ -22,6 +22,8 @@ from typing import Any
 
 from volviz.io._checks import HDF5_SIGNATURE, read_bytes
 from volviz.io.errors import PathLike, ReadError
+from volviz.io.loaders import loader_call
+from volviz.io.registry import get_reader
 
 #: kind -> (reader spec name, what the file is, in words)
 KINDS: dict[str, tuple[str, str]] = {
@@ -51,6 +53,7 @@ def _is_netcdf4(f: Any) -> bool:
 
 def kind_of_open(f: Any) -> str | None:
     """The kind (see the module) of an open ``h5py.File``, None for plain arrays."""
+    # heavy: h5py (about 45 modules), loaded only when an HDF5 file is looked into
     import h5py
 
     if isinstance(f.get("VTKHDF"), h5py.Group):
@@ -69,6 +72,7 @@ def kind_of_open(f: Any) -> str | None:
 def hdf5_kind(path: PathLike) -> str | None:
     """The kind of the HDF5 file at ``path`` (see the module); None for plain arrays or a file h5py cannot open
     (the reader then says what is wrong)."""
+    # heavy: h5py (about 45 modules), loaded only when an HDF5 file is looked into
     import h5py
 
     head = read_bytes(path, 128)
@@ -103,9 +107,6 @@ def check_named_kind(path: PathLike, f: Any) -> None:
 def read_as_kind(path: PathLike, kind: str, allow_nonfinite: bool = True) -> Any:
     """Read an HDF5 file of ``kind`` with the reader registered for it; a ReadError saying what the file is and what
     to do when no such reader is installed (the plugin's formats: Fluent CFF, CGNS, Exodus, netCDF)."""
-    from volviz.io.loaders import loader_call
-    from volviz.io.registry import get_reader
-
     spec_name, words = KINDS[kind]
     try:
         spec = get_reader(spec_name)

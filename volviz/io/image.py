@@ -14,8 +14,11 @@ from __future__ import annotations
 import numpy as np
 
 from volviz.io._checks import check_file, open_file, read_bytes
+from volviz.io.elevation import geotiff_tags, read_geotiff_dem
 from volviz.io.errors import PathLike, ReadError
 from volviz.io.tiffstack import is_tiff, read_tiff_stack
+from volviz.io.vtk_lazy import vtk
+from volviz.io.vtkfiles import _run
 from volviz.model import Image2D, RegularVolume, TimeSeries
 
 EXTENSIONS = (".png", ".jpg", ".jpeg", ".tif", ".tiff", ".bmp")
@@ -25,6 +28,7 @@ MAX_PIXELS = 1 << 28
 def read_image(path: PathLike) -> Image2D | RegularVolume | TimeSeries:
     """Read a PNG/JPEG/TIFF/BMP into Image2D: (rows, cols) grey or (rows, cols, 3|4) color, row 0 at the top; a
     TIFF whose pages make a stack becomes a volume (``volviz.io.tiffstack``)."""
+    # heavy: Pillow, loaded only when an image file is read
     from PIL import Image, UnidentifiedImageError
 
     check_file(path)
@@ -32,7 +36,6 @@ def read_image(path: PathLike) -> Image2D | RegularVolume | TimeSeries:
         stack = read_tiff_stack(path)
         if stack is not None:
             return stack
-        from volviz.io.elevation import geotiff_tags, read_geotiff_dem
 
         tags = geotiff_tags(path)
         if tags is not None:
@@ -72,6 +75,7 @@ def read_image(path: PathLike) -> Image2D | RegularVolume | TimeSeries:
 
 def _tiff_page(path: PathLike) -> np.ndarray:
     """The first page of a TIFF of 32-bit samples (float heights, counts) as stored, by tifffile."""
+    # heavy: tifffile (about 15 modules), loaded only when a TIFF is read
     import tifffile
 
     try:
@@ -84,10 +88,8 @@ def _tiff_page(path: PathLike) -> np.ndarray:
 def _jpeg_pixels(path: PathLike) -> np.ndarray:
     """A JPEG's pixels by ``vtkJPEGReader`` (libjpeg's warnings are errors there): (rows, cols) grey or
     (rows, cols, 3), row 0 at the top."""
-    from volviz.io.vtk_lazy import vtk
+    # heavy: VTK's numpy_support (vtkCommonCore), loaded only when VTK reads the image
     from vtkmodules.util.numpy_support import vtk_to_numpy
-
-    from volviz.io.vtkfiles import _run
 
     reader = vtk.vtkJPEGReader()
     reader.SetFileName(str(path))

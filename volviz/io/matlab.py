@@ -11,7 +11,9 @@
 """
 from __future__ import annotations
 
+import mmap
 import struct
+import zlib
 from pathlib import Path
 from typing import Any
 
@@ -39,9 +41,7 @@ def _choose(path: PathLike, found: list[tuple[str, tuple[int, ...]]], variable: 
 
 
 def _v5(path: PathLike, variable: str | None) -> tuple[str, np.ndarray]:
-    import mmap
-    import zlib
-
+    # heavy: SciPy's io (about 250 modules), loaded only when a MATLAB file is read
     import scipy.io
 
     with open(path, "rb") as f, mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ) as data:
@@ -68,6 +68,7 @@ def _v5(path: PathLike, variable: str | None) -> tuple[str, np.ndarray]:
 
 
 def _v73(path: PathLike, variable: str | None) -> tuple[str, np.ndarray]:
+    # heavy: h5py (about 45 modules), loaded only for a v7.3 (HDF5) MATLAB file
     import h5py
 
     try:

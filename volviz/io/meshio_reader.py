@@ -17,6 +17,7 @@ from volviz.model import UnstructuredMesh
 
 
 def meshio_extensions() -> list[str]:
+    # heavy: meshio (about 180 modules), loaded only when a meshio format is read
     import meshio
 
     return sorted(meshio.extension_to_filetypes)
@@ -24,6 +25,7 @@ def meshio_extensions() -> list[str]:
 
 def read_meshio(path: PathLike, file_format: str | None = None, allow_nonfinite: bool = True) -> UnstructuredMesh:
     """Read a mesh with meshio and convert it (cells as VTK type ids)."""
+    # heavy: meshio (about 180 modules), loaded only when a meshio format is read
     import meshio
     from meshio._vtk_common import meshio_to_vtk_type
 

@@ -16,6 +16,7 @@ from volviz.io._checks import (
     require_bytes,
 )
 from volviz.io.errors import PathLike, ReadError, ReadWarning, human_bytes
+from volviz.io.raw import read_slice_stack
 from volviz.io.trailing import check_trailing
 from volviz.model import Image2D, RegularVolume, vec3
 
@@ -182,7 +183,6 @@ def _read_metaimage(path: PathLike, allow_nonfinite: bool) -> RegularVolume | Im
         if ndims != 3 or compressed or not binary:
             raise ReadError(path, "MetaImage slice files (ElementDataFile LIST or a pattern) are read for 3D "
                                   "uncompressed binary data only")
-        from volviz.io.raw import read_slice_stack
 
         slices = _slice_files(path, data_name, head[header_end:], dims[2])
         header_size = parse_int(path, fields.get("headersize", "0"), "MetaImage HeaderSize")

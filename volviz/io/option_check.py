@@ -14,6 +14,8 @@ import typing
 from typing import Any, Literal, Union
 
 from volviz.io.errors import PathLike, ReadError
+from volviz.io.loaders import ReaderOptionError, loader_call
+from volviz.io.registry import is_pattern, spec_of
 
 __all__ = ["OptionProblem", "check_reader_options", "fits"]
 
@@ -102,9 +104,6 @@ def check_reader_options(path: PathLike, options: dict[str, Any]) -> None:
     """Check ``options`` against the reader that would read ``path``: every option one it takes, every parameter it
     needs given, every value of the annotated type. Raises :class:`OptionProblem`; a path whose reader cannot be
     found (missing, unknown format, a series pattern, a ``.vvz``) is left to the read, which reports it."""
-    from volviz.io.loaders import ReaderOptionError, loader_call
-    from volviz.io.registry import is_pattern, spec_of
-
     if is_pattern(path) or os.fspath(path).lower().endswith(".vvz"):
         return
     try:

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from itertools import product
+from pathlib import Path
 
 import numpy as np
 
@@ -338,8 +339,6 @@ def read_flow_conditions(q_path: PathLike, block: int | None = None, gamma: floa
 
 def companion_q_file(xyz_path: PathLike):
     """The q file next to an xyz file by the usual naming (``bluntfinxyz.bin`` -> ``bluntfinq.bin``), or None."""
-    from pathlib import Path
-
     p = Path(xyz_path)
     name = p.name
     for a, b in (("xyz", "q"), ("XYZ", "Q"), (".x", ".q"), (".X", ".Q")):

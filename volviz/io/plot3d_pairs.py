@@ -6,14 +6,14 @@ import os
 from pathlib import Path
 from typing import Optional, Sequence
 
+from volviz.io.plot3d import read_flow_conditions
+
 #: (solution, grid) name parts: ``bluntfinq.bin`` -> ``bluntfinxyz.bin``, ``wing.q`` -> ``wing.x`` / ``wing.xyz``
 _NAME_PAIRS = (("q", "xyz"), ("Q", "XYZ"), (".q", ".x"), (".q", ".xyz"))
 
 
 def is_plot3d_solution(path: str | os.PathLike) -> bool:
     """Whether ``path`` reads as a PLOT3D solution file (its flow-conditions header parses)."""
-    from volviz.io.plot3d import read_flow_conditions
-
     try:
         read_flow_conditions(Path(path))
     except Exception:  # noqa: BLE001 -- any failure means: not a solution file

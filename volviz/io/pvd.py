@@ -22,8 +22,10 @@ from typing import Any
 
 import numpy as np
 
+from volviz.io import read
 from volviz.io._checks import check_file, describe_bytes, file_size, read_bytes
 from volviz.io.errors import PathLike, ReadError, human_bytes
+from volviz.io.vtkconvert import vtk_to_model
 from volviz.model import TimeSeries
 
 MAX_COLLECTION_BYTES = 64 << 20  # a listing of files; a larger .pvd is not one
@@ -87,8 +89,6 @@ def collection_steps(path: PathLike) -> tuple[np.ndarray, list[list[Path]]]:
 
 def _read_step(path: PathLike, members: list[Path], allow_nonfinite: bool) -> Any:
     """One time step: its one file, or its parts merged into one unstructured data set."""
-    from volviz.io import read
-
     datasets = [read(member, isolate=False, allow_nonfinite=allow_nonfinite) for member in members]
     for member, dataset in zip(members, datasets):
         if isinstance(dataset, TimeSeries):
@@ -96,9 +96,7 @@ def _read_step(path: PathLike, members: list[Path], allow_nonfinite: bool) -> An
                                     "be one data set")
     if len(datasets) == 1:
         return datasets[0]
-    import pyvista as pv
-
-    from volviz.io.vtkconvert import vtk_to_model
+    import pyvista as pv  # heavy: PyVista and VTK, loaded only when a .pvd series is read
 
     return vtk_to_model(path, pv.MultiBlock([d.to_pyvista() for d in datasets]), allow_nonfinite)
 

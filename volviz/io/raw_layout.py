@@ -20,6 +20,7 @@ as a MetaImage header beside the data, which then opens like any other file.
 from __future__ import annotations
 
 import math
+import os
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -28,7 +29,9 @@ from typing import Any, Sequence
 import numpy as np
 
 from volviz.io._checks import file_size, read_at
+from volviz.io.atomic import atomic_write_text
 from volviz.io.errors import PathLike, ReadError
+from volviz.io.registry import spec_of
 
 #: the sample types tried, with their MetaImage names
 SAMPLE_TYPES = {"uint8": "MET_UCHAR", "int8": "MET_CHAR", "uint16": "MET_USHORT", "int16": "MET_SHORT",
@@ -183,8 +186,6 @@ def headerless_data(path: PathLike) -> list[Path] | None:
     """The files of headerless data that ``path`` belongs to -- a ``.raw`` file without a MetaImage header beside
     it, or one of a stack of numbered slices of equal size (``quarter.1`` ... ``quarter.93``, by number) -- or None
     when volviz reads the file by itself (or it is something else)."""
-    from volviz.io.registry import spec_of
-
     p = Path(path)
     if not p.is_file():
         return None
@@ -247,10 +248,6 @@ def write_header(files: Sequence[PathLike], layout: RawLayout, spacing: Sequence
     """Write the MetaImage header of ``layout`` beside the data (``quarter.mhd`` for ``quarter.1`` ...,
     ``head.mhd`` for ``head.raw``), naming the data files relative to it; where that folder is not writable, in
     ``fallback_folder`` naming them by absolute path. Written atomically; returns the header's path."""
-    import os
-
-    from volviz.io.atomic import atomic_write_text
-
     first = Path(files[0])
     stem = re.sub(r"\.\d+$", "", first.name) if len(files) > 1 else first.stem
     folder = first.parent

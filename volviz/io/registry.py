@@ -158,6 +158,7 @@ def _sniff_vtk_xml(head: bytes) -> bool:
 
 def read_plot3d_auto(path: PathLike, q: PathLike | None = None, **options: Any):
     """PLOT3D grid, with its solution file given as ``q=`` or found next to it by name."""
+    # the reader module, imported when its format is read: the registry loads no reader up front
     from volviz.io.plot3d import companion_q_file, read_plot3d
 
     return read_plot3d(path, q if q is not None else companion_q_file(path), **options)
@@ -226,6 +227,7 @@ BUILTIN_READERS: list[ReaderSpec] = [
 
 
 def meshio_globs() -> tuple[str, ...]:
+    # the reader module, imported when its formats are listed: the registry loads no reader up front
     from volviz.io.meshio_reader import meshio_extensions
 
     return tuple(f"*{e}" for e in meshio_extensions())
@@ -236,6 +238,7 @@ _registry: list[ReaderSpec] | None = None
 
 
 def _plugin_specs() -> Iterable[ReaderSpec]:
+    # importlib.metadata (about 40 modules), loaded only when plugins' entry points are looked up
     from importlib.metadata import entry_points
 
     for ep in entry_points(group=ENTRY_POINT_GROUP):

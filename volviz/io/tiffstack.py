@@ -84,6 +84,7 @@ def _spacing(tif: Any) -> tuple[float, float, float]:
     sx, sy = _resolution(page, "XResolution"), _resolution(page, "YResolution")
     sz = _positive((tif.imagej_metadata or {}).get("spacing")) if tif.is_imagej else None
     if tif.is_ome:
+        # heavy: tifffile (about 15 modules), loaded only when a TIFF stack is read
         import tifffile
 
         try:
@@ -198,6 +199,7 @@ def read_tiff_stack(path: PathLike, allow_nonfinite: bool = True) -> RegularVolu
     """The TIFF's stack as a volume (or a time series of them), or None when its pages make no stack. A file
     tifffile finds damaged (it logs a warning: a page beyond the end, corrupted ImageJ metadata) is refused, whatever
     its first page holds."""
+    # heavy: tifffile (about 15 modules), loaded only when a TIFF stack is read
     import tifffile
 
     if file_size(path) < 8:

@@ -51,6 +51,7 @@ class LazyVTK:
         module = MODULE_OF.get(name) or ("vtkCommonCore" if name.startswith("VTK_") else None)
         found = getattr(importlib.import_module(f"vtkmodules.{module}"), name, None) if module else None
         if found is None:
+            # heavy: all of VTK (1.2-2 s), only for a name outside MODULE_OF
             import vtk as everything
 
             found = getattr(everything, name)

@@ -15,7 +15,9 @@ import numpy as np
 
 from volviz.io._checks import check_finite
 from volviz.io.errors import PathLike, ReadError, ReadWarning
+from volviz.io.vtk_lazy import vtk
 from volviz.model import CELL_SIZES, CurvilinearGrid, RegularVolume, UnstructuredMesh
+from volviz.model.arrays import default_array, scalar_of
 
 _VTK_POLYHEDRON = 42
 #: VTK's axis-aligned cells as the general ones, corners reordered: a voxel (11) is a hexahedron (12) and a pixel (8)
@@ -29,6 +31,7 @@ def _arrays(path: PathLike, attributes, n: int, allow_nonfinite: bool, where: st
             filled: dict[str, np.ndarray] | None = None) -> dict[str, np.ndarray]:
     """The numeric arrays of ``n`` tuples, checked for NaN/Inf except where ``filled`` (name -> mask) says the merge
     put NaN for a block without the array (``_with_partial_arrays``)."""
+    # heavy: VTK's numpy_support (vtkCommonCore), loaded only when a VTK dataset converts
     from vtkmodules.util.numpy_support import vtk_to_numpy
 
     out: dict[str, np.ndarray] = {}
@@ -60,6 +63,7 @@ _FILLED = "volviz filled "  # field data of a merged data set: where a partial a
 
 def _filled(obj, where: str) -> dict[str, np.ndarray]:
     """The masks ``merge_composite`` left in ``obj``'s field data: array name -> True where it put NaN."""
+    # heavy: VTK's numpy_support (vtkCommonCore), loaded only when a VTK dataset converts
     from vtkmodules.util.numpy_support import vtk_to_numpy
 
     fd, out = obj.GetFieldData(), {}
@@ -75,7 +79,7 @@ def _with_partial_arrays(path: PathLike, leaves: list) -> tuple[list, dict[tuple
     blocks) added to the others as NaN, as doubles in every block: vtkAppendFilter keeps only the arrays all its
     inputs share, and ParaView shows a partial array with NaN (no colour) where a block lacks it. A ReadWarning names
     them. Arrays whose component counts differ between blocks stay left out."""
-    from volviz.io.vtk_lazy import vtk
+    # heavy: VTK's numpy_support (vtkCommonCore), loaded only when a VTK dataset converts
     from vtkmodules.util.numpy_support import numpy_to_vtk, vtk_to_numpy
 
     found: dict[tuple[str, str], list[int]] = {}
@@ -115,7 +119,7 @@ def _with_partial_arrays(path: PathLike, leaves: list) -> tuple[list, dict[tuple
 def merge_composite(path: PathLike, obj):
     """A composite data set (multiblock / partitioned) as one data set; ReadError if it holds nothing. Arrays only
     some blocks carry are kept, NaN elsewhere, with masks of the filled places in the field data (``_filled``)."""
-    from volviz.io.vtk_lazy import vtk
+    # heavy: VTK's numpy_support (vtkCommonCore), loaded only when a VTK dataset converts
     from vtkmodules.util.numpy_support import numpy_to_vtk
 
     if not obj.IsA("vtkCompositeDataSet"):
@@ -159,6 +163,7 @@ def vtk_to_model(path: PathLike, obj, allow_nonfinite: bool = True):
 
 
 def _to_model(path: PathLike, obj, allow_nonfinite: bool):
+    # heavy: VTK's numpy_support (vtkCommonCore), loaded only when a VTK dataset converts
     from vtkmodules.util.numpy_support import vtk_to_numpy
 
     if obj is None:
@@ -199,6 +204,7 @@ def _to_model(path: PathLike, obj, allow_nonfinite: bool):
 
 
 def _unstructured(path: PathLike, obj, allow_nonfinite: bool) -> UnstructuredMesh:
+    # heavy: PyVista (about 200 modules), loaded only when a PyVista dataset converts
     import pyvista as pv
 
     grid = pv.wrap(obj)
@@ -237,10 +243,6 @@ def _unstructured(path: PathLike, obj, allow_nonfinite: bool) -> UnstructuredMes
 
 def _image(path: PathLike, obj, allow_nonfinite: bool) -> RegularVolume:
     """vtkImageData -> RegularVolume keeping every point array (cell arrays through VTK's cell-to-point filter)."""
-    from volviz.io.vtk_lazy import vtk
-
-    from volviz.model.arrays import default_array, scalar_of
-
     if obj.GetPointData().GetNumberOfArrays() == 0 and obj.GetCellData().GetNumberOfArrays() > 0:
         to_points = vtk.vtkCellDataToPointData()
         to_points.SetInputData(obj)

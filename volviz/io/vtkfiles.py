@@ -6,9 +6,11 @@ array, read past a buffer or loop for ever. VTK's error events are turned into R
 """
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Any
 
 from volviz.io.errors import PathLike, ReadError
+from volviz.io.vtk_lazy import vtk
 from volviz.io.vtkconvert import vtk_to_model
 from volviz.io.vtklegacy import check_legacy_file
 from volviz.io.vtkxml import check_xml_file
@@ -24,8 +26,6 @@ XML_READERS = {
 
 def _run(path: PathLike, reader) -> Any:
     """Update a VTK reader with its messages captured (kept off the console); ReadError on any error."""
-    from volviz.io.vtk_lazy import vtk
-
     previous = vtk.vtkOutputWindow.GetInstance()
     capture = vtk.vtkStringOutputWindow()
     vtk.vtkOutputWindow.SetInstance(capture)
@@ -52,8 +52,6 @@ def read_vtk_file(path: PathLike, allow_nonfinite: bool = True):
     """Read .vtk/.vti/.vtu/.vts/.vtr/.vtp with VTK's reader and convert to the matching model type.
 
     The file is checked first (VTK is imported only for a file that passed)."""
-    from pathlib import Path
-
     ext = Path(path).suffix.lower()
     if ext == ".vtk":
         check_legacy_file(path)
@@ -61,7 +59,6 @@ def read_vtk_file(path: PathLike, allow_nonfinite: bool = True):
         check_xml_file(path, XML_READERS[ext][0])
     else:
         raise ReadError(path, f"extension {ext!r} is not a VTK format ({', '.join(['.vtk', *XML_READERS])})")
-    from volviz.io.vtk_lazy import vtk
 
     if ext == ".vtk":
         reader = vtk.vtkDataSetReader()

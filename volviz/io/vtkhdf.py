@@ -11,14 +11,17 @@ import numpy as np
 
 from volviz.io._checks import HDF5_SIGNATURE, check_finite, describe_bytes, file_size, read_bytes
 from volviz.io.errors import PathLike, ReadError
+from volviz.io.hdf5arrays import has_vtkhdf_group, read_hdf5
+from volviz.io.vtk_lazy import vtk
 from volviz.io.vtkconvert import vtk_to_model
+from volviz.io.vtkfiles import _run
 from volviz.io.vtkhdfcheck import check_structure
 from volviz.model import TimeSeries
 
 
-
 def _inspect(path: PathLike) -> tuple[str, np.ndarray | None]:
     """(data set type, step times or None); ReadError if this is not a VTKHDF file."""
+    # heavy: h5py (about 45 modules), loaded only when a VTKHDF file is read
     import h5py
 
     size = file_size(path)
@@ -57,10 +60,6 @@ def _printable(exc: Exception) -> str:
 
 
 def _read_step(path: PathLike, step: int | None, allow_nonfinite: bool):
-    from volviz.io.vtk_lazy import vtk
-
-    from volviz.io.vtkfiles import _run
-
     reader = vtk.vtkHDFReader()
     reader.SetFileName(str(path))
     if step is not None:
@@ -72,8 +71,6 @@ def _read_step(path: PathLike, step: int | None, allow_nonfinite: bool):
 def read_vtkhdf(path: PathLike, allow_nonfinite: bool = True):
     """Read a VTKHDF file: a model dataset, or a TimeSeries (lazy frames) when the file is transient. An HDF5 file
     without a /VTKHDF group (a .hdf of arrays) is read by ``volviz.io.hdf5arrays``."""
-    from volviz.io.hdf5arrays import has_vtkhdf_group, read_hdf5
-
     if read_bytes(path, 8) == HDF5_SIGNATURE and not has_vtkhdf_group(path):
         return read_hdf5(path, allow_nonfinite=allow_nonfinite)
     _kind, times = _inspect(path)

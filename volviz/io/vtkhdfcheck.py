@@ -31,6 +31,7 @@ DEFLATE_BUDGET = 1100  # bytes a dataset may claim per byte of file: deflate exp
 def check_dataset_sizes(path: PathLike, root, size: int) -> None:
     """No dataset may claim more bytes than the file could hold after decompression, so a corrupt shape cannot
     make VTK allocate a huge array."""
+    # heavy: h5py (about 45 modules), loaded only when a VTKHDF file is checked
     import h5py
 
     budget = DEFLATE_BUDGET * size + (1 << 20)
@@ -67,6 +68,7 @@ class _Structure:
 
     def counts(self, name: str, group=None, ndim: tuple[int, ...] = (1,)) -> np.ndarray:
         """A small integer count dataset, read after its shape and type are checked; never negative."""
+        # heavy: h5py (about 45 modules), loaded only when a VTKHDF file is checked
         import h5py
 
         group = self.group if group is None else group
@@ -125,6 +127,7 @@ class _Structure:
                               f"{needed} of the WholeExtent {extent.tolist()}")
 
     def arrays(self, section: str):
+        # heavy: h5py (about 45 modules), loaded only when a VTKHDF file is checked
         import h5py
 
         if section not in self.group:
@@ -202,6 +205,7 @@ class _Structure:
             self.fail(f"{self.where}/{label}: step {s} reaches row {int(ends[s])}, but it has {rows} rows")
 
     def blocks(self) -> None:
+        # heavy: h5py (about 45 modules), loaded only when a VTKHDF file is checked
         import h5py
 
         for name, child in self.group.items():

@@ -8,12 +8,25 @@ end of its stdin, and with its parent (Linux: PR_SET_PDEATHSIG).
 """
 from __future__ import annotations
 
+import importlib
 import json
 import os
+import resource
+import select
 import sys
+import threading
+import time
 import warnings
 from collections import OrderedDict
 from typing import Any, BinaryIO
+
+import numpy as np
+
+from volviz.io.errors import ChoiceWarning, ReadError
+from volviz.io.isolated import proc_bytes
+from volviz.io.isolated.codec import CodecError, encode
+from volviz.io.loaders import ReaderOptionError, loader_call
+from volviz.io.vtk_lazy import MODULE_OF
 
 SERIES_CACHE = 2  # transient files kept open for their lazy frames
 
@@ -31,9 +44,6 @@ def _die_with_parent() -> None:
     id every half second (PR_SET_PDEATHSIG would fire when the parent *thread* that started this child ends, and
     the app starts readers from short-lived worker threads). Between reads the child also leaves at the end of its
     stdin."""
-    import threading
-    import time
-
     parent = os.getppid()
 
     def watch() -> None:
@@ -47,8 +57,6 @@ def _die_with_parent() -> None:
 
 def _warning(message: Warning | str) -> list:
     """A caught warning for the parent: [category, message], and a ``ChoiceWarning``'s choices as a third item."""
-    from volviz.io.errors import ChoiceWarning
-
     item: list = [type(message).__name__ if isinstance(message, Warning) else "UserWarning", str(message)[:2000]]
     if isinstance(message, ChoiceWarning):
         item.append(message.fields())
@@ -61,10 +69,6 @@ class _MemoryLimit:
         self.budget = budget
 
     def __enter__(self) -> None:
-        import resource
-
-        from volviz.io.isolated import proc_bytes
-
         self._old = resource.getrlimit(resource.RLIMIT_AS)
         if self.budget > 0:
             hard = self._old[1]
@@ -72,15 +76,11 @@ class _MemoryLimit:
             resource.setrlimit(resource.RLIMIT_AS, (soft if hard == resource.RLIM_INFINITY else min(soft, hard), hard))
 
     def __exit__(self, *exc: Any) -> None:
-        import resource
-
         resource.setrlimit(resource.RLIMIT_AS, self._old)
 
 
 def _names(value: Any) -> list[str]:
     """A loader's list of names, checked (the parent checks again)."""
-    from volviz.io.isolated.codec import CodecError
-
     if not isinstance(value, (list, tuple)) or not all(isinstance(v, str) for v in value):
         raise CodecError(f"the function returned a {type(value).__name__}, not a list of names")
     return list(value)
@@ -94,8 +94,6 @@ class Child:
         """The loader's dataset, or with ``frame`` one frame of the time series it returns. A lazy series stays open
         here (the last few, keyed by loader, path, options and the file's mtime and size) for its later frames,
         holding frame 0 only: a frame handed back is dropped again."""
-        from volviz.io.loaders import loader_call
-
         f, opts = loader_call(request["kind"], request["loader"], request["options"])
         frame = request.get("frame")
         try:
@@ -121,12 +119,6 @@ class Child:
         return item
 
     def handle(self, request: dict) -> dict:
-        import numpy as np
-
-        from volviz.io.errors import ReadError
-        from volviz.io.isolated.codec import CodecError, encode
-        from volviz.io.loaders import ReaderOptionError
-
         for entry in request.get("sys_path", []):
             if isinstance(entry, str) and entry not in sys.path:
                 sys.path.append(entry)
@@ -169,11 +161,6 @@ def _load_vtk_when_idle() -> None:
     issue #31) until a request is waiting. A child kept warm for later reads (the app's pool) has them
     loaded before they come; one started for a read at hand (``volviz render FILE``) answers at once, its reader
     importing only the VTK modules it uses (``volviz.io.vtk_lazy``: 0.4 s instead of 1.2-2 s)."""
-    import importlib
-    import select
-
-    from volviz.io.vtk_lazy import MODULE_OF
-
     if select.select([sys.stdin.buffer], [], [], IDLE_SECONDS)[0]:
         return
     for module in sorted(set(MODULE_OF.values())):
@@ -188,9 +175,6 @@ def _load_vtk_when_idle() -> None:
 def main() -> None:
     out = _protocol_stdout()
     _die_with_parent()
-    import numpy  # noqa: F401 - the imports every read needs, done before the parent is told we are ready
-
-    import volviz.io.loaders  # noqa: F401 - and with it the package: the registry, the series, the raw readers
     out.write(json.dumps({"ready": True, "pid": os.getpid()}).encode() + b"\n")
     _load_vtk_when_idle()
     child = Child()
