@@ -229,7 +229,7 @@ def test_a_frame_computed_after_the_view_was_removed(demo) -> None:
     request = view.begin(cam)
     view.remove()
     poly, frame, stats = view.compute(request)
-    assert poly.n_points > 0 and frame.mesh.n_triangles == stats["terrain_triangles"] > 1000
+    assert poly is frame.mesh and len(poly.points) > 0 and frame.mesh.n_triangles == stats["terrain_triangles"] > 1000
     assert frame.clouds is not None and frame.clouds.n_leaves > 0 and frame.prisms
     pl.close()
 

@@ -338,8 +338,9 @@ class GLNatureView(NatureView):
 
     def compute(self, request: tuple[Any, tuple[int, int], int],
                 progress: Any = None) -> tuple[Any, Any, dict[str, float]]:
-        """Any thread: the LOD work of a frame (no image): the terrain's C-LOD mesh as VTK poly data and as the
-        ``TerrainMesh`` the prisms stand on with each prism layer's vertex buffer (``prism_buffers``), on a second
+        """Any thread: the LOD work of a frame (no image): the terrain's C-LOD mesh (``TerrainMesh``, also in the
+        frame: ``finish`` makes its VTK poly data on the GUI thread, see ``NatureView.compute``), the prisms standing on
+        it with each prism layer's vertex buffer (``prism_buffers``), on a second
         thread meanwhile the clouds' refinement and leaf list (``cloud_leaves``; both parts run
         Numba kernels that release the GIL), statistics (``lod_s``: seconds spent here). Each part's kernels get
         half the caller's Numba threads; the terrain's fan emission and prism buffers get all of them once the
@@ -373,24 +374,24 @@ class GLNatureView(NatureView):
                 wait([terrain])                    # no terrain work left behind
                 raise
             clouds_done.set()
-            mesh, poly, prisms = terrain.result()
+            mesh, prisms = terrain.result()
         if mesh is not None:
             stats["terrain_triangles"] = float(mesh.n_triangles)
         stats["lod_s"] = time.perf_counter() - t0
-        return poly, SimpleNamespace(mesh=mesh, clouds=clouds, prisms=prisms,
+        return mesh, SimpleNamespace(mesh=mesh, clouds=clouds, prisms=prisms,
                                      eye=np.asarray(cam.position, np.float64)), stats
 
     def _terrain_part(self, cam: Any, size: tuple[int, int], threads: Callable[[], int]
-                      ) -> tuple[Any, Any, dict[str, Any]]:
-        """The terrain's C-LOD mesh, as VTK poly data, and each prism layer's (geometry, ``prism_buffers``), their
-        kernels on ``threads()`` Numba threads (asked for when each stage starts)."""
+                      ) -> tuple[Any, dict[str, Any]]:
+        """The terrain's C-LOD mesh and each prism layer's (geometry, ``prism_buffers``), their kernels on
+        ``threads()`` Numba threads (asked for when each stage starts)."""
         scene = self.scene
         with numba_threads(threads()):
             mesh = scene.terrain_mesh(cam, size, emit_threads=threads)
         if mesh is None:
-            return None, None, {}
+            return None, {}
         with numba_threads(threads()):
-            return mesh, mesh.to_pyvista(), self._prism_layers(mesh)
+            return mesh, self._prism_layers(mesh)
 
     def _prism_layers(self, mesh: Any) -> dict[str, Any]:
         """Each prism layer's (geometry, ``prism_buffers``) on the terrain ``mesh``, by name."""
@@ -402,12 +403,13 @@ class GLNatureView(NatureView):
             prisms[fog.name] = (geometry, prism_buffers(*geometry, layer=fog.layer))
         return prisms
 
-    def finish(self, request: tuple[Any, tuple[int, int], int], poly: Any, frame: Any,
+    def finish(self, request: tuple[Any, tuple[int, int], int], mesh: Any, frame: Any,
                stats: dict[str, float]) -> dict[str, float]:
-        """GUI thread: the terrain mesh and the vertex buffers of the prisms and cloud tetrahedra made by ``compute``
-        to VTK (uploaded and drawn at the next render); ``upload_s``: seconds spent here."""
+        """GUI thread: the terrain mesh (made VTK poly data here) and the vertex buffers of the prisms and cloud
+        tetrahedra made by ``compute`` to VTK (uploaded and drawn at the next render); ``upload_s``: seconds spent
+        here."""
         t0 = time.perf_counter()
-        self._show_terrain(poly)
+        self._show_terrain(mesh.to_pyvista() if mesh is not None else None)
         scene = self.scene
         for kind, fog in scene.volume_order(frame.eye):    # made in this order: the first frame moves nothing
             if kind == "fog" and fog.name in frame.prisms:

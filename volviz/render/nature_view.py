@@ -24,6 +24,7 @@ if TYPE_CHECKING:   # type-only imports for the signatures
 
     from volviz.jobs import ProgressCallback
     from volviz.model.camera import Camera
+    from volviz.nature.terrain import TerrainMesh
     from volviz.render.framing import Bounds
     from volviz.scene.datasets import LoadedDataset
     from volviz.session import Component, CameraState
@@ -165,7 +166,7 @@ class NatureView:
         cam = camera or self._camera()     # after the dome moved: the clipping range depends on where it stands
         coarse, self._coarse = self._coarse, None
         if scale > 1 and coarse is not None:  # the camera starts moving: draw the shown view's coarse terrain at once
-            self._show_terrain(coarse)
+            self._show_terrain(coarse.to_pyvista())
         if camera is not None:
             camera.apply_to(self.plotter.camera)
             self._fit_clipping(camera.clipping_range)  # the VTK side only: ``cam`` keeps the caller's range
@@ -173,9 +174,12 @@ class NatureView:
         return cam, (w, h), max(1, int(scale))
 
     def compute(self, request: NatureRequest, progress: Optional[ProgressCallback] = None
-                ) -> tuple[Optional[pv.PolyData], np.ndarray, dict[str, float]]:
-        """Any thread (one at a time): the C-LOD terrain mesh as VTK poly data (None without terrain), the fog and
-        cloud overlay as 8-bit premultiplied RGBA rows bottom-up, and the statistics. ``progress(fraction, message)``
+                ) -> tuple[Optional[TerrainMesh], np.ndarray, dict[str, float]]:
+        """Any thread (one at a time): the C-LOD terrain mesh (None without terrain; ``finish`` makes its VTK poly data
+        on the GUI thread: a VTK object made on a worker while the GUI thread renders can deadlock the two, the
+        worker holding the GIL in VTK's garbage collector while a render collects a PyVista object that needs the
+        GIL, as a drag over Mount St. Helens did), the fog and cloud overlay as 8-bit premultiplied RGBA rows
+        bottom-up, and the statistics. ``progress(fraction, message)``
         is called between the stages (a job runner cancels there). A preview (``scale`` > 1, e.g. while the camera
         moves) renders the fog and clouds at 1/scale of the size in each direction (OpenGL magnifies them:
         ``_set_overlay``) over a coarser terrain of about ``PREVIEW_TRIANGLES`` triangles (the C-LOD resolution
@@ -190,20 +194,18 @@ class NatureView:
         w, h = size
         stats: dict[str, float] = {}
         depth = np.full((h, w), np.inf)
-        poly = None
         if mesh is not None:
             if progress is not None:
                 progress(0.3, "terrain")
-            poly = mesh.to_pyvista()
             if self.keep_coarse and not preview and not self.full:   # the view's preview terrain, for the next move
                 coarse = self._preview_mesh(cam, size)
-                self._coarse = coarse.to_pyvista() if coarse is not None and coarse.n_triangles else None
+                self._coarse = coarse if coarse is not None and coarse.n_triangles else None
             depth, _ = render_terrain(mesh.points, mesh.triangles, mesh.tcoords, cam, size, self.scene._pyramid)
             stats["terrain_triangles"] = float(mesh.n_triangles)
         if progress is not None:
             progress(0.5, "fog and clouds")
         overlay = _overlay_rgba(self.scene.render_volumes(cam, size, mesh, depth, full=self.full, stats=stats))
-        return poly, overlay, stats
+        return mesh, overlay, stats
 
     def _preview_mesh(self, cam: Any, size: tuple[int, int]) -> Any:
         """The terrain at ``preview_detail``, refitted to ``PREVIEW_TRIANGLES`` (C-LOD's count grows about as
@@ -220,10 +222,10 @@ class NatureView:
             self.preview_detail = detail
         return mesh
 
-    def finish(self, request: NatureRequest, poly: Optional[pv.PolyData], overlay: np.ndarray,
+    def finish(self, request: NatureRequest, mesh: Optional[TerrainMesh], overlay: np.ndarray,
                stats: dict[str, float]) -> dict[str, float]:
-        """GUI thread: show a ``compute`` result (terrain mesh and overlay image)."""
-        self._show_terrain(poly)
+        """GUI thread: show a ``compute`` result (terrain mesh, made VTK poly data here, and overlay image)."""
+        self._show_terrain(mesh.to_pyvista() if mesh is not None else None)
         self._set_overlay(overlay, smooth=int(request[2]) > 1)
         self.last_stats = stats
         self.shown_scale = int(request[2])
