@@ -80,8 +80,6 @@ def reasonless_by_module(root: Path = ROOT) -> dict[str, int]:
 REASONLESS: dict[str, int] = {
     "volviz/bench/first_open.py": 22,
     "volviz/cli.py": 28,
-    "volviz/optics/boundary.py": 1,
-    "volviz/optics/presets.py": 1,
     "volviz/render/backend.py": 1,
     "volviz/render/clipping.py": 1,
     "volviz/render/collision.py": 3,
@@ -113,13 +111,6 @@ REASONLESS: dict[str, int] = {
     "volviz/render/slices.py": 3,
     "volviz/render/vtk_scene.py": 10,
     "volviz/render/vtk_tf.py": 1,
-    "volviz/unstructured/boundary_pairs.py": 1,
-    "volviz/unstructured/iso.py": 1,
-    "volviz/unstructured/prefetch.py": 1,
-    "volviz/unstructured/reference.py": 1,
-    "volviz/unstructured/render.py": 3,
-    "volviz/unstructured/sort.py": 1,
-    "volviz/unstructured/tetrahedralize.py": 5,
     "volviz/warmup.py": 13,
 }
 

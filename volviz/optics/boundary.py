@@ -26,6 +26,7 @@ from typing import Any, Optional, Sequence
 
 import numpy as np
 
+from volviz.model.datasets import RegularVolume, TimeSeries
 from volviz.optics.auto_tf import (COOL_WARM, auto_transfer_function, finite_sample, held_flat, one_sided_range,
                                    peak_extinction)
 from volviz.optics.transfer_function import TransferFunction
@@ -63,8 +64,6 @@ class BoundaryProfile:
 def regular_fields(dataset: Any) -> Optional[tuple[list[np.ndarray], tuple[float, float, float]]]:
     """The 3-D scalar arrays (one per step, at most ``MAX_STEPS`` of a time series) and the grid spacing of a
     regular volume, or None for any other dataset (meshes keep the histogram rule)."""
-    from volviz.model.datasets import RegularVolume, TimeSeries
-
     if isinstance(dataset, TimeSeries):
         if len(dataset) == 0 or not isinstance(dataset.frame(0), RegularVolume):
             return None

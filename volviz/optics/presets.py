@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import volviz_resources
 
 from volviz.io.atomic import atomic_write_text
 from volviz.optics.transfer_function import TransferFunction
@@ -30,8 +31,6 @@ __all__ = ["list_presets", "load_preset", "preset_path", "tf_from_paraview", "tf
 
 
 def _presets_dir() -> Path:
-    import volviz_resources
-
     return volviz_resources.path("presets")
 
 

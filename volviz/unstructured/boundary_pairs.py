@@ -42,6 +42,7 @@ def inner_boundary(topo: Topology) -> np.ndarray:
     cached = topo.inner_boundary_faces
     if cached is not None:
         return cached
+    # heavy: SciPy's spatial (Qhull, about 230 modules), loaded only when boundary pairs are found
     from scipy.spatial import ConvexHull, QhullError
 
     bf = topo.boundary

@@ -24,6 +24,7 @@ import numpy as np
 
 from volviz.model.datasets import TetMesh
 from volviz.model.object_cache import ObjectCache
+from volviz.optics.isosurface import heaviside_alpha
 from volviz.unstructured.topology import cell_ranges
 
 
@@ -94,8 +95,6 @@ def iso_segment_rgba(table: Any, s_f: np.ndarray, s_b: np.ndarray, h_f: np.ndarr
     (increasing values when s_f < s_b, decreasing otherwise), each with its opacity and side color; with shading
     intensities ``h_f``/``h_b`` at the segment's ends each surface's color is scaled by the intensity where it is
     crossed (smooth shading; see the module docstring), else flat."""
-    from volviz.optics.isosurface import heaviside_alpha
-
     sf = np.asarray(s_f, dtype=np.float64)
     sb = np.asarray(s_b, dtype=np.float64)
     smooth = h_f is not None and h_b is not None

@@ -19,8 +19,9 @@ from typing import Any, Iterator, Optional, Sequence
 import numpy as np
 
 from volviz.jobs import JobRunner
-from volviz.model.datasets import TetMesh
 from volviz.model.camera import Camera
+from volviz.model.datasets import TetMesh
+from volviz.unstructured.render import render
 from volviz.unstructured.sort import SortResult, visibility_order
 from volviz.unstructured.topology import topology
 
@@ -116,8 +117,6 @@ def render_path(mesh: TetMesh, tf: Any, cameras: Sequence[Camera], size: tuple[i
     background while frame i rasterises. Yields ``(image, UnstructuredRenderStats)``; ``stats.sort_s`` is then only the
     wait for the prefetched order plus the zero-opacity filter, and ``stats.extra["sort_prefetched"]`` says whether the
     order came from the background. Images equal those of separate ``render`` calls exactly."""
-    from volviz.unstructured.render import render
-
     size = (int(size[0]), int(size[1]))
     with SortPrefetcher(mesh, sort=sort, nonconvex=nonconvex, runner=runner) as pre:
         if cameras:

@@ -23,17 +23,16 @@ Robustness (the ground truth must not depend on round-off):
 from __future__ import annotations
 
 import warnings
-
 from typing import Any, Callable, Iterator
 
 import numpy as np
 from numba import njit
 
-from volviz.model.datasets import TetMesh
 from volviz.model.camera import Camera
+from volviz.model.datasets import TetMesh
+from volviz.optics import integrate_segment
 from volviz.unstructured.raster import SOS
 from volviz.unstructured.topology import cell_ranges, topology
-
 
 _SOS = SOS                  # the generic displacement of the simulation-of-simplicity tie-break (shared with "pt")
 
@@ -267,8 +266,6 @@ def render_reference(mesh: TetMesh, tf: Any, camera: Camera, size: tuple[int, in
     """Exact float64 image (H, W, 4), premultiplied RGBA, row 0 at the top (``depth``: per-pixel far limits).
     ``segment_rgba(s_f, s_b, l)`` replaces the exact TF integral (e.g. exact flat isosurfaces); with an ``extra``
     point field it is called as ``segment_rgba(s_f, s_b, l, x_f, x_b)`` with that field at the segment's ends."""
-    from volviz.optics import integrate_segment
-
     if segment_rgba is None:
         def segment_rgba(sf: np.ndarray, sb: np.ndarray, ln: np.ndarray) -> np.ndarray:
             return integrate_segment(tf, sf, sb, ln)

@@ -21,10 +21,13 @@ from typing import Any, Literal, overload
 
 import numpy as np
 
+from volviz.model.camera import Camera
 from volviz.model.datasets import TetMesh
 from volviz.model.object_cache import ObjectCache
+from volviz.optics import build_table3d
 from volviz.optics.integrate import integrate_preclassified
-from volviz.model.camera import Camera
+from volviz.optics.separable import SeparableTable, build_separable
+from volviz.optics.table3d import Table3D
 from volviz.unstructured.iso import iso_lut, iso_segment_rgba, iso_visible, vertex_shade
 from volviz.unstructured.project import raster_triangles, shirley_tuchman
 from volviz.unstructured.raster import SOS, TILE, bin_tiles, lut_args, project_cells, raster_tiles, ray_images
@@ -98,10 +101,6 @@ def table_for(mesh: TetMesh, tf: Any, kind: str, sizes: tuple[int, int], l_max: 
     """The pre-integration table (``kind`` "3d" or "pre" (pre-classified 3D): sizes = (n_s, n_l); "separable":
     sizes = (n_s, degree)) over the union of the TF range and the data range (so out-of-range parts stay transparent),
     kept per mesh while it lives for the last TF and sizes of each kind."""
-    from volviz.optics import build_table3d
-    from volviz.optics.separable import SeparableTable, build_separable
-    from volviz.optics.table3d import Table3D
-
     r = cell_ranges(mesh)
     ok = ~r.nan
     lo, hi = tf.range

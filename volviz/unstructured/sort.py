@@ -34,11 +34,12 @@ from functools import partial
 import numpy as np
 from numba import njit, prange
 
-from volviz.model.datasets import TetMesh
 from volviz.model.camera import Camera
-from volviz.unstructured.boundary_pairs import inner_boundary, object_relations
+from volviz.model.datasets import TetMesh
 from volviz.unstructured import mpvo
+from volviz.unstructured.boundary_pairs import inner_boundary, object_relations
 from volviz.unstructured.mpvo import add_extra, face_sides, kahn_into
+from volviz.unstructured.reference import screen_bboxes
 from volviz.unstructured.topology import FACES, Topology, topology
 
 METHODS = ("mpvo", "centroid", "power")
@@ -205,8 +206,6 @@ def _gap_relations(pix: np.ndarray, depth: np.ndarray, fid: np.ndarray, n_pix: i
 
 
 def _boundary_box(cam: Camera, topo: Topology, size: tuple[int, int]) -> np.ndarray:
-    from volviz.unstructured.reference import screen_bboxes
-
     tri = topo.tets[topo.boundary[:, 0][:, None], FACES[topo.boundary[:, 1]]]     # (b, 3)
     tri4 = np.concatenate([tri, tri[:, :1]], axis=1)
     return screen_bboxes(cam, topo.points + topo.origin, tri4, size)

@@ -113,6 +113,7 @@ def pyramids_to_tets(pyramids: np.ndarray, rank: np.ndarray | None = None) -> np
 
 def _hex_vertex_colors(hexes: np.ndarray, n_points: int) -> np.ndarray:
     """2-color the vertices along hexahedron edges (BFS); raise when the vertex graph is not bipartite."""
+    # heavy: SciPy's sparse graphs (about 200 modules), loaded only for hexahedral meshes
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import breadth_first_order
 
@@ -255,6 +256,7 @@ def _vtk_tets(points: np.ndarray, cells: list[tuple[int, np.ndarray]]) -> tuple[
     """Conforming tetrahedra of any linear 3D cells by VTK's vtkDataSetTriangleFilter (its ordered triangulator
     splits shared faces alike by global point ids), for hexahedral meshes whose vertex graph is not bipartite; the
     points are kept as they are."""
+    # heavy: PyVista and VTK's triangulator, only for hexahedra whose vertex graph is not bipartite
     import pyvista as pv
     from vtkmodules.vtkFiltersGeneral import vtkDataSetTriangleFilter
 
@@ -273,6 +275,7 @@ def _vtk_tets(points: np.ndarray, cells: list[tuple[int, np.ndarray]]) -> tuple[
 
 def _from_pyvista(grid: Any, scalars: str | None) -> CurvilinearGrid | UnstructuredMesh:
     """Wrap a pyvista StructuredGrid / UnstructuredGrid into the volviz model types."""
+    # heavy: PyVista (about 180 modules), loaded only when a PyVista grid is wrapped
     import pyvista as pv
 
     point_data = {k: np.asarray(grid.point_data[k]) for k in grid.point_data.keys()
