@@ -3,7 +3,9 @@
 By default the viewport gets most of the window: the transfer-function editor sits at the top of a narrow right-hand
 column with the other panels (scene, render settings, clipping, statistics) tabbed below it, and the timeline is one
 row along the bottom. Every dock's content sits in a scroll area, so no panel's minimum size keeps the window from
-fitting a laptop screen (1366x768): a panel that is too small scrolls instead of growing the window.
+fitting a laptop screen (1366x768): a panel that is too small scrolls instead of growing the window. The tabs of
+tabbed docks keep their whole titles and scroll with arrow buttons (Qt elides them: on that screen the six tabs read
+"S…", "Render s…", "Cl…", "Sta…", "Sl…", "Isosu…").
 
 The window's geometry and dock arrangement are stored in ``QSettings`` when it closes and restored when the next one
 opens (``saveGeometry`` / ``saveState``); ``reset`` (View > Reset Layout) brings back the defaults.
@@ -13,7 +15,7 @@ from __future__ import annotations
 from typing import Any, Optional
 
 from PySide6.QtCore import QByteArray, QEvent, QObject, QSettings, Qt, QTimer
-from PySide6.QtWidgets import QDockWidget, QFrame, QMainWindow, QScrollArea, QWidget
+from PySide6.QtWidgets import QDockWidget, QFrame, QMainWindow, QScrollArea, QTabBar, QWidget
 
 DEFAULT_SIZE = (1280, 860)
 SIDE_WIDTH = 340          # the right-hand column of panels, in pixels, by default
@@ -34,6 +36,12 @@ def scrolled(widget: QWidget) -> QScrollArea:
     scrollbar = area.verticalScrollBar().sizeHint().width()
     area.setMinimumWidth(widget.minimumSizeHint().width() + scrollbar)
     return area
+
+
+def whole_titles(tabs: QTabBar) -> None:
+    """``tabs`` shows each title whole, and arrow buttons when they do not all fit."""
+    tabs.setElideMode(Qt.TextElideMode.ElideNone)
+    tabs.setUsesScrollButtons(True)
 
 
 class WindowLayout(QObject):
@@ -86,6 +94,8 @@ class WindowLayout(QObject):
         if event.type() == QEvent.Type.Show and self._size_on_show:
             self._size_on_show = False
             QTimer.singleShot(0, self.size_docks)
+        elif event.type() == QEvent.Type.ChildPolished and isinstance(event.child(), QTabBar):
+            whole_titles(event.child())    # the window makes a tab bar for each group of tabbed docks
         return False
 
     def default_size(self) -> tuple[int, int]:
