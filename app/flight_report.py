@@ -88,7 +88,8 @@ def fly(app: Any, window: Any, target: str | None, seconds: float) -> dict[str, 
             "gaps_over_100ms": sum(g > 0.1 for g in worst), "blocked_max_ms": 1e3 * max(gaps.blocked),
             "blocked_over_100ms": sum(b > 0.1 for b in gaps.blocked), "load": os.getloadavg()[0],
             "size": f"{SIZE[0]}x{SIZE[1]}", "target": str(target or "resources/sessions/yukon.json"),
-            "viewport": f"{viewport[0]}x{viewport[1]}", "reduced_frames": drawn_reduced,
+            "viewport": f"{viewport[0]}x{viewport[1]}", "viewport_class": type(window.plotter).__name__,
+            "reduced_frames": drawn_reduced,
             "reduced_size": f"{drawn_at[0]}x{drawn_at[1]}", **stop}
 
 
@@ -127,9 +128,9 @@ def markdown(result: dict[str, Any], command: str) -> str:
         f"{r['blocked_max_ms']:.0f} ms, {r['blocked_over_100ms']} over 100 ms (the renderer's threads' waits stay in).",
         "",
         f"Frames drawn while flying at {r['reduced_size']} ({r['reduced_frames']} of them), magnified to the "
-        f"{r['viewport']} viewport. After the release: the full-resolution frame {r['stop_s']:.2f} s later (the "
-        f"views' full-size updates made in the background), its render {r['stop_render_ms']:.0f} ms; longest "
-        f"event-loop gap from the release to it {r['stop_gap_max_ms']:.0f} ms.",
+        f"{r['viewport']} viewport ({r['viewport_class']}). After the release: the full-resolution frame "
+        f"{r['stop_s']:.2f} s later (the views' full-size updates made in the background), its render "
+        f"{r['stop_render_ms']:.0f} ms; longest event-loop gap from the release to it {r['stop_gap_max_ms']:.0f} ms.",
         ""])
 
 

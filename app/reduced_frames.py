@@ -36,6 +36,10 @@ class ReducedFrames:
         self.last_size: tuple[int, int] = (0, 0)   # the render window's size in the last reduced paint
         self._full: tuple[int, int] | None = None   # the render window's size before it was reduced
         self._serial = 0
+        reduce_paints = getattr(self.widget, "reduce_paints", None)
+        if reduce_paints is not None:   # a native viewport (app/native_viewport.py) draws its paints reduced itself
+            reduce_paints(self)
+            return
         self.ren_win.AddObserver("StartEvent", self._render_starts)
         self.widget.aboutToCompose.connect(self._restore)
 

@@ -28,9 +28,11 @@ import logging
 import os
 import time
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Callable, Optional
+from typing import TYPE_CHECKING, Any, Callable, Optional, cast
 
-from PySide6.QtCore import QSettings, Qt
+import numpy as np
+from PySide6.QtCore import QPoint, QSettings, Qt
+from PySide6.QtGui import QImage, QPainter, QPixmap
 from PySide6.QtWidgets import QFileDialog, QMainWindow, QMenu, QMessageBox, QWidget
 
 from volviz.render.backend import plotter_gl_info
@@ -57,9 +59,26 @@ from .window_widgets import build_docks, build_menus, build_status_bar, fill_doc
 from .workers import JobBridge
 
 if TYPE_CHECKING:
+    from pyvistaqt import QtInteractor
+
     from volviz.model.clip import ClipSettings
 
 log = logging.getLogger(__name__)
+
+
+def make_plotter(parent: QWidget) -> QtInteractor:
+    """The viewport: pyvistaqt's ``QtInteractor``, or with ``VOLVIZ_VIEWPORT=native`` on X11 (``xcb``) the native-window
+    ``NativeViewport``, which Qt does not compose (issue #28, an opt-in until it is made the default; see
+    ``app/native_viewport.py``). Typed as ``QtInteractor``, whose plotter and widget interface it has too."""
+    from PySide6.QtWidgets import QApplication
+    from pyvistaqt import QtInteractor
+
+    if os.environ.get("VOLVIZ_VIEWPORT", "") == "native" and QApplication.platformName() == "xcb":
+        from .native_viewport import NativeViewport
+
+        log.info("viewport: NativeViewport (VOLVIZ_VIEWPORT=native)")
+        return cast("QtInteractor", NativeViewport(parent))
+    return QtInteractor(parent, auto_update=False)  # we render when something changed, never on a timer
 
 
 def _import_gui_thread_modules() -> None:
@@ -91,13 +110,11 @@ class MainWindow(WindowBase, QMainWindow):
     def __init__(self, parent: Optional[QWidget] = None, settings: Optional[QSettings] = None,
                  recovery_dir: Optional[Path] = None):
         super().__init__(parent)
-        from pyvistaqt import QtInteractor
-
         self.setWindowTitle("volviz")
         _import_gui_thread_modules()
         self.collector = GuiThreadCollector(self)  # cycles are freed on this thread, never in a worker
         self.settings = settings or QSettings("volviz", "volviz")
-        self.plotter = QtInteractor(self, auto_update=False)  # we render when something changed, never on a timer
+        self.plotter = make_plotter(self)
         self.setCentralWidget(self.plotter.interactor)
         self.jobs = JobBridge(self)
         self.session = Session()
@@ -167,6 +184,22 @@ class MainWindow(WindowBase, QMainWindow):
             self.scene_undo_stack.clear()
 
     # ------------------------------------------------------------------------------------------------ rendering
+    def grab(self, *args: Any) -> QPixmap:
+        """``QWidget.grab``; of the whole window with the native viewport (``make_plotter``), its frame drawn over the
+        viewport's rectangle: Qt's grab paints widgets through their paint engines, which a native GLX window lacks
+        (its region of the grab was garbage: docs/bench/flight.md). ``--screenshot``, screenshots and the
+        first-open figure grab the window."""
+        pixmap = super().grab(*args)
+        if args or not hasattr(self.plotter, "reduce_paints") or self.plotter.ren_win is None:
+            return pixmap
+        frame = np.ascontiguousarray(np.asarray(self.plotter.screenshot(None, return_img=True))[..., :3])
+        image = QImage(frame.data, frame.shape[1], frame.shape[0], 3 * frame.shape[1], QImage.Format.Format_RGB888)
+        image.setDevicePixelRatio(pixmap.devicePixelRatio())
+        painter = QPainter(pixmap)
+        painter.drawImage(self.plotter.interactor.mapTo(self, QPoint(0, 0)), image)
+        painter.end()
+        return pixmap
+
     def render_scene(self) -> None:
         start = time.perf_counter()
         self.plotter.render()

@@ -1,0 +1,147 @@
+"""The viewport as a native X child window that VTK draws into with its own GLX context (issue #28, opt-in:
+``VOLVIZ_VIEWPORT=native`` on the ``xcb`` platform; ``window.make_plotter``).
+
+pyvistaqt's ``QtInteractor`` is a ``QOpenGLWidget``: VTK renders into its framebuffers, the paint blits the frame into
+the widget's, and Qt then composes the whole window through OpenGL (on llvmpipe, 60-72 ms per pass of a loaded
+machine). VTK's own ``QVTKRenderWindowInteractor`` on a plain ``QWidget`` is a native window that
+``vtkXOpenGLRenderWindow`` swaps into directly, so Qt composes nothing for it. With the flight's frames reduced in its
+own paint, a 20-s Yukon flight had 7-14 gaps over 100 ms less CPU waits against 70-86, and 18-21 fps against 10-14
+(docs/bench/flight.md, "A viewport that Qt does not compose"). A native GLX window needs X11 (pyvistaqt gh-445
+left native windows for Wayland), so pyvistaqt's widget stays the default everywhere else."""
+from __future__ import annotations
+
+import ctypes
+from typing import TYPE_CHECKING, Any
+
+import vtkmodules.qt
+from PySide6.QtCore import Qt, Signal
+from PySide6.QtGui import QPaintEvent
+from PySide6.QtWidgets import QWidget
+from pyvista import global_theme
+from pyvista.plotting.plotter import BasePlotter
+from pyvista.plotting.render_window_interactor import RenderWindowInteractor
+from pyvistaqt.plotting import _no_base_plotter_init
+from vtkmodules.vtkRenderingCore import vtkRenderWindow
+
+vtkmodules.qt.QVTKRWIBase = "QWidget"   # read when the module below is first imported: a native QWidget, not GL
+from vtkmodules.qt.QVTKRenderWindowInteractor import QVTKRenderWindowInteractor  # noqa: E402
+
+if QVTKRenderWindowInteractor.__mro__[1] is not QWidget:   # imported before with another base: not native
+    raise ImportError(f"vtkmodules.qt.QVTKRenderWindowInteractor is a {QVTKRenderWindowInteractor.__mro__[1]}, "
+                      "not a native QWidget")
+
+if TYPE_CHECKING:
+    from .reduced_frames import ReducedFrames
+
+_GL_DRAW_FRAMEBUFFER, _GL_BACK, _GL_COLOR_BUFFER_BIT, _GL_LINEAR = 0x8CA9, 0x0405, 0x4000, 0x2601
+
+
+class _GLX:
+    """The three GLX calls the reduced paint needs (``libGL.so.1``), loaded at its first use."""
+
+    lib: Any = None
+
+    @classmethod
+    def swap_current(cls) -> None:
+        if cls.lib is None:
+            lib = ctypes.CDLL("libGL.so.1")
+            lib.glXGetCurrentDisplay.restype = ctypes.c_void_p
+            lib.glXGetCurrentDrawable.restype = ctypes.c_ulong
+            lib.glXSwapBuffers.argtypes = [ctypes.c_void_p, ctypes.c_ulong]
+            cls.lib = lib
+        cls.lib.glXSwapBuffers(cls.lib.glXGetCurrentDisplay(), cls.lib.glXGetCurrentDrawable())
+
+
+class NativeViewport(QVTKRenderWindowInteractor, BasePlotter):  # type: ignore[misc]
+    """A pyvista plotter in VTK's native-window widget: what pyvistaqt's ``QtInteractor`` adds to its widget (the
+    renderers, pyvista's interactor, key events, depth peeling, drops), with the flight's reduced frames drawn in its
+    own paint (``reduce_paints``)."""
+
+    aboutToCompose = Signal()   # never emitted: Qt composes nothing for this widget
+
+    def __init__(self, parent: QWidget | None = None) -> None:
+        with _no_base_plotter_init():
+            QVTKRenderWindowInteractor.__init__(self, parent)
+        BasePlotter.__init__(self)
+        self.setAttribute(Qt.WidgetAttribute.WA_NativeWindow)
+        self.interactor = self
+        self._in_paint = False
+        self.frames: ReducedFrames | None = None
+        self.setAcceptDrops(True)   # the window's file drop filter takes them
+        self.ren_win = self.GetRenderWindow()
+        self.ren_win.SetMultiSamples(global_theme.multi_samples)
+        for renderer in self.renderers:
+            renderer.view_isometric()
+            self.ren_win.AddRenderer(renderer)
+        self.background_color = global_theme.background
+        self._off_screen = False
+        self.iren = RenderWindowInteractor(self, interactor=self.ren_win.GetInteractor())
+        self.iren.interactor.RemoveObservers("MouseMoveEvent")
+        self.iren.initialize()
+        self.enable_trackball_style()   # type: ignore[call-arg]  # pyvista's decorator hides the bound self
+        self._observers: dict[Any, Any] = {}
+        self.iren.add_observer("KeyPressEvent", self.key_press_event)
+        self.reset_key_events()
+        if global_theme.depth_peeling["enabled"] and self.enable_depth_peeling():  # type: ignore[call-arg]
+            for renderer in self.renderers:
+                renderer.enable_depth_peeling()
+        self._first_time = False   # BasePlotter: this plotter renders on screen
+
+    def reduce_paints(self, frames: ReducedFrames) -> None:
+        """``frames`` decides when paints are reduced and by how much; this widget draws them so (``ReducedFrames``
+        cannot resize the render window: ``vtkXOpenGLRenderWindow.SetSize`` resizes the X window)."""
+        self.frames = frames
+
+    def paintEvent(self, ev: QPaintEvent) -> None:
+        if self._in_paint:
+            return
+        frames = self.frames
+        self._in_paint = True
+        try:
+            if frames is not None and frames.active and frames.factor > 1:
+                self._reduced_render(frames)
+            else:
+                self._Iren.Render()
+        finally:
+            self._in_paint = False
+
+    def _reduced_render(self, frames: ReducedFrames) -> None:
+        """Render at 1/factor of the window's size into VTK's display framebuffer (no blit, no swap), magnify it into
+        the window's back buffer and swap; the render window's size is the full one again afterwards."""
+        rw = self._RenderWindow
+        full_w, full_h = (int(v) for v in rw.GetSize())
+        w, h = -(-full_w // frames.factor), -(-full_h // frames.factor)
+        try:
+            vtkRenderWindow.SetSize(rw, w, h)   # the base class's: no XResizeWindow
+            rw.SetFrameBlitModeToNoBlit()       # Frame() resolves into the display framebuffer ...
+            rw.SetDoubleBuffer(0)               # ... and swaps only when double-buffered
+            self._Iren.Render()
+            frames.renders += 1
+            frames.last_size = (w, h)
+            rw.MakeCurrent()
+            state = rw.GetState()
+            state.PushDrawFramebufferBinding()
+            state.vtkglBindFramebuffer(_GL_DRAW_FRAMEBUFFER, 0)
+            state.vtkglDrawBuffer(_GL_BACK)
+            rw.BlitDisplayFramebuffer(0, 0, 0, w, h, 0, 0, full_w, full_h, _GL_COLOR_BUFFER_BIT, _GL_LINEAR)
+            state.PopDrawFramebufferBinding()
+            _GLX.swap_current()
+        finally:
+            vtkRenderWindow.SetSize(rw, full_w, full_h)
+            rw.SetFrameBlitModeToBlitToHardware()
+            rw.SetDoubleBuffer(1)
+
+    def render(self) -> None:  # type: ignore[override]  # BasePlotter.render, as QtInteractor's
+        """``BasePlotter.render`` now (on the GUI thread), never after ``close``."""
+        if getattr(self, "_closed", False):
+            return
+        self._rendered = True
+        BasePlotter.render(self)
+
+    def close(self) -> None:  # type: ignore[override]
+        """As ``QtInteractor.close``: the plotter's close (it finalizes the render window while the X window still
+        exists), then the widget's. Again, or from the parent's ``destroyed``: nothing."""
+        if getattr(self, "_closed", True):
+            return
+        BasePlotter.close(self)
+        QVTKRenderWindowInteractor.close(self)
