@@ -1,6 +1,8 @@
 """The probe tool: the value, position and voxel (or cell and point) under the mouse cursor, shown in the status bar
 as the mouse moves over the viewport (``volviz.render.probe_pick``), and pinned with a click (a click without a
-drag) to the Probe dock's list, which Clear empties."""
+drag) to the Probe dock's list, which Clear empties. What is under a resting cursor is probed again when the scene
+is replaced or rebuilt (a file opened with a key or a drop, another array) and when the display time changes (a
+time step, playback): the status bar never names a value of data no longer shown."""
 from __future__ import annotations
 
 from typing import Any, Optional
@@ -41,6 +43,13 @@ class ProbeTool(QObject):
         self.timer = QTimer(self, singleShot=True, interval=PROBE_DELAY_MS)
         self.timer.timeout.connect(self.probe_now)
         window.plotter.interactor.installEventFilter(self)
+        window.scene_tree.populated.connect(self.probe_again)   # after the new scene's docks are filled
+        window.timeline.timeChanged.connect(self.probe_again)   # the timer runs after the scene took the time
+
+    def probe_again(self, *_: Any) -> None:
+        """The data under the cursor changed: probe the resting cursor again (a moment later, coalesced)."""
+        if self._pos is not None and self.label.text():
+            self.timer.start()
 
     def eventFilter(self, watched: Any, event: Any) -> bool:  # noqa: N802 (Qt's name)
         kind = event.type()
@@ -57,6 +66,7 @@ class ProbeTool(QObject):
                 self.pin()
         elif kind == QEvent.Type.Leave:
             self.timer.stop()
+            self._pos = None
             self.label.setText("")
         return False
 
