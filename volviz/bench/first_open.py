@@ -28,8 +28,12 @@ legibility of regular volumes drawn with the boundary transfer function (Kindlma
 """
 from __future__ import annotations
 
+import cProfile
 import os
+import platform
+import pstats
 import re
+import resource
 import subprocess
 import sys
 import tempfile
@@ -42,6 +46,15 @@ from typing import Any, Optional
 import numpy as np
 
 from volviz.argtypes import UsageParser
+from volviz.io import ReadError
+from volviz.io.doc_section import merge_rows, read_section
+from volviz.io.doc_section import write_section as write_marked
+from volviz.io.registry import spec_of
+from volviz.model.stats import scalar_values
+from volviz.optics import TransferFunction
+from volviz.optics.auto_tf import BACKGROUND_FRACTION, MODE_WIDTH, background_mode, finite_sample, mean_chord
+from volviz.optics.boundary import boundary_transfer_function, regular_fields
+from volviz.scene.series import series_pattern
 
 DEFAULT_DATA = Path(os.environ.get("VOLVIZ_DATA", Path(__file__).resolve().parents[2].parent / "shared" / "data"))
 REPORT = Path(__file__).resolve().parents[2] / "docs" / "first-open.md"
@@ -62,10 +75,6 @@ Timing = tuple[Optional[float], Optional[float], Optional[float], str, Optional[
 def opened_files(root: Path) -> list[Path]:
     """The files under ``root`` a user opens: every data file, one member (the first) of each numbered series, a
     folder that a reader opens whole (an OpenFOAM case) as itself; no README, no sidecar a header names."""
-    from volviz.io import ReadError
-    from volviz.io.registry import spec_of
-    from volviz.scene.series import series_pattern
-
     found: list[Path] = []
     seen: set[str] = set()
     for folder, dirs, files in os.walk(root):
@@ -170,8 +179,6 @@ class FirstImage:
 def render_timed(path: Path, out: Path) -> tuple[float, float, int, str]:
     """Wall seconds, CPU seconds (user + system of the process and the children it waited for), exit status and
     last stderr line of ``volviz render PATH -o OUT`` in a fresh process."""
-    import resource
-
     def cpu() -> float:
         used = resource.getrusage(resource.RUSAGE_CHILDREN)
         return used.ru_utime + used.ru_stime
@@ -217,8 +224,6 @@ def object_transfer_function(lo: float, hi: float, chord: float, mode: Optional[
     values ``low <= v < high``, or up to ``hi`` when the mode ends the range); opaque everywhere without one. The
     steps are ``1e-6`` of the range wide, far below a histogram bin (1/256 of it). A region at ``hi`` itself is
     opaque (``volviz.render.vtk_tf.tf_to_vtk`` keeps VTK's top inclusive): a footprint has no holes there."""
-    from volviz.optics import TransferFunction
-
     rho = 60.0 / chord
     if mode is None:
         return TransferFunction([lo, hi], [(1.0, 1.0, 1.0)] * 2, [rho] * 2, name=name)
@@ -237,14 +242,12 @@ def legibility(path: Path, boundary_rule: bool = False) -> tuple[str, Optional[F
     """How ``path`` (a data or session file) is drawn, and for a volume its footprints (``Footprints``) and mode
     contrast (see the module docstring); ``boundary_rule``: of a regular volume drawn with
     ``volviz.optics.boundary``'s transfer function instead."""
-    from volviz.model.stats import scalar_values
-    from volviz.optics.auto_tf import background_mode, finite_sample, mean_chord
-    from volviz.optics.boundary import boundary_transfer_function, regular_fields
+    # heavy: the rendering layer (render.export loads PyVista and VTK), only when legibility is measured
     from volviz.render.export import open_target, render_session
     from volviz.render.scene_builder import ensure_transfer_functions
+    from volviz.render.vtk_scene import volume_grid
     from volviz.scene.datasets import component_dataset, drawn_as, load_datasets
     from volviz.scene.drawn_tf import component_transfer_function
-    from volviz.render.vtk_scene import volume_grid
 
     session, session_file = open_target(path)
     comp = session.components[0]
@@ -298,9 +301,7 @@ def _footprint(image: np.ndarray) -> np.ndarray:
 def where_time_goes(path: Path, top: int = 6) -> list[str]:
     """The volviz functions (and VTK's render) that took the most cumulative time of an in-process render of
     ``path`` after imports: cProfile, top ``top`` by own module, as 'module.function s'."""
-    import cProfile
-    import pstats
-
+    # heavy: the rendering layer (render.export loads PyVista and VTK), only for a profiled render
     from volviz.render.export import open_target, render_session
 
     with warnings.catch_warnings():
@@ -348,6 +349,7 @@ def measure(root: Path, names: Optional[list[str]] = None, boundary_rule: bool =
                 runs = [render_timed(path, out) for _ in range(1 + max(repeats, 1))][1:]   # the first warms caches
                 status, last = runs[-1][2], runs[-1][3]
                 if status == 0:
+                    # heavy: Pillow, loaded only to read a rendered image back
                     from PIL import Image
 
                     record.seconds = float(np.median([run[0] for run in runs]))
@@ -381,10 +383,6 @@ def markdown(records: list[FirstImage], profiles: dict[str, list[str]], loads: O
              repeats: int = REPEATS) -> str:
     """The section of ``docs/first-open.md`` this benchmark writes (without its markers); ``loads``: the machine's
     load averages at the run's start and end, said when given."""
-    import platform
-
-    from volviz.optics.auto_tf import BACKGROUND_FRACTION, MODE_WIDTH
-
     lines = ["## `volviz render`: time to the first image, and legibility of the automatic transfer "
              "function", "", "Regenerate (about 10 minutes):", "", "```", COMMAND, "```", "",
              f"The legibility columns alone, keeping each file's time, drawn share and notes (and the profiles) as "
@@ -435,8 +433,6 @@ def kept_timings(report: Path = REPORT) -> dict[str, Timing]:
     """File -> (seconds, CPU seconds, drawn share, note, slowest seconds) of the rows of ``report``'s section, read
     by its header's column names (*first image*, *CPU*, *drawn*, *notes*, *slowest*; a report without a column
     gives None): what a ``--legibility-only`` run keeps."""
-    from volviz.io.doc_section import read_section
-
     timings: dict[str, Timing] = {}
     columns: list[str] = []
     for line in read_section(report, BEGIN, END).splitlines():
@@ -458,8 +454,6 @@ def kept_timings(report: Path = REPORT) -> dict[str, Timing]:
 def kept_rows(text: str, profiled: bool, order: list[str], report: Path = REPORT) -> str:
     """The section ``text`` of an ``--only`` run with the rows of the other files kept from ``report``'s section (in
     ``order``), and its "where the time goes" list when this run profiled none."""
-    from volviz.io.doc_section import merge_rows, read_section
-
     old = read_section(report, BEGIN, END)
     text = merge_rows(old, text, order)
     if not profiled and PROFILE_HEAD in old:
@@ -470,8 +464,6 @@ def kept_rows(text: str, profiled: bool, order: list[str], report: Path = REPORT
 def write_section(text: str, report: Path = REPORT) -> None:
     """Replace this benchmark's section of ``report`` (between ``BEGIN`` and ``END``) by ``text``, keeping the rest
     of the document (the app's window table, prose)."""
-    from volviz.io.doc_section import write_section as write_marked
-
     write_marked(report, BEGIN, END, text)
 
 

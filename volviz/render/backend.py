@@ -117,6 +117,7 @@ def plotter_gl_info(plotter: pv.BasePlotter) -> GLInfo:
 
 def offscreen_gl_info() -> GLInfo:
     """The OpenGL driver of VTK's offscreen render windows on this machine (a tiny one, made and closed here)."""
+    # heavy: PyVista and VTK (an offscreen plotter), loaded only when the driver is asked about
     from volviz.render.offscreen import offscreen_plotter
 
     plotter = offscreen_plotter((8, 8))

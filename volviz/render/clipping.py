@@ -30,6 +30,7 @@ MAX_GL_PLANES = 6
 
 
 def vtk_plane(plane: ClipPlane) -> vtkPlane:
+    # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
     from volviz.render.vtk_facade import vtk
 
     p = vtk.vtkPlane()

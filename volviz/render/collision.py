@@ -51,6 +51,7 @@ class OpaqueObstacles:
         self._locator: Any = None
 
     def _surfaces(self) -> list[Any]:
+        # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
         from volviz.render.vtk_facade import vtk
 
         names = {id(a) for name, a in getattr(self.renderer, "actors", {}).items() if name in NOT_OBSTACLES}
@@ -76,6 +77,7 @@ class OpaqueObstacles:
         return out
 
     def _build(self) -> Any:
+        # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
         from volviz.render.vtk_facade import vtk
 
         surfaces = self._surfaces()
@@ -94,6 +96,7 @@ class OpaqueObstacles:
         return self._locator
 
     def __call__(self, start: np.ndarray, end: np.ndarray) -> Optional[float]:
+        # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
         from volviz.render.vtk_facade import vtk_to_numpy, vtk
 
         built = self._build()

@@ -12,6 +12,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any, Optional
 
 from volviz.render.framing import Bounds, points_bounds, prop_bounds, union
+from volviz.render.vtk_scene import update_volume_property
 from volviz.scene.isosurfaces import isosurface_parts
 
 if TYPE_CHECKING:   # type-only imports for the signatures
@@ -54,7 +55,6 @@ class VtkPropView:
         if self.prop.IsA("vtkVolume"):
             if tf is None:
                 return
-            from volviz.render.vtk_scene import update_volume_property
 
             update_volume_property(self.prop.GetProperty(), tf, opacity)
         else:
@@ -62,6 +62,7 @@ class VtkPropView:
 
     def set_clip(self, clip: ClipSettings) -> bool:
         """Clip by ``volviz.model.clip.ClipSettings`` at once (True: nothing for the caller to cut)."""
+        # heavy: the clip's Numba kernels and SciPy, loaded only when a component is clipped
         from volviz.render.clipping import clip_vtk_prop
 
         self._uncut = clip_vtk_prop(self.prop, clip, self._uncut)
@@ -132,7 +133,7 @@ class IsoSurfacesView(VtkPropView):
         if self.prop is not None:
             self.plotter.remove_actor(self.prop, render=False)
         self.parts = parts
-        from volviz.render.iso_actors import add_isosurface_actors   # volviz.iso: only for isosurfaces (start-up)
+        from volviz.render.iso_actors import add_isosurface_actors  # volviz.iso: only for isosurfaces (start-up)
 
         self.prop = add_isosurface_actors(self.plotter, self.comp.id, parts, spectrum=self.spectrum)
 

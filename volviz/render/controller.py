@@ -26,10 +26,23 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Callable, Iterator, Optional
 
+from volviz.jobs import report
 from volviz.model import TimeSeries
 from volviz.model.applicability import DatasetTraits
 from volviz.model.events import ChangeNotifier, SceneChange
+from volviz.render.decorations import apply_decorations, legend_margin, update_legend, update_outline
+from volviz.render.framing import frame_scene, union
 from volviz.render.image_overlay import single_sample_on_software
+from volviz.render.scene_builder import (PreparedScene, ensure_transfer_functions, install_component, install_nature,
+                                         install_scene, prepare_component, prepare_scene, time_input, view_backend)
+from volviz.render.views import view_class
+from volviz.render.volume_peeling import peel_volumes, regular_volumes
+from volviz.render.vtk_scene import apply_camera, camera_state, is_surface
+from volviz.scene.datasets import NATURE_TYPES, component_dataset, dataset_traits, drawn_as
+from volviz.scene.drawn_tf import component_transfer_function, drawn_tf
+from volviz.scene.errors import SceneError
+from volviz.scene.isosurfaces import IsoParts, isosurface_parts
+from volviz.scene.nature import prepare_nature
 from volviz.session import ISO_MODES, CameraState, Component, Session
 
 if TYPE_CHECKING:   # type-only imports for the signatures
@@ -44,9 +57,7 @@ if TYPE_CHECKING:   # type-only imports for the signatures
     from volviz.render.iso_overlay import IsoOverlay
     from volviz.render.lod_volume import LodVolume
     from volviz.render.pt_prop import PTVolume
-    from volviz.render.scene_builder import PreparedScene
     from volviz.scene.datasets import LoadedDataset
-    from volviz.scene.isosurfaces import IsoParts
 
 __all__ = ["ISO_MODES", "SceneController", "ensure_lights", "iso_summary", "no_render", "session_interpolates"]
 
@@ -148,8 +159,6 @@ class SceneController:
         """Any thread, before ``install``: the heavy part of building (``volviz.render.scene_builder.prepare_scene``) at
         display time ``t`` of a time series (default: the session's display time). Touches no plotter, so the app
         runs it in the background."""
-        from volviz.render.scene_builder import prepare_scene
-
         span = self.time_span()
         if t is None or not span:
             t = span[0] if span else None
@@ -162,8 +171,6 @@ class SceneController:
         """GUI thread: add the props of a ``prepare`` result to the plotter without rendering. The view-dependent
         parts (PT images, LOD blocks, terrain and overlay) are drawn now when ``views``; the app instead updates them
         in the background (``pt_volume``, ``lod_volumes``, ``nature``: ``begin`` / ``compute`` / ``finish``)."""
-        from volviz.render.scene_builder import install_scene
-
         self._listen()
 
         ensure_lights(self.plotter)
@@ -248,8 +255,6 @@ class SceneController:
     def decorate(self) -> None:
         """(Re)draw the scalar bar, orientation axes and outline box as the session's render options say
         (``volviz.render.decorations``); call after a transfer function, visibility or option changed."""
-        from volviz.render.decorations import apply_decorations
-
         apply_decorations(self.plotter, self.session, self.shown_props(), self.datasets)
 
     def shown_props(self) -> dict[str, Any]:
@@ -261,16 +266,12 @@ class SceneController:
         return self.session.component(comp_id)
 
     def dataset_of(self, comp_id: str) -> Any:
-        from volviz.scene.datasets import component_dataset
-
         return component_dataset(self.component(comp_id), self.datasets)
 
     def dataset_traits(self, comp_id: str) -> Optional[DatasetTraits]:
         """What the component's dataset is, for the settings that apply to some datasets only
         (``volviz.model.applicability``): no traits for a component without a dataset, None while its dataset is
         not read (a component hidden at load)."""
-        from volviz.scene.datasets import dataset_traits
-
         comp = self.component(comp_id)
         if comp.dataset is None:
             return DatasetTraits()
@@ -279,8 +280,6 @@ class SceneController:
     def drawn_as(self, comp_id: str) -> Optional[str]:
         """How a volume component draws its dataset (``volviz.scene.datasets.drawn_as``); None for other components
         and while the dataset is not read."""
-        from volviz.scene.datasets import drawn_as
-
         comp = self.component(comp_id)
         if comp.type != "volume" or comp.dataset not in self.datasets:
             return None
@@ -288,14 +287,10 @@ class SceneController:
 
     # -- transfer functions, visibility, opacity --------------------------------------------------------------------
     def transfer_function(self, comp_id: str) -> Optional[TransferFunction]:
-        from volviz.scene.drawn_tf import component_transfer_function
-
         return component_transfer_function(self.session, self.component(comp_id))
 
     def _drawn(self, comp: Component, tf: Any) -> Any:
         """``tf`` as the component is drawn with it (through log10 with its setting ``log_scale``)."""
-        from volviz.scene.drawn_tf import drawn_tf
-
         return tf if comp.dataset not in self.datasets else drawn_tf(comp, tf, self.dataset_of(comp.id))
 
     def set_transfer_function(self, comp_id: str, tf: TransferFunction, update: bool = True) -> None:
@@ -313,7 +308,6 @@ class SceneController:
             view.set_tf(self._drawn(comp, self.session.transfer_function(comp_id)), comp.opacity)
             if update:
                 view.update()
-        from volviz.render.decorations import update_legend
 
         update_legend(self.plotter, self.session, self.datasets)   # the scalar bar shows the new colors and range
 
@@ -326,8 +320,6 @@ class SceneController:
             self.session.set_visible(comp_id, visible)
 
     def _show_visible(self, comp_id: str, nature: bool, build: bool) -> None:
-        from volviz.scene.datasets import NATURE_TYPES
-
         comp = self.component(comp_id)
         visible = comp.visible
         if comp.type in NATURE_TYPES:  # the natural scene is one view of all its components
@@ -345,16 +337,11 @@ class SceneController:
 
     def needs_build(self, comp_id: str) -> bool:
         """Whether showing the component needs ``prepare_component`` / ``install_component`` (it has no view yet)."""
-        from volviz.scene.datasets import NATURE_TYPES
-
         return self.component(comp_id).type not in NATURE_TYPES and self.views.get(comp_id) is None
 
     def prepare_component(self, comp_id: str, progress: Optional[ProgressCallback] = None) -> PreparedScene:
         """Any thread: the heavy part of showing a non-nature component that was hidden at build time
         (``volviz.render.scene_builder.prepare_component`` at the display time). Touches no plotter."""
-        from volviz.jobs import report
-        from volviz.render.scene_builder import PreparedScene, ensure_transfer_functions, prepare_component
-
         ensure_transfer_functions(self.session, self.datasets)
         prepared = PreparedScene(time=self.time if self.time_series() else None)
         report(progress, 0.0, f"preparing {comp_id}")
@@ -366,8 +353,6 @@ class SceneController:
     def install_component(self, comp_id: str, prepared: PreparedScene, views: bool = True) -> Any:
         """GUI thread: add the view of a ``prepare_component`` result without rendering (a PT volume's image and a
         LOD volume's blocks are drawn now when ``views``; the app updates them in the background)."""
-        from volviz.render.scene_builder import install_component
-
         comp = self.component(comp_id)
         with no_render(self.plotter):
             view = install_component(self.plotter, self.session, comp, self.datasets, prepared, spectrum=True,
@@ -453,8 +438,6 @@ class SceneController:
 
     def time_volumes(self) -> list[str]:
         """The VTK volumes and surfaces shown from a time series (what a display-time change re-blends)."""
-        from volviz.render.vtk_scene import is_surface
-
         views = self._views_of("vtk")
         series = self.time_series()
         return [comp_id for comp_id in series if comp_id in views
@@ -466,8 +449,6 @@ class SceneController:
         """Any thread: the VTK input of a time-series volume or surface at display time ``t`` (the 4D blend of the
         neighbouring steps when interpolating, libMini note "4D Visualization"; ``scene_builder.time_input``);
         ``show_volumes`` puts it on screen."""
-        from volviz.render.scene_builder import time_input
-
         interpolate = self.interpolate_time if interpolate is None else bool(interpolate)
         return time_input(self.time_series()[comp_id], float(t), interpolate)
 
@@ -482,8 +463,6 @@ class SceneController:
                 view.set_input(data, self.clip)
                 changed = changed or view.bounds() != before
         if changed:
-            from volviz.render.decorations import update_outline
-
             update_outline(self.plotter, self.session, self.shown_props())
 
     def time_isosurfaces(self) -> list[str]:
@@ -496,8 +475,8 @@ class SceneController:
         """Any thread: the surfaces of an isosurface component at display time ``t`` (the 4D blend of the
         neighbouring steps when interpolating, libMini note "4D Visualization"), cut by the component's own
         clipping (``volviz.iso.prepare``); ``show_isosurfaces`` puts them on screen."""
+        # heavy: volviz.iso's Numba kernels and SciPy, loaded only when an isosurface is extracted
         from volviz.iso import IsoSettings, prepare
-        from volviz.scene.errors import SceneError
 
         comp = self.component(comp_id)
         settings_doc = dict(comp.settings)  # a snapshot: the GUI thread replaces (never mutates) comp.settings
@@ -512,8 +491,6 @@ class SceneController:
                          progress: Optional[ProgressCallback] = None) -> IsoParts:
         """Any thread: ``extract_isosurfaces`` cut by the scene's clipping, with their LOD chains
         (``volviz.scene.isosurfaces.IsoParts``), so that ``show_isosurfaces`` only makes actors."""
-        from volviz.scene.isosurfaces import isosurface_parts
-
         meshes = self.extract_isosurfaces(comp_id, t, interpolate, progress)
         return isosurface_parts(self.component(comp_id), meshes=meshes, clip=self.session.clip)
 
@@ -522,8 +499,6 @@ class SceneController:
         ``extract_isosurfaces``, or better the ``isosurface_parts``, whose clipping and LOD chains were made off this
         thread and are redone here only when the clipping or opacity changed since); the overlay's meshes follow
         (not re-rendered)."""
-        from volviz.scene.isosurfaces import IsoParts
-
         with no_render(self.plotter):  # no render per added actor: the caller draws once afterwards
             for comp_id, surfaces in meshes.items():
                 view = self.views.get(comp_id)
@@ -538,19 +513,12 @@ class SceneController:
 
     # -- camera -----------------------------------------------------------------------------------------------------
     def camera(self) -> CameraState:
-        from volviz.render.vtk_scene import camera_state
-
         return camera_state(self.plotter)
 
     def set_camera(self, camera: Optional[CameraState], update: bool = True) -> None:
         """Apply ``camera`` (None: frame the scene); re-run the view-dependent parts when ``update`` (the app runs
         them in the background instead)."""
-        from volviz.render.vtk_scene import apply_camera
-
         if camera is None:
-            from volviz.render.decorations import legend_margin
-            from volviz.render.framing import frame_scene
-
             frame_scene(self.plotter, self.shown_props(), right_margin=legend_margin(self.session, self.datasets))
         else:
             apply_camera(self.plotter, camera)
@@ -612,8 +580,6 @@ class SceneController:
         """Any thread: the CPU images and meshes of ``begin_views`` requests (NumPy/Numba; no VTK call on the
         calling thread: the iso overlay's volume in front of its surfaces renders on its own GL thread,
         ``volviz.render.gl_thread``): each view's ``compute`` (``volviz.render.views.View``)."""
-        from volviz.jobs import report
-
         results: list[Any] = []
         for i, (_, view, request) in enumerate(requests):
             report(progress, i / max(len(requests), 1), f"rendering view {i + 1} of {len(requests)}")
@@ -658,15 +624,11 @@ class SceneController:
 
     def prepare_nature(self, progress: Optional[ProgressCallback] = None) -> Optional[NatureScene]:
         """Any thread: the NatureScene of the visible terrain / fog / clouds / sky components (None: none)."""
-        from volviz.scene.nature import prepare_nature
-
         return prepare_nature(self.session, self.datasets)
 
     def install_nature(self, scene: Optional[NatureScene], views: bool = True) -> Any:
         """GUI thread: show a ``prepare_nature`` result. With ``views`` its first view is computed now; otherwise
         the old terrain and overlay stay on screen until the new view's first ``finish_nature`` replaces them."""
-        from volviz.render.scene_builder import install_nature, view_backend
-
         old = self.views.pop("nature", None)
         backend = view_backend(self.plotter, self.session, "nature")
         if old is not None and "gpu" in (old.backend, backend):
@@ -692,8 +654,6 @@ class SceneController:
         """(xmin, xmax, ymin, ymax, zmin, zmax) of everything the visible components show, including what VTK does
         not see (PT volumes, isosurfaces drawn by a CPU mode, the natural scene's terrain and clouds; not the sky
         dome around the eye); uncut extents."""
-        from volviz.render.framing import union
-
         visible = {c.id for c in self.session.components if c.visible}
         boxes = [view.bounds() for comp_id, view in self.views.items() if comp_id == "nature" or comp_id in visible]
         return union([box for box in boxes if box is not None]) or (-1.0, 1.0, -1.0, 1.0, -1.0, 1.0)
@@ -744,7 +704,6 @@ class SceneController:
         if view is not None:
             view.show_cut(cut, self.component(comp_id).visible)
             self._sync_iso_overlay()
-            from volviz.render.decorations import update_outline
 
             update_outline(self.plotter, self.session, self.shown_props())
 
@@ -786,9 +745,6 @@ class SceneController:
         (``volviz.render.iso_volume_split``; the GPU passes are blended before VTK's volume pass, so the whole volume
         would lie over them), and exact mode on the GPU only where the renderer can peel the surfaces with the volume
         (no render pass of its own: ``volviz.render.gl_iso``)."""
-        from volviz.render.scene_builder import view_backend
-        from volviz.render.volume_peeling import regular_volumes
-
         backend = view_backend(self.plotter, self.session, "iso")
         if regular_volumes([p for p in self.shown_props().values() if hasattr(p, "IsA")]):
             peels = self.iso_mode == "exact" and self.plotter.renderer.GetPass() is None
@@ -803,8 +759,6 @@ class SceneController:
             view.remove()
             view = self.iso_view = None
         if view is None and mode != "vtk" and self._iso_props():
-            from volviz.render.views import view_class
-
             view = self.iso_view = view_class("iso", backend)(self.plotter, mode=mode)
         if view is not None:
             view.mode = mode
@@ -847,8 +801,6 @@ class SceneController:
         """In "vtk" mode (and the GPU's exact mode) translucent isosurfaces inside a regular volume are depth-peeled
         with it, so the volume behind a surface, the surface and the volume in front composite in that order
         (``volviz.render.volume_peeling``); the app's window, ``volviz render`` and exports alike."""
-        from volviz.render.volume_peeling import peel_volumes
-
         shown = self.shown_props()
         translucent = self.iso_view is None and any(
             prop.GetVisibility() and any(a.GetVisibility() for a in prop.volviz_translucent)

@@ -7,7 +7,15 @@ from typing import TYPE_CHECKING, Any, Optional, Sequence
 
 import numpy as np
 
+from volviz.model.arrays import MAGNITUDE, default_array, is_appearance_array, parse_array_spec
 from volviz.model.settings import ScalarBarStyle, array_key, validated
+from volviz.optics.log_scale import log_mapped, log_ticks
+from volviz.render.framing import scene_bounds
+from volviz.render.vtk_scene import is_surface
+from volviz.render.vtk_tf import tf_to_vtk
+from volviz.scene.datasets import component_dataset
+from volviz.scene.drawn_tf import log_floor, uses_log_scale
+from volviz.scene.errors import SceneError
 from volviz.session import Session
 
 if TYPE_CHECKING:   # type-only: PyVista's mesh class, imported where an outline is made
@@ -71,8 +79,6 @@ def update_outline(plotter: Any, session: Session, props: dict[str, Any]) -> Non
     """Redraw only the outline box around ``props`` (data that moved: the scalar bar and axes stay as they are)."""
     plotter.remove_actor(OUTLINE_NAME, render=False)
     if decoration_enabled(session, "outline"):
-        from volviz.render.framing import scene_bounds
-
         data = {k: p for k, p in props.items() if k != "nature"}   # a landscape needs no box around it
         bounds = scene_bounds(data)
         if bounds is not None:
@@ -85,6 +91,7 @@ def update_outline(plotter: Any, session: Session, props: dict[str, Any]) -> Non
 def outline_box(bounds: Sequence[float]) -> pv.PolyData:
     """The 12 edges of the box ``bounds`` (xmin, xmax, ymin, ymax, zmin, zmax) as a float64 ``pyvista.PolyData``:
     ``pv.Box(...).outline()`` made float32 points, up to 0.5 m off at UTM coordinates (y = 7e6)."""
+    # heavy: PyVista (about 180 modules), loaded only when an outline is drawn
     import pyvista as pv
 
     b = np.asarray(bounds, dtype=np.float64).reshape(3, 2)
@@ -150,19 +157,14 @@ def _bar_scale(session: Session, comp: Any, datasets: dict[str, Any]) -> tuple[A
     """The scalar bar's color function, label values, label format and whether it is logarithmic: the component's
     transfer function (through log10 with ``log_scale``: log ticks from the smallest positive value) over the edited
     range, else over the function's own."""
-    from volviz.optics.log_scale import log_mapped, log_ticks
-    from volviz.scene.drawn_tf import log_floor, uses_log_scale
+    # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
     from volviz.render.vtk_facade import vtk
-    from volviz.render.vtk_tf import tf_to_vtk
 
     style = scalar_bar_style(session)
     tf = session.transfer_functions[comp.transfer_function]
     lo, hi = style.range or tf.range
     log = False
     if uses_log_scale(comp):
-        from volviz.scene.datasets import component_dataset
-        from volviz.scene.errors import SceneError
-
         try:
             floor = log_floor(tf, component_dataset(comp, datasets))
         except (SceneError, KeyError):
@@ -187,6 +189,7 @@ def _bar_scale(session: Session, comp: Any, datasets: dict[str, Any]) -> tuple[A
 
 def _add_scalar_bar(plotter: Any, session: Session, comp: Any, datasets: dict[str, Any],
                     color: tuple[float, float, float]) -> None:
+    # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
     from volviz.render.vtk_facade import numpy_to_vtk, vtk
 
     ctf, labels, fmt, log = _bar_scale(session, comp, datasets)
@@ -231,8 +234,6 @@ def _shows_array(comp: Any, datasets: dict[str, Any]) -> bool:
     vertex colors (``vtk_scene.surface_input``): no scale to explain either way."""
     if comp.type != "volume":
         return True
-    from volviz.model.arrays import default_array, is_appearance_array, parse_array_spec
-    from volviz.render.vtk_scene import is_surface
 
     dataset = datasets.get(comp.dataset)
     if dataset is None or not is_surface(dataset):
@@ -251,8 +252,6 @@ def _array_title(comp: Any, datasets: dict[str, Any]) -> str:
     shown = comp.settings.get(array_key(comp.type))
     if shown:
         return _readable(str(shown))
-    from volviz.scene.datasets import component_dataset
-    from volviz.scene.errors import SceneError
 
     try:
         shown = component_dataset(comp, datasets)
@@ -265,8 +264,6 @@ def _array_title(comp: Any, datasets: dict[str, Any]) -> str:
 
 def _readable(spec: str) -> str:
     """An array spec as a legend title: ``V:magnitude`` -> ``V (magnitude)``, ``V:1`` -> ``V[1]``."""
-    from volviz.model.arrays import MAGNITUDE, parse_array_spec
-
     parsed = parse_array_spec(spec)
     if parsed.component == MAGNITUDE:
         return f"{parsed.name} (magnitude)"

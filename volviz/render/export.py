@@ -7,25 +7,35 @@ this machine's memory is an ``ExportError`` naming the output, never a temporary
 """
 from __future__ import annotations
 
+import importlib.util
 import io
 import math
 import os
 from contextlib import contextmanager
+from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Iterator, Optional, Sequence
 
 import numpy as np
+from PIL import Image
 
 from volviz.argtypes import MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE, MAX_MOVIE_FRAMES
-from volviz.jobs import ProgressCallback, report
 from volviz.io.atomic import OutputPathError, atomic_write_bytes, check_output_path, remove_stale_temporaries, temp_name
+from volviz.jobs import ProgressCallback, report
+from volviz.model.camera import Camera
+from volviz.model.settings import array_key
+from volviz.render.camera_path import frame_times, interpolate_path
+from volviz.render.controller import SceneController
 from volviz.render.offscreen import offscreen_plotter
-from volviz.session import Session
+from volviz.scene.datasets import load_datasets
+from volviz.scene.demo import demo_session, demo_volume_session
+from volviz.scene.errors import SceneError
+from volviz.scene.opening import data_session
+from volviz.session import Session, load
 
 if TYPE_CHECKING:   # type-only imports for the signatures
     import pyvista as pv
 
-    from volviz.render.controller import SceneController
     from volviz.scene.datasets import LoadedDataset
     from volviz.session import CameraState
 
@@ -49,8 +59,6 @@ def output_kind(path: str | os.PathLike, movie: bool = False) -> str:
     suffix = p.suffix.lower()
     if movie:
         if suffix in MOVIE_FORMATS:
-            import importlib.util
-
             if importlib.util.find_spec("imageio_ffmpeg") is None:
                 raise ExportError(f"{p}: writing {suffix} movies needs imageio-ffmpeg, which is not installed: pip "
                                   "install 'volviz[movies]' (or give a folder to receive PNG frames)")
@@ -95,8 +103,6 @@ def check_image_size(size: tuple[int, int]) -> None:
 
 def encode_image(image: np.ndarray, image_format: str = "PNG") -> bytes:
     """An (H, W, 3|4) uint8 image encoded as ``image_format`` (PNG, JPEG at quality 95, or deflated TIFF)."""
-    from PIL import Image
-
     picture = Image.fromarray(np.ascontiguousarray(image))
     options: dict[str, Any] = {}
     if image_format == "JPEG":
@@ -143,8 +149,6 @@ def offscreen_scene(session: Session, datasets: dict[str, LoadedDataset],
     """An offscreen plotter of ``size`` and a ``SceneController`` of ``session`` over it, not built yet: ``build()``
     here, or (the app) ``prepare`` on a worker, ``install(views=False)``, then ``begin_views`` / ``compute_views`` /
     ``finish_views``, and ``snapshot``. The caller ends it with ``close_scene``."""
-    from volviz.render.controller import SceneController
-
     plotter = offscreen_plotter(size)
     return plotter, SceneController(plotter, session, datasets)
 
@@ -222,8 +226,6 @@ def render_session(session: Session, session_file: Optional[str | os.PathLike], 
                    datasets: Optional[dict[str, LoadedDataset]] = None, transparent: bool = False) -> np.ndarray:
     """Render a session offscreen (its datasets read now unless given); returns the (H, W, 3) uint8 image, or with
     ``transparent`` the (H, W, 4) straight-alpha one without the background (``snapshot``)."""
-    from volviz.scene.datasets import load_datasets
-
     datasets = load_datasets(session, session_file, progress, loaded=datasets)
     report(progress, 0.8, "rendering")
     plotter, controller = offscreen_scene(session, datasets, size)
@@ -242,11 +244,6 @@ def open_target(target: str | os.PathLike, array: Optional[str] = None, q: Optio
     file shown with the array spec ``array`` (``volviz.model.arrays``), the PLOT3D solution file ``q`` and the
     options of its reader (``dataset=`` of an HDF5 file ...), kept in the session's dataset. A member of a numbered
     series opens the whole series at that member's time step (``data_session``)."""
-    from volviz.model.settings import array_key
-    from volviz.scene.demo import demo_session, demo_volume_session
-    from volviz.scene.opening import data_session
-    from volviz.session import load
-
     if str(target) in ("demo", "demo-volume"):
         return (demo_session() if str(target) == "demo" else demo_volume_session()), None
     path = Path(target)
@@ -295,8 +292,6 @@ def is_session_file(path: Path) -> bool:
 def orbit_cameras(camera: CameraState, n: int, turns: float = 1.0) -> list[CameraState]:
     """``n`` cameras evenly spaced over ``turns`` full turns of ``camera`` around its view-up axis through the focal
     point (the last frame stops one step short of the first, so the movie loops)."""
-    from dataclasses import replace
-
     focal = np.asarray(camera.focal_point, dtype=np.float64)
     axis = np.asarray(camera.view_up, dtype=np.float64)
     axis = axis / (np.linalg.norm(axis) or 1.0)
@@ -317,14 +312,10 @@ def movie_frames(controller: SceneController, path_name: Optional[str], fps: flo
     """(camera, display time) for every frame: along a recorded camera path or an orbit of the current camera
     (one turn over ``duration``, default 8 s), through the time series, or both. ExportError past
     ``MAX_MOVIE_FRAMES``."""
-    from volviz.render.camera_path import frame_times, interpolate_path
-
     session = controller.session
     cameras: Sequence[Optional[CameraState]] = [None]
     if path_name is not None:
         if path_name not in session.camera_paths:
-            from volviz.scene.errors import SceneError
-
             known = ", ".join(sorted(session.camera_paths)) or "none"
             raise SceneError(f"the session has no camera path named {path_name!r} (it has: {known})")
         keys = session.camera_paths[path_name]
@@ -354,8 +345,6 @@ def frame_count(fps: float, seconds: float) -> int:
 def _prefetch_sorts(controller: Any, camera: Any, size: tuple[int, int]) -> None:
     """Start sorting every visible PT volume (either backend) for the next frame's camera while this frame renders
     (``volviz.unstructured.prefetch``)."""
-    from volviz.model.camera import Camera
-
     cam = Camera(camera.position, camera.focal_point, camera.view_up, camera.view_angle, camera.parallel,
                  camera.parallel_scale)
     for comp_id in list(controller.props):
@@ -372,8 +361,6 @@ def render_movie(session: Session, session_file: Optional[str | os.PathLike], ou
     """Render a movie offscreen (``movie_frames``): MP4/MOV (H.264 through imageio-ffmpeg) for ``.mp4``, ``.m4v``
     and ``.mov``, else a PNG sequence in the folder ``out`` (frame_00000.png, ...). The output and the size are
     checked first; the MP4 is written to a temporary file and renamed when complete."""
-    from volviz.scene.datasets import load_datasets
-
     check_output(out, movie=True)
     check_image_size(size)
     datasets = load_datasets(session, session_file, loaded=datasets)
@@ -448,6 +435,7 @@ class MovieWriter:
     def _start(self, width: int, height: int) -> Any:
         """The ffmpeg process writing H.264 into the temporary file (its container named, as the temporary's name
         has no extension)."""
+        # optional: imageio-ffmpeg (volviz[movies]), needed only to write a movie
         import imageio_ffmpeg
 
         writer = imageio_ffmpeg.write_frames(str(self.tmp), (width, height), fps=self.fps, codec="libx264",

@@ -19,9 +19,10 @@ from typing import Any
 
 import numpy as np
 
-from volviz.nature.fog import FogLayer, layer_emission
-from volviz.render.gl import ScenePass, color_target, glenum, release, set_ray_uniforms, shader_source
 from volviz.model.camera import Camera
+from volviz.nature.fog import FogLayer, layer_emission
+from volviz.render._prism_kernels import kept_connectivity, layer_buffer
+from volviz.render.gl import ScenePass, color_target, glenum, release, set_ray_uniforms, shader_source
 
 __all__ = ["GLFogLayer", "PrismBuffers", "add_fog_layer", "layer_values", "prism_buffers"]
 
@@ -35,8 +36,6 @@ def layer_values(points: np.ndarray, bottom: np.ndarray, top: np.ndarray, emissi
     as float32 (n + 2, 3) (x, y; z the bottom height; then the box's two corners, in no triangle, so that VTK's
     bounds hold the whole layer), the four per-point values as float32 (n + 2, 4) (bottom and top height relative
     to the centre, bottom and top emission; 0 at the corners) and the box relative to the centre (3, 2)."""
-    from volviz.render._prism_kernels import layer_buffer
-
     pts = np.ascontiguousarray(points, dtype=np.float64)
     zb, zt, eb, et = (np.ascontiguousarray(a, dtype=np.float64) for a in (bottom, top, emission_bottom, emission_top))
     lo, hi, rel, values = layer_buffer(pts, zb, zt, eb, et)
@@ -73,8 +72,6 @@ def prism_buffers(points: np.ndarray, bottom: np.ndarray, top: np.ndarray, trian
     (``fog_prism_gs.glsl``). Triangles whose prism has no area, no thickness or all six emissions <= 0 are left out
     here (``_prism_kernels.kept_connectivity``, the shader's own test, which it also applies), as the CPU PCP leaves
     them out: ``drawn`` prisms, 3 indices each in ``connectivity``."""
-    from volviz.render._prism_kernels import kept_connectivity
-
     points, bottom, top = (np.asarray(a, dtype=np.float64) for a in (points, bottom, top))
     eb, et = layer_emission(bottom, top, layer, emission)
     centre, rel, values, bounds = layer_values(points, bottom, top, eb, et)
@@ -89,6 +86,7 @@ def _resolve_polydata(bounds: np.ndarray) -> Any:
     """The resolve's geometry: the 8 corners of ``bounds`` (3, 2) in the actor's bounds (for VTK's culling) and one
     triangle whose ``fogCorner`` attribute covers the viewport in normalised device coordinates (the other corners'
     is (0, 0): the bounds' zero-area triangle stays one)."""
+    # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
     from volviz.render.vtk_facade import box_corners_polydata, numpy_to_vtk
 
     pd = box_corners_polydata(bounds, [(0, 1, 2)])
@@ -111,6 +109,7 @@ class GLFogLayer:
     def __init__(self, plotter: Any, points: np.ndarray, bottom: np.ndarray, top: np.ndarray,
                  triangles: np.ndarray, layer: FogLayer, emission: tuple[np.ndarray, np.ndarray] | None = None,
                  buffers: PrismBuffers | None = None) -> None:
+        # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
         from volviz.render.vtk_facade import shader_observer, vtk
 
         self.plotter = plotter
@@ -160,6 +159,7 @@ class GLFogLayer:
     # --- set-up --------------------------------------------------------------------------------------------------
     @staticmethod
     def _translucent_actor(mapper: Any, vs: str, fs: str, gs: str | None = None) -> Any:
+        # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
         from volviz.render.vtk_facade import premultiplied_texture, vtk
 
         sp = vtk.vtkShaderProperty()
@@ -182,6 +182,7 @@ class GLFogLayer:
         """GUI thread: show a ``prism_buffers`` result (made for this layer's optics, e.g. on a worker for the next
         frame's C-LOD triangles): the prisms' and the resolve's poly data to the mappers, uploaded at the next
         render."""
+        # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
         from volviz.render.vtk_facade import shared_polydata
 
         pd = shared_polydata(buffers.points, buffers.attributes, buffers.connectivity)

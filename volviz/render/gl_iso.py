@@ -62,6 +62,7 @@ def iso_polydata(meshes: Sequence[IsoMesh], centre: np.ndarray, shading: str = "
     """One vtkPolyData of ``meshes`` in their order: points relative to ``centre`` (float32), triangles wound as
     ``_oriented_triangles``, and per-vertex attributes ``isoNormal`` (unit normal), ``isoStyle`` (color, opacity)
     and ``isoFit`` (the iso-spectrum (a, b) of translucent surfaces with ``shading="spectrum"``, else (0, 0))."""
+    # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
     from volviz.render.vtk_facade import numpy_to_vtk, vtk
 
     pts, tris = [], []
@@ -108,6 +109,7 @@ class GLIsoSurfaces:
 
     def __init__(self, plotter: Any, meshes: Sequence[IsoMesh], mode: str = "3pass", shading: str = "spectrum",
                  lighting: bool = True, peels: int = 64, peel_with_volumes: bool = True) -> None:
+        # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
         from volviz.render.vtk_facade import vtk
 
         if shading not in ("spectrum", "flat"):
@@ -149,6 +151,7 @@ class GLIsoSurfaces:
     # --- set-up --------------------------------------------------------------------------------------------------
     def _add(self, kind: int, pd: Any, renderer: Any = None) -> Any:
         """An actor of ``pd`` drawing the pass ``kind``, added to ``renderer`` (default: the plotter's)."""
+        # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
         from volviz.render.vtk_facade import premultiplied_texture, shader_observer, vtk
 
         mapper = vtk.vtkOpenGLPolyDataMapper()
@@ -207,6 +210,7 @@ class GLIsoSurfaces:
     def _bind_back_target(self, state: Any) -> None:
         """Bind (making it at the renderer's size when needed) the framebuffer with a float depth texture into which
         the back faces are drawn with depth writes on; its depth is cleared to the far plane."""
+        # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
         from volviz.render.vtk_facade import vtk
 
         ren_win = self.renderer.GetRenderWindow()
@@ -334,6 +338,7 @@ class GLIsoView(IsoModeView):
 
     def __init__(self, plotter: Any, meshes: Sequence[IsoMesh] = (), mode: str = "3pass",
                  shading: str = "spectrum") -> None:
+        # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
         from volviz.render.vtk_facade import vtk
 
         self.plotter = plotter

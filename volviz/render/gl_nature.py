@@ -57,11 +57,13 @@ from volviz.model.datasets import TetMesh
 from volviz.nature.clouds import CloudFrame, CloudLOD, CloudShading, CloudVolume
 from volviz.nature.nature_scene import NatureScene
 from volviz.numba_threads import numba_threads, share
-from volviz.render.nature_view import NatureView
-from volviz.render.gl_fog import GLFogLayer, prism_buffers
+from volviz.render.cloud_slots import RESERVED, LeafSlots, leaf_keys
 from volviz.render.gl import release, resolve_polydata, shader_source, texel_array
+from volviz.render.gl_fog import GLFogLayer, prism_buffers
 from volviz.render.gl_pt import GLPTVolume
 from volviz.render.image_overlay import hold_single_sample, release_single_sample
+from volviz.render.nature_view import NatureView
+from volviz.unstructured.topology import visible_intervals
 
 __all__ = ["CloudLeaves", "CloudPTVolume", "GLNatureView", "cloud_field_texels", "cloud_leaves",
            "modulation_scale"]
@@ -122,8 +124,6 @@ class CloudLeaves:
 
 def cloud_leaves(frame: CloudFrame) -> CloudLeaves:
     """Any thread: a frame's leaves (``CloudLOD.update(..., morph=False)``: the GPU morphs them) with their keys."""
-    from volviz.render.cloud_slots import leaf_keys
-
     lod = frame.lod
     vol = lod.volume
     origin = np.asarray(vol.origin, np.float64)
@@ -139,8 +139,6 @@ def _visible_intervals(tf: Any) -> list[tuple[float, float]]:
     """The table field's intervals where the TF has extinction (``visible_intervals``), at most
     ``_VISIBLE_INTERVALS``: past that, the neighbours nearest each other are joined (a superset: leaves in the gaps
     are drawn and add nothing)."""
-    from volviz.unstructured.topology import visible_intervals
-
     merged = visible_intervals(tf.scalars, tf.extinction)
     while len(merged) > _VISIBLE_INTERVALS:
         gap = int(np.argmin([merged[i + 1][0] - merged[i][1] for i in range(len(merged) - 1)]))
@@ -175,7 +173,7 @@ class CloudPTVolume(GLPTVolume):
 
     def __init__(self, plotter: Any, leaves: CloudLeaves, lod: CloudLOD, shading: CloudShading, table: Any
                  ) -> None:
-        from volviz.render.cloud_slots import LeafSlots
+        # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
         from volviz.render.vtk_facade import vtk
 
         if lod.levels > _MAX_LEVELS:
@@ -214,7 +212,7 @@ class CloudPTVolume(GLPTVolume):
     def set_frame(self, leaves: CloudLeaves) -> None:
         """GUI thread: the next frame's leaves (back to front): their slots (the new ones' texels uploaded at the
         next render, ``last_update``), drawn in this order for every camera, with the same table."""
-        from volviz.render.cloud_slots import RESERVED
+        # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
         from volviz.render.vtk_facade import shared_polydata
 
         update = self.slots.place(leaves.leaves, leaves.keys)
@@ -242,6 +240,7 @@ class CloudPTVolume(GLPTVolume):
     def _set_index_buffer(self, order: np.ndarray, visible: np.ndarray) -> np.ndarray:
         """Draw the slots of ``order`` with ``visible[slot]`` in this order from the next render on, one point each
         (32-bit indices shared with VTK, kept referenced here); returns them."""
+        # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
         from volviz.render.vtk_facade import numpy_to_vtk, vtk
 
         cells = order[visible[order]]
@@ -262,6 +261,7 @@ class CloudPTVolume(GLPTVolume):
     def _upload(self, ren_win: Any) -> None:
         """What changed since the last render: the grid's fields (once), the refinement thresholds (when C, c or
         the cutoff changed) and the slot updates in order (a region each, or the whole array after a compaction)."""
+        # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
         from volviz.render.vtk_facade import vtk
 
         if self._fields is not None:

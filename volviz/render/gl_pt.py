@@ -34,6 +34,7 @@ from volviz.render.pt_view import PTView
 from volviz.render.reduced_fill import INTERACTIVE_PIXELS, reduced_size, scaled_rays
 from volviz.unstructured.index_buffer import IndexBuffer, fill_cells
 from volviz.unstructured.iso import iso_visible
+from volviz.unstructured.render import Preclassified, auto_lookup, table_for, table_size
 from volviz.unstructured.topology import topology, visible_cells
 
 if TYPE_CHECKING:   # type-only: the session's clipping model
@@ -74,6 +75,7 @@ class GLPTVolume(CellOrder, PTView):
                  n_l: int = 64, degree: int | None = None, sort: str = "mpvo", nonconvex: str = "auto",
                  iso: Any = None, iso_shading: str = "flat", classification: str = "post",
                  keep_multisampling: bool = False, order_texture: bool | None = None) -> None:
+        # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
         from volviz.render.vtk_facade import numpy_to_vtk, premultiplied_texture, shader_observer, vtk
 
         if not isinstance(mesh, TetMesh):
@@ -199,6 +201,7 @@ class GLPTVolume(CellOrder, PTView):
         on; returns them. The cull and the 32-bit triangles are one Numba pass into arrays kept between frames
         (``volviz.unstructured.index_buffer``) and shared with VTK, which builds and uploads the index buffer from
         them; they are refilled only here, between renders."""
+        # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
         from volviz.render.vtk_facade import numpy_to_vtk
 
         if self.order_texture:                       # the order texture's cells, uploaded as the program is bound
@@ -239,8 +242,6 @@ class GLPTVolume(CellOrder, PTView):
 
     def _resolved_lookup(self) -> tuple[str, int | None]:
         """(lookup, degree) with "auto" decided as the CPU ``pt`` does, by the TF's largest optical depth per cell."""
-        from volviz.unstructured.render import auto_lookup
-
         if self.lookup != "auto":
             return self.lookup, self.degree
         lookup, auto_degree = auto_lookup(self.tf.max_extinction * max(self.topo.max_edge, 1e-12))
@@ -257,8 +258,6 @@ class GLPTVolume(CellOrder, PTView):
                 pt_shader("pt_tet_fs.glsl", self.iso is not None and self.iso_shading == "smooth", *self._kind))
 
     def _build_table(self) -> Any:
-        from volviz.unstructured.render import Preclassified, table_for, table_size
-
         if self.iso is not None:
             return self.iso
         if self.classification == "pre":

@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from volviz.model.datasets import TetMesh
+from volviz.unstructured.iso import vertex_normals
 from volviz.unstructured.topology import cell_ranges, topology
 
 if TYPE_CHECKING:   # type-only: VTK's classes, reached through the facade at run time
@@ -39,8 +40,6 @@ def cell_attributes(mesh: TetMesh, smooth: bool = False) -> dict[str, np.ndarray
     out["ptScalar"] = np.concatenate([g, c[:, None]], axis=1)
     out["ptRange"] = np.stack([r.smin, r.smax, np.zeros_like(r.smin), np.zeros_like(r.smin)], axis=1)
     if smooth:
-        from volviz.unstructured.iso import vertex_normals
-
         normals = vertex_normals(mesh)[topo.tets]                     # (m, 4, 3)
         for axis, name in enumerate("XYZ"):
             out[f"ptNormal{name}"] = normals[..., axis]
@@ -68,6 +67,7 @@ def tet_polydata(mesh: TetMesh, smooth: bool = False, attributes: bool = True) -
     """The static vertex buffer as vtkPolyData: 4 points per tetrahedron (relative to the centre) with the cell
     attributes repeated at each (unless ``attributes`` is False: the order texture's layout reads them from
     ``cell_texels``), and no cells yet (the order sets them)."""
+    # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
     from volviz.render.vtk_facade import numpy_to_vtk, vtk
 
     topo = topology(mesh)

@@ -69,6 +69,7 @@ class CellOrder:
         """Before a render for ``cam`` at ``size``: the back-to-front index buffer for this camera (unchanged cameras
         keep theirs; a prefetched order for this camera is taken; with ``reuse_order`` the last order is kept for any
         camera, but never one older than the previous frame's camera: ``_follow``)."""
+        # heavy: the sort's Numba kernels and SciPy, loaded only when a PT order is computed
         from volviz.unstructured.sort import visibility_order
 
         key = order_key(cam, size)
@@ -109,6 +110,7 @@ class CellOrder:
 
     def _sorter(self) -> Any:
         """The background sorter (``volviz.unstructured.prefetch.SortPrefetcher``), made at its first use."""
+        # heavy: the sort's Numba kernels and SciPy (through the prefetcher), only when sorting ahead
         from volviz.unstructured.prefetch import SortPrefetcher
 
         if self._prefetcher is None:
@@ -146,6 +148,7 @@ class CellOrder:
     def compute(self, request: dict[str, Any], progress: Any = None) -> tuple[Any]:
         """Any thread: the visibility order for ``begin``'s camera (``volviz.unstructured.sort``); None when the
         volume has it already (e.g. a transfer-function edit asked for a new image)."""
+        # heavy: the sort's Numba kernels and SciPy, loaded only when a PT order is computed
         from volviz.unstructured.sort import visibility_order
 
         if request["have"]:

@@ -71,6 +71,7 @@ class PTTargets:
         of each pixel when the window is multisampled) into the volume's depth texture (then, for a frame drawn
         smaller, the nearest sample of it into the ``drawn``-size one), then bind and clear the color target for the
         cells (and set the viewport to ``drawn``). Returns the depth texture the cells read."""
+        # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
         from volviz.render.vtk_facade import vtk
 
         state = self.renderer.GetRenderWindow().GetState()

@@ -68,6 +68,7 @@ class GLThread:
 
 def _window() -> tuple[vtkRenderWindow, vtkRenderer]:
     """An offscreen, single-sampled render window with alpha planes and one renderer."""
+    # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
     from volviz.render.vtk_facade import vtk
 
     window = vtk.vtkRenderWindow()

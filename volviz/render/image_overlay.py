@@ -41,6 +41,7 @@ from typing import Any
 
 import numpy as np
 
+from volviz.model.camera import Camera
 from volviz.render.backend import plotter_gl_info
 
 __all__ = ["ImageOverlay", "OverlayRequest", "OverlayView", "block_min", "overlay_rgba8", "read_buffers",
@@ -80,7 +81,7 @@ def overlay_rgba8(image: np.ndarray, request: dict[str, Any] | None = None) -> n
     a preview of ``request`` (``OverlayView.begin`` with ``scale`` > 1) magnified to the window first
     (``preview_upsample``). Made on a worker where possible (``PTVolume.compute``)."""
     if request is not None and request.get("preview") and ("window_depth" in request or "_read_back" in request):
-        from volviz.render.preview_upsample import upsample_preview   # Numba: loaded by a moving camera's preview
+        from volviz.render.preview_upsample import upsample_preview  # Numba: loaded by a moving camera's preview
 
         image = upsample_preview(image, request["depth"], request["window_depth"])
     return unpremultiply_rgba8(image)
@@ -99,7 +100,8 @@ def unpremultiply_rgba8(image: np.ndarray) -> np.ndarray:
 
 def read_buffers(ren_win: Any, w: int, h: int) -> tuple[np.ndarray, np.ndarray]:
     """(z (H, W) float64, rgb (H, W, 3) uint8) of the render window, row 0 at the top."""
-    from volviz.render.vtk_facade import vtk_to_numpy, vtk
+    # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
+    from volviz.render.vtk_facade import vtk, vtk_to_numpy
 
     z = vtk.vtkFloatArray()
     ren_win.GetZbufferData(0, 0, w - 1, h - 1, z)
@@ -163,6 +165,7 @@ class ImageOverlay:
     """One full-window image over a plotter's scene (see the module docstring). Starts hidden."""
 
     def __init__(self, plotter: Any) -> None:
+        # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
         from volviz.render.vtk_facade import vtk
 
         self.plotter = plotter
@@ -202,6 +205,7 @@ class ImageOverlay:
         """Upload straight-alpha RGBA8 (H, W, 4), row 0 at the top, and redraw the window unless ``render`` is False
         or the plotter's rendering is suppressed. The image fills the window whatever its size (pixel blocks where
         it is smaller: a preview is magnified by ``overlay_rgba8`` before)."""
+        # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
         from volviz.render.vtk_facade import numpy_to_vtk
 
         h, w = rgba8.shape[:2]
@@ -297,8 +301,6 @@ class OverlayView:
         limit of each preview pixel the nearest opaque depth under it (``block_min``), the scene color at its
         first pixel and the window's own depth (``window_depth``, for ``upsample_preview``); only the read-back is
         done here, the rest where the request is first used (``OverlayRequest``)."""
-        from volviz.model.camera import Camera
-
         t_start = time.perf_counter()
         w, h = (int(v) for v in self.plotter.ren_win.GetSize())
         z, rgb = self._overlay.opaque_buffers((w, h))

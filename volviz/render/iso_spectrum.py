@@ -61,6 +61,7 @@ def iso_actor(mesh: IsoMesh, parallel: bool = False, spectrum: bool = True) -> v
     blends them unsorted (the note's 2-pass mode). The accurate modes are the CPU compositor's
     (``volviz.iso.composite``); opaque surfaces are plain opaque actors.
     """
+    # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
     from volviz.render.vtk_facade import vtk
 
     mapper = vtk.vtkOpenGLPolyDataMapper()

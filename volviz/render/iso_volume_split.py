@@ -33,6 +33,7 @@ from typing import TYPE_CHECKING, Any, Sequence
 
 import numpy as np
 
+from volviz.render.gl_thread import GLThread
 from volviz.render.volume_peeling import regular_volumes
 
 if TYPE_CHECKING:   # type-only imports for the signatures
@@ -56,6 +57,7 @@ def shown_regular_volumes(renderer: vtkRenderer) -> list[vtkVolume]:
 
 def _occluder(meshes: Sequence[IsoMesh]) -> vtkActor:
     """One opaque actor of ``meshes`` that writes depth and the colour (0, 0, 0, 0)."""
+    # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
     from volviz.render.vtk_facade import vtk
 
     append = vtk.vtkAppendPolyData()
@@ -113,6 +115,7 @@ _MAPPER_SETTINGS = ("RequestedRenderMode", "BlendMode", "InterpolationMode", "Sa
 
 def _copy_planes(mapper: Any) -> list[Any]:
     """Copies of ``mapper``'s clipping planes."""
+    # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
     from volviz.render.vtk_facade import vtk
 
     planes = mapper.GetClippingPlanes()
@@ -133,13 +136,12 @@ class FrontVolume:
     (``docs/bench/iso_split_off_gui_thread.md``). ``close`` ends the thread."""
 
     def __init__(self) -> None:
-        from volviz.render.gl_thread import GLThread
-
         self.gl = GLThread("volviz-front-volume")
 
     def snapshot(self, plotter: pv.BasePlotter, meshes: Sequence[IsoMesh]) -> FrontScene | None:
         """GUI thread: what ``render`` needs of ``plotter``'s scene now; None when it shows no regular volume or
         ``meshes`` (the translucent surfaces) no triangle."""
+        # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
         from volviz.render.vtk_facade import vtk
 
         ren = plotter.renderer
@@ -179,6 +181,7 @@ class FrontVolume:
 def _draw(ren: vtkRenderer, state: dict[str, Any], scene: FrontScene) -> np.ndarray:
     """On the window's thread: bring ``ren`` to ``scene`` (the volumes made or updated, the occluder of the surfaces,
     the camera and lights), render and read back."""
+    # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
     from volviz.render.vtk_facade import vtk, vtk_to_numpy
 
     kept: dict[int, Any] = state.setdefault("volumes", {})

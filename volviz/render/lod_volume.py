@@ -43,18 +43,21 @@ from typing import TYPE_CHECKING, Any, Optional, TypedDict, Union
 import numpy as np
 
 from volviz.model import vec3
+from volviz.model.camera import Camera
 from volviz.regular.lod import Block, LodCamera, LodTree, Selection
-from volviz.render.vtk_scene import update_volume_property, vtk_volume_property
+from volviz.regular.raycast import STEP, pack_blocks, render_blocks, segment_table
+from volviz.render.clipping import clip_vtk_prop
 from volviz.render.image_overlay import ImageOverlay, unpremultiply_rgba8, zbuffer_to_depth
+from volviz.render.vtk_scene import update_volume_property, vtk_volume_property
 from volviz.scene.lod import lod_bounds
 
 if TYPE_CHECKING:   # type-only imports for the signatures
     import pyvista as pv
-    from volviz.render.vtk_facade import vtkCamera
 
     from volviz.jobs import ProgressCallback
     from volviz.model.clip import ClipSettings
     from volviz.optics.transfer_function import TransferFunction
+    from volviz.render.vtk_facade import vtkCamera
 
 RENDERERS = ("volviz", "vtk")
 
@@ -80,6 +83,7 @@ def lod_camera(vtk_camera: Union[pv.Camera, vtkCamera], size: tuple[int, int]) -
 
 def _image(block: Block) -> Any:
     """A vtkImageData of one block (samples at origin + spacing * index, x fastest)."""
+    # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
     from volviz.render.vtk_facade import numpy_to_vtk, vtk
 
     img = vtk.vtkImageData()
@@ -134,13 +138,13 @@ class LodVolume:
                  opacity: float = 1.0, renderer: str = "volviz", step: Optional[float] = None) -> None:
         """``renderer``: "volviz" (our ray caster) or "vtk" (vtkMultiBlockVolumeMapper); ``step``: the ray
         caster's sample distance in voxels of each block's level (default ``volviz.regular.raycast.STEP``)."""
+        # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
         from volviz.render.vtk_facade import vtk
 
         if renderer not in RENDERERS:
             raise ValueError(f"LOD renderer must be one of {RENDERERS}, got {renderer!r}")
         self.plotter, self.tree, self.tf = plotter, tree, tf
         self.budget, self.mode, self.opacity = int(budget), mode, float(opacity)
-        from volviz.regular.raycast import STEP
 
         self.renderer, self.step = renderer, float(STEP if step is None else step)
         self.mapper = vtk.vtkMultiBlockVolumeMapper()
@@ -197,8 +201,6 @@ class LodVolume:
     def set_clip(self, clip: ClipSettings) -> bool:
         """The mapper's clipping planes, which the ray caster reads at the next selection's draw (True: nothing for
         the caller to cut)."""
-        from volviz.render.clipping import clip_vtk_prop
-
         clip_vtk_prop(self.volume, clip)
         return True
 
@@ -221,8 +223,6 @@ class LodVolume:
         renderer it also captures what a ray cast of that view needs from the plotter (the full camera, the opaque
         scene's depth when there is visible geometry, the clipping planes), so that ``decode`` can ray cast on the
         worker too."""
-        from volviz.model.camera import Camera
-
         cam = self._lod_camera()
         if self.renderer == "volviz" and self._overlay is not None and self.volume.GetVisibility():
             depth = self._overlay.depth((cam.width, cam.height))
@@ -265,8 +265,6 @@ class LodVolume:
         return tf, repr(tf.to_dict())
 
     def _prepare(self, selection: Selection, blocks: list[Block]) -> None:
-        from volviz.regular.raycast import pack_blocks, render_blocks
-
         with self._lock:
             entry = self._cameras.get(id(selection))
             held = dict(self._images)
@@ -303,6 +301,7 @@ class LodVolume:
         self.selection = selection
         self.stats = self.show_stats(selection, blocks, select_s, decode_s)
         if self.renderer == "vtk":
+            # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
             from volviz.render.vtk_facade import vtk
 
             mb = vtk.vtkMultiBlockDataSet()
@@ -313,7 +312,6 @@ class LodVolume:
             return
         if prepared is not None and self._use_prepared(selection, prepared):
             return
-        from volviz.regular.raycast import pack_blocks
 
         t0 = time.perf_counter()
         self._pool = pack_blocks([self._images[k] for k in selection.nodes], self.tree.shapes[0], self.tree.origin,
@@ -345,8 +343,6 @@ class LodVolume:
 
     def _segment_table(self, tf: Any, pool: Any) -> Any:
         """The separable table for ``tf`` over the data range of every level (cached per TF)."""
-        from volviz.regular.raycast import segment_table
-
         lo = min(float(self.tree._to_data(st.vmin.min())) for st in self.tree.stats)
         hi = max(float(self.tree._to_data(st.vmax.max())) for st in self.tree.stats)
         plo, phi = pool.scalar_range
@@ -363,8 +359,6 @@ class LodVolume:
         the opaque scene's depth, and put the image on the overlay; returns the premultiplied image."""
         if self._pool is None or self._overlay is None:
             return None
-        from volviz.regular.raycast import render_blocks
-        from volviz.model.camera import Camera
 
         t0 = time.perf_counter()
         w, h = (int(v) for v in self.plotter.ren_win.GetSize())

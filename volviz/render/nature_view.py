@@ -16,18 +16,21 @@ from typing import TYPE_CHECKING, Any, Callable, Optional, Sequence, Union
 
 import numpy as np
 
+from volviz.model.camera import Camera
 from volviz.nature.nature_scene import NatureScene, scene_from_components
 from volviz.nature.raster import render_terrain
+from volviz.nature.sky import sky_dome_mesh
+from volviz.render.backend import plotter_gl_info
+from volviz.render.framing import nature_bounds
 
 if TYPE_CHECKING:   # type-only imports for the signatures
     import pyvista as pv
 
     from volviz.jobs import ProgressCallback
-    from volviz.model.camera import Camera
     from volviz.nature.terrain import TerrainMesh
     from volviz.render.framing import Bounds
     from volviz.scene.datasets import LoadedDataset
-    from volviz.session import Component, CameraState
+    from volviz.session import CameraState, Component
 
 
 #: a natural-scene view's request: (camera, image size (width, height), preview scale)
@@ -46,8 +49,6 @@ class NatureView:
 
     def bounds(self) -> Optional[Bounds]:
         """The terrain's and the clouds' box (``volviz.render.framing.nature_bounds``; not the sky dome's)."""
-        from volviz.render.framing import nature_bounds
-
         return nature_bounds(self.scene)
 
     def __init__(self, plotter: Any, scene: NatureScene, size: tuple[int, int] | None = None,
@@ -55,9 +56,8 @@ class NatureView:
         """``filter_texture``: mip-map the terrain's color map (``_filtered_texture``); None: on a hardware OpenGL
         driver, not on a software rasteriser, where it costs more than it is worth (``texture_filtering``).
         ``full``: the reference view, every terrain triangle, prism and non-empty cloud cell (no LOD)."""
+        # heavy: PyVista (about 180 modules), loaded only when a nature view is made
         import pyvista as pv
-
-        from volviz.nature.sky import sky_dome_mesh
 
         self.plotter = plotter
         self.scene = scene
@@ -107,8 +107,6 @@ class NatureView:
                                                                           _refit(weakref.ref(self)))
 
     def _camera(self) -> Camera:
-        from volviz.model.camera import Camera
-
         self._fit_clipping()
         return Camera.from_pyvista(self.plotter.camera)
 
@@ -263,6 +261,7 @@ class NatureView:
         preview smaller than the viewport); at the viewport's size each pixel shows its texel either way. A preview
         uploads 1/scale² of the pixels and needs no magnification on the CPU (PIL took 34 ms per 990x673 preview on
         the worker, beside 2.6 MB copied and uploaded on the GUI thread)."""
+        # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
         from volviz.render.vtk_facade import numpy_to_vtk, vtk
 
         h, w = overlay.shape[:2]
@@ -300,8 +299,6 @@ def texture_filtering(plotter: pv.BasePlotter) -> bool:
     not on a software rasteriser (``volviz.render.backend``): on llvmpipe the mip-mapped terrain took 62-78 ms
     against 35-39 ms per 320x200 frame, and its first frame (making the mip-maps) 170-260 ms against 95-145 ms, on
     the GUI thread; unfiltered, the terrain shimmers as the camera moves (``_filtered_texture``)."""
-    from volviz.render.backend import plotter_gl_info
-
     return not plotter_gl_info(plotter).software
 
 
@@ -324,6 +321,7 @@ def _viewport_quad(image: Any) -> Any:
     viewport (corners in normalized viewport coordinates, texture coordinates 0..1: at the viewport's size the
     centre of pixel i samples texel i exactly), blended with (ONE, ONE_MINUS_SRC_ALPHA) (``PremultipliedAlpha``), so
     no colour bleeds from transparent texels where OpenGL filters it."""
+    # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
     from volviz.render.vtk_facade import numpy_to_vtk, vtk
 
     quad = vtk.vtkPolyData()
@@ -377,8 +375,6 @@ def build_nature_components(plotter: pv.BasePlotter, components: Sequence[Compon
 
 
 def _as_camera(camera: Any, scene: NatureScene) -> Any:
-    from volviz.model.camera import Camera
-
     if isinstance(camera, Camera):
         return camera
     near, far = 5.0, 20000.0

@@ -40,6 +40,7 @@ class PeelLayer:
     image and depth ``renderer`` leaves (module docstring)."""
 
     def __init__(self, renderer: Any, peels: int = 64) -> None:
+        # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
         from volviz.render.vtk_facade import vtk
 
         self.base = renderer
@@ -69,6 +70,7 @@ class PeelLayer:
 
     def add(self, actor: vtkActor) -> None:
         """Peel ``actor`` from the next render on; a box of its bounds joins the renderer's bounds."""
+        # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
         from volviz.render.vtk_facade import box_corners_polydata, vtk
 
         self.renderer.AddActor(actor)

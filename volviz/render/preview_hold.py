@@ -44,6 +44,7 @@ class PreviewCameraHold:
     FRAME_LOG = 1000
 
     def __init__(self, plotter: Any) -> None:
+        # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
         from volviz.render.vtk_facade import vtk
 
         self._vtk = vtk

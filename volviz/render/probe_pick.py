@@ -10,7 +10,12 @@ from typing import TYPE_CHECKING, Any, Optional
 
 import numpy as np
 
+from volviz.model import CurvilinearGrid, RegularVolume, TetMesh, TimeSeries, UnstructuredMesh
 from volviz.model.probe import ProbeResult, probe_regular
+from volviz.model.representation import representation
+from volviz.model.timeseries import frame_at
+from volviz.render.pt_view import is_pt_view
+from volviz.scene.drawn_tf import drawn_tf
 
 if TYPE_CHECKING:   # type-only: VTK's renderer, reached through the facade at run time
     from volviz.render.vtk_facade import vtkRenderer
@@ -55,11 +60,8 @@ def probe_volume(controller: Any, comp: Any, origin: np.ndarray, direction: np.n
     projected-tetrahedra view, a LOD tree, a regular volume, or the frame of a time series at the controller's
     display time (a regular volume, or a mesh through its tetrahedra), each in the part the scene's clipping keeps;
     None for what none of these draws."""
-    from volviz.model import RegularVolume, TimeSeries
-    from volviz.model.timeseries import frame_at
+    # heavy: the LOD tree's Numba kernels and SciPy, loaded only when a point is probed
     from volviz.regular.lod import LodTree
-    from volviz.scene.drawn_tf import drawn_tf
-    from volviz.render.pt_view import is_pt_view
 
     dataset = controller.dataset_of(comp.id)
     tf = drawn_tf(comp, controller.transfer_function(comp.id), dataset)
@@ -67,10 +69,12 @@ def probe_volume(controller: Any, comp: Any, origin: np.ndarray, direction: np.n
     if is_pt_view(view):
         if not view.visible:
             return None
+        # heavy: the probe's Numba kernels and SciPy, loaded only when a mesh is probed
         from volviz.unstructured.probe import probe_tetmesh
 
         return probe_tetmesh(view.mesh, origin, direction, tf, comp.id, comp.opacity, controller.clip)
     if isinstance(dataset, LodTree):
+        # heavy: the LOD probe's Numba kernels and SciPy, loaded only when a LOD volume is probed
         from volviz.regular.probe_lod import probe_lod
 
         return probe_lod(dataset, origin, direction, tf, comp.id, comp.opacity, controller.clip)
@@ -80,6 +84,7 @@ def probe_volume(controller: Any, comp: Any, origin: np.ndarray, direction: np.n
         return probe_regular(dataset, origin, direction, tf, comp.id, comp.opacity, controller.clip)
     mesh = _volume_tets(dataset)
     if mesh is not None:        # a mesh VTK's volume mapper draws (a time series, the "vtk" render method)
+        # heavy: the probe's Numba kernels and SciPy, loaded only when a mesh is probed
         from volviz.unstructured.probe import probe_tetmesh
 
         return probe_tetmesh(mesh, origin, direction, tf, comp.id, comp.opacity, controller.clip)
@@ -89,9 +94,6 @@ def probe_volume(controller: Any, comp: Any, origin: np.ndarray, direction: np.n
 def _volume_tets(dataset: Any) -> Optional[Any]:
     """The tetrahedral mesh of a volumetric mesh dataset (made once and kept while it lives), None for anything else
     (a surface: VTK's cell picker answers for it)."""
-    from volviz.model import CurvilinearGrid, TetMesh, UnstructuredMesh
-    from volviz.model.representation import representation
-
     if not isinstance(dataset, (TetMesh, UnstructuredMesh, CurvilinearGrid)) or \
             representation(dataset).kind != "volume":
         return None
@@ -99,6 +101,7 @@ def _volume_tets(dataset: Any) -> Optional[Any]:
         return dataset
     kept = _TETS.get(id(dataset))
     if kept is None or kept[0]() is not dataset:
+        # heavy: the tetrahedralisation's Numba kernels and SciPy, only when a grid is probed
         from volviz.unstructured.tetrahedralize import tetrahedralize
 
         tets = tetrahedralize(dataset, dataset.active)
@@ -117,6 +120,7 @@ def _forget_tets(key: int) -> Any:
 def _pick_cell(renderer: Any, x: float, y: float) -> Optional[ProbeResult]:
     """The cell of a pickable surface or mesh actor under the pixel, with the value of its active point scalars at
     the cell's point nearest the hit (None: nothing, or no scalars)."""
+    # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
     from volviz.render.vtk_facade import vtk
 
     picker = vtk.vtkCellPicker()

@@ -32,13 +32,15 @@ from typing import TYPE_CHECKING, Any, Optional
 
 import numpy as np
 
+from volviz.model.camera import Camera
 from volviz.model.datasets import TetMesh
-from volviz.render.image_overlay import (OverlayView, overlay_rgba8, unpremultiply_rgba8, window_size,
-                                         zbuffer_to_depth)
+from volviz.optics.metrics import max_abs, rmse
+from volviz.render.image_overlay import OverlayView, overlay_rgba8, unpremultiply_rgba8, window_size, zbuffer_to_depth
 from volviz.render.preview_hold import PreviewCameraHold, holds_previews
 from volviz.render.pt_view import PTView
-from volviz.model.camera import Camera
+from volviz.unstructured.prefetch import SortPrefetcher
 from volviz.unstructured.render import render
+from volviz.unstructured.tetrahedralize import tetrahedralize
 
 if TYPE_CHECKING:   # type-only imports for the signatures
     import pyvista as pv
@@ -60,8 +62,6 @@ class PTVolume(OverlayView, PTView):
     def __init__(self, plotter: Any, mesh: Any, tf: Any, method: str = "pt", **render_opts: Any) -> None:
         scalars = render_opts.pop("scalars", None)
         if not isinstance(mesh, TetMesh):
-            from volviz.unstructured.tetrahedralize import tetrahedralize
-
             mesh = tetrahedralize(mesh, scalars)
         if method not in ("pt", "reference"):
             raise ValueError(f"PT volume method must be 'pt' or 'reference', got {method!r}")
@@ -121,8 +121,6 @@ class PTVolume(OverlayView, PTView):
     def prefetch(self, camera: Camera, size: tuple[int, int] | None = None) -> None:
         """Sort the mesh for ``camera`` (the next frame's; ``size`` defaults to the window's) in the background, so
         that the ``update`` for that camera skips the sort (``volviz.unstructured.prefetch``)."""
-        from volviz.unstructured.prefetch import SortPrefetcher
-
         if self.method != "pt":
             return
         if self._prefetcher is None or self._prefetcher.mesh is not self.mesh:
@@ -139,8 +137,6 @@ class PTVolume(OverlayView, PTView):
         """Any-thread: the current method's error against the exact float64 reference for this view and TF, measured
         on a small image (``size``, same camera and aspect): RMSE and max abs in 8-bit units. This is what the app's
         statistics show as the error estimate."""
-        from volviz.optics.metrics import max_abs, rmse
-
         w, h = request["size"]
         sw, sh = size
         sh = max(8, int(round(sw * h / max(w, 1))))

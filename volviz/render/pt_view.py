@@ -50,6 +50,7 @@ class PTView:
     def cut(self, clip: ClipSettings, progress: Optional[ProgressCallback] = None) -> Optional[TetMesh]:
         """Any thread: the uncut mesh cut by ``clip`` exactly (``volviz.iso.clip.clip_tetmesh``), with its topology
         built; None when the clipping removes all of it."""
+        # heavy: the cut's Numba kernels and SciPy, loaded only when a mesh is cut
         from volviz.scene.tetra import cut_tetmesh
 
         return cut_tetmesh(self.whole_mesh, clip)

@@ -97,6 +97,7 @@ def drag_index(dataset: Any, axis: str, anchor: npt.ArrayLike, origin: npt.Array
 
 def _plane_grid(volume: RegularVolume, axis: str, index: int, tf: Any) -> Any:
     """A one-sample-thick ImageData at plane ``axis = index`` with the slice's colours as point data."""
+    # heavy: PyVista (about 180 modules), loaded only when a slice plane is made
     import pyvista as pv
 
     a = AXES.index(axis)
@@ -130,6 +131,7 @@ class SlicesView(VtkPropView):
         self._show()
 
     def _show(self) -> None:
+        # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
         from volviz.render.vtk_facade import vtk
 
         visible = True
@@ -164,6 +166,7 @@ class SlicesView(VtkPropView):
     def plane_at(self, renderer: vtkRenderer, x: float, y: float) -> Optional[tuple[str, np.ndarray]]:
         """The plane under display pixel (x, y) of ``renderer`` (VTK's coordinates, y up) and the world point hit
         on it; None when no plane is there or the planes are hidden."""
+        # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
         from volviz.render.vtk_facade import vtk
 
         if self.prop is None or not self.prop.GetVisibility() or not self.actors:

@@ -13,15 +13,20 @@ from typing import TYPE_CHECKING, Any, Optional
 import numpy as np
 
 from volviz.model import CurvilinearGrid, Image2D, RegularVolume, TetMesh, TimeSeries, UnstructuredMesh, vec3
+from volviz.model.arrays import is_appearance_array, vertex_colors
+from volviz.model.representation import VOLUME, representation
+from volviz.model.stats import scalar_values
+from volviz.optics import TransferFunction
+from volviz.optics.auto_tf import auto_transfer_function, mean_chord
+from volviz.render.backend import choose_backend, plotter_gl_info
 from volviz.render.vtk_tf import tf_to_vtk
 from volviz.scene.lod import is_lod, lod_bounds, lod_scalar_range
 from volviz.session import CameraState
 
 if TYPE_CHECKING:   # type-only imports for the signatures
     import pyvista as pv
-    from volviz.render.vtk_facade import vtkVolumeProperty
 
-    from volviz.optics.transfer_function import TransferFunction
+    from volviz.render.vtk_facade import vtkVolumeProperty
 
 PLAIN_COLOR = (0.80, 0.80, 0.78)    # geometry without a field: a neutral light grey, shaded by the lights
 DEFAULT_COLORS = ((0.23, 0.30, 0.75), (0.87, 0.87, 0.87), (0.71, 0.02, 0.15))  # cool-warm: low, middle, high
@@ -34,8 +39,6 @@ def default_transfer_function(scalar_range: tuple[float, float], diagonal: float
     The extinction peaks at 8 / diagonal, so a ray through the whole bounding box at the top of the range reaches an
     optical depth of about 8 (opaque) while lower values stay translucent.
     """
-    from volviz.optics import TransferFunction
-
     lo, hi = scalar_range
     if not (np.isfinite(lo) and np.isfinite(hi)):
         lo, hi = 0.0, 1.0
@@ -82,6 +85,7 @@ def set_volume_shading(prop: vtkVolumeProperty, shade: bool) -> None:
 
 def vtk_volume_property(tf: TransferFunction, opacity: float = 1.0, shade: bool = False) -> vtkVolumeProperty:
     """A vtkVolumeProperty of ``tf`` (``update_volume_property``), linearly interpolated, lit with ``shade``."""
+    # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
     from volviz.render.vtk_facade import vtk
 
     prop = vtk.vtkVolumeProperty()
@@ -113,8 +117,6 @@ def default_transfer_function_for(dataset: Any, name: str = "default") -> Transf
     for a time series) by ``volviz.optics.auto_tf``; a compressed LOD volume gets the ramp over its range."""
     if is_lod(dataset):
         return default_transfer_function(lod_scalar_range(dataset), bounds_diagonal(lod_bounds(dataset)), name)
-    from volviz.model.stats import scalar_values
-    from volviz.optics.auto_tf import auto_transfer_function, mean_chord
 
     grid = volume_grid(dataset)
     return auto_transfer_function(scalar_values(dataset), mean_chord(grid.bounds), name)
@@ -122,6 +124,7 @@ def default_transfer_function_for(dataset: Any, name: str = "default") -> Transf
 
 def volume_input(dataset: Any) -> Any:
     """The VTK data object a volume mapper draws for ``dataset`` (tetrahedralised for non-image grids)."""
+    # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
     from volviz.render.vtk_facade import vtk
 
     grid = transparent_nonfinite(volume_grid(dataset))
@@ -178,9 +181,8 @@ def volume_prop(plotter: pv.BasePlotter, data: Any, regular: bool, tf: TransferF
     vtkSmartVolumeMapper (its CPU ray caster where ``backend`` picks "cpu": by default on a software OpenGL, see
     ``volviz.render.backend``), lit with ``shade`` (the component setting); others through
     vtkProjectedTetrahedraMapper, which draws no lighting. Returns the volume."""
+    # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
     from volviz.render.vtk_facade import vtk
-
-    from volviz.render.backend import choose_backend, plotter_gl_info
 
     mapper = vtk.vtkSmartVolumeMapper() if regular else vtk.vtkProjectedTetrahedraMapper()
     if regular:
@@ -202,16 +204,12 @@ def is_surface(dataset: Any) -> bool:
     """Whether ``dataset`` (a time series: at its first step where the field varies) is not drawn as a volume: a
     mesh of surface cells or vertices, a grid one layer thick, geometry without a field or a constant field (the
     one rule of ``volviz.model.representation``). Such data is drawn as a surface colored by its field, or plain."""
-    from volviz.model.representation import VOLUME, representation
-
     return representation(dataset).kind != VOLUME
 
 
 def shows_no_field(dataset: Any) -> bool:
     """Whether ``dataset`` (a volviz dataset) is geometry alone, drawn in a plain color without a scalar bar (a mesh
     with only block ids, an STL)."""
-    from volviz.model.representation import representation
-
     known = isinstance(dataset, (TimeSeries, CurvilinearGrid, UnstructuredMesh))
     return known and representation(dataset).field is None
 
@@ -225,8 +223,6 @@ def surface_input(dataset: Any, plain: bool = False) -> Any:
     scalars kept active unless they are an appearance attribute (``volviz.model.arrays.is_appearance_array``) or
     the dataset is drawn ``plain`` (geometry alone): then its vertex colours (``VERTEX_COLORS``), if it has any, else
     none. The cells touching NaN/Inf (land in an ocean field, a solver's failed points) are left out."""
-    from volviz.model.arrays import is_appearance_array, vertex_colors
-
     grid = volume_grid(dataset)
     name = grid.active_scalars_name
     if name is not None and (plain or is_appearance_array(name)):

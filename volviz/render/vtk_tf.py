@@ -88,6 +88,7 @@ def tf_to_vtk(tf: TransferFunction, unit_distance: float) -> tuple[vtkColorTrans
     unit_distance = float(unit_distance)
     if not (np.isfinite(unit_distance) and unit_distance > 0):
         raise ValueError(f"unit_distance must be finite and > 0, got {unit_distance}")
+    # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
     from volviz.render.vtk_facade import vtk
 
     ctf = vtk.vtkColorTransferFunction()

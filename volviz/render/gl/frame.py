@@ -31,6 +31,7 @@ def resolve_polydata(bounds: np.ndarray) -> vtkPolyData:
     """The resolve's geometry: the 8 corners of ``bounds`` (3, 2) in the actor's bounds, so that VTK culls it with
     the pass, and the triangle (0, 1, 2), which ``pt_resolve_vs.glsl`` places over the viewport by ``gl_VertexID``
     (vertex 7 of the bounds' zero-area triangle lands on vertex 0)."""
+    # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
     from volviz.render.vtk_facade import box_corners_polydata
 
     return box_corners_polydata(bounds, [(0, 1, 2)])

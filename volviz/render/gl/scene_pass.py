@@ -22,6 +22,7 @@ class ScenePass:
     _installed: weakref.WeakKeyDictionary[vtkRenderer, ScenePass] = weakref.WeakKeyDictionary()
 
     def __init__(self, renderer: vtkRenderer) -> None:
+        # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
         from volviz.render.vtk_facade import vtk
 
         self.renderer = renderer

@@ -22,6 +22,7 @@ _DEPTH_FORMATS = {0x81A5: "Fixed16", 0x81A6: "Fixed24", 0x81A7: "Fixed32", 0x8CA
 def _attached(ren_win: vtkOpenGLRenderWindow, tex: vtkTextureObject,
               attach: Callable[[vtkOpenGLFramebufferObject, vtkTextureObject], None]) -> Target:
     """(``tex``, a new framebuffer object with ``tex`` attached by ``attach(fbo, tex)``), the caller's binding kept."""
+    # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
     from volviz.render.vtk_facade import vtk
 
     fbo = vtk.vtkOpenGLFramebufferObject()
@@ -36,6 +37,7 @@ def _attached(ren_win: vtkOpenGLRenderWindow, tex: vtkTextureObject,
 def color_target(ren_win: vtkOpenGLRenderWindow, width: int, height: int, components: int, linear: bool) -> Target:
     """(texture, framebuffer object): a float32 color target of ``components`` channels; ``linear``: filtered
     linearly and clamped to its edges (a target sampled between texels), else nearest."""
+    # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
     from volviz.render.vtk_facade import vtk
 
     tex = vtk.vtkTextureObject()
@@ -53,6 +55,7 @@ def color_target(ren_win: vtkOpenGLRenderWindow, width: int, height: int, compon
 def depth_target(ren_win: vtkOpenGLRenderWindow, width: int, height: int, fmt: int) -> Target:
     """(texture, framebuffer object): a depth target of the vtkTextureObject depth format ``fmt`` (read by
     texelFetch: no filtering)."""
+    # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
     from volviz.render.vtk_facade import vtk
 
     tex = vtk.vtkTextureObject()
@@ -63,6 +66,7 @@ def depth_target(ren_win: vtkOpenGLRenderWindow, width: int, height: int, fmt: i
 
 def depth_format(depth_texture: Optional[vtkTextureObject]) -> int:
     """The vtkTextureObject depth format of ``depth_texture`` (a framebuffer's depth attachment; None: Fixed32)."""
+    # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
     from volviz.render.vtk_facade import vtk
 
     internal = depth_texture.GetInternalFormat(vtk.VTK_FLOAT, 1, False) if depth_texture is not None else 0
@@ -72,6 +76,7 @@ def depth_format(depth_texture: Optional[vtkTextureObject]) -> int:
 def table_texture(ren_win: vtkOpenGLRenderWindow, data: np.ndarray, layered: bool) -> vtkTextureObject:
     """A float32 RGBA lookup table, linear and clamped to its edges: ``data`` (nz, ny, nx, 4) as a 3D texture, or
     (``layered``) as a 2D array of nz layers (bilinear within a layer: 4 taps instead of 8)."""
+    # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
     from volviz.render.vtk_facade import vtk
 
     nz, ny, nx = data.shape[:3]
@@ -94,6 +99,7 @@ def texel_array(ren_win: vtkOpenGLRenderWindow, texels: np.ndarray, what: str,
     """``texels`` (n, components) as float32 texels in VTK's 2D emulation of a texture buffer (read by index in the
     shader with the texture's width); ``what`` names it in the error when OpenGL refuses it. ``into``: a texture
     made here before, whose storage is replaced (a per-frame upload keeps one texture object)."""
+    # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
     from volviz.render.vtk_facade import vtk
 
     tex = into
