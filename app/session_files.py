@@ -228,6 +228,7 @@ class SessionFiles:
                 on_chosen(path)
 
         dialog.fileSelected.connect(file_selected)
+        _fit_to_window(dialog, self.window)
         dialog.open()
         self.file_dialog = dialog
         return dialog
@@ -305,3 +306,19 @@ class SessionFiles:
         answer = self.ask_unsaved_changes()
         return not (answer == QMessageBox.StandardButton.Cancel or (
             answer == QMessageBox.StandardButton.Save and not self.save()))
+
+
+DIALOG_SHARE = 0.8   # of the window's width and height a file dialog takes
+
+
+def _fit_to_window(dialog: QFileDialog, window: Any) -> None:
+    """Most of the window (``DIALOG_SHARE``), within its screen, centred on it: Qt's own 632x412 cut the Size and
+    Date Modified columns of the file list (issue #28, a new user's 1366x768 screen)."""
+    screen = window.screen().availableGeometry()
+    width = min(int(window.width() * DIALOG_SHARE), screen.width())
+    height = min(int(window.height() * DIALOG_SHARE), screen.height())
+    dialog.resize(width, height)
+    frame = dialog.frameGeometry()
+    frame.moveCenter(window.frameGeometry().center())
+    dialog.move(min(max(frame.x(), screen.left()), screen.right() - frame.width() + 1),
+                min(max(frame.y(), screen.top()), screen.bottom() - frame.height() + 1))
