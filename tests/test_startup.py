@@ -90,3 +90,56 @@ def test_the_app_reports_its_first_frame() -> None:
     assert len(line) == 1
     at, since_main = (float(v) for v in line[0].split()[2:])
     assert start < at < end and 0 < since_main < at - start
+
+
+READER_PROBE = """
+import json, sys
+from volviz.io import isolated
+calls = []
+plain = isolated.prewarm
+def prewarm(*args, **kwargs):
+    calls.append({"render_layer": "volviz.render.export" in sys.modules, "args": list(args), "kwargs": kwargs})
+    plain(*args, **kwargs)
+isolated.prewarm = prewarm
+from volviz.cli import main
+code = main(sys.argv[1:])
+print(json.dumps({"code": code, "calls": calls}))
+"""
+
+
+def test_render_starts_the_reader_child_before_the_render_layer_for_its_read_at_hand(tmp_path) -> None:
+    """The child's start (Python, numpy, ``volviz.io``) overlaps the render layer's imports, and the child, started
+    for that one read, loads no reader's VTK modules while it waits for it."""
+    done = subprocess.run([sys.executable, "-c", READER_PROBE, "render", str(data_file("volumes/hydrogen.vti")),
+                           "-o", str(tmp_path / "h.png"), "--size", "64x48"], cwd=REPO, capture_output=True,
+                          text=True, timeout=300)
+    assert done.returncode == 0, done.stderr[-3000:]
+    report = json.loads(done.stdout.strip().splitlines()[-1])
+    assert report == {"code": 0, "calls": [{"render_layer": False, "args": [], "kwargs": {"idle_load": False}}]}
+
+
+def _maps_vtk_module(pid: int, module: str) -> bool:
+    with open(f"/proc/{pid}/maps") as maps:
+        return module in maps.read()
+
+
+def test_a_child_for_the_read_at_hand_loads_no_readers_vtk_modules_while_idle() -> None:
+    """A child kept warm loads every reader's VTK modules while it waits (the Exodus reader's among them); one
+    started for the read at hand (``worker.AT_HAND``) loads none of them in that time."""
+    import time
+
+    from volviz.io.isolated.worker import Worker
+
+    warm, at_hand = Worker(), Worker(idle_load=False)
+    try:
+        warm.wait_ready()
+        at_hand.wait_ready()
+        deadline = time.monotonic() + 60
+        while not _maps_vtk_module(warm.proc.pid, "vtkIOExodus") and time.monotonic() < deadline:
+            time.sleep(0.1)
+        assert _maps_vtk_module(warm.proc.pid, "vtkIOExodus")
+        assert not _maps_vtk_module(at_hand.proc.pid, "vtkIOExodus")
+        assert not _maps_vtk_module(at_hand.proc.pid, "vtkIOXML")
+    finally:
+        warm.close()
+        at_hand.close()

@@ -317,9 +317,6 @@ def run(argv: Optional[Sequence[str]] = None) -> int:
 
 
 def _render(args: argparse.Namespace) -> int:
-    from volviz.render.export import (check_image_size, check_output, is_session_file, open_target, render_movie,
-                                      render_to_file)
-
     movie = args.path is not None or args.time or args.orbit
     if args.path is not None and args.orbit:
         raise UsageError("--orbit and --path each move the camera: give one")
@@ -329,6 +326,12 @@ def _render(args: argparse.Namespace) -> int:
         raise UsageError(f"--duration {args.duration:g} at --fps {args.fps:g} makes "
                          f"{args.fps * args.duration:.0f} frames; at most {MAX_MOVIE_FRAMES}")
     target = Path(args.target)
+    if str(args.target) not in ("demo", "demo-volume") and target.exists():   # a session's format starts no child
+        _start_reader(target, {**dict(args.option), **({"q": args.q} if args.q else {})})
+    # the render layer (pyvista, VTK's rendering): heavy, imported while the reader child starts
+    from volviz.render.export import (check_image_size, check_output, is_session_file, open_target, render_movie,
+                                      render_to_file)
+
     data_file = str(args.target) not in ("demo", "demo-volume") and not is_session_file(target)
     if not data_file and (args.array is not None or args.q is not None or args.option):
         raise UsageError("--array, --q and --option apply to data files (a session names the array of each "
@@ -336,8 +339,6 @@ def _render(args: argparse.Namespace) -> int:
     if data_file and not target.exists():
         raise UsageError(f"{target}: no such file (give a session, a data file, 'demo' or 'demo-volume')")
     check_output(args.output, movie)
-    if data_file:
-        _start_reader(target, {**dict(args.option), **({"q": args.q} if args.q else {})})
     session, session_file = open_target(args.target, args.array, args.q, dict(args.option))
     size = args.size or session.render.size
     check_image_size(size)
@@ -363,7 +364,8 @@ def _render(args: argparse.Namespace) -> int:
 def _start_reader(path: Path, options: dict[str, Any]) -> None:
     """Start the reader child now when ``path``'s reader runs in one (``volviz.io.isolated``): the child is a fresh
     interpreter (a crash cannot take the render with it), so its start (Python, numpy, ``volviz.io``) overlaps the
-    import of the render layer instead of following it (issue #31, docs/architecture.md "Start-up")."""
+    import of the render layer instead of following it (issue #31, docs/architecture.md "Start-up"); ``_render``
+    calls it before that import. A session file's format is none a reader takes: it starts no child."""
     from volviz.io import ReadError, isolated
     from volviz.io.registry import format_of, get_reader
 
@@ -372,7 +374,7 @@ def _start_reader(path: Path, options: dict[str, Any]) -> None:
     except (ReadError, OSError, KeyError, ValueError):   # the read itself says what is wrong with the file
         return
     if isolates and isolated.isolation_enabled():
-        isolated.prewarm()
+        isolated.prewarm(idle_load=False)   # its one read comes soon: no reader's VTK modules it may not use
 
 
 def _read_for_render(session: Any, datasets: dict[str, Any], args: argparse.Namespace) -> None:

@@ -110,9 +110,10 @@ limits = Limits()
 _pool = Pool()
 
 
-def prewarm() -> None:
-    """Start a reader child in the background so that the first isolated read does not wait for its start-up."""
-    _pool.prewarm()
+def prewarm(idle_load: bool = True) -> None:
+    """Start a reader child in the background so that the first isolated read does not wait for its start-up;
+    ``idle_load=False`` for a child started for one read at hand (``worker.Worker``)."""
+    _pool.prewarm(idle_load)
 
 
 def shutdown() -> None:

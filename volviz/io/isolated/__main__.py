@@ -159,8 +159,9 @@ IDLE_SECONDS = 0.25
 def _load_vtk_when_idle() -> None:
     """Import the VTK modules of volviz's readers (``volviz.io.vtk_lazy.MODULE_OF``, by name: not the whole of VTK,
     issue #31) until a request is waiting. A child kept warm for later reads (the app's pool) has them
-    loaded before they come; one started for a read at hand (``volviz render FILE``) answers at once, its reader
-    importing only the VTK modules it uses (``volviz.io.vtk_lazy``: 0.4 s instead of 1.2-2 s)."""
+    loaded before they come; one started for a read at hand (``volviz render FILE``, with ``worker.AT_HAND``) does
+    not run this: its reader imports only the VTK modules it uses (``volviz.io.vtk_lazy``: 0.4 s instead of 1.2-2 s).
+    """
     if select.select([sys.stdin.buffer], [], [], IDLE_SECONDS)[0]:
         return
     for module in sorted(set(MODULE_OF.values())):
@@ -175,8 +176,11 @@ def _load_vtk_when_idle() -> None:
 def main() -> None:
     out = _protocol_stdout()
     _die_with_parent()
+    from volviz.io.isolated.worker import AT_HAND   # loaded with the package above
+
     out.write(json.dumps({"ready": True, "pid": os.getpid()}).encode() + b"\n")
-    _load_vtk_when_idle()
+    if AT_HAND not in sys.argv[1:]:
+        _load_vtk_when_idle()
     child = Child()
     for line in sys.stdin.buffer:
         try:
