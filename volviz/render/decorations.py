@@ -66,8 +66,9 @@ def apply_decorations(plotter: Any, session: Session, props: dict[str, Any], dat
     color = _contrast(session.render.background)
     axes = getattr(plotter.renderer, "axes_widget", None)
     if decoration_enabled(session, "axes"):
-        if axes is None:
-            plotter.add_axes(color=color, interactive=False)
+        if axes is None:   # 1-pixel shafts: pyvista's 2-pixel lines were drawn a pixel apart on screen and in
+            # ``volviz render`` (VTK's wide lines take the driver's or its own path by context; issue #28)
+            plotter.add_axes(color=color, interactive=False, line_width=1)
         else:
             plotter.renderer.show_axes()
     elif axes is not None:
