@@ -26,7 +26,7 @@ from volviz.model.camera import Camera
 from volviz.model.settings import array_key
 from volviz.render.camera_path import frame_times, interpolate_path
 from volviz.render.controller import SceneController
-from volviz.render.offscreen import offscreen_plotter
+from volviz.render.offscreen import draw_projected_tetrahedra_once, offscreen_plotter
 from volviz.scene.datasets import load_datasets
 from volviz.scene.demo import demo_session, demo_volume_session
 from volviz.scene.errors import SceneError
@@ -192,7 +192,9 @@ def snapshot(plotter: pv.BasePlotter, size: tuple[int, int], transparent: bool =
 
 
 def _render_image(plotter: Any) -> np.ndarray:
-    if not plotter._first_time:  # the first image pyvista renders itself (and places a camera that was never set)
+    if plotter._first_time:  # the first image pyvista renders itself (and places a camera that was never set)
+        draw_projected_tetrahedra_once(plotter)
+    else:
         plotter.render()
     return np.asarray(plotter.screenshot(None, return_img=True))[..., :3]
 
