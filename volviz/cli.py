@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import argparse
 import atexit
+import gc
 import importlib
 import json
 import math
@@ -46,6 +47,7 @@ MOVIE_FPS = float_in(0.0, 240.0, low_open=True)
 
 def _array_spec(text: str) -> str:
     """An argument type: an array spec ``NAME``, ``NAME:c`` or ``NAME:magnitude`` (``volviz.model.arrays``)."""
+    # NumPy: only when --array is given (the parser stays light for --help)
     from volviz.model.arrays import parse_array_spec
 
     try:
@@ -134,6 +136,7 @@ def build_parser() -> argparse.ArgumentParser:
 def _reading(path: str | os.PathLike, q: Optional[str]) -> Iterator[None]:
     """Reading ``path`` (with the PLOT3D solution file ``q``) inside: a missing ``q`` and an option the reader does not
     take are usage errors, and a solution file given alone says what to do instead of failing to read."""
+    # NumPy and the readers: loaded by the commands that read, not by --help or a refused argument
     from volviz.io import ReadError
     from volviz.io.loaders import ReaderOptionError
 
@@ -152,6 +155,7 @@ def _reading(path: str | os.PathLike, q: Optional[str]) -> Iterator[None]:
 
 def plot3d_solution_hint(path: str | os.PathLike) -> Optional[str]:
     """What to do with a PLOT3D solution (q) file opened alone, or None when ``path`` is not one."""
+    # NumPy and the readers: loaded by the commands that read, not by --help or a refused argument
     from volviz.io.plot3d_pairs import grid_of_solution, is_plot3d_solution
 
     p = Path(path)
@@ -171,12 +175,15 @@ def describe(path: str, array: Optional[str] = None, q: Optional[str] = None,
         if array is not None or q is not None or reader_options:
             raise UsageError("--array, --q and --option apply to data files, not to compressed volumes")
         if p.suffix.lower() == ".vvz":
+            # the wavelet codec (NumPy, its Numba kernels): only for a .vvz file
             from volviz.regular.codec import info as vvz_info
 
             return {"file": str(p), **vvz_info(p)}
+        # the animated codec: only for a compressed series
         from volviz.regular.animation import series_info
 
         return {"file": str(p), **series_info(p)}
+    # NumPy and the readers: loaded by the commands that read, not by --help or a refused argument
     from volviz.model import TimeSeries
     from volviz.model.arrays import default_array, list_arrays, select_array
 
@@ -217,6 +224,7 @@ def describe(path: str, array: Optional[str] = None, q: Optional[str] = None,
 def describe_gl() -> dict[str, Any]:
     """The OpenGL driver of an offscreen VTK render window and the backend "auto" picks on it for each view kind
     (``volviz.render.backend``)."""
+    # heavy: VTK's rendering, only for --gl
     from volviz.render.backend import VIEW_KINDS, choose_backend, offscreen_gl_info
 
     info = offscreen_gl_info()
@@ -232,6 +240,7 @@ def _finite(pair: Sequence[float]) -> list[Optional[float]]:
 
 def _series_membership(path: Path) -> Optional[dict[str, Any]]:
     """Which numbered series ``path`` belongs to (the pattern, its position, its time), or None."""
+    # NumPy and the readers: loaded by the commands that read, not by --help or a refused argument
     from volviz.io.series import expand_pattern, member_time
     from volviz.scene.series import series_pattern
 
@@ -292,21 +301,25 @@ def run(argv: Optional[Sequence[str]] = None) -> int:
     if args.command == "render":
         return _render(args)
     if args.command == "bench":
+        # the benchmarks and their dependencies: only for volviz bench
         from volviz.bench import require_plotting
 
         require_plotting(args.name)
         module = importlib.import_module(f"volviz.bench.{args.name}")
         return int(module.main(list(rest)) or 0)
     if args.command == "compress":
+        # the wavelet codec (Numba kernels): only for volviz compress
         from volviz.regular.cli import compress_main
 
         return int(compress_main(list(rest)) or 0)
     if args.command == "warmup":
         return _warmup()
     if args.command == "schema":
+        # pydantic's session models: only for volviz schema
         from volviz.model.session_schema import session_schema_text
 
         if args.output:
+            # NumPy and the readers: loaded by the commands that read, not by --help or a refused argument
             from volviz.io.atomic import atomic_write_bytes
 
             atomic_write_bytes(args.output, session_schema_text().encode("utf-8"))
@@ -366,6 +379,7 @@ def _start_reader(path: Path, options: dict[str, Any]) -> None:
     interpreter (a crash cannot take the render with it), so its start (Python, numpy, ``volviz.io``) overlaps the
     import of the render layer instead of following it (issue #31, docs/architecture.md "Start-up"); ``_render``
     calls it before that import. A session file's format is none a reader takes: it starts no child."""
+    # NumPy and the readers: loaded by the commands that read, not by --help or a refused argument
     from volviz.io import ReadError, isolated
     from volviz.io.registry import format_of, get_reader
 
@@ -380,6 +394,7 @@ def _start_reader(path: Path, options: dict[str, Any]) -> None:
 def _read_for_render(session: Any, datasets: dict[str, Any], args: argparse.Namespace) -> None:
     """Read a data file's dataset into ``datasets`` (a PLOT3D solution file given alone says what to do) and check
     that it has the ``--array`` asked for (a usage error naming the arrays it has)."""
+    # the scene layer (NumPy, readers, Numba): only for volviz render
     from volviz.scene.datasets import read_any, shown_array
 
     ref = session.datasets[0]
@@ -393,6 +408,7 @@ def _read_for_render(session: Any, datasets: dict[str, Any], args: argparse.Name
 
 
 def _warmup() -> int:
+    # heavy: every kernel and VTK's rendering, only for volviz warmup
     from volviz.warmup import warm_up
 
     def progress(fraction: float, message: str) -> None:
@@ -405,6 +421,7 @@ def _warmup() -> int:
 
 
 def user_errors() -> tuple[type[BaseException], ...]:
+    # the error classes of the layers a command loaded (NumPy, pydantic, VTK): imported when an error is caught
     from volviz.io import ReadError
     from volviz.io.atomic import OutputPathError
     from volviz.render.export import ExportError
@@ -435,8 +452,6 @@ def _as_program() -> None:
     and again (issue #30: a Blunt Fin render ran 555 young, 50 middle and 4 full collections, 0.30 s of CPU; with
     these thresholds 39, 3 and 0, 0.12 s, the same peak memory), and no collection at the exit
     (``_no_collection_at_exit``)."""
-    import gc
-
     gc.set_threshold(*PROGRAM_GC_THRESHOLDS)
     atexit.register(_no_collection_at_exit)
 
@@ -447,8 +462,6 @@ def _no_collection_at_exit() -> None:
     had written its image (issue #30, time to the first image: ``gc.freeze`` moves them out of the collector's
     reach). Run last among the exit handlers, so that those (the reader child's shutdown, ``weakref.finalize``)
     still run."""
-    import gc
-
     gc.freeze()
 
 

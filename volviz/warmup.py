@@ -71,6 +71,7 @@ def _blob(n: int, phase: float = 0.0) -> np.ndarray:
 
 
 def _render(doc: dict, folder: Path, name: str) -> None:
+    # heavy: VTK's rendering and pydantic, loaded only when the warm-up runs (not at the CLI's import)
     from volviz.render.export import render_session
     from volviz.session import load
 
@@ -80,6 +81,7 @@ def _render(doc: dict, folder: Path, name: str) -> None:
 
 
 def _natural_scene(folder: Path) -> None:
+    # heavy: the natural scene's kernels and VTK's rendering, loaded only when the warm-up runs
     from volviz.nature.fog import FogLayer
     from volviz.render.export import render_session
     from volviz.render.gl_fog import prism_buffers
@@ -118,6 +120,7 @@ def _tetrahedral_volume(folder: Path) -> None:
 
 
 def _compressed_volume(folder: Path) -> None:
+    # the wavelet codec's Numba kernels, loaded only when the warm-up runs
     from volviz.model.datasets import RegularVolume
     from volviz.regular.animation import compress_series, decompress_series
     from volviz.regular.codec import compress, decompress
@@ -145,6 +148,7 @@ def _compressed_volume(folder: Path) -> None:
 
 
 def _time_series(folder: Path) -> None:
+    # heavy: PyVista and VTK's rendering, loaded only when the warm-up runs
     import pyvista as pv
 
     from volviz.render.controller import ISO_MODES
@@ -189,6 +193,7 @@ def warm_up(progress: Optional[ProgressCallback] = None, workers: Optional[int] 
     exercises compile mostly disjoint kernels (Numba's cache takes concurrent writers), so they run in ``workers``
     processes at once (one per core, at most one per exercise; Numba compiles on one thread): on 2 cores the warm-up
     takes about its longest exercise instead of their sum."""
+    # process pools (multiprocessing): only when the warm-up compiles in parallel
     from concurrent.futures import ProcessPoolExecutor, as_completed
     from multiprocessing import get_context
 
