@@ -82,10 +82,6 @@ ISO_PARTS = ("IsoParts or a list of IsoMesh: the body tells them apart with a co
 ALLOWED: dict[str, str] = {
     "volviz.render.backend:GLInfo.to_dict": JSON,
     "volviz.render.backend:backend_setting": JSON,
-    "volviz.render.clipping:set_mapper_planes": ELSEWHERE,
-    "volviz.render.clipping:clip_vtk_prop": ELSEWHERE,
-    "volviz.render.collision:fly_clearance": ELSEWHERE,
-    "volviz.render.collision:fly_bounds": ELSEWHERE,
     "volviz.render.component_views:VtkPropView.set_input": DATASET,
     "volviz.render.component_views:VtkPropView.update": STATS,
     "volviz.render.component_views:IsoSurfacesView.update": STATS,
@@ -154,6 +150,7 @@ ALLOWED: dict[str, str] = {
     "volviz.render.lod_volume:LodVolume.finish": STATS,
     "volviz.render.lod_volume:LodVolume.update": STATS,
     "volviz.render.lod_volume:LodVolume.show_stats": STATS,
+    "volviz.render.offscreen:draw_projected_tetrahedra_once": PLOTTER,
     "volviz.render.offscreen:offscreen_plotter":
         "pv.Plotter: PyVista 0.49's _Wrapped decorator mistypes its methods for callers outside this change (bench)",
     "volviz.render.preview_hold:hold_previews": PLOTTER,

@@ -16,13 +16,13 @@ How each prop honours them:
 from __future__ import annotations
 
 import logging
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Optional
 
 from volviz.iso.clip import clip_grid
 from volviz.model.clip import ClipPlane, ClipSettings
 
 if TYPE_CHECKING:   # type-only: VTK's classes, reached through the facade at run time
-    from volviz.render.vtk_facade import vtkPlane
+    from volviz.render.vtk_facade import vtkAbstractMapper, vtkDataObject, vtkPlane, vtkProp
 
 log = logging.getLogger(__name__)
 
@@ -39,7 +39,7 @@ def vtk_plane(plane: ClipPlane) -> vtkPlane:
     return p
 
 
-def set_mapper_planes(mapper: Any, planes: list[ClipPlane], limit: int | None = None) -> None:
+def set_mapper_planes(mapper: vtkAbstractMapper, planes: list[ClipPlane], limit: int | None = None) -> None:
     """Replace a mapper's clipping planes (``limit``: the most the mapper can honour)."""
     mapper.RemoveAllClippingPlanes()
     if limit is not None and len(planes) > limit:
@@ -50,7 +50,8 @@ def set_mapper_planes(mapper: Any, planes: list[ClipPlane], limit: int | None = 
     mapper.Modified()  # else a screenshot re-uses the previous frame
 
 
-def clip_vtk_prop(prop: Any, clip: ClipSettings, source: Any = None) -> Any:
+def clip_vtk_prop(prop: vtkProp, clip: ClipSettings,
+                  source: Optional[vtkDataObject] = None) -> Optional[vtkDataObject]:
     """Apply ``clip`` to a VTK prop of a scene; returns the original (uncut) mapper input to keep for the next change.
 
     ``source``: the uncut input kept from an earlier call (tetrahedral volumes are cut on the CPU from it).

@@ -6,15 +6,18 @@ by its height function instead) and the decorations are not obstacles. The locat
 surfaces change."""
 from __future__ import annotations
 
-from typing import Any, Optional
+from typing import TYPE_CHECKING, Any, Mapping, Optional, Sequence
 
 import numpy as np
+
+if TYPE_CHECKING:   # type-only: the natural scene's terrain
+    from volviz.nature.heightfield import HeightField
 
 NOT_OBSTACLES = ("nature-terrain", "nature-sky", "volviz-outline")
 DEFAULT_CLEARANCE = 0.01      # of the scene's size
 
 
-def fly_clearance(options: dict[str, Any]) -> float:
+def fly_clearance(options: Mapping[str, object]) -> float:
     """The fly-mode clearance as a share of the scene's size: the render option ``fly_clearance`` (0 to 0.5), else
     ``DEFAULT_CLEARANCE``."""
     value = options.get("fly_clearance", DEFAULT_CLEARANCE)
@@ -23,7 +26,8 @@ def fly_clearance(options: dict[str, Any]) -> float:
     return float(value)
 
 
-def fly_bounds(scene_bounds: Any, eye: Any, terrain: Any = None) -> tuple[float, ...]:
+def fly_bounds(scene_bounds: Sequence[float], eye: Sequence[float],
+               terrain: Optional[HeightField] = None) -> tuple[float, ...]:
     """The box a flying eye stays in: around a terrain, half its extent beyond each side and up to its extent above
     its highest point (the sky dome's bounds are 6 times wider); else the scene's bounds grown by their size on
     every side. The box holds the ``eye`` where the flight starts, so the first step never jumps."""

@@ -60,7 +60,7 @@ from vtkmodules.vtkRenderingVolume import (  # noqa: F401
 from vtkmodules.vtkRenderingVolumeOpenGL2 import vtkMultiBlockVolumeMapper, vtkSmartVolumeMapper  # noqa: F401
 
 if TYPE_CHECKING:   # types other modules of render annotate with; not ones ``vtk`` holds (no caller makes one)
-    from vtkmodules.vtkRenderingCore import vtkProp  # noqa: F401
+    from vtkmodules.vtkRenderingCore import vtkAbstractMapper, vtkProp  # noqa: F401
     from vtkmodules.vtkRenderingOpenGL2 import vtkOpenGLRenderWindow, vtkShaderProgram  # noqa: F401
 
 #: the VTK classes and constants imported above, by their VTK names: ``vtk.vtkActor()`` as with VTK's own module
