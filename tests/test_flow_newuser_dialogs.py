@@ -25,6 +25,10 @@ def _laptop_window(qtbot, make_window):
 
 def test_iso_dock_buttons_are_in_view_without_scrolling(qtbot, make_window) -> None:
     window = _laptop_window(qtbot, make_window)
+    window.open_demo()         # as `volviz-app` starts: the demo has no volume, and the dock says so in its note
+    wait_loaded(qtbot, window)
+    assert window.iso_tool.dock.note.text()
+    window.dirty = False
     window.open_path(data_file("volumes/hydrogen.vti"))   # as the new user did: data whose surfaces the dock adds
     wait_loaded(qtbot, window)
     wait_settled(qtbot, window)

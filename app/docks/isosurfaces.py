@@ -9,7 +9,7 @@ from typing import Any, Optional
 from PySide6.QtCore import Qt, Signal
 from PySide6.QtGui import QColor
 from PySide6.QtWidgets import (QAbstractItemView, QColorDialog, QComboBox, QDoubleSpinBox, QFormLayout, QHBoxLayout,
-                               QLabel, QPushButton, QTableWidget, QTableWidgetItem, QVBoxLayout, QWidget)
+                               QLabel, QPushButton, QSizePolicy, QTableWidget, QTableWidgetItem, QVBoxLayout, QWidget)
 
 from volviz.session import ISO_MODES
 
@@ -36,6 +36,12 @@ class IsosurfacesDock(QWidget):
         self.table.setEditTriggers(QAbstractItemView.EditTrigger.NoEditTriggers)
         self.table.verticalHeader().setVisible(False)
         self.table.setMinimumHeight(90)
+        # its height is what the editors leave (at least 90): once the word-wrapped note had text ("Isosurfaces need a
+        # volume." after the demo) the dock's scroll area sized the dock by height-for-width from the table's 192-pixel
+        # hint and hid Add/Apply/Remove below the fold of a 1366x768 screen (issue #28)
+        policy = self.table.sizePolicy()
+        policy.setVerticalPolicy(QSizePolicy.Policy.Ignored)
+        self.table.setSizePolicy(policy)
         self.value = QDoubleSpinBox()
         self.value.setDecimals(4)
         self.value.setRange(-1e12, 1e12)
