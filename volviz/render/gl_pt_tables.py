@@ -5,11 +5,21 @@ kind packed as float32 texels (3D pre-integration table, separable table layers,
 rows), and its uniforms."""
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Iterable, Union, cast
 
 import numpy as np
 
 from volviz.render.gl import shader_source, table_texture, with_defines
+
+if TYPE_CHECKING:   # type-only: the tables a PT pass evaluates, VTK's classes reached through the facade at run time
+    from volviz.optics.isosurface import IsoTable
+    from volviz.optics.separable import SeparableTable
+    from volviz.optics.table3d import Table3D
+    from volviz.render.vtk_facade import vtkOpenGLRenderWindow, vtkShaderProgram, vtkTextureObject
+    from volviz.unstructured.render import Preclassified
+
+    #: a table of any kind ``gl_pt`` builds (``GLPTVolume._build_table``), told apart by its attributes
+    PTTable = Union[IsoTable, Preclassified, Table3D, SeparableTable]
 
 __all__ = ["AMBIENT", "KINDS", "pt_shader", "resolve_shader", "set_table_uniforms", "table_texels",
            "upload_table"]
@@ -32,7 +42,7 @@ def resolve_shader(upsample: bool) -> str:
     return with_defines(shader_source("pt_resolve_fs.glsl"), "#define PT_UPSAMPLE\n" if upsample else "")
 
 
-def table_texels(table: Any) -> tuple[np.ndarray, bool]:
+def table_texels(table: PTTable) -> tuple[np.ndarray, bool]:
     """(texels (nz, ny, nx, 4) float32, layered) of a table of any kind: isosurfaces (rows: value and opacity, front
     colors, back colors; one texel per surface in value order), pre-classified (rows: kappa's color and rho; the
     scalar), the 3D table (x = l, y = s_b, z = s_f) or the separable one (x = s_f, y = s_b, a layer per polynomial
@@ -61,18 +71,21 @@ def table_texels(table: Any) -> tuple[np.ndarray, bool]:
     return np.ascontiguousarray(layers), True
 
 
-def upload_table(ren_win: Any, table: Any) -> Any:
+def upload_table(ren_win: vtkOpenGLRenderWindow, table: PTTable) -> vtkTextureObject:
     """The texture of ``table`` (``table_texels``) in ``ren_win``'s context."""
     data, layered = table_texels(table)
     return table_texture(ren_win, data, layered)
 
 
-def set_table_uniforms(program: Any, table: Any, smooth: bool, light: Any) -> None:
+def set_table_uniforms(program: vtkShaderProgram, table: PTTable, smooth: bool, light: Iterable[float]) -> None:
     """The uniforms of ``table``'s kind: row counts (isosurfaces, pre-classified), the thickening and, for
     ``smooth`` isosurfaces, the headlight direction ``light`` and the ambient term; the tables' axes otherwise."""
+    # each kind is told apart by an attribute as in table_texels; mypy's hasattr keeps the other kinds in the union,
+    # so the branch names its kind (a cast: nothing checked or converted at run time)
     if hasattr(table, "isosurfaces"):
-        program.SetUniformi("rowCount", len(table.isosurfaces))
-        program.SetUniformf("isoThicken", float(table.thicken))
+        iso = cast("IsoTable", table)
+        program.SetUniformi("rowCount", len(iso.isosurfaces))
+        program.SetUniformf("isoThicken", float(iso.thicken))
         if smooth:
             program.SetUniform3f("shadeLight", [float(x) for x in light])
             program.SetUniformf("shadeAmbient", AMBIENT)
@@ -82,7 +95,8 @@ def set_table_uniforms(program: Any, table: Any, smooth: bool, light: Any) -> No
         return
     program.SetUniform4f("tableAxis", [float(table.s_lo), float(1.0 / table.ds), float(table.n_s), 0.0])
     if hasattr(table, "rgba"):
-        program.SetUniform4f("tableLength", [float(1.0 / table.dl), float(table.n_l), 0.0, 0.0])
+        table3d = cast("Table3D", table)
+        program.SetUniform4f("tableLength", [float(1.0 / table3d.dl), float(table3d.n_l), 0.0, 0.0])
     else:
         program.SetUniform4f("tableLength", [float(1.0 / table.l_max), 0.0, float(table.degree), 0.0])
         program.SetUniform3f("kappaMax", [float(x) for x in table.kappa_max])
