@@ -75,6 +75,8 @@ VIEW_OBJECTS = ("a view of one of several classes, each with its own request typ
                 "natural scene's view has no stats and the GL isosurfaces' no job, which these callers use")
 PLOTTER = ("a PyVista plotter (pv.Plotter offscreen, pyvistaqt's QtInteractor in the app), untyped for the reason "
            "of offscreen_plotter's entry")
+PLOTTER_WINDOW = ("a PyVista plotter whose ren_win these read and set: PyVista types it Optional (None once closed), "
+                  "so typing the plotter needs a None check in the body, a code change")
 ISO_PARTS = ("IsoParts or a list of IsoMesh: the body tells them apart with a conditional expression mypy "
              "cannot follow")
 
@@ -131,11 +133,9 @@ ALLOWED: dict[str, str] = {
     "volviz.render.gl_pt_order:CellOrder.compute": GL,
     "volviz.render.gl_pt_order:CellOrder.finish": GL,
     "volviz.render.image_overlay:overlay_rgba8": GL,
-    "volviz.render.image_overlay:read_buffers": GL,
-    "volviz.render.image_overlay:window_size": GL,
-    "volviz.render.image_overlay:hold_single_sample": GL,
-    "volviz.render.image_overlay:single_sample_on_software": GL,
-    "volviz.render.image_overlay:release_single_sample": GL,
+    "volviz.render.image_overlay:hold_single_sample": PLOTTER_WINDOW,
+    "volviz.render.image_overlay:single_sample_on_software": PLOTTER_WINDOW,
+    "volviz.render.image_overlay:release_single_sample": PLOTTER_WINDOW,
     "volviz.render.image_overlay:OverlayView.begin": GL,
     "volviz.render.image_overlay:OverlayView.compute": GL,
     "volviz.render.image_overlay:OverlayView.finish": GL,

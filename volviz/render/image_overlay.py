@@ -37,12 +37,15 @@ from __future__ import annotations
 import time
 import weakref
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any, Union
 
 import numpy as np
 
 from volviz.model.camera import Camera
 from volviz.render.backend import plotter_gl_info
+
+if TYPE_CHECKING:   # type-only: VTK's classes, reached through the facade at run time
+    from volviz.render.vtk_facade import vtkRenderer, vtkRenderWindow
 
 __all__ = ["ImageOverlay", "OverlayRequest", "OverlayView", "block_min", "overlay_rgba8", "read_buffers",
            "single_sample_on_software", "unpremultiply_rgba8", "zbuffer_to_depth"]
@@ -98,7 +101,7 @@ def unpremultiply_rgba8(image: np.ndarray) -> np.ndarray:
     return out
 
 
-def read_buffers(ren_win: Any, w: int, h: int) -> tuple[np.ndarray, np.ndarray]:
+def read_buffers(ren_win: vtkRenderWindow, w: int, h: int) -> tuple[np.ndarray, np.ndarray]:
     """(z (H, W) float64, rgb (H, W, 3) uint8) of the render window, row 0 at the top."""
     # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
     from volviz.render.vtk_facade import vtk, vtk_to_numpy
@@ -112,7 +115,7 @@ def read_buffers(ren_win: Any, w: int, h: int) -> tuple[np.ndarray, np.ndarray]:
     return zz, cc
 
 
-def window_size(window: Any) -> tuple[int, int]:
+def window_size(window: Union[vtkRenderer, vtkRenderWindow]) -> tuple[int, int]:
     """The (width, height) in pixels of a vtkRenderer or vtkRenderWindow."""
     width, height = window.GetSize()
     return int(width), int(height)
@@ -130,7 +133,7 @@ class _SingleSample:
 _single_sample: weakref.WeakKeyDictionary[Any, _SingleSample] = weakref.WeakKeyDictionary()   # by plotter
 
 
-def hold_single_sample(plotter: Any, holder: Any) -> None:
+def hold_single_sample(plotter: Any, holder: object) -> None:
     """Multisampling off while ``holder`` is in the plotter (one color and depth per pixel: the overlays read the
     depth back, the GL PT pass draws into a single-sample float target; module docstring)."""
     held = _single_sample.get(plotter)
@@ -150,7 +153,7 @@ def single_sample_on_software(plotter: Any) -> None:
             held.restore = 0
 
 
-def release_single_sample(plotter: Any, holder: Any) -> None:
+def release_single_sample(plotter: Any, holder: object) -> None:
     """``holder`` is gone: the last one restores the plotter's multisampling."""
     held = _single_sample.get(plotter)
     if held is None:
