@@ -4,15 +4,24 @@ depth-peeled with it, ``volviz.render.volume_peeling``, so that the volume in fr
 volume behind it does not)."""
 from __future__ import annotations
 
-from typing import Any, Optional
+from typing import TYPE_CHECKING, Optional
 
 from volviz.render.iso_spectrum import iso_actor
 from volviz.render.vtk_facade import vtk
 from volviz.scene.isosurfaces import IsoParts, isosurface_parts
 from volviz.session import Component
 
+if TYPE_CHECKING:   # type-only: PyVista's plotter, the dataset and surfaces, VTK's assembly (through the facade)
+    import pyvista as pv
 
-def add_isosurface_actors(plotter: Any, name: str, parts: IsoParts, spectrum: bool = True) -> Any:
+    from volviz.iso.extract import IsoMesh
+    from volviz.model.clip import ClipSettings
+    from volviz.render.vtk_facade import vtkPropAssembly
+    from volviz.scene.datasets import LoadedDataset
+
+
+def add_isosurface_actors(plotter: pv.BasePlotter, name: str, parts: IsoParts,
+                          spectrum: bool = True) -> vtkPropAssembly:
     """GUI thread: the shown surfaces of ``parts`` as one prop assembly of VTK actors named ``name``, with the
     iso-spectrum shader when ``spectrum`` (drawn by VTK as the note's 2-pass blend). The assembly keeps the uncut
     surfaces as ``volviz_meshes`` and the shown ones as ``volviz_shown`` (the CPU transparency modes draw those,
@@ -39,8 +48,9 @@ def add_isosurface_actors(plotter: Any, name: str, parts: IsoParts, spectrum: bo
     return assembly
 
 
-def add_isosurfaces(plotter: Any, comp: Component, dataset: Any, t: Optional[float] = None,
-                    spectrum: bool = True, clip: Any = None, meshes: Optional[list[Any]] = None) -> Any:
+def add_isosurfaces(plotter: pv.BasePlotter, comp: Component, dataset: LoadedDataset, t: Optional[float] = None,
+                    spectrum: bool = True, clip: Optional[ClipSettings] = None,
+                    meshes: Optional[list[IsoMesh]] = None) -> vtkPropAssembly:
     """The isosurfaces of an ``isosurface`` component as one prop assembly, now: ``isosurface_parts`` (``clip``:
     the scene's clipping; ``meshes``: the extracted surfaces when already known) then ``add_isosurface_actors``."""
     return add_isosurface_actors(plotter, comp.id, isosurface_parts(comp, dataset, t, clip, meshes),

@@ -17,8 +17,10 @@ from volviz.model.timeseries import frame_at
 from volviz.render.pt_view import is_pt_view
 from volviz.scene.drawn_tf import drawn_tf
 
-if TYPE_CHECKING:   # type-only: VTK's renderer, reached through the facade at run time
+if TYPE_CHECKING:   # type-only: the scene's controller and components; VTK's renderer, reached through the facade
+    from volviz.render.controller import SceneController
     from volviz.render.vtk_facade import vtkRenderer
+    from volviz.session import Component
 
 # id(dataset) -> (weak reference to it, its tetrahedra): the datasets are dataclasses compared by value, so no weak
 # dictionary can key them; an entry leaves with its dataset
@@ -38,7 +40,7 @@ def pick_ray(renderer: vtkRenderer, x: float, y: float) -> tuple[np.ndarray, np.
     return ends[0], direction / np.linalg.norm(direction)
 
 
-def probe_scene(controller: Any, x: float, y: float) -> Optional[ProbeResult]:
+def probe_scene(controller: SceneController, x: float, y: float) -> Optional[ProbeResult]:
     """What is under display pixel (x, y) of ``controller``'s viewport: the nearest hit among the visible volumes
     (``probe_volume``, each with its drawn transfer function) and the meshes VTK can pick."""
     origin, direction = pick_ray(controller.plotter.renderer, x, y)
@@ -55,7 +57,8 @@ def probe_scene(controller: Any, x: float, y: float) -> Optional[ProbeResult]:
     return min(hits, key=lambda h: h[0])[1] if hits else None
 
 
-def probe_volume(controller: Any, comp: Any, origin: np.ndarray, direction: np.ndarray) -> Optional[ProbeResult]:
+def probe_volume(controller: SceneController, comp: Component, origin: np.ndarray,
+                 direction: np.ndarray) -> Optional[ProbeResult]:
     """The first visible sample of volume component ``comp`` along the ray, by what its view draws: the mesh of a
     projected-tetrahedra view, a LOD tree, a regular volume, or the frame of a time series at the controller's
     display time (a regular volume, or a mesh through its tetrahedra), each in the part the scene's clipping keeps;
