@@ -15,7 +15,7 @@ closing the plotter.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -23,6 +23,11 @@ from volviz.model.camera import Camera
 from volviz.nature.fog import FogLayer, layer_emission
 from volviz.render._prism_kernels import kept_connectivity, layer_buffer
 from volviz.render.gl import ScenePass, color_target, glenum, release, set_ray_uniforms, shader_source
+
+if TYPE_CHECKING:   # type-only: PyVista's plotter, the natural scene's terrain mesh
+    import pyvista as pv
+
+    from volviz.nature.terrain import TerrainMesh
 
 __all__ = ["GLFogLayer", "PrismBuffers", "add_fog_layer", "layer_values", "prism_buffers"]
 
@@ -304,7 +309,7 @@ class GLFogLayer:
         self.scene_pass.release(self)
 
 
-def add_fog_layer(plotter: Any, mesh: Any, layer: FogLayer, top: str, bottom: str = "terrain",
+def add_fog_layer(plotter: pv.BasePlotter, mesh: TerrainMesh, layer: FogLayer, top: str, bottom: str = "terrain",
                   emission: tuple[np.ndarray, np.ndarray] | None = None) -> GLFogLayer:
     """A GPU fog layer on a terrain mesh as the natural scene holds it (``TerrainMesh``: ``points``, ``triangles``
     and named height ``layers``): from the terrain (``bottom="terrain"``) or a named layer up to the layer ``top``."""

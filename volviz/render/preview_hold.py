@@ -16,7 +16,10 @@ Only for a plotter whose owner re-makes the images while the camera moves and af
 from __future__ import annotations
 
 import weakref
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:   # type-only: VTK's camera, reached through the facade at run time
+    from volviz.render.vtk_facade import vtkCamera
 
 __all__ = ["PreviewCameraHold", "hold_previews", "holds_previews"]
 
@@ -70,14 +73,14 @@ class PreviewCameraHold:
     def _interaction_started(self, *_: Any) -> None:
         self.interacting = self.holding = True
 
-    def snapshot(self) -> tuple[Any, int]:
+    def snapshot(self) -> tuple[vtkCamera, int]:
         """The live camera now (a copy) and its serial, for the image a ``begin`` starts."""
         live = self.renderer.GetActiveCamera()
         copy = self._vtk.vtkCamera()
         copy.DeepCopy(live)
         return copy, self.live_serial + (_key(live) != self._last_key)
 
-    def shown(self, snapshot: tuple[Any, int], preview: bool) -> None:
+    def shown(self, snapshot: tuple[vtkCamera, int], preview: bool) -> None:
         """A ``finish`` showed an image made for ``snapshot``'s camera."""
         self.image_camera, self.image_serial = snapshot
         if self.holding and not self.interacting and not preview \
