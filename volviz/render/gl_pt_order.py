@@ -7,14 +7,33 @@ logs (camera serial, order serial): the order's age in frames."""
 from __future__ import annotations
 
 import time
-from typing import Any
+from typing import TYPE_CHECKING, Any, Optional, TypedDict
 
 import numpy as np
 
+from volviz.jobs import ProgressCallback
 from volviz.model.camera import Camera
 from volviz.render.image_overlay import window_size
 
-__all__ = ["CellOrder", "order_key"]
+if TYPE_CHECKING:   # type-only: the sort's classes, loaded only when a PT order is computed
+    from volviz.unstructured.prefetch import SortPrefetcher
+    from volviz.unstructured.sort import SortResult
+    from volviz.unstructured.topology import Topology
+
+__all__ = ["CellOrder", "OrderRequest", "order_key"]
+
+
+class OrderRequest(TypedDict):
+    """What ``CellOrder.begin`` asks a worker to sort (``compute``) and ``finish`` checks the order against."""
+
+    camera: Camera
+    size: tuple[int, int]
+    key: tuple[object, ...]
+    topo: Topology
+    preview: bool
+    serial: int
+    have: bool            # the volume has this order already: nothing to sort
+    prefetcher: Optional[SortPrefetcher]
 
 
 def order_key(cam: Camera, size: tuple[int, ...]) -> tuple[object, ...]:
@@ -133,7 +152,7 @@ class CellOrder:
         self._frame_sort = (self.camera_serial, cam, size)
         return res, serial, made_for
 
-    def begin(self, scale: int = 1) -> dict[str, Any]:
+    def begin(self, scale: int = 1) -> OrderRequest:
         """GUI thread: the order to make next, for the renderer's camera and size now (``scale`` > 1: asked for
         during an interaction; the order is the same). A caller that makes the orders on a worker from now on
         (``compute``) keeps them off the GUI thread: renders reuse the newest order (``reuse_order``)."""
@@ -145,7 +164,8 @@ class CellOrder:
         return {"camera": cam, "size": size, "key": key, "topo": self.topo, "preview": scale > 1, "serial": serial,
                 "have": self._sorted is not None and key == self._sorted_key, "prefetcher": self._prefetcher}
 
-    def compute(self, request: dict[str, Any], progress: Any = None) -> tuple[Any]:
+    def compute(self, request: OrderRequest,
+                progress: Optional[ProgressCallback] = None) -> tuple[Optional[SortResult]]:
         """Any thread: the visibility order for ``begin``'s camera (``volviz.unstructured.sort``); None when the
         volume has it already (e.g. a transfer-function edit asked for a new image)."""
         # heavy: the sort's Numba kernels and SciPy, loaded only when a PT order is computed
@@ -159,7 +179,7 @@ class CellOrder:
             return (res,)
         return (visibility_order(request["topo"], request["camera"], request["size"], self.sort, self.nonconvex),)
 
-    def finish(self, request: dict[str, Any], result: Any) -> None:
+    def finish(self, request: OrderRequest, result: Optional[SortResult]) -> None:
         """GUI thread: draw with ``compute``'s order from the next render on: exact for its camera, and with
         ``reuse_order`` the newest order for any other (during an interaction the camera has moved on meanwhile)."""
         if result is None or request["topo"] is not self.topo or request.get("serial", 0) < self.order_serial:
