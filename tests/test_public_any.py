@@ -123,7 +123,6 @@ ALLOWED: dict[str, str] = {
         "duck-typed: reads a NatureScene's optional parts through getattr, which mypy cannot narrow",
     "volviz.render.framing:scene_bounds": VTK_ANY,
     "volviz.render.framing:frame_scene": VTK_ANY,
-    "volviz.render.gl_iso:GLIsoView.set_surfaces": GL,
     "volviz.render.gl_iso:GLIsoView.update": STATS,
     "volviz.render.gl_iso:GLIsoView.finish": STATS,
     "volviz.render.gl_nature:GLNatureView.compute": GL,

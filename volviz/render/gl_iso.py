@@ -19,7 +19,7 @@ frame times: docs/bench/gl-passes.md "gl_iso", ``docs/bench/iso.md``.
 from __future__ import annotations
 
 import time
-from typing import TYPE_CHECKING, Any, Sequence
+from typing import TYPE_CHECKING, Any, Optional, Sequence
 
 import numpy as np
 
@@ -33,7 +33,8 @@ from volviz.render.iso_volume_split import shown_regular_volumes
 from volviz.render.peel_layer import PeelLayer
 from volviz.render.volume_peeling import peel_volumes
 
-if TYPE_CHECKING:   # type-only: VTK's classes, reached through the facade at run time; the progress callback
+if TYPE_CHECKING:   # type-only: VTK's classes, reached through the facade at run time; the progress callback; LOD
+    from volviz.iso.lod import LodChain
     from volviz.jobs import ProgressCallback
     from volviz.render.vtk_facade import vtkPolyData
 
@@ -343,7 +344,7 @@ class GLIsoView(IsoModeView):
 
         self.plotter = plotter
         self.meshes: list[IsoMesh] = []
-        self.lod: list[Any] = []
+        self.lod: list[Optional[tuple[LodChain, float]]] = []   # per mesh: its LOD chain, triangles per pixel²
         self.shading = shading
         self.surfaces: GLIsoSurfaces | None = None
         self.stats: dict[str, Any] = {}
@@ -361,7 +362,8 @@ class GLIsoView(IsoModeView):
         if self.surfaces is not None:
             self.surfaces.set_mode(mode)
 
-    def set_surfaces(self, meshes: Sequence[IsoMesh], lod: Sequence[Any], shading: str) -> None:
+    def set_surfaces(self, meshes: Sequence[IsoMesh], lod: Sequence[Optional[tuple[LodChain, float]]],
+                     shading: str) -> None:
         """Draw ``meshes`` (translucent surfaces of any number of volumes) from the next render on; the vertex buffer
         is made again only when the meshes or the shading changed (the controller passes the same meshes after
         every visibility, clipping or mode call)."""
