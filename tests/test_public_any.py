@@ -62,7 +62,6 @@ def public_any_signatures(root: Path = ROOT, packages: tuple[str, ...] = PACKAGE
 
 GL = ("not yet typed: the VTK objects a GL pass hands around (render windows, programs, textures, props); "
       "render.gl, the facade and vtk_tf are typed with VTK's classes, the passes themselves not yet")
-ELSEWHERE = "not yet typed (a module outside the typed-seams change)"
 JSON = "JSON: a session file's settings, options, clipping or schema, free-form by design"
 STATS = "statistics: a free-form dict of numbers and labels for the status bar and the reports"
 RESULT = "a view's own result tuple, unpacked (each view chooses its shape: View.finish)"
@@ -117,7 +116,7 @@ ALLOWED: dict[str, str] = {
     "volviz.render.decorations:scalar_bar_actor": PLOTTER,
     "volviz.render.decorations:scalar_bar_title": PLOTTER,
     "volviz.render.decorations:scalar_bar_hit": PLOTTER,
-    "volviz.render.error_budget:error_budget_choice": ELSEWHERE,
+    "volviz.render.error_budget:error_budget_choice": JSON,
     "volviz.render.export:open_target": JSON,
     "volviz.render.framing:nature_bounds":
         "duck-typed: reads a NatureScene's optional parts through getattr, which mypy cannot narrow",
