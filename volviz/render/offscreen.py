@@ -6,7 +6,6 @@ import os
 from typing import Any
 
 import pyvista as pv
-from pyvista.plotting import plotter as pyvista_plotter
 
 from volviz.render.vtk_facade import vtk
 
@@ -25,6 +24,10 @@ def skip_display_probe() -> None:
     OpenGL context) only to warn that an on-screen window would fail, which an offscreen plotter never opens (issue
     #30, time to the first image: 0.045 s of CPU of each ``volviz render``). The answer is kept where pyvista keeps
     its own; a process that already asked keeps it."""
+    # heavy: pyvista's plotting (and matplotlib's colours with it), not loaded until a plotter is made: an error
+    # class of this package caught by the CLI must not need matplotlib (a bench without it is a usage error)
+    from pyvista.plotting import plotter as pyvista_plotter
+
     probe = getattr(pyvista_plotter, "_warn_xserver", None)
     if probe is not None and not hasattr(probe, "has_support"):
         probe.has_support = True
