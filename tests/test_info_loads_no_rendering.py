@@ -26,13 +26,24 @@ print(json.dumps({{"code": code, "loaded": loaded, "cli": "volviz.cli" in sys.mo
 def _loaded_by_info(path: str) -> dict:
     done = subprocess.run([sys.executable, "-c", PROBE.format(rendering=RENDERING), path], cwd=REPO,
                           capture_output=True, text=True, timeout=300)
-    assert done.returncode == 0, done.stderr[-3000:]
+    assert done.returncode == 0, done.stderr[-3000:]    # the probe's own exit: main returns the command's code
     return json.loads(done.stdout.strip().splitlines()[-1])
 
 
 def test_volviz_info_loads_no_rendering_module():
     report = _loaded_by_info(str(data_file("volumes/embryo.slc")))
     assert report["code"] == 0 and report["cli"]
+    assert report["loaded"] == []
+
+
+def test_a_refused_file_loads_no_rendering_module(tmp_path):
+    """A file ``volviz info`` refuses is one line and exit 2, and its error handling imports no render layer (the
+    CLI's user errors are taken from the modules the command loaded: before, ``render.export`` was imported for its
+    ExportError, VTK's rendering with it, 0.7-0.9 s of a refusal)."""
+    bad = tmp_path / "bad.vti"
+    bad.write_text("junk")
+    report = _loaded_by_info(str(bad))
+    assert report["code"] == 2
     assert report["loaded"] == []
 
 
