@@ -56,6 +56,9 @@ if TYPE_CHECKING:   # type-only imports for the signatures
     from volviz.render.gl_pt import GLPTVolume
     from volviz.render.iso_overlay import IsoOverlay
     from volviz.render.lod_volume import LodVolume
+    from volviz.nature.terrain import TerrainMesh
+    from volviz.render.gl_nature import EitherNatureView
+    from volviz.render.nature_view import FrameT, NatureRequest, NatureSceneView
     from volviz.render.pt_prop import PTVolume
     from volviz.scene.datasets import LoadedDataset
 
@@ -527,8 +530,9 @@ class SceneController:
 
     # -- view-dependent parts (terrain LOD, fog and cloud images) ---------------------------------------------------
     @property
-    def nature(self) -> Any:
-        return self.views.get("nature")
+    def nature(self) -> Optional[EitherNatureView]:
+        view: Optional[EitherNatureView] = self.views.get("nature")
+        return view
 
     def camera_views(self) -> dict[str, Any]:
         """The shown views that re-make something for a new camera (``volviz.render.views.View``: ``begin`` /
@@ -626,7 +630,7 @@ class SceneController:
         """Any thread: the NatureScene of the visible terrain / fog / clouds / sky components (None: none)."""
         return prepare_nature(self.session, self.datasets)
 
-    def install_nature(self, scene: Optional[NatureScene], views: bool = True) -> Any:
+    def install_nature(self, scene: Optional[NatureScene], views: bool = True) -> Optional[EitherNatureView]:
         """GUI thread: show a ``prepare_nature`` result. With ``views`` its first view is computed now; otherwise
         the old terrain and overlay stay on screen until the new view's first ``finish_nature`` replaces them."""
         old = self.views.pop("nature", None)
@@ -644,11 +648,11 @@ class SceneController:
                 self.set_iso_mode(self.iso_mode, update=views)  # the GPU scene's pass may rule out exact GL
         return view
 
-    def finish_nature(self, view: Any, request: Any, result: tuple[Any, ...]) -> dict[str, Any]:
+    def finish_nature(self, view: NatureSceneView[FrameT], request: NatureRequest,
+                      result: tuple[Optional[TerrainMesh], FrameT, dict[str, float]]) -> dict[str, float]:
         """GUI thread: show a computed view of the natural scene (``view.compute``; a scene without terrain drops
         the terrain of the view it replaced)."""
-        stats: dict[str, Any] = view.finish(request, *result)  # adds its actors with ``render=False``
-        return stats
+        return view.finish(request, *result)  # adds its actors with ``render=False``
 
     def bounds(self) -> tuple[float, float, float, float, float, float]:
         """(xmin, xmax, ymin, ymax, zmin, zmax) of everything the visible components show, including what VTK does

@@ -48,8 +48,7 @@ import threading
 import time
 from concurrent.futures import ThreadPoolExecutor, wait
 from dataclasses import dataclass
-from types import SimpleNamespace
-from typing import Any, Callable
+from typing import TYPE_CHECKING, Any, Callable, Optional, Union
 
 import numpy as np
 
@@ -59,14 +58,19 @@ from volviz.nature.nature_scene import NatureScene
 from volviz.numba_threads import numba_threads, share
 from volviz.render.cloud_slots import RESERVED, LeafSlots, leaf_keys
 from volviz.render.gl import release, resolve_polydata, shader_source, texel_array
-from volviz.render.gl_fog import GLFogLayer, prism_buffers
+from volviz.render.gl_fog import GLFogLayer, PrismBuffers, prism_buffers
 from volviz.render.gl_pt import GLPTVolume
 from volviz.render.image_overlay import hold_single_sample, release_single_sample
-from volviz.render.nature_view import NatureView
+from volviz.render.nature_view import NatureRequest, NatureSceneView, NatureView
 from volviz.unstructured.topology import visible_intervals
 
-__all__ = ["CloudLeaves", "CloudPTVolume", "GLNatureView", "cloud_field_texels", "cloud_leaves",
-           "modulation_scale"]
+if TYPE_CHECKING:   # type-only imports for the signatures
+    from volviz.jobs import ProgressCallback
+    from volviz.model.camera import Camera
+    from volviz.nature.terrain import TerrainMesh
+
+__all__ = ["CloudLeaves", "CloudPTVolume", "EitherNatureView", "GLNatureFrame", "GLNatureView", "PrismGeometry",
+           "cloud_field_texels", "cloud_leaves", "modulation_scale"]
 
 # (anchor in gl_pt's fragment shader, text added after it): the modulation's flat varying, and the length scaled by
 # the modulating field at the middle of the clipped segment
@@ -144,6 +148,22 @@ def _visible_intervals(tf: Any) -> list[tuple[float, float]]:
         gap = int(np.argmin([merged[i + 1][0] - merged[i][1] for i in range(len(merged) - 1)]))
         merged[gap:gap + 2] = [(merged[gap][0], merged[gap + 1][1])]
     return merged
+
+
+#: a prism layer's geometry on a frame's terrain: points (n, 3), bottom and top heights (n,), triangles (m, 3)
+PrismGeometry = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+
+
+@dataclass
+class GLNatureFrame:
+    """What ``GLNatureView.compute`` makes for ``finish`` besides the terrain mesh: the terrain ``mesh`` again (None
+    without terrain), the clouds' leaves (None without clouds), each prism layer's geometry and vertex buffer by
+    name, and the ``eye`` the layers are ordered from."""
+
+    mesh: Optional[TerrainMesh]
+    clouds: Optional[CloudLeaves]
+    prisms: dict[str, tuple[PrismGeometry, PrismBuffers]]
+    eye: np.ndarray
 
 
 @dataclass
@@ -319,7 +339,7 @@ class CloudPTVolume(GLPTVolume):
         super().remove()
 
 
-class GLNatureView(NatureView):
+class GLNatureView(NatureSceneView[GLNatureFrame]):
     """A ``NatureScene`` in a PyVista plotter, fog and clouds on the GPU (module docstring). ``layers``: the
     ``GLFogLayer`` of each prism layer by name; ``clouds``: the ``CloudPTVolume`` (None without clouds or before the
     first frame)."""
@@ -336,8 +356,8 @@ class GLNatureView(NatureView):
         self._terrain_worker = ThreadPoolExecutor(max_workers=1, thread_name_prefix="volviz-terrain-lod")
         self._single_sample = False             # held once a fog layer or the clouds draw (``finish``)
 
-    def compute(self, request: tuple[Any, tuple[int, int], int],
-                progress: Any = None) -> tuple[Any, Any, dict[str, float]]:
+    def compute(self, request: NatureRequest, progress: Optional[ProgressCallback] = None
+                ) -> tuple[Optional[TerrainMesh], GLNatureFrame, dict[str, float]]:
         """Any thread: the LOD work of a frame (no image): the terrain's C-LOD mesh (``TerrainMesh``, also in the
         frame: ``finish`` makes its VTK poly data on the GUI thread, see ``NatureView.compute``), the prisms standing on
         it with each prism layer's vertex buffer (``prism_buffers``), on a second
@@ -378,11 +398,10 @@ class GLNatureView(NatureView):
         if mesh is not None:
             stats["terrain_triangles"] = float(mesh.n_triangles)
         stats["lod_s"] = time.perf_counter() - t0
-        return mesh, SimpleNamespace(mesh=mesh, clouds=clouds, prisms=prisms,
-                                     eye=np.asarray(cam.position, np.float64)), stats
+        return mesh, GLNatureFrame(mesh, clouds, prisms, np.asarray(cam.position, np.float64)), stats
 
-    def _terrain_part(self, cam: Any, size: tuple[int, int], threads: Callable[[], int]
-                      ) -> tuple[Any, dict[str, Any]]:
+    def _terrain_part(self, cam: Camera, size: tuple[int, int], threads: Callable[[], int]
+                      ) -> tuple[Optional[TerrainMesh], dict[str, tuple[PrismGeometry, PrismBuffers]]]:
         """The terrain's C-LOD mesh and each prism layer's (geometry, ``prism_buffers``), their kernels on
         ``threads()`` Numba threads (asked for when each stage starts)."""
         scene = self.scene
@@ -393,17 +412,17 @@ class GLNatureView(NatureView):
         with numba_threads(threads()):
             return mesh, self._prism_layers(mesh)
 
-    def _prism_layers(self, mesh: Any) -> dict[str, Any]:
+    def _prism_layers(self, mesh: TerrainMesh) -> dict[str, tuple[PrismGeometry, PrismBuffers]]:
         """Each prism layer's (geometry, ``prism_buffers``) on the terrain ``mesh``, by name."""
         scene = self.scene
-        prisms = {}
+        prisms: dict[str, tuple[PrismGeometry, PrismBuffers]] = {}
         for fog in scene.fogs:
             bottom = mesh.points[:, 2] if fog.bottom == "terrain" else mesh.layers[fog.bottom]
-            geometry = (mesh.points, bottom, mesh.layers[fog.top], mesh.triangles)
+            geometry: PrismGeometry = (mesh.points, bottom, mesh.layers[fog.top], mesh.triangles)
             prisms[fog.name] = (geometry, prism_buffers(*geometry, layer=fog.layer))
         return prisms
 
-    def finish(self, request: tuple[Any, tuple[int, int], int], mesh: Any, frame: Any,
+    def finish(self, request: NatureRequest, mesh: Optional[TerrainMesh], frame: GLNatureFrame,
                stats: dict[str, float]) -> dict[str, float]:
         """GUI thread: the terrain mesh (made VTK poly data here) and the vertex buffers of the prisms and cloud
         tetrahedra made by ``compute`` to VTK (uploaded and drawn at the next render); ``upload_s``: seconds spent
@@ -411,7 +430,8 @@ class GLNatureView(NatureView):
         t0 = time.perf_counter()
         self._show_terrain(mesh.to_pyvista() if mesh is not None else None)
         scene = self.scene
-        for kind, fog in scene.volume_order(frame.eye):    # made in this order: the first frame moves nothing
+        # made in this order: the first frame moves nothing
+        for kind, fog in scene.volume_order([float(v) for v in frame.eye]):
             if kind == "fog" and fog.name in frame.prisms:
                 (points, bottom, top, triangles), buffers = frame.prisms[fog.name]
                 if fog.name in self.layers:
@@ -477,3 +497,7 @@ class GLNatureView(NatureView):
             release_single_sample(self.plotter, self)
             self._single_sample = False
         super().remove()
+
+
+#: the natural scene's view of either backend (what the controller keeps under "nature")
+EitherNatureView = Union[NatureView, GLNatureView]

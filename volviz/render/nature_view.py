@@ -5,14 +5,17 @@ occlusion is already in it, from the CPU terrain z-buffer): a premultiplied text
 so that an image of any size covers it (a preview smaller than the window, a frame drawn at a reduced size).
 ``NatureView.update(camera)`` recomputes the terrain LOD mesh and the overlay for a camera; the app does it in the
 background (``begin`` / ``compute`` / ``finish``).
-``volviz.render.gl_nature.GLNatureView`` is the GPU backend with the same calls.
+``volviz.render.gl_nature.GLNatureView`` is the GPU backend with the same calls; what both share (terrain, sky, the
+clipping range, ``begin``) is ``NatureSceneView``, generic in the frame its ``compute`` makes besides the terrain mesh
+(the CPU's overlay image, the GPU's vertex buffers).
 
 ``build_nature_components`` builds a view from a session's terrain / fog / clouds / sky components.
 """
 from __future__ import annotations
 
 import weakref
-from typing import TYPE_CHECKING, Any, Callable, Optional, Sequence, Union
+from abc import ABC, abstractmethod
+from typing import TYPE_CHECKING, Any, Callable, Generic, Optional, Sequence, TypeVar, Union
 
 import numpy as np
 
@@ -35,15 +38,19 @@ if TYPE_CHECKING:   # type-only imports for the signatures
 
 #: a natural-scene view's request: (camera, image size (width, height), preview scale)
 NatureRequest = tuple["Camera", tuple[int, int], int]
+#: what a natural-scene view's ``compute`` makes besides the terrain mesh and the statistics, and its ``finish``
+#: shows: ``NatureView``'s overlay image, ``GLNatureView``'s ``GLNatureFrame``
+FrameT = TypeVar("FrameT")
 
 PREVIEW_TRIANGLES = 60_000   # terrain triangles of a frame drawn while the camera moves (~60 ms on llvmpipe)
 
-class NatureView:
-    """A ``NatureScene`` inside a PyVista plotter: terrain mesh, sky dome and the volume overlay (see module doc).
-    The CPU backend of the natural-scene view; ``volviz.render.gl_nature.GLNatureView`` is the GPU one."""
+class NatureSceneView(ABC, Generic[FrameT]):
+    """A ``NatureScene`` inside a PyVista plotter, what both backends share: the terrain mesh, the sky dome, the
+    clipping range, ``begin`` and ``update``; ``compute`` and ``finish`` are the backend's (``NatureView``,
+    ``volviz.render.gl_nature.GLNatureView``), of its own frame type."""
 
     kind = "nature"
-    backend = "cpu"
+    backend: str   # the backend's: "cpu" or "gpu"
     job = ("nature", "natural scene")  # the app's key for its updates, and what its worker makes
     camera_dependent = True
 
@@ -171,6 +178,51 @@ class NatureView:
         w, h = self.size or (int(self.plotter.window_size[0]), int(self.plotter.window_size[1]))
         return cam, (w, h), max(1, int(scale))
 
+    @abstractmethod
+    def compute(self, request: NatureRequest, progress: Optional[ProgressCallback] = None
+                ) -> tuple[Optional[TerrainMesh], FrameT, dict[str, float]]:
+        """Any thread: the terrain's C-LOD mesh for ``request`` (None without terrain), the backend's frame and the
+        statistics."""
+
+    @abstractmethod
+    def finish(self, request: NatureRequest, mesh: Optional[TerrainMesh], frame: FrameT,
+               stats: dict[str, float]) -> dict[str, float]:
+        """GUI thread: show a ``compute`` result; returns its statistics."""
+
+    def _show_terrain(self, poly: Any) -> None:
+        """The C-LOD terrain mesh (VTK poly data; None: keep the shown one) as the textured terrain actor. A scene
+        without terrain takes the terrain of the view it replaced (still shown until this first frame) off the
+        plotter. While no triangle is in view (e.g. the camera looks at the sky) before the first one, no actor is
+        made (PyVista refuses empty meshes)."""
+        if poly is not None:
+            if self.terrain_actor is None and poly.n_points == 0:
+                return
+            if self.terrain_actor is None:
+                self.terrain_actor = self.plotter.add_mesh(poly, texture=self._texture, lighting=False,
+                                                           name="nature-terrain", render=False)
+            else:
+                self.terrain_actor.mapper.SetInputData(poly)
+            self._mesh = poly
+        elif self.terrain_actor is None:
+            self.plotter.remove_actor("nature-terrain", render=False)
+
+    def remove(self) -> None:
+        """Take the view's actors (sky, terrain, overlay) and its clipping observer out of the plotter."""
+        if self._clip_observer is not None and self.plotter.renderer is not None:
+            self.plotter.renderer.RemoveObserver(self._clip_observer)
+        self._clip_observer = None
+        for name in ("nature-sky", "nature-terrain", "nature-overlay"):
+            self.plotter.remove_actor(name, render=False)
+        self.terrain_actor = self._overlay_actor = self._overlay_image = None
+
+
+class NatureView(NatureSceneView[np.ndarray]):
+    """The CPU backend of the natural-scene view: the fog and clouds rendered by ``volviz.nature`` into one
+    screen-space overlay image in front of the terrain (module docstring); ``volviz.render.gl_nature.GLNatureView``
+    is the GPU one."""
+
+    backend = "cpu"
+
     def compute(self, request: NatureRequest, progress: Optional[ProgressCallback] = None
                 ) -> tuple[Optional[TerrainMesh], np.ndarray, dict[str, float]]:
         """Any thread (one at a time): the C-LOD terrain mesh (None without terrain; ``finish`` makes its VTK poly data
@@ -229,32 +281,6 @@ class NatureView:
         self.shown_scale = int(request[2])
         return stats
 
-    def _show_terrain(self, poly: Any) -> None:
-        """The C-LOD terrain mesh (VTK poly data; None: keep the shown one) as the textured terrain actor. A scene
-        without terrain takes the terrain of the view it replaced (still shown until this first frame) off the
-        plotter. While no triangle is in view (e.g. the camera looks at the sky) before the first one, no actor is
-        made (PyVista refuses empty meshes)."""
-        if poly is not None:
-            if self.terrain_actor is None and poly.n_points == 0:
-                return
-            if self.terrain_actor is None:
-                self.terrain_actor = self.plotter.add_mesh(poly, texture=self._texture, lighting=False,
-                                                           name="nature-terrain", render=False)
-            else:
-                self.terrain_actor.mapper.SetInputData(poly)
-            self._mesh = poly
-        elif self.terrain_actor is None:
-            self.plotter.remove_actor("nature-terrain", render=False)
-
-    def remove(self) -> None:
-        """Take the view's actors (sky, terrain, overlay) and its clipping observer out of the plotter."""
-        if self._clip_observer is not None and self.plotter.renderer is not None:
-            self.plotter.renderer.RemoveObserver(self._clip_observer)
-        self._clip_observer = None
-        for name in ("nature-sky", "nature-terrain", "nature-overlay"):
-            self.plotter.remove_actor(name, render=False)
-        self.terrain_actor = self._overlay_actor = self._overlay_image = None
-
     def _set_overlay(self, overlay: np.ndarray, smooth: bool = False) -> None:
         """Show an overlay image of ``_overlay_rgba`` (8-bit premultiplied RGBA, rows bottom-up) in front of the scene,
         over the whole viewport whatever the image's size (``_viewport_quad``). ``smooth``: filtered linearly (a
@@ -278,7 +304,7 @@ class NatureView:
         self._overlay_actor.GetTexture().SetInterpolate(bool(smooth))
 
 
-def _refit(view: weakref.ref[NatureView]) -> Callable[..., None]:
+def _refit(view: weakref.ref[NatureSceneView[Any]]) -> Callable[..., None]:
     """The observer that sets the view's clipping range after VTK fitted its own (the view held weakly: the
     renderer outlives it)."""
 

@@ -34,7 +34,7 @@ if TYPE_CHECKING:   # type-only imports for the signatures
 
     from volviz.nature.nature_scene import NatureScene
     from volviz.optics.transfer_function import TransferFunction
-    from volviz.render.nature_view import NatureView
+    from volviz.render.gl_nature import EitherNatureView
     from volviz.render.views import ComponentView
     from volviz.scene.datasets import LoadedDataset
 
@@ -153,14 +153,14 @@ def add_volume_prop(plotter: pv.BasePlotter, dataset: Any, data: Any, tf: Transf
 
 
 def install_nature(plotter: pv.BasePlotter, scene: Optional[NatureScene], views: bool = True,
-                   backend: str = "cpu") -> Any:
+                   backend: str = "cpu") -> Optional[EitherNatureView]:
     """GUI thread: a view of a prepared NatureScene (None: none): ``NatureView`` (fog and clouds rendered on the CPU
     as an overlay) or, for ``backend`` "gpu", ``volviz.render.gl_nature.GLNatureView`` (drawn by VTK's OpenGL; see
     ``view_backend``). Its first view is computed now when ``views`` (the app computes it in the background:
     ``begin`` / ``compute`` / ``finish``)."""
     if scene is None:
         return None
-    view = view_class("nature", backend)(plotter, scene)
+    view: EitherNatureView = view_class("nature", backend)(plotter, scene)
     if views:
         view.update()
     return view
@@ -295,6 +295,7 @@ def view_backend(plotter: pv.BasePlotter, session: Session, view_kind: str) -> s
     return choose_backend(backend_setting(session.render.options), view_kind, plotter_gl_info(plotter))
 
 
-def build_nature(plotter: pv.BasePlotter, session: Session, datasets: dict[str, LoadedDataset]) -> Optional[NatureView]:
+def build_nature(plotter: pv.BasePlotter, session: Session, datasets: dict[str, LoadedDataset]
+                 ) -> Optional[EitherNatureView]:
     """The NatureView of the session's visible terrain / fog / clouds / sky components (None when it has none)."""
     return install_nature(plotter, prepare_nature(session, datasets), backend=view_backend(plotter, session, "nature"))
