@@ -1,7 +1,8 @@
 """The array selector of the scene tree: which array of its dataset the selected component shows.
 
 The choices are ``volviz.model.arrays.list_arrays``'s (a scalar array by name; a vector or tensor array as its
-magnitude or one component). A choice is one undoable step on the window's undo stack
+magnitude or one component; a name on both the points and the cells once for each, "p (points)" and "p (cells)",
+the cell one's spec ``p@cells``). A choice is one undoable step on the window's undo stack
 (``volviz_app.component_settings``); it sets the component setting ``"array"`` (saved with the session) and
 re-prepares the component through the window's settings path (``apply_component_settings``), which keeps the camera
 and the docks as they are."""
@@ -14,6 +15,18 @@ from PySide6.QtGui import QUndoStack
 from PySide6.QtWidgets import QComboBox
 
 from .component_settings import edit_settings
+
+
+def choice_label(spec: str, association: str, shared: bool) -> str:
+    """The combo's text of ``spec``: the spec itself, and for a name on both the points and the cells its association
+    in words, as ParaView's list tells them apart ("p (points)", "U:0 (cells)"), never the spec's ``@cells``."""
+    from dataclasses import replace
+
+    from volviz.model.arrays import parse_array_spec
+
+    if not shared:
+        return spec
+    return f"{replace(parse_array_spec(spec), association=None)} ({association}s)"
 
 
 class ArrayChoice:
@@ -50,11 +63,12 @@ class ArrayChoice:
             if dataset is not None:  # (a hidden component's dataset is read when it is shown)
                 infos = list_arrays(dataset)
                 self.shown = shown = self.current(comp_id) or default_array(dataset)
+        names = [info.name for info in infos]
         for info in infos:
             for spec in info.choices:
                 lo, hi = info.range
                 bad = f", {info.nonfinite:,} non-finite" if info.nonfinite else ""
-                self.combo.addItem(spec, spec)
+                self.combo.addItem(choice_label(spec, info.association, names.count(info.name) > 1), spec)
                 self.combo.setItemData(self.combo.count() - 1, f"{info.association} array, range {lo:.4g} … "
                                        f"{hi:.4g}{bad}", Qt.ItemDataRole.ToolTipRole)
         if shown is not None and self.combo.findData(shown) < 0:

@@ -46,7 +46,8 @@ MOVIE_FPS = float_in(0.0, 240.0, low_open=True)
 
 
 def _array_spec(text: str) -> str:
-    """An argument type: an array spec ``NAME``, ``NAME:c`` or ``NAME:magnitude`` (``volviz.model.arrays``)."""
+    """An argument type: an array spec ``NAME``, ``NAME:c`` or ``NAME:magnitude``, ``NAME@cells`` for the cell array
+    of a name also on the points (``volviz.model.arrays``)."""
     # NumPy: only when --array is given (the parser stays light for --help)
     from volviz.model.arrays import parse_array_spec
 
@@ -71,7 +72,8 @@ def _reader_option(text: str) -> tuple[str, Any]:
 
 def _data_options(command: argparse.ArgumentParser) -> None:
     command.add_argument("--array", type=_array_spec, metavar="NAME[:c]",
-                         help="the array to show: NAME, NAME:0.. (one component) or NAME:magnitude")
+                         help="the array to show: NAME, NAME:0.. (one component) or NAME:magnitude; "
+                              "NAME@cells:... the cell array of a name also on the points")
     command.add_argument("--q", metavar="FILE", help="the PLOT3D solution (q) file of a PLOT3D grid file")
     command.add_argument("--option", type=_reader_option, action="append", default=[], metavar="KEY=VALUE",
                          help="an option of the file's reader (repeatable), e.g. dataset=/entry/data/data (HDF5), "
@@ -275,7 +277,7 @@ def _print_arrays(arrays: list[dict[str, Any]], width: int) -> None:
     for i, a in enumerate(arrays):
         lo, hi = a["range"]
         rng = "no finite values" if lo is None else f"{lo:g} .. {hi:g}"
-        choices = f"  (--array {' | '.join(a['choices'])})" if a["components"] > 1 else ""
+        choices = f"  (--array {' | '.join(a['choices'])})" if a["choices"] != [a["name"]] else ""
         print(f"{'arrays' if i == 0 else '':<{width}}  {a['name']:<{names}}  {a['association']:<5}  "
               f"{a['components']} component{'s' if a['components'] > 1 else ' '}  range {rng}  "
               f"non-finite {a['nonfinite']}{choices}")

@@ -2,14 +2,16 @@
 
 A dataset keeps every point and cell array of its file. What a view draws is one scalar per point: a scalar array,
 one component of a vector/tensor array, or its magnitude, named by an array spec ``NAME``, ``NAME:c`` (component
-``c``, from 0) or ``NAME:magnitude``. Cell arrays are shown as point scalars through VTK's cell-to-point filter (the
-average of the cells around each point, as ParaView does). Non-finite values are kept and counted; the renderers draw
-them transparent.
+``c``, from 0) or ``NAME:magnitude``. A name on both the points and the cells (OpenFOAM's ``p`` and ``U``) is told
+apart as ParaView's ``ColorBy(('CELLS', 'p'))`` does, by an association in the spec: ``NAME@cells`` (``@points``)
+before the component, ``U@cells:0``; a spec without one names the point array when there is one. Cell arrays are
+shown as point scalars through VTK's cell-to-point filter (the average of the cells around each point, as ParaView
+does). Non-finite values are kept and counted; the renderers draw them transparent.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
-from typing import Any, Union
+from typing import Any, Optional, Union
 
 import numpy as np
 
@@ -19,33 +21,59 @@ MAGNITUDE = "magnitude"
 MAX_COMPONENTS = 9           # tensors: 3x3
 
 
+#: the association words of a spec (``NAME@cells``) -> ``ArrayInfo.association``; the plural is the one written
+ASSOCIATIONS = {"points": "point", "point": "point", "cells": "cell", "cell": "cell"}
+
+
 @dataclass(frozen=True)
 class ArraySpec:
-    """A parsed array spec: the array's ``name`` and ``component`` (an index, ``"magnitude"``, or None for a
-    scalar array / the default of a vector: its magnitude)."""
+    """A parsed array spec: the array's ``name``, ``component`` (an index, ``"magnitude"``, or None for a
+    scalar array / the default of a vector: its magnitude) and ``association`` (``"point"``, ``"cell"``, or None:
+    the point array when the name is on the points, else the cell array)."""
 
     name: str
     component: Union[int, str, None] = None
+    association: Optional[str] = None
 
     def __str__(self) -> str:
-        return self.name if self.component is None else f"{self.name}:{self.component}"
+        where = "" if self.association is None else f"@{self.association}s"
+        return f"{self.name}{where}" if self.component is None else f"{self.name}{where}:{self.component}"
+
+    def matches(self, name: str, association: str) -> bool:
+        """Whether this spec names the array ``name`` on ``association`` (a spec without one names either)."""
+        return name == self.name and self.association in (None, association)
+
+
+def _split_association(text: str) -> tuple[str, Optional[str]]:
+    """``"p@cells"`` -> ("p", "cell"); a text without a trailing association word is kept whole."""
+    name, sep, word = text.rpartition("@")
+    where = ASSOCIATIONS.get(word.lower()) if sep and name else None
+    return (name, where) if where is not None else (text, None)
 
 
 def parse_array_spec(text: str) -> ArraySpec:
-    """``"T"`` -> ArraySpec("T"), ``"V:1"`` -> component 1, ``"V:magnitude"`` (or ``"V:mag"``) -> the magnitude.
-    A name may itself hold colons: only a trailing ``:digits`` or ``:magnitude`` is read as the component."""
+    """``"T"`` -> ArraySpec("T"), ``"V:1"`` -> component 1, ``"V:magnitude"`` (or ``"V:mag"``) -> the magnitude,
+    ``"V@cells:1"`` (or ``"V:1@cells"``) -> component 1 of the cell array V. A name may itself hold colons and
+    ``@``: only a trailing ``:digits`` or ``:magnitude`` is read as the component, and only ``@points`` / ``@cells``
+    right before it (or at the end) as the association."""
     if not isinstance(text, str) or not text.strip():
-        raise ValueError("an array spec is NAME, NAME:COMPONENT or NAME:magnitude, got an empty one")
-    name, sep, tail = text.rpartition(":")
+        raise ValueError("an array spec is NAME, NAME:COMPONENT or NAME:magnitude (NAME@cells for a cell array of "
+                         "a name also on the points), got an empty one")
+    rest, association = _split_association(text)
+    name, sep, tail = rest.rpartition(":")
+    component: Union[int, str, None] = None
     if sep and name:
         if tail.isdigit():
             component = int(tail)
             if component >= MAX_COMPONENTS:
                 raise ValueError(f"array spec {text!r}: component {component} is out of range 0..{MAX_COMPONENTS - 1}")
-            return ArraySpec(name, component)
-        if tail.lower() in ("magnitude", "mag"):
-            return ArraySpec(name, MAGNITUDE)
-    return ArraySpec(text)
+        elif tail.lower() in ("magnitude", "mag"):
+            component = MAGNITUDE
+    if component is None:
+        name = rest
+    if association is None:
+        name, association = _split_association(name)
+    return ArraySpec(name, component, association)
 
 
 @dataclass
@@ -126,15 +154,25 @@ def list_arrays(dataset: Union[Dataset, TimeSeries]) -> list[ArrayInfo]:
     values and the specs a user can choose for it."""
     d = _base(dataset)
     spatial = 3 if isinstance(d, (RegularVolume, CurvilinearGrid)) else 1
+    arrays = _arrays_of(d)
+    on_points = {name for name, association, _, _ in arrays if association == "point"}
     infos = []
-    for name, association, values, n in _arrays_of(d):
+    for name, association, values, n in arrays:
         vectors = _as_vectors(values, association, n, d)
         shown = _reduce(vectors, ArraySpec(name), n, spatial)
         rng, _ = _finite_range(shown)
         _, bad = _finite_range(values)
-        choices = [name] if n == 1 else [f"{name}:{MAGNITUDE}"] + [f"{name}:{c}" for c in range(n)]
+        where = "cell" if association == "cell" and name in on_points else None   # a plain name is the point array
+        choices = [str(ArraySpec(name, c, where)) for c in ([None] if n == 1 else [MAGNITUDE, *range(n)])]
         infos.append(ArrayInfo(name, association, n, rng, bad, choices))
     return infos
+
+
+def array_info(dataset: Union[Dataset, TimeSeries], spec: str) -> Optional[ArrayInfo]:
+    """The ``list_arrays`` entry of the array ``spec`` names (its association's when it has one, else the point
+    array's before the cell array's); None when the dataset has no such array."""
+    parsed = parse_array_spec(spec)
+    return next((i for i in list_arrays(dataset) if parsed.matches(i.name, i.association)), None)
 
 
 #: names of arrays that describe how a surface looks rather than data on it: vertex normals (as PLY and VTK name
@@ -273,10 +311,12 @@ def select_array(dataset: Any, spec: str | None) -> Any:
         if spec is None:
             return dataset
     parsed = parse_array_spec(spec)
-    found = [(n, a, v, c) for n, a, v, c in _arrays_of(dataset) if n == parsed.name]
+    found = [(n, a, v, c) for n, a, v, c in _arrays_of(dataset) if parsed.matches(n, a)]
     if not found:
-        names = ", ".join(i.name for i in list_arrays(dataset)) or "none"
-        raise ValueError(f"no array {parsed.name!r}; the arrays are: {names}")
+        names = ", ".join(str(replace(parse_array_spec(i.choices[0]), component=None))
+                          for i in list_arrays(dataset)) or "none"
+        what = "array" if parsed.association is None else f"{parsed.association} array"
+        raise ValueError(f"no {what} {parsed.name!r}; the arrays are: {names}")
     name, association, values, n = found[0]
     spatial = 3 if isinstance(dataset, (RegularVolume, CurvilinearGrid)) else 1
     scalar = _reduce(_as_vectors(values, association, n, dataset), parsed, n, spatial)

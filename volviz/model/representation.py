@@ -20,7 +20,7 @@ from typing import Any, Optional, Union
 
 import numpy as np
 
-from volviz.model.arrays import default_array, list_arrays, parse_array_spec
+from volviz.model.arrays import array_info, default_array
 from volviz.model.datasets import CurvilinearGrid, Dataset, RegularVolume, TetMesh, TimeSeries, UnstructuredMesh
 from volviz.model.object_cache import ObjectCache
 
@@ -140,7 +140,8 @@ def _by_default_array(dataset: Any, kind: str, reason: str) -> Representation:
     if spec is None:
         return Representation(POINTS if kind == POINTS else SURFACE, None,
                               reason="no field to show: drawn as plain geometry")
-    info = next(i for i in list_arrays(dataset) if i.name == parse_array_spec(spec).name)
+    info = array_info(dataset, spec)
+    assert info is not None  # the default is one of the dataset's arrays
     if not info.varies:
         return _constant(kind, spec, info.range[0])
     return Representation(kind, spec, reason=reason)
