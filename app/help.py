@@ -4,7 +4,7 @@ The shortcut list is made from the window's menus when the dialog opens (every a
 that holds it) and from fly mode's key table, so it cannot fall out of step with what the keys do."""
 from __future__ import annotations
 
-from typing import Any, Optional
+from typing import Any, Callable, Optional
 
 from PySide6.QtGui import QAction, QKeySequence
 from PySide6.QtWidgets import (QDialog, QDialogButtonBox, QLabel, QMainWindow, QMenu, QMessageBox, QTableWidget,
@@ -110,9 +110,11 @@ def about_text(render_window: Optional[Any] = None) -> str:
 
 
 class HelpMenu:
-    """The Help menu of ``window``: Keyboard Shortcuts and About (the open dialog is kept as ``dialog``)."""
+    """The Help menu of ``window``: Keyboard Shortcuts and About (the open dialog is kept as ``dialog``).
+    ``render_window`` gives the viewport's render window when asked (None once closed): holding the render window
+    would keep a closed native viewport's X connection open (``app/native_viewport.py``)."""
 
-    def __init__(self, window: QMainWindow, menu: QMenu, render_window: Any) -> None:
+    def __init__(self, window: QMainWindow, menu: QMenu, render_window: Callable[[], Any]) -> None:
         self.window, self.render_window = window, render_window
         self.dialog: Optional[QWidget] = None
         self.action_shortcuts = QAction("&Keyboard Shortcuts", window)
@@ -130,7 +132,7 @@ class HelpMenu:
         return dialog
 
     def show_about(self) -> QMessageBox:
-        box = QMessageBox(QMessageBox.Icon.Information, "About volviz", about_text(self.render_window),
+        box = QMessageBox(QMessageBox.Icon.Information, "About volviz", about_text(self.render_window()),
                           QMessageBox.StandardButton.Ok, self.window)
         box.open()
         self.dialog = box

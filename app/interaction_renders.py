@@ -19,7 +19,6 @@ class SingleRenderDuringInteraction:
     def __init__(self, plotter: Any) -> None:
         self.widget = plotter.interactor
         self.iren = plotter.iren.interactor          # the vtkRenderWindowInteractor
-        self.ren_win = plotter.ren_win
         hold_previews(plotter)
         self.iren.AddObserver("StartInteractionEvent", self._start)
         self.iren.AddObserver("EndInteractionEvent", self._end)
@@ -36,6 +35,6 @@ class SingleRenderDuringInteraction:
         if self.iren.GetEnableRender():
             return                                  # rendered already (outside an interaction)
         if getattr(self.widget, "_in_paint", False):
-            self.ren_win.Render()                   # the repaint: the one render of this frame
+            self.iren.GetRenderWindow().Render()    # the repaint: the one render of this frame
         else:
             self.widget.update()                    # a move: ask for a repaint instead of rendering now

@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING, Any
 
 import vtkmodules.qt
 from PySide6.QtCore import Qt, Signal
-from PySide6.QtGui import QPaintEvent
+from PySide6.QtGui import QPaintEvent, QResizeEvent
 from PySide6.QtWidgets import QWidget
 from pyvista import global_theme
 from pyvista.plotting.plotter import BasePlotter
@@ -93,7 +93,7 @@ class NativeViewport(QVTKRenderWindowInteractor, BasePlotter):  # type: ignore[m
         self.frames = frames
 
     def paintEvent(self, ev: QPaintEvent) -> None:
-        if self._in_paint:
+        if self._in_paint or self._RenderWindow is None:   # (closed: nothing to draw)
             return
         frames = self.frames
         self._in_paint = True
@@ -138,10 +138,27 @@ class NativeViewport(QVTKRenderWindowInteractor, BasePlotter):  # type: ignore[m
         self._rendered = True
         BasePlotter.render(self)
 
+    def resizeEvent(self, ev: QResizeEvent) -> None:
+        if self._RenderWindow is not None:
+            super().resizeEvent(ev)
+
+    def Finalize(self) -> None:
+        if self._RenderWindow is not None:
+            self._RenderWindow.Finalize()
+
     def close(self) -> None:  # type: ignore[override]
         """As ``QtInteractor.close``: the plotter's close (it finalizes the render window while the X window still
-        exists), then the widget's. Again, or from the parent's ``destroyed``: nothing."""
+        exists), then the widget's, then the render window is let go. Again, or from the parent's ``destroyed``:
+        nothing.
+
+        VTK opens one X connection per process to load GLX (``vtkXOpenGLRenderWindow::EnsureGLX``) and closes it
+        only when its last ``vtkXOpenGLRenderWindow`` is deleted. A closed viewport's render window held until the
+        process exits kept it open: an X server that stopped before (pytest-xvfb's, at the end of a test run) made
+        that late ``XCloseDisplay`` Xlib's fatal I/O error, exit status 1. So the widget and its interactor drop the
+        render window here (nothing else in the app holds it: ``tests/test_native_viewport_close.py``)."""
         if getattr(self, "_closed", True):
             return
         BasePlotter.close(self)
         QVTKRenderWindowInteractor.close(self)
+        self._Iren.SetRenderWindow(None)
+        self._RenderWindow = None

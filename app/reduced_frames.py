@@ -29,7 +29,6 @@ class ReducedFrames:
 
     def __init__(self, plotter: Any, factor: int = FACTOR) -> None:
         self.widget = plotter.interactor
-        self.ren_win = plotter.ren_win
         self.factor = max(1, int(factor))
         self.active = False
         self.renders = 0             # paints drawn reduced so far
@@ -38,8 +37,9 @@ class ReducedFrames:
         self._serial = 0
         reduce_paints = getattr(self.widget, "reduce_paints", None)
         if reduce_paints is not None:   # a native viewport (app/native_viewport.py) draws its paints reduced itself
-            reduce_paints(self)
+            reduce_paints(self)   # (and holds no render window: a closed one's X connection stays open while held)
             return
+        self.ren_win = plotter.ren_win
         self.ren_win.AddObserver("StartEvent", self._render_starts)
         self.widget.aboutToCompose.connect(self._restore)
 

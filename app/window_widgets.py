@@ -166,7 +166,7 @@ def build_menus(window: WindowBase) -> None:
     _action(window, view_menu, "&Reset Camera", "R", window.reset_camera)
 
     window.camera_bookmarks.add_to_menu(window.menuBar().addMenu("&Camera"))
-    window.help = HelpMenu(window, window.menuBar().addMenu("&Help"), window.plotter.ren_win)
+    window.help = HelpMenu(window, window.menuBar().addMenu("&Help"), lambda: window.plotter.ren_win)
     window.file_drop = FileDrop([window, window.plotter.interactor], files.open_path_asking)
 
 

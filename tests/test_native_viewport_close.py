@@ -1,0 +1,51 @@
+"""The native-window viewport (issue #28, ``app/native_viewport.py``) opened and closed in the test process: closing
+the window lets VTK's render window go, and with it the X connection VTK opened to load GLX, so a test run whose X
+server stops before the process exits (pytest-xvfb's) still exits with status 0. Before, Xlib's fatal I/O error on
+that connection at exit made the run's exit status 1 although every test passed."""
+from __future__ import annotations
+
+import gc
+import os
+import subprocess
+import sys
+import weakref
+from pathlib import Path
+
+import pytest
+
+
+def _sockets() -> int:
+    """The process's open sockets (its X connections among them)."""
+    fds = Path("/proc/self/fd")
+    return sum(os.readlink(fd).startswith("socket:") for fd in fds.iterdir() if fd.exists())
+
+
+def test_native_window_closes_in_process(make_window, monkeypatch: pytest.MonkeyPatch) -> None:
+    from PySide6.QtWidgets import QApplication
+
+    if QApplication.platformName() != "xcb":
+        pytest.skip(f"the native viewport needs X11, the platform is {QApplication.platformName()}")
+    monkeypatch.setenv("VOLVIZ_VIEWPORT", "native")
+    before = _sockets()
+    window = make_window()
+    assert type(window.plotter).__name__ == "NativeViewport"
+    render_window = weakref.ref(window.plotter.GetRenderWindow())
+    assert render_window().GetClassName() == "vtkXOpenGLRenderWindow"
+    window.plotter.render()
+    assert _sockets() > before                      # VTK's own X connections while the viewport is open
+    window.dirty = False
+    window.close()
+    gc.collect()
+    assert render_window() is None                  # nothing holds the closed viewport's render window ...
+    assert _sockets() == before                     # ... and VTK's X connections are closed
+
+
+def test_a_run_that_closed_a_native_window_exits_cleanly(tmp_path: Path) -> None:
+    """The test above alone in its own pytest run under its own Xvfb: pytest's exit status is 0."""
+    node = f"{Path(__file__).name}::test_native_window_closes_in_process"
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("PYTEST_XDIST", "PYTEST_CURRENT"))}
+    proc = subprocess.run([sys.executable, "-m", "pytest", "-n", "0", "-p", "no:cacheprovider", "-q", node],
+                          cwd=Path(__file__).parent, env=dict(env, QT_QPA_PLATFORM="xcb"),
+                          capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
+    assert "1 passed" in proc.stdout
