@@ -18,8 +18,11 @@ from volviz.scene.drawn_tf import log_floor, uses_log_scale
 from volviz.scene.errors import SceneError
 from volviz.session import Session
 
-if TYPE_CHECKING:   # type-only: PyVista's mesh class, imported where an outline is made
+if TYPE_CHECKING:   # type-only: PyVista's mesh and plotter classes, imported where an outline is made; VTK's prop
     import pyvista as pv
+
+    from volviz.render.vtk_facade import vtkProp
+    from volviz.scene.datasets import LoadedDataset
 
 DECORATIONS = ("scalar_bar", "axes", "outline")
 OUTLINE_NAME = "volviz-outline"
@@ -114,7 +117,7 @@ def _in_front_of_coincident(actor: Any) -> None:
         f"//VTK::PositionVC::Impl\n  gl_Position.z -= {OUTLINE_DEPTH_OFFSET!r} * gl_Position.w;\n", False)
 
 
-def update_legend(plotter: Any, session: Session, datasets: dict[str, Any]) -> None:
+def update_legend(plotter: pv.BasePlotter, session: Session, datasets: dict[str, LoadedDataset]) -> None:
     """Redraw only the scalar bar (after a transfer-function edit: the outline and axes stay as they are)."""
     _remove_scalar_bar(plotter)
     comp = _legend_component(session) if decoration_enabled(session, "scalar_bar") else None
@@ -276,18 +279,18 @@ def _remove_scalar_bar(plotter: Any) -> None:
     plotter.remove_actor(SCALAR_BAR_TITLE_NAME, render=False)
 
 
-def scalar_bar_actor(plotter: Any) -> Optional[Any]:
+def scalar_bar_actor(plotter: pv.BasePlotter) -> Optional[vtkProp]:
     """The scalar bar ``apply_decorations`` added (None when off or when nothing has a transfer function)."""
     return plotter.renderer.actors.get(SCALAR_BAR_NAME)
 
 
-def scalar_bar_title(plotter: Any) -> Optional[str]:
+def scalar_bar_title(plotter: pv.BasePlotter) -> Optional[str]:
     """The scalar bar's title (the shown array's name), None without a scalar bar."""
     heading = plotter.renderer.actors.get(SCALAR_BAR_TITLE_NAME)
     return None if heading is None else str(heading.GetInput())
 
 
-def scalar_bar_hit(plotter: Any, x: float, y: float) -> bool:
+def scalar_bar_hit(plotter: pv.BasePlotter, x: float, y: float) -> bool:
     """Whether display pixel (x, y) (VTK's: rows from the bottom) is on the scalar bar or its title."""
     renderer = plotter.renderer
     for name in (SCALAR_BAR_NAME, SCALAR_BAR_TITLE_NAME):
