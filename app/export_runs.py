@@ -22,16 +22,15 @@ from .errors import hide_temporary_names
 from .shown_scene import ShownScene
 
 if TYPE_CHECKING:
-    from pyvistaqt import QtInteractor
-
     from .frame_export import FrameExport
+    from .viewport_types import Viewport
     from .workers import JobBridge
 
 
 class ExportRuns:
     """Screenshot and movie export (see the module's docstring)."""
 
-    def __init__(self, scene: ShownScene, jobs: JobBridge, plotter: QtInteractor, status: QLabel,
+    def __init__(self, scene: ShownScene, jobs: JobBridge, plotter: Viewport, status: QLabel,
                  set_busy: Callable[[bool], None], busy_elsewhere: Callable[[], bool],
                  show_error: Callable[[str, str], None]) -> None:
         self.scene, self.jobs, self.plotter, self.status = scene, jobs, plotter, status

@@ -58,6 +58,9 @@ class NativeViewport(QVTKRenderWindowInteractor, BasePlotter):  # type: ignore[m
     own paint (``reduce_paints``)."""
 
     aboutToCompose = Signal()   # never emitted: Qt composes nothing for this widget
+    # pyvista's RenderWindowInteractor, as on pyvistaqt's untyped QtInteractor: the window's parts use it while the
+    # window is open (BasePlotter types it Optional: None once closed)
+    iren: Any
 
     def __init__(self, parent: QWidget | None = None) -> None:
         with _no_base_plotter_init():

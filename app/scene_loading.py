@@ -30,9 +30,8 @@ from .shown_scene import ShownScene
 from .stand_in import StandInFrame
 
 if TYPE_CHECKING:
-    from pyvistaqt import QtInteractor
-
     from volviz.render.controller import SceneController
+    from .viewport_types import Viewport
     from .workers import JobBridge
 
 log = logging.getLogger("volviz_app.window")  # the logger these methods had in window.py
@@ -43,7 +42,7 @@ STAGE_MS = 30            # pause between GUI-thread stages of showing a new scen
 class SceneLoading:
     """Opening files and showing sessions (see the module's docstring)."""
 
-    def __init__(self, scene: ShownScene, window: QMainWindow, plotter: QtInteractor, jobs: JobBridge,
+    def __init__(self, scene: ShownScene, window: QMainWindow, plotter: Viewport, jobs: JobBridge,
                  settings: QSettings, recent: RecentFiles, stand_in: StandInFrame, status: QLabel, *,
                  set_busy: Callable[[bool], None], show_error: Callable[[str, str], None],
                  supersede: Callable[[], None], installed: Callable[[SceneController, str, bool, bool], None],

@@ -18,17 +18,16 @@ from .shown_scene import ShownScene
 from .view_scheduler import interactive_rate
 
 if TYPE_CHECKING:
-    from pyvistaqt import QtInteractor
-
     from volviz.render.controller import SceneController
     from .docks.timeline import Timeline
+    from .viewport_types import Viewport
     from .workers import JobBridge
 
 
 class TimeViews:
     """The scene at the timeline's display time (see the module's docstring)."""
 
-    def __init__(self, scene: ShownScene, plotter: QtInteractor, jobs: JobBridge, timeline: Timeline, *,
+    def __init__(self, scene: ShownScene, plotter: Viewport, jobs: JobBridge, timeline: Timeline, *,
                  show_error: Callable[[str, str], None], schedule_render: Callable[[], None],
                  refresh_iso_overlay: Callable[[], None]) -> None:
         self.scene, self.plotter, self.jobs, self.timeline = scene, plotter, jobs, timeline

@@ -35,13 +35,12 @@ from volviz.render.error_budget import error_budget_choice
 from .shown_scene import ShownScene
 
 if TYPE_CHECKING:
-    from pyvistaqt import QtInteractor
-
     from volviz.model.events import SceneChange
     from .docks.render_settings import RenderSettingsDock
     from .gc_guard import GuiThreadCollector
     from .navigation import FlyMode
     from .stand_in import StandInFrame
+    from .viewport_types import Viewport
     from .workers import JobBridge
 
 MOVING_SCALE = 2         # previews while the camera moves or a TF point is dragged: 1/2 x 1/2 of the window
@@ -50,7 +49,7 @@ RESIZE_MS = 200          # overlays re-render once the viewport stopped resizing
 FLY_SETTLE_MS = 300      # fly mode: full-size images once no key moved the camera for 300 ms
 
 
-def interactive_rate(plotter: QtInteractor, on: bool) -> None:
+def interactive_rate(plotter: Viewport, on: bool) -> None:
     """VTK's interactive update rate for the window (``on``; what its interactor styles set during a mouse drag) or its
     still rate: during playback and flight, as during a drag, its ray casters cast fewer rays and the GPU PT pass fills
     a reduced target (``GLPTVolume.set_interactive``)."""
@@ -74,7 +73,7 @@ def _shown(request: Any, result: Any) -> dict[str, Any]:
 class ViewScheduler:
     """The window's background view refreshes (see the module's docstring)."""
 
-    def __init__(self, scene: ShownScene, parent: QObject, plotter: QtInteractor, jobs: JobBridge, status: QLabel,
+    def __init__(self, scene: ShownScene, parent: QObject, plotter: Viewport, jobs: JobBridge, status: QLabel,
                  render_settings: RenderSettingsDock, stand_in: StandInFrame,
                  collector: GuiThreadCollector, *, render_scene: Callable[[], None],
                  show_statistics: Callable[[], None], show_error: Callable[[str, str], None],

@@ -28,7 +28,7 @@ import logging
 import os
 import time
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Callable, Optional, cast
+from typing import TYPE_CHECKING, Any, Callable, Optional
 
 import numpy as np
 from PySide6.QtCore import QPoint, QSettings, Qt
@@ -59,17 +59,16 @@ from .window_widgets import build_docks, build_menus, build_status_bar, fill_doc
 from .workers import JobBridge
 
 if TYPE_CHECKING:
-    from pyvistaqt import QtInteractor
-
     from volviz.model.clip import ClipSettings
+    from .viewport_types import Viewport
 
 log = logging.getLogger(__name__)
 
 
-def make_plotter(parent: QWidget) -> QtInteractor:
+def make_plotter(parent: QWidget) -> Viewport:
     """The viewport: pyvistaqt's ``QtInteractor``, or with ``VOLVIZ_VIEWPORT=native`` on X11 (``xcb``) the native-window
     ``NativeViewport``, which Qt does not compose (issue #28, an opt-in until it is made the default; see
-    ``app/native_viewport.py``). Typed as ``QtInteractor``, whose plotter and widget interface it has too."""
+    ``app/native_viewport.py``)."""
     from PySide6.QtWidgets import QApplication
     from pyvistaqt import QtInteractor
 
@@ -77,7 +76,7 @@ def make_plotter(parent: QWidget) -> QtInteractor:
         from .native_viewport import NativeViewport
 
         log.info("viewport: NativeViewport (VOLVIZ_VIEWPORT=native)")
-        return cast("QtInteractor", NativeViewport(parent))
+        return NativeViewport(parent)
     return QtInteractor(parent, auto_update=False)  # we render when something changed, never on a timer
 
 

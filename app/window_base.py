@@ -22,7 +22,6 @@ if TYPE_CHECKING:
     from PySide6.QtCore import QSettings
     from PySide6.QtGui import QAction, QUndoGroup, QUndoStack
     from PySide6.QtWidgets import QDockWidget, QLabel, QMainWindow, QMenu, QMessageBox, QProgressBar, QPushButton
-    from pyvistaqt import QtInteractor
 
     from volviz.model.clip import ClipSettings
     from volviz.render.controller import SceneController
@@ -60,6 +59,7 @@ if TYPE_CHECKING:
     from .navigation import FlyMode
     from .nonfinite_status import NonFiniteStatus
     from .recent import RecentFiles
+    from .viewport_types import Viewport
     from .workers import JobBridge
 
     _QtWindow = QMainWindow
@@ -73,7 +73,7 @@ class WindowBase(_QtWindow):
     # -- set by MainWindow.__init__
     settings: QSettings
     collector: GuiThreadCollector
-    plotter: QtInteractor
+    plotter: Viewport
     jobs: JobBridge
     nonfinite: NonFiniteStatus
     file_choices: FileChoices
