@@ -149,6 +149,11 @@ class NativeViewport(QVTKRenderWindowInteractor, BasePlotter):  # type: ignore[m
         if self._RenderWindow is not None:
             self._RenderWindow.Finalize()
 
+    def ShowCursor(self) -> None:
+        """VTK's cursor as the widget's (VTK's widget maps it a moment after VTK changes it; not once closed)."""
+        if self._RenderWindow is not None:
+            super().ShowCursor()
+
     def close(self) -> None:  # type: ignore[override]
         """As ``QtInteractor.close``: the plotter's close (it finalizes the render window while the X window still
         exists), then the widget's, then the render window is let go. Again, or from the parent's ``destroyed``:
@@ -158,7 +163,7 @@ class NativeViewport(QVTKRenderWindowInteractor, BasePlotter):  # type: ignore[m
         only when its last ``vtkXOpenGLRenderWindow`` is deleted. A closed viewport's render window held until the
         process exits kept it open: an X server that stopped before (pytest-xvfb's, at the end of a test run) made
         that late ``XCloseDisplay`` Xlib's fatal I/O error, exit status 1. So the widget and its interactor drop the
-        render window here (nothing else in the app holds it: ``tests/test_native_viewport_close.py``)."""
+        render window here (nothing else in the app holds it: ``tests/test_native_viewport_in_process.py``)."""
         if getattr(self, "_closed", True):
             return
         BasePlotter.close(self)

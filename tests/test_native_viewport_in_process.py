@@ -1,7 +1,8 @@
-"""The native-window viewport (issue #28, ``app/native_viewport.py``) opened and closed in the test process: closing
-the window lets VTK's render window go, and with it the X connection VTK opened to load GLX, so a test run whose X
-server stops before the process exits (pytest-xvfb's) still exits with status 0. Before, Xlib's fatal I/O error on
-that connection at exit made the run's exit status 1 although every test passed."""
+"""The native-window viewport (issue #28, ``app/native_viewport.py``) in the test process: a file dropped on it opens,
+VTK's cursor changes reach the widget, and closing the window lets VTK's render window go, and with it the X
+connection VTK opened to load GLX, so a test run whose X server stops before the process exits (pytest-xvfb's) still
+exits with status 0. Before, Xlib's fatal I/O error on that connection at exit made the run's exit status 1 although
+every test passed."""
 from __future__ import annotations
 
 import gc
@@ -13,6 +14,10 @@ from pathlib import Path
 
 import pytest
 
+from conftest import data_file
+from test_app_open import drop
+from test_app_window import wait_loaded
+
 
 def _sockets() -> int:
     """The process's open sockets (its X connections among them)."""
@@ -20,12 +25,32 @@ def _sockets() -> int:
     return sum(os.readlink(fd).startswith("socket:") for fd in fds.iterdir() if fd.exists())
 
 
-def test_native_window_closes_in_process(make_window, monkeypatch: pytest.MonkeyPatch) -> None:
+@pytest.fixture
+def native(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The windows made from now on have the native viewport (X11 only)."""
     from PySide6.QtWidgets import QApplication
 
     if QApplication.platformName() != "xcb":
         pytest.skip(f"the native viewport needs X11, the platform is {QApplication.platformName()}")
     monkeypatch.setenv("VOLVIZ_VIEWPORT", "native")
+
+
+def test_a_file_dropped_on_the_native_viewport_opens(qtbot, make_window, native: None) -> None:
+    from PySide6.QtCore import Qt
+    from vtkmodules.vtkCommonCore import VTK_CURSOR_HAND
+
+    window = make_window()
+    assert type(window.plotter).__name__ == "NativeViewport"
+    hydrogen = data_file("volumes/hydrogen.vti")
+    assert drop(window.plotter.interactor, [hydrogen])   # taken by the window's FileDrop, not VTK's widget
+    wait_loaded(qtbot, window)
+    qtbot.waitUntil(lambda: "hydrogen.vti" in window.windowTitle())
+    assert window.session.datasets[0].path == str(hydrogen.resolve())
+    window.plotter.GetRenderWindow().SetCurrentCursor(VTK_CURSOR_HAND)   # as a VTK widget under the mouse does
+    qtbot.waitUntil(lambda: window.plotter.interactor.cursor().shape() == Qt.CursorShape.PointingHandCursor)
+
+
+def test_native_window_closes_in_process(make_window, native: None) -> None:
     before = _sockets()
     window = make_window()
     assert type(window.plotter).__name__ == "NativeViewport"
