@@ -69,7 +69,6 @@ VTK_ANY = "VTK props of several unrelated classes (vtkVolume, vtkActor, a volviz
 DATASET = ("a dataset of several kinds (volviz.scene.datasets.LoadedDataset, an array view of one, its PyVista form) "
            "whose body uses attributes of some kinds only: typing it needs narrowing there, a code change")
 DATASET_TO_PROP = "a loaded dataset in (DATASET), a VTK prop of several classes out (VTK_ANY)"
-OVERLAY = "the request dict of image_overlay.OverlayView, which this change does not edit (GL passes: being moved)"
 VIEW_OBJECTS = ("a view of one of several classes, each with its own request type; View[Any] would not do: the "
                 "natural scene's view has no stats and the GL isosurfaces' no job, which these callers use")
 PLOTTER = ("a PyVista plotter (pv.Plotter offscreen, pyvistaqt's QtInteractor in the app): pv.BasePlotter would "
@@ -120,16 +119,9 @@ ALLOWED: dict[str, str] = {
     "volviz.render.framing:frame_scene": VTK_ANY,
     "volviz.render.gl_iso:GLIsoView.update": STATS,
     "volviz.render.gl_iso:GLIsoView.finish": STATS,
-    "volviz.render.image_overlay:overlay_rgba8": GL,
     "volviz.render.image_overlay:hold_single_sample": PLOTTER_WINDOW,
     "volviz.render.image_overlay:single_sample_on_software": PLOTTER_WINDOW,
     "volviz.render.image_overlay:release_single_sample": PLOTTER_WINDOW,
-    "volviz.render.image_overlay:OverlayView.begin": GL,
-    "volviz.render.image_overlay:OverlayView.compute": GL,
-    "volviz.render.image_overlay:OverlayView.finish": GL,
-    "volviz.render.iso_overlay:IsoOverlay.begin": OVERLAY,
-    "volviz.render.iso_overlay:IsoOverlay.compute": OVERLAY,
-    "volviz.render.iso_overlay:IsoOverlay.finish": OVERLAY,
     "volviz.render.lod_volume:LodVolume.finish": STATS,
     "volviz.render.lod_volume:LodVolume.update": STATS,
     "volviz.render.lod_volume:LodVolume.show_stats": STATS,
@@ -138,10 +130,6 @@ ALLOWED: dict[str, str] = {
         "pv.Plotter: PyVista 0.49's _Wrapped decorator mistypes its methods for callers outside this change (bench)",
     "volviz.render.preview_hold:hold_previews": PLOTTER_HELD,
     "volviz.render.preview_hold:holds_previews": PLOTTER_HELD,
-    "volviz.render.pt_prop:PTVolume.begin": OVERLAY,
-    "volviz.render.pt_prop:PTVolume.compute": OVERLAY,
-    "volviz.render.pt_prop:PTVolume.error_estimate": OVERLAY,
-    "volviz.render.pt_prop:PTVolume.finish": OVERLAY,
     "volviz.render.pt_prop:add_pt_volume": DATASET_TO_PROP,
     "volviz.render.pt_view:is_pt_view": VTK_ANY,
     "volviz.render.scene_builder:prepared_volume_input": DATASET,
@@ -232,11 +220,11 @@ def test_the_counter_sees_any_wherever_it_is_written(tmp_path: Path) -> None:
 #: each registered view's request type (``View[RequestT]``), as mypy checks it: an import and the type
 REQUESTS: dict[tuple[str, str], tuple[str, str]] = {
     ("pt", "gpu"): ("from volviz.render.gl_pt_order import OrderRequest", "OrderRequest"),
-    ("pt", "cpu"): ("", "dict[str, Any]"),
+    ("pt", "cpu"): ("from volviz.render.image_overlay import OverlayRequest", "OverlayRequest"),
     ("nature", "gpu"): ("from volviz.render.nature_view import NatureRequest", "NatureRequest"),
     ("nature", "cpu"): ("from volviz.render.nature_view import NatureRequest", "NatureRequest"),
     ("iso", "gpu"): ("", "None"),
-    ("iso", "cpu"): ("", "dict[str, Any]"),
+    ("iso", "cpu"): ("from volviz.render.image_overlay import OverlayRequest", "OverlayRequest"),
     ("lod", "cpu"): ("from volviz.render.lod_volume import LodRequest", "LodRequest"),
 }
 

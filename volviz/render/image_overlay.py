@@ -24,12 +24,12 @@ the typical clipping ratio f/n = 1000 resolves about 1e-4 of the view distance.
 Multisampling (PyVista's default, 4 samples) is switched off while any overlay is in the plotter and back on when the
 last one is removed: with MSAA a silhouette pixel of opaque geometry has a blended color (object and what is behind
 it) but VTK's depth read-back gives one depth, so the image was cut there by that one depth for the whole pixel: a
-one-pixel edge around opaque objects (max 18 of 255 against 1.6 without MSAA on the PT test scene at 256x192).
+one-pixel edge around opaque objects (docs/bench/docstring-figures.md).
 Compositing per sample would need every sample's depth, which ``GetZbufferData`` does not give.
 
-A plotter drawn by a software rasteriser has no multisampling at all (``single_sample_on_software``): on llvmpipe 4x
-MSAA made every frame 3-4x as costly (docs/bench/multisampling.md), so each still frame of the Yukon scene held the
-window for half a second. Hardware drivers keep the plotter's setting; ``volviz render`` and the app follow the same
+A plotter drawn by a software rasteriser has no multisampling at all (``single_sample_on_software``): there 4x MSAA
+made every frame several times as costly (docs/bench/multisampling.md), and each still frame of a large scene held
+the window that much longer. Hardware drivers keep the plotter's setting; ``volviz render`` and the app follow the same
 rule, so their pictures still agree.
 """
 from __future__ import annotations
@@ -37,18 +37,19 @@ from __future__ import annotations
 import time
 import weakref
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, Union
+from typing import TYPE_CHECKING, Any, Generic, Optional, Protocol, TypeVar, Union
 
 import numpy as np
 
 from volviz.model.camera import Camera
 from volviz.render.backend import plotter_gl_info
 
-if TYPE_CHECKING:   # type-only: VTK's classes, reached through the facade at run time
+if TYPE_CHECKING:   # type-only: VTK's classes, reached through the facade at run time; the progress callback
+    from volviz.jobs import ProgressCallback
     from volviz.render.vtk_facade import vtkRenderer, vtkRenderWindow
 
-__all__ = ["ImageOverlay", "OverlayRequest", "OverlayView", "block_min", "overlay_rgba8", "read_buffers",
-           "single_sample_on_software", "unpremultiply_rgba8", "zbuffer_to_depth"]
+__all__ = ["ImageOverlay", "OverlayRequest", "OverlayStats", "OverlayView", "StatsT", "block_min", "overlay_rgba8",
+           "read_buffers", "single_sample_on_software", "unpremultiply_rgba8", "zbuffer_to_depth"]
 
 #: every overlay renderer of a plotter (the renderers are VTK objects: a plotter's list lives as long as it does)
 _SIBLINGS: "weakref.WeakKeyDictionary[Any, list[Any]]" = weakref.WeakKeyDictionary()
@@ -79,7 +80,7 @@ def block_min(depth: np.ndarray, size: tuple[int, int]) -> np.ndarray:
     return np.minimum.reduceat(np.minimum.reduceat(depth, rows, axis=0), cols, axis=1)
 
 
-def overlay_rgba8(image: np.ndarray, request: dict[str, Any] | None = None) -> np.ndarray:
+def overlay_rgba8(image: np.ndarray, request: Optional[OverlayRequest] = None) -> np.ndarray:
     """Premultiplied float RGBA as ``ImageOverlay.show`` takes it: straight-alpha RGBA8 (``unpremultiply_rgba8``);
     a preview of ``request`` (``OverlayView.begin`` with ``scale`` > 1) magnified to the window first
     (``preview_upsample``). Made on a worker where possible (``PTVolume.compute``)."""
@@ -253,7 +254,8 @@ class OverlayRequest(dict[str, Any]):
     """A request of ``OverlayView.begin``: its ``depth`` (the depth limit of each image pixel), ``rgb`` (the opaque
     scene's colour under it) and, for a preview, ``window_depth`` are made from the GUI thread's raw read-back on
     their first use, on whichever thread asks first: the job's worker, so that the conversion and the preview's
-    block minimum (20-40 ms at 1000x700 under load, issue #28) stay off the GUI thread."""
+    block minimum (a stall of the GUI thread under load, issue #28; docs/bench/docstring-figures.md) stay off the GUI
+    thread."""
 
     def __missing__(self, key: str) -> Any:
         if key not in ("depth", "rgb", "window_depth") or "_read_back" not in self:
@@ -269,7 +271,20 @@ class OverlayRequest(dict[str, Any]):
         return self[key]
 
 
-class OverlayView:
+class OverlayStats(Protocol):
+    """What an overlay's ``compute`` reports and ``OverlayView.finish`` reads: the seconds it took (``total_s``);
+    ``sort_s``, ``project_s``, ``raster_s``, ``fragments`` and ``n_visible`` are read where the renderer has them
+    (``volviz.unstructured.render.UnstructuredRenderStats``, ``volviz.render.iso_overlay.IsoStats``)."""
+
+    @property
+    def total_s(self) -> float: ...
+
+
+#: the statistics type of an ``OverlayView``'s ``compute``
+StatsT = TypeVar("StatsT", bound=OverlayStats)
+
+
+class OverlayView(Generic[StatsT]):
     """An image of ours (a CPU renderer's premultiplied RGBA) kept over a plotter's scene and re-made in three parts,
     so that the app can run the middle one in its job runner:
 
@@ -278,7 +293,8 @@ class OverlayView:
     - ``compute(request)`` (any thread, no VTK): the image and its statistics; subclasses implement it;
     - ``finish(request, img, st)`` (GUI thread): show it and record the statistics.
 
-    ``update`` does all three. Subclasses: ``pt_prop.PTVolume`` and ``iso_overlay.IsoOverlay``."""
+    ``update`` does all three. Subclasses: ``pt_prop.PTVolume`` and ``iso_overlay.IsoOverlay``, each of its own
+    statistics type (``StatsT``)."""
 
     def __init__(self, plotter: Any) -> None:
         self.plotter = plotter
@@ -298,7 +314,7 @@ class OverlayView:
         request = self.begin()
         return self.finish(request, *self.compute(request))
 
-    def begin(self, scale: int = 1) -> dict[str, Any]:
+    def begin(self, scale: int = 1) -> OverlayRequest:
         """GUI-thread part 1: the opaque scene's depth and color, the camera and the image size: the window's, or
         for a preview (``scale`` > 1, e.g. while the camera moves) the window's divided by ``scale``, with the depth
         limit of each preview pixel the nearest opaque depth under it (``block_min``), the scene color at its
@@ -315,11 +331,13 @@ class OverlayView:
         return OverlayRequest(camera=cam, size=size, preview=scale > 1, t_start=t_start, t_read=time.perf_counter(),
                               _read_back=(z, rgb, live.clipping_range, live.parallel))
 
-    def compute(self, request: dict[str, Any], progress: Any = None) -> tuple[Any, ...]:
-        """Any-thread part: (premultiplied image, statistics with ``total_s``[, straight-alpha RGBA8])."""
+    def compute(self, request: OverlayRequest, progress: Optional[ProgressCallback] = None
+                ) -> tuple[np.ndarray, StatsT, np.ndarray]:
+        """Any-thread part: (premultiplied image, statistics with ``total_s``, straight-alpha RGBA8)."""
         raise NotImplementedError
 
-    def finish(self, request: dict[str, Any], img: np.ndarray, st: Any, rgba8: np.ndarray | None = None) -> np.ndarray:
+    def finish(self, request: OverlayRequest, img: np.ndarray, st: StatsT, rgba8: np.ndarray | None = None
+               ) -> np.ndarray:
         """GUI-thread part 2: show a computed image and record the statistics. ``rgba8``: the image (straight alpha,
         row 0 at the top) as ``compute`` converted it (else converted here). The window redraws unless the
         plotter's rendering is suppressed (the caller then draws once itself)."""

@@ -28,7 +28,7 @@ triangles drawn.
 from __future__ import annotations
 
 import time
-from types import SimpleNamespace
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Optional, Sequence
 
 import numpy as np
@@ -36,7 +36,7 @@ import numpy as np
 from volviz.iso.composite import MODES, Fragments, composite, fragments, triangles_drawn
 from volviz.iso.extract import IsoMesh
 from volviz.iso.lod import lod_mesh, select_level
-from volviz.render.image_overlay import OverlayView, overlay_rgba8
+from volviz.render.image_overlay import OverlayRequest, OverlayView, overlay_rgba8
 from volviz.render.iso_volume_split import FrontVolume, in_volume
 from volviz.model.camera import Camera
 
@@ -44,7 +44,7 @@ if TYPE_CHECKING:   # type-only imports for the signatures
     from volviz.iso.lod import LodChain
     from volviz.jobs import ProgressCallback
 
-__all__ = ["IsoModeView", "IsoOverlay", "cut_at_depth"]
+__all__ = ["IsoModeView", "IsoOverlay", "IsoStats", "cut_at_depth"]
 
 
 def cut_at_depth(frags: Fragments, depth: np.ndarray) -> Fragments:
@@ -58,7 +58,25 @@ def cut_at_depth(frags: Fragments, depth: np.ndarray) -> Fragments:
                      frags.n_triangles, frags.n_opaque_triangles, frags.seconds)
 
 
-def _shown_rgba8(img: np.ndarray, request: dict[str, Any]) -> tuple[np.ndarray, int]:
+@dataclass
+class IsoStats:
+    """``IsoOverlay.compute``'s statistics (``image_overlay.OverlayStats``): seconds (``raster_s`` the fragment
+    lists, ``total_s`` with the compositing), fragments, triangles rasterised (``n_visible``), drawn by the mode and in
+    the full-resolution meshes, and saturated pixels (composited over the scene colour)."""
+
+    raster_s: float
+    total_s: float
+    fragments: int
+    n_visible: int
+    triangles_drawn: int
+    full_triangles: int
+    saturated_px: int
+    sort_s: float = 0.0
+    project_s: float = 0.0
+    extra: dict[str, Any] = field(default_factory=dict)
+
+
+def _shown_rgba8(img: np.ndarray, request: OverlayRequest) -> tuple[np.ndarray, int]:
     """Any thread: the overlay image ``img`` (premultiplied) as VTK shows it (``overlay_rgba8``; a preview magnified
     to the window) and the number of saturated pixels. Straight-alpha blending cannot show a color above its alpha,
     which the order-independent sums of 3/4-pass produce; those pixels are composited over the scene color read back
@@ -95,7 +113,7 @@ class IsoModeView:
         """Called after every change of ``mode``."""
 
 
-class IsoOverlay(OverlayView, IsoModeView):
+class IsoOverlay(OverlayView[IsoStats], IsoModeView):
     """The isosurfaces of a scene drawn by one of the CPU transparency modes as a depth-composited overlay. With a
     regular volume shown, ``split_volume`` (default) puts the volume in front of the surfaces over them and the rest
     under them (``volviz.render.iso_volume_split``; ``front_volume`` draws that volume on a thread of its own); False
@@ -129,7 +147,7 @@ class IsoOverlay(OverlayView, IsoModeView):
         p = np.concatenate(pts)
         return float(((p - cam.position) @ cam.frame()[2]).max())
 
-    def begin(self, scale: int = 1) -> dict[str, Any]:
+    def begin(self, scale: int = 1) -> OverlayRequest:
         """GUI thread: ``OverlayView.begin`` (the scene drawn and read back), and with a regular volume shown what
         ``compute`` needs to draw the volume in front of the translucent surfaces off this thread
         (``FrontVolume.snapshot``)."""
@@ -144,7 +162,7 @@ class IsoOverlay(OverlayView, IsoModeView):
                        front_scene=front)
         return request
 
-    def _front_image(self, request: dict[str, Any]) -> np.ndarray | None:
+    def _front_image(self, request: OverlayRequest) -> np.ndarray | None:
         """Any thread: the volume in front of the surfaces for ``request`` (``FrontVolume.render``, at the window's
         size; for a preview each preview pixel's first window pixel, as its scene color), or None."""
         scene = request.get("front_scene")
@@ -156,13 +174,13 @@ class IsoOverlay(OverlayView, IsoModeView):
             front = front[(np.arange(h) * big_h) // h][:, (np.arange(w) * big_w) // w]
         return front
 
-    def compute(self, request: dict[str, Any], progress: Optional[ProgressCallback] = None) -> tuple[np.ndarray, Any,
-                np.ndarray]:
+    def compute(self, request: OverlayRequest, progress: Optional[ProgressCallback] = None
+                ) -> tuple[np.ndarray, IsoStats, np.ndarray]:
         """Any thread: rasterise all surfaces once, cut at the opaque depth, composite in the request's mode (the
         volume in front of the surfaces over it, ``in_volume``); then the
         image as VTK will show it (``_shown_rgba8``: saturated pixels over the scene color, straight-alpha RGBA8, a
         preview magnified to the window), made here so that ``finish`` on the GUI thread only hands it over (the
-        magnification took 40-60 ms of the GUI thread per preview, issue #28)."""
+        magnification stalled the GUI thread per preview, issue #28; docs/bench/docstring-figures.md)."""
         if progress is not None:
             progress(0.0, f"isosurfaces: {request['mode']}")
         t0 = time.perf_counter()
@@ -175,10 +193,10 @@ class IsoOverlay(OverlayView, IsoModeView):
         img = in_volume(composite(fr, request["mode"]), self._front_image(request))
         t2 = time.perf_counter()
         rgba8, saturated = _shown_rgba8(img, request)
-        st = SimpleNamespace(sort_s=0.0, project_s=0.0, raster_s=t1 - t0, total_s=t2 - t0, fragments=len(fr.depth),
-                             n_visible=fr.n_triangles, triangles_drawn=triangles_drawn(fr, request["mode"]),
-                             full_triangles=sum(m.n_triangles for m in request["meshes"]), saturated_px=saturated,
-                             extra={})
+        st = IsoStats(sort_s=0.0, project_s=0.0, raster_s=t1 - t0, total_s=t2 - t0, fragments=len(fr.depth),
+                      n_visible=fr.n_triangles, triangles_drawn=triangles_drawn(fr, request["mode"]),
+                      full_triangles=sum(m.n_triangles for m in request["meshes"]), saturated_px=saturated,
+                      extra={})
         return img, st, rgba8
 
     def remove(self) -> None:
@@ -186,7 +204,8 @@ class IsoOverlay(OverlayView, IsoModeView):
         super().remove()
         self.front_volume.close()
 
-    def finish(self, request: dict[str, Any], img: np.ndarray, st: Any, rgba8: np.ndarray | None = None) -> np.ndarray:
+    def finish(self, request: OverlayRequest, img: np.ndarray, st: IsoStats, rgba8: np.ndarray | None = None
+               ) -> np.ndarray:
         """GUI thread: show ``rgba8`` as ``compute`` made it (made here from ``img`` when not given) and record the
         statistics; returns the premultiplied image."""
         saturated = getattr(st, "saturated_px", 0)

@@ -28,18 +28,19 @@ volumes should be merged into one mesh). Multisampling is off while a volume is 
 """
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any, Optional
+from typing import TYPE_CHECKING, Any, Optional, TypedDict
 
 import numpy as np
 
 from volviz.model.camera import Camera
 from volviz.model.datasets import TetMesh
 from volviz.optics.metrics import max_abs, rmse
-from volviz.render.image_overlay import OverlayView, overlay_rgba8, unpremultiply_rgba8, window_size, zbuffer_to_depth
+from volviz.render.image_overlay import (OverlayRequest, OverlayView, overlay_rgba8, unpremultiply_rgba8, window_size,
+                                         zbuffer_to_depth)
 from volviz.render.preview_hold import PreviewCameraHold, holds_previews
 from volviz.render.pt_view import PTView
 from volviz.unstructured.prefetch import SortPrefetcher
-from volviz.unstructured.render import render
+from volviz.unstructured.render import UnstructuredRenderStats, render
 from volviz.unstructured.tetrahedralize import tetrahedralize
 
 if TYPE_CHECKING:   # type-only imports for the signatures
@@ -49,10 +50,19 @@ if TYPE_CHECKING:   # type-only imports for the signatures
     from volviz.model.clip import ClipSettings
     from volviz.optics.transfer_function import TransferFunction
 
-__all__ = ["PTVolume", "add_pt_volume", "unpremultiply_rgba8", "zbuffer_to_depth"]
+__all__ = ["ErrorEstimate", "PTVolume", "add_pt_volume", "unpremultiply_rgba8", "zbuffer_to_depth"]
 
 
-class PTVolume(OverlayView, PTView):
+class ErrorEstimate(TypedDict):
+    """``PTVolume.error_estimate``: RMSE and max abs in 8-bit units against the exact reference, and the image size
+    (w, h) they were measured at."""
+
+    rmse: float
+    max: float
+    size: tuple[int, int]
+
+
+class PTVolume(OverlayView[UnstructuredRenderStats], PTView):
     """A volviz PT volume attached to a PyVista plotter (see the module docstring). The CPU side of the PT view
     interface ``volviz.render.pt_view.PTView``; ``mesh`` is what is drawn (a cut of ``whole_mesh`` under clipping)."""
 
@@ -82,7 +92,7 @@ class PTVolume(OverlayView, PTView):
         fwd = cam.frame()[2]
         return float(((corners - cam.position) @ fwd).max())
 
-    def begin(self, scale: int = 1) -> dict[str, Any]:
+    def begin(self, scale: int = 1) -> OverlayRequest:
         """GUI-thread part 1: render the opaque scene, read its depth, fix the camera (see the module docstring);
         ``scale`` > 1: a preview image that much smaller (``OverlayView.begin``). The opaque scene is rendered with
         the live camera (``hold`` suspended)."""
@@ -98,8 +108,8 @@ class PTVolume(OverlayView, PTView):
         request["tf"], request["mesh"] = self.tf, self.mesh   # what the image is of, whatever is set meanwhile
         return request
 
-    def compute(self, request: dict[str, Any], progress: Optional[ProgressCallback] = None) -> tuple[np.ndarray, Any,
-                np.ndarray]:
+    def compute(self, request: OverlayRequest, progress: Optional[ProgressCallback] = None
+                ) -> tuple[np.ndarray, UnstructuredRenderStats, np.ndarray]:
         """Any-thread part: the volume image for a request of ``begin`` (pure NumPy/Numba, no VTK), its statistics,
         and the image as VTK will show it (``overlay_rgba8``: straight-alpha 8-bit RGBA, a preview magnified
         to the window), made here so that ``finish`` on the GUI thread only hands it over."""
@@ -132,8 +142,8 @@ class PTVolume(OverlayView, PTView):
             size = window_size(self.plotter.ren_win)
         self._prefetcher.prefetch(camera, size)
 
-    def error_estimate(self, request: dict[str, Any], size: tuple[int, int] = (96, 72),
-                       progress: Optional[ProgressCallback] = None) -> dict[str, Any]:
+    def error_estimate(self, request: OverlayRequest, size: tuple[int, int] = (96, 72),
+                       progress: Optional[ProgressCallback] = None) -> ErrorEstimate:
         """Any-thread: the current method's error against the exact float64 reference for this view and TF, measured
         on a small image (``size``, same camera and aspect): RMSE and max abs in 8-bit units. This is what the app's
         statistics show as the error estimate."""
@@ -147,7 +157,8 @@ class PTVolume(OverlayView, PTView):
         exact = render(mesh, request["tf"], request["camera"], (sw, sh), "reference")
         return {"rmse": float(rmse(fast, exact)), "max": float(max_abs(fast, exact)), "size": (sw, sh)}
 
-    def finish(self, request: dict[str, Any], img: np.ndarray, st: Any, rgba8: np.ndarray | None = None) -> np.ndarray:
+    def finish(self, request: OverlayRequest, img: np.ndarray, st: UnstructuredRenderStats,
+               rgba8: np.ndarray | None = None) -> np.ndarray:
         """GUI-thread part 2: show a computed image as the overlay and record the statistics (``OverlayView``)."""
         super().finish(request, img, st, rgba8)
         if self.hold is not None and "held_camera" in request:
