@@ -24,8 +24,8 @@ class GuiThreadCollector(QObject):
 
     def freeze_long_lived(self) -> None:
         """Collect once, then move every surviving object (modules, classes, widgets: ~300,000 once the window
-        exists) to the permanent generation. A full collection had to scan them all every few seconds: 50-70 ms of
-        blocked event loop on an idle 2-core machine, more under load (the responsiveness test's > 100 ms gaps).
+        exists) to the permanent generation. A full collection had to scan them all every few seconds, a blocked event
+        loop each time, longer under load (the responsiveness test's > 100 ms gaps; docs/bench/docstring-figures.md).
         Called once, when the window is built; cycles made later are still collected."""
         gc.collect()
         gc.freeze()

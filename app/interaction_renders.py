@@ -1,10 +1,11 @@
 """One render per mouse move while the user drags the camera.
 
-pyvistaqt's viewport renders twice for each move of a drag: VTK's interactor style renders when it moves the camera,
-and the repaint that this render schedules renders again (pyvistaqt's ``paintGL`` always renders, since PyVista
-changes scenes without asking for a repaint). On a software OpenGL each render of a large viewport takes 20-30 ms, so
-a drag spent half its time drawing frames nobody saw. While an interaction lasts, the interactor's own renders are
-turned into repaint requests; the repaint draws the frame once. Outside interactions nothing changes.
+pyvistaqt's viewport renders twice for each move of a drag: VTK's interactor style renders when it moves the camera, and
+the repaint that this render schedules renders again (pyvistaqt's ``paintGL`` always renders, since PyVista changes
+scenes without asking for a repaint). On a software OpenGL each render of a large viewport is costly
+(docs/bench/docstring-figures.md), so a drag spent half its time drawing frames nobody saw. While an interaction lasts,
+the interactor's own renders are turned into repaint requests; the repaint draws the frame once. Outside interactions
+nothing changes.
 
 The app re-makes its CPU volume images while the camera moves and after, so its plotter's CPU PT volumes draw those
 frames with the camera of the image they show (``volviz.render.preview_hold``, issue #28)."""

@@ -181,7 +181,7 @@ class ViewScheduler:
     def schedule_render(self) -> None:
         """Draw once control returns to the event loop: a repaint of the viewport, which renders (Qt merges the
         repaints asked for in one pass). One render per frame instead of two: ``render_scene`` renders, then the
-        widget's paint renders again (pyvistaqt), each 10-70 ms on llvmpipe."""
+        widget's paint renders again (pyvistaqt), each a full render (docs/bench/docstring-figures.md)."""
         self.plotter.interactor.update()
 
     def _schedule_camera_moving(self) -> None:

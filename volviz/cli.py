@@ -431,7 +431,7 @@ LAYER_ERRORS = (("volviz.io.errors", "ReadError"), ("volviz.session", "SessionEr
 def user_errors() -> tuple[type[BaseException], ...]:
     """The exceptions that are the user's errors (one line, exit 2). A layer's error class is taken only from a module
     the command loaded, since only a loaded module can have raised it: a refused file is not followed by an import of
-    the render layer (0.7-0.9 s and VTK's rendering for a failed ``volviz info``)."""
+    the render layer (VTK's rendering, most of a failed ``volviz info``'s time; docs/bench/docstring-figures.md)."""
     loaded = tuple(getattr(sys.modules[module], name) for module, name in LAYER_ERRORS if module in sys.modules)
     return (UsageError, *loaded, FileNotFoundError, IsADirectoryError, PermissionError)
 
@@ -462,9 +462,9 @@ def _as_program() -> None:
 
 def _no_collection_at_exit() -> None:
     """The interpreter's exit skips the garbage collector's last passes over every object still alive: they only
-    free memory the exit returns anyway, and took 0.55-0.6 s of CPU (1-2 s of wall on 2 loaded cores) after a render
-    had written its image (issue #30, time to the first image: ``gc.freeze`` moves them out of the collector's
-    reach). Run last among the exit handlers, so that those (the reader child's shutdown, ``weakref.finalize``)
+    free memory the exit returns anyway, and cost up to a second after a render had written its image (issue #30,
+    time to the first image; docs/bench/docstring-figures.md): ``gc.freeze`` moves them out of the collector's
+    reach. Run last among the exit handlers, so that those (the reader child's shutdown, ``weakref.finalize``)
     still run."""
     gc.freeze()
 

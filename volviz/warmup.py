@@ -2,12 +2,13 @@
 
 volviz's hot loops are Numba kernels cached on disk (``cache=True``). Without the cache, the first use of each one
 compiles it: seconds of CPU per renderer, and while a worker compiles, Numba's compiler lock and the garbage it makes
-stall every other thread that needs a kernel, the GUI thread included (measured: 100-130 ms event-loop stalls while
-the app loaded its first tetrahedral scene on a fresh install, none with the cache). Warming up renders each kind of
-scene the app and the CLI draw (natural scene, tetrahedral volume, compressed level-of-detail volume, isosurfaces and
-a blended volume of a time series), compresses with every coder and transform, and runs each unstructured method,
-all at tiny sizes through the same code paths, so the kernels and the type signatures they are called with are
-compiled once and written to the cache. First it writes the bytecode of volviz's modules (``compile_bytecode``).
+stall every other thread that needs a kernel, the GUI thread included (event-loop stalls while the app loaded its first
+tetrahedral scene on a fresh install, none with the cache: docs/bench/docstring-figures.md). Warming up renders each
+kind of scene the app and the CLI draw (natural scene, tetrahedral volume, compressed level-of-detail volume,
+isosurfaces and a blended volume of a time series), compresses with every coder and transform, and runs each
+unstructured method, all at tiny sizes through the same code paths, so the kernels and the type signatures they are
+called with are compiled once and written to the cache. First it writes the bytecode of volviz's modules
+(``compile_bytecode``).
 """
 from __future__ import annotations
 
@@ -52,8 +53,9 @@ def compile_bytecode(folders: Optional[Sequence[Path]] = None) -> list[Path]:
     source changed, checked against the source's hash (``BYTECODE_CHECK``); returns the folders written to. pip
     compiles a package it installs; an editable install, or ``PYTHONDONTWRITEBYTECODE`` (which stops Python writing
     what it compiles, not ``compileall``), leaves volviz's modules without bytecode, and every fresh process compiled
-    the 120-odd modules a render imports again: 0.2-0.5 s of CPU of each ``volviz render`` (issue #30, time to the
-    first image; docs/bench/startup-cuts.md). Folders it may not write to (a system install) are left as they are."""
+    the 120-odd modules a render imports again, a large share of each ``volviz render``'s start (issue #30, time to
+    the first image; docs/bench/startup-cuts.md). Folders it may not write to (a system install) are left as they
+    are."""
     if getattr(sys, "frozen", False):   # a frozen app runs its bundled bytecode
         return []
     written = [Path(f) for f in (bytecode_folders() if folders is None else folders) if os.access(f, os.W_OK)]

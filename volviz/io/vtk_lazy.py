@@ -1,8 +1,8 @@
 """VTK for volviz's readers, each VTK module imported when a class of it is first asked for.
 
-``import vtk`` loads every VTK module: 1.2-2 s on a 2-core machine, most of the cold start of a reader child
-(``volviz.io.isolated``), which a fresh ``volviz render FILE`` waits for before it reads (issue #30: time to the
-first image, ``docs/first-open.md``). The readers use ``from volviz.io.vtk_lazy import vtk`` as they used the ``vtk``
+``import vtk`` loads every VTK module, most of the cold start of a reader child (``volviz.io.isolated``), which a fresh
+``volviz render FILE`` waits for before it reads (issue #30: time to the first image, ``docs/first-open.md``; its cost:
+docs/bench/docstring-figures.md). The readers use ``from volviz.io.vtk_lazy import vtk`` as they used the ``vtk``
 module: a name of ``MODULE_OF`` (the classes volviz's readers and the reader plugins use) or a ``VTK_*`` constant
 imports only its own module, any other name the whole of VTK, so every name VTK has is still there.
 """

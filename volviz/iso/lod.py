@@ -7,7 +7,8 @@ cubes survives (duplicates removed). The cubes of level k+1 contain whole cubes 
 one parent vertex on level k+1: its geomorph target. The displayed mesh at a continuous level λ = k + f uses level
 k's topology with positions (1 − f)·p + f·parent(p) and normals blended alike; at f = 1 each triangle coincides with a
 level-(k+1) triangle or has collapsed to zero area, so switching to level k+1 moves no vertex. (Quadric decimation
-gives better coarse meshes but no vertex correspondence; closest-point targets fold and pop, measured RMSE 1.7 vs 0.)
+gives better coarse meshes but no vertex correspondence; closest-point targets fold and pop:
+docs/bench/docstring-figures.md.)
 Levels are chosen per surface from its screen size: the bounding sphere's projected radius r (pixels) asks for about
 ``triangles_per_pixel2 · π r²`` triangles and λ interpolates log(triangles) between the levels. (The note's C-LOD
 refines per region; this picks one level per surface, so a surface far away is coarse everywhere.)

@@ -12,8 +12,8 @@
 - **Optical Δ** (``extinction`` = ρ_max > 0): Δ_local is scaled by ρ_max s before the propagation, i.e. Δ becomes the
   optical-depth error of a ray crossing the node. A field deviation δ over a node of edge s changes the pixel's
   opacity by up to about ρ_max δ s — a coarse node's error grows with its size, which the bare scalar Δ ignores (it
-  treats a 32-cell node like a 2-cell one). Measured on the 513 x 513 x 65 benchmark clouds (docs/bench/nature.md):
-  for the same cloud RMSE about 3x fewer tetrahedra than the scalar Δ.
+  treats a 32-cell node like a 2-cell one): for the same cloud error it draws fewer tetrahedra than the scalar Δ
+  (docs/bench/docstring-figures.md, docs/bench/nature.md).
 - **Morphing** Eq. (11.6) e' = clamp(e − 1, 0, 1) and the CORRECTED Eq. (11.8) S' = (1 − w) coarse + w S (digest
   §14 erratum), w the minimum e' of all same-level nodes sharing the vertex (unrefined or non-existent = 0) and
   capped by the parent's. Coarse values: edge = mean of its ends, face = mean of the parity diagonal, centroid = mean
@@ -25,9 +25,8 @@
   density cannot exceed the cutoff in it (``fbound``: the largest value the morph gives any of its grid points for
   any weights), not when the data cannot (``fmax``). A leaf whose data is transparent but whose corners carry a
   coarser neighbour's values (T-vertices, morphing) is drawn; dropped, its neighbour's cloud ended at their shared
-  face: straight vertical and horizontal seams along the leaves' faces (issue #28; at the demo camera, 1024 x 640,
-  the centre column, the eye's plane x = 500, stepped 5.8x as much as its neighbours, 0.69x with ``fbound``;
-  tests/test_cloud_seams.py). Costs 17 % more leaves there (5,462 -> 6,447), each with a morphed corner above the
+  face: straight vertical and horizontal seams along the leaves' faces (issue #28; tests/test_cloud_seams.py, the
+  figures in docs/bench/docstring-figures.md). It draws a few more leaves, each with a morphed corner above the
   cutoff.
 - **Projection**: ``render_cloud_image`` is an exact per-pixel equivalent of pre-integrated projected tetrahedra:
   per leaf and pixel the ray is clipped to the cube and to [near, terrain depth] (volumetric near-plane clipping and

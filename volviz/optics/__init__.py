@@ -8,8 +8,9 @@
 - ``volviz.optics.metrics``: RMSE / max abs in 8-bit units, PSNR, error heat map.
 
 The names are imported on first use (PEP 562 ``__getattr__``): the tables and the integral are Numba kernels, and
-importing Numba (with SciPy) costs 0.2-1 s of a fresh process's start (issue #30), which a render that only needs a
-``TransferFunction`` (a regular volume drawn by VTK) should not pay.
+importing Numba (with SciPy) costs up to a second of a fresh process's start (issue #30;
+docs/bench/docstring-figures.md), which a render that only needs a ``TransferFunction`` (a regular volume drawn by VTK)
+should not pay.
 """
 from __future__ import annotations
 

@@ -23,8 +23,8 @@ Method (analytic, no quadrature error beyond the special functions):
 4. Pieces are composited front to back ("over"); pieces behind an accumulated optical depth of 750 are skipped
    (their weight e^{−750} underflows to 0).
 
-Measured accuracy (``tests/test_optics_integrate.py``): M against adaptive quadrature over p, q spanning 0 … 1e6 has
-absolute error < 1e-13 (measured 3e-16 on a 41×41 grid of end densities 0, 1e-6 … 1e6); ``erfcx``/``dawson`` agree
+Accuracy (``tests/test_optics_integrate.py``; the readings: docs/bench/docstring-figures.md): M against adaptive
+quadrature over p, q spanning 0 … 1e6 has absolute error < 1e-13; ``erfcx``/``dawson`` agree
 with SciPy to < 2e-14 relative; whole segments agree with 10^6-step Riemann sums to the sums' own O(h²) error
 (≤ 4e-12 measured) and with closed forms to < 1e-12. Error propagation: an error δ in M changes a piece's color by
 |κ_b − κ_a|·δ and its opacity not at all (α uses e^{−T} directly); compositing multiplies by transmittances ≤ 1, so a

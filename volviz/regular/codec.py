@@ -11,9 +11,9 @@ Modes
   halves the rate roughly); subband steps ``delta / sqrt(weight)`` with the 5/3 synthesis energy weights
   (``wavelet.subband_weights``), so the error spreads evenly over subbands, rounded to integers (>= 1; 1 = that
   subband is lossless). Integer steps on the integer coefficients give bins of equal integer counts; fractional
-  steps in (1, 2) cost rate for almost no error reduction. Measured on embryo with the arithmetic coder: 57.0 dB
-  at 0.99 bit/voxel with integer steps against 56.4 dB at 1.0 with fractional ones (Q = 90: about 63 dB;
-  Q >= 95: lossless). The quality knob therefore moves in discrete steps near lossless.
+  steps in (1, 2) cost rate for almost no error reduction (on embryo integer steps gave a higher PSNR at a lower
+  rate; Q >= 95 is lossless there: docs/bench/docstring-figures.md). The quality knob therefore moves in discrete
+  steps near lossless.
 - ``psnr=DB``: bisection over log(delta) until the PSNR (peak = the dtype's maximum, 255 for 8-bit, 65535 for
   16-bit and quantised float) is at least DB; the search measures the true reconstruction (quantise + inverse
   wavelet) of the whole volume, or of a central 256^3 crop for volumes above 2^25 voxels (then stated in ``info``).

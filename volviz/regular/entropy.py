@@ -7,9 +7,9 @@ subband and per sub-block (the significance map) says whether it holds any non-z
 sub-blocks carry coefficients. An all-zero tile codes to zero bytes (a stripped node, see ``codec``). Context class
 of a subband = number of highpass axes - 1 (0, 1, 2); class 3 is the root's lowpass residual.
 
-``CODER_RANS`` (the fast coder; a measured replacement of the thesis's fixed gamma-Huffman): coefficients are sign
-mapped (c -> 2c for c >= 0, -2c-1 for c < 0, the thesis's mapping) to v. Tokens are v for v < 16 and
-``11 + bitlength(v)`` otherwise, followed by the bits of v below its leading one as raw bits (the thesis's
+``CODER_RANS`` (the fast coder; a replacement of the thesis's fixed gamma-Huffman, chosen by measurement):
+coefficients are sign mapped (c -> 2c for c >= 0, -2c-1 for c < 0, the thesis's mapping) to v. Tokens are v for
+v < 16 and ``11 + bitlength(v)`` otherwise, followed by the bits of v below its leading one as raw bits (the thesis's
 gamma-code structure). Tokens are coded with a static rANS coder (32-bit state, 16-bit renormalisation, 12-bit
 probabilities; version 2: two interleaved states, token n uses state n & 1, so the decoder runs two independent
 dependency chains -- about 25% faster entropy decoding than one state) whose per-class frequency tables are stored in
@@ -25,17 +25,16 @@ as context and each coefficient as zero flag, sign, unary bit length and mantiss
 bucketed magnitude sum of the three causal neighbours (previous sample along each axis in the same subband) plus the
 magnitudes at the same position in the subbands already coded (cross-subband), and -- in lossless files only, where
 the decoder's lowpass equals the encoder's -- the bucketed activity (3^3 max - min) of the lowpass at that position.
-Measured on embryo (256^3, lossless): 6.10:1 with version 1 (causal neighbours only, fixed rate 1/16), 6.34:1 with
-version 2; at quality 80: 8.49:1 -> 8.87:1 (same PSNR). A damaged coarse brick in a lossless arith file also
+Version 2's contexts and adaptation rate raised the ratio over version 1's (causal neighbours only, fixed rate 1/16),
+lossless and lossy (docs/bench/docstring-figures.md). A damaged coarse brick in a lossless arith file also
 perturbs the contexts of its children, whose region is then approximate too (it is the damaged region anyway).
 
 Version 3 adds the model of bricks coded with the integer S-transform (lossless files, see ``wavelet.py``):
 :func:`encode_haar_arith` visits the details block by block (the 7 details of one 2x2x2 voxel block together, with
 a per-block significance flag) instead of subband by subband, with contexts from the block's lowpass, its
 neighbours' lowpass and the causal neighbour blocks' details, and an S+P-style prediction of the single-axis details
-from the lowpass slope. The rANS coder codes S-transform bricks with its unchanged subband scan. Measured on embryo
-(256^3, lossless, every node choosing the smaller of 5/3 and S-transform): arith 7.81:1 (1.02 bit/voxel; 5/3 only:
-6.34:1), rANS 6.25:1 (5/3 only: 5.75:1).
+from the lowpass slope. The rANS coder codes S-transform bricks with its unchanged subband scan. Letting every node
+choose the smaller of 5/3 and S-transform raises both coders' lossless ratio (docs/bench/docstring-figures.md).
 """
 from __future__ import annotations
 
@@ -958,8 +957,8 @@ def encode_haar_arith(w, n0, n1, n2, out, base):
     r = d - pred (:func:`_hpred`) with zero flag, sign, unary bit length and mantissa (top bit modelled, the rest
     raw). Contexts: the block's lowpass magnitude, the detail magnitudes of the three causal neighbour blocks, the
     largest lowpass magnitude of the six face neighbours (non-causal: the lowpass is known), the subband, the
-    number of non-zero details already coded in the block, the prediction's size and sign. Measured on embryo
-    level 1 (S-transform on every tile): 0.91 bit/voxel against 1.01 with the subband coder of :func:`encode_arith`."""
+    number of non-zero details already coded in the block, the prediction's size and sign. It codes S-transform
+    tiles in fewer bits than the subband coder of :func:`encode_arith` (docs/bench/docstring-figures.md)."""
     if not _haar_any(w, n0, n1, n2):
         return 0
     l0 = (n0 + 1) // 2

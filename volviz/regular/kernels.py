@@ -9,11 +9,11 @@ is coded with the 5/3 and with the integer S-transform and keeps the smaller (``
 it as context. Quantisation (lossy modes): detail subband ``b`` uses step ``steps[b]``; a step <= 1 means no
 quantisation
 (lossless integers). Coefficient c -> q = sign(c) * floor(|c| / step + ROUND) (a dead-zone quantiser),
-reconstruction c' = sign(q) * round((|q| + BIAS) * step). ROUND = 0.40, BIAS = 0 measured best on embryo with
-integer steps (PSNR at 1 bit/voxel: 57.0 dB; 0.30/0: 56.9, 0.25/0.05: 56.3, the former 0.40/0.10 with fractional
-steps: 56.4).
+reconstruction c' = sign(q) * round((|q| + BIAS) * step). ROUND = 0.40, BIAS = 0 gave the best PSNR on embryo at
+1 bit/voxel with integer steps of the pairs tried (docs/bench/docstring-figures.md).
 The kernels are plain ``nogil`` Numba functions over a strided subset of tiles (``first``, ``first + stride``, ...);
-:func:`run_tiles` runs them on a small thread pool. (A ``prange`` version compiled 3-4x slower for no speed gain.)
+:func:`run_tiles` runs them on a small thread pool. (A ``prange`` version compiled several times slower for no
+speed gain.)
 """
 from __future__ import annotations
 

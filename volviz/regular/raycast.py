@@ -21,9 +21,9 @@ How a ray is walked (``raycast_kernels.cast_blocks``):
 - Each segment (s_f, s_b, l) is integrated with the separable table (Roettger §9.1, ``volviz.optics.build_separable``,
   degree 2): the opacity 1 − exp(−l ρ̂(s_f, s_b)) is exact for any l (only ρ̂ is bilinear in the scalars), so the
   varying step lengths of the levels and the shortened last step in each block need no table axis in l; the color is
-  a quadratic in l/l_max. Measured table error (``SeparableTable.error``, 256^2 entries over [0, 255], l_max = 4):
-  max 1.5e-4 (0.04 of 255) for the embryo walkthrough's TF, 2.4e-4 (0.06 of 255) for the tests' TF (degree 1 or
-  128^2 entries measured no faster: the lookups take ~40% of the time, the sampling the rest).
+  a quadratic in l/l_max. The table's error (``SeparableTable.error``, 256^2 entries over [0, 255], l_max = 4) is a
+  small fraction of one 8-bit level (docs/bench/docstring-figures.md); degree 1 or 128^2 entries were no faster (the
+  lookups are well under half the time, the sampling the rest).
 - Blocks whose scalar range (with overlap) maps to ρ = 0 under the TF are marked inactive and leapt over whole
   (§2.3.5; the selection has already dropped nodes transparent over their footprint + apron); a segment whose two
   scalars both lie below (or above) the support of ρ is transparent without a table lookup (``zero_opacity_ends``).

@@ -9,28 +9,24 @@ View kinds with both paths:
 - ``"regular"``: regular volumes by VTK's ray casters: ``vtkSmartVolumeMapper``'s GPU ray caster or its CPU one.
 
 ``auto`` takes the GPU path on a hardware OpenGL driver. On a software rasteriser (Mesa llvmpipe, softpipe, swrast,
-Google SwiftShader) the GPU's work runs on the same CPU cores, so ``auto`` takes the path measured faster there:
+Google SwiftShader) the GPU's work runs on the same CPU cores, so ``auto`` takes the path that was faster there (the
+figures: ``docs/bench/pt-gl/unstructured.md``, ``docs/bench/iso.md``, docs/bench/docstring-figures.md):
 
-- PT: the CPU ``pt``. ``docs/bench/pt-gl/unstructured.md`` (Blunt Fin, 187,318 tetrahedra, llvmpipe, 2 cores) has
-  0.37 s / 0.67 s per frame (CPU ``pt`` / GL PT) at 256², 1.09 / 1.69 s at 512², 2.6 / 5.2 s at 1024² and 6.1 / 6.2 s
-  at 1920x1080: the CPU path is faster at every size measured. In the app it also renders off the GUI thread and
-  draws half-size previews while the camera moves, where the GL pass blocks the GUI thread for a full-size draw.
+- PT: the CPU ``pt``, faster at every window size on the Blunt Fin. In the app it also renders off the GUI thread
+  and draws half-size previews while the camera moves, where the GL pass blocks the GUI thread for a full-size
+  draw.
 - ``"nature"``: the natural scene's fog and cloud layers and C-LOD clouds: ``volviz.render.gl_nature.GLNatureView``
   (GL prisms and GL PT in the scene's depth buffer) or the CPU ``volviz.render.nature_view.NatureView`` (an overlay
-  made off the GUI thread). Auto takes the CPU on a software rasteriser: the demo scene on llvmpipe (2 shared cores,
-  ~25k cloud tetrahedra, ~60k fog prisms, median of 5 frames) takes 0.18 s per frame on the CPU against 0.22 s on
-  the GL path at 512x384 (0.01 s of it LOD selection and handing the buffers to VTK, the rest llvmpipe's draw) and
-  0.04 / 0.13 s at 64x48 (llvmpipe runs the prisms' and tetrahedra's geometry shaders on the CPU cores).
+  made off the GUI thread). Auto takes the CPU on a software rasteriser, faster on the demo scene: a software
+  rasteriser runs the prisms' and tetrahedra's geometry shaders on the CPU cores, nearly all of the GL path's
+  frame.
 - ``"iso"``: the isosurfaces' transparency modes of the libMini note §4 (2-pass, 3-pass, 4-pass, exact):
   ``volviz.render.gl_iso.GLIsoView`` (the passes as VTK actors, drawn at every render) or the CPU
   ``volviz.render.iso_overlay.IsoOverlay`` (fragment lists composited off the GUI thread, pasted over the scene).
-  Auto takes the GPU on a software rasteriser too: ``docs/bench/iso.md`` (384², llvmpipe, 2 shared cores; the Storm,
-  two overlapping Storm volumes and the Blunt Fin) has 10-13 / 61-107 ms per frame (GPU / CPU) for 2-pass, 20-36 /
-  83-165 ms for 3-pass, 37-45 / 106-150 ms for 4-pass and 85-124 / 102-149 ms for exact: the GPU is faster in every
-  mode on every scene, the GPU's time including the read-back of the frame.
-- regular: VTK's CPU ray caster (measured on 2 cores: the embryo 256³ at 512² takes 0.07 s against 0.26 s with the
-  GPU ray caster on llvmpipe; in the app, loading the embryo blocked the event loop 4.3 s with the GPU mapper and 1.2 s
-  with the CPU one, and a Storm playback frame took 450 ms against 230 ms).
+  Auto takes the GPU on a software rasteriser too: it is faster in every mode on every scene of ``docs/bench/iso.md``,
+  the GPU's time including the read-back of the frame.
+- regular: VTK's CPU ray caster, faster on the embryo, and in the app it blocks the event loop for less at load and
+  per playback frame.
 
     info = gl_info(plotter.ren_win)              # GLInfo(vendor, renderer, version)
     choose_backend("auto", "pt", info)           # "cpu" on llvmpipe, "gpu" on a hardware driver
@@ -92,7 +88,7 @@ def parse_capabilities(text: str) -> GLInfo:
 def gl_info(render_window: vtkRenderWindow) -> GLInfo:
     """The OpenGL driver of a VTK render window. One without a context yet gets one: an offscreen window by
     ``Initialize()``, which makes the context without drawing the scene (issue #30: the render it replaces drew the
-    whole scene once more before the first image, 0.47 s of CPU for a 1024x768 sphere on llvmpipe against 0.01 s);
+    whole scene once more before the first image; docs/bench/docstring-figures.md);
     an on-screen one, whose context its toolkit makes, by one render."""
     text = render_window.ReportCapabilities()
     if "renderer string" not in text and render_window.GetOffScreenRendering():

@@ -77,7 +77,8 @@ def iso_summary(stats: dict[str, Any]) -> str:
 @contextmanager
 def no_render(plotter: pv.BasePlotter) -> Iterator[None]:
     """PyVista renders after every added actor or mesh (``render=True``); inside this block it does not, and the
-    caller draws once afterwards (each render of a big scene on llvmpipe is 50-600 ms of a blocked GUI thread)."""
+    caller draws once afterwards (each render of a big scene on a software rasteriser blocks the GUI thread for a
+    noticeable time; docs/bench/docstring-figures.md)."""
     suppressed = getattr(plotter, "suppress_rendering", False)
     plotter.suppress_rendering = True
     try:

@@ -1,9 +1,9 @@
 """matplotlib's pyplot and Agg backend run on first use: pyvista 0.49 imports ``matplotlib.pyplot`` in
 ``pyvista.plotting.colors`` and ``.charts`` for one rcParams lookup (its default color cycler) and its matplotlib
 charts, and ``matplotlib.backends.backend_agg`` in ``.charts`` for the canvas of ``ChartMPL``, which a render never
-makes; pyplot's body (the figure manager, the backend's resolution) costs 0.2-1 s of a fresh process's start under
-load (issue #30, docs/bench/startup.md), the backend's (``matplotlib.backend_bases``: text, fonts, mathtext, patches,
-widgets) 0.18 s of CPU on a quiet machine (docs/bench/startup-cuts.md).
+makes; pyplot's body (the figure manager, the backend's resolution) and the backend's (``matplotlib.backend_bases``:
+text, fonts, mathtext, patches, widgets) cost up to a second of a fresh process's start under load (issue #30;
+docs/bench/startup.md, docs/bench/startup-cuts.md, docs/bench/docstring-figures.md).
 
 ``defer_pyplot`` puts a finder first on ``sys.meta_path`` that gives each of ``DEFERRED`` a module whose body runs
 at the first lookup of a name it does not hold yet (a module-level ``__getattr__``): ``import matplotlib.pyplot``

@@ -138,8 +138,8 @@ class NatureSceneView(ABC, Generic[FrameT]):
         ``volviz render``'s camera, ``_as_camera``), the far one just beyond the sky dome. A function of the scene,
         the eye and the dome alone: VTK's fit to the props' bounds put the near plane at 1e-3 of a far plane that
         depended on where the dome stood (about 6.4 units on Yukon, where ``volviz render`` had 1.0), and a flight
-        that ended a few terrain cells from a hillside showed it cut open (issue #28: RMSE 20-27 against the
-        render of the saved session)."""
+        that ended a few terrain cells from a hillside showed it cut open (issue #28;
+        docs/bench/docstring-figures.md)."""
         centre = np.asarray(self.sky_actor.GetPosition() if self.sky_actor is not None else eye, dtype=np.float64)
         offset = float(np.linalg.norm(np.asarray(eye, dtype=np.float64) - centre))
         return self._near, 1.05 * (self.dome_radius + offset)
@@ -234,8 +234,8 @@ class NatureView(NatureSceneView[np.ndarray]):
         moves) renders the fog and clouds at 1/scale of the size in each direction (OpenGL magnifies them:
         ``_set_overlay``) over a coarser terrain of about ``PREVIEW_TRIANGLES`` triangles (the C-LOD resolution
         scaled by ``preview_detail``, refitted after each preview): the full mesh, half a million triangles on Yukon,
-        took 0.4 s to draw on a software OpenGL, and each frame drawn while flying blocked the window that long. The
-        clouds' levels of detail are those of the full size."""
+        is slow to draw on a software OpenGL, and each frame drawn while flying blocked the window that long
+        (docs/bench/docstring-figures.md). The clouds' levels of detail are those of the full size."""
         cam, size, scale = request
         preview = scale > 1 and not self.full
         mesh = self._preview_mesh(cam, size) if preview else self.scene.terrain_mesh(cam, size, full=self.full)
@@ -285,8 +285,8 @@ class NatureView(NatureSceneView[np.ndarray]):
         """Show an overlay image of ``_overlay_rgba`` (8-bit premultiplied RGBA, rows bottom-up) in front of the scene,
         over the whole viewport whatever the image's size (``_viewport_quad``). ``smooth``: filtered linearly (a
         preview smaller than the viewport); at the viewport's size each pixel shows its texel either way. A preview
-        uploads 1/scale² of the pixels and needs no magnification on the CPU (PIL took 34 ms per 990x673 preview on
-        the worker, beside 2.6 MB copied and uploaded on the GUI thread)."""
+        uploads 1/scale² of the pixels and needs no magnification on the CPU (a magnified preview cost the worker a
+        resize and the GUI thread a full-size copy and upload; docs/bench/docstring-figures.md)."""
         # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
         from volviz.render.vtk_facade import numpy_to_vtk, vtk
 
@@ -322,20 +322,19 @@ ANISOTROPY = 1.0
 
 def texture_filtering(plotter: pv.BasePlotter) -> bool:
     """Whether the terrain texture is mip-mapped in ``plotter`` by default: on a hardware OpenGL driver (free there),
-    not on a software rasteriser (``volviz.render.backend``): on llvmpipe the mip-mapped terrain took 62-78 ms
-    against 35-39 ms per 320x200 frame, and its first frame (making the mip-maps) 170-260 ms against 95-145 ms, on
-    the GUI thread; unfiltered, the terrain shimmers as the camera moves (``_filtered_texture``)."""
+    not on a software rasteriser (``volviz.render.backend``), where the mip-mapped terrain nearly doubles the time of
+    a frame and of the first one (making the mip-maps) on the GUI thread (docs/bench/docstring-figures.md);
+    unfiltered, the terrain shimmers as the camera moves (``_filtered_texture``)."""
     return not plotter_gl_info(plotter).software
 
 
 def _filtered_texture(texture: Any) -> Any:
     """The terrain's color map filtered as the CPU raster shades it (``volviz.nature.raster``: an isotropic mip-map
     pyramid): mip-mapped and trilinear. Unfiltered, every small camera step re-sampled the map's texels differently:
-    on the Yukon path the frames of the GPU and CPU views changed 2.4 times as much per step as the full-resolution
-    reference's (a shimmer no LOD setting could remove) and stood RMSE 8.8 - 10.9 from it; filtered, RMSE 6.9 - 8.1
-    and about the reference's change per step (``volviz bench nature``). Anisotropic filtering (4 or 16) is sharper at
-    grazing angles but farther from the reference: RMSE 4.45 / 3.45 against 4.25 / 3.31 isotropic on frames 0 and 3
-    at the accurate LOD setting (terrain 9, 160; clouds 2, 50)."""
+    the views changed far more per step than the full-resolution reference (a shimmer no LOD setting could remove)
+    and stood farther from it; filtered, about the reference's change per step (``volviz bench nature``).
+    Anisotropic filtering is sharper at grazing angles but farther from the reference
+    (docs/bench/docstring-figures.md)."""
     texture.SetMipmap(True)
     texture.InterpolateOn()
     texture.SetMaximumAnisotropicFiltering(ANISOTROPY)

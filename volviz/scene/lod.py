@@ -28,7 +28,7 @@ def vvz_voxels(path: str | os.PathLike) -> int:
 def is_lod(dataset: object) -> TypeIs[LodTree]:
     """Whether a loaded dataset is a compressed volume drawn at a level of detail. A LodTree exists only once its
     module was imported, so the question never imports that module (the wavelet decoder's Numba kernels and SciPy,
-    0.4-0.9 s of a render of any regular volume, issue #30)."""
+    up to a second of a render of any regular volume, issue #30; docs/bench/docstring-figures.md)."""
     lod = sys.modules.get("volviz.regular.lod")
     return lod is not None and isinstance(dataset, lod.LodTree)
 

@@ -41,9 +41,8 @@ LOOKUPS = ("auto", "separable", "3d")
 
 def auto_lookup(max_depth: float) -> tuple[str, int]:
     """The lookup for "pt" by the largest optical depth of one cell (max rho x longest edge): the separable table
-    with degree 2 up to 6, degree 4 up to 24, else the 3D table. Measured against the reference (8-bit RMSE / max):
-    degree 2 0.06 / 0.60 at depth 7, 0.60 / 3.7 at 14.5; degree 4 0.06 / 0.26 at 14.5, 0.11 / 1.0 at 29; 3D
-    0.08 / 1.05 at 29 (one tetrahedron and a jittered 5^3 grid, 40 x 32)."""
+    with degree 2 up to 6, degree 4 up to 24, else the 3D table: each switches where the cheaper lookup's error
+    against the reference grows past the next one's (the errors by depth: docs/bench/docstring-figures.md)."""
     if max_depth <= 6.0:
         return "separable", 2
     if max_depth <= 24.0:
@@ -168,7 +167,7 @@ def render(mesh: TetMesh, tf: Any, camera: Camera, size: tuple[int, int] = (512,
     (Roettger §8.8-8.10; ``tf`` is then ignored). "pt" with ``iso_mode="exact"`` evaluates the §8.13 Heaviside
     limit per pixel segment (equal to the reference up to float32 isovalues); ``iso_mode="texture"`` looks up the
     bilinear (s_f, s_b) texture like the GPU method (segments ending within a texel of an isovalue are partly
-    covered: measured RMSE 5, 5% of pixels off by > 4/255 on a 7^3 jittered grid at 48 x 40). "reference" evaluates
+    covered, an error of a few 8-bit levels: docs/bench/docstring-figures.md). "reference" evaluates
     the Heaviside limit per exact segment. ``iso_shading="smooth"`` (exact mode) shades each surface with a
     headlight through vertex normals interpolated linearly inside cells (Roettger §8.9, ``iso.vertex_shade``);
     "flat" (default) keeps the surfaces' colors.

@@ -160,7 +160,7 @@ def _load_vtk_when_idle() -> None:
     """Import the VTK modules of volviz's readers (``volviz.io.vtk_lazy.MODULE_OF``, by name: not the whole of VTK,
     issue #31) until a request is waiting. A child kept warm for later reads (the app's pool) has them
     loaded before they come; one started for a read at hand (``volviz render FILE``, with ``worker.AT_HAND``) does
-    not run this: its reader imports only the VTK modules it uses (``volviz.io.vtk_lazy``: 0.4 s instead of 1.2-2 s).
+    not run this: its reader imports only the VTK modules it uses (``volviz.io.vtk_lazy``, a fraction of the whole).
     """
     if select.select([sys.stdin.buffer], [], [], IDLE_SECONDS)[0]:
         return
