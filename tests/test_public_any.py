@@ -76,8 +76,10 @@ PLOTTER = ("a PyVista plotter (pv.Plotter offscreen, pyvistaqt's QtInteractor in
            "mypy reads them as unbound), so typing it needs another call in the body, a code change")
 PLOTTER_HELD = ("a PyVista plotter: pv.BasePlotter fits (mypy finds nothing), left for preview_hold.py was being "
                 "edited by another change when the others were typed")
-PLOTTER_WINDOW = ("a PyVista plotter whose ren_win these read and set: PyVista types it Optional (None once closed), "
-                  "so typing the plotter needs a None check in the body, a code change")
+PLOTTER_WINDOW = ("a PyVista plotter whose ren_win this reads and sets and which it hands to plotter_gl_info (a "
+                  "pv.BasePlotter): PyVista types ren_win Optional (None once closed), so neither BasePlotter nor "
+                  "image_overlay.WindowPlotter (what the multisampling holds take) fits without a None check in the "
+                  "body, a code change")
 ISO_PARTS = ("IsoParts or a list of IsoMesh: the body tells them apart with a conditional expression mypy "
              "cannot follow")
 
@@ -113,25 +115,17 @@ ALLOWED: dict[str, str] = {
     "volviz.render.decorations:update_outline": PLOTTER,
     "volviz.render.error_budget:error_budget_choice": JSON,
     "volviz.render.export:open_target": JSON,
-    "volviz.render.framing:nature_bounds":
-        "duck-typed: reads a NatureScene's optional parts through getattr, which mypy cannot narrow",
-    "volviz.render.framing:scene_bounds": VTK_ANY,
-    "volviz.render.framing:frame_scene": VTK_ANY,
     "volviz.render.gl_iso:GLIsoView.update": STATS,
     "volviz.render.gl_iso:GLIsoView.finish": STATS,
-    "volviz.render.image_overlay:hold_single_sample": PLOTTER_WINDOW,
     "volviz.render.image_overlay:single_sample_on_software": PLOTTER_WINDOW,
-    "volviz.render.image_overlay:release_single_sample": PLOTTER_WINDOW,
     "volviz.render.lod_volume:LodVolume.finish": STATS,
     "volviz.render.lod_volume:LodVolume.update": STATS,
     "volviz.render.lod_volume:LodVolume.show_stats": STATS,
-    "volviz.render.offscreen:draw_projected_tetrahedra_once": PLOTTER_WINDOW,
     "volviz.render.offscreen:offscreen_plotter":
         "pv.Plotter: PyVista 0.49's _Wrapped decorator mistypes its methods for callers outside this change (bench)",
     "volviz.render.preview_hold:hold_previews": PLOTTER_HELD,
     "volviz.render.preview_hold:holds_previews": PLOTTER_HELD,
     "volviz.render.pt_prop:add_pt_volume": DATASET_TO_PROP,
-    "volviz.render.pt_view:is_pt_view": VTK_ANY,
     "volviz.render.scene_builder:prepared_volume_input": DATASET,
     "volviz.render.scene_builder:time_input": DATASET,
     "volviz.render.scene_builder:add_volume_prop": DATASET_TO_PROP,

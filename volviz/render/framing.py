@@ -3,7 +3,7 @@
 those bounds fill a given share of the viewport."""
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any, Optional
+from typing import TYPE_CHECKING, Any, Mapping, Optional
 
 import numpy as np
 
@@ -12,7 +12,8 @@ from volviz.scene.lod import lod_bounds
 if TYPE_CHECKING:   # type-only imports for the signatures
     import numpy.typing as npt
     import pyvista as pv
-    from volviz.render.vtk_facade import vtkProp
+
+    from volviz.nature.nature_scene import NatureScene
 
 Bounds = tuple[float, float, float, float, float, float]
 
@@ -25,17 +26,17 @@ def _valid(bounds: Any) -> bool:
     return b.shape == (6,) and bool(np.all(np.isfinite(b))) and bool(np.all(b[1::2] >= b[0::2]))
 
 
-def nature_bounds(scene: Any) -> Optional[Bounds]:
+def nature_bounds(scene: NatureScene) -> Optional[Bounds]:
     """The bounds of a NatureScene: its terrain and the clouds above it (not the sky dome around the eye)."""
-    parts = []
-    if getattr(scene, "terrain", None) is not None:
+    parts: list[tuple[float, ...]] = []
+    if scene.terrain is not None:
         parts.append(scene.terrain.bounds())
-    if getattr(scene, "cloud_lod", None) is not None:
+    if scene.cloud_lod is not None:
         parts.append(scene.cloud_lod.volume.bounds())
     return union([tuple(float(v) for v in b) for b in parts if _valid(b)])  # type: ignore[misc]
 
 
-def prop_bounds(prop: vtkProp) -> Optional[Bounds]:
+def prop_bounds(prop: object) -> Optional[Bounds]:
     """The world bounds of one component's prop: a NatureView (its terrain, else its clouds), a PT volume (its
     mesh), a LOD volume (its samples), a VTK prop (what VTK reports); None when empty or a hidden VTK prop (callers
     leave out the props of hidden components)."""
@@ -70,7 +71,7 @@ def points_bounds(points: np.ndarray) -> Bounds:
     return (float(lo[0]), float(hi[0]), float(lo[1]), float(hi[1]), float(lo[2]), float(hi[2]))
 
 
-def scene_bounds(props: dict[str, Any]) -> Optional[Bounds]:
+def scene_bounds(props: Mapping[str, object]) -> Optional[Bounds]:
     """The union of the bounds of every component prop (None when nothing has bounds)."""
     return union([b for b in (prop_bounds(p) for p in props.values()) if b is not None])
 
@@ -139,6 +140,7 @@ def frame_bounds(plotter: pv.BasePlotter, bounds: Optional[Bounds], fill: float 
     plotter.camera_set = True          # else PyVista re-frames its own props at the next render
 
 
-def frame_scene(plotter: pv.BasePlotter, props: dict[str, Any], fill: float = FILL, right_margin: float = 0.0) -> None:
+def frame_scene(plotter: pv.BasePlotter, props: Mapping[str, object], fill: float = FILL, right_margin: float = 0.0
+                ) -> None:
     """Frame every visible component of a scene (``scene_bounds``)."""
     frame_bounds(plotter, scene_bounds(props), fill, right_margin)

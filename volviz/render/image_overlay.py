@@ -48,8 +48,8 @@ if TYPE_CHECKING:   # type-only: VTK's classes, reached through the facade at ru
     from volviz.jobs import ProgressCallback
     from volviz.render.vtk_facade import vtkRenderer, vtkRenderWindow
 
-__all__ = ["ImageOverlay", "OverlayRequest", "OverlayStats", "OverlayView", "StatsT", "block_min", "overlay_rgba8",
-           "read_buffers", "single_sample_on_software", "unpremultiply_rgba8", "zbuffer_to_depth"]
+__all__ = ["ImageOverlay", "OverlayRequest", "OverlayStats", "OverlayView", "StatsT", "WindowPlotter", "block_min",
+           "overlay_rgba8", "read_buffers", "single_sample_on_software", "unpremultiply_rgba8", "zbuffer_to_depth"]
 
 #: every overlay renderer of a plotter (the renderers are VTK objects: a plotter's list lives as long as it does)
 _SIBLINGS: "weakref.WeakKeyDictionary[Any, list[Any]]" = weakref.WeakKeyDictionary()
@@ -122,6 +122,14 @@ def window_size(window: Union[vtkRenderer, vtkRenderWindow]) -> tuple[int, int]:
     return int(width), int(height)
 
 
+class WindowPlotter(Protocol):
+    """A plotter with an open render window, what the multisampling holds read (PyVista types ``ren_win`` Optional,
+    None once the plotter is closed; these are called while it is open)."""
+
+    @property
+    def ren_win(self) -> vtkRenderWindow: ...
+
+
 @dataclass
 class _SingleSample:
     """A plotter's multisampling while overlays hold it off: the setting to restore and the ids of the holders (ids,
@@ -134,7 +142,7 @@ class _SingleSample:
 _single_sample: weakref.WeakKeyDictionary[Any, _SingleSample] = weakref.WeakKeyDictionary()   # by plotter
 
 
-def hold_single_sample(plotter: Any, holder: object) -> None:
+def hold_single_sample(plotter: WindowPlotter, holder: object) -> None:
     """Multisampling off while ``holder`` is in the plotter (one color and depth per pixel: the overlays read the
     depth back, the GL PT pass draws into a single-sample float target; module docstring)."""
     held = _single_sample.get(plotter)
@@ -154,7 +162,7 @@ def single_sample_on_software(plotter: Any) -> None:
             held.restore = 0
 
 
-def release_single_sample(plotter: Any, holder: object) -> None:
+def release_single_sample(plotter: WindowPlotter, holder: object) -> None:
     """``holder`` is gone: the last one restores the plotter's multisampling."""
     held = _single_sample.get(plotter)
     if held is None:

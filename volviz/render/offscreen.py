@@ -3,11 +3,25 @@
 from __future__ import annotations
 
 import os
-from typing import Any
+from typing import TYPE_CHECKING, Any, Protocol, cast
 
 import pyvista as pv
 
 from volviz.render.vtk_facade import vtk
+
+if TYPE_CHECKING:   # type-only: VTK's classes, named by the protocol
+    from volviz.render.vtk_facade import vtkRenderer, vtkRenderWindow, vtkVolume
+
+
+class OpenPlotter(Protocol):
+    """A plotter with an open render window, what ``draw_projected_tetrahedra_once`` reads (PyVista types
+    ``render_window`` Optional, None once the plotter is closed)."""
+
+    @property
+    def renderer(self) -> vtkRenderer: ...
+
+    @property
+    def render_window(self) -> vtkRenderWindow: ...
 
 
 def offscreen_plotter(size: tuple[int, int]) -> Any:
@@ -33,7 +47,7 @@ def skip_display_probe() -> None:
         probe.has_support = True
 
 
-def draw_projected_tetrahedra_once(plotter: Any) -> None:
+def draw_projected_tetrahedra_once(plotter: OpenPlotter) -> None:
     """Before an offscreen plotter's first image: draw its scene once at 8 x 8 pixels when it holds a VTK
     projected-tetrahedra volume (a time series of meshes, ``vtk_scene.volume_prop``). VTK 9.7's
     vtkOpenGLProjectedTetrahedraMapper (seen on Mesa llvmpipe) leaves cells out of the first frame a render window
@@ -41,8 +55,8 @@ def draw_projected_tetrahedra_once(plotter: Any) -> None:
     dropped the lid strip's far half, RMSE 5.8 against the app's screen, which draws many frames (issue #28). At 8 x 8
     the extra draw costs the mapper's sort and no rasterisation to speak of."""
     volumes = plotter.renderer.GetVolumes()
-    if not any(isinstance(volumes.GetItemAsObject(i).GetMapper(), vtk.vtkProjectedTetrahedraMapper)
-               for i in range(volumes.GetNumberOfItems())):
+    if not any(isinstance(cast("vtkVolume", volumes.GetItemAsObject(i)).GetMapper(), vtk.vtkProjectedTetrahedraMapper)
+               for i in range(volumes.GetNumberOfItems())):   # (a volume collection holds vtkVolumes)
         return
     window = plotter.render_window
     width, height = window.GetSize()

@@ -76,5 +76,5 @@ class PTView:
         return points_bounds(self.whole_mesh.points)
 
 
-def is_pt_view(prop: Any) -> TypeGuard[PTView]:
+def is_pt_view(prop: object) -> TypeGuard[PTView]:
     return isinstance(prop, PTView)
