@@ -7,7 +7,9 @@ the session's datasets (``{"dataset": True}``) or of the dataset's arrays (``{"a
 (the isosurfaces' ``styles``); a nested object without a model (the isosurfaces' clipping) is shown read-only.
 
 A field the session sets has its label ticked; unticking it removes the key, so the model's default applies again
-(sessions store only the settings that were set). Every committed edit (a spin box's editing finished, a combo box's
+(sessions store only the settings that were set). A bool field is one check box with its title, ticked when on (issue
+#28: a label box "set" beside an untitled value box read as the switch, and a click on "Log color scale" stored
+false and changed nothing). Every committed edit (a spin box's editing finished, a combo box's
 or check box's change, a color chosen) is checked with ``typed_settings`` first: a refused value shows the problem
 next to its field and changes nothing; an accepted one is emitted as the whole new settings dict (``committed``).
 """
@@ -22,7 +24,7 @@ from PySide6.QtWidgets import QCheckBox, QFormLayout, QLabel, QVBoxLayout, QWidg
 
 from volviz.model.settings import SettingsError, settings_model, typed_settings
 
-from .settings_editors import Editor, editor_for, field_default, plain
+from .settings_editors import CheckBoxEditor, Editor, editor_for, field_default, plain
 
 __all__ = ["SettingsForm"]
 
@@ -34,15 +36,19 @@ class _Row:
         self.name, self.info, self.editor = name, info, editor
         self.default = field_default(info)
         title = info.title or name
-        self.label: QWidget = QCheckBox(title) if not info.is_required() else QLabel(title)
+        self.switch = isinstance(editor, CheckBoxEditor)   # a bool: its box is the label, and the value
+        if isinstance(editor, CheckBoxEditor):
+            editor.widget.setText(title)
+        self.label: QWidget = (editor.widget if self.switch else QCheckBox(title) if not info.is_required()
+                               else QLabel(title))
         self.error = QLabel()
         self.error.setWordWrap(True)
         self.error.setStyleSheet("color: #c00000")
         self.error.hide()
         tip = info.description or title
-        self.label.setToolTip(f"{tip}\nTicked: set in the session; unticked: the default"
-                              if isinstance(self.label, QCheckBox) else tip)
         editor.widget.setToolTip(tip)
+        if isinstance(self.label, QCheckBox) and not self.switch:
+            self.label.setToolTip(f"{tip}\nTicked: set in the session; unticked: the default")
         self.shown: Any = None   # the editor's value when it was last shown or committed
 
     def show(self, settings: dict[str, Any]) -> None:
@@ -55,8 +61,8 @@ class _Row:
         self.tick(self.name in settings)
 
     def tick(self, on: bool) -> None:
-        """Tick (or untick) the label of a field with a default, reporting nothing."""
-        if isinstance(self.label, QCheckBox):
+        """Tick (or untick) the label of a field with a default, reporting nothing (a bool's box shows its value)."""
+        if isinstance(self.label, QCheckBox) and not self.switch:
             self.label.blockSignals(True)
             self.label.setChecked(on)
             self.label.blockSignals(False)
@@ -95,9 +101,12 @@ class SettingsForm(QWidget):
             column.setContentsMargins(0, 0, 0, 0)
             column.addWidget(row.editor.widget)
             column.addWidget(row.error)
-            layout.addRow(row.label, cell)
+            if row.switch:
+                layout.addRow(cell)      # the box with its title, the whole row
+            else:
+                layout.addRow(row.label, cell)
             row.show(self.settings)
-            if isinstance(row.label, QCheckBox):
+            if isinstance(row.label, QCheckBox) and not row.switch:
                 row.label.toggled.connect(lambda on, r=row: self._set_toggled(r, on))
             self.rows[name] = row
         if not self.rows:

@@ -197,12 +197,19 @@ def test_opening_another_scene_forgets_the_settings_edits_of_the_old_one(qtbot, 
 
 
 def _row_labels(form: SettingsForm) -> list[str]:
-    """The texts of the form's row labels, as the dock shows them."""
+    """The texts of the form's row labels, as the dock shows them (an on/off setting's row is its titled box)."""
     from PySide6.QtWidgets import QFormLayout
 
     layout = form.layout()
-    items = [layout.itemAt(i, QFormLayout.ItemRole.LabelRole) for i in range(layout.rowCount())]
-    return [item.widget().text() for item in items if item is not None and item.widget() is not None]
+    texts = []
+    for i in range(layout.rowCount()):
+        label = layout.itemAt(i, QFormLayout.ItemRole.LabelRole)
+        whole = layout.itemAt(i, QFormLayout.ItemRole.SpanningRole)
+        if label is not None and label.widget() is not None:
+            texts.append(label.widget().text())
+        elif whole is not None and whole.widget() is not None:
+            texts += [box.text() for box in whole.widget().findChildren(QCheckBox) if box.text()]
+    return texts
 
 
 def test_form_shows_only_the_settings_that_apply_to_the_dataset(qtbot, make_window, tmp_path: Path) -> None:
