@@ -65,10 +65,10 @@ GL = ("not yet typed: the VTK objects a GL pass hands around (render windows, pr
 JSON = "JSON: a session file's settings, options, clipping or schema, free-form by design"
 STATS = "statistics: a free-form dict of numbers and labels for the status bar and the reports"
 RESULT = "a view's own result tuple, unpacked (each view chooses its shape: View.finish)"
-VTK_ANY = "VTK props of several unrelated classes (vtkVolume, vtkActor, a volviz view standing in as its prop)"
 DATASET = ("a dataset of several kinds (volviz.scene.datasets.LoadedDataset, an array view of one, its PyVista form) "
            "whose body uses attributes of some kinds only: typing it needs narrowing there, a code change")
-DATASET_TO_PROP = "a loaded dataset in (DATASET), a VTK prop of several classes out (VTK_ANY)"
+DATASET_TO_PROP = ("a loaded dataset in (DATASET), a prop of several unrelated classes out (vtkVolume, vtkActor, a "
+                   "volviz view standing in as its prop), which callers use as what they know it to be")
 VIEW_OBJECTS = ("a view of one of several classes, each with its own request type; View[Any] would not do: the "
                 "natural scene's view has no stats and the GL isosurfaces' no job, which these callers use")
 PLOTTER = ("a PyVista plotter (pv.Plotter offscreen, pyvistaqt's QtInteractor in the app): pv.BasePlotter would "
@@ -91,10 +91,7 @@ ALLOWED: dict[str, str] = {
     "volviz.render.component_views:VtkPropView.update": STATS,
     "volviz.render.component_views:IsoSurfacesView.update": STATS,
     "volviz.render.controller:iso_summary": STATS,
-    "volviz.render.controller:SceneController.props": VTK_ANY,
-    "volviz.render.controller:SceneController.shown_props": VTK_ANY,
     "volviz.render.controller:SceneController.dataset_of": DATASET,
-    "volviz.render.controller:SceneController.install_component": VTK_ANY,
     "volviz.render.controller:SceneController.blend_volume": DATASET,
     "volviz.render.controller:SceneController.show_volumes": DATASET,
     "volviz.render.controller:SceneController.show_isosurfaces": ISO_PARTS,
@@ -105,10 +102,6 @@ ALLOWED: dict[str, str] = {
     "volviz.render.controller:SceneController.finish_views": VIEW_OBJECTS,
     "volviz.render.controller:SceneController.pt_stats": STATS,
     "volviz.render.controller:SceneController.set_clip": JSON,
-    "volviz.render.controller:SceneController.cut":
-        "a cut of one of several kinds (a TetMesh, isosurface parts), by the component's view",
-    "volviz.render.controller:SceneController.show_cut":
-        "a cut of one of several kinds (a TetMesh, isosurface parts), by the component's view",
     "volviz.render.controller:SceneController.iso_stats": STATS,
     "volviz.render.decorations:legend_margin": DATASET,
     "volviz.render.decorations:apply_decorations": PLOTTER,

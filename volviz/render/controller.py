@@ -24,7 +24,7 @@ from __future__ import annotations
 
 from contextlib import contextmanager
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Callable, Iterator, Optional
+from typing import TYPE_CHECKING, Any, Callable, Iterator, Optional, Union, cast
 
 from volviz.jobs import report
 from volviz.model import TimeSeries
@@ -51,18 +51,29 @@ if TYPE_CHECKING:   # type-only imports for the signatures
     from volviz.iso.extract import IsoMesh
     from volviz.jobs import ProgressCallback
     from volviz.model.clip import ClipSettings
+    from volviz.model.datasets import TetMesh
     from volviz.nature.nature_scene import NatureScene
+    from volviz.nature.terrain import TerrainMesh
     from volviz.optics.transfer_function import TransferFunction
+    from volviz.render.gl_nature import EitherNatureView
     from volviz.render.gl_pt import GLPTVolume
     from volviz.render.iso_overlay import IsoOverlay
     from volviz.render.lod_volume import LodVolume
-    from volviz.nature.terrain import TerrainMesh
-    from volviz.render.gl_nature import EitherNatureView
     from volviz.render.nature_view import FrameT, NatureRequest, NatureSceneView
     from volviz.render.pt_prop import PTVolume
+    from volviz.render.vtk_facade import vtkProp
     from volviz.scene.datasets import LoadedDataset
 
-__all__ = ["ISO_MODES", "SceneController", "ensure_lights", "iso_summary", "no_render", "session_interpolates"]
+__all__ = ["Cut", "ISO_MODES", "SceneController", "ensure_lights", "iso_summary", "no_render", "session_interpolates"]
+
+#: a component's data cut by the clipping, as its view draws it: a PT volume's tetrahedra (None: nothing left), an
+#: isosurface component's parts
+Cut = Union["TetMesh", IsoParts, None]
+
+
+def _vtk_props(props: dict[str, object]) -> list[vtkProp]:
+    """The VTK props among ``props`` (volviz's own views stand in as their props and are no VTK objects)."""
+    return [cast("vtkProp", p) for p in props.values() if hasattr(p, "IsA")]
 
 
 def iso_summary(stats: dict[str, Any]) -> str:
@@ -146,7 +157,7 @@ class SceneController:
             self._listen()
 
     @property
-    def props(self) -> dict[str, Any]:
+    def props(self) -> dict[str, object]:
         """What each view shows by id: volviz's own views themselves (PT, LOD, the natural scene), the VTK prop of
         the others (a vtkVolume, an actor, an isosurface component's prop assembly)."""
         return {comp_id: getattr(view, "prop", view) for comp_id, view in self.views.items()}
@@ -261,7 +272,7 @@ class SceneController:
         (``volviz.render.decorations``); call after a transfer function, visibility or option changed."""
         apply_decorations(self.plotter, self.session, self.shown_props(), self.datasets)
 
-    def shown_props(self) -> dict[str, Any]:
+    def shown_props(self) -> dict[str, object]:
         """The props of the visible components (the natural scene's view under ``"nature"``)."""
         visible = {c.id for c in self.session.components if c.visible}
         return {k: p for k, p in self.props.items() if k == "nature" or k in visible}
@@ -354,7 +365,7 @@ class SceneController:
         report(progress, 1.0, f"{comp_id} prepared")
         return prepared
 
-    def install_component(self, comp_id: str, prepared: PreparedScene, views: bool = True) -> Any:
+    def install_component(self, comp_id: str, prepared: PreparedScene, views: bool = True) -> object:
         """GUI thread: add the view of a ``prepare_component`` result without rendering (a PT volume's image and a
         LOD volume's blocks are drawn now when ``views``; the app updates them in the background)."""
         comp = self.component(comp_id)
@@ -696,13 +707,13 @@ class SceneController:
         return pending
 
     def cut(self, comp_id: str, clip: Optional[ClipSettings] = None,
-            progress: Optional[ProgressCallback] = None) -> Any:
+            progress: Optional[ProgressCallback] = None) -> Cut:
         """Any thread: the component's data cut by ``clip`` (default: the session's) as its view draws it (the
         view's ``cut``: the exact cut of a PT volume's tetrahedra, ``volviz.iso.clip.clip_tetmesh``; the isosurfaces'
         triangles, ``clip_isosurfaces``, scaled by the opacity, with their LOD chains)."""
         return self.views[comp_id].cut(self.clip if clip is None else clip)
 
-    def show_cut(self, comp_id: str, cut: Any) -> None:
+    def show_cut(self, comp_id: str, cut: Cut) -> None:
         """GUI thread: show a ``cut`` (not rendered; a CPU PT volume's image is re-made afterwards); the outline box
         follows the cut data, as it does in a scene built with this clipping (``volviz render``)."""
         view = self.views.get(comp_id)
@@ -751,7 +762,7 @@ class SceneController:
         would lie over them), and exact mode on the GPU only where the renderer can peel the surfaces with the volume
         (no render pass of its own: ``volviz.render.gl_iso``)."""
         backend = view_backend(self.plotter, self.session, "iso")
-        if regular_volumes([p for p in self.shown_props().values() if hasattr(p, "IsA")]):
+        if regular_volumes(_vtk_props(self.shown_props())):
             peels = self.iso_mode == "exact" and self.plotter.renderer.GetPass() is None
             return "gpu" if backend == "gpu" and peels else "cpu"
         return backend
@@ -811,4 +822,4 @@ class SceneController:
             prop.GetVisibility() and any(a.GetVisibility() for a in prop.volviz_translucent)
             for comp_id, prop in self._iso_props().items() if comp_id in shown)
         translucent = translucent or bool(getattr(self.iso_view, "peels_volumes", False))   # the GPU's exact mode
-        peel_volumes(self.plotter, [p for p in shown.values() if hasattr(p, "IsA")], translucent)
+        peel_volumes(self.plotter, _vtk_props(shown), translucent)
