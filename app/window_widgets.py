@@ -145,7 +145,7 @@ def build_menus(window: WindowBase) -> None:
     undo = window.undo_group.createUndoAction(window, "&Undo")
     undo.setShortcut(QKeySequence.StandardKey.Undo)
     redo = window.undo_group.createRedoAction(window, "&Redo")
-    redo.setShortcut(QKeySequence.StandardKey.Redo)
+    redo.setShortcuts(redo_keys())
     edit_menu.addAction(undo)
     edit_menu.addAction(redo)
     window.action_undo, window.action_redo = undo, redo
@@ -168,6 +168,14 @@ def build_menus(window: WindowBase) -> None:
     window.camera_bookmarks.add_to_menu(window.menuBar().addMenu("&Camera"))
     window.help = HelpMenu(window, window.menuBar().addMenu("&Help"), lambda: window.plotter.ren_win)
     window.file_drop = FileDrop([window, window.plotter.interactor], files.open_path_asking)
+
+
+def redo_keys() -> list[QKeySequence]:
+    """The platform's redo keys, and Ctrl+Y where they lack it: on X11 Qt's standard redo is only Ctrl+Shift+Z, and
+    Ctrl+Y, the redo key on Windows, did nothing (issue #28)."""
+    keys = QKeySequence.keyBindings(QKeySequence.StandardKey.Redo)
+    ctrl_y = QKeySequence("Ctrl+Y")
+    return keys if ctrl_y in keys else [*keys, ctrl_y]
 
 
 def _activate_undo_stack(window: WindowBase, stack: Any) -> None:
