@@ -71,9 +71,6 @@ DATASET_TO_PROP = ("a loaded dataset in (DATASET), a prop of several unrelated c
                    "volviz view standing in as its prop), which callers use as what they know it to be")
 VIEW_OBJECTS = ("a view of one of several classes, each with its own request type; View[Any] would not do: the "
                 "natural scene's view has no stats and the GL isosurfaces' no job, which these callers use")
-PLOTTER = ("a PyVista plotter (pv.Plotter offscreen, pyvistaqt's QtInteractor in the app): pv.BasePlotter would "
-           "fit, but PyVista 0.49's _Wrapped decorator mistypes the methods these call (add_axes, remove_actor: "
-           "mypy reads them as unbound), so typing it needs another call in the body, a code change")
 PLOTTER_HELD = ("a PyVista plotter: pv.BasePlotter fits (mypy finds nothing), left for preview_hold.py was being "
                 "edited by another change when the others were typed")
 PLOTTER_WINDOW = ("a PyVista plotter whose ren_win this reads and sets and which it hands to plotter_gl_info (a "
@@ -104,8 +101,6 @@ ALLOWED: dict[str, str] = {
     "volviz.render.controller:SceneController.set_clip": JSON,
     "volviz.render.controller:SceneController.iso_stats": STATS,
     "volviz.render.decorations:legend_margin": DATASET,
-    "volviz.render.decorations:apply_decorations": PLOTTER,
-    "volviz.render.decorations:update_outline": PLOTTER,
     "volviz.render.error_budget:error_budget_choice": JSON,
     "volviz.render.export:open_target": JSON,
     "volviz.render.gl_iso:GLIsoView.update": STATS,
@@ -114,8 +109,6 @@ ALLOWED: dict[str, str] = {
     "volviz.render.lod_volume:LodVolume.finish": STATS,
     "volviz.render.lod_volume:LodVolume.update": STATS,
     "volviz.render.lod_volume:LodVolume.show_stats": STATS,
-    "volviz.render.offscreen:offscreen_plotter":
-        "pv.Plotter: PyVista 0.49's _Wrapped decorator mistypes its methods for callers outside this change (bench)",
     "volviz.render.preview_hold:hold_previews": PLOTTER_HELD,
     "volviz.render.preview_hold:holds_previews": PLOTTER_HELD,
     "volviz.render.pt_prop:add_pt_volume": DATASET_TO_PROP,

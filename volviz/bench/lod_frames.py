@@ -142,7 +142,7 @@ def render_walkthrough(tree: Any, volume: np.ndarray, tf: Any, budgets: Sequence
     plotter = offscreen_plotter((size, size))
     rows, shots = [], {}
     try:
-        plotter.set_background("black")
+        plotter.set_background("black")  # type: ignore[arg-type]  # pyvista's _Wrapped decorator hides self
         exact, vtk_full, info = _references(plotter, tree, volume, tf, views, size, ref_step)
         for budget in budgets:
             ours, img_o = _walk(plotter, tree, tf, int(budget), views, "volviz", exact, vtk_full)

@@ -118,7 +118,7 @@ def offscreen_gl_info() -> GLInfo:
 
     plotter = offscreen_plotter((8, 8))
     try:
-        return gl_info(plotter.ren_win)
+        return gl_info(plotter.ren_win)  # type: ignore[arg-type]  # None once closed; just made
     finally:
         plotter.close()
 

@@ -3,7 +3,7 @@ the orientation axes and the outline box of the data. Each is a render option of
 ``axes``, ``outline``; on unless set to false), so it is saved with the session and can be switched off."""
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any, Optional, Sequence
+from typing import TYPE_CHECKING, Any, Mapping, Optional, Sequence
 
 import numpy as np
 
@@ -60,7 +60,8 @@ def _contrast(background: Any) -> tuple[float, float, float]:
     return (0.1, 0.1, 0.1) if luminance > 0.5 else (0.92, 0.92, 0.92)
 
 
-def apply_decorations(plotter: Any, session: Session, props: dict[str, Any], datasets: dict[str, Any]) -> None:
+def apply_decorations(plotter: pv.BasePlotter, session: Session, props: Mapping[str, object],
+                      datasets: dict[str, LoadedDataset]) -> None:
     """Show or hide the scalar bar, orientation axes and outline box of the scene in ``plotter`` as the session's
     render options say (``props``: the components' props, whose bounds the outline draws; ``datasets``: the loaded
     datasets, whose shown array names the scalar bar). Safe to call again after any change: it replaces what it
@@ -71,7 +72,7 @@ def apply_decorations(plotter: Any, session: Session, props: dict[str, Any], dat
     if decoration_enabled(session, "axes"):
         if axes is None:   # 1-pixel shafts: pyvista's 2-pixel lines were drawn a pixel apart on screen and in
             # ``volviz render`` (VTK's wide lines take the driver's or its own path by context; issue #28)
-            plotter.add_axes(color=color, interactive=False, line_width=1)
+            plotter.add_axes(color=color, interactive=False, line_width=1)  # type: ignore[call-arg]  # _Wrapped: no self
         else:
             plotter.renderer.show_axes()
     elif axes is not None:
@@ -79,9 +80,9 @@ def apply_decorations(plotter: Any, session: Session, props: dict[str, Any], dat
     update_legend(plotter, session, datasets)
 
 
-def update_outline(plotter: Any, session: Session, props: dict[str, Any]) -> None:
+def update_outline(plotter: pv.BasePlotter, session: Session, props: Mapping[str, object]) -> None:
     """Redraw only the outline box around ``props`` (data that moved: the scalar bar and axes stay as they are)."""
-    plotter.remove_actor(OUTLINE_NAME, render=False)
+    plotter.remove_actor(OUTLINE_NAME, render=False)  # type: ignore[arg-type]  # pyvista's _Wrapped hides self
     if decoration_enabled(session, "outline"):
         data = {k: p for k, p in props.items() if k != "nature"}   # a landscape needs no box around it
         bounds = scene_bounds(data)

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import os
-from typing import TYPE_CHECKING, Any, Protocol, cast
+from typing import TYPE_CHECKING, Protocol, cast
 
 import pyvista as pv
 
@@ -24,7 +24,7 @@ class OpenPlotter(Protocol):
     def render_window(self) -> vtkRenderWindow: ...
 
 
-def offscreen_plotter(size: tuple[int, int]) -> Any:
+def offscreen_plotter(size: tuple[int, int]) -> pv.Plotter:
     """A ``pyvista.Plotter`` that renders off screen at ``size`` (width, height) pixels."""
     if not os.environ.get("DISPLAY"):  # VTK tries X first and warns before it falls back to EGL: not the user's concern
         vtk.vtkLogger.SetStderrVerbosity(vtk.vtkLogger.VERBOSITY_ERROR)
