@@ -153,8 +153,6 @@ ALLOWED: dict[str, str] = {
     "volviz.model.clip:BoxCrop.from_dict": JSON,
     "volviz.model.clip:ClipSettings.to_dict": JSON,
     "volviz.model.clip:ClipSettings.from_dict": JSON,
-    "volviz.model.datasets:RegularVolume.to_pyvista":
-        "pv.ImageData breaks volviz.iso.extract (a name reused as str and Optional[str]), outside this change",
     "volviz.model.session_schema:session_schema": JSON,
     "volviz.model.settings:validated": JSON,
     "volviz.model.settings:typed_settings": JSON,

@@ -78,11 +78,11 @@ class IsoMesh:
 def _vtk_input(volume: Any, scalars: str | None) -> tuple[Any, bool]:
     """A VTK dataset with the active point scalars set; True for image data (FlyingEdges applies)."""
     if isinstance(volume, RegularVolume):
-        grid = volume.to_pyvista()
-        name = grid.point_data.keys()[0]
-        grid.point_data[name] = np.asarray(grid.point_data[name], dtype=np.float32)
-        grid.set_active_scalars(name)
-        return grid, True
+        image = volume.to_pyvista()
+        first = image.point_data.keys()[0]
+        image.point_data[first] = np.asarray(image.point_data[first], dtype=np.float32)
+        image.set_active_scalars(first)
+        return image, True
     if isinstance(volume, (CurvilinearGrid, UnstructuredMesh, TetMesh)):
         grid = volume.to_pyvista()
         name = scalars or getattr(volume, "active", None) or getattr(volume, "name", None)

@@ -12,7 +12,7 @@ Conventions (used everywhere in volviz):
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, Callable, Iterable, Union
+from typing import TYPE_CHECKING, Callable, Iterable, Union
 
 import numpy as np
 
@@ -91,7 +91,7 @@ class RegularVolume:
         hi = lo + (np.asarray(self.data.shape) - 1) * np.asarray(self.spacing)
         return (lo[0], hi[0], lo[1], hi[1], lo[2], hi[2])
 
-    def to_pyvista(self) -> Any:
+    def to_pyvista(self) -> pv.ImageData:
         # PyVista (VTK, heavy): the model stays VTK-free until a PyVista form is asked for
         import pyvista as pv
 
