@@ -208,7 +208,7 @@ def is_bookkeeping_array(name: str) -> bool:
     return _plain_name(name) in BOOKKEEPING_ARRAYS
 
 
-def vertex_colors(dataset: Any) -> np.ndarray | None:
+def vertex_colors(dataset: object) -> np.ndarray | None:
     """The point colors of a surface (a mesh, or the PyVista data set drawn for it) as (n, 3) or (n, 4)
     uint8: its red, green, blue (and alpha) arrays, or one RGB / RGBA / colors array of 3 or 4 components; integers
     as bytes (meshio reads PLY's unsigned bytes as signed ones), floats in [0, 1] scaled to 255. None when it has

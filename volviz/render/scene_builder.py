@@ -254,7 +254,7 @@ def add_lod_component(plotter: pv.BasePlotter, session: Session, comp: Component
 PT_DATASETS = ("TetMesh", "UnstructuredMesh", "CurvilinearGrid")
 
 
-def uses_pt(session: Session, dataset: Any) -> bool:
+def uses_pt(session: Session, dataset: object) -> bool:
     """Unstructured and curvilinear data are drawn by volviz's pre-integrated projected tetrahedra unless the
     session asks for VTK's own mappers (render method "vtk"); regular volumes go to VTK's ray casters."""
     if isinstance(dataset, TimeSeries):

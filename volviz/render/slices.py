@@ -46,7 +46,7 @@ def _volume(dataset: Any, axis: str, index: int) -> RegularVolume:
     return dataset
 
 
-def slice_values(dataset: Any, axis: str, index: int) -> np.ndarray:
+def slice_values(dataset: object, axis: str, index: int) -> np.ndarray:
     """The samples of plane ``axis = index`` as an image (rows, cols), row 0 at the top: for z the columns run along
     x and the rows down y; for x along y and down z; for y along x and down z."""
     data = _volume(dataset, axis, index).data
@@ -68,7 +68,7 @@ def value_color(tf: TransferFunction, value: float) -> tuple[float, float, float
     return (float(rgb[0]) / 255.0, float(rgb[1]) / 255.0, float(rgb[2]) / 255.0)
 
 
-def slice_image(dataset: Any, axis: str, index: int, tf: TransferFunction) -> np.ndarray:
+def slice_image(dataset: object, axis: str, index: int, tf: TransferFunction) -> np.ndarray:
     """The (rows, cols, 3) uint8 image of one slice, row 0 at the top (``slice_values`` through ``slice_colors``)."""
     return slice_colors(slice_values(dataset, axis, index), tf)
 
@@ -78,7 +78,8 @@ def slice_indices(settings: dict[str, Any]) -> dict[str, int]:
     return {axis: int(settings[axis]) for axis in AXES if settings.get(axis) is not None}
 
 
-def drag_index(dataset: Any, axis: str, anchor: npt.ArrayLike, origin: npt.ArrayLike, direction: npt.ArrayLike) -> int:
+def drag_index(dataset: object, axis: str, anchor: npt.ArrayLike, origin: npt.ArrayLike, direction: npt.ArrayLike
+               ) -> int:
     """The index of plane ``axis`` a drag has moved to: the grid index nearest the point of the line through
     ``anchor`` (where the plane was grabbed) along the axis that is closest to the mouse ray (``origin``,
     ``direction``), clamped to the grid; a ray along the axis leaves the plane where it was grabbed."""

@@ -8,7 +8,7 @@ the app's viewport.
 """
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any, Optional
+from typing import TYPE_CHECKING, Any, Optional, Union
 
 import numpy as np
 
@@ -26,6 +26,7 @@ from volviz.session import CameraState
 if TYPE_CHECKING:   # type-only imports for the signatures
     import pyvista as pv
 
+    from volviz.model.datasets import Dataset
     from volviz.render.vtk_facade import vtkVolumeProperty
 
 PLAIN_COLOR = (0.80, 0.80, 0.78)    # geometry without a field: a neutral light grey, shaded by the lights
@@ -112,7 +113,7 @@ def volume_grid(dataset: Any) -> Any:
     return grid
 
 
-def default_transfer_function_for(dataset: Any, name: str = "default") -> TransferFunction:
+def default_transfer_function_for(dataset: Union[Dataset, TimeSeries], name: str = "default") -> TransferFunction:
     """The first-look transfer function of a dataset: placed from the histogram of its shown scalar (of every step,
     for a time series) by ``volviz.optics.auto_tf``; a compressed LOD volume gets the ramp over its range."""
     if is_lod(dataset):
@@ -207,7 +208,7 @@ def is_surface(dataset: Any) -> bool:
     return representation(dataset).kind != VOLUME
 
 
-def shows_no_field(dataset: Any) -> bool:
+def shows_no_field(dataset: Union[Dataset, TimeSeries]) -> bool:
     """Whether ``dataset`` (a volviz dataset) is geometry alone, drawn in a plain color without a scalar bar (a mesh
     with only block ids, an STL)."""
     known = isinstance(dataset, (TimeSeries, CurvilinearGrid, UnstructuredMesh))

@@ -24,7 +24,7 @@ def uses_log_scale(comp: Component) -> bool:
     return bool(comp.settings.get("log_scale", False))
 
 
-def log_floor(tf: TransferFunction, dataset: Any) -> float:
+def log_floor(tf: TransferFunction, dataset: object) -> float:
     """The smallest positive value the log scale of ``tf`` over ``dataset``'s shown array maps (values at or below
     it take its color): the TF's low end when positive, else the data's smallest positive value (cached per
     dataset: one pass over the values)."""
@@ -51,7 +51,7 @@ def _values(dataset: Any) -> np.ndarray:
         return np.zeros(0)
 
 
-def drawn_tf(comp: Component, tf: Optional[TransferFunction], dataset: Any) -> Optional[TransferFunction]:
+def drawn_tf(comp: Component, tf: Optional[TransferFunction], dataset: object) -> Optional[TransferFunction]:
     """``tf`` (the component's stored function) as the component is drawn with it over ``dataset``."""
     if tf is None or not uses_log_scale(comp):
         return tf
@@ -66,6 +66,6 @@ def component_transfer_function(session: Session, comp: Component) -> Optional[T
     return session.transfer_functions[comp.transfer_function]
 
 
-def drawn_transfer_function(session: Session, comp: Component, dataset: Any) -> Any:
+def drawn_transfer_function(session: Session, comp: Component, dataset: object) -> Any:
     """The component's transfer function as drawn (through log10 with the setting ``log_scale``)."""
     return drawn_tf(comp, component_transfer_function(session, comp), dataset)

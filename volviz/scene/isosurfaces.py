@@ -4,7 +4,7 @@ display time, cut exactly by the scene's clipping, scaled by the component's opa
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
-from typing import TYPE_CHECKING, Any, Optional
+from typing import TYPE_CHECKING, Optional
 
 from volviz.jobs import ProgressCallback
 from volviz.model.clip import ClipSettings
@@ -30,7 +30,7 @@ class IsoParts:
     opacity: float = 1.0                                 # the component opacity they were scaled by
 
 
-def isosurface_parts(comp: Component, dataset: Any = None, t: Optional[float] = None,
+def isosurface_parts(comp: Component, dataset: object = None, t: Optional[float] = None,
                      clip: Optional[ClipSettings] = None,
                      meshes: Optional[list[IsoMesh]] = None, progress: Optional[ProgressCallback] = None) -> IsoParts:
     """Any thread: the surfaces of an ``isosurface`` component (settings: ``volviz.iso.IsoSettings``) extracted at

@@ -13,11 +13,9 @@ if TYPE_CHECKING:   # type-only imports for the signatures
     from volviz.model.clip import ClipSettings
 
 
-def pt_mesh(dataset: Any) -> TetMesh:
+def pt_mesh(dataset: object) -> TetMesh:
     """Any thread: the tetrahedral mesh a PT volume draws for ``dataset``, with its topology built (cached on it)."""
-    mesh = dataset
-    if not isinstance(dataset, TetMesh):
-        mesh = tetrahedralize(dataset, getattr(dataset, "active", None))
+    mesh = dataset if isinstance(dataset, TetMesh) else tetrahedralize(dataset, getattr(dataset, "active", None))
     topology(mesh)
     return mesh
 
