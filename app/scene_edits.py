@@ -238,12 +238,17 @@ class SceneEdits:
     def scene_changed(self, change: SceneChange) -> None:
         """The session's state was edited and the shown scene's views hold the edit (``SceneController.changes``,
         wherever the edit came from: a dock, an undo step, a failed show reverted, a script): the session is marked
-        edited, the scene dock shows a component's visibility and opacity as they now are, and the camera views
-        follow (``views_follow``)."""
+        edited, the scene dock shows a component's visibility and opacity as they now are, the TF editor the selected
+        component's transfer function, and the camera views follow (``views_follow``)."""
         self.set_dirty()
         if change.what in ("visible", "opacity") and change.component is not None and self.controller is not None:
             comp = self.controller.component(change.component)
             self.scene_tree.show_state(comp.id, comp.visible, comp.opacity)
+        if (change.what == "transfer_function" and not change.preview and self.controller is not None
+                and change.component is not None and change.component == self.scene_tree.current_component()):
+            tf = self.controller.transfer_function(change.component)
+            if tf is not None:
+                self.tf_editor.follow(tf)   # set by a script: the dock shows it (its own edits it holds already)
         self.views.views_follow(change)
         controller = self.controller
         if change.what in ("opacity", "clip") and controller is not None:  # stale cuts made in the background

@@ -153,6 +153,18 @@ class TransferFunctionEditor(QWidget):
         """Replace the transfer function as one undoable edit."""
         self.undo_stack.push(_SetTransferFunction(self, self._committed_tf, tf, text))
 
+    def follow(self, tf: TransferFunction) -> None:
+        """The shown component's function was set elsewhere (a script in the Python console): show it as one
+        undoable edit, not emitted again (the session holds it). Without this the dock kept the old function, and the
+        next drag of a point put the old colors back (issue #28)."""
+        if tf is self._tf or tf is self._committed_tf:
+            return
+        self.blockSignals(True)
+        try:
+            self.edit(tf, "Set from outside the editor")
+        finally:
+            self.blockSignals(False)
+
     def fit_to_data(self) -> None:
         if self._data_range is not None and self._data_range[1] > self._data_range[0]:
             self.edit(self._tf.rescaled(*self._data_range), "Fit to data range")
