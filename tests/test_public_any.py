@@ -62,7 +62,9 @@ def public_any_signatures(root: Path = ROOT, packages: tuple[str, ...] = PACKAGE
 
 GL = ("not yet typed: the VTK objects a GL pass hands around (render windows, programs, textures, props); "
       "render.gl, the facade and vtk_tf are typed with VTK's classes, the passes themselves not yet")
-JSON = "JSON: a session file's settings, options, clipping or schema, free-form by design"
+JSON = ("JSON: a session file's settings, options, clipping or schema, free-form by design; where the body reads "
+        "typed values out of it (float(...), a constructor's arguments), dict[str, object] needs a check per value, a "
+        "code change (where it does not, the signature says dict[str, object])")
 STATS = "statistics: a free-form dict of numbers and labels for the status bar and the reports"
 RESULT = "a view's own result tuple, unpacked (each view chooses its shape: View.finish)"
 DATASET = ("a dataset of several kinds (volviz.scene.datasets.LoadedDataset, an array view of one, its PyVista form) "
@@ -98,11 +100,9 @@ ALLOWED: dict[str, str] = {
     "volviz.render.controller:SceneController.compute_views": VIEW_OBJECTS,
     "volviz.render.controller:SceneController.finish_views": VIEW_OBJECTS,
     "volviz.render.controller:SceneController.pt_stats": STATS,
-    "volviz.render.controller:SceneController.set_clip": JSON,
     "volviz.render.controller:SceneController.iso_stats": STATS,
     "volviz.render.decorations:legend_margin": DATASET,
     "volviz.render.error_budget:error_budget_choice": JSON,
-    "volviz.render.export:open_target": JSON,
     "volviz.render.gl_iso:GLIsoView.update": STATS,
     "volviz.render.gl_iso:GLIsoView.finish": STATS,
     "volviz.render.image_overlay:single_sample_on_software": PLOTTER_WINDOW,
@@ -132,21 +132,11 @@ ALLOWED: dict[str, str] = {
         "LoadedDataset breaks app.first_open, which narrows it by class name (outside this change)",
     "volviz.scene.drawn_tf:drawn_transfer_function":
         "Optional[TransferFunction] needs narrowing in scene_builder's callers (a behaviour edit, not this change)",
-    "volviz.scene.tetra:pt_options": JSON,
     "volviz.model.arrays:select_array": DATASET,
-    "volviz.model.camera:Camera.to_dict": JSON,
     "volviz.model.camera:Camera.from_dict": JSON,
-    "volviz.model.clip:ClipPlane.to_dict": JSON,
     "volviz.model.clip:ClipPlane.from_dict": JSON,
-    "volviz.model.clip:BoxCrop.to_dict": JSON,
     "volviz.model.clip:BoxCrop.from_dict": JSON,
-    "volviz.model.clip:ClipSettings.to_dict": JSON,
     "volviz.model.clip:ClipSettings.from_dict": JSON,
-    "volviz.model.session_schema:session_schema": JSON,
-    "volviz.model.settings:validated": JSON,
-    "volviz.model.settings:typed_settings": JSON,
-    "volviz.model.settings:validate_settings": JSON,
-    "volviz.model.settings:validate_render_options": JSON,
     "volviz.model.timeseries:frame_at": DATASET,
 }
 

@@ -158,7 +158,7 @@ class Camera:
         vtk_camera.SetClippingRange(*self.clipping_range)
         vtk_camera.OrthogonalizeViewUp()
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, object]:
         return {"position": list(map(float, self.position)), "focal_point": list(map(float, self.focal_point)),
                 "view_up": list(map(float, self.view_up)), "view_angle": float(self.view_angle),
                 "parallel": bool(self.parallel), "parallel_scale": float(self.parallel_scale),

@@ -41,7 +41,7 @@ class ClipPlane:
     def distance(self, points: np.ndarray) -> np.ndarray:
         return (np.asarray(points, dtype=np.float64) - np.asarray(self.point)) @ np.asarray(self.normal)
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, object]:
         return {"point": list(self.point), "normal": list(self.normal)}
 
     @classmethod
@@ -75,7 +75,7 @@ class BoxCrop:
             out.append(ClipPlane(self.hi, (e[0], e[1], e[2])))
         return out
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, object]:
         return {"lo": list(self.lo), "hi": list(self.hi)}
 
     @classmethod
@@ -105,7 +105,7 @@ class ClipSettings:
             keep &= p.distance(pts) >= -tol
         return keep
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, object]:
         return {"planes": [p.to_dict() for p in self.planes], "box": None if self.box is None else self.box.to_dict()}
 
     @classmethod

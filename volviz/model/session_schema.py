@@ -116,7 +116,7 @@ class SessionDocument(_Strict):
     clip: ClipDoc = Field(default_factory=ClipDoc)
 
 
-def session_schema() -> dict[str, Any]:
+def session_schema() -> dict[str, object]:
     """The JSON schema (draft 2020-12) of a session file."""
     schema = SessionDocument.model_json_schema()
     return {"$schema": "https://json-schema.org/draft/2020-12/schema", "$id": SCHEMA_ID, **schema}

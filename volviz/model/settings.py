@@ -314,7 +314,7 @@ def _problems(exc: ValidationError, where: str) -> list[tuple[str, str]]:
 M = TypeVar("M", bound=Settings)
 
 
-def validated(model: type[M], settings: dict[str, Any], where: str = "settings") -> M:
+def validated(model: type[M], settings: dict[str, object], where: str = "settings") -> M:
     """``settings`` as an instance of ``model`` (SettingsError naming the field path of each problem)."""
     try:
         return model.model_validate(settings)
@@ -322,7 +322,7 @@ def validated(model: type[M], settings: dict[str, Any], where: str = "settings")
         raise SettingsError(_problems(exc, where)) from None
 
 
-def typed_settings(component_type: str, settings: dict[str, Any], where: str = "settings") -> Settings:
+def typed_settings(component_type: str, settings: dict[str, object], where: str = "settings") -> Settings:
     """The model instance of a component's settings (``validated`` by ``SETTINGS_MODELS[component_type]``); a caller
     that knows the type asks ``validated(FogSettings, ...)`` for the typed model."""
     return validated(settings_model(component_type), settings, where)
@@ -338,7 +338,7 @@ def former_names(component_type: str) -> dict[str, str]:
     return former
 
 
-def validate_settings(component_type: str, settings: dict[str, Any], where: str = "settings") -> dict[str, Any]:
+def validate_settings(component_type: str, settings: dict[str, object], where: str = "settings") -> dict[str, object]:
     """``settings`` checked against its model; returned with only the keys set, as sessions store them, a key
     written under a field's former name (``former_names``) under its name now, so that a session saves it so."""
     typed_settings(component_type, settings, where)
@@ -346,7 +346,7 @@ def validate_settings(component_type: str, settings: dict[str, Any], where: str 
     return {former.get(key, key): value for key, value in settings.items()}
 
 
-def validate_render_options(options: dict[str, Any], where: str = "render.options") -> RenderOptions:
+def validate_render_options(options: dict[str, object], where: str = "render.options") -> RenderOptions:
     """``render.options`` as a ``RenderOptions`` (SettingsError naming the field path of each problem)."""
     try:
         return RenderOptions.model_validate(options)

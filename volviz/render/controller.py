@@ -679,7 +679,7 @@ class SceneController:
     def clip(self) -> ClipSettings:
         return self.session.clip
 
-    def set_clip(self, clip: dict[str, Any] | ClipSettings, update: bool = True) -> list[str]:
+    def set_clip(self, clip: dict[str, object] | ClipSettings, update: bool = True) -> list[str]:
         """Store new clipping (``session.clip`` JSON or ClipSettings: ``Session.set_clip``), which every view is then
         given (``apply_clip``); returns the ids of the views drawn from a cut made on the CPU (a CPU PT volume's mesh,
         an isosurface component's surfaces; ``pending``), which are cut and re-made here when ``update``; the app

@@ -241,7 +241,7 @@ def render_session(session: Session, session_file: Optional[str | os.PathLike], 
 
 
 def open_target(target: str | os.PathLike, array: Optional[str] = None, q: Optional[str | os.PathLike] = None,
-                reader_options: Optional[dict[str, Any]] = None) -> tuple[Session, Optional[Path]]:
+                reader_options: Optional[dict[str, object]] = None) -> tuple[Session, Optional[Path]]:
     """The session a command-line target names, and its file: ``demo``, ``demo-volume``, a session file, or a data
     file shown with the array spec ``array`` (``volviz.model.arrays``), the PLOT3D solution file ``q`` and the
     options of its reader (``dataset=`` of an HDF5 file ...), kept in the session's dataset. A member of a numbered

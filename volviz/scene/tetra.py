@@ -33,7 +33,7 @@ def cut_tetmesh(mesh: TetMesh, clip: ClipSettings) -> Optional[TetMesh]:
     return cut
 
 
-def pt_options(options: dict[str, Any]) -> dict[str, Any]:
+def pt_options(options: dict[str, object]) -> dict[str, object]:
     """Render settings -> keywords of ``volviz.unstructured.render``: sort ("mpvo", "centroid", "power"), table
     ("auto" by optical depth, "3d", or "separable-N" with a color polynomial of degree N) and its resolution."""
     out: dict[str, Any] = {}
