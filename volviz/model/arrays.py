@@ -284,18 +284,39 @@ def volume_of(data: np.ndarray, name: str, spacing: tuple[float, float, float] =
     return volume
 
 
-def _cell_to_point(dataset: Any, name: str, scalar: np.ndarray) -> np.ndarray:
-    """A cell scalar averaged onto the points by VTK's cell-to-point filter (as ParaView shows cell data)."""
-    grid = dataset.to_pyvista() if not isinstance(dataset, CurvilinearGrid) else CurvilinearGrid(
-        dataset.points, source=dataset.source).to_pyvista()
-    grid.clear_data()
-    flat = scalar.reshape(-1, order="F") if isinstance(dataset, CurvilinearGrid) else scalar
-    grid.cell_data["volviz_cell_scalar"] = np.asarray(flat, dtype=np.float64)
-    points = grid.cell_data_to_point_data()
-    values = np.asarray(points.point_data["volviz_cell_scalar"])
+def _cell_to_point(dataset: Any, scalar: np.ndarray) -> np.ndarray:
+    """A cell scalar averaged onto the points as VTK's cell-to-point filter does (as ParaView shows cell data): each
+    point gets the mean of the cells that use it (a cell naming a point twice counts twice, as in VTK's cell links;
+    a point no cell uses gets 0). NumPy, no VTK object: this runs on the app's worker threads, where making VTK
+    objects can deadlock a render on the GUI thread (``volviz.jobs``)."""
+    values = np.asarray(scalar, dtype=np.float64)
     if isinstance(dataset, CurvilinearGrid):
-        return values.reshape(dataset.dimensions, order="F")
-    return values
+        return _structured_cell_to_point(values, dataset.dimensions)
+    total = np.zeros(dataset.n_points)
+    count = np.zeros(dataset.n_points)
+    start = 0
+    for _, conn in dataset.cells:
+        if conn.size:
+            per_cell = np.repeat(values[start:start + len(conn)], conn.shape[1])
+            np.add.at(total, conn.ravel(), per_cell)
+            np.add.at(count, conn.ravel(), 1.0)
+        start += len(conn)
+    return np.divide(total, count, out=np.zeros_like(total), where=count > 0)
+
+
+def _structured_cell_to_point(cells: np.ndarray, dims: tuple[int, ...]) -> np.ndarray:
+    """``_cell_to_point`` on a structured grid of ``dims`` points: each cell adds its value to its 2, 4 or 8 corner
+    points (an axis of one point is flat: its cells have one corner along it)."""
+    total = np.zeros(dims)
+    count = np.zeros(dims)
+    shifts = [(0, 1) if n > 1 else (0,) for n in dims]
+    for di in shifts[0]:
+        for dj in shifts[1]:
+            for dk in shifts[2]:
+                corner = tuple(slice(d, d + c) for d, c in zip((di, dj, dk), cells.shape[:3]))
+                total[corner] += cells
+                count[corner] += 1.0
+    return total / count
 
 
 def select_array(dataset: Any, spec: str | None) -> Any:
@@ -327,7 +348,7 @@ def select_array(dataset: Any, spec: str | None) -> Any:
         return dataset
     cell_data = dataset.cell_data
     if association == "cell":   # shown at the points; the view keeps no cell array of the same name
-        scalar = _cell_to_point(dataset, name, scalar)
+        scalar = _cell_to_point(dataset, scalar)
         cell_data = {k: v for k, v in cell_data.items() if k != key}
     point_data = {**dataset.point_data, key: scalar}
     return replace(dataset, point_data=point_data, cell_data=cell_data, active=key)
