@@ -40,6 +40,15 @@ def _key(camera: Any) -> tuple[Any, ...]:
             camera.GetParallelProjection(), camera.GetParallelScale())
 
 
+def _assign(camera: vtkCamera, source: vtkCamera) -> None:
+    """``camera`` set to ``source``'s parameters, and marked modified: ``DeepCopy`` keeps the time stamp, and VTK's
+    OpenGL camera re-uses its matrices until the camera's time stamp passes theirs, so a frame drew with the matrices
+    of the camera swapped in or out before (issue #28: after an orbit the outline box, and the opaque depth the next
+    volume image was cut by, stayed at a preview's camera while the image was made for the live one)."""
+    camera.DeepCopy(source)
+    camera.Modified()
+
+
 class PreviewCameraHold:
     """The camera swap of the module docstring for one plotter; ``snapshot`` in a view's ``begin``, ``shown`` in
     its ``finish``, ``suspend`` around the opaque render of ``begin`` (which must see the live camera)."""
@@ -98,7 +107,7 @@ class PreviewCameraHold:
         drawn = self.live_serial
         if self.holding and self.image_camera is not None and _key(self.image_camera) != key:
             self._live.DeepCopy(live)
-            live.DeepCopy(self.image_camera)
+            _assign(live, self.image_camera)
             self._swapped = True
             drawn = self.image_serial
         self.frames.append((self.live_serial, self.image_serial, drawn))
@@ -106,7 +115,7 @@ class PreviewCameraHold:
 
     def _end(self, *_: Any) -> None:
         if self._swapped:
-            self.renderer.GetActiveCamera().DeepCopy(self._live)
+            _assign(self.renderer.GetActiveCamera(), self._live)
             self._swapped = False
 
     def remove(self) -> None:
