@@ -5,7 +5,8 @@ column with the other panels (scene, render settings, clipping, statistics) tabb
 row along the bottom. Every dock's content sits in a scroll area, so no panel's minimum size keeps the window from
 fitting a laptop screen (1366x768): a panel that is too small scrolls instead of growing the window. The tabs of
 tabbed docks keep their whole titles and scroll with arrow buttons (Qt elides them: on that screen the six tabs read
-"S…", "Render s…", "Cl…", "Sta…", "Sl…", "Isosu…").
+"S…", "Render s…", "Cl…", "Sta…", "Sl…", "Isosu…"). A dock behind a tab comes to the front when the keyboard's focus
+goes into it.
 
 The window's geometry and dock arrangement are stored in ``QSettings`` when it closes and restored when the next one
 opens (``saveGeometry`` / ``saveState``); ``reset`` (View > Reset Layout) brings back the defaults.
@@ -15,7 +16,7 @@ from __future__ import annotations
 from typing import Any, Optional
 
 from PySide6.QtCore import QByteArray, QEvent, QObject, QSettings, Qt, QTimer
-from PySide6.QtWidgets import QDockWidget, QFrame, QMainWindow, QScrollArea, QTabBar, QWidget
+from PySide6.QtWidgets import QApplication, QDockWidget, QFrame, QMainWindow, QScrollArea, QTabBar, QWidget
 
 DEFAULT_SIZE = (1280, 860)
 SIDE_WIDTH = 340          # the right-hand column of panels, in pixels, by default
@@ -55,6 +56,9 @@ class WindowLayout(QObject):
         self.side, self.bottom = side, bottom
         self._size_on_show = False
         window.installEventFilter(self)
+        app = QApplication.instance()
+        if isinstance(app, QApplication):
+            app.focusChanged.connect(self._focus_changed)
         window.setDockOptions(QMainWindow.DockOption.AnimatedDocks | QMainWindow.DockOption.AllowTabbedDocks
                               | QMainWindow.DockOption.AllowNestedDocks)
 
@@ -97,6 +101,17 @@ class WindowLayout(QObject):
         elif event.type() == QEvent.Type.ChildPolished and isinstance(event.child(), QTabBar):
             whole_titles(event.child())    # the window makes a tab bar for each group of tabbed docks
         return False
+
+    def _focus_changed(self, _old: Optional[QWidget], new: Optional[QWidget]) -> None:
+        """The focus went into a dock behind another's tab (Qt keeps those in the Tab chain): that dock comes to the
+        front, so that the keys go to a control the user sees (issue #28: Tab from the Scene dock walked through the
+        hidden Render settings, Clipping, Slices and Isosurfaces controls)."""
+        dock = new
+        while dock is not None and not isinstance(dock, QDockWidget):
+            dock = dock.parentWidget()
+        if (dock is not None and dock.window() is self.window and self.window.tabifiedDockWidgets(dock)
+                and dock.visibleRegion().isEmpty()):
+            dock.raise_()
 
     def default_size(self) -> tuple[int, int]:
         """``DEFAULT_SIZE``, or less on a smaller screen (the window's frame included)."""
