@@ -60,12 +60,12 @@ def public_any_signatures(root: Path = ROOT, packages: tuple[str, ...] = PACKAGE
     return out
 
 
-GL = ("not yet typed: the VTK objects a GL pass hands around (render windows, programs, textures, props); "
-      "render.gl, the facade and vtk_tf are typed with VTK's classes, the passes themselves not yet")
 JSON = ("JSON: a session file's settings, options, clipping or schema, free-form by design; where the body reads "
         "typed values out of it (float(...), a constructor's arguments), dict[str, object] needs a check per value, a "
         "code change (where it does not, the signature says dict[str, object])")
-STATS = "statistics: a free-form dict of numbers and labels for the status bar and the reports"
+STATS = ("statistics: a free-form dict of numbers and labels for the status bar and the reports; these are read "
+         "as numbers by their callers (app/window.py's statistics, the benches), where dict[str, object] needs a check "
+         "per value, a code change (where no caller reads them so, the signature says dict[str, object])")
 RESULT = "a view's own result tuple, unpacked (each view chooses its shape: View.finish)"
 DATASET = ("a dataset of several kinds (volviz.scene.datasets.LoadedDataset, an array view of one, its PyVista form) "
            "whose body uses attributes of some kinds only: typing it needs narrowing there, a code change")
@@ -73,8 +73,6 @@ DATASET_TO_PROP = ("a loaded dataset in (DATASET), a prop of several unrelated c
                    "volviz view standing in as its prop), which callers use as what they know it to be")
 VIEW_OBJECTS = ("a view of one of several classes, each with its own request type; View[Any] would not do: the "
                 "natural scene's view has no stats and the GL isosurfaces' no job, which these callers use")
-PLOTTER_HELD = ("a PyVista plotter: pv.BasePlotter fits (mypy finds nothing), left for preview_hold.py was being "
-                "edited by another change when the others were typed")
 PLOTTER_WINDOW = ("a PyVista plotter whose ren_win this reads and sets and which it hands to plotter_gl_info (a "
                   "pv.BasePlotter): PyVista types ren_win Optional (None once closed), so neither BasePlotter nor "
                   "image_overlay.WindowPlotter (what the multisampling holds take) fits without a None check in the "
@@ -86,46 +84,27 @@ ISO_PARTS = ("IsoParts or a list of IsoMesh: the body tells them apart with a co
 ALLOWED: dict[str, str] = {
     "volviz.render.backend:GLInfo.to_dict": JSON,
     "volviz.render.backend:backend_setting": JSON,
-    "volviz.render.component_views:VtkPropView.set_input": DATASET,
-    "volviz.render.component_views:VtkPropView.update": STATS,
-    "volviz.render.component_views:IsoSurfacesView.update": STATS,
     "volviz.render.controller:iso_summary": STATS,
     "volviz.render.controller:SceneController.dataset_of": DATASET,
-    "volviz.render.controller:SceneController.blend_volume": DATASET,
-    "volviz.render.controller:SceneController.show_volumes": DATASET,
     "volviz.render.controller:SceneController.show_isosurfaces": ISO_PARTS,
     "volviz.render.controller:SceneController.camera_views": VIEW_OBJECTS,
-    "volviz.render.controller:SceneController.update_views": STATS,
-    "volviz.render.controller:SceneController.begin_views": VIEW_OBJECTS,
     "volviz.render.controller:SceneController.compute_views": VIEW_OBJECTS,
     "volviz.render.controller:SceneController.finish_views": VIEW_OBJECTS,
     "volviz.render.controller:SceneController.pt_stats": STATS,
-    "volviz.render.controller:SceneController.iso_stats": STATS,
     "volviz.render.decorations:legend_margin": DATASET,
     "volviz.render.error_budget:error_budget_choice": JSON,
-    "volviz.render.gl_iso:GLIsoView.update": STATS,
-    "volviz.render.gl_iso:GLIsoView.finish": STATS,
     "volviz.render.image_overlay:single_sample_on_software": PLOTTER_WINDOW,
-    "volviz.render.lod_volume:LodVolume.finish": STATS,
     "volviz.render.lod_volume:LodVolume.update": STATS,
-    "volviz.render.lod_volume:LodVolume.show_stats": STATS,
-    "volviz.render.preview_hold:hold_previews": PLOTTER_HELD,
-    "volviz.render.preview_hold:holds_previews": PLOTTER_HELD,
     "volviz.render.pt_prop:add_pt_volume": DATASET_TO_PROP,
-    "volviz.render.scene_builder:prepared_volume_input": DATASET,
     "volviz.render.scene_builder:time_input": DATASET,
-    "volviz.render.scene_builder:add_volume_prop": DATASET_TO_PROP,
     "volviz.render.scene_builder:add_lod_component": DATASET_TO_PROP,
     "volviz.render.scene_builder:add_pt_component": DATASET_TO_PROP,
     "volviz.render.slices:slice_indices": JSON,
     "volviz.render.views:View.finish": RESULT,
     "volviz.render.vtk_scene:volume_grid": DATASET,
-    "volviz.render.vtk_scene:volume_input": DATASET,
     "volviz.render.vtk_scene:transparent_nonfinite": DATASET,
     "volviz.render.vtk_scene:add_dataset": DATASET_TO_PROP,
-    "volviz.render.vtk_scene:volume_prop": DATASET_TO_PROP,
     "volviz.render.vtk_scene:is_surface": DATASET,
-    "volviz.render.vtk_scene:surface_input": DATASET,
     "volviz.render.vtk_scene:add_surface": DATASET_TO_PROP,
     "volviz.scene.datasets:read_any": JSON,
     "volviz.scene.datasets:component_dataset":
@@ -137,7 +116,6 @@ ALLOWED: dict[str, str] = {
     "volviz.model.clip:ClipPlane.from_dict": JSON,
     "volviz.model.clip:BoxCrop.from_dict": JSON,
     "volviz.model.clip:ClipSettings.from_dict": JSON,
-    "volviz.model.timeseries:frame_at": DATASET,
 }
 
 

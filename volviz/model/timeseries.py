@@ -8,7 +8,7 @@ from typing import Any, Union, cast
 
 import numpy as np
 
-from volviz.model.datasets import CurvilinearGrid, RegularVolume, TetMesh, TimeSeries, UnstructuredMesh
+from volviz.model.datasets import CurvilinearGrid, Dataset, RegularVolume, TetMesh, TimeSeries, UnstructuredMesh
 
 
 def bracket(series: TimeSeries, t: float) -> tuple[int, int, float]:
@@ -43,7 +43,7 @@ def _moved_points(a: Any, b: Any, w: float) -> np.ndarray:
     return (1.0 - w) * np.asarray(a.points, np.float64) + w * np.asarray(b.points, np.float64)
 
 
-def frame_at(series: TimeSeries, t: float, interpolate: bool = True) -> Any:
+def frame_at(series: TimeSeries, t: float, interpolate: bool = True) -> Dataset:
     """The dataset shown at display time ``t``: the nearest earlier step, or the blend of its two neighbours (their
     point values, and the point positions of a mesh that moves with one topology). Between two steps of different
     sizes (an adaptively refined mesh, a regridded volume) there is no blend: the earlier step is shown."""

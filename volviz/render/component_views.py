@@ -68,14 +68,14 @@ class VtkPropView:
         self._uncut = clip_vtk_prop(self.prop, clip, self._uncut)
         return True
 
-    def set_input(self, data: Any, clip: ClipSettings) -> None:
+    def set_input(self, data: object, clip: ClipSettings) -> None:
         """A new mapper input (a time series' volume at a new display time), cut by ``clip``."""
         self._uncut = None
         self.prop.GetMapper().SetInputData(data)
         if clip.all_planes():
             self.set_clip(clip)
 
-    def update(self) -> dict[str, Any]:
+    def update(self) -> dict[str, object]:
         """Nothing to re-make: VTK draws it at every render."""
         return {}
 
@@ -137,7 +137,7 @@ class IsoSurfacesView(VtkPropView):
 
         self.prop = add_isosurface_actors(self.plotter, self.comp.id, parts, spectrum=self.spectrum)
 
-    def update(self) -> dict[str, Any]:
+    def update(self) -> dict[str, object]:
         """Cut again now when the clipping or the opacity changed."""
         if self.stale():
             self.show_cut(self.cut(), self.visible)

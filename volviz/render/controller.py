@@ -34,7 +34,8 @@ from volviz.render.decorations import apply_decorations, legend_margin, update_l
 from volviz.render.framing import frame_scene, union
 from volviz.render.image_overlay import single_sample_on_software
 from volviz.render.scene_builder import (PreparedScene, ensure_transfer_functions, install_component, install_nature,
-                                         install_scene, prepare_component, prepare_scene, time_input, view_backend)
+                                         display_frame, frame_input, install_scene, prepare_component,
+                                         prepare_scene, view_backend)
 from volviz.render.views import view_class
 from volviz.render.volume_peeling import peel_volumes, regular_volumes
 from volviz.render.vtk_scene import apply_camera, camera_state, is_surface
@@ -460,19 +461,23 @@ class SceneController:
                                                               and is_surface(series[comp_id])))]
 
     def blend_volume(self, comp_id: str, t: float, interpolate: Optional[bool] = None,
-                     progress: Optional[ProgressCallback] = None) -> Any:
-        """Any thread: the VTK input of a time-series volume or surface at display time ``t`` (the 4D blend of the
-        neighbouring steps when interpolating, libMini note "4D Visualization"; ``scene_builder.time_input``);
-        ``show_volumes`` puts it on screen."""
+                     progress: Optional[ProgressCallback] = None) -> object:
+        """Any thread: a time-series volume or surface at display time ``t`` (the 4D blend of the neighbouring
+        steps when interpolating, libMini note "4D Visualization"; ``scene_builder.display_frame``): arrays, no VTK
+        object; ``show_volumes`` makes its VTK input and puts it on screen. (Made in the job, the VTK input froze the
+        window: playing a surface series while orbiting, issue #28.)"""
         interpolate = self.interpolate_time if interpolate is None else bool(interpolate)
-        return time_input(self.time_series()[comp_id], float(t), interpolate)
+        return display_frame(self.time_series()[comp_id], float(t), interpolate)
 
-    def show_volumes(self, inputs: dict[str, Any]) -> None:
-        """GUI thread: give time-series volumes and surfaces new inputs (``comp_id → blend_volume(...)``), cut by the
-        clipping; the outline box follows data that moves."""
+    def show_volumes(self, inputs: dict[str, object]) -> None:
+        """GUI thread: give time-series volumes and surfaces new inputs made here from their frames
+        (``comp_id → blend_volume(...)``; ``scene_builder.frame_input``), cut by the clipping; the outline box
+        follows data that moves."""
         changed = False
-        for comp_id, data in inputs.items():
+        series = self.time_series()
+        for comp_id, frame in inputs.items():
             view = self.views.get(comp_id)
+            data = frame_input(series[comp_id], frame) if view is not None and comp_id in series else None
             if view is not None and data is not None:
                 before = view.bounds()
                 view.set_input(data, self.clip)
@@ -562,7 +567,7 @@ class SceneController:
             out[self.iso_overlay.job[0]] = self.iso_overlay
         return out
 
-    def update_views(self, pt: bool = True, nature: bool = True, lod: bool = True) -> dict[str, Any]:
+    def update_views(self, pt: bool = True, nature: bool = True, lod: bool = True) -> dict[str, object]:
         """Re-make what depends on the camera now (``update`` of each of ``camera_views``; the natural scene unless
         ``nature`` is false, PT volumes and the isosurface view unless ``pt`` is false, volumes at a level of detail
         unless ``lod`` is false: for callers that do those in the background); returns their statistics."""
@@ -581,7 +586,7 @@ class SceneController:
                 stats[key] = dict(view.stats)
         return stats
 
-    def begin_views(self, stage: int) -> list[tuple[str, Any, Any]]:
+    def begin_views(self, stage: int) -> list[tuple[str, object, object]]:
         """GUI thread: the requests of the view-dependent parts for the current camera, in two stages because the
         PT volumes and the isosurfaces' CPU mode read the opaque scene's depth: stage 0 the natural scene and the
         volumes at a level of detail, stage 1 (after stage 0 is finished) the CPU images of PT volumes and the iso
@@ -731,7 +736,7 @@ class SceneController:
         view = self.iso_view
         return view if view is not None and view.backend == "cpu" else None
 
-    def iso_stats(self) -> dict[str, Any]:
+    def iso_stats(self) -> dict[str, object]:
         """The isosurface view's last statistics (``iso_summary`` prints them); {} with
         none."""
         view = self.iso_view

@@ -395,7 +395,7 @@ class GLIsoView(IsoModeView):
     def _on_end(self, *_: Any) -> None:
         self._frame_s = time.perf_counter() - self._frame_start
 
-    def update(self) -> dict[str, Any]:
+    def update(self) -> dict[str, object]:
         """The statistics of the last render (nothing to re-make: VTK draws the passes at every render)."""
         n = sum(m.n_triangles for m in self.meshes)
         passes = {"2pass": 1, "3pass": 2, "4pass": 3}.get(self.mode)
@@ -411,7 +411,7 @@ class GLIsoView(IsoModeView):
     def compute(self, request: None, progress: ProgressCallback | None = None) -> tuple[()]:
         return ()
 
-    def finish(self, request: None) -> dict[str, Any]:
+    def finish(self, request: None) -> dict[str, object]:
         return self.update()
 
     def remove(self) -> None:

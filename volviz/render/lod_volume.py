@@ -395,7 +395,7 @@ class LodVolume:
         return selection, blocks, t1 - t0, time.perf_counter() - t1
 
     def finish(self, request: LodRequest, selection: Selection, blocks: list[Block], select_s: float = 0.0,
-               decode_s: float = 0.0) -> dict[str, Any]:
+               decode_s: float = 0.0) -> dict[str, object]:
         """GUI thread: draw ``compute``'s selection (``show``); returns the statistics."""
         self.show(selection, blocks, select_s, decode_s)
         return self.stats
@@ -411,7 +411,7 @@ class LodVolume:
         return self.stats
 
     def show_stats(self, selection: Selection, blocks: list[Block], select_s: float,
-                   decode_s: float) -> dict[str, Any]:
+                   decode_s: float) -> dict[str, object]:
         levels: dict[int, int] = {}
         for level, _ in selection.nodes:
             levels[level] = levels.get(level, 0) + 1

@@ -18,7 +18,9 @@ from __future__ import annotations
 import weakref
 from typing import TYPE_CHECKING, Any
 
-if TYPE_CHECKING:   # type-only: VTK's camera, reached through the facade at run time
+if TYPE_CHECKING:   # type-only: VTK's camera, reached through the facade at run time; PyVista's plotter
+    import pyvista as pv
+
     from volviz.render.vtk_facade import vtkCamera
 
 __all__ = ["PreviewCameraHold", "hold_previews", "holds_previews"]
@@ -26,12 +28,12 @@ __all__ = ["PreviewCameraHold", "hold_previews", "holds_previews"]
 _holding: weakref.WeakSet[Any] = weakref.WeakSet()   # the plotters whose CPU volumes hold their images' camera
 
 
-def hold_previews(plotter: Any) -> None:
+def hold_previews(plotter: pv.BasePlotter) -> None:
     """The CPU PT volumes of ``plotter`` made from now on draw moving frames with their image's camera."""
     _holding.add(plotter)
 
 
-def holds_previews(plotter: Any) -> bool:
+def holds_previews(plotter: pv.BasePlotter) -> bool:
     return plotter in _holding
 
 

@@ -111,11 +111,11 @@ def prepare_component(session: Session, comp: Component, datasets: dict[str, Loa
         prepared.parts[comp.id] = mesh
         if clip.all_planes():
             prepared.cut[comp.id] = cut_tetmesh(mesh, clip)
-    else:
-        prepared.parts[comp.id] = time_input(dataset, t, interpolate) if series else prepared_volume_input(dataset)
+    else:   # arrays: ``frame_input`` makes the mapper's input in ``install_component``, on the GUI thread
+        prepared.parts[comp.id] = display_frame(dataset, t, interpolate)
 
 
-def prepared_volume_input(dataset: Any, t: Optional[float] = None, interpolate: bool = True) -> Any:
+def prepared_volume_input(dataset: object, t: Optional[float] = None, interpolate: bool = True) -> object:
     """Any thread: the VTK data object a volume mapper draws for ``dataset`` (a time series: blended at display
     time ``t``, libMini note "4D Visualization"), or None when ``add_dataset`` does not draw it as a volume."""
     if isinstance(dataset, TimeSeries):
@@ -125,21 +125,40 @@ def prepared_volume_input(dataset: Any, t: Optional[float] = None, interpolate: 
     return volume_input(dataset)
 
 
+def display_frame(dataset: LoadedDataset, t: Optional[float] = None, interpolate: bool = True) -> LoadedDataset:
+    """Any thread: ``dataset`` at display time ``t`` as the model has it, arrays and no VTK object: a time series'
+    frame there (the blend of the neighbouring steps when interpolating, libMini note "4D Visualization"), else the
+    dataset itself. ``frame_input`` makes its VTK object on the GUI thread: a job that makes VTK objects while the
+    GUI thread renders can freeze the window for good (issue #28; ``volviz.jobs``)."""
+    if isinstance(dataset, TimeSeries):
+        return frame_at(dataset, float(dataset.times[0] if t is None else t), interpolate)
+    return dataset
+
+
+def frame_input(dataset: LoadedDataset, frame: object) -> object:
+    """GUI thread: what the VTK prop of ``dataset`` draws for ``frame`` (``display_frame``'s; None: nothing
+    prepared): a volume mapper's input (``prepared_volume_input``), a time series' surface (``vtk_scene.surface_input``
+    of the frame), or None for what ``add_dataset`` draws its own way (a 2D image, geometry alone)."""
+    if frame is None:
+        return None
+    if isinstance(dataset, TimeSeries):
+        if isinstance(dataset.frame(0), Image2D):
+            return None
+        if is_surface(dataset):
+            return surface_input(frame)
+    return prepared_volume_input(frame)
+
+
 def time_input(series: Any, t: Optional[float] = None, interpolate: bool = True) -> Any:
     """Any thread: what a VTK prop of a time series draws at display time ``t`` (default: the first step): a
     volume's mapper input (``prepared_volume_input``, blended) or a surface's (``vtk_scene.surface_input`` of the
     frame at ``t``: points and values blended between steps of one topology); None for what does not follow the
     time (a 2D image)."""
-    t = float(series.times[0] if t is None else t)
-    if isinstance(series.frame(0), Image2D):
-        return None
-    if is_surface(series):
-        return surface_input(frame_at(series, t, interpolate))
-    return prepared_volume_input(series, t, interpolate)
+    return frame_input(series, display_frame(series, t, interpolate))
 
 
-def add_volume_prop(plotter: pv.BasePlotter, dataset: Any, data: Any, tf: TransferFunction, opacity: float, name: str,
-                    backend: str = "auto", shade: bool = False) -> Any:
+def add_volume_prop(plotter: pv.BasePlotter, dataset: object, data: object, tf: TransferFunction, opacity: float,
+                    name: str, backend: str = "auto", shade: bool = False) -> object:
     """GUI thread: a vtkVolume drawing ``data`` (from ``prepared_volume_input``), the surface of a time series at
     its display time (``data`` from ``time_input``), or (``data`` None) ``add_dataset``'s default visual;
     ``backend``: the render option (``volviz.render.backend``), which picks VTK's GPU or CPU ray caster; ``shade``:
@@ -222,7 +241,8 @@ def install_component(plotter: pv.BasePlotter, session: Session, comp: Component
     if uses_pt(session, dataset):
         return add_pt_component(plotter, session, comp, prepared.parts[comp.id], update=views)
     tf = drawn_transfer_function(session, comp, dataset)
-    return VtkPropView(add_volume_prop(plotter, dataset, prepared.parts.get(comp.id), tf, comp.opacity, comp.id,
+    return VtkPropView(add_volume_prop(plotter, dataset, frame_input(dataset, prepared.parts.get(comp.id)), tf,
+                                       comp.opacity, comp.id,
                                        backend_setting(session.render.options), bool(comp.settings.get("shade"))))
 
 
@@ -262,7 +282,7 @@ def uses_pt(session: Session, dataset: object) -> bool:
     return session.render.method != "vtk" and type(dataset).__name__ in PT_DATASETS and not is_surface(dataset)
 
 
-def add_pt_component(plotter: pv.BasePlotter, session: Session, comp: Component, dataset: Any,
+def add_pt_component(plotter: pv.BasePlotter, session: Session, comp: Component, dataset: object,
                      update: bool = True) -> Any:
     """A PT volume for a component (``volviz.render.pt_view``), with its TF scaled by its opacity: drawn on the GPU
     (``volviz.render.gl_pt``) or the CPU (``volviz.render.pt_prop``) as the render option ``backend`` picks for this

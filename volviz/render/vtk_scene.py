@@ -123,7 +123,7 @@ def default_transfer_function_for(dataset: Union[Dataset, TimeSeries], name: str
     return auto_transfer_function(scalar_values(dataset), mean_chord(grid.bounds), name)
 
 
-def volume_input(dataset: Any) -> Any:
+def volume_input(dataset: object) -> object:
     """The VTK data object a volume mapper draws for ``dataset`` (tetrahedralised for non-image grids)."""
     # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
     from volviz.render.vtk_facade import vtk
@@ -175,9 +175,9 @@ def add_dataset(plotter: pv.BasePlotter, dataset: Any, tf: Optional[TransferFunc
     return volume_prop(plotter, volume_input(dataset), isinstance(dataset, RegularVolume), tf, opacity, name)
 
 
-def volume_prop(plotter: pv.BasePlotter, data: Any, regular: bool, tf: TransferFunction, opacity: float,
+def volume_prop(plotter: pv.BasePlotter, data: object, regular: bool, tf: TransferFunction, opacity: float,
                 name: Optional[str],
-                backend: str = "auto", shade: bool = False) -> Any:
+                backend: str = "auto", shade: bool = False) -> object:
     """Add a ``vtkVolume`` drawing the VTK dataset ``data`` with ``tf`` to ``plotter``: regular volumes through
     vtkSmartVolumeMapper (its CPU ray caster where ``backend`` picks "cpu": by default on a software OpenGL, see
     ``volviz.render.backend``), lit with ``shade`` (the component setting); others through
@@ -219,7 +219,7 @@ def shows_no_field(dataset: Union[Dataset, TimeSeries]) -> bool:
 VERTEX_COLORS = "volviz vertex colours"
 
 
-def surface_input(dataset: Any, plain: bool = False) -> Any:
+def surface_input(dataset: object, plain: bool = False) -> object:
     """The PyVista surface drawn for a dataset of surface cells (``is_surface``; or its ``volume_grid``), its active
     scalars kept active unless they are an appearance attribute (``volviz.model.arrays.is_appearance_array``) or
     the dataset is drawn ``plain`` (geometry alone): then its vertex colours (``VERTEX_COLORS``), if it has any, else
