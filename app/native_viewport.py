@@ -2,12 +2,12 @@
 ``VOLVIZ_VIEWPORT=native`` on the ``xcb`` platform; ``window.make_plotter``).
 
 pyvistaqt's ``QtInteractor`` is a ``QOpenGLWidget``: VTK renders into its framebuffers, the paint blits the frame into
-the widget's, and Qt then composes the whole window through OpenGL (on llvmpipe, 60-72 ms per pass of a loaded
-machine). VTK's own ``QVTKRenderWindowInteractor`` on a plain ``QWidget`` is a native window that
-``vtkXOpenGLRenderWindow`` swaps into directly, so Qt composes nothing for it. With the flight's frames reduced in its
-own paint, a 20-s Yukon flight had 7-14 gaps over 100 ms less CPU waits against 70-86, and 18-21 fps against 10-14
-(docs/bench/flight.md, "A viewport that Qt does not compose"). A native GLX window needs X11 (pyvistaqt gh-445
-left native windows for Wayland), so pyvistaqt's widget stays the default everywhere else."""
+the widget's, and Qt then composes the whole window through OpenGL (costly on a software rasteriser:
+docs/bench/docstring-figures.md). VTK's own ``QVTKRenderWindowInteractor`` on a plain ``QWidget`` is a native window
+that ``vtkXOpenGLRenderWindow`` swaps into directly, so Qt composes nothing for it. With the flight's frames reduced in
+its own paint, a Yukon flight had far fewer long gaps and a higher frame rate (docs/bench/flight.md, "A viewport that Qt
+does not compose"). A native GLX window needs X11 (pyvistaqt gh-445 left native windows for Wayland), so pyvistaqt's
+widget stays the default everywhere else."""
 from __future__ import annotations
 
 import ctypes

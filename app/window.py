@@ -82,7 +82,7 @@ def make_plotter(parent: QWidget) -> Viewport:
 
 def _import_gui_thread_modules() -> None:
     """Import at start-up what the GUI thread later imports inside functions: a first ``import vtk`` (the natural
-    scene's overlay) took 0.2-0.5 s of a blocked event loop in the middle of loading a scene."""
+    scene's overlay) blocked the event loop in the middle of loading a scene (docs/bench/docstring-figures.md)."""
     import volviz.nature.nature_scene  # noqa: F401
     import volviz.render.controller  # noqa: F401
     import volviz.render.pt_prop  # noqa: F401

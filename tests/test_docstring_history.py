@@ -61,13 +61,8 @@ RULES: dict[str, re.Pattern[str]] = {
 #: a file name's dot and "docs/x.md" stay inside their sentence)
 _SENTENCE = re.compile(r"(?<=[.;!?])\s+")
 
-OTHER_CHANGE = "owned by another change this session (not edited here): the next session moves its figures"
-
 #: docstrings (``path:name``, ``<module>`` for a module's) left with measured history, and why
 ALLOWED: dict[str, str] = {
-    "app/native_viewport.py:<module>": OTHER_CHANGE,
-    "app/window.py:_import_gui_thread_modules": OTHER_CHANGE,
-    "volviz/jobs.py:_yield_the_cpu": OTHER_CHANGE,
 }
 
 

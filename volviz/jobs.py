@@ -109,8 +109,8 @@ _thread_state = threading.local()
 def _yield_the_cpu() -> None:
     """Run this worker thread at a lower scheduling priority (nice + ``BACKGROUND_NICE``; Linux schedules threads
     one by one), once per thread; threads it starts (Numba's pool) inherit it. On two busy cores the UI thread then
-    wins the CPU from background work: under a load of 5-6 the event loop's gaps during a table build were 80-140
-    ms at equal priority. Without per-thread priorities (not Linux) nothing changes."""
+    wins the CPU from background work, where at equal priority the event loop's gaps during a table build were long
+    under load (docs/bench/docstring-figures.md). Without per-thread priorities (not Linux) nothing changes."""
     if getattr(_thread_state, "niced", False):
         return
     _thread_state.niced = True
