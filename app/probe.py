@@ -92,4 +92,15 @@ class ProbeTool(QObject):
         if hit is None:
             return
         self.pinned.addItem(hit.text())
+        self._place_dock()
         self.dock.show()
+        self.dock.raise_()
+
+    def _place_dock(self) -> None:
+        """Before its first showing the dock goes behind a tab of the Scene dock's group (unless the user's layout put
+        it in a group already): shown below that group, it took 250 pixels of the column's height from the transfer
+        function dock, whose Undo, Redo, Import and Export buttons then scrolled out of view (issue #28)."""
+        window, scene = self.window, getattr(self.window, "scene_dock", None)
+        if (self.dock.isHidden() and not self.dock.isFloating() and not window.tabifiedDockWidgets(self.dock)
+                and scene is not None and scene.isVisible() and not scene.isFloating()):
+            window.tabifyDockWidget(scene, self.dock)
