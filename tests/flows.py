@@ -30,6 +30,17 @@ def open_blunt_fin(qtbot, make_window):
     return window
 
 
+def open_settled(qtbot, make_window, relative: str, size: tuple[int, int] = (1280, 740)):
+    """A window of ``size`` (the default window on a 1366x768 laptop screen) with the shared dataset ``relative``
+    opened and its final picture shown."""
+    window = make_window()
+    window.resize(*size)
+    window.open_path(data_file(relative))
+    wait_loaded(qtbot, window)
+    wait_settled(qtbot, window)
+    return window
+
+
 def wait_settled(qtbot, window, timeout: int = 60000) -> None:
     """Until no background job is running and the window is not busy: the view is at its final quality."""
     import time

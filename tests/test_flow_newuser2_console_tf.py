@@ -8,8 +8,7 @@ import numpy as np
 from PySide6.QtCore import QPoint, Qt
 from PySide6.QtWidgets import QApplication
 
-from conftest import data_file
-from flows import assert_matches_render, drag, screen, wait_loaded, wait_settled
+from flows import assert_matches_render, drag, open_settled, screen, wait_settled
 from test_flow_console import _run
 
 
@@ -20,11 +19,7 @@ def test_a_console_edit_of_the_tf_is_kept_by_the_next_drag_in_the_dock(qtbot, ma
     matches ``volviz render`` of the saved session; Ctrl+Z twice gives back the first picture exactly."""
     from volviz.optics.presets import load_preset
 
-    window = make_window()
-    window.resize(1280, 740)
-    window.open_path(data_file("volumes/HeadMRVolume.mhd"))
-    wait_loaded(qtbot, window)
-    wait_settled(qtbot, window)
+    window = open_settled(qtbot, make_window, "volumes/HeadMRVolume.mhd")
     window.python_console.action.trigger()
     console = window.python_console
     qtbot.waitUntil(lambda: console.widget is not None and console.widget.isVisible(), timeout=30000)

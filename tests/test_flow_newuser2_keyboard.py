@@ -8,8 +8,7 @@ from __future__ import annotations
 from PySide6.QtCore import Qt
 from PySide6.QtWidgets import QApplication, QDockWidget
 
-from conftest import data_file
-from flows import wait_loaded, wait_settled
+from flows import open_settled
 
 
 def _dock_of(widget) -> QDockWidget | None:
@@ -23,11 +22,7 @@ def test_tab_through_the_window_shows_each_focused_control(qtbot, make_window) -
     viewport; after each press the focused control is painted somewhere on screen (a non-empty visible region), and
     every tabbed dock (Render settings, Statistics, Clipping, Slices, Isosurfaces) was brought to the front on the
     way; Shift+Tab back into the Scene dock brings it to the front again."""
-    window = make_window()
-    window.resize(1280, 740)
-    window.open_path(data_file("ecosystem/sqnz_s.adf.cgns"))
-    wait_loaded(qtbot, window)
-    wait_settled(qtbot, window)
+    window = open_settled(qtbot, make_window, "ecosystem/sqnz_s.adf.cgns")
     window.activateWindow()
     qtbot.waitUntil(window.isActiveWindow)
     viewport = window.plotter.interactor

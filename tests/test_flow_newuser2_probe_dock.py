@@ -6,8 +6,7 @@ from __future__ import annotations
 
 from PySide6.QtCore import QPoint
 
-from conftest import data_file
-from flows import assert_matches_render, click, hover, wait_loaded, wait_settled
+from flows import assert_matches_render, click, hover, open_settled, wait_settled
 
 
 def _whole(widget) -> bool:
@@ -20,11 +19,7 @@ def test_a_pinned_probe_leaves_the_tf_dock_whole(qtbot, make_window, tmp_path) -
     line are whole; a click at the viewport's centre pins the value there: the Probe dock is in front and lists it,
     the TF dock's buttons and info line are still whole and its height unchanged, and the viewport (its size too)
     matches ``volviz render`` of the saved session."""
-    window = make_window()
-    window.resize(1280, 740)
-    window.open_path(data_file("ecosystem/disk_out_ref.ex2"))
-    wait_loaded(qtbot, window)
-    wait_settled(qtbot, window)
+    window = open_settled(qtbot, make_window, "ecosystem/disk_out_ref.ex2")
     editor = window.tf_editor
     controls = [editor.undo_button, editor.redo_button, editor.import_button, editor.export_button, editor.info]
     assert all(_whole(w) for w in controls)

@@ -11,8 +11,7 @@ import numpy as np
 from PySide6.QtCore import QPoint, Qt
 from PySide6.QtWidgets import QCheckBox, QStyle
 
-from conftest import data_file
-from flows import assert_matches_render, screen, wait_loaded, wait_settled
+from flows import assert_matches_render, open_settled, screen, wait_settled
 
 
 def _box_titled(window, title: str) -> QCheckBox:
@@ -38,11 +37,7 @@ def test_a_click_on_the_words_log_color_scale_turns_it_on(qtbot, make_window, tm
     color scale (the session saves ``log_scale: true``, the picture changes, and matches ``volviz render`` of the
     saved session); a second click turns it off again: the first picture exactly. The form has one box per on/off
     setting (Log color scale, Shading), none untitled."""
-    window = make_window()
-    window.resize(1280, 740)
-    window.open_path(data_file("volumes/HeadMRVolume.mhd"))
-    wait_loaded(qtbot, window)
-    wait_settled(qtbot, window)
+    window = open_settled(qtbot, make_window, "volumes/HeadMRVolume.mhd")
     linear = screen(window)
     window.scene_dock.raise_()
     qtbot.waitUntil(lambda: window.scene_tree.form is not None and "log_scale" in window.scene_tree.form.rows)

@@ -7,8 +7,7 @@ import numpy as np
 from PySide6.QtCore import QEvent, QPoint, QPointF, Qt
 from PySide6.QtWidgets import QApplication
 
-from conftest import data_file
-from flows import _mouse, assert_matches_render, click, drag, pick_combo_item, screen, wait_loaded, wait_settled
+from flows import _mouse, assert_matches_render, click, drag, open_settled, pick_combo_item, screen, wait_settled
 
 
 def _points(canvas) -> list[QPoint]:
@@ -28,11 +27,7 @@ def test_mouse_edits_of_the_tf_undo_and_redo_from_the_keyboard_to_the_same_pictu
     click, a color preset picked: four edits, four different pictures. Ctrl+Z four times gives back each earlier
     picture exactly, down to the first; Ctrl+Y four times each later one, up to the last, which matches ``volviz
     render`` of the saved session."""
-    window = make_window()
-    window.resize(1280, 740)
-    window.open_path(data_file("volumes/ironProt.vtk"))
-    wait_loaded(qtbot, window)
-    wait_settled(qtbot, window)
+    window = open_settled(qtbot, make_window, "volumes/ironProt.vtk")
     canvas = window.tf_editor.canvas
     window.tf_dock.raise_()
     shots = [screen(window)]
