@@ -111,11 +111,6 @@ ALLOWED: dict[str, str] = {
         "LoadedDataset breaks app.first_open, which narrows it by class name (outside this change)",
     "volviz.scene.drawn_tf:drawn_transfer_function":
         "Optional[TransferFunction] needs narrowing in scene_builder's callers (a behaviour edit, not this change)",
-    "volviz.model.arrays:select_array": DATASET,
-    "volviz.model.camera:Camera.from_dict": JSON,
-    "volviz.model.clip:ClipPlane.from_dict": JSON,
-    "volviz.model.clip:BoxCrop.from_dict": JSON,
-    "volviz.model.clip:ClipSettings.from_dict": JSON,
 }
 
 

@@ -11,11 +11,12 @@ does). Non-finite values are kept and counted; the renderers draw them transpare
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
-from typing import Any, Optional, Union
+from typing import Any, Optional, Union, overload
 
 import numpy as np
 
-from volviz.model.datasets import CurvilinearGrid, Dataset, RegularVolume, TetMesh, TimeSeries, UnstructuredMesh
+from volviz.model.datasets import (CurvilinearGrid, Dataset, Image2D, RegularVolume, TetMesh, TimeSeries,
+                                   UnstructuredMesh)
 
 MAGNITUDE = "magnitude"
 MAX_COMPONENTS = 9           # tensors: 3x3
@@ -319,7 +320,15 @@ def _structured_cell_to_point(cells: np.ndarray, dims: tuple[int, ...]) -> np.nd
     return total / count
 
 
-def select_array(dataset: Any, spec: str | None) -> Any:
+@overload
+def select_array(dataset: TimeSeries, spec: str | None) -> TimeSeries: ...
+
+
+@overload
+def select_array(dataset: Dataset, spec: str | None) -> Dataset: ...
+
+
+def select_array(dataset: Union[Dataset, TimeSeries], spec: str | None) -> Union[Dataset, TimeSeries]:
     """``dataset`` showing the array ``spec`` (None: ``default_array``): a dataset of the same kind whose active
     point scalar is that array's scalar, component or magnitude, named by the spec. ValueError (naming the
     available arrays) when the dataset has no such array."""
@@ -344,7 +353,7 @@ def select_array(dataset: Any, spec: str | None) -> Any:
     key = str(parsed)
     if isinstance(dataset, RegularVolume):
         return replace(dataset, data=scalar, name=key, arrays=dataset.arrays or {dataset.name: dataset.data})
-    if isinstance(dataset, TetMesh):
+    if isinstance(dataset, (TetMesh, Image2D)):   # (an image has no arrays: it does not come this far)
         return dataset
     cell_data = dataset.cell_data
     if association == "cell":   # shown at the points; the view keeps no cell array of the same name

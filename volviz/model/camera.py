@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, Protocol, Sequence, Union
+from typing import TYPE_CHECKING, Protocol, Sequence, TypedDict, Union
 
 import numpy as np
 
@@ -67,6 +67,18 @@ class RayBasis:
     def as_array(self) -> np.ndarray:
         """(6, 3) float64: o0, ox, oy, d0, dx, dy (the layout the Numba kernels take)."""
         return np.ascontiguousarray(np.stack([self.o0, self.ox, self.oy, self.d0, self.dx, self.dy]))
+
+
+class CameraDict(TypedDict):
+    """A camera as the session file and ``Camera.to_dict`` write it (JSON: lists for the vectors)."""
+
+    position: list[float]
+    focal_point: list[float]
+    view_up: list[float]
+    view_angle: float
+    parallel: bool
+    parallel_scale: float
+    clipping_range: list[float]
 
 
 @dataclass
@@ -158,16 +170,17 @@ class Camera:
         vtk_camera.SetClippingRange(*self.clipping_range)
         vtk_camera.OrthogonalizeViewUp()
 
-    def to_dict(self) -> dict[str, object]:
+    def to_dict(self) -> CameraDict:
         return {"position": list(map(float, self.position)), "focal_point": list(map(float, self.focal_point)),
                 "view_up": list(map(float, self.view_up)), "view_angle": float(self.view_angle),
                 "parallel": bool(self.parallel), "parallel_scale": float(self.parallel_scale),
                 "clipping_range": list(self.clipping_range)}
 
     @classmethod
-    def from_dict(cls, d: dict[str, Any]) -> "Camera":
+    def from_dict(cls, d: CameraDict) -> "Camera":
+        near, far = d["clipping_range"]
         return cls(d["position"], d["focal_point"], d["view_up"], d["view_angle"], d["parallel"],
-                   d["parallel_scale"], tuple(d["clipping_range"]))
+                   d["parallel_scale"], (near, far))
 
     @classmethod
     def orbit(cls, points: np.ndarray, azimuth: float = 30.0, elevation: float = 20.0, distance: float = 2.5,

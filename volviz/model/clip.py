@@ -7,14 +7,14 @@ JSON (``ClipSettings.to_dict`` / ``from_dict``) for the session file.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
-
 import numpy as np
+
+from volviz.model.json_types import JSONValue
 
 __all__ = ["BoxCrop", "ClipPlane", "ClipSettings"]
 
 
-def _vec3(v: Any, what: str) -> tuple[float, float, float]:
+def _vec3(v: object, what: str) -> tuple[float, float, float]:
     a = np.asarray(v, dtype=np.float64).reshape(-1)
     if a.shape != (3,) or not np.all(np.isfinite(a)):
         raise ValueError(f"{what} must be 3 finite numbers, got {v!r}")
@@ -45,10 +45,10 @@ class ClipPlane:
         return {"point": list(self.point), "normal": list(self.normal)}
 
     @classmethod
-    def from_dict(cls, d: dict[str, Any]) -> "ClipPlane":
+    def from_dict(cls, d: JSONValue) -> "ClipPlane":
         if not isinstance(d, dict) or set(d) != {"point", "normal"}:
             raise ValueError(f"clip plane must be an object with 'point' and 'normal', got {d!r}")
-        return cls(d["point"], d["normal"])
+        return cls(_vec3(d["point"], "clip plane point"), _vec3(d["normal"], "clip plane normal"))
 
 
 @dataclass(frozen=True)
@@ -79,10 +79,10 @@ class BoxCrop:
         return {"lo": list(self.lo), "hi": list(self.hi)}
 
     @classmethod
-    def from_dict(cls, d: dict[str, Any]) -> "BoxCrop":
+    def from_dict(cls, d: JSONValue) -> "BoxCrop":
         if not isinstance(d, dict) or set(d) != {"lo", "hi"}:
             raise ValueError(f"box crop must be an object with 'lo' and 'hi', got {d!r}")
-        return cls(d["lo"], d["hi"])
+        return cls(_vec3(d["lo"], "box lo"), _vec3(d["hi"], "box hi"))
 
 
 @dataclass(frozen=True)
@@ -109,7 +109,7 @@ class ClipSettings:
         return {"planes": [p.to_dict() for p in self.planes], "box": None if self.box is None else self.box.to_dict()}
 
     @classmethod
-    def from_dict(cls, d: dict[str, Any]) -> "ClipSettings":
+    def from_dict(cls, d: JSONValue) -> "ClipSettings":
         if not isinstance(d, dict) or not set(d) <= {"planes", "box"}:
             raise ValueError(f"clip settings must be an object with 'planes' and 'box', got {d!r}")
         planes = d.get("planes", [])

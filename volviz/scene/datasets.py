@@ -123,7 +123,7 @@ def _views_of(dataset: LoadedDataset) -> Optional[dict[Optional[str], Any]]:
     return views
 
 
-def _detached(dataset: LoadedDataset) -> LoadedDataset:
+def _detached(dataset: Union[Dataset, TimeSeries]) -> Union[Dataset, TimeSeries]:
     """What the views of ``dataset`` are made from: the dataset, or for a time series a twin sharing its frame list
     and loader (frames loaded through a view are kept in the series as before), since a series' view loads its
     frames through what it was made from, and a view kept in ``_VIEWS`` must not keep its dataset alive."""

@@ -17,11 +17,11 @@ from __future__ import annotations
 
 import time
 from dataclasses import asdict, dataclass, field
-from typing import Any, Literal, overload
+from typing import Any, Literal, cast, overload
 
 import numpy as np
 
-from volviz.model.camera import Camera
+from volviz.model.camera import Camera, CameraDict
 from volviz.model.datasets import TetMesh
 from volviz.model.object_cache import ObjectCache
 from volviz.optics import build_table3d
@@ -193,8 +193,8 @@ def render(mesh: TetMesh, tf: Any, camera: Camera, size: tuple[int, int] = (512,
         raise ValueError(f"unknown lookup {lookup!r}; choose one of {LOOKUPS}")
     if not isinstance(mesh, TetMesh):
         raise TypeError(f"render needs a TetMesh (use volviz.unstructured.tetrahedralize), got {type(mesh).__name__}")
-    if isinstance(camera, dict):
-        camera = Camera.from_dict(camera)
+    if isinstance(camera, dict):   # (untyped callers: a camera as Camera.to_dict writes it)
+        camera = Camera.from_dict(cast(CameraDict, camera))
     w, h = (int(v) for v in size)
     stats = UnstructuredRenderStats(method, (w, h), n_tets=mesh.n_cells)
     t_start = time.perf_counter()
