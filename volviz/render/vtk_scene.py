@@ -119,8 +119,24 @@ def default_transfer_function_for(dataset: Union[Dataset, TimeSeries], name: str
     if is_lod(dataset):
         return default_transfer_function(lod_scalar_range(dataset), bounds_diagonal(lod_bounds(dataset)), name)
 
-    grid = volume_grid(dataset)
-    return auto_transfer_function(scalar_values(dataset), mean_chord(grid.bounds), name)
+    return auto_transfer_function(scalar_values(dataset), mean_chord(dataset_bounds(dataset)), name)
+
+
+def dataset_bounds(dataset: Union[Dataset, TimeSeries]) -> tuple[float, ...]:
+    """The bounds of a dataset (the first step of a time series) from its own arrays: the bounds VTK gives its grid
+    (the same to the bit on every file of ../shared/data that has points), without making that grid, so the first
+    look's transfer function, placed in the scene-loading job, makes no VTK object off the GUI thread (issue #28,
+    ``volviz.jobs``). What has no points of its own (a 2D image) asks VTK's grid."""
+    if isinstance(dataset, TimeSeries):
+        dataset = dataset.frame(0)
+    if isinstance(dataset, RegularVolume):
+        return tuple(float(v) for v in dataset.bounds())
+    points = getattr(dataset, "points", None)
+    if isinstance(dataset, Image2D) or points is None or not np.size(points):
+        return tuple(volume_grid(dataset).bounds)
+    flat = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    lo, hi = flat.min(axis=0), flat.max(axis=0)
+    return (float(lo[0]), float(hi[0]), float(lo[1]), float(hi[1]), float(lo[2]), float(hi[2]))
 
 
 def volume_input(dataset: object) -> object:
