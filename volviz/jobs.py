@@ -9,6 +9,15 @@ other policy: one job of a kind at a time, the newest waiting request next, so t
 while requests keep coming (the app's view refreshes).
 
 This module is Qt-free; the app bridges ``on_progress`` and ``on_done`` to Qt signals.
+
+A job makes no VTK (PyVista) object and hands none over: it returns arrays (model datasets, meshes) and the GUI
+thread makes the VTK objects when it shows them (``finish``, ``install``, ``show_volumes``). A worker that makes or
+drops a VTK object from Python holds the GIL while VTK's garbage collector may be waiting for a collection on the
+GUI thread, and that collection, inside a render (which releases the GIL), may be freeing a PyVista object whose
+clean-up needs the GIL: each waits for the other and the window freezes for good (issue #28: orbiting a terrain;
+playing a surface series while orbiting). ``tests/test_jobs_vtk_threads.py`` holds the view updates,
+scene preparation, first-look transfer functions and time blends to it. Not yet: isosurface extraction and cuts
+(VTK's contour, clip and probe filters in ``volviz.iso``) and frame export still run VTK filters on workers.
 """
 from __future__ import annotations
 
