@@ -60,9 +60,6 @@ def public_any_signatures(root: Path = ROOT, packages: tuple[str, ...] = PACKAGE
     return out
 
 
-JSON = ("JSON: a session file's settings, options, clipping or schema, free-form by design; where the body reads "
-        "typed values out of it (float(...), a constructor's arguments), dict[str, object] needs a check per value, a "
-        "code change (where it does not, the signature says dict[str, object])")
 STATS = ("statistics: a free-form dict of numbers and labels for the status bar and the reports; these are read "
          "as numbers by their callers (app/window.py's statistics, the benches), where dict[str, object] needs a check "
          "per value, a code change (where no caller reads them so, the signature says dict[str, object])")
@@ -82,8 +79,6 @@ ISO_PARTS = ("IsoParts or a list of IsoMesh: the body tells them apart with a co
 
 #: the public signatures allowed to keep ``Any``, with the reason
 ALLOWED: dict[str, str] = {
-    "volviz.render.backend:GLInfo.to_dict": JSON,
-    "volviz.render.backend:backend_setting": JSON,
     "volviz.render.controller:iso_summary": STATS,
     "volviz.render.controller:SceneController.dataset_of": DATASET,
     "volviz.render.controller:SceneController.show_isosurfaces": ISO_PARTS,
@@ -92,21 +87,18 @@ ALLOWED: dict[str, str] = {
     "volviz.render.controller:SceneController.finish_views": VIEW_OBJECTS,
     "volviz.render.controller:SceneController.pt_stats": STATS,
     "volviz.render.decorations:legend_margin": DATASET,
-    "volviz.render.error_budget:error_budget_choice": JSON,
     "volviz.render.image_overlay:single_sample_on_software": PLOTTER_WINDOW,
     "volviz.render.lod_volume:LodVolume.update": STATS,
     "volviz.render.pt_prop:add_pt_volume": DATASET_TO_PROP,
     "volviz.render.scene_builder:time_input": DATASET,
     "volviz.render.scene_builder:add_lod_component": DATASET_TO_PROP,
     "volviz.render.scene_builder:add_pt_component": DATASET_TO_PROP,
-    "volviz.render.slices:slice_indices": JSON,
     "volviz.render.views:View.finish": RESULT,
     "volviz.render.vtk_scene:volume_grid": DATASET,
     "volviz.render.vtk_scene:transparent_nonfinite": DATASET,
     "volviz.render.vtk_scene:add_dataset": DATASET_TO_PROP,
     "volviz.render.vtk_scene:is_surface": DATASET,
     "volviz.render.vtk_scene:add_surface": DATASET_TO_PROP,
-    "volviz.scene.datasets:read_any": JSON,
     "volviz.scene.datasets:component_dataset":
         "LoadedDataset breaks app.first_open, which narrows it by class name (outside this change)",
     "volviz.scene.drawn_tf:drawn_transfer_function":

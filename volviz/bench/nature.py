@@ -34,7 +34,7 @@ import shlex
 import sys
 import time
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -42,6 +42,9 @@ from volviz.argtypes import UsageParser, float_in, image_size, int_in, joined
 from volviz.bench.offscreen import bench_plotter, finish, render_window, screenshot_rgb
 from volviz.model.camera import Camera
 from volviz.optics.metrics import error_heatmap, max_abs, rmse
+
+if TYPE_CHECKING:   # type-only import for a signature (the rendering layer loads where a case draws)
+    from volviz.render.backend import GLInfoDict
 
 DEFAULT_DATA = Path(os.environ.get("VOLVIZ_DATA", Path(__file__).resolve().parents[2].parent / "shared" / "data"))
 REPO = Path(__file__).resolve().parents[2]
@@ -394,7 +397,7 @@ class _GLFrames:
         out["gl_fps"] = 1.0 / max(out["gl_frame_s"], 1e-9)
         return out, img
 
-    def close(self) -> dict[str, str]:
+    def close(self) -> GLInfoDict:
         # heavy: VTK's rendering, loaded where a case draws (not for --help or a refused argument)
         from volviz.render.backend import gl_info
 

@@ -36,7 +36,7 @@ from __future__ import annotations
 
 import weakref
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Mapping, TypedDict
 
 from volviz.session import RENDER_BACKENDS
 
@@ -52,6 +52,15 @@ SOFTWARE_RENDERERS = ("llvmpipe", "softpipe", "swrast", "swiftshader", "software
 _FASTER_ON_SOFTWARE = {"pt": "cpu", "regular": "cpu", "nature": "cpu", "iso": "gpu"}     # measured (module docstring)
 
 
+class GLInfoDict(TypedDict):
+    """``GLInfo.to_dict``: the driver's strings and whether it is a software rasteriser (for the bench reports)."""
+
+    vendor: str
+    renderer: str
+    version: str
+    software: bool
+
+
 @dataclass(frozen=True)
 class GLInfo:
     """The OpenGL driver of a render window, as ``glGetString`` reports it ("" where unknown)."""
@@ -64,7 +73,7 @@ class GLInfo:
     def software(self) -> bool:
         return is_software_renderer(self.renderer)
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> GLInfoDict:
         return {"vendor": self.vendor, "renderer": self.renderer, "version": self.version, "software": self.software}
 
 
@@ -123,10 +132,10 @@ def offscreen_gl_info() -> GLInfo:
         plotter.close()
 
 
-def backend_setting(options: dict[str, Any]) -> str:
+def backend_setting(options: Mapping[str, object]) -> str:
     """The render option ``backend`` ("auto" when missing)."""
     value = options.get("backend", "auto")
-    return value if value in RENDER_BACKENDS else "auto"
+    return value if isinstance(value, str) and value in RENDER_BACKENDS else "auto"
 
 
 def choose_backend(setting: str, view_kind: str, info: GLInfo) -> str:

@@ -9,6 +9,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any, Mapping, Optional
 
+from volviz.model.json_types import json_float
+
 MOST_ACCURATE_TABLE: dict[str, Any] = {"table": "separable-4", "table_resolution": 512}
 DEFAULT_BUDGET = 1.0  # RMSE of 8-bit units, when the options name none
 
@@ -22,11 +24,11 @@ class BudgetChoice:
     message: Optional[str] = None
 
 
-def error_budget_choice(rmse: float, options: Mapping[str, Any]) -> BudgetChoice:
+def error_budget_choice(rmse: float, options: Mapping[str, object]) -> BudgetChoice:
     """What to do about a measured error ``rmse`` under the render ``options`` (their ``error_budget``, ``table``
     and ``table_resolution``)."""
     given = options.get("error_budget")
-    budget = DEFAULT_BUDGET if given is None else float(given)   # None (the model's default): no budget set
+    budget = DEFAULT_BUDGET if given is None else json_float(given)   # None (the model's default): no budget set
     if rmse <= budget:
         return BudgetChoice()
     if all(options.get(k) == v for k, v in MOST_ACCURATE_TABLE.items()):

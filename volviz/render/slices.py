@@ -9,11 +9,12 @@ clamped to 0..1: ``slice_colors``.
 """
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any, Optional
+from typing import TYPE_CHECKING, Any, Mapping, Optional
 
 import numpy as np
 
 from volviz.model.datasets import RegularVolume
+from volviz.model.json_types import json_int
 from volviz.render.component_views import VtkPropView
 from volviz.render.framing import Bounds, prop_bounds
 from volviz.scene.errors import SceneError
@@ -73,9 +74,9 @@ def slice_image(dataset: object, axis: str, index: int, tf: TransferFunction) ->
     return slice_colors(slice_values(dataset, axis, index), tf)
 
 
-def slice_indices(settings: dict[str, Any]) -> dict[str, int]:
+def slice_indices(settings: Mapping[str, object]) -> dict[str, int]:
     """The planes that are on in a slices component's settings, by axis."""
-    return {axis: int(settings[axis]) for axis in AXES if settings.get(axis) is not None}
+    return {axis: json_int(settings[axis]) for axis in AXES if settings.get(axis) is not None}
 
 
 def drag_index(dataset: object, axis: str, anchor: npt.ArrayLike, origin: npt.ArrayLike, direction: npt.ArrayLike

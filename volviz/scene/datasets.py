@@ -5,13 +5,14 @@ from __future__ import annotations
 import os
 import weakref
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Optional, Union
+from typing import TYPE_CHECKING, Any, Mapping, Optional, Union
 
 from volviz.io import read
 from volviz.jobs import ProgressCallback, report
 from volviz.model import Dataset, Image2D, TimeSeries
 from volviz.model.applicability import DatasetTraits
 from volviz.model.demo import demo_tet_mesh
+from volviz.model.json_types import json_int
 from volviz.model.arrays import select_array
 from volviz.model.representation import representation
 from volviz.scene.errors import SceneError
@@ -54,7 +55,8 @@ def load_datasets(session: Session, session_file: Optional[str | os.PathLike],
     return loaded
 
 
-def read_any(path: Path, options: dict[str, Any], progress: Optional[ProgressCallback] = None) -> LoadedDataset:
+def read_any(path: Path, options: Mapping[str, object], progress: Optional[ProgressCallback] = None
+             ) -> LoadedDataset:
     """A data file through ``volviz.io.read``, or a volviz-compressed volume (``.vvz``): with the dataset option
     ``lod`` a ``LodTree`` drawn at a view-dependent level of detail (``volviz.render.lod_volume``), else through the
     wavelet decoder
@@ -63,11 +65,12 @@ def read_any(path: Path, options: dict[str, Any], progress: Optional[ProgressCal
         if options.get("lod"):           # level of detail: blocks decoded on demand for each view
             from volviz.regular.lod import LodTree   # heavy (Numba kernels): only for a compressed volume
 
-            return LodTree(path, cache_bytes=int(options.get("cache_mb", 256)) << 20)
+            return LodTree(path, cache_bytes=json_int(options.get("cache_mb", 256)) << 20)
         from volviz.regular.codec import decompress   # heavy (Numba kernels): only for a compressed volume
 
         return decompress(path, progress=progress)
-    return read(path, **options)
+    reader_options: Mapping[str, Any] = options   # volviz.io.read's keyword options: each reader checks its own
+    return read(path, **reader_options)
 
 
 def component_dataset(comp: Component, datasets: dict[str, LoadedDataset]) -> Any:
