@@ -29,6 +29,23 @@ def choice_label(spec: str, association: str, shared: bool) -> str:
     return f"{replace(parse_array_spec(spec), association=None)} ({association}s)"
 
 
+def offered_spec(spec: str, infos: list[Any]) -> str:
+    """The choice of ``infos`` (``list_arrays``'s) that names the same array and component as ``spec`` (a session may
+    say ``p@points``, or ``V`` for a vector's magnitude, where the list offers ``p`` and ``V:magnitude``); ``spec``
+    itself when none does (an array the dataset lacks: still listed, so the setting shows)."""
+    from volviz.model.arrays import MAGNITUDE, parse_array_spec
+
+    wanted = parse_array_spec(spec)
+    for info in infos:
+        if wanted.matches(info.name, info.association):
+            for choice in info.choices:
+                component = parse_array_spec(choice).component
+                if component == wanted.component or (wanted.component is None and component == MAGNITUDE):
+                    return choice
+            return spec
+    return spec
+
+
 class ArrayChoice:
     """Fills ``combo`` for the component the scene tree selects and turns a user's choice into an undoable settings
     edit on ``undo_stack``. ``window`` provides ``controller``, ``session`` and ``apply_component_settings``."""
@@ -71,6 +88,8 @@ class ArrayChoice:
                 self.combo.addItem(choice_label(spec, info.association, names.count(info.name) > 1), spec)
                 self.combo.setItemData(self.combo.count() - 1, f"{info.association} array, range {lo:.4g} … "
                                        f"{hi:.4g}{bad}", Qt.ItemDataRole.ToolTipRole)
+        if shown is not None and self.combo.findData(shown) < 0:
+            shown = offered_spec(shown, infos)   # "p@points" where the list says "p"
         if shown is not None and self.combo.findData(shown) < 0:
             self.combo.addItem(shown, shown)
         self.combo.setCurrentIndex(max(self.combo.findData(shown), 0) if shown is not None else -1)

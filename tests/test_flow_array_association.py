@@ -68,3 +68,17 @@ def test_the_cavity_shows_the_cell_velocity_it_is_asked_for(qtbot, make_window, 
     tf_lo, tf_hi = window.controller.transfer_function(comp).range
     assert np.isclose(tf_lo, lo, rtol=1e-3) and np.isclose(tf_hi, hi, rtol=1e-3), (tf_lo, tf_hi, lo, hi)
     assert_matches_render(window, tmp_path, "cells-component")
+
+
+def test_a_spec_worded_otherwise_selects_the_item_that_names_it() -> None:
+    """A session may name an array as the list does not (``p@points``; ``U`` for the magnitude): the combo selects
+    the item of that array and component instead of listing the spec once more."""
+    from volviz.io import read
+    from volviz.model.arrays import list_arrays
+    from volviz_app.array_choice import offered_spec
+
+    infos = list_arrays(read(data_file("ecosystem/openfoam-cavity/case.foam")).frame(1))
+    assert offered_spec("p@points", infos) == "p" and offered_spec("p@cells", infos) == "p@cells"
+    assert offered_spec("U@points", infos) == offered_spec("U", infos) == "U:magnitude"
+    assert offered_spec("U@cells:mag", infos) == "U@cells:magnitude" and offered_spec("U:1", infos) == "U:1"
+    assert offered_spec("q", infos) == "q" and offered_spec("U:7", infos) == "U:7"   # not offered: kept as given
