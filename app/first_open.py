@@ -88,6 +88,7 @@ def _kind(window: Any) -> str:
     ``terrain (natural scene)`` ..."""
     from volviz.render.scene_builder import uses_pt
     from volviz.scene.datasets import component_dataset
+    from volviz.model import TimeSeries
     from volviz.scene.lod import is_lod
     from volviz.render.vtk_scene import is_surface
 
@@ -103,7 +104,7 @@ def _kind(window: Any) -> str:
             dataset = component_dataset(comp, controller.datasets)
             how = ("LOD" if is_lod(dataset) else "PT" if uses_pt(window.session, dataset)
                    else "surface" if is_surface(dataset) else "VTK")
-            if type(dataset).__name__ == "TimeSeries":
+            if isinstance(dataset, TimeSeries):
                 how += f", {len(dataset)} steps"
         kinds.append(f"{comp.type} ({how})" if how else comp.type)
     return "; ".join(kinds)

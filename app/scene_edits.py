@@ -119,9 +119,11 @@ class SceneEdits:
         if tf is None:
             return
         if comp_id in self.controller.lod_volumes():  # too large to decode whole: the range from node statistics
-            from volviz.scene.lod import lod_scalar_range
+            from volviz.scene.lod import is_lod, lod_scalar_range
 
-            self.tf_editor.set_transfer_function(tf, data_range=lod_scalar_range(self.controller.dataset_of(comp_id)))
+            dataset = self.controller.dataset_of(comp_id)
+            assert is_lod(dataset)   # what a LOD view draws
+            self.tf_editor.set_transfer_function(tf, data_range=lod_scalar_range(dataset))
             return
         known = self.controller.histograms.get(comp_id)
         self.tf_editor.blockSignals(True)  # the scene already shows this TF: no preview re-render
@@ -140,6 +142,7 @@ class SceneEdits:
         placeholder; a newer selection supersedes it. ``histograms_computed`` counts the ones shown."""
         from volviz.model.stats import histogram
         from volviz.scene.datasets import load_datasets
+        from volviz.scene.lod import is_lod
 
         controller, session_path = self.controller, self.session_path
         if controller is None:
@@ -149,7 +152,10 @@ class SceneEdits:
         def compute(progress: Any = None) -> Any:
             load_datasets(controller.session, session_path, loaded=controller.datasets, also=(comp_id,))  # hidden
             self.histogram_threads.add(threading.get_ident())
-            return histogram(controller.dataset_of(comp_id))
+            dataset = controller.dataset_of(comp_id)
+            if is_lod(dataset):   # never decoded whole (a hidden one comes here): scalar_values' own refusal
+                raise TypeError(f"no scalar values for {type(dataset).__name__}")
+            return histogram(dataset)
 
         def done(outcome: JobOutcome) -> None:
             if outcome.ok and self.controller is controller:

@@ -80,7 +80,6 @@ ISO_PARTS = ("IsoParts or a list of IsoMesh: the body tells them apart with a co
 #: the public signatures allowed to keep ``Any``, with the reason
 ALLOWED: dict[str, str] = {
     "volviz.render.controller:iso_summary": STATS,
-    "volviz.render.controller:SceneController.dataset_of": DATASET,
     "volviz.render.controller:SceneController.show_isosurfaces": ISO_PARTS,
     "volviz.render.controller:SceneController.camera_views": VIEW_OBJECTS,
     "volviz.render.controller:SceneController.compute_views": VIEW_OBJECTS,
@@ -99,8 +98,6 @@ ALLOWED: dict[str, str] = {
     "volviz.render.vtk_scene:add_dataset": DATASET_TO_PROP,
     "volviz.render.vtk_scene:is_surface": DATASET,
     "volviz.render.vtk_scene:add_surface": DATASET_TO_PROP,
-    "volviz.scene.datasets:component_dataset":
-        "LoadedDataset breaks app.first_open, which narrows it by class name (outside this change)",
     "volviz.scene.drawn_tf:drawn_transfer_function":
         "Optional[TransferFunction] needs narrowing in scene_builder's callers (a behaviour edit, not this change)",
 }

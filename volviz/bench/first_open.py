@@ -248,6 +248,7 @@ def legibility(path: Path, boundary_rule: bool = False) -> tuple[str, Optional[F
     from volviz.render.vtk_scene import volume_grid
     from volviz.scene.datasets import component_dataset, drawn_as, load_datasets
     from volviz.scene.drawn_tf import component_transfer_function
+    from volviz.scene.lod import is_lod
 
     session, session_file = open_target(path)
     comp = session.components[0]
@@ -266,6 +267,8 @@ def legibility(path: Path, boundary_rule: bool = False) -> tuple[str, Optional[F
         session.render.options.update(axes=False, outline=False)   # the data alone (the box's outline is no data)
         tf_name = str(comp.transfer_function)
         dataset = component_dataset(comp, datasets)
+        if is_lod(dataset):
+            raise ValueError(f"{path}: legibility measures a volume decoded whole, not one at a level of detail")
         chord = mean_chord(volume_grid(dataset).bounds)
         raw = scalar_values(dataset)
         values = np.asarray(raw, dtype=np.float64).reshape(-1)

@@ -281,7 +281,7 @@ class SceneController:
     def component(self, comp_id: str) -> Component:
         return self.session.component(comp_id)
 
-    def dataset_of(self, comp_id: str) -> Any:
+    def dataset_of(self, comp_id: str) -> LoadedDataset:
         return component_dataset(self.component(comp_id), self.datasets)
 
     def dataset_traits(self, comp_id: str) -> Optional[DatasetTraits]:
@@ -414,7 +414,9 @@ class SceneController:
         out = {}
         for comp in self.session.components:
             if comp.dataset is not None and isinstance(self.datasets.get(comp.dataset), TimeSeries):
-                out[comp.id] = self.dataset_of(comp.id)
+                shown = self.dataset_of(comp.id)    # the series showing the component's array: a series too
+                if isinstance(shown, TimeSeries):
+                    out[comp.id] = shown
         return out
 
     def time_span(self) -> Optional[tuple[float, float]]:

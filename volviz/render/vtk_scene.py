@@ -28,6 +28,7 @@ if TYPE_CHECKING:   # type-only imports for the signatures
 
     from volviz.model.datasets import Dataset
     from volviz.render.vtk_facade import vtkVolumeProperty
+    from volviz.scene.datasets import LoadedDataset
 
 PLAIN_COLOR = (0.80, 0.80, 0.78)    # geometry without a field: a neutral light grey, shaded by the lights
 DEFAULT_COLORS = ((0.23, 0.30, 0.75), (0.87, 0.87, 0.87), (0.71, 0.02, 0.15))  # cool-warm: low, middle, high
@@ -113,7 +114,7 @@ def volume_grid(dataset: Any) -> Any:
     return grid
 
 
-def default_transfer_function_for(dataset: Union[Dataset, TimeSeries], name: str = "default") -> TransferFunction:
+def default_transfer_function_for(dataset: LoadedDataset, name: str = "default") -> TransferFunction:
     """The first-look transfer function of a dataset: placed from the histogram of its shown scalar (of every step,
     for a time series) by ``volviz.optics.auto_tf``; a compressed LOD volume gets the ramp over its range."""
     if is_lod(dataset):

@@ -73,7 +73,7 @@ def read_any(path: Path, options: Mapping[str, object], progress: Optional[Progr
     return read(path, **reader_options)
 
 
-def component_dataset(comp: Component, datasets: dict[str, LoadedDataset]) -> Any:
+def component_dataset(comp: Component, datasets: dict[str, LoadedDataset]) -> LoadedDataset:
     """The dataset a component shows: generated for the demo, else the loaded dataset it names."""
     if comp.type == "demo":
         key = f"demo:{int(comp.settings.get('cells_per_edge', 20))}"

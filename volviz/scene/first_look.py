@@ -15,6 +15,7 @@ from volviz.model import TimeSeries
 from volviz.model.object_cache import ObjectCache
 from volviz.model.representation import first_varying_step, representation
 from volviz.scene.datasets import component_dataset
+from volviz.scene.lod import is_lod
 from volviz.session import Session
 
 if TYPE_CHECKING:   # type-only imports for the signatures
@@ -38,6 +39,8 @@ def first_look(session: Session, datasets: dict[str, LoadedDataset], t: Optional
         if not comp.visible or comp.type != "volume" or comp.dataset not in datasets:
             continue
         dataset = component_dataset(comp, datasets)
+        if is_lod(dataset):   # a volume at a level of detail: always drawn as a volume, nothing to say
+            continue
         path = next((ref.path for ref in session.datasets if ref.id == comp.dataset), comp.dataset)
         said = _SAID.setdefault(dataset, set)
         if isinstance(dataset, TimeSeries):
