@@ -14,17 +14,90 @@ CPU (``volviz.render.pt_prop`` + ``volviz.render.preview_hold``): the preview im
 time a preview takes (measured: previews of cameras 2, 12 and 20 shown during a 21-camera drag, so up to 10 frames
 old); every frame draws the outline box with the preview's camera (drawn serial equals image serial), so the box and
 the image agree, and the whole view lags the mouse by those frames instead of the box sliding off the volume.
+
+Pixels (issue #28): the serials say which camera a frame was meant to draw, not which one VTK drew with (VTK's
+OpenGL camera re-uses its matrices until the camera's time stamp passes theirs, and the hold's swap once kept the
+stamp: frames drew the outline box and cut the volume at another camera than the log said). So the frame shown is
+also held to ``volviz render`` of the saved session at the camera the frame drew: during the drag (a held frame
+right after a mouse move, and one after a new preview arrived with the mouse still) and after it. A preview is a
+half-size image (``app.view_scheduler.MOVING_SCALE``) against the reference's full size, held to ``PREVIEW_RMSE``
+(measured RMSE 1.0-1.3 on held frames; after the drag 0.0). The orientation axes follow the live camera while a
+held frame draws the scene at the preview's, so a frame that swapped the camera is compared outside their corner.
+On the code before the hold marked the swapped camera modified (6de5f7c) 3 of 3 runs failed: 2 at the held frame
+after a move (RMSE 5.9), 1 at the frame after a new preview (5.8; run on with the bounds off: 15.0 after the drag).
 """
 from __future__ import annotations
 
+import json
+from pathlib import Path
+
+import imageio.v3 as iio
+import numpy as np
 from PySide6.QtCore import QEvent, QPoint, QPointF, Qt
 
-from flows import _mouse, drag, open_blunt_fin, wait_loaded, wait_settled
+from flows import _mouse, assert_matches_render, open_blunt_fin, render_saved, screen, wait_loaded, wait_settled
+from volviz.optics.metrics import rmse
 from volviz.render.gl_pt import GLPTVolume
 from volviz.render.pt_prop import PTVolume
 
+PREVIEW_RMSE = 4.0    # a half-size preview against the full-size reference (8-bit units; module docstring)
+MAX_OFF = 0.01        # the flow tests' share of pixels off by more than 24
 
-def test_gpu_drag_draws_no_order_older_than_the_previous_frames_camera(qtbot, make_window) -> None:
+
+def _outside_axes(window, shape: tuple[int, ...]) -> np.ndarray:
+    """(H, W) bool: the pixels outside the orientation axes' viewport (row 0 at the top)."""
+    x0, y0, x1, y1 = window.plotter.renderer.axes_widget.GetViewport()
+    h, w = shape[:2]
+    keep = np.ones((h, w), bool)
+    keep[int(h * (1 - y1)):int(np.ceil(h * (1 - y0))), int(w * x0):int(np.ceil(w * x1))] = False
+    return keep
+
+
+def assert_drawn_as_rendered(window, tmp_path: Path, name: str, camera, max_rmse: float,
+                             without_axes: bool = False) -> dict[str, float]:
+    """The frame on screen now (``flows.screen``) against ``volviz render`` of the saved session with its camera
+    set to ``camera`` (the one the frame drew: a vtkCamera), at the viewport's size; RMSE in 8-bit units and the
+    share of pixels off by more than 24, held to ``max_rmse`` and ``MAX_OFF``. ``without_axes``: the orientation
+    axes' corner left out (they follow the live camera, not the preview's a held frame swaps in). On failure both
+    images are kept in ``tmp_path`` and named in the message."""
+    shown = screen(window)
+    session = tmp_path / f"{name}.json"
+    assert window.save_session(session)
+    doc = json.loads(session.read_text())
+    doc["camera"].update(position=list(camera.GetPosition()), focal_point=list(camera.GetFocalPoint()),
+                         view_up=list(camera.GetViewUp()), view_angle=camera.GetViewAngle())
+    session.write_text(json.dumps(doc))
+    ref = render_saved(session, (shown.shape[1], shown.shape[0]), tmp_path / f"{name}.png")
+    keep = _outside_axes(window, shown.shape) if without_axes else np.ones(shown.shape[:2], bool)
+    err = {"rmse": rmse(shown[keep] / 255.0, ref[keep] / 255.0),
+           "off": float((np.abs(shown - ref).max(axis=2) > 24)[keep].mean())}
+    if not (err["rmse"] < max_rmse and err["off"] < MAX_OFF):
+        grab = tmp_path / f"{name}-screen.png"
+        iio.imwrite(grab, np.clip(np.rint(shown), 0, 255).astype(np.uint8))
+        raise AssertionError(f"{name}: {err} (bounds: rmse < {max_rmse}, off < {MAX_OFF}); screen grab {grab}, "
+                             f"reference {tmp_path / f'{name}.png'}")
+    return err
+
+
+def assert_held_frame_as_rendered(window, hold, tmp_path: Path, name: str) -> tuple[int, int, int]:
+    """The frame on screen now drawn as the hold's log says (``assert_drawn_as_rendered`` at the preview's camera,
+    the orientation axes left out, when the frame swapped it in, else at the live camera); returns the frame's log
+    entry."""
+    screen(window)                  # the log entry of the frame ``assert_drawn_as_rendered`` reads back
+    frame = hold.frames[-1]
+    live, image, drawn = frame
+    assert drawn == image, f"{name}: a frame drew the box off the image's camera: {frame}"
+    camera = hold.image_camera if drawn != live else window.plotter.renderer.GetActiveCamera()
+    err = assert_drawn_as_rendered(window, tmp_path, name, camera, PREVIEW_RMSE, without_axes=drawn != live)
+    assert hold.frames[-1] == frame, f"{name}: the frame read back is not the one logged: {hold.frames[-3:]}"
+    print(f"{name}: frame {frame}: screen vs volviz render at its camera: {err}")
+    return frame
+
+
+def test_gpu_drag_draws_no_order_older_than_the_previous_frames_camera(qtbot, make_window, tmp_path) -> None:
+    """GPU: the orders drawn during the drag (module docstring), and the pixels: a frame with the mouse held still at
+    the end of the drag and the still frame after it match ``volviz render`` of the saved session at the live
+    camera."""
     window = open_blunt_fin(qtbot, make_window)
     old = window.controller
     window.render_settings.backend.setCurrentText("gpu")
@@ -38,8 +111,15 @@ def test_gpu_drag_draws_no_order_older_than_the_previous_frames_camera(qtbot, ma
                                                                        and not gpu.stats["sort_prefetched"]))
     canvas = window.plotter.interactor
     centre = QPoint(canvas.width() // 2, canvas.height() // 2)
-    drag(qtbot, canvas, centre, centre + QPoint(160, 40), steps=24)
+    held = Qt.MouseButton.LeftButton
+    _mouse(canvas, QEvent.Type.MouseButtonPress, QPointF(centre), held)
+    for k in range(1, 25):
+        _mouse(canvas, QEvent.Type.MouseMove, QPointF(centre + QPoint(160 * k // 24, 40 * k // 24)), held)
+        qtbot.wait(30)
     frames = gpu.frames[first:]
+    err = assert_drawn_as_rendered(window, tmp_path, "gpu-held", window.plotter.renderer.GetActiveCamera(), 2.0)
+    print("held still during the drag: screen vs volviz render:", err)
+    _mouse(canvas, QEvent.Type.MouseButtonRelease, QPointF(centre + QPoint(160, 40)), Qt.MouseButton.NoButton)
     cameras = {c for c, _ in frames}
     assert len(cameras) >= 8, f"the drag drew {len(cameras)} cameras: {frames}"
     old_orders = [(c, o) for c, o in frames if o < c - 1]
@@ -50,12 +130,17 @@ def test_gpu_drag_draws_no_order_older_than_the_previous_frames_camera(qtbot, ma
     wait_settled(qtbot, window)
     window.plotter.render()
     assert gpu.frames[-1][1] == gpu.frames[-1][0], "the still frame after the drag is not exact"
+    print("after the drag: screen vs volviz render:", assert_matches_render(window, tmp_path, "gpu-after-drag"))
 
 
-def test_cpu_drag_draws_the_box_with_the_previews_camera(qtbot, make_window) -> None:
+def test_cpu_drag_draws_the_box_with_the_previews_camera(qtbot, make_window, tmp_path) -> None:
     """CPU (issue #28): while the mouse drags the camera each frame is drawn with the camera the shown preview was
     made for (``volviz.render.preview_hold``), so the outline box and the volume image agree in every frame; the
-    view lags the mouse by the preview's age instead (stated in frames by the log: live minus image serial)."""
+    view lags the mouse by the preview's age instead (stated in frames by the log: live minus image serial). The
+    pixels follow the log: a held frame right after a mouse move (the preview's camera swapped in), a frame after a
+    new preview arrived with the mouse held still (the swap without a mouse move, which drew the previous camera's
+    matrices before the fix) and the still frame after the drag each match ``volviz render`` at the camera the log
+    says the frame drew."""
     window = open_blunt_fin(qtbot, make_window)
     wait_settled(qtbot, window)
     cpu = next(v for v in window.controller.props.values() if isinstance(v, PTVolume))
@@ -64,9 +149,22 @@ def test_cpu_drag_draws_the_box_with_the_previews_camera(qtbot, make_window) -> 
     canvas = window.plotter.interactor
     centre = QPoint(canvas.width() // 2, canvas.height() // 2)
     held = Qt.MouseButton.LeftButton
-    _mouse(canvas, QEvent.Type.MouseButtonPress, QPointF(centre), held)
-    for k in range(1, 21):        # a slow drag (4 s): previews are shown while it lasts
+
+    def move(k: int) -> None:
         _mouse(canvas, QEvent.Type.MouseMove, QPointF(centre + QPoint(8 * k, 2 * k)), held)
+
+    _mouse(canvas, QEvent.Type.MouseButtonPress, QPointF(centre), held)
+    for k in range(1, 11):        # a slow drag (4 s in all): previews are shown while it lasts
+        move(k)
+        qtbot.wait(200)
+    move(11)                      # no event handled since: the preview shown is of an older camera
+    live, image, drawn = assert_held_frame_as_rendered(window, hold, tmp_path, "held-after-move")
+    assert drawn == image < live, f"the frame after the move did not swap in the preview's camera: {hold.frames[-3:]}"
+    shown_preview = hold.image_serial
+    qtbot.waitUntil(lambda: hold.image_serial != shown_preview, timeout=30000)   # a new preview, the mouse still
+    assert_held_frame_as_rendered(window, hold, tmp_path, "held-new-preview")
+    for k in range(12, 21):
+        move(k)
         qtbot.wait(200)
     _mouse(canvas, QEvent.Type.MouseButtonRelease, QPointF(centre + QPoint(160, 40)), Qt.MouseButton.NoButton)
     during = hold.frames[first:]
@@ -78,3 +176,4 @@ def test_cpu_drag_draws_the_box_with_the_previews_camera(qtbot, make_window) -> 
     assert all(drawn == image for _, image, drawn in frames), f"a frame drew the box off the image's camera: {frames}"
     live, image, drawn = hold.frames[-1]
     assert live == image == drawn, "the still frame after the drag is not of the live camera"
+    print("after the drag: screen vs volviz render:", assert_matches_render(window, tmp_path, "after-drag"))
