@@ -116,9 +116,12 @@ class SessionFiles:
         except SessionError as exc:
             self.show_error("Cannot save session", str(exc))
             return False
-        self.scene.session, self.scene.session_path = session, target
-        if self.scene.controller is not None:
-            self.scene.controller.session = session
+        shown = self.scene.session   # kept, not swapped for the one saved: a script's ``session`` (the Python
+        shown.datasets[:] = session.datasets   # console's) and the scene's subscription stay on it (issue #28)
+        shown.camera, shown.render, shown.layout = session.camera, session.render, session.layout
+        self.scene.session_path = target
+        if self.scene.controller is not None and self.scene.controller.session is not shown:
+            self.scene.controller.session = shown
         self.recent.add(target)
         self.set_dirty(False)
         self.clear_recovery()
