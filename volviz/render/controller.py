@@ -24,7 +24,7 @@ from __future__ import annotations
 
 from contextlib import contextmanager
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Callable, Iterator, Optional, Union, cast
+from typing import TYPE_CHECKING, Any, Callable, Iterator, Mapping, Optional, Union, cast
 
 from volviz.jobs import report
 from volviz.model import TimeSeries
@@ -63,6 +63,7 @@ if TYPE_CHECKING:   # type-only imports for the signatures
     from volviz.render.nature_view import FrameT, NatureRequest, NatureSceneView
     from volviz.render.pt_prop import PTVolume
     from volviz.render.vtk_facade import vtkProp
+    from volviz.model.datasets import Dataset
     from volviz.scene.datasets import LoadedDataset
 
 __all__ = ["Cut", "ISO_MODES", "SceneController", "ensure_lights", "iso_summary", "no_render", "session_interpolates"]
@@ -463,7 +464,7 @@ class SceneController:
                                                               and is_surface(series[comp_id])))]
 
     def blend_volume(self, comp_id: str, t: float, interpolate: Optional[bool] = None,
-                     progress: Optional[ProgressCallback] = None) -> object:
+                     progress: Optional[ProgressCallback] = None) -> Dataset:
         """Any thread: a time-series volume or surface at display time ``t`` (the 4D blend of the neighbouring
         steps when interpolating, libMini note "4D Visualization"; ``scene_builder.display_frame``): arrays, no VTK
         object; ``show_volumes`` makes its VTK input and puts it on screen. (Made in the job, the VTK input froze the
@@ -471,7 +472,7 @@ class SceneController:
         interpolate = self.interpolate_time if interpolate is None else bool(interpolate)
         return display_frame(self.time_series()[comp_id], float(t), interpolate)
 
-    def show_volumes(self, inputs: dict[str, object]) -> None:
+    def show_volumes(self, inputs: Mapping[str, Union[Dataset, TimeSeries, None]]) -> None:
         """GUI thread: give time-series volumes and surfaces new inputs made here from their frames
         (``comp_id → blend_volume(...)``; ``scene_builder.frame_input``), cut by the clipping; the outline box
         follows data that moves."""

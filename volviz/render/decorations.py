@@ -16,7 +16,8 @@ from volviz.render.vtk_tf import tf_to_vtk
 from volviz.scene.datasets import component_dataset
 from volviz.scene.drawn_tf import log_floor, uses_log_scale
 from volviz.scene.errors import SceneError
-from volviz.session import Session
+from volviz.scene.lod import is_lod
+from volviz.session import Component, Session
 
 if TYPE_CHECKING:   # type-only: PyVista's mesh and plotter classes, imported where an outline is made; VTK's prop
     import pyvista as pv
@@ -38,7 +39,7 @@ def decoration_enabled(session: Session, name: str) -> bool:
 LEGEND_MARGIN = 0.2        # the share of the viewport's width at its right that framing keeps for the scalar bar
 
 
-def legend_margin(session: Session, datasets: Optional[dict[str, Any]] = None) -> float:
+def legend_margin(session: Session, datasets: Optional[dict[str, LoadedDataset]] = None) -> float:
     """How much of the viewport's width, at its right, the scalar bar takes (0 when none is shown; with the loaded
     ``datasets``, also when the component it would explain colors by no array)."""
     comp = _legend_component(session) if decoration_enabled(session, "scalar_bar") else None
@@ -232,7 +233,7 @@ def _add_scalar_bar(plotter: Any, session: Session, comp: Any, datasets: dict[st
     plotter.add_actor(heading, name=SCALAR_BAR_TITLE_NAME, reset_camera=False, render=False, pickable=False)
 
 
-def _shows_array(comp: Any, datasets: dict[str, Any]) -> bool:
+def _shows_array(comp: Component, datasets: dict[str, LoadedDataset]) -> bool:
     """Whether the component colors by an array through its transfer function (its setting, else its dataset's
     default): a surface of geometry alone (an STL, a PLY of normals) is drawn in a plain color, and one showing an
     appearance array (``red`` of a coloured point cloud, ``volviz.model.arrays.is_appearance_array``) in its own
@@ -240,8 +241,8 @@ def _shows_array(comp: Any, datasets: dict[str, Any]) -> bool:
     if comp.type != "volume":
         return True
 
-    dataset = datasets.get(comp.dataset)
-    if dataset is None or not is_surface(dataset):
+    dataset = datasets.get(comp.dataset) if comp.dataset is not None else None
+    if dataset is None or is_lod(dataset) or not is_surface(dataset):   # (a LOD volume is drawn as a volume)
         return True
     spec = comp.settings.get(array_key(comp.type))
     if not spec:

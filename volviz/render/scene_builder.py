@@ -7,10 +7,10 @@ the props and views are made (``install_scene``, GUI thread). Only the component
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, Optional
+from typing import TYPE_CHECKING, Any, Optional, Union, cast, overload
 
 from volviz.jobs import ProgressCallback, report
-from volviz.model import Image2D, RegularVolume, TimeSeries
+from volviz.model import CurvilinearGrid, Image2D, RegularVolume, TetMesh, TimeSeries, UnstructuredMesh
 from volviz.model.stats import histogram
 from volviz.model.timeseries import frame_at
 from volviz.render.backend import backend_setting, choose_backend, plotter_gl_info
@@ -36,6 +36,8 @@ if TYPE_CHECKING:   # type-only imports for the signatures
     from volviz.optics.transfer_function import TransferFunction
     from volviz.render.gl_nature import EitherNatureView
     from volviz.render.views import ComponentView
+    from volviz.model.datasets import Dataset
+    from volviz.render.vtk_scene import MapperInput
     from volviz.scene.datasets import LoadedDataset
 
 
@@ -115,7 +117,8 @@ def prepare_component(session: Session, comp: Component, datasets: dict[str, Loa
         prepared.parts[comp.id] = display_frame(dataset, t, interpolate)
 
 
-def prepared_volume_input(dataset: object, t: Optional[float] = None, interpolate: bool = True) -> object:
+def prepared_volume_input(dataset: Union[Dataset, TimeSeries], t: Optional[float] = None, interpolate: bool = True
+                          ) -> Optional[MapperInput]:
     """Any thread: the VTK data object a volume mapper draws for ``dataset`` (a time series: blended at display
     time ``t``, libMini note "4D Visualization"), or None when ``add_dataset`` does not draw it as a volume."""
     if isinstance(dataset, TimeSeries):
@@ -123,6 +126,14 @@ def prepared_volume_input(dataset: object, t: Optional[float] = None, interpolat
     if isinstance(dataset, Image2D) or is_surface(dataset) or volume_grid(dataset).active_scalars is None:
         return None
     return volume_input(dataset)
+
+
+@overload
+def display_frame(dataset: TimeSeries, t: Optional[float] = None, interpolate: bool = True) -> Dataset: ...
+
+
+@overload
+def display_frame(dataset: LoadedDataset, t: Optional[float] = None, interpolate: bool = True) -> LoadedDataset: ...
 
 
 def display_frame(dataset: LoadedDataset, t: Optional[float] = None, interpolate: bool = True) -> LoadedDataset:
@@ -135,7 +146,7 @@ def display_frame(dataset: LoadedDataset, t: Optional[float] = None, interpolate
     return dataset
 
 
-def frame_input(dataset: LoadedDataset, frame: object) -> object:
+def frame_input(dataset: LoadedDataset, frame: Union[Dataset, TimeSeries, None]) -> Optional[MapperInput]:
     """GUI thread: what the VTK prop of ``dataset`` draws for ``frame`` (``display_frame``'s; None: nothing
     prepared): a volume mapper's input (``prepared_volume_input``), a time series' surface (``vtk_scene.surface_input``
     of the frame), or None for what ``add_dataset`` draws its own way (a 2D image, geometry alone)."""
@@ -149,7 +160,7 @@ def frame_input(dataset: LoadedDataset, frame: object) -> object:
     return prepared_volume_input(frame)
 
 
-def time_input(series: Any, t: Optional[float] = None, interpolate: bool = True) -> Any:
+def time_input(series: TimeSeries, t: Optional[float] = None, interpolate: bool = True) -> Optional[MapperInput]:
     """Any thread: what a VTK prop of a time series draws at display time ``t`` (default: the first step): a
     volume's mapper input (``prepared_volume_input``, blended) or a surface's (``vtk_scene.surface_input`` of the
     frame at ``t``: points and values blended between steps of one topology); None for what does not follow the
@@ -157,8 +168,9 @@ def time_input(series: Any, t: Optional[float] = None, interpolate: bool = True)
     return frame_input(series, display_frame(series, t, interpolate))
 
 
-def add_volume_prop(plotter: pv.BasePlotter, dataset: object, data: object, tf: TransferFunction, opacity: float,
-                    name: str, backend: str = "auto", shade: bool = False) -> object:
+def add_volume_prop(plotter: pv.BasePlotter, dataset: Union[Dataset, TimeSeries], data: Optional[MapperInput],
+                    tf: TransferFunction, opacity: float, name: str, backend: str = "auto", shade: bool = False
+                    ) -> object:
     """GUI thread: a vtkVolume drawing ``data`` (from ``prepared_volume_input``), the surface of a time series at
     its display time (``data`` from ``time_input``), or (``data`` None) ``add_dataset``'s default visual;
     ``backend``: the render option (``volviz.render.backend``), which picks VTK's GPU or CPU ray caster; ``shade``:
@@ -166,7 +178,7 @@ def add_volume_prop(plotter: pv.BasePlotter, dataset: object, data: object, tf: 
     if data is None:
         return add_dataset(plotter, dataset, tf=tf, opacity=opacity, name=name)
     if is_surface(dataset):        # a time series' surface at the display time (``time_input``)
-        return add_surface(plotter, data, tf, opacity, name)
+        return add_surface(plotter, cast("pv.DataSet", data), tf, opacity, name)   # surface_input's
     regular = isinstance(dataset.frame(0) if isinstance(dataset, TimeSeries) else dataset, RegularVolume)
     return volume_prop(plotter, data, regular, tf, opacity, name, backend, shade)
 
@@ -279,7 +291,8 @@ def uses_pt(session: Session, dataset: object) -> bool:
     session asks for VTK's own mappers (render method "vtk"); regular volumes go to VTK's ray casters."""
     if isinstance(dataset, TimeSeries):
         return False  # time-varying meshes stay on VTK's mapper for now
-    return session.render.method != "vtk" and type(dataset).__name__ in PT_DATASETS and not is_surface(dataset)
+    return (session.render.method != "vtk" and isinstance(dataset, (TetMesh, UnstructuredMesh, CurvilinearGrid))
+            and not is_surface(dataset))
 
 
 def add_pt_component(plotter: pv.BasePlotter, session: Session, comp: Component, dataset: object,

@@ -27,8 +27,11 @@ if TYPE_CHECKING:   # type-only imports for the signatures
     import pyvista as pv
 
     from volviz.model.datasets import Dataset
-    from volviz.render.vtk_facade import vtkVolumeProperty
+    from volviz.render.vtk_facade import vtkDataObject, vtkVolumeProperty
     from volviz.scene.datasets import LoadedDataset
+
+    #: what a mapper draws: a PyVista grid, or a VTK filter's output (the tetrahedra of ``volume_input``)
+    MapperInput = Union[pv.DataSet, vtkDataObject]
 
 PLAIN_COLOR = (0.80, 0.80, 0.78)    # geometry without a field: a neutral light grey, shaded by the lights
 DEFAULT_COLORS = ((0.23, 0.30, 0.75), (0.87, 0.87, 0.87), (0.71, 0.02, 0.15))  # cool-warm: low, middle, high
@@ -101,7 +104,7 @@ def bounds_diagonal(bounds: tuple[float, ...]) -> float:
     return float(np.linalg.norm(np.subtract(bounds[1::2], bounds[0::2])))
 
 
-def volume_grid(dataset: Any) -> Any:
+def volume_grid(dataset: Union[Dataset, TimeSeries, pv.DataSet]) -> pv.DataSet:
     """The PyVista grid a dataset is drawn from, with scalar active (vectors shown by their magnitude)."""
     if isinstance(dataset, TimeSeries):
         dataset = dataset.frame(0)
@@ -140,7 +143,7 @@ def dataset_bounds(dataset: Union[Dataset, TimeSeries]) -> tuple[float, ...]:
     return (float(lo[0]), float(hi[0]), float(lo[1]), float(hi[1]), float(lo[2]), float(hi[2]))
 
 
-def volume_input(dataset: object) -> object:
+def volume_input(dataset: Union[Dataset, TimeSeries]) -> MapperInput:
     """The VTK data object a volume mapper draws for ``dataset`` (tetrahedralised for non-image grids)."""
     # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
     from volviz.render.vtk_facade import vtk
@@ -157,7 +160,7 @@ def volume_input(dataset: object) -> object:
     return tets.GetOutput()
 
 
-def transparent_nonfinite(grid: Any) -> Any:
+def transparent_nonfinite(grid: pv.DataSet) -> pv.DataSet:
     """``grid`` with NaN/Inf of its active scalars replaced by a value below their finite range, which VTK's mappers
     draw transparent (the transfer functions are not clamped: ``TransferFunction.to_vtk``), as volviz's own
     renderers draw non-finite samples. Also keeps NaN out of VTK's scalar-range bookkeeping."""
@@ -169,13 +172,14 @@ def transparent_nonfinite(grid: Any) -> Any:
     cleaned = np.where(np.isfinite(values), values, lo - max(hi - lo, abs(lo), 1.0))
     grid = grid.copy(deep=False)
     name = grid.active_scalars_name
+    assert name is not None   # the grid has active scalars (values), so they have a name
     grid.point_data[name] = cleaned.astype(values.dtype)
     grid.set_active_scalars(name)
     return grid
 
 
-def add_dataset(plotter: pv.BasePlotter, dataset: Any, tf: Optional[TransferFunction] = None, opacity: float = 1.0,
-                name: Optional[str] = None) -> Any:
+def add_dataset(plotter: pv.BasePlotter, dataset: Union[Dataset, TimeSeries], tf: Optional[TransferFunction] = None,
+                opacity: float = 1.0, name: Optional[str] = None) -> object:
     """Add a dataset to ``plotter`` as its default visual (a volume with ``tf``); returns the VTK prop."""
     if isinstance(dataset, TimeSeries):
         return add_dataset(plotter, dataset.frame(0), tf, opacity, name)
@@ -218,7 +222,7 @@ def volume_prop(plotter: pv.BasePlotter, data: object, regular: bool, tf: Transf
     return volume
 
 
-def is_surface(dataset: Any) -> bool:
+def is_surface(dataset: Union[Dataset, TimeSeries]) -> bool:
     """Whether ``dataset`` (a time series: at its first step where the field varies) is not drawn as a volume: a
     mesh of surface cells or vertices, a grid one layer thick, geometry without a field or a constant field (the
     one rule of ``volviz.model.representation``). Such data is drawn as a surface colored by its field, or plain."""
@@ -236,7 +240,7 @@ def shows_no_field(dataset: Union[Dataset, TimeSeries]) -> bool:
 VERTEX_COLORS = "volviz vertex colours"
 
 
-def surface_input(dataset: object, plain: bool = False) -> object:
+def surface_input(dataset: Union[Dataset, TimeSeries, pv.DataSet], plain: bool = False) -> pv.DataSet:
     """The PyVista surface drawn for a dataset of surface cells (``is_surface``; or its ``volume_grid``), its active
     scalars kept active unless they are an appearance attribute (``volviz.model.arrays.is_appearance_array``) or
     the dataset is drawn ``plain`` (geometry alone): then its vertex colours (``VERTEX_COLORS``), if it has any, else
@@ -250,7 +254,8 @@ def surface_input(dataset: object, plain: bool = False) -> object:
             grid.point_data[VERTEX_COLORS] = colors
     values = np.asarray(grid.active_scalars) if name is not None else np.zeros(0)
     if values.dtype.kind == "f" and not np.isfinite(values).all():   # cells touching NaN/Inf are not drawn
-        grid = grid.extract_points(np.flatnonzero(np.isfinite(values)), adjacent_cells=False)
+        kept: np.ndarray = np.flatnonzero(np.isfinite(values))
+        grid = grid.extract_points(kept, adjacent_cells=False)
     surface = grid.extract_surface(algorithm="dataset_surface") if hasattr(grid, "extract_surface") else grid
     if surface.n_points == 0 and grid.n_points and hasattr(grid, "extract_surface"):
         surface = grid.extract_surface(algorithm=None)   # a grid of one line (170 x 1 x 1): its polyline
@@ -262,8 +267,8 @@ def surface_input(dataset: object, plain: bool = False) -> object:
     return surface
 
 
-def add_surface(plotter: pv.BasePlotter, surface: Any, tf: Optional[TransferFunction], opacity: float,
-                name: Optional[str]) -> Any:
+def add_surface(plotter: pv.BasePlotter, surface: pv.DataSet, tf: Optional[TransferFunction], opacity: float,
+                name: Optional[str]) -> pv.Actor:
     """A surface made by ``surface_input``, colored by its active scalars through the transfer function's colors, or
     in its own vertex colours when it shows no array."""
     if surface.active_scalars_name is None and VERTEX_COLORS in surface.point_data:
