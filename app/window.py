@@ -65,17 +65,26 @@ if TYPE_CHECKING:
 log = logging.getLogger(__name__)
 
 
+def viewport_kind(platform: str, setting: str) -> str:
+    """Which viewport ``make_plotter`` makes: ``"native"`` (``NativeViewport``) on X11 (Qt's ``xcb`` platform) unless
+    ``setting`` (``VOLVIZ_VIEWPORT``) is ``"qt"``; ``"qt"`` (pyvistaqt's ``QtInteractor``) there and everywhere else
+    (Wayland, offscreen, Windows, macOS: a native GLX window needs X11, and pyvistaqt left native windows for Wayland,
+    pyvistaqt gh-445). Another setting is named in a warning and gives the default."""
+    if setting not in ("", "native", "qt"):
+        log.warning("VOLVIZ_VIEWPORT=%r is neither 'native' nor 'qt': the default viewport is used", setting)
+    return "native" if platform == "xcb" and setting != "qt" else "qt"
+
+
 def make_plotter(parent: QWidget) -> Viewport:
-    """The viewport: pyvistaqt's ``QtInteractor``, or with ``VOLVIZ_VIEWPORT=native`` on X11 (``xcb``) the native-window
-    ``NativeViewport``, which Qt does not compose (issue #28, an opt-in until it is made the default; see
-    ``app/native_viewport.py``)."""
+    """The viewport (``viewport_kind``): on X11 the native-window ``NativeViewport``, which Qt does not compose, so a
+    flight has fewer long event-loop stalls and more frames (issue #28, docs/bench/flight.md); with
+    ``VOLVIZ_VIEWPORT=qt``, and off X11, pyvistaqt's ``QtInteractor``."""
     from PySide6.QtWidgets import QApplication
     from pyvistaqt import QtInteractor
 
-    if os.environ.get("VOLVIZ_VIEWPORT", "") == "native" and QApplication.platformName() == "xcb":
+    if viewport_kind(QApplication.platformName(), os.environ.get("VOLVIZ_VIEWPORT", "")) == "native":
         from .native_viewport import NativeViewport
 
-        log.info("viewport: NativeViewport (VOLVIZ_VIEWPORT=native)")
         return NativeViewport(parent)
     return QtInteractor(parent, auto_update=False)  # we render when something changed, never on a timer
 

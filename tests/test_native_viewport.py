@@ -1,8 +1,7 @@
-"""The native-window viewport, opt-in with ``VOLVIZ_VIEWPORT=native`` on X11 (issue #28, ``app/native_viewport.py``):
-a Yukon flight in the real window, run in its own process so that a GLX teardown problem cannot take down the test
-worker. The flight's frames are drawn reduced by the native widget's own paint, the picture left after the stop is
-``volviz render``'s, what X shows in the viewport's window is that picture, the window's ``grab()`` shows it too, and
-the process closes its window and exits cleanly."""
+"""The native-window viewport, the default on X11 (issue #28, ``app/native_viewport.py``): a Yukon flight in the real
+window, run in its own process. The flight's frames are drawn reduced by the native widget's own paint, the picture
+left after the stop is ``volviz render``'s, what X shows in the viewport's window is that picture, the window's
+``grab()`` shows it too, and the process closes its window and exits cleanly."""
 from __future__ import annotations
 
 import json
@@ -80,7 +79,8 @@ def _rmse(a: np.ndarray, b: np.ndarray) -> float:
 
 def test_native_viewport_flight_in_a_subprocess(tmp_path: Path) -> None:
     data_file("yukon/Yukon.map.pgm")
-    env = dict(os.environ, VOLVIZ_VIEWPORT="native", QT_QPA_PLATFORM="xcb")
+    env = {name: value for name, value in os.environ.items() if name != "VOLVIZ_VIEWPORT"}   # the default
+    env["QT_QPA_PLATFORM"] = "xcb"
     proc = subprocess.run([sys.executable, "-c", SCRIPT, str(tmp_path)], env=env, capture_output=True, text=True,
                           timeout=600)
     assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]   # a clean close of the GLX window
@@ -90,7 +90,7 @@ def test_native_viewport_flight_in_a_subprocess(tmp_path: Path) -> None:
     print(report)
 
     assert result["platform"] == "xcb"
-    assert result["viewport_class"] == "NativeViewport"            # the opt-in was taken ...
+    assert result["viewport_class"] == "NativeViewport"            # the default on X11 ...
     assert result["ren_win"] == "vtkXOpenGLRenderWindow"           # ... and VTK draws into its own X window
     assert "(NativeViewport)" in report
     w, h = (int(v) for v in result["viewport"].split("x"))

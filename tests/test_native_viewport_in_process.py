@@ -1,4 +1,5 @@
-"""The native-window viewport (issue #28, ``app/native_viewport.py``) in the test process: a file dropped on it opens,
+"""The native-window viewport (issue #28, ``app/native_viewport.py``) in the test process: the default on X11 only,
+pyvistaqt's with ``VOLVIZ_VIEWPORT=qt``; a file dropped on it opens,
 VTK's cursor changes reach the widget, and closing the window lets VTK's render window go, and with it the X
 connection VTK opened to load GLX, so a test run whose X server stops before the process exits (pytest-xvfb's) still
 exits with status 0. Before, Xlib's fatal I/O error on that connection at exit made the run's exit status 1 although
@@ -33,6 +34,23 @@ def native(monkeypatch: pytest.MonkeyPatch) -> None:
     if QApplication.platformName() != "xcb":
         pytest.skip(f"the native viewport needs X11, the platform is {QApplication.platformName()}")
     monkeypatch.setenv("VOLVIZ_VIEWPORT", "native")
+
+
+def test_the_viewport_is_native_on_x11_unless_the_setting_says_qt(caplog: pytest.LogCaptureFixture) -> None:
+    from volviz_app.window import viewport_kind
+
+    assert [viewport_kind("xcb", setting) for setting in ("", "native", "qt")] == ["native", "native", "qt"]
+    for platform in ("wayland", "offscreen", "windows", "cocoa"):   # a native GLX window needs X11
+        assert [viewport_kind(platform, setting) for setting in ("", "native", "qt")] == ["qt", "qt", "qt"]
+    assert viewport_kind("xcb", "qtt") == "native" and "VOLVIZ_VIEWPORT='qtt'" in caplog.text
+
+
+def test_the_qt_setting_gives_pyvistaqts_viewport(make_window, monkeypatch: pytest.MonkeyPatch) -> None:
+    from pyvistaqt import QtInteractor
+
+    monkeypatch.setenv("VOLVIZ_VIEWPORT", "qt")
+    window = make_window()
+    assert type(window.plotter) is QtInteractor
 
 
 def test_a_file_dropped_on_the_native_viewport_opens(qtbot, make_window, native: None) -> None:
