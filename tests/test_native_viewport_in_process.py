@@ -18,6 +18,7 @@ import pytest
 from conftest import data_file
 from test_app_open import drop
 from test_app_window import wait_loaded
+from test_fly_reduced_frames import test_frames_while_flying_are_drawn_at_half_size as flight
 
 
 def _sockets() -> int:
@@ -45,12 +46,21 @@ def test_the_viewport_is_native_on_x11_unless_the_setting_says_qt(caplog: pytest
     assert viewport_kind("xcb", "qtt") == "native" and "VOLVIZ_VIEWPORT='qtt'" in caplog.text
 
 
-def test_the_qt_setting_gives_pyvistaqts_viewport(make_window, monkeypatch: pytest.MonkeyPatch) -> None:
+def test_the_qt_setting_gives_pyvistaqts_viewport_and_its_reduced_frames(qtbot, make_window, tmp_path: Path,
+                                                                          monkeypatch: pytest.MonkeyPatch) -> None:
+    """The opt-out (and the viewport off X11) keeps its own reduced frames (the render window resized at each
+    paint's render): ``test_fly_reduced_frames``' flight in pyvistaqt's widget."""
     from pyvistaqt import QtInteractor
 
     monkeypatch.setenv("VOLVIZ_VIEWPORT", "qt")
-    window = make_window()
-    assert type(window.plotter) is QtInteractor
+    made = []
+
+    def make():
+        made.append(make_window())
+        return made[-1]
+
+    flight(qtbot, make, tmp_path)
+    assert [type(window.plotter) for window in made] == [QtInteractor]
 
 
 def test_a_file_dropped_on_the_native_viewport_opens(qtbot, make_window, native: None) -> None:
