@@ -79,8 +79,6 @@ ISO_PARTS = ("IsoParts or a list of IsoMesh: the body tells them apart with a co
 
 #: the public signatures allowed to keep ``Any``, with the reason
 ALLOWED: dict[str, str] = {
-    "volviz.render.controller:iso_summary": STATS,
-    "volviz.render.controller:SceneController.show_isosurfaces": ISO_PARTS,
     "volviz.render.controller:SceneController.camera_views": VIEW_OBJECTS,
     "volviz.render.controller:SceneController.compute_views": VIEW_OBJECTS,
     "volviz.render.controller:SceneController.finish_views": VIEW_OBJECTS,
@@ -88,11 +86,7 @@ ALLOWED: dict[str, str] = {
     "volviz.render.image_overlay:single_sample_on_software": PLOTTER_WINDOW,
     "volviz.render.lod_volume:LodVolume.update": STATS,
     "volviz.render.pt_prop:add_pt_volume": DATASET_TO_PROP,
-    "volviz.render.scene_builder:add_lod_component": DATASET_TO_PROP,
-    "volviz.render.scene_builder:add_pt_component": DATASET_TO_PROP,
     "volviz.render.views:View.finish": RESULT,
-    "volviz.scene.drawn_tf:drawn_transfer_function":
-        "Optional[TransferFunction] needs narrowing in scene_builder's callers (a behaviour edit, not this change)",
 }
 
 

@@ -30,6 +30,7 @@ from volviz.jobs import report
 from volviz.model import TimeSeries
 from volviz.model.applicability import DatasetTraits
 from volviz.model.events import ChangeNotifier, SceneChange
+from volviz.model.json_types import json_float
 from volviz.render.decorations import apply_decorations, legend_margin, update_legend, update_outline
 from volviz.render.framing import frame_scene, union
 from volviz.render.image_overlay import single_sample_on_software
@@ -78,13 +79,14 @@ def _vtk_props(props: dict[str, object]) -> list[vtkProp]:
     return [cast("vtkProp", p) for p in props.values() if hasattr(p, "IsA")]
 
 
-def iso_summary(stats: dict[str, Any]) -> str:
+def iso_summary(stats: Mapping[str, object]) -> str:
     """One line of an isosurface view's statistics (``SceneController.iso_stats``: ``volviz.render.iso_overlay.
     IsoOverlay`` or ``volviz.render.gl_iso.GLIsoView``): the mode, the triangles, those a GPU draws per frame where
     known, and the seconds of the last image (CPU) or frame (GPU)."""
     drawn = stats.get("triangles_drawn")
     drawn_text = "" if drawn is None else f", {drawn:,} drawn"
-    return f"{stats['method']}: {stats['triangles']:,} triangles{drawn_text}, {stats['volume_s'] * 1000:.0f} ms"
+    ms = json_float(stats["volume_s"]) * 1000
+    return f"{stats['method']}: {stats['triangles']:,} triangles{drawn_text}, {ms:.0f} ms"
 
 
 @contextmanager
@@ -517,7 +519,7 @@ class SceneController:
         meshes = self.extract_isosurfaces(comp_id, t, interpolate, progress)
         return isosurface_parts(self.component(comp_id), meshes=meshes, clip=self.session.clip)
 
-    def show_isosurfaces(self, meshes: dict[str, Any]) -> None:
+    def show_isosurfaces(self, meshes: Mapping[str, Union[IsoParts, list[IsoMesh]]]) -> None:
         """GUI thread: replace the actors of isosurface components by new surfaces (``comp_id →`` the meshes of
         ``extract_isosurfaces``, or better the ``isosurface_parts``, whose clipping and LOD chains were made off this
         thread and are redone here only when the clipping or opacity changed since); the overlay's meshes follow
@@ -528,9 +530,9 @@ class SceneController:
                 if view is None:
                     continue
                 comp = self.component(comp_id)
-                parts = surfaces if isinstance(surfaces, IsoParts) else None
+                parts, given = (surfaces, surfaces.meshes) if isinstance(surfaces, IsoParts) else (None, surfaces)
                 if parts is None or parts.clip != self.clip or parts.opacity != comp.opacity:
-                    parts = view.cut(self.clip, meshes=list(parts.meshes if parts else surfaces))
+                    parts = view.cut(self.clip, meshes=list(given))
                 view.show(parts)
         self._sync_iso_overlay()
 

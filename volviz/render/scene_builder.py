@@ -23,6 +23,7 @@ from volviz.render.vtk_scene import (add_dataset, add_surface, apply_camera, def
                                      surface_input, volume_grid, volume_input, volume_prop)
 from volviz.scene.datasets import NATURE_TYPES, component_dataset
 from volviz.scene.drawn_tf import component_transfer_function, drawn_transfer_function
+from volviz.scene.errors import SceneError
 from volviz.scene.first_look import first_look
 from volviz.scene.isosurfaces import isosurface_parts
 from volviz.scene.lod import is_lod, lod_bounds
@@ -35,6 +36,8 @@ if TYPE_CHECKING:   # type-only imports for the signatures
     from volviz.nature.nature_scene import NatureScene
     from volviz.optics.transfer_function import TransferFunction
     from volviz.render.gl_nature import EitherNatureView
+    from volviz.regular.lod import LodTree
+    from volviz.render.lod_volume import LodVolume
     from volviz.render.views import ComponentView
     from volviz.model.datasets import Dataset
     from volviz.render.vtk_scene import MapperInput
@@ -169,8 +172,8 @@ def time_input(series: TimeSeries, t: Optional[float] = None, interpolate: bool 
 
 
 def add_volume_prop(plotter: pv.BasePlotter, dataset: Union[Dataset, TimeSeries], data: Optional[MapperInput],
-                    tf: TransferFunction, opacity: float, name: str, backend: str = "auto", shade: bool = False
-                    ) -> object:
+                    tf: Optional[TransferFunction], opacity: float, name: str, backend: str = "auto",
+                    shade: bool = False) -> object:
     """GUI thread: a vtkVolume drawing ``data`` (from ``prepared_volume_input``), the surface of a time series at
     its display time (``data`` from ``time_input``), or (``data`` None) ``add_dataset``'s default visual;
     ``backend``: the render option (``volviz.render.backend``), which picks VTK's GPU or CPU ray caster; ``shade``:
@@ -179,6 +182,8 @@ def add_volume_prop(plotter: pv.BasePlotter, dataset: Union[Dataset, TimeSeries]
         return add_dataset(plotter, dataset, tf=tf, opacity=opacity, name=name)
     if is_surface(dataset):        # a time series' surface at the display time (``time_input``)
         return add_surface(plotter, cast("pv.DataSet", data), tf, opacity, name)   # surface_input's
+    if tf is None:   # (ensure_transfer_functions gives every volume one; an image takes add_dataset's way)
+        raise SceneError(f"volume {name!r} has no transfer function")
     regular = isinstance(dataset.frame(0) if isinstance(dataset, TimeSeries) else dataset, RegularVolume)
     return volume_prop(plotter, data, regular, tf, opacity, name, backend, shade)
 
@@ -264,8 +269,8 @@ def build_scene(plotter: pv.BasePlotter, session: Session, datasets: dict[str, L
     return install_scene(plotter, session, datasets, prepare_scene(session, datasets), spectrum)
 
 
-def add_lod_component(plotter: pv.BasePlotter, session: Session, comp: Component, dataset: Any,
-                      update: bool = True) -> Any:
+def add_lod_component(plotter: pv.BasePlotter, session: Session, comp: Component, dataset: LodTree,
+                      update: bool = True) -> LodVolume:
     """A compressed volume at a view-dependent level of detail (``volviz.render.lod_volume``); the component
     setting ``budget`` is the number of blocks per view (default 256). Its blocks are selected now when ``update``
     (the app selects them in the background: ``select`` / ``decode`` / ``show``)."""
@@ -296,12 +301,14 @@ def uses_pt(session: Session, dataset: object) -> bool:
 
 
 def add_pt_component(plotter: pv.BasePlotter, session: Session, comp: Component, dataset: object,
-                     update: bool = True) -> Any:
+                     update: bool = True) -> ComponentView:
     """A PT volume for a component (``volviz.render.pt_view``), with its TF scaled by its opacity: drawn on the GPU
     (``volviz.render.gl_pt``) or the CPU (``volviz.render.pt_prop``) as the render option ``backend`` picks for this
     plotter's OpenGL (``volviz.render.backend``; the exact "reference" method is CPU only). A CPU volume's image is
     rendered now when ``update`` (the app renders it in the background: ``begin`` / ``compute`` / ``finish``)."""
     tf = drawn_transfer_function(session, comp, dataset)
+    if tf is None:   # (ensure_transfer_functions gives every mesh one)
+        raise SceneError(f"component {comp.id!r} has no transfer function")
     if comp.opacity != 1.0:
         tf = tf.scaled_extinction(comp.opacity)
     method = "reference" if session.render.method == "reference" else "pt"

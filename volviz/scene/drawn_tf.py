@@ -66,6 +66,6 @@ def component_transfer_function(session: Session, comp: Component) -> Optional[T
     return session.transfer_functions[comp.transfer_function]
 
 
-def drawn_transfer_function(session: Session, comp: Component, dataset: object) -> Any:
+def drawn_transfer_function(session: Session, comp: Component, dataset: object) -> Optional[TransferFunction]:
     """The component's transfer function as drawn (through log10 with the setting ``log_scale``)."""
     return drawn_tf(comp, component_transfer_function(session, comp), dataset)
