@@ -60,32 +60,29 @@ def public_any_signatures(root: Path = ROOT, packages: tuple[str, ...] = PACKAGE
     return out
 
 
-STATS = ("statistics: a free-form dict of numbers and labels for the status bar and the reports; these are read "
-         "as numbers by their callers (app/window.py's statistics, the benches), where dict[str, object] needs a check "
-         "per value, a code change (where no caller reads them so, the signature says dict[str, object])")
-RESULT = "a view's own result tuple, unpacked (each view chooses its shape: View.finish)"
-DATASET = ("a dataset of several kinds (volviz.scene.datasets.LoadedDataset, an array view of one, its PyVista form) "
-           "whose body uses attributes of some kinds only: typing it needs narrowing there, a code change")
-DATASET_TO_PROP = ("a loaded dataset in (DATASET), a prop of several unrelated classes out (vtkVolume, vtkActor, a "
-                   "volviz view standing in as its prop), which callers use as what they know it to be")
-VIEW_OBJECTS = ("a view of one of several classes, each with its own request type; View[Any] would not do: the "
-                "natural scene's view has no stats and the GL isosurfaces' no job, which these callers use")
-PLOTTER_WINDOW = ("a PyVista plotter whose ren_win this reads and sets and which it hands to plotter_gl_info (a "
-                  "pv.BasePlotter): PyVista types ren_win Optional (None once closed), so neither BasePlotter nor "
-                  "image_overlay.WindowPlotter (what the multisampling holds take) fits without a None check in the "
-                  "body, a code change")
-ISO_PARTS = ("IsoParts or a list of IsoMesh: the body tells them apart with a conditional expression mypy "
-             "cannot follow")
+VIEWS_OF_EACH_REQUEST = (
+    "views of several classes, each with its own request type (View[LodRequest], View[NatureRequest], "
+    "View[OrderRequest], View[OverlayRequest]), listed together, and for compute_views / finish_views paired with "
+    "their own requests and results: each pair's request and result types are those of its view, an existential type "
+    "that Python's type system cannot write (a Union of the views loses the pairing: compute(request) would be "
+    "refused for every view but one), so the element type is View[Any]")
+RESULT = ("a view's own compute result, unpacked: a real type exists (the protocol generic in a TypeVarTuple of the "
+          "result, a second type parameter of View), but every View[...] in volviz and app and test_every_registered_"
+          "view_satisfies_its_protocol's REQUESTS would carry it: not done here")
+PT_STATS = ("the PT volumes' statistics, an open set of keys (UnstructuredRenderStats' fields, the extras of each "
+            "sort and the GPU pass's own) read as numbers by app/window.py's status (s.get('total_s', 0.0) summed): "
+            "dict[str, dict[str, object]] needs a float() check there, in a file another helper holds this session")
+PT_OPTIONS = ("**opts: PTVolume's method and scalars and any keyword of volviz.unstructured.render, of several "
+              "types: a real type exists (a TypedDict of those keywords with Unpack), not written yet; mesh is "
+              "anything volviz.unstructured.tetrahedralize takes (its own parameter is Any)")
 
 #: the public signatures allowed to keep ``Any``, with the reason
 ALLOWED: dict[str, str] = {
-    "volviz.render.controller:SceneController.camera_views": VIEW_OBJECTS,
-    "volviz.render.controller:SceneController.compute_views": VIEW_OBJECTS,
-    "volviz.render.controller:SceneController.finish_views": VIEW_OBJECTS,
-    "volviz.render.controller:SceneController.pt_stats": STATS,
-    "volviz.render.image_overlay:single_sample_on_software": PLOTTER_WINDOW,
-    "volviz.render.lod_volume:LodVolume.update": STATS,
-    "volviz.render.pt_prop:add_pt_volume": DATASET_TO_PROP,
+    "volviz.render.controller:SceneController.camera_views": VIEWS_OF_EACH_REQUEST,
+    "volviz.render.controller:SceneController.compute_views": VIEWS_OF_EACH_REQUEST,
+    "volviz.render.controller:SceneController.finish_views": VIEWS_OF_EACH_REQUEST,
+    "volviz.render.controller:SceneController.pt_stats": PT_STATS,
+    "volviz.render.pt_prop:add_pt_volume": PT_OPTIONS,
     "volviz.render.views:View.finish": RESULT,
 }
 

@@ -17,6 +17,7 @@ from typing import Any, Optional, Sequence
 import numpy as np
 
 from volviz.model import vec3
+from volviz.model.json_types import json_float, json_int
 
 DEFAULT_PNG = Path(__file__).resolve().parents[2] / "docs" / "bench" / "compression-animation.png"
 SECTION = "### Rendered walkthrough frames"
@@ -112,8 +113,8 @@ def _walk(plotter: Any, tree: Any, tf: Any, budget: int, views: list, renderer: 
             img = _frame(plotter)
             if i:                                                   # frame 0 is the cold start
                 times.append(time.perf_counter() - t0)
-                kernel.append(st.get("render_s", float("nan")))
-                blocks.append(st["blocks"])
+                kernel.append(json_float(st.get("render_s", float("nan"))))
+                blocks.append(json_int(st["blocks"]))
                 e, m = _err(img, exact[i])
                 errs.append(e)
                 maxs.append(m)

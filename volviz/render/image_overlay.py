@@ -45,6 +45,8 @@ from volviz.model.camera import Camera
 from volviz.render.backend import plotter_gl_info
 
 if TYPE_CHECKING:   # type-only: VTK's classes, reached through the facade at run time; the progress callback
+    import pyvista as pv
+
     from volviz.jobs import ProgressCallback
     from volviz.render.vtk_facade import vtkRenderer, vtkRenderWindow
 
@@ -152,11 +154,13 @@ def hold_single_sample(plotter: WindowPlotter, holder: object) -> None:
     held.holders.append(id(holder))
 
 
-def single_sample_on_software(plotter: Any) -> None:
+def single_sample_on_software(plotter: pv.BasePlotter) -> None:
     """No multisampling in ``plotter`` when a software rasteriser draws it, and none to restore when the last
     overlay leaves (module docstring); a hardware driver keeps the plotter's setting."""
     if plotter_gl_info(plotter).software:
-        plotter.ren_win.SetMultiSamples(0)
+        window = plotter.ren_win
+        assert window is not None   # open: its driver was just asked (PyVista types it None once closed)
+        window.SetMultiSamples(0)
         held = _single_sample.get(plotter)
         if held is not None:
             held.restore = 0

@@ -400,7 +400,7 @@ class LodVolume:
         self.show(selection, blocks, select_s, decode_s)
         return self.stats
 
-    def update(self) -> dict[str, Any]:
+    def update(self) -> dict[str, object]:
         """Select for the plotter's current camera, decode and draw; returns the statistics."""
         t0 = time.perf_counter()
         sel = self.select(self.camera())
