@@ -66,14 +66,16 @@ class ExportRuns:
         self._export(Path(path).name, size, lambda controller: [(None, None)], lambda: ImageFile(path), transparent)
 
     def export_movie(self, path: str | os.PathLike, path_name: Optional[str], through_time: bool,
-                     fps: float = 24.0, size: Optional[tuple[int, int]] = None, orbit: bool = False) -> None:
+                     fps: float = 24.0, size: Optional[tuple[int, int]] = None, orbit: bool = False,
+                     duration: Optional[float] = None) -> None:
         """Render a movie offscreen along the camera path ``path_name`` (or, with ``orbit``, one turn around the
-        current view) and/or through time, in the background like a screenshot (``result``): MP4 through
-        imageio-ffmpeg for ``.mp4``, else a PNG sequence in the folder ``path``."""
+        current view) and/or through time (over ``duration`` seconds; None: one second per unit of data time), in
+        the background like a screenshot (``result``): MP4 through imageio-ffmpeg for ``.mp4``, else a PNG sequence
+        in the folder ``path``."""
         from volviz.render.export import MovieWriter, movie_frames
 
         self._export(Path(path).name, size or self.scene.session.render.size,
-                     lambda controller: movie_frames(controller, path_name, fps, through_time, orbit=orbit),
+                     lambda controller: movie_frames(controller, path_name, fps, through_time, duration, orbit=orbit),
                      lambda: MovieWriter(Path(path), fps))
 
     def _export(self, name: str, size: tuple[int, int], frames_of: Callable[[Any], list[Any]],
