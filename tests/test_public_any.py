@@ -72,9 +72,6 @@ RESULT = ("a view's own compute result, unpacked: a real type exists (the protoc
 PT_STATS = ("the PT volumes' statistics, an open set of keys (UnstructuredRenderStats' fields, the extras of each "
             "sort and the GPU pass's own) read as numbers by app/window.py's status (s.get('total_s', 0.0) summed): "
             "dict[str, dict[str, object]] needs a float() check there, in a file another helper holds this session")
-PT_OPTIONS = ("**opts: PTVolume's method and scalars and any keyword of volviz.unstructured.render, of several "
-              "types: a real type exists (a TypedDict of those keywords with Unpack), not written yet; mesh is "
-              "anything volviz.unstructured.tetrahedralize takes (its own parameter is Any)")
 
 #: the public signatures allowed to keep ``Any``, with the reason
 ALLOWED: dict[str, str] = {
@@ -82,7 +79,6 @@ ALLOWED: dict[str, str] = {
     "volviz.render.controller:SceneController.compute_views": VIEWS_OF_EACH_REQUEST,
     "volviz.render.controller:SceneController.finish_views": VIEWS_OF_EACH_REQUEST,
     "volviz.render.controller:SceneController.pt_stats": PT_STATS,
-    "volviz.render.pt_prop:add_pt_volume": PT_OPTIONS,
     "volviz.render.views:View.finish": RESULT,
 }
 

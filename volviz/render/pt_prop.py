@@ -45,6 +45,7 @@ from volviz.unstructured.tetrahedralize import tetrahedralize
 
 if TYPE_CHECKING:   # type-only imports for the signatures
     import pyvista as pv
+    from typing_extensions import Unpack
 
     from volviz.jobs import ProgressCallback
     from volviz.model.clip import ClipSettings
@@ -185,7 +186,30 @@ class PTVolume(OverlayView[UnstructuredRenderStats], PTView):
             self.hold.remove()
         super().remove()
 
-def add_pt_volume(plotter: pv.BasePlotter, mesh: Any, tf: TransferFunction, **opts: Any) -> PTVolume:
+class PTOptions(TypedDict, total=False):
+    """``add_pt_volume``'s keywords: ``PTVolume``'s method and scalars, and those of ``volviz.unstructured.render``
+    (its table and iso are its own to check)."""
+
+    method: str
+    scalars: Optional[str]
+    sort: str
+    nonconvex: str
+    order: Optional[np.ndarray]
+    lookup: str
+    n_s: Optional[int]
+    n_l: int
+    degree: Optional[int]
+    table: object
+    t_min: float
+    depth: Optional[np.ndarray]
+    iso: object
+    iso_mode: str
+    iso_shading: str
+    classification: str
+
+
+def add_pt_volume(plotter: pv.BasePlotter, mesh: object, tf: TransferFunction, **opts: Unpack[PTOptions]
+                  ) -> PTVolume:
     """Add a volviz PT volume to ``plotter`` (composited through the depth buffer) and render it once.
 
     ``opts``: ``method`` ("pt" or "reference"), ``scalars`` (point-data name when ``mesh`` is not a TetMesh) and any
