@@ -36,8 +36,15 @@ def scalar_values(dataset: Union[Dataset, TimeSeries]) -> np.ndarray:
     return np.asarray(values).reshape(-1)
 
 
+def constant_pad(value: float) -> float:
+    """Half the width given to the range of a field that is ``value`` everywhere (its histogram's and its first
+    transfer function's, ``volviz.optics.auto_tf``): a thousandth of the value, at least 1e-6."""
+    return max(abs(value) * 1e-3, 1e-6)
+
+
 def histogram(dataset: Union[Dataset, TimeSeries], bins: int = 128) -> tuple[np.ndarray, np.ndarray]:
-    """Counts and bin edges of the finite active-scalar values (NaN/Inf are left out)."""
+    """Counts and bin edges of the finite active-scalar values (NaN/Inf are left out); a constant field's range is
+    its value +- ``constant_pad``, as its first transfer function's."""
     values = scalar_values(dataset)
     if values.dtype.kind == "f":
         values = values[np.isfinite(values)]
@@ -45,5 +52,5 @@ def histogram(dataset: Union[Dataset, TimeSeries], bins: int = 128) -> tuple[np.
         return np.zeros(bins, dtype=np.int64), np.linspace(0.0, 1.0, bins + 1)
     lo, hi = float(values.min()), float(values.max())
     if hi <= lo:
-        hi = lo + 1.0
+        lo, hi = lo - constant_pad(lo), hi + constant_pad(lo)
     return np.histogram(values, bins=bins, range=(lo, hi))

@@ -34,6 +34,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from volviz.model.stats import constant_pad
 from volviz.optics.transfer_function import TransferFunction
 
 BACKGROUND_FRACTION = 0.2      # an end bin holding more than this share of the values is background
@@ -101,7 +102,7 @@ def auto_transfer_function(values: np.ndarray, chord: float, name: str = "auto")
         return _ramp(0.0, 1.0, np.linspace(0.0, 1.0, len(RAMP)), TARGET_DEPTH / chord, name)
     full_lo, full_hi = float(sample.min()), float(sample.max())
     if full_hi <= full_lo:   # constant data: a faint uniform fog around the one value
-        pad = max(abs(full_lo) * 1e-3, 1e-6)
+        pad = constant_pad(full_lo)
         return _ramp(full_lo - pad, full_hi + pad, np.linspace(full_lo - pad, full_hi + pad, len(RAMP)),
                      MIN_DEPTH / chord, name)
     mode = background_mode(sample)
