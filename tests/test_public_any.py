@@ -69,9 +69,6 @@ CAMERA_VIEWS = ("the views that re-make something for a new camera: a real type 
                 "LodVolume, PTVolume, GLPTVolume and IsoOverlay), but its callers (update_views, begin_views, "
                 "app/view_scheduler.py) use members only some of them have (stats, job) by their kind, which needs "
                 "an isinstance narrowing at each: not written yet")
-RESULT = ("a view's own compute result, unpacked: a real type exists (the protocol generic in a TypeVarTuple of the "
-          "result, a second type parameter of View), but every View[...] in volviz and app and test_every_registered_"
-          "view_satisfies_its_protocol's REQUESTS would carry it: not done here")
 PT_STATS = ("the PT volumes' statistics, an open set of keys (UnstructuredRenderStats' fields, the extras of each "
             "sort and the GPU pass's own) read as numbers by app/window.py's status (s.get('total_s', 0.0) summed): "
             "dict[str, dict[str, object]] needs a float() check there, in a file another helper holds this session")
@@ -82,7 +79,6 @@ ALLOWED: dict[str, str] = {
     "volviz.render.controller:SceneController.compute_views": VIEWS_OF_EACH_REQUEST,
     "volviz.render.controller:SceneController.finish_views": VIEWS_OF_EACH_REQUEST,
     "volviz.render.controller:SceneController.pt_stats": PT_STATS,
-    "volviz.render.views:View.finish": RESULT,
 }
 
 
@@ -119,15 +115,25 @@ def test_the_counter_sees_any_wherever_it_is_written(tmp_path: Path) -> None:
         "volviz.scene.m:a", "volviz.scene.m:b", "volviz.scene.m:c", "volviz.scene.m:d", "volviz.scene.m:C.g"]
 
 
-#: each registered view's request type (``View[RequestT]``), as mypy checks it: an import and the type
+#: each registered view's request and result types (``View[Request, *Results]``), as mypy checks them: the imports
+#: (one line) and the type arguments
+_ND, _NATURE = "from numpy import ndarray", "from volviz.render.nature_view import NatureRequest"
+_TERRAIN = "from volviz.nature.terrain import TerrainMesh"
 REQUESTS: dict[tuple[str, str], tuple[str, str]] = {
-    ("pt", "gpu"): ("from volviz.render.gl_pt_order import OrderRequest", "OrderRequest"),
-    ("pt", "cpu"): ("from volviz.render.image_overlay import OverlayRequest", "OverlayRequest"),
-    ("nature", "gpu"): ("from volviz.render.nature_view import NatureRequest", "NatureRequest"),
-    ("nature", "cpu"): ("from volviz.render.nature_view import NatureRequest", "NatureRequest"),
+    ("pt", "gpu"): ("from volviz.render.gl_pt_order import OrderRequest; "
+                    "from volviz.unstructured.sort import SortResult", "OrderRequest, SortResult | None"),
+    ("pt", "cpu"): (f"from volviz.render.image_overlay import OverlayRequest; {_ND}; "
+                    "from volviz.unstructured.render import UnstructuredRenderStats",
+                    "OverlayRequest, ndarray, UnstructuredRenderStats, ndarray"),
+    ("nature", "gpu"): (f"{_NATURE}; {_TERRAIN}; from volviz.render.gl_nature import GLNatureFrame",
+                        "NatureRequest, TerrainMesh | None, GLNatureFrame, dict[str, float]"),
+    ("nature", "cpu"): (f"{_NATURE}; {_TERRAIN}; {_ND}",
+                        "NatureRequest, TerrainMesh | None, ndarray, dict[str, float]"),
     ("iso", "gpu"): ("", "None"),
-    ("iso", "cpu"): ("from volviz.render.image_overlay import OverlayRequest", "OverlayRequest"),
-    ("lod", "cpu"): ("from volviz.render.lod_volume import LodRequest", "LodRequest"),
+    ("iso", "cpu"): (f"from volviz.render.image_overlay import OverlayRequest; {_ND}; "
+                     "from volviz.render.iso_overlay import IsoStats", "OverlayRequest, ndarray, IsoStats, ndarray"),
+    ("lod", "cpu"): ("from volviz.render.lod_volume import LodRequest; from volviz.regular.lod import Block, Selection",
+                     "LodRequest, Selection, list[Block], float, float"),
 }
 
 
@@ -150,7 +156,7 @@ def test_every_registered_view_satisfies_its_protocol(tmp_path: Path) -> None:
     # what must be refused, so a check that cannot fail is seen failing: no view at all, and another request type
     lines += ["from volviz.model.clip import ClipSettings", "_bad: type[View[Any]] = ClipSettings"]
     lines += [f"from {VIEWS[('lod', 'cpu')].split(':')[0]} import LodVolume",
-              "_wrong: type[View[NatureRequest]] = LodVolume"]
+              "_wrong: type[View[NatureRequest, Selection, list[Block], float, float]] = LodVolume"]
     source = tmp_path / "view_protocols.py"
     source.write_text("\n".join(lines) + "\n", encoding="utf-8")
     done = subprocess.run([mypy, "--config-file", str(ROOT / "pyproject.toml"), str(source)], cwd=ROOT,

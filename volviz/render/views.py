@@ -24,6 +24,8 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING, Any, Optional, Protocol, TypeVar, runtime_checkable
 
+from typing_extensions import TypeVarTuple, Unpack   # (typing's own from Python 3.11; pydantic needs it too)
+
 if TYPE_CHECKING:   # type-only: the views' argument types, without importing the optics and VTK at run time
     from volviz.jobs import ProgressCallback
     from volviz.model.clip import ClipSettings
@@ -35,6 +37,7 @@ __all__ = ["COMPONENT_VIEWS", "ComponentView", "RequestT", "VIEWS", "View", "com
 #: what a view's ``begin`` makes and its ``compute`` and ``finish`` take back (each view has its own: a dict of the
 #: camera and image size, the natural scene's (camera, size, scale), None for a view with nothing to compute)
 RequestT = TypeVar("RequestT")
+ResultTs = TypeVarTuple("ResultTs")
 
 #: (view kind, backend) -> "module:class"
 VIEWS: dict[tuple[str, str], str] = {
@@ -49,18 +52,18 @@ VIEWS: dict[tuple[str, str], str] = {
 
 
 @runtime_checkable
-class View(Protocol[RequestT]):
-    """What every registered view offers (module docstring), generic in its request type. ``begin`` is called with
-    ``scale`` by keyword (the natural scene's ``begin`` takes a camera first); ``finish`` takes back the tuple
-    ``compute`` returned, unpacked, whose shape each view chooses."""
+class View(Protocol[RequestT, Unpack[ResultTs]]):
+    """What every registered view offers (module docstring), generic in its request type and in the tuple its
+    ``compute`` returns (``View[Request, *Results]``), which ``finish`` takes back unpacked: each view chooses its
+    shape. ``begin`` is called with ``scale`` by keyword (the natural scene's ``begin`` takes a camera first)."""
 
     backend: str
 
     def begin(self, *, scale: int = 1) -> RequestT: ...
 
-    def compute(self, request: RequestT, progress: Optional[ProgressCallback] = None) -> tuple[object, ...]: ...
+    def compute(self, request: RequestT, progress: Optional[ProgressCallback] = None) -> tuple[Unpack[ResultTs]]: ...
 
-    def finish(self, request: RequestT, *result: Any) -> object: ...
+    def finish(self, request: RequestT, *result: Unpack[ResultTs]) -> object: ...
 
     def remove(self) -> None: ...
 
