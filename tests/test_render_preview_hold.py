@@ -60,3 +60,30 @@ def test_a_held_frame_draws_the_preview_camera_and_the_next_one_the_live_camera(
     assert np.allclose(live.GetPosition(), LIVE[0])       # the live camera is put back
     hold.remove()
     pl.close()
+
+
+def test_a_held_frame_draws_the_orientation_axes_at_the_preview_camera() -> None:
+    """The orientation axes (their own renderer, whose camera follows the plotter's at each render's start) are
+    drawn at the camera the held frame draws the scene with: before, they followed the live camera while the box
+    was drawn at the preview's (up to ~10 frames out of step in a CPU PT drag)."""
+    pl = pv.Plotter(off_screen=True, window_size=list(SIZE))
+    pl.set_background("black")
+    pl.add_mesh(pv.Box((0.0, 0.4, 0.0, 0.1, 0.0, 0.01)).outline(), color="white")
+    pl.add_axes(interactive=False, line_width=1)
+    preview = _aim(pl, PREVIEW)
+    at_preview = _frame(pl)
+    _aim(pl, LIVE)
+    at_live = _frame(pl)
+    x0, y0, x1, y1 = pl.renderer.axes_widget.GetViewport()
+    corner = (slice(int(SIZE[1] * (1 - y1)), int(SIZE[1] * (1 - y0))), slice(int(SIZE[0] * x0), int(SIZE[0] * x1)))
+    assert np.abs(at_live[corner] - at_preview[corner]).max() > 100   # the two poses draw the axes apart
+    hold = PreviewCameraHold(pl)
+    hold.holding, hold.image_camera = True, preview
+    pl.renderer.GetActiveCamera().Modified()
+    held = _frame(pl)
+    assert np.array_equal(held[corner], at_preview[corner]), "the held frame drew the axes at the live camera"
+    assert np.array_equal(held, at_preview)
+    hold.holding = False
+    assert np.array_equal(_frame(pl), at_live), "the frame after the hold drew the axes at the preview's camera"
+    hold.remove()
+    pl.close()

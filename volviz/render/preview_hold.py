@@ -6,7 +6,8 @@ camera, so the volume preview was drawn for a camera several frames older than t
 apart and the opaque depth the image was cut by no longer lay under the box. From the start of an interaction until
 a full-size image of the live camera is shown after its end, each render of the plotter's renderer is drawn with
 the camera the shown image was made for (swapped in at the renderer's ``StartEvent``, the live camera put back at
-its ``EndEvent``): box and volume agree, and the whole view lags the mouse by the image's age instead. ``frames``
+its ``EndEvent``): box and volume agree, and the whole view lags the mouse by the image's age instead. The swap
+runs before the orientation axes copy the camera into their own renderer, so they are drawn at the same camera. ``frames``
 logs per frame (live camera serial, image camera serial, drawn camera serial) for the flow test and the statement
 of the lag.
 
@@ -25,6 +26,7 @@ if TYPE_CHECKING:   # type-only: VTK's camera, reached through the facade at run
 
 __all__ = ["PreviewCameraHold", "hold_previews", "holds_previews"]
 
+AXES_FIRST = 10.0     # the swap's StartEvent priority: before vtkOrientationMarkerWidget's camera update runs
 _holding: weakref.WeakSet[Any] = weakref.WeakSet()   # the plotters whose CPU volumes hold their images' camera
 
 
@@ -75,7 +77,9 @@ class PreviewCameraHold:
         self._swapped = False
         iren = plotter.iren.interactor
         self._observers = [
-            (self.renderer, self.renderer.AddObserver("StartEvent", self._start)),
+            # before the orientation axes' observer copies the camera into their renderer, so they are
+            # drawn at the camera the scene is (issue #28: they followed the live camera, ~10 frames apart)
+            (self.renderer, self.renderer.AddObserver("StartEvent", self._start, AXES_FIRST)),
             (self.renderer, self.renderer.AddObserver("EndEvent", self._end)),
             (iren, iren.AddObserver("StartInteractionEvent", self._interaction_started)),
             (iren, iren.AddObserver("EndInteractionEvent", lambda *a: setattr(self, "interacting", False))),
