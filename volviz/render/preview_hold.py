@@ -7,9 +7,9 @@ apart and the opaque depth the image was cut by no longer lay under the box. Fro
 a full-size image of the live camera is shown after its end, each render of the plotter's renderer is drawn with
 the camera the shown image was made for (swapped in at the renderer's ``StartEvent``, the live camera put back at
 its ``EndEvent``): box and volume agree, and the whole view lags the mouse by the image's age instead. The swap
-runs before the orientation axes copy the camera into their own renderer, so they are drawn at the same camera. ``frames``
-logs per frame (live camera serial, image camera serial, drawn camera serial) for the flow test and the statement
-of the lag.
+runs before the orientation axes copy the camera into their own renderer, so they are drawn at the same camera.
+``frames`` logs per frame (live camera serial, image camera serial, drawn camera serial) for the flow test and the
+statement of the lag.
 
 Only for a plotter whose owner re-makes the images while the camera moves and after (the app:
 ``hold_previews(plotter)``); elsewhere an interactive plotter would stay at the image's camera after a drag.
