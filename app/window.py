@@ -35,6 +35,7 @@ from PySide6.QtCore import QPoint, QSettings, Qt
 from PySide6.QtGui import QImage, QPainter, QPixmap
 from PySide6.QtWidgets import QFileDialog, QMainWindow, QMenu, QMessageBox, QWidget
 
+from volviz.model.json_types import json_float
 from volviz.render.backend import plotter_gl_info
 from volviz.render.controller import SceneController, iso_summary
 from volviz.session import Session
@@ -224,10 +225,10 @@ class MainWindow(WindowBase, QMainWindow):
         pt = self.controller.pt_stats() if self.controller is not None else {}
         if pt and self.controller is not None:  # volviz's own renderer: the split of its last frame
             last = list(pt.values())
-            stats.update(frame_seconds=sum(s.get("total_s", 0.0) for s in last) + elapsed,
-                         sort_seconds=sum(s.get("sort_s", 0.0) for s in last),
-                         project_seconds=sum(s.get("project_s", 0.0) for s in last),
-                         raster_seconds=sum(s.get("raster_s", 0.0) for s in last),
+            stats.update(frame_seconds=sum(json_float(s.get("total_s", 0.0)) for s in last) + elapsed,
+                         sort_seconds=sum(json_float(s.get("sort_s", 0.0)) for s in last),
+                         project_seconds=sum(json_float(s.get("project_s", 0.0)) for s in last),
+                         raster_seconds=sum(json_float(s.get("raster_s", 0.0)) for s in last),
                          method=", ".join(sorted({str(s.get("method")) for s in last})),
                          error=self.view_scheduler.error_estimate, backends=self.controller.pt_backends())
         iso = self.controller.iso_stats() if self.controller is not None else {}

@@ -65,21 +65,11 @@ VIEWS_OF_EACH_REQUEST = (
     "View[OrderRequest], View[OverlayRequest]), each paired with its own request and result: each pair's types are "
     "those of its view, an existential type that Python's type system cannot write (a Union of the views loses the "
     "pairing: compute(request) would be refused for every view but one), so the element type is View[Any]")
-CAMERA_VIEWS = ("the views that re-make something for a new camera: a real type exists (a Union of EitherNatureView, "
-                "LodVolume, PTVolume, GLPTVolume and IsoOverlay; tried: mypy then wants update_views to tell the "
-                "natural scene's views, which have no stats, from the rest, which it does by their kind, a str; a "
-                "Literal kind does not fit ComponentView's mutable kind: str, and an isinstance needs "
-                "render.nature_view (the nature kernels) imported at run time): not written yet")
-PT_STATS = ("the PT volumes' statistics, an open set of keys (UnstructuredRenderStats' fields, the extras of each "
-            "sort and the GPU pass's own) read as numbers by app/window.py's status (s.get('total_s', 0.0) summed): "
-            "dict[str, dict[str, object]] needs a float() check there, in a file another helper holds this session")
 
 #: the public signatures allowed to keep ``Any``, with the reason
 ALLOWED: dict[str, str] = {
-    "volviz.render.controller:SceneController.camera_views": CAMERA_VIEWS,
     "volviz.render.controller:SceneController.compute_views": VIEWS_OF_EACH_REQUEST,
     "volviz.render.controller:SceneController.finish_views": VIEWS_OF_EACH_REQUEST,
-    "volviz.render.controller:SceneController.pt_stats": PT_STATS,
 }
 
 

@@ -67,6 +67,9 @@ if TYPE_CHECKING:   # type-only imports for the signatures
     from volviz.model.datasets import Dataset
     from volviz.scene.datasets import LoadedDataset
 
+    #: a view that re-makes something for a new camera; ``kind`` (a Literal on each class) tells them apart
+    CameraView = Union[EitherNatureView, LodVolume, PTVolume, GLPTVolume, IsoOverlay]
+
 __all__ = ["Cut", "ISO_MODES", "SceneController", "ensure_lights", "iso_summary", "no_render", "session_interpolates"]
 
 #: a component's data cut by the clipping, as its view draws it: a PT volume's tetrahedra (None: nothing left), an
@@ -556,12 +559,12 @@ class SceneController:
         view: Optional[EitherNatureView] = self.views.get("nature")
         return view
 
-    def camera_views(self) -> dict[str, Any]:
+    def camera_views(self) -> dict[str, CameraView]:
         """The shown views that re-make something for a new camera (``volviz.render.views.View``: ``begin`` /
         ``compute`` / ``finish``), by the key of their updates (``view.job[0]``, with the component's id): the natural
         scene, volumes at a level of detail, PT volumes (a CPU volume's image, a GPU volume's visibility order) and
         the isosurfaces' CPU overlay, in this order (the later ones read the opaque scene's depth)."""
-        out: dict[str, Any] = {}
+        out: dict[str, CameraView] = {}
         if self.nature is not None:
             out[self.nature.job[0]] = self.nature
         for kind in ("lod", "pt"):
@@ -577,17 +580,17 @@ class SceneController:
         ``nature`` is false, PT volumes and the isosurface view unless ``pt`` is false, volumes at a level of detail
         unless ``lod`` is false: for callers that do those in the background); returns their statistics."""
         skip = {kind for kind, on in (("nature", nature), ("pt", pt), ("iso", pt), ("lod", lod)) if not on}
-        stats: dict[str, Any] = {}
+        stats: dict[str, object] = {}
         views = {key.split(":", 1)[-1]: view for key, view in self.camera_views().items() if view.kind != "iso"}
         if self.iso_view is not None:
             views["iso"] = self.iso_view  # the CPU overlay's image, or only the GPU passes' statistics
         for key, view in views.items():
             if view.kind in skip:
                 continue
-            result = view.update()
-            if view.kind == "nature":
-                stats.update(result)
+            if view.kind == "nature":   # (its Literal narrows the view: the natural scene's update gives its stats)
+                stats.update(view.update())
             else:
+                view.update()
                 stats[key] = dict(view.stats)
         return stats
 
@@ -636,7 +639,7 @@ class SceneController:
         view = self._views_of("pt").get(comp_id)
         return view if view is not None and view.backend == "gpu" else None
 
-    def pt_stats(self) -> dict[str, Any]:
+    def pt_stats(self) -> dict[str, dict[str, object]]:
         """The last frame statistics of every PT volume (sort / project / raster seconds, fragments, method)."""
         return {comp_id: dict(view.stats) for comp_id, view in self._views_of("pt").items()}
 

@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, Optional, Sequence
+from typing import TYPE_CHECKING, Any, Literal, Optional, Sequence
 
 import numpy as np
 
@@ -121,7 +121,7 @@ class IsoOverlay(OverlayView[IsoStats], IsoModeView):
 
     split_volume = True
 
-    kind = "iso"
+    kind: Literal["iso"] = "iso"
     backend = "cpu"
     job = ("iso-overlay", "isosurfaces")  # the app's key for its updates, and what its worker makes
 

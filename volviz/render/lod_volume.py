@@ -38,7 +38,7 @@ from __future__ import annotations
 
 import threading
 import time
-from typing import TYPE_CHECKING, Any, Optional, TypedDict, Union
+from typing import TYPE_CHECKING, Any, Literal, Optional, TypedDict, Union
 
 import numpy as np
 
@@ -174,7 +174,7 @@ class LodVolume:
         if self._overlay is not None:
             self._overlay.renderer.SetDraw(bool(self.volume.GetVisibility()) and self.image is not None)
 
-    kind = "lod"
+    kind: Literal["lod"] = "lod"
     job = ("lod", "level of detail")  # the app's key for its updates, and what its worker makes
     coarse_first = True  # a settled camera first shows a coarse selection (``begin(scale=2)``), then the full one
     while_moving = False  # VTK draws the selected blocks for any camera: nothing to re-make while it moves

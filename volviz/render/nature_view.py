@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import weakref
 from abc import ABC, abstractmethod
-from typing import TYPE_CHECKING, Any, Callable, Generic, Optional, Sequence, TypeVar, Union
+from typing import TYPE_CHECKING, Any, Callable, Generic, Literal, Optional, Sequence, TypeVar, Union
 
 import numpy as np
 
@@ -49,7 +49,7 @@ class NatureSceneView(ABC, Generic[FrameT]):
     clipping range, ``begin`` and ``update``; ``compute`` and ``finish`` are the backend's (``NatureView``,
     ``volviz.render.gl_nature.GLNatureView``), of its own frame type."""
 
-    kind = "nature"
+    kind: Literal["nature"] = "nature"
     backend: str   # the backend's: "cpu" or "gpu"
     job = ("nature", "natural scene")  # the app's key for its updates, and what its worker makes
     camera_dependent = True

@@ -5,7 +5,7 @@
 """
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any, Optional, TypeGuard
+from typing import TYPE_CHECKING, Any, Literal, Optional, TypeGuard
 
 from volviz.render.framing import Bounds, points_bounds
 
@@ -23,7 +23,7 @@ class PTView:
     ``backend`` ("gpu" or "cpu"), ``mesh`` (the TetMesh drawn), ``whole_mesh`` (uncut), ``tf``, ``stats`` (the last
     frame's: ``method``, ``sort_s``, ...), ``visible``."""
 
-    kind = "pt"
+    kind: Literal["pt"] = "pt"
     camera_dependent = True
     backend = ""
     mesh: Any

@@ -82,10 +82,12 @@ COMPONENT_VIEWS: dict[str, tuple[str, ...]] = {
 class ComponentView(Protocol):
     """What the view of every shown component offers (module docstring)."""
 
-    kind: str
     camera_dependent: bool
     visible: bool
     stats: dict[str, Any]
+
+    @property
+    def kind(self) -> str: ...   # read-only: a view's class may narrow it to a Literal (the controller's CameraView)
 
     @property
     def prop(self) -> object: ...
