@@ -1,5 +1,5 @@
 """The viewport as a native X child window that VTK draws into with its own GLX context (issue #28: the default on
-the ``xcb`` platform, ``VOLVIZ_VIEWPORT=qt`` keeps pyvistaqt's widget; ``window.make_plotter``).
+the ``xcb`` platform, ``VOLVIZ_VIEWPORT=qt`` keeps pyvistaqt's widget; ``viewport_types.make_plotter``).
 
 pyvistaqt's ``QtInteractor`` is a ``QOpenGLWidget``: VTK renders into its framebuffers, the paint blits the frame into
 the widget's, and Qt then composes the whole window through OpenGL (costly on a software rasteriser:

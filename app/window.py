@@ -47,6 +47,7 @@ from .gc_guard import GuiThreadCollector
 from .interaction_renders import SingleRenderDuringInteraction
 from .navigation import FlyMode
 from .stand_in import StandInFrame
+from .startup_imports import import_gui_thread_modules
 from .nonfinite_status import NonFiniteStatus
 from .part_attribute import PartAttribute
 from .recent import RecentFiles
@@ -55,62 +56,15 @@ from .scene_loading import SceneLoading
 from .session_files import SessionFiles, default_recovery_dir
 from .time_views import TimeViews
 from .view_scheduler import ViewScheduler
+from .viewport_types import make_plotter
 from .window_base import WindowBase
 from .window_widgets import build_docks, build_menus, build_status_bar, fill_docks
 from .workers import JobBridge
 
 if TYPE_CHECKING:
     from volviz.model.clip import ClipSettings
-    from .viewport_types import Viewport
 
 log = logging.getLogger(__name__)
-
-
-def viewport_kind(platform: str, setting: str) -> str:
-    """Which viewport ``make_plotter`` makes: ``"native"`` (``NativeViewport``) on X11 (Qt's ``xcb`` platform) unless
-    ``setting`` (``VOLVIZ_VIEWPORT``) is ``"qt"``; ``"qt"`` (pyvistaqt's ``QtInteractor``) there and everywhere else
-    (Wayland, offscreen, Windows, macOS: a native GLX window needs X11, and pyvistaqt left native windows for Wayland,
-    pyvistaqt gh-445). Another setting is named in a warning and gives the default."""
-    if setting not in ("", "native", "qt"):
-        log.warning("VOLVIZ_VIEWPORT=%r is neither 'native' nor 'qt': the default viewport is used", setting)
-    return "native" if platform == "xcb" and setting != "qt" else "qt"
-
-
-def make_plotter(parent: QWidget) -> Viewport:
-    """The viewport (``viewport_kind``): on X11 the native-window ``NativeViewport``, which Qt does not compose, so a
-    flight has fewer long event-loop stalls and more frames (issue #28, docs/bench/flight.md); with
-    ``VOLVIZ_VIEWPORT=qt``, and off X11, pyvistaqt's ``QtInteractor``."""
-    from PySide6.QtWidgets import QApplication
-    from pyvistaqt import QtInteractor
-
-    if viewport_kind(QApplication.platformName(), os.environ.get("VOLVIZ_VIEWPORT", "")) == "native":
-        from .native_viewport import NativeViewport
-
-        return NativeViewport(parent)
-    return QtInteractor(parent, auto_update=False)  # we render when something changed, never on a timer
-
-
-def _import_gui_thread_modules() -> None:
-    """Import at start-up what the GUI thread later imports inside functions: a first ``import vtk`` (the natural
-    scene's overlay) blocked the event loop in the middle of loading a scene (docs/bench/docstring-figures.md)."""
-    import volviz.nature.nature_scene  # noqa: F401
-    import volviz.render.controller  # noqa: F401
-    import volviz.render.pt_prop  # noqa: F401
-    import volviz.render.scene_builder  # noqa: F401
-    import volviz.render.vtk_facade  # noqa: F401
-    import pyvista
-    import scipy.optimize  # noqa: F401 - the iso-spectrum fit's least squares, when an isosurface is first shown
-
-    from volviz.io.registry import reader_specs
-
-    # every reader's file-name patterns resolved now (meshio's extensions import meshio, the plugins' entry points are
-    # read): a first File > Open did it on the GUI thread, 80-150 ms of a blocked event loop while a session loaded
-    for spec in reader_specs():
-        spec.globs()
-
-    # pyvista asks once per process whether this system can plot (it runs ``xset -q``) when the first offscreen plotter
-    # of an export is made: ~60 ms of a blocked event loop at the start of the first export, here at start-up instead
-    pyvista.system_supports_plotting()
 
 
 class MainWindow(WindowBase, QMainWindow):
@@ -120,7 +74,7 @@ class MainWindow(WindowBase, QMainWindow):
                  recovery_dir: Optional[Path] = None):
         super().__init__(parent)
         self.setWindowTitle("volviz")
-        _import_gui_thread_modules()
+        import_gui_thread_modules()
         self.collector = GuiThreadCollector(self)  # cycles are freed on this thread, never in a worker
         self.settings = settings or QSettings("volviz", "volviz")
         self.plotter = make_plotter(self)

@@ -38,7 +38,7 @@ def native(monkeypatch: pytest.MonkeyPatch) -> None:
 
 
 def test_the_viewport_is_native_on_x11_unless_the_setting_says_qt(caplog: pytest.LogCaptureFixture) -> None:
-    from volviz_app.window import viewport_kind
+    from volviz_app.viewport_types import viewport_kind
 
     assert [viewport_kind("xcb", setting) for setting in ("", "native", "qt")] == ["native", "native", "qt"]
     for platform in ("wayland", "offscreen", "windows", "cocoa"):   # a native GLX window needs X11
