@@ -193,6 +193,11 @@ def _bar_scale(session: Session, comp: Any, datasets: dict[str, Any]) -> tuple[A
     return ctf, labels, style.format or ("%.3g" if log else label_format(lo, hi)), log
 
 
+BAR_LEFT = 0.84             # the scalar bar's left edge (normalized viewport), its color strip's too
+TITLE_TOP = (BAR_LEFT, 0.86)   # the title's place (normalized viewport, bottom left of the text): over the bar
+TITLE_RIGHT = 0.98          # the furthest right its end may reach (normalized viewport)
+
+
 def _add_scalar_bar(plotter: Any, session: Session, comp: Any, datasets: dict[str, Any],
                     color: tuple[float, float, float]) -> None:
     # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
@@ -208,20 +213,20 @@ def _add_scalar_bar(plotter: Any, session: Session, comp: Any, datasets: dict[st
     bar.UseCustomLabelsOn()
     bar.SetLabelFormat(fmt)
     bar.SetOrientationToVertical()          # at the right edge, as ParaView places it
-    bar.SetPosition(0.84, 0.12)
+    bar.SetPosition(BAR_LEFT, 0.12)
     bar.SetWidth(0.12)
     bar.SetHeight(0.72)
     bar.SetMaximumWidthInPixels(110)
     bar.SetBarRatio(0.25)
     bar.UnconstrainedFontSizeOn()
     label = bar.GetLabelTextProperty()
-    # the title is a text of its own, right-aligned above the bar: a long array name runs left, not off the window
+    # the title is a text of its own above the bar, placed at each render (``_place_title``)
     heading = vtk.vtkTextActor()
     heading.SetInput(str(title))
     heading.GetPositionCoordinate().SetCoordinateSystemToNormalizedViewport()
-    heading.SetPosition(0.98, 0.86)
+    heading.SetPosition(TITLE_TOP[0], TITLE_TOP[1])
     heading_text = heading.GetTextProperty()
-    heading_text.SetJustificationToRight()
+    heading_text.SetJustificationToLeft()
     heading_text.SetVerticalJustificationToBottom()
     for text in (heading_text, label):
         text.SetColor(*color)
@@ -231,6 +236,23 @@ def _add_scalar_bar(plotter: Any, session: Session, comp: Any, datasets: dict[st
         text.SetFontSize(12)
     plotter.add_actor(bar, name=SCALAR_BAR_NAME, reset_camera=False, render=False, pickable=False)
     plotter.add_actor(heading, name=SCALAR_BAR_TITLE_NAME, reset_camera=False, render=False, pickable=False)
+    renderer = plotter.renderer
+    tag = renderer.AddObserver("StartEvent", lambda *_: _place_title(heading, renderer))
+    heading.volviz_observer = (renderer, tag)   # removed with the title (``_remove_scalar_bar``)
+
+
+def _place_title(heading: Any, renderer: Any) -> None:
+    """The scalar bar's title left-aligned with the bar, as ParaView draws it over its bar; a title too long for
+    the room from there to ``TITLE_RIGHT`` is moved left until its end is there (it runs left, not off the window).
+    Done at each render: the bar's pixel place and the title's pixel width depend on the window's size. Before, the
+    title was right-aligned at ``TITLE_RIGHT``, 60-100 pixels right of the bar (issue #28)."""
+    width = renderer.GetSize()[0]
+    if width <= 0:
+        return
+    box = [0.0] * 4
+    heading.GetBoundingBox(renderer, box)
+    room = TITLE_RIGHT - (box[1] - box[0]) / width
+    heading.SetPosition(max(0.0, min(TITLE_TOP[0], room)), TITLE_TOP[1])
 
 
 def _shows_array(comp: Component, datasets: dict[str, LoadedDataset]) -> bool:
@@ -277,6 +299,10 @@ def _readable(spec: str) -> str:
 
 
 def _remove_scalar_bar(plotter: Any) -> None:
+    heading = plotter.renderer.actors.get(SCALAR_BAR_TITLE_NAME)
+    if heading is not None and hasattr(heading, "volviz_observer"):
+        owner, tag = heading.volviz_observer
+        owner.RemoveObserver(tag)
     plotter.remove_actor(SCALAR_BAR_NAME, render=False)
     plotter.remove_actor(SCALAR_BAR_TITLE_NAME, render=False)
 
