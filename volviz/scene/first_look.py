@@ -41,7 +41,10 @@ def first_look(session: Session, datasets: dict[str, LoadedDataset], t: Optional
         dataset = component_dataset(comp, datasets)
         if is_lod(dataset):   # a volume at a level of detail: always drawn as a volume, nothing to say
             continue
-        path = next((ref.path for ref in session.datasets if ref.id == comp.dataset), comp.dataset)
+        # the path its reader read (as the user gave it, absolute from a session file; a series' first file), as
+        # read warnings name it: the stored path is relative to the session file (issue #28: "../../work/shared/...")
+        source = (dataset.frame(0) if isinstance(dataset, TimeSeries) else dataset).source
+        path = source or next((ref.path for ref in session.datasets if ref.id == comp.dataset), comp.dataset)
         said = _SAID.setdefault(dataset, set)
         if isinstance(dataset, TimeSeries):
             first = float(dataset.times[0])
