@@ -9,7 +9,7 @@ from typing import Optional
 
 import numpy as np
 from PySide6.QtCore import QPointF, QRectF, Qt, Signal
-from PySide6.QtGui import QBrush, QColor, QLinearGradient, QMouseEvent, QPainter, QPainterPath, QPaintEvent, QPen
+from PySide6.QtGui import QColor, QImage, QMouseEvent, QPainter, QPainterPath, QPaintEvent, QPen
 from PySide6.QtWidgets import QSizePolicy, QWidget
 
 from volviz.optics.log_scale import axis_fraction, axis_value, log_ticks
@@ -20,6 +20,7 @@ GESTURES = ("Click: add a point · drag a point: move it · right-click: remove 
 POINT_RADIUS = 5.0
 MARGIN = 8.0
 COLOR_BAR_HEIGHT = 18.0
+MIN_HEIGHT = 160          # the canvas's least height, pixels
 
 
 class TransferFunctionCanvas(QWidget):
@@ -31,7 +32,7 @@ class TransferFunctionCanvas(QWidget):
 
     def __init__(self, parent: Optional[QWidget] = None):
         super().__init__(parent)
-        self.setMinimumSize(260, 160)
+        self.setMinimumSize(260, MIN_HEIGHT)
         self.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Expanding)
         self.setMouseTracking(True)
         self.scalars = np.array([0.0, 1.0])
@@ -115,11 +116,23 @@ class TransferFunctionCanvas(QWidget):
             painter.setPen(QPen(QColor(255, 220, 0) if i == self.selected else QColor(250, 250, 250), 1.5))
             painter.drawEllipse(self.to_screen(s, rho), POINT_RADIUS, POINT_RADIUS)
         bar = QRectF(r.left(), r.bottom() + MARGIN, r.width(), COLOR_BAR_HEIGHT)
-        gradient = QLinearGradient(bar.topLeft(), bar.topRight())
-        for f, c in zip(axis_fraction(self.scalars, lo, hi, self.log_floor), self.colors):
-            gradient.setColorAt(float(np.clip(f, 0, 1)), QColor.fromRgbF(*np.clip(c, 0, 1)))
-        painter.fillRect(bar, QBrush(gradient))
+        row = self.bar_colors(int(round(bar.width())))
+        data = row.tobytes()               # kept while the image that reads it is drawn
+        image = QImage(data, row.shape[0], 1, 3 * row.shape[0], QImage.Format.Format_RGB888)
+        painter.drawImage(bar, image)      # one texel a pixel column: no smoothing to blur it
         painter.end()
+
+    def bar_colors(self, columns: int) -> np.ndarray:
+        """(columns, 3) uint8: the color bar's color at each pixel column's centre, the control points' colors
+        interpolated along the axis (linear, or log10 with ``log_floor``) as the volume is colored. Qt's
+        QLinearGradient looked colors up in a 1024-entry table, a third of a pixel apart on a 338-pixel bar, so on a
+        steep stretch (the neghip flow's 192 .. 255 under a log axis: ~8 levels a pixel) a column showed a color 3
+        levels off its centre's at one bar width and not another (issue #28: seen when the dock lost its scroll bar)."""
+        lo, hi = self._view_range()
+        stops = np.clip(axis_fraction(self.scalars, lo, hi, self.log_floor), 0.0, 1.0)
+        centres = (np.arange(max(columns, 1)) + 0.5) / max(columns, 1)
+        rgb = np.stack([np.interp(centres, stops, np.clip(self.colors[:, k], 0.0, 1.0)) for k in range(3)], axis=1)
+        return np.ascontiguousarray(np.rint(rgb * 255.0).astype(np.uint8))
 
     def _paint_log_ticks(self, painter: QPainter, r: QRectF) -> None:
         """The log axis's ticks (``log_ticks`` from the floor to the top of the range): a line and its value each."""
