@@ -20,7 +20,8 @@ GESTURES = ("Click: add a point · drag a point: move it · right-click: remove 
 POINT_RADIUS = 5.0
 MARGIN = 8.0
 COLOR_BAR_HEIGHT = 18.0
-MIN_HEIGHT = 160          # the canvas's least height, pixels
+MIN_HEIGHT = 110          # the canvas's least height, pixels: the dock then fits its column without scrolling at
+#                           1280x740 and 1024x572 (issue #28: at 160 it scrolled and cut its last hint line)
 
 
 class TransferFunctionCanvas(QWidget):
