@@ -76,11 +76,15 @@ class TransferFunctionCanvas(QWidget):
         return (float(np.clip(s, lo, hi)), float(np.clip(rho, 0.0, self.rho_view)))
 
     def point_at(self, pos: QPointF) -> Optional[int]:
+        """The control point nearest ``pos`` within reach of a click, or None: the nearest, not the first in reach,
+        so that a click on a point of a dense function (a 33-point preset in a short canvas) takes that point and not
+        its neighbour."""
+        nearest, reach = None, 2.5 * POINT_RADIUS
         for i in range(len(self.scalars)):
-            p = self.to_screen(self.scalars[i], self.extinction[i])
-            if (p - pos).manhattanLength() <= 2.5 * POINT_RADIUS:
-                return i
-        return None
+            distance = (self.to_screen(self.scalars[i], self.extinction[i]) - pos).manhattanLength()
+            if distance <= reach:
+                nearest, reach = i, distance
+        return nearest
 
     # -- painting ---------------------------------------------------------------------------------------------------
     def paintEvent(self, event: QPaintEvent) -> None:
