@@ -33,6 +33,16 @@ def scrolled(widget: QWidget) -> QScrollArea:
     area.setWidget(widget)
     area.setWidgetResizable(True)
     area.setFrameShape(QFrame.Shape.NoFrame)
+    scrolls_focus = area.focusPolicy()
+
+    def tab_stop_when_scrolling(low: int, high: int) -> None:
+        """A Tab stop (keys then scroll it) only while there is something to scroll: else the area is all its
+        widget, and the focus on it would show nowhere; its controls take the focus either way."""
+        area.setFocusPolicy(scrolls_focus if high > low else Qt.FocusPolicy.NoFocus)
+
+    bar = area.verticalScrollBar()
+    bar.rangeChanged.connect(tab_stop_when_scrolling)
+    tab_stop_when_scrolling(bar.minimum(), bar.maximum())
     area.setHorizontalScrollBarPolicy(Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
     scrollbar = area.verticalScrollBar().sizeHint().width()
     area.setMinimumWidth(widget.minimumSizeHint().width() + scrollbar)
