@@ -208,8 +208,6 @@ class MainWindow(WindowBase, QMainWindow):
                             clearance=fly_clearance(self.session.render.options) * size,
                             obstacle=OpaqueObstacles(self.plotter.renderer))
         self.fly.set_bounds(fly_bounds(bounds, self.plotter.camera.position, terrain))
-        if nature is not None:   # while flying, each full frame also makes the coarse terrain the next move draws
-            nature.keep_coarse = enabled
         self.action_fly.setChecked(enabled)
         self.status_label.setText("Fly mode: W/A/S/D or arrows move, Q/E sink/rise, drag to look, +/- speed"
                                   if enabled else "Orbit mode")

@@ -224,3 +224,27 @@ def test_terrain_texture_is_mip_mapped_on_a_hardware_driver_only(demo) -> None:
         assert texture_filtering(plotter) and NatureView(plotter, demo)._texture.GetMipmap()
     finally:
         plotter.close()
+
+
+def test_a_move_draws_the_coarse_terrain_of_the_last_full_frame(demo, monkeypatch) -> None:
+    """Each full-size frame also makes the terrain at preview detail, and the first ``begin(scale > 1)`` after it (a
+    drag or a flight starts) draws that coarse terrain at once, whatever the mode: drawing the full C-LOD mesh until
+    the first preview came cost 60-150 ms of the GUI thread per frame on llvmpipe with Yukon's 512k triangles, the
+    first seconds of a flight's event-loop gaps over 100 ms (issue #28, docs/bench/flight.md)."""
+    import pyvista as pv
+    import volviz.render.nature_view as nature_view
+
+    monkeypatch.setattr(nature_view, "PREVIEW_TRIANGLES", 1500)
+    size = (160, 120)
+    cam = demo_camera()
+    plotter = pv.Plotter(off_screen=True, window_size=size)
+    try:
+        view = NatureView(plotter, demo, size=size)
+        view.update(cam)
+        full = view.terrain_actor.mapper.GetInput().GetNumberOfCells()
+        view.begin(cam, scale=4)
+        moving = view.terrain_actor.mapper.GetInput().GetNumberOfCells()
+    finally:
+        plotter.close()
+    print(f"full frame {full} triangles, first moving frame {moving}")
+    assert full > 4 * 1500 and 0 < moving < 1.5 * 1500   # (the first fit of the preview detail undershoots here)

@@ -82,7 +82,6 @@ class NatureSceneView(ABC, Generic[FrameT]):
         self.shown_scale = 1          # the preview scale of the overlay shown (``compute``)
         self.preview_detail = 0.25    # the C-LOD resolution factor of previews, fitted to PREVIEW_TRIANGLES
         self._coarse: Any = None      # a full-size frame's terrain at preview detail: drawn from the first move on
-        self.keep_coarse = False      # make ``_coarse`` with each full-size frame (fly mode: the next key moves)
         if scene.terrain is not None and scene.color_map is not None:
             img = np.clip(scene.color_map.transpose(1, 0, 2)[::-1] * 255.0, 0, 255).astype(np.uint8)
             self._texture = pv.Texture(np.ascontiguousarray(img))
@@ -247,7 +246,7 @@ class NatureView(NatureSceneView[np.ndarray]):
         if mesh is not None:
             if progress is not None:
                 progress(0.3, "terrain")
-            if self.keep_coarse and not preview and not self.full:   # the view's preview terrain, for the next move
+            if not preview and not self.full:   # the view's preview terrain, drawn from the next move on (``begin``)
                 coarse = self._preview_mesh(cam, size)
                 self._coarse = coarse if coarse is not None and coarse.n_triangles else None
             depth, _ = render_terrain(mesh.points, mesh.triangles, mesh.tcoords, cam, size, self.scene._pyramid)
