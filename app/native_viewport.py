@@ -69,6 +69,7 @@ class NativeViewport(QVTKRenderWindowInteractor, BasePlotter):  # type: ignore[m
         self.setAttribute(Qt.WidgetAttribute.WA_NativeWindow)
         self.interactor = self
         self._in_paint = False
+        self._magnified = False   # whether a magnifying blit was drawn yet (``_magnify``)
         self.frames: ReducedFrames | None = None
         self.setAcceptDrops(True)   # the window's file drop filter takes them
         self.ren_win = self.GetRenderWindow()
@@ -105,6 +106,8 @@ class NativeViewport(QVTKRenderWindowInteractor, BasePlotter):  # type: ignore[m
                 self._reduced_render(frames)
             else:
                 self._Iren.Render()
+                if not self._magnified:   # the first reduced paint's one-time cost, now, before anything moves
+                    self._magnify((1, 1), (2, 2))
         finally:
             self._in_paint = False
 
@@ -121,18 +124,27 @@ class NativeViewport(QVTKRenderWindowInteractor, BasePlotter):  # type: ignore[m
             self._Iren.Render()
             frames.renders += 1
             frames.last_size = (w, h)
-            rw.MakeCurrent()
-            state = rw.GetState()
-            state.PushDrawFramebufferBinding()
-            state.vtkglBindFramebuffer(_GL_DRAW_FRAMEBUFFER, 0)
-            state.vtkglDrawBuffer(_GL_BACK)
-            rw.BlitDisplayFramebuffer(0, 0, 0, w, h, 0, 0, full_w, full_h, _GL_COLOR_BUFFER_BIT, _GL_LINEAR)
-            state.PopDrawFramebufferBinding()
+            self._magnify((w, h), (full_w, full_h))
             _GLX.swap_current()
         finally:
             vtkRenderWindow.SetSize(rw, full_w, full_h)
             rw.SetFrameBlitModeToBlitToHardware()
             rw.SetDoubleBuffer(1)
+
+    def _magnify(self, size: tuple[int, int], to: tuple[int, int]) -> None:
+        """Blit the bottom-left ``size`` of VTK's display framebuffer, filtered linearly, over ``to`` of the window's
+        back buffer (not swapped). A software OpenGL compiles its blit shader at the first such blit: in the first
+        flight frame that made an event-loop gap over 100 ms, so the first full paint also draws one, of 1 pixel to
+        2x2, which the next frame covers (docs/bench/flight.md)."""
+        rw = self._RenderWindow
+        rw.MakeCurrent()
+        state = rw.GetState()
+        state.PushDrawFramebufferBinding()
+        state.vtkglBindFramebuffer(_GL_DRAW_FRAMEBUFFER, 0)
+        state.vtkglDrawBuffer(_GL_BACK)
+        rw.BlitDisplayFramebuffer(0, 0, 0, size[0], size[1], 0, 0, to[0], to[1], _GL_COLOR_BUFFER_BIT, _GL_LINEAR)
+        state.PopDrawFramebufferBinding()
+        self._magnified = True
 
     def render(self) -> None:  # type: ignore[override]  # BasePlotter.render, as QtInteractor's
         """``BasePlotter.render`` now (on the GUI thread), never after ``close``."""
