@@ -111,9 +111,10 @@ def volume_grid(dataset: Union[Dataset, TimeSeries, pv.DataSet]) -> pv.DataSet:
     grid = dataset.to_pyvista() if isinstance(dataset, (TetMesh, UnstructuredMesh, CurvilinearGrid,
                                                         RegularVolume, Image2D)) else dataset
     scalars = grid.active_scalars
-    if scalars is not None and np.asarray(scalars).ndim > 1:
-        grid.point_data["magnitude"] = np.linalg.norm(np.asarray(scalars), axis=1)
-        grid.set_active_scalars("magnitude")
+    if scalars is not None and np.asarray(scalars).ndim > 1:   # beside the vectors: on the points or the cells
+        cells = grid.active_scalars_info.association.name == "CELL"
+        (grid.cell_data if cells else grid.point_data)["magnitude"] = np.linalg.norm(np.asarray(scalars), axis=1)
+        grid.set_active_scalars("magnitude", preference="cell" if cells else "point")
     return grid
 
 
