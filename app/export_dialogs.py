@@ -6,14 +6,14 @@ whatever the window's shape, or the window's size times a scale factor, and a tr
 nothing is drawn). Its format follows the file's extension (PNG, JPEG, TIFF), and any other extension, a size this
 machine cannot render, or transparency in a JPEG is refused with a message before rendering
 (``volviz.render.export``). A movie is an orbit of the current view (no recorded path needed), a recorded camera
-path, or a run through the time series."""
+path, or a run through the time series, at the size and frame rate its dialog (``MovieDialog``) sets."""
 from __future__ import annotations
 
 import os
 from typing import Any, Optional
 
-from PySide6.QtWidgets import (QCheckBox, QDialog, QDialogButtonBox, QDoubleSpinBox, QFormLayout, QHBoxLayout,
-                               QInputDialog, QLabel, QSpinBox, QWidget)
+from PySide6.QtWidgets import (QCheckBox, QComboBox, QDialog, QDialogButtonBox, QDoubleSpinBox, QFormLayout,
+                               QHBoxLayout, QLabel, QSpinBox, QWidget)
 
 from volviz.argtypes import MAX_IMAGE_SIDE
 
@@ -22,6 +22,29 @@ IMAGE_FILTER = ("Images (*.png *.jpg *.jpeg *.tif *.tiff);;PNG image (*.png);;JP
 MOVIE_FILTER = "MP4 video (*.mp4);;QuickTime movie (*.mov);;Folder of PNG frames (*)"
 ORBIT = "Orbit around the current view"
 THROUGH_TIME = "Through time"
+MOVIE_FPS = 24.0
+
+
+def size_boxes(size: tuple[int, int], least: int = 1, step: int = 1) -> tuple[QSpinBox, QSpinBox, QHBoxLayout]:
+    """Width and height boxes (``least`` .. ``MAX_IMAGE_SIDE`` pixels) at ``size``, and the row that shows them."""
+    boxes = QSpinBox(), QSpinBox()
+    row = QHBoxLayout()
+    for box, value in zip(boxes, size):
+        box.setRange(least, MAX_IMAGE_SIDE)
+        box.setSingleStep(step)
+        box.setSuffix(" px")
+        box.setValue(int(value))
+    row.addWidget(boxes[0])
+    row.addWidget(QLabel("x"))
+    row.addWidget(boxes[1])
+    return boxes[0], boxes[1], row
+
+
+def ok_cancel(dialog: QDialog) -> QDialogButtonBox:
+    buttons = QDialogButtonBox(QDialogButtonBox.StandardButton.Ok | QDialogButtonBox.StandardButton.Cancel)
+    buttons.accepted.connect(dialog.accept)
+    buttons.rejected.connect(dialog.reject)
+    return buttons
 
 
 def scaled_size(viewport: tuple[int, int], scale: float) -> tuple[int, int]:
@@ -38,11 +61,7 @@ class ScreenshotDialog(QDialog):
         super().__init__(parent)
         self.setWindowTitle("Export screenshot")
         self.viewport = (int(viewport[0]), int(viewport[1]))
-        self.width_box, self.height_box = QSpinBox(), QSpinBox()
-        for box, value in ((self.width_box, size[0]), (self.height_box, size[1])):
-            box.setRange(1, MAX_IMAGE_SIDE)
-            box.setSuffix(" px")
-            box.setValue(int(value))
+        self.width_box, self.height_box, size_row = size_boxes(size)
         self.of_window = QCheckBox(f"The window's size ({self.viewport[0]}x{self.viewport[1]}) times")
         self.scale = QDoubleSpinBox()
         self.scale.setRange(0.25, 8.0)
@@ -50,16 +69,10 @@ class ScreenshotDialog(QDialog):
         self.scale.setValue(2.0)
         self.scale.setSuffix("x")
         self.transparent = QCheckBox("Transparent background (PNG, TIFF)")
-        size_row = QHBoxLayout()
-        size_row.addWidget(self.width_box)
-        size_row.addWidget(QLabel("x"))
-        size_row.addWidget(self.height_box)
         window_row = QHBoxLayout()
         window_row.addWidget(self.of_window)
         window_row.addWidget(self.scale)
-        buttons = QDialogButtonBox(QDialogButtonBox.StandardButton.Ok | QDialogButtonBox.StandardButton.Cancel)
-        buttons.accepted.connect(self.accept)
-        buttons.rejected.connect(self.reject)
+        buttons = ok_cancel(self)
         self.ok_button = buttons.button(QDialogButtonBox.StandardButton.Ok)
         form = QFormLayout(self)
         form.addRow("Size:", size_row)
@@ -84,13 +97,52 @@ class ScreenshotDialog(QDialog):
         return (self.width_box.value(), self.height_box.value()), self.transparent.isChecked()
 
 
+class MovieDialog(QDialog):
+    """Which movie (one of ``choices``), its size (the render settings' export size at first, even sides for the
+    video encoder) and frames per second; ``chosen()`` reads them. The movie's length is the orbit's turn, the
+    camera path's duration or the timeline's playback, so the frame rate sets how many frames are rendered."""
+
+    def __init__(self, parent: QWidget, choices: list[str], label: str, size: tuple[int, int]) -> None:
+        super().__init__(parent)
+        self.setWindowTitle("Export movie")
+        self.label = QLabel(label)
+        self.combo = QComboBox()
+        self.combo.addItems(choices)
+        self.width_box, self.height_box, size_row = size_boxes((size[0] + size[0] % 2, size[1] + size[1] % 2),
+                                                               least=16, step=2)
+        self.fps = QDoubleSpinBox()
+        self.fps.setRange(1.0, 120.0)
+        self.fps.setDecimals(1)
+        self.fps.setValue(MOVIE_FPS)
+        self.fps.setSuffix(" frames/s")
+        form = QFormLayout(self)
+        form.addRow(self.label)
+        form.addRow(self.combo)
+        form.addRow("Size:", size_row)
+        form.addRow("Frame rate:", self.fps)
+        form.addRow(ok_cancel(self))
+
+    def labelText(self) -> str:   # noqa: N802 - as QInputDialog's, which this dialog replaced
+        return self.label.text()
+
+    def comboBoxItems(self) -> list[str]:   # noqa: N802
+        return [self.combo.itemText(i) for i in range(self.combo.count())]
+
+    def setTextValue(self, text: str) -> None:   # noqa: N802
+        self.combo.setCurrentText(text)
+
+    def chosen(self) -> tuple[str, tuple[int, int], float]:
+        """(the movie, its size in pixels, frames per second)."""
+        return self.combo.currentText(), (self.width_box.value(), self.height_box.value()), self.fps.value()
+
+
 class ExportDialogs:
     """The export menu entries of ``window`` (``ask_file``, ``export_screenshot``, ``export_movie``, ``show_error``).
     The open choice of movie is kept as ``movie_dialog``."""
 
     def __init__(self, window: Any) -> None:
         self.window = window
-        self.movie_dialog: Optional[QInputDialog] = None
+        self.movie_dialog: Optional[MovieDialog] = None
         self.screenshot_dialog: Optional[ScreenshotDialog] = None
 
     def refused(self, path: str | os.PathLike, movie: bool = False, size: Optional[tuple[int, int]] = None,
@@ -147,13 +199,16 @@ class ExportDialogs:
         through_time = bool(controller is not None and controller.time_series())
         return [ORBIT] + list(self.window.session.camera_paths) + ([THROUGH_TIME] if through_time else [])
 
-    def movie(self, path: str | os.PathLike, choice: str) -> bool:
-        """Export the movie ``choice`` (``movie_choices``) to ``path`` (False: the name was refused)."""
-        if self.refused(path, movie=True):
+    def movie(self, path: str | os.PathLike, choice: str, size: Optional[tuple[int, int]] = None,
+              fps: float = MOVIE_FPS) -> bool:
+        """Export the movie ``choice`` (``movie_choices``) to ``path`` at ``size`` (default: the render settings'
+        export size) and ``fps`` (False: the name or size was refused)."""
+        if self.refused(path, movie=True, size=size):
             return False
         orbit, through_time = choice == ORBIT, choice == THROUGH_TIME
-        self.window.export_runs.export_movie(path, None if orbit or through_time else choice, through_time,
-                                             orbit=orbit, duration=self.playback_seconds() if through_time else None)
+        self.window.export_runs.export_movie(path, None if orbit or through_time else choice, through_time, fps=fps,
+                                             size=size, orbit=orbit,
+                                             duration=self.playback_seconds() if through_time else None)
         return True
 
     def playback_seconds(self) -> float:
@@ -163,18 +218,19 @@ class ExportDialogs:
         timeline = self.window.timeline
         return max(len(timeline.steps) - 1, 1) / float(timeline.speed.value())
 
-    def ask_movie(self) -> QInputDialog:
-        """Which movie (non-blocking), then where to write it."""
-        dialog = QInputDialog(self.window)
-        dialog.setWindowTitle("Export movie")
+    def ask_movie(self) -> MovieDialog:
+        """Which movie, its size and frame rate (non-blocking ``MovieDialog``), then where to write it."""
         choices = self.movie_choices()
-        dialog.setLabelText(f"Movie ({THROUGH_TIME.lower()}: {self.playback_seconds():.3g} s at the timeline's speed):"
-                            if THROUGH_TIME in choices else "Movie:")
-        dialog.setComboBoxItems(choices)
-        dialog.setComboBoxEditable(False)
-        dialog.textValueSelected.connect(lambda choice: self.window.ask_file(
-            "Export movie", MOVIE_FILTER, lambda path: self.movie(path, choice), save=True,
-            default_name="volviz.mp4"))
+        label = (f"Movie ({THROUGH_TIME.lower()}: {self.playback_seconds():.3g} s at the timeline's speed):"
+                 if THROUGH_TIME in choices else "Movie:")
+        dialog = MovieDialog(self.window, choices, label, self.screenshot_size())
+
+        def chosen() -> None:
+            choice, size, fps = dialog.chosen()
+            self.window.ask_file("Export movie", MOVIE_FILTER, lambda path: self.movie(path, choice, size, fps),
+                                 save=True, default_name="volviz.mp4")
+
+        dialog.accepted.connect(chosen)
         dialog.open()
         self.movie_dialog = dialog
         return dialog

@@ -7,9 +7,11 @@ from pathlib import Path
 import imageio.v3 as iio
 import pytest
 from PIL import Image
+from PySide6.QtCore import Qt
 
 from conftest import data_file
 from test_app_window import wait_loaded, window  # noqa: F401  (the fixture)
+from test_flow_export import choose_file
 from volviz_app.export_dialogs import ORBIT
 from volviz_app.window import MainWindow
 
@@ -51,21 +53,26 @@ def test_unknown_image_format_is_refused_with_a_message(qtbot, neghip_window: Ma
 
 
 def test_orbit_movie_needs_no_recorded_path(qtbot, neghip_window: MainWindow, tmp_path: Path) -> None:
+    """File > Export Movie, the orbit (no recorded path), 64x48 at 1 frame per second typed into the dialog: a folder
+    of 8 frames (one turn of 8 s) of that size, the camera going round (the dialog had no size or frame rate: the
+    movie took the render settings' size at 24 frames per second)."""
     window = neghip_window
     assert not window.session.camera_paths
     dialog = window.export_dialogs.ask_movie()
     qtbot.waitUntil(dialog.isVisible)
     assert dialog.comboBoxItems()[0] == ORBIT
+    assert (dialog.width_box.value(), dialog.height_box.value(), dialog.fps.value()) == (240, 100, 24.0)
     dialog.setTextValue(ORBIT)
+    for box, text in ((dialog.width_box, "64"), (dialog.height_box, "48"), (dialog.fps, "1")):
+        box.setFocus()
+        qtbot.keyClick(box, Qt.Key.Key_A, Qt.KeyboardModifier.ControlModifier)
+        qtbot.keyClicks(box, text)
     dialog.accept()
-    qtbot.waitUntil(lambda: getattr(window, "file_dialog", None) is not None and window.file_dialog.isVisible())
-    assert window.file_dialog.windowTitle() == "Export movie"
-    window.file_dialog.reject()
-
     frames = tmp_path / "orbit"
-    window.export_movie(frames, None, through_time=False, fps=1.0, size=(64, 48), orbit=True)
+    choose_file(qtbot, window, "Export movie", frames)
     qtbot.waitUntil(lambda: window.export_result is not None, timeout=120000)
     assert window.export_result, window.status_label.text()
     written = sorted(frames.glob("frame_*.png"))
     assert len(written) == 8  # one turn of 8 s at 1 frame per second
+    assert iio.imread(written[0]).shape[:2] == (48, 64)
     assert (iio.imread(written[0]) != iio.imread(written[2])).any()  # the camera went round
