@@ -261,7 +261,7 @@ class ViewScheduler:
         if change.what == "transfer_function":   # the isosurfaces' CPU overlay holds the volume in front of them
             if not self.refresh_views([comp, "iso-overlay"] if comp else None, estimate=not change.preview,
                                       scale=MOVING_SCALE if change.preview else 1):
-                self.render_scene()
+                self.render_edit(change.preview)
             return
         self.render_scene()
         if change.what == "iso_mode":
@@ -271,6 +271,21 @@ class ViewScheduler:
                                 if view.kind != "nature" and key.split(":", 1)[-1] not in controller.pending])
         elif comp not in controller.pending:
             self.refresh_views([comp, "iso-overlay"])
+
+    def render_edit(self, preview: bool) -> None:
+        """Draw an edit now: a ``preview`` (a TF point being dragged) at VTK's interactive rate, as a camera drag's
+        frames (its ray casters cast fewer rays: a still frame of a regular volume holds the event loop well over
+        100 ms on a software OpenGL, docs/bench/flow-gaps.md), the finished edit at the rate the window had."""
+        ren_win = self.plotter.ren_win
+        if not preview or ren_win is None:
+            self.render_scene()
+            return
+        rate = ren_win.GetDesiredUpdateRate()
+        interactive_rate(self.plotter, True)
+        try:
+            self.render_scene()
+        finally:
+            ren_win.SetDesiredUpdateRate(rate)
 
     def refresh_nature(self, settled: Optional[Callable[[], None]] = None, scale: int = 1) -> None:
         """Re-compute the natural scene's view-dependent parts (C-LOD terrain, fog and clouds) for the newest camera
