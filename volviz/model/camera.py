@@ -18,6 +18,8 @@ from typing import TYPE_CHECKING, Protocol, Sequence, TypedDict, Union
 
 import numpy as np
 
+from volviz.model.extent import point_extent
+
 if TYPE_CHECKING:   # type-only imports for the signatures
     import pyvista as pv
 
@@ -187,7 +189,7 @@ class Camera:
               view_angle: float = 30.0, parallel: bool = False, up: Sequence[float] = (0.0, 0.0, 1.0)) -> "Camera":
         """A camera looking at the centre of ``points`` from ``distance`` bounding radii (angles in degrees)."""
         pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
-        lo, hi = pts.min(axis=0), pts.max(axis=0)
+        lo, hi = point_extent(pts)
         centre = 0.5 * (lo + hi)
         radius = 0.5 * float(np.linalg.norm(hi - lo)) or 1.0
         a, e = math.radians(azimuth), math.radians(elevation)

@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING, Any, Mapping, Optional
 
 import numpy as np
 
+from volviz.model.extent import point_extent
 from volviz.scene.lod import lod_bounds
 
 if TYPE_CHECKING:   # type-only imports for the signatures
@@ -67,7 +68,7 @@ def union(boxes: list[Bounds]) -> Optional[Bounds]:
 
 
 def points_bounds(points: np.ndarray) -> Bounds:
-    lo, hi = points.min(axis=0), points.max(axis=0)
+    lo, hi = point_extent(points)
     return (float(lo[0]), float(hi[0]), float(lo[1]), float(hi[1]), float(lo[2]), float(hi[2]))
 
 

@@ -26,6 +26,7 @@ import numpy as np
 from volviz.iso.composite import AMBIENT, MODES
 from volviz.iso.extract import IsoMesh
 from volviz.iso.spectrum import fit_spectrum
+from volviz.model.extent import point_extent
 from volviz.render.gl import glenum, shader_source
 from volviz.render.image_overlay import hold_single_sample, release_single_sample, window_size
 from volviz.render.iso_overlay import IsoModeView
@@ -128,7 +129,7 @@ class GLIsoSurfaces:
                        ren.GetOcclusionRatio())
         pts = [m.points for m in self.meshes if len(m.points)]
         allp = np.concatenate(pts) if pts else np.zeros((1, 3))
-        self.centre = 0.5 * (allp.min(axis=0) + allp.max(axis=0))
+        self.centre = 0.5 * sum(point_extent(allp))
         opaque = [m for m in self.meshes if m.style.opaque and m.n_triangles]
         clear = [m for m in self.meshes if not m.style.opaque and m.n_triangles]
         self._fbo: Any = None

@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING, Any, Sequence
 import numpy as np
 
 from volviz.model.datasets import TetMesh
+from volviz.model.extent import point_extent
 from volviz.render.gl import ScenePass, resolve_polydata, set_ray_uniforms, shader_source, texel_array, with_defines
 from volviz.render.gl_pt_mesh import cell_texels, tet_polydata, texels_per_cell
 from volviz.render.gl_pt_order import CellOrder
@@ -152,7 +153,7 @@ class GLPTVolume(CellOrder, PTView):
         self.resolve_mapper = vtk.vtkOpenGLPolyDataMapper()
         self.resolve_mapper.ScalarVisibilityOff()
         pts = self.topo.points
-        self.resolve_mapper.SetInputData(resolve_polydata(np.stack([pts.min(axis=0), pts.max(axis=0)], axis=1)))
+        self.resolve_mapper.SetInputData(resolve_polydata(np.stack(point_extent(pts), axis=1)))
         rsp = vtk.vtkShaderProperty()
         rsp.SetVertexShaderCode(shader_source("pt_resolve_vs.glsl"))
         rsp.SetFragmentShaderCode(resolve_shader(False))

@@ -34,6 +34,7 @@ import numpy as np
 
 from volviz.model.camera import Camera
 from volviz.model.datasets import TetMesh
+from volviz.model.extent import point_extent
 from volviz.optics.metrics import max_abs, rmse
 from volviz.render.image_overlay import (OverlayRequest, OverlayView, overlay_rgba8, unpremultiply_rgba8, window_size,
                                          zbuffer_to_depth)
@@ -88,7 +89,7 @@ class PTVolume(OverlayView[UnstructuredRenderStats], PTView):
 
     def _far(self, cam: Camera) -> float:
         p = self.mesh.points
-        lo, hi = p.min(axis=0), p.max(axis=0)
+        lo, hi = point_extent(p)
         corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
         fwd = cam.frame()[2]
         return float(((corners - cam.position) @ fwd).max())

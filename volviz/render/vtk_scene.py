@@ -14,6 +14,7 @@ import numpy as np
 
 from volviz.model import CurvilinearGrid, Image2D, RegularVolume, TetMesh, TimeSeries, UnstructuredMesh, vec3
 from volviz.model.arrays import is_appearance_array, vertex_colors
+from volviz.model.extent import point_extent
 from volviz.model.representation import VOLUME, representation
 from volviz.model.stats import scalar_values
 from volviz.optics import TransferFunction
@@ -140,7 +141,7 @@ def dataset_bounds(dataset: Union[Dataset, TimeSeries]) -> tuple[float, ...]:
     if isinstance(dataset, Image2D) or points is None or not np.size(points):
         return tuple(volume_grid(dataset).bounds)
     flat = np.asarray(points, dtype=np.float64).reshape(-1, 3)
-    lo, hi = flat.min(axis=0), flat.max(axis=0)
+    lo, hi = point_extent(flat)
     return (float(lo[0]), float(hi[0]), float(lo[1]), float(hi[1]), float(lo[2]), float(hi[2]))
 
 

@@ -16,6 +16,7 @@ import numpy as np
 from numba import njit, prange
 
 from volviz.model.datasets import TetMesh
+from volviz.model.extent import point_extent
 from volviz.model.object_cache import ObjectCache
 
 #: local vertex ids of face f (the face opposite vertex f), outward for a positively oriented tetrahedron.
@@ -190,7 +191,7 @@ def build_topology(mesh: TetMesh) -> Topology:
     used = mesh.points[in_cells]
     if not np.all(np.isfinite(used)):
         raise ValueError("TetMesh has non-finite point coordinates")
-    origin = 0.5 * (used.min(axis=0) + used.max(axis=0))
+    origin = 0.5 * sum(point_extent(used))
     pts = np.ascontiguousarray(mesh.points - origin)
     tets = np.ascontiguousarray(mesh.tets, dtype=np.int64).copy()
     m = len(tets)
