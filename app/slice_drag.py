@@ -1,6 +1,7 @@
 """Slices dragged in the 3D view: a left press on a shown plane grabs it (the camera does not move), moving the mouse
 moves the plane along its axis to the grid index nearest the mouse ray (``volviz.render.slices.drag_index``), and
-the release lets go (a closed hand meanwhile). The plane moves through the Slices dock's spin box, so the slider,
+the release lets go (a closed hand meanwhile; the moves are drawn at VTK's interactive rate, the release draws the
+still frame: ``SliceTool.let_go``). The plane moves through the Slices dock's spin box, so the slider,
 the 2D view, the scene and the undo stack (consecutive moves of one plane: one step) follow as for a slider move
 (``volviz_app.slice_tool``)."""
 from __future__ import annotations
@@ -47,6 +48,7 @@ class SliceDrag(QObject):
         if kind == QEvent.Type.MouseButtonRelease and event.button() == Qt.MouseButton.LeftButton:
             self.grabbed = None
             watched.unsetCursor()
+            self.tool.let_go()
             return True
         return False
 

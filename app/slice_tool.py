@@ -5,8 +5,9 @@ first regular volume, sharing that volume's transfer function, so they are saved
 ``volviz render`` draws them. Turning the first plane on adds the component (a document edit, rebuilt in the
 background: ``volviz_app.scene_doc``); moving or toggling a plane afterwards moves the planes of the shown view at
 once (``SlicesView.set_indices``, no rebuild); a plane is also dragged in the 3D view (``volviz_app.slice_drag``,
-through the dock's spin box). Every edit is on the scene's undo stack; consecutive moves of one plane are one
-step. A new transfer function recolours the planes and the 2D views.
+through the dock's spin box); the moves of a plane still held (dragged, or its slider down) are drawn at VTK's
+interactive rate, the still frame once it is let go. Every edit is on the scene's undo stack; consecutive moves of
+one plane are one step. A new transfer function recolours the planes and the 2D views.
 """
 from __future__ import annotations
 
@@ -49,6 +50,9 @@ class SliceTool:
         self.dock.changed.connect(self._changed)
         self._unsubscribe: Optional[Callable[[], None]] = None
         self.drag = SliceDrag(self)
+        self._previewed = False     # the last move was drawn at the interactive rate: the still frame is owed
+        for slider in self.dock.sliders.values():
+            slider.sliderReleased.connect(self.let_go)
 
     # -- what is sliced -----------------------------------------------------------------------------------------------
     def volume_id(self) -> Optional[str]:
@@ -115,8 +119,10 @@ class SliceTool:
             tf = controller.transfer_function(comp_id)
             self.dock.views[axis].show_rgb(slice_image(controller.dataset_of(comp_id), axis, index, tf))
 
-    def show_settings(self, settings: dict[str, Any]) -> None:
-        """Put ``settings`` on the slices component and move the shown planes to them (an undo or redo step)."""
+    def show_settings(self, settings: dict[str, Any], preview: bool = False) -> None:
+        """Put ``settings`` on the slices component and move the shown planes to them (an undo or redo step; a
+        ``preview``: a move of a plane still held, drawn at once at VTK's interactive rate, ``let_go`` draws the
+        still frame)."""
         from volviz.render.slices import slice_indices
 
         comp = self.slices_component()
@@ -129,7 +135,23 @@ class SliceTool:
         self.dock.set_state({axis: settings.get(axis) for axis in AXES})
         self.show_images()
         self.window.set_dirty()
-        self.window.schedule_render()
+        self._previewed = preview
+        if preview:
+            self.window.view_scheduler.render_edit(True)
+        else:
+            self.window.schedule_render()
+
+    def held(self, axis: str) -> bool:
+        """The user still holds the ``axis`` plane: dragged in the 3D view, or its slider pressed."""
+        grabbed = self.drag.grabbed
+        return (grabbed is not None and grabbed[0] == axis) or self.dock.sliders[axis].isSliderDown()
+
+    def let_go(self) -> None:
+        """A held plane is released: the still frame of where it ended (its moves were drawn at the interactive
+        rate)."""
+        if self._previewed:
+            self._previewed = False
+            self.window.schedule_render()
 
     # -- edits ---------------------------------------------------------------------------------------------------------
     def _changed(self, axis: str, index: Optional[int]) -> None:
@@ -140,7 +162,7 @@ class SliceTool:
             return
         before = dict(comp.settings)
         after = {**before, axis: index}
-        self.show_settings(after)
+        self.show_settings(after, preview=self.held(axis))
         self.window.scene_undo_stack.push(MoveSlices(self, before, after, axis))
 
     def _add(self, axis: str, index: int) -> None:

@@ -47,6 +47,19 @@ def _plane_mask(window, volume, k: int) -> np.ndarray:
     return np.all([side >= 0 for side in sides], axis=0) | np.all([side <= 0 for side in sides], axis=0)
 
 
+def z_plane_shown(qtbot, make_window):
+    """neghip with the Slices dock in front and its Z plane checked (at z = 0), the final picture shown: the window
+    and the dock."""
+    window = make_window()
+    open_and_show_dock(qtbot, window, data_file("volumes/neghip.slc"), window.slices_dock)
+    dock = window.slice_tool.dock
+    qtbot.mouseClick(dock.checks["z"], Qt.MouseButton.LeftButton)
+    qtbot.waitUntil(lambda: any(c.type == "slices" for c in window.controller.session.components), timeout=30000)
+    wait_loaded(qtbot, window)
+    wait_settled(qtbot, window)
+    return window, dock
+
+
 def _shown_pixels(view) -> np.ndarray:
     """The 2D view's pixels (what it paints), one per sample: the centre of each zoomed cell."""
     z = view.zoom
@@ -126,13 +139,7 @@ def test_a_z_slice_dragged_in_the_3d_view_moves_its_slider_and_2d_view(qtbot, ma
 
     from flows import drag
 
-    window = make_window()
-    open_and_show_dock(qtbot, window, data_file("volumes/neghip.slc"), window.slices_dock)
-    dock = window.slice_tool.dock
-    qtbot.mouseClick(dock.checks["z"], Qt.MouseButton.LeftButton)
-    qtbot.waitUntil(lambda: any(c.type == "slices" for c in window.controller.session.components), timeout=30000)
-    wait_loaded(qtbot, window)
-    wait_settled(qtbot, window)
+    window, dock = z_plane_shown(qtbot, make_window)
     volume = window.controller.dataset_of("data")
     canvas = window.plotter.interactor
     ratio = canvas.devicePixelRatioF()

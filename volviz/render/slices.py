@@ -156,7 +156,7 @@ class SlicesView(VtkPropView):
             self.actors[axis] = actor
         assembly.SetVisibility(visible)
         self.prop = assembly
-        self.plotter.add_actor(assembly, name=self.comp_id, reset_camera=False)
+        self.plotter.add_actor(assembly, name=self.comp_id, reset_camera=False, render=False)
 
     def set_indices(self, indices: dict[str, int]) -> None:
         """Show the planes ``indices`` (axis -> index) instead (not rendered)."""
