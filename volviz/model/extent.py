@@ -1,8 +1,8 @@
 """The extent of a point set: the least and greatest coordinate on each axis.
 
-numpy's ``points.min(axis=0)`` over an (n, 3) array reduces across rows, which is 10-20x slower than reducing each
-column on its own (docs/bench/flow-gaps.md: 148,877 points, 10.4 ms for min and max against 0.5 ms). Bounds are
-taken on the GUI thread when a scene is installed and for each PT frame, so they use this.
+numpy's ``points.min(axis=0)`` over an (n, 3) array reduces across rows, many times slower than reducing each column
+on its own (measured in docs/bench/flow-gaps.md). Bounds are taken on the GUI thread when a scene is installed and
+for each PT frame, so they use this.
 """
 from __future__ import annotations
 

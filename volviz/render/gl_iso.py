@@ -129,7 +129,8 @@ class GLIsoSurfaces:
                        ren.GetOcclusionRatio())
         pts = [m.points for m in self.meshes if len(m.points)]
         allp = np.concatenate(pts) if pts else np.zeros((1, 3))
-        self.centre = 0.5 * sum(point_extent(allp))
+        lo, hi = point_extent(allp)
+        self.centre = 0.5 * (lo + hi)
         opaque = [m for m in self.meshes if m.style.opaque and m.n_triangles]
         clear = [m for m in self.meshes if not m.style.opaque and m.n_triangles]
         self._fbo: Any = None

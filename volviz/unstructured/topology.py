@@ -191,7 +191,8 @@ def build_topology(mesh: TetMesh) -> Topology:
     used = mesh.points[in_cells]
     if not np.all(np.isfinite(used)):
         raise ValueError("TetMesh has non-finite point coordinates")
-    origin = 0.5 * sum(point_extent(used))
+    lo, hi = point_extent(used)
+    origin = 0.5 * (lo + hi)
     pts = np.ascontiguousarray(mesh.points - origin)
     tets = np.ascontiguousarray(mesh.tets, dtype=np.int64).copy()
     m = len(tets)
