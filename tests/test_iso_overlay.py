@@ -59,6 +59,9 @@ def scene(components: list[Component], clip: ClipSettings | None = None) -> tupl
 
 
 def shot(p: pv.Plotter) -> np.ndarray:
+    """The scene as it is now (an edit adds its props without rendering; pyvista's screenshot of a shown plotter
+    reads the last frame)."""
+    p.render()
     return p.screenshot(None, return_img=True).astype(np.float64) / 255.0
 
 

@@ -115,8 +115,8 @@ def frame_bounds(plotter: pv.BasePlotter, bounds: Optional[Bounds], fill: float 
     left of a ``right_margin`` share of its width (kept for the scalar bar); with no bounds, VTK's own reset."""
     camera = plotter.renderer.GetActiveCamera()
     if bounds is None:
-        plotter.view_isometric()  # type: ignore[call-arg]  # pyvista's _Wrapped decorator hides self from mypy
-        plotter.reset_camera()  # type: ignore[call-arg]  # pyvista's _Wrapped decorator hides self from mypy
+        plotter.view_isometric(render=False)  # type: ignore[call-arg]  # pyvista's _Wrapped decorator hides self from mypy
+        plotter.renderer.reset_camera(render=False)   # (the plotter's own reset_camera renders in any case)
         return
     width, height = plotter.window_size
     aspect = width / max(height, 1)

@@ -44,7 +44,7 @@ def add_isosurface_actors(plotter: pv.BasePlotter, name: str, parts: IsoParts,
     assembly.volviz_shading = parts.settings.shading
     assembly.volviz_translucent = translucent
     assembly.volviz_lod = parts.lod
-    plotter.add_actor(assembly, name=name, reset_camera=False)
+    plotter.add_actor(assembly, name=name, reset_camera=False, render=False)
     return assembly
 
 

@@ -276,7 +276,7 @@ def add_lod_component(plotter: pv.BasePlotter, session: Session, comp: Component
     (the app selects them in the background: ``select`` / ``decode`` / ``show``)."""
     if session.camera is None:
         lo, hi = dataset.node_box((dataset.levels, (0, 0, 0)))
-        plotter.view_isometric()  # type: ignore[call-arg]  # pyvista's _Wrapped decorator hides self from mypy
+        plotter.view_isometric(render=False)  # type: ignore[call-arg]  # pyvista's _Wrapped decorator hides self from mypy
         plotter.renderer.ResetCamera(lo[0], hi[0], lo[1], hi[1], lo[2], hi[2])
         plotter.camera_set = True
     from volviz.render.lod_volume import LodVolume   # the LOD codec's modules: only for compressed volumes

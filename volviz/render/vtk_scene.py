@@ -220,7 +220,7 @@ def volume_prop(plotter: pv.BasePlotter, data: object, regular: bool, tf: Transf
     volume = vtk.vtkVolume()
     volume.SetMapper(mapper)
     volume.SetProperty(vtk_volume_property(tf, opacity, shade and regular))
-    plotter.add_actor(volume, name=name, reset_camera=False)
+    plotter.add_actor(volume, name=name, reset_camera=False, render=False)
     return volume
 
 
@@ -299,19 +299,19 @@ def _add_image(plotter: Any, image: Image2D, name: Optional[str]) -> Any:
         colors = np.asarray(image.data[..., :3], dtype=np.float64).reshape(-1, 3)
         scale = float(image.maxval or max(colors.max(), 1.0))
         grid.point_data["rgb"] = np.clip(colors / scale * 255.0, 0, 255).astype(np.uint8)
-        return plotter.add_mesh(grid, scalars="rgb", rgb=True, name=name, reset_camera=False)
+        return plotter.add_mesh(grid, scalars="rgb", rgb=True, name=name, reset_camera=False, render=False)
     values = np.asarray(grid.point_data["values"], dtype=np.float64)
     finite = values[np.isfinite(values)]
     limits = (float(finite.min()), float(finite.max())) if finite.size else (0.0, 1.0)
     return plotter.add_mesh(grid, scalars="values", cmap="gray", clim=limits, show_scalar_bar=False, name=name,
-                            nan_opacity=0.0, reset_camera=False)
+                            nan_opacity=0.0, reset_camera=False, render=False)
 
 
 def apply_camera(plotter: pv.BasePlotter, camera: Optional[CameraState]) -> None:
     """Set the plotter's camera from a session camera, or frame the scene from a pleasant oblique view."""
     if camera is None:
-        plotter.view_isometric()  # type: ignore[call-arg]  # pyvista's _Wrapped decorator hides self from mypy
-        plotter.reset_camera()  # type: ignore[call-arg]  # pyvista's _Wrapped decorator hides self from mypy
+        plotter.view_isometric(render=False)  # type: ignore[call-arg]  # pyvista's _Wrapped decorator hides self from mypy
+        plotter.renderer.reset_camera(render=False)   # (the plotter's own reset_camera renders in any case)
         return
     cam = plotter.camera
     cam.position = camera.position
