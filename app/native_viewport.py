@@ -32,6 +32,7 @@ if QVTKRenderWindowInteractor.__mro__[1] is not QWidget:   # imported before wit
 
 if TYPE_CHECKING:
     from .reduced_frames import ReducedFrames
+    from .still_strips import StillStrips
 
 _GL_DRAW_FRAMEBUFFER, _GL_BACK, _GL_COLOR_BUFFER_BIT, _GL_LINEAR = 0x8CA9, 0x0405, 0x4000, 0x2601
 
@@ -71,6 +72,7 @@ class NativeViewport(QVTKRenderWindowInteractor, BasePlotter):  # type: ignore[m
         self._in_paint = False
         self._magnified = False   # whether a magnifying blit was drawn yet (``_magnify``)
         self.frames: ReducedFrames | None = None
+        self.still_strips: StillStrips | None = None   # draws slow still frames in strips (``strip_stills``)
         self.setAcceptDrops(True)   # the window's file drop filter takes them
         self.ren_win = self.GetRenderWindow()
         self.ren_win.SetMultiSamples(global_theme.multi_samples)
@@ -96,6 +98,11 @@ class NativeViewport(QVTKRenderWindowInteractor, BasePlotter):  # type: ignore[m
         cannot resize the render window: ``vtkXOpenGLRenderWindow.SetSize`` resizes the X window)."""
         self.frames = frames
 
+    def strip_stills(self, strips: StillStrips) -> None:
+        """``strips`` draws this widget's paints at the still rate in strips when a whole frame would hold the event
+        loop too long (``volviz_app.still_strips``)."""
+        self.still_strips = strips
+
     def paintEvent(self, ev: QPaintEvent) -> None:
         if self._in_paint or self._RenderWindow is None:   # (closed: nothing to draw)
             return
@@ -105,7 +112,8 @@ class NativeViewport(QVTKRenderWindowInteractor, BasePlotter):  # type: ignore[m
             if frames is not None and frames.active and frames.factor > 1:
                 self._reduced_render(frames)
             else:
-                self._Iren.Render()
+                if self.still_strips is None or not self.still_strips.paint():
+                    self._Iren.Render()
                 if not self._magnified:   # the first reduced paint's one-time cost, now, before anything moves
                     self._magnify((1, 1), (2, 2))
         finally:

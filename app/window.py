@@ -48,6 +48,7 @@ from .interaction_renders import SingleRenderDuringInteraction
 from .navigation import FlyMode
 from .stand_in import StandInFrame
 from .startup_imports import import_gui_thread_modules
+from .still_strips import StillStrips
 from .nonfinite_status import NonFiniteStatus
 from .part_attribute import PartAttribute
 from .recent import RecentFiles
@@ -126,6 +127,11 @@ class MainWindow(WindowBase, QMainWindow):
         self.layout_keeper.restore()
         self.fly = FlyMode(self.plotter, on_camera_moved=views.fly_moved)
         self.single_render = SingleRenderDuringInteraction(self.plotter)  # one render per move of a drag
+        self.still_strips: StillStrips | None = None   # the native viewport's slow still frames, drawn in strips
+        if hasattr(self.plotter, "strip_stills"):
+            self.still_strips = StillStrips(self.plotter, lambda: self.controller is not None
+                                            and self.controller.drawn_by_vtk_alone())
+            self.plotter.strip_stills(self.still_strips)
         self.clip_widget = ClipPlaneWidget(self.plotter, self.clipping)
         views.watch_viewport(self.fly)  # interaction observers, fly-mode settle and resize timers
         self.collector.freeze_long_lived()
@@ -164,6 +170,12 @@ class MainWindow(WindowBase, QMainWindow):
         return pixmap
 
     def render_scene(self) -> None:
+        """Draw the scene: now, or in strips from the next paint on when a whole still frame would hold the event
+        loop too long (``volviz_app.still_strips``)."""
+        if self.still_strips is not None and self.still_strips.wanted():
+            self.plotter.interactor.update()
+            self.show_statistics(self.still_strips.cost)
+            return
         start = time.perf_counter()
         self.plotter.render()
         self.show_statistics(time.perf_counter() - start)

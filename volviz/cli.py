@@ -39,6 +39,8 @@ BENCHMARKS = {
     "startup": "fresh processes: volviz info / render and the app's first frame (wall time, peak memory, imports)",
     "iso_modes_volume": "the note's isosurface modes with a regular volume: frame time before and after the volume "
                         "split",
+    "strips": "a slow still frame drawn in strips across event-loop turns, as the app does: the longest pass "
+              "against the whole frame",
 }
 #: commands whose arguments go, unread here, to their own parser (``volviz.regular.cli``, ``volviz.bench.NAME``)
 PASSED_ON = ("bench", "compress")

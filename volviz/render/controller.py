@@ -129,6 +129,10 @@ class _Remake:
     build: bool = True
 
 
+#: the kinds of view VTK draws with its own mappers (``drawn_by_vtk_alone``)
+_VTK_DRAWN = frozenset({"vtk", "slices", "isosurfaces"})
+
+
 class SceneController:
     def __init__(self, plotter: Any, session: Session, datasets: dict[str, LoadedDataset], on_screen: bool = False):
         self.plotter = plotter
@@ -558,6 +562,13 @@ class SceneController:
     def nature(self) -> Optional[EitherNatureView]:
         view: Optional[EitherNatureView] = self.views.get("nature")
         return view
+
+    def drawn_by_vtk_alone(self) -> bool:
+        """Whether VTK's own mappers draw the whole scene (volumes, surfaces, slices, isosurfaces as VTK actors): no
+        camera view, no custom OpenGL pass and no image of ours in it, so a frame can be drawn in strips
+        (``volviz.render.strips``)."""
+        return (not self.camera_views()
+                and all(getattr(view, "kind", "") in _VTK_DRAWN for view in self.views.values()))
 
     def camera_views(self) -> dict[str, CameraView]:
         """The shown views that re-make something for a new camera (``volviz.render.views.View``: ``begin`` /

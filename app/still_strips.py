@@ -1,0 +1,100 @@
+"""Still frames drawn in strips across turns of the event loop (issue #28: no event-loop stall over 100 ms in any
+flow).
+
+VTK renders on the GUI thread; on a software OpenGL a still frame of a regular volume holds it well over 100 ms at
+the window's size (measured in docs/bench/flow-gaps.md). When the last still frame took longer than
+``strips.SPLIT_OVER_S`` and VTK draws the whole scene itself (``SceneController.drawn_by_vtk_alone``), a paint of the
+native viewport at the still rate draws the frame in strips (``volviz.render.strips``: ``strips_for`` of them), one
+per turn of the event loop; the window shows the previous frame until the last strip swaps. A render by anyone else
+in between (``plotter.render()``: it draws a whole frame) or a paint at the interactive rate ends the strips; a newer
+paint starts them over. The window's ``render_scene`` asks for such a paint instead of rendering when ``wanted()``;
+other renders outside a paint (screenshots, exports, read-backs) draw whole frames.
+"""
+from __future__ import annotations
+
+import time
+from typing import Any, Callable, Optional
+
+from PySide6.QtCore import QTimer
+
+from volviz.render import strips
+from volviz.render.strips import StripFrame, can_strip, strips_for
+
+
+class StillStrips:
+    """Paints of a native viewport's still frames in strips (see the module's docstring); ``allowed()`` says
+    whether the scene shown can be drawn so."""
+
+    def __init__(self, plotter: Any, allowed: Callable[[], bool]) -> None:
+        self.plotter, self.allowed = plotter, allowed
+        self.ren_win = plotter.ren_win
+        self.frame: Optional[StripFrame] = None
+        self.cost = 0.0        # seconds the last still frame took to draw (whole, or its passes together)
+        self.frames = 0        # frames drawn in strips so far
+        self.longest = 0.0     # the longest pass of the last frame drawn in strips (seconds)
+        self.last_rows: list[tuple[int, int]] = []   # the rows [lo, hi) of its strips
+        self._renders = 0      # renders of the window so far: one by anyone else ends a frame's strips
+        self._mark = 0
+        self._ours = False
+        self._started = 0.0
+        self._spent: list[float] = []
+        self.ren_win.AddObserver("StartEvent", self._render_starts)
+        self.ren_win.AddObserver("EndEvent", self._render_ends)
+
+    @property
+    def drawing(self) -> bool:
+        """Whether a frame is being drawn in strips (its last strip not swapped yet)."""
+        return self.frame is not None
+
+    def _still(self) -> bool:
+        iren = self.plotter.iren.interactor if hasattr(self.plotter.iren, "interactor") else self.plotter.iren
+        return bool(self.ren_win.GetDesiredUpdateRate() <= iren.GetStillUpdateRate())
+
+    def _render_starts(self, *args: Any) -> None:
+        self._renders += 1
+        self._started = time.perf_counter()
+
+    def _render_ends(self, *args: Any) -> None:
+        if not self._ours and self._still():
+            self.cost = time.perf_counter() - self._started
+
+    def wanted(self) -> bool:
+        """Whether the next still frame is drawn in strips: the last took longer than ``strips.SPLIT_OVER_S``, the
+        window is at its still rate, and the scene allows it."""
+        return (self.cost > strips.SPLIT_OVER_S and self._still() and self.allowed()
+                and can_strip(self.ren_win, self.plotter.renderer))
+
+    def paint(self) -> bool:
+        """A paint of the viewport: its frame's first strip drawn now and the others queued (True), or nothing
+        drawn (False: the caller renders the whole frame)."""
+        self.frame = None
+        if not self.wanted():
+            return False
+        self.frame = StripFrame(self.ren_win, self.plotter.renderer, strips_for(self.cost), strips.PASS_BUDGET_S)
+        self._spent = []
+        self._step(self.frame)
+        return True
+
+    def _step(self, frame: StripFrame) -> None:
+        self._ours = True
+        start = time.perf_counter()
+        try:
+            frame.step()
+        finally:
+            self._ours = False
+        self._spent.append(time.perf_counter() - start)
+        self._mark = self._renders
+        if frame.done:
+            self.frame = None
+            self.frames += 1
+            self.cost, self.longest, self.last_rows = sum(self._spent), max(self._spent), list(frame.drawn)
+        else:
+            QTimer.singleShot(0, lambda: self._next(frame))
+
+    def _next(self, frame: StripFrame) -> None:
+        if frame is not self.frame:                 # a newer paint started its own
+            return
+        if self.plotter.ren_win is None or self._renders != self._mark or not self._still():   # (None: closed)
+            self.frame = None                       # a whole frame was drawn since, or the camera moves
+            return
+        self._step(frame)

@@ -1,0 +1,160 @@
+"""A still frame drawn in horizontal strips, one VTK render each (issue #28: no event-loop stall over 100 ms).
+
+VTK renders on the GUI thread; on a software OpenGL a still frame of a regular volume holds it well over 100 ms at
+the window's size, most of it per pixel (measured in docs/bench/flow-gaps.md). Strip k of n draws the renderer into
+pixel rows [r_k, r_k+1) of its viewport with the same camera's sub-frustum of those rows (the camera's window centre
+moved, its vertical view angle or parallel scale narrowed by the strip's share of the height), without swapping: the
+render framebuffer keeps the strips drawn before. The renderer's 2D props (scalar bar, titles), placed in viewport
+coordinates, and the renderers over it (the orientation axes) are left out of the strips and drawn in a last pass
+over the whole viewport that erases nothing, then the frame is swapped. The camera, viewport, visibilities and
+swapping are put back after each pass, so no other code sees them changed; a render by anyone else between two
+passes draws a whole frame over the strips (the caller notices it: ``volviz_app.still_strips``).
+"""
+from __future__ import annotations
+
+import math
+import time
+from typing import Any, Optional
+
+MAX_STRIPS = 16
+SPLIT_OVER_S = 0.08      # a still frame that took longer is drawn in strips next time (the app's rule)
+STRIP_BUDGET_S = 0.05    # the mean time of a strip; the volume fills the middle strips: twice as many as that needs
+PASS_BUDGET_S = 0.03     # each later strip's rows drawn in this time at the last strip's rate (denser ones follow)
+
+
+def strips_for(seconds: float) -> int:
+    """How many strips a still frame that takes ``seconds`` whole is drawn in (1: whole)."""
+    if seconds <= SPLIT_OVER_S:
+        return 1
+    return min(MAX_STRIPS, max(2, math.ceil(2.0 * seconds / STRIP_BUDGET_S)))
+
+
+def strip_window_center(center_y: float, lo: float, hi: float) -> float:
+    """The camera's vertical window centre that shows rows [``lo``, ``hi``) (fractions of the viewport's height,
+    from the bottom) of the frame a camera with ``center_y`` shows: VTK's frustum spans (c - 1) h .. (c + 1) h in
+    height; the strip's spans (c - 1 + 2 lo) h .. (c - 1 + 2 hi) h, which is (c' - 1) f h .. (c' + 1) f h with
+    f = hi - lo."""
+    return (center_y - 1.0 + 2.0 * lo) / (hi - lo) + 1.0
+
+
+def _renderers(ren_win: Any) -> list[Any]:
+    found = ren_win.GetRenderers()
+    found.InitTraversal()
+    return [found.GetNextItem() for _ in range(found.GetNumberOfItems())]
+
+
+def can_strip(ren_win: Any, renderer: Any) -> bool:
+    """Whether ``renderer`` is the only renderer of ``ren_win`` drawn in its layer or below (renderers in layers
+    above, such as the orientation axes', are overlays drawn in the last pass): another one would draw over the
+    strips or between them."""
+    return not any(r is not renderer and r.GetDraw() and r.GetLayer() <= renderer.GetLayer()
+                   for r in _renderers(ren_win))
+
+
+class StripFrame:
+    """One still frame of ``ren_win`` drawn in strips of ``renderer``, bottom first, then a last pass for its 2D props
+    and the renderers over it when there are any. ``strips``: how many strips at first; with ``budget_s`` each strip
+    after the first gets the rows the last one drew in that time (a denser part of the picture gets thinner strips;
+    none higher than the first), else all have the same height. ``step()`` draws the next pass; ``done`` once the
+    frame is swapped."""
+
+    def __init__(self, ren_win: Any, renderer: Any, strips: int, budget_s: Optional[float] = None) -> None:
+        self.ren_win, self.renderer, self.budget_s = ren_win, renderer, budget_s
+        self.height = max(1, int(renderer.GetSize()[1]))
+        self.rows_per_strip = self.most_rows = math.ceil(self.height / max(1, min(MAX_STRIPS, int(strips))))
+        self.overlays = [r for r in _renderers(ren_win)
+                         if r is not renderer and r.GetDraw() and r.GetLayer() > renderer.GetLayer()]
+        self.last_pass_2d = bool(self._shown_2d() or self.overlays)
+        self.drawn: list[tuple[int, int]] = []     # the rows [lo, hi) of each strip drawn so far
+        self.done = False
+
+    def _shown_2d(self) -> list[Any]:
+        props = self.renderer.GetActors2D()
+        props.InitTraversal()
+        shown = []
+        for _ in range(props.GetNumberOfItems()):
+            prop = props.GetNextActor2D()
+            if prop is not None and prop.GetVisibility():
+                shown.append(prop)
+        return shown
+
+    def step(self) -> bool:
+        """Draw the next pass; True once the frame is complete and swapped."""
+        if self.done:
+            return True
+        lo = self.drawn[-1][1] if self.drawn else 0
+        if lo >= self.height:
+            self._props_2d()
+            self.done = True
+            return True
+        hi = min(self.height, lo + self.rows_per_strip)
+        swap = hi >= self.height and not self.last_pass_2d
+        start = time.perf_counter()
+        self._strip(lo, hi, swap)
+        if self.budget_s is not None:
+            per_row = max(time.perf_counter() - start, 1e-6) / (hi - lo)
+            self.rows_per_strip = max(1, min(self.most_rows, int(self.budget_s / per_row)))
+        self.drawn.append((lo, hi))
+        self.done = swap
+        return self.done
+
+    def _render(self, swap: bool) -> None:
+        """One pass; a pass that does not swap waits for the GPU (``WaitForCompletion``), so that its drawing is done
+        in its own turn, not left to the next pass."""
+        swapping = self.ren_win.GetSwapBuffers()
+        self.ren_win.SetSwapBuffers(1 if swap else 0)
+        try:
+            self.ren_win.Render()
+            if not swap:
+                self.ren_win.WaitForCompletion()
+        finally:
+            self.ren_win.SetSwapBuffers(swapping)
+
+    def _strip(self, lo: int, hi: int, swap: bool) -> None:
+        ren, cam = self.renderer, self.renderer.GetActiveCamera()
+        viewport = ren.GetViewport()
+        angle, center, scale = cam.GetViewAngle(), cam.GetWindowCenter(), cam.GetParallelScale()
+        hidden = self._shown_2d()
+        a, b = lo / self.height, hi / self.height
+        try:
+            for prop in hidden:
+                prop.SetVisibility(0)
+            for overlay in self.overlays:
+                overlay.SetDraw(0)
+            ren.SetViewport(viewport[0], viewport[1] + a * (viewport[3] - viewport[1]),
+                            viewport[2], viewport[1] + b * (viewport[3] - viewport[1]))
+            if cam.GetParallelProjection():
+                cam.SetParallelScale(scale * (b - a))
+            elif not cam.GetUseHorizontalViewAngle():   # (a horizontal angle narrows with the strip's aspect)
+                cam.SetViewAngle(math.degrees(2.0 * math.atan((b - a) * math.tan(math.radians(angle) / 2.0))))
+            cam.SetWindowCenter(center[0], strip_window_center(center[1], a, b))
+            self._render(swap)
+        finally:
+            ren.SetViewport(*viewport)
+            cam.SetViewAngle(angle)
+            cam.SetParallelScale(scale)
+            cam.SetWindowCenter(*center)
+            for prop in hidden:
+                prop.SetVisibility(1)
+            for overlay in self.overlays:
+                overlay.SetDraw(1)
+
+    def _props_2d(self) -> None:
+        ren = self.renderer
+        props = ren.GetViewProps()
+        props.InitTraversal()
+        hidden = []
+        for _ in range(props.GetNumberOfItems()):
+            prop = props.GetNextProp()
+            if prop is not None and prop.GetVisibility() and not prop.IsA("vtkActor2D"):
+                hidden.append(prop)
+        erase = ren.GetErase()
+        try:
+            for prop in hidden:
+                prop.SetVisibility(0)
+            ren.SetErase(0)
+            self._render(swap=True)
+        finally:
+            ren.SetErase(erase)
+            for prop in hidden:
+                prop.SetVisibility(1)
