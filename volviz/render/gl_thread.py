@@ -8,9 +8,10 @@ the threads the calls ran on (one; tests check that it is not the GUI thread), `
 """
 from __future__ import annotations
 
+import queue
 import threading
 import weakref
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import Future
 from typing import TYPE_CHECKING, Any, Callable, TypeVar
 
 if TYPE_CHECKING:   # type-only imports for the signatures
@@ -19,11 +20,32 @@ if TYPE_CHECKING:   # type-only imports for the signatures
 __all__ = ["GLThread"]
 
 T = TypeVar("T")
+_STOP = None   # the item that ends the thread
 
 
-def _end(pool: ThreadPoolExecutor, state: dict[str, Any], threads: set[int]) -> None:
+def _serve(jobs: queue.SimpleQueue) -> None:
+    """The thread's loop: run each (function, arguments, future) put on ``jobs`` until ``_STOP``."""
+    while True:
+        item = jobs.get()
+        if item is _STOP:
+            return
+        fn, args, future = item
+        if future.set_running_or_notify_cancel():
+            try:
+                future.set_result(fn(*args))
+            except BaseException as exc:   # noqa: BLE001  (handed to the caller, which raises it)
+                future.set_exception(exc)
+        del item, fn, args, future     # no reference to a caller (its GLThread) while waiting for the next job
+
+
+def _end(jobs: queue.SimpleQueue, state: dict[str, Any], threads: set[int]) -> None:
     """Close the window on its thread (its props' graphics resources with it), then let the thread end. Run there
-    directly when the object is collected on that thread (its last call's work item held the last reference)."""
+    directly when the object is collected on that thread (its last call's work item held the last reference).
+
+    This runs as a finalizer too, wherever the collector runs, so it takes no lock another thread's code could hold:
+    a ``SimpleQueue``'s ``put`` is reentrant, and waiting on a future needs only that future's. (With a
+    ``ThreadPoolExecutor`` it submitted the close: a collection inside another executor's ``submit``, which holds
+    the module's global shutdown lock, deadlocked the process.)"""
     def close() -> None:
         window = state.pop("window", None)
         state.clear()                   # the props (kept by the caller's state) go while the context is current
@@ -31,12 +53,13 @@ def _end(pool: ThreadPoolExecutor, state: dict[str, Any], threads: set[int]) -> 
             window.Finalize()
     if threading.get_ident() in threads:
         close()
-    else:
-        try:
-            pool.submit(close).result()
-        except RuntimeError:            # the interpreter is shutting its pools down: nothing to release
-            pass
-    pool.shutdown(wait=False)
+        jobs.put(_STOP)
+        return
+    done: Future = Future()
+    jobs.put((close, (), done))
+    jobs.put(_STOP)
+    if threads:                         # (a thread that never ran a call has no window to close)
+        done.result()
 
 
 class GLThread:
@@ -44,15 +67,19 @@ class GLThread:
     caller's functions keep their VTK objects in, so that they are released on this thread by ``close``."""
 
     def __init__(self, name: str = "volviz-gl") -> None:
-        self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix=name)
+        self._jobs: queue.SimpleQueue = queue.SimpleQueue()
+        # a daemon thread: the interpreter joins other threads before it runs the finalizers that stop them
+        threading.Thread(target=_serve, args=(self._jobs,), name=name, daemon=True).start()
         self.state: dict[str, Any] = {}
         self.threads: set[int] = set()
         self.calls = 0
-        self._end = weakref.finalize(self, _end, self._pool, self.state, self.threads)
+        self._end = weakref.finalize(self, _end, self._jobs, self.state, self.threads)
 
     def call(self, fn: Callable[..., T], *args: object) -> T:
         """``fn(renderer, *args)`` on the thread, the window made first; returns its result (its error raised)."""
-        return self._pool.submit(self._run, fn, *args).result()
+        future: Future = Future()
+        self._jobs.put((self._run, (fn, *args), future))
+        return future.result()
 
     def _run(self, fn: Callable[..., T], *args: object) -> T:
         self.threads.add(threading.get_ident())
