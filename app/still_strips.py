@@ -27,7 +27,6 @@ class StillStrips:
 
     def __init__(self, plotter: Any, allowed: Callable[[], bool]) -> None:
         self.plotter, self.allowed = plotter, allowed
-        self.ren_win = plotter.ren_win
         self.frame: Optional[StripFrame] = None
         self.cost = 0.0        # seconds the last still frame took to draw (whole, or its passes together)
         self.frames = 0        # frames drawn in strips so far
@@ -38,8 +37,10 @@ class StillStrips:
         self._ours = False
         self._started = 0.0
         self._spent: list[float] = []
-        self.ren_win.AddObserver("StartEvent", self._render_starts)
-        self.ren_win.AddObserver("EndEvent", self._render_ends)
+        # (the render window is not held here: its observers hold this object, and a closed viewport's window held
+        # keeps VTK's X connection open, tests/test_native_viewport_in_process.py)
+        plotter.ren_win.AddObserver("StartEvent", self._render_starts)
+        plotter.ren_win.AddObserver("EndEvent", self._render_ends)
 
     @property
     def drawing(self) -> bool:
@@ -47,8 +48,11 @@ class StillStrips:
         return self.frame is not None
 
     def _still(self) -> bool:
-        iren = self.plotter.iren.interactor if hasattr(self.plotter.iren, "interactor") else self.plotter.iren
-        return bool(self.ren_win.GetDesiredUpdateRate() <= iren.GetStillUpdateRate())
+        ren_win, iren = self.plotter.ren_win, self.plotter.iren
+        if ren_win is None or iren is None:   # closed
+            return False
+        iren = iren.interactor if hasattr(iren, "interactor") else iren
+        return bool(ren_win.GetDesiredUpdateRate() <= iren.GetStillUpdateRate())
 
     def _render_starts(self, *args: Any) -> None:
         self._renders += 1
@@ -62,7 +66,7 @@ class StillStrips:
         """Whether the next still frame is drawn in strips: the last took longer than ``strips.SPLIT_OVER_S``, the
         window is at its still rate, and the scene allows it."""
         return (self.cost > strips.SPLIT_OVER_S and self._still() and self.allowed()
-                and can_strip(self.ren_win, self.plotter.renderer))
+                and can_strip(self.plotter.ren_win, self.plotter.renderer))
 
     def paint(self) -> bool:
         """A paint of the viewport: its frame's first strip drawn now and the others queued (True), or nothing
@@ -70,7 +74,8 @@ class StillStrips:
         self.frame = None
         if not self.wanted():
             return False
-        self.frame = StripFrame(self.ren_win, self.plotter.renderer, strips_for(self.cost), strips.PASS_BUDGET_S)
+        self.frame = StripFrame(self.plotter.ren_win, self.plotter.renderer, strips_for(self.cost),
+                                strips.PASS_BUDGET_S)
         self._spent = []
         self._step(self.frame)
         return True
@@ -94,7 +99,7 @@ class StillStrips:
     def _next(self, frame: StripFrame) -> None:
         if frame is not self.frame:                 # a newer paint started its own
             return
-        if self.plotter.ren_win is None or self._renders != self._mark or not self._still():   # (None: closed)
+        if self._renders != self._mark or not self._still():     # (not still: also once the viewport is closed)
             self.frame = None                       # a whole frame was drawn since, or the camera moves
             return
         self._step(frame)

@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 
 from volviz.argtypes import UsageParser, image_size, int_in
-from volviz.bench.offscreen import finish, timed_renders
+from volviz.bench.offscreen import finish, render_window, timed_renders
 from volviz.io.atomic import atomic_write_text
 
 REPO = Path(__file__).resolve().parents[2]
@@ -36,12 +36,13 @@ def _striped(plotter: Any, strips: int, budget_s: float | None) -> tuple[list[fl
     """The seconds of each pass of one frame in ``strips`` strips (at first, with ``budget_s``), and its image."""
     from volviz.render.strips import StripFrame
 
-    frame = StripFrame(plotter.ren_win, plotter.renderer, strips, budget_s)
+    window = render_window(plotter)
+    frame = StripFrame(window, plotter.renderer, strips, budget_s)
     passes = []
     while not frame.done:
         t0 = time.perf_counter()
         frame.step()
-        finish(plotter.ren_win)
+        finish(window)
         passes.append(time.perf_counter() - t0)
     return passes, _image(plotter)
 
@@ -61,7 +62,7 @@ def measure(target: str, size: tuple[int, int], reps: int, strips: int | None = 
     plotter, controller = offscreen_scene(session, datasets, size)
     try:
         controller.build()
-        window = plotter.ren_win
+        window = render_window(plotter)
         window.SetDesiredUpdateRate(0.0001)   # the still rate
         whole_s = float(np.median(timed_renders(window, reps + 1)[1:]))
         whole = _image(plotter)

@@ -14,7 +14,10 @@ from __future__ import annotations
 
 import math
 import time
-from typing import Any, Optional
+from typing import TYPE_CHECKING, Any, Optional
+
+if TYPE_CHECKING:   # type-only imports for the signatures
+    from volviz.render.vtk_facade import vtkRenderer, vtkRenderWindow
 
 MAX_STRIPS = 16
 SPLIT_OVER_S = 0.08      # a still frame that took longer is drawn in strips next time (the app's rule)
@@ -37,13 +40,13 @@ def strip_window_center(center_y: float, lo: float, hi: float) -> float:
     return (center_y - 1.0 + 2.0 * lo) / (hi - lo) + 1.0
 
 
-def _renderers(ren_win: Any) -> list[Any]:
+def _renderers(ren_win: vtkRenderWindow) -> list[Any]:
     found = ren_win.GetRenderers()
     found.InitTraversal()
     return [found.GetNextItem() for _ in range(found.GetNumberOfItems())]
 
 
-def can_strip(ren_win: Any, renderer: Any) -> bool:
+def can_strip(ren_win: vtkRenderWindow, renderer: vtkRenderer) -> bool:
     """Whether ``renderer`` is the only renderer of ``ren_win`` drawn in its layer or below (renderers in layers
     above, such as the orientation axes', are overlays drawn in the last pass): another one would draw over the
     strips or between them."""
@@ -58,7 +61,8 @@ class StripFrame:
     none higher than the first), else all have the same height. ``step()`` draws the next pass; ``done`` once the
     frame is swapped."""
 
-    def __init__(self, ren_win: Any, renderer: Any, strips: int, budget_s: Optional[float] = None) -> None:
+    def __init__(self, ren_win: vtkRenderWindow, renderer: vtkRenderer, strips: int,
+                 budget_s: Optional[float] = None) -> None:
         self.ren_win, self.renderer, self.budget_s = ren_win, renderer, budget_s
         self.height = max(1, int(renderer.GetSize()[1]))
         self.rows_per_strip = self.most_rows = math.ceil(self.height / max(1, min(MAX_STRIPS, int(strips))))
