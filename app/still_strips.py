@@ -102,4 +102,8 @@ class StillStrips:
         if self._renders != self._mark or not self._still():     # (not still: also once the viewport is closed)
             self.frame = None                       # a whole frame was drawn since, or the camera moves
             return
+        if frame.stale():                           # the camera or the window changed between two strips
+            self.frame = None
+            self.plotter.interactor.update()        # the frame again, from its first strip
+            return
         self._step(frame)

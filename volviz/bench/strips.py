@@ -22,6 +22,7 @@ import numpy as np
 from volviz.argtypes import UsageParser, image_size, int_in
 from volviz.bench.offscreen import finish, render_window, timed_renders
 from volviz.io.atomic import atomic_write_text
+from volviz.render.strips import StripFrame
 
 REPO = Path(__file__).resolve().parents[2]
 DATA = Path(os.environ.get("VOLVIZ_DATA", REPO.parent / "shared" / "data"))
@@ -34,8 +35,6 @@ def _image(plotter: Any) -> np.ndarray:
 
 def _striped(plotter: Any, strips: int, budget_s: float | None) -> tuple[list[float], np.ndarray]:
     """The seconds of each pass of one frame in ``strips`` strips (at first, with ``budget_s``), and its image."""
-    from volviz.render.strips import StripFrame
-
     window = render_window(plotter)
     frame = StripFrame(window, plotter.renderer, strips, budget_s)
     passes = []

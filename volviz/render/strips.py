@@ -71,6 +71,19 @@ class StripFrame:
         self.last_pass_2d = bool(self._shown_2d() or self.overlays)
         self.drawn: list[tuple[int, int]] = []     # the rows [lo, hi) of each strip drawn so far
         self.done = False
+        self.view = self._view()
+
+    def _view(self) -> tuple[Any, ...]:
+        """What the strips' picture depends on that others may change between passes: the camera's pose and lens,
+        and the window's size (not the clipping range, which VTK may reset at any render)."""
+        cam = self.renderer.GetActiveCamera()
+        return (cam.GetPosition(), cam.GetFocalPoint(), cam.GetViewUp(), cam.GetViewAngle(), cam.GetWindowCenter(),
+                cam.GetParallelProjection(), cam.GetParallelScale(), tuple(self.ren_win.GetSize()),
+                tuple(self.renderer.GetSize()))
+
+    def stale(self) -> bool:
+        """Whether the camera or the window changed since the frame began: its strips would not fit together."""
+        return self._view() != self.view
 
     def _shown_2d(self) -> list[Any]:
         props = self.renderer.GetActors2D()
