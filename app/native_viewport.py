@@ -14,7 +14,7 @@ import ctypes
 from typing import TYPE_CHECKING, Any
 
 import vtkmodules.qt
-from PySide6.QtCore import Qt, Signal
+from PySide6.QtCore import Qt, QTimer, Signal
 from PySide6.QtGui import QPaintEvent, QResizeEvent
 from PySide6.QtWidgets import QWidget
 from pyvista import global_theme
@@ -35,6 +35,7 @@ if TYPE_CHECKING:
     from .still_strips import StillStrips
 
 _GL_DRAW_FRAMEBUFFER, _GL_BACK, _GL_COLOR_BUFFER_BIT, _GL_LINEAR = 0x8CA9, 0x0405, 0x4000, 0x2601
+WARM_AFTER_MS = 30   # the first magnifying blit waits this long after the first paint, so that timers due run first
 
 
 class _GLX:
@@ -114,8 +115,9 @@ class NativeViewport(QVTKRenderWindowInteractor, BasePlotter):  # type: ignore[m
             else:
                 if self.still_strips is None or not self.still_strips.paint():
                     self._Iren.Render()
-                if not self._magnified:   # the first reduced paint's one-time cost, now, before anything moves
-                    self._magnify((1, 1), (2, 2))
+                if not self._magnified:   # the first reduced paint's one-time cost, before anything moves, after
+                    self._magnified = True    # timers due (with the first paint's it held the loop 110-135 ms)
+                    QTimer.singleShot(WARM_AFTER_MS, self._warm_magnify)
         finally:
             self._in_paint = False
 
@@ -138,6 +140,11 @@ class NativeViewport(QVTKRenderWindowInteractor, BasePlotter):  # type: ignore[m
             vtkRenderWindow.SetSize(rw, full_w, full_h)
             rw.SetFrameBlitModeToBlitToHardware()
             rw.SetDoubleBuffer(1)
+
+    def _warm_magnify(self) -> None:
+        """The first magnifying blit (``_magnify``), of 1 pixel to 2x2, which the next frame covers."""
+        if self._RenderWindow is not None:
+            self._magnify((1, 1), (2, 2))
 
     def _magnify(self, size: tuple[int, int], to: tuple[int, int]) -> None:
         """Blit the bottom-left ``size`` of VTK's display framebuffer, filtered linearly, over ``to`` of the window's

@@ -23,10 +23,12 @@ from volviz.render.strips import StripFrame, can_strip, strips_for
 
 class StillStrips:
     """Paints of a native viewport's still frames in strips (see the module's docstring); ``allowed()`` says
-    whether the scene shown can be drawn so."""
+    whether the scene shown can be drawn so; ``drawn(seconds)`` is told each frame drawn in strips and what its passes
+    took together."""
 
-    def __init__(self, plotter: Any, allowed: Callable[[], bool]) -> None:
-        self.plotter, self.allowed = plotter, allowed
+    def __init__(self, plotter: Any, allowed: Callable[[], bool],
+                 drawn: Optional[Callable[[float], None]] = None) -> None:
+        self.plotter, self.allowed, self.drawn = plotter, allowed, drawn
         self.frame: Optional[StripFrame] = None
         self.cost = 0.0        # seconds the last still frame took to draw (whole, or its passes together)
         self.frames = 0        # frames drawn in strips so far
@@ -62,6 +64,12 @@ class StillStrips:
         if not self._ours and self._still():
             self.cost = time.perf_counter() - self._started
 
+    def new_scene(self) -> None:
+        """A new scene is shown: its first still frame's cost is not known, and on a software OpenGL its first frame
+        also builds the mappers' textures and tables; it is drawn in strips as though it took
+        ``strips.FIRST_FRAME_S`` (where VTK draws it alone), then by its own cost."""
+        self.cost = strips.FIRST_FRAME_S
+
     def wanted(self) -> bool:
         """Whether the next still frame is drawn in strips: the last took longer than ``strips.SPLIT_OVER_S``, the
         window is at its still rate, and the scene allows it."""
@@ -93,6 +101,8 @@ class StillStrips:
             self.frame = None
             self.frames += 1
             self.cost, self.longest, self.last_rows = sum(self._spent), max(self._spent), list(frame.drawn)
+            if self.drawn is not None:
+                self.drawn(self.cost)
         else:
             QTimer.singleShot(0, lambda: self._next(frame))
 

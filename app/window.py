@@ -130,7 +130,7 @@ class MainWindow(WindowBase, QMainWindow):
         self.still_strips: StillStrips | None = None   # the native viewport's slow still frames, drawn in strips
         if hasattr(self.plotter, "strip_stills"):
             self.still_strips = StillStrips(self.plotter, lambda: self.controller is not None
-                                            and self.controller.drawn_by_vtk_alone())
+                                            and self.controller.drawn_by_vtk_alone(), drawn=self.show_statistics)
             self.plotter.strip_stills(self.still_strips)
         self.clip_widget = ClipPlaneWidget(self.plotter, self.clipping)
         views.watch_viewport(self.fly)  # interaction observers, fly-mode settle and resize timers
@@ -146,6 +146,8 @@ class MainWindow(WindowBase, QMainWindow):
         self.view_scheduler.scene_installed()
         self.time_views.scene_installed()
         self.scene_edits.scene_installed()
+        if self.still_strips is not None:
+            self.still_strips.new_scene()
         self.camera_bookmarks.refresh_menu()
         self.title = title
         self.set_dirty(dirty)
@@ -173,8 +175,7 @@ class MainWindow(WindowBase, QMainWindow):
         """Draw the scene: now, or in strips from the next paint on when a whole still frame would hold the event
         loop too long (``volviz_app.still_strips``)."""
         if self.still_strips is not None and self.still_strips.wanted():
-            self.plotter.interactor.update()
-            self.show_statistics(self.still_strips.cost)
+            self.plotter.interactor.update()   # (the statistics once its strips are drawn)
             return
         start = time.perf_counter()
         self.plotter.render()

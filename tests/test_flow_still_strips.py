@@ -11,7 +11,8 @@ from __future__ import annotations
 import numpy as np
 from PySide6.QtCore import QTimer
 
-from flows import drag_viewport, open_settled
+from conftest import data_file
+from flows import drag_viewport, open_settled, wait_loaded
 from volviz.optics.metrics import rmse
 from volviz.render import strips as strips_module
 from volviz.render.strips import strip_window_center, strips_for
@@ -101,3 +102,32 @@ def test_a_camera_moved_between_two_strips_starts_the_frame_again(qtbot, make_wi
     monkeypatch.setattr(strips_module, "SPLIT_OVER_S", 1e9)
     window.plotter.render()
     assert float((np.abs(striped - _frame(window)).max(axis=2) > 24).mean()) < 0.002
+
+
+def test_a_new_scenes_first_still_frame_is_drawn_in_strips(qtbot, make_window, monkeypatch) -> None:
+    # its cost is not known yet, and its first frame also builds the mapper's tables: drawn whole, it held the loop
+    # 194-276 ms for neghip at this size, the machine quiet (docs/bench/flow-gaps.md)
+    window = make_window()
+    window.resize(1280, 740)
+    strips = window.still_strips
+    turns = [0]
+    ticker = QTimer()
+    ticker.setInterval(0)
+    ticker.timeout.connect(lambda: turns.__setitem__(0, turns[0] + 1))
+    passes: list[tuple[object, int]] = []     # (the frame, the event-loop turn) of each pass
+    step = strips._step
+    monkeypatch.setattr(strips, "_step", lambda frame: (passes.append((frame, turns[0])), step(frame)))
+    ticker.start()
+    window.open_path(data_file("volumes/neghip.slc"))
+    wait_loaded(qtbot, window)
+    qtbot.waitUntil(lambda: strips.frames == 1 and not strips.drawing, timeout=30000)
+    ticker.stop()
+    assert window.controller.drawn_by_vtk_alone()
+    drawn = [turn for frame, turn in passes if frame is passes[-1][0]]      # the frame finished (a paint of the
+    assert len(drawn) >= 3 and all(b > a for a, b in zip(drawn, drawn[1:])), passes    # window resized restarts)
+    assert window.last_stats["render_seconds"] == strips.cost > 0                        # what the passes took
+    striped = _frame(window)
+    monkeypatch.setattr(strips_module, "SPLIT_OVER_S", 1e9)
+    window.plotter.render()
+    assert float((np.abs(striped - _frame(window)).max(axis=2) > 24).mean()) < 0.002
+

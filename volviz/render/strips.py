@@ -23,6 +23,7 @@ MAX_STRIPS = 16
 SPLIT_OVER_S = 0.08      # a still frame that took longer is drawn in strips next time (the app's rule)
 STRIP_BUDGET_S = 0.05    # the mean time of a strip; the volume fills the middle strips: twice as many as that needs
 PASS_BUDGET_S = 0.03     # each later strip's rows drawn in this time at the last strip's rate (denser ones follow)
+FIRST_FRAME_S = 0.2      # what a new scene's first still frame is taken to cost before it is measured
 
 
 def strips_for(seconds: float) -> int:
