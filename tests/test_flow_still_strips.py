@@ -9,7 +9,7 @@ neghip at this size takes 150-330 ms, over the 80 ms that start them in the app)
 from __future__ import annotations
 
 import numpy as np
-from PySide6.QtCore import QTimer
+from PySide6.QtCore import Qt, QTimer
 
 from conftest import data_file
 from flows import drag_viewport, open_settled, wait_loaded
@@ -131,3 +131,27 @@ def test_a_new_scenes_first_still_frame_is_drawn_in_strips(qtbot, make_window, m
     window.plotter.render()
     assert float((np.abs(striped - _frame(window)).max(axis=2) > 24).mean()) < 0.002
 
+
+def test_a_clip_added_in_the_dock_is_drawn_in_strips_only(qtbot, make_window, monkeypatch) -> None:
+    # the scene controller drew a whole frame for every clipping edit, and the window then drew it again in strips:
+    # 413-468 ms blocked for a clip of a regular volume (docs/bench/flow-gaps.md)
+    monkeypatch.setattr(strips_module, "SPLIT_OVER_S", 0.0)
+    window = open_settled(qtbot, make_window, "volumes/neghip.slc", size=(900, 600))
+    strips = window.still_strips
+    frames = strips.frames
+    renders: list[bool] = []      # for each render of the window: whether it was a pass of a frame in strips
+    ren_win = window.plotter.ren_win
+    tag = ren_win.AddObserver("StartEvent", lambda *args: renders.append(strips._ours))
+    try:
+        window.clip_dock.show()
+        qtbot.mouseClick(window.clipping.add_button, Qt.MouseButton.LeftButton)
+        qtbot.waitUntil(lambda: strips.frames > frames and not strips.drawing, timeout=30000)
+        qtbot.wait(300)
+    finally:
+        ren_win.RemoveObserver(tag)
+    assert len(window.controller.clip.planes) == 1
+    assert renders and all(renders), renders                     # no whole frame
+    striped = _frame(window)
+    monkeypatch.setattr(strips_module, "SPLIT_OVER_S", 1e9)
+    window.plotter.render()
+    assert float((np.abs(striped - _frame(window)).max(axis=2) > 24).mean()) < 0.002

@@ -714,8 +714,9 @@ class SceneController:
 
     def apply_clip(self, update: bool = True) -> list[str]:
         """Give the session's clipping to every view (``set_clip``: VTK's mapper planes, a GPU PT volume's
-        per-fragment planes at once); returns the ids of those drawn from a CPU cut, which are cut now when
-        ``update`` (see ``set_clip``)."""
+        per-fragment planes at once); returns the ids of those drawn from a CPU cut, which are cut now and the scene
+        drawn when ``update`` (see ``set_clip``; else the caller draws it: the app, in strips when a still frame is
+        slow)."""
         clip = self.clip
         pending = []
         for comp_id, view in self.views.items():
@@ -727,7 +728,8 @@ class SceneController:
                 if view.camera_dependent and view.visible:
                     view.update()
         self._sync_iso_overlay()
-        self.plotter.render()
+        if update:
+            self.plotter.render()
         return pending
 
     def cut(self, comp_id: str, clip: Optional[ClipSettings] = None,
@@ -805,7 +807,7 @@ class SceneController:
         self._sync_iso_overlay()
         if update and self.iso_overlay is not None:
             self.iso_overlay.update()
-        else:
+        elif update:
             self.plotter.render()
 
     def _iso_props(self) -> dict[str, Any]:
