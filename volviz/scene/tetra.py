@@ -6,6 +6,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any, Optional
 
 from volviz.model.datasets import TetMesh
+from volviz.unstructured.boundary_pairs import inner_boundary
 from volviz.unstructured.tetrahedralize import tetrahedralize
 from volviz.unstructured.topology import topology
 
@@ -16,8 +17,20 @@ if TYPE_CHECKING:   # type-only imports for the signatures
 def pt_mesh(dataset: object) -> TetMesh:
     """Any thread: the tetrahedral mesh a PT volume draws for ``dataset``, with its topology built (cached on it)."""
     mesh = dataset if isinstance(dataset, TetMesh) else tetrahedralize(dataset, getattr(dataset, "active", None))
-    topology(mesh)
+    _with_adjacency(mesh)
     return mesh
+
+
+def _with_adjacency(mesh: TetMesh) -> None:
+    """Build ``mesh``'s topology with what its first visibility order reads (``volviz.unstructured.sort``: the face
+    adjacency, the boundary faces off the convex hull), here on the caller's thread instead of in the first frame,
+    which a GPU PT volume draws on the GUI thread."""
+    topo = topology(mesh)
+    try:
+        topo.back_face   # (and the adjacency it is made from)
+    except ValueError:   # not manifold: the sort says so, where it is used, as before
+        return
+    inner_boundary(topo)
 
 
 def cut_tetmesh(mesh: TetMesh, clip: ClipSettings) -> Optional[TetMesh]:
@@ -29,7 +42,7 @@ def cut_tetmesh(mesh: TetMesh, clip: ClipSettings) -> Optional[TetMesh]:
         cut = clip_tetmesh(mesh, clip)
     except ValueError:  # everything clipped away
         return None
-    topology(cut)
+    _with_adjacency(cut)
     return cut
 
 
