@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING, Any
 
 import vtkmodules.qt
 from PySide6.QtCore import Qt, QTimer, Signal
-from PySide6.QtGui import QPaintEvent, QResizeEvent
+from PySide6.QtGui import QPaintEvent, QResizeEvent, QShowEvent
 from PySide6.QtWidgets import QWidget
 from pyvista import global_theme
 from pyvista.plotting.plotter import BasePlotter
@@ -36,6 +36,7 @@ if TYPE_CHECKING:
 
 _GL_DRAW_FRAMEBUFFER, _GL_BACK, _GL_COLOR_BUFFER_BIT, _GL_LINEAR = 0x8CA9, 0x0405, 0x4000, 0x2601
 WARM_AFTER_MS = 30   # the first magnifying blit waits this long after the first paint, so that timers due run first
+EXPOSE_AFTER_MS = 15  # a paint nobody asked for (an expose) is drawn this long later, one for all that came meanwhile
 
 
 class _GLX:
@@ -54,7 +55,7 @@ class _GLX:
         cls.lib.glXSwapBuffers(cls.lib.glXGetCurrentDisplay(), cls.lib.glXGetCurrentDrawable())
 
 
-class NativeViewport(QVTKRenderWindowInteractor, BasePlotter):  # type: ignore[misc]
+class NativeViewport(QVTKRenderWindowInteractor, BasePlotter):
     """A pyvista plotter in VTK's native-window widget: what pyvistaqt's ``QtInteractor`` adds to its widget (the
     renderers, pyvista's interactor, key events, depth peeling, drops), with the flight's reduced frames drawn in its
     own paint (``reduce_paints``)."""
@@ -71,6 +72,9 @@ class NativeViewport(QVTKRenderWindowInteractor, BasePlotter):  # type: ignore[m
         self.setAttribute(Qt.WidgetAttribute.WA_NativeWindow)
         self.interactor = self
         self._in_paint = False
+        self._asked = False          # a paint was asked for by ``update`` / ``repaint`` (else: ``_coalesce_expose``)
+        self._expose_queued = False
+        self._painted = 0            # paints that drew so far
         self._magnified = False   # whether a magnifying blit was drawn yet (``_magnify``)
         self.frames: ReducedFrames | None = None
         self.still_strips: StillStrips | None = None   # draws slow still frames in strips (``strip_stills``)
@@ -104,9 +108,44 @@ class NativeViewport(QVTKRenderWindowInteractor, BasePlotter):  # type: ignore[m
         loop too long (``volviz_app.still_strips``)."""
         self.still_strips = strips
 
+    def update(self, *args: object) -> None:
+        """``QWidget.update``; the paint it asks for renders (``paintEvent``)."""
+        self._asked = True
+        super().update(*args)
+
+    def repaint(self, *args: object) -> None:
+        """``QWidget.repaint``; the paint renders now."""
+        self._asked = True
+        super().repaint(*args)
+
+    def showEvent(self, ev: QShowEvent) -> None:
+        """Shown: its first paint, in the window system's exposes of the window, is drawn later (``_coalesce_expose``),
+        in a turn of the event loop of its own."""
+        self._asked = False
+        super().showEvent(ev)
+
+    def _coalesce_expose(self) -> None:
+        """A paint nobody in Python asked for (the window system's exposes, Qt's own updates) is drawn as one asked
+        for ``EXPOSE_AFTER_MS`` later: the exposes of a window being shown (two of the viewport, with the docks',
+        in one turn of the event loop) were each a whole render there; now one, in a turn of its own."""
+        if not self._expose_queued:
+            self._expose_queued = True
+            painted = self._painted
+            QTimer.singleShot(EXPOSE_AFTER_MS, lambda: self._exposed(painted))
+
+    def _exposed(self, painted: int) -> None:
+        self._expose_queued = False
+        if self._RenderWindow is not None and self._painted == painted:   # (else a paint asked for drew it since)
+            self.update()
+
     def paintEvent(self, ev: QPaintEvent) -> None:
         if self._in_paint or self._RenderWindow is None:   # (closed: nothing to draw)
             return
+        if not self._asked:
+            self._coalesce_expose()
+            return
+        self._asked = False
+        self._painted += 1
         frames = self.frames
         self._in_paint = True
         try:

@@ -1,0 +1,62 @@
+"""Paints of the native viewport that nobody asked for (the window system's exposes) are drawn once, a moment later, in
+a turn of the event loop of their own (``NativeViewport._coalesce_expose``; issue #28: no event-loop stall over 100
+ms). Showing the window exposed the viewport twice in one turn, with the docks: two whole renders there, and two
+more after."""
+from __future__ import annotations
+
+import gc
+
+import pytest
+from PySide6.QtCore import QRect, QSettings
+from PySide6.QtGui import QPaintEvent, QRegion
+from PySide6.QtWidgets import QApplication
+
+
+@pytest.fixture
+def unshown_window(qtbot, tmp_path):
+    from volviz_app.window import MainWindow
+
+    settings = QSettings(str(tmp_path / "settings.ini"), QSettings.Format.IniFormat)
+    window = MainWindow(settings=settings, recovery_dir=tmp_path / "recovery")
+    if not hasattr(window.plotter, "reduce_paints"):
+        pytest.fail("the app did not make its native viewport (VOLVIZ_VIEWPORT?)")
+    yield window
+    window.dirty = False
+    window.close()
+    gc.collect()
+
+
+def _count_renders(window) -> list[int]:
+    renders: list[int] = []
+    window.plotter.ren_win.AddObserver("StartEvent", lambda *args: renders.append(1))
+    return renders
+
+
+def test_a_window_shown_renders_its_viewport_at_most_twice(qtbot, unshown_window) -> None:
+    window = unshown_window
+    renders = _count_renders(window)
+    window.resize(1280, 740)
+    window.show()
+    qtbot.waitExposed(window)
+    qtbot.wait(600)
+    # the first exposes of the viewport and its resizes, one render; the window system exposes it once more after it
+    # (here: 2 renders, before 4)
+    assert 1 <= len(renders) <= 2
+
+
+def test_paints_nobody_asked_for_are_one_render_a_moment_later(qtbot, unshown_window) -> None:
+    window = unshown_window
+    window.resize(900, 600)
+    window.show()
+    qtbot.waitExposed(window)
+    qtbot.wait(600)
+    canvas = window.plotter.interactor
+    renders = _count_renders(window)
+    for _ in range(3):   # as the window system's exposes deliver them
+        QApplication.sendEvent(canvas, QPaintEvent(QRegion(QRect(0, 0, canvas.width(), canvas.height()))))
+    assert renders == []
+    qtbot.wait(300)
+    assert len(renders) == 1
+    canvas.update()      # a paint asked for renders
+    qtbot.wait(300)
+    assert len(renders) == 2
