@@ -34,6 +34,7 @@ class StillStrips:
         self.frames = 0        # frames drawn in strips so far
         self.longest = 0.0     # the longest pass of the last frame drawn in strips (seconds)
         self.last_rows: list[tuple[int, int]] = []   # the rows [lo, hi) of its strips
+        self.profile: list[tuple[int, int, float]] = []   # its strips' rows and seconds: the next frame's plan
         self._renders = 0      # renders of the window so far: one by anyone else ends a frame's strips
         self._mark = 0
         self._ours = False
@@ -69,6 +70,7 @@ class StillStrips:
         also builds the mappers' textures and tables; it is drawn in strips as though it took
         ``strips.FIRST_FRAME_S`` (where VTK draws it alone), then by its own cost."""
         self.cost = strips.FIRST_FRAME_S
+        self.profile = []
 
     def wanted(self) -> bool:
         """Whether the next still frame is drawn in strips: the last took longer than ``strips.SPLIT_OVER_S``, the
@@ -83,7 +85,7 @@ class StillStrips:
         if not self.wanted():
             return False
         self.frame = StripFrame(self.plotter.ren_win, self.plotter.renderer, strips_for(self.cost),
-                                strips.PASS_BUDGET_S)
+                                strips.PASS_BUDGET_S, self.profile)
         self._spent = []
         self._step(self.frame)
         return True
@@ -101,6 +103,7 @@ class StillStrips:
             self.frame = None
             self.frames += 1
             self.cost, self.longest, self.last_rows = sum(self._spent), max(self._spent), list(frame.drawn)
+            self.profile = list(frame.costs)
             if self.drawn is not None:
                 self.drawn(self.cost)
         else:

@@ -15,7 +15,7 @@ from conftest import data_file
 from flows import drag_viewport, open_settled, wait_loaded
 from volviz.optics.metrics import rmse
 from volviz.render import strips as strips_module
-from volviz.render.strips import strip_window_center, strips_for
+from volviz.render.strips import planned_rows, strip_window_center, strips_for
 
 
 def _frame(window) -> np.ndarray:
@@ -155,3 +155,13 @@ def test_a_clip_added_in_the_dock_is_drawn_in_strips_only(qtbot, make_window, mo
     monkeypatch.setattr(strips_module, "SPLIT_OVER_S", 1e9)
     window.plotter.render()
     assert float((np.abs(striped - _frame(window)).max(axis=2) > 24).mean()) < 0.002
+
+
+def test_strips_are_planned_from_the_rates_of_the_frame_before() -> None:
+    # rows 0-100 took 0.01 s (1e-4 s a row), rows 100-200 0.1 s (1e-3 s a row), rows 200-300 0.01 s
+    profile = [(0, 100, 0.01), (100, 200, 0.1), (200, 300, 0.01)]
+    assert planned_rows(profile, 0, 0.03, 300) == 120        # 100 cheap rows (0.01 s), then 20 dense ones (0.02 s)
+    assert planned_rows(profile, 120, 0.03, 300) == 30       # dense: 0.03 s is 30 rows
+    assert planned_rows(profile, 190, 0.03, 300) == 110      # 10 dense rows (0.01 s), then 100 cheap ones, to the end
+    assert planned_rows(profile, 0, 0.03, 50) == 50          # none taller than ``most``
+    assert planned_rows(profile, 150, 1e-6, 300) == 1        # at least one row

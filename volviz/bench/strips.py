@@ -3,10 +3,10 @@
 
 Each session is built as ``volviz render`` builds it (``offscreen_scene``), then its still frame is drawn whole
 (median of ``--reps`` draws after a warm-up, each to the GPU's completion) and in strips as the app draws them
-(``strips_for(whole)`` at first, then each strip sized to ``PASS_BUDGET_S`` at the last one's rate; or ``--strips``
-of the same height), each pass timed to the GPU's completion; median over ``--reps`` frames of the longest pass and
-of the sum. The peer is the whole frame; the image difference (RMSE and the share of pixels off by more than 24,
-8-bit units) says that the strips draw the same picture. Writes docs/bench/strips.md.
+(``strips_for(whole)`` at first, each strip sized to ``PASS_BUDGET_S`` at the rates of the frame before; or
+``--strips`` of the same height), each pass timed to the GPU's completion; median over ``--reps`` frames of the
+longest pass and of the sum. The peer is the whole frame; the image difference (RMSE and the share of pixels off
+by more than 24, 8-bit units) says that the strips draw the same picture. Writes docs/bench/strips.md.
 """
 from __future__ import annotations
 
@@ -22,7 +22,7 @@ import numpy as np
 from volviz.argtypes import UsageParser, image_size, int_in
 from volviz.bench.offscreen import finish, render_window, timed_renders
 from volviz.io.atomic import atomic_write_text
-from volviz.render.strips import StripFrame
+from volviz.render.strips import StripCosts, StripFrame
 
 REPO = Path(__file__).resolve().parents[2]
 DATA = Path(os.environ.get("VOLVIZ_DATA", REPO.parent / "shared" / "data"))
@@ -33,17 +33,19 @@ def _image(plotter: Any) -> np.ndarray:
     return np.asarray(plotter.screenshot(None, return_img=True), dtype=np.float64)[..., :3]
 
 
-def _striped(plotter: Any, strips: int, budget_s: float | None) -> tuple[list[float], np.ndarray]:
-    """The seconds of each pass of one frame in ``strips`` strips (at first, with ``budget_s``), and its image."""
+def _striped(plotter: Any, strips: int, budget_s: float | None,
+             profile: StripCosts | None = None) -> tuple[list[float], np.ndarray, StripCosts]:
+    """The seconds of each pass of one frame in ``strips`` strips (at first, with ``budget_s``, planned from the
+    ``profile`` of the frame before as the app does), its image and its strips' costs."""
     window = render_window(plotter)
-    frame = StripFrame(window, plotter.renderer, strips, budget_s)
+    frame = StripFrame(window, plotter.renderer, strips, budget_s, profile)
     passes = []
     while not frame.done:
         t0 = time.perf_counter()
         frame.step()
         finish(window)
         passes.append(time.perf_counter() - t0)
-    return passes, _image(plotter)
+    return passes, _image(plotter), frame.costs
 
 
 def measure(target: str, size: tuple[int, int], reps: int, strips: int | None = None) -> dict[str, Any]:
@@ -67,14 +69,17 @@ def measure(target: str, size: tuple[int, int], reps: int, strips: int | None = 
         whole = _image(plotter)
         budget = None if strips else PASS_BUDGET_S     # a number of strips given: all of the same height
         strips = strips or strips_for(whole_s)
-        _striped(plotter, strips, budget)    # warm-up
-        frames = [_striped(plotter, strips, budget) for _ in range(reps)]
+        profile = None if budget is None else _striped(plotter, strips, budget)[2]   # warm-up
+        frames = []
+        for _ in range(reps):
+            frames.append(_striped(plotter, strips, budget, profile))
+            profile = None if budget is None else frames[-1][2]
         diff = np.abs(frames[-1][1] - whole)
         return {"target": target, "size": f"{size[0]}x{size[1]}", "gl": plotter_gl_info(plotter).renderer,
                 "whole_ms": 1e3 * whole_s, "strips": strips, "passes": len(frames[-1][0]),
-                "longest_ms": 1e3 * float(np.median([max(p) for p, _ in frames])),
-                "sum_ms": 1e3 * float(np.median([sum(p) for p, _ in frames])),
-                "last_pass_ms": 1e3 * float(np.median([p[-1] for p, _ in frames])),
+                "longest_ms": 1e3 * float(np.median([max(p) for p, _, _ in frames])),
+                "sum_ms": 1e3 * float(np.median([sum(p) for p, _, _ in frames])),
+                "last_pass_ms": 1e3 * float(np.median([p[-1] for p, _, _ in frames])),
                 "rmse": float(np.sqrt((diff ** 2).mean())), "off_24": float((diff.max(axis=2) > 24).mean())}
     finally:
         close_scene(plotter, controller)
@@ -85,8 +90,9 @@ def report(rows: list[dict[str, Any]], command: str) -> str:
     lines = ["# Still frames in strips: the longest pass against the whole frame", "",
              f"Command: `{command}` (load average at the end {load:.1f}; OpenGL: {rows[0]['gl'] if rows else '?'}).",
              "", "Whole: median of the timed still draws after a warm-up, each ending with `WaitForCompletion` (the "
-             "peer). Strips: `strips_for(whole)` strips at first, each later one sized to `PASS_BUDGET_S` at the last "
-             "one's rate (or `--strips` of one height), and a last pass for the 2D props and the axes; "
+             "peer). Strips: `strips_for(whole)` strips at first, each one sized to `PASS_BUDGET_S` at the rates of "
+             "the frame before (the app's plan; the warm-up frame's later strips at the last one's rate), or "
+             "`--strips` of one height, and a last pass for the 2D props and the axes; "
              "median over the frames of the longest pass, of the last pass (it swaps) and of all passes together, "
              "each pass to the GPU's completion. Image difference of the striped frame from the whole one: 8-bit "
              "units over RGB; off = share of pixels off by more than 24.", "",

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import math
 import time
-from typing import TYPE_CHECKING, Any, Optional
+from typing import TYPE_CHECKING, Any, Optional, Sequence
 
 if TYPE_CHECKING:   # type-only imports for the signatures
     from volviz.render.vtk_facade import vtkRenderer, vtkRenderWindow
@@ -24,6 +24,31 @@ SPLIT_OVER_S = 0.08      # a still frame that took longer is drawn in strips nex
 STRIP_BUDGET_S = 0.05    # the mean time of a strip; the volume fills the middle strips: twice as many as that needs
 PASS_BUDGET_S = 0.03     # each later strip's rows drawn in this time at the last strip's rate (denser ones follow)
 FIRST_FRAME_S = 0.2      # what a new scene's first still frame is taken to cost before it is measured
+
+
+#: the strips of a frame: (first row, row past the last, seconds its pass took)
+StripCosts = Sequence[tuple[int, int, float]]
+
+
+def planned_rows(profile: StripCosts, lo: int, budget_s: float, most: int) -> int:
+    """How many rows from ``lo`` up a strip gets so that it takes ``budget_s`` at the rates of ``profile`` (the strips
+    of an earlier frame of the same height: each row costs its strip's seconds over its rows), at least 1, at most
+    ``most``: a denser part of the picture gets thinner strips before it is drawn, not after."""
+    rows, spent = 0, 0.0
+    for a, b, seconds in profile:
+        if b <= lo:
+            continue
+        per_row = max(seconds, 1e-9) / max(1, b - a)
+        start = max(a, lo + rows)
+        fit = int((budget_s - spent) / per_row + 1e-9)   # (rows that fit exactly count)
+        if fit < b - start:
+            rows += max(0, fit)
+            break
+        rows += b - start
+        spent += (b - start) * per_row
+        if rows >= most:
+            break
+    return max(1, min(most, rows))
 
 
 def strips_for(seconds: float) -> int:
@@ -59,14 +84,17 @@ class StripFrame:
     """One still frame of ``ren_win`` drawn in strips of ``renderer``, bottom first, then a last pass for its 2D props
     and the renderers over it when there are any. ``strips``: how many strips at first; with ``budget_s`` each strip
     after the first gets the rows the last one drew in that time (a denser part of the picture gets thinner strips;
-    none higher than the first), else all have the same height. ``step()`` draws the next pass; ``done`` once the
-    frame is swapped."""
+    none higher than the first), else all have the same height; with the ``profile`` of an earlier frame of the
+    same height too, each strip is planned from its rates (``planned_rows``). ``step()`` draws the next pass;
+    ``done`` once the frame is swapped; ``costs`` has its strips' rows and seconds."""
 
     def __init__(self, ren_win: vtkRenderWindow, renderer: vtkRenderer, strips: int,
-                 budget_s: Optional[float] = None) -> None:
+                 budget_s: Optional[float] = None, profile: Optional[StripCosts] = None) -> None:
         self.ren_win, self.renderer, self.budget_s = ren_win, renderer, budget_s
         self.height = max(1, int(renderer.GetSize()[1]))
         self.rows_per_strip = self.most_rows = math.ceil(self.height / max(1, min(MAX_STRIPS, int(strips))))
+        self.profile = list(profile) if profile and budget_s is not None and profile[-1][1] == self.height else None
+        self.costs: list[tuple[int, int, float]] = []
         self.overlays = [r for r in _renderers(ren_win)
                          if r is not renderer and r.GetDraw() and r.GetLayer() > renderer.GetLayer()]
         self.last_pass_2d = bool(self._shown_2d() or self.overlays)
@@ -105,13 +133,18 @@ class StripFrame:
             self._props_2d()
             self.done = True
             return True
-        hi = min(self.height, lo + self.rows_per_strip)
+        rows = self.rows_per_strip
+        if self.profile is not None and self.budget_s is not None:
+            rows = planned_rows(self.profile, lo, self.budget_s, self.most_rows)
+        hi = min(self.height, lo + rows)
         swap = hi >= self.height and not self.last_pass_2d
         start = time.perf_counter()
         self._strip(lo, hi, swap)
+        elapsed = time.perf_counter() - start
         if self.budget_s is not None:
-            per_row = max(time.perf_counter() - start, 1e-6) / (hi - lo)
+            per_row = max(elapsed, 1e-6) / (hi - lo)
             self.rows_per_strip = max(1, min(self.most_rows, int(self.budget_s / per_row)))
+        self.costs.append((lo, hi, elapsed))
         self.drawn.append((lo, hi))
         self.done = swap
         return self.done
