@@ -35,6 +35,7 @@ class StillStrips:
         self.longest = 0.0     # the longest pass of the last frame drawn in strips (seconds)
         self.last_rows: list[tuple[int, int]] = []   # the rows [lo, hi) of its strips
         self.profile: list[tuple[int, int, float]] = []   # its strips' rows and seconds: the next frame's plan
+        self.pays = True       # whether strips pay in this scene (its thinnest strip took under ``PAYS_UNDER_S``)
         self._renders = 0      # renders of the window so far: one by anyone else ends a frame's strips
         self._mark = 0
         self._ours = False
@@ -71,11 +72,12 @@ class StillStrips:
         ``strips.FIRST_FRAME_S`` (where VTK draws it alone), then by its own cost."""
         self.cost = strips.FIRST_FRAME_S
         self.profile = []
+        self.pays = True
 
     def wanted(self) -> bool:
         """Whether the next still frame is drawn in strips: the last took longer than ``strips.SPLIT_OVER_S``, the
-        window is at its still rate, and the scene allows it."""
-        return (self.cost > strips.SPLIT_OVER_S and self._still() and self.allowed()
+        window is at its still rate, the scene allows it, and strips paid in it so far."""
+        return (self.cost > strips.SPLIT_OVER_S and self.pays and self._still() and self.allowed()
                 and can_strip(self.plotter.ren_win, self.plotter.renderer))
 
     def paint(self) -> bool:
@@ -104,6 +106,9 @@ class StillStrips:
             self.frames += 1
             self.cost, self.longest, self.last_rows = sum(self._spent), max(self._spent), list(frame.drawn)
             self.profile = list(frame.costs)
+            # a scene whose every strip costs as much as a pass may (geometry: each pass draws all of it) is drawn
+            # whole until the next scene: one stall instead of one per strip
+            self.pays = min((seconds for _, _, seconds in frame.costs), default=0.0) < strips.PAYS_UNDER_S
             if self.drawn is not None:
                 self.drawn(self.cost)
         else:

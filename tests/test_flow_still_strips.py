@@ -12,10 +12,11 @@ import numpy as np
 from PySide6.QtCore import Qt, QTimer
 
 from conftest import data_file
-from flows import drag_viewport, open_settled, wait_loaded
+from flows import drag_viewport, open_settled, pick_combo_item, wait_loaded, wait_settled
 from volviz.optics.metrics import rmse
 from volviz.render import strips as strips_module
-from volviz.render.strips import planned_rows, strip_window_center, strips_for
+from volviz.render.strips import planned_rows, ray_cast_volumes, strip_window_center, strips_for
+from volviz.render.vtk_facade import vtk
 
 
 def _frame(window) -> np.ndarray:
@@ -165,3 +166,45 @@ def test_strips_are_planned_from_the_rates_of_the_frame_before() -> None:
     assert planned_rows(profile, 190, 0.03, 300) == 110      # 10 dense rows (0.01 s), then 100 cheap ones, to the end
     assert planned_rows(profile, 0, 0.03, 50) == 50          # none taller than ``most``
     assert planned_rows(profile, 150, 1e-6, 300) == 1        # at least one row
+
+
+def test_only_ray_cast_volumes_are_drawn_in_strips() -> None:
+    # VTK's projected tetrahedra sort and project every cell at each render: a strip would cost the whole frame
+    renderer = vtk.vtkRenderer()
+    ray_cast, projected = vtk.vtkVolume(), vtk.vtkVolume()
+    ray_cast.SetMapper(vtk.vtkSmartVolumeMapper())
+    projected.SetMapper(vtk.vtkProjectedTetrahedraMapper())
+    renderer.AddVolume(ray_cast)
+    assert ray_cast_volumes(renderer)
+    renderer.AddVolume(projected)
+    assert not ray_cast_volumes(renderer)
+    projected.SetVisibility(False)
+    assert ray_cast_volumes(renderer)
+
+
+def test_a_blunt_fin_drawn_by_vtks_projected_tetrahedra_is_drawn_whole(qtbot, make_window, monkeypatch) -> None:
+    monkeypatch.setattr(strips_module, "SPLIT_OVER_S", 0.0)
+    window = make_window()
+    window.open_path(data_file("bluntfin/bluntfinxyz.bin"))
+    wait_loaded(qtbot, window)
+    pick_combo_item(qtbot, window.render_settings.method, "vtk")
+    qtbot.waitUntil(lambda: window.session.render.method == "vtk", timeout=60000)
+    wait_settled(qtbot, window)
+    strips = window.still_strips
+    assert window.controller.drawn_by_vtk_alone() and strips.cost > 0
+    assert not strips.wanted() and strips.frames == 0
+
+
+def test_a_scene_whose_strips_do_not_pay_is_drawn_whole_until_the_next(qtbot, make_window, monkeypatch) -> None:
+    monkeypatch.setattr(strips_module, "SPLIT_OVER_S", 0.0)
+    monkeypatch.setattr(strips_module, "PAYS_UNDER_S", 0.0)     # no strip is thin enough
+    window = open_settled(qtbot, make_window, "volumes/neghip.slc", size=(900, 600))
+    strips = window.still_strips
+    assert strips.frames == 1 and not strips.pays and not strips.wanted()   # the first frame told
+    drag_viewport(qtbot, window, 120, 30)
+    wait_settled(qtbot, window)
+    assert strips.frames == 1                                              # drawn whole
+    window.dirty = False                                                   # (a camera moved: no question)
+    window.open_path(data_file("volumes/neghip.slc"))                      # another scene: strips tried again
+    wait_loaded(qtbot, window)
+    qtbot.waitUntil(lambda: strips.frames == 2 and not strips.drawing, timeout=30000)

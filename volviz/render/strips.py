@@ -23,7 +23,8 @@ MAX_STRIPS = 16
 SPLIT_OVER_S = 0.08      # a still frame that took longer is drawn in strips next time (the app's rule)
 STRIP_BUDGET_S = 0.05    # the mean time of a strip; the volume fills the middle strips: twice as many as that needs
 PASS_BUDGET_S = 0.03     # each later strip's rows drawn in this time at the last strip's rate (denser ones follow)
-FIRST_FRAME_S = 0.2      # what a new scene's first still frame is taken to cost before it is measured
+FIRST_FRAME_S = 0.4      # what a new scene's first still frame is taken to cost before it is measured (16 strips)
+PAYS_UNDER_S = 0.08      # strips pay where a frame's thinnest strip took less: else each pass holds the loop as long
 
 
 #: the strips of a frame: (first row, row past the last, seconds its pass took)
@@ -75,9 +76,23 @@ def _renderers(ren_win: vtkRenderWindow) -> list[Any]:
 def can_strip(ren_win: vtkRenderWindow, renderer: vtkRenderer) -> bool:
     """Whether ``renderer`` is the only renderer of ``ren_win`` drawn in its layer or below (renderers in layers
     above, such as the orientation axes', are overlays drawn in the last pass): another one would draw over the
-    strips or between them."""
-    return not any(r is not renderer and r.GetDraw() and r.GetLayer() <= renderer.GetLayer()
-                   for r in _renderers(ren_win))
+    strips or between them; and whether its volumes are all ray cast (``ray_cast_volumes``)."""
+    return (not any(r is not renderer and r.GetDraw() and r.GetLayer() <= renderer.GetLayer()
+                    for r in _renderers(ren_win)) and ray_cast_volumes(renderer))
+
+
+def ray_cast_volumes(renderer: vtkRenderer) -> bool:
+    """Whether every visible volume of ``renderer`` is drawn by a ray caster of image data (``vtkVolumeMapper``:
+    its cost follows the pixels, so a strip costs its share). VTK's projected tetrahedra sort and project every cell
+    at each render: each strip would cost the whole frame."""
+    volumes = renderer.GetVolumes()
+    volumes.InitTraversal()
+    for _ in range(volumes.GetNumberOfItems()):
+        volume = volumes.GetNextVolume()
+        mapper = volume.GetMapper() if volume is not None and volume.GetVisibility() else None
+        if mapper is not None and not mapper.IsA("vtkVolumeMapper"):
+            return False
+    return True
 
 
 class StripFrame:
