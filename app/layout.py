@@ -107,7 +107,11 @@ class WindowLayout(QObject):
     def eventFilter(self, watched: Any, event: Any) -> bool:
         if event.type() == QEvent.Type.Show and self._size_on_show:
             self._size_on_show = False
-            QTimer.singleShot(0, self.size_docks)
+            self.size_docks()                 # now, in the show: the viewport's first frame is drawn at its size
+            layout = self.window.layout()
+            if layout is not None:
+                layout.activate()
+            QTimer.singleShot(0, self.size_docks)   # and once laid out (a later reset sizes the docks only so)
         elif event.type() == QEvent.Type.ChildPolished and isinstance(event.child(), QTabBar):
             whole_titles(event.child())    # the window makes a tab bar for each group of tabbed docks
         return False

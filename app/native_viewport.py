@@ -76,6 +76,7 @@ class NativeViewport(QVTKRenderWindowInteractor, BasePlotter):
         self._expose_queued = False
         self._painted = 0            # paints that drew so far
         self._magnified = False   # whether a magnifying blit was drawn yet (``_magnify``)
+        self._drawn_before_mapped = False
         self.frames: ReducedFrames | None = None
         self.still_strips: StillStrips | None = None   # draws slow still frames in strips (``strip_stills``)
         self.setAcceptDrops(True)   # the window's file drop filter takes them
@@ -123,6 +124,18 @@ class NativeViewport(QVTKRenderWindowInteractor, BasePlotter):
         in a turn of the event loop of its own."""
         self._asked = False
         super().showEvent(ev)
+
+    def draw_before_mapped(self) -> None:
+        """The first time: draw a frame at the widget's size and the first magnifying blit (``_warm_magnify``) now,
+        while its window is being shown, before it is mapped. A new render window's first frame at its size makes
+        OpenGL's framebuffers at that size and has a software rasteriser compile shaders for them, and the first
+        magnifying blit compiles its own: in the exposes' paint and the timer after it, these held the event loop of
+        a window just shown over 100 ms. The exposes then draw a frame like any other."""
+        if self._drawn_before_mapped or self._RenderWindow is None:
+            return
+        self._drawn_before_mapped = True
+        self._Iren.Render()
+        self._warm_magnify()
 
     def _coalesce_expose(self) -> None:
         """A paint nobody in Python asked for (the window system's exposes, Qt's own updates) is drawn as one asked

@@ -32,7 +32,7 @@ from typing import TYPE_CHECKING, Any, Callable, Optional
 
 import numpy as np
 from PySide6.QtCore import QPoint, QSettings, Qt
-from PySide6.QtGui import QImage, QPainter, QPixmap
+from PySide6.QtGui import QImage, QPainter, QPixmap, QShowEvent
 from PySide6.QtWidgets import QFileDialog, QMainWindow, QMenu, QMessageBox, QWidget
 
 from volviz.model.json_types import json_float
@@ -135,6 +135,13 @@ class MainWindow(WindowBase, QMainWindow):
         self.clip_widget = ClipPlaneWidget(self.plotter, self.clipping)
         views.watch_viewport(self.fly)  # interaction observers, fly-mode settle and resize timers
         self.collector.freeze_long_lived()
+
+    def showEvent(self, ev: QShowEvent) -> None:
+        """Shown: the first time, after the docks took their sizes (``layout``), the native viewport draws its first
+        frame before the window is mapped (``NativeViewport.draw_before_mapped``)."""
+        super().showEvent(ev)
+        if hasattr(self.plotter, "draw_before_mapped"):
+            self.plotter.draw_before_mapped()
 
     # ------------------------------------------------------------------------------------------------ a new scene
     def _scene_installed(self, controller: SceneController, title: str, dirty: bool, new_data: bool) -> None:

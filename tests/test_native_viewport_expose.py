@@ -1,7 +1,7 @@
 """Paints of the native viewport that nobody asked for (the window system's exposes) are drawn once, a moment later, in
 a turn of the event loop of their own (``NativeViewport._coalesce_expose``; issue #28: no event-loop stall over 100
 ms). Showing the window exposed the viewport twice in one turn, with the docks: two whole renders there, and two
-more after."""
+more after. The first frame is drawn inside the show, before the window is mapped (``draw_before_mapped``)."""
 from __future__ import annotations
 
 import gc
@@ -37,11 +37,33 @@ def test_a_window_shown_renders_its_viewport_at_most_twice(qtbot, unshown_window
     renders = _count_renders(window)
     window.resize(1280, 740)
     window.show()
+    assert len(renders) == 1   # inside the show (``draw_before_mapped``)
+    del renders[:]
     qtbot.waitExposed(window)
     qtbot.wait(600)
     # the first exposes of the viewport and its resizes, one render; the window system exposes it once more after it
     # (here: 2 renders, before 4)
     assert 1 <= len(renders) <= 2
+
+
+def test_the_viewports_first_frame_is_drawn_in_the_show_at_the_size_it_keeps(qtbot, unshown_window) -> None:
+    """A new render window's first frame at its size (framebuffers at that size, a software rasteriser's shaders)
+    and the first magnifying blit are drawn while the window is shown, before it is mapped, at the size the docks
+    leave the viewport: the exposes after it draw at that size too, so none makes framebuffers again (before, the
+    docks took their sizes a turn after the show, and the first paint drew at a new size)."""
+    window = unshown_window
+    sizes: list[tuple[int, int]] = []
+    window.plotter.ren_win.AddObserver("StartEvent", lambda rw, _e: sizes.append(tuple(rw.GetSize())))
+    window.resize(1280, 740)
+    window.show()
+    in_show = list(sizes)
+    assert window.plotter._magnified
+    qtbot.waitExposed(window)
+    qtbot.wait(600)
+    canvas = window.plotter.interactor
+    final = (canvas.width(), canvas.height())
+    assert in_show == [final]
+    assert len(sizes) > 1 and set(sizes) == {final}
 
 
 def test_paints_nobody_asked_for_are_one_render_a_moment_later(qtbot, unshown_window) -> None:
