@@ -41,6 +41,8 @@ class StillStrips:
         self._ours = False
         self._started = 0.0
         self._spent: list[float] = []
+        self._last_share: Optional[float] = None   # the last strip's share of the frame just drawn in strips
+        self._allotted: Optional[float] = None     # the renderer's allotted time while a render has it scaled
         # (the render window is not held here: its observers hold this object, and a closed viewport's window held
         # keeps VTK's X connection open, tests/test_native_viewport_in_process.py)
         plotter.ren_win.AddObserver("StartEvent", self._render_starts)
@@ -61,8 +63,17 @@ class StillStrips:
     def _render_starts(self, *args: Any) -> None:
         self._renders += 1
         self._started = time.perf_counter()
+        share, self._last_share = self._last_share, None
+        if not self._ours and share is not None and not self._still():
+            # the first render at the interactive rate after a frame in strips (``strips.last_strip_share``)
+            renderer = self.plotter.renderer
+            self._allotted = renderer.GetAllocatedRenderTime()
+            renderer.SetAllocatedRenderTime(self._allotted * share)
 
     def _render_ends(self, *args: Any) -> None:
+        if self._allotted is not None:
+            self.plotter.renderer.SetAllocatedRenderTime(self._allotted)
+            self._allotted = None
         if not self._ours and self._still():
             self.cost = time.perf_counter() - self._started
 
@@ -106,6 +117,7 @@ class StillStrips:
             self.frames += 1
             self.cost, self.longest, self.last_rows = sum(self._spent), max(self._spent), list(frame.drawn)
             self.profile = list(frame.costs)
+            self._last_share = strips.last_strip_share(frame.costs)
             # a scene whose every strip costs as much as a pass may (geometry: each pass draws all of it) is drawn
             # whole until the next scene: one stall instead of one per strip
             self.pays = min((seconds for _, _, seconds in frame.costs), default=0.0) < strips.PAYS_UNDER_S

@@ -15,7 +15,7 @@ from conftest import data_file
 from flows import drag_viewport, open_settled, pick_combo_item, wait_loaded, wait_settled
 from volviz.optics.metrics import rmse
 from volviz.render import strips as strips_module
-from volviz.render.strips import planned_rows, ray_cast_volumes, strip_window_center, strips_for
+from volviz.render.strips import last_strip_share, planned_rows, ray_cast_volumes, strip_window_center, strips_for
 from volviz.render.vtk_facade import vtk
 
 
@@ -166,6 +166,39 @@ def test_strips_are_planned_from_the_rates_of_the_frame_before() -> None:
     assert planned_rows(profile, 190, 0.03, 300) == 110      # 10 dense rows (0.01 s), then 100 cheap ones, to the end
     assert planned_rows(profile, 0, 0.03, 50) == 50          # none taller than ``most``
     assert planned_rows(profile, 150, 1e-6, 300) == 1        # at least one row
+
+
+def test_the_last_strips_share_of_the_frame() -> None:
+    assert last_strip_share([(0, 100, 0.25), (100, 200, 0.5), (200, 300, 0.25)]) == 0.25
+    assert last_strip_share([(0, 300, 0.1)]) == 1.0
+    assert last_strip_share([]) == 1.0
+
+
+def test_the_first_interactive_frame_after_strips_is_allotted_by_the_frames_cost(qtbot, make_window,
+                                                                                 monkeypatch) -> None:
+    """VTK's CPU ray caster sizes a frame's rays from its last render's time: after a frame in strips, the last
+    strip's. The first frame of a drag after it is allotted the interactive time scaled by the last strip's share of
+    the frame (``last_strip_share``), the next ones the interactive time (unscaled, that first frame cast a ray for
+    every pixel: 134-151 ms at 1280x740 on neghip here, the next ones 22-35 ms; scaled, 29-33 ms)."""
+    monkeypatch.setattr(strips_module, "SPLIT_OVER_S", 0.0)
+    window = open_settled(qtbot, make_window, "volumes/neghip.slc", size=(900, 600))
+    strips = window.still_strips
+    assert strips.frames >= 1 and len(strips.profile) > 1
+    share = last_strip_share(strips.profile)
+    assert share < 1.0
+    ren_win, renderer = window.plotter.ren_win, window.plotter.renderer
+    allotted: list[tuple[float, float]] = []     # (the window's desired rate, the renderer's allotted time)
+    ren_win.AddObserver("StartEvent", lambda *args: allotted.append(
+        (ren_win.GetDesiredUpdateRate(), renderer.GetAllocatedRenderTime())))
+    drag_viewport(qtbot, window, 120, 30)
+    wait_settled(qtbot, window)
+    renderers = ren_win.GetRenderers().GetNumberOfItems()
+    moving = [(rate, time) for rate, time in allotted if rate > 1.0]
+    assert len(moving) >= 2, allotted
+    whole = 1.0 / (moving[0][0] * renderers)
+    assert abs(moving[0][1] - whole * share) < 1e-9 * whole, (moving[0], whole, share)
+    assert all(abs(time - 1.0 / (rate * renderers)) < 1e-9 * time for rate, time in moving[1:]), moving
+    assert abs(renderer.GetAllocatedRenderTime() - 1.0 / (ren_win.GetDesiredUpdateRate() * renderers)) < 1e-6
 
 
 def test_only_ray_cast_volumes_are_drawn_in_strips() -> None:

@@ -52,6 +52,18 @@ def planned_rows(profile: StripCosts, lo: int, budget_s: float, most: int) -> in
     return max(1, min(most, rows))
 
 
+def last_strip_share(costs: StripCosts) -> float:
+    """The share of a frame drawn in strips (``StripFrame.costs``) that its last strip took, in (0, 1]. VTK's ray
+    casters size the next frame's rays from the time their last render took over the time it is allotted
+    (``vtkFixedPointVolumeRayCastMapper::ComputeRequiredImageSampleDistance``): after a frame in strips that render
+    was the last strip's, so the next interactive frame, allotted its time scaled by this share, gets the rays
+    of the frame's whole cost (unscaled, the first frame of a drag after it cast rays for every pixel)."""
+    total = sum(seconds for _, _, seconds in costs)
+    if not costs or total <= 0.0:
+        return 1.0
+    return min(1.0, max(costs[-1][2], 1e-6) / total)
+
+
 def strips_for(seconds: float) -> int:
     """How many strips a still frame that takes ``seconds`` whole is drawn in (1: whole)."""
     if seconds <= SPLIT_OVER_S:
