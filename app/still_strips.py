@@ -3,12 +3,12 @@ flow).
 
 VTK renders on the GUI thread; on a software OpenGL a still frame of a regular volume holds it well over 100 ms at
 the window's size (measured in docs/bench/flow-gaps.md). When the last still frame took longer than
-``strips.SPLIT_OVER_S`` and VTK draws the whole scene itself (``SceneController.drawn_by_vtk_alone``), a paint of the
-native viewport at the still rate draws the frame in strips (``volviz.render.strips``: ``strips_for`` of them), one
-per turn of the event loop; the window shows the previous frame until the last strip swaps. A render by anyone else
-in between (``plotter.render()``: it draws a whole frame) or a paint at the interactive rate ends the strips; a newer
-paint starts them over. The window's ``render_scene`` asks for such a paint instead of rendering when ``wanted()``;
-other renders outside a paint (screenshots, exports, read-backs) draw whole frames.
+``strips.SPLIT_OVER_S`` and VTK draws the scene under at most images of ours (``SceneController.drawn_in_strips``),
+a paint of the native viewport at the still rate draws the frame in strips (``volviz.render.strips``: ``strips_for``
+of them), one per turn of the event loop; the window shows the previous frame until the last strip swaps. A render
+by anyone else in between (``plotter.render()``: it draws a whole frame) or a paint at the interactive rate ends the
+strips; a newer paint starts them over. The window's ``render_scene`` asks for such a paint instead of rendering
+when ``wanted()``; other renders outside a paint (screenshots, exports, read-backs) draw whole frames.
 """
 from __future__ import annotations
 

@@ -130,7 +130,7 @@ class MainWindow(WindowBase, QMainWindow):
         self.still_strips: StillStrips | None = None   # the native viewport's slow still frames, drawn in strips
         if hasattr(self.plotter, "strip_stills"):
             self.still_strips = StillStrips(self.plotter, lambda: self.controller is not None
-                                            and self.controller.drawn_by_vtk_alone(), drawn=self.show_statistics)
+                                            and self.controller.drawn_in_strips(), drawn=self.show_statistics)
             self.plotter.strip_stills(self.still_strips)
         self.clip_widget = ClipPlaneWidget(self.plotter, self.clipping)
         views.watch_viewport(self.fly)  # interaction observers, fly-mode settle and resize timers

@@ -12,11 +12,13 @@ import numpy as np
 from PySide6.QtCore import Qt, QTimer
 
 from conftest import data_file
+from iso_volume_scene import session, write_datasets
 from flows import drag_viewport, open_settled, pick_combo_item, wait_loaded, wait_settled
 from volviz.optics.metrics import rmse
 from volviz.render import strips as strips_module
 from volviz.render.strips import last_strip_share, planned_rows, ray_cast_volumes, strip_window_center, strips_for
 from volviz.render.vtk_facade import vtk
+from volviz.session import save
 
 
 def _frame(window) -> np.ndarray:
@@ -158,6 +160,44 @@ def test_a_clip_added_in_the_dock_is_drawn_in_strips_only(qtbot, make_window, mo
     assert float((np.abs(striped - _frame(window)).max(axis=2) > 24).mean()) < 0.002
 
 
+def test_a_volume_under_the_isosurfaces_cpu_overlay_is_drawn_in_strips(qtbot, make_window, monkeypatch,
+                                                                      tmp_path) -> None:
+    """The isosurfaces' CPU 3-pass mode over a regular volume (``iso_volume_scene``): the overlay's image is drawn
+    by a renderer in a layer above, so the volume's still frame is drawn in strips and the overlay in their last
+    pass (drawn whole, its first frame and the one after each overlay update held the loop 0.8-1.8 s here); the
+    frame the strips leave is the whole frame."""
+    monkeypatch.setattr(strips_module, "SPLIT_OVER_S", 0.0)
+    path = tmp_path / "plane_in_ball.json"
+    save(session("auto", "3pass", write_datasets(tmp_path)), path)
+    window = make_window()
+    window.resize(900, 600)
+    window.open_path(path)
+    wait_loaded(qtbot, window)
+    wait_settled(qtbot, window)
+    strips, controller = window.still_strips, window.controller
+    overlay = controller.iso_overlay
+    assert overlay is not None and overlay.visible and not controller.drawn_by_vtk_alone()
+    assert controller.drawn_in_strips()
+    frames = strips.frames
+    window.plotter.interactor.repaint()                  # a still frame: in strips, the overlay in the last pass
+    qtbot.waitUntil(lambda: strips.frames > frames and not strips.drawing, timeout=30000)
+    assert len(strips.last_rows) > 1
+    striped = _frame(window)
+    monkeypatch.setattr(strips_module, "SPLIT_OVER_S", 1e9)
+    window.plotter.render()
+    whole = _frame(window)
+    assert float((np.abs(striped - whole).max(axis=2) > 24).mean()) < 0.002
+    assert float(np.abs(whole - _frame_without(window, overlay)).max()) > 24     # the overlay is in the frame
+
+
+def _frame_without(window, overlay) -> np.ndarray:
+    overlay.visible = False      # (draws the window again)
+    try:
+        return _frame(window)
+    finally:
+        overlay.visible = True
+
+
 def test_strips_are_planned_from_the_rates_of_the_frame_before() -> None:
     # rows 0-100 took 0.01 s (1e-4 s a row), rows 100-200 0.1 s (1e-3 s a row), rows 200-300 0.01 s
     profile = [(0, 100, 0.01), (100, 200, 0.1), (200, 300, 0.01)]
@@ -225,7 +265,10 @@ def test_a_blunt_fin_drawn_by_vtks_projected_tetrahedra_is_drawn_whole(qtbot, ma
     wait_settled(qtbot, window)
     strips = window.still_strips
     assert window.controller.drawn_by_vtk_alone() and strips.cost > 0
-    assert not strips.wanted() and strips.frames == 0
+    assert not strips.wanted()
+    frames = strips.frames   # (the CPU PT scene before: its image is an overlay, the box under it drawn in strips)
+    window.plotter.interactor.repaint()                  # a still frame: whole
+    assert strips.frames == frames and not strips.drawing
 
 
 def test_a_scene_whose_strips_do_not_pay_is_drawn_whole_until_the_next(qtbot, make_window, monkeypatch) -> None:

@@ -33,7 +33,7 @@ from volviz.model.events import ChangeNotifier, SceneChange
 from volviz.model.json_types import json_float
 from volviz.render.decorations import apply_decorations, legend_margin, update_legend, update_outline
 from volviz.render.framing import frame_scene, union
-from volviz.render.image_overlay import single_sample_on_software
+from volviz.render.image_overlay import OverlayView, single_sample_on_software
 from volviz.render.scene_builder import (PreparedScene, ensure_transfer_functions, install_component, install_nature,
                                          display_frame, frame_input, install_scene, prepare_component,
                                          prepare_scene, view_backend)
@@ -569,6 +569,15 @@ class SceneController:
         (``volviz.render.strips``)."""
         return (not self.camera_views()
                 and all(getattr(view, "kind", "") in _VTK_DRAWN for view in self.views.values()))
+
+    def drawn_in_strips(self) -> bool:
+        """Whether a still frame of the scene can be drawn in strips (``volviz.render.strips``): VTK's own mappers
+        draw it, and what else there is are images of ours over it (``OverlayView``: a PT volume's CPU image, the
+        isosurfaces' CPU modes), each drawn by a renderer of its own in a layer above, which the strips' last pass
+        draws over them; no custom OpenGL pass, and no view that re-makes VTK's props for a new camera."""
+        return (all(isinstance(view, OverlayView) for view in self.camera_views().values())
+                and all(getattr(view, "kind", "") in _VTK_DRAWN or isinstance(view, OverlayView)
+                        for view in self.views.values()))
 
     def camera_views(self) -> dict[str, CameraView]:
         """The shown views that re-make something for a new camera (``volviz.render.views.View``: ``begin`` /
