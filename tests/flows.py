@@ -47,8 +47,12 @@ def wait_settled(qtbot, window, timeout: int = 60000) -> None:
 
     idle_since = [None]
 
+    def drawing() -> bool:   # the still frame after an interaction is pending, or being drawn in strips
+        strips, single = getattr(window, "still_strips", None), getattr(window, "single_render", None)
+        return bool((strips is not None and strips.drawing) or (single is not None and single.settle.isActive()))
+
     def settled() -> bool:   # idle for 0.6 s in a row: edits wait on short timers (previews, cuts) before a job
-        if window.progress_bar.isVisible() or window.jobs.busy():
+        if window.progress_bar.isVisible() or window.jobs.busy() or drawing():
             idle_since[0] = None
             return False
         idle_since[0] = idle_since[0] or time.monotonic()

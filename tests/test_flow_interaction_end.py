@@ -6,13 +6,12 @@ inside the event's handler, then the repaint drew it again: for neghip at this s
 ``SPLIT_OVER_S`` is 0 here, so that the still frames are drawn in strips whatever this machine's speed."""
 from __future__ import annotations
 
-import numpy as np
 from PySide6.QtCore import QPoint, QPointF, Qt
 from PySide6.QtGui import QWheelEvent
 from PySide6.QtWidgets import QApplication
 
-from flows import drag_viewport, open_settled
-from volviz.render import strips as strips_module
+from flows import drag_viewport
+from strip_flows import assert_strips_left_the_whole_frame, neghip_in_strips
 
 
 def _renders(window) -> list[tuple[str, bool]]:
@@ -26,24 +25,16 @@ def _renders(window) -> list[tuple[str, bool]]:
     return seen
 
 
-def _frame(window) -> np.ndarray:
-    return np.asarray(window.plotter.screenshot(None, return_img=True))[..., :3].astype(np.float64)
-
-
 def _settled_frame_is_the_still_frame(qtbot, window, monkeypatch) -> None:
     strips = window.still_strips
     qtbot.waitUntil(lambda: strips.frames > 0 and not strips.drawing and not window.single_render.settle.isActive(),
                     timeout=30000)
-    striped = _frame(window)
-    monkeypatch.setattr(strips_module, "SPLIT_OVER_S", 1e9)
-    window.plotter.render()
-    assert float((np.abs(striped - _frame(window)).max(axis=2) > 24).mean()) < 0.002
+    assert_strips_left_the_whole_frame(window, monkeypatch)
 
 
 def test_a_wheel_notch_draws_nothing_in_its_handler_then_the_still_frame_in_strips(qtbot, make_window,
                                                                                     monkeypatch) -> None:
-    monkeypatch.setattr(strips_module, "SPLIT_OVER_S", 0.0)
-    window = open_settled(qtbot, make_window, "volumes/neghip.slc", size=(900, 600))
+    window = neghip_in_strips(qtbot, make_window, monkeypatch)
     distance = window.plotter.camera.GetDistance()
     renders = _renders(window)
     frames = window.still_strips.frames
@@ -60,8 +51,7 @@ def test_a_wheel_notch_draws_nothing_in_its_handler_then_the_still_frame_in_stri
 
 
 def test_a_drags_release_draws_the_still_frame_only_in_strips(qtbot, make_window, monkeypatch) -> None:
-    monkeypatch.setattr(strips_module, "SPLIT_OVER_S", 0.0)
-    window = open_settled(qtbot, make_window, "volumes/neghip.slc", size=(900, 600))
+    window = neghip_in_strips(qtbot, make_window, monkeypatch)
     renders = _renders(window)
     frames = window.still_strips.frames
     drag_viewport(qtbot, window, 120, 30)

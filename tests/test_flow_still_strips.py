@@ -4,8 +4,8 @@ frame they leave is the whole frame; a render by anyone else in between ends the
 too, grabbed right after the last swap: on the loaded CI machine the grab got an older frame, RMSE 13, once; VTK
 swaps through its own X connection. The native viewport's X picture is checked by test_native_viewport.)
 
-``SPLIT_OVER_S`` is set to 0 here, so that the strips do not depend on this machine's speed (on it a still frame of
-neghip at this size takes 150-330 ms, over the 80 ms that start them in the app)."""
+``SPLIT_OVER_S`` is set to 0 here, so that the strips do not depend on this machine's speed
+(``strip_flows.neghip_in_strips``)."""
 from __future__ import annotations
 
 import numpy as np
@@ -13,17 +13,12 @@ from PySide6.QtCore import Qt, QTimer
 
 from conftest import data_file
 from iso_volume_scene import session, write_datasets
-from flows import drag_viewport, open_settled, pick_combo_item, wait_loaded, wait_settled
-from volviz.optics.metrics import rmse
+from flows import drag_viewport, pick_combo_item, wait_loaded, wait_settled
+from strip_flows import assert_strips_left_the_whole_frame, last_frame, neghip_in_strips
 from volviz.render import strips as strips_module
 from volviz.render.strips import last_strip_share, planned_rows, ray_cast_volumes, strip_window_center, strips_for
 from volviz.render.vtk_facade import vtk
 from volviz.session import save
-
-
-def _frame(window) -> np.ndarray:
-    """The render window's last frame (RGB), read without drawing it again."""
-    return np.asarray(window.plotter.screenshot(None, return_img=True))[..., :3].astype(np.float64)
 
 
 def test_window_centres_tile_the_frustum_and_the_count_follows_the_time() -> None:
@@ -37,8 +32,7 @@ def test_window_centres_tile_the_frustum_and_the_count_follows_the_time() -> Non
 
 
 def test_a_slow_still_frame_is_drawn_in_strips_and_leaves_the_whole_frame(qtbot, make_window, monkeypatch) -> None:
-    monkeypatch.setattr(strips_module, "SPLIT_OVER_S", 0.0)
-    window = open_settled(qtbot, make_window, "volumes/neghip.slc", size=(900, 600))
+    window = neghip_in_strips(qtbot, make_window, monkeypatch)
     strips = window.still_strips
     assert strips is not None and window.controller.drawn_by_vtk_alone()
     turns = [0]
@@ -60,22 +54,11 @@ def test_a_slow_still_frame_is_drawn_in_strips_and_leaves_the_whole_frame(qtbot,
     assert all(a[1] == b[0] and a[1] > a[0] for a, b in zip(rows, rows[1:])), rows
     assert all(b > a for a, b in zip(still, still[1:])), passes   # each pass in a turn of its own
 
-    striped = _frame(window)                                      # the frame the strips left, not drawn again
-    monkeypatch.setattr(strips_module, "SPLIT_OVER_S", 1e9)
-    window.plotter.render()                                       # the same frame drawn whole
-    whole = _frame(window)
-    # measured: 0.04-0.10 % of the pixels off by more than 24 levels, where the outline's lines fall a pixel apart
-    # (their ends projected through a strip's frustum round otherwise; as few pixels far off, they make the RMSE
-    # 1.3-4.4 from run to run); with one strip's frustum 0.05 of its half-height off (a row or two): 1.2 % off,
-    # RMSE 11.8
-    error = rmse(striped / 255.0, whole / 255.0)
-    off = float((np.abs(striped - whole).max(axis=2) > 24).mean())
-    assert off < 0.002, (error, off)
+    assert_strips_left_the_whole_frame(window, monkeypatch)
 
 
 def test_a_whole_render_in_between_ends_the_strips(qtbot, make_window, monkeypatch) -> None:
-    monkeypatch.setattr(strips_module, "SPLIT_OVER_S", 0.0)
-    window = open_settled(qtbot, make_window, "volumes/neghip.slc", size=(900, 600))
+    window = neghip_in_strips(qtbot, make_window, monkeypatch)
     strips = window.still_strips
     frames = strips.frames
     canvas = window.plotter.interactor
@@ -87,8 +70,7 @@ def test_a_whole_render_in_between_ends_the_strips(qtbot, make_window, monkeypat
 
 
 def test_a_camera_moved_between_two_strips_starts_the_frame_again(qtbot, make_window, monkeypatch) -> None:
-    monkeypatch.setattr(strips_module, "SPLIT_OVER_S", 0.0)
-    window = open_settled(qtbot, make_window, "volumes/neghip.slc", size=(900, 600))
+    window = neghip_in_strips(qtbot, make_window, monkeypatch)
     strips = window.still_strips
     frames = strips.frames
     canvas = window.plotter.interactor
@@ -101,10 +83,7 @@ def test_a_camera_moved_between_two_strips_starts_the_frame_again(qtbot, make_wi
     assert first.stale()
     qtbot.waitUntil(lambda: strips.frames > frames and not strips.drawing, timeout=30000)
     assert strips.frame is None and strips.last_rows[0][0] == 0   # a frame drawn whole from its first strip again
-    striped = _frame(window)
-    monkeypatch.setattr(strips_module, "SPLIT_OVER_S", 1e9)
-    window.plotter.render()
-    assert float((np.abs(striped - _frame(window)).max(axis=2) > 24).mean()) < 0.002
+    assert_strips_left_the_whole_frame(window, monkeypatch)
 
 
 def test_a_new_scenes_first_still_frame_is_drawn_in_strips(qtbot, make_window, monkeypatch) -> None:
@@ -129,17 +108,13 @@ def test_a_new_scenes_first_still_frame_is_drawn_in_strips(qtbot, make_window, m
     drawn = [turn for frame, turn in passes if frame is passes[-1][0]]      # the frame finished (a paint of the
     assert len(drawn) >= 3 and all(b > a for a, b in zip(drawn, drawn[1:])), passes    # window resized restarts)
     assert window.last_stats["render_seconds"] == strips.cost > 0                        # what the passes took
-    striped = _frame(window)
-    monkeypatch.setattr(strips_module, "SPLIT_OVER_S", 1e9)
-    window.plotter.render()
-    assert float((np.abs(striped - _frame(window)).max(axis=2) > 24).mean()) < 0.002
+    assert_strips_left_the_whole_frame(window, monkeypatch)
 
 
 def test_a_clip_added_in_the_dock_is_drawn_in_strips_only(qtbot, make_window, monkeypatch) -> None:
     # the scene controller drew a whole frame for every clipping edit, and the window then drew it again in strips:
     # 413-468 ms blocked for a clip of a regular volume (docs/bench/flow-gaps.md)
-    monkeypatch.setattr(strips_module, "SPLIT_OVER_S", 0.0)
-    window = open_settled(qtbot, make_window, "volumes/neghip.slc", size=(900, 600))
+    window = neghip_in_strips(qtbot, make_window, monkeypatch)
     strips = window.still_strips
     frames = strips.frames
     renders: list[bool] = []      # for each render of the window: whether it was a pass of a frame in strips
@@ -154,10 +129,7 @@ def test_a_clip_added_in_the_dock_is_drawn_in_strips_only(qtbot, make_window, mo
         ren_win.RemoveObserver(tag)
     assert len(window.controller.clip.planes) == 1
     assert renders and all(renders), renders                     # no whole frame
-    striped = _frame(window)
-    monkeypatch.setattr(strips_module, "SPLIT_OVER_S", 1e9)
-    window.plotter.render()
-    assert float((np.abs(striped - _frame(window)).max(axis=2) > 24).mean()) < 0.002
+    assert_strips_left_the_whole_frame(window, monkeypatch)
 
 
 def test_a_volume_under_the_isosurfaces_cpu_overlay_is_drawn_in_strips(qtbot, make_window, monkeypatch,
@@ -182,18 +154,14 @@ def test_a_volume_under_the_isosurfaces_cpu_overlay_is_drawn_in_strips(qtbot, ma
     window.plotter.interactor.repaint()                  # a still frame: in strips, the overlay in the last pass
     qtbot.waitUntil(lambda: strips.frames > frames and not strips.drawing, timeout=30000)
     assert len(strips.last_rows) > 1
-    striped = _frame(window)
-    monkeypatch.setattr(strips_module, "SPLIT_OVER_S", 1e9)
-    window.plotter.render()
-    whole = _frame(window)
-    assert float((np.abs(striped - whole).max(axis=2) > 24).mean()) < 0.002
+    whole = assert_strips_left_the_whole_frame(window, monkeypatch)
     assert float(np.abs(whole - _frame_without(window, overlay)).max()) > 24     # the overlay is in the frame
 
 
 def _frame_without(window, overlay) -> np.ndarray:
     overlay.visible = False      # (draws the window again)
     try:
-        return _frame(window)
+        return last_frame(window)
     finally:
         overlay.visible = True
 
@@ -220,8 +188,7 @@ def test_the_first_interactive_frame_after_strips_is_allotted_by_the_frames_cost
     strip's. The first frame of a drag after it is allotted the interactive time scaled by the last strip's share of
     the frame (``last_strip_share``), the next ones the interactive time (unscaled, that first frame cast a ray for
     every pixel: 134-151 ms at 1280x740 on neghip here, the next ones 22-35 ms; scaled, 29-33 ms)."""
-    monkeypatch.setattr(strips_module, "SPLIT_OVER_S", 0.0)
-    window = open_settled(qtbot, make_window, "volumes/neghip.slc", size=(900, 600))
+    window = neghip_in_strips(qtbot, make_window, monkeypatch)
     strips = window.still_strips
     assert strips.frames >= 1 and len(strips.profile) > 1
     share = last_strip_share(strips.profile)
@@ -272,9 +239,8 @@ def test_a_blunt_fin_drawn_by_vtks_projected_tetrahedra_is_drawn_whole(qtbot, ma
 
 
 def test_a_scene_whose_strips_do_not_pay_is_drawn_whole_until_the_next(qtbot, make_window, monkeypatch) -> None:
-    monkeypatch.setattr(strips_module, "SPLIT_OVER_S", 0.0)
     monkeypatch.setattr(strips_module, "PAYS_UNDER_S", 0.0)     # no strip is thin enough
-    window = open_settled(qtbot, make_window, "volumes/neghip.slc", size=(900, 600))
+    window = neghip_in_strips(qtbot, make_window, monkeypatch)
     strips = window.still_strips
     assert strips.frames == 1 and not strips.pays and not strips.wanted()   # the first frame told
     drag_viewport(qtbot, window, 120, 30)

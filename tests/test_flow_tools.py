@@ -128,6 +128,7 @@ def test_scalar_bar_edited_by_double_click_is_saved_and_rendered(qtbot, make_win
     assert scalar_bar_title(window.plotter) == "Density"
     assert tuple(bar.GetLookupTable().GetRange()) == (0.0, 100.0)
     assert bar.GetLabelFormat() == "%.3g"
+    wait_settled(qtbot, window)             # the still frame after the double click's interaction
     err = compare_with_render(window, tmp_path, "bar")
     saved = json.loads((tmp_path / "bar.json").read_text())
     assert saved["render"]["options"]["scalar_bar_style"] == {"title": "Density", "range": [0.0, 100.0],
