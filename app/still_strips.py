@@ -18,6 +18,7 @@ from typing import Any, Callable, Optional
 from PySide6.QtCore import QTimer
 
 from volviz.render import strips
+from volviz.render.image_overlay import Buffers, read_buffers
 from volviz.render.strips import StripFrame, can_strip, strips_for
 
 
@@ -41,6 +42,8 @@ class StillStrips:
         self._ours = False
         self._started = 0.0
         self._spent: list[float] = []
+        self._waiters: list[Callable[[Optional[Buffers]], None]] = []   # ``after_still_frame``'s
+        self._drawn: Optional[Buffers] = None      # the opaque scene read back from the frame being drawn
         self._last_share: Optional[float] = None   # the last strip's share of the frame just drawn in strips
         self._allotted: Optional[float] = None     # the renderer's allotted time while a render has it scaled
         # (the render window is not held here: its observers hold this object, and a closed viewport's window held
@@ -77,6 +80,33 @@ class StillStrips:
         if not self._ours and self._still():
             self.cost = time.perf_counter() - self._started
 
+    def after_still_frame(self, done: Callable[[Optional[Buffers]], None]) -> bool:
+        """Draw a still frame in strips from the next paint (or finish the one being drawn) and hand ``done`` the
+        opaque scene read back from it in the turn of its last pass: (z, rgb) at the window's size, read once its
+        strips drew the scene, before their last pass drew the 2D props and the images over it
+        (``StripFrame.after_base``; what ``OverlayView.begin`` reads back, there a whole frame held the loop
+        0.5-1 s for a volume under the isosurfaces' CPU overlay). ``done(None)`` when the frame is not finished
+        (a render by anyone else, a move, another scene). False, ``done`` not kept: still frames are not drawn in
+        strips now."""
+        if not self.wanted():
+            return False
+        self._waiters.append(done)
+        if self.frame is None:
+            self.plotter.interactor.update()
+        elif self.frame.after_base is None:   # a frame being drawn: read back once its strips drew the scene
+            self.frame.after_base = self._read_back
+        return True
+
+    def _read_back(self) -> None:
+        ren_win = self.plotter.ren_win
+        w, h = (int(v) for v in ren_win.GetSize())
+        self._drawn = read_buffers(ren_win, w, h)
+
+    def _serve(self, drawn: Optional[Buffers]) -> None:
+        waiters, self._waiters, self._drawn = self._waiters, [], None
+        for done in waiters:
+            done(drawn)
+
     def new_scene(self) -> None:
         """A new scene is shown: its first still frame's cost is not known, and on a software OpenGL its first frame
         also builds the mappers' textures and tables; it is drawn in strips as though it took
@@ -84,6 +114,7 @@ class StillStrips:
         self.cost = strips.FIRST_FRAME_S
         self.profile = []
         self.pays = True
+        self._serve(None)
 
     def wanted(self) -> bool:
         """Whether the next still frame is drawn in strips: the last took longer than ``strips.SPLIT_OVER_S``, the
@@ -96,9 +127,12 @@ class StillStrips:
         drawn (False: the caller renders the whole frame)."""
         self.frame = None
         if not self.wanted():
+            self._serve(None)
             return False
+        self._drawn = None
         self.frame = StripFrame(self.plotter.ren_win, self.plotter.renderer, strips_for(self.cost),
-                                strips.PASS_BUDGET_S, self.profile)
+                                strips.PASS_BUDGET_S, self.profile,
+                                after_base=self._read_back if self._waiters else None)
         self._spent = []
         self._step(self.frame)
         return True
@@ -123,6 +157,7 @@ class StillStrips:
             self.pays = min((seconds for _, _, seconds in frame.costs), default=0.0) < strips.PAYS_UNDER_S
             if self.drawn is not None:
                 self.drawn(self.cost)
+            self._serve(self._drawn)
         else:
             QTimer.singleShot(0, lambda: self._next(frame))
 
@@ -131,6 +166,7 @@ class StillStrips:
             return
         if self._renders != self._mark or not self._still():     # (not still: also once the viewport is closed)
             self.frame = None                       # a whole frame was drawn since, or the camera moves
+            self._serve(None)
             return
         if frame.stale():                           # the camera or the window changed between two strips
             self.frame = None

@@ -32,6 +32,7 @@ from PySide6.QtWidgets import QLabel
 from volviz.jobs import JobOutcome, OneInFlight
 from volviz.render.controller import SceneController, no_render
 from volviz.render.error_budget import error_budget_choice
+from volviz.render.image_overlay import Buffers, OverlayView
 from .shown_scene import ShownScene
 
 if TYPE_CHECKING:
@@ -93,6 +94,9 @@ class ViewScheduler:
         self.error_estimate: Optional[str] = None   # the last CPU PT error estimate, as the statistics dock shows it
         self.last_error_rmse: Optional[float] = None   # and its RMSE, which the error budget is checked against
         self.loading_views = False         # the newest scene is installed, its first views are computed
+        # the opaque scene read back from the next still frame drawn in strips (``StillStrips.after_still_frame``):
+        # False when still frames are not drawn so now
+        self.read_back: Optional[Callable[[Callable[[Optional[Buffers]], None]], bool]] = None
 
     @property
     def controller(self) -> Optional[SceneController]:
@@ -348,7 +352,18 @@ class ViewScheduler:
                 if not still_shown():
                     next_request()
                     return
-                request = view.begin(scale=scale)
+                # an image over the scene reads the scene back: from the next still frame drawn in strips when there
+                # is one (``read_back``), else drawn whole here (``ImageOverlay.opaque_buffers``)
+                if scale == 1 and isinstance(view, OverlayView) and self.read_back is not None:
+                    if self.read_back(lambda drawn: begin(next_request, drawn)):
+                        return
+                begin(next_request, None)
+
+            def begin(next_request: Callable[[], None], drawn: Optional[Buffers]) -> None:
+                if not still_shown():
+                    next_request()
+                    return
+                request = view.begin(scale=scale) if drawn is None else view.begin(scale=scale, drawn=drawn)
 
                 def done(outcome: JobOutcome) -> None:
                     if outcome.ok and still_shown():

@@ -132,6 +132,7 @@ class MainWindow(WindowBase, QMainWindow):
             self.still_strips = StillStrips(self.plotter, lambda: self.controller is not None
                                             and self.controller.drawn_in_strips(), drawn=self.show_statistics)
             self.plotter.strip_stills(self.still_strips)
+            views.read_back = self.still_strips.after_still_frame
         self.clip_widget = ClipPlaneWidget(self.plotter, self.clipping)
         views.watch_viewport(self.fly)  # interaction observers, fly-mode settle and resize timers
         self.collector.freeze_long_lived()

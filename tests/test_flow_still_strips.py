@@ -13,8 +13,8 @@ from PySide6.QtCore import Qt, QTimer
 
 from conftest import data_file
 from iso_volume_scene import session, write_datasets
-from flows import drag_viewport, pick_combo_item, wait_loaded, wait_settled
-from strip_flows import assert_strips_left_the_whole_frame, last_frame, neghip_in_strips
+from flows import assert_matches_render, drag_viewport, pick_combo_item, wait_loaded, wait_settled
+from strip_flows import WHOLE_FRAME_OFF, assert_strips_left_the_whole_frame, last_frame, neghip_in_strips
 from volviz.render import strips as strips_module
 from volviz.render.strips import last_strip_share, planned_rows, ray_cast_volumes, strip_window_center, strips_for
 from volviz.render.vtk_facade import vtk
@@ -138,14 +138,7 @@ def test_a_volume_under_the_isosurfaces_cpu_overlay_is_drawn_in_strips(qtbot, ma
     by a renderer in a layer above, so the volume's still frame is drawn in strips and the overlay in their last
     pass (drawn whole, its first frame and the one after each overlay update held the loop 0.8-1.8 s here); the
     frame the strips leave is the whole frame."""
-    monkeypatch.setattr(strips_module, "SPLIT_OVER_S", 0.0)
-    path = tmp_path / "plane_in_ball.json"
-    save(session("auto", "3pass", write_datasets(tmp_path)), path)
-    window = make_window()
-    window.resize(900, 600)
-    window.open_path(path)
-    wait_loaded(qtbot, window)
-    wait_settled(qtbot, window)
+    window = _ball_under_cpu_overlay(qtbot, make_window, monkeypatch, tmp_path)
     strips, controller = window.still_strips, window.controller
     overlay = controller.iso_overlay
     assert overlay is not None and overlay.visible and not controller.drawn_by_vtk_alone()
@@ -156,6 +149,52 @@ def test_a_volume_under_the_isosurfaces_cpu_overlay_is_drawn_in_strips(qtbot, ma
     assert len(strips.last_rows) > 1
     whole = assert_strips_left_the_whole_frame(window, monkeypatch)
     assert float(np.abs(whole - _frame_without(window, overlay)).max()) > 24     # the overlay is in the frame
+
+
+def _ball_under_cpu_overlay(qtbot, make_window, monkeypatch, tmp_path):
+    """A 900x600 window showing a translucent plane isosurface in the CPU 3-pass mode through a ball-shaped volume
+    (``iso_volume_scene``), its final picture shown, every still frame drawn in strips."""
+    monkeypatch.setattr(strips_module, "SPLIT_OVER_S", 0.0)
+    path = tmp_path / "plane_in_ball.json"
+    save(session("auto", "3pass", write_datasets(tmp_path)), path)
+    window = make_window()
+    window.resize(900, 600)
+    window.open_path(path)
+    wait_loaded(qtbot, window)
+    wait_settled(qtbot, window)
+    return window
+
+
+def test_the_cpu_overlays_read_back_comes_from_the_still_frame_in_strips(qtbot, make_window, monkeypatch,
+                                                                         tmp_path) -> None:
+    """After a drag, the isosurfaces' CPU overlay reads the opaque scene back from the still frame drawn in strips
+    (``StillStrips.after_still_frame``: before the strips' last pass drew the overlay), not from a whole frame of its
+    own (those held the loop 0.5-1 s here, gap survey 8); what a frame in strips reads back is the whole frame's
+    read-back, and the screen then is ``volviz render``'s picture."""
+    window = _ball_under_cpu_overlay(qtbot, make_window, monkeypatch, tmp_path)
+    overlay = window.controller.iso_overlay
+    begins: list[tuple[int, bool]] = []    # (scale, whether the opaque scene was handed over) of each update
+    begin = overlay.begin
+    monkeypatch.setattr(overlay, "begin", lambda scale=1, drawn=None: (
+        begins.append((scale, drawn is not None)), begin(scale, drawn))[1])
+    drag_viewport(qtbot, window, 60, 20)
+    wait_settled(qtbot, window)
+    full = [handed for scale, handed in begins if scale == 1]
+    assert full and all(full), begins
+
+    got: list = []
+    assert window.still_strips.after_still_frame(got.append)
+    qtbot.waitUntil(lambda: bool(got), timeout=30000)
+    assert got[0] is not None
+    z, rgb = got[0]
+    w, h = window.plotter.ren_win.GetSize()
+    z_whole, rgb_whole = overlay._overlay.opaque_buffers((w, h))
+    assert z.shape == z_whole.shape == (h, w) and rgb.shape == rgb_whole.shape
+    assert float(np.abs(z - z_whole).max()) < 1e-6
+    off = float((np.abs(rgb.astype(np.float64) - rgb_whole).max(axis=2) > 24).mean())
+    assert off < WHOLE_FRAME_OFF, off
+    wait_settled(qtbot, window)
+    assert_matches_render(window, tmp_path, "overlay-strips", 1.5, 0.002)
 
 
 def _frame_without(window, overlay) -> np.ndarray:

@@ -104,7 +104,11 @@ def unpremultiply_rgba8(image: np.ndarray) -> np.ndarray:
     return out
 
 
-def read_buffers(ren_win: vtkRenderWindow, w: int, h: int) -> tuple[np.ndarray, np.ndarray]:
+#: a render window's (z (H, W) float64, rgb (H, W, 3) uint8), row 0 at the top (``read_buffers``)
+Buffers = tuple[np.ndarray, np.ndarray]
+
+
+def read_buffers(ren_win: vtkRenderWindow, w: int, h: int) -> Buffers:
     """(z (H, W) float64, rgb (H, W, 3) uint8) of the render window, row 0 at the top."""
     # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
     from volviz.render.vtk_facade import vtk, vtk_to_numpy
@@ -326,15 +330,18 @@ class OverlayView(Generic[StatsT]):
         request = self.begin()
         return self.finish(request, *self.compute(request))
 
-    def begin(self, scale: int = 1) -> OverlayRequest:
+    def begin(self, scale: int = 1, drawn: Optional[Buffers] = None) -> OverlayRequest:
         """GUI-thread part 1: the opaque scene's depth and color, the camera and the image size: the window's, or
         for a preview (``scale`` > 1, e.g. while the camera moves) the window's divided by ``scale``, with the depth
         limit of each preview pixel the nearest opaque depth under it (``block_min``), the scene color at its
         first pixel and the window's own depth (``window_depth``, for ``upsample_preview``); only the read-back is
-        done here, the rest where the request is first used (``OverlayRequest``)."""
+        done here, the rest where the request is first used (``OverlayRequest``). ``drawn``: the opaque scene's
+        (z, rgb) read back already, for the current camera and the window's size (a still frame drawn in strips, read
+        before their last pass drew the overlays: ``volviz.render.strips.StripFrame``); else it is drawn and read
+        here (``ImageOverlay.opaque_buffers``)."""
         t_start = time.perf_counter()
         w, h = (int(v) for v in self.plotter.ren_win.GetSize())
-        z, rgb = self._overlay.opaque_buffers((w, h))
+        z, rgb = drawn if drawn is not None else self._overlay.opaque_buffers((w, h))
         live = Camera.from_pyvista(self.plotter.renderer.GetActiveCamera())
         near, far = live.clipping_range
         cam = Camera(live.position, live.focal_point, live.view_up, live.view_angle, live.parallel,

@@ -36,7 +36,7 @@ import numpy as np
 from volviz.iso.composite import MODES, Fragments, composite, fragments, triangles_drawn
 from volviz.iso.extract import IsoMesh
 from volviz.iso.lod import lod_mesh, select_level
-from volviz.render.image_overlay import OverlayRequest, OverlayView, overlay_rgba8
+from volviz.render.image_overlay import Buffers, OverlayRequest, OverlayView, overlay_rgba8
 from volviz.render.iso_volume_split import FrontVolume, in_volume
 from volviz.model.camera import Camera
 
@@ -147,13 +147,13 @@ class IsoOverlay(OverlayView[IsoStats], IsoModeView):
         p = np.concatenate(pts)
         return float(((p - cam.position) @ cam.frame()[2]).max())
 
-    def begin(self, scale: int = 1) -> OverlayRequest:
-        """GUI thread: ``OverlayView.begin`` (the scene drawn and read back), and with a regular volume shown what
-        ``compute`` needs to draw the volume in front of the translucent surfaces off this thread
+    def begin(self, scale: int = 1, drawn: Optional[Buffers] = None) -> OverlayRequest:
+        """GUI thread: ``OverlayView.begin`` (the scene drawn and read back, or ``drawn``), and with a regular volume
+        shown what ``compute`` needs to draw the volume in front of the translucent surfaces off this thread
         (``FrontVolume.snapshot``)."""
         translucent = [m for m in self.meshes if m.style.opacity < 1.0] if self.split_volume else []
         front = self.front_volume.snapshot(self.plotter, translucent) if translucent else None
-        request = super().begin(scale)
+        request = super().begin(scale, drawn)
         cam = request["camera"]
         near = min(cam.clipping_range[0], 1e-3 * cam.clipping_range[1])  # VTK's range ignores the hidden actors
         request["camera"] = Camera(cam.position, cam.focal_point, cam.view_up, cam.view_angle, cam.parallel,

@@ -36,8 +36,8 @@ from volviz.model.camera import Camera
 from volviz.model.datasets import TetMesh
 from volviz.model.extent import point_extent
 from volviz.optics.metrics import max_abs, rmse
-from volviz.render.image_overlay import (OverlayRequest, OverlayView, overlay_rgba8, unpremultiply_rgba8, window_size,
-                                         zbuffer_to_depth)
+from volviz.render.image_overlay import (Buffers, OverlayRequest, OverlayView, overlay_rgba8, unpremultiply_rgba8,
+                                         window_size, zbuffer_to_depth)
 from volviz.render.preview_hold import PreviewCameraHold, holds_previews
 from volviz.render.pt_view import PTView
 from volviz.unstructured.prefetch import SortPrefetcher
@@ -94,16 +94,16 @@ class PTVolume(OverlayView[UnstructuredRenderStats], PTView):
         fwd = cam.frame()[2]
         return float(((corners - cam.position) @ fwd).max())
 
-    def begin(self, scale: int = 1) -> OverlayRequest:
+    def begin(self, scale: int = 1, drawn: Optional[Buffers] = None) -> OverlayRequest:
         """GUI-thread part 1: render the opaque scene, read its depth, fix the camera (see the module docstring);
-        ``scale`` > 1: a preview image that much smaller (``OverlayView.begin``). The opaque scene is rendered with
-        the live camera (``hold`` suspended)."""
+        ``scale`` > 1: a preview image that much smaller, ``drawn``: the opaque scene read back already
+        (``OverlayView.begin``). The opaque scene is rendered with the live camera (``hold`` suspended)."""
         if self.hold is None:
-            request = super().begin(scale)
+            request = super().begin(scale, drawn)
         else:
             self.hold.suspended = True
             try:
-                request = super().begin(scale)
+                request = super().begin(scale, drawn)
             finally:
                 self.hold.suspended = False
             request["held_camera"] = self.hold.snapshot()

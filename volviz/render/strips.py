@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import math
 import time
-from typing import TYPE_CHECKING, Any, Optional, Sequence
+from typing import TYPE_CHECKING, Any, Callable, Optional, Sequence
 
 if TYPE_CHECKING:   # type-only imports for the signatures
     from volviz.render.vtk_facade import vtkRenderer, vtkRenderWindow
@@ -113,11 +113,15 @@ class StripFrame:
     after the first gets the rows the last one drew in that time (a denser part of the picture gets thinner strips;
     none higher than the first), else all have the same height; with the ``profile`` of an earlier frame of the
     same height too, each strip is planned from its rates (``planned_rows``). ``step()`` draws the next pass;
-    ``done`` once the frame is swapped; ``costs`` has its strips' rows and seconds."""
+    ``done`` once the frame is swapped; ``costs`` has its strips' rows and seconds. ``after_base`` is called when
+    the strips have drawn the whole renderer, before the pass of its 2D props and the renderers over it: what is
+    then in the render window is the scene without them (``ImageOverlay.opaque_buffers``' read-back)."""
 
     def __init__(self, ren_win: vtkRenderWindow, renderer: vtkRenderer, strips: int,
-                 budget_s: Optional[float] = None, profile: Optional[StripCosts] = None) -> None:
+                 budget_s: Optional[float] = None, profile: Optional[StripCosts] = None,
+                 after_base: Optional[Callable[[], None]] = None) -> None:
         self.ren_win, self.renderer, self.budget_s = ren_win, renderer, budget_s
+        self.after_base = after_base   # called once the strips drew the whole renderer, before the 2D pass
         self.height = max(1, int(renderer.GetSize()[1]))
         self.rows_per_strip = self.most_rows = math.ceil(self.height / max(1, min(MAX_STRIPS, int(strips))))
         self.profile = list(profile) if profile and budget_s is not None and profile[-1][1] == self.height else None
@@ -167,6 +171,8 @@ class StripFrame:
         swap = hi >= self.height and not self.last_pass_2d
         start = time.perf_counter()
         self._strip(lo, hi, swap)
+        if hi >= self.height and self.after_base is not None:
+            self.after_base()
         elapsed = time.perf_counter() - start
         if self.budget_s is not None:
             per_row = max(elapsed, 1e-6) / (hi - lo)
