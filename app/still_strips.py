@@ -18,7 +18,7 @@ from typing import Any, Callable, Optional
 from PySide6.QtCore import QTimer
 
 from volviz.render import strips
-from volviz.render.image_overlay import Buffers, read_buffers
+from volviz.render.image_overlay import Buffers, image_renderers, read_buffers
 from volviz.render.strips import StripFrame, can_strip, strips_for
 
 
@@ -94,7 +94,7 @@ class StillStrips:
         if self.frame is None:
             self.plotter.interactor.update()
         elif self.frame.after_base is None:   # a frame being drawn: read back once its strips drew the scene
-            self.frame.after_base = self._read_back
+            self.frame.read_after_base(self._read_back, image_renderers(self.plotter))
         return True
 
     def _read_back(self) -> None:
@@ -132,7 +132,8 @@ class StillStrips:
         self._drawn = None
         self.frame = StripFrame(self.plotter.ren_win, self.plotter.renderer, strips_for(self.cost),
                                 strips.PASS_BUDGET_S, self.profile,
-                                after_base=self._read_back if self._waiters else None)
+                                after_base=self._read_back if self._waiters else None,
+                                images=image_renderers(self.plotter))
         self._spent = []
         self._step(self.frame)
         return True

@@ -108,6 +108,11 @@ def unpremultiply_rgba8(image: np.ndarray) -> np.ndarray:
 Buffers = tuple[np.ndarray, np.ndarray]
 
 
+def image_renderers(plotter: Any) -> list[Any]:
+    """The renderers of ``plotter``'s image overlays (``ImageOverlay``), which its read-back leaves out."""
+    return list(_SIBLINGS.get(plotter, []))
+
+
 def read_buffers(ren_win: vtkRenderWindow, w: int, h: int) -> Buffers:
     """(z (H, W) float64, rgb (H, W, 3) uint8) of the render window, row 0 at the top."""
     # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made

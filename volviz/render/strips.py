@@ -114,14 +114,16 @@ class StripFrame:
     none higher than the first), else all have the same height; with the ``profile`` of an earlier frame of the
     same height too, each strip is planned from its rates (``planned_rows``). ``step()`` draws the next pass;
     ``done`` once the frame is swapped; ``costs`` has its strips' rows and seconds. ``after_base`` is called when
-    the strips have drawn the whole renderer, before the pass of its 2D props and the renderers over it: what is
-    then in the render window is the scene without them (``ImageOverlay.opaque_buffers``' read-back)."""
+    the whole frame but the renderers ``images`` is drawn: what is then in the render window is the scene without
+    those images (``ImageOverlay.opaque_buffers``' read-back; the last pass is then two: all but the images, and
+    the images)."""
 
     def __init__(self, ren_win: vtkRenderWindow, renderer: vtkRenderer, strips: int,
                  budget_s: Optional[float] = None, profile: Optional[StripCosts] = None,
-                 after_base: Optional[Callable[[], None]] = None) -> None:
+                 after_base: Optional[Callable[[], None]] = None, images: Sequence[Any] = ()) -> None:
         self.ren_win, self.renderer, self.budget_s = ren_win, renderer, budget_s
-        self.after_base = after_base   # called once the strips drew the whole renderer, before the 2D pass
+        self.after_base = after_base   # called once all but the ``images`` renderers over it are drawn
+        self.images = list(images)
         self.height = max(1, int(renderer.GetSize()[1]))
         self.rows_per_strip = self.most_rows = math.ceil(self.height / max(1, min(MAX_STRIPS, int(strips))))
         self.profile = list(profile) if profile and budget_s is not None and profile[-1][1] == self.height else None
@@ -132,6 +134,14 @@ class StripFrame:
         self.drawn: list[tuple[int, int]] = []     # the rows [lo, hi) of each strip drawn so far
         self.done = False
         self.view = self._view()
+
+    def read_after_base(self, read: Callable[[], None], images: Sequence[Any] = ()) -> None:
+        """``after_base`` and ``images`` from now on (a read-back asked for while the frame is drawn): ``read()`` now
+        when the strips have drawn the whole frame already, which has no last pass (no 2D props, no renderers over
+        it)."""
+        self.after_base, self.images = read, list(images)
+        if self.drawn and self.drawn[-1][1] >= self.height and not self.done and not self.last_pass_2d:
+            read()
 
     def _view(self) -> tuple[Any, ...]:
         """What the strips' picture depends on that others may change between passes: the camera's pose and lens,
@@ -171,7 +181,7 @@ class StripFrame:
         swap = hi >= self.height and not self.last_pass_2d
         start = time.perf_counter()
         self._strip(lo, hi, swap)
-        if hi >= self.height and self.after_base is not None:
+        if hi >= self.height and self.after_base is not None and not self.last_pass_2d:
             self.after_base()
         elapsed = time.perf_counter() - start
         if self.budget_s is not None:
@@ -232,13 +242,38 @@ class StripFrame:
             prop = props.GetNextProp()
             if prop is not None and prop.GetVisibility() and not prop.IsA("vtkActor2D"):
                 hidden.append(prop)
+        images = [r for r in self.overlays if r in self.images] if self.after_base is not None else []
         erase = ren.GetErase()
         try:
             for prop in hidden:
                 prop.SetVisibility(0)
             ren.SetErase(0)
+            if self.after_base is not None:
+                # all but the images, read back, then the images alone in the pass that swaps
+                others = [r for r in self.overlays if r not in images]
+                self._drawing(images, False, lambda: self._render(swap=not images))
+                self.after_base()
+                if not images:
+                    return
+                hidden += self._shown_2d()
+                for prop in hidden:
+                    prop.SetVisibility(0)
+                self._drawing(others, False, lambda: self._render(swap=True))
+                return
             self._render(swap=True)
         finally:
             ren.SetErase(erase)
             for prop in hidden:
                 prop.SetVisibility(1)
+
+    @staticmethod
+    def _drawing(renderers: Sequence[Any], on: bool, draw: Callable[[], None]) -> None:
+        """``draw()`` with ``renderers`` drawing (``on``) or not, as they were after."""
+        was = [r.GetDraw() for r in renderers]
+        for r in renderers:
+            r.SetDraw(int(on))
+        try:
+            draw()
+        finally:
+            for r, drew in zip(renderers, was):
+                r.SetDraw(drew)
