@@ -84,8 +84,8 @@ class StillStrips:
         """Draw a still frame in strips from the next paint (or finish the one being drawn) and hand ``done`` the
         opaque scene read back from it in the turn of its last pass: (z, rgb) at the window's size, read once its
         strips drew the scene, before their last pass drew the 2D props and the images over it
-        (``StripFrame.after_base``; what ``OverlayView.begin`` reads back, there a whole frame held the loop
-        0.5-1 s for a volume under the isosurfaces' CPU overlay). ``done(None)`` when the frame is not finished
+        (``StripFrame.after_base``; what ``OverlayView.begin`` reads back, there from a whole frame of its own, a
+        long stall under the isosurfaces' CPU overlay). ``done(None)`` when the frame is not finished
         (a render by anyone else, a move, another scene). False, ``done`` not kept: still frames are not drawn in
         strips now."""
         if not self.wanted():

@@ -108,7 +108,7 @@ def unpremultiply_rgba8(image: np.ndarray) -> np.ndarray:
 Buffers = tuple[np.ndarray, np.ndarray]
 
 
-def image_renderers(plotter: Any) -> list[Any]:
+def image_renderers(plotter: object) -> list[vtkRenderer]:
     """The renderers of ``plotter``'s image overlays (``ImageOverlay``), which its read-back leaves out."""
     return list(_SIBLINGS.get(plotter, []))
 

@@ -120,7 +120,7 @@ class StripFrame:
 
     def __init__(self, ren_win: vtkRenderWindow, renderer: vtkRenderer, strips: int,
                  budget_s: Optional[float] = None, profile: Optional[StripCosts] = None,
-                 after_base: Optional[Callable[[], None]] = None, images: Sequence[Any] = ()) -> None:
+                 after_base: Optional[Callable[[], None]] = None, images: Sequence[vtkRenderer] = ()) -> None:
         self.ren_win, self.renderer, self.budget_s = ren_win, renderer, budget_s
         self.after_base = after_base   # called once all but the ``images`` renderers over it are drawn
         self.images = list(images)
@@ -135,7 +135,7 @@ class StripFrame:
         self.done = False
         self.view = self._view()
 
-    def read_after_base(self, read: Callable[[], None], images: Sequence[Any] = ()) -> None:
+    def read_after_base(self, read: Callable[[], None], images: Sequence[vtkRenderer] = ()) -> None:
         """``after_base`` and ``images`` from now on (a read-back asked for while the frame is drawn): ``read()`` now
         when the strips have drawn the whole frame already, which has no last pass (no 2D props, no renderers over
         it)."""
