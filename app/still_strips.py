@@ -22,6 +22,9 @@ from volviz.render.image_overlay import Buffers, image_renderers, read_buffers
 from volviz.render.strips import StripFrame, can_strip, strips_for
 
 
+FRAME_STARTS_MS = 100   # a read-back waits this long for the paint it asked for to start a frame in strips
+
+
 class StillStrips:
     """Paints of a native viewport's still frames in strips (see the module's docstring); ``allowed()`` says
     whether the scene shown can be drawn so; ``drawn(seconds)`` is told each frame drawn in strips and what its passes
@@ -93,9 +96,16 @@ class StillStrips:
         self._waiters.append(done)
         if self.frame is None:
             self.plotter.interactor.update()
+            QTimer.singleShot(FRAME_STARTS_MS, self._unless_drawing)
         elif self.frame.after_base is None:   # a frame being drawn: read back once its strips drew the scene
             self.frame.read_after_base(self._read_back, image_renderers(self.plotter))
         return True
+
+    def _unless_drawing(self) -> None:
+        """The paint asked for drew no frame in strips (a reduced flight frame, or none yet): the waiters read back
+        themselves."""
+        if self.frame is None and self._waiters:
+            self._serve(None)
 
     def _read_back(self) -> None:
         ren_win = self.plotter.ren_win
