@@ -143,7 +143,7 @@ class StillStrips:
         self.frame = StripFrame(self.plotter.ren_win, self.plotter.renderer, strips_for(self.cost),
                                 strips.PASS_BUDGET_S, self.profile,
                                 after_base=self._read_back if self._waiters else None,
-                                images=image_renderers(self.plotter))
+                                images=image_renderers(self.plotter), stop_after_s=strips.STOP_AFTER_S)
         self._spent = []
         self._step(self.frame)
         return True

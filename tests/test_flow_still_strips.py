@@ -9,6 +9,7 @@ swaps through its own X connection. The native viewport's X picture is checked b
 from __future__ import annotations
 
 import numpy as np
+import pyvista as pv
 from PySide6.QtCore import Qt, QTimer
 
 from conftest import data_file
@@ -55,6 +56,53 @@ def test_a_slow_still_frame_is_drawn_in_strips_and_leaves_the_whole_frame(qtbot,
     assert all(b > a for a, b in zip(still, still[1:])), passes   # each pass in a turn of its own
 
     assert_strips_left_the_whole_frame(window, monkeypatch)
+
+
+def test_a_strip_denser_than_planned_is_stopped_and_drawn_again_thinner(qtbot, make_window, monkeypatch) -> None:
+    """A strip whose volume is still ray cast ``STOP_AFTER_S`` after its pass began is stopped (VTK's render abort,
+    checked by the CPU ray caster as it goes) and its rows are drawn again by a strip a quarter as high: a band
+    denser than its plan (the profile of another picture: an isosurface added, a transfer function changed) held a
+    pass for the whole band (183 ms at 1366x645 on hydrogen with an isosurface added). 0 here: every strip of the
+    volume over ``STOP_OVER_ROWS`` rows is stopped at the ray caster's first check; the frame left is the whole
+    frame."""
+    window = neghip_in_strips(qtbot, make_window, monkeypatch)
+    strips = window.still_strips
+    monkeypatch.setattr(strips_module, "STOP_AFTER_S", 0.0)
+    frames_seen: list = []
+    step = strips._step
+    monkeypatch.setattr(strips, "_step", lambda frame: (frames_seen.append(frame), step(frame)))
+    frames = strips.frames
+    drag_viewport(qtbot, window, 120, 30)
+    qtbot.waitUntil(lambda: strips.frames > frames and not strips.drawing, timeout=30000)
+    frame = frames_seen[-1]
+    assert frame.done and frame.stopped, frame.drawn
+    assert all(hi - lo > strips_module.STOP_OVER_ROWS for lo, hi, _ in frame.stopped), frame.stopped
+    for i, (lo, hi, _) in enumerate(frame.stopped):   # tried again from the same row, a quarter as high
+        again = [(a, b) for a, b, _ in frame.stopped[i + 1:] if a == lo] + [(a, b) for a, b in frame.drawn if a == lo]
+        assert again and again[0] == (lo, lo + (hi - lo) // 4), (lo, hi, frame.stopped, frame.drawn)
+    rows = frame.drawn
+    assert rows[0][0] == 0 and rows[-1][1] == window.plotter.renderer.GetSize()[1], rows
+    assert all(a[1] == b[0] and a[1] > a[0] for a, b in zip(rows, rows[1:])), rows
+    assert strips.last_rows == rows and [(a, b) for a, b, _ in frame.costs] == rows
+    assert_strips_left_the_whole_frame(window, monkeypatch)
+
+
+def test_a_strip_of_geometry_alone_is_never_stopped() -> None:
+    # only the volumes' ray casting is watched: a scene without one draws each strip to its end
+    ren_win, renderer = vtk.vtkRenderWindow(), vtk.vtkRenderer()
+    ren_win.SetOffScreenRendering(1)
+    ren_win.SetSize(200, 160)
+    ren_win.AddRenderer(renderer)
+    mapper = vtk.vtkPolyDataMapper()
+    mapper.SetInputData(pv.Sphere())
+    actor = vtk.vtkActor()
+    actor.SetMapper(mapper)
+    renderer.AddActor(actor)
+    renderer.ResetCamera()
+    frame = strips_module.StripFrame(ren_win, renderer, 4, stop_after_s=0.0)
+    while not frame.step():
+        pass
+    assert frame.stopped == [] and frame.drawn == [(0, 40), (40, 80), (80, 120), (120, 160)]
 
 
 def test_a_whole_render_in_between_ends_the_strips(qtbot, make_window, monkeypatch) -> None:

@@ -14,10 +14,12 @@ from __future__ import annotations
 
 import math
 import time
-from typing import TYPE_CHECKING, Any, Callable, Optional, Sequence
+from typing import TYPE_CHECKING, Any, Callable, Optional, Sequence, TypeVar
 
 if TYPE_CHECKING:   # type-only imports for the signatures
     from volviz.render.vtk_facade import vtkRenderer, vtkRenderWindow
+
+T = TypeVar("T")
 
 MAX_STRIPS = 16
 SPLIT_OVER_S = 0.08      # a still frame that took longer is drawn in strips next time (the app's rule)
@@ -25,6 +27,8 @@ STRIP_BUDGET_S = 0.05    # the mean time of a strip; the volume fills the middle
 PASS_BUDGET_S = 0.03     # each later strip's rows drawn in this time at the last strip's rate (denser ones follow)
 FIRST_FRAME_S = 0.4      # what a new scene's first still frame is taken to cost before it is measured (16 strips)
 PAYS_UNDER_S = 0.08      # strips pay where a frame's thinnest strip took less: else each pass holds the loop as long
+STOP_AFTER_S = 0.05      # a strip still ray casting this long after its pass began is stopped (``StripFrame``)
+STOP_OVER_ROWS = 8       # a strip of more rows can be stopped: a thinner one is drawn to its end
 
 
 #: the strips of a frame: (first row, row past the last, seconds its pass took)
@@ -116,12 +120,18 @@ class StripFrame:
     ``done`` once the frame is swapped; ``costs`` has its strips' rows and seconds. ``after_base`` is called when
     the whole frame but the renderers ``images`` is drawn: what is then in the render window is the scene without
     those images (``ImageOverlay.opaque_buffers``' read-back; the last pass is then two: all but the images, and
-    the images)."""
+    the images). With ``stop_after_s``, a strip of over ``STOP_OVER_ROWS`` rows whose volumes are still ray cast that
+    long after its pass began is stopped (VTK's abort of a render, checked by the CPU ray caster every few rows; the
+    GPU ray caster does not check it): its rows are drawn again by strips a quarter as high, planned from their own
+    rates, so that a band denser than its plan (the profile is of the frame before, at another camera or of another
+    picture) does not hold the pass for the whole band; ``stopped`` has the rows and seconds of each."""
 
     def __init__(self, ren_win: vtkRenderWindow, renderer: vtkRenderer, strips: int,
                  budget_s: Optional[float] = None, profile: Optional[StripCosts] = None,
-                 after_base: Optional[Callable[[], None]] = None, images: Sequence[vtkRenderer] = ()) -> None:
-        self.ren_win, self.renderer, self.budget_s = ren_win, renderer, budget_s
+                 after_base: Optional[Callable[[], None]] = None, images: Sequence[vtkRenderer] = (),
+                 stop_after_s: Optional[float] = None) -> None:
+        self.ren_win, self.renderer, self.budget_s, self.stop_after_s = ren_win, renderer, budget_s, stop_after_s
+        self.stopped: list[tuple[int, int, float]] = []   # the strips stopped: their rows and seconds
         self.after_base = after_base   # called once all but the ``images`` renderers over it are drawn
         self.images = list(images)
         self.height = max(1, int(renderer.GetSize()[1]))
@@ -179,8 +189,14 @@ class StripFrame:
             rows = planned_rows(self.profile, lo, self.budget_s, self.most_rows)
         hi = min(self.height, lo + rows)
         swap = hi >= self.height and not self.last_pass_2d
+        stop = self.stop_after_s if not swap and hi - lo > STOP_OVER_ROWS else None
         start = time.perf_counter()
-        self._strip(lo, hi, swap)
+        if self._strip(lo, hi, swap, stop):
+            # denser than planned: these rows again, thinner, from this frame's own rates from now on
+            self.stopped.append((lo, hi, time.perf_counter() - start))
+            self.profile = None
+            self.rows_per_strip = max(1, (hi - lo) // 4)
+            return False
         if hi >= self.height and self.after_base is not None and not self.last_pass_2d:
             self.after_base()
         elapsed = time.perf_counter() - start
@@ -192,19 +208,45 @@ class StripFrame:
         self.done = swap
         return self.done
 
-    def _render(self, swap: bool) -> None:
+    def _render(self, swap: bool, stop_after_s: Optional[float] = None) -> bool:
         """One pass; a pass that does not swap waits for the GPU (``WaitForCompletion``), so that its drawing is done
-        in its own turn, not left to the next pass."""
+        in its own turn, not left to the next pass. With ``stop_after_s``, the volumes' ray casting is stopped when
+        it still runs that long after the pass began; True when it was."""
         swapping = self.ren_win.GetSwapBuffers()
         self.ren_win.SetSwapBuffers(1 if swap else 0)
+        watched = self._stop_after(stop_after_s) if stop_after_s is not None else []
         try:
             self.ren_win.Render()
+            stopped = bool(watched) and bool(self.ren_win.GetAbortRender())
             if not swap:
                 self.ren_win.WaitForCompletion()
         finally:
+            for mapper, tag in watched:
+                mapper.RemoveObserver(tag)
             self.ren_win.SetSwapBuffers(swapping)
+        return stopped
 
-    def _strip(self, lo: int, hi: int, swap: bool) -> None:
+    def _stop_after(self, seconds: float) -> list[tuple[Any, int]]:
+        """Observers of the renderer's volume mappers' ray casting progress (``VolumeMapperRenderProgressEvent``,
+        sent by the CPU ray caster every few rows) that abort the render once ``seconds`` passed: VTK's ray casters
+        check the window's abort flag as they go; the mappers with their observers' tags."""
+        ren_win, deadline = self.ren_win, time.perf_counter() + seconds
+
+        def check(*args: Any) -> None:
+            if time.perf_counter() > deadline:
+                ren_win.SetAbortRender(1)
+
+        volumes = self.renderer.GetVolumes()
+        volumes.InitTraversal()
+        watched = []
+        for _ in range(volumes.GetNumberOfItems()):
+            volume = volumes.GetNextVolume()
+            mapper: Any = volume.GetMapper() if volume is not None and volume.GetVisibility() else None
+            if mapper is not None and mapper.IsA("vtkVolumeMapper"):
+                watched.append((mapper, mapper.AddObserver("VolumeMapperRenderProgressEvent", check)))
+        return watched
+
+    def _strip(self, lo: int, hi: int, swap: bool, stop_after_s: Optional[float] = None) -> bool:
         ren, cam = self.renderer, self.renderer.GetActiveCamera()
         viewport = ren.GetViewport()
         angle, center, scale = cam.GetViewAngle(), cam.GetWindowCenter(), cam.GetParallelScale()
@@ -213,8 +255,6 @@ class StripFrame:
         try:
             for prop in hidden:
                 prop.SetVisibility(0)
-            for overlay in self.overlays:
-                overlay.SetDraw(0)
             ren.SetViewport(viewport[0], viewport[1] + a * (viewport[3] - viewport[1]),
                             viewport[2], viewport[1] + b * (viewport[3] - viewport[1]))
             if cam.GetParallelProjection():
@@ -222,7 +262,7 @@ class StripFrame:
             elif not cam.GetUseHorizontalViewAngle():   # (a horizontal angle narrows with the strip's aspect)
                 cam.SetViewAngle(math.degrees(2.0 * math.atan((b - a) * math.tan(math.radians(angle) / 2.0))))
             cam.SetWindowCenter(center[0], strip_window_center(center[1], a, b))
-            self._render(swap)
+            return self._drawing(self.overlays, False, lambda: self._render(swap, stop_after_s))
         finally:
             ren.SetViewport(*viewport)
             cam.SetViewAngle(angle)
@@ -230,8 +270,6 @@ class StripFrame:
             cam.SetWindowCenter(*center)
             for prop in hidden:
                 prop.SetVisibility(1)
-            for overlay in self.overlays:
-                overlay.SetDraw(1)
 
     def _props_2d(self) -> None:
         ren = self.renderer
@@ -267,13 +305,13 @@ class StripFrame:
                 prop.SetVisibility(1)
 
     @staticmethod
-    def _drawing(renderers: Sequence[Any], on: bool, draw: Callable[[], None]) -> None:
-        """``draw()`` with ``renderers`` drawing (``on``) or not, as they were after."""
+    def _drawing(renderers: Sequence[Any], on: bool, draw: Callable[[], T]) -> T:
+        """``draw()`` with ``renderers`` drawing (``on``) or not, as they were after; what it returned."""
         was = [r.GetDraw() for r in renderers]
         for r in renderers:
             r.SetDraw(int(on))
         try:
-            draw()
+            return draw()
         finally:
             for r, drew in zip(renderers, was):
                 r.SetDraw(drew)
