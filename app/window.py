@@ -82,6 +82,8 @@ class MainWindow(WindowBase, QMainWindow):
         self.setCentralWidget(self.plotter.interactor)
         self.jobs = JobBridge(self)
         self.session = Session()
+        # the empty viewport (before a scene, or when the first open failed) in a scene's colour, not pyvista's white
+        self.plotter.set_background(self.session.render.background)  # type: ignore[arg-type]  # pyvista's wrapper
         self.session_path = None
         self.datasets = {}
         self.controller = None
