@@ -101,14 +101,20 @@ def ray_cast_volumes(renderer: vtkRenderer) -> bool:
     """Whether every visible volume of ``renderer`` is drawn by a ray caster of image data (``vtkVolumeMapper``:
     its cost follows the pixels, so a strip costs its share). VTK's projected tetrahedra sort and project every cell
     at each render: each strip would cost the whole frame."""
+    return all(mapper.IsA("vtkVolumeMapper") for mapper in _shown_volume_mappers(renderer))
+
+
+def _shown_volume_mappers(renderer: vtkRenderer) -> list[Any]:
+    """The mappers of ``renderer``'s visible volumes."""
     volumes = renderer.GetVolumes()
     volumes.InitTraversal()
+    shown = []
     for _ in range(volumes.GetNumberOfItems()):
         volume = volumes.GetNextVolume()
         mapper = volume.GetMapper() if volume is not None and volume.GetVisibility() else None
-        if mapper is not None and not mapper.IsA("vtkVolumeMapper"):
-            return False
-    return True
+        if mapper is not None:
+            shown.append(mapper)
+    return shown
 
 
 class StripFrame:
@@ -236,15 +242,8 @@ class StripFrame:
             if time.perf_counter() > deadline:
                 ren_win.SetAbortRender(1)
 
-        volumes = self.renderer.GetVolumes()
-        volumes.InitTraversal()
-        watched = []
-        for _ in range(volumes.GetNumberOfItems()):
-            volume = volumes.GetNextVolume()
-            mapper: Any = volume.GetMapper() if volume is not None and volume.GetVisibility() else None
-            if mapper is not None and mapper.IsA("vtkVolumeMapper"):
-                watched.append((mapper, mapper.AddObserver("VolumeMapperRenderProgressEvent", check)))
-        return watched
+        return [(mapper, mapper.AddObserver("VolumeMapperRenderProgressEvent", check))
+                for mapper in _shown_volume_mappers(self.renderer) if mapper.IsA("vtkVolumeMapper")]
 
     def _strip(self, lo: int, hi: int, swap: bool, stop_after_s: Optional[float] = None) -> bool:
         ren, cam = self.renderer, self.renderer.GetActiveCamera()
