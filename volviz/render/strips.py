@@ -92,16 +92,20 @@ def _renderers(ren_win: vtkRenderWindow) -> list[Any]:
 def can_strip(ren_win: vtkRenderWindow, renderer: vtkRenderer) -> bool:
     """Whether ``renderer`` is the only renderer of ``ren_win`` drawn in its layer or below (renderers in layers
     above, such as the orientation axes', are overlays drawn in the last pass): another one would draw over the
-    strips or between them; and whether its volumes are all ray cast (``ray_cast_volumes``)."""
+    strips or between them; and whether it shows volumes, all ray cast (``ray_cast_volumes``)."""
     return (not any(r is not renderer and r.GetDraw() and r.GetLayer() <= renderer.GetLayer()
                     for r in _renderers(ren_win)) and ray_cast_volumes(renderer))
 
 
 def ray_cast_volumes(renderer: vtkRenderer) -> bool:
-    """Whether every visible volume of ``renderer`` is drawn by a ray caster of image data (``vtkVolumeMapper``:
+    """Whether ``renderer`` shows volumes and every one is drawn by a ray caster of image data (``vtkVolumeMapper``:
     its cost follows the pixels, so a strip costs its share). VTK's projected tetrahedra sort and project every cell
-    at each render: each strip would cost the whole frame."""
-    return all(mapper.IsA("vtkVolumeMapper") for mapper in _shown_volume_mappers(renderer))
+    at each render: each strip would cost the whole frame. Geometry alone is drawn whole too: each strip draws all
+    of it, and each strip's own projection rounds a 1-pixel line's pixels its own way, so a line can move a pixel
+    between a frame in strips and a whole one; a CPU image over the scene cut by the depth read back from one of
+    them (``image_overlay``) then shows the volume over the line, and a hole beside it, in the other."""
+    mappers = _shown_volume_mappers(renderer)
+    return bool(mappers) and all(mapper.IsA("vtkVolumeMapper") for mapper in mappers)
 
 
 def _shown_volume_mappers(renderer: vtkRenderer) -> list[Any]:
