@@ -51,7 +51,19 @@ def isosurface_parts(comp: Component, dataset: object = None, t: Optional[float]
     shown = clip_isosurfaces(meshes, scene_clip) if scene_clip.all_planes() else list(meshes)
     if comp.opacity < 1.0:  # the component's opacity scales every surface's
         shown = [replace(m, style=replace(m.style, opacity=m.style.opacity * comp.opacity)) for m in shown]
+    fit_spectra(shown)
     lod = None  # LOD chains of the shown surfaces (the CPU modes draw them view-dependently)
     if settings.lod:
         lod = [(build_lod(m), settings.triangles_per_pixel2) if m.n_triangles else None for m in shown]
     return IsoParts(list(meshes), shown, lod, settings, scene_clip, float(comp.opacity))
+
+
+def fit_spectra(meshes: list[IsoMesh]) -> None:
+    """Any thread: the iso-spectrum fits of the translucent ``meshes``' opacities (``volviz.iso.fit_spectrum``, cached
+    per opacity), made where the surfaces are, so that the actors and the CPU compositor that use them find them in
+    the cache: the first fit imports SciPy's optimizer, a stall on the GUI thread that makes the actors (issue #28)."""
+    from volviz.iso import fit_spectrum   # the iso kernels: only for isosurfaces (start-up)
+
+    for opacity in {float(m.style.opacity) for m in meshes}:
+        if 0.0 < opacity < 1.0:
+            fit_spectrum(opacity)
