@@ -266,6 +266,44 @@ def test_order_made_on_a_worker_is_drawn_and_reused_until_the_next_one():
     pl.close()
 
 
+def test_a_volume_held_until_its_first_view_is_drawn_from_arrays_made_on_the_worker(monkeypatch):
+    """``hold_until_finished`` (the app's install): the volume draws nothing until the first ``finish``; the first
+    ``compute`` (on another thread) makes the cells' texels and the pre-integration table there, so the first draw's
+    program bind makes neither on the GUI thread, and draws the image of a volume that was never held."""
+    import importlib
+    import threading
+
+    from volviz.render import gl_pt
+
+    unstructured_render = importlib.import_module("volviz.unstructured.render")   # (the package names a function so)
+
+    mesh = syn.cavity_box(6)
+    size = (40, 32)
+    cam = Camera.orbit(mesh.points, 30, 20, 2.5)
+    exact = _gl_image(mesh, TF, cam, size)
+    pl = _plotter(size, cam)
+    empty = _drawn(pl)
+    vol = GLPTVolume(pl, mesh, TF)
+    assert vol.order_texture
+    vol.hold_until_finished()
+    assert np.array_equal(_drawn(pl), empty) and vol.visible    # held: nothing drawn, still visible as asked
+    made_here: list[str] = []
+    request = vol.begin()
+    worker = threading.Thread(target=lambda: made_here.append(vol.compute(request)))
+    worker.start()
+    worker.join()
+    monkeypatch.setattr(gl_pt, "cell_texels", lambda *a: made_here.append("texels"))
+    for build in ("build_table3d", "build_separable"):       # what ``table_for`` makes when its cache has none
+        monkeypatch.setattr(unstructured_render, build, lambda *a, **k: made_here.append("table"))
+    vol.finish(request, *made_here.pop())
+    assert np.array_equal(_drawn(pl), exact)
+    assert made_here == [] and vol._texels is None     # the worker's arrays were drawn (and the texels let go)
+    vol.visible = False
+    assert np.array_equal(_drawn(pl), empty)
+    vol.remove()
+    pl.close()
+
+
 def _drawn(pl: pv.Plotter) -> np.ndarray:
     """Render now (a screenshot alone shows the last frame) and read the image."""
     pl.ren_win.Render()

@@ -19,7 +19,7 @@ renderer (drawn in order). Call ``remove()`` before closing the plotter.
 from __future__ import annotations
 
 import time
-from typing import TYPE_CHECKING, Any, Sequence
+from typing import TYPE_CHECKING, Any, Optional, Sequence
 
 import numpy as np
 
@@ -27,7 +27,8 @@ from volviz.model.datasets import TetMesh
 from volviz.model.extent import point_extent
 from volviz.render.gl import ScenePass, resolve_polydata, set_ray_uniforms, shader_source, texel_array, with_defines
 from volviz.render.gl_pt_mesh import cell_texels, tet_polydata, texels_per_cell
-from volviz.render.gl_pt_order import CellOrder
+from volviz.jobs import ProgressCallback
+from volviz.render.gl_pt_order import CellOrder, OrderRequest
 from volviz.render.gl_pt_tables import KINDS, pt_shader, resolve_shader, set_table_uniforms, upload_table
 from volviz.render.gl_pt_targets import PTTargets
 from volviz.render.image_overlay import hold_single_sample, release_single_sample, window_size
@@ -38,8 +39,9 @@ from volviz.unstructured.iso import iso_visible
 from volviz.unstructured.render import Preclassified, auto_lookup, table_for, table_size
 from volviz.unstructured.topology import topology, visible_cells
 
-if TYPE_CHECKING:   # type-only: the session's clipping model
+if TYPE_CHECKING:   # type-only: the session's clipping model, the sort's result
     from volviz.model.clip import ClipSettings
+    from volviz.unstructured.sort import SortResult
 
 __all__ = ["GLPTVolume"]
 
@@ -123,6 +125,9 @@ class GLPTVolume(CellOrder, PTView):
         self._order_tex: Any = None                 # the order texture (uploaded as the program is bound)
         self._order_dirty = False
         self._cells_tex: Any = None                 # the cells' corners and data as texels (uploaded once)
+        self._texels: np.ndarray | None = None      # those texels made by ``compute`` on a worker, for that upload
+        self._wanted = True                         # ``visible`` as asked for
+        self._held = False                          # not drawn until the first ``finish`` (``hold_until_finished``)
 
         self.polydata = tet_polydata(mesh, smooth, attributes=not self.order_texture)
         if self.order_texture:                       # the static index buffer: slot s draws vertices 4 s .. 4 s + 3
@@ -307,8 +312,10 @@ class GLPTVolume(CellOrder, PTView):
         order, uploaded when a new one was set since the last draw (0.75 MB for the Blunt Fin: the only per-camera
         upload; VTK's index buffer stays)."""
         if self._cells_tex is None:
-            self._cells_tex = texel_array(ren_win, cell_texels(self.mesh, self.iso is not None
-                                                               and self.iso_shading == "smooth"), "cells'")
+            texels, self._texels = self._texels, None
+            if texels is None:
+                texels = cell_texels(self.mesh, self._smooth_cells())
+            self._cells_tex = texel_array(ren_win, texels, "cells'")
         if self._order_dirty or self._order_tex is None:
             start = time.perf_counter()
             self._order_tex = texel_array(ren_win, self._order_cells[:, None], "cell order", into=self._order_tex)
@@ -399,16 +406,53 @@ class GLPTVolume(CellOrder, PTView):
         return True
 
     def update(self) -> None:
-        """Nothing to re-make: the next render sorts for its camera and draws (``PTView.update``)."""
+        """Nothing to re-make: the next render sorts for its camera and draws (``PTView.update``), a volume held
+        until its first ``finish`` too (the views made here, not on a worker)."""
+        self._release()
+
+    def compute(self, request: OrderRequest, progress: Optional[ProgressCallback] = None
+                ) -> tuple[Optional[SortResult]]:
+        """Any thread: the order (``CellOrder.compute``) and, before the first draw, the arrays the first bind of the
+        cells' program would make on the GUI thread: the cells' texels (``cell_texels``, handed to the upload) and
+        the pre-integration table (``table_for``'s cache, which the bind then finds for this TF)."""
+        if self.order_texture and self._cells_tex is None and self._texels is None:
+            self._texels = cell_texels(self.mesh, self._smooth_cells())
+        if self._table is None:
+            self._build_table()
+        return super().compute(request, progress)
+
+    def finish(self, request: OrderRequest, result: Optional[SortResult]) -> None:
+        """GUI thread: ``CellOrder.finish``; a volume held until now is drawn from the next render on."""
+        super().finish(request, result)
+        self._release()
+
+    def hold_until_finished(self) -> None:
+        """Draw nothing until the first ``finish``: a caller that makes the views on a worker (the app) then has the
+        first draw's arrays made there too (``compute``), not in a render of the GUI thread."""
+        self._held = True
+        self._show()
+
+    def _release(self) -> None:
+        if self._held:
+            self._held = False
+            self._show()
+
+    def _smooth_cells(self) -> bool:
+        return self.iso is not None and self.iso_shading == "smooth"
+
+    def _show(self) -> None:
+        on = self._wanted and not self._held
+        self.actor.SetVisibility(on)
+        self.resolve_actor.SetVisibility(on)
 
     @property
     def visible(self) -> bool:
-        return bool(self.actor.GetVisibility())
+        return self._wanted
 
     @visible.setter
     def visible(self, on: bool) -> None:
-        self.actor.SetVisibility(bool(on))
-        self.resolve_actor.SetVisibility(bool(on))
+        self._wanted = bool(on)
+        self._show()
 
     def remove(self) -> None:
         """Take the volume out of the renderer; the last GL pass of a renderer removes the float scene target (call

@@ -316,7 +316,10 @@ def add_pt_component(plotter: pv.BasePlotter, session: Session, comp: Component,
 
     opts = pt_options(session.render.options) if method == "pt" else {}
     if method == "pt" and pt_backend(plotter, session) == "gpu":
-        return view_class("pt", "gpu")(plotter, dataset, tf, **{"lookup": "auto", **opts})  # the CPU path's table
+        volume = view_class("pt", "gpu")(plotter, dataset, tf, **{"lookup": "auto", **opts})  # the CPU path's table
+        if not update:       # its first draw's arrays made with its first order, in the background
+            volume.hold_until_finished()
+        return volume
     handle = view_class("pt", "cpu")(plotter, dataset, tf, method=method, scalars=getattr(dataset, "active", None),
                                      **opts)
     if update:
