@@ -1,7 +1,7 @@
 """The iso-spectrum fits of an isosurface component's translucent surfaces are made with its surfaces
 (``volviz.scene.isosurfaces.isosurface_parts``, any thread: the app runs it on a worker), so that the actors made on
 the GUI thread find them in ``fit_spectrum``'s cache; the first fit imports SciPy's optimizer (issue #28: a 169 ms
-stall of the GUI thread in the isosurface flow of gap survey 12, docs/bench/flow-gaps.md)."""
+stall of the GUI thread in test_first_hour_flow[isosurfaces]: docs/bench/flow-gaps.md, survey 12)."""
 from __future__ import annotations
 
 import numpy as np
