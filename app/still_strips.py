@@ -70,6 +70,8 @@ class StillStrips:
         self._renders += 1
         self._started = time.perf_counter()
         share, self._last_share = self._last_share, None
+        if share is None and not self._ours and self.frame is not None and self.frame.costs:
+            share = strips.last_strip_share(self.frame.costs, self.frame.height)   # a frame this render cuts short
         if not self._ours and share is not None and not self._still():
             # the first render at the interactive rate after a frame in strips (``strips.last_strip_share``)
             renderer = self.plotter.renderer
@@ -176,6 +178,8 @@ class StillStrips:
         if frame is not self.frame:                 # a newer paint started its own
             return
         if self._renders != self._mark or not self._still():     # (not still: also once the viewport is closed)
+            if self._renders == self._mark and frame.costs:   # cut short by a move or a playback: its first render
+                self._last_share = strips.last_strip_share(frame.costs, frame.height)   # comes after a strip
             self.frame = None                       # a whole frame was drawn since, or the camera moves
             self._serve(None)
             return

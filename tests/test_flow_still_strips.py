@@ -20,6 +20,7 @@ from volviz.render import strips as strips_module
 from volviz.render.strips import last_strip_share, planned_rows, ray_cast_volumes, strip_window_center, strips_for
 from volviz.render.vtk_facade import vtk
 from volviz.session import save
+from volviz_app.view_scheduler import interactive_rate
 
 
 def test_window_centres_tile_the_frustum_and_the_count_follows_the_time() -> None:
@@ -268,6 +269,8 @@ def test_the_last_strips_share_of_the_frame() -> None:
     assert last_strip_share([(0, 100, 0.25), (100, 200, 0.5), (200, 300, 0.25)]) == 0.25
     assert last_strip_share([(0, 300, 0.1)]) == 1.0
     assert last_strip_share([]) == 1.0
+    # a frame cut short after 100 of its 300 rows: its whole cost taken as 3 times what they took
+    assert abs(last_strip_share([(0, 50, 0.1), (50, 100, 0.1)], 300) - 0.1 / 0.6) < 1e-12
 
 
 def test_the_first_interactive_frame_after_strips_is_allotted_by_the_frames_cost(qtbot, make_window,
@@ -294,6 +297,38 @@ def test_the_first_interactive_frame_after_strips_is_allotted_by_the_frames_cost
     assert abs(moving[0][1] - whole * share) < 1e-9 * whole, (moving[0], whole, share)
     assert all(abs(time - 1.0 / (rate * renderers)) < 1e-9 * time for rate, time in moving[1:]), moving
     assert abs(renderer.GetAllocatedRenderTime() - 1.0 / (ren_win.GetDesiredUpdateRate() * renderers)) < 1e-6
+
+
+def test_an_interactive_frame_that_cuts_a_frame_in_strips_short_is_allotted_by_its_cost(qtbot, make_window,
+                                                                                          monkeypatch) -> None:
+    """A playback or a drag that begins before the still frame's last strip: its first render, the first after a
+    strip, is allotted the interactive time scaled by the share of the frame that strip took, the frame's cost taken
+    from the rows drawn (``last_strip_share`` with the frame's height). Unscaled, the CPU ray caster cast a ray for
+    every pixel in it: the playback's first render took 117-141 ms of test_app_background's 800x600 window, failing
+    its 100 ms in the fresh-clone CI twice."""
+    window = neghip_in_strips(qtbot, make_window, monkeypatch)
+    strips = window.still_strips
+    ren_win, renderer = window.plotter.ren_win, window.plotter.renderer
+    allotted: list[float] = []
+    ren_win.AddObserver("StartEvent", lambda *args: allotted.append(renderer.GetAllocatedRenderTime()))
+    for render_first in (True, False):    # the interactive render before the strips' next turn, or after it
+        window.plotter.interactor.repaint()              # a still frame: its first strip drawn in this paint
+        frame = strips.frame
+        assert frame is not None and frame.costs and not frame.done
+        share = last_strip_share(frame.costs, frame.height)
+        assert share < 1.0
+        interactive_rate(window.plotter, True)           # what the playback does, then a render by the window
+        if not render_first:
+            qtbot.waitUntil(lambda: strips.frame is None, timeout=10000)   # the strips' turn ends the frame
+            assert not frame.done
+            share = last_strip_share(frame.costs, frame.height)
+        del allotted[:]
+        window.plotter.render()
+        whole = 1.0 / (ren_win.GetDesiredUpdateRate() * ren_win.GetRenderers().GetNumberOfItems())
+        assert allotted and abs(allotted[0] - whole * share) < 1e-9 * whole, (render_first, allotted, whole, share)
+        assert abs(renderer.GetAllocatedRenderTime() - whole) < 1e-9 * whole       # put back after it
+        interactive_rate(window.plotter, False)
+        wait_settled(qtbot, window)
 
 
 def test_only_ray_cast_volumes_are_drawn_in_strips() -> None:

@@ -56,15 +56,19 @@ def planned_rows(profile: StripCosts, lo: int, budget_s: float, most: int) -> in
     return max(1, min(most, rows))
 
 
-def last_strip_share(costs: StripCosts) -> float:
+def last_strip_share(costs: StripCosts, height: Optional[int] = None) -> float:
     """The share of a frame drawn in strips (``StripFrame.costs``) that its last strip took, in (0, 1]. VTK's ray
     casters size the next frame's rays from the time their last render took over the time it is allotted
     (``vtkFixedPointVolumeRayCastMapper::ComputeRequiredImageSampleDistance``): after a frame in strips that render
     was the last strip's, so the next interactive frame, allotted its time scaled by this share, gets the rays
-    of the frame's whole cost (unscaled, the first frame of a drag after it cast rays for every pixel)."""
-    total = sum(seconds for _, _, seconds in costs)
-    if not costs or total <= 0.0:
+    of the frame's whole cost (unscaled, the first frame of a drag after it cast rays for every pixel). ``height``:
+    the frame's rows, for a frame cut short (a playback or a drag began before its last strip): its whole cost is
+    taken as what its strips took, times its rows over theirs."""
+    spent = sum(seconds for _, _, seconds in costs)
+    rows = sum(hi - lo for lo, hi, _ in costs)
+    if not costs or spent <= 0.0 or rows <= 0:
         return 1.0
+    total = spent * max(1.0, (height if height is not None else rows) / rows)
     return min(1.0, max(costs[-1][2], 1e-6) / total)
 
 
