@@ -226,6 +226,36 @@ def test_terrain_texture_is_mip_mapped_on_a_hardware_driver_only(demo) -> None:
         plotter.close()
 
 
+def test_the_terrain_texture_image_is_made_with_the_scene_not_by_its_view(monkeypatch) -> None:
+    """The 8-bit image of the terrain's color map is made by ``finalize`` (run by ``prepare_nature`` on the app's
+    worker), not by the view the GUI thread makes (issue #28: a 132 ms stall while a Yukon session opened); the view's
+    texture holds exactly that image (row 0 at the largest y)."""
+    import pyvista as pv
+
+    from volviz.nature import nature_scene
+    from volviz.render.vtk_facade import vtk_to_numpy
+
+    scene = demo_scene(terrain_size=65, cloud_shape=(17, 17, 5))
+    scene.finalize()
+    image = scene.texture_image()
+    assert image is not None and image.dtype == np.uint8 and image.flags.c_contiguous
+    expected = np.clip(scene.color_map.transpose(1, 0, 2)[::-1] * 255.0, 0, 255).astype(np.uint8)
+    np.testing.assert_array_equal(image, expected)
+
+    def made_again(*args: object) -> None:
+        raise AssertionError("the view made the texture's image again")
+
+    monkeypatch.setattr(nature_scene, "_texture_bytes", made_again)
+    plotter = pv.Plotter(off_screen=True, window_size=[64, 48])
+    try:
+        texture = NatureView(plotter, scene)._texture
+        shown = vtk_to_numpy(texture.GetInput().GetPointData().GetScalars())
+        h, w = image.shape[:2]
+        np.testing.assert_array_equal(shown.reshape(h, w, 3)[::-1], image)   # (VTK's rows from the bottom)
+    finally:
+        plotter.close()
+
+
 def test_a_move_draws_the_coarse_terrain_of_the_last_full_frame(demo, monkeypatch) -> None:
     """Each full-size frame also makes the terrain at preview detail, and the first ``begin(scale > 1)`` after it (a
     drag or a flight starts) draws that coarse terrain at once, whatever the mode: drawing the full C-LOD mesh until

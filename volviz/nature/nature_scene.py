@@ -75,6 +75,7 @@ class NatureScene:
         self.lod: TerrainLOD | None = None
         self.color_map: np.ndarray | None = None
         self._pyramid: Any = None
+        self._texture_image: np.ndarray | None = None
 
     # ----------------------------------------------------------------------------------------------- building
     def _grid(self, values: np.ndarray) -> np.ndarray:
@@ -121,6 +122,15 @@ class NatureScene:
             if self.color_map is None:
                 self.color_map = bake_color_map(self.terrain.normals(), self.texture, self.light)
                 self._pyramid = mip_pyramid(self.color_map)
+        if self.color_map is not None and self._texture_image is None:
+            self._texture_image = _texture_bytes(self.color_map)
+
+    def texture_image(self) -> np.ndarray | None:
+        """The baked color map as the 8-bit RGB image of the terrain's texture (rows from the top, x across; None
+        without a terrain), made by ``finalize``: on the worker that prepares the scene, not by the view that the
+        GUI thread makes (issue #28: no event-loop stall over 100 ms)."""
+        self.finalize()
+        return self._texture_image
 
     # ----------------------------------------------------------------------------------------------- rendering
     def terrain_mesh(self, camera: Any, size: tuple[int, int], full: bool = False,
@@ -333,3 +343,8 @@ def scene_from_components(components: Sequence[Any], datasets: dict[str, Any]) -
         scene.add_clouds(volume, shading, st.C, st.c)
     scene.finalize()
     return scene
+
+
+def _texture_bytes(color_map: np.ndarray) -> np.ndarray:
+    """``color_map`` (x, y, RGB in [0, 1]) as a contiguous 8-bit image with row 0 at the largest y."""
+    return np.ascontiguousarray(np.clip(color_map.transpose(1, 0, 2)[::-1] * 255.0, 0, 255).astype(np.uint8))

@@ -82,9 +82,9 @@ class NatureSceneView(ABC, Generic[FrameT]):
         self.shown_scale = 1          # the preview scale of the overlay shown (``compute``)
         self.preview_detail = 0.25    # the C-LOD resolution factor of previews, fitted to PREVIEW_TRIANGLES
         self._coarse: Any = None      # a full-size frame's terrain at preview detail: drawn from the first move on
-        if scene.terrain is not None and scene.color_map is not None:
-            img = np.clip(scene.color_map.transpose(1, 0, 2)[::-1] * 255.0, 0, 255).astype(np.uint8)
-            self._texture = pv.Texture(np.ascontiguousarray(img))
+        img = scene.texture_image()
+        if scene.terrain is not None and img is not None:
+            self._texture = pv.Texture(img)
             if texture_filtering(plotter) if filter_texture is None else filter_texture:
                 _filtered_texture(self._texture)
             b = scene.terrain.bounds()
