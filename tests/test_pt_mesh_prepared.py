@@ -9,7 +9,8 @@ import numpy as np
 from volviz.model.clip import ClipPlane, ClipSettings
 from volviz.model.datasets import TetMesh
 from volviz.scene.tetra import cut_tetmesh, pt_mesh
-from volviz.unstructured.topology import topology
+from volviz.unstructured import topology as topology_module
+from volviz.unstructured.topology import cell_ranges, topology
 
 
 def _two_cubes_apart() -> TetMesh:
@@ -29,3 +30,14 @@ def test_a_pt_mesh_and_its_cut_come_with_their_adjacency_and_inner_boundary() ->
     assert cut is not None
     cut_topo = topology(cut)
     assert "neighbor" in vars(cut_topo) and cut_topo.inner_boundary_faces is not None
+
+
+def test_a_pt_mesh_and_its_cut_come_with_their_cells_scalar_ranges() -> None:
+    """The cells' scalar ranges that a PT view culls by (``visible_cells``, made as a GPU PT volume is made on the GUI
+    thread: 33 ms of a 124 ms stall opening the Blunt Fin) are built with the mesh."""
+    mesh = pt_mesh(_two_cubes_apart())
+    cached = topology_module._RANGES.get(mesh)
+    assert cached is not None and cached[1] is cell_ranges(mesh)
+    np.testing.assert_array_equal(cached[1].smin, mesh.scalars[mesh.tets].min(axis=1))
+    cut = cut_tetmesh(mesh, ClipSettings(planes=(ClipPlane((0.5, 0.0, 0.0), (1.0, 0.0, 0.0)),)))
+    assert cut is not None and topology_module._RANGES.get(cut) is not None

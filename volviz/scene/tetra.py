@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING, Any, Optional
 from volviz.model.datasets import TetMesh
 from volviz.unstructured.boundary_pairs import inner_boundary
 from volviz.unstructured.tetrahedralize import tetrahedralize
-from volviz.unstructured.topology import topology
+from volviz.unstructured.topology import cell_ranges, topology
 
 if TYPE_CHECKING:   # type-only imports for the signatures
     from volviz.model.clip import ClipSettings
@@ -23,9 +23,11 @@ def pt_mesh(dataset: object) -> TetMesh:
 
 def _with_adjacency(mesh: TetMesh) -> None:
     """Build ``mesh``'s topology with what its first visibility order reads (``volviz.unstructured.sort``: the face
-    adjacency, the boundary faces off the convex hull), here on the caller's thread instead of in the first frame,
-    which a GPU PT volume draws on the GUI thread."""
+    adjacency, the boundary faces off the convex hull) and the cells' scalar ranges its view culls by
+    (``visible_cells``, as a GPU PT volume is made), here on the caller's thread instead of on the GUI thread, which
+    makes the view and draws its first frame."""
     topo = topology(mesh)
+    cell_ranges(mesh)
     try:
         topo.back_face   # (and the adjacency it is made from)
     except ValueError:   # not manifold: the sort says so, where it is used, as before
