@@ -1,7 +1,8 @@
 """Loading a scene in the main window: ``open_path``, the one code path behind File > Open, Open Recent,
 drag-and-drop and the command line, the demo scenes, and ``show_session``, which shows a session: its datasets are
 read and the scene prepared in the background (``SceneController.prepare``) with progress and cancel in the status
-bar, then installed on the GUI thread (``_install``: props added, the window told, one render) in short stages, and
+bar, its CPU ray-cast volumes set up off the GUI thread (``set_up_volumes``), then installed on the GUI thread
+(``_install``: props added, the window told, one render) in short stages, and
 its first views computed in the background (``volviz_app.view_scheduler``). A newer open supersedes an older one;
 the shown scene stays until the new one is ready, and stays on when it fails.
 
@@ -31,6 +32,8 @@ from .stand_in import StandInFrame
 
 if TYPE_CHECKING:
     from volviz.render.controller import SceneController
+    from volviz.render.scene_builder import PreparedScene
+    from volviz.render.volume_setup import VolumeSetup
     from .viewport_types import Viewport
     from .workers import JobBridge
 
@@ -56,6 +59,7 @@ class SceneLoading:
         self.current_job: Optional[Job] = None   # the newest scene's reading and preparing, until it is installed
         self.raw_dialog: Optional[Any] = None    # the layout dialog of the last headerless data opened
         self.missing_dialog: Optional[Any] = None  # the dialog locating a session's missing data files
+        self.volume_setup: Optional[VolumeSetup] = None   # its thread set up since the first CPU ray-cast volume
 
     def loading(self) -> bool:
         """A scene is being read and prepared (the Cancel button stops it)."""
@@ -174,11 +178,51 @@ class SceneLoading:
                 self.status.setText(f"Could not load {title}")
                 self.show_error(f"Cannot open {title}", open_error(path, outcome.error, title))
                 return
-            if self._install(controller, outcome.result, session_path, title, dirty, serial, path,
-                             same_data=datasets is not None) and on_shown:
-                on_shown()
+
+            def install(cancelled: bool) -> None:
+                if serial != self.serial:
+                    return
+                if cancelled:
+                    self.set_busy(False)
+                    self.status.setText(f"Loading {title} cancelled")
+                    return
+                if self._install(controller, outcome.result, session_path, title, dirty, serial, path,
+                                 same_data=datasets is not None) and on_shown:
+                    on_shown()
+
+            self.current_job = self.set_up_volumes(controller, outcome.result, title, install)
 
         self.current_job = self.jobs.submit(load, name=f"load {title}", key="load", on_done=done)
+
+    def set_up_volumes(self, controller: SceneController, prepared: PreparedScene, title: str,
+                       then: Callable[[bool], None]) -> Optional[Job]:
+        """GUI thread: ``then(cancelled)`` once the volumes that VTK's CPU ray caster will draw for ``prepared`` are
+        set up off the GUI thread (``volviz.render.volume_setup``: the empty-space volume and gradients their first
+        render made, in the scene's first frame), at once where there are none. A failed set-up is logged and the
+        scene shown all the same (its first render makes them). Returns the set-up's job (None: none)."""
+        try:
+            volumes = controller.volumes_to_set_up(prepared)
+        except Exception:   # (install makes them again, and says what is wrong)
+            log.exception("making the volumes of %s failed", title)
+            volumes = []
+        if not volumes:
+            then(False)
+            return None
+        if self.volume_setup is None:
+            from volviz.render.volume_setup import VolumeSetup   # (a thread and window: from the first such volume)
+
+            self.volume_setup = VolumeSetup()
+        setup = self.volume_setup
+        ticket = setup.hold(volumes)
+        del volumes
+
+        def done(outcome: JobOutcome) -> None:
+            setup.release(ticket)
+            if outcome.error is not None:
+                log.warning("setting up the volumes of %s failed: %s", title, outcome.error)
+            then(outcome.cancelled)
+
+        return self.jobs.submit(setup.run, ticket, name=f"set up the volumes of {title}", on_done=done)
 
     def _install(self, controller: SceneController, prepared: Any, session_path: Optional[Path], title: str,
                  dirty: bool, serial: int, path: Optional[Path] = None, same_data: bool = False) -> bool:

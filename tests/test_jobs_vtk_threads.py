@@ -8,7 +8,8 @@ test_flow_play_orbit). So the jobs hand over arrays (model datasets, meshes) and
 Each real file is opened in the real window and each job kind the app submits for it is run as the app runs it, on
 a thread of its own under ``vtk_threads.on_worker``: the view updates (``view.compute``: PT volume, natural scene),
 the preparation of a component (what loading and showing run: ``prepare_component``), the first look's transfer
-function (``default_transfer_function_for``, in the loading job), the time blend of a series (``blend_volume``). Not covered, still making VTK objects on workers: isosurface extraction and cuts (VTK's
+function (``default_transfer_function_for``, in the loading job), the set-up of a CPU ray-cast volume (its VTK work
+on the set-up window's thread, ``volviz.render.volume_setup``), the time blend of a series (``blend_volume``). Not covered, still making VTK objects on workers: isosurface extraction and cuts (VTK's
 contour, clip and probe filters inside ``volviz.iso``) and frame export."""
 from __future__ import annotations
 
@@ -51,6 +52,12 @@ def test_the_jobs_of_a_shown_file_make_no_vtk_object(qtbot, make_window, name: s
             jobs += 1
         if comp.type == "volume":   # what loading runs for a component without a transfer function yet
             _clean(f"first look {comp.id}", lambda: default_transfer_function_for(controller.dataset_of(comp.id)))
+    setup = window.scene_loading.volume_setup
+    if setup is not None:          # a regular volume drawn by the CPU ray caster: the loading's set-up job
+        ticket = setup.hold(controller.volumes_to_set_up(controller.prepare()))
+        assert _clean("volume set-up", lambda: setup.run(ticket)) == 1
+        setup.release(ticket)
+        jobs += 1
     for comp_id in controller.time_volumes():
         frame = _clean(f"blend {comp_id}", lambda: controller.blend_volume(comp_id, controller.time))
         controller.show_volumes({comp_id: frame})   # and the GUI thread makes its VTK input

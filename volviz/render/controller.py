@@ -35,8 +35,8 @@ from volviz.render.decorations import apply_decorations, legend_margin, update_l
 from volviz.render.framing import frame_scene, union
 from volviz.render.image_overlay import OverlayView, single_sample_on_software
 from volviz.render.scene_builder import (PreparedScene, ensure_transfer_functions, install_component, install_nature,
-                                         display_frame, frame_input, install_scene, prepare_component,
-                                         prepare_scene, view_backend)
+                                         display_frame, frame_input, install_scene, make_ray_cast_volumes,
+                                         prepare_component, prepare_scene, view_backend)
 from volviz.render.views import view_class
 from volviz.render.volume_peeling import peel_volumes, regular_volumes
 from volviz.render.vtk_scene import apply_camera, camera_state, is_surface
@@ -63,7 +63,7 @@ if TYPE_CHECKING:   # type-only imports for the signatures
     from volviz.render.lod_volume import LodVolume
     from volviz.render.nature_view import FrameT, NatureRequest, NatureSceneView
     from volviz.render.pt_prop import PTVolume
-    from volviz.render.vtk_facade import vtkProp
+    from volviz.render.vtk_facade import vtkProp, vtkVolume
     from volviz.model.datasets import Dataset
     from volviz.scene.datasets import LoadedDataset
 
@@ -222,6 +222,12 @@ class SceneController:
             self.set_iso_mode(self.iso_mode, update=False)
             if views:
                 self.update_views()
+
+    def volumes_to_set_up(self, prepared: PreparedScene) -> list[vtkVolume]:
+        """GUI thread: the vtkVolumes that VTK's CPU ray caster will draw for ``prepared`` (``install`` or
+        ``install_component`` adds them), made now and in no renderer, for the caller to set up off the GUI thread
+        first (``volviz.render.volume_setup``); none where the GPU ray caster draws them."""
+        return list(make_ray_cast_volumes(self.plotter, self.session, self.datasets, prepared).values())
 
     def clear(self) -> None:
         """Remove everything this controller added, including PT overlay renderers, which ``plotter.clear()`` keeps."""

@@ -20,7 +20,7 @@ from volviz.render.framing import frame_bounds, nature_bounds, points_bounds, un
 from volviz.render.slices import SlicesView
 from volviz.render.views import view_class
 from volviz.render.vtk_scene import (add_dataset, add_surface, apply_camera, default_transfer_function_for, is_surface,
-                                     surface_input, volume_grid, volume_input, volume_prop)
+                                     make_volume, surface_input, volume_grid, volume_input, volume_prop)
 from volviz.scene.datasets import NATURE_TYPES, component_dataset
 from volviz.scene.drawn_tf import component_transfer_function, drawn_transfer_function
 from volviz.scene.errors import SceneError
@@ -41,6 +41,7 @@ if TYPE_CHECKING:   # type-only imports for the signatures
     from volviz.render.views import ComponentView
     from volviz.model.datasets import Dataset
     from volviz.render.vtk_scene import MapperInput
+    from volviz.render.vtk_facade import vtkVolume
     from volviz.scene.datasets import LoadedDataset
 
 
@@ -69,6 +70,7 @@ class PreparedScene:
     cut: dict[str, Any] = field(default_factory=dict)       # PT comp id -> mesh cut by the scene clip (None: all cut)
     histograms: dict[str, Any] = field(default_factory=dict)  # comp id -> (counts, edges) of its data
     nature: Any = None                                      # the NatureScene of the terrain/fog/clouds/sky components
+    volumes: dict[str, vtkVolume] = field(default_factory=dict)   # comp id -> made before install (GUI thread)
 
 
 def prepare_scene(session: Session, datasets: dict[str, LoadedDataset], t: Optional[float] = None,
@@ -257,10 +259,39 @@ def install_component(plotter: pv.BasePlotter, session: Session, comp: Component
         return add_lod_component(plotter, session, comp, dataset, update=views)
     if uses_pt(session, dataset):
         return add_pt_component(plotter, session, comp, prepared.parts[comp.id], update=views)
+    made = prepared.volumes.pop(comp.id, None)
+    if made is not None:        # made (and set up) before: ``make_ray_cast_volumes``
+        plotter.add_actor(made, name=comp.id, reset_camera=False, render=False)  # type: ignore[arg-type]  # _Wrapped
+        return VtkPropView(made)
     tf = drawn_transfer_function(session, comp, dataset)
     return VtkPropView(add_volume_prop(plotter, dataset, frame_input(dataset, prepared.parts.get(comp.id)), tf,
                                        comp.opacity, comp.id,
                                        backend_setting(session.render.options), bool(comp.settings.get("shade"))))
+
+
+def make_ray_cast_volumes(plotter: pv.BasePlotter, session: Session, datasets: dict[str, LoadedDataset],
+                          prepared: PreparedScene) -> dict[str, vtkVolume]:
+    """GUI thread: the vtkVolumes of ``prepared``'s regular volumes that VTK's CPU ray caster draws in ``plotter``
+    (``backend``), made as ``install_component`` makes them but in no renderer, and kept in ``prepared.volumes``,
+    which ``install_component`` adds: between the two the caller sets them up off the GUI thread
+    (``volviz.render.volume_setup``). Returns them by component id."""
+    cpu = choose_backend(backend_setting(session.render.options), "regular", plotter_gl_info(plotter)) == "cpu"
+    for comp in session.components if cpu else ():
+        if not comp.visible or comp.type in NATURE_TYPES or comp.type in ("isosurface", "slices") \
+                or comp.id not in prepared.parts or comp.id in prepared.volumes:
+            continue
+        dataset = component_dataset(comp, datasets)
+        if is_lod(dataset):
+            continue
+        first = dataset.frame(0) if isinstance(dataset, TimeSeries) else dataset
+        tf = drawn_transfer_function(session, comp, dataset)
+        if not isinstance(first, RegularVolume) or is_surface(dataset) or tf is None:
+            continue
+        data = frame_input(dataset, prepared.parts[comp.id])
+        if data is not None:
+            prepared.volumes[comp.id] = make_volume(data, True, tf, comp.opacity, True,
+                                                    bool(comp.settings.get("shade")))
+    return dict(prepared.volumes)
 
 
 def build_scene(plotter: pv.BasePlotter, session: Session, datasets: dict[str, LoadedDataset],

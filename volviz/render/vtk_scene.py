@@ -28,7 +28,7 @@ if TYPE_CHECKING:   # type-only imports for the signatures
     import pyvista as pv
 
     from volviz.model.datasets import Dataset
-    from volviz.render.vtk_facade import vtkDataObject, vtkVolumeProperty
+    from volviz.render.vtk_facade import vtkDataObject, vtkVolume, vtkVolumeProperty
     from volviz.scene.datasets import LoadedDataset
 
     #: what a mapper draws: a PyVista grid, or a VTK filter's output (the tetrahedra of ``volume_input``)
@@ -201,10 +201,20 @@ def add_dataset(plotter: pv.BasePlotter, dataset: Union[Dataset, TimeSeries], tf
 def volume_prop(plotter: pv.BasePlotter, data: object, regular: bool, tf: TransferFunction, opacity: float,
                 name: Optional[str],
                 backend: str = "auto", shade: bool = False) -> object:
-    """Add a ``vtkVolume`` drawing the VTK dataset ``data`` with ``tf`` to ``plotter``: regular volumes through
-    vtkSmartVolumeMapper (its CPU ray caster where ``backend`` picks "cpu": by default on a software OpenGL, see
-    ``volviz.render.backend``), lit with ``shade`` (the component setting); others through
-    vtkProjectedTetrahedraMapper, which draws no lighting. Returns the volume."""
+    """Add a ``vtkVolume`` drawing the VTK dataset ``data`` with ``tf`` to ``plotter`` (``make_volume``): a regular
+    volume by VTK's CPU ray caster where ``backend`` picks "cpu" (by default on a software OpenGL, see
+    ``volviz.render.backend``). Returns the volume."""
+    cpu = regular and choose_backend(backend, "regular", plotter_gl_info(plotter)) == "cpu"
+    volume = make_volume(data, regular, tf, opacity, cpu, shade)
+    plotter.add_actor(volume, name=name, reset_camera=False, render=False)  # type: ignore[arg-type]  # pyvista's _Wrapped decorator
+    return volume
+
+
+def make_volume(data: object, regular: bool, tf: TransferFunction, opacity: float, cpu: bool = False,
+                shade: bool = False) -> vtkVolume:
+    """A ``vtkVolume`` drawing the VTK dataset ``data`` with ``tf``, in no renderer yet: regular volumes through
+    vtkSmartVolumeMapper (its CPU ray caster with ``cpu``), lit with ``shade`` (the component setting); others
+    through vtkProjectedTetrahedraMapper, which draws no lighting."""
     # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
     from volviz.render.vtk_facade import vtk
 
@@ -214,13 +224,12 @@ def volume_prop(plotter: pv.BasePlotter, data: object, regular: bool, tf: Transf
         # interactive rate and then keeps the coarse distance of the last drag: the still frame stayed blocky.
         # Adapting always (to the time each frame is allotted) gives coarse frames during a drag and full ones after.
         mapper.InteractiveAdjustSampleDistancesOff()
-    if regular and choose_backend(backend, "regular", plotter_gl_info(plotter)) == "cpu":
+    if regular and cpu:
         mapper.SetRequestedRenderModeToRayCast()  # VTK's CPU ray caster
     mapper.SetInputData(data)
     volume = vtk.vtkVolume()
     volume.SetMapper(mapper)
     volume.SetProperty(vtk_volume_property(tf, opacity, shade and regular))
-    plotter.add_actor(volume, name=name, reset_camera=False, render=False)
     return volume
 
 
