@@ -59,7 +59,7 @@ class SceneLoading:
         self.current_job: Optional[Job] = None   # the newest scene's reading and preparing, until it is installed
         self.raw_dialog: Optional[Any] = None    # the layout dialog of the last headerless data opened
         self.missing_dialog: Optional[Any] = None  # the dialog locating a session's missing data files
-        self.volume_setup: Optional[VolumeSetup] = None   # its thread set up since the first CPU ray-cast volume
+        self.volume_setup: Optional[VolumeSetup] = None   # the process's, since the first CPU ray-cast volume
 
     def loading(self) -> bool:
         """A scene is being read and prepared (the Cancel button stops it)."""
@@ -208,11 +208,9 @@ class SceneLoading:
         if not volumes:
             then(False)
             return None
-        if self.volume_setup is None:
-            from volviz.render.volume_setup import VolumeSetup   # (a thread and window: from the first such volume)
+        from volviz.render.volume_setup import shared_setup   # (made and primed at start-up: startup_imports)
 
-            self.volume_setup = VolumeSetup()
-        setup = self.volume_setup
+        setup = self.volume_setup = shared_setup()
         ticket = setup.hold(volumes)
         del volumes
 

@@ -1,5 +1,6 @@
-"""What the GUI thread would otherwise import in the middle of its work, imported at start-up instead (the window calls
-``import_gui_thread_modules`` once, before its first scene), so a first use does not block the event loop."""
+"""What the GUI thread would otherwise import (or make) in the middle of its work, imported at start-up instead (the
+window calls ``import_gui_thread_modules`` once, before its first scene), so a first use does not block the event
+loop."""
 from __future__ import annotations
 
 
@@ -20,6 +21,13 @@ def import_gui_thread_modules() -> None:
     # read): a first File > Open did it on the GUI thread, 80-150 ms of a blocked event loop while a session loaded
     for spec in reader_specs():
         spec.globs()
+
+    # the thread and offscreen window that set up CPU ray-cast volumes before they are shown
+    # (volviz.render.volume_setup): making an OpenGL window holds the GIL, 40-100 ms here, which stalled the event
+    # loop in the first load that made it
+    from volviz.render.volume_setup import shared_setup
+
+    shared_setup().prime()
 
     # pyvista asks once per process whether this system can plot (it runs ``xset -q``) when the first offscreen plotter
     # of an export is made: ~60 ms of a blocked event loop at the start of the first export, here at start-up instead

@@ -12,7 +12,7 @@ import pytest
 from conftest import data_file
 from flows import wait_loaded, wait_settled
 from volviz.io import read
-from volviz.render.volume_setup import VolumeSetup, cpu_ray_cast
+from volviz.render.volume_setup import VolumeSetup, cpu_ray_cast, shared_setup
 from volviz.render.vtk_scene import default_transfer_function_for, make_volume, volume_input
 
 
@@ -63,15 +63,17 @@ def test_a_set_up_volume_is_drawn_without_its_set_up_and_the_same(neghip) -> Non
 
 
 def test_the_app_shows_a_regular_volume_set_up_off_the_gui_thread(qtbot, make_window) -> None:
-    """Opening the embryo on this machine (CPU ray caster): its volume is set up by the loading's set-up job, on the
-    set-up window's thread, before it is installed; the window then shows it (and ``volviz render``'s picture, as
-    the regular flows check)."""
+    """Opening neghip on this machine (CPU ray caster): its volume is set up by the loading's set-up job, on the
+    process's set-up window's thread (made at the window's start-up: making it holds the GIL), before it is
+    installed; the window then shows it (and ``volviz render``'s picture, as the regular flows check)."""
     window = make_window()
+    setup = shared_setup()
+    assert setup.gl.calls >= 1 and "window" in setup.gl.state        # primed before any scene
+    calls = setup.gl.calls
     window.open_path(data_file("volumes/neghip.slc"))
     wait_loaded(qtbot, window)
     wait_settled(qtbot, window)
-    setup = window.scene_loading.volume_setup
-    assert setup is not None and setup.gl.calls == 1
+    assert window.scene_loading.volume_setup is setup and setup.gl.calls == calls + 1
     assert threading.get_ident() not in setup.gl.threads
     volume = window.controller.views["data"].prop
     assert cpu_ray_cast(volume) and window.plotter.renderer.HasViewProp(volume)

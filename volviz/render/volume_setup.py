@@ -12,7 +12,8 @@ app's window finds it made and the picture is the same (tests/test_volume_setup.
 The GUI thread makes the VTK objects and keeps them (``hold``) until it ``release``s them after ``run``: the thread
 that runs ``run`` (a worker waiting for the window's thread) and the window's thread only call their methods and
 never drop the last reference (``volviz.jobs``: a worker that makes or drops a VTK object can deadlock a render).
-While held, nothing else may use the volumes.
+While held, nothing else may use the volumes. Making an OpenGL window holds the GIL (the GUI thread's event loop
+with it), so the process has one set-up window (``shared_setup``), made at the app's start-up (``prime``).
 """
 from __future__ import annotations
 
@@ -26,7 +27,7 @@ if TYPE_CHECKING:   # type-only imports for the signatures
     from volviz.jobs import ProgressCallback
     from volviz.render.vtk_facade import vtkRenderer, vtkVolume
 
-__all__ = ["SETUP_SIZE", "VolumeSetup", "cpu_ray_cast"]
+__all__ = ["SETUP_SIZE", "VolumeSetup", "cpu_ray_cast", "shared_setup"]
 
 SETUP_SIZE = 8   # pixels each way of the render that makes the set-up: its rays cost nothing to speak of
 
@@ -70,8 +71,28 @@ class VolumeSetup:
         with self._lock:
             self._held.pop(ticket, None)
 
+    def prime(self) -> None:
+        """Make the window and its OpenGL context now (the caller waits): at start-up, not in a scene's loading."""
+        self.gl.call(_initialize)
+
     def close(self) -> None:
         self.gl.close()
+
+
+_shared: list[VolumeSetup] = []
+_shared_lock = threading.Lock()
+
+
+def shared_setup() -> VolumeSetup:
+    """The process's one ``VolumeSetup`` (module docstring), made at the first call."""
+    with _shared_lock:
+        if not _shared:
+            _shared.append(VolumeSetup())
+        return _shared[0]
+
+
+def _initialize(ren: vtkRenderer) -> None:
+    ren.GetRenderWindow().Initialize()
 
 
 def _set_up(ren: vtkRenderer, held: dict[int, list[tuple[Any, Any]]], lock: threading.Lock, ticket: int) -> int:
