@@ -25,9 +25,10 @@ def import_gui_thread_modules() -> None:
     # the thread and offscreen window that set up CPU ray-cast volumes before they are shown
     # (volviz.render.volume_setup): making an OpenGL window holds the GIL, 40-100 ms here, which stalled the event
     # loop in the first load that made it
-    from volviz.render.volume_setup import shared_setup
+    # (the window releases it when it closes: ``volume_setup.release_shared``)
+    from volviz.render.volume_setup import acquire_shared
 
-    shared_setup().prime()
+    acquire_shared()
 
     # pyvista asks once per process whether this system can plot (it runs ``xset -q``) when the first offscreen plotter
     # of an export is made: ~60 ms of a blocked event loop at the start of the first export, here at start-up instead

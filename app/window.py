@@ -38,6 +38,7 @@ from PySide6.QtWidgets import QFileDialog, QMainWindow, QMenu, QMessageBox, QWid
 from volviz.model.json_types import json_float
 from volviz.render.backend import plotter_gl_info
 from volviz.render.controller import SceneController, iso_summary
+from volviz.render.volume_setup import release_shared
 from volviz.session import Session
 from .busy_status import BusyStatus
 from .camera_bookmarks import CameraBookmarks
@@ -392,6 +393,7 @@ class MainWindow(WindowBase, QMainWindow):
         self.export_runs.abandon()  # no partial movie left behind, no callbacks into a closed window
         self.jobs.shutdown()
         self.plotter.close()
+        release_shared()   # the volume set-up's window (``startup_imports``) closes with the last app window
         self.collector.unfreeze()  # what was long-lived while the window was open can be collected again
         self.python_console.shutdown()   # the console's kernel stops with the window
         super().closeEvent(event)

@@ -65,7 +65,9 @@ def test_a_set_up_volume_is_drawn_without_its_set_up_and_the_same(neghip) -> Non
 def test_the_app_shows_a_regular_volume_set_up_off_the_gui_thread(qtbot, make_window) -> None:
     """Opening neghip on this machine (CPU ray caster): its volume is set up by the loading's set-up job, on the
     process's set-up window's thread (made at the window's start-up: making it holds the GIL), before it is
-    installed; the window then shows it (and ``volviz render``'s picture, as the regular flows check)."""
+    installed; the window then shows it (and ``volviz render``'s picture, as the regular flows check). Closing the
+    last app window closes the set-up window: an X connection left open made the process's exit fail once the X
+    server had gone (tests/test_native_viewport_in_process.py)."""
     window = make_window()
     setup = shared_setup()
     assert setup.gl.calls >= 1 and "window" in setup.gl.state        # primed before any scene
@@ -78,3 +80,6 @@ def test_the_app_shows_a_regular_volume_set_up_off_the_gui_thread(qtbot, make_wi
     volume = window.controller.views["data"].prop
     assert cpu_ray_cast(volume) and window.plotter.renderer.HasViewProp(volume)
     assert not setup._held                                    # released once installed
+    window.dirty = False
+    window.close()                   # the last app window: the set-up window (and its X connection) closes with it
+    assert setup.closed and setup.run(1) == 0

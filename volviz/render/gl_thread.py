@@ -77,9 +77,13 @@ class GLThread:
 
     def call(self, fn: Callable[..., T], *args: object) -> T:
         """``fn(renderer, *args)`` on the thread, the window made first; returns its result (its error raised)."""
+        return self.submit(fn, *args).result()
+
+    def submit(self, fn: Callable[..., T], *args: object) -> Future:
+        """``fn(renderer, *args)`` queued for the thread (``call`` without waiting): its future."""
         future: Future = Future()
         self._jobs.put((self._run, (fn, *args), future))
-        return future.result()
+        return future
 
     def _run(self, fn: Callable[..., T], *args: object) -> T:
         self.threads.add(threading.get_ident())

@@ -13,7 +13,8 @@ The GUI thread makes the VTK objects and keeps them (``hold``) until it ``releas
 that runs ``run`` (a worker waiting for the window's thread) and the window's thread only call their methods and
 never drop the last reference (``volviz.jobs``: a worker that makes or drops a VTK object can deadlock a render).
 While held, nothing else may use the volumes. Making an OpenGL window holds the GIL (the GUI thread's event loop
-with it), so the process has one set-up window (``shared_setup``), made at the app's start-up (``prime``).
+with it), so the process has one set-up window (``shared_setup``), made at an app window's start-up
+(``acquire_shared``) and closed with the last (``release_shared``).
 """
 from __future__ import annotations
 
@@ -27,7 +28,7 @@ if TYPE_CHECKING:   # type-only imports for the signatures
     from volviz.jobs import ProgressCallback
     from volviz.render.vtk_facade import vtkRenderer, vtkVolume
 
-__all__ = ["SETUP_SIZE", "VolumeSetup", "cpu_ray_cast", "shared_setup"]
+__all__ = ["SETUP_SIZE", "VolumeSetup", "acquire_shared", "cpu_ray_cast", "release_shared", "shared_setup"]
 
 SETUP_SIZE = 8   # pixels each way of the render that makes the set-up: its rays cost nothing to speak of
 
@@ -51,7 +52,9 @@ class VolumeSetup:
         self.gl = GLThread("volviz-volume-setup")
         self._held: dict[int, list[tuple[Any, Any]]] = {}
         self._tickets = itertools.count(1)
-        self._lock = threading.Lock()
+        self._lock = threading.Lock()          # the held volumes (the window's thread reads them)
+        self._state = threading.Lock()         # closing, and a run queued before it
+        self.closed = False
 
     def hold(self, volumes: Sequence[vtkVolume]) -> int:
         """GUI thread: keep ``volumes`` (in no renderer, used by nothing else until released) for ``run``; their
@@ -64,7 +67,11 @@ class VolumeSetup:
     def run(self, ticket: int, progress: Optional[ProgressCallback] = None) -> int:
         """Any thread (a background job): render the held volumes of ``ticket`` once on the window's thread; returns
         how many were set up."""
-        return self.gl.call(_set_up, self._held, self._lock, ticket)
+        with self._state:
+            if self.closed:
+                return 0
+            done = self.gl.submit(_set_up, self._held, self._lock, ticket)
+        return int(done.result())
 
     def release(self, ticket: int) -> None:
         """GUI thread: drop the volumes of ``ticket`` (after its ``run`` returned, or when it never ran)."""
@@ -76,19 +83,42 @@ class VolumeSetup:
         self.gl.call(_initialize)
 
     def close(self) -> None:
-        self.gl.close()
+        """End the thread and close the window (and its X connection) after the runs queued; later runs do nothing."""
+        with self._state:
+            self.closed = True
+            self.gl.close()
 
 
 _shared: list[VolumeSetup] = []
+_users = [0]
 _shared_lock = threading.Lock()
 
 
 def shared_setup() -> VolumeSetup:
-    """The process's one ``VolumeSetup`` (module docstring), made at the first call."""
+    """The process's one ``VolumeSetup`` (module docstring), made at the first call after the last was closed."""
     with _shared_lock:
         if not _shared:
             _shared.append(VolumeSetup())
         return _shared[0]
+
+
+def acquire_shared() -> VolumeSetup:
+    """``shared_setup`` for one more user (an app window), primed (``prime``): the caller ``release_shared``s it."""
+    setup = shared_setup()
+    with _shared_lock:
+        _users[0] += 1
+    setup.prime()
+    return setup
+
+
+def release_shared() -> None:
+    """One user less; the last one closes the window: an X connection left open when the X server goes first made
+    Xlib's fatal I/O error at the process's exit (tests/test_native_viewport_in_process.py)."""
+    with _shared_lock:
+        _users[0] = max(0, _users[0] - 1)
+        ended = _shared.pop() if _shared and _users[0] == 0 else None
+    if ended is not None:
+        ended.close()
 
 
 def _initialize(ren: vtkRenderer) -> None:
