@@ -585,3 +585,38 @@ def test_preclassified_segments_match_reference():
     assert _err(_gl_image(m, PEAK, cam, size, classification="pre"), post[..., :3])[1] > 20.0
     with pytest.raises(ValueError, match="post-classified"):
         GLPTVolume(None, m, PEAK, iso=ISO, classification="pre")
+
+
+def test_the_first_order_made_on_a_worker_loads_the_index_kernels_there(tmp_path):
+    """A Numba kernel's first call in a process loads its code holding the GIL: the GPU drag's first frame filled
+    its index from the GUI thread with that load (403 ms in the flow-gap survey 13). In a fresh process, the first
+    ``compute`` (on another thread) leaves the fills loaded for the order's types before any render."""
+    import subprocess
+    import sys
+
+    script = tmp_path / "first_order.py"
+    script.write_text(
+        "import threading\n"
+        "import numba\n"
+        "import pyvista as pv\n"
+        "from volviz.model.camera import Camera\n"
+        "from volviz.optics import TransferFunction\n"
+        "from volviz.render.gl_pt import GLPTVolume\n"
+        "from volviz.unstructured import index_buffer, synthetic\n"
+        "mesh = synthetic.cavity_box(4)\n"
+        "tf = TransferFunction([0.0, 0.5, 1.0], [[1, 0, 0], [0, 1, 0], [0, 0, 1]], [0.0, 3.0, 6.0])\n"
+        "pl = pv.Plotter(off_screen=True, window_size=(32, 32))\n"
+        "vol = GLPTVolume(pl, mesh, tf)\n"
+        "vol.hold_until_finished()\n"
+        "assert vol.order_texture and not index_buffer.fill_cells.signatures\n"
+        "request = vol.begin()\n"
+        "out = []\n"
+        "worker = threading.Thread(target=lambda: out.append(vol.compute(request)))\n"
+        "worker.start(); worker.join()\n"
+        "order = out[0][0].order\n"
+        "want = (numba.typeof(order), numba.typeof(vol._vis))\n"
+        "print(any(s[:2] == want for s in index_buffer.fill_cells.signatures),\n"
+        "      any(s[:2] == want for s in index_buffer.fill_triangles.signatures))\n")
+    run = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=300)
+    assert run.returncode == 0, run.stderr[-2000:]
+    assert run.stdout.split("\n")[-2] == "True True", run.stdout

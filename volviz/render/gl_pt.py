@@ -34,7 +34,7 @@ from volviz.render.gl_pt_targets import PTTargets
 from volviz.render.image_overlay import hold_single_sample, release_single_sample, window_size
 from volviz.render.pt_view import PTView
 from volviz.render.reduced_fill import INTERACTIVE_PIXELS, reduced_size, scaled_rays
-from volviz.unstructured.index_buffer import IndexBuffer, fill_cells
+from volviz.unstructured.index_buffer import IndexBuffer, fill_cells, load_kernels
 from volviz.unstructured.iso import iso_visible
 from volviz.unstructured.render import Preclassified, auto_lookup, table_for, table_size
 from volviz.unstructured.topology import topology, visible_cells
@@ -414,12 +414,16 @@ class GLPTVolume(CellOrder, PTView):
                 ) -> tuple[Optional[SortResult]]:
         """Any thread: the order (``CellOrder.compute``) and, before the first draw, the arrays the first bind of the
         cells' program would make on the GUI thread: the cells' texels (``cell_texels``, handed to the upload) and
-        the pre-integration table (``table_for``'s cache, which the bind then finds for this TF)."""
+        the pre-integration table (``table_for``'s cache, which the bind then finds for this TF); the index buffer's
+        kernels are loaded for the order's types (``load_kernels``)."""
         if self.order_texture and self._cells_tex is None and self._texels is None:
             self._texels = cell_texels(self.mesh, self._smooth_cells())
         if self._table is None:
             self._build_table()
-        return super().compute(request, progress)
+        result = super().compute(request, progress)
+        if result[0] is not None:
+            load_kernels(result[0].order, self._vis)
+        return result
 
     def finish(self, request: OrderRequest, result: Optional[SortResult]) -> None:
         """GUI thread: ``CellOrder.finish``; a volume held until now is drawn from the next render on."""

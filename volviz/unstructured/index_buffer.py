@@ -14,7 +14,7 @@ from numba import njit
 
 from volviz.unstructured.topology import FACES
 
-__all__ = ["IndexBuffer", "fill_cells", "fill_triangles"]
+__all__ = ["IndexBuffer", "fill_cells", "fill_triangles", "load_kernels"]
 
 #: the 12 corner ids of a cell's 4 faces, in FACES order
 _CORNERS = np.ascontiguousarray(FACES.reshape(12), dtype=np.int32)
@@ -50,6 +50,15 @@ def fill_cells(order: np.ndarray, visible: np.ndarray, cells: np.ndarray) -> int
             cells[n] = c
             n += 1
     return n
+
+
+def load_kernels(order: np.ndarray, visible: np.ndarray) -> None:
+    """Any thread: call both fills on no cells for the types of ``order`` and ``visible``. A Numba kernel's first
+    call in a process loads its compiled code from the cache while holding the GIL; the worker that makes a volume's
+    first order calls this, so that the first frame's fill on the GUI thread finds them loaded (issue #28)."""
+    none = np.empty(0, np.int32)
+    fill_triangles(order[:0], visible[:0], none, none)
+    fill_cells(order[:0], visible[:0], np.empty(0, np.float32))
 
 
 class IndexBuffer:
