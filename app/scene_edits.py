@@ -31,6 +31,7 @@ from volviz.jobs import Job, JobOutcome
 from volviz.session import Session, SessionError
 from .docks.render_settings import RENDERER_DEFAULTS
 from .shown_scene import ShownScene
+from .volume_setup_job import set_up_volumes
 
 if TYPE_CHECKING:
     from volviz.model.clip import ClipSettings
@@ -205,8 +206,9 @@ class SceneEdits:
 
     def show_component(self, comp_id: str) -> None:
         """A component hidden at load was shown: prepare it in the background (extraction, tetrahedralisation, VTK
-        volume input, histogram; a newer request for it supersedes), add its prop on this thread, then compute its
-        view-dependent parts in the background. ``components_shown`` counts the ones installed."""
+        volume input, histogram; a newer request for it supersedes), set up its CPU ray-cast volume off the GUI thread
+        (``volume_setup_job``), add its prop on this thread, then compute its view-dependent parts in the background.
+        ``components_shown`` counts the ones installed."""
         from volviz.scene.datasets import load_datasets
 
         controller, session_path = self.controller, self.session_path
@@ -218,18 +220,24 @@ class SceneEdits:
             load_datasets(controller.session, session_path, loaded=controller.datasets)  # a component shown anew
             return controller.prepare_component(comp_id, progress)
 
+        def install(cancelled: bool, prepared: Any) -> None:
+            if cancelled or self.controller is not controller:
+                return
+            if not controller.component(comp_id).visible or not controller.needs_build(comp_id):
+                return  # hidden again meanwhile (or already shown)
+            controller.install_component(comp_id, prepared, views=False)
+            self.scene_tree.dataset_read(comp_id)
+            self.components_shown += 1
+            self.status.setText(f"Showing {comp_id}")
+            self.views.schedule_render()
+            self.views.refresh_views([comp_id, "iso-overlay"])
+
         def done(outcome: JobOutcome) -> None:
             if self.controller is not controller:
                 return
-            if outcome.ok:
-                if not controller.component(comp_id).visible or not controller.needs_build(comp_id):
-                    return  # hidden again meanwhile (or already shown)
-                controller.install_component(comp_id, outcome.result, views=False)
-                self.scene_tree.dataset_read(comp_id)
-                self.components_shown += 1
-                self.status.setText(f"Showing {comp_id}")
-                self.views.schedule_render()
-                self.views.refresh_views([comp_id, "iso-overlay"])
+            if outcome.ok:   # its CPU ray-cast volume set up off the GUI thread first, as a loaded scene's
+                set_up_volumes(self.jobs, controller, outcome.result, comp_id,
+                               lambda cancelled: install(cancelled, outcome.result))
             elif outcome.error is not None:
                 self._revert_visibility(controller, comp_id, True)
                 self.show_error(f"Cannot show {comp_id}", str(outcome.error))

@@ -29,6 +29,7 @@ from .errors import open_error
 from .recent import RecentFiles
 from .shown_scene import ShownScene
 from .stand_in import StandInFrame
+from .volume_setup_job import set_up_volumes
 
 if TYPE_CHECKING:
     from volviz.render.controller import SceneController
@@ -196,31 +197,14 @@ class SceneLoading:
 
     def set_up_volumes(self, controller: SceneController, prepared: PreparedScene, title: str,
                        then: Callable[[bool], None]) -> Optional[Job]:
-        """GUI thread: ``then(cancelled)`` once the volumes that VTK's CPU ray caster will draw for ``prepared`` are
-        set up off the GUI thread (``volviz.render.volume_setup``: the empty-space volume and gradients their first
-        render made, in the scene's first frame), at once where there are none. A failed set-up is logged and the
-        scene shown all the same (its first render makes them). Returns the set-up's job (None: none)."""
-        try:
-            volumes = controller.volumes_to_set_up(prepared)
-        except Exception:   # (install makes them again, and says what is wrong)
-            log.exception("making the volumes of %s failed", title)
-            volumes = []
-        if not volumes:
-            then(False)
-            return None
-        from volviz.render.volume_setup import shared_setup   # (made and primed at start-up: startup_imports)
+        """GUI thread: ``then(cancelled)`` once ``prepared``'s CPU ray-cast volumes are set up off the GUI thread
+        (``volume_setup_job.set_up_volumes``); ``volume_setup`` is the process's set-up from the first one on."""
+        job = set_up_volumes(self.jobs, controller, prepared, title, then)
+        if job is not None:
+            from volviz.render.volume_setup import shared_setup   # (made and primed at start-up: startup_imports)
 
-        setup = self.volume_setup = shared_setup()
-        ticket = setup.hold(volumes)
-        del volumes
-
-        def done(outcome: JobOutcome) -> None:
-            setup.release(ticket)
-            if outcome.error is not None:
-                log.warning("setting up the volumes of %s failed: %s", title, outcome.error)
-            then(outcome.cancelled)
-
-        return self.jobs.submit(setup.run, ticket, name=f"set up the volumes of {title}", on_done=done)
+            self.volume_setup = shared_setup()
+        return job
 
     def _install(self, controller: SceneController, prepared: Any, session_path: Optional[Path], title: str,
                  dirty: bool, serial: int, path: Optional[Path] = None, same_data: bool = False) -> bool:

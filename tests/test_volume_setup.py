@@ -3,11 +3,13 @@
 there (the 256^3 volume's first frame 620 ms here, 162 ms after the set-up), and the picture is the same."""
 from __future__ import annotations
 
+import json
 import threading
 
 import numpy as np
 import pyvista as pv
 import pytest
+from PySide6.QtCore import Qt
 
 from conftest import data_file
 from flows import wait_loaded, wait_settled
@@ -83,3 +85,30 @@ def test_the_app_shows_a_regular_volume_set_up_off_the_gui_thread(qtbot, make_wi
     window.dirty = False
     window.close()                   # the last app window: the set-up window (and its X connection) closes with it
     assert setup.closed and setup.run(1) == 0
+
+
+def test_a_volume_hidden_at_load_and_shown_later_is_set_up_off_the_gui_thread(qtbot, make_window, tmp_path) -> None:
+    """A regular volume hidden at load and shown from the scene tree goes through the same set-up as a loaded one
+    (``volume_setup_job``): its gradients (lit) were made by its first render on the GUI thread."""
+    session = tmp_path / "hidden.json"
+    session.write_text(json.dumps({
+        "format": "volviz-session", "version": 1,
+        "datasets": [{"id": "neghip", "path": str(data_file("volumes/neghip.slc"))}],
+        "components": [{"id": "box", "type": "demo", "settings": {"cells_per_edge": 3}},
+                       {"id": "vol", "type": "volume", "dataset": "neghip", "visible": False,
+                        "settings": {"shade": True}}]}))
+    window = make_window()
+    window.open_path(session)
+    wait_loaded(qtbot, window)
+    setup = shared_setup()
+    calls = setup.gl.calls
+    assert "vol" not in window.controller.views
+    window.scene_tree.item("vol").setCheckState(0, Qt.CheckState.Checked)     # what a click on its box does
+    qtbot.waitUntil(lambda: window.components_shown == 1, timeout=60000)
+    assert setup.gl.calls == calls + 1 and not setup._held
+    volume = window.controller.views["vol"].prop
+    assert cpu_ray_cast(volume) and window.plotter.renderer.HasViewProp(volume)
+    made = _gradients_counted(volume)
+    wait_settled(qtbot, window)
+    window.plotter.render()
+    assert made == []                                           # made by the set-up, not by a render here
