@@ -96,7 +96,8 @@ def prepare_component(session: Session, comp: Component, datasets: dict[str, Loa
                       t: Optional[float] = None, interpolate: bool = True) -> None:
     """Any thread: the heavy part of showing one non-nature component (isosurface extraction with clipping and LOD
     chains, tetrahedralisation and topology, the VTK volume input at display time ``t``, its data histogram), put into
-    ``prepared``; ``install_component`` adds its prop on the GUI thread."""
+    ``prepared``; ``install_component`` adds its prop on the GUI thread. A mesh that VTK's projected tetrahedra draw
+    is tetrahedralised here as for volviz's (``volviz.unstructured.tetrahedralize``): the two draw the same cells."""
     clip = session.clip
     dataset = component_dataset(comp, datasets)
     series = isinstance(dataset, TimeSeries)
@@ -118,6 +119,12 @@ def prepare_component(session: Session, comp: Component, datasets: dict[str, Loa
         prepared.parts[comp.id] = mesh
         if clip.all_planes():
             prepared.cut[comp.id] = cut_tetmesh(mesh, clip)
+    elif isinstance(dataset, (UnstructuredMesh, CurvilinearGrid)) and not is_surface(dataset):
+        # VTK's projected tetrahedra (render method "vtk") draw volviz's tetrahedra, made here: ``volume_input``
+        # ran vtkDataSetTriangleFilter on the GUI thread in ``frame_input``
+        from volviz.unstructured.tetrahedralize import tetrahedralize   # (the tetrahedra's modules: only for meshes)
+
+        prepared.parts[comp.id] = tetrahedralize(dataset, getattr(dataset, "active", None))
     else:   # arrays: ``frame_input`` makes the mapper's input in ``install_component``, on the GUI thread
         prepared.parts[comp.id] = display_frame(dataset, t, interpolate)
 
