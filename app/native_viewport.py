@@ -76,6 +76,9 @@ class NativeViewport(QVTKRenderWindowInteractor, BasePlotter):
         self._expose_queued = False
         self._painted = 0            # paints that drew so far
         self._magnified = False   # whether a magnifying blit was drawn yet (``_magnify``)
+        self._reducing = False
+        self._swapped_size: tuple[int, int] | None = None   # the last frame swapped whole (``_frame_ended``)
+        self.exposes_redrawn = 0     # exposes drawn from the last frame, without a render (``_exposed``)
         self._drawn_before_mapped = False
         self.frames: ReducedFrames | None = None
         self.still_strips: StillStrips | None = None   # draws slow still frames in strips (``strip_stills``)
@@ -98,6 +101,7 @@ class NativeViewport(QVTKRenderWindowInteractor, BasePlotter):
             for renderer in self.renderers:
                 renderer.enable_depth_peeling()
         self._first_time = False   # BasePlotter: this plotter renders on screen
+        self.ren_win.AddObserver("EndEvent", self._frame_ended)
 
     def reduce_paints(self, frames: ReducedFrames) -> None:
         """``frames`` decides when paints are reduced and by how much; this widget draws them so (``ReducedFrames``
@@ -147,9 +151,35 @@ class NativeViewport(QVTKRenderWindowInteractor, BasePlotter):
             QTimer.singleShot(EXPOSE_AFTER_MS, lambda: self._exposed(painted))
 
     def _exposed(self, painted: int) -> None:
+        """An expose's paint: the last frame again where VTK's display framebuffer holds it (``_redraw_last``), else a
+        render."""
         self._expose_queued = False
-        if self._RenderWindow is not None and self._painted == painted:   # (else a paint asked for drew it since)
+        if self._RenderWindow is None or self._painted != painted:   # (a paint asked for drew it since)
+            return
+        if not self._redraw_last():
             self.update()
+
+    def _frame_ended(self, *_: object) -> None:
+        """After each render: whether it was a whole frame that was swapped to the window (not a reduced frame, nor
+        a strip drawn without a swap), which VTK's display framebuffer then holds at the window's size."""
+        rw = self._RenderWindow
+        whole = rw is not None and not self._reducing and bool(rw.GetSwapBuffers()) and bool(rw.GetDoubleBuffer())
+        self._swapped_size = (int(rw.GetSize()[0]), int(rw.GetSize()[1])) if whole else None
+
+    def _redraw_last(self) -> bool:
+        """Draw the last frame into the window again from VTK's display framebuffer (a blit and a swap, no render),
+        where it holds the window's picture: the last render swapped a whole frame at this size and no frame in
+        strips is under way. An expose (a menu, a combo box's list or a dialog closed over the viewport) re-rendered
+        the whole scene: a slow scene (VTK's projected tetrahedra, a CPU ray caster) held the event loop as long as
+        a frame takes (issue #28). Returns whether it drew."""
+        rw = self._RenderWindow
+        size = (int(rw.GetSize()[0]), int(rw.GetSize()[1]))
+        if self._swapped_size != size or (self.still_strips is not None and self.still_strips.drawing):
+            return False
+        self._magnify(size, size)
+        _GLX.swap_current()
+        self.exposes_redrawn += 1
+        return True
 
     def paintEvent(self, ev: QPaintEvent) -> None:
         if self._in_paint or self._RenderWindow is None:   # (closed: nothing to draw)
@@ -179,6 +209,7 @@ class NativeViewport(QVTKRenderWindowInteractor, BasePlotter):
         rw = self._RenderWindow
         full_w, full_h = (int(v) for v in rw.GetSize())
         w, h = -(-full_w // frames.factor), -(-full_h // frames.factor)
+        self._reducing = True
         try:
             vtkRenderWindow.SetSize(rw, w, h)   # the base class's: no XResizeWindow
             rw.SetFrameBlitModeToNoBlit()       # Frame() resolves into the display framebuffer ...
@@ -189,6 +220,7 @@ class NativeViewport(QVTKRenderWindowInteractor, BasePlotter):
             self._magnify((w, h), (full_w, full_h))
             _GLX.swap_current()
         finally:
+            self._reducing = False
             vtkRenderWindow.SetSize(rw, full_w, full_h)
             rw.SetFrameBlitModeToBlitToHardware()
             rw.SetDoubleBuffer(1)
