@@ -20,7 +20,8 @@ from volviz.render.framing import frame_bounds, nature_bounds, points_bounds, un
 from volviz.render.slices import SlicesView
 from volviz.render.views import view_class
 from volviz.render.vtk_scene import (add_dataset, add_surface, apply_camera, default_transfer_function_for, is_surface,
-                                     make_volume, surface_input, volume_grid, volume_input, volume_prop)
+                                     make_volume, ray_casts_on_cpu, surface_input, volume_grid, volume_input,
+                                     volume_prop)
 from volviz.scene.datasets import NATURE_TYPES, component_dataset
 from volviz.scene.drawn_tf import component_transfer_function, drawn_transfer_function
 from volviz.scene.errors import SceneError
@@ -266,8 +267,10 @@ def install_component(plotter: pv.BasePlotter, session: Session, comp: Component
         return add_lod_component(plotter, session, comp, dataset, update=views)
     if uses_pt(session, dataset):
         return add_pt_component(plotter, session, comp, prepared.parts[comp.id], update=views)
-    made = prepared.volumes.pop(comp.id, None)
-    if made is not None:        # made (and set up) before: ``make_ray_cast_volumes``
+    made = prepared.volumes.pop(comp.id, None)   # made (and set up) before: ``make_ray_cast_volumes``
+    if made is None:
+        made = ray_cast_volume(plotter, session, comp, dataset, prepared.parts.get(comp.id))
+    if made is not None:
         plotter.add_actor(made, name=comp.id, reset_camera=False, render=False)  # type: ignore[arg-type]  # _Wrapped
         return VtkPropView(made)
     tf = drawn_transfer_function(session, comp, dataset)
@@ -278,27 +281,35 @@ def install_component(plotter: pv.BasePlotter, session: Session, comp: Component
 
 def make_ray_cast_volumes(plotter: pv.BasePlotter, session: Session, datasets: dict[str, LoadedDataset],
                           prepared: PreparedScene) -> dict[str, vtkVolume]:
-    """GUI thread: the vtkVolumes of ``prepared``'s regular volumes that VTK's CPU ray caster draws in ``plotter``
-    (``backend``), made as ``install_component`` makes them but in no renderer, and kept in ``prepared.volumes``,
-    which ``install_component`` adds: between the two the caller sets them up off the GUI thread
-    (``volviz.render.volume_setup``). Returns them by component id."""
-    cpu = choose_backend(backend_setting(session.render.options), "regular", plotter_gl_info(plotter)) == "cpu"
-    for comp in session.components if cpu else ():
-        if not comp.visible or comp.type in NATURE_TYPES or comp.type in ("isosurface", "slices") \
-                or comp.id not in prepared.parts or comp.id in prepared.volumes:
-            continue
-        dataset = component_dataset(comp, datasets)
-        if is_lod(dataset):
-            continue
-        first = dataset.frame(0) if isinstance(dataset, TimeSeries) else dataset
-        tf = drawn_transfer_function(session, comp, dataset)
-        if not isinstance(first, RegularVolume) or is_surface(dataset) or tf is None:
-            continue
-        data = frame_input(dataset, prepared.parts[comp.id])
-        if data is not None:
-            prepared.volumes[comp.id] = make_volume(data, True, tf, comp.opacity, True,
-                                                    bool(comp.settings.get("shade")))
+    """GUI thread: the vtkVolumes of ``prepared``'s visible components that VTK's CPU ray caster draws in ``plotter``
+    (``ray_cast_volume``), made in no renderer and kept in ``prepared.volumes``, which ``install_component`` adds:
+    between the two the caller sets them up off the GUI thread (``volviz.render.volume_setup``). Returns them by
+    component id."""
+    for comp in session.components:
+        if comp.visible and comp.id in prepared.parts and comp.id not in prepared.volumes:
+            volume = ray_cast_volume(plotter, session, comp, component_dataset(comp, datasets),
+                                     prepared.parts[comp.id])
+            if volume is not None:
+                prepared.volumes[comp.id] = volume
     return dict(prepared.volumes)
+
+
+def ray_cast_volume(plotter: pv.BasePlotter, session: Session, comp: Component, dataset: LoadedDataset,
+                    frame: object) -> Optional[vtkVolume]:
+    """GUI thread: the vtkVolume, in no renderer, of a component that ``install_component`` draws as a regular volume
+    by VTK's CPU ray caster (``vtk_scene.ray_casts_on_cpu`` for the session's backend in ``plotter``), from its
+    prepared ``frame``; None for any other component (isosurfaces, slices, LOD, PT, surfaces, the GPU ray caster)."""
+    if comp.type in NATURE_TYPES or comp.type in ("isosurface", "slices") or is_lod(dataset):
+        return None
+    first = dataset.frame(0) if isinstance(dataset, TimeSeries) else dataset
+    if not isinstance(first, RegularVolume) or is_surface(dataset) \
+            or not ray_casts_on_cpu(plotter, backend_setting(session.render.options)):
+        return None
+    tf = drawn_transfer_function(session, comp, dataset)
+    data = frame_input(dataset, cast("Union[Dataset, TimeSeries, None]", frame))
+    if tf is None or data is None:
+        return None
+    return make_volume(data, True, tf, comp.opacity, True, bool(comp.settings.get("shade")))
 
 
 def build_scene(plotter: pv.BasePlotter, session: Session, datasets: dict[str, LoadedDataset],

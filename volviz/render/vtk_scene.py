@@ -204,10 +204,15 @@ def volume_prop(plotter: pv.BasePlotter, data: object, regular: bool, tf: Transf
     """Add a ``vtkVolume`` drawing the VTK dataset ``data`` with ``tf`` to ``plotter`` (``make_volume``): a regular
     volume by VTK's CPU ray caster where ``backend`` picks "cpu" (by default on a software OpenGL, see
     ``volviz.render.backend``). Returns the volume."""
-    cpu = regular and choose_backend(backend, "regular", plotter_gl_info(plotter)) == "cpu"
-    volume = make_volume(data, regular, tf, opacity, cpu, shade)
+    volume = make_volume(data, regular, tf, opacity, regular and ray_casts_on_cpu(plotter, backend), shade)
     plotter.add_actor(volume, name=name, reset_camera=False, render=False)  # type: ignore[arg-type]  # pyvista's _Wrapped decorator
     return volume
+
+
+def ray_casts_on_cpu(plotter: pv.BasePlotter, backend: str = "auto") -> bool:
+    """Whether ``plotter``'s regular volumes are drawn by VTK's CPU ray caster for the render option ``backend``
+    (``volviz.render.backend``: by default on a software OpenGL)."""
+    return choose_backend(backend, "regular", plotter_gl_info(plotter)) == "cpu"
 
 
 def make_volume(data: object, regular: bool, tf: TransferFunction, opacity: float, cpu: bool = False,
