@@ -114,7 +114,9 @@ def image_renderers(plotter: object) -> list[vtkRenderer]:
 
 
 def read_buffers(ren_win: vtkRenderWindow, w: int, h: int) -> Buffers:
-    """(z (H, W) float64, rgb (H, W, 3) uint8) of the render window, row 0 at the top."""
+    """(z (H, W) float64, rgb (H, W, 3) uint8) of the render window, row 0 at the top. ``rgb`` is a view of the RGBA
+    rows copied whole: gathering 3 of 4 bytes per pixel into a new array was most of the read-back's time on the
+    GUI thread."""
     # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
     from volviz.render.vtk_facade import vtk, vtk_to_numpy
 
@@ -123,7 +125,7 @@ def read_buffers(ren_win: vtkRenderWindow, w: int, h: int) -> Buffers:
     rgb = vtk.vtkUnsignedCharArray()
     ren_win.GetRGBACharPixelData(0, 0, w - 1, h - 1, 0, rgb)
     zz = vtk_to_numpy(z).reshape(h, w)[::-1].astype(np.float64)
-    cc = vtk_to_numpy(rgb).reshape(h, w, 4)[::-1, :, :3].copy()
+    cc = np.ascontiguousarray(vtk_to_numpy(rgb).reshape(h, w, 4)[::-1])[:, :, :3]
     return zz, cc
 
 
