@@ -23,6 +23,8 @@ from pyvista.plotting.render_window_interactor import RenderWindowInteractor
 from pyvistaqt.plotting import _no_base_plotter_init
 from vtkmodules.vtkRenderingCore import vtkRenderWindow
 
+from volviz.render.image_overlay import window_size
+
 vtkmodules.qt.QVTKRWIBase = "QWidget"   # read when the module below is first imported: a native QWidget, not GL
 from vtkmodules.qt.QVTKRenderWindowInteractor import QVTKRenderWindowInteractor  # noqa: E402
 
@@ -164,7 +166,7 @@ class NativeViewport(QVTKRenderWindowInteractor, BasePlotter):
         a strip drawn without a swap), which VTK's display framebuffer then holds at the window's size."""
         rw = self._RenderWindow
         whole = rw is not None and not self._reducing and bool(rw.GetSwapBuffers()) and bool(rw.GetDoubleBuffer())
-        self._swapped_size = (int(rw.GetSize()[0]), int(rw.GetSize()[1])) if whole else None
+        self._swapped_size = window_size(rw) if whole else None
 
     def _redraw_last(self) -> bool:
         """Draw the last frame into the window again from VTK's display framebuffer (a blit and a swap, no render),
@@ -172,8 +174,7 @@ class NativeViewport(QVTKRenderWindowInteractor, BasePlotter):
         strips is under way. An expose (a menu, a combo box's list or a dialog closed over the viewport) re-rendered
         the whole scene: a slow scene (VTK's projected tetrahedra, a CPU ray caster) held the event loop as long as
         a frame takes (issue #28). Returns whether it drew."""
-        rw = self._RenderWindow
-        size = (int(rw.GetSize()[0]), int(rw.GetSize()[1]))
+        size = window_size(self._RenderWindow)
         if self._swapped_size != size or (self.still_strips is not None and self.still_strips.drawing):
             return False
         self._magnify(size, size)
