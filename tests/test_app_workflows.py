@@ -14,6 +14,7 @@ from PySide6.QtGui import QMouseEvent
 from PySide6.QtWidgets import QApplication, QMessageBox
 
 from conftest import data_file
+from flows import wait_settled
 from loop_latency import LoopGaps
 from volviz_app.window import MainWindow
 
@@ -336,7 +337,11 @@ def test_unstructured_data_renders_with_volviz_pt_and_shows_the_frame_split(qtbo
     rmse = float(window.statistics.text("error").split()[1].rstrip(","))
     assert 0.0 <= rmse <= 1.0  # the fast path's measured error for this very view is within the product's budget
     window.render_settings.method.setCurrentText("vtk")  # VTK's own projected-tetrahedra mapper instead
-    qtbot.waitUntil(lambda: not window.controller.pt_stats(), timeout=30000)
+    # drawn as an image off the GUI thread too (``volviz.render.vtk_pt_image``), with its own statistics
+    qtbot.waitUntil(lambda: [s.get("method") for s in window.controller.pt_stats().values()] == ["vtk"],
+                    timeout=30000)
+    wait_settled(qtbot, window)
+    assert window.statistics.text("method") == "vtk"
     vtk_image = viewport(window)
     assert pt_image.std() > 3.0 and vtk_image.std() > 3.0  # neither is blank
     assert np.abs(vtk_image - pt_image).mean() > 0.2  # and they are different renderers

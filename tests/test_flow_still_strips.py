@@ -346,15 +346,19 @@ def test_only_ray_cast_volumes_are_drawn_in_strips() -> None:
     assert ray_cast_volumes(renderer)
 
 
-def test_a_blunt_fin_drawn_by_vtks_projected_tetrahedra_is_drawn_whole(qtbot, make_window, monkeypatch) -> None:
+def test_a_mesh_series_drawn_by_vtks_projected_tetrahedra_is_drawn_whole(qtbot, make_window, monkeypatch) -> None:
+    """The OpenFOAM cavity, a time series of meshes, is drawn by VTK's projected tetrahedra in the scene's window
+    (``scene_builder.uses_pt``: a mesh of one time is an image made off the GUI thread), which sort and project every
+    cell in each strip: its frames are drawn whole."""
     monkeypatch.setattr(strips_module, "SPLIT_OVER_S", 0.0)
     window = make_window()
-    window.open_path(data_file("bluntfin/bluntfinxyz.bin"))
+    window.open_path(data_file("ecosystem/openfoam-cavity"))
     wait_loaded(qtbot, window)
-    pick_combo_item(qtbot, window.render_settings.method, "vtk")
-    qtbot.waitUntil(lambda: window.session.render.method == "vtk", timeout=60000)
     wait_settled(qtbot, window)
     strips = window.still_strips
+    volumes = window.plotter.renderer.GetVolumes()
+    assert volumes.GetNumberOfItems() == 1 and volumes.GetItemAsObject(0).GetMapper().IsA(
+        "vtkProjectedTetrahedraMapper")
     assert window.controller.drawn_by_vtk_alone() and strips.cost > 0
     assert not strips.wanted()
     frames = strips.frames

@@ -50,8 +50,9 @@ def test_a_pt_mesh_and_its_cut_come_with_their_cells_scalar_ranges() -> None:
 
 def test_vtks_projected_tetrahedra_draw_volvizs_tetrahedra_made_on_the_loading_thread() -> None:
     """Render method "vtk": the Blunt Fin's curvilinear grid is tetrahedralised by ``prepare_scene`` (any thread) as
-    for volviz's own PT, and the mapper draws those cells; ``install_component`` ran vtkDataSetTriangleFilter on the
-    GUI thread (224,874 tetrahedra; 0.4-0.6 s here, a 107-132 ms gap in the flow-gap survey)."""
+    for volviz's own PT, and VTK's mapper draws those cells, as an image of a window of a thread of its own
+    (``volviz.render.vtk_pt_image``; before, the mapper drew in the scene's window on the GUI thread, after
+    ``install_component`` ran vtkDataSetTriangleFilter there: 224,874 tetrahedra, 0.4-0.6 s)."""
     session = data_session(data_file("bluntfin/bluntfinxyz.bin"), None)
     session.render.method = "vtk"
     datasets = {"data": read(data_file("bluntfin/bluntfinxyz.bin"))}
@@ -61,8 +62,14 @@ def test_vtks_projected_tetrahedra_draw_volvizs_tetrahedra_made_on_the_loading_t
     plotter = pv.Plotter(off_screen=True, window_size=(64, 48))
     try:
         views = install_scene(plotter, session, datasets, prepared, views=False)
-        drawn = views[comp_id].prop.GetMapper().GetInput()
+        view = views[comp_id]
+        assert view.kind == "pt" and view.method == "vtk" and view.mesh is mesh
+        assert plotter.renderer.GetVolumes().GetNumberOfItems() == 0      # nothing of it drawn in the scene's window
+        view.update()
+        drawn = view._vtk_images.gl.state["volume"].GetMapper().GetInput()
         assert drawn.GetNumberOfCells() == len(mesh.tets)
         np.testing.assert_array_equal(pv.wrap(drawn).points, mesh.points)
+        assert view.image[..., 3].max() > 0.5 and view.stats["method"] == "vtk"
+        view.remove()
     finally:
         plotter.close()

@@ -16,6 +16,8 @@ How a frame is made (``update``):
    ratio f/n = 1000 resolves about 1e-4 of the view distance;
 3. the volume is rendered by ``volviz.unstructured.render(..., depth=d)``: every ray segment is clipped at the opaque
    depth of its pixel, so the volume stops exactly at the surface (not at the cell containing it);
+   with the method "vtk" VTK's projected tetrahedra draw it instead, over that depth, in a window of a thread of its
+   own (``volviz.render.vtk_pt_image``);
 4. the premultiplied result is drawn over the scene by ``volviz.render.image_overlay.ImageOverlay`` (straight-alpha
    RGBA8 in an overlay renderer on a higher layer: the premultiplied "over" C = C_vol + (1 - a_vol) C_scene; the
    8-bit round trip costs at most about 1/255 per channel, measured in the tests).
@@ -40,6 +42,7 @@ from volviz.render.image_overlay import (Buffers, OverlayRequest, OverlayView, o
                                          window_size, zbuffer_to_depth)
 from volviz.render.preview_hold import PreviewCameraHold, holds_previews
 from volviz.render.pt_view import PTView
+from volviz.render.vtk_pt_image import VTKProjectedTetrahedra
 from volviz.unstructured.prefetch import SortPrefetcher
 from volviz.unstructured.render import UnstructuredRenderStats, render
 from volviz.unstructured.tetrahedralize import tetrahedralize
@@ -52,7 +55,12 @@ if TYPE_CHECKING:   # type-only imports for the signatures
     from volviz.model.clip import ClipSettings
     from volviz.optics.transfer_function import TransferFunction
 
-__all__ = ["ErrorEstimate", "PTVolume", "add_pt_volume", "unpremultiply_rgba8", "zbuffer_to_depth"]
+__all__ = ["METHODS", "ErrorEstimate", "PTVolume", "add_pt_volume", "unpremultiply_rgba8", "zbuffer_to_depth"]
+
+
+#: what draws a PT volume's image: volviz's pre-integrated PT, the exact float64 reference, or VTK's projected
+#: tetrahedra (``volviz.render.vtk_pt_image``, drawn in a window of a thread of its own)
+METHODS = ("pt", "reference", "vtk")
 
 
 class ErrorEstimate(TypedDict):
@@ -75,8 +83,8 @@ class PTVolume(OverlayView[UnstructuredRenderStats], PTView):
         scalars = render_opts.pop("scalars", None)
         if not isinstance(mesh, TetMesh):
             mesh = tetrahedralize(mesh, scalars)
-        if method not in ("pt", "reference"):
-            raise ValueError(f"PT volume method must be 'pt' or 'reference', got {method!r}")
+        if method not in METHODS:
+            raise ValueError(f"PT volume method must be one of {', '.join(METHODS)}, got {method!r}")
         super().__init__(plotter)
         self.mesh = mesh
         self.whole_mesh = mesh                        # uncut: what clipping cuts and ``bounds`` measures
@@ -84,6 +92,7 @@ class PTVolume(OverlayView[UnstructuredRenderStats], PTView):
         self.method = method
         self.render_opts = render_opts
         self._prefetcher: Any = None                  # sorts for a known next camera in the background
+        self._vtk_images: VTKProjectedTetrahedra | None = None   # method "vtk": VTK's mapper in a thread of its own
         # the app's frames drawn with the shown image's camera while the camera moves (``preview_hold``)
         self.hold = PreviewCameraHold(plotter) if holds_previews(plotter) else None
 
@@ -117,10 +126,13 @@ class PTVolume(OverlayView[UnstructuredRenderStats], PTView):
         to the window), made here so that ``finish`` on the GUI thread only hands it over."""
         if progress is not None:
             progress(0.0, "rendering volume")
+        mesh = request["mesh"]
+        if self.method == "vtk":
+            img, st = self._vtk().render(mesh, request["tf"], request["camera"], request["size"], request["depth"])
+            return img, st, overlay_rgba8(img, request)
         opts = dict(self.render_opts)
         pre = self._prefetcher
         res = None
-        mesh = request["mesh"]
         if self.method == "pt" and pre is not None and pre.mesh is mesh and "order" not in opts:
             res = pre.take(request["camera"], request["size"])
         if res is not None:
@@ -129,6 +141,12 @@ class PTVolume(OverlayView[UnstructuredRenderStats], PTView):
                          depth=request["depth"], return_stats=True, **opts)
         st.extra["sort_prefetched"] = res is not None
         return img, st, overlay_rgba8(img, request)
+
+    def _vtk(self) -> VTKProjectedTetrahedra:
+        """Method "vtk": the window and thread that VTK's projected tetrahedra draw this volume's images in."""
+        if self._vtk_images is None:
+            self._vtk_images = VTKProjectedTetrahedra()
+        return self._vtk_images
 
     def prefetch(self, camera: Camera, size: tuple[int, int] | None = None) -> None:
         """Sort the mesh for ``camera`` (the next frame's; ``size`` defaults to the window's) in the background, so
@@ -153,7 +171,10 @@ class PTVolume(OverlayView[UnstructuredRenderStats], PTView):
         sw, sh = size
         sh = max(8, int(round(sw * h / max(w, 1))))
         mesh = request["mesh"]   # both of the same mesh, though a cut may be shown meanwhile
-        fast = render(mesh, request["tf"], request["camera"], (sw, sh), self.method, **self.render_opts)
+        if self.method == "vtk":
+            fast = self._vtk().render(mesh, request["tf"], request["camera"], (sw, sh))[0]
+        else:
+            fast = render(mesh, request["tf"], request["camera"], (sw, sh), self.method, **self.render_opts)
         if progress is not None:
             progress(0.5, "error estimate: exact reference")
         exact = render(mesh, request["tf"], request["camera"], (sw, sh), "reference")
@@ -183,6 +204,9 @@ class PTVolume(OverlayView[UnstructuredRenderStats], PTView):
         if self._prefetcher is not None:
             self._prefetcher.close()
             self._prefetcher = None
+        if self._vtk_images is not None:
+            self._vtk_images.close()
+            self._vtk_images = None
         if self.hold is not None:
             self.hold.remove()
         super().remove()

@@ -97,8 +97,8 @@ def prepare_component(session: Session, comp: Component, datasets: dict[str, Loa
                       t: Optional[float] = None, interpolate: bool = True) -> None:
     """Any thread: the heavy part of showing one non-nature component (isosurface extraction with clipping and LOD
     chains, tetrahedralisation and topology, the VTK volume input at display time ``t``, its data histogram), put into
-    ``prepared``; ``install_component`` adds its prop on the GUI thread. A mesh that VTK's projected tetrahedra draw
-    is tetrahedralised here as for volviz's (``volviz.unstructured.tetrahedralize``): the two draw the same cells."""
+    ``prepared``; ``install_component`` adds its prop on the GUI thread. A mesh is tetrahedralised here whichever
+    projected tetrahedra draw it (``uses_pt``): volviz's and VTK's draw the same cells."""
     clip = session.clip
     dataset = component_dataset(comp, datasets)
     series = isinstance(dataset, TimeSeries)
@@ -120,12 +120,6 @@ def prepare_component(session: Session, comp: Component, datasets: dict[str, Loa
         prepared.parts[comp.id] = mesh
         if clip.all_planes():
             prepared.cut[comp.id] = cut_tetmesh(mesh, clip)
-    elif isinstance(dataset, (UnstructuredMesh, CurvilinearGrid)) and not is_surface(dataset):
-        # VTK's projected tetrahedra (render method "vtk") draw volviz's tetrahedra, made here: ``volume_input``
-        # ran vtkDataSetTriangleFilter on the GUI thread in ``frame_input``
-        from volviz.unstructured.tetrahedralize import tetrahedralize   # (the tetrahedra's modules: only for meshes)
-
-        prepared.parts[comp.id] = tetrahedralize(dataset, getattr(dataset, "active", None))
     else:   # arrays: ``frame_input`` makes the mapper's input in ``install_component``, on the GUI thread
         prepared.parts[comp.id] = display_frame(dataset, t, interpolate)
 
@@ -341,26 +335,27 @@ PT_DATASETS = ("TetMesh", "UnstructuredMesh", "CurvilinearGrid")
 
 
 def uses_pt(session: Session, dataset: object) -> bool:
-    """Unstructured and curvilinear data are drawn by volviz's pre-integrated projected tetrahedra unless the
-    session asks for VTK's own mappers (render method "vtk"); regular volumes go to VTK's ray casters."""
+    """Unstructured and curvilinear data are drawn as a PT volume (``volviz.render.pt_view``): by volviz's
+    pre-integrated projected tetrahedra, or by VTK's when the session asks for VTK's own mappers (render method
+    "vtk"), as an image made off the GUI thread either way; regular volumes go to VTK's ray casters."""
     if isinstance(dataset, TimeSeries):
         return False  # time-varying meshes stay on VTK's mapper for now
-    return (session.render.method != "vtk" and isinstance(dataset, (TetMesh, UnstructuredMesh, CurvilinearGrid))
-            and not is_surface(dataset))
+    return isinstance(dataset, (TetMesh, UnstructuredMesh, CurvilinearGrid)) and not is_surface(dataset)
 
 
 def add_pt_component(plotter: pv.BasePlotter, session: Session, comp: Component, dataset: object,
                      update: bool = True) -> ComponentView:
     """A PT volume for a component (``volviz.render.pt_view``), with its TF scaled by its opacity: drawn on the GPU
     (``volviz.render.gl_pt``) or the CPU (``volviz.render.pt_prop``) as the render option ``backend`` picks for this
-    plotter's OpenGL (``volviz.render.backend``; the exact "reference" method is CPU only). A CPU volume's image is
-    rendered now when ``update`` (the app renders it in the background: ``begin`` / ``compute`` / ``finish``)."""
+    plotter's OpenGL (``volviz.render.backend``; the exact "reference" method and VTK's projected tetrahedra, "vtk",
+    are images made by ``pt_prop``'s view on any OpenGL). A CPU volume's image is rendered now when ``update`` (the
+    app renders it in the background: ``begin`` / ``compute`` / ``finish``)."""
     tf = drawn_transfer_function(session, comp, dataset)
     if tf is None:   # (ensure_transfer_functions gives every mesh one)
         raise SceneError(f"component {comp.id!r} has no transfer function")
     if comp.opacity != 1.0:
         tf = tf.scaled_extinction(comp.opacity)
-    method = "reference" if session.render.method == "reference" else "pt"
+    method = session.render.method if session.render.method in ("reference", "vtk") else "pt"
     from volviz.scene.tetra import pt_options   # the tetrahedra's modules: only for meshes (start-up)
 
     opts = pt_options(session.render.options) if method == "pt" else {}
