@@ -73,3 +73,29 @@ def test_vtks_projected_tetrahedra_draw_volvizs_tetrahedra_made_on_the_loading_t
         view.remove()
     finally:
         plotter.close()
+
+
+_KERNELS_LOADED = """
+import numpy as np
+from volviz.scene.tetra import pt_mesh
+from volviz.unstructured import index_buffer, probe
+from volviz.unstructured.synthetic import box_tets
+
+assert not probe._ray_spans.signatures and not index_buffer.fill_triangles.signatures
+pt_mesh(box_tets(2))
+assert len(probe._ray_spans.signatures) == 1
+assert [str(t) for t in index_buffer.fill_triangles.signatures[0][:2]] == [
+    "array(int32, 1d, C)", "array(bool, 1d, C)"]
+"""
+
+
+def test_a_pt_mesh_is_prepared_with_the_kernels_the_gui_thread_calls_first_loaded() -> None:
+    """A Numba kernel's first call in a process loads it holding the GIL: the GPU volume's static index buffer
+    (filled as it is installed, on the GUI thread: 233 ms in the flow-gap survey) and the probe under the cursor (494
+    ms). ``pt_mesh``, on the loading thread, loads both, with the types of those calls. In a fresh process: no other
+    test has called them."""
+    import subprocess
+    import sys
+
+    run = subprocess.run([sys.executable, "-c", _KERNELS_LOADED], capture_output=True, text=True, timeout=300)
+    assert run.returncode == 0, run.stderr[-3000:]

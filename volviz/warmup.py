@@ -103,6 +103,7 @@ def _tetrahedral_volume(folder: Path) -> None:
     from volviz.unstructured import render
     from volviz.model.camera import Camera
     from volviz.model.clip import BoxCrop, ClipSettings
+    from volviz.unstructured.probe import probe_tetmesh
     from volviz.unstructured.synthetic import box_tets, holed_box
 
     render_session(demo_volume_session(), None, SIZE)
@@ -115,6 +116,7 @@ def _tetrahedral_volume(folder: Path) -> None:
     render(mesh, tf, camera, (24, 24), method="pt-st", n_s=32, n_l=16)
     render(mesh, tf, camera, (24, 24), method="reference")
     render(holed_box(4), tf, camera, (24, 24))  # a non-convex mesh: the sort's boundary-gap relations
+    probe_tetmesh(mesh, camera.position, np.subtract(camera.focal_point, camera.position), tf)  # the app's probe
     clipped = demo_volume_session()
     clipped.clip = ClipSettings(box=BoxCrop((0.0, 0.0, 0.0), (0.5, 0.5, 0.5)))  # a cut mesh
     render_session(clipped, None, SIZE)

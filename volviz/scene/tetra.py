@@ -5,7 +5,10 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any, Optional
 
+import numpy as np
+
 from volviz.model.datasets import TetMesh
+from volviz.unstructured import index_buffer, probe
 from volviz.unstructured.boundary_pairs import inner_boundary
 from volviz.unstructured.tetrahedralize import tetrahedralize
 from volviz.unstructured.topology import cell_ranges, topology
@@ -15,10 +18,20 @@ if TYPE_CHECKING:   # type-only imports for the signatures
 
 
 def pt_mesh(dataset: object) -> TetMesh:
-    """Any thread: the tetrahedral mesh a PT volume draws for ``dataset``, with its topology built (cached on it)."""
+    """Any thread: the tetrahedral mesh a PT volume draws for ``dataset``, with its topology built (cached on it) and
+    the kernels the GUI thread calls first for it loaded (``_load_gui_kernels``)."""
     mesh = dataset if isinstance(dataset, TetMesh) else tetrahedralize(dataset, getattr(dataset, "active", None))
     _with_adjacency(mesh)
+    _load_gui_kernels()
     return mesh
+
+
+def _load_gui_kernels() -> None:
+    """Load from Numba's cache, here on the caller's thread, the kernels that the GUI thread calls first for a PT
+    volume: a kernel's first call in a process holds the GIL while it loads (issue #28). They are the GPU volume's
+    static index buffer, filled as the volume is installed, and the probe under the cursor."""
+    index_buffer.load_kernels(np.empty(0, np.int32), np.empty(0, bool))
+    probe.load_kernels()
 
 
 def _with_adjacency(mesh: TetMesh) -> None:

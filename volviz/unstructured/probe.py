@@ -58,6 +58,14 @@ def _ray_spans(points: np.ndarray, tets: np.ndarray, o: np.ndarray,
     return ids[:n_hit], t_in[:n_hit], t_out[:n_hit]
 
 
+def load_kernels() -> None:
+    """Any thread: call the probe's kernel on one tetrahedron, with the types ``probe_tetmesh`` calls it with. A
+    Numba kernel's first call in a process loads its compiled code from the cache while holding the GIL (issue #28:
+    the first probe under the cursor held the GUI thread); a scene's loading calls this for its meshes
+    (``volviz.scene.tetra.pt_mesh``)."""
+    _ray_spans(np.eye(4, 3), np.arange(4, dtype=np.int64).reshape(1, 4), np.zeros(3), np.array([0.0, 0.0, 1.0]))
+
+
 def barycentric(points: np.ndarray, tet: np.ndarray, x: np.ndarray) -> np.ndarray:
     """The barycentric coordinates (4,) of point ``x`` in the tetrahedron of vertices ``points[tet]``."""
     p = points[tet]
