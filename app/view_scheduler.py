@@ -172,7 +172,8 @@ class ViewScheduler:
     def enforce_error_budget(self, rmse: float) -> None:
         """Measured error above the budget: switch to the most accurate table once, or say that it cannot be met
         (``volviz.render.error_budget``)."""
-        choice = error_budget_choice(rmse, self.scene.session.render.options)
+        render = self.scene.session.render
+        choice = error_budget_choice(rmse, render.options, render.method)
         if choice.message is not None:
             self.status.setText(choice.message)
         if choice.table is None:

@@ -336,12 +336,21 @@ def test_unstructured_data_renders_with_volviz_pt_and_shows_the_frame_split(qtbo
     qtbot.waitUntil(lambda: "vs exact" in window.statistics.text("error"), timeout=60000)
     rmse = float(window.statistics.text("error").split()[1].rstrip(","))
     assert 0.0 <= rmse <= 1.0  # the fast path's measured error for this very view is within the product's budget
+    table = {k: window.render_settings.settings()["options"][k] for k in ("table", "table_resolution")}
+    assert table != {"table": "separable-4", "table_resolution": 512}     # not the finest table already
     window.render_settings.method.setCurrentText("vtk")  # VTK's own projected-tetrahedra mapper instead
-    # drawn as an image off the GUI thread too (``volviz.render.vtk_pt_image``), with its own statistics
+    # drawn as an image off the GUI thread too (``volviz.render.vtk_pt_image``), with its own statistics and error
     qtbot.waitUntil(lambda: [s.get("method") for s in window.controller.pt_stats().values()] == ["vtk"],
                     timeout=30000)
     wait_settled(qtbot, window)
     assert window.statistics.text("method") == "vtk"
+    qtbot.waitUntil(lambda: "vs exact" in window.statistics.text("error"), timeout=60000)
+    vtk_rmse = float(window.statistics.text("error").split()[1].rstrip(","))
+    assert vtk_rmse > rmse
+    wait_settled(qtbot, window)
+    # over the budget, VTK's method gets a message and keeps the user's table (volviz's table draws nothing of it)
+    assert {k: window.session.render.options[k] for k in table} == table
+    assert window.status_label.text().startswith(f"Measured error {vtk_rmse:.2f} of VTK's projected tetrahedra")
     vtk_image = viewport(window)
     assert pt_image.std() > 3.0 and vtk_image.std() > 3.0  # neither is blank
     assert np.abs(vtk_image - pt_image).mean() > 0.2  # and they are different renderers

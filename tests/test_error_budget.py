@@ -38,3 +38,14 @@ def test_a_budget_of_none_is_the_default() -> None:
     """The settings model's default for ``error_budget`` is None (a session may say ``"error_budget": null``)."""
     assert error_budget_choice(0.9, {"error_budget": None}) == BudgetChoice()
     assert error_budget_choice(1.5, {"error_budget": None}).table == MOST_ACCURATE_TABLE
+
+
+def test_vtks_projected_tetrahedra_get_a_message_and_no_table() -> None:
+    """The render method "vtk" (VTK's projected tetrahedra, drawn as a PT view's image) has no table of ours: the
+    finest table would change nothing it draws, and the user's table settings stay."""
+    choice = error_budget_choice(3.1, {"error_budget": 1.0, "table": "auto"}, "vtk")
+    assert choice == BudgetChoice(None, "Measured error 3.10 of VTK's projected tetrahedra exceeds the budget 1.00; "
+                                        "volviz's 'pt' renderer adapts its table to the budget and the exact "
+                                        "'reference' renderer meets any budget")
+    assert error_budget_choice(0.8, {"error_budget": 1.0}, "vtk") == BudgetChoice()
+    assert error_budget_choice(3.1, {"error_budget": 1.0}, "pt").table == MOST_ACCURATE_TABLE
