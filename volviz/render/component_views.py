@@ -1,6 +1,6 @@
 """The views of the components that VTK draws with its own props, behind the calls ``SceneController`` makes of every
 component's view (``volviz.render.views.ComponentView``): a volume drawn by VTK's ray casters (or its projected
-tetrahedra for the render method "vtk"), a surface, and the surfaces of an isosurface component (libMini note §3-4:
+tetrahedra for a time series of meshes), a surface, and the surfaces of an isosurface component (libMini note §3-4:
 extracted once, cut exactly by the scene's clipping and scaled by the component's opacity on the CPU, drawn by VTK;
 a transparency mode of the note draws their translucent part through the scene-wide iso view).
 

@@ -654,8 +654,9 @@ class SceneController:
         return {comp_id: view for comp_id, view in self._views_of("lod").items() if view.visible}
 
     def pt_volume(self, comp_id: str) -> Optional[PTVolume]:
-        """The PT volume of a component whose images volviz renders (the CPU backend: ``begin`` / ``compute`` /
-        ``finish``), or None when VTK draws it (the GPU backend, or VTK's own mappers)."""
+        """The PT volume of a component whose images are made off the GUI thread (``begin`` / ``compute`` /
+        ``finish``: volviz's CPU PT or reference, or VTK's projected tetrahedra in a window of their own), or None when
+        it is drawn in the scene's window (the GPU backend)."""
         view = self._views_of("pt").get(comp_id)
         return view if view is not None and view.backend == "cpu" else None
 
