@@ -54,3 +54,25 @@ def test_half_transparent_image_blends_over_the_scene_and_msaa_comes_back() -> N
     overlay.remove()
     assert pl.ren_win.GetMultiSamples() == samples
     pl.close()
+
+
+def test_the_image_is_blended_without_order_independent_transparency_over_translucent_geometry() -> None:
+    """The image is one translucent layer: VTK's order-independent transparency (its default) drew it through float
+    targets of the window's size and a full-window resolve, most of an overlay's cost per frame on llvmpipe
+    (docs/bench/flow-gaps.md, survey 15). Without it the "over" is exact, also over the scene's own translucent
+    geometry (drawn by the scene's renderer, which keeps its setting)."""
+    pl = pv.Plotter(off_screen=True, window_size=list(SIZE))
+    pl.set_background("white")
+    pl.add_mesh(pv.Plane(i_size=10, j_size=10), color=(0.0, 0.0, 1.0), opacity=0.5, lighting=False)
+    pl.camera_position = [(0, 0, 5), (0, 0, 0), (0, 1, 0)]
+    under = pl.screenshot(return_img=True)[..., :3].astype(float)
+    overlay = ImageOverlay(pl)
+    assert not overlay.renderer.GetUseOIT() and pl.renderer.GetUseOIT()
+    premult = np.zeros((SIZE[1], SIZE[0], 4))
+    premult[..., 1] = 0.25                                  # quarter-opaque pure green, premultiplied
+    premult[..., 3] = 0.25
+    overlay.show(unpremultiply_rgba8(premult))
+    shot = pl.screenshot(return_img=True)[..., :3].astype(float)
+    assert np.abs(under - np.array([128, 128, 255])).max() <= 1    # the half-transparent blue plane over white
+    assert np.abs(shot - (np.array([0, 64, 0]) + 0.75 * under)).max() <= 1.5
+    pl.close()

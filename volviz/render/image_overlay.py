@@ -203,6 +203,9 @@ class ImageOverlay:
         hold_single_sample(plotter, self.renderer)
         self.renderer.SetLayer(layer)
         self.renderer.InteractiveOff()
+        # one translucent image: VTK's order-independent transparency (on by default) would draw it through float
+        # targets of the window's size and a full-window resolve, the most of the image's cost on a software OpenGL
+        self.renderer.SetUseOIT(False)
         self.renderer.SetViewport(plotter.renderer.GetViewport())
         self.data = vtk.vtkImageData()
         self.actor = vtk.vtkImageActor()
