@@ -102,7 +102,7 @@ def _kind(window: Any) -> str:
             how = "natural scene"
         elif comp.dataset is not None:
             dataset = component_dataset(comp, controller.datasets)
-            how = ("LOD" if is_lod(dataset) else "PT" if uses_pt(window.session, dataset)
+            how = ("LOD" if is_lod(dataset) else "PT" if uses_pt(dataset)
                    else "surface" if is_surface(dataset) else "VTK")
             if isinstance(dataset, TimeSeries):
                 how += f", {len(dataset)} steps"

@@ -6,14 +6,15 @@ interactive rate (``view_scheduler.interactive_rate``).
 
 Held by the window as ``window.time_views`` (issue #31: a part with its own state, not a mixin). Its collaborators
 are the shown scene (``shown_scene.ShownScene``), the plotter, the window's ``jobs`` and the timeline (whose signals
-it connects), and as callbacks ``show_error(title, text)``, ``schedule_render()`` and ``refresh_iso_overlay()`` (the
-view scheduler's: the isosurfaces' CPU overlay follows new isosurfaces). The window calls ``scene_installed()`` for
-a new scene."""
+it connects), and as callbacks ``show_error(title, text)``, ``schedule_render()``, ``refresh_iso_overlay()`` and
+``refresh_views(comp_ids, estimate=False)`` (the view scheduler's: the isosurfaces' CPU overlay follows new
+isosurfaces, a PT volume's image its new mesh). The window calls ``scene_installed()`` for a new scene."""
 from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any, Callable, Optional
 
 from volviz.jobs import JobOutcome, OneInFlight
+from volviz.render.controller import MeshFrame
 from .shown_scene import ShownScene
 from .view_scheduler import interactive_rate
 
@@ -29,10 +30,11 @@ class TimeViews:
 
     def __init__(self, scene: ShownScene, plotter: Viewport, jobs: JobBridge, timeline: Timeline, *,
                  show_error: Callable[[str, str], None], schedule_render: Callable[[], None],
-                 refresh_iso_overlay: Callable[[], None]) -> None:
+                 refresh_iso_overlay: Callable[[], None], refresh_views: Callable[..., int]) -> None:
         self.scene, self.plotter, self.jobs, self.timeline = scene, plotter, jobs, timeline
         self.show_error, self.schedule_render = show_error, schedule_render
         self.refresh_iso_overlay = refresh_iso_overlay
+        self.refresh_views = refresh_views
         self._iso_jobs = OneInFlight()     # isosurface extraction for the display time
         self._volume_jobs = OneInFlight()  # blended volumes of time series for the display time
         self.volume_time_shown: Optional[tuple[float, bool]] = None  # (time, interpolated) of the shown volumes
@@ -82,6 +84,9 @@ class TimeViews:
         def shown(controller: Any, result: dict[str, Any], key: tuple[float, bool]) -> None:
             controller.show_volumes(result)
             self.volume_time_shown = key
+            meshes = [comp_id for comp_id, frame in result.items() if isinstance(frame, MeshFrame)]
+            if meshes:                                   # a PT volume's image of its new mesh
+                self.refresh_views(meshes, estimate=False)
 
         self._time_job(self._volume_jobs, "time blend", "Cannot show the volume at this time",
                        lambda c: c.time_volumes(), lambda c: c.blend_volume, shown)

@@ -108,7 +108,8 @@ class MainWindow(WindowBase, QMainWindow):
             load_serial=lambda: self.scene_loading.serial, report_nonfinite=self.nonfinite.report)
         self.time_views = TimeViews(self, self.plotter, self.jobs, self.timeline, show_error=self.show_error,
                                     schedule_render=views.schedule_render,
-                                    refresh_iso_overlay=views.refresh_iso_overlay)
+                                    refresh_iso_overlay=views.refresh_iso_overlay,
+                                    refresh_views=views.refresh_views)
         self.camera_bookmarks = CameraBookmarks(self, self, self.status_label, self.set_dirty, views.camera_moved)
         self.export_runs = ExportRuns(self, self.jobs, self.plotter, self.status_label, busy.set_busy,
                                       busy.busy_elsewhere, self.show_error)

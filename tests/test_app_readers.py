@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from conftest import data_file
+from flows import wait_settled
 from test_app_workflows import wait_loaded
 from volviz_app.window import MainWindow
 
@@ -65,7 +66,7 @@ READERS = [  # file, component, how it is drawn, scalar bar title (None: no lege
     ("ecosystem/disk_out_ref.ex2", "data", "pt", "Temp", 0.03),
     # 4.9 % since the first look's histogram-equalized stops (638b48e) leave its near-zero end fainter
     ("ecosystem/notch_disp.vtu", "data", "pt", "Nodal Displacement (magnitude)", 0.045),
-    ("ecosystem/openfoam-cavity", "data", "volume", "U (magnitude)", 0.0),
+    ("ecosystem/openfoam-cavity", "data", "pt", "U (magnitude)", 0.0),   # a series of meshes: volviz's PT too
     ("ecosystem/sampleCurveGrid4.nc", "data", "surface", "sample", 0.1),
     ("ecosystem/sqnz_s.adf.cgns", "data", "pt", "Density", 0.1),
     ("ecosystem/tos_O1_2001-2002.nc", "data", "surface", "tos", 0.1),
@@ -93,16 +94,25 @@ def test_openfoam_cavity_shows_its_flow_once_the_lid_has_moved(qtbot, make_windo
     """At t = 0 the cavity's U is zero inside (only the lid moves), so the first image shows the lid alone (reported
     in docs/first-open.md): its layer at the TF's top value, drawn since 2a27a37 (before, VTK left a region at the
     top value transparent and the image was nearly empty), 1.4 % of this window; the last step shows the vortex,
-    several times that."""
+    several times that. The series of meshes is a PT volume: each step's mesh is made on a worker
+    (``SceneController.blend_volume``) and its image after it (``refresh_views``), both off the GUI thread."""
     window = small_window(make_window)
     window.open_path(data_file("ecosystem/openfoam-cavity"))
     wait_loaded(qtbot, window)
+    wait_settled(qtbot, window)
     steps = window.timeline.steps
     assert len(steps) == 6 and steps[0] == 0.0
+    volume = window.controller.pt_volume("data")
+    first = volume.whole_mesh
     at_rest = data_share(window)
+    updates = window.view_updates.get("pt:data", 0)
     window.timeline.set_time(steps[-1])
     qtbot.waitUntil(lambda: window.volume_time_shown is not None and window.volume_time_shown[0] == steps[-1],
                     timeout=30000)
+    wait_settled(qtbot, window)
+    assert window.controller.pt_volume("data") is volume and volume.whole_mesh is not first
+    assert window.view_updates["pt:data"] > updates
+    assert not window.plotter.renderer.GetVolumes().GetNumberOfItems()       # nothing of it drawn by VTK's mappers
     moved = data_share(window)
     assert at_rest < 0.02 and moved > 0.05 and moved > 4 * at_rest     # from the lid to the whole vortex
 

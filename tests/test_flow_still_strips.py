@@ -14,7 +14,7 @@ from PySide6.QtCore import Qt, QTimer
 
 from conftest import data_file
 from iso_volume_scene import session, write_datasets
-from flows import assert_matches_render, drag_viewport, open_blunt_fin, pick_combo_item, wait_loaded, wait_settled
+from flows import assert_matches_render, drag_viewport, open_blunt_fin, wait_loaded, wait_settled
 from strip_flows import WHOLE_FRAME_OFF, assert_strips_left_the_whole_frame, last_frame, neghip_in_strips
 from volviz.render import strips as strips_module
 from volviz.render.strips import last_strip_share, planned_rows, ray_cast_volumes, strip_window_center, strips_for
@@ -344,26 +344,6 @@ def test_only_ray_cast_volumes_are_drawn_in_strips() -> None:
     assert not ray_cast_volumes(renderer)
     projected.SetVisibility(False)
     assert ray_cast_volumes(renderer)
-
-
-def test_a_mesh_series_drawn_by_vtks_projected_tetrahedra_is_drawn_whole(qtbot, make_window, monkeypatch) -> None:
-    """The OpenFOAM cavity, a time series of meshes, is drawn by VTK's projected tetrahedra in the scene's window
-    (``scene_builder.uses_pt``: a mesh of one time is an image made off the GUI thread), which sort and project every
-    cell in each strip: its frames are drawn whole."""
-    monkeypatch.setattr(strips_module, "SPLIT_OVER_S", 0.0)
-    window = make_window()
-    window.open_path(data_file("ecosystem/openfoam-cavity"))
-    wait_loaded(qtbot, window)
-    wait_settled(qtbot, window)
-    strips = window.still_strips
-    volumes = window.plotter.renderer.GetVolumes()
-    assert volumes.GetNumberOfItems() == 1 and volumes.GetItemAsObject(0).GetMapper().IsA(
-        "vtkProjectedTetrahedraMapper")
-    assert window.controller.drawn_by_vtk_alone() and strips.cost > 0
-    assert not strips.wanted()
-    frames = strips.frames
-    window.plotter.interactor.repaint()                  # a still frame: whole
-    assert strips.frames == frames and not strips.drawing
 
 
 def test_a_cpu_pt_image_over_geometry_alone_is_drawn_and_read_back_whole(qtbot, make_window, monkeypatch) -> None:

@@ -37,6 +37,7 @@ from volviz.render.image_overlay import OverlayView, single_sample_on_software
 from volviz.render.scene_builder import (PreparedScene, ensure_transfer_functions, install_component, install_nature,
                                          display_frame, frame_input, install_scene, make_ray_cast_volumes,
                                          prepare_component, prepare_scene, view_backend)
+from volviz.render.pt_view import is_pt_view
 from volviz.render.views import view_class
 from volviz.render.volume_peeling import peel_volumes, regular_volumes
 from volviz.render.vtk_scene import apply_camera, camera_state, is_surface
@@ -70,11 +71,21 @@ if TYPE_CHECKING:   # type-only imports for the signatures
     #: a view that re-makes something for a new camera; ``kind`` (a Literal on each class) tells them apart
     CameraView = Union[EitherNatureView, LodVolume, PTVolume, GLPTVolume, IsoOverlay]
 
-__all__ = ["Cut", "ISO_MODES", "SceneController", "ensure_lights", "iso_summary", "no_render", "session_interpolates"]
+__all__ = ["Cut", "ISO_MODES", "MeshFrame", "SceneController", "ensure_lights", "iso_summary", "no_render",
+           "session_interpolates"]
 
 #: a component's data cut by the clipping, as its view draws it: a PT volume's tetrahedra (None: nothing left), an
 #: isosurface component's parts
 Cut = Union["TetMesh", IsoParts, None]
+
+
+@dataclass(frozen=True)
+class MeshFrame:
+    """A PT volume's mesh at a display time (``SceneController.blend_volume``): the whole tetrahedral mesh, and what
+    is drawn of it (its cut by the clipping; None: nothing left)."""
+
+    whole: TetMesh
+    shown: Optional[TetMesh]
 
 
 def _vtk_props(props: dict[str, object]) -> list[vtkProp]:
@@ -467,39 +478,63 @@ class SceneController:
         if volumes:
             self.show_volumes({comp_id: self.blend_volume(comp_id, self.time) for comp_id in self.time_volumes()})
         self._sync_iso_overlay()
-        if update and self.iso_overlay is not None:
-            self.iso_overlay.update()
+        if update:
+            for comp_id in self.time_volumes():     # a PT volume's image of its new mesh
+                view = self.views[comp_id]
+                if is_pt_view(view) and view.visible:
+                    view.update()
+            if self.iso_overlay is not None:
+                self.iso_overlay.update()
 
     def time_volumes(self) -> list[str]:
-        """The VTK volumes and surfaces shown from a time series (what a display-time change re-blends)."""
-        views = self._views_of("vtk")
+        """The volumes and surfaces shown from a time series (what a display-time change re-blends): VTK's volumes
+        and surfaces, and PT volumes (a series of meshes)."""
+        views = self.views
         series = self.time_series()
         return [comp_id for comp_id in series if comp_id in views
-                and (views[comp_id].prop.IsA("vtkVolume") or (views[comp_id].prop.IsA("vtkActor")
-                                                              and is_surface(series[comp_id])))]
+                and (is_pt_view(views[comp_id])
+                     or (getattr(views[comp_id], "kind", "") == "vtk"
+                         and (views[comp_id].prop.IsA("vtkVolume")
+                              or (views[comp_id].prop.IsA("vtkActor") and is_surface(series[comp_id])))))]
 
     def blend_volume(self, comp_id: str, t: float, interpolate: Optional[bool] = None,
-                     progress: Optional[ProgressCallback] = None) -> Dataset:
+                     progress: Optional[ProgressCallback] = None) -> Union[Dataset, MeshFrame]:
         """Any thread: a time-series volume or surface at display time ``t`` (the 4D blend of the neighbouring
         steps when interpolating, libMini note "4D Visualization"; ``scene_builder.display_frame``): arrays, no VTK
         object; ``show_volumes`` makes its VTK input and puts it on screen. (Made in the job, the VTK input froze the
-        window: playing a surface series while orbiting, issue #28.)"""
+        window: playing a surface series while orbiting, issue #28.) For a PT volume: its tetrahedra with their
+        topology and their cut by the clipping (``MeshFrame``), made here too."""
         interpolate = self.interpolate_time if interpolate is None else bool(interpolate)
-        return display_frame(self.time_series()[comp_id], float(t), interpolate)
+        frame = display_frame(self.time_series()[comp_id], float(t), interpolate)
+        if not is_pt_view(self.views.get(comp_id)):
+            return frame
+        # the tetrahedra's modules: only for a series of meshes (start-up)
+        from volviz.scene.tetra import cut_tetmesh, pt_mesh
 
-    def show_volumes(self, inputs: Mapping[str, Union[Dataset, TimeSeries, None]]) -> None:
+        whole = pt_mesh(frame)
+        clip = self.clip
+        return MeshFrame(whole, cut_tetmesh(whole, clip) if clip.all_planes() else whole)
+
+    def show_volumes(self, inputs: Mapping[str, Union[Dataset, TimeSeries, MeshFrame, None]]) -> None:
         """GUI thread: give time-series volumes and surfaces new inputs made here from their frames
-        (``comp_id → blend_volume(...)``; ``scene_builder.frame_input``), cut by the clipping; the outline box
-        follows data that moves."""
+        (``comp_id → blend_volume(...)``; ``scene_builder.frame_input``), cut by the clipping, and PT volumes their
+        new mesh (its image re-made after, as after a cut); the outline box follows data that moves."""
         changed = False
         series = self.time_series()
         for comp_id, frame in inputs.items():
             view = self.views.get(comp_id)
-            data = frame_input(series[comp_id], frame) if view is not None and comp_id in series else None
-            if view is not None and data is not None:
-                before = view.bounds()
+            if view is None or comp_id not in series:
+                continue
+            before = view.bounds()
+            if isinstance(frame, MeshFrame) and is_pt_view(view):
+                view.whole_mesh = frame.whole
+                view.show_cut(frame.shown, self.component(comp_id).visible)
+            else:
+                data = frame_input(series[comp_id], frame) if not isinstance(frame, MeshFrame) else None
+                if data is None:
+                    continue
                 view.set_input(data, self.clip)
-                changed = changed or view.bounds() != before
+            changed = changed or view.bounds() != before
         if changed:
             update_outline(self.plotter, self.session, self.shown_props())
 

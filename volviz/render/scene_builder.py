@@ -113,10 +113,10 @@ def prepare_component(session: Session, comp: Component, datasets: dict[str, Loa
         prepared.histograms[comp.id] = histogram(dataset)
     if is_lod(dataset):
         return
-    if uses_pt(session, dataset):
+    if uses_pt(dataset):
         from volviz.scene.tetra import cut_tetmesh, pt_mesh   # the tetrahedra's modules: only for meshes (start-up)
 
-        mesh = pt_mesh(dataset)
+        mesh = pt_mesh(display_frame(dataset, t, interpolate))   # a time series: its mesh at display time ``t``
         prepared.parts[comp.id] = mesh
         if clip.all_planes():
             prepared.cut[comp.id] = cut_tetmesh(mesh, clip)
@@ -223,7 +223,7 @@ def install_scene(plotter: pv.BasePlotter, session: Session, datasets: dict[str,
         dataset = component_dataset(comp, datasets)
         if comp.type not in ("isosurface", "slices") and is_lod(dataset):
             lod_components.append((comp, dataset))   # selected for the final camera
-        elif comp.type not in ("isosurface", "slices") and uses_pt(session, dataset):
+        elif comp.type not in ("isosurface", "slices") and uses_pt(dataset):
             pt_components.append((comp, prepared.parts[comp.id]))  # drawn last: over the opaque scene's depth
         else:
             props[comp.id] = install_component(plotter, session, comp, datasets, prepared, spectrum, views)
@@ -259,8 +259,9 @@ def install_component(plotter: pv.BasePlotter, session: Session, comp: Component
         return SlicesView(plotter, comp, dataset, component_transfer_function(session, comp))
     if is_lod(dataset):
         return add_lod_component(plotter, session, comp, dataset, update=views)
-    if uses_pt(session, dataset):
-        return add_pt_component(plotter, session, comp, prepared.parts[comp.id], update=views)
+    if uses_pt(dataset):
+        return add_pt_component(plotter, session, comp, prepared.parts[comp.id], update=views,
+                                series=isinstance(dataset, TimeSeries))
     made = prepared.volumes.pop(comp.id, None)   # made (and set up) before: ``make_ray_cast_volumes``
     if made is None:
         made = ray_cast_volume(plotter, session, comp, dataset, prepared.parts.get(comp.id))
@@ -334,22 +335,24 @@ def add_lod_component(plotter: pv.BasePlotter, session: Session, comp: Component
 PT_DATASETS = ("TetMesh", "UnstructuredMesh", "CurvilinearGrid")
 
 
-def uses_pt(session: Session, dataset: object) -> bool:
-    """Unstructured and curvilinear data are drawn as a PT volume (``volviz.render.pt_view``): by volviz's
-    pre-integrated projected tetrahedra, or by VTK's when the session asks for VTK's own mappers (render method
-    "vtk"), as an image made off the GUI thread either way; regular volumes go to VTK's ray casters."""
-    if isinstance(dataset, TimeSeries):
-        return False  # time-varying meshes stay on VTK's mapper for now
-    return isinstance(dataset, (TetMesh, UnstructuredMesh, CurvilinearGrid)) and not is_surface(dataset)
+def uses_pt(dataset: object) -> bool:
+    """Unstructured and curvilinear data, and time series of them, are drawn as a PT volume
+    (``volviz.render.pt_view``; a series' at its display time): by volviz's pre-integrated projected tetrahedra, or by
+    VTK's when the session asks for VTK's own mappers (render method "vtk"); regular volumes go to VTK's ray
+    casters."""
+    meshes = (TetMesh, UnstructuredMesh, CurvilinearGrid)
+    frame = dataset.frame(0) if isinstance(dataset, TimeSeries) else dataset
+    return isinstance(frame, meshes) and isinstance(dataset, (TimeSeries, *meshes)) and not is_surface(dataset)
 
 
 def add_pt_component(plotter: pv.BasePlotter, session: Session, comp: Component, dataset: object,
-                     update: bool = True) -> ComponentView:
+                     update: bool = True, series: bool = False) -> ComponentView:
     """A PT volume for a component (``volviz.render.pt_view``), with its TF scaled by its opacity: drawn on the GPU
     (``volviz.render.gl_pt``) or the CPU (``volviz.render.pt_prop``) as the render option ``backend`` picks for this
     plotter's OpenGL (``volviz.render.backend``; the exact "reference" method and VTK's projected tetrahedra, "vtk",
-    are images made by ``pt_prop``'s view on any OpenGL). A CPU volume's image is rendered now when ``update`` (the
-    app renders it in the background: ``begin`` / ``compute`` / ``finish``)."""
+    are images made by ``pt_prop``'s view on any OpenGL, as is the mesh of a time ``series``, which each display
+    time gives a new mesh: ``SceneController.show_volumes``). A CPU volume's image is rendered now when ``update``
+    (the app renders it in the background: ``begin`` / ``compute`` / ``finish``)."""
     tf = drawn_transfer_function(session, comp, dataset)
     if tf is None:   # (ensure_transfer_functions gives every mesh one)
         raise SceneError(f"component {comp.id!r} has no transfer function")
@@ -359,7 +362,7 @@ def add_pt_component(plotter: pv.BasePlotter, session: Session, comp: Component,
     from volviz.scene.tetra import pt_options   # the tetrahedra's modules: only for meshes (start-up)
 
     opts = pt_options(session.render.options) if method == "pt" else {}
-    if method == "pt" and pt_backend(plotter, session) == "gpu":
+    if method == "pt" and not series and pt_backend(plotter, session) == "gpu":
         volume = view_class("pt", "gpu")(plotter, dataset, tf, **{"lookup": "auto", **opts})  # the CPU path's table
         if not update:       # its first draw's arrays made with its first order, in the background
             volume.hold_until_finished()
