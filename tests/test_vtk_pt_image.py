@@ -83,3 +83,20 @@ def test_vtks_projected_tetrahedra_drawn_off_the_callers_thread_match_them_drawn
     assert sphere.sum() > 20 and np.abs(shown[sphere] - opaque[sphere]).max() <= 2
     assert free.sum() > 500 and (~free).sum() > 500
     assert handle.stats["method"] == "vtk" and handle.stats["size"] == SIZE
+
+
+def test_an_image_asked_for_after_the_view_is_removed_is_transparent_and_makes_no_window() -> None:
+    """The app removes a view (a new scene, another renderer) while a worker may still compute an image of a request
+    begun before: that image is not shown, so none is drawn, and no window and thread are made again for it."""
+    mesh = syn.box_tets(3)
+    pl = _plotter()
+    try:
+        handle = add_pt_volume(pl, mesh, TF, method="vtk")
+        assert handle.image[..., 3].max() > 0.1
+        request = handle.begin()
+        handle.remove()
+        img, stats, rgba8 = handle.compute(request)
+        assert handle._vtk_images is None and stats.method == "vtk"
+        assert img.shape == (SIZE[1], SIZE[0], 4) and not img.any() and not rgba8.any()
+    finally:
+        pl.close()

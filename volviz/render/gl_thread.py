@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Any, Callable, TypeVar
 if TYPE_CHECKING:   # type-only imports for the signatures
     from volviz.render.vtk_facade import vtkRenderer, vtkRenderWindow
 
-__all__ = ["GLThread"]
+__all__ = ["GLThread", "GLThreadClosed"]
 
 T = TypeVar("T")
 _STOP = None   # the item that ends the thread
@@ -38,7 +38,7 @@ def _serve(jobs: queue.SimpleQueue) -> None:
         del item, fn, args, future     # no reference to a caller (its GLThread) while waiting for the next job
 
 
-def _end(jobs: queue.SimpleQueue, state: dict[str, Any], threads: set[int]) -> None:
+def _end(jobs: queue.SimpleQueue, state: dict[str, Any], threads: set[int], wait: bool = True) -> None:
     """Close the window on its thread (its props' graphics resources with it), then let the thread end. Run there
     directly when the object is collected on that thread (its last call's work item held the last reference).
 
@@ -58,8 +58,12 @@ def _end(jobs: queue.SimpleQueue, state: dict[str, Any], threads: set[int]) -> N
     done: Future = Future()
     jobs.put((close, (), done))
     jobs.put(_STOP)
-    if threads:                         # (a thread that never ran a call has no window to close)
+    if threads and wait:                # (a thread that never ran a call has no window to close)
         done.result()
+
+
+class GLThreadClosed(RuntimeError):
+    """A call submitted to a ``GLThread`` after its ``close``: no thread serves it."""
 
 
 class GLThread:
@@ -73,6 +77,9 @@ class GLThread:
         self.state: dict[str, Any] = {}
         self.threads: set[int] = set()
         self.calls = 0
+        self.name = name
+        self._closed = False
+        self._lock = threading.Lock()   # (taken by ``submit`` and ``close`` only, never by the finalizer)
         self._end = weakref.finalize(self, _end, self._jobs, self.state, self.threads)
 
     def call(self, fn: Callable[..., T], *args: object) -> T:
@@ -80,9 +87,14 @@ class GLThread:
         return self.submit(fn, *args).result()
 
     def submit(self, fn: Callable[..., T], *args: object) -> Future:
-        """``fn(renderer, *args)`` queued for the thread (``call`` without waiting): its future."""
+        """``fn(renderer, *args)`` queued for the thread (``call`` without waiting): its future; after ``close`` a
+        future that raises ``GLThreadClosed`` (queued after the thread's end, it would never be served)."""
         future: Future = Future()
-        self._jobs.put((self._run, (fn, *args), future))
+        with self._lock:
+            if self._closed:
+                future.set_exception(GLThreadClosed(f"{self.name}: the thread is closed"))
+            else:
+                self._jobs.put((self._run, (fn, *args), future))
         return future
 
     def _run(self, fn: Callable[..., T], *args: object) -> T:
@@ -92,9 +104,16 @@ class GLThread:
             self.state["window"], self.state["renderer"] = _window()
         return fn(self.state["renderer"], *args)
 
-    def close(self) -> None:
-        """Release the window and its props on the thread and end it (also when the object is collected)."""
-        self._end()
+    def close(self, wait: bool = True) -> None:
+        """Release the window and its props on the thread and end it (also when the object is collected). With
+        ``wait`` False the close is queued after the call in progress, without waiting for either: a view removed
+        on the GUI thread while its image is drawn here (issue #28)."""
+        with self._lock:
+            self._closed = True
+        if wait:
+            self._end()
+        elif self._end.detach() is not None:
+            _end(self._jobs, self.state, self.threads, wait=False)
 
 
 def _window() -> tuple[vtkRenderWindow, vtkRenderer]:

@@ -41,6 +41,7 @@ from volviz.optics.metrics import max_abs, rmse
 from volviz.render.image_overlay import (Buffers, OverlayRequest, OverlayView, overlay_rgba8, unpremultiply_rgba8,
                                          window_size, zbuffer_to_depth)
 from volviz.render.preview_hold import PreviewCameraHold, holds_previews
+from volviz.render.gl_thread import GLThreadClosed
 from volviz.render.pt_view import PTView
 from volviz.render.vtk_pt_image import VTKProjectedTetrahedra
 from volviz.unstructured.prefetch import SortPrefetcher
@@ -93,6 +94,7 @@ class PTVolume(OverlayView[UnstructuredRenderStats], PTView):
         self.render_opts = render_opts
         self._prefetcher: Any = None                  # sorts for a known next camera in the background
         self._vtk_images: VTKProjectedTetrahedra | None = None   # method "vtk": VTK's mapper in a thread of its own
+        self._removed = False
         # the app's frames drawn with the shown image's camera while the camera moves (``preview_hold``)
         self.hold = PreviewCameraHold(plotter) if holds_previews(plotter) else None
 
@@ -128,7 +130,7 @@ class PTVolume(OverlayView[UnstructuredRenderStats], PTView):
             progress(0.0, "rendering volume")
         mesh = request["mesh"]
         if self.method == "vtk":
-            img, st = self._vtk().render(mesh, request["tf"], request["camera"], request["size"], request["depth"])
+            img, st = self._vtk_image(request, request["size"], request["depth"])
             return img, st, overlay_rgba8(img, request)
         opts = dict(self.render_opts)
         pre = self._prefetcher
@@ -142,11 +144,20 @@ class PTVolume(OverlayView[UnstructuredRenderStats], PTView):
         st.extra["sort_prefetched"] = res is not None
         return img, st, overlay_rgba8(img, request)
 
-    def _vtk(self) -> VTKProjectedTetrahedra:
-        """Method "vtk": the window and thread that VTK's projected tetrahedra draw this volume's images in."""
-        if self._vtk_images is None:
-            self._vtk_images = VTKProjectedTetrahedra()
-        return self._vtk_images
+    def _vtk_image(self, request: OverlayRequest, size: tuple[int, int], depth: Optional[np.ndarray] = None
+                   ) -> tuple[np.ndarray, UnstructuredRenderStats]:
+        """Method "vtk": the request's image at ``size`` drawn by VTK's projected tetrahedra in a window of a thread
+        of their own (made at the first image); a transparent one once the view is removed (``remove`` closes that
+        thread: an image of a request begun before is not shown)."""
+        images = self._vtk_images
+        if images is None and not self._removed:
+            images = self._vtk_images = VTKProjectedTetrahedra()
+        if images is not None:
+            try:
+                return images.render(request["mesh"], request["tf"], request["camera"], size, depth)
+            except GLThreadClosed:
+                pass
+        return np.zeros((size[1], size[0], 4)), UnstructuredRenderStats(method="vtk", size=size)
 
     def prefetch(self, camera: Camera, size: tuple[int, int] | None = None) -> None:
         """Sort the mesh for ``camera`` (the next frame's; ``size`` defaults to the window's) in the background, so
@@ -172,7 +183,7 @@ class PTVolume(OverlayView[UnstructuredRenderStats], PTView):
         sh = max(8, int(round(sw * h / max(w, 1))))
         mesh = request["mesh"]   # both of the same mesh, though a cut may be shown meanwhile
         if self.method == "vtk":
-            fast = self._vtk().render(mesh, request["tf"], request["camera"], (sw, sh))[0]
+            fast = self._vtk_image(request, (sw, sh))[0]
         else:
             fast = render(mesh, request["tf"], request["camera"], (sw, sh), self.method, **self.render_opts)
         if progress is not None:
@@ -204,6 +215,7 @@ class PTVolume(OverlayView[UnstructuredRenderStats], PTView):
         if self._prefetcher is not None:
             self._prefetcher.close()
             self._prefetcher = None
+        self._removed = True
         if self._vtk_images is not None:
             self._vtk_images.close()
             self._vtk_images = None

@@ -62,7 +62,9 @@ class VTKProjectedTetrahedra:
         return image, stats
 
     def close(self) -> None:
-        self.gl.close()
+        """End the thread, its window closed there after the image in progress, without waiting for it (the caller is
+        the GUI thread, removing the view)."""
+        self.gl.close(wait=False)
 
 
 def _volume(state: dict[str, Any], mesh: TetMesh, tf: TransferFunction) -> Any:
