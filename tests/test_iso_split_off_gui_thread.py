@@ -48,8 +48,11 @@ def test_begin_draws_the_window_once_and_the_volume_in_front_on_its_own_thread(b
     e = errors(c, p, "3pass")
     print(backend, e)
     assert e["share"] > 0.3 and e["rmse"] < 1.0 and e["max"] <= 3.0, e
+    request = view.begin()
     view.remove()
     assert not gl._end.alive                            # the window and its thread released with the overlay
+    # a request begun before the removal: no volume in front drawn, no error (the image is not shown)
+    assert view.front_volume.render(request["front_scene"]) is None and gl.calls == calls + 2
 
 
 def test_orbit_in_the_window_renders_the_volume_in_front_off_the_gui_thread(qtbot, make_window, tmp_path) -> None:

@@ -169,7 +169,7 @@ class IsoOverlay(OverlayView[IsoStats], IsoModeView):
         if scene is None:
             return None
         front = self.front_volume.render(scene)
-        if request["preview"]:
+        if front is not None and request["preview"]:
             (w, h), (big_h, big_w) = request["size"], front.shape[:2]
             front = front[(np.arange(h) * big_h) // h][:, (np.arange(w) * big_w) // w]
         return front

@@ -33,7 +33,7 @@ from typing import TYPE_CHECKING, Any, Sequence
 
 import numpy as np
 
-from volviz.render.gl_thread import GLThread
+from volviz.render.gl_thread import GLThread, GLThreadClosed
 from volviz.render.volume_peeling import regular_volumes
 
 if TYPE_CHECKING:   # type-only imports for the signatures
@@ -169,13 +169,19 @@ class FrontVolume:
         return FrontScene((w, h), tuple(ren.GetViewport()), camera, lights, bool(ren.GetTwoSidedLighting()),
                           volumes, list(meshes))
 
-    def render(self, scene: FrontScene) -> np.ndarray:
+    def render(self, scene: FrontScene) -> np.ndarray | None:
         """Any thread: ``scene``'s volumes in front of its surfaces as premultiplied float RGBA (H, W, 4), row 0 at
-        the top, in 8-bit steps (drawn on the window's thread)."""
-        return self.gl.call(_draw, self.gl.state, scene)
+        the top, in 8-bit steps (drawn on the window's thread); None once ``close``d (the overlay was removed: an
+        image of a request begun before is not shown)."""
+        try:
+            return self.gl.call(_draw, self.gl.state, scene)
+        except GLThreadClosed:
+            return None
 
     def close(self) -> None:
-        self.gl.close()
+        """End the thread, its window closed there after the drawing in progress, without waiting for it (the caller
+        is the GUI thread, removing the overlay)."""
+        self.gl.close(wait=False)
 
 
 def _draw(ren: vtkRenderer, state: dict[str, Any], scene: FrontScene) -> np.ndarray:
