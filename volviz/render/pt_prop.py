@@ -30,6 +30,7 @@ volumes should be merged into one mesh). Multisampling is off while a volume is 
 """
 from __future__ import annotations
 
+import threading
 from typing import TYPE_CHECKING, Any, Optional, TypedDict
 
 import numpy as np
@@ -40,8 +41,8 @@ from volviz.model.extent import point_extent
 from volviz.optics.metrics import max_abs, rmse
 from volviz.render.image_overlay import (Buffers, OverlayRequest, OverlayView, overlay_rgba8, unpremultiply_rgba8,
                                          window_size, zbuffer_to_depth)
-from volviz.render.preview_hold import PreviewCameraHold, holds_previews
 from volviz.render.gl_thread import GLThreadClosed
+from volviz.render.preview_hold import PreviewCameraHold, holds_previews
 from volviz.render.pt_view import PTView
 from volviz.render.vtk_pt_image import VTKProjectedTetrahedra
 from volviz.unstructured.prefetch import SortPrefetcher
@@ -95,6 +96,7 @@ class PTVolume(OverlayView[UnstructuredRenderStats], PTView):
         self._prefetcher: Any = None                  # sorts for a known next camera in the background
         self._vtk_images: VTKProjectedTetrahedra | None = None   # method "vtk": VTK's mapper in a thread of its own
         self._removed = False
+        self._vtk_lock = threading.Lock()            # the image and the error estimate's workers make one window
         # the app's frames drawn with the shown image's camera while the camera moves (``preview_hold``)
         self.hold = PreviewCameraHold(plotter) if holds_previews(plotter) else None
 
@@ -149,9 +151,10 @@ class PTVolume(OverlayView[UnstructuredRenderStats], PTView):
         """Method "vtk": the request's image at ``size`` drawn by VTK's projected tetrahedra in a window of a thread
         of their own (made at the first image); a transparent one once the view is removed (``remove`` closes that
         thread: an image of a request begun before is not shown)."""
-        images = self._vtk_images
-        if images is None and not self._removed:
-            images = self._vtk_images = VTKProjectedTetrahedra()
+        with self._vtk_lock:
+            images = self._vtk_images
+            if images is None and not self._removed:
+                images = self._vtk_images = VTKProjectedTetrahedra()
         if images is not None:
             try:
                 return images.render(request["mesh"], request["tf"], request["camera"], size, depth)
@@ -215,10 +218,11 @@ class PTVolume(OverlayView[UnstructuredRenderStats], PTView):
         if self._prefetcher is not None:
             self._prefetcher.close()
             self._prefetcher = None
-        self._removed = True
-        if self._vtk_images is not None:
-            self._vtk_images.close()
-            self._vtk_images = None
+        with self._vtk_lock:
+            self._removed = True
+            images, self._vtk_images = self._vtk_images, None
+        if images is not None:
+            images.close()
         if self.hold is not None:
             self.hold.remove()
         super().remove()
