@@ -51,7 +51,8 @@ if TYPE_CHECKING:   # type-only: VTK's classes, reached through the facade at ru
     from volviz.render.vtk_facade import vtkRenderer, vtkRenderWindow
 
 __all__ = ["ImageOverlay", "OverlayRequest", "OverlayStats", "OverlayView", "StatsT", "WindowPlotter", "block_min",
-           "overlay_rgba8", "read_buffers", "single_sample_on_software", "unpremultiply_rgba8", "zbuffer_to_depth"]
+           "overlay_rgba8", "read_buffers", "read_premultiplied", "single_sample_on_software", "unpremultiply_rgba8",
+           "zbuffer_to_depth"]
 
 #: every overlay renderer of a plotter (the renderers are VTK objects: a plotter's list lives as long as it does)
 _SIBLINGS: "weakref.WeakKeyDictionary[Any, list[Any]]" = weakref.WeakKeyDictionary()
@@ -127,6 +128,18 @@ def read_buffers(ren_win: vtkRenderWindow, w: int, h: int) -> Buffers:
     zz = vtk_to_numpy(z).reshape(h, w)[::-1].astype(np.float64)
     cc = np.ascontiguousarray(vtk_to_numpy(rgb).reshape(h, w, 4)[::-1])[:, :, :3]
     return zz, cc
+
+
+def read_premultiplied(ren_win: vtkRenderWindow, w: int, h: int) -> np.ndarray:
+    """The render window's colour and alpha as float RGBA (H, W, 4) in 8-bit steps, row 0 at the top: the
+    premultiplied image of what it drew over a transparent black background (the offscreen windows of
+    ``volviz.render.gl_thread``)."""
+    # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
+    from volviz.render.vtk_facade import vtk, vtk_to_numpy
+
+    rgba = vtk.vtkUnsignedCharArray()
+    ren_win.GetRGBACharPixelData(0, 0, w - 1, h - 1, 0, rgba)
+    return vtk_to_numpy(rgba).reshape(h, w, 4)[::-1].astype(np.float64) / 255.0
 
 
 def window_size(window: Union[vtkRenderer, vtkRenderWindow]) -> tuple[int, int]:

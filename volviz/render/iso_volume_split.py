@@ -34,6 +34,7 @@ from typing import TYPE_CHECKING, Any, Sequence
 import numpy as np
 
 from volviz.render.gl_thread import GLThread, GLThreadClosed
+from volviz.render.image_overlay import read_premultiplied
 from volviz.render.volume_peeling import regular_volumes
 
 if TYPE_CHECKING:   # type-only imports for the signatures
@@ -188,7 +189,7 @@ def _draw(ren: vtkRenderer, state: dict[str, Any], scene: FrontScene) -> np.ndar
     """On the window's thread: bring ``ren`` to ``scene`` (the volumes made or updated, the occluder of the surfaces,
     the camera and lights), render and read back."""
     # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
-    from volviz.render.vtk_facade import vtk, vtk_to_numpy
+    from volviz.render.vtk_facade import vtk
 
     kept: dict[int, Any] = state.setdefault("volumes", {})
     for key in set(kept) - {v[0] for v in scene.volumes}:
@@ -233,9 +234,7 @@ def _draw(ren: vtkRenderer, state: dict[str, Any], scene: FrontScene) -> np.ndar
     if tuple(window.GetSize()) != (w, h):
         window.SetSize(w, h)
     window.Render()
-    rgba = vtk.vtkUnsignedCharArray()
-    window.GetRGBACharPixelData(0, 0, w - 1, h - 1, 0, rgba)
-    return vtk_to_numpy(rgba).reshape(h, w, 4)[::-1].astype(np.float64) / 255.0
+    return read_premultiplied(window, w, h)
 
 
 def in_volume(image: np.ndarray, front: np.ndarray | None) -> np.ndarray:

@@ -20,6 +20,7 @@ import numpy as np
 
 from volviz.model.camera import Camera
 from volviz.render.gl_thread import GLThread
+from volviz.render.image_overlay import read_premultiplied
 from volviz.unstructured.render import UnstructuredRenderStats
 
 if TYPE_CHECKING:   # type-only imports for the signatures
@@ -91,7 +92,7 @@ def _draw(ren: vtkRenderer, state: dict[str, Any], mesh: TetMesh, tf: TransferFu
     """On the window's thread: draw ``mesh`` over the depth ``z`` (window depth, row 0 at the top; None: none) and
     read the image back."""
     # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
-    from volviz.render.vtk_facade import numpy_to_vtk, vtk, vtk_to_numpy
+    from volviz.render.vtk_facade import numpy_to_vtk, vtk
 
     volume = _volume(state, mesh, tf)
     if not ren.HasViewProp(volume):
@@ -119,9 +120,7 @@ def _draw(ren: vtkRenderer, state: dict[str, Any], mesh: TetMesh, tf: TransferFu
     if z is None:
         state["depth"] = None
     window.Render()
-    rgba = vtk.vtkUnsignedCharArray()
-    window.GetRGBACharPixelData(0, 0, w - 1, h - 1, 0, rgba)
-    return vtk_to_numpy(rgba).reshape(h, w, 4)[::-1].astype(np.float64) / 255.0
+    return read_premultiplied(window, w, h)
 
 
 def _write_depth(ren: vtkRenderer, state: dict[str, Any]) -> None:
