@@ -526,11 +526,11 @@ class SceneController:
             if view is None or comp_id not in series:
                 continue
             before = view.bounds()
-            if isinstance(frame, MeshFrame) and is_pt_view(view):
+            if isinstance(frame, MeshFrame):             # (``blend_volume`` makes one for a PT volume only)
                 view.whole_mesh = frame.whole
                 view.show_cut(frame.shown, self.component(comp_id).visible)
             else:
-                data = frame_input(series[comp_id], frame) if not isinstance(frame, MeshFrame) else None
+                data = frame_input(series[comp_id], frame)
                 if data is None:
                     continue
                 view.set_input(data, self.clip)
