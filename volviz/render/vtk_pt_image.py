@@ -99,7 +99,6 @@ def _draw(ren: vtkRenderer, state: dict[str, Any], mesh: TetMesh, tf: TransferFu
         ren.AddVolume(volume)
         ren.SetBackground(0.0, 0.0, 0.0)
         ren.SetBackgroundAlpha(0.0)
-        state["depth"] = None
         ren.AddObserver(vtk.vtkCommand.StartEvent, lambda *_: _write_depth(ren, state))
     camera.apply_to(ren.GetActiveCamera())
     window = ren.GetRenderWindow()
@@ -113,12 +112,9 @@ def _draw(ren: vtkRenderer, state: dict[str, Any], mesh: TetMesh, tf: TransferFu
         state["drawn"] = True
     if tuple(window.GetSize()) != (w, h):
         window.SetSize(w, h)
-    if z is not None:
-        state["depth"] = numpy_to_vtk(np.ascontiguousarray(z[::-1], dtype=np.float32).ravel(), deep=1)
-    state["depth_size"] = (w, h)
+    state["depth"] = None if z is None else (
+        numpy_to_vtk(np.ascontiguousarray(z[::-1], dtype=np.float32).ravel(), deep=1), (w, h))
     ren.SetPreserveDepthBuffer(z is not None)
-    if z is None:
-        state["depth"] = None
     window.Render()
     return read_premultiplied(window, w, h)
 
@@ -126,7 +122,6 @@ def _draw(ren: vtkRenderer, state: dict[str, Any], mesh: TetMesh, tf: TransferFu
 def _write_depth(ren: vtkRenderer, state: dict[str, Any]) -> None:
     """The renderer's start: the opaque scene's depth written into the window's depth buffer, which the renderer
     keeps (``PreserveDepthBuffer``) and the mapper's depth test reads."""
-    depth = state.get("depth")
-    if depth is not None:
-        w, h = state["depth_size"]
+    if state.get("depth") is not None:
+        depth, (w, h) = state["depth"]
         ren.GetRenderWindow().SetZbufferData(0, 0, w - 1, h - 1, depth)
