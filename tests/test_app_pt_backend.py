@@ -14,7 +14,7 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from PySide6.QtCore import QEvent, QPoint, Qt
+from PySide6.QtCore import QEvent, QPoint, QSignalBlocker, Qt
 
 from test_app_workflows import _mouse, viewport, wait_loaded
 from volviz.render.backend import plotter_gl_info
@@ -32,9 +32,12 @@ def _difference(a: np.ndarray, b: np.ndarray) -> tuple[float, float]:
 
 
 def _set_backend(qtbot, window: MainWindow, backend: str) -> Any:
-    """Choose ``backend`` in the render settings dock, as a user does; returns the rebuilt demo volume once shown
-    (a CPU volume once its full-size image is on screen)."""
+    """Choose ``backend`` in the render settings dock, as a user does, the GPU pass in the scene's window ("GPU in a
+    thread" off: as "auto" on a hardware OpenGL); returns the rebuilt demo volume once shown (a CPU volume once its
+    full-size image is on screen)."""
     old = window.controller
+    with QSignalBlocker(window.render_settings.gpu_thread):
+        window.render_settings.gpu_thread.setCurrentText("off")
     window.render_settings.backend.setCurrentText(backend)
     qtbot.waitUntil(lambda: window.controller is not old, timeout=60000)
     wait_loaded(qtbot, window)

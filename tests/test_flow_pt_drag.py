@@ -1,8 +1,11 @@
 """A camera drag over the Blunt Fin in the real window, on both PT backends (issues #29 and #28).
 
-GPU (``volviz.render.gl_pt``): every frame drawn during the drag draws a visibility order made for its own camera or
-the previous frame's, never an older one; the frames' orders are made on the worker (``GLPTVolume._follow``: each
-frame takes the sort the previous frame started and starts its own), none on the GUI thread. Measured per frame from
+GPU (``volviz.render.gl_pt``, drawn in the scene's window as on a hardware OpenGL: render option ``gpu_thread``
+"off"; on llvmpipe "auto" draws it in a thread of its own instead, ``test_flow_pt_gl_thread``, because here each
+still frame's software raster holds the GUI thread): every frame drawn during the drag draws a visibility order made
+for its own camera or the previous frame's, never an older one; the frames' orders are made on the worker
+(``GLPTVolume._follow``: each frame takes the sort the previous frame started and starts its own), none on the GUI
+thread. Measured per frame from
 ``GLPTVolume.frames`` (camera serial, order serial) while real mouse events drag the camera. Measured in a 900x650
 window on llvmpipe (load average 7 on 2 cores): 24 cameras in 25 frames, every frame drew the previous frame's
 camera's order, the still frame after the drag its own; the frame's wait for the worker's order median 0.7 ms,
@@ -35,7 +38,7 @@ from pathlib import Path
 
 import imageio.v3 as iio
 import numpy as np
-from PySide6.QtCore import QEvent, QPoint, QPointF, Qt
+from PySide6.QtCore import QEvent, QPoint, QPointF, QSignalBlocker, Qt
 
 from flows import _mouse, assert_matches_render, open_blunt_fin, render_saved, screen, wait_loaded, wait_settled
 from volviz.optics.metrics import rmse
@@ -99,6 +102,8 @@ def test_gpu_drag_draws_no_order_older_than_the_previous_frames_camera(qtbot, ma
     camera."""
     window = open_blunt_fin(qtbot, make_window)
     old = window.controller
+    with QSignalBlocker(window.render_settings.gpu_thread):   # the pass in the scene's window, as on a hardware GL
+        window.render_settings.gpu_thread.setCurrentText("off")
     window.render_settings.backend.setCurrentText("gpu")
     qtbot.waitUntil(lambda: window.controller is not old, timeout=60000)
     wait_loaded(qtbot, window)

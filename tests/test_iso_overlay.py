@@ -239,7 +239,7 @@ c.set_clip({"planes": [{"point": list(mid), "normal": [1.0, 0.0, 0.0]}], "box": 
 cut = c.pt_volume("demo").mesh
 assert cut.points[:, 0].min() == pytest.approx(mid[0]) and cut.points[:, 0].max() == pytest.approx(hi[0])
 assert cut.n_cells < whole.n_cells
-drawn = view._vtk_images.gl.state["volume"].GetMapper().GetInput()
+drawn = view._thread_images.gl.state["volume"].GetMapper().GetInput()
 assert drawn.GetNumberOfCells() == cut.n_cells
 assert np.abs(shot(p) - full).max() > 0.05
 c.set_clip({"planes": [], "box": None})

@@ -66,7 +66,7 @@ def test_vtks_projected_tetrahedra_draw_volvizs_tetrahedra_made_on_the_loading_t
         assert view.kind == "pt" and view.method == "vtk" and view.mesh is mesh
         assert plotter.renderer.GetVolumes().GetNumberOfItems() == 0      # nothing of it drawn in the scene's window
         view.update()
-        drawn = view._vtk_images.gl.state["volume"].GetMapper().GetInput()
+        drawn = view._thread_images.gl.state["volume"].GetMapper().GetInput()
         assert drawn.GetNumberOfCells() == len(mesh.tets)
         np.testing.assert_array_equal(pv.wrap(drawn).points, mesh.points)
         assert view.image[..., 3].max() > 0.5 and view.stats["method"] == "vtk"

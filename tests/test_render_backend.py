@@ -9,7 +9,8 @@ import sys
 import pytest
 
 from volviz import session as S
-from volviz.render.backend import GLInfo, choose_backend, is_software_renderer, offscreen_gl_info, parse_capabilities
+from volviz.render.backend import (GLInfo, choose_backend, gpu_in_thread, is_software_renderer, offscreen_gl_info,
+                                   parse_capabilities)
 
 HARDWARE = GLInfo("NVIDIA Corporation", "NVIDIA H100 80GB HBM3/PCIe/SSE2", "4.6.0 NVIDIA 550.54.15")
 LLVMPIPE = GLInfo("Mesa/X.org", "llvmpipe (LLVM 15.0.6, 256 bits)", "4.5 (Core Profile) Mesa 22.3.6")
@@ -36,6 +37,19 @@ def test_auto_picks_the_gpu_on_hardware_and_the_measured_faster_path_on_llvmpipe
         choose_backend("fast", "pt", HARDWARE)
     with pytest.raises(ValueError, match="unknown view kind"):
         choose_backend("auto", "terrain", HARDWARE)
+
+
+def test_the_gpu_pass_draws_in_a_thread_on_a_software_rasteriser_unless_told_otherwise() -> None:
+    """``gpu_thread``: "auto" (or missing) draws the GPU PT pass in a thread on llvmpipe only; "on" and "off" are
+    honoured on either driver; the session refuses another value, naming the field."""
+    assert gpu_in_thread({}, LLVMPIPE) and gpu_in_thread({"gpu_thread": "auto"}, LLVMPIPE)
+    assert not gpu_in_thread({}, HARDWARE) and not gpu_in_thread({"gpu_thread": "auto"}, HARDWARE)
+    for info in (HARDWARE, LLVMPIPE):
+        assert gpu_in_thread({"gpu_thread": "on"}, info) and not gpu_in_thread({"gpu_thread": "off"}, info)
+    doc = _doc("gpu")
+    doc["render"]["options"]["gpu_thread"] = "sometimes"
+    with pytest.raises(S.SessionError, match="render.options.gpu_thread"):
+        S.session_from_dict(doc, "scene.json")
 
 
 def test_capabilities_of_a_real_offscreen_window() -> None:

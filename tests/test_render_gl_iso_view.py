@@ -149,7 +149,7 @@ def _pt_and_iso(mode: str, backend: str, volume: bool = True) -> np.ndarray:
     demo = [Component(id="demo", type="demo", settings={"cells_per_edge": 4})] if volume else []
     s = Session(datasets=[DatasetRef("b", "/unused")], components=[iso_component(), *demo], camera=CAMERA_BESIDE)
     s.render.background = BG
-    s.render.options.update(PLAIN, backend=backend, iso_mode=mode)
+    s.render.options.update(PLAIN, backend=backend, iso_mode=mode, gpu_thread="off")   # the GPU pass in the window
     p = plotter()
     c = SceneController(p, s, {"b": ball()})
     c.build()

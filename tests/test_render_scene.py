@@ -149,7 +149,7 @@ def test_movie_export_sorts_the_next_frame_of_a_gpu_volume_in_the_background() -
     from volviz.session import CameraState, Component, RenderSettings, Session
 
     session = Session(components=[Component(id="demo", type="demo", settings={"cells_per_edge": 5})],
-                      render=RenderSettings(method="pt", size=(64, 48), options={"backend": "gpu"}))
+                      render=RenderSettings(method="pt", size=(64, 48), options={"backend": "gpu", "gpu_thread": "off"}))
     plotter = offscreen_plotter((64, 48))
     try:
         controller = SceneController(plotter, session, {})

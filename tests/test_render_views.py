@@ -71,10 +71,12 @@ def test_each_component_view_offers_the_component_calls(kind):
         assert isinstance(getattr(cls, "visible", None), property) or "visible" in cls.__annotations__
 
 
-@pytest.mark.parametrize("backend", ["cpu", "gpu"])
-def test_every_kind_of_component_answers_the_same_calls_through_the_controller(tmp_path, backend):
+@pytest.mark.parametrize("backend, gpu_thread", [("cpu", "auto"), ("gpu", "off"), ("gpu", "on")])
+def test_every_kind_of_component_answers_the_same_calls_through_the_controller(tmp_path, backend, gpu_thread):
     """A volume VTK draws, a PT volume, a volume at a level of detail and isosurfaces in one scene: the controller
-    gives each the same calls (TF, opacity, visibility, clipping, bounds) and each does its own thing with them."""
+    gives each the same calls (TF, opacity, visibility, clipping, bounds) and each does its own thing with them. The
+    GPU pass in the scene's window (``gpu_thread`` "off") and in a thread of its own ("on": an image, as the CPU's,
+    of a cut mesh under clipping)."""
     import pyvista as pv
 
     from conftest import blob_vvz
@@ -98,7 +100,8 @@ def test_every_kind_of_component_answers_the_same_calls_through_the_controller(t
                                   Component("demo", "demo", settings={"cells_per_edge": 6}),
                                   Component("blob", "volume", "blob", settings={"budget": 16})],
                       camera=CameraState((15.0, -80.0, 20.0), (15.0, 0.0, 0.0), (0.0, 0.0, 1.0)))
-    session.render.options.update(backend=backend, scalar_bar=False, axes=False, outline=False)
+    session.render.options.update(backend=backend, gpu_thread=gpu_thread, scalar_bar=False, axes=False, outline=False)
+    image_view = backend == "cpu" or gpu_thread == "on"       # the PT volume is an image made off the window
     pl = pv.Plotter(off_screen=True, window_size=[96, 72])
     try:
         c = SceneController(pl, session, datasets)
@@ -106,8 +109,8 @@ def test_every_kind_of_component_answers_the_same_calls_through_the_controller(t
         kinds = {comp_id: view.kind for comp_id, view in c.views.items()}
         assert kinds == {"vol": "vtk", "iso": "isosurfaces", "demo": "pt", "blob": "lod"}
         assert all(isinstance(view, ComponentView) for view in c.views.values())
-        assert c.views["demo"].backend == backend
-        assert set(c.camera_views()) == {"lod:blob", ("pt-order:demo" if backend == "gpu" else "pt:demo")}
+        assert c.views["demo"].backend == ("cpu" if image_view else "gpu") and c.views["demo"].drawn_by == backend
+        assert set(c.camera_views()) == {"lod:blob", ("pt:demo" if image_view else "pt-order:demo")}
         whole = c.bounds()
 
         # transfer functions: each view draws the new one (VTK's property, the PT table, the LOD volume's TF)
@@ -138,12 +141,15 @@ def test_every_kind_of_component_answers_the_same_calls_through_the_controller(t
         # are cut (here, now); the scene's bounds stay the uncut extents
         half = ClipSettings([ClipPlane((0.0, 0.0, 0.0), (1.0, 0.0, 0.0))])  # keeps x >= 0
         cut = c.set_clip(half)
-        assert sorted(cut) == (["demo", "iso"] if backend == "cpu" else ["iso"])
+        assert sorted(cut) == (["demo", "iso"] if image_view else ["iso"])
         assert c.views["vol"].prop.GetMapper().GetNumberOfClippingPlanes() == 1
         assert c.views["blob"].volume.GetMapper().GetNumberOfClippingPlanes() == 1
         assert c.views["iso"].parts.clip == half
-        if backend == "cpu":
+        if image_view:
             assert c.views["demo"].mesh.n_cells < c.views["demo"].whole_mesh.n_cells
+            c.update_views()
+            assert c.views["demo"].stats["method"] == ("pt" if backend == "cpu" else "pt-gl")
+            assert c.views["demo"].image[..., 3].max() > 0.1
         assert c.bounds() == pytest.approx(whole)
         c.clear()
     finally:

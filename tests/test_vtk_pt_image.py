@@ -1,6 +1,6 @@
-"""VTK's projected tetrahedra (render method "vtk") drawn as an image in a window of a thread of its own and shown
-over the scene (``volviz.render.vtk_pt_image`` through ``pt_prop``'s view; issue #28): the picture equals the one
-VTK's mapper draws in the scene's own window, an opaque plane through the volume and a sphere in front of it
+"""VTK's projected tetrahedra (render method "vtk") and volviz's GPU PT pass ("pt-gl") drawn as an image in a window
+of a thread of its own and shown over the scene (``volviz.render.vtk_pt_image`` through ``pt_prop``'s view; issue
+#28): the picture equals the one each draws in the scene's own window, an opaque plane through the volume and a sphere in front of it
 included (the opaque scene's depth is written into the image's window), and no render of it runs on the caller's
 thread."""
 from __future__ import annotations
@@ -13,6 +13,7 @@ import pytest
 pv = pytest.importorskip("pyvista")
 
 from volviz.optics import TransferFunction  # noqa: E402
+from volviz.render.gl_pt import GLPTVolume  # noqa: E402
 from volviz.render.image_overlay import zbuffer_to_depth  # noqa: E402
 from volviz.render.pt_prop import add_pt_volume  # noqa: E402
 from volviz.render.vtk_pt_image import window_z  # noqa: E402
@@ -53,25 +54,34 @@ def _shot(pl: pv.Plotter) -> np.ndarray:
     return pl.screenshot(return_img=True).astype(np.float64)
 
 
-def test_vtks_projected_tetrahedra_drawn_off_the_callers_thread_match_them_drawn_in_the_window() -> None:
+@pytest.mark.parametrize("method", ["vtk", "pt-gl"])
+def test_pt_drawn_off_the_callers_thread_matches_it_drawn_in_the_window(method: str) -> None:
+    """VTK's projected tetrahedra ("vtk") and volviz's GPU PT pass ("pt-gl", ``volviz.render.gl_pt.GLPTVolume``)."""
     mesh = syn.box_tets(6)                                          # the unit cube
     pl = _plotter()
     try:
         opaque = _shot(pl)
         camera = pl.camera.copy()
-        volume = make_volume(volume_input(mesh), False, TF, 1.0)
-        pl.add_actor(volume, reset_camera=False)
-        pl.renderer.ResetCameraClippingRange()
-        pl.render()
-        pl.render()                                                 # (VTK's mapper: its first frame lacks cells)
-        direct = _shot(pl)
-        pl.remove_actor(volume)
+        if method == "vtk":
+            volume = make_volume(volume_input(mesh), False, TF, 1.0)
+            pl.add_actor(volume, reset_camera=False)
+            pl.renderer.ResetCameraClippingRange()
+            pl.render()
+            pl.render()                                             # (VTK's mapper: its first frame lacks cells)
+            direct = _shot(pl)
+            pl.remove_actor(volume)
+        else:
+            gl = GLPTVolume(pl, mesh, TF, lookup="auto")
+            pl.renderer.ResetCameraClippingRange()
+            pl.render()
+            direct = _shot(pl)
+            gl.remove()
         pl.camera = camera
-        handle = add_pt_volume(pl, mesh, TF, method="vtk")
+        handle = add_pt_volume(pl, mesh, TF, method=method)
         shown = _shot(pl)
         free = ~np.isfinite(handle.depth)
         sphere = np.all(np.abs(opaque / 255.0 - np.array(SPHERE)) < 0.02, axis=-1)
-        threads = handle._vtk_images.gl.threads
+        threads = handle._thread_images.gl.threads
         handle.remove()
         assert threading.get_ident() not in threads and len(threads) == 1
     finally:
@@ -82,7 +92,7 @@ def test_vtks_projected_tetrahedra_drawn_off_the_callers_thread_match_them_drawn
     # the depth is honoured: the sphere in front stays as it is, the plane cuts the cube's left half
     assert sphere.sum() > 20 and np.abs(shown[sphere] - opaque[sphere]).max() <= 2
     assert free.sum() > 500 and (~free).sum() > 500
-    assert handle.stats["method"] == "vtk" and handle.stats["size"] == SIZE
+    assert handle.stats["method"] == method and handle.stats["size"] == SIZE
 
 
 def test_an_image_asked_for_after_the_view_is_removed_is_transparent_and_makes_no_window() -> None:
@@ -96,7 +106,7 @@ def test_an_image_asked_for_after_the_view_is_removed_is_transparent_and_makes_n
         request = handle.begin()
         handle.remove()
         img, stats, rgba8 = handle.compute(request)
-        assert handle._vtk_images is None and stats.method == "vtk"
+        assert handle._thread_images is None and stats.method == "vtk"
         assert img.shape == (SIZE[1], SIZE[0], 4) and not img.any() and not rgba8.any()
     finally:
         pl.close()

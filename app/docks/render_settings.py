@@ -1,4 +1,5 @@
-"""Render settings dock: renderer method, backend (GPU or CPU, ``volviz.render.backend``), pre-integration table kind
+"""Render settings dock: renderer method, backend (GPU or CPU, ``volviz.render.backend``; the GPU's PT volumes in a
+thread of their own or in the scene's window, ``backend.gpu_in_thread``), pre-integration table kind
 and resolution, sort mode, error budget, export image size. The table and sort settings apply to volviz's PT renderer
 ("auto" picks the table by each cell's optical depth); the error budget is checked against the measured error of the
 current view (see MainWindow.estimate_error)."""
@@ -16,7 +17,8 @@ METHODS = ("auto", "pt", "reference", "vtk")
 TABLE_KINDS = ("auto", "3d", "separable-1", "separable-2", "separable-4")
 SORTS = ("mpvo", "centroid", "power")
 RENDERER_DEFAULTS = {"sort": "mpvo", "table": "auto", "table_resolution": 128,   # what the widgets start with
-                     "backend": "auto"}
+                     "backend": "auto", "gpu_thread": "auto"}
+GPU_THREAD = ("auto", "on", "off")
 
 
 class RenderSettingsDock(QWidget):
@@ -33,6 +35,12 @@ class RenderSettingsDock(QWidget):
         self.backend.setToolTip("Where volumes, isosurfaces and the natural scene are drawn: gpu (VTK's OpenGL with "
                                 "volviz's shaders), cpu (volviz's renderers, VTK's CPU ray caster), or auto: the GPU "
                                 "on a hardware OpenGL, the path measured faster on a software one such as llvmpipe")
+        self.gpu_thread = QComboBox()
+        self.gpu_thread.addItems(GPU_THREAD)
+        self.gpu_thread.setToolTip("Where the GPU backend draws PT volumes: on, in a window of a thread of their own "
+                                   "(shown as an image, the window never waits for them); off, in the scene's "
+                                   "window; auto: in a thread on a software OpenGL such as llvmpipe, whose raster "
+                                   "runs on the CPU")
         self.table_kind = QComboBox()
         self.table_kind.addItems(TABLE_KINDS)
         self.table_resolution = QComboBox()
@@ -73,6 +81,7 @@ class RenderSettingsDock(QWidget):
         form = QFormLayout(self)
         form.addRow("Renderer", self.method)
         form.addRow("Backend", self.backend)
+        form.addRow("GPU in a thread", self.gpu_thread)
         form.addRow("Table", self.table_kind)
         form.addRow("Table resolution", self.table_resolution)
         form.addRow("Sort", self.sort)
@@ -80,7 +89,8 @@ class RenderSettingsDock(QWidget):
         form.addRow("Isosurfaces", self.iso_mode)
         form.addRow("Export width", self.width_box)
         form.addRow("Export height", self.height_box)
-        for combo in (self.method, self.backend, self.table_kind, self.table_resolution, self.sort, self.iso_mode):
+        for combo in (self.method, self.backend, self.gpu_thread, self.table_kind, self.table_resolution, self.sort,
+                      self.iso_mode):
             combo.currentTextChanged.connect(self._emit)
         for spin_box in (self.error_budget, self.width_box, self.height_box):
             spin_box.valueChanged.connect(self._emit)
@@ -88,7 +98,8 @@ class RenderSettingsDock(QWidget):
 
     def settings(self) -> dict[str, Any]:
         return {"method": self.method.currentText(), "size": (self.width_box.value(), self.height_box.value()),
-                "options": {"backend": self.backend.currentText(), "table": self.table_kind.currentText(),
+                "options": {"backend": self.backend.currentText(), "gpu_thread": self.gpu_thread.currentText(),
+                            "table": self.table_kind.currentText(),
                             "table_resolution": int(self.table_resolution.currentText()),
                             "sort": self.sort.currentText(), "error_budget": self.error_budget.value(),
                             "iso_mode": self.iso_mode.currentText()}}
@@ -100,6 +111,7 @@ class RenderSettingsDock(QWidget):
         self.height_box.setValue(render.size[1])
         opts = render.options
         self.backend.setCurrentText(str(opts.get("backend", "auto")))
+        self.gpu_thread.setCurrentText(str(opts.get("gpu_thread", "auto")))
         self.table_kind.setCurrentText(str(opts.get("table", "auto")))
         self.table_resolution.setCurrentText(str(opts.get("table_resolution", 128)))
         self.sort.setCurrentText(str(opts.get("sort", "mpvo")))

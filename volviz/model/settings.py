@@ -18,7 +18,7 @@ from pydantic import AliasChoices, BaseModel, ConfigDict, Field, ValidationError
 __all__ = ["Settings", "TerrainSettings", "FogSettings", "CloudSettings", "SkySettings", "VolumeSettings",
            "MeshSettings", "IsoStyleSettings", "IsosurfaceSettings", "DemoSettings", "RenderOptions",
            "SETTINGS_MODELS", "FogMode", "CloudShadingName", "IsoMode", "IsoShading", "IsoOverlayMode", "Backend",
-           "SortName", "APPLIES_TO", "array_key", "settings_model", "former_names", "validate_settings",
+           "GpuThread", "SortName", "APPLIES_TO", "array_key", "settings_model", "former_names", "validate_settings",
            "validate_render_options", "typed_settings", "validated", "SettingsError",
            "ScalarBarStyle", "SlicesSettings"]
 
@@ -28,6 +28,7 @@ IsoMode = Literal["2pass", "3pass", "4pass", "exact"]
 IsoOverlayMode = Literal["vtk", "2pass", "3pass", "4pass", "exact"]
 IsoShading = Literal["spectrum", "flat"]
 Backend = Literal["auto", "gpu", "cpu"]
+GpuThread = Literal["auto", "on", "off"]
 SortName = Literal["mpvo", "centroid", "power"]
 TableName = Literal["auto", "3d", "separable-1", "separable-2", "separable-4"]
 
@@ -245,6 +246,10 @@ class RenderOptions(Settings):
     backend: Backend = Field("auto", title="Backend", description="gpu (VTK's OpenGL with volviz's shaders), cpu "
                              "(volviz's own renderers), or auto (the GPU on a hardware driver; on a software "
                              "rasteriser the one measured faster)")
+    gpu_thread: GpuThread = Field("auto", title="GPU volumes in a thread", description="the app draws GPU PT volumes "
+                                  "in a window of a thread of their own, shown over the scene as an image: on, off "
+                                  "(in the scene's window), or auto (on a software rasteriser, whose raster is CPU "
+                                  "work that would hold the window)")
     sort: SortName = Field("mpvo", title="Cell sort", description="PT visibility order: mpvo (exact for convex "
                            "meshes, with Guthe's boundary relations otherwise), centroid or power")
     table: TableName = Field("auto", title="Pre-integration table", description="auto (by optical depth), 3d, or "

@@ -45,7 +45,7 @@ if TYPE_CHECKING:   # type-only imports for the signatures
     from volviz.render.vtk_facade import vtkRenderWindow
 
 __all__ = ["RENDER_BACKENDS", "VIEW_KINDS", "GLInfo", "backend_setting", "choose_backend", "gl_info",
-           "is_software_renderer", "offscreen_gl_info", "parse_capabilities", "plotter_gl_info"]
+           "gpu_in_thread", "is_software_renderer", "offscreen_gl_info", "parse_capabilities", "plotter_gl_info"]
 
 VIEW_KINDS = ("pt", "regular", "nature", "iso")
 SOFTWARE_RENDERERS = ("llvmpipe", "softpipe", "swrast", "swiftshader", "software rasterizer")
@@ -149,3 +149,12 @@ def choose_backend(setting: str, view_kind: str, info: GLInfo) -> str:
     if setting != "auto":
         return setting
     return _FASTER_ON_SOFTWARE[view_kind] if info.software else "gpu"
+
+
+def gpu_in_thread(options: Mapping[str, object], info: GLInfo) -> bool:
+    """Whether the app draws its GPU PT volumes in a window of a thread of their own (``volviz.render.vtk_pt_image``,
+    shown over the scene as an image) instead of in the scene's window: the render option ``gpu_thread`` "on" or
+    "off", or "auto" (the default): on a software rasteriser, whose raster of a still frame is CPU work that would
+    hold the GUI thread (issue #28)."""
+    setting = options.get("gpu_thread", "auto")
+    return setting == "on" or (setting not in ("on", "off") and info.software)

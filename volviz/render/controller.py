@@ -706,8 +706,8 @@ class SceneController:
         return {comp_id: dict(view.stats) for comp_id, view in self._views_of("pt").items()}
 
     def pt_backends(self) -> dict[str, str]:
-        """The backend ("gpu" or "cpu") of every PT volume (``volviz.render.backend``)."""
-        return {comp_id: view.backend for comp_id, view in self._views_of("pt").items()}
+        """Where every PT volume is drawn, "gpu" or "cpu" (``volviz.render.backend``; ``PTView.drawn_by``)."""
+        return {comp_id: view.drawn_by for comp_id, view in self._views_of("pt").items()}
 
     def rebuild_nature(self) -> None:
         """Rebuild the natural scene for the visible nature components now (``prepare_nature``, ``install_nature``)."""

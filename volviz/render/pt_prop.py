@@ -17,7 +17,7 @@ How a frame is made (``update``):
 3. the volume is rendered by ``volviz.unstructured.render(..., depth=d)``: every ray segment is clipped at the opaque
    depth of its pixel, so the volume stops exactly at the surface (not at the cell containing it);
    with the method "vtk" VTK's projected tetrahedra draw it instead, over that depth, in a window of a thread of its
-   own (``volviz.render.vtk_pt_image``);
+   own (``volviz.render.vtk_pt_image``), and with "pt-gl" volviz's GPU PT pass does there;
 4. the premultiplied result is drawn over the scene by ``volviz.render.image_overlay.ImageOverlay`` (straight-alpha
    RGBA8 in an overlay renderer on a higher layer: the premultiplied "over" C = C_vol + (1 - a_vol) C_scene; the
    8-bit round trip costs at most about 1/255 per channel, measured in the tests).
@@ -44,7 +44,7 @@ from volviz.render.image_overlay import (Buffers, OverlayRequest, OverlayView, o
 from volviz.render.gl_thread import GLThreadClosed
 from volviz.render.preview_hold import PreviewCameraHold, holds_previews
 from volviz.render.pt_view import PTView
-from volviz.render.vtk_pt_image import VTKProjectedTetrahedra
+from volviz.render.vtk_pt_image import THREAD_METHODS, ThreadPTImages
 from volviz.unstructured.prefetch import SortPrefetcher
 from volviz.unstructured.render import UnstructuredRenderStats, render
 from volviz.unstructured.tetrahedralize import tetrahedralize
@@ -60,9 +60,11 @@ if TYPE_CHECKING:   # type-only imports for the signatures
 __all__ = ["METHODS", "ErrorEstimate", "PTVolume", "add_pt_volume", "unpremultiply_rgba8", "zbuffer_to_depth"]
 
 
-#: what draws a PT volume's image: volviz's pre-integrated PT, the exact float64 reference, or VTK's projected
-#: tetrahedra (``volviz.render.vtk_pt_image``, drawn in a window of a thread of its own)
-METHODS = ("pt", "reference", "vtk")
+#: what draws a PT volume's image: volviz's pre-integrated PT, the exact float64 reference, VTK's projected
+#: tetrahedra or volviz's GPU PT pass (both ``volviz.render.vtk_pt_image``, drawn in a window of a thread of its own)
+METHODS = ("pt", "reference", "vtk", "pt-gl")
+#: the keywords of a "pt-gl" image's GPU pass (``volviz.render.gl_pt.GLPTVolume``) among the render options
+_GL_OPTIONS = ("sort", "nonconvex", "lookup", "n_s", "n_l", "degree", "iso", "iso_shading", "classification")
 
 
 class ErrorEstimate(TypedDict):
@@ -94,11 +96,15 @@ class PTVolume(OverlayView[UnstructuredRenderStats], PTView):
         self.method = method
         self.render_opts = render_opts
         self._prefetcher: Any = None                  # sorts for a known next camera in the background
-        self._vtk_images: VTKProjectedTetrahedra | None = None   # method "vtk": VTK's mapper in a thread of its own
+        self._thread_images: ThreadPTImages | None = None   # methods "vtk", "pt-gl": a window in a thread of its own
         self._removed = False
-        self._vtk_lock = threading.Lock()            # the image and the error estimate's workers make one window
+        self._thread_lock = threading.Lock()         # the image and the error estimate's workers make one window
         # the app's frames drawn with the shown image's camera while the camera moves (``preview_hold``)
         self.hold = PreviewCameraHold(plotter) if holds_previews(plotter) else None
+
+    @property
+    def drawn_by(self) -> str:
+        return "gpu" if self.method == "pt-gl" else "cpu"
 
     def _far(self, cam: Camera) -> float:
         p = self.mesh.points
@@ -131,8 +137,8 @@ class PTVolume(OverlayView[UnstructuredRenderStats], PTView):
         if progress is not None:
             progress(0.0, "rendering volume")
         mesh = request["mesh"]
-        if self.method == "vtk":
-            img, st = self._vtk_image(request, request["size"], request["depth"])
+        if self.method in THREAD_METHODS:
+            img, st = self._thread_image(request, request["size"], request["depth"])
             return img, st, overlay_rgba8(img, request)
         opts = dict(self.render_opts)
         pre = self._prefetcher
@@ -146,21 +152,22 @@ class PTVolume(OverlayView[UnstructuredRenderStats], PTView):
         st.extra["sort_prefetched"] = res is not None
         return img, st, overlay_rgba8(img, request)
 
-    def _vtk_image(self, request: OverlayRequest, size: tuple[int, int], depth: Optional[np.ndarray] = None
-                   ) -> tuple[np.ndarray, UnstructuredRenderStats]:
-        """Method "vtk": the request's image at ``size`` drawn by VTK's projected tetrahedra in a window of a thread
-        of their own (made at the first image); a transparent one once the view is removed (``remove`` closes that
-        thread: an image of a request begun before is not shown)."""
-        with self._vtk_lock:
-            images = self._vtk_images
+    def _thread_image(self, request: OverlayRequest, size: tuple[int, int], depth: Optional[np.ndarray] = None
+                      ) -> tuple[np.ndarray, UnstructuredRenderStats]:
+        """Methods "vtk" and "pt-gl": the request's image at ``size`` drawn by VTK's projected tetrahedra or volviz's
+        GPU PT pass in a window of a thread of their own (made at the first image); a transparent one once the view
+        is removed (``remove`` closes that thread: an image of a request begun before is not shown)."""
+        with self._thread_lock:
+            images = self._thread_images
             if images is None and not self._removed:
-                images = self._vtk_images = VTKProjectedTetrahedra()
+                options = {k: v for k, v in self.render_opts.items() if k in _GL_OPTIONS}
+                images = self._thread_images = ThreadPTImages(self.method, options)
         if images is not None:
             try:
                 return images.render(request["mesh"], request["tf"], request["camera"], size, depth)
             except GLThreadClosed:
                 pass
-        return np.zeros((size[1], size[0], 4)), UnstructuredRenderStats(method="vtk", size=size)
+        return np.zeros((size[1], size[0], 4)), UnstructuredRenderStats(method=self.method, size=size)
 
     def prefetch(self, camera: Camera, size: tuple[int, int] | None = None) -> None:
         """Sort the mesh for ``camera`` (the next frame's; ``size`` defaults to the window's) in the background, so
@@ -185,8 +192,8 @@ class PTVolume(OverlayView[UnstructuredRenderStats], PTView):
         sw, sh = size
         sh = max(8, int(round(sw * h / max(w, 1))))
         mesh = request["mesh"]   # both of the same mesh, though a cut may be shown meanwhile
-        if self.method == "vtk":
-            fast = self._vtk_image(request, (sw, sh))[0]
+        if self.method in THREAD_METHODS:
+            fast = self._thread_image(request, (sw, sh))[0]
         else:
             fast = render(mesh, request["tf"], request["camera"], (sw, sh), self.method, **self.render_opts)
         if progress is not None:
@@ -218,9 +225,9 @@ class PTVolume(OverlayView[UnstructuredRenderStats], PTView):
         if self._prefetcher is not None:
             self._prefetcher.close()
             self._prefetcher = None
-        with self._vtk_lock:
+        with self._thread_lock:
             self._removed = True
-            images, self._vtk_images = self._vtk_images, None
+            images, self._thread_images = self._thread_images, None
         if images is not None:
             images.close()
         if self.hold is not None:

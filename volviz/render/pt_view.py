@@ -35,6 +35,12 @@ class PTView:
     def prop(self) -> PTView:
         return self
 
+    @property
+    def drawn_by(self) -> str:
+        """Whose raster makes the picture, "gpu" or "cpu" (the statistics' backend): the ``backend``, unless a CPU
+        view's image is drawn by the GPU pass in a thread (``pt_prop``'s method "pt-gl")."""
+        return self.backend
+
     def set_tf(self, tf: TransferFunction, opacity: float = 1.0) -> None:
         """Draw with a new transfer function from the next frame on; ``opacity`` scales its extinction."""
         self._use_tf(tf.scaled_extinction(opacity) if opacity != 1.0 else tf)

@@ -13,7 +13,7 @@ from volviz.jobs import ProgressCallback, report
 from volviz.model import CurvilinearGrid, Image2D, RegularVolume, TetMesh, TimeSeries, UnstructuredMesh
 from volviz.model.stats import histogram
 from volviz.model.timeseries import frame_at
-from volviz.render.backend import backend_setting, choose_backend, plotter_gl_info
+from volviz.render.backend import backend_setting, choose_backend, gpu_in_thread, plotter_gl_info
 from volviz.render.component_views import IsoSurfacesView, VtkPropView
 from volviz.render.decorations import legend_margin
 from volviz.render.framing import frame_bounds, nature_bounds, points_bounds, union
@@ -352,7 +352,8 @@ def add_pt_component(plotter: pv.BasePlotter, session: Session, comp: Component,
     plotter's OpenGL (``volviz.render.backend``; the exact "reference" method and VTK's projected tetrahedra, "vtk",
     are images made by ``pt_prop``'s view on any OpenGL, as is the mesh of a time ``series``, which each display
     time gives a new mesh: ``SceneController.show_volumes``). A CPU volume's image is rendered now when ``update``
-    (the app renders it in the background: ``begin`` / ``compute`` / ``finish``)."""
+    (the app renders it in the background: ``begin`` / ``compute`` / ``finish``); so is the GPU pass's where it
+    draws in a thread of its own (``backend.gpu_in_thread``: ``pt_prop``'s method "pt-gl"), a series' too."""
     tf = drawn_transfer_function(session, comp, dataset)
     if tf is None:   # (ensure_transfer_functions gives every mesh one)
         raise SceneError(f"component {comp.id!r} has no transfer function")
@@ -362,7 +363,10 @@ def add_pt_component(plotter: pv.BasePlotter, session: Session, comp: Component,
     from volviz.scene.tetra import pt_options   # the tetrahedra's modules: only for meshes (start-up)
 
     opts = pt_options(session.render.options) if method == "pt" else {}
-    if method == "pt" and not series and pt_backend(plotter, session) == "gpu":
+    if method == "pt" and pt_backend(plotter, session) == "gpu" \
+            and gpu_in_thread(session.render.options, plotter_gl_info(plotter)):
+        method = "pt-gl"
+    elif method == "pt" and not series and pt_backend(plotter, session) == "gpu":
         volume = view_class("pt", "gpu")(plotter, dataset, tf, **{"lookup": "auto", **opts})  # the CPU path's table
         if not update:       # its first draw's arrays made with its first order, in the background
             volume.hold_until_finished()

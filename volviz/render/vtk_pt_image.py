@@ -1,20 +1,23 @@
-"""VTK's projected tetrahedra (vtkProjectedTetrahedraMapper, the render method "vtk") drawn as an image in an
-offscreen window of a thread of its own, to be shown over the scene as volviz's CPU PT image is
-(``volviz.render.pt_prop``; issue #28: in the scene's window the mapper's per-frame work, the cells' depth sort and
-projection on the CPU, held the GUI thread at every frame).
+"""PT volumes drawn by VTK's OpenGL as an image in an offscreen window of a thread of its own, to be shown over the
+scene as volviz's CPU PT image is (``volviz.render.pt_prop``; issue #28): VTK's projected tetrahedra
+(vtkProjectedTetrahedraMapper, the render method "vtk"), whose per-frame work, the cells' depth sort and projection on
+the CPU, held the GUI thread at every frame in the scene's window; and volviz's GPU PT pass (``volviz.render.gl_pt``,
+"pt-gl") where it is drawn off the scene's window (``volviz.render.backend.gpu_in_thread``: on a software rasteriser
+its raster is CPU work, which held the GUI thread for a whole still frame).
 
-The image is the one the scene's window would draw: VTK's mapper blends the cells front to back into a transparent
-black background, which leaves the premultiplied colour and alpha of the volume (the "over" of
-``volviz.render.image_overlay``). Its cells are depth-tested against the opaque scene as in the scene's window: the
-opaque scene's depth (read back by the overlay's ``begin``) is written into the window's depth buffer before the
-volume is drawn (``SetZbufferData`` when the renderer starts, the renderer keeping its depth buffer), in the window
-depth of the image's camera (``window_z``: its far plane is moved to the volume's far side). Guthe §4.5: the volume
-behind an opaque surface is hidden.
+The image is the one the scene's window would draw: both blend the cells into a transparent black background, which
+leaves the premultiplied colour and alpha of the volume (the "over" of ``volviz.render.image_overlay``). The cells
+are depth-tested against the opaque scene as in the scene's window: the opaque scene's depth (read back by the
+overlay's ``begin``) is written into the window's depth buffer before the volume is drawn (``SetZbufferData`` when
+the renderer starts, the renderer keeping its depth buffer), in the window depth of the image's camera
+(``window_z``: its far plane is moved to the volume's far side). Guthe §4.5: the volume behind an opaque surface is
+hidden.
 """
 from __future__ import annotations
 
 import time
-from typing import TYPE_CHECKING, Any, Optional
+from types import SimpleNamespace
+from typing import TYPE_CHECKING, Any, Callable, Optional
 
 import numpy as np
 
@@ -28,7 +31,10 @@ if TYPE_CHECKING:   # type-only imports for the signatures
     from volviz.optics.transfer_function import TransferFunction
     from volviz.render.vtk_facade import vtkRenderer
 
-__all__ = ["VTKProjectedTetrahedra", "window_z"]
+__all__ = ["THREAD_METHODS", "ThreadPTImages", "window_z"]
+
+#: the PT methods drawn here: VTK's projected tetrahedra, volviz's GPU PT pass
+THREAD_METHODS = ("vtk", "pt-gl")
 
 
 def window_z(depth: np.ndarray, clipping_range: tuple[float, float], parallel: bool) -> np.ndarray:
@@ -43,12 +49,17 @@ def window_z(depth: np.ndarray, clipping_range: tuple[float, float], parallel: b
     return np.where(finite, np.clip(z, 0.0, 1.0), 1.0)
 
 
-class VTKProjectedTetrahedra:
-    """Images of a TetMesh drawn by VTK's projected tetrahedra in a window of a thread of its own
-    (``volviz.render.gl_thread``): ``render`` from any thread; ``close`` ends the thread."""
+class ThreadPTImages:
+    """Images of a TetMesh drawn by ``method`` (``THREAD_METHODS``) in a window of a thread of its own
+    (``volviz.render.gl_thread``): ``render`` from any thread; ``close`` ends the thread. ``options``: the GPU PT
+    pass's keywords (``GLPTVolume``'s lookup, table and sort)."""
 
-    def __init__(self) -> None:
-        self.gl = GLThread("volviz-vtk-pt")
+    def __init__(self, method: str = "vtk", options: Optional[dict[str, Any]] = None) -> None:
+        if method not in THREAD_METHODS:
+            raise ValueError(f"a thread's PT method must be one of {', '.join(THREAD_METHODS)}, got {method!r}")
+        self.method = method
+        self.options = dict(options or {})
+        self.gl = GLThread(f"volviz-{method}")
 
     def render(self, mesh: TetMesh, tf: TransferFunction, camera: Camera, size: tuple[int, int],
                depth: Optional[np.ndarray] = None) -> tuple[np.ndarray, UnstructuredRenderStats]:
@@ -57,18 +68,22 @@ class VTKProjectedTetrahedra:
         eye-space depth (+inf: nothing), which hides the cells behind it."""
         t0 = time.perf_counter()
         z = None if depth is None else window_z(depth, camera.clipping_range, camera.parallel)
-        image = self.gl.call(_draw, self.gl.state, mesh, tf, camera, size, z)
-        stats = UnstructuredRenderStats(method="vtk", size=size, n_tets=mesh.n_cells,
+        prop = _pt_gl_volume if self.method == "pt-gl" else _volume
+        image = self.gl.call(_draw, self.gl.state, prop, mesh, tf, camera, size, z, self.options)
+        stats = UnstructuredRenderStats(method=self.method, size=size, n_tets=mesh.n_cells,
                                         total_s=time.perf_counter() - t0)
         return image, stats
 
     def close(self) -> None:
         """End the thread, its window closed there after the image in progress, without waiting for it (the caller is
-        the GUI thread, removing the view)."""
+        the GUI thread, removing the view); a GPU PT volume's graphics resources are released there first."""
+        if self.method == "pt-gl":
+            self.gl.submit(_release, self.gl.state)
         self.gl.close(wait=False)
 
 
-def _volume(state: dict[str, Any], mesh: TetMesh, tf: TransferFunction) -> Any:
+def _volume(ren: vtkRenderer, state: dict[str, Any], mesh: TetMesh, tf: TransferFunction,
+            options: dict[str, Any]) -> None:
     """The window's vtkVolume drawing ``mesh`` with ``tf`` (its input and property made again when either is new)."""
     # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
     from volviz.render.vtk_facade import vtk
@@ -84,32 +99,63 @@ def _volume(state: dict[str, Any], mesh: TetMesh, tf: TransferFunction) -> Any:
     if state.get("tf") is not tf:
         volume.SetProperty(vtk_volume_property(tf))
         state["tf"] = tf
-    return volume
-
-
-def _draw(ren: vtkRenderer, state: dict[str, Any], mesh: TetMesh, tf: TransferFunction, camera: Camera,
-          size: tuple[int, int], z: Optional[np.ndarray]) -> np.ndarray:
-    """On the window's thread: draw ``mesh`` over the depth ``z`` (window depth, row 0 at the top; None: none) and
-    read the image back."""
-    # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
-    from volviz.render.vtk_facade import numpy_to_vtk, vtk
-
-    volume = _volume(state, mesh, tf)
     if not ren.HasViewProp(volume):
         ren.AddVolume(volume)
-        ren.SetBackground(0.0, 0.0, 0.0)
-        ren.SetBackgroundAlpha(0.0)
-        ren.AddObserver(vtk.vtkCommand.StartEvent, lambda *_: _write_depth(ren, state))
-    camera.apply_to(ren.GetActiveCamera())
-    window = ren.GetRenderWindow()
-    w, h = (int(v) for v in size)
     if not state.get("drawn"):
         # VTK's mapper leaves cells out of the first frame a window draws with it (``offscreen``'s
         # ``draw_projected_tetrahedra_once``): a first frame at 8 x 8 costs its sort and no raster
+        window = ren.GetRenderWindow()
         window.SetSize(8, 8)
         ren.PreserveDepthBufferOff()
         window.Render()
         state["drawn"] = True
+
+
+def _pt_gl_volume(ren: vtkRenderer, state: dict[str, Any], mesh: TetMesh, tf: TransferFunction,
+                  options: dict[str, Any]) -> None:
+    """The window's GPU PT volume (``volviz.render.gl_pt.GLPTVolume`` with ``options``) drawing ``mesh`` with
+    ``tf``: made again for a new mesh (a cut under clipping), given a new ``tf``; every frame at full size, its
+    cells sorted for the frame's camera here."""
+    # heavy: VTK (all of it, through gl_pt), loaded where VTK objects are made
+    from volviz.render.gl_pt import GLPTVolume
+
+    volume = state.get("pt-gl")
+    if volume is not None and volume.whole_mesh is not mesh:
+        volume.remove()
+        volume = state["pt-gl"] = None
+    if volume is None:
+        # the window's own renderer, single-sampled, no scene pass: the cells read the depth buffer written by
+        # ``_write_depth``
+        volume = state["pt-gl"] = GLPTVolume(SimpleNamespace(renderer=ren), mesh, tf, keep_multisampling=True,
+                                             **{"lookup": "auto", **options})
+        volume.set_interactive(False)
+    elif volume.tf is not tf:
+        volume.set_tf(tf)
+
+
+def _release(ren: vtkRenderer, state: dict[str, Any]) -> None:
+    """On the window's thread: the GPU PT volume's textures and targets released while its context is current."""
+    volume = state.pop("pt-gl", None)
+    if volume is not None:
+        volume.remove()
+
+
+def _draw(ren: vtkRenderer, state: dict[str, Any], prop: Callable[..., None], mesh: TetMesh, tf: TransferFunction,
+          camera: Camera, size: tuple[int, int], z: Optional[np.ndarray], options: dict[str, Any]) -> np.ndarray:
+    """On the window's thread: draw ``mesh`` (the volume ``prop`` puts in the renderer) over the depth ``z``
+    (window depth, row 0 at the top; None: none) and read the image back."""
+    # heavy: VTK (all of it, through vtk_facade), loaded where VTK objects are made
+    from volviz.render.vtk_facade import numpy_to_vtk, vtk
+
+    if not state.get("set up"):
+        ren.SetBackground(0.0, 0.0, 0.0)
+        ren.SetBackgroundAlpha(0.0)
+        ren.AddObserver(vtk.vtkCommand.StartEvent, lambda *_: _write_depth(ren, state))
+        state["set up"] = True
+    prop(ren, state, mesh, tf, options)
+    camera.apply_to(ren.GetActiveCamera())
+    window = ren.GetRenderWindow()
+    w, h = (int(v) for v in size)
     if tuple(window.GetSize()) != (w, h):
         window.SetSize(w, h)
     state["depth"] = None if z is None else (
