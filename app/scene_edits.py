@@ -319,12 +319,16 @@ class SceneEdits:
         """Cut the views of ``comp_ids`` by ``settings`` (``SceneController.cut``: a PT volume's tetrahedra, an
         isosurface component's surfaces with their LOD chains) on a worker (a newer request for a component
         supersedes), then show each cut here and refresh its camera views; ``clipping_shown()`` tells when all
-        are shown."""
+        are shown. A PT volume given a new whole mesh meanwhile (a time series' next step) is cut again."""
         self.cuts_pending.update(comp_ids)
         for comp_id in comp_ids:
+            whole = getattr(controller.views.get(comp_id), "whole_mesh", None)   # what the cut is made of
 
-            def done(outcome: JobOutcome, comp_id: str = comp_id) -> None:
-                if outcome.ok and self.controller is controller and controller.clip == settings:
+            def done(outcome: JobOutcome, comp_id: str = comp_id, whole: Any = whole) -> None:
+                if (outcome.ok and self.controller is controller and controller.clip == settings
+                        and getattr(controller.views.get(comp_id), "whole_mesh", None) is not whole):
+                    self.cut_in_background(controller, settings, [comp_id])
+                elif outcome.ok and self.controller is controller and controller.clip == settings:
                     controller.show_cut(comp_id, outcome.result)
                     self.cuts_pending.discard(comp_id)
                     self.render_scene()

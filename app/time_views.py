@@ -6,9 +6,11 @@ interactive rate (``view_scheduler.interactive_rate``).
 
 Held by the window as ``window.time_views`` (issue #31: a part with its own state, not a mixin). Its collaborators
 are the shown scene (``shown_scene.ShownScene``), the plotter, the window's ``jobs`` and the timeline (whose signals
-it connects), and as callbacks ``show_error(title, text)``, ``schedule_render()``, ``refresh_iso_overlay()`` and
+it connects), and as callbacks ``show_error(title, text)``, ``schedule_render()``, ``refresh_iso_overlay()``,
 ``refresh_views(comp_ids, estimate=False)`` (the view scheduler's: the isosurfaces' CPU overlay follows new
-isosurfaces, a PT volume's image its new mesh). The window calls ``scene_installed()`` for a new scene."""
+isosurfaces, a PT volume's image its new mesh) and ``cut_again(controller, comp_ids)`` (the clipping's cut of a PT
+volume's new mesh, made in the background, when the clipping changed while its blend was made). The window calls
+``scene_installed()`` for a new scene."""
 from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any, Callable, Optional
@@ -30,11 +32,13 @@ class TimeViews:
 
     def __init__(self, scene: ShownScene, plotter: Viewport, jobs: JobBridge, timeline: Timeline, *,
                  show_error: Callable[[str, str], None], schedule_render: Callable[[], None],
-                 refresh_iso_overlay: Callable[[], None], refresh_views: Callable[..., int]) -> None:
+                 refresh_iso_overlay: Callable[[], None], refresh_views: Callable[..., int],
+                 cut_again: Callable[[SceneController, list[str]], None]) -> None:
         self.scene, self.plotter, self.jobs, self.timeline = scene, plotter, jobs, timeline
         self.show_error, self.schedule_render = show_error, schedule_render
         self.refresh_iso_overlay = refresh_iso_overlay
         self.refresh_views = refresh_views
+        self.cut_again = cut_again
         self._iso_jobs = OneInFlight()     # isosurface extraction for the display time
         self._volume_jobs = OneInFlight()  # blended volumes of time series for the display time
         self.volume_time_shown: Optional[tuple[float, bool]] = None  # (time, interpolated) of the shown volumes
@@ -82,9 +86,12 @@ class TimeViews:
         newest display time next: ``OneInFlight``), then give them to VTK on this thread and draw once."""
 
         def shown(controller: Any, result: dict[str, Any], key: tuple[float, bool]) -> None:
-            controller.show_volumes(result)
+            stale = controller.show_volumes(result)
             self.volume_time_shown = key
-            meshes = [comp_id for comp_id, frame in result.items() if isinstance(frame, MeshFrame)]
+            if stale:                                    # cut by an older clipping: cut again, shown when made
+                self.cut_again(controller, stale)
+            meshes = [comp_id for comp_id, frame in result.items() if isinstance(frame, MeshFrame)
+                      and comp_id not in stale]
             if meshes:                                   # a PT volume's image of its new mesh
                 self.refresh_views(meshes, estimate=False)
 

@@ -109,7 +109,8 @@ class MainWindow(WindowBase, QMainWindow):
         self.time_views = TimeViews(self, self.plotter, self.jobs, self.timeline, show_error=self.show_error,
                                     schedule_render=views.schedule_render,
                                     refresh_iso_overlay=views.refresh_iso_overlay,
-                                    refresh_views=views.refresh_views)
+                                    refresh_views=views.refresh_views,
+                                    cut_again=lambda c, ids: self.scene_edits.cut_in_background(c, c.clip, ids))
         self.camera_bookmarks = CameraBookmarks(self, self, self.status_label, self.set_dirty, views.camera_moved)
         self.export_runs = ExportRuns(self, self.jobs, self.plotter, self.status_label, busy.set_busy,
                                       busy.busy_elsewhere, self.show_error)

@@ -77,3 +77,27 @@ def test_a_new_display_time_keeps_the_clipping() -> None:
     finally:
         c.clear()
         p.close()
+
+
+def test_a_display_time_cut_by_an_older_clipping_is_not_shown() -> None:
+    """A blend made on a worker before the clipping changed (``blend_volume`` cuts its mesh by the clipping of its
+    start): ``show_volumes`` gives the view the new whole mesh, keeps the mesh it shows and names the view to be cut
+    again; its cut then shows the new step cut by the new clipping. Before, the old clipping's cut was shown until
+    the next step."""
+    p, c = _scene(_series())
+    try:
+        view = c.pt_volume("vol")
+        frame = c.blend_volume("vol", 1.0)                             # no clipping yet
+        shown = view.mesh
+        c.set_clip(ClipSettings(planes=(ClipPlane((0.5, 0.0, 0.0), (1.0, 0.0, 0.0)),)), update=False)
+        c.show_cut("vol", c.cut("vol"))                                 # the clipping's cut of the step shown
+        shown = view.mesh
+        assert c.show_volumes({"vol": frame}) == ["vol"]
+        assert view.whole_mesh is frame.whole and view.mesh is shown    # not the uncut frame
+        c.show_cut("vol", c.cut("vol"))
+        assert view.mesh.points[:, 0].min() == pytest.approx(0.5)
+        np.testing.assert_allclose(view.mesh.scalars, 0.5 * view.mesh.points[:, 0] + 0.25)   # the cut of t = 1
+        assert c.show_volumes({"vol": c.blend_volume("vol", 2.0)}) == []   # a blend of the clipping shown
+    finally:
+        c.clear()
+        p.close()

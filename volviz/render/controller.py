@@ -81,11 +81,12 @@ Cut = Union["TetMesh", IsoParts, None]
 
 @dataclass(frozen=True)
 class MeshFrame:
-    """A PT volume's mesh at a display time (``SceneController.blend_volume``): the whole tetrahedral mesh, and what
-    is drawn of it (its cut by the clipping; None: nothing left)."""
+    """A PT volume's mesh at a display time (``SceneController.blend_volume``): the whole tetrahedral mesh, what is
+    drawn of it (its cut by the clipping; None: nothing left), and that clipping."""
 
     whole: TetMesh
     shown: Optional[TetMesh]
+    clip: ClipSettings
 
 
 def _vtk_props(props: dict[str, object]) -> list[vtkProp]:
@@ -513,13 +514,16 @@ class SceneController:
 
         whole = pt_mesh(frame)
         clip = self.clip
-        return MeshFrame(whole, cut_tetmesh(whole, clip) if clip.all_planes() else whole)
+        return MeshFrame(whole, cut_tetmesh(whole, clip) if clip.all_planes() else whole, clip)
 
-    def show_volumes(self, inputs: Mapping[str, Union[Dataset, TimeSeries, MeshFrame, None]]) -> None:
+    def show_volumes(self, inputs: Mapping[str, Union[Dataset, TimeSeries, MeshFrame, None]]) -> list[str]:
         """GUI thread: give time-series volumes and surfaces new inputs made here from their frames
         (``comp_id → blend_volume(...)``; ``scene_builder.frame_input``), cut by the clipping, and PT volumes their
-        new mesh (its image re-made after, as after a cut); the outline box follows data that moves."""
+        new mesh (its image re-made after, as after a cut); the outline box follows data that moves. Returns the PT
+        volumes whose frame was cut by a clipping changed since: they keep the mesh they show, their new whole mesh
+        is to be cut again (``cut``, ``show_cut``)."""
         changed = False
+        stale = []
         series = self.time_series()
         for comp_id, frame in inputs.items():
             view = self.views.get(comp_id)
@@ -528,6 +532,9 @@ class SceneController:
             before = view.bounds()
             if isinstance(frame, MeshFrame):             # (``blend_volume`` makes one for a PT volume only)
                 view.whole_mesh = frame.whole
+                if frame.clip != self.clip:
+                    stale.append(comp_id)
+                    continue
                 view.show_cut(frame.shown, self.component(comp_id).visible)
             else:
                 data = frame_input(series[comp_id], frame)
@@ -537,6 +544,7 @@ class SceneController:
             changed = changed or view.bounds() != before
         if changed:
             update_outline(self.plotter, self.session, self.shown_props())
+        return stale
 
     def time_isosurfaces(self) -> list[str]:
         """The isosurface components shown from a time series (what a display-time change re-extracts)."""
