@@ -29,10 +29,11 @@ def is_height_map(path: str | os.PathLike) -> bool:
 def terrain_session(path: str | os.PathLike) -> Session:
     """A height map (DEM, GeoTIFF or SRTM tile in metres, PGM in grey levels) as a natural scene: its C-LOD terrain
     under a sky, moved to the origin; a PGM's grey levels are scaled so that its relief is at most ``RELIEF`` of its
-    width (the others keep their true heights)."""
-    image = read(path)
+    width (the others keep their true heights, so only a PGM is read here: opening a file runs this on the GUI
+    thread, and reading an ASCII DEM takes as long as its loading does)."""
     settings: dict[str, Any] = {"origin": [0.0, 0.0]}
     if Path(path).suffix.lower() == ".pgm":
+        image = read(path)
         rows, cols = image.data.shape[:2]
         lo, hi = image.scalar_range()
         span = hi - lo if np.isfinite(hi - lo) and hi > lo else 1.0
