@@ -38,6 +38,32 @@ def console_modules() -> Optional[tuple[Any, Any]]:
     return QtInProcessKernelManager, RichJupyterWidget
 
 
+#: what the console's first opening imports (its widget, kernel and the kernel's debugger), imported in the
+#: background when the window starts, not on the GUI thread at the first View > Python Console
+PRELOADED = ("qtconsole.inprocess", "qtconsole.rich_jupyter_widget", "ipykernel.inprocess.ipkernel",
+             "ipykernel.debugger", "IPython.core.application", "IPython.core.completerlib",
+             "IPython.core.oinspect", "tornado.queues")
+
+
+def preload_console() -> None:
+    """Import ``PRELOADED`` and compile the console's Python lexer on a thread of its own (Python's import lock makes
+    a first opening during it wait for the rest); nothing when they are not installed."""
+    import importlib
+    import threading
+
+    def load() -> None:
+        if console_modules() is None:
+            return
+        for name in PRELOADED:
+            try:
+                importlib.import_module(name)
+            except ImportError:
+                return
+        importlib.import_module("pygments.lexers").Python3Lexer()   # its rules are compiled at the first lexer
+
+    threading.Thread(target=load, name="volviz-console-imports", daemon=True).start()
+
+
 class PythonConsole(QObject):
     """The View menu's "Python Console" action and, once triggered, ``dock``: the console widget (``widget``, its
     kernel ``manager``) or, without qtconsole, a label saying how to install it (``message``)."""
@@ -53,6 +79,7 @@ class PythonConsole(QObject):
         self.action = menu.addAction("Python &Console")
         self.action.triggered.connect(self.show)
         window.scene_tree.populated.connect(self.scene_shown)
+        preload_console()
 
     def show(self) -> None:
         """Open the dock (made, and the kernel started, the first time)."""
