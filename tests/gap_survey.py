@@ -8,7 +8,9 @@ A 10 ms timer ticks on the GUI thread while the test waits in ``qtbot.wait`` / `
 loop). A gap between two ticks of one wait is how long the app held its loop; gaps that span the test's own code
 between waits (its checks, ``volviz render`` subprocesses) are not counted. An input event the test delivers itself
 (``QApplication.sendEvent``, qtbot's mouse and key functions) is handled at once, outside the loop: each such
-delivery counts as a gap of its own length. ``blocked`` is a gap less the time the
+delivery counts as a gap of its own length, and so does each window call a test makes in place of a user's event
+(``USER_CALLS``: File > Open's ``open_path``, an action's ``trigger``, ...; until survey 16 these were not counted:
+opening a DEM read it there for 128 ms). ``blocked`` is a gap less the time the
 machine took (``loop_latency``: the GUI thread's and the renderer's run-queue waits, steal). For each test one JSON
 line: the gaps over 100 ms blocked, each with the GUI thread's most sampled stacks in it (app, volviz and test
 frames; a sampling thread needs the GIL, so a stack in C++ code that holds it is seen only at its edges).
@@ -48,15 +50,30 @@ def _counted(wait: Any) -> Any:
 _deliveries: list[tuple[float, float, dict[str, float]]] = []   # (start, end, machine time lost) of input events
 
 
+_delivering = {"depth": 0}   # nesting of the timed calls (an action's trigger delivers events): the outermost counts
+
+
 def _timed(deliver: Any) -> Any:
     def timed(*args: Any, **kwargs: Any) -> Any:
         start, wait, steal = time.perf_counter(), _run_queue_wait_s(), _steal_s()
+        _delivering["depth"] += 1
         try:
             return deliver(*args, **kwargs)
         finally:
-            _deliveries.append((start, time.perf_counter(),
-                                {"lost": (_run_queue_wait_s() - wait) + (_steal_s() - steal)}))
+            _delivering["depth"] -= 1
+            if _delivering["depth"] == 0:
+                _deliveries.append((start, time.perf_counter(),
+                                    {"lost": (_run_queue_wait_s() - wait) + (_steal_s() - steal)}))
     return timed
+
+
+#: the window's calls a test makes in place of a user's event (File > Open, a menu action, an edit in a dock, the
+#: timeline, an export), each a stall of its own length as an input event's delivery is
+USER_CALLS = {"volviz_app.window:MainWindow": ("open_path", "open_demo", "open_demo_volume", "save_session"),
+              "PySide6.QtGui:QAction": ("trigger",),
+              "volviz_app.docks.tf_editor:TransferFunctionEditor": ("edit", "apply_preset"),
+              "volviz_app.docks.timeline:Timeline": ("set_time",),
+              "volviz_app.export_dialogs:ExportDialogs": ("screenshot",)}
 
 
 def pytest_configure(config: Any) -> None:
@@ -73,6 +90,13 @@ def pytest_configure(config: Any) -> None:
             setattr(QtBot, name, staticmethod(_timed(found.__func__)))
         elif found is not None:
             setattr(QtBot, name, _timed(found))
+    import importlib
+
+    for spec, names in USER_CALLS.items():
+        module, _, name = spec.partition(":")
+        cls = getattr(importlib.import_module(module), name)
+        for method in names:
+            setattr(cls, method, _timed(getattr(cls, method)))
 
 
 def _stack(dump: str, thread: int, depth: int = 14) -> str:
