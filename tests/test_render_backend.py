@@ -92,5 +92,6 @@ def test_info_gl_prints_the_renderer_and_the_auto_backends() -> None:
     assert run.returncode == 0, run.stderr
     doc = json.loads(run.stdout)
     assert doc["opengl_renderer"] == info.renderer and doc["auto_backend"]["pt"] == auto
+    assert doc["auto_gpu_pt_in_thread"] is info.software
     run = subprocess.run([sys.executable, "-m", "volviz.cli", "info"], capture_output=True, text=True, timeout=300)
     assert run.returncode == 2 and "info needs a file, or --gl" in run.stderr

@@ -226,15 +226,16 @@ def describe(path: str, array: Optional[str] = None, q: Optional[str] = None,
 
 
 def describe_gl() -> dict[str, Any]:
-    """The OpenGL driver of an offscreen VTK render window and the backend "auto" picks on it for each view kind
-    (``volviz.render.backend``)."""
+    """The OpenGL driver of an offscreen VTK render window, the backend "auto" picks on it for each view kind, and
+    whether "auto" draws the GPU backend's PT volumes in a thread of their own there (``volviz.render.backend``)."""
     # heavy: VTK's rendering, only for --gl
-    from volviz.render.backend import VIEW_KINDS, choose_backend, offscreen_gl_info
+    from volviz.render.backend import VIEW_KINDS, choose_backend, gpu_in_thread, offscreen_gl_info
 
     info = offscreen_gl_info()
     return {"opengl_vendor": info.vendor, "opengl_renderer": info.renderer, "opengl_version": info.version,
             "software_rasteriser": info.software,
-            "auto_backend": {kind: choose_backend("auto", kind, info) for kind in VIEW_KINDS}}
+            "auto_backend": {kind: choose_backend("auto", kind, info) for kind in VIEW_KINDS},
+            "auto_gpu_pt_in_thread": gpu_in_thread({}, info)}
 
 
 def _finite(pair: Sequence[float]) -> list[Optional[float]]:
