@@ -366,3 +366,15 @@ def test_file_named_like_a_pattern_is_read_as_a_file(tmp_path):
     path = tmp_path / "scan[1].pvm"
     path.write_bytes(b"PVM\n1 1 1\n1\n\x05")
     assert vio.read(path).data.ravel().tolist() == [5]
+
+
+def test_a_size_is_given_once_where_its_short_form_says_nothing_more(tmp_path):
+    """``bytes_and_size``: "500 bytes", not "500 bytes (500 bytes)"; a larger count keeps its short form."""
+    from volviz.io.errors import bytes_and_size
+
+    assert bytes_and_size(500) == "500 bytes" and bytes_and_size(10000) == "10000 bytes (10 KB)"
+    path = tmp_path / "short.pgm"
+    path.write_bytes(b"P5\n100 100\n255\n" + bytes(500))
+    with pytest.raises(vio.ReadError) as info:
+        vio.read(path)
+    assert "needs 10000 bytes (10 KB) but the file holds only 500 bytes there" in str(info.value)

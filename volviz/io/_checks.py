@@ -11,7 +11,7 @@ from typing import Sequence
 
 import numpy as np
 
-from volviz.io.errors import NonFiniteWarning, PathLike, ReadError, human_bytes
+from volviz.io.errors import NonFiniteWarning, PathLike, ReadError, bytes_and_size
 
 
 HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"   # at the start of an HDF5 file (at 512 after a user block: MAT v7.3)
@@ -129,8 +129,8 @@ def describe_dims(dims: Sequence[int]) -> str:
 def require_bytes(path: PathLike, needed: int, available: int, what: str) -> None:
     """Fail fast when the file holds fewer bytes than the header says (no allocation has happened yet)."""
     if needed > available:
-        raise ReadError(path, f"{what} needs {needed} bytes ({human_bytes(needed)}) but the file holds only "
-                              f"{available} bytes ({human_bytes(available)}) there: the file is truncated or the "
+        raise ReadError(path, f"{what} needs {bytes_and_size(needed)} but the file holds only "
+                              f"{bytes_and_size(available)} there: the file is truncated or the "
                               f"header is wrong")
 
 

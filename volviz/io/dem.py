@@ -24,7 +24,7 @@ import re
 import numpy as np
 
 from volviz.io._checks import describe_bytes, describe_dims, file_size, read_bytes
-from volviz.io.errors import PathLike, ReadError, human_bytes
+from volviz.io.errors import PathLike, ReadError, bytes_and_size
 from volviz.model import Image2D
 
 FEET = 0.3048
@@ -82,8 +82,8 @@ def _grid_fits(path: PathLike, cols: float, rows: float, size: int, what: str) -
     """Columns and rows as ints once they are finite, positive and not more cells than the file has bytes."""
     ok = np.isfinite(cols) and np.isfinite(rows) and cols >= 1 and rows >= 1 and cols * rows <= max(size, 1)
     if not ok:
-        raise ReadError(path, f"{what} a {cols:g} x {rows:g} grid, which does not fit the file's {size} bytes "
-                              f"({human_bytes(size)}): corrupt coordinates or resolution")
+        raise ReadError(path, f"{what} a {cols:g} x {rows:g} grid, which does not fit the file's {bytes_and_size(size)}"
+                              f": corrupt coordinates or resolution")
     return int(cols), int(rows)
 
 

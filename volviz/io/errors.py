@@ -85,6 +85,12 @@ class NonFiniteWarning(UserWarning):
     """Emitted when a reader was called with ``allow_nonfinite=True`` and the data holds NaN or Inf values."""
 
 
+def bytes_and_size(n: int) -> str:
+    """An exact byte count with its ``human_bytes`` size where that says something more: ``'500 bytes'``,
+    ``'18047 bytes (18 KB)'`` (an error message names both the header's claim and the file's size)."""
+    return f"{int(n)} bytes" if abs(int(n)) < 1000 else f"{int(n)} bytes ({human_bytes(n)})"
+
+
 def human_bytes(n: int) -> str:
     """``18047`` -> ``'18 KB'``; exact for small sizes, one decimal otherwise."""
     value = float(n)

@@ -15,7 +15,7 @@ from volviz.io._checks import (
     check_dims, check_finite, describe_bytes, describe_dims, file_size, parse_float, parse_int, read_at, read_bytes,
     require_bytes,
 )
-from volviz.io.errors import PathLike, ReadError, ReadWarning, human_bytes
+from volviz.io.errors import PathLike, ReadError, ReadWarning, bytes_and_size, human_bytes
 from volviz.io.raw import read_slice_stack
 from volviz.io.trailing import check_trailing
 from volviz.model import Image2D, RegularVolume, vec3
@@ -108,7 +108,7 @@ def _inflate(data_path: Path, offset: int, stored: int, n_bytes: int, declared: 
     if stored <= 0:
         raise ReadError(data_path, "MetaImage compressed data is empty")
     if n_bytes > DEFLATE_MAX_RATIO * stored + 64:
-        raise ReadError(data_path, f"{what} needs {n_bytes} bytes ({human_bytes(n_bytes)}), more than its "
+        raise ReadError(data_path, f"{what} needs {bytes_and_size(n_bytes)}, more than its "
                                    f"{stored} compressed bytes can inflate to (zlib expands at most "
                                    f"{DEFLATE_MAX_RATIO}:1)")
     packed = bytes(read_at(data_path, offset, stored))

@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from volviz.io._checks import check_finite, describe_dims, file_size, read_at, read_bytes
-from volviz.io.errors import PathLike, ReadError, human_bytes
+from volviz.io.errors import PathLike, ReadError, bytes_and_size
 from volviz.model import CurvilinearGrid
 
 PADDING_LIMIT = 512  # bytes of trailing padding accepted after the last record
@@ -155,11 +155,11 @@ def detect_layout(path: PathLike, kind: str, head: bytes, size: int, *, byteorde
     need, best = min(tried, key=lambda t: abs(t[0] - size))
     desc = ", ".join(describe_dims(d) for d in best.dims[:3]) + (" ..." if len(best.dims) > 3 else "")
     raise ReadError(path, f"PLOT3D {kind} header claims {len(best.dims)} block(s) of {desc} points, which needs "
-                          f"{need} bytes ({human_bytes(need)}) in the closest layout "
+                          f"{bytes_and_size(need)} in the closest layout "
                           f"({'big' if best.byteorder == '>' else 'little'}-endian, "
                           f"{'with' if best.record_markers else 'no'} record markers, "
                           f"{'double' if best.precision == 8 else 'single'} precision), "
-                          f"but the file holds {size} bytes ({human_bytes(size)})")
+                          f"but the file holds {bytes_and_size(size)}")
 
 
 def is_plot3d_grid(head: bytes, size: int | None = None) -> bool:

@@ -11,7 +11,7 @@ import numpy as np
 from numpy.typing import DTypeLike
 
 from volviz.io._checks import check_dims, check_finite, describe_dims, file_size, read_at
-from volviz.io.errors import PathLike, ReadError, human_bytes
+from volviz.io.errors import PathLike, ReadError, bytes_and_size, human_bytes
 from volviz.io.series import expand_pattern
 from volviz.model import Image2D, RegularVolume, vec3
 
@@ -92,7 +92,7 @@ def _size_problem(path: PathLike, dims: Sequence[int], disk: np.dtype, header_by
         if header_bytes:
             claim += f" after a {header_bytes}-byte header"
         more = "more" if size > need else "less"
-        raise ReadError(path, f"{claim} need {need} bytes ({human_bytes(need)}) but the file holds {size} bytes "
+        raise ReadError(path, f"{claim} need {bytes_and_size(need)} but the file holds {size} bytes "
                               f"({human_bytes(size)}, {abs(size - need)} {more}): wrong dimensions, type or header")
 
 

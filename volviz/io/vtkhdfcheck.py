@@ -20,7 +20,7 @@ from typing import NoReturn
 
 import numpy as np
 
-from volviz.io.errors import PathLike, ReadError, human_bytes
+from volviz.io.errors import PathLike, ReadError, bytes_and_size
 
 TYPES = ("ImageData", "UnstructuredGrid", "PolyData", "OverlappingAMR", "MultiBlockDataSet",
          "PartitionedDataSetCollection", "HyperTreeGrid")
@@ -85,8 +85,8 @@ class _Structure:
         if values.size and values.min() < 0:
             self.fail(f"{label} holds a negative count ({int(values.min())})")
         if values.size and float(values.max()) > DEFLATE_BUDGET * self.size:
-            self.fail(f"{label} holds the count {float(values.max()):.0f}, more than the file's {self.size} bytes "
-                      f"({human_bytes(self.size)}) can describe")
+            self.fail(f"{label} holds the count {float(values.max()):.0f}, more than the file's "
+                      f"{bytes_and_size(self.size)} can describe")
         return values.astype(np.int64)
 
     def agree(self, label: str, rows: int, expected: int) -> None:

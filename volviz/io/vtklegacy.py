@@ -25,7 +25,7 @@ from typing import NoReturn
 import numpy as np
 
 from volviz.io._checks import describe_bytes, open_file
-from volviz.io.errors import PathLike, ReadError, human_bytes
+from volviz.io.errors import PathLike, ReadError, bytes_and_size
 
 MAGIC = b"# vtk DataFile Version"
 # bytes per value in a binary file (0: bits; None: strings, each with its own length); "long" as VTK reads it here
@@ -82,7 +82,7 @@ class _Scan:
         else:
             needed = values if name in _STRINGS else max(2 * values - 1, 0)
         if needed > left:
-            self.fail(f"{what} needs {needed} bytes ({human_bytes(needed)}) but only {left} bytes remain in the "
+            self.fail(f"{what} needs {bytes_and_size(needed)} but only {left} bytes remain in the "
                       "file: the count is wrong or the file is truncated")
 
     def agree(self, what: str, value: int, expected: int | None, source: str) -> None:

@@ -29,7 +29,7 @@ from typing import NoReturn, overload
 import numpy as np
 
 from volviz.io._checks import describe_bytes, open_file
-from volviz.io.errors import PathLike, ReadError, human_bytes
+from volviz.io.errors import PathLike, ReadError, bytes_and_size
 
 TYPE_BYTES = {"Int8": 1, "UInt8": 1, "Char": 1, "Int16": 2, "UInt16": 2, "Int32": 4, "UInt32": 4, "Int64": 8,
               "UInt64": 8, "Float32": 4, "Float64": 8, "Bit": 0, "String": None}
@@ -90,8 +90,8 @@ class _Check:
         if values[0] < 0:
             self.fail(f"{where} {key} is {values[0]}, a negative count")
         if values[0] > self.budget:
-            self.fail(f"{where} {key} is {values[0]}, more than the file's {self.size} bytes "
-                      f"({human_bytes(self.size)}) can hold")
+            self.fail(f"{where} {key} is {values[0]}, more than the file's {bytes_and_size(self.size)}"
+                      f" can hold")
         return values[0]
 
     def finite(self, attrs: dict[str, str], key: str, n: int, where: str) -> None:
@@ -112,8 +112,8 @@ class _Check:
             self.fail(f"{where} {key} {e} has a lower bound above its upper bound")
         points = int(np.prod([e[2 * i + 1] - e[2 * i] + 1 for i in range(3)], dtype=object))
         if points > self.budget:
-            self.fail(f"{where} {key} {e} claims {points} points, more than the file's {self.size} bytes "
-                      f"({human_bytes(self.size)}) can hold")
+            self.fail(f"{where} {key} {e} claims {points} points, more than the file's {bytes_and_size(self.size)}"
+                      f" can hold")
         return e
 
     # -- elements ---------------------------------------------------------------------------------------------------
@@ -200,7 +200,7 @@ class _Check:
             values = tuples * components
             nbytes = -(-values // 8) if size == 0 else values * size
             if nbytes > self.budget:
-                self.fail(f"{where}: {tuples} tuples of {components} need {nbytes} bytes ({human_bytes(nbytes)}), "
+                self.fail(f"{where}: {tuples} tuples of {components} need {bytes_and_size(nbytes)}, "
                           f"more than the file's {self.size} bytes can hold")
         if fmt == "appended":
             self.appended(attrs, where, nbytes)
@@ -285,9 +285,9 @@ class _Check:
             stored = table + sum(sizes)
             if total > self.ratio * sum(sizes) + 64 * blocks:
                 self.fail(f"{where}: {blocks} compressed blocks of {sum(sizes)} bytes cannot expand to the "
-                          f"{total} bytes ({human_bytes(total)}) their header claims")
+                          f"{bytes_and_size(total)} their header claims")
         if stored > room + 3:
-            self.fail(f"{where}: its binary data needs {stored} bytes ({human_bytes(stored)}), but only {room} "
+            self.fail(f"{where}: its binary data needs {bytes_and_size(stored)}, but only {room} "
                       "bytes remain")
         if nbytes is not None and total != nbytes:
             self.fail(f"{where}: its binary data holds {total} bytes, but its tuples and components need {nbytes}")
