@@ -275,6 +275,7 @@ class _Read:
         try:
             answer = worker.request(request, seconds)
         except (ChildTimedOut, ChildDied):
+            worker.kill()    # gone or stopped: its pipes are closed now
             _pool.prewarm()  # the next read finds a child started, not a cold start
             raise
         except BaseException:

@@ -80,6 +80,7 @@ class Worker:
         while True:
             chunk = stream.read1(4096)
             if not chunk:
+                stream.close()      # the child has gone: its stderr pipe is closed here, not left to the collector
                 return
             self._tail.append(chunk)
             self._tail_size += len(chunk)
