@@ -70,3 +70,23 @@ def test_damaged_fits_files_are_refused_or_read_whole(tmp_path):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         assert read_mutations(path, mutations, truncated_reads_same=True) >= 8     # cut in the padding: whole
+
+
+def test_a_header_astropy_cannot_parse_leaves_no_file_open(tmp_path):
+    """NAXIS1 given as a string: astropy's parse fails inside ``fits.open``, which then left the file it had opened
+    open ("unclosed file" ResourceWarnings landing in whichever test collected it); the reader now hands astropy a
+    handle of its own and closes it."""
+    import gc
+
+    fits.PrimaryHDU(CUBE).writeto(tmp_path / "cube.fits")
+    raw = bytearray((tmp_path / "cube.fits").read_bytes())
+    at = raw.find(b"NAXIS1")
+    raw[at + 10:at + 30] = b"   'four'           "
+    (tmp_path / "bad.fits").write_bytes(bytes(raw))
+    gc.collect()
+    with warnings.catch_warnings(record=True) as seen:
+        warnings.simplefilter("always")
+        with pytest.raises(ReadError, match="bad.fits: astropy cannot read it as FITS"):
+            vio.read(tmp_path / "bad.fits", isolate=False)
+        gc.collect()
+    assert not [str(w.message) for w in seen if issubclass(w.category, ResourceWarning)]

@@ -28,21 +28,32 @@ from volviz.model import Image2D, RegularVolume
 from volviz_astronomy.specs import is_fits
 
 
-def _open(path: PathLike) -> Any:
+def _open(path: PathLike) -> tuple[Any, Any]:
+    """The file's HDU list, read whole, and the file handle it reads from (the caller closes both). astropy is given
+    a handle of ours: a file it opens itself stays open when its parsing fails."""
     from astropy.io import fits
     from astropy.utils.exceptions import AstropyUserWarning
 
+    handle = open(path, "rb")
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", category=AstropyUserWarning)   # "may have been truncated": checked below
             warnings.simplefilter("error", category=fits.verify.VerifyWarning)
-            hdus = fits.open(path, memmap=False, lazy_load_hdus=False)
-            hdus.verify("exception")
-        return hdus
+            hdus = fits.open(handle, memmap=False, lazy_load_hdus=False)
+            try:
+                hdus.verify("exception")
+            except BaseException:
+                hdus.close()
+                raise
+        return hdus, handle
     except (OSError, ValueError, TypeError, IndexError, KeyError, fits.verify.VerifyError,
             fits.verify.VerifyWarning) as exc:
+        handle.close()
         _not_an_extension(path)
         raise ReadError(path, f"astropy cannot read it as FITS ({str(exc).strip()[:200]})") from None
+    except BaseException:
+        handle.close()
+        raise
 
 
 def _fields(hdu: Any) -> str:
@@ -91,9 +102,9 @@ def _not_an_extension(path: PathLike) -> None:
     from astropy.io import fits
 
     try:
-        with warnings.catch_warnings():
+        with warnings.catch_warnings(), open(path, "rb") as handle:   # (a handle of ours: see ``_open``)
             warnings.simplefilter("ignore")
-            with fits.open(path, memmap=False, lazy_load_hdus=True) as hdus:
+            with fits.open(handle, memmap=False, lazy_load_hdus=True) as hdus:
                 first = hdus[0]  # hdus.fileinfo(0) would parse the HDUs after it
                 start, span = int(first._data_offset), int(first._data_size)
                 fields, data_bytes, end = _fields(first), _expected_bytes(first), start + span
@@ -148,7 +159,7 @@ def read_fits(path: PathLike, hdu: int | str | None = None,
     if not is_fits(head):
         raise ReadError(p, f"is not a FITS file (it does not start with SIMPLE =; its content is "
                            f"{describe_bytes(head)})")
-    hdus = _open(p)
+    hdus, handle = _open(p)
     try:
         chosen = _pick(p, hdus, hdu)
         header = chosen.header
@@ -166,6 +177,7 @@ def read_fits(path: PathLike, hdu: int | str | None = None,
         raw_ints = data.dtype.kind in "iu"
     finally:
         hdus.close()
+        handle.close()
     data = np.squeeze(data)
     if blank is not None and raw_ints:
         data = np.where(data == blank, np.nan, data.astype(np.float32))
