@@ -325,10 +325,10 @@ class SceneEdits:
             whole = getattr(controller.views.get(comp_id), "whole_mesh", None)   # what the cut is made of
 
             def done(outcome: JobOutcome, comp_id: str = comp_id, whole: Any = whole) -> None:
-                if (outcome.ok and self.controller is controller and controller.clip == settings
-                        and getattr(controller.views.get(comp_id), "whole_mesh", None) is not whole):
+                current = outcome.ok and self.controller is controller and controller.clip == settings
+                if current and getattr(controller.views.get(comp_id), "whole_mesh", None) is not whole:
                     self.cut_in_background(controller, settings, [comp_id])
-                elif outcome.ok and self.controller is controller and controller.clip == settings:
+                elif current:
                     controller.show_cut(comp_id, outcome.result)
                     self.cuts_pending.discard(comp_id)
                     self.render_scene()

@@ -363,10 +363,10 @@ def add_pt_component(plotter: pv.BasePlotter, session: Session, comp: Component,
     from volviz.scene.tetra import pt_options   # the tetrahedra's modules: only for meshes (start-up)
 
     opts = pt_options(session.render.options) if method == "pt" else {}
-    if method == "pt" and pt_backend(plotter, session) == "gpu" \
-            and gpu_in_thread(session.render.options, plotter_gl_info(plotter)):
+    gpu = method == "pt" and pt_backend(plotter, session) == "gpu"
+    if gpu and gpu_in_thread(session.render.options, plotter_gl_info(plotter)):
         method = "pt-gl"
-    elif method == "pt" and not series and pt_backend(plotter, session) == "gpu":
+    elif gpu and not series:
         volume = view_class("pt", "gpu")(plotter, dataset, tf, **{"lookup": "auto", **opts})  # the CPU path's table
         if not update:       # its first draw's arrays made with its first order, in the background
             volume.hold_until_finished()

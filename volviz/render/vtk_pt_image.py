@@ -68,8 +68,7 @@ class ThreadPTImages:
         eye-space depth (+inf: nothing), which hides the cells behind it."""
         t0 = time.perf_counter()
         z = None if depth is None else window_z(depth, camera.clipping_range, camera.parallel)
-        prop = _pt_gl_volume if self.method == "pt-gl" else _volume
-        image = self.gl.call(_draw, self.gl.state, prop, mesh, tf, camera, size, z, self.options)
+        image = self.gl.call(_draw, self.gl.state, _PROPS[self.method], mesh, tf, camera, size, z, self.options)
         stats = UnstructuredRenderStats(method=self.method, size=size, n_tets=mesh.n_cells,
                                         total_s=time.perf_counter() - t0)
         return image, stats
@@ -131,6 +130,10 @@ def _pt_gl_volume(ren: vtkRenderer, state: dict[str, Any], mesh: TetMesh, tf: Tr
         volume.set_interactive(False)
     elif volume.tf is not tf:
         volume.set_tf(tf)
+
+
+#: what puts each method's volume into the window's renderer
+_PROPS: dict[str, Callable[..., None]] = {"vtk": _volume, "pt-gl": _pt_gl_volume}
 
 
 def _release(ren: vtkRenderer, state: dict[str, Any]) -> None:
